@@ -1,0 +1,77 @@
+//! Command-line interface (SPEC §6). Every subcommand takes `--json` and then
+//! prints exactly one JSON object on stdout; errors print `{"error": ...}`
+//! under `--json` and exit with status 2.
+//!
+//! One module per command group; each exposes a clap `Args`/`Subcommand`
+//! type and a `run` returning an [`Output`].
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+pub mod kin;
+
+/// Result of a command: the JSON object for `--json` and the text for humans.
+pub struct Output {
+    /// The object printed under `--json`.
+    pub json: serde_json::Value,
+    /// What a person reads on the terminal.
+    pub human: String,
+}
+
+/// A command-line failure, reported as one line.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// Bad user input (argument out of range, malformed file, ...).
+    #[error("{0}")]
+    Input(String),
+    /// A computation that failed (no convergence, I/O, ...).
+    #[error("{0}")]
+    Failed(String),
+}
+
+#[derive(Parser)]
+#[command(
+    name = "ivt",
+    version,
+    about = "IVT toolkit: kinematics, harmonic balance, controller and simulator (Wang 2017)"
+)]
+struct Cli {
+    /// Print exactly one JSON object on stdout instead of text.
+    #[arg(long, global = true)]
+    json: bool,
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Kinematics of the GIVT, SGIVT and its variant (Chapter 2).
+    #[command(subcommand)]
+    Kin(kin::KinCommand),
+}
+
+/// Parse the process arguments, run, print, and map errors to exit codes.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Command::Kin(cmd)) => kin::run(cmd),
+        None => kin::summary(),
+    };
+    match result {
+        Ok(out) => {
+            if cli.json {
+                println!("{}", out.json);
+            } else {
+                print!("{}", out.human);
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            if cli.json {
+                println!("{}", serde_json::json!({ "error": e.to_string() }));
+            }
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
