@@ -44,7 +44,10 @@ impl fmt::Display for KinError {
                 name,
                 value,
                 requirement,
-            } => write!(f, "input `{name}` = {value} is out of domain: {requirement}"),
+            } => write!(
+                f,
+                "input `{name}` = {value} is out of domain: {requirement}"
+            ),
             KinError::BufferTooSmall { needed, capacity } => write!(
                 f,
                 "output buffer too small: needs at least {needed}, holds {capacity}"

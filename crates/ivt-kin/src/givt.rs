@@ -101,7 +101,13 @@ impl GivtGeometry {
 
     fn check_r(&self, r: f64) -> Result<f64, KinError> {
         self.validate()?;
-        in_range("r", r, 0.0, self.l1, "0 <= r < l1 (Eq. 8 divides by |l1 - r|)")
+        in_range(
+            "r",
+            r,
+            0.0,
+            self.l1,
+            "0 <= r < l1 (Eq. 8 divides by |l1 - r|)",
+        )
     }
 
     /// Ratio of one crank-slider, Eq. 8:
@@ -223,8 +229,8 @@ impl GivtGeometry {
                 }
                 let c = 0.5 * (lo + hi);
                 let mut c = c - MODULE_PERIOD * libm::floor(c / MODULE_PERIOD);
-                if c >= MODULE_PERIOD {
-                    c -= MODULE_PERIOD; // rounding of a corner just below 0
+                if c >= MODULE_PERIOD * (1.0 - 1e-12) {
+                    c = 0.0; // a corner at the period boundary found from below
                 }
                 if count == out.len() {
                     return Err(KinError::BufferTooSmall {
@@ -570,7 +576,8 @@ mod tests {
             assert!((f.omega_sun - sun).abs() < 1e-12 && (f.omega_carrier1 - c1).abs() < 1e-12);
             assert!((c1 / w2 - m.forward_ratio()).abs() < 1e-14);
             // residuals of Eq. 18–19 themselves
-            let res18 = f.omega_sun * s + f.omega_rg1 * (s + 2.0 * p) - 2.0 * f.omega_carrier1 * (s + p);
+            let res18 =
+                f.omega_sun * s + f.omega_rg1 * (s + 2.0 * p) - 2.0 * f.omega_carrier1 * (s + p);
             let res19 = f.omega_sun * s + w2 * (s + 2.0 * p) - 2.0 * f.omega_rg1 * (s + p);
             assert!(res18.abs() < 1e-12 && res19.abs() < 1e-12);
             // Reverse: ω_sun = 0 ⇒ Eq. 19: ω_rg1 = (s+2p)ω_rg2/(2(s+p));
@@ -591,15 +598,27 @@ mod tests {
     #[test]
     fn out_of_domain_is_an_error() {
         let g = GivtGeometry::illustrative();
-        assert!(matches!(g.single_ratio(f64::NAN, 0.01), Err(KinError::NotFinite { .. })));
-        assert!(matches!(g.single_ratio(0.1, -0.01), Err(KinError::OutOfDomain { .. })));
-        assert!(matches!(g.module_ratio(0.1, g.l1), Err(KinError::OutOfDomain { .. })));
+        assert!(matches!(
+            g.single_ratio(f64::NAN, 0.01),
+            Err(KinError::NotFinite { .. })
+        ));
+        assert!(matches!(
+            g.single_ratio(0.1, -0.01),
+            Err(KinError::OutOfDomain { .. })
+        ));
+        assert!(matches!(
+            g.module_ratio(0.1, g.l1),
+            Err(KinError::OutOfDomain { .. })
+        ));
         assert!(g.module_ratio(0.1, f64::INFINITY).is_err());
         assert!(g.reduced_ratio(0.1, 0.0).is_err());
         let mut bad = g;
         bad.r_output = 0.0;
         assert!(bad.single_ratio(0.1, 0.01).is_err());
-        let m = DirectionModule { r_sun: -1.0, r_planet: 1.0 };
+        let m = DirectionModule {
+            r_sun: -1.0,
+            r_planet: 1.0,
+        };
         assert!(m.speeds(DirectionMode::Forward, 1.0).is_err());
     }
 }

@@ -140,7 +140,12 @@ pub fn fourier_coefficient<G: GearRatio>(gear: &G, k: u32) -> Result<f64, KinErr
 }
 
 /// ∫_a^b g over [a, b] ⊂ one or more periods, split at the gear's corners.
-fn integrate_pieces<G: GearRatio, F: Fn(f64) -> f64>(gear: &G, g: &F, a: f64, b: f64) -> (f64, bool) {
+fn integrate_pieces<G: GearRatio, F: Fn(f64) -> f64>(
+    gear: &G,
+    g: &F,
+    a: f64,
+    b: f64,
+) -> (f64, bool) {
     let p = gear.period();
     let mut total = 0.0;
     let mut ok = true;
@@ -321,10 +326,8 @@ pub fn pitch_profile<G: GearRatio>(
             theta_driving: phi,
             r_driving: r1,
         };
-        check.max_centre_distance_error = libm::fmax(
-            check.max_centre_distance_error,
-            libm::fabs(r1 + r2 - d),
-        );
+        check.max_centre_distance_error =
+            libm::fmax(check.max_centre_distance_error, libm::fabs(r1 + r2 - d));
         check.r_driven_range = (
             libm::fmin(check.r_driven_range.0, r2),
             libm::fmax(check.r_driven_range.1, r2),
@@ -448,7 +451,11 @@ mod tests {
         assert!(check.closure_error.abs() < 1e-12, "{}", check.closure_error);
         for p in &pts {
             let exact = closed_form_phi(p.theta_driven);
-            assert!((p.theta_driving - exact).abs() < 1e-12, "θ₂={}", p.theta_driven);
+            assert!(
+                (p.theta_driving - exact).abs() < 1e-12,
+                "θ₂={}",
+                p.theta_driven
+            );
             let r1 = closed_form_r1(p.theta_driving, d);
             assert!((r1 + p.r_driven - d).abs() < 1e-12 * d);
         }
@@ -488,7 +495,10 @@ mod tests {
         assert!((fourier_coefficient(&SgivtNcg, 0).unwrap() - 1.0).abs() < 1e-13);
         for k in 1..=8 {
             let num = fourier_coefficient(&SgivtNcg, k).unwrap();
-            assert!((num - fourier_coefficient_eq38(k)).abs() < 1e-13, "k={k}: {num}");
+            assert!(
+                (num - fourier_coefficient_eq38(k)).abs() < 1e-13,
+                "k={k}: {num}"
+            );
         }
         for (k, printed) in EQ42_PRINTED.iter().enumerate() {
             let exact = fourier_coefficient_eq38(k as u32 + 1);
@@ -521,7 +531,9 @@ mod tests {
         assert!(c.closure_error.abs() < 1e-10, "{}", c.closure_error);
         assert!(c.max_centre_distance_error < 1e-15);
         assert!((fourier_coefficient(&g, 0).unwrap() - 3.0).abs() < 1e-12);
-        let avg = GivtGeometry::illustrative().average_module_ratio(0.010).unwrap();
+        let avg = GivtGeometry::illustrative()
+            .average_module_ratio(0.010)
+            .unwrap();
         for k in 0..500 {
             let t = k as f64 * 0.0123;
             assert!((g.output_to_ng1(t, 0.010).unwrap() - avg).abs() < 1e-12 * avg);

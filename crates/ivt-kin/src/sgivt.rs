@@ -73,7 +73,10 @@ impl SgivtGeometry {
         let (ds, dp) = (self.d_sg, self.d_pg);
         let den = ds + 2.0 * dp;
         let carrier = 2.0 * (ds + dp) * omega_in;
-        ((carrier - ds * omega_sg1) / den, (carrier - ds * omega_sg2) / den)
+        (
+            (carrier - ds * omega_sg1) / den,
+            (carrier - ds * omega_sg2) / den,
+        )
     }
 
     /// Crank-gear speeds from the ring-gear speeds (external mesh eRG → eCG):
@@ -100,7 +103,10 @@ impl SgivtGeometry {
         let (sg1, sg2) = self.sun_speeds(omega_acg);
         let (rg1, rg2) = self.ring_speeds(omega_in, sg1, sg2);
         let (cg1, cg2) = self.crank_gear_speeds(rg1, rg2);
-        (-self.crank_speed(cg1, cg2), self.crank_length_rate(cg1, cg2))
+        (
+            -self.crank_speed(cg1, cg2),
+            self.crank_length_rate(cg1, cg2),
+        )
     }
 
     /// Crank-length rate per stepper speed, v_CRK/ω_CT = 7 r_CG/288 (Eq. 184),
@@ -250,13 +256,28 @@ mod tests {
     #[test]
     fn planetary_relations_eq31_to_33() {
         let g = SgivtGeometry::prototype();
-        for &(w_in, w_acg) in &[(10.0, 0.0), (10.0, 3.0), (-4.0, 7.5), (0.0, 2.0), (123.4, -56.7)] {
+        for &(w_in, w_acg) in &[
+            (10.0, 0.0),
+            (10.0, 3.0),
+            (-4.0, 7.5),
+            (0.0, 2.0),
+            (123.4, -56.7),
+        ] {
             let (sg1, sg2) = g.sun_speeds(w_acg);
             assert!((sg1 + sg2).abs() < 1e-15, "ω_SG1 = −ω_SG2");
-            assert!((sg1 + 7.0 * w_acg / 18.0).abs() < 1e-12, "ω_SG1 = −7ω_ACG/18");
+            assert!(
+                (sg1 + 7.0 * w_acg / 18.0).abs() < 1e-12,
+                "ω_SG1 = −7ω_ACG/18"
+            );
             let (rg1, rg2) = g.ring_speeds(w_in, sg1, sg2);
-            assert!((rg1 - (4.0 / 3.0 * w_in - sg1 / 3.0)).abs() < 1e-12, "Eq. 31");
-            assert!((rg2 - (4.0 / 3.0 * w_in + sg1 / 3.0)).abs() < 1e-12, "Eq. 32");
+            assert!(
+                (rg1 - (4.0 / 3.0 * w_in - sg1 / 3.0)).abs() < 1e-12,
+                "Eq. 31"
+            );
+            assert!(
+                (rg2 - (4.0 / 3.0 * w_in + sg1 / 3.0)).abs() < 1e-12,
+                "Eq. 32"
+            );
             let (cg1, cg2) = g.crank_gear_speeds(rg1, rg2);
             assert!((g.crank_speed(cg1, cg2) + w_in).abs() < 1e-12);
             let (w_crk, _) = g.crank_speed_clockwise(w_in, w_acg);
@@ -318,8 +339,10 @@ mod tests {
         // ±sin or ±cos on each cell), i.e. 9.8e-8·e/r_OG for n = 4096.
         let e = 0.02;
         let h = 2.0 * PI / n as f64;
-        let mean: f64 =
-            (0..n).map(|k| g.ratio((k as f64 + 0.5) * h, e).unwrap()).sum::<f64>() / n as f64;
+        let mean: f64 = (0..n)
+            .map(|k| g.ratio((k as f64 + 0.5) * h, e).unwrap())
+            .sum::<f64>()
+            / n as f64;
         let exact = g.average_ratio(e).unwrap();
         let bound = h * h / 24.0 * e / g.r_og;
         assert!((mean - exact).abs() <= bound, "{mean} vs {exact}");
@@ -357,8 +380,14 @@ mod tests {
     #[test]
     fn out_of_domain_is_an_error() {
         let g = SgivtGeometry::prototype();
-        assert!(matches!(g.ratio(f64::NAN, 0.01), Err(KinError::NotFinite { .. })));
-        assert!(matches!(g.ratio(0.1, -0.01), Err(KinError::OutOfDomain { .. })));
+        assert!(matches!(
+            g.ratio(f64::NAN, 0.01),
+            Err(KinError::NotFinite { .. })
+        ));
+        assert!(matches!(
+            g.ratio(0.1, -0.01),
+            Err(KinError::OutOfDomain { .. })
+        ));
         assert!(g.ratio(0.1, f64::INFINITY).is_err());
         assert!(g.crank_length(-0.1).is_err());
         assert!(g.crank_length(deg_to_rad(3700.0)).is_err());
