@@ -75,7 +75,7 @@ proptest! {
     fn variant_modulation(theta in -100.0f64..100.0) {
         let f = variant::f(theta);
         prop_assert!(f.is_finite());
-        prop_assert!(f >= PI / 4.0 * (1.0 - 1e-12) && f <= PI / (2.0 * SQRT_2) * (1.0 + 1e-15));
+        prop_assert!((PI / 4.0 * (1.0 - 1e-12)..=PI / (2.0 * SQRT_2) * (1.0 + 1e-15)).contains(&f));
         prop_assert!(close(variant::f(theta + FRAC_PI_2), f, 1e-11));
         prop_assert!(close(variant::f(-theta), f, 1e-11));
     }
