@@ -206,6 +206,8 @@ pub fn driving_angle<G: GearRatio>(gear: &G, theta2: f64) -> Result<f64, KinErro
 
 /// Driven-gear angle θ₂ for a driving-gear angle φ ≥ 0: the inverse of
 /// [`driving_angle`] by safeguarded Newton (φ' = R_n > 0), to 1e-14 rad.
+/// φ is integrated once at the first guess; each Newton step then adds only
+/// the integral over the step, so the cost is about one quadrature.
 ///
 /// # Errors
 /// φ must be finite and ≥ 0; `NotConverged` if Newton stalls.
@@ -224,8 +226,9 @@ pub fn driven_angle<G: GearRatio>(gear: &G, phi: f64) -> Result<f64, KinError> {
     let target = ph - whole * per;
     let (mut lo, mut hi) = (0.0, p);
     let mut t = target / gear.turns_ratio();
+    let mut phi_t = driving_angle(gear, t)?;
     for _ in 0..100 {
-        let f = driving_angle(gear, t)? - target;
+        let f = phi_t - target;
         if libm::fabs(f) <= 1e-14 {
             return Ok(whole * p + t);
         }
@@ -235,7 +238,7 @@ pub fn driven_angle<G: GearRatio>(gear: &G, phi: f64) -> Result<f64, KinError> {
             lo = t;
         }
         let newton = t - f / gear.ratio(t);
-        t = if newton > lo && newton < hi {
+        let next = if newton > lo && newton < hi {
             newton
         } else {
             0.5 * (lo + hi)
@@ -243,6 +246,20 @@ pub fn driven_angle<G: GearRatio>(gear: &G, phi: f64) -> Result<f64, KinError> {
         if hi - lo <= 4.0 * f64::EPSILON * p {
             return Ok(whole * p + t);
         }
+        let (a, b, sign) = if next >= t {
+            (t, next, 1.0)
+        } else {
+            (next, t, -1.0)
+        };
+        let (inc, ok) = integrate_pieces(gear, &|x| gear.ratio(x), a, b);
+        if !ok {
+            return Err(KinError::NotConverged {
+                what: "inverse angle map",
+                achieved: libm::fabs(f),
+            });
+        }
+        phi_t += sign * inc;
+        t = next;
     }
     Err(KinError::NotConverged {
         what: "inverse angle map",
