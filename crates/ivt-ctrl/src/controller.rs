@@ -29,7 +29,7 @@
 //! the open-loop value and ω_a, ω_T read 0.
 
 use crate::actuator::{ActuatorMap, StepGenerator, StepperLimits};
-use crate::averager::AngleAverager;
+use crate::averager::{AngleAverager, Targets};
 use crate::law::{DelayLaw, FeedbackLaw, LawState, NoDelayLaw, NoFeedback, PropLaw, PulseSample};
 use crate::open_loop::{clamp_f32, OlRegion, OpenLoopCoeffs, THESIS};
 use crate::units;
@@ -260,7 +260,7 @@ pub struct Controller<const PPR: usize> {
     /// r_d and its Kahan compensation.
     r_d: f32,
     r_d_comp: f32,
-    omega0: f32,
+    targets: Targets,
     dtheta: f32,
     safe_r: f32,
     v_m_valid: [f32; 2],
@@ -319,7 +319,7 @@ impl<const PPR: usize> Controller<PPR> {
             actuator: config.actuator,
             r_d: 0.0,
             r_d_comp: 0.0,
-            omega0: config.omega0,
+            targets: AngleAverager::<PPR>::targets(f, config.omega0),
             dtheta: core::f32::consts::TAU / (PPR.max(1) as f32),
             safe_r: config.safe_r,
             v_m_valid: config.v_m_valid,
@@ -490,9 +490,9 @@ impl<const PPR: usize> Controller<PPR> {
                     ticks,
                     omega,
                     omega_prev: self.omega_prev,
-                    omega_a,
                     omega_t,
-                    omega0: self.omega0,
+                    omega_a_err: self.targets.omega_a_error(s.revolution_ticks),
+                    omega_err: self.targets.omega_error(s.interval_ticks),
                     dtheta: self.dtheta,
                 };
                 let inc = self.law.increment(&sample);
