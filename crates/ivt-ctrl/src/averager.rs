@@ -67,19 +67,37 @@ pub struct TargetTicks {
 /// 2π − TAU_f32 (TAU_f32 = 6.2831854820251465).
 const TAU_LO: f32 = -1.748_455_6e-7;
 
+/// Veltkamp split of an f32 into two halves of ≤ 12 significant bits.
+fn split(a: f32) -> (f32, f32) {
+    let c = 4097.0 * a; // 2¹² + 1
+    let hi = c - (c - a);
+    (hi, a - hi)
+}
+
+/// Dekker's exact product: `a·b = p + e` with `p = fl(a·b)` (no FMA, f32 only).
+fn two_prod(a: f32, b: f32) -> (f32, f32) {
+    let p = a * b;
+    let (a_hi, a_lo) = split(a);
+    let (b_hi, b_lo) = split(b);
+    let e = ((a_hi * b_hi - p) + a_hi * b_lo + a_lo * b_hi) + a_lo * b_lo;
+    (p, e)
+}
+
 impl TargetTicks {
     /// Ticks of angle `(angle_hi + angle_lo)` at speed ω0 on a timer of f:
-    /// `D0 = angle·f/ω0`, formed with fused multiply–adds so that D0 is good
+    /// `D0 = angle·f/ω0`, formed with exact products (Dekker) so that D0 is good
     /// to ~1e-6 tick (an f32 quotient would be off by up to 2⁻²⁴·D0, i.e.
     /// 0.04 tick at 6e5 ticks, and that offset would be a permanent bias).
     /// Runs once, at construction.
     fn new(angle_hi: f32, angle_lo: f32, f_timer_hz: f32, omega0: f32) -> Self {
         // (angle_hi + angle_lo)·f as hi + lo.
-        let p_hi = angle_hi * f_timer_hz;
-        let p_lo = libm::fmaf(angle_hi, f_timer_hz, -p_hi) + angle_lo * f_timer_hz;
-        // Divide by ω0 with the remainder made exact by FMA.
+        let (p_hi, p_err) = two_prod(angle_hi, f_timer_hz);
+        let p_lo = p_err + angle_lo * f_timer_hz;
+        // Divide by ω0; the remainder p_hi − q·ω0 is exact (q·ω0 = m + e
+        // exactly, and p_hi − m is exact by Sterbenz since m ≈ p_hi).
         let q = p_hi / omega0;
-        let rem = libm::fmaf(-q, omega0, p_hi) + p_lo;
+        let (m, e) = two_prod(q, omega0);
+        let rem = ((p_hi - m) - e) + p_lo;
         let q_lo = rem / omega0;
         let int = q as u32; // truncation; saturates, NaN → 0 (invalid configs)
                             // q − trunc(q) is exact (Sterbenz) for q ≥ 1 and trivially for q < 1.
@@ -108,7 +126,7 @@ impl TargetTicks {
 /// r per 10⁶ pulses against the f64 reference). Instead
 /// `ω_meas − ω0 = ω0·(D0 − D)/D`, where `D0 − D` is an exact integer
 /// difference plus the fraction of D0: the result is good to a few 2⁻²⁴ of
-/// *itself*, so there is no bias when the error is near zero. No FMA per pulse.
+/// *itself*, so there is no bias when the error is near zero.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpeedError {
     target: TargetTicks,
@@ -207,7 +225,8 @@ impl<const PPR: usize> AngleAverager<PPR> {
         let revolution = TargetTicks::new(core::f32::consts::TAU, TAU_LO, f_timer_hz, omega0);
         // 2π/PPR as hi + lo.
         let a_hi = core::f32::consts::TAU / n;
-        let a_lo = (libm::fmaf(-a_hi, n, core::f32::consts::TAU) + TAU_LO) / n;
+        let (m, e) = two_prod(a_hi, n);
+        let a_lo = (((core::f32::consts::TAU - m) - e) + TAU_LO) / n;
         Targets {
             pulse: TargetTicks::new(a_hi, a_lo, f_timer_hz, omega0),
             revolution,
