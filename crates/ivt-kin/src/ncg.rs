@@ -129,11 +129,11 @@ pub fn fourier_coefficient<G: GearRatio>(gear: &G, k: u32) -> Result<f64, KinErr
     let p = gear.period();
     let w = 2.0 * PI * k as f64 / p;
     let g = |t: f64| gear.ratio(t) * libm::cos(w * t);
-    let (value, ok) = integrate_pieces(gear, &g, 0.0, p);
+    let (value, ok, err) = integrate_pieces(gear, &g, 0.0, p);
     if !ok {
         return Err(KinError::NotConverged {
             what: "Fourier coefficient",
-            achieved: f64::NAN,
+            achieved: err,
         });
     }
     Ok(if k == 0 { value / p } else { 2.0 * value / p })
@@ -171,10 +171,11 @@ fn integrate_pieces<G: GearRatio, F: Fn(f64) -> f64>(
     g: &F,
     a: f64,
     b: f64,
-) -> (f64, bool) {
+) -> (f64, bool, f64) {
     let p = gear.period();
     let mut total = 0.0;
     let mut ok = true;
+    let mut err = 0.0;
     let mut lo = a;
     let first = libm::floor(a / p);
     let mut m = first;
@@ -189,6 +190,7 @@ fn integrate_pieces<G: GearRatio, F: Fn(f64) -> f64>(
             }
             let q = simpson(g, lo, x, ANGLE_TOL);
             ok &= q.converged;
+            err += q.error;
             total += q.value;
             lo = x;
         }
@@ -199,7 +201,7 @@ fn integrate_pieces<G: GearRatio, F: Fn(f64) -> f64>(
     }
     let q = simpson(g, lo, b, ANGLE_TOL);
     ok &= q.converged;
-    (total + q.value, ok)
+    (total + q.value, ok, err + q.error)
 }
 
 /// Driving-gear angle φ(θ₂) = ∫₀^θ₂ R_n (Eq. 17, 41), for θ₂ ≥ 0: whole
@@ -220,11 +222,11 @@ pub fn driving_angle<G: GearRatio>(gear: &G, theta2: f64) -> Result<f64, KinErro
     let p = gear.period();
     let whole = libm::floor(th / p);
     let rem = th - whole * p;
-    let (part, ok) = integrate_pieces(gear, &|t| gear.ratio(t), 0.0, rem);
+    let (part, ok, err) = integrate_pieces(gear, &|t| gear.ratio(t), 0.0, rem);
     if !ok {
         return Err(KinError::NotConverged {
             what: "angle map Eq. 17/41",
-            achieved: f64::NAN,
+            achieved: err,
         });
     }
     Ok(whole * gear.turns_ratio() * p + part)
@@ -277,7 +279,7 @@ pub fn driven_angle<G: GearRatio>(gear: &G, phi: f64) -> Result<f64, KinError> {
         } else {
             (next, t, -1.0)
         };
-        let (inc, ok) = integrate_pieces(gear, &|x| gear.ratio(x), a, b);
+        let (inc, ok, _) = integrate_pieces(gear, &|x| gear.ratio(x), a, b);
         if !ok {
             return Err(KinError::NotConverged {
                 what: "inverse angle map",
@@ -350,11 +352,11 @@ pub fn pitch_profile<G: GearRatio>(
     for (j, pt) in out.iter_mut().enumerate() {
         let th = if j == n - 1 { 2.0 * PI } else { j as f64 * h };
         if j > 0 {
-            let (inc, ok) = integrate_pieces(gear, &|t| gear.ratio(t), prev, th);
+            let (inc, ok, err) = integrate_pieces(gear, &|t| gear.ratio(t), prev, th);
             if !ok {
                 return Err(KinError::NotConverged {
                     what: "pitch profile angle map",
-                    achieved: f64::NAN,
+                    achieved: err,
                 });
             }
             phi += inc;
