@@ -113,6 +113,10 @@ proptest! {
         prop_assert!(is_domain(&g.module_ratio(theta, neg)));
         prop_assert!(is_not_finite(&g.module_ratio(f64::NAN, 0.5 * g.l1)));
         prop_assert!(is_not_finite(&g.single_ratio(theta, f64::NAN)));
+        prop_assert!(is_not_finite(&variant::f_checked(f64::NAN)));
+        prop_assert!(is_domain(&variant::output_to_motor_ratio_checked(neg, 0.0222)));
+        prop_assert!(is_domain(&variant::output_to_motor_ratio_checked(0.01, neg)));
+        prop_assert!(variant::f_checked(theta).unwrap().is_finite());
         let s = SgivtGeometry::prototype();
         prop_assert!(is_domain(&s.ratio(theta, neg)));
         prop_assert!(is_not_finite(&s.ratio(f64::INFINITY, 0.01)));
