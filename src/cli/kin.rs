@@ -6,8 +6,8 @@ use clap::{Subcommand, ValueEnum};
 use ivt_kin::arcs::{fit_arcs, Arc, ArcFit, ArcOptions, GearProfile, Member};
 use ivt_kin::givt::{DirectionMode, DirectionModule, GivtGeometry, MAX_CORNERS};
 use ivt_kin::ncg::{
-    fourier_coefficient, fourier_coefficient_eq38, pitch_profile, GearRatio, GivtNcg, PitchPoint,
-    SgivtNcg, SmoothNcg, EQ42_PRINTED,
+    fourier_coefficient, fourier_coefficient_eq38, output_ripple, pitch_profile, GearRatio,
+    GivtNcg, PitchPoint, SgivtNcg, SmoothNcg, EQ42_PRINTED,
 };
 use ivt_kin::plant::PlantParams;
 use ivt_kin::sgivt::{SgivtGeometry, R_AVG_SLOPE_PRINTED_PER_DEG};
@@ -454,8 +454,20 @@ fn fourier(harmonics: u32) -> Result<Output, CliError> {
         "The printed coefficients are 0.9 × the Fourier coefficients (to the printed digits),\n\
          not the Fourier coefficients themselves.\n",
     );
+    let ripple_printed = output_ripple(&SmoothNcg::PRINTED, 100_000).map_err(kin_err)?;
+    let ripple_fourier = output_ripple(&SmoothNcg::fourier(), 100_000).map_err(kin_err)?;
+    let _ = writeln!(
+        human,
+        "output/engine ratio R/R_smooth (Eq. 37) relative to its mean: printed {:.4} .. {:.4}, \
+         Fourier {:.4} .. {:.4}",
+        ripple_printed.0, ripple_printed.1, ripple_fourier.0, ripple_fourier.1
+    );
     Ok(Output {
-        json: json!({ "coefficients": rows }),
+        json: json!({
+            "coefficients": rows,
+            "ripple_printed": [ripple_printed.0, ripple_printed.1],
+            "ripple_fourier": [ripple_fourier.0, ripple_fourier.1],
+        }),
         human,
     })
 }

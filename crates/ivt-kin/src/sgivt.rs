@@ -178,6 +178,23 @@ impl SgivtGeometry {
     }
 }
 
+impl SgivtGeometry {
+    /// Output-to-engine speed ratio with a noncircular pair, Eq. 37: R/R_n at
+    /// θ_in. Constant, (2√2/π) e/r_OG, for the exact pair Eq. 38; nearly
+    /// constant for the smooth Eq. 42 (Fig. 24).
+    ///
+    /// # Errors
+    /// As [`Self::ratio`].
+    pub fn output_to_engine_ratio<G: crate::ncg::GearRatio>(
+        &self,
+        ncg: &G,
+        theta_in: f64,
+        e: f64,
+    ) -> Result<f64, KinError> {
+        Ok(self.ratio(theta_in, e)? / ncg.ratio(theta_in))
+    }
+}
+
 impl Default for SgivtGeometry {
     fn default() -> Self {
         Self::prototype()
@@ -374,6 +391,22 @@ mod tests {
             let (a, b, m) = (at(t - dt), at(t + dt), at(t));
             assert!(((b.x1 - a.x1) / (2.0 * dt) - m.v1).abs() < 1e-8);
             assert!(((b.x2 - a.x2) / (2.0 * dt) - m.v2).abs() < 1e-8);
+        }
+    }
+
+    /// Eq. 37–38: with the exact pair the output/engine ratio R/R_n is the
+    /// constant (2√2/π) e/r_OG at every θ_in.
+    #[test]
+    fn eq37_constant_with_exact_pair() {
+        let g = SgivtGeometry::prototype();
+        let e = 0.03;
+        let expected = g.average_ratio(e).unwrap();
+        for k in 0..5000 {
+            let th = -4.0 + k as f64 * 0.0017;
+            let v = g
+                .output_to_engine_ratio(&crate::ncg::SgivtNcg, th, e)
+                .unwrap();
+            assert!((v - expected).abs() <= 1e-12 * expected, "θ={th}");
         }
     }
 

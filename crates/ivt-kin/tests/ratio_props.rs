@@ -70,6 +70,22 @@ proptest! {
         prop_assert!(close(g.final_ratio(theta, r).unwrap(), 3.0 * v, 1e-15));
     }
 
+    /// The period average of Eq. 9 (Fig. 9(b)) exists, is finite and lies
+    /// between the extremes of R, for every geometry and 0 ≤ r < l1.
+    #[test]
+    fn givt_average_over_domain(g in givt_geometry(), frac in 0.0f64..0.99999) {
+        let r = frac * g.l1;
+        let avg = g.average_module_ratio(r).unwrap();
+        prop_assert!(avg.is_finite() && avg >= 0.0);
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for k in 0..200 {
+            let v = g.module_ratio(FRAC_PI_2 * k as f64 / 200.0, r).unwrap();
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+        prop_assert!(avg >= lo * (1.0 - 1e-9) - 1e-12 && avg <= hi * (1.0 + 1e-9) + 1e-12);
+    }
+
     /// Eq. 43/38: finite, in [π/4, π/(2√2)], period π/2, even.
     #[test]
     fn variant_modulation(theta in -100.0f64..100.0) {
@@ -97,6 +113,10 @@ proptest! {
         prop_assert!(is_domain(&g.module_ratio(theta, neg)));
         prop_assert!(is_not_finite(&g.module_ratio(f64::NAN, 0.5 * g.l1)));
         prop_assert!(is_not_finite(&g.single_ratio(theta, f64::NAN)));
+        prop_assert!(is_not_finite(&variant::f_checked(f64::NAN)));
+        prop_assert!(is_domain(&variant::output_to_motor_ratio_checked(neg, 0.0222)));
+        prop_assert!(is_domain(&variant::output_to_motor_ratio_checked(0.01, neg)));
+        prop_assert!(variant::f_checked(theta).unwrap().is_finite());
         let s = SgivtGeometry::prototype();
         prop_assert!(is_domain(&s.ratio(theta, neg)));
         prop_assert!(is_not_finite(&s.ratio(f64::INFINITY, 0.01)));
