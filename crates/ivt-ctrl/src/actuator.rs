@@ -94,6 +94,7 @@ pub struct StepGenerator {
     delay: f32,
     last_step: u32,
     dir: i8,
+    stepped: bool,
     c0: f32,
     c_min: f32,
 }
@@ -118,6 +119,7 @@ impl StepGenerator {
             delay: c0,
             last_step: 0,
             dir: 0,
+            stepped: false,
             c0,
             c_min,
         }
@@ -165,7 +167,13 @@ impl StepGenerator {
             if self.position == self.target {
                 return self.decision(false);
             }
+            // From rest the last step must be at least c0 ago (the start-stop
+            // rate), so a reversal never steps back at speed.
+            if self.stepped && now.wrapping_sub(self.last_step) < self.delay_ticks() {
+                return self.decision(false);
+            }
             // Start from rest: first step now, then wait c0.
+            self.stepped = true;
             self.dir = if self.target > self.position { 1 } else { -1 };
             self.n = 0;
             self.delay = self.c0;
