@@ -1,5 +1,7 @@
 #![doc = include_str!("../README.md")]
 
+pub mod backend;
 pub mod integrate;
 pub mod ode;
 pub mod plant;
+pub mod sensors;
