@@ -4,4 +4,6 @@ pub mod backend;
 pub mod integrate;
 pub mod ode;
 pub mod plant;
+pub mod profile;
+pub mod scene;
 pub mod sensors;
