@@ -3,7 +3,11 @@
 pub mod backend;
 pub mod integrate;
 pub mod ode;
+pub mod output;
 pub mod plant;
+pub mod plot;
 pub mod profile;
+pub mod progress;
+pub mod run;
 pub mod scene;
 pub mod sensors;
