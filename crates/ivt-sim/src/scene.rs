@@ -437,6 +437,34 @@ fn line_of(src: &str, key: &str) -> Option<usize> {
         .map(|i| i + 1)
 }
 
+/// Line of a validation error: for `outputs.channels[k]` errors the k-th
+/// `name`/`every` after the first `[[outputs.channels]]`, else [`line_of`].
+fn locate(src: &str, key: &str, msg: &str) -> Option<usize> {
+    let k: Option<usize> = msg
+        .strip_prefix("(outputs.channels[")
+        .and_then(|m| m.split(']').next())
+        .and_then(|d| d.parse().ok());
+    let Some(k) = k else {
+        return line_of(src, key);
+    };
+    let start = src.lines().position(|l| l.trim() == "[[outputs.channels]]")?;
+    let mut seen = 0;
+    let mut table = 0;
+    for (i, l) in src.lines().enumerate().skip(start) {
+        let t = l.trim_start();
+        if t.starts_with("[[outputs.channels]]") {
+            table += 1;
+        }
+        if table == k + 1 && t.strip_prefix(key).is_some_and(|r| r.trim_start().starts_with('=')) {
+            seen += 1;
+            if seen == 1 {
+                return Some(i + 1);
+            }
+        }
+    }
+    None
+}
+
 impl Scene {
     /// Parse and validate a scene. `origin` names the source in errors.
     ///
@@ -458,7 +486,7 @@ impl Scene {
         })?;
         scene
             .validate()
-            .map_err(|(key, msg)| match line_of(src, key) {
+            .map_err(|(key, msg)| match locate(src, key, &msg) {
                 Some(l) => SceneError(format!("{origin}:{l}: `{key}` {msg}")),
                 None => SceneError(format!("{origin}: `{key}` {msg}")),
             })?;
@@ -839,8 +867,8 @@ t_u = [[0.0, 4.0]]
         assert!(e.contains("plant.r_a"), "{e}");
         let e = err(&format!("{OK}\n[controller]\nlaw = \"pid\"\n"));
         assert!(e.contains("controller.law"), "{e}");
-        let e = err(&format!("{OK}\n[[outputs.channels]]\nname = \"nope\"\n"));
-        assert!(e.contains("nope"), "{e}");
+        let e = err(&format!("{OK}\n[[outputs.channels]]\nname = \"plant\"\n[[outputs.channels]]\nname = \"nope\"\n"));
+        assert!(e.contains("nope") && e.contains("s.toml:10"), "{e}");
         let e = err("duration_s = 1.0\n");
         assert!(e.contains("inputs"), "{e}");
         let e = err("duration_s = \n");
