@@ -99,7 +99,10 @@ fn json_schema(name: &str) -> String {
 
 /// Non-finite numbers (ω_a before the first revolution) are written as
 /// `null` in JSON and as empty cells in CSV.
-fn samples_as_json<T: Serialize>(v: &[T]) -> Vec<(f64, Vec<u8>)> {
+/// (time, JSON bytes) of each sample of one channel.
+type Messages = Vec<(f64, Vec<u8>)>;
+
+fn samples_as_json<T: Serialize>(v: &[T]) -> Messages {
     v.iter()
         .map(|s| {
             let value = serde_json::to_value(s).unwrap_or(serde_json::Value::Null);
@@ -112,7 +115,7 @@ fn samples_as_json<T: Serialize>(v: &[T]) -> Vec<(f64, Vec<u8>)> {
         .collect()
 }
 
-fn channel_messages(ch: &Channels) -> Vec<(&'static str, Vec<(f64, Vec<u8>)>)> {
+fn channel_messages(ch: &Channels) -> Vec<(&'static str, Messages)> {
     let mut out = vec![];
     if let Some(v) = &ch.plant {
         out.push(("plant", samples_as_json(v)));
