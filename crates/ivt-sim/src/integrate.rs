@@ -163,6 +163,20 @@ pub struct PlantIntegrator {
     pub stats: Stats,
     h_time: f64,
     h_angle: f64,
+    /// F at the end of the last angle step (first-same-as-last), with the
+    /// segment, r and inputs it was evaluated with: reused as the next
+    /// step's first stage when all of them are unchanged.
+    fsal: Option<Fsal>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Fsal {
+    theta: f64,
+    z: [f64; DIM],
+    seg: i64,
+    r: f64,
+    inputs: (f64, f64),
+    k: [f64; DIM],
 }
 
 /// Relative slack used to decide that θ sits on a corner already.
@@ -182,6 +196,7 @@ impl PlantIntegrator {
             stats: Stats::default(),
             h_time: 0.0,
             h_angle: 0.0,
+            fsal: None,
         }
     }
 
@@ -263,7 +278,19 @@ impl PlantIntegrator {
                 Ok(())
             }
             Method::Dp5(tol) => {
-                let k1 = sys.rhs(theta, &z);
+                let inputs = prof.at(z[0]);
+                let k1 = match self.fsal {
+                    Some(c)
+                        if c.theta == theta
+                            && c.z == z
+                            && c.seg == seg
+                            && c.r == r
+                            && c.inputs == inputs =>
+                    {
+                        c.k
+                    }
+                    _ => sys.rhs(theta, &z),
+                };
                 if self.h_angle <= 0.0 {
                     self.h_angle = initial_step(&sys, theta, &z, &k1, &tol);
                 }
@@ -277,7 +304,16 @@ impl PlantIntegrator {
                         if !lands || h * fac > self.h_angle {
                             self.h_angle = h * fac;
                         }
-                        self.commit_angle(if lands { bp } else { theta + h }, st.y1);
+                        let theta1 = if lands { bp } else { theta + h };
+                        self.commit_angle(theta1, st.y1);
+                        self.fsal = Some(Fsal {
+                            theta: theta1,
+                            z: st.y1,
+                            seg,
+                            r,
+                            inputs: prof.at(st.y1[0]),
+                            k: st.k7,
+                        });
                         return Ok(());
                     }
                     self.stats.rejected += 1;

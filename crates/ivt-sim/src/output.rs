@@ -144,6 +144,8 @@ pub fn write_mcap(path: &Path, result: &RunResult, scene: &Scene) -> Result<(), 
     let file = File::create(path).map_err(io(path))?;
     let mut w = mcap::WriteOptions::new()
         .compression(Some(mcap::Compression::Zstd))
+        // level 1: ~3× faster than the default 3 on these JSON logs, files ~10 % larger
+        .compression_level(1)
         .profile("")
         .create(BufWriter::new(file))
         .map_err(err)?;
