@@ -298,11 +298,15 @@ impl PlantIntegrator {
                     let lands = self.h_angle >= bp - theta;
                     let h = if lands { bp - theta } else { self.h_angle };
                     let st = dp5_step(&sys, theta, &z, &k1, h, &tol);
-                    let fac = st.factor();
                     if st.err <= 1.0 {
-                        // a landing step that was cut short says nothing about the next h
-                        if !lands || h * fac > self.h_angle {
-                            self.h_angle = h * fac;
+                        // A landing step that was cut short says nothing about the
+                        // next h, except that it may grow; the factor is ≤ 5, so
+                        // skip its powf when even 5h would not exceed h_angle.
+                        if !lands || 5.0 * h > self.h_angle {
+                            let hn = h * st.factor();
+                            if !lands || hn > self.h_angle {
+                                self.h_angle = hn;
+                            }
                         }
                         let theta1 = if lands { bp } else { theta + h };
                         self.commit_angle(theta1, st.y1);
@@ -317,7 +321,7 @@ impl PlantIntegrator {
                         return Ok(());
                     }
                     self.stats.rejected += 1;
-                    self.h_angle = h * fac;
+                    self.h_angle = h * st.factor();
                     if self.h_angle < 1e-14 * theta.abs().max(1.0) {
                         return Err(self.underflow(self.h_angle));
                     }

@@ -2,7 +2,7 @@
 //! signal group, zstd chunks, Foxglove-readable), CSV files, the summary JSON
 //! and a PNG with one panel per requested plot.
 
-use crate::run::{Channels, RunResult};
+use crate::run::{Channels, RunResult, Timed};
 use crate::scene::Scene;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -102,16 +102,9 @@ fn json_schema(name: &str) -> String {
 /// (time, JSON bytes) of each sample of one channel.
 type Messages = Vec<(f64, Vec<u8>)>;
 
-fn samples_as_json<T: Serialize>(v: &[T]) -> Messages {
+fn samples_as_json<T: Serialize + Timed>(v: &[T]) -> Messages {
     v.iter()
-        .map(|s| {
-            let value = serde_json::to_value(s).unwrap_or(serde_json::Value::Null);
-            let t = value
-                .get("t")
-                .and_then(serde_json::Value::as_f64)
-                .unwrap_or(0.0);
-            (t, serde_json::to_vec(&value).unwrap_or_default())
-        })
+        .map(|s| (s.time(), serde_json::to_vec(s).unwrap_or_default()))
         .collect()
 }
 

@@ -111,6 +111,17 @@ pub struct SensorSample {
     pub t_u: f64,
 }
 
+/// A logged sample with its simulation time.
+pub trait Timed {
+    /// Time \[s\].
+    fn time(&self) -> f64;
+}
+
+macro_rules! timed {
+    ($($t:ty),*) => {$(impl Timed for $t { fn time(&self) -> f64 { self.t } })*};
+}
+timed!(PlantSample, ControlSample, StepperSample, SensorSample);
+
 /// The channels that were asked for (None = not recorded at all).
 #[derive(Clone, Debug, Default)]
 pub struct Channels {
