@@ -8,6 +8,7 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+pub mod bench;
 pub mod kin;
 pub mod sim;
 
@@ -51,6 +52,9 @@ enum Command {
     Kin(kin::KinCommand),
     /// Simulate a scene (TOML): plant, sensors, controller, outputs.
     Sim(sim::SimArgs),
+    /// Benchmarks (work–precision of the plant integrators).
+    #[command(subcommand)]
+    Bench(bench::BenchCommand),
 }
 
 /// Parse the process arguments, run, print, and map errors to exit codes.
@@ -59,6 +63,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Some(Command::Kin(cmd)) => kin::run(cmd),
         Some(Command::Sim(args)) => sim::run_file(&args, cli.json),
+        Some(Command::Bench(cmd)) => bench::run(cmd),
         None => sim::run_default(cli.json),
     };
     match result {

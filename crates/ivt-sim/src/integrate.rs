@@ -179,6 +179,14 @@ struct Fsal {
     k: [f64; DIM],
 }
 
+/// The step actually taken when x advances to fl(x + h): integrating h but
+/// storing fl(x + h) would drift x against the solution by up to ½ ulp(x) per
+/// step (1e-10 rad over 10⁶ RK4 steps at θ ≈ 100).
+#[inline]
+fn representable_step(x: f64, h: f64) -> f64 {
+    (x + h) - x
+}
+
 /// Relative slack used to decide that θ sits on a corner already.
 const CORNER_EPS: f64 = 1e-12;
 
@@ -272,7 +280,7 @@ impl PlantIntegrator {
         let z = [self.t, self.y[1], self.y[2]];
         match self.method {
             Method::Rk4 { dtheta, .. } => {
-                let h = dtheta.min(bp - theta);
+                let h = representable_step(theta, dtheta.min(bp - theta));
                 let z1 = rk4_step(&sys, theta, &z, h);
                 self.commit_angle(if h == bp - theta { bp } else { theta + h }, z1);
                 Ok(())
@@ -296,7 +304,11 @@ impl PlantIntegrator {
                 }
                 loop {
                     let lands = self.h_angle >= bp - theta;
-                    let h = if lands { bp - theta } else { self.h_angle };
+                    let h = if lands {
+                        bp - theta
+                    } else {
+                        representable_step(theta, self.h_angle)
+                    };
                     let st = dp5_step(&sys, theta, &z, &k1, h, &tol);
                     if st.err <= 1.0 {
                         // A landing step that was cut short says nothing about the
@@ -383,7 +395,11 @@ impl PlantIntegrator {
         }
         loop {
             let lands = self.h_time >= t_max - self.t;
-            let h = if lands { t_max - self.t } else { self.h_time };
+            let h = if lands {
+                t_max - self.t
+            } else {
+                representable_step(self.t, self.h_time)
+            };
             let st = dp5_step(&sys, self.t, &self.y, &k1, h, &tol);
             let fac = st.factor();
             if st.err > 1.0 {

@@ -11,3 +11,4 @@ pub mod progress;
 pub mod run;
 pub mod scene;
 pub mod sensors;
+pub mod work_precision;
