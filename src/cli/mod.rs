@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 pub mod bench;
+pub mod ctrl;
 pub mod kin;
 pub mod sim;
 
@@ -55,6 +56,9 @@ enum Command {
     /// Benchmarks (work–precision of the plant integrators).
     #[command(subcommand)]
     Bench(bench::BenchCommand),
+    /// The rig controller (ivt-ctrl): offline replay of pulse logs.
+    #[command(subcommand)]
+    Ctrl(ctrl::CtrlCommand),
 }
 
 /// Parse the process arguments, run, print, and map errors to exit codes.
@@ -64,6 +68,7 @@ pub fn main() -> ExitCode {
         Some(Command::Kin(cmd)) => kin::run(cmd),
         Some(Command::Sim(args)) => sim::run_file(&args, cli.json),
         Some(Command::Bench(cmd)) => bench::run(cmd),
+        Some(Command::Ctrl(cmd)) => ctrl::run(cmd),
         None => sim::run_default(cli.json),
     };
     match result {
