@@ -77,6 +77,19 @@ pub enum IntegrateError {
         /// Last tried step.
         h: f64,
     },
+    /// An `advance` call needed more steps than [`MAX_STEPS_PER_ADVANCE`]
+    /// (a very stiff plant, e.g. a tiny L_a, or an absurd tolerance).
+    #[error("no progress: {steps} steps without reaching the next event at t = {t} s, θ = {theta} rad, ω = {omega} rad/s (stiff plant or tolerance too tight?)")]
+    TooManySteps {
+        /// Time.
+        t: f64,
+        /// Angle.
+        theta: f64,
+        /// Speed.
+        omega: f64,
+        /// The budget that ran out.
+        steps: u64,
+    },
     /// The state became NaN or infinite.
     #[error("state not finite at t = {t} s: {state:?}")]
     NotFinite {
@@ -187,6 +200,10 @@ fn representable_step(x: f64, h: f64) -> f64 {
     (x + h) - x
 }
 
+/// Step budget of one [`PlantIntegrator::advance`] call: the closed loop
+/// advances one pulse (or sensor sample) at a time, normally in 1–10 steps.
+pub const MAX_STEPS_PER_ADVANCE: u64 = 2_000_000;
+
 /// Relative slack used to decide that θ sits on a corner already.
 const CORNER_EPS: f64 = 1e-12;
 
@@ -230,7 +247,7 @@ impl PlantIntegrator {
         theta_target: f64,
         t_max: f64,
     ) -> Result<Reached, IntegrateError> {
-        loop {
+        for _ in 0..MAX_STEPS_PER_ADVANCE {
             if self.y[0] >= theta_target {
                 return Ok(Reached::Angle);
             }
@@ -249,6 +266,12 @@ impl PlantIntegrator {
                 });
             }
         }
+        Err(IntegrateError::TooManySteps {
+            t: self.t,
+            theta: self.y[0],
+            omega: self.y[1],
+            steps: MAX_STEPS_PER_ADVANCE,
+        })
     }
 
     /// Segment index and its forward corner for a step starting at θ going forward.

@@ -271,3 +271,37 @@ fn shipped_scenes_parse_and_drive_cycle_stays_in_band() {
     let rel = (res.summary.final_omega_a_rad_s / res.summary.omega0_rad_s - 1.0).abs();
     assert!(rel < 1e-3, "{rel}");
 }
+
+/// Sensor noise and quantization, encoder jitter and 1 % missed steps: the
+/// delay law still holds ω_a at ω0 on average (the integral absorbs the lost
+/// steps), the lost steps are counted, and a run is reproducible from its seed.
+#[test]
+fn noisy_sensors_jitter_and_missed_steps() {
+    let mut s = scene("load_step_delay");
+    s.encoder.jitter_s = 2e-6;
+    s.sensors.v_m_noise = 0.02;
+    s.sensors.v_m_quantum = 0.01;
+    s.sensors.t_u_noise = 0.05;
+    s.stepper.miss_prob = 0.01;
+    s.seed = 42;
+    let a = go(&s);
+    let b = go(&s);
+    assert_eq!(a.summary.static_error_rad_s, b.summary.static_error_rad_s);
+    assert!(a.summary.missed_steps > 10, "{}", a.summary.missed_steps);
+    // jitter of 2 µs on a ≈ 0.6 s revolution: ω_a noise ≈ 5e-5 rad/s per sample
+    assert!(
+        a.summary.static_error_rad_s.abs() < 1e-3,
+        "{}",
+        a.summary.static_error_rad_s
+    );
+    assert_eq!(a.summary.fault_pulses, 0);
+}
+
+/// A stiff inductance is refused with a one-line error naming `plant.l_a`.
+#[test]
+fn tiny_inductance_is_refused() {
+    let src =
+        "duration_s = 1.0\n[plant]\nl_a = 1e-9\n[inputs]\nv_m = [[0.0, 8.0]]\nt_u = [[0.0, 4.0]]\n";
+    let e = Scene::parse(src, "s.toml").unwrap_err().0;
+    assert!(e.contains("plant.l_a") && e.contains("s.toml:3"), "{e}");
+}
