@@ -262,7 +262,7 @@ fn shipped_scenes_parse_and_drive_cycle_stays_in_band() {
             n += 1;
         }
     }
-    assert!(n >= 6, "{n} scenes");
+    assert!(n >= 7, "{n} scenes");
     let mut s = scene("drive");
     s.outputs.channels.clear();
     s.outputs.plots.clear();
