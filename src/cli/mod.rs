@@ -8,8 +8,10 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+pub mod bench;
 pub mod ctrl;
 pub mod kin;
+pub mod sim;
 
 /// Result of a command: the JSON object for `--json` and the text for humans.
 pub struct Output {
@@ -49,6 +51,11 @@ enum Command {
     /// Kinematics of the GIVT, SGIVT and its variant (Chapter 2).
     #[command(subcommand)]
     Kin(kin::KinCommand),
+    /// Simulate a scene (TOML): plant, sensors, controller, outputs.
+    Sim(sim::SimArgs),
+    /// Benchmarks (work–precision of the plant integrators).
+    #[command(subcommand)]
+    Bench(bench::BenchCommand),
     /// The rig controller (ivt-ctrl): offline replay of pulse logs.
     #[command(subcommand)]
     Ctrl(ctrl::CtrlCommand),
@@ -59,8 +66,10 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Kin(cmd)) => kin::run(cmd),
+        Some(Command::Sim(args)) => sim::run_file(&args, cli.json),
+        Some(Command::Bench(cmd)) => bench::run(cmd),
         Some(Command::Ctrl(cmd)) => ctrl::run(cmd),
-        None => kin::summary(),
+        None => sim::run_default(cli.json),
     };
     match result {
         Ok(out) => {
