@@ -8,6 +8,7 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+pub mod hb;
 pub mod kin;
 
 /// Result of a command: the JSON object for `--json` and the text for humans.
@@ -48,6 +49,9 @@ enum Command {
     /// Kinematics of the GIVT, SGIVT and its variant (Chapter 2).
     #[command(subcommand)]
     Kin(kin::KinCommand),
+    /// Harmonic balance: Duffing, frequency response, Mathieu–Duffing (Chapter 3).
+    #[command(subcommand)]
+    Hb(hb::HbCommand),
 }
 
 /// Parse the process arguments, run, print, and map errors to exit codes.
@@ -55,6 +59,7 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Kin(cmd)) => kin::run(cmd),
+        Some(Command::Hb(cmd)) => hb::run(cmd),
         None => kin::summary(),
     };
     match result {

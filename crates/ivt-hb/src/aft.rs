@@ -193,10 +193,9 @@ pub fn resize_harmonics(coeffs: &[f64], n_to: usize) -> Vec<f64> {
     let n = (coeffs.len() - 1) / 2;
     let mut out = vec![0.0; 2 * n_to + 1];
     out[0] = coeffs[0];
-    for k in 1..=n.min(n_to) {
-        out[k] = coeffs[k];
-        out[n_to + k] = coeffs[n + k];
-    }
+    let kmax = n.min(n_to);
+    out[1..=kmax].copy_from_slice(&coeffs[1..=kmax]);
+    out[n_to + 1..=n_to + kmax].copy_from_slice(&coeffs[n + 1..=n + kmax]);
     out
 }
 

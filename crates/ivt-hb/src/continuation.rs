@@ -149,7 +149,9 @@ where
             "need at least one unknown and the parameter",
         ));
     }
-    if !start.iter().all(|v| v.is_finite()) || !(opts.ds > 0.0) {
+    if !start.iter().all(|v| v.is_finite())
+        || opts.ds.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+    {
         return Err(ContinuationError::Input("non-finite start or step"));
     }
     let m = n1 - 1;

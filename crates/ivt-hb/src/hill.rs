@@ -72,7 +72,7 @@ pub fn fourier_blocks(dim: usize, samples: &[f64], m: usize, kmax: usize) -> Vec
 /// [`HillError`] on inconsistent sizes or eigen-solver failure.
 pub fn hill_multipliers(dim: usize, theta_hat: &[c64], h: usize) -> Result<HillResult, HillError> {
     let d2 = dim * dim;
-    if d2 == 0 || theta_hat.len() % d2 != 0 || (theta_hat.len() / d2) % 2 == 0 {
+    if d2 == 0 || !theta_hat.len().is_multiple_of(d2) || (theta_hat.len() / d2).is_multiple_of(2) {
         return Err(HillError::Dimension {
             expected: d2 * (2 * h + 1),
             got: theta_hat.len(),

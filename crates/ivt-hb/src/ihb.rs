@@ -154,7 +154,7 @@ pub(crate) fn validate<P: PeriodicProblem>(problem: &P, opts: &HbOptions) -> Res
             )));
         }
     }
-    if !(opts.broyden.tol > 0.0) {
+    if opts.broyden.tol.is_nan() || opts.broyden.tol <= 0.0 {
         return Err(HbError::InvalidInput("tolerance must be positive".into()));
     }
     Ok(())

@@ -1,4 +1,7 @@
 #![doc = include_str!("../README.md")]
+// Dense kernels index several arrays with the same row/column counters; iterator
+// chains would hide the matrix structure the equations are written in.
+#![allow(clippy::needless_range_loop)]
 
 pub mod aft;
 pub mod broyden;

@@ -65,6 +65,9 @@ impl Default for CascadeOptions {
     }
 }
 
+/// A path point with its period-doubling indicator (μ_min + 1).
+type Sample = (Vec<f64>, f64);
+
 /// One period-doubling point.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PeriodDoubling {
@@ -157,7 +160,7 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
         ..ContinuationOptions::default()
     };
     let mut prev: Option<(Vec<f64>, f64)> = None;
-    let mut bracket: Option<((Vec<f64>, f64), (Vec<f64>, f64))> = None;
+    let mut bracket: Option<(Sample, Sample)> = None;
     let mut p = problem.clone();
     let stab = |an: &mut StabilityAnalyzer,
                 p: &MathieuDuffing,
@@ -285,7 +288,7 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
             ..ContinuationOptions::default()
         };
         let mut prev: Option<(Vec<f64>, f64)> = None;
-        let mut bracket: Option<((Vec<f64>, f64), (Vec<f64>, f64))> = None;
+        let mut bracket: Option<(Sample, Sample)> = None;
         // Skip the start region where the new branch's multiplier is still ≈ +1.
         pseudo_arclength(
             |x: &[f64], r: &mut [f64]| ctl.eval(&x[..l], x[l], r),

@@ -1,9 +1,11 @@
 //! Modified IHB (§3.2.2): AFT residual (Eq. 61–65) and Broyden's method (Eq. 66–67)
 //! seeded with the linear Jacobian Eq. 60 and the linear solution `q₀ = B₀⁻¹ r_F`;
 //! parameter stepping in the nonlinearity (ε from 0 in steps, reusing the last
-//! Broyden matrix) when the direct iteration fails.
+//! Broyden matrix) when the direct iteration fails, and pseudo-arclength in the
+//! stepping parameter when that path folds.
 
 use crate::broyden::{broyden_solve, BroydenStats, BroydenWorkspace};
+use crate::continuation::{pseudo_arclength, ContinuationOptions};
 use crate::ihb::{validate_omega, HbError, HbOptions, HbResidual, HbSolution};
 use crate::linalg::matvec;
 use crate::problem::PeriodicProblem;
@@ -198,6 +200,55 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         }
         if s_done >= 1.0 {
             return Ok(total);
+        }
+        // Last resort: the solution path in s may turn back (a fold in s), which
+        // plain stepping cannot pass; follow it by pseudo-arclength in s from the
+        // last converged point and solve at s = 1 from the point that crosses it.
+        let mut x0 = q_ok.clone();
+        x0.push(s_done);
+        let copts = ContinuationOptions {
+            ds: 0.05,
+            ds_max: 0.5,
+            lambda_min: -1.0,
+            lambda_max: 1.0,
+            max_points: 2000,
+            broyden: opts.broyden.clone(),
+            ..ContinuationOptions::default()
+        };
+        let mut crossing: Option<(Vec<f64>, Vec<f64>)> = None;
+        let mut prev: Option<Vec<f64>> = None;
+        let m1 = m;
+        let traced = pseudo_arclength(
+            |x: &[f64], r: &mut [f64]| res.eval(problem, &x[..m1], omega_f, x[m1], r),
+            &x0,
+            None,
+            1.0,
+            &copts,
+            |pt| {
+                if pt.lambda() >= 1.0 {
+                    crossing = Some((prev.take().unwrap_or_else(|| pt.x.clone()), pt.x.clone()));
+                    return false;
+                }
+                prev = Some(pt.x.clone());
+                true
+            },
+        );
+        if let (Ok(_), Some((a, b))) = (traced, crossing) {
+            let (sa, sb) = (a[m], b[m]);
+            let t = if sb != sa {
+                (1.0 - sa) / (sb - sa)
+            } else {
+                1.0
+            };
+            for i in 0..m {
+                q[i] = a[i] + t * (b[i] - a[i]);
+            }
+            ws.clear_jacobian();
+            let mut f = |x: &[f64], r: &mut [f64]| res.eval(problem, x, omega_f, 1.0, r);
+            match broyden_solve(&mut f, q, ws, &opts.broyden) {
+                Ok(st) => return Ok(st),
+                Err(e) => last_err = Some(e),
+            }
         }
         Err(HbError::Solve(last_err.expect("at least one attempt ran")))
     }
