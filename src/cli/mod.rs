@@ -10,6 +10,7 @@ use std::process::ExitCode;
 
 pub mod bench;
 pub mod ctrl;
+pub mod hb;
 pub mod kin;
 pub mod sim;
 
@@ -59,6 +60,9 @@ enum Command {
     /// The rig controller (ivt-ctrl): offline replay of pulse logs.
     #[command(subcommand)]
     Ctrl(ctrl::CtrlCommand),
+    /// Harmonic balance: Duffing, frequency response, Mathieu–Duffing (Chapter 3).
+    #[command(subcommand)]
+    Hb(hb::HbCommand),
 }
 
 /// Parse the process arguments, run, print, and map errors to exit codes.
@@ -70,6 +74,7 @@ pub fn main() -> ExitCode {
         Some(Command::Bench(cmd)) => bench::run(cmd),
         Some(Command::Ctrl(cmd)) => ctrl::run(cmd),
         None => sim::run_default(cli.json),
+        Some(Command::Hb(cmd)) => hb::run(cmd),
     };
     match result {
         Ok(out) => {

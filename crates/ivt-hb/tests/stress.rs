@@ -1,0 +1,193 @@
+//! Stress: strong nonlinearity, tiny damping, many harmonics, points near folds,
+//! and bad inputs. Every converged answer is checked against one RK4 period started
+//! on the HB orbit (an independent test that it solves the ODE); every failure
+//! must be an error, never a panic or a silent wrong answer.
+
+use ivt_hb::aft::eval_series;
+use ivt_hb::ode::{first_order, rk4};
+use ivt_hb::{
+    frequency_response, BroydenOptions, ClassicIhb, Duffing, FrcOptions, HbError, HbOptions,
+    HbSolution, ModifiedIhb,
+};
+use std::f64::consts::PI;
+
+/// Max |x_RK − x_HB| over one period, RK4 with `per` steps started at the HB state.
+fn orbit_defect(problem: &Duffing, sol: &HbSolution, per: usize) -> f64 {
+    let w = sol.omega_f;
+    let c = sol.dof(0);
+    let mut y = [eval_series(c, 0.0, 0), w * eval_series(c, 0.0, 1)];
+    let period = 2.0 * PI / w;
+    let dt = period / per as f64;
+    let mut err = 0.0f64;
+    for j in 0..64 {
+        err = err.max((y[0] - eval_series(c, 2.0 * PI * j as f64 / 64.0, 0)).abs());
+        rk4(
+            first_order(problem, w),
+            j as f64 * period / 64.0,
+            &mut y,
+            dt,
+            per / 64,
+        );
+    }
+    err
+}
+
+#[test]
+fn strong_nonlinearity_up_to_eps_100() {
+    for eps in [1.0, 10.0, 100.0] {
+        for omega_f in [0.5, 1.5, 3.0] {
+            let d = Duffing::new(0.02, 1.0, eps, 1.0);
+            let sol = ModifiedIhb::new(d.clone(), HbOptions::new(40, 100))
+                .unwrap()
+                .solve(omega_f, None)
+                .unwrap();
+            let err = orbit_defect(&d, &sol, 1 << 15);
+            eprintln!(
+                "ε = {eps}, ω_f = {omega_f}: amp {:.4}, {} it, orbit defect {err:.1e}",
+                sol.amplitude(0),
+                sol.stats.iterations
+            );
+            // n = 40 truncation error for these cases is below 1e-8 (cf. the
+            // convergence study at ε = 100), RK4 error at T/32768 below 1e-10.
+            assert!(err < 1e-7, "ε = {eps}, ω_f = {omega_f}: {err:e}");
+        }
+    }
+}
+
+#[test]
+fn tiny_damping() {
+    for omega_f in [0.4, 0.9, 2.0] {
+        let d = Duffing::new(1e-4, 1.0, 1.0, 0.1);
+        let sol = ModifiedIhb::new(d.clone(), HbOptions::new(30, 80))
+            .unwrap()
+            .solve(omega_f, None)
+            .unwrap();
+        let err = orbit_defect(&d, &sol, 1 << 14);
+        eprintln!(
+            "ξ = 1e-4, ω_f = {omega_f}: amp {:.4}, orbit defect {err:.1e}",
+            sol.amplitude(0)
+        );
+        assert!(err < 1e-8, "{err:e}");
+    }
+}
+
+#[test]
+fn many_harmonics_and_classic_agree() {
+    let d = Duffing::fig28();
+    let opts = HbOptions::new(64, 160);
+    let a = ModifiedIhb::new(d.clone(), opts.clone())
+        .unwrap()
+        .solve(1.3, None)
+        .unwrap();
+    let b = ClassicIhb::new(d.clone(), opts)
+        .unwrap()
+        .solve(1.3, Some(&a.coeffs))
+        .unwrap();
+    let diff = a
+        .coeffs
+        .iter()
+        .zip(&b.coeffs)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    assert!(diff < 1e-9, "{diff:e}");
+    assert!(orbit_defect(&d, &a, 1 << 14) < 1e-8);
+}
+
+#[test]
+fn near_the_folds() {
+    // Solve at fixed ω_f just inside each fold, from the nearest FRC point.
+    let d = Duffing::fig28();
+    let hb = HbOptions::new(20, 64);
+    let frc = frequency_response(&d, &hb, &FrcOptions::default()).unwrap();
+    for f in &frc.folds {
+        let p = &frc.points[f.index];
+        let mut solver = ModifiedIhb::new(d.clone(), hb.clone()).unwrap();
+        let sol = solver.solve(p.omega_f, Some(&p.coeffs)).unwrap();
+        assert!(orbit_defect(&d, &sol, 1 << 14) < 1e-8);
+        let gap = sol
+            .coeffs
+            .iter()
+            .zip(&p.coeffs)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(gap < 1e-7, "fold at {}: {gap:e}", f.lambda);
+    }
+}
+
+#[test]
+fn bad_inputs_are_errors() {
+    let d = Duffing::fig28();
+    // N ≤ n.
+    assert!(matches!(
+        ModifiedIhb::new(d.clone(), HbOptions::new(20, 20)),
+        Err(HbError::Aft(_))
+    ));
+    assert!(matches!(
+        ClassicIhb::new(d.clone(), HbOptions::new(20, 10)),
+        Err(HbError::Aft(_))
+    ));
+    // No harmonics (n < p) and p = 0.
+    assert!(matches!(
+        ModifiedIhb::new(d.clone(), HbOptions::new(0, 8)),
+        Err(HbError::InvalidInput(_))
+    ));
+    assert!(matches!(
+        ModifiedIhb::new(d.clone(), HbOptions::new(4, 8).with_subharmonic(0)),
+        Err(HbError::InvalidInput(_))
+    ));
+    // NaN parameters and frequencies.
+    assert!(ModifiedIhb::new(Duffing::new(f64::NAN, 1.0, 1.0, 0.1), HbOptions::default()).is_err());
+    assert!(ModifiedIhb::new(
+        Duffing::new(0.02, 1.0, 1.0, f64::INFINITY),
+        HbOptions::default()
+    )
+    .is_err());
+    let mut s = ModifiedIhb::new(d.clone(), HbOptions::default()).unwrap();
+    assert!(matches!(
+        s.solve(f64::NAN, None),
+        Err(HbError::InvalidInput(_))
+    ));
+    assert!(matches!(s.solve(-1.0, None), Err(HbError::InvalidInput(_))));
+    assert!(matches!(
+        s.solve(0.4, Some(&[f64::NAN; 41])),
+        Err(HbError::InvalidInput(_))
+    ));
+    assert!(matches!(
+        s.solve(0.4, Some(&[0.0; 3])),
+        Err(HbError::InvalidInput(_))
+    ));
+    // NaN in the nonlinearity: the residual is not finite → error, no panic.
+    let nan = Duffing::new(0.02, 1.0, f64::NAN, 0.1);
+    assert!(ModifiedIhb::new(nan, HbOptions::default())
+        .and_then(|mut s| s.solve(0.4, None))
+        .is_err());
+    // Bad sweep bounds.
+    let bad = FrcOptions {
+        from: 0.0,
+        ..FrcOptions::default()
+    };
+    assert!(frequency_response(&d, &HbOptions::default(), &bad).is_err());
+}
+
+#[test]
+fn non_convergence_returns_the_residual_history() {
+    // A tolerance below round-off cannot be met by any of the fall-backs.
+    let d = Duffing::new(0.02, 1.0, 100.0, 1.0);
+    let mut opts = HbOptions::new(20, 64);
+    opts.broyden = BroydenOptions {
+        max_iter: 20,
+        tol: 1e-300,
+        ..BroydenOptions::default()
+    };
+    let err = ModifiedIhb::new(d, opts)
+        .unwrap()
+        .solve(1.0, None)
+        .unwrap_err();
+    match err {
+        HbError::Solve(e) => {
+            assert!(!e.history().is_empty(), "{e}");
+            assert!(e.history().iter().all(|v| v.is_finite()));
+        }
+        other => panic!("expected a solve error, got {other}"),
+    }
+}
