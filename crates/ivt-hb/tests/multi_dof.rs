@@ -1,7 +1,7 @@
 //! Two coupled DOFs through the general interface: M, C, K matrices plus a cubic
 //! spring on DOF 0 and a force on DOF 1. Checked against one RK4 period started on
 //! the HB orbit, and Hsu vs Hill for the 4×4 state-space Θ.
-
+#![allow(clippy::needless_range_loop)] // DOF-indexed state vectors
 use ivt_hb::aft::eval_series;
 use ivt_hb::ode::{first_order, rk4};
 use ivt_hb::{GeneralProblem, HbOptions, HsuRule, ModifiedIhb, StabilityAnalyzer};
