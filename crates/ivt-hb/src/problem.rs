@@ -259,3 +259,39 @@ where
         (self.f)(theta, out)
     }
 }
+
+/// A borrowed problem is a problem (lets solvers borrow problems that are not
+/// `Clone`, e.g. [`GeneralProblem`] with closures).
+impl<P: PeriodicProblem + ?Sized> PeriodicProblem for &P {
+    fn n_dof(&self) -> usize {
+        (**self).n_dof()
+    }
+    fn mass(&self) -> &[f64] {
+        (**self).mass()
+    }
+    fn damping(&self) -> &[f64] {
+        (**self).damping()
+    }
+    fn stiffness(&self) -> &[f64] {
+        (**self).stiffness()
+    }
+    fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
+        (**self).nonlinear(x, v, theta, out)
+    }
+    fn excitation(&self, theta: f64, out: &mut [f64]) {
+        (**self).excitation(theta, out)
+    }
+    fn velocity_dependent(&self) -> bool {
+        (**self).velocity_dependent()
+    }
+    fn nonlinear_jacobian(
+        &self,
+        x: &[f64],
+        v: &[f64],
+        theta: f64,
+        dg_dx: &mut [f64],
+        dg_dv: &mut [f64],
+    ) {
+        (**self).nonlinear_jacobian(x, v, theta, dg_dx, dg_dv)
+    }
+}
