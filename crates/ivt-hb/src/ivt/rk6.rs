@@ -49,7 +49,11 @@ pub fn pieces(a: f64, b: f64) -> impl Iterator<Item = (f64, f64, Segment)> {
         let end = (seg.centre + FRAC_PI_4).min(b);
         let piece = (start, end, seg);
         // Guard against a start that rounding put a hair below a corner.
-        start = if end - start < 1e-14 { end + 1e-14 } else { end };
+        start = if end - start < 1e-14 {
+            end + 1e-14
+        } else {
+            end
+        };
         Some(piece)
     })
 }
@@ -63,7 +67,14 @@ const A: [[f64; 6]; 7] = [
     [1.0 / 12.0, 1.0 / 3.0, -1.0 / 12.0, 0.0, 0.0, 0.0],
     [-1.0 / 16.0, 9.0 / 8.0, -3.0 / 16.0, -3.0 / 8.0, 0.0, 0.0],
     [0.0, 9.0 / 8.0, -3.0 / 8.0, -3.0 / 4.0, 0.5, 0.0],
-    [9.0 / 44.0, -9.0 / 11.0, 63.0 / 44.0, 18.0 / 11.0, 0.0, -16.0 / 11.0],
+    [
+        9.0 / 44.0,
+        -9.0 / 11.0,
+        63.0 / 44.0,
+        18.0 / 11.0,
+        0.0,
+        -16.0 / 11.0,
+    ],
 ];
 const B: [f64; 7] = [
     11.0 / 120.0,

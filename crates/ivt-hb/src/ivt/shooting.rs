@@ -201,7 +201,15 @@ pub fn shoot_steady_state(
     let mut r = r_seed.unwrap_or_else(|| averaged_r(plant, op));
     let mut history = Vec::new();
     for _ in 0..opts.max_iter {
-        let (y, lo, hi) = revolution(plant, op.v_m, op.t_u, r, w0, opts.steps_per_segment, &mut rk)?;
+        let (y, lo, hi) = revolution(
+            plant,
+            op.v_m,
+            op.t_u,
+            r,
+            w0,
+            opts.steps_per_segment,
+            &mut rk,
+        )?;
         let p1 = y[0] - w0; // periodicity
         let p2 = y[1] - t_target; // time mean = ω0
         history.push((p1 / op.omega0).hypot(p2 / t_target));

@@ -117,10 +117,6 @@ pub struct SteadyState {
 }
 
 impl SteadyState {
-    fn n(&self) -> usize {
-        self.q.len() / 2
-    }
-
     /// θ₁(τ) and its τ-derivative.
     fn theta1(&self, tau: f64) -> (f64, f64) {
         theta1_of(&self.q, tau)
@@ -318,16 +314,16 @@ impl IhbSolver {
             let (f, ft) = seg.f_and_f_theta(theta);
             let p = plant.terms_with_f(theta, f, ft, r, op.v_m, op.t_u);
             let s = 1.0 + t1d;
-            self.res[j] = w0 * w0 * (p.j * t1dd + 0.5 * p.j_theta * s * s) + w0 * p.f_m * s
-                - p.drive(r);
+            self.res[j] =
+                w0 * w0 * (p.j * t1dd + 0.5 * p.j_theta * s * s) + w0 * p.f_m * s - p.drive(r);
             if jac {
                 // ∂/∂θ of the coefficients on one smooth segment (f_θθ = −f there).
                 let j_tt = 2.0 * (jc * r * r + jd) * (ft * ft - f * f);
                 let fm_t = 2.0 * c * f * ft;
                 let (st, ct) = theta.sin_cos();
                 let drive_t = gg * (ct - st) * r + a * ft * op.v_m - b * ft * op.t_u * r;
-                let r_theta = w0 * w0 * (p.j_theta * t1dd + 0.5 * j_tt * s * s) + w0 * fm_t * s
-                    - drive_t;
+                let r_theta =
+                    w0 * w0 * (p.j_theta * t1dd + 0.5 * j_tt * s * s) + w0 * fm_t * s - drive_t;
                 let r_s = w0 * w0 * p.j_theta * s + w0 * p.f_m;
                 let r_ss = w0 * w0 * p.j;
                 self.dres[(j, 0)] =
@@ -351,7 +347,9 @@ impl IhbSolver {
                 let right = Segment::containing(theta_c + 1e-9);
                 let jt = |seg: Segment| {
                     let (f, ft) = seg.f_and_f_theta(theta_c);
-                    plant.terms_with_f(theta_c, f, ft, r, op.v_m, op.t_u).j_theta
+                    plant
+                        .terms_with_f(theta_c, f, ft, r, op.v_m, op.t_u)
+                        .j_theta
                 };
                 let jump = 0.5 * w0 * w0 * (jt(left) - jt(right)) * s * s;
                 // dτ_c/dq = −∂θ₁/∂q (τ_c) / (1 + θ₁'(τ_c)); dτ_c/dr = 0.
