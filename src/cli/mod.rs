@@ -8,6 +8,7 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+pub mod ctrl;
 pub mod kin;
 pub mod ol;
 pub mod stability;
@@ -57,6 +58,9 @@ enum Command {
     Stability(stability::StabilityArgs),
     /// Max |multiplier| over a grid (Fig. 42 analogue).
     StabilityMap(stability::MapArgs),
+    /// The rig controller (ivt-ctrl): offline replay of pulse logs.
+    #[command(subcommand)]
+    Ctrl(ctrl::CtrlCommand),
 }
 
 /// Parse the process arguments, run, print, and map errors to exit codes.
@@ -67,6 +71,7 @@ pub fn main() -> ExitCode {
         Some(Command::Ol(cmd)) => ol::run(cmd),
         Some(Command::Stability(a)) => stability::run(a),
         Some(Command::StabilityMap(a)) => stability::run_map(a),
+        Some(Command::Ctrl(cmd)) => ctrl::run(cmd),
         None => kin::summary(),
     };
     match result {
