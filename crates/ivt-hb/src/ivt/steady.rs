@@ -254,7 +254,15 @@ impl IhbSolver {
             }
             let step = (tau + v - theta) / (1.0 + d).max(1e-3);
             tau -= step;
-            if step.abs() < 1e-15 {
+            // Quadratic convergence: one more step after 1e-9 reaches round-off.
+            if step.abs() < 1e-9 {
+                let (mut v, mut d) = (0.0, 0.0);
+                for k in 1..=n {
+                    let (s, c) = (k as f64 * tau).sin_cos();
+                    v += q[k - 1] * c + q[n + k - 1] * s;
+                    d += k as f64 * (q[n + k - 1] * c - q[k - 1] * s);
+                }
+                tau -= (tau + v - theta) / (1.0 + d).max(1e-3);
                 break;
             }
         }
