@@ -30,6 +30,21 @@ impl Segment {
         }
     }
 
+    /// (f, f_θ) on this segment from sin θ and cos θ (no trig call): the
+    /// segment centred at kπ/2 rotates (sin, cos) by k quarter turns.
+    #[inline]
+    pub fn f_and_f_theta_from(&self, sin_theta: f64, cos_theta: f64) -> (f64, f64) {
+        let k = (self.centre / FRAC_PI_2).round() as i64;
+        // (sin φ, cos φ) with φ = θ − kπ/2.
+        let (s, c) = match k.rem_euclid(4) {
+            0 => (sin_theta, cos_theta),
+            1 => (-cos_theta, sin_theta),
+            2 => (-sin_theta, -cos_theta),
+            _ => (cos_theta, -sin_theta),
+        };
+        (NCG_AMPLITUDE * c, -NCG_AMPLITUDE * s)
+    }
+
     /// (f, f_θ) on this segment, valid up to and including both ends.
     #[inline]
     pub fn f_and_f_theta(&self, theta: f64) -> (f64, f64) {
@@ -186,6 +201,8 @@ mod tests {
             let (f, ft) = s.f_and_f_theta(m);
             assert!((f - ivt_kin::variant::f(m)).abs() < 1e-14);
             assert!((ft - ivt_kin::variant::f_theta(m)).abs() < 1e-14);
+            let (f2, ft2) = s.f_and_f_theta_from(m.sin(), m.cos());
+            assert!((f2 - f).abs() < 1e-14 && (ft2 - ft).abs() < 1e-14);
         }
     }
 }
