@@ -176,3 +176,37 @@ fn thesis_grid_solves_everywhere() {
     assert_eq!(pts.len(), 416);
     assert!(pts.iter().all(|p| p.result.is_ok()));
 }
+
+/// Issue 7 acceptance: the predicted max |multiplier| (Chebyshev Tau, N = 16)
+/// matches the contraction per revolution of a direct simulation of the
+/// nonlinear delay loop Eq. 172 started 1 µm off r̄, at three feasible points.
+/// The issue asks for 5 %; the two routes share only the plant model and
+/// agree to ~1e-4, so 1e-3 is asserted. Gains k = 1, k2 = 2 mm·rad⁻¹ (ctrl
+/// reading, k_SI = 1e-3, 2e-3) make the dominant multiplier 0.7–0.85, well
+/// separated from the others (|λ| < 0.4), so 200 revolutions resolve it; the
+/// fourth case uses the thesis's 0.01/0.02 (λ ≈ 0.996).
+#[test]
+fn predicted_multiplier_matches_simulated_contraction() {
+    use ivt_hb::ivt::delay_sim::{simulate_contraction, DelaySimOptions};
+    let plant = PlantParams::printed();
+    let cases = [
+        (8.4, 4.0, 1.0, 2.0),
+        (8.0, 2.0, 1.0, 2.0),
+        (9.2, 8.0, 1.0, 2.0),
+        (8.4, 4.0, 0.01, 0.02),
+    ];
+    for (v, t, k, k2) in cases {
+        let op = OperatingPoint::at_100_rpm(v, t);
+        let g = FeedbackGains::from_thesis_mm_per_rad(k, k2);
+        let s = delay_stability(&plant, &op, g, &DelayOptions::default()).unwrap();
+        let c =
+            simulate_contraction(&plant, &op, g, &s.orbit, &DelaySimOptions::default()).unwrap();
+        let rel = (c.measured - s.max_abs_multiplier).abs() / s.max_abs_multiplier;
+        assert!(
+            rel < 1e-3,
+            "({v},{t}) k={k}: predicted {} simulated {}",
+            s.max_abs_multiplier,
+            c.measured
+        );
+    }
+}

@@ -17,6 +17,7 @@
 //! Units are SI inside: rad/s, m, V, N·m. rpm only through [`rpm_to_rad_s`].
 
 pub mod delay;
+pub mod delay_sim;
 pub mod fit;
 pub mod gains;
 pub mod rk6;
