@@ -7,6 +7,10 @@ use super::{IvtError, OperatingPoint};
 use ivt_kin::plant::PlantParams;
 use rayon::prelude::*;
 
+/// One point of a stability map: the operating point and its max |multiplier|
+/// (or why it could not be computed).
+pub type MapEntry = (OperatingPoint, Result<f64, String>);
+
 /// Best gains on a grid over the box, and the max |multiplier| they give.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GainChoice {
@@ -89,7 +93,7 @@ pub fn stability_map(
     points: &[OperatingPoint],
     gains: FeedbackGains,
     opts: &DelayOptions,
-) -> Result<Vec<(OperatingPoint, Result<f64, String>)>, IvtError> {
+) -> Result<Vec<MapEntry>, IvtError> {
     if points.is_empty() {
         return Err(IvtError::EmptyGrid("no operating points"));
     }
