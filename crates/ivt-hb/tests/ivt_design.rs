@@ -210,3 +210,24 @@ fn predicted_multiplier_matches_simulated_contraction() {
         );
     }
 }
+
+/// Broyden (thesis Eq. 156–157, default) and Newton reach the same r̄: both
+/// stop at ‖R_p‖ < 1e-10 N·m, which bounds their difference far below the
+/// truncation error; 1e-9 relative is asserted.
+#[test]
+fn broyden_and_newton_agree() {
+    use ivt_hb::ivt::steady::IhbMethod;
+    let plant = PlantParams::printed();
+    for (v, t) in [(8.4, 1.5), (6.0, 6.0), (12.0, 9.0)] {
+        let op = OperatingPoint::at_100_rpm(v, t);
+        let solve = |method| {
+            let o = IhbOptions {
+                method,
+                ..Default::default()
+            };
+            solve_steady_state(&plant, &op, o).unwrap().r
+        };
+        let (b, n) = (solve(IhbMethod::Broyden), solve(IhbMethod::Newton));
+        assert!((b - n).abs() <= 1e-9 * n.abs(), "({v},{t}): {b} vs {n}");
+    }
+}

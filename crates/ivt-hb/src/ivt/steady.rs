@@ -12,13 +12,13 @@
 //! `C̃_s = {½, cos τ … cos nτ, sin τ … sin nτ}` (alternating frequency–time).
 //! The 2n+1 balanced residuals are zeroed in the 2n+1 unknowns `x_p = {r, q_p}`.
 //!
-//! Solver: Newton with the exact Jacobian of the sampled residual (the
-//! Galerkin Jacobian of the classic IHB, §3.2.1). The projection is a direct
-//! sum over precomputed cos/sin tables (a plan made once per (n, samples)):
-//! for n = 7 and 64 samples that is ~1 k multiply–adds, no cheaper by FFT.
-//! Limitation: the thesis solves Eq. 156–157 by Broyden's update; the generic
-//! Broyden of this crate's HB engine was not available when this was written,
-//! and Newton converges in 2–4 iterations from a warm start (see README).
+//! Solver: Broyden's update (Eq. 156–157, [`IhbMethod::Broyden`], default)
+//! through [`crate::broyden`], seeded on a cold start by the exact Jacobian of
+//! the sampled residual and along a sweep by the previous point's matrix; or
+//! Newton with that exact Jacobian at every step ([`IhbMethod::Newton`], the
+//! classic IHB of §3.2.1). The projection is a direct sum over cos/sin tables
+//! at the quadrature nodes: for n = 7 that is ~1 k multiply–adds per residual,
+//! no cheaper by FFT.
 //!
 //! Accuracy: f_θ (Eq. 139) jumps at the gear corners, so ω̄(θ) has kinks and
 //! θ₁ has Fourier coefficients decaying like k⁻³. The truncation at n
@@ -27,6 +27,7 @@
 
 use super::rk6::Segment;
 use super::{averaged_r, check_plant, IvtError, OperatingPoint, Verdict};
+use crate::broyden::{broyden_solve, BroydenOptions, BroydenWorkspace, System};
 use core::f64::consts::PI;
 use ivt_kin::plant::PlantParams;
 use nalgebra::{DMatrix, DVector};
@@ -46,6 +47,21 @@ pub struct IhbOptions {
     pub max_iter: usize,
     /// How the balanced residual integral is evaluated.
     pub quadrature: Quadrature,
+    /// Nonlinear solver for Eq. 156–157.
+    pub method: IhbMethod,
+}
+
+/// Solver of the balanced equations.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum IhbMethod {
+    /// Broyden's update, Eq. 156–157 (the thesis's modified IHB), via
+    /// [`crate::broyden::broyden_solve`]: the exact Jacobian seeds it on a cold
+    /// start, and along a sweep the matrix left by the previous point seeds
+    /// the next, so most points need no Jacobian at all.
+    #[default]
+    Broyden,
+    /// Newton with the exact Jacobian at every step (the classic IHB, §3.2.1).
+    Newton,
 }
 
 /// Quadrature of the harmonic-balance integral `(1/π)∫ C̃_s R_p dτ`.
@@ -71,6 +87,7 @@ impl Default for IhbOptions {
             tol: 1e-10,
             max_iter: 40,
             quadrature: Quadrature::default(),
+            method: IhbMethod::default(),
         }
     }
 }
@@ -173,6 +190,8 @@ pub struct IhbSolver {
     jump_jac: DMatrix<f64>,
     /// (sin kτ_c, cos kτ_c) at one corner crossing, k = 0..=n.
     trig_c: Vec<(f64, f64)>,
+    /// Broyden matrices, kept between solves (warm start along a sweep).
+    broyden: BroydenWorkspace,
 }
 
 impl IhbSolver {
@@ -210,6 +229,7 @@ impl IhbSolver {
             res: DVector::zeros(m),
             jump_jac: DMatrix::zeros(2 * n + 1, 2 * n + 1),
             trig_c: vec![(0.0, 1.0); n + 1],
+            broyden: BroydenWorkspace::new(2 * n + 1),
         };
         for j in 0..m {
             s.tau[j] = 2.0 * PI * j as f64 / m as f64;
@@ -401,6 +421,9 @@ impl IhbSolver {
             }
             _ => x[0] = averaged_r(plant, op),
         }
+        if self.opts.method == IhbMethod::Broyden {
+            return self.solve_broyden(plant, op, x, warm.is_some());
+        }
         let mut history = Vec::new();
         self.sample(plant, op, &x, true);
         let mut rb = &self.project * &self.res;
@@ -442,6 +465,18 @@ impl IhbSolver {
             }
             history.push(norm);
         }
+        self.finish(plant, op, &x, iterations, norm)
+    }
+
+    /// Package a converged {r, q_p} with min/max ω̄ and the verdict.
+    fn finish(
+        &self,
+        plant: &PlantParams,
+        op: &OperatingPoint,
+        x: &[f64],
+        iterations: usize,
+        norm: f64,
+    ) -> Result<SteadyState, IvtError> {
         let q = x[1..].to_vec();
         let mut st = SteadyState {
             op: *op,
@@ -466,6 +501,72 @@ impl IhbSolver {
             });
         }
         Ok(st)
+    }
+
+    /// Eq. 156–157 by Broyden's method (the crate's generic solver).
+    fn solve_broyden(
+        &mut self,
+        plant: &PlantParams,
+        op: &OperatingPoint,
+        mut x: Vec<f64>,
+        warm: bool,
+    ) -> Result<SteadyState, IvtError> {
+        let dim = x.len();
+        let mut ws = core::mem::replace(&mut self.broyden, BroydenWorkspace::new(0));
+        if !warm {
+            ws = BroydenWorkspace::new(dim); // cold: seed with the exact Jacobian
+        }
+        let bopts = BroydenOptions {
+            tol: self.opts.tol,
+            max_iter: self.opts.max_iter,
+            ..Default::default()
+        };
+        let mut sys = BalancedResidual {
+            solver: self,
+            plant,
+            op,
+        };
+        let result = broyden_solve(&mut sys, &mut x, &mut ws, &bopts);
+        self.broyden = ws;
+        match result {
+            Ok(stats) => self.finish(plant, op, &x, stats.iterations, stats.residual_norm),
+            Err(e) => {
+                self.broyden = BroydenWorkspace::new(dim);
+                Err(IvtError::NoConvergence {
+                    method: "modified IHB (Broyden, Eq. 156-157)",
+                    iterations: e.history().len(),
+                    history: e.history().to_vec(),
+                })
+            }
+        }
+    }
+}
+
+/// The harmonic-balanced residual R_p as a [`System`] for the Broyden solver,
+/// with the exact Jacobian for (re)seeding.
+struct BalancedResidual<'a> {
+    solver: &'a mut IhbSolver,
+    plant: &'a PlantParams,
+    op: &'a OperatingPoint,
+}
+
+impl System for BalancedResidual<'_> {
+    fn residual(&mut self, x: &[f64], r: &mut [f64]) {
+        self.solver.sample(self.plant, self.op, x, false);
+        let rb = &self.solver.project * &self.solver.res;
+        r.copy_from_slice(rb.as_slice());
+    }
+
+    fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> bool {
+        self.solver.sample(self.plant, self.op, x, true);
+        let j = &self.solver.project * &self.solver.dres + &self.solver.jump_jac;
+        let m = x.len();
+        for i in 0..m {
+            for k in 0..m {
+                jac[i * m + k] = j[(i, k)];
+            }
+        }
+        true
     }
 }
 
