@@ -23,6 +23,13 @@ pub struct StabilityArgs {
     tu: f64,
     #[command(flatten)]
     common: Common,
+    /// Gain design: search k ∈ [0, K_MAX], k2 ∈ [0, K2_MAX] (same unit as --k)
+    /// for the smallest max |multiplier| at this point (grid + one refinement).
+    #[arg(long, num_args = 2, value_names = ["K_MAX", "K2_MAX"])]
+    design: Option<Vec<f64>>,
+    /// Grid points per axis for --design.
+    #[arg(long, default_value_t = 9)]
+    design_steps: usize,
 }
 
 /// Gains and discretization shared by both commands.
@@ -106,7 +113,26 @@ pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
     let s = delay_stability(&PlantParams::printed(), &op, g, &a.common.opts())
         .map_err(|e| CliError::Failed(e.to_string()))?;
     let dt = t0.elapsed().as_secs_f64();
+    let design = match &a.design {
+        Some(b) => {
+            let scale = if a.common.si { 1.0 } else { 1e-3 };
+            let c = ivt_hb::ivt::gains::best_gains(
+                &PlantParams::printed(),
+                &op,
+                (0.0, b[0] * scale),
+                (0.0, b[1] * scale),
+                a.design_steps,
+                &a.common.opts(),
+            )
+            .map_err(|e| CliError::Failed(e.to_string()))?;
+            Some(json!({"k_si": c.gains.k, "k2_si": c.gains.k2,
+                        "k": c.gains.k / scale, "k2": c.gains.k2 / scale,
+                        "max_abs_multiplier": c.max_abs_multiplier}))
+        }
+        None => None,
+    };
     let json = json!({
+        "design": design,
         "max_abs_multiplier": s.max_abs_multiplier, "structural": [s.structural.0, s.structural.1],
         "multipliers": s.multipliers.iter().map(|m| [m.0, m.1]).collect::<Vec<_>>(),
         "r_bar": s.orbit.r, "k_si": g.k, "k2_si": g.k2, "chebyshev_order": a.common.n,
