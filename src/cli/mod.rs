@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 pub mod ctrl;
+pub mod heatmap;
 pub mod kin;
 pub mod ol;
 pub mod stability;

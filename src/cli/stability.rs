@@ -95,6 +95,10 @@ pub struct MapArgs {
     /// Only points with a feasible r̄ (0 ≤ r̄ ≤ r_max).
     #[arg(long)]
     feasible_only: bool,
+    /// Write a PNG heat map (Fig. 42 analogue): blue 0 → yellow 1, red ≥ 1,
+    /// grey = skipped/failed.
+    #[arg(long)]
+    plot: Option<std::path::PathBuf>,
 }
 
 /// `ivt stability`.
@@ -199,6 +203,30 @@ pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
         .collect();
     let json = json!({"points": pts, "worst": worst, "k_si": a.common.gains().k,
                       "k2_si": a.common.gains().k2, "solve_time_s": dt});
+    if let Some(path) = &a.plot {
+        let value = |v: f64, t: f64| {
+            map.iter()
+                .find(|(op, _)| (op.v_m - v).abs() < 1e-9 && (op.t_u - t).abs() < 1e-9)
+                .and_then(|(_, r)| r.as_ref().ok().copied())
+        };
+        let cells: Vec<(f64, f64, Option<f64>)> = grid
+            .t_u
+            .iter()
+            .flat_map(|&t| grid.v_m.iter().map(move |&v| (v, t)))
+            .map(|(v, t)| (v, t, value(v, t)))
+            .collect();
+        let g = a.common.gains();
+        super::heatmap::draw(
+            path,
+            &format!(
+                "max |multiplier|, k = {:.3e}, k2 = {:.3e} m·s/rad² (N = {})",
+                g.k, g.k2, a.common.n
+            ),
+            &cells,
+            a.vm[1],
+            a.tu[1],
+        )?;
+    }
     let human = format!(
         "{} points, worst max |multiplier| = {:.6}, {:.2} s\n",
         map.len(),
