@@ -12,7 +12,9 @@ pub mod bench;
 pub mod ctrl;
 pub mod hb;
 pub mod kin;
+pub mod ol;
 pub mod sim;
+pub mod stability;
 
 /// Result of a command: the JSON object for `--json` and the text for humans.
 pub struct Output {
@@ -57,6 +59,13 @@ enum Command {
     /// Benchmarks (work–precision of the plant integrators).
     #[command(subcommand)]
     Bench(bench::BenchCommand),
+    /// Open-loop law from the model: IHB steady state, grid table, refit (§4.2.1).
+    #[command(subcommand)]
+    Ol(ol::OlCommand),
+    /// Floquet multipliers of the time-delay loop at one point (§4.3).
+    Stability(stability::StabilityArgs),
+    /// Max |multiplier| over a grid (Fig. 42 analogue).
+    StabilityMap(stability::MapArgs),
     /// The rig controller (ivt-ctrl): offline replay of pulse logs.
     #[command(subcommand)]
     Ctrl(ctrl::CtrlCommand),
@@ -72,6 +81,9 @@ pub fn main() -> ExitCode {
         Some(Command::Kin(cmd)) => kin::run(cmd),
         Some(Command::Sim(args)) => sim::run_file(&args, cli.json),
         Some(Command::Bench(cmd)) => bench::run(cmd),
+        Some(Command::Ol(cmd)) => ol::run(cmd),
+        Some(Command::Stability(a)) => stability::run(a),
+        Some(Command::StabilityMap(a)) => stability::run_map(a),
         Some(Command::Ctrl(cmd)) => ctrl::run(cmd),
         None => sim::run_default(cli.json),
         Some(Command::Hb(cmd)) => hb::run(cmd),
