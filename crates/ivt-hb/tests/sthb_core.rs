@@ -148,3 +148,31 @@ fn newton_converges_quadratically() {
     let k = h.len();
     assert!(h[k - 1] < 1e-11 && h[k - 2] < 1e-3, "{h:?}");
 }
+
+#[test]
+fn direct_spatial_sums_equal_rustdct() {
+    for boundary in [Boundary::Fixed, Boundary::Spring { k0: 7.0 }] {
+        let p = StringParams {
+            kd: 30.0,
+            modes: 6,
+            harmonics: 5,
+            boundary,
+            ..Default::default()
+        };
+        let mut fast = StringHb::with_spatial(p.clone(), Some(false)).unwrap();
+        let mut direct = StringHb::with_spatial(p, Some(true)).unwrap();
+        let n = fast.dim();
+        let a = guess(&fast, 0.3, 7);
+        let (mut r1, mut r2) = (vec![0.0; n], vec![0.0; n]);
+        let (mut j1, mut j2) = (Mat::zeros(n, n), Mat::zeros(n, n));
+        fast.residual_jacobian(&a, 2.5, &mut r1, &mut j1);
+        direct.residual_jacobian(&a, 2.5, &mut r2, &mut j2);
+        // Same sums in a different order: rounding only (entries up to ~1e3).
+        for i in 0..n {
+            assert!((r1[i] - r2[i]).abs() < 1e-10, "residual {i}");
+            for j in 0..n {
+                assert!((j1[(i, j)] - j2[(i, j)]).abs() < 1e-9, "jacobian {i},{j}");
+            }
+        }
+    }
+}

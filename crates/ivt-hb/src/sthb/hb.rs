@@ -12,6 +12,101 @@ use super::lu::LuWorkspace;
 use super::toeplitz::{add_real_toeplitz, BlockLayout, PeriodicSpectrum};
 use super::{Boundary, SthbError, StringParams};
 
+/// Up to this many modes the spatial balance sums the few needed DST-I/DCT-I
+/// terms directly (`O(N·N_s)` per time sample); rustdct's DST-I/DCT-I of these
+/// odd lengths run a complex FFT of length `2 N_s`, which measured ~10× slower
+/// for `N = 5`, `N_s = 64`. Both give the same numbers (tested).
+const DIRECT_MAX_MODES: usize = 12;
+
+/// Spatial balance (Eq. 94, 97): DST-I on the interior points and DCT-I on the
+/// closed grid, by rustdct or by direct partial sums over a sine table.
+struct Spatial {
+    dst: Arc<dyn Dst1<f64>>,
+    dct: Arc<dyn Dct1<f64>>,
+    scratch: Vec<f64>,
+    /// Rows `sin(π(m+1)(k+1)/N_s)`, `m < 2N`, `k < N_s − 1`.
+    sin_t: Vec<f64>,
+    /// Rows `cos(π m k/N_s)`, `m ≤ 2N`, `k ≤ N_s`.
+    cos_t: Vec<f64>,
+    tmp: Vec<f64>,
+    direct: bool,
+}
+
+impl Spatial {
+    fn new(
+        dst: Arc<dyn Dst1<f64>>,
+        dct: Arc<dyn Dct1<f64>>,
+        ns: usize,
+        modes: usize,
+        direct: bool,
+    ) -> Self {
+        let angle = |j: usize| PI * j as f64 / ns as f64;
+        let mut sin_t = Vec::with_capacity(2 * modes * (ns - 1));
+        for m in 0..2 * modes {
+            sin_t.extend((0..ns - 1).map(|k| angle((m + 1) * (k + 1)).sin()));
+        }
+        let mut cos_t = Vec::with_capacity((2 * modes + 1) * (ns + 1));
+        for m in 0..=2 * modes {
+            cos_t.extend((0..=ns).map(|k| angle(m * k).cos()));
+        }
+        Self {
+            scratch: vec![0.0; dst.get_scratch_len().max(dct.get_scratch_len())],
+            dst,
+            dct,
+            sin_t,
+            cos_t,
+            tmp: vec![0.0; ns + 1],
+            direct,
+        }
+    }
+
+    /// DST-I of `buf` (length `N_s − 1`, `X_r = Σ_k x_k sin(π(k+1)(r+1)/N_s)`) when
+    /// only the first `nin` inputs are nonzero and the first `nout` outputs are used
+    /// (one of them at most `2N`).
+    fn sine(&mut self, buf: &mut [f64], nin: usize, nout: usize) {
+        if !self.direct {
+            self.dst.process_dst1_with_scratch(buf, &mut self.scratch);
+            return;
+        }
+        Self::partial(&self.sin_t, &mut self.tmp, buf, nin, nout);
+    }
+
+    /// DCT-I of `buf` (length `N_s + 1`, half weight at both ends) with the
+    /// first `nin` inputs nonzero and the first `nout` outputs used.
+    fn cosine(&mut self, buf: &mut [f64], nin: usize, nout: usize) {
+        if !self.direct {
+            self.dct.process_dct1_with_scratch(buf, &mut self.scratch);
+            return;
+        }
+        let len = buf.len();
+        if nin == len {
+            buf[0] *= 0.5;
+            buf[len - 1] *= 0.5;
+        }
+        Self::partial(&self.cos_t, &mut self.tmp, buf, nin, nout);
+    }
+
+    /// `buf ← T buf` for the symmetric table `T` (rows of length `buf.len()`).
+    fn partial(table: &[f64], tmp: &mut [f64], buf: &mut [f64], nin: usize, nout: usize) {
+        let len = buf.len();
+        let rows = table.chunks_exact(len);
+        if nin < len {
+            // Synthesis: few inputs, all outputs.
+            tmp[..nin].copy_from_slice(&buf[..nin]);
+            buf.fill(0.0);
+            for (x, row) in tmp[..nin].iter().zip(rows) {
+                buf.iter_mut().zip(row).for_each(|(o, t)| *o += x * t);
+            }
+        } else {
+            // Projection: all inputs, few outputs.
+            tmp[..len].copy_from_slice(buf);
+            for (o, row) in buf[..nout].iter_mut().zip(rows) {
+                *o = row.iter().zip(&tmp[..len]).map(|(t, x)| t * x).sum();
+            }
+        }
+    }
+}
+
 /// Newton–Raphson statistics of one converged solve.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SolveStats {
@@ -31,10 +126,7 @@ pub struct SolveStats {
 pub struct StringHb {
     p: StringParams,
     nq: usize,
-    dst: Arc<dyn Dst1<f64>>,
-    dct: Arc<dyn Dct1<f64>>,
-    dct_scratch: Vec<f64>,
-    dst_scratch: Vec<f64>,
+    spatial: Spatial,
     fwd: Arc<dyn RealToComplex<f64>>,
     inv: Arc<dyn ComplexToReal<f64>>,
     fft_scratch: Vec<Complex<f64>>,
@@ -54,6 +146,7 @@ pub struct StringHb {
     pub(crate) s_hat: PeriodicSpectrum,
     e_proj: Vec<f64>,
     nl: Vec<f64>,
+    toeplitz_scratch: Vec<Complex<f64>>,
     pub(crate) lu: LuWorkspace,
 }
 
@@ -63,6 +156,15 @@ impl StringHb {
     /// # Errors
     /// [`SthbError::Invalid`] if the parameters fail [`StringParams::validate`].
     pub fn new(params: StringParams) -> Result<Self, SthbError> {
+        Self::with_spatial(params, None)
+    }
+
+    /// As [`StringHb::new`], forcing rustdct (`Some(false)`) or the direct sums
+    /// (`Some(true)`) for the spatial balance; `None` picks by `N`.
+    ///
+    /// # Errors
+    /// As [`StringHb::new`].
+    pub fn with_spatial(params: StringParams, direct: Option<bool>) -> Result<Self, SthbError> {
         params.validate()?;
         let (n, m, ns, ms) = (params.modes, params.harmonics, params.ns, params.ms);
         let nq = match params.boundary {
@@ -85,10 +187,7 @@ impl StringHb {
         let dim = nq * (2 * m + 1);
         Ok(Self {
             nq,
-            dct_scratch: vec![0.0; dct.get_scratch_len()],
-            dst_scratch: scr,
-            dst,
-            dct,
+            spatial: Spatial::new(dst, dct, ns, n, direct.unwrap_or(n <= DIRECT_MAX_MODES)),
             fft_scratch: vec![Complex::new(0.0, 0.0); fft_scratch_len],
             fwd,
             inv,
@@ -107,6 +206,7 @@ impl StringHb {
             s_hat: PeriodicSpectrum::zeros(n, nq, ms, p_max),
             e_proj,
             nl: vec![0.0; dim],
+            toeplitz_scratch: Vec::new(),
             lu: LuWorkspace::new(dim),
             p: params,
         })
@@ -271,10 +371,8 @@ impl StringHb {
                 self.wxx[j] = -k * k * q;
             }
             // w_x(x_k) = Σ nπ q_n cos(nπk/N_s), k = 0..N_s (DCT-I); w_xx on the interior (DST-I).
-            self.dct
-                .process_dct1_with_scratch(&mut self.wx, &mut self.dct_scratch);
-            self.dst
-                .process_dst1_with_scratch(&mut self.wxx, &mut self.dst_scratch);
+            self.spatial.cosine(&mut self.wx, n + 1, ns + 1);
+            self.spatial.sine(&mut self.wxx, n, ns - 1);
             if nq > n {
                 let qe = self.q_t[n * ms + i];
                 self.wx.iter_mut().for_each(|v| *v += qe);
@@ -282,8 +380,7 @@ impl StringHb {
             for k in 1..ns {
                 self.g[k - 1] = kd * self.wx[k] * self.wx[k] * self.wxx[k - 1];
             }
-            self.dst
-                .process_dst1_with_scratch(&mut self.g, &mut self.dst_scratch);
+            self.spatial.sine(&mut self.g, ns - 1, n);
             for j in 0..n {
                 self.gamma_t[j * ms + i] = scale * self.g[j];
             }
@@ -294,10 +391,8 @@ impl StringHb {
                 for k in 0..=ns {
                     self.g2[k] = kd * self.wx[k] * self.wx[k];
                 }
-                self.dst
-                    .process_dst1_with_scratch(&mut self.g, &mut self.dst_scratch);
-                self.dct
-                    .process_dct1_with_scratch(&mut self.g2, &mut self.dct_scratch);
+                self.spatial.sine(&mut self.g, ns - 1, 2 * n);
+                self.spatial.cosine(&mut self.g2, ns + 1, 2 * n + 1);
                 for r in 0..2 * n {
                     self.b_t[r * ms + i] = scale * self.g[r];
                 }
@@ -407,7 +502,7 @@ impl StringHb {
         self.fill_jacobian(omega, jac);
     }
 
-    fn fill_jacobian(&self, omega: f64, jac: &mut Mat<f64>) {
+    fn fill_jacobian(&mut self, omega: f64, jac: &mut Mat<f64>) {
         jac.fill(0.0);
         self.for_each_linear(omega, false, |r, c, v| jac[(r, c)] += v);
         let layout = BlockLayout {
@@ -416,7 +511,16 @@ impl StringHb {
             col_block: self.nq,
             col_off: 0,
         };
-        add_real_toeplitz(&self.s_hat, self.p.harmonics, -1.0, layout, jac.as_mut());
+        let mut scratch = std::mem::take(&mut self.toeplitz_scratch);
+        add_real_toeplitz(
+            &self.s_hat,
+            self.p.harmonics,
+            -1.0,
+            layout,
+            jac.as_mut(),
+            &mut scratch,
+        );
+        self.toeplitz_scratch = scratch;
     }
 
     /// Newton–Raphson (step a6) from the guess in `a`, overwritten by the solution.

@@ -90,40 +90,58 @@ pub struct BlockLayout {
     pub col_off: usize,
 }
 
-/// Add `scale ×` the real Toeplitz form of `s` with `harmonics` harmonics to `target`.
+/// Add `scale ×` the real Toeplitz form of `s` with `harmonics` harmonics to
+/// `target`. `scratch` holds the blocks `Ŝ_r, |r| ≤ 2M` (grown once, reused).
 pub fn add_real_toeplitz(
     s: &PeriodicSpectrum,
     harmonics: usize,
     scale: f64,
     layout: BlockLayout,
     mut target: MatMut<'_, f64>,
+    scratch: &mut Vec<Complex<f64>>,
 ) {
-    let nh = 2 * harmonics + 1;
-    let freq = |h: usize| h.div_ceil(2) as isize;
-    for h in 0..nh {
-        for g in 0..nh {
-            let (k, l) = (freq(h), freq(g));
-            for i in 0..s.rows {
-                for j in 0..s.cols {
-                    let dif = s.get(k - l, i, j);
-                    let sum = s.get(k + l, i, j);
-                    let single = s.get(if h == 0 { l } else { k }, i, j);
-                    // Table in the module docs; `single` is Ŝ_l (row 1) or Ŝ_k (column 1).
-                    let v = match (h == 0, h % 2 == 1, g == 0, g % 2 == 1) {
-                        (true, _, true, _) => single.re,
-                        (true, _, false, true) => single.re,
-                        (true, _, false, false) => -single.im,
-                        (false, true, true, _) => 2.0 * single.re,
-                        (false, false, true, _) => -2.0 * single.im,
-                        (false, true, false, true) => dif.re + sum.re,
-                        (false, true, false, false) => dif.im - sum.im,
-                        (false, false, false, true) => -(dif.im + sum.im),
-                        (false, false, false, false) => dif.re - sum.re,
-                    };
-                    if v != 0.0 {
-                        let r = h * layout.row_block + layout.row_off + i;
-                        let c = g * layout.col_block + layout.col_off + j;
-                        target[(r, c)] += scale * v;
+    let m = harmonics as isize;
+    let (rows, cols) = (s.rows, s.cols);
+    let nb = rows * cols;
+    scratch.clear();
+    for r in -2 * m..=2 * m {
+        for i in 0..rows {
+            for j in 0..cols {
+                scratch.push(s.get(r, i, j));
+            }
+        }
+    }
+    let blk = |r: isize| &scratch[(r + 2 * m) as usize * nb..][..nb];
+    let mut add = |h: usize, g: usize, i: usize, j: usize, v: f64| {
+        let r = h * layout.row_block + layout.row_off + i;
+        let c = g * layout.col_block + layout.col_off + j;
+        target[(r, c)] += scale * v;
+    };
+    for k in 0..=m {
+        for l in 0..=m {
+            let (d, su) = (blk(k - l), blk(k + l));
+            let (hc, hs) = ((2 * k - 1).max(0) as usize, (2 * k) as usize);
+            let (gc, gs) = ((2 * l - 1).max(0) as usize, (2 * l) as usize);
+            for i in 0..rows {
+                for j in 0..cols {
+                    let (d, su) = (d[i * cols + j], su[i * cols + j]);
+                    // Table in the module docs.
+                    match (k == 0, l == 0) {
+                        (true, true) => add(0, 0, i, j, d.re),
+                        (true, false) => {
+                            add(0, gc, i, j, su.re);
+                            add(0, gs, i, j, -su.im);
+                        }
+                        (false, true) => {
+                            add(hc, 0, i, j, 2.0 * d.re);
+                            add(hs, 0, i, j, -2.0 * d.im);
+                        }
+                        (false, false) => {
+                            add(hc, gc, i, j, d.re + su.re);
+                            add(hc, gs, i, j, d.im - su.im);
+                            add(hs, gc, i, j, -(d.im + su.im));
+                            add(hs, gs, i, j, d.re - su.re);
+                        }
                     }
                 }
             }
