@@ -173,9 +173,12 @@ fn s_at(s: &PeriodicSpectrum, t: f64, out: &mut [f64]) {
     for (o, z) in out.iter_mut().zip(&s.data[..nc]) {
         *o = z.re;
     }
+    let base = Complex::from_polar(1.0, t);
+    let mut rot = Complex::new(1.0, 0.0);
     for p in 1..=s.p_max {
+        rot *= base;
         let w = if 2 * p == s.ms { 1.0 } else { 2.0 };
-        let e = Complex::from_polar(w, p as f64 * t);
+        let e = rot * w;
         for (o, z) in out.iter_mut().zip(&s.data[p * nc..(p + 1) * nc]) {
             *o += (z * e).re;
         }
