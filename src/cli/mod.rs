@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 pub mod kin;
+pub mod string;
 
 /// Result of a command: the JSON object for `--json` and the text for humans.
 pub struct Output {
@@ -48,6 +49,9 @@ enum Command {
     /// Kinematics of the GIVT, SGIVT and its variant (Chapter 2).
     #[command(subcommand)]
     Kin(kin::KinCommand),
+    /// Nonlinear string by STHB (§3.3): frequency–response curve (to move under `ivt hb string`).
+    #[command(name = "hb-string")]
+    HbString(string::StringArgs),
 }
 
 /// Parse the process arguments, run, print, and map errors to exit codes.
@@ -55,6 +59,7 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Kin(cmd)) => kin::run(cmd),
+        Some(Command::HbString(args)) => string::run(args),
         None => kin::summary(),
     };
     match result {

@@ -311,13 +311,16 @@ impl StringHb {
         }
         if let (Boundary::Spring { k0 }, false) = (self.p.boundary, d_omega) {
             // Eq. 134: (k0 − 1) q_{N+1} − Σ nπ (−1)^n q_n = 0 for every harmonic.
+            // Divided by max(|k0 − 1|, 1) so the row is O(1) like the others
+            // (same zeros; keeps Broyden's updates and ‖R‖ balanced for k0 = 1e4).
+            let scale = 1.0 / (k0 - 1.0).abs().max(1.0);
             for h in 0..2 * m + 1 {
                 let row = self.index(h, n);
-                f(row, row, k0 - 1.0);
+                f(row, row, (k0 - 1.0) * scale);
                 for j in 0..n {
                     let n1 = (j + 1) as f64;
                     let sign = if (j + 1) % 2 == 0 { 1.0 } else { -1.0 };
-                    f(row, self.index(h, j), -n1 * PI * sign);
+                    f(row, self.index(h, j), -n1 * PI * sign * scale);
                 }
             }
         }
@@ -523,7 +526,8 @@ impl StringHb {
         self.toeplitz_scratch = scratch;
     }
 
-    /// Newton–Raphson (step a6) from the guess in `a`, overwritten by the solution.
+    /// Newton–Raphson (step a6) with step halving on `‖R‖`, from the guess in `a`,
+    /// overwritten by the solution.
     /// Converged when `‖R‖ ≤ tol (1 + y0)`.
     ///
     /// # Errors
@@ -537,7 +541,7 @@ impl StringHb {
         max_iter: usize,
     ) -> Result<SolveStats, SthbError> {
         let dim = self.dim();
-        let mut r = vec![0.0; dim];
+        let (mut r, mut step, mut trial) = (vec![0.0; dim], vec![0.0; dim], vec![0.0; dim]);
         let mut history = Vec::with_capacity(max_iter + 1);
         let target = tol * (1.0 + self.p.y0.abs());
         let mut jac = std::mem::replace(&mut self.lu.mat, Mat::zeros(0, 0));
@@ -569,8 +573,26 @@ impl StringHb {
                 if !ok {
                     return Err(SthbError::Singular { omega });
                 }
-                for (x, d) in a.iter_mut().zip(&r) {
-                    *x -= d;
+                // Backtracking: halve the Newton step while ‖R‖ does not decrease
+                // (the full step is kept if no halving helps; the history shows it).
+                step.copy_from_slice(&r);
+                let mut lambda = 1.0;
+                for _ in 0..8 {
+                    for ((t, x), d) in trial.iter_mut().zip(a.iter()).zip(&step) {
+                        *t = x - lambda * d;
+                    }
+                    self.balance(&trial, false);
+                    self.finish_residual(&trial, omega, &mut r);
+                    if norm2(&r) < norm {
+                        break;
+                    }
+                    lambda *= 0.5;
+                }
+                if norm2(&r) >= norm {
+                    lambda = 1.0;
+                }
+                for (x, d) in a.iter_mut().zip(&step) {
+                    *x -= lambda * d;
                 }
             }
             Err(SthbError::NoConvergence {

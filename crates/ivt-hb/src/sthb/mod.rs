@@ -9,8 +9,8 @@
 //!
 //! * [`StringHb`] — residual Eq. 116 and the exact Jacobian `J = J_lin − S_T`
 //!   (Eq. 115–125) from the Toeplitz form of the balanced partial derivatives.
-//! * [`StringHb::solve`] — Newton–Raphson; [`broyden`] — Broyden's method used
-//!   for the spring boundary as in §3.3.5.
+//! * [`StringHb::solve`] — Newton–Raphson; [`spring`] — the spring boundary
+//!   (§3.3.5) traced with the engine's Broyden continuation as in the thesis.
 //! * [`stability`] — Hill's method (Eq. 126–131) and a monodromy matrix of the
 //!   same linearization, with the classification stable / fold / period
 //!   doubling / Neimark–Sacker.
@@ -27,11 +27,11 @@
 //! blocks in [`toeplitz`]. The norm reported for Figs. 34–35 is the Euclidean
 //! norm of the complex `a` (Eq. 114), see [`StringHb::complex_norm`].
 
-mod broyden_impl;
 pub mod continuation;
 mod hb;
 mod lu;
 pub mod modal;
+pub mod spring;
 pub mod stability;
 pub mod toeplitz;
 
@@ -165,6 +165,9 @@ pub enum SthbError {
         /// The last corrector failure.
         cause: Box<SthbError>,
     },
+    /// An error from the general HB engine (Broyden, continuation).
+    #[error("HB engine: {0}")]
+    Engine(String),
     /// Hill or monodromy eigenvalues could not be computed.
     #[error("eigenvalue computation failed: {0}")]
     Eigen(String),

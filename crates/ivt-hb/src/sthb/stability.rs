@@ -258,13 +258,13 @@ pub fn monodromy_matrix(hb: &StringHb, omega: f64, steps: usize) -> Result<Mat<f
     Ok(Mat::from_fn(d, d, |i, j| y[j * d + i]))
 }
 
-/// RK4 steps that keep `h ρ ≤ 0.5` for the fastest mode (`ρ² ≈ (N²π² + ‖S‖)/ω²`).
+/// RK4 steps that keep `h ρ ≤ 0.3` for the fastest mode (`ρ² ≈ (N²π² + ‖S‖)/ω²`).
 pub fn default_steps(hb: &StringHb, omega: f64) -> usize {
     let s = hb.s_spectrum();
     let bound: f64 = s.data.iter().map(|z| 2.0 * z.norm()).sum::<f64>() / (s.rows.max(1) as f64);
     let n = hb.params().modes as f64;
     let rho = ((n * n * PI * PI + bound) / (omega * omega)).sqrt();
-    ((2.0 * PI * rho / 0.5).ceil() as usize).clamp(64, 100_000)
+    ((2.0 * PI * rho / 0.3).ceil() as usize).clamp(64, 100_000)
 }
 
 /// Floquet multipliers from [`monodromy_matrix`], largest modulus first.
