@@ -142,11 +142,20 @@ fn newton_converges_quadratically() {
     let mut hb = StringHb::new(StringParams::default()).unwrap();
     let mut a = vec![0.0; hb.dim()];
     let stats = hb.solve(3.5, &mut a, 1e-12, 30).unwrap();
-    // Quadratic convergence: the last ratios shrink (r_{k+1} ≤ C r_k²).
+    // From a = 0 next to the peak: a damped phase (step halving), then the
+    // quadratic tail of the exact Jacobian, r_{k+1} ≤ C r_k² with C ~ 1
+    // (measured: 5.2e-3, 2.8e-5, 3.2e-10, 3.6e-16 in 13 iterations).
     let h = &stats.history;
-    assert!(stats.iterations <= 12, "{h:?}");
+    assert!(stats.iterations <= 15, "{h:?}");
     let k = h.len();
-    assert!(h[k - 1] < 1e-11 && h[k - 2] < 1e-3, "{h:?}");
+    assert!(h[k - 1] < 1e-11, "{h:?}");
+    // (the last step sits at the rounding floor, so check the two before it)
+    for i in k - 4..k - 2 {
+        assert!(
+            h[i + 1] <= 10.0 * h[i] * h[i],
+            "not quadratic at {i}: {h:?}"
+        );
+    }
 }
 
 #[test]
