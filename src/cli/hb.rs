@@ -22,6 +22,8 @@ pub enum HbCommand {
     DuffingFrc(FrcArgs),
     /// Period-doubling cascade of the Mathieu–Duffing equation (§3.2.5).
     MathieuDuffing(MathieuArgs),
+    /// Nonlinear string by STHB (§3.3): frequency–response curve with stability (Figs. 34–36).
+    String(super::string::StringArgs),
 }
 
 /// Duffing parameters shared by `duffing` and `duffing-frc` (defaults: Fig. 28).
@@ -137,6 +139,7 @@ pub fn run(cmd: HbCommand) -> Result<Output, CliError> {
         HbCommand::Duffing(a) => duffing(a),
         HbCommand::DuffingFrc(a) => duffing_frc(a),
         HbCommand::MathieuDuffing(a) => mathieu(a),
+        HbCommand::String(a) => super::string::run(a),
     }
 }
 

@@ -15,6 +15,7 @@ pub mod kin;
 pub mod ol;
 pub mod sim;
 pub mod stability;
+pub mod string;
 
 /// Result of a command: the JSON object for `--json` and the text for humans.
 pub struct Output {

@@ -36,3 +36,5 @@ pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;
 pub use problem::{Duffing, GeneralProblem, MathieuDuffing, PeriodicProblem};
 pub use stability::{classify, Floquet, StabilityAnalyzer, StabilityKind};
+
+pub mod sthb;

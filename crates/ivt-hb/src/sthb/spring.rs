@@ -1,0 +1,95 @@
+//! Frequency–response of the string with the spring boundary (§3.3.5, Fig. 36)
+//! by the spectral Tau method, solved with Broyden's method as in the thesis.
+//!
+//! The residual is [`StringHb`] with [`super::Boundary::Spring`] (Tau rows
+//! Eq. 134–136); the path follower is the engine's
+//! [`crate::continuation::pseudo_arclength`], whose corrector is Broyden's
+//! method (Eq. 66–67) with the exact augmenting row. It is seeded once with the
+//! exact STHB Jacobian `[J | ∂R/∂ω]` at the start point; afterwards only
+//! rank-one updates (and the engine's Jacobian refresh if Broyden stalls).
+
+use faer::Mat;
+
+use crate::continuation::{pseudo_arclength, ContinuationOptions, Termination};
+
+use super::{SthbError, StringHb, StringParams};
+
+/// One point `(ω, ‖a‖)` of a spring-boundary curve, with the solution.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpringPoint {
+    /// Excitation frequency.
+    pub omega: f64,
+    /// `‖a‖` over all `N + 1` coordinates (complex coefficients, Fig. 36).
+    pub norm: f64,
+    /// Broyden corrector iterations.
+    pub iterations: usize,
+}
+
+/// Trace ‖a‖(ω) from `omega_from` to `omega_to` (`omega_from < omega_to`).
+///
+/// # Errors
+/// [`SthbError::Invalid`] for bad parameters, [`SthbError::NoConvergence`] if
+/// the start does not converge, [`SthbError::Stalled`] if the path stops short.
+pub fn spring_frequency_response(
+    params: StringParams,
+    omega_from: f64,
+    omega_to: f64,
+    step_max: f64,
+) -> Result<Vec<SpringPoint>, SthbError> {
+    if !(omega_from > 0.0 && omega_to > omega_from && omega_to.is_finite()) {
+        return Err(SthbError::Invalid(format!(
+            "need 0 < from < to, got {omega_from} .. {omega_to}"
+        )));
+    }
+    let mut hb = StringHb::new(params)?;
+    let n = hb.dim();
+    // Start: Newton with the exact Jacobian, then the seed Jacobian [J | R_ω].
+    let mut a = vec![0.0; n];
+    hb.solve(omega_from, &mut a, 1e-12, 50)?;
+    let (mut r, mut r_w, mut jac) = (vec![0.0; n], vec![0.0; n], Mat::<f64>::zeros(n, n));
+    hb.residual_jacobian(&a, omega_from, &mut r, &mut jac);
+    hb.d_residual_d_omega(&a, omega_from, &mut r_w);
+    let mut jac0 = vec![0.0; n * (n + 1)];
+    for i in 0..n {
+        for j in 0..n {
+            jac0[i * (n + 1) + j] = jac[(i, j)];
+        }
+        jac0[i * (n + 1) + n] = r_w[i];
+    }
+    let mut start = a.clone();
+    start.push(omega_from);
+    let opts = ContinuationOptions {
+        ds: 0.5 * step_max,
+        ds_max: step_max,
+        lambda_min: omega_from,
+        lambda_max: omega_to,
+        target_iter: 10,
+        ..Default::default()
+    };
+    let residual = |x: &[f64], out: &mut [f64]| hb.residual(&x[..n], x[n], out);
+    let path = pseudo_arclength(residual, &start, Some(&jac0), 1.0, &opts, |p| {
+        if std::env::var_os("IVT_STHB_TRACE").is_some() {
+            eprintln!("spring point ω = {:.5} its {}", p.lambda(), p.iterations);
+        }
+        true
+    })
+    .map_err(|e| SthbError::Engine(e.to_string()))?;
+    let points: Vec<SpringPoint> = path
+        .points
+        .iter()
+        .map(|p| SpringPoint {
+            omega: p.lambda(),
+            norm: hb.complex_norm(&p.x[..n]),
+            iterations: p.iterations,
+        })
+        .collect();
+    if let Termination::StepTooSmall(e) = path.termination {
+        let last = points.last().map_or(omega_from, |p| p.omega);
+        return Err(SthbError::Stalled {
+            omega: last,
+            step: opts.ds_min,
+            cause: Box::new(SthbError::Engine(e.to_string())),
+        });
+    }
+    Ok(points)
+}
