@@ -25,6 +25,8 @@ pub enum WireError {
     PayloadTooLong,
     /// A frame kind this side does not know.
     UnknownKind(u8),
+    /// A field that is not a valid value (an enum code out of range).
+    BadValue,
     /// A known kind with the wrong payload length.
     BadLength {
         /// The frame kind.
@@ -40,6 +42,7 @@ impl core::fmt::Display for WireError {
             WireError::BadCrc => write!(f, "frame CRC mismatch"),
             WireError::BufferTooSmall => write!(f, "buffer too small for the frame"),
             WireError::PayloadTooLong => write!(f, "payload longer than {MAX_PAYLOAD} bytes"),
+            WireError::BadValue => write!(f, "field value out of range"),
             WireError::UnknownKind(k) => write!(f, "unknown frame kind 0x{k:02x}"),
             WireError::BadLength { kind, len } => {
                 write!(f, "frame kind 0x{kind:02x} with wrong payload length {len}")

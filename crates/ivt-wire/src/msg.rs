@@ -7,13 +7,18 @@
 //! | 0x02 | host → fw | `Pulse`   | `ticks: u32`                                                    |
 //! | 0x03 | host → fw | `Inputs`  | `v_m: f32, t_u: f32`                                            |
 //! | 0x04 | host → fw | `Exit`    | —                                                               |
+//! | 0x05 | host → fw | `Configure` | `ivt_ctrl::Config`, 212 bytes in declaration order (see [`Request::Configure`]) |
 //! | 0x81 | fw → host | `Hello`   | `version: u16, ppr: u32`                                        |
-//! | 0x82 | fw → host | `Output`  | `omega, omega_a, omega_t, r_ol, r_d, r: f32, stepper_target: i32, saturated: u8, fault: u8` |
+//! | 0x82 | fw → host | `Output`  | `omega, omega_a, omega_t, r_ol, r_d, r: f32, stepper_target: i32, flags: u8 (bit0 saturated, bit1 ready, bit2 inputs_clamped), fault: u8, ol_region: u8` |
 //! | 0x83 | fw → host | `Ack`     | —                                                               |
 //! | 0x8F | fw → host | `Error`   | `code: u8` (see [`ErrorCode`])                                  |
 //! | 0x90 | fw → host | telemetry | `time_ticks: u32, omega, omega_a, r: f32, stepper_position: i32, fault: u8` |
 
 use crate::frame::{encode, WireError};
+use ivt_ctrl::{
+    ActuatorMap, Config, ControlOutput, Fault, Gains, LawKind, OlRegion, OpenLoopCoeffs,
+    StepperLimits,
+};
 
 /// Protocol version reported by `Hello`; bump on any incompatible change.
 pub const VERSION: u16 = 1;
@@ -22,6 +27,7 @@ const K_HELLO: u8 = 0x01;
 const K_PULSE: u8 = 0x02;
 const K_INPUTS: u8 = 0x03;
 const K_EXIT: u8 = 0x04;
+const K_CONFIGURE: u8 = 0x05;
 const K_R_HELLO: u8 = 0x81;
 const K_R_OUTPUT: u8 = 0x82;
 const K_R_ACK: u8 = 0x83;
@@ -30,6 +36,9 @@ const K_R_ERROR: u8 = 0x8F;
 pub const K_TELEMETRY: u8 = 0x90;
 
 /// Host → firmware.
+// `Configure` is ~200 bytes; boxing it is not an option without a heap, and a
+// request lives only between decoding and handling.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Request {
     /// Asks for the protocol version and the controller's PPR.
@@ -48,29 +57,9 @@ pub enum Request {
     },
     /// Ends the session (the QEMU image exits with status 0).
     Exit,
-}
-
-/// The controller's answer to one pulse (the fields of `ivt_ctrl::ControlOutput`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Output {
-    /// ω [rad/s] over the last pulse interval.
-    pub omega: f32,
-    /// ω_a [rad/s], mean over the last revolution.
-    pub omega_a: f32,
-    /// ω_T [rad/s], ω one revolution earlier.
-    pub omega_t: f32,
-    /// Open-loop eccentricity u_ol [m].
-    pub r_ol: f32,
-    /// Feedback part r_d [m].
-    pub r_d: f32,
-    /// Commanded eccentricity r [m] after saturation.
-    pub r: f32,
-    /// Stepper target [steps].
-    pub stepper_target: i32,
-    /// Whether r was saturated.
-    pub saturated: bool,
-    /// Fault code (`ivt_ctrl::Fault as u8`).
-    pub fault: u8,
+    /// Replaces the controller by `Controller::new(config)` (a fresh state).
+    /// Every field travels, in declaration order; enums as `u8`, bools as 0/1.
+    Configure(Config),
 }
 
 /// Why the firmware rejected a request.
@@ -83,6 +72,19 @@ pub enum ErrorCode {
     UnknownKind = 2,
     /// Known kind, wrong payload length.
     BadLength = 3,
+    /// A field that is not a valid enum value.
+    BadValue = 4,
+}
+
+impl From<WireError> for ErrorCode {
+    fn from(e: WireError) -> Self {
+        match e {
+            WireError::BadCrc => ErrorCode::BadCrc,
+            WireError::UnknownKind(_) => ErrorCode::UnknownKind,
+            WireError::BadValue => ErrorCode::BadValue,
+            _ => ErrorCode::BadLength,
+        }
+    }
 }
 
 /// Firmware → host.
@@ -95,9 +97,9 @@ pub enum Reply {
         /// Pulses per revolution of θ (the controller's const generic).
         ppr: u32,
     },
-    /// Answer to a pulse.
-    Output(Output),
-    /// `Inputs` or `Exit` accepted.
+    /// Answer to a pulse: the whole `ControlOutput`, bit-exact.
+    Output(ControlOutput),
+    /// `Inputs`, `Configure` or `Exit` accepted.
     Ack,
     /// A request was rejected (the raw error code, see [`ErrorCode`]).
     Error(u8),
@@ -142,6 +144,11 @@ impl<const N: usize> Put<N> {
     fn u32(&mut self, v: u32) {
         self.bytes(&v.to_le_bytes());
     }
+    fn f32s(&mut self, v: &[f32]) {
+        for &x in v {
+            self.f32(x);
+        }
+    }
     fn done(&self) -> &[u8] {
         &self.buf[..self.at.min(N)]
     }
@@ -173,6 +180,157 @@ impl Get<'_> {
     fn u8(&mut self) -> u8 {
         self.take::<1>()[0]
     }
+    fn f32s<const N: usize>(&mut self) -> [f32; N] {
+        core::array::from_fn(|_| self.f32())
+    }
+}
+
+fn fault_from(code: u8) -> Result<Fault, WireError> {
+    Ok(match code {
+        0 => Fault::None,
+        1 => Fault::Stall,
+        2 => Fault::IntervalTooShort,
+        3 => Fault::InputInvalid,
+        4 => Fault::Config,
+        _ => return Err(WireError::BadValue),
+    })
+}
+
+fn region_from(code: u8) -> Result<OlRegion, WireError> {
+    Ok(match code {
+        0 => OlRegion::Normal,
+        1 => OlRegion::OverDrive,
+        2 => OlRegion::UnderDrive,
+        _ => return Err(WireError::BadValue),
+    })
+}
+
+fn law_code(law: LawKind) -> u8 {
+    match law {
+        LawKind::Delay => 0,
+        LawKind::NoDelay => 1,
+        LawKind::Prop => 2,
+        LawKind::Open => 3,
+    }
+}
+
+fn law_from(code: u8) -> Result<LawKind, WireError> {
+    Ok(match code {
+        0 => LawKind::Delay,
+        1 => LawKind::NoDelay,
+        2 => LawKind::Prop,
+        3 => LawKind::Open,
+        _ => return Err(WireError::BadValue),
+    })
+}
+
+/// Payload length of `Configure`.
+pub const CONFIG_LEN: usize = 212;
+
+fn put_config(p: &mut Put<CONFIG_LEN>, c: &Config) {
+    // Exhaustive destructuring: a field added to Config fails to compile here
+    // until the wire format carries it.
+    let Config {
+        f_timer_hz,
+        omega0,
+        decimation,
+        law,
+        gains:
+            Gains {
+                k,
+                k2,
+                k_prop,
+                prop_period_s,
+            },
+        open_loop:
+            OpenLoopCoeffs {
+                poly,
+                boundary,
+                r_max,
+                v_m_range,
+                t_u_range,
+            },
+        feedforward,
+        actuator: ActuatorMap {
+            steps_per_metre,
+            offset_steps,
+        },
+        stepper: StepperLimits { max_speed, accel },
+        stall_timeout_s,
+        omega_max,
+        safe_r,
+        v_m_valid,
+        t_u_valid,
+        initial_inputs,
+    } = *c;
+    p.f32s(&[f_timer_hz, omega0]);
+    p.bytes(&decimation.to_le_bytes());
+    p.bytes(&[law_code(law)]);
+    p.f32s(&[k, k2, k_prop, prop_period_s]);
+    for row in &poly {
+        p.f32s(row);
+    }
+    p.f32s(&boundary);
+    p.f32(r_max);
+    p.f32s(&v_m_range);
+    p.f32s(&t_u_range);
+    p.bytes(&[feedforward as u8]);
+    p.f32(steps_per_metre);
+    p.bytes(&offset_steps.to_le_bytes());
+    p.f32s(&[max_speed, accel, stall_timeout_s, omega_max, safe_r]);
+    p.f32s(&v_m_valid);
+    p.f32s(&t_u_valid);
+    p.f32s(&initial_inputs);
+}
+
+fn get_config(g: &mut Get<'_>) -> Result<Config, WireError> {
+    let f_timer_hz = g.f32();
+    let omega0 = g.f32();
+    let decimation = u16::from_le_bytes(g.take());
+    let law = law_from(g.u8())?;
+    let gains = Gains {
+        k: g.f32(),
+        k2: g.f32(),
+        k_prop: g.f32(),
+        prop_period_s: g.f32(),
+    };
+    let poly = core::array::from_fn(|_| g.f32s());
+    let open_loop = OpenLoopCoeffs {
+        poly,
+        boundary: g.f32s(),
+        r_max: g.f32(),
+        v_m_range: g.f32s(),
+        t_u_range: g.f32s(),
+    };
+    let feedforward = match g.u8() {
+        0 => false,
+        1 => true,
+        _ => return Err(WireError::BadValue),
+    };
+    let actuator = ActuatorMap {
+        steps_per_metre: g.f32(),
+        offset_steps: g.i32(),
+    };
+    Ok(Config {
+        f_timer_hz,
+        omega0,
+        decimation,
+        law,
+        gains,
+        open_loop,
+        feedforward,
+        actuator,
+        stepper: StepperLimits {
+            max_speed: g.f32(),
+            accel: g.f32(),
+        },
+        stall_timeout_s: g.f32(),
+        omega_max: g.f32(),
+        safe_r: g.f32(),
+        v_m_valid: g.f32s(),
+        t_u_valid: g.f32s(),
+        initial_inputs: g.f32s(),
+    })
 }
 
 fn expect_len(kind: u8, payload: &[u8], len: usize) -> Result<Get<'_>, WireError> {
@@ -186,7 +344,7 @@ fn expect_len(kind: u8, payload: &[u8], len: usize) -> Result<Get<'_>, WireError
     }
 }
 
-const OUTPUT_LEN: usize = 6 * 4 + 4 + 2;
+const OUTPUT_LEN: usize = 6 * 4 + 4 + 3;
 const TELEMETRY_LEN: usize = 4 * 4 + 4 + 1;
 
 impl Request {
@@ -195,7 +353,7 @@ impl Request {
     /// # Errors
     /// [`WireError::BufferTooSmall`].
     pub fn encode(&self, out: &mut [u8]) -> Result<usize, WireError> {
-        let mut p = Put::<8>::new();
+        let mut p = Put::<CONFIG_LEN>::new();
         let kind = match *self {
             Request::Hello => K_HELLO,
             Request::Pulse { ticks } => {
@@ -208,6 +366,10 @@ impl Request {
                 K_INPUTS
             }
             Request::Exit => K_EXIT,
+            Request::Configure(ref c) => {
+                put_config(&mut p, c);
+                K_CONFIGURE
+            }
         };
         encode(kind, p.done(), out)
     }
@@ -236,6 +398,9 @@ impl Request {
                 expect_len(kind, payload, 0)?;
                 Request::Exit
             }
+            K_CONFIGURE => {
+                Request::Configure(get_config(&mut expect_len(kind, payload, CONFIG_LEN)?)?)
+            }
             other => return Err(WireError::UnknownKind(other)),
         })
     }
@@ -255,11 +420,24 @@ impl Reply {
                 K_R_HELLO
             }
             Reply::Output(o) => {
-                for v in [o.omega, o.omega_a, o.omega_t, o.r_ol, o.r_d, o.r] {
-                    p.f32(v);
-                }
-                p.bytes(&o.stepper_target.to_le_bytes());
-                p.bytes(&[o.saturated as u8, o.fault]);
+                let ControlOutput {
+                    omega,
+                    omega_a,
+                    omega_t,
+                    r_ol,
+                    r_d,
+                    r,
+                    stepper_target,
+                    saturated,
+                    fault,
+                    ready,
+                    inputs_clamped,
+                    ol_region,
+                } = o;
+                p.f32s(&[omega, omega_a, omega_t, r_ol, r_d, r]);
+                p.bytes(&stepper_target.to_le_bytes());
+                let flags = saturated as u8 | (ready as u8) << 1 | (inputs_clamped as u8) << 2;
+                p.bytes(&[flags, fault as u8, ol_region as u8]);
                 K_R_OUTPUT
             }
             Reply::Ack => K_R_ACK,
@@ -286,16 +464,22 @@ impl Reply {
             }
             K_R_OUTPUT => {
                 let mut g = expect_len(kind, payload, OUTPUT_LEN)?;
-                Reply::Output(Output {
-                    omega: g.f32(),
-                    omega_a: g.f32(),
-                    omega_t: g.f32(),
-                    r_ol: g.f32(),
-                    r_d: g.f32(),
-                    r: g.f32(),
-                    stepper_target: g.i32(),
-                    saturated: g.u8() != 0,
-                    fault: g.u8(),
+                let [omega, omega_a, omega_t, r_ol, r_d, r] = g.f32s();
+                let stepper_target = g.i32();
+                let flags = g.u8();
+                Reply::Output(ControlOutput {
+                    omega,
+                    omega_a,
+                    omega_t,
+                    r_ol,
+                    r_d,
+                    r,
+                    stepper_target,
+                    saturated: flags & 1 != 0,
+                    ready: flags & 2 != 0,
+                    inputs_clamped: flags & 4 != 0,
+                    fault: fault_from(g.u8())?,
+                    ol_region: region_from(g.u8())?,
                 })
             }
             K_R_ACK => {
@@ -349,12 +533,12 @@ mod tests {
     use super::*;
     use crate::frame::{Decoder, MAX_FRAME};
 
-    fn one_frame(bytes: &[u8]) -> (u8, [u8; 64], usize) {
+    fn one_frame(bytes: &[u8]) -> (u8, [u8; MAX_FRAME], usize) {
         let mut dec = Decoder::new();
         for &b in bytes {
             if let Some(r) = dec.push(b) {
                 let f = r.unwrap();
-                let mut p = [0u8; 64];
+                let mut p = [0u8; MAX_FRAME];
                 p[..f.payload.len()].copy_from_slice(f.payload);
                 return (f.kind, p, f.payload.len());
             }
@@ -391,7 +575,7 @@ mod tests {
     #[test]
     fn replies_round_trip() {
         let mut buf = [0u8; MAX_FRAME];
-        let out = Output {
+        let out = ControlOutput {
             omega: 10.471_975,
             omega_a: 10.5,
             omega_t: f32::INFINITY,
@@ -400,7 +584,10 @@ mod tests {
             r: 0.012,
             stepper_target: -123_456,
             saturated: true,
-            fault: 3,
+            fault: Fault::InputInvalid,
+            ready: false,
+            inputs_clamped: true,
+            ol_region: OlRegion::UnderDrive,
         };
         for rep in [
             Reply::Hello {
@@ -415,7 +602,60 @@ mod tests {
             let (k, p, len) = one_frame(&buf[..n]);
             assert_eq!(Reply::decode(k, &p[..len]).unwrap(), rep);
         }
-        assert_eq!(Reply::Output(out).encode(&mut buf).unwrap(), 30 + 5);
+        assert_eq!(Reply::Output(out).encode(&mut buf).unwrap(), 31 + 5);
+    }
+
+    #[test]
+    fn config_round_trip_is_exact() {
+        // Every field distinct so a swapped pair shows up.
+        let mut c = Config::default();
+        let mut x = 1.0f32;
+        let mut next = || {
+            x += 0.125;
+            x
+        };
+        c.f_timer_hz = next();
+        c.omega0 = next();
+        c.decimation = 7;
+        c.law = LawKind::Prop;
+        c.gains = Gains {
+            k: next(),
+            k2: next(),
+            k_prop: next(),
+            prop_period_s: next(),
+        };
+        for row in c.open_loop.poly.iter_mut() {
+            for v in row.iter_mut() {
+                *v = next();
+            }
+        }
+        c.open_loop.boundary = [next(), next(), next()];
+        c.open_loop.r_max = next();
+        c.open_loop.v_m_range = [next(), next()];
+        c.open_loop.t_u_range = [next(), next()];
+        c.feedforward = false;
+        c.actuator = ActuatorMap {
+            steps_per_metre: next(),
+            offset_steps: -9,
+        };
+        c.stepper = StepperLimits {
+            max_speed: next(),
+            accel: next(),
+        };
+        c.stall_timeout_s = next();
+        c.omega_max = next();
+        c.safe_r = next();
+        c.v_m_valid = [next(), next()];
+        c.t_u_valid = [next(), next()];
+        c.initial_inputs = [next(), next()];
+        let mut buf = [0u8; MAX_FRAME];
+        let n = Request::Configure(c).encode(&mut buf).unwrap();
+        assert_eq!(n, CONFIG_LEN + 5);
+        let (k, p, len) = one_frame(&buf[..n]);
+        assert_eq!(
+            Request::decode(k, &p[..len]).unwrap(),
+            Request::Configure(c)
+        );
     }
 
     #[test]
@@ -448,7 +688,11 @@ mod tests {
             Request::decode(0x55, &[]),
             Err(WireError::UnknownKind(0x55))
         );
-        assert!(Reply::decode(K_R_OUTPUT, &[0; 29]).is_err());
+        assert!(Reply::decode(K_R_OUTPUT, &[0; 30]).is_err());
+        // A fault code the controller does not define.
+        let mut bad = [0u8; OUTPUT_LEN];
+        bad[OUTPUT_LEN - 2] = 99;
+        assert_eq!(Reply::decode(K_R_OUTPUT, &bad), Err(WireError::BadValue));
         assert!(Telemetry::decode(K_R_ACK, &[0; 21]).is_err());
     }
 }

@@ -59,7 +59,21 @@ pub fn exit(ok: bool) -> ! {
     }
 }
 
-/// Prints a line on the host's stderr via semihosting.
-pub fn log(msg: &str) {
-    hprintln!("{}", msg);
+/// Prints `key=value` lines on QEMU's stdout via semihosting (the host's
+/// scripts parse them).
+pub fn report(items: &[(&str, usize)]) {
+    for (key, value) in items {
+        hprintln!("{}={}", key, value);
+    }
+}
+
+impl crate::app::Link for CmsdkUart {
+    fn read_byte(&mut self) -> u8 {
+        CmsdkUart::read_byte(self)
+    }
+    fn write_all(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_byte(b);
+        }
+    }
 }

@@ -1,0 +1,70 @@
+//! The QEMU firmware (`firmware/`, image `ivt-fw-qemu`) against the same
+//! controller in-process: every output field must match bit for bit, since
+//! both run the same f32 code (thumbv7em FPU vs x86-64 SSE, both IEEE-754
+//! single precision with round-to-nearest; no fused multiply-add on either
+//! side unless the compiler emits one — this test is what proves it doesn't).
+//!
+//! Needs QEMU and the built image: run through `firmware/run-qemu.sh test`
+//! (scripts/test does), hence `#[ignore]` in a plain `cargo test`.
+
+use ivt_ctrl::{Config, ControlOutput, Controller, LawKind};
+use ivt_wire::host::{QemuOptions, QemuPil};
+
+const PPR: usize = 1200;
+
+fn bits(o: &ControlOutput) -> [u32; 6] {
+    [o.omega, o.omega_a, o.omega_t, o.r_ol, o.r_d, o.r].map(f32::to_bits)
+}
+
+/// A pulse train of θ at ~100 rpm with a speed ripple and a slow drift, and
+/// inputs that step the load: deterministic, no RNG.
+fn drive(n: usize, f_timer: f32) -> Vec<(u32, Option<(f32, f32)>)> {
+    let mut t: u32 = 0xFFF0_0000; // start near the u32 wrap on purpose
+    let mut v = Vec::with_capacity(n);
+    for k in 0..n {
+        let ripple = 1.0 + 0.05 * (((k % 300) as f32 / 300.0) - 0.5);
+        let drift = 1.0 + 0.1 * (k as f32 / n as f32);
+        let omega = 10.47 * ripple * drift;
+        let dt = (core::f32::consts::TAU / PPR as f32 / omega * f_timer) as u32;
+        t = t.wrapping_add(dt);
+        let inputs = if k % 100 == 0 {
+            let t_u = if k < n / 2 { 4.0 } else { 7.5 }; // load step
+            Some((8.0 + 0.001 * (k % 7) as f32, t_u))
+        } else {
+            None
+        };
+        v.push((t, inputs));
+    }
+    v
+}
+
+#[test]
+#[ignore = "needs qemu-system-arm and the firmware image; run by firmware/run-qemu.sh test"]
+fn qemu_firmware_matches_in_process_controller_bit_for_bit() {
+    let config = Config {
+        f_timer_hz: 1.0e6,
+        law: LawKind::Delay,
+        ..Config::default()
+    };
+    let mut sil = Controller::<PPR>::new(config);
+    let mut pil = QemuPil::start(&QemuOptions::from_env(), PPR as u32).expect("start QEMU PIL");
+    pil.configure(&config).unwrap();
+    let pulses = drive(3 * PPR, config.f_timer_hz);
+    let mut ready = 0;
+    for (k, &(ticks, inputs)) in pulses.iter().enumerate() {
+        if let Some((v_m, t_u)) = inputs {
+            sil.update_inputs(v_m, t_u);
+            pil.update_inputs(v_m, t_u).unwrap();
+        }
+        let a = sil.on_pulse(ticks);
+        let b = pil.on_pulse(ticks).unwrap();
+        assert_eq!(bits(&a), bits(&b), "pulse {k}: SIL {a:?} vs PIL {b:?}");
+        assert_eq!(a, b, "pulse {k}");
+        ready += a.ready as usize;
+    }
+    // The comparison must cover the closed loop, not just the start-up.
+    assert!(ready > PPR, "only {ready} ready outputs");
+    let rep = pil.finish().unwrap();
+    assert_eq!(rep.pulses, pulses.len() as u64);
+    eprintln!("firmware report: {rep:?}");
+}
