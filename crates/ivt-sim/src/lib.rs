@@ -1,1 +1,7 @@
-//! Plant integration, sensors and actuators, closed loop with ivt-ctrl, scenes and MCAP logs. Being built under issue 6; nothing here yet.
+#![doc = include_str!("../README.md")]
+
+pub mod backend;
+pub mod integrate;
+pub mod ode;
+pub mod plant;
+pub mod sensors;
