@@ -1,7 +1,10 @@
 //! Board-independent part of the firmware: the controller instance, the pulse
 //! path, and the PIL request handler. Its control path is `ivt-ctrl` only.
 
-use ivt_ctrl::{ControlOutput, Controller};
+use core::mem::MaybeUninit;
+use core::sync::atomic::{AtomicBool, Ordering};
+
+use ivt_ctrl::{Config, ControlOutput, Controller};
 use ivt_wire::{frame::Decoder, msg, ErrorCode, Reply, Request, MAX_FRAME};
 
 /// Samples per revolution of θ the firmware is built for (the encoder of the
@@ -21,6 +24,23 @@ pub type Ctrl = Controller<PPR>;
 #[inline(never)]
 pub fn ivt_fw_pulse(ctrl: &mut Ctrl, ticks: u32) -> ControlOutput {
     ctrl.on_pulse(ticks)
+}
+
+/// Takes the firmware's one controller, built in place in a static (not on
+/// the stack: `Controller<1200>` holds a 4.8 KiB ring buffer and the RAM
+/// budget is 8 KiB). Returns `None` on a second call.
+#[inline(never)]
+pub fn take_controller(config: Config) -> Option<&'static mut Ctrl> {
+    static TAKEN: AtomicBool = AtomicBool::new(false);
+    static mut CTRL: MaybeUninit<Ctrl> = MaybeUninit::uninit();
+    if TAKEN.swap(true, Ordering::AcqRel) {
+        return None;
+    }
+    // SAFETY: TAKEN guarantees this runs once, so the &'static mut is unique.
+    unsafe {
+        let slot = &mut *core::ptr::addr_of_mut!(CTRL);
+        Some(slot.write(Ctrl::new(config)))
+    }
 }
 
 /// A byte pipe to the host.

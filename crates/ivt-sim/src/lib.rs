@@ -3,5 +3,6 @@
 pub mod backend;
 pub mod integrate;
 pub mod ode;
+pub mod pil;
 pub mod plant;
 pub mod sensors;

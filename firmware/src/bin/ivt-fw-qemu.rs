@@ -7,14 +7,14 @@
 
 use cortex_m_rt::entry;
 use ivt_ctrl::Config;
-use ivt_firmware::app::{Ctrl, PilServer, Session, TelemetryTx};
+use ivt_firmware::app::{take_controller, PilServer, Session, TelemetryTx};
 use ivt_firmware::board::qemu::{self, CmsdkUart};
 use ivt_firmware::stack;
 
 #[entry]
 fn main() -> ! {
     stack::paint();
-    let ctrl: &'static mut Ctrl = match cortex_m::singleton!(: Ctrl = Ctrl::new(Config::default())) {
+    let ctrl = match take_controller(Config::default()) {
         Some(c) => c,
         None => qemu::exit(false),
     };

@@ -1,5 +1,5 @@
-//! The QEMU firmware (`firmware/`, image `ivt-fw-qemu`) against the same
-//! controller in-process: every output field must match bit for bit, since
+//! Processor in the loop: the QEMU firmware (`firmware/`, image `ivt-fw-qemu`)
+//! behind the `Pil` backend against the in-process `Sil` backend: every output field must match bit for bit, since
 //! both run the same f32 code (thumbv7em FPU vs x86-64 SSE, both IEEE-754
 //! single precision with round-to-nearest; no fused multiply-add on either
 //! side unless the compiler emits one — this test is what proves it doesn't).
@@ -7,8 +7,9 @@
 //! Needs QEMU and the built image: run through `firmware/run-qemu.sh test`
 //! (scripts/test does), hence `#[ignore]` in a plain `cargo test`.
 
-use ivt_ctrl::{Config, ControlOutput, Controller, LawKind};
-use ivt_wire::host::{QemuOptions, QemuPil};
+use ivt_ctrl::{Config, ControlOutput, LawKind};
+use ivt_sim::backend::{sil, BackendError, ControllerBackend};
+use ivt_sim::pil::Pil;
 
 const PPR: usize = 1200;
 
@@ -40,23 +41,22 @@ fn drive(n: usize, f_timer: f32) -> Vec<(u32, Option<(f32, f32)>)> {
 
 #[test]
 #[ignore = "needs qemu-system-arm and the firmware image; run by firmware/run-qemu.sh test"]
-fn qemu_firmware_matches_in_process_controller_bit_for_bit() {
+fn pil_backend_matches_sil_backend_bit_for_bit() {
     let config = Config {
         f_timer_hz: 1.0e6,
         law: LawKind::Delay,
         ..Config::default()
     };
-    let mut sil = Controller::<PPR>::new(config);
-    let mut pil = QemuPil::start(&QemuOptions::from_env(), PPR as u32).expect("start QEMU PIL");
-    pil.configure(&config).unwrap();
+    let mut sil = sil(PPR, config).unwrap();
+    let mut pil = Pil::start(PPR, &config).expect("start QEMU PIL");
     let pulses = drive(3 * PPR, config.f_timer_hz);
     let mut ready = 0;
     for (k, &(ticks, inputs)) in pulses.iter().enumerate() {
         if let Some((v_m, t_u)) = inputs {
-            sil.update_inputs(v_m, t_u);
+            sil.update_inputs(v_m, t_u).unwrap();
             pil.update_inputs(v_m, t_u).unwrap();
         }
-        let a = sil.on_pulse(ticks);
+        let a = sil.on_pulse(ticks).unwrap();
         let b = pil.on_pulse(ticks).unwrap();
         assert_eq!(bits(&a), bits(&b), "pulse {k}: SIL {a:?} vs PIL {b:?}");
         assert_eq!(a, b, "pulse {k}");
@@ -67,4 +67,27 @@ fn qemu_firmware_matches_in_process_controller_bit_for_bit() {
     let rep = pil.finish().unwrap();
     assert_eq!(rep.pulses, pulses.len() as u64);
     eprintln!("firmware report: {rep:?}");
+}
+
+#[test]
+#[ignore = "needs qemu-system-arm and the firmware image; run by firmware/run-qemu.sh test"]
+fn pil_refuses_a_ppr_the_firmware_was_not_built_for() {
+    match Pil::start(360, &Config::default()) {
+        Err(BackendError::Protocol(msg)) => assert!(msg.contains("PPR 1200"), "{msg}"),
+        Err(e) => panic!("wrong error {e}"),
+        Ok(_) => panic!("PIL accepted PPR 360 on a PPR-1200 firmware"),
+    }
+}
+
+#[test]
+fn pil_without_an_image_is_a_clear_error() {
+    let opts = ivt_wire::host::QemuOptions {
+        elf: "/nonexistent/ivt-fw-qemu".into(),
+        ..ivt_wire::host::QemuOptions::from_env()
+    };
+    match Pil::start_with(&opts, PPR, &Config::default()) {
+        Err(BackendError::Io(msg)) => assert!(msg.contains("run-qemu.sh build"), "{msg}"),
+        Err(e) => panic!("wrong error {e}"),
+        Ok(_) => panic!("started without an image"),
+    }
 }
