@@ -3,6 +3,12 @@
 pub mod backend;
 pub mod integrate;
 pub mod ode;
+pub mod output;
 pub mod pil;
 pub mod plant;
+pub mod plot;
+pub mod profile;
+pub mod progress;
+pub mod run;
+pub mod scene;
 pub mod sensors;
