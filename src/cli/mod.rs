@@ -8,6 +8,7 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+pub mod ctrl;
 pub mod kin;
 pub mod sim;
 
@@ -51,6 +52,9 @@ enum Command {
     Kin(kin::KinCommand),
     /// Simulate a scene (TOML): plant, sensors, controller, outputs.
     Sim(sim::SimArgs),
+    /// The rig controller (ivt-ctrl): offline replay of pulse logs.
+    #[command(subcommand)]
+    Ctrl(ctrl::CtrlCommand),
 }
 
 /// Parse the process arguments, run, print, and map errors to exit codes.
@@ -59,6 +63,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Some(Command::Kin(cmd)) => kin::run(cmd),
         Some(Command::Sim(args)) => sim::run_file(&args, cli.json),
+        Some(Command::Ctrl(cmd)) => ctrl::run(cmd),
         None => sim::run_default(cli.json),
     };
     match result {

@@ -19,6 +19,7 @@ fn main() -> ! {
         None => qemu::exit(false),
     };
     let mut pil = CmsdkUart::new(CmsdkUart::UART0);
+    pil.enable_rx_wakeup();
     let mut telemetry = TelemetryTx::new(CmsdkUart::new(CmsdkUart::UART1));
     let mut server = PilServer::new();
     loop {

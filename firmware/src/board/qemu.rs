@@ -5,12 +5,27 @@ use cortex_m_semihosting::{debug, hprintln};
 /// CMSDK APB UART (ARM DDI 0479, §4.3): DATA, STATE, CTRL, INTSTATUS, BAUDDIV.
 pub struct CmsdkUart {
     base: usize,
+    rx_irq: u16,
+}
+
+/// An external interrupt number of the board.
+#[derive(Clone, Copy)]
+struct Irq(u16);
+
+// SAFETY: the numbers come from the AN385/AN386 interrupt map.
+unsafe impl cortex_m::interrupt::InterruptNumber for Irq {
+    fn number(self) -> u16 {
+        self.0
+    }
 }
 
 const DATA: usize = 0x00;
 const STATE: usize = 0x04;
 const CTRL: usize = 0x08;
+const INTSTATUS: usize = 0x0C;
 const BAUDDIV: usize = 0x10;
+const CTRL_RX_INT: u32 = 1 << 3;
+const INT_RX: u32 = 1 << 1;
 const STATE_TX_FULL: u32 = 1 << 0;
 const STATE_RX_FULL: u32 = 1 << 1;
 
@@ -22,7 +37,9 @@ impl CmsdkUart {
 
     /// Enables TX and RX. QEMU refuses to move bytes while BAUDDIV < 16.
     pub fn new(base: usize) -> Self {
-        let uart = Self { base };
+        // RX interrupt numbers of UART0/UART1 in the AN385/AN386 map.
+        let rx_irq = if base == Self::UART1 { 2 } else { 0 };
+        let uart = Self { base, rx_irq };
         uart.write_reg(BAUDDIV, 16);
         uart.write_reg(CTRL, 0b11);
         uart
@@ -44,10 +61,27 @@ impl CmsdkUart {
         self.write_reg(DATA, b as u32);
     }
 
-    /// Blocks until a byte arrives.
+    /// Blocks until a byte arrives, sleeping in WFI between bytes (see
+    /// [`CmsdkUart::enable_rx_wakeup`]).
     pub fn read_byte(&mut self) -> u8 {
-        while self.read_reg(STATE) & STATE_RX_FULL == 0 {}
-        self.read_reg(DATA) as u8
+        while self.read_reg(STATE) & STATE_RX_FULL == 0 {
+            cortex_m::asm::wfi();
+        }
+        let b = self.read_reg(DATA) as u8;
+        self.write_reg(INTSTATUS, INT_RX);
+        cortex_m::peripheral::NVIC::unpend(Irq(self.rx_irq));
+        b
+    }
+
+    /// Lets a received byte wake the core from WFI: RX interrupt enabled in
+    /// the UART and the NVIC, PRIMASK set so no handler runs. A guest that
+    /// busy-polls the UART holds QEMU's I/O lock and starves the host link
+    /// (≈ 3.5 ms per PIL round trip); sleeping lets the bytes in at once.
+    pub fn enable_rx_wakeup(&mut self) {
+        cortex_m::interrupt::disable();
+        self.write_reg(CTRL, 0b11 | CTRL_RX_INT);
+        // SAFETY: no handler runs (PRIMASK set); the IRQ only ends WFI.
+        unsafe { cortex_m::peripheral::NVIC::unmask(Irq(self.rx_irq)) };
     }
 }
 
