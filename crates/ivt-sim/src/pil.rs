@@ -77,3 +77,53 @@ impl ControllerBackend for Pil {
         self.link()?.update_inputs(v_m, t_u).map_err(to_backend)
     }
 }
+
+/// Runs a scene with the QEMU firmware as the controller (`ivt sim SCENE
+/// --pil`): the same closed loop as [`crate::run::run`] with the [`Pil`]
+/// backend in place of the in-process one. The QEMU session is ended cleanly
+/// afterwards (a firmware that died mid-run surfaces as a backend error).
+///
+/// # Errors
+/// Scene, integration and backend failures, as [`crate::run::run`].
+pub fn run_pil(
+    scene: &crate::scene::Scene,
+    progress: &mut dyn FnMut(f64),
+) -> Result<crate::run::RunResult, crate::run::SimError> {
+    let params = scene
+        .plant_params()
+        .map_err(|(k, m)| crate::run::SimError::Scene(format!("`{k}` {m}")))?;
+    let Some(config) = crate::run::controller_config(scene, params.r_max) else {
+        return Err(crate::run::SimError::Scene(
+            "`controller.law = \"none\"` has no controller to put in the loop".into(),
+        ));
+    };
+    let backend = Shared::new(Pil::start(scene.encoder.ppr, &config)?);
+    let result = crate::run::run_with_backend(scene, Some(Box::new(backend.clone())), progress)?;
+    backend.finish()?;
+    Ok(result)
+}
+
+/// A [`Pil`] the run loop can own as a boxed backend while the caller keeps a
+/// handle to end the session afterwards.
+#[derive(Clone)]
+struct Shared(std::rc::Rc<std::cell::RefCell<Pil>>);
+
+impl Shared {
+    fn new(pil: Pil) -> Self {
+        Self(std::rc::Rc::new(std::cell::RefCell::new(pil)))
+    }
+
+    fn finish(&self) -> Result<ivt_wire::host::FirmwareReport, BackendError> {
+        self.0.borrow_mut().finish()
+    }
+}
+
+impl ControllerBackend for Shared {
+    fn on_pulse(&mut self, ticks: u32) -> Result<ControlOutput, BackendError> {
+        self.0.borrow_mut().on_pulse(ticks)
+    }
+
+    fn update_inputs(&mut self, v_m: f32, t_u: f32) -> Result<(), BackendError> {
+        self.0.borrow_mut().update_inputs(v_m, t_u)
+    }
+}

@@ -447,7 +447,9 @@ fn locate(src: &str, key: &str, msg: &str) -> Option<usize> {
     let Some(k) = k else {
         return line_of(src, key);
     };
-    let start = src.lines().position(|l| l.trim() == "[[outputs.channels]]")?;
+    let start = src
+        .lines()
+        .position(|l| l.trim() == "[[outputs.channels]]")?;
     let mut seen = 0;
     let mut table = 0;
     for (i, l) in src.lines().enumerate().skip(start) {
@@ -455,7 +457,10 @@ fn locate(src: &str, key: &str, msg: &str) -> Option<usize> {
         if t.starts_with("[[outputs.channels]]") {
             table += 1;
         }
-        if table == k + 1 && t.strip_prefix(key).is_some_and(|r| r.trim_start().starts_with('=')) {
+        if table == k + 1
+            && t.strip_prefix(key)
+                .is_some_and(|r| r.trim_start().starts_with('='))
+        {
             seen += 1;
             if seen == 1 {
                 return Some(i + 1);
@@ -867,7 +872,9 @@ t_u = [[0.0, 4.0]]
         assert!(e.contains("plant.r_a"), "{e}");
         let e = err(&format!("{OK}\n[controller]\nlaw = \"pid\"\n"));
         assert!(e.contains("controller.law"), "{e}");
-        let e = err(&format!("{OK}\n[[outputs.channels]]\nname = \"plant\"\n[[outputs.channels]]\nname = \"nope\"\n"));
+        let e = err(&format!(
+            "{OK}\n[[outputs.channels]]\nname = \"plant\"\n[[outputs.channels]]\nname = \"nope\"\n"
+        ));
         assert!(e.contains("nope") && e.contains("s.toml:10"), "{e}");
         let e = err("duration_s = 1.0\n");
         assert!(e.contains("inputs"), "{e}");

@@ -91,3 +91,68 @@ fn pil_without_an_image_is_a_clear_error() {
         Ok(_) => panic!("started without an image"),
     }
 }
+
+/// A short closed-loop scene with a load step: 2 s of θ at ~100 rpm (the
+/// delay law is active after two revolutions, ≈ 1.3 s), T_U 6 → 8 N·m at
+/// 1.5 s, every pulse logged.
+const SHORT_LOAD_STEP: &str = r#"
+name = "pil_load_step"
+description = "PIL acceptance: T_U step 6 -> 8 N·m at 1.5 s, V_m = 8.6 V, delay law"
+duration_s = 2.5
+
+[inputs]
+v_m = [[0.0, 8.6]]
+t_u = [[0.0, 6.0], [1.5, 6.0], [1.51, 8.0]]
+
+[initial]
+omega = 10.0
+
+[controller]
+law = "delay"
+k_mm_per_rad = 2.0
+k2_mm_per_rad = 1.0
+feedforward = false
+
+[stepper]
+max_speed = 8000
+
+[[outputs.channels]]
+name = "control"
+every = 1
+"#;
+
+#[test]
+#[ignore = "needs qemu-system-arm and the firmware image; run by firmware/run-qemu.sh test"]
+fn pil_scene_with_load_step_gives_the_sil_r_sequence_bit_for_bit() {
+    use ivt_sim::run::run;
+    use ivt_sim::scene::Scene;
+    let scene = Scene::parse(SHORT_LOAD_STEP, "pil_load_step").unwrap();
+    let sil = run(&scene, &mut |_| {}).unwrap();
+    let pil = ivt_sim::pil::run_pil(&scene, &mut |_| {}).unwrap();
+    let a = sil.channels.control.as_ref().unwrap();
+    let b = pil.channels.control.as_ref().unwrap();
+    assert_eq!(a.len(), b.len(), "pulse counts differ");
+    let ready_after_step = a.iter().filter(|s| s.t > 1.5 && s.omega_t != 0.0).count();
+    assert!(
+        ready_after_step > 500,
+        "feedback active on only {ready_after_step} pulses after the step"
+    );
+    for (k, (x, y)) in a.iter().zip(b).enumerate() {
+        assert_eq!(
+            x.r.to_bits(),
+            y.r.to_bits(),
+            "r differs at pulse {k} (t = {} s)",
+            x.t
+        );
+        assert_eq!(x, y, "pulse {k}");
+    }
+    // The load step must have moved r, or the comparison proves little.
+    let r_before = a.iter().rev().find(|s| s.t < 1.5).unwrap().r;
+    let r_end = a.last().unwrap().r;
+    assert_ne!(
+        r_before.to_bits(),
+        r_end.to_bits(),
+        "r did not respond to the load step"
+    );
+    eprintln!("{} pulses compared; r {r_before} → {r_end} m", a.len());
+}

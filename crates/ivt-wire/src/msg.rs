@@ -7,7 +7,7 @@
 //! | 0x02 | host → fw | `Pulse`   | `ticks: u32`                                                    |
 //! | 0x03 | host → fw | `Inputs`  | `v_m: f32, t_u: f32`                                            |
 //! | 0x04 | host → fw | `Exit`    | —                                                               |
-//! | 0x05 | host → fw | `Configure` | `ivt_ctrl::Config`, 212 bytes in declaration order (see [`Request::Configure`]) |
+//! | 0x05 | host → fw | `Configure` | `ivt_ctrl::Config` in declaration order, [`CONFIG_LEN`] bytes (see [`Request::Configure`]) |
 //! | 0x81 | fw → host | `Hello`   | `version: u16, ppr: u32`                                        |
 //! | 0x82 | fw → host | `Output`  | `omega, omega_a, omega_t, r_ol, r_d, r: f32, stepper_target: i32, flags: u8 (bit0 saturated, bit1 ready, bit2 inputs_clamped), fault: u8, ol_region: u8` |
 //! | 0x83 | fw → host | `Ack`     | —                                                               |
@@ -224,8 +224,10 @@ fn law_from(code: u8) -> Result<LawKind, WireError> {
     })
 }
 
-/// Payload length of `Configure`.
-pub const CONFIG_LEN: usize = 212;
+/// Payload length of `Configure` (see `put_config`): 27 four-byte scalars,
+/// the u16 decimation, two u8 (law, feedforward) and the open-loop polynomial.
+pub const CONFIG_LEN: usize =
+    4 * 27 + 2 + 2 + 4 * ivt_ctrl::open_loop::POLY_V_TERMS * ivt_ctrl::open_loop::POLY_T_TERMS;
 
 fn put_config(p: &mut Put<CONFIG_LEN>, c: &Config) {
     // Exhaustive destructuring: a field added to Config fails to compile here
