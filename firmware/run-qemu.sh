@@ -2,7 +2,7 @@
 # Firmware builds and QEMU checks (scripts/test calls `test`).
 #
 #   firmware/run-qemu.sh build     build the qemu images (PIL server, bench) and the rig image
-#   firmware/run-qemu.sh pil       the PIL-vs-SIL test (ivt-sim, needs `build`)
+#   firmware/run-qemu.sh pil       PIL-vs-SIL tests (ivt-sim) and `ivt rig record` end to end (needs `build`)
 #   firmware/run-qemu.sh panic     prove from the release ELFs that the pulse path cannot reach the panic handler
 #   firmware/run-qemu.sh budgets   flash/RAM, instructions per pulse, stack; fails over the targets
 #   firmware/run-qemu.sh test      all of the above
@@ -20,7 +20,9 @@ build() {
 }
 
 pil() {
-  (cd .. && IVT_FW_ELF="$here/$out/ivt-fw-qemu" cargo test -p ivt-sim --release --test pil -- --include-ignored)
+  (cd .. && export IVT_FW_ELF="$here/$out/ivt-fw-qemu" &&
+    cargo test -p ivt-sim --release --test pil -- --include-ignored &&
+    cargo test --release --test rig_record -- --include-ignored)
 }
 
 panic_check() {

@@ -10,6 +10,7 @@ use std::process::ExitCode;
 
 pub mod ctrl;
 pub mod kin;
+pub mod rig;
 pub mod sim;
 
 /// Result of a command: the JSON object for `--json` and the text for humans.
@@ -55,6 +56,9 @@ enum Command {
     /// The rig controller (ivt-ctrl): offline replay of pulse logs.
     #[command(subcommand)]
     Ctrl(ctrl::CtrlCommand),
+    /// The rig: record firmware telemetry into MCAP.
+    #[command(subcommand)]
+    Rig(rig::RigCommand),
 }
 
 /// Parse the process arguments, run, print, and map errors to exit codes.
@@ -64,6 +68,7 @@ pub fn main() -> ExitCode {
         Some(Command::Kin(cmd)) => kin::run(cmd),
         Some(Command::Sim(args)) => sim::run_file(&args, cli.json),
         Some(Command::Ctrl(cmd)) => ctrl::run(cmd),
+        Some(Command::Rig(cmd)) => rig::run(cmd),
         None => sim::run_default(cli.json),
     };
     match result {

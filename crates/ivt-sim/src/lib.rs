@@ -12,3 +12,4 @@ pub mod progress;
 pub mod run;
 pub mod scene;
 pub mod sensors;
+pub mod telemetry;

@@ -9,10 +9,10 @@
 //! with the host listening on `SOCK` (QEMU connects as client, so there is no
 //! race on start-up). UART1 (telemetry) goes to `null` unless asked otherwise.
 
-use std::io::{Read, Write};
+use std::io::{BufRead, BufReader, Read, Write};
 use std::os::unix::net::{UnixListener, UnixStream};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, ChildStdout, Command, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
@@ -81,6 +81,7 @@ pub struct QemuOptions {
     /// The QEMU binary.
     pub qemu: String,
     /// QEMU `-serial` spec for UART1 (telemetry), e.g. `null`, `pty`, `file:PATH`.
+    /// With `pty`, [`QemuPil::telemetry_pty`] gives the device QEMU allocated.
     pub telemetry_serial: String,
     /// Time allowed for QEMU to start and for each answer.
     pub timeout: Duration,
@@ -126,6 +127,8 @@ pub struct FirmwareReport {
 /// A running QEMU firmware with its PIL link.
 pub struct QemuPil {
     child: Child,
+    stdout: Option<BufReader<ChildStdout>>,
+    telemetry_pty: Option<PathBuf>,
     stream: UnixStream,
     socket: PathBuf,
     dec: Decoder,
@@ -173,6 +176,37 @@ impl QemuPil {
                 program: opts.qemu.clone(),
                 source,
             })?;
+        let mut stdout = child.stdout.take().map(BufReader::new);
+        let telemetry_pty = if opts.telemetry_serial == "pty" {
+            // QEMU announces "char device redirected to /dev/pts/N (label serial1)"
+            // on stdout while it creates the chardevs, before the guest runs.
+            let mut found = None;
+            let mut line = String::new();
+            while let Some(out) = stdout.as_mut() {
+                line.clear();
+                if out.read_line(&mut line)? == 0 {
+                    break;
+                }
+                if let Some(rest) = line.split("redirected to ").nth(1) {
+                    if line.contains("(label serial1)") {
+                        found = rest.split_whitespace().next().map(PathBuf::from);
+                        break;
+                    }
+                }
+            }
+            if found.is_none() {
+                let _ = child.kill();
+                let status = child.wait()?;
+                let _ = std::fs::remove_file(&socket);
+                return Err(PilError::Exited {
+                    status,
+                    output: format!("no pty announced for UART1; last line: {line}"),
+                });
+            }
+            found
+        } else {
+            None
+        };
         let t0 = Instant::now();
         let stream = loop {
             match listener.accept() {
@@ -182,7 +216,7 @@ impl QemuPil {
                         let _ = std::fs::remove_file(&socket);
                         return Err(PilError::Exited {
                             status,
-                            output: drain_output(&mut child),
+                            output: drain_output(&mut child, &mut stdout),
                         });
                     }
                     if t0.elapsed() > opts.timeout {
@@ -200,6 +234,8 @@ impl QemuPil {
         stream.set_read_timeout(Some(opts.timeout))?;
         let mut pil = Self {
             child,
+            stdout,
+            telemetry_pty,
             stream,
             socket,
             dec: Decoder::new(),
@@ -229,6 +265,12 @@ impl QemuPil {
         }
     }
 
+    /// The pty QEMU allocated for UART1 (telemetry) when started with
+    /// `telemetry_serial = "pty"`.
+    pub fn telemetry_pty(&self) -> Option<&Path> {
+        self.telemetry_pty.as_deref()
+    }
+
     /// Sends one request and waits for its reply.
     ///
     /// # Errors
@@ -242,7 +284,7 @@ impl QemuPil {
                     Ok(0) => {
                         return Err(PilError::Exited {
                             status: self.child.wait()?,
-                            output: drain_output(&mut self.child),
+                            output: drain_output(&mut self.child, &mut self.stdout),
                         })
                     }
                     Ok(n) => n,
@@ -312,7 +354,7 @@ impl QemuPil {
     pub fn finish(mut self) -> Result<FirmwareReport, PilError> {
         self.expect_ack(&Request::Exit, "Ack to Exit")?;
         let status = self.child.wait()?;
-        let output = drain_output(&mut self.child);
+        let output = drain_output(&mut self.child, &mut self.stdout);
         if !status.success() {
             return Err(PilError::Exited { status, output });
         }
@@ -344,9 +386,9 @@ impl Drop for QemuPil {
     }
 }
 
-fn drain_output(child: &mut Child) -> String {
+fn drain_output(child: &mut Child, stdout: &mut Option<BufReader<ChildStdout>>) -> String {
     let mut s = String::new();
-    if let Some(out) = child.stdout.as_mut() {
+    if let Some(out) = stdout.as_mut() {
         let _ = out.read_to_string(&mut s);
     }
     if let Some(err) = child.stderr.as_mut() {
