@@ -8,6 +8,7 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+pub mod bench;
 pub mod ctrl;
 pub mod kin;
 pub mod rig;
@@ -53,6 +54,9 @@ enum Command {
     Kin(kin::KinCommand),
     /// Simulate a scene (TOML): plant, sensors, controller, outputs.
     Sim(sim::SimArgs),
+    /// Benchmarks (work–precision of the plant integrators).
+    #[command(subcommand)]
+    Bench(bench::BenchCommand),
     /// The rig controller (ivt-ctrl): offline replay of pulse logs.
     #[command(subcommand)]
     Ctrl(ctrl::CtrlCommand),
@@ -67,6 +71,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Some(Command::Kin(cmd)) => kin::run(cmd),
         Some(Command::Sim(args)) => sim::run_file(&args, cli.json),
+        Some(Command::Bench(cmd)) => bench::run(cmd),
         Some(Command::Ctrl(cmd)) => ctrl::run(cmd),
         Some(Command::Rig(cmd)) => rig::run(cmd),
         None => sim::run_default(cli.json),

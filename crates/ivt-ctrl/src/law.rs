@@ -11,6 +11,8 @@
 //! independent variable of Eq. 171 is θ, not t), so no time measurement and
 //! no trigonometry enter the pulse path.
 
+use crate::averager::SpeedError;
+
 /// What a law sees at one pulse.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PulseSample {
@@ -20,12 +22,13 @@ pub struct PulseSample {
     pub omega: f32,
     /// ω at the previous (decimated) pulse \[rad/s\].
     pub omega_prev: f32,
-    /// ω_a, mean over the last revolution \[rad/s\].
-    pub omega_a: f32,
     /// ω_T, ω one revolution earlier \[rad/s\].
     pub omega_t: f32,
-    /// Target speed ω0 \[rad/s\].
-    pub omega0: f32,
+    /// ω_a − ω0 \[rad/s\], formed without the f32 bias of ω_a
+    /// ([`crate::Targets::omega_a_error`]); `.get()` evaluates it.
+    pub omega_a_err: SpeedError,
+    /// ω − ω0 \[rad/s\], likewise ([`crate::Targets::omega_error`]).
+    pub omega_err: SpeedError,
     /// Angle step of one (decimated) pulse, 2π/PPR \[rad\].
     pub dtheta: f32,
 }
@@ -50,7 +53,7 @@ pub struct DelayLaw {
 impl FeedbackLaw for DelayLaw {
     #[inline]
     fn increment(&mut self, s: &PulseSample) -> f32 {
-        (self.k * (s.omega_a - s.omega0) + self.k2 * (s.omega - s.omega_t)) * s.dtheta
+        (self.k * s.omega_a_err.get() + self.k2 * (s.omega - s.omega_t)) * s.dtheta
     }
     fn reset(&mut self, _ticks: u32) {}
 }
@@ -69,7 +72,7 @@ pub struct NoDelayLaw {
 impl FeedbackLaw for NoDelayLaw {
     #[inline]
     fn increment(&mut self, s: &PulseSample) -> f32 {
-        self.k * (s.omega - s.omega0) * s.dtheta + self.k2 * (s.omega - s.omega_prev)
+        self.k * s.omega_err.get() * s.dtheta + self.k2 * (s.omega - s.omega_prev)
     }
     fn reset(&mut self, _ticks: u32) {}
 }
@@ -122,7 +125,7 @@ impl FeedbackLaw for PropLaw {
         } else {
             s.ticks.wrapping_add(self.period_ticks)
         };
-        self.k_r * (s.omega_a - s.omega0)
+        self.k_r * s.omega_a_err.get()
     }
     fn reset(&mut self, _ticks: u32) {
         self.primed = false;
@@ -178,14 +181,15 @@ impl FeedbackLaw for LawState {
 mod tests {
     use super::*;
 
+    /// ω0 = 10 rad/s; ω_prev = ω_T = 10.
     fn sample(ticks: u32, omega: f32, omega_a: f32) -> PulseSample {
         PulseSample {
             ticks,
             omega,
             omega_prev: 10.0,
-            omega_a,
             omega_t: 10.0,
-            omega0: 10.0,
+            omega_a_err: SpeedError::from_value(omega_a - 10.0),
+            omega_err: SpeedError::from_value(omega - 10.0),
             dtheta: 0.5,
         }
     }

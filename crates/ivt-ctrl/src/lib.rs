@@ -22,7 +22,7 @@ pub mod open_loop;
 pub mod units;
 
 pub use actuator::{ActuatorMap, StepGenerator, StepperLimits};
-pub use averager::AngleAverager;
+pub use averager::{AngleAverager, SpeedError, TargetTicks, Targets};
 pub use controller::{Config, ControlOutput, Controller, Fault, Gains, LawKind, StepTick};
 pub use law::FeedbackLaw;
 pub use open_loop::{OlRegion, OpenLoopCoeffs, THESIS};

@@ -12,4 +12,8 @@ pub mod progress;
 pub mod run;
 pub mod scene;
 pub mod sensors;
+<<<<<<< HEAD
 pub mod telemetry;
+=======
+pub mod work_precision;
+>>>>>>> sim

@@ -2,7 +2,7 @@
 //! signal group, zstd chunks, Foxglove-readable), CSV files, the summary JSON
 //! and a PNG with one panel per requested plot.
 
-use crate::run::{Channels, RunResult};
+use crate::run::{Channels, RunResult, Timed};
 use crate::scene::Scene;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -100,20 +100,16 @@ pub fn json_schema(name: &str) -> String {
 
 /// Non-finite numbers (ω_a before the first revolution) are written as
 /// `null` in JSON and as empty cells in CSV.
-fn samples_as_json<T: Serialize>(v: &[T]) -> Vec<(f64, Vec<u8>)> {
+/// (time, JSON bytes) of each sample of one channel.
+type Messages = Vec<(f64, Vec<u8>)>;
+
+fn samples_as_json<T: Serialize + Timed>(v: &[T]) -> Messages {
     v.iter()
-        .map(|s| {
-            let value = serde_json::to_value(s).unwrap_or(serde_json::Value::Null);
-            let t = value
-                .get("t")
-                .and_then(serde_json::Value::as_f64)
-                .unwrap_or(0.0);
-            (t, serde_json::to_vec(&value).unwrap_or_default())
-        })
+        .map(|s| (s.time(), serde_json::to_vec(s).unwrap_or_default()))
         .collect()
 }
 
-fn channel_messages(ch: &Channels) -> Vec<(&'static str, Vec<(f64, Vec<u8>)>)> {
+fn channel_messages(ch: &Channels) -> Vec<(&'static str, Messages)> {
     let mut out = vec![];
     if let Some(v) = &ch.plant {
         out.push(("plant", samples_as_json(v)));
@@ -142,6 +138,8 @@ pub fn write_mcap(path: &Path, result: &RunResult, scene: &Scene) -> Result<(), 
     let file = File::create(path).map_err(io(path))?;
     let mut w = mcap::WriteOptions::new()
         .compression(Some(mcap::Compression::Zstd))
+        // level 1: ~3× faster than the default 3 on these JSON logs, files ~10 % larger
+        .compression_level(1)
         .profile("")
         .create(BufWriter::new(file))
         .map_err(err)?;

@@ -2,12 +2,16 @@
 //! their knots).
 
 use crate::integrate::InputProfile;
+use std::cell::Cell;
 
 /// A piecewise-linear function of time through `(t, value)` knots with
 /// strictly increasing t.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pwl {
     knots: Vec<(f64, f64)>,
+    /// Segment of the last lookup: queries come in nearly increasing time,
+    /// so the search usually ends at once (the RHS calls this every stage).
+    hint: Cell<usize>,
 }
 
 impl Pwl {
@@ -15,14 +19,15 @@ impl Pwl {
     /// least one knot, finite values and strictly increasing times.
     pub fn new(knots: Vec<(f64, f64)>) -> Self {
         debug_assert!(!knots.is_empty());
-        Self { knots }
+        Self {
+            knots,
+            hint: Cell::new(1),
+        }
     }
 
     /// A constant.
     pub fn constant(v: f64) -> Self {
-        Self {
-            knots: vec![(0.0, v)],
-        }
+        Self::new(vec![(0.0, v)])
     }
 
     /// Value at `t`.
@@ -36,8 +41,15 @@ impl Pwl {
         if t >= last.0 {
             return last.1;
         }
-        // first knot with time > t (k[0].0 < t < last.0 so 1 ≤ i ≤ len−1)
-        let i = k.partition_point(|&(tk, _)| tk <= t);
+        // i = first knot with time > t (k[0].0 < t < last.0 so 1 ≤ i ≤ len−1)
+        let h = self.hint.get().clamp(1, k.len() - 1);
+        let i = if k[h - 1].0 <= t && t < k[h].0 {
+            h
+        } else {
+            let i = k.partition_point(|&(tk, _)| tk <= t);
+            self.hint.set(i);
+            i
+        };
         let (t0, v0) = k[i - 1];
         let (t1, v1) = k[i];
         v0 + (v1 - v0) * (t - t0) / (t1 - t0)
@@ -78,5 +90,13 @@ mod tests {
         assert_eq!(p.at(3.5), 6.0);
         assert_eq!(p.at(10.0), 6.0);
         assert_eq!(Pwl::constant(3.0).at(-5.0), 3.0);
+        // the cached segment does not change answers for out-of-order queries
+        let ts = [3.7, 1.2, 2.9, 0.5, 3.99, 1.01, 2.0];
+        let fresh: Vec<f64> = ts
+            .iter()
+            .map(|&t| Pwl::new(p.knots().to_vec()).at(t))
+            .collect();
+        let cached: Vec<f64> = ts.iter().map(|&t| p.at(t)).collect();
+        assert_eq!(fresh, cached);
     }
 }

@@ -111,6 +111,17 @@ pub struct SensorSample {
     pub t_u: f64,
 }
 
+/// A logged sample with its simulation time.
+pub trait Timed {
+    /// Time \[s\].
+    fn time(&self) -> f64;
+}
+
+macro_rules! timed {
+    ($($t:ty),*) => {$(impl Timed for $t { fn time(&self) -> f64 { self.t } })*};
+}
+timed!(PlantSample, ControlSample, StepperSample, SensorSample);
+
 /// The channels that were asked for (None = not recorded at all).
 #[derive(Clone, Debug, Default)]
 pub struct Channels {
@@ -183,6 +194,7 @@ pub struct RunResult {
 
 #[derive(Default)]
 struct Metrics {
+    dtheta: f64,
     from: f64,
     band: f64,
     static_from: f64,
@@ -204,16 +216,7 @@ struct Metrics {
 }
 
 impl Metrics {
-    fn pulse(
-        &mut self,
-        t: f64,
-        omega_a: f64,
-        dr: f64,
-        dtheta: f64,
-        dt: f64,
-        sat: bool,
-        fault: bool,
-    ) {
+    fn pulse(&mut self, t: f64, omega_a: f64, dr: f64, dt: f64, sat: bool, fault: bool) {
         self.pulses += 1;
         self.faults += u64::from(fault);
         if omega_a.is_finite() {
@@ -228,7 +231,7 @@ impl Metrics {
             self.drdt_sq += rate * rate;
             self.max_drdt = self.max_drdt.max(rate.abs());
         }
-        self.drdth_sq += (dr / dtheta) * (dr / dtheta);
+        self.drdth_sq += (dr / self.dtheta) * (dr / self.dtheta);
         self.n_rate += 1;
         if !omega_a.is_finite() {
             self.last_out = Some(t);
@@ -412,6 +415,7 @@ pub fn run_with_backend(
         band: m.band,
         static_from: (duration - m.static_window_s).max(m.from_s),
         omega0,
+        dtheta,
         final_omega_a: f64::NAN,
         ..Metrics::default()
     };
@@ -440,7 +444,7 @@ pub fn run_with_backend(
                 b.update_inputs(rv as f32, rt as f32)?;
             }
             if let (Some(buf), Some(e)) = (ch.sensors.as_mut(), ev_sensors) {
-                if n_sensor % e as u64 == 0 {
+                if n_sensor.is_multiple_of(e as u64) {
                     buf.push(SensorSample {
                         t: integ.t,
                         v_m: rv,
@@ -480,7 +484,7 @@ pub fn run_with_backend(
             let out = b.on_pulse(ticks)?;
             target = i64::from(out.stepper_target);
             if let (Some(buf), Some(e)) = (ch.control.as_mut(), ev_control) {
-                if n_pulse % e as u64 == 0 {
+                if n_pulse.is_multiple_of(e as u64) {
                     buf.push(ControlSample {
                         t,
                         ticks,
@@ -502,19 +506,11 @@ pub fn run_with_backend(
             r = rs;
             (rs, false, false)
         };
-        met.pulse(
-            t,
-            omega_a,
-            r_cmd - r_cmd_prev,
-            dtheta,
-            t - last_pulse_t,
-            sat,
-            fault,
-        );
+        met.pulse(t, omega_a, r_cmd - r_cmd_prev, t - last_pulse_t, sat, fault);
         r_cmd_prev = r_cmd;
         last_pulse_t = t;
         if let (Some(buf), Some(e)) = (ch.plant.as_mut(), ev_plant) {
-            if n_pulse % e as u64 == 0 {
+            if n_pulse.is_multiple_of(e as u64) {
                 let (v, tu) = drive.at_time(t);
                 buf.push(PlantSample {
                     t,
@@ -529,7 +525,7 @@ pub fn run_with_backend(
             }
         }
         if let (Some(buf), Some(e)) = (ch.stepper.as_mut(), ev_stepper) {
-            if n_pulse % e as u64 == 0 {
+            if n_pulse.is_multiple_of(e as u64) {
                 buf.push(StepperSample {
                     t,
                     target,
@@ -540,7 +536,7 @@ pub fn run_with_backend(
             }
         }
         if let Some(buf) = ch.plot.as_mut() {
-            if n_pulse % plot_every == 0 {
+            if n_pulse.is_multiple_of(plot_every) {
                 let (v, tu) = drive.at_time(t);
                 buf.push([t, integ.omega(), omega_a, r, v, tu]);
             }

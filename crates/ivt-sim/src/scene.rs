@@ -600,6 +600,14 @@ impl Scene {
             format!("must be in (0, 1e6] s, got {}", self.duration_s),
         )?;
         let params = self.plant_params()?;
+        check(
+            params.l_a == 0.0 || params.l_a >= 1e-7,
+            "plant.l_a",
+            format!(
+                "= {} H: below 1e-7 H the current mode (R_a/L_a > 2e6 /s) is too stiff for the explicit integrators; use 0 (Eq. 138)",
+                params.l_a
+            ),
+        )?;
         profile_ok(
             &self.inputs.v_m,
             "inputs.v_m",

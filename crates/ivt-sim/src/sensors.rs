@@ -144,7 +144,7 @@ impl Stepper {
 
     /// Move towards `target` for `dt` seconds.
     pub fn advance(&mut self, target: i64, dt: f64, rng: &mut Rng) {
-        if !(dt > 0.0) {
+        if dt.is_nan() || dt <= 0.0 {
             return;
         }
         // sub-steps so that the acceleration profile is resolved

@@ -164,3 +164,40 @@ fn start_up_converges_to_the_unique_periodic_solution() {
         });
     assert!(hi - lo > 0.1, "ω range {lo}..{hi}");
 }
+
+/// Eq. 137 with a small armature inductance tends to Eq. 151 (L_a → 0): the
+/// steady ω_a over a revolution differs from the L_a = 0 plant by an amount
+/// that shrinks ∝ L_a (the electrical lag τ = L_a/R_a), here by ≈ 10× per
+/// decade, and the current ends near its quasi-static value.
+#[test]
+fn inductance_tends_to_the_quasi_static_motor() {
+    let prof = ConstantInputs {
+        v_m: U.v_m,
+        t_u: U.t_u,
+    };
+    let tol = Tolerance {
+        rtol: 1e-10,
+        atol: 1e-10,
+    };
+    let omega_a = |l_a: f64| {
+        let mut params = PlantParams::printed();
+        params.l_a = l_a;
+        let plant = Plant::new(params);
+        let i0 = plant.quasi_static_current(0.0, 10.0, U.v_m);
+        let mut it = PlantIntegrator::new(plant, Method::Dp5(tol), 0.0, 0.0, 10.0, i0);
+        it.advance(&prof, U.r, 20.0 * PI, 1e9).unwrap();
+        let t0 = it.t;
+        it.advance(&prof, U.r, 22.0 * PI, 1e9).unwrap();
+        let i_qs = plant.quasi_static_current(it.theta(), it.omega(), U.v_m);
+        (2.0 * PI / (it.t - t0), (it.y[2] - i_qs).abs() / i_qs.abs())
+    };
+    let (w0, _) = omega_a(0.0);
+    let (w4, di4) = omega_a(1e-4);
+    let (w5, di5) = omega_a(1e-5);
+    let (d4, d5) = ((w4 - w0).abs(), (w5 - w0).abs());
+    assert!(
+        d4 > 0.0 && d5 < d4 / 5.0 && d5 < 1e-3,
+        "Δω_a: {d4:e} (1e-4 H), {d5:e} (1e-5 H)"
+    );
+    assert!(di5 < di4 && di5 < 0.05, "current lag {di4} {di5}");
+}

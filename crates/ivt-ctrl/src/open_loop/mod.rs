@@ -20,8 +20,10 @@ pub const POLY_V_TERMS: usize = 3;
 /// Number of powers of T_U in `poly` (T_U⁰…T_U⁴, as in Eq. 158).
 pub const POLY_T_TERMS: usize = 5;
 
-/// Coefficients of an open-loop law of the form of Eq. 158–160.
+/// Coefficients of an open-loop law of the form of Eq. 158–160; the law
+/// itself is [`OpenLoopCoeffs::evaluate`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[doc(alias = "OpenLoopLaw")]
 pub struct OpenLoopCoeffs {
     /// `poly[i][j]` multiplies `V_m^i · T_U^j`, r_f in metres: the form of
     /// Eq. 158 (degree ≤ 2 in V_m, ≤ 4 in T_U; unused terms are 0).
