@@ -12,8 +12,5 @@ pub mod progress;
 pub mod run;
 pub mod scene;
 pub mod sensors;
-<<<<<<< HEAD
 pub mod telemetry;
-=======
 pub mod work_precision;
->>>>>>> sim
