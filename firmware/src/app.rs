@@ -1,7 +1,6 @@
 //! Board-independent part of the firmware: the controller instance, the pulse
 //! path, and the PIL request handler. Its control path is `ivt-ctrl` only.
 
-use core::mem::MaybeUninit;
 use core::sync::atomic::{AtomicBool, Ordering};
 
 use ivt_ctrl::{Config, ControlOutput, Controller};
@@ -26,21 +25,22 @@ pub fn ivt_fw_pulse(ctrl: &mut Ctrl, ticks: u32) -> ControlOutput {
     ctrl.on_pulse(ticks)
 }
 
-/// Takes the firmware's one controller, built in place in a static (not on
-/// the stack: `Controller<1200>` holds a 4.8 KiB ring buffer and the RAM
-/// budget is 8 KiB). Returns `None` on a second call.
+/// Takes the firmware's one controller: a static initialised to
+/// `Controller::unconfigured()` at link time and configured in place with
+/// `reset` — `Controller::new` would build the 4.8 KiB ring on the stack and
+/// move it, a 10.7 KiB boot stack peak against an 8 KiB RAM budget. Returns
+/// `None` on a second call.
 #[inline(never)]
 pub fn take_controller(config: Config) -> Option<&'static mut Ctrl> {
     static TAKEN: AtomicBool = AtomicBool::new(false);
-    static mut CTRL: MaybeUninit<Ctrl> = MaybeUninit::uninit();
+    static mut CTRL: Ctrl = Ctrl::unconfigured();
     if TAKEN.swap(true, Ordering::AcqRel) {
         return None;
     }
     // SAFETY: TAKEN guarantees this runs once, so the &'static mut is unique.
-    unsafe {
-        let slot = &mut *core::ptr::addr_of_mut!(CTRL);
-        Some(slot.write(Ctrl::new(config)))
-    }
+    let ctrl = unsafe { &mut *core::ptr::addr_of_mut!(CTRL) };
+    ctrl.reset(config);
+    Some(ctrl)
 }
 
 /// A byte pipe to the host.
@@ -114,8 +114,9 @@ impl PilServer {
                 Reply::Ack
             }
             Ok(Request::Configure(config)) => {
-                // An invalid config gives the controller's own Fault::Config state.
-                *ctrl = Ctrl::new(config);
+                // In place (no stack temporary); an invalid config gives the
+                // controller's own Fault::Config state.
+                ctrl.reset(config);
                 self.pulses = 0;
                 Reply::Ack
             }
