@@ -43,12 +43,16 @@ pub fn take_controller(config: Config) -> Option<&'static mut Ctrl> {
     Some(ctrl)
 }
 
-/// A byte pipe to the host.
-pub trait Link {
-    /// Blocks until a byte arrives.
-    fn read_byte(&mut self) -> u8;
+/// Where bytes go (a UART transmitter).
+pub trait ByteSink {
     /// Sends all bytes (blocking).
     fn write_all(&mut self, bytes: &[u8]);
+}
+
+/// A two-way byte pipe to the host.
+pub trait Link: ByteSink {
+    /// Blocks until a byte arrives.
+    fn read_byte(&mut self) -> u8;
 }
 
 /// What the session loop should do after a request.
@@ -134,14 +138,14 @@ impl PilServer {
 }
 
 /// Streams telemetry frames (`ivt_wire::Telemetry`) over a link.
-pub struct TelemetryTx<L: Link> {
+pub struct TelemetryTx<L: ByteSink> {
     link: L,
     buf: [u8; 32],
     /// Frames sent so far.
     pub frames: u32,
 }
 
-impl<L: Link> TelemetryTx<L> {
+impl<L: ByteSink> TelemetryTx<L> {
     /// A sender over `link`.
     pub fn new(link: L) -> Self {
         Self {

@@ -15,7 +15,7 @@ use cortex_m::interrupt::{free, Mutex};
 use cortex_m_rt::entry;
 use defmt_rtt as _;
 use ivt_ctrl::{ControlOutput, Fault};
-use ivt_firmware::app::{ivt_fw_pulse, take_controller, Ctrl, Link, TelemetryTx};
+use ivt_firmware::app::{ivt_fw_pulse, take_controller, ByteSink, Ctrl, TelemetryTx};
 use ivt_firmware::board::rig::{self, F_TIMER_HZ, STEP_TICK_HZ, T_U_SCALE, V_M_SCALE};
 use stm32f4xx_hal::{
     adc::{config::AdcConfig, config::SampleTime, Adc},
@@ -41,10 +41,7 @@ static SHARED: Mutex<RefCell<Option<Shared>>> = Mutex::new(RefCell::new(None));
 /// USART1 transmit through the PAC (the HAL configured pins and baud rate).
 struct Usart1;
 
-impl Link for Usart1 {
-    fn read_byte(&mut self) -> u8 {
-        0 // telemetry is transmit-only
-    }
+impl ByteSink for Usart1 {
     fn write_all(&mut self, bytes: &[u8]) {
         // SAFETY: USART1 is owned by this image; only its TX side is used here.
         let u = unsafe { &*pac::USART1::ptr() };
@@ -57,8 +54,7 @@ impl Link for Usart1 {
 
 #[entry]
 fn main() -> ! {
-    let (Some(dp), Some(mut cp)) = (pac::Peripherals::take(), cortex_m::Peripherals::take())
-    else {
+    let (Some(dp), Some(mut cp)) = (pac::Peripherals::take(), cortex_m::Peripherals::take()) else {
         halt()
     };
     let mut rcc = dp
@@ -86,7 +82,9 @@ fn main() -> ! {
     let v_m_pin = gpioa.pa1.into_analog();
     let t_u_pin = gpioa.pa4.into_analog();
     let mut adc = Adc::new(dp.ADC1, true, AdcConfig::default(), &mut rcc);
-    let Ok(_tx): Result<stm32f4xx_hal::serial::Tx<pac::USART1, u8>, _> = dp.USART1.tx(gpioa.pa9, rig::TELEMETRY_BAUD.bps(), &mut rcc) else {
+    let Ok(_tx): Result<stm32f4xx_hal::serial::Tx<pac::USART1, u8>, _> =
+        dp.USART1.tx(gpioa.pa9, rig::TELEMETRY_BAUD.bps(), &mut rcc)
+    else {
         halt()
     };
     let mut telemetry = TelemetryTx::new(Usart1);
@@ -115,7 +113,11 @@ fn main() -> ! {
         cortex_m::peripheral::NVIC::unmask(Interrupt::TIM2);
         cortex_m::peripheral::NVIC::unmask(Interrupt::TIM3);
     }
-    defmt::info!("ivt-fw-rig: PPR {}, f_timer {} Hz", ivt_firmware::app::PPR, F_TIMER_HZ);
+    defmt::info!(
+        "ivt-fw-rig: PPR {}, f_timer {} Hz",
+        ivt_firmware::app::PPR,
+        F_TIMER_HZ
+    );
 
     let mut n: u32 = 0;
     loop {

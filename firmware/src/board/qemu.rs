@@ -87,7 +87,11 @@ impl CmsdkUart {
 
 /// Ends the QEMU run with a status (semihosting SYS_EXIT).
 pub fn exit(ok: bool) -> ! {
-    debug::exit(if ok { debug::EXIT_SUCCESS } else { debug::EXIT_FAILURE });
+    debug::exit(if ok {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
     loop {
         cortex_m::asm::wfi();
     }
@@ -101,13 +105,16 @@ pub fn report(items: &[(&str, usize)]) {
     }
 }
 
-impl crate::app::Link for CmsdkUart {
-    fn read_byte(&mut self) -> u8 {
-        CmsdkUart::read_byte(self)
-    }
+impl crate::app::ByteSink for CmsdkUart {
     fn write_all(&mut self, bytes: &[u8]) {
         for &b in bytes {
             self.write_byte(b);
         }
+    }
+}
+
+impl crate::app::Link for CmsdkUart {
+    fn read_byte(&mut self) -> u8 {
+        CmsdkUart::read_byte(self)
     }
 }
