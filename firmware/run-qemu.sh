@@ -29,7 +29,7 @@ pil() {
 panic_check() {
   python3 panic_reach.py "$out/ivt-fw-bench" --root ivt_fw_pulse --must-reach ivt_fw_canary
   python3 panic_reach.py "$out/ivt-fw-qemu" --root ivt_fw_pulse
-  python3 panic_reach.py "$out/ivt-fw-rig" --root ivt_fw_pulse --root TIM2
+  python3 panic_reach.py "$out/ivt-fw-rig" --root ivt_fw_pulse --root TIM2 --root TIM3
 }
 
 budgets() {
