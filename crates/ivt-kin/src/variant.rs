@@ -12,6 +12,25 @@ pub fn f(theta: f64) -> f64 {
     NCG_AMPLITUDE * libm::fmax(libm::fabs(libm::sin(theta)), libm::fabs(libm::cos(theta)))
 }
 
+/// [`f`] with its domain checked: θ must be finite (a NaN angle gives an
+/// error, not a NaN ratio). The unchecked [`f`] stays for the plant's inner loop.
+///
+/// # Errors
+/// `NotFinite` for NaN/inf θ.
+pub fn f_checked(theta: f64) -> Result<f64, crate::KinError> {
+    Ok(f(crate::error::finite("theta", theta)?))
+}
+
+/// [`output_to_motor_ratio`] with its domain checked: r ≥ 0, r_u > 0, finite.
+///
+/// # Errors
+/// `NotFinite` or `OutOfDomain` naming the offending input.
+pub fn output_to_motor_ratio_checked(r: f64, r_u: f64) -> Result<f64, crate::KinError> {
+    let r = crate::error::in_range("r", r, 0.0, f64::INFINITY, "eccentricity r >= 0")?;
+    let r_u = crate::error::positive("r_u", r_u)?;
+    Ok(output_to_motor_ratio(r, r_u))
+}
+
 /// df/dθ, Eq. 139: −π/(2√2)·sin(mod(θ + π/4, π/2) − π/4).
 ///
 /// Discontinuous at θ = π/4 + kπ/2 (the sharp corners of the gear ratio);

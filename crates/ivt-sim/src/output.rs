@@ -140,6 +140,8 @@ pub fn write_mcap(path: &Path, result: &RunResult, scene: &Scene) -> Result<(), 
         .compression(Some(mcap::Compression::Zstd))
         // level 1: ~3× faster than the default 3 on these JSON logs, files ~10 % larger
         .compression_level(1)
+        // no worker threads: chunks are small, and threads only add overhead
+        .compression_threads(0)
         .profile("")
         .create(BufWriter::new(file))
         .map_err(err)?;

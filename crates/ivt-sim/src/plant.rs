@@ -19,7 +19,7 @@
 
 use ivt_kin::plant::PlantParams;
 use ivt_kin::NCG_AMPLITUDE;
-use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, TAU};
 
 /// Dimension of the plant state `[θ, ω, i_a]`.
 pub const DIM: usize = 3;
@@ -83,15 +83,19 @@ impl Plant {
         let (theta, omega) = (y[0], y[1]);
         let (f, f_theta) = f_on_segment(theta, seg);
         let p = &self.params;
+        // θ only enters G(θ) here (f is given), which is 2π-periodic: reducing θ
+        // to [0, 2π) first lets sin/cos skip their slow argument reduction at
+        // large θ; the reduction error, ≤ |θ/2π|·ulp(2π), is ~1e-14 rad.
+        let theta_g = theta - TAU * libm::floor(theta / TAU);
         if self.has_inductance() {
-            let t = p.terms_with_f(theta, f, f_theta, u.r, 0.0, u.t_u);
+            let t = p.terms_with_f(theta_g, f, f_theta, u.r, 0.0, u.t_u);
             let i_a = y[2];
             let torque = t.g * u.r - t.f2 * u.r + f * p.k_t * i_a;
             let accel = (torque - 0.5 * t.j_theta * omega * omega) / t.j;
             let di = (u.v_m - p.r_a * i_a - p.k_e * f * omega) / p.l_a;
             [omega, accel, di]
         } else {
-            let t = p.terms_with_f(theta, f, f_theta, u.r, u.v_m, u.t_u);
+            let t = p.terms_with_f(theta_g, f, f_theta, u.r, u.v_m, u.t_u);
             [omega, t.acceleration(omega, u.r), 0.0]
         }
     }

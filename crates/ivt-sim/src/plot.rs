@@ -1,23 +1,10 @@
 //! PNG plots of a run: one stacked panel per requested signal. Pure Rust:
-//! plotters' bitmap backend with an embedded font (a subset of DejaVu Sans,
-//! license in `assets/DejaVu-LICENSE.txt`) registered at run time.
+//! plotters' bitmap backend with the font that `ivt-plot` embeds and
+//! registers at run time (one font setup for the whole toolkit).
 
 use crate::output::OutputError;
 use plotters::prelude::*;
-use plotters::style::{register_font, FontStyle};
 use std::path::Path;
-use std::sync::Once;
-
-static FONT: &[u8] = include_bytes!("../assets/DejaVuSans-subset.ttf");
-static REGISTER: Once = Once::new();
-
-fn ensure_font() {
-    REGISTER.call_once(|| {
-        // The embedded font is valid (checked by the plot test); if it were
-        // not, text would be missing but nothing else breaks.
-        let _ = register_font("sans-serif", FontStyle::Normal, FONT);
-    });
-}
 
 /// Panel title, unit and column of the plot series `(t, ω, ω_a, r, V_m, T_U)`.
 fn panel(name: &str) -> (&'static str, usize, f64) {
@@ -41,7 +28,7 @@ pub fn draw(
     series: &[[f64; 6]],
     omega0: f64,
 ) -> Result<(), OutputError> {
-    ensure_font();
+    ivt_plot::ensure_font();
     let err = |e: String| OutputError::Plot {
         path: path.to_path_buf(),
         msg: e,

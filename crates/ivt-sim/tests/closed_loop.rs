@@ -207,6 +207,16 @@ fn mcap_has_exactly_the_requested_channels() {
         }
         *counts.entry(m.channel.topic.clone()).or_insert(0usize) += 1;
     }
+    // CSV on request: one file per channel, a header and one row per sample
+    let mut s_csv = s.clone();
+    s_csv.outputs.mcap = false;
+    s_csv.outputs.csv = true;
+    let csv = ivt_sim::output::write_all(&dir, &s_csv, &res).unwrap();
+    assert_eq!(csv.len(), 2);
+    let plant_csv = std::fs::read_to_string(&csv[0]).unwrap();
+    let mut lines = plant_csv.lines();
+    assert_eq!(lines.next().unwrap(), "t,theta,omega,omega_a,r,v_m,t_u,i_a");
+    assert_eq!(lines.count(), n_plant);
     let _ = std::fs::remove_dir_all(&dir);
     let expected: std::collections::BTreeMap<String, usize> = [
         ("/plant".to_string(), n_plant),
@@ -262,7 +272,7 @@ fn shipped_scenes_parse_and_drive_cycle_stays_in_band() {
             n += 1;
         }
     }
-    assert!(n >= 6, "{n} scenes");
+    assert!(n >= 7, "{n} scenes");
     let mut s = scene("drive");
     s.outputs.channels.clear();
     s.outputs.plots.clear();

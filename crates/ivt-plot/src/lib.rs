@@ -1,0 +1,356 @@
+//! PNG figures for the IVT toolkit, shared by the CLI, the simulator and the
+//! reproduction report, so that every crate draws with one font setup and one
+//! look.
+//!
+//! Pure Rust: plotters' bitmap backend with an embedded font (a subset of
+//! DejaVu Sans with Greek letters, licence in `assets/DejaVu-LICENSE.txt`)
+//! registered at run time — no fontconfig/freetype needed at build time.
+//!
+//! - [`line_plot`]: x–y curves and markers; a NaN point breaks a curve, which
+//!   is how stable and unstable branches are drawn as separate pieces.
+//! - [`heat_map`]: a value on a rectangular grid (e.g. a stability map).
+
+use plotters::prelude::*;
+use plotters::style::{register_font, FontStyle};
+use std::path::{Path, PathBuf};
+use std::sync::Once;
+
+static FONT: &[u8] = include_bytes!("../assets/DejaVuSans-subset.ttf");
+static REGISTER: Once = Once::new();
+
+/// Register the embedded font under the family name `"sans-serif"` (once per
+/// process). Called by every drawing function; public for callers that draw
+/// with plotters directly.
+pub fn ensure_font() {
+    REGISTER.call_once(|| {
+        // The embedded font is checked by this crate's tests; a failure here
+        // would only lose text, never the figure.
+        let _ = register_font("sans-serif", FontStyle::Normal, FONT);
+    });
+}
+
+/// A drawing failure, with the file it was for.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot draw {path}: {msg}")]
+pub struct PlotError {
+    /// The PNG being written.
+    pub path: PathBuf,
+    /// What plotters or the encoder reported.
+    pub msg: String,
+}
+
+/// How a series is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Style {
+    /// Solid line through the points (NaN points break it).
+    Line,
+    /// Dashed line (NaN points break it).
+    Dashed,
+    /// A small filled circle at each point.
+    Markers,
+}
+
+/// One curve of a [`Figure`].
+#[derive(Clone, Copy, Debug)]
+pub struct Series<'a> {
+    /// Legend text (empty: no legend entry).
+    pub label: &'a str,
+    /// The (x, y) points in plot units.
+    pub points: &'a [(f64, f64)],
+    /// How it is drawn.
+    pub style: Style,
+}
+
+/// A titled x–y figure.
+#[derive(Clone, Debug)]
+pub struct Figure<'a> {
+    /// Title above the plot.
+    pub title: &'a str,
+    /// x-axis label with unit, e.g. `"ω [rad/s]"`.
+    pub x_label: &'a str,
+    /// y-axis label with unit.
+    pub y_label: &'a str,
+    /// Curves, drawn in order with the palette colours.
+    pub series: Vec<Series<'a>>,
+}
+
+/// The palette, chosen to stay distinguishable in print.
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(23, 190, 207),
+];
+
+/// Width and height of every figure in pixels.
+const SIZE: (u32, u32) = (1000, 640);
+
+fn finite_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    if !lo.is_finite() {
+        return (0.0, 1.0);
+    }
+    let pad = ((hi - lo) * 0.05).max(1e-9 * hi.abs().max(1.0));
+    (lo - pad, hi + pad)
+}
+
+/// Split a point list at non-finite points into drawable pieces.
+fn pieces(points: &[(f64, f64)]) -> impl Iterator<Item = &[(f64, f64)]> {
+    points
+        .split(|p| !(p.0.is_finite() && p.1.is_finite()))
+        .filter(|s| !s.is_empty())
+}
+
+/// Draw `figure` into the PNG at `path`.
+///
+/// # Errors
+/// Drawing or encoding failures, as a [`PlotError`] naming the file.
+pub fn line_plot(path: &Path, figure: &Figure<'_>) -> Result<(), PlotError> {
+    ensure_font();
+    let err = |e: &dyn std::fmt::Display| PlotError {
+        path: path.to_path_buf(),
+        msg: e.to_string(),
+    };
+    let all = || figure.series.iter().flat_map(|s| s.points.iter());
+    let (x0, x1) = finite_range(all().map(|p| p.0));
+    let (y0, y1) = finite_range(all().map(|p| p.1));
+    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(figure.title, ("sans-serif", 24))
+        .margin(12)
+        .x_label_area_size(48)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc(figure.x_label)
+        .y_desc(figure.y_label)
+        .label_style(("sans-serif", 15))
+        .draw()
+        .map_err(|e| err(&e))?;
+    let mut legend = false;
+    for (i, series) in figure.series.iter().enumerate() {
+        let color = PALETTE[i % PALETTE.len()];
+        let mut first = true;
+        for piece in pieces(series.points) {
+            let anno = match series.style {
+                Style::Line => chart.draw_series(LineSeries::new(
+                    piece.iter().copied(),
+                    color.stroke_width(2),
+                )),
+                Style::Dashed => chart.draw_series(DashedLineSeries::new(
+                    piece.iter().copied(),
+                    8,
+                    6,
+                    color.stroke_width(2),
+                )),
+                Style::Markers => {
+                    chart.draw_series(piece.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                }
+            }
+            .map_err(|e| err(&e))?;
+            if first && !series.label.is_empty() {
+                anno.label(series.label).legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                });
+                legend = true;
+            }
+            first = false;
+        }
+    }
+    if legend {
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 15))
+            .draw()
+            .map_err(|e| err(&e))?;
+    }
+    root.present().map_err(|e| err(&e))
+}
+
+/// A value on a grid: `values[j * xs.len() + i]` belongs to `(xs[i], ys[j])`.
+#[derive(Clone, Debug)]
+pub struct HeatMap<'a> {
+    /// Title above the plot.
+    pub title: &'a str,
+    /// x-axis label with unit.
+    pub x_label: &'a str,
+    /// y-axis label with unit.
+    pub y_label: &'a str,
+    /// What the colour means, with unit (shown in the title line).
+    pub value_label: &'a str,
+    /// Grid abscissae, increasing.
+    pub xs: &'a [f64],
+    /// Grid ordinates, increasing.
+    pub ys: &'a [f64],
+    /// Row-major values; NaN cells are drawn grey (e.g. infeasible points).
+    pub values: &'a [f64],
+}
+
+/// Draw a [`HeatMap`] into the PNG at `path`, cells coloured from blue (low)
+/// to red (high) over the finite values' range.
+///
+/// # Errors
+/// A size mismatch between the grid and the values, or drawing failures.
+pub fn heat_map(path: &Path, map: &HeatMap<'_>) -> Result<(), PlotError> {
+    ensure_font();
+    let err = |e: &dyn std::fmt::Display| PlotError {
+        path: path.to_path_buf(),
+        msg: e.to_string(),
+    };
+    let (nx, ny) = (map.xs.len(), map.ys.len());
+    if nx == 0 || ny == 0 || map.values.len() != nx * ny {
+        return Err(err(&format!(
+            "grid {nx}×{ny} does not match {} values",
+            map.values.len()
+        )));
+    }
+    let half = |v: &[f64], k: usize| {
+        if v.len() == 1 {
+            0.5
+        } else if k + 1 < v.len() {
+            0.5 * (v[k + 1] - v[k])
+        } else {
+            0.5 * (v[k] - v[k - 1])
+        }
+    };
+    let (lo, hi) = finite_range(map.values.iter().copied());
+    let title = format!(
+        "{} — colour: {} ({:.4} … {:.4})",
+        map.title, map.value_label, lo, hi
+    );
+    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let (x0, x1) = (
+        map.xs[0] - half(map.xs, 0),
+        map.xs[nx - 1] + half(map.xs, nx - 1),
+    );
+    let (y0, y1) = (
+        map.ys[0] - half(map.ys, 0),
+        map.ys[ny - 1] + half(map.ys, ny - 1),
+    );
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(48)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(map.x_label)
+        .y_desc(map.y_label)
+        .label_style(("sans-serif", 15))
+        .draw()
+        .map_err(|e| err(&e))?;
+    let cells = (0..ny).flat_map(|j| (0..nx).map(move |i| (i, j)));
+    chart
+        .draw_series(cells.map(|(i, j)| {
+            let v = map.values[j * nx + i];
+            let color = if v.is_finite() {
+                let s = ((v - lo) / (hi - lo)).clamp(0.0, 1.0);
+                RGBColor((255.0 * s) as u8, 60, (255.0 * (1.0 - s)) as u8)
+            } else {
+                RGBColor(200, 200, 200)
+            };
+            let (x, y) = (map.xs[i], map.ys[j]);
+            Rectangle::new(
+                [
+                    (x - half(map.xs, i), y - half(map.ys, j)),
+                    (x + half(map.xs, i), y + half(map.ys, j)),
+                ],
+                color.filled(),
+            )
+        }))
+        .map_err(|e| err(&e))?;
+    root.present().map_err(|e| err(&e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn png_ok(path: &Path) -> bool {
+        let bytes = std::fs::read(path).unwrap_or_default();
+        bytes.len() > 1000 && bytes.starts_with(&[0x89, b'P', b'N', b'G'])
+    }
+
+    #[test]
+    fn draws_lines_markers_and_breaks() {
+        let dir = std::env::temp_dir().join(format!("ivt-plot-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let a: Vec<(f64, f64)> = (0..50)
+            .map(|k| (k as f64, (k as f64 * 0.2).sin()))
+            .collect();
+        let b = [
+            (0.0, 0.0),
+            (1.0, 1.0),
+            (f64::NAN, f64::NAN),
+            (2.0, 0.5),
+            (3.0, 0.2),
+        ];
+        let fig = Figure {
+            title: "test ω",
+            x_label: "θ [rad]",
+            y_label: "ω [rad/s]",
+            series: vec![
+                Series {
+                    label: "sin",
+                    points: &a,
+                    style: Style::Line,
+                },
+                Series {
+                    label: "broken",
+                    points: &b,
+                    style: Style::Dashed,
+                },
+                Series {
+                    label: "",
+                    points: &b,
+                    style: Style::Markers,
+                },
+            ],
+        };
+        let path = dir.join("lines.png");
+        line_plot(&path, &fig).unwrap();
+        assert!(png_ok(&path));
+        assert_eq!(pieces(&b).count(), 2);
+    }
+
+    #[test]
+    fn heat_map_checks_sizes() {
+        let dir = std::env::temp_dir().join(format!("ivt-plot-h-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let xs = [1.0, 2.0, 3.0];
+        let ys = [0.5, 1.0];
+        let values = [0.1, 0.2, 0.3, f64::NAN, 0.5, 0.6];
+        let map = HeatMap {
+            title: "t",
+            x_label: "V_m [V]",
+            y_label: "T_U [N·m]",
+            value_label: "|μ|",
+            xs: &xs,
+            ys: &ys,
+            values: &values,
+        };
+        let path = dir.join("heat.png");
+        heat_map(&path, &map).unwrap();
+        assert!(png_ok(&path));
+        let bad = HeatMap {
+            values: &values[..5],
+            ..map
+        };
+        assert!(heat_map(&dir.join("bad.png"), &bad).is_err());
+    }
+}
