@@ -27,7 +27,14 @@ fn rig_record_captures_every_frame_the_qemu_firmware_sends() {
         .arg(&pty)
         .arg("--out")
         .arg(&out)
-        .args(["--f-timer-hz", "1e6", "--idle-timeout-s", "5"])
+        .args([
+            "--f-timer-hz",
+            "1e6",
+            "--idle-timeout-s",
+            "10",
+            "--frames",
+            "700",
+        ])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -42,17 +49,19 @@ fn rig_record_captures_every_frame_the_qemu_firmware_sends() {
     let config = Config::default(); // 1 MHz timer
     pil.configure(&config).unwrap();
     pil.update_inputs(8.6, 6.0).unwrap();
-    let n = 700u32;
+    let n = 700u32; // = --frames above
     let mut t = 0u32;
     let mut last = None;
     for k in 0..n {
         t = t.wrapping_add(500 + (k % 40)); // ~100 rpm of θ at PPR 1200
         last = Some(pil.on_pulse(t).unwrap());
     }
+    // Let the recorder drain the pty while QEMU still holds it open (closing
+    // the master side discards unread bytes); it stops at 700 frames or,
+    // if frames were lost, after 10 s idle with fewer.
+    let output = rec.wait_with_output().unwrap();
     let report = pil.finish().unwrap();
     assert_eq!(report.telemetry_frames, u64::from(n));
-
-    let output = rec.wait_with_output().unwrap();
     assert!(output.status.success(), "recorder failed: {output:?}");
     let summary: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
     assert_eq!(summary["frames"], u64::from(n), "{summary}");
