@@ -13,6 +13,7 @@ pub mod ctrl;
 pub mod hb;
 pub mod kin;
 pub mod ol;
+pub mod rig;
 pub mod sim;
 pub mod stability;
 pub mod string;
@@ -73,6 +74,9 @@ enum Command {
     /// Harmonic balance: Duffing, frequency response, Mathieu–Duffing (Chapter 3).
     #[command(subcommand)]
     Hb(hb::HbCommand),
+    /// The rig: record firmware telemetry into MCAP.
+    #[command(subcommand)]
+    Rig(rig::RigCommand),
 }
 
 /// Parse the process arguments, run, print, and map errors to exit codes.
@@ -86,6 +90,7 @@ pub fn main() -> ExitCode {
         Some(Command::Stability(a)) => stability::run(a),
         Some(Command::StabilityMap(a)) => stability::run_map(a),
         Some(Command::Ctrl(cmd)) => ctrl::run(cmd),
+        Some(Command::Rig(cmd)) => rig::run(cmd),
         None => sim::run_default(cli.json),
         Some(Command::Hb(cmd)) => hb::run(cmd),
     };

@@ -20,6 +20,10 @@ pub struct SimArgs {
     /// Directory for the outputs the scene asks for.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
+    /// Processor in the loop: run the controller in the QEMU firmware
+    /// (`firmware/run-qemu.sh build` first; `$IVT_FW_ELF` overrides the image).
+    #[arg(long)]
+    pub pil: bool,
 }
 
 /// Run a scene file.
@@ -28,7 +32,7 @@ pub struct SimArgs {
 /// Scene errors as [`CliError::Input`], run/output failures as [`CliError::Failed`].
 pub fn run_file(args: &SimArgs, json: bool) -> Result<Output, CliError> {
     let scene = Scene::load(&args.scene).map_err(|e| CliError::Input(e.to_string()))?;
-    run_scene(&scene, &args.out, json)
+    run_scene(&scene, &args.out, json, args.pil)
 }
 
 /// `ivt` with no arguments: the default drive scene into `out/`.
@@ -38,12 +42,17 @@ pub fn run_file(args: &SimArgs, json: bool) -> Result<Output, CliError> {
 pub fn run_default(json: bool) -> Result<Output, CliError> {
     let scene = Scene::parse(DEFAULT_SCENE, "scenes/drive.toml")
         .map_err(|e| CliError::Input(e.to_string()))?;
-    run_scene(&scene, Path::new("out"), json)
+    run_scene(&scene, Path::new("out"), json, false)
 }
 
-fn run_scene(scene: &Scene, out: &Path, json: bool) -> Result<Output, CliError> {
+fn run_scene(scene: &Scene, out: &Path, json: bool, pil: bool) -> Result<Output, CliError> {
     let mut bar = Progress::new(!json && scene.duration_s >= 5.0, &scene.name);
-    let result = run(scene, &mut |f| bar.update(f)).map_err(|e| CliError::Failed(e.to_string()))?;
+    let result = if pil {
+        ivt_sim::pil::run_pil(scene, &mut |f| bar.update(f))
+    } else {
+        run(scene, &mut |f| bar.update(f))
+    }
+    .map_err(|e| CliError::Failed(e.to_string()))?;
     bar.finish();
     let paths = write_all(out, scene, &result).map_err(|e| CliError::Failed(e.to_string()))?;
     let outputs: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();

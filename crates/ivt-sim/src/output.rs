@@ -84,7 +84,8 @@ pub fn channel_fields(name: &str) -> &'static [(&'static str, &'static str)] {
     }
 }
 
-fn json_schema(name: &str) -> String {
+/// The JSON schema of a channel (`ivt.<name>`), as written into MCAP logs.
+pub fn json_schema(name: &str) -> String {
     let props: serde_json::Map<String, serde_json::Value> = channel_fields(name)
         .iter()
         .map(|(f, ty)| ((*f).to_string(), serde_json::json!({ "type": ty })))

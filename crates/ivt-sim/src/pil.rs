@@ -1,0 +1,129 @@
+//! Processor in the loop: the QEMU firmware (`firmware/`, image
+//! `ivt-fw-qemu`) runs the controller; each pulse and each reading goes over
+//! its UART (a Unix socket on the host side, frames of `ivt-wire`) and the
+//! firmware's `ControlOutput` comes back bit-exact. The firmware is built for
+//! one PPR (`firmware/src/app.rs`, 1200); a scene with another PPR is refused
+//! at start with the firmware's and the scene's values.
+
+use ivt_ctrl::{Config, ControlOutput};
+use ivt_wire::host::{PilError, QemuOptions, QemuPil};
+
+use crate::backend::{BackendError, ControllerBackend};
+
+/// The QEMU firmware as a controller backend.
+pub struct Pil {
+    link: Option<QemuPil>,
+}
+
+impl Pil {
+    /// Starts QEMU (options from [`QemuOptions::from_env`]: `$IVT_FW_ELF` or
+    /// the image built by `firmware/run-qemu.sh build`) and loads `config`.
+    ///
+    /// # Errors
+    /// [`BackendError::Io`] if QEMU or the image is missing or does not
+    /// answer; [`BackendError::Protocol`] if the firmware's PPR differs.
+    pub fn start(ppr: usize, config: &Config) -> Result<Self, BackendError> {
+        Self::start_with(&QemuOptions::from_env(), ppr, config)
+    }
+
+    /// As [`Pil::start`] with explicit QEMU options.
+    ///
+    /// # Errors
+    /// As [`Pil::start`].
+    pub fn start_with(
+        opts: &QemuOptions,
+        ppr: usize,
+        config: &Config,
+    ) -> Result<Self, BackendError> {
+        let mut link = QemuPil::start(opts, ppr as u32).map_err(to_backend)?;
+        link.configure(config).map_err(to_backend)?;
+        Ok(Self { link: Some(link) })
+    }
+
+    fn link(&mut self) -> Result<&mut QemuPil, BackendError> {
+        self.link
+            .as_mut()
+            .ok_or_else(|| BackendError::Io("PIL session already finished".into()))
+    }
+
+    /// Ends the session cleanly (QEMU exits 0) and returns the firmware's
+    /// report (pulses served, stack high-water mark).
+    ///
+    /// # Errors
+    /// As [`Pil::start`].
+    pub fn finish(&mut self) -> Result<ivt_wire::host::FirmwareReport, BackendError> {
+        match self.link.take() {
+            Some(link) => link.finish().map_err(to_backend),
+            None => Err(BackendError::Io("PIL session already finished".into())),
+        }
+    }
+}
+
+fn to_backend(e: PilError) -> BackendError {
+    match e {
+        PilError::Protocol { .. } | PilError::Incompatible { .. } | PilError::Wire(_) => {
+            BackendError::Protocol(e.to_string())
+        }
+        _ => BackendError::Io(e.to_string()),
+    }
+}
+
+impl ControllerBackend for Pil {
+    fn on_pulse(&mut self, ticks: u32) -> Result<ControlOutput, BackendError> {
+        self.link()?.on_pulse(ticks).map_err(to_backend)
+    }
+
+    fn update_inputs(&mut self, v_m: f32, t_u: f32) -> Result<(), BackendError> {
+        self.link()?.update_inputs(v_m, t_u).map_err(to_backend)
+    }
+}
+
+/// Runs a scene with the QEMU firmware as the controller (`ivt sim SCENE
+/// --pil`): the same closed loop as [`crate::run::run`] with the [`Pil`]
+/// backend in place of the in-process one. The QEMU session is ended cleanly
+/// afterwards (a firmware that died mid-run surfaces as a backend error).
+///
+/// # Errors
+/// Scene, integration and backend failures, as [`crate::run::run`].
+pub fn run_pil(
+    scene: &crate::scene::Scene,
+    progress: &mut dyn FnMut(f64),
+) -> Result<crate::run::RunResult, crate::run::SimError> {
+    let params = scene
+        .plant_params()
+        .map_err(|(k, m)| crate::run::SimError::Scene(format!("`{k}` {m}")))?;
+    let Some(config) = crate::run::controller_config(scene, params.r_max) else {
+        return Err(crate::run::SimError::Scene(
+            "`controller.law = \"none\"` has no controller to put in the loop".into(),
+        ));
+    };
+    let backend = Shared::new(Pil::start(scene.encoder.ppr, &config)?);
+    let result = crate::run::run_with_backend(scene, Some(Box::new(backend.clone())), progress)?;
+    backend.finish()?;
+    Ok(result)
+}
+
+/// A [`Pil`] the run loop can own as a boxed backend while the caller keeps a
+/// handle to end the session afterwards.
+#[derive(Clone)]
+struct Shared(std::rc::Rc<std::cell::RefCell<Pil>>);
+
+impl Shared {
+    fn new(pil: Pil) -> Self {
+        Self(std::rc::Rc::new(std::cell::RefCell::new(pil)))
+    }
+
+    fn finish(&self) -> Result<ivt_wire::host::FirmwareReport, BackendError> {
+        self.0.borrow_mut().finish()
+    }
+}
+
+impl ControllerBackend for Shared {
+    fn on_pulse(&mut self, ticks: u32) -> Result<ControlOutput, BackendError> {
+        self.0.borrow_mut().on_pulse(ticks)
+    }
+
+    fn update_inputs(&mut self, v_m: f32, t_u: f32) -> Result<(), BackendError> {
+        self.0.borrow_mut().update_inputs(v_m, t_u)
+    }
+}

@@ -1,0 +1,11 @@
+#![doc = include_str!("../README.md")]
+#![cfg_attr(not(feature = "host"), no_std)]
+
+pub mod frame;
+pub mod msg;
+
+#[cfg(feature = "host")]
+pub mod host;
+
+pub use frame::{crc16, Decoder, RawFrame, WireError, MAX_FRAME};
+pub use msg::{ErrorCode, Reply, Request, Telemetry};
