@@ -1,2 +1,28 @@
-//! The rig controller (no_std, f32, no heap): angle-sampled averaging, open-loop law, time-delay feedback, actuator output. Being built under issue 5; nothing here yet.
+#![doc = include_str!("../README.md")]
 #![no_std]
+#![warn(missing_docs)]
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::indexing_slicing,
+        clippy::unreachable,
+        clippy::todo,
+        clippy::unimplemented
+    )
+)]
+
+pub mod actuator;
+pub mod averager;
+pub mod controller;
+pub mod law;
+pub mod open_loop;
+pub mod units;
+
+pub use actuator::{ActuatorMap, StepGenerator, StepperLimits};
+pub use averager::AngleAverager;
+pub use controller::{Config, ControlOutput, Controller, Fault, Gains, LawKind, StepTick};
+pub use law::FeedbackLaw;
+pub use open_loop::{OlRegion, OpenLoopCoeffs, THESIS};

@@ -1,0 +1,567 @@
+//! The top-level controller: the three calls the firmware, the simulator and
+//! the Python bindings drive (BRIEF controller contract).
+//!
+//! ```text
+//! on_pulse(ticks)        encoder pulse → ω, ω_a, ω_T → law → r = u_ol + r_d → stepper target
+//! update_inputs(V_m,T_U) slow readings → u_ol (Eq. 158–160), evaluated here, not per pulse
+//! step_tick(now)         step/dir generator; also detects a stalled encoder
+//! ```
+//!
+//! # Saturation and anti-windup
+//! `r = clamp(u_ol + r_d, 0, r_max)`. After each increment the integrator
+//! state itself is clamped to `[−u_ol, r_max − u_ol]`, so r_d never winds up
+//! beyond the bound: r leaves a bound at the first pulse whose increment
+//! points back inside. r_d is a Kahan-compensated sum, so 10⁶ tiny
+//! increments do not drift against an f64 reference.
+//!
+//! # Faults and safe state
+//! | code | [`Fault`] | cause | output |
+//! |---|---|---|---|
+//! | 0 | `None` | — | normal |
+//! | 1 | `Stall` | no encoder pulse for `stall_timeout_s` (seen by `step_tick`, or a pulse arriving after that long) | r = `safe_r` (default 0: geared neutral, the motor is unloaded); averager, law and r_d reset; normal control resumes after a full revolution of fresh pulses (open loop r = u_ol until then) |
+//! | 2 | `IntervalTooShort` | zero tick difference or faster than `omega_max` (double edge, noise) | pulse ignored, outputs held |
+//! | 3 | `InputInvalid` | V_m or T_U NaN/∞ or outside the plausible sensor range `v_m_valid`/`t_u_valid` | reading ignored, last valid inputs held; code reported until a valid reading arrives |
+//! | 4 | `Config` | invalid [`Config`] (non-finite or non-positive f_timer, ω0, r_max, limits; PPR = 0; …) | permanent safe state r = clamp(`safe_r`), no steps emitted |
+//!
+//! Readings that are plausible but outside the working region of the
+//! open-loop fit are clamped, not faults: `ControlOutput::inputs_clamped`.
+//! Before a full revolution has been seen (`ready == false`) the output is
+//! the open-loop value and ω_a, ω_T read 0.
+
+use crate::actuator::{ActuatorMap, StepGenerator, StepperLimits};
+use crate::averager::AngleAverager;
+use crate::law::{DelayLaw, FeedbackLaw, LawState, NoDelayLaw, NoFeedback, PropLaw, PulseSample};
+use crate::open_loop::{clamp_f32, OlRegion, OpenLoopCoeffs, THESIS};
+use crate::units;
+
+/// Fault codes (see the module doc for the safe state of each).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[repr(u8)]
+pub enum Fault {
+    /// No fault.
+    #[default]
+    None = 0,
+    /// Encoder stalled (no pulse within the timeout).
+    Stall = 1,
+    /// Zero or implausibly short pulse interval; the pulse was ignored.
+    IntervalTooShort = 2,
+    /// NaN/∞ or implausible V_m/T_U reading; it was ignored.
+    InputInvalid = 3,
+    /// Invalid configuration; permanent safe state.
+    Config = 4,
+}
+
+impl Fault {
+    /// The numeric code (`repr(u8)`).
+    #[must_use]
+    pub fn code(self) -> u8 {
+        self as u8
+    }
+}
+
+/// Which feedback law runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum LawKind {
+    /// Integral time-delay law, Eq. 180.
+    #[default]
+    Delay,
+    /// No-delay law, Eq. 181.
+    NoDelay,
+    /// Proportional increment at a fixed period, Eq. 189.
+    Prop,
+    /// Open loop only, Eq. 160.
+    Open,
+}
+
+/// Gains in SI. Build from the thesis's printed values with
+/// [`Gains::from_thesis_mm_per_rad`] (the unit interpretation is in [`crate::units`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gains {
+    /// k of Eq. 180/181 \[m·s/rad²\].
+    pub k: f32,
+    /// k2 of Eq. 180/181 \[m·s/rad² for Eq. 180, m·s/rad for Eq. 181\].
+    pub k2: f32,
+    /// K_r of Eq. 189 in eccentricity \[m per rad/s\].
+    pub k_prop: f32,
+    /// Sample period of Eq. 189 \[s\].
+    pub prop_period_s: f32,
+}
+
+impl Gains {
+    /// Gains from the thesis's printed "mm·rad⁻¹" values (e.g. 0.01, 0.02 for
+    /// Eq. 180); the Eq. 189 part is K = 50 deg/rpm every 0.1 s.
+    #[must_use]
+    pub fn from_thesis_mm_per_rad(k: f32, k2: f32) -> Self {
+        Self {
+            k: units::gain_from_mm_per_rad(k),
+            k2: units::gain_from_mm_per_rad(k2),
+            ..Self::default()
+        }
+    }
+}
+
+impl Default for Gains {
+    /// Eq. 180 with k = 0.01, k2 = 0.02 mm·rad⁻¹ (§4.3, Fig. 42), Eq. 189 with
+    /// K = 50 (§4.4.3) and a 0.1 s sample period (the thesis gives none: an
+    /// assumption, configurable).
+    fn default() -> Self {
+        Self {
+            k: units::gain_from_mm_per_rad(0.01),
+            k2: units::gain_from_mm_per_rad(0.02),
+            k_prop: units::prop_gain_from_deg_per_rpm(units::THESIS_PROP_K_DEG_PER_RPM),
+            prop_period_s: 0.1,
+        }
+    }
+}
+
+/// Everything a controller needs; `Config::default()` is the thesis setup
+/// (100 rpm, PPR from the type, 1 MHz timer, Eq. 180 with the Fig. 42 gains,
+/// the `THESIS` open-loop preset, SGIVT actuator map with 3200 steps/rev).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Config {
+    /// Timer frequency of the timestamps \[Hz\].
+    pub f_timer_hz: f32,
+    /// Target speed ω0 \[rad/s\].
+    pub omega0: f32,
+    /// Encoder pulses per controller sample (≥ 1): the encoder has
+    /// `PPR·decimation` pulses per revolution and the law runs on every
+    /// `decimation`-th one (RAM for resolution).
+    pub decimation: u16,
+    /// The feedback law.
+    pub law: LawKind,
+    /// Gains (SI).
+    pub gains: Gains,
+    /// Open-loop coefficients (Eq. 158–160); also gives r_max.
+    pub open_loop: OpenLoopCoeffs,
+    /// Add u_ol to r (true: Eq. 180/181; false: r = r_d alone, as the
+    /// driving test of §4.4.3 ran Eq. 189 without feed-forward).
+    pub feedforward: bool,
+    /// Eccentricity → stepper position.
+    pub actuator: ActuatorMap,
+    /// Stepper speed/acceleration limits.
+    pub stepper: StepperLimits,
+    /// No pulse for this long → `Fault::Stall` \[s\].
+    pub stall_timeout_s: f32,
+    /// Pulse intervals shorter than this speed implies are rejected \[rad/s\].
+    pub omega_max: f32,
+    /// Eccentricity commanded in the stall/config safe state \[m\].
+    pub safe_r: f32,
+    /// Plausible V_m sensor range \[V\]; outside → `Fault::InputInvalid`.
+    pub v_m_valid: [f32; 2],
+    /// Plausible T_U sensor range \[N·m\]; outside → `Fault::InputInvalid`.
+    pub t_u_valid: [f32; 2],
+    /// Inputs assumed until the first valid `update_inputs` (V, N·m): the
+    /// §4.3 scene's 8 V / 8 N·m.
+    pub initial_inputs: [f32; 2],
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Self {
+            f_timer_hz: 1.0e6,
+            omega0: units::rpm_to_rad_s(100.0),
+            decimation: 1,
+            law: LawKind::Delay,
+            gains: Gains::default(),
+            open_loop: THESIS,
+            feedforward: true,
+            actuator: ActuatorMap::sgivt(3200.0),
+            stepper: StepperLimits {
+                max_speed: 4000.0,
+                accel: 40_000.0,
+            },
+            stall_timeout_s: 0.5,
+            omega_max: 200.0,
+            safe_r: 0.0,
+            v_m_valid: [-1.0, 48.0],
+            t_u_valid: [-1.0, 50.0],
+            initial_inputs: [8.0, 8.0],
+        }
+    }
+}
+
+impl Config {
+    fn is_valid(&self, ppr: usize) -> bool {
+        let pos = |x: f32| x.is_finite() && x > 0.0;
+        let ordered = |r: [f32; 2]| r[0].is_finite() && r[1].is_finite() && r[0] <= r[1];
+        ppr >= 1
+            && pos(self.f_timer_hz)
+            && pos(self.omega0)
+            && pos(self.omega_max)
+            && pos(self.stall_timeout_s)
+            && self.decimation >= 1
+            && self.gains.k.is_finite()
+            && self.gains.k2.is_finite()
+            && self.gains.k_prop.is_finite()
+            && pos(self.gains.prop_period_s)
+            && self.open_loop.is_valid()
+            && self.actuator.is_valid()
+            && self.stepper.is_valid()
+            && self.safe_r.is_finite()
+            && ordered(self.v_m_valid)
+            && ordered(self.t_u_valid)
+    }
+}
+
+/// What one pulse produces (the parts of the law, as the simulator logs them).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ControlOutput {
+    /// ω over the last pulse \[rad/s\] (0 before two pulses).
+    pub omega: f32,
+    /// ω_a, mean over the last revolution \[rad/s\] (0 until `ready`).
+    pub omega_a: f32,
+    /// ω_T, ω one revolution earlier \[rad/s\] (0 until `ready`).
+    pub omega_t: f32,
+    /// Open-loop part u_ol \[m\] (0 if `feedforward` is off).
+    pub r_ol: f32,
+    /// Feedback part r_d \[m\].
+    pub r_d: f32,
+    /// Commanded eccentricity r ∈ \[0, r_max\] \[m\].
+    pub r: f32,
+    /// Stepper position for r \[steps\].
+    pub stepper_target: i32,
+    /// True if r is at a bound (anti-windup active).
+    pub saturated: bool,
+    /// Fault code of this call.
+    pub fault: Fault,
+    /// True once a full revolution of pulses has been seen and the law runs.
+    pub ready: bool,
+    /// True if the open-loop inputs were clamped to the working region.
+    pub inputs_clamped: bool,
+    /// Branch of Eq. 160 for the current inputs.
+    pub ol_region: OlRegion,
+}
+
+/// What one step-generator tick produces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StepTick {
+    /// Emit a step pulse now.
+    pub step: bool,
+    /// Direction line: true = towards larger positions (larger r for a positive map).
+    pub forward: bool,
+    /// Stepper position after this tick \[steps\].
+    pub position: i32,
+    /// Timer tick at which the next step is due (while `moving`).
+    pub next_step_at: u32,
+    /// True while a move is in progress.
+    pub moving: bool,
+    /// `Fault::Stall` if the encoder has stalled, else the last pulse's fault.
+    pub fault: Fault,
+}
+
+/// The rig controller for an encoder sampled `PPR` times per revolution of θ.
+#[derive(Clone, Debug)]
+pub struct Controller<const PPR: usize> {
+    averager: AngleAverager<PPR>,
+    law: LawState,
+    stepper: StepGenerator,
+    open_loop: OpenLoopCoeffs,
+    actuator: ActuatorMap,
+    /// r_d and its Kahan compensation.
+    r_d: f32,
+    r_d_comp: f32,
+    omega0: f32,
+    dtheta: f32,
+    safe_r: f32,
+    v_m_valid: [f32; 2],
+    t_u_valid: [f32; 2],
+    min_interval: u32,
+    max_interval: u32,
+    decimation: u16,
+    skip: u16,
+    feedforward: bool,
+    config_ok: bool,
+    running: bool,
+    stalled: bool,
+    input_fault: bool,
+    last_raw: u32,
+    omega_prev: f32,
+    out: ControlOutput,
+}
+
+impl<const PPR: usize> Controller<PPR> {
+    /// A controller for `config`. An invalid config gives a controller in the
+    /// permanent `Fault::Config` safe state (never a panic).
+    #[must_use]
+    pub fn new(config: Config) -> Self {
+        let config_ok = config.is_valid(PPR);
+        let f = config.f_timer_hz;
+        let samples = PPR as f32 * f32::from(config.decimation.max(1));
+        let dtheta_enc = core::f32::consts::TAU / samples;
+        // Shortest accepted interval: a pulse at omega_max. Longest: the stall
+        // timeout, and at most u32::MAX/(PPR+1)·decimation so one revolution
+        // always spans fewer than 2³² ticks (wrapping differences stay exact).
+        let min_interval = ((f * dtheta_enc / config.omega_max) as u32).max(1);
+        let rev_cap = u32::MAX
+            / (PPR as u32)
+                .saturating_add(1)
+                .saturating_mul(u32::from(config.decimation.max(1)));
+        let stall = (config.stall_timeout_s * f) as u32;
+        let max_interval = stall.min(rev_cap).min(0x7FFF_FFFF).max(min_interval);
+        let period = (config.gains.prop_period_s * f) as u32;
+        let law = match config.law {
+            LawKind::Delay => LawState::Delay(DelayLaw {
+                k: config.gains.k,
+                k2: config.gains.k2,
+            }),
+            LawKind::NoDelay => LawState::NoDelay(NoDelayLaw {
+                k: config.gains.k,
+                k2: config.gains.k2,
+            }),
+            LawKind::Prop => LawState::Prop(PropLaw::new(config.gains.k_prop, period)),
+            LawKind::Open => LawState::Open(NoFeedback),
+        };
+        let mut c = Self {
+            averager: AngleAverager::new(f),
+            law,
+            stepper: StepGenerator::new(config.stepper, f),
+            open_loop: config.open_loop,
+            actuator: config.actuator,
+            r_d: 0.0,
+            r_d_comp: 0.0,
+            omega0: config.omega0,
+            dtheta: core::f32::consts::TAU / (PPR.max(1) as f32),
+            safe_r: config.safe_r,
+            v_m_valid: config.v_m_valid,
+            t_u_valid: config.t_u_valid,
+            min_interval,
+            max_interval,
+            decimation: config.decimation.max(1),
+            skip: 0,
+            feedforward: config.feedforward,
+            config_ok,
+            running: false,
+            stalled: false,
+            input_fault: false,
+            last_raw: 0,
+            omega_prev: 0.0,
+            out: ControlOutput {
+                omega: 0.0,
+                omega_a: 0.0,
+                omega_t: 0.0,
+                r_ol: 0.0,
+                r_d: 0.0,
+                r: 0.0,
+                stepper_target: 0,
+                saturated: false,
+                fault: Fault::None,
+                ready: false,
+                inputs_clamped: false,
+                ol_region: OlRegion::Normal,
+            },
+        };
+        let [v, t] = config.initial_inputs;
+        c.set_inputs(v, t);
+        if config_ok {
+            c.command(Fault::None);
+        } else {
+            c.enter_safe(Fault::Config);
+        }
+        c
+    }
+
+    /// r_max of the open-loop coefficient set \[m\].
+    #[must_use]
+    pub fn r_max(&self) -> f32 {
+        self.open_loop.r_max
+    }
+
+    /// The output of the most recent call (pulse, input update or stall).
+    #[must_use]
+    pub fn output(&self) -> ControlOutput {
+        self.out
+    }
+
+    /// Clamp without the `f32::clamp` assertion; NaN → lo.
+    #[inline]
+    fn clamp_r(&self, r: f32) -> f32 {
+        if r.is_nan() {
+            0.0
+        } else {
+            clamp_f32(r, 0.0, self.open_loop.r_max)
+        }
+    }
+
+    /// Evaluate u_ol for (already validated) inputs.
+    fn set_inputs(&mut self, v_m: f32, t_u: f32) {
+        let ol = self.open_loop.evaluate(v_m, t_u);
+        self.out.r_ol = if self.feedforward { ol.r_ol } else { 0.0 };
+        self.out.inputs_clamped = ol.inputs_clamped;
+        self.out.ol_region = ol.region;
+    }
+
+    /// Form r from r_ol and r_d with saturation and anti-windup, and set the
+    /// stepper target.
+    fn command(&mut self, fault: Fault) {
+        let r_ol = self.out.r_ol;
+        let lo = -r_ol;
+        let hi = self.open_loop.r_max - r_ol;
+        let mut saturated = false;
+        if self.r_d < lo {
+            self.r_d = lo;
+            self.r_d_comp = 0.0;
+            saturated = true;
+        } else if self.r_d > hi {
+            self.r_d = hi;
+            self.r_d_comp = 0.0;
+            saturated = true;
+        }
+        let r = self.clamp_r(r_ol + self.r_d);
+        saturated |= r <= 0.0 || r >= self.open_loop.r_max;
+        self.out.r_d = self.r_d;
+        self.out.r = r;
+        self.out.saturated = saturated;
+        self.set_target(r);
+        self.out.fault = if fault == Fault::None && self.input_fault {
+            Fault::InputInvalid
+        } else {
+            fault
+        };
+    }
+
+    fn set_target(&mut self, r: f32) {
+        let target = self.actuator.steps(r);
+        self.out.stepper_target = target;
+        self.stepper.set_target(target);
+    }
+
+    /// Safe state: r = safe_r, history and integrator forgotten.
+    fn enter_safe(&mut self, fault: Fault) {
+        self.averager.reset();
+        self.law.reset(self.last_raw);
+        self.r_d = 0.0;
+        self.r_d_comp = 0.0;
+        self.skip = 0;
+        let r = self.clamp_r(self.safe_r);
+        self.out.omega = 0.0;
+        self.out.omega_a = 0.0;
+        self.out.omega_t = 0.0;
+        self.out.r_d = 0.0;
+        self.out.r = r;
+        self.out.saturated = false;
+        self.out.ready = false;
+        self.out.fault = fault;
+        self.set_target(r);
+    }
+
+    /// One encoder pulse with its timer timestamp \[ticks\]. O(1), no trig,
+    /// no heap; see the module doc for faults.
+    pub fn on_pulse(&mut self, ticks: u32) -> ControlOutput {
+        if !self.config_ok {
+            return self.out;
+        }
+        let mut event = Fault::None;
+        if self.running {
+            let dt = ticks.wrapping_sub(self.last_raw);
+            if dt < self.min_interval {
+                // Double edge or noise: ignore the pulse, hold the outputs.
+                self.out.fault = Fault::IntervalTooShort;
+                return self.out;
+            }
+            if dt > self.max_interval {
+                // Restart after a stall: this pulse is the first of a new history.
+                self.enter_safe(Fault::Stall);
+                event = Fault::Stall;
+            }
+        }
+        self.running = true;
+        self.stalled = false;
+        self.last_raw = ticks;
+        if self.skip > 0 {
+            self.skip -= 1;
+            self.out.fault = if event == Fault::None && self.input_fault {
+                Fault::InputInvalid
+            } else {
+                event
+            };
+            return self.out;
+        }
+        self.skip = self.decimation - 1;
+
+        let s = self.averager.push(ticks);
+        let omega = s.omega.unwrap_or(0.0);
+        self.out.omega = omega;
+        match (s.omega_a, s.omega_t) {
+            (Some(omega_a), Some(omega_t)) => {
+                self.out.omega_a = omega_a;
+                self.out.omega_t = omega_t;
+                self.out.ready = true;
+                let sample = PulseSample {
+                    ticks,
+                    omega,
+                    omega_prev: self.omega_prev,
+                    omega_a,
+                    omega_t,
+                    omega0: self.omega0,
+                    dtheta: self.dtheta,
+                };
+                let inc = self.law.increment(&sample);
+                if inc.is_finite() {
+                    // Kahan-compensated r_d += inc.
+                    let y = inc - self.r_d_comp;
+                    let t = self.r_d + y;
+                    self.r_d_comp = (t - self.r_d) - y;
+                    self.r_d = t;
+                }
+            }
+            (omega_a, _) => {
+                self.out.omega_a = omega_a.unwrap_or(0.0);
+                self.out.omega_t = 0.0;
+                self.out.ready = false;
+            }
+        }
+        self.omega_prev = omega;
+        self.command(event);
+        self.out
+    }
+
+    /// Slow readings: motor voltage V_m \[V\] and brake torque T_U \[N·m\].
+    /// Invalid readings are ignored and flagged (`Fault::InputInvalid`).
+    pub fn update_inputs(&mut self, v_m: f32, t_u: f32) {
+        if !self.config_ok {
+            return;
+        }
+        let inside = |x: f32, r: [f32; 2]| x.is_finite() && x >= r[0] && x <= r[1];
+        if inside(v_m, self.v_m_valid) && inside(t_u, self.t_u_valid) {
+            self.input_fault = false;
+            self.set_inputs(v_m, t_u);
+        } else {
+            self.input_fault = true;
+        }
+        if self.stalled {
+            self.out.fault = if self.input_fault {
+                Fault::InputInvalid
+            } else {
+                Fault::Stall
+            };
+        } else {
+            self.command(Fault::None);
+        }
+    }
+
+    /// Step-generator tick at `now` \[ticks\]: whether to emit a step now and
+    /// in which direction. Also declares a stall if no pulse arrived within
+    /// the timeout.
+    pub fn step_tick(&mut self, now: u32) -> StepTick {
+        if self.config_ok && self.running && !self.stalled {
+            let since = now.wrapping_sub(self.last_raw);
+            if since > self.max_interval && since < 0x8000_0000 {
+                self.stalled = true;
+                self.enter_safe(Fault::Stall);
+            }
+        }
+        let d = self.stepper.tick(now);
+        StepTick {
+            step: d.step,
+            forward: d.forward,
+            position: d.position,
+            next_step_at: d.next_step_at,
+            moving: d.moving,
+            fault: if self.stalled {
+                Fault::Stall
+            } else {
+                self.out.fault
+            },
+        }
+    }
+}
