@@ -21,6 +21,12 @@ def main() -> None:
     print(f"f(0.3) = {scalar:.6f}, J = {terms['j'].round(5)}")
     print(f"max ω_U = {plant_speed_profile(0.006).max():.4f} rad/s")
 
+    k, k2 = ivt.ctrl.thesis_gains(0.06, 0.12)
+    controller = ivt.ctrl.Controller(1200, k=k, k2=k2, law="delay")
+    ticks = np.cumsum(np.full(3000, 500, dtype=np.int64))  # 10.47 rad/s at 1 MHz
+    out = controller.on_pulses(ticks)
+    print(f"ω_a = {float(out['omega_a'][-1]):.3f} rad/s, r = {float(out['r'][-1]) * 1e3:.3f} mm")
+
 
 if __name__ == "__main__":
     main()

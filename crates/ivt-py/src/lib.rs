@@ -9,6 +9,7 @@
 
 use pyo3::prelude::*;
 
+mod ctrl;
 mod kin;
 mod vectorize;
 
@@ -17,5 +18,6 @@ mod vectorize;
 fn _ivt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     kin::register(m)?;
+    ctrl::register(m)?;
     Ok(())
 }

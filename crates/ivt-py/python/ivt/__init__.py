@@ -5,13 +5,13 @@ Submodules (each mirrors a command group of the ``ivt`` command line, with the
 same names and dict keys as its ``--json`` output, SPEC §6):
 
 - :mod:`ivt.kin`   kinematics and plant coefficients (numpy-vectorized)
+- :mod:`ivt.ctrl`  the rig controller (f32, as on the MCU)
 
 The numerics are the Rust crates of the workspace, reached through the private
 native module ``ivt._ivt``; long calls release the GIL.
 """
 
-from . import _ivt, kin
+from . import ctrl, kin
+from ._ivt import __version__
 
-__version__: str = _ivt.__version__
-
-__all__ = ["kin", "__version__"]
+__all__ = ["ctrl", "kin", "__version__"]

@@ -7,16 +7,16 @@ from ._types import ArrayLike, FloatArray
 NCG_AMPLITUDE: float
 
 @overload
-def f(theta: float) -> float: ...  # type: ignore[overload-overlap]
+def f(theta: float) -> float: ...
 @overload
 def f(theta: ArrayLike) -> FloatArray: ...
 @overload
-def f_theta(theta: float) -> float: ...  # type: ignore[overload-overlap]
+def f_theta(theta: float) -> float: ...
 @overload
 def f_theta(theta: ArrayLike) -> FloatArray: ...
 def mean_f_squared() -> float: ...
 @overload
-def ring_speeds(  # type: ignore[overload-overlap]
+def ring_speeds(
     omega: float, omega_c: float, d_s: float = 1.0, d_p: float = 1.0
 ) -> Tuple[float, float]: ...
 @overload
@@ -24,7 +24,7 @@ def ring_speeds(
     omega: ArrayLike, omega_c: ArrayLike, d_s: float = 1.0, d_p: float = 1.0
 ) -> Tuple[FloatArray, FloatArray]: ...
 @overload
-def driver_speeds(  # type: ignore[overload-overlap]
+def driver_speeds(
     theta: float, omega: float, r: float
 ) -> Tuple[float, float]: ...
 @overload
@@ -32,7 +32,7 @@ def driver_speeds(
     theta: ArrayLike, omega: ArrayLike, r: ArrayLike
 ) -> Tuple[FloatArray, FloatArray]: ...
 @overload
-def output_speed(  # type: ignore[overload-overlap]
+def output_speed(
     theta: float, omega: float, r: float, r_u: float = 0.0222
 ) -> float: ...
 @overload
@@ -40,7 +40,7 @@ def output_speed(
     theta: ArrayLike, omega: ArrayLike, r: ArrayLike, r_u: float = 0.0222
 ) -> FloatArray: ...
 @overload
-def output_to_motor_ratio(r: float, r_u: float = 0.0222) -> float: ...  # type: ignore[overload-overlap]
+def output_to_motor_ratio(r: float, r_u: float = 0.0222) -> float: ...
 @overload
 def output_to_motor_ratio(r: ArrayLike, r_u: float = 0.0222) -> FloatArray: ...
 
@@ -72,7 +72,7 @@ class Plant:
     @property
     def r_max(self) -> float: ...
     @overload
-    def terms(  # type: ignore[overload-overlap]
+    def terms(
         self, theta: float, r: float, v_m: float, t_u: float
     ) -> Dict[str, float]: ...
     @overload
@@ -80,7 +80,7 @@ class Plant:
         self, theta: ArrayLike, r: ArrayLike, v_m: ArrayLike, t_u: ArrayLike
     ) -> Dict[str, FloatArray]: ...
     @overload
-    def acceleration(  # type: ignore[overload-overlap]
+    def acceleration(
         self, theta: float, omega: float, r: float, v_m: float, t_u: float
     ) -> float: ...
     @overload
