@@ -18,6 +18,8 @@
 //!   and the speeds of the SGIVT variant (Eq. 44–47).
 //! - [`plant`]: Table 1 parameters and the coefficients of the dynamic
 //!   equation Eq. 151.
+#![doc = ""]
+#![doc = include_str!("../README.md")]
 #![cfg_attr(not(feature = "std"), no_std)]
 #![warn(missing_docs)]
 
