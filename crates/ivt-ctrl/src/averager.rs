@@ -39,7 +39,7 @@ pub struct Speeds {
 #[derive(Clone, Debug)]
 pub struct AngleAverager<const PPR: usize> {
     ring: [u32; PPR],
-    head: usize,
+    head: u32,
     last: u32,
     older: u32,
     seen: u32,
@@ -105,7 +105,7 @@ impl<const PPR: usize> AngleAverager<PPR> {
         // The slot under `head` holds t_{k−PPR} once the ring is full.
         let mut omega_a = None;
         let mut omega_t = None;
-        if let Some(slot) = self.ring.get_mut(self.head) {
+        if let Some(slot) = self.ring.get_mut(self.head as usize) {
             let oldest = *slot;
             if seen >= PPR {
                 omega_a = Self::rate(self.two_pi_f, ticks.wrapping_sub(oldest));
@@ -115,11 +115,8 @@ impl<const PPR: usize> AngleAverager<PPR> {
             }
             self.older = oldest;
             *slot = ticks;
-            self.head = if self.head + 1 >= PPR {
-                0
-            } else {
-                self.head + 1
-            };
+            let next = self.head.wrapping_add(1);
+            self.head = if next as usize >= PPR { 0 } else { next };
         }
         self.last = ticks;
         if seen < PPR.saturating_add(2) {

@@ -184,7 +184,7 @@ impl Config {
     fn is_valid(&self, ppr: usize) -> bool {
         let pos = |x: f32| x.is_finite() && x > 0.0;
         let ordered = |r: [f32; 2]| r[0].is_finite() && r[1].is_finite() && r[0] <= r[1];
-        ppr >= 1
+        (1..=1 << 20).contains(&ppr)
             && pos(self.f_timer_hz)
             && pos(self.omega0)
             && pos(self.omega_max)
@@ -565,3 +565,7 @@ impl<const PPR: usize> Controller<PPR> {
         }
     }
 }
+
+// Issue 5: the controller for the thesis's 1200-line encoder fits in 5 KiB
+// (4800 bytes of timestamps + state). Checked at compile time on every target.
+const _: () = assert!(core::mem::size_of::<Controller<1200>>() <= 5 * 1024);

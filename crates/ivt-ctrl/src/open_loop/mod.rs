@@ -15,14 +15,17 @@
 mod thesis;
 pub use thesis::THESIS;
 
-/// Degree bound of the polynomial in each variable (`poly` is 5×5).
-pub const POLY_DIM: usize = 5;
+/// Number of powers of V_m in `poly` (V_m⁰…V_m², as in Eq. 158).
+pub const POLY_V_TERMS: usize = 3;
+/// Number of powers of T_U in `poly` (T_U⁰…T_U⁴, as in Eq. 158).
+pub const POLY_T_TERMS: usize = 5;
 
 /// Coefficients of an open-loop law of the form of Eq. 158–160.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OpenLoopCoeffs {
-    /// `poly[i][j]` multiplies `V_m^i · T_U^j`, r_f in metres (Eq. 158 form).
-    pub poly: [[f32; POLY_DIM]; POLY_DIM],
+    /// `poly[i][j]` multiplies `V_m^i · T_U^j`, r_f in metres: the form of
+    /// Eq. 158 (degree ≤ 2 in V_m, ≤ 4 in T_U; unused terms are 0).
+    pub poly: [[f32; POLY_T_TERMS]; POLY_V_TERMS],
     /// Boundary `f_B = b[0]·V_m + b[1]·T_U + b[2]` (Eq. 159); `f_B > 0` means
     /// over-drive (u_ol = r_max). A set without a boundary uses `[0, 0, -1]`.
     pub boundary: [f32; 3],

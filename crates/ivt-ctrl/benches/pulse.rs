@@ -1,0 +1,75 @@
+//! Hot paths of the controller (issue 5 target: one encoder-pulse update
+//! ≤ 50 ns median on the host). Run: `cargo bench -p ivt-ctrl --bench pulse`.
+#![allow(missing_docs)]
+
+use divan::{black_box, Bencher};
+use ivt_ctrl::{AngleAverager, Config, Controller, LawKind};
+
+fn main() {
+    divan::main();
+}
+
+/// A controller that has seen two revolutions at 100 rpm (PPR 1200, 1 MHz),
+/// so every benchmarked pulse runs the full law.
+fn warmed<const P: usize>(law: LawKind, interval: u32) -> (Controller<P>, u32) {
+    let mut c = Controller::<P>::new(Config {
+        law,
+        ..Config::default()
+    });
+    let mut t = 0u32;
+    for _ in 0..(2 * P + 4) {
+        t = t.wrapping_add(interval);
+        c.on_pulse(t);
+    }
+    (c, t)
+}
+
+#[divan::bench(args = [LawKind::Delay, LawKind::NoDelay, LawKind::Prop, LawKind::Open])]
+fn on_pulse_ppr1200(bencher: Bencher, law: LawKind) {
+    let (mut c, mut t) = warmed::<1200>(law, 500);
+    // Alternate two intervals so ω, ω_T and the law see changing data.
+    let mut k = 0u32;
+    bencher.bench_local(move || {
+        k = k.wrapping_add(1);
+        t = t.wrapping_add(if k & 1 == 0 { 499 } else { 501 });
+        black_box(c.on_pulse(black_box(t)))
+    });
+}
+
+#[divan::bench]
+fn on_pulse_ppr80(bencher: Bencher) {
+    let (mut c, mut t) = warmed::<80>(LawKind::Delay, 7500);
+    bencher.bench_local(move || {
+        t = t.wrapping_add(7500);
+        black_box(c.on_pulse(black_box(t)))
+    });
+}
+
+#[divan::bench]
+fn averager_push_ppr1200(bencher: Bencher) {
+    let mut a = AngleAverager::<1200>::new(1.0e6);
+    let mut t = 0u32;
+    bencher.bench_local(move || {
+        t = t.wrapping_add(500);
+        black_box(a.push(black_box(t)))
+    });
+}
+
+#[divan::bench]
+fn update_inputs(bencher: Bencher) {
+    let (mut c, _) = warmed::<1200>(LawKind::Delay, 500);
+    let mut v = 6.0f32;
+    bencher.bench_local(move || {
+        v = if v > 11.0 { 6.0 } else { v + 0.01 };
+        c.update_inputs(black_box(v), black_box(6.0));
+    });
+}
+
+#[divan::bench]
+fn step_tick(bencher: Bencher) {
+    let (mut c, mut t) = warmed::<1200>(LawKind::Delay, 500);
+    bencher.bench_local(move || {
+        t = t.wrapping_add(10);
+        black_box(c.step_tick(black_box(t)))
+    });
+}
