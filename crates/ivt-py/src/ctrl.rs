@@ -2,6 +2,7 @@
 //! runs), driven from Python pulse by pulse or over whole arrays of encoder
 //! timestamps (GIL released).
 
+use ivt_ctrl::open_loop::{POLY_T_TERMS, POLY_V_TERMS};
 use ivt_ctrl::{
     units, Config, ControlOutput, Controller as RustController, Fault, Gains, LawKind, OlRegion,
     OpenLoopCoeffs, StepTick, THESIS,
@@ -98,7 +99,7 @@ fn region_name(r: OlRegion) -> &'static str {
 }
 
 /// Open-loop coefficients from `"thesis"` or a dict with the fields of
-/// `OpenLoopCoeffs` (poly 5×5, boundary 3, r_max, v_m_range 2, t_u_range 2).
+/// `OpenLoopCoeffs` (poly 3×5, boundary 3, r_max, v_m_range 2, t_u_range 2).
 pub fn open_loop_from_py(ob: &Bound<'_, PyAny>) -> PyResult<OpenLoopCoeffs> {
     if let Ok(name) = ob.extract::<String>() {
         return match name.as_str() {
@@ -117,16 +118,18 @@ pub fn open_loop_from_py(ob: &Bound<'_, PyAny>) -> PyResult<OpenLoopCoeffs> {
         let bad = |what: &str| PyTypeError::new_err(format!("open_loop[{key:?}] must be {what}"));
         match key.as_str() {
             "poly" => {
-                let rows: Vec<Vec<f32>> = value.extract().map_err(|_| bad("5 rows of 5 floats"))?;
-                let mut poly = [[0.0f32; 5]; 5];
-                if rows.len() > 5 || rows.iter().any(|r| r.len() > 5) {
-                    return Err(PyValueError::new_err(
-                        "open_loop[\"poly\"] must have at most 5 rows of at most 5 floats",
-                    ));
+                let (nv, nt) = (POLY_V_TERMS, POLY_T_TERMS);
+                let shape = format!("at most {nv} rows (powers of V_m) of at most {nt} floats");
+                let rows: Vec<Vec<f32>> = value.extract().map_err(|_| bad(&shape))?;
+                if rows.len() > nv || rows.iter().any(|r| r.len() > nt) {
+                    return Err(PyValueError::new_err(format!(
+                        "open_loop[\"poly\"] must have {shape}"
+                    )));
                 }
-                for (i, row) in rows.iter().enumerate() {
-                    for (j, v) in row.iter().enumerate() {
-                        poly[i][j] = *v;
+                let mut poly = [[0.0f32; POLY_T_TERMS]; POLY_V_TERMS];
+                for (dst, row) in poly.iter_mut().zip(&rows) {
+                    for (d, v) in dst.iter_mut().zip(row) {
+                        *d = *v;
                     }
                 }
                 c.poly = poly;

@@ -23,7 +23,7 @@ def thesis_r_ol(v_m: float, t_u: float) -> float:
     """Eq. 158–160 with the printed coefficients, float64, no clamping of inputs
     (test points lie inside 2 ≤ V_m ≤ 12, 1.5 ≤ T_U ≤ 9)."""
     poly = np.array(ctrl.open_loop_preset("thesis")["poly"], dtype=np.float64)
-    r_f = sum(poly[i, j] * v_m**i * t_u**j for i in range(5) for j in range(5))
+    r_f = sum(poly[i, j] * v_m**i * t_u**j for i in range(poly.shape[0]) for j in range(poly.shape[1]))
     f_b = v_m - 1.579 * t_u - 0.632
     if f_b > 0 or r_f > 0.012:
         return 0.012
