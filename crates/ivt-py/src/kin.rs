@@ -1,6 +1,7 @@
 //! `ivt.kin`: kinematics of the SGIVT variant (§2.3) and the plant
 //! coefficients of Eq. 151, vectorized over numpy arrays.
 
+use crate::fields::{self, Field};
 use crate::vectorize::{map, map1};
 use ivt_kin::plant::{GravityModel, PlantParams};
 use ivt_kin::variant;
@@ -123,15 +124,8 @@ fn output_to_motor_ratio<'py>(
     map1(py, [("r", r)], |[r]| variant::output_to_motor_ratio(r, r_u))
 }
 
-/// Getter and setter of one numeric field of [`PlantParams`].
-type Field = (
-    &'static str,
-    fn(&PlantParams) -> f64,
-    fn(&mut PlantParams, f64),
-);
-
 /// The numeric Table 1 parameters by their Rust (and Python) names.
-const FIELDS: &[Field] = &[
+const FIELDS: &[Field<PlantParams>] = &[
     ("r_a", |p| p.r_a, |p, v| p.r_a = v),
     ("k_e", |p| p.k_e, |p, v| p.k_e = v),
     ("k_t", |p| p.k_t, |p, v| p.k_t = v),
@@ -167,37 +161,24 @@ fn apply_overrides(
     params: &mut PlantParams,
     overrides: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<()> {
-    if let Some(kw) = overrides {
-        for (key, value) in kw.iter() {
-            let key: String = key.extract()?;
-            if key == "gravity" {
-                let name: String = value.extract().map_err(|_| {
-                    PyTypeError::new_err("argument `gravity` must be 'printed' or 'roller_mass'")
-                })?;
-                params.gravity = match name.as_str() {
-                    "printed" => GravityModel::Printed,
-                    "roller_mass" => GravityModel::RollerMass,
-                    other => {
-                        return Err(PyValueError::new_err(format!(
-                            "argument `gravity` = {other:?} must be 'printed' or 'roller_mass'"
-                        )))
-                    }
-                };
-                continue;
-            }
-            let Some((_, _, set)) = FIELDS.iter().find(|(n, _, _)| *n == key) else {
-                let names: Vec<&str> = FIELDS.iter().map(|(n, _, _)| *n).collect();
-                return Err(PyTypeError::new_err(format!(
-                    "unknown plant parameter `{key}` (known: {}, gravity)",
-                    names.join(", ")
-                )));
-            };
-            let v: f64 = value.extract().map_err(|_| {
-                PyTypeError::new_err(format!("plant parameter `{key}` must be a float"))
-            })?;
-            set(params, v);
+    fields::apply("plant", FIELDS, params, overrides, |p, key, value| {
+        if key != "gravity" {
+            return Ok(false);
         }
-    }
+        let name: String = value.extract().map_err(|_| {
+            PyTypeError::new_err("argument `gravity` must be 'printed' or 'roller_mass'")
+        })?;
+        p.gravity = match name.as_str() {
+            "printed" => GravityModel::Printed,
+            "roller_mass" => GravityModel::RollerMass,
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "argument `gravity` = {other:?} must be 'printed' or 'roller_mass'"
+                )))
+            }
+        };
+        Ok(true)
+    })?;
     params
         .validate()
         .map_err(|e| PyValueError::new_err(e.to_string()))
@@ -235,10 +216,7 @@ impl Plant {
 
     /// All parameters as a dict (keys are the constructor keywords).
     fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        for (name, get, _) in FIELDS {
-            d.set_item(name, get(&self.params))?;
-        }
+        let d = fields::to_dict(py, FIELDS, &self.params)?;
         d.set_item("gravity", gravity_name(self.params.gravity))?;
         Ok(d)
     }
@@ -381,10 +359,8 @@ impl Plant {
 
     fn __repr__(&self) -> String {
         let printed = PlantParams::printed();
-        let changed: Vec<String> = FIELDS
-            .iter()
-            .filter(|(_, get, _)| get(&self.params) != get(&printed))
-            .map(|(n, get, _)| format!("{n}={}", get(&self.params)))
+        let changed: Vec<String> = fields::changed(FIELDS, &self.params, &printed)
+            .into_iter()
             .chain(
                 (self.params.gravity != printed.gravity)
                     .then(|| format!("gravity={:?}", gravity_name(self.params.gravity))),
@@ -420,5 +396,6 @@ pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(output_to_motor_ratio, &m)?)?;
     m.add_class::<Plant>()?;
     m.add("NCG_AMPLITUDE", ivt_kin::NCG_AMPLITUDE)?;
+    crate::gears::register(&m)?;
     parent.add_submodule(&m)
 }

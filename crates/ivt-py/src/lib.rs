@@ -10,6 +10,8 @@
 use pyo3::prelude::*;
 
 mod ctrl;
+mod fields;
+mod gears;
 mod kin;
 mod vectorize;
 
