@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 pub mod kin;
+pub mod sim;
 
 /// Result of a command: the JSON object for `--json` and the text for humans.
 pub struct Output {
@@ -48,6 +49,8 @@ enum Command {
     /// Kinematics of the GIVT, SGIVT and its variant (Chapter 2).
     #[command(subcommand)]
     Kin(kin::KinCommand),
+    /// Simulate a scene (TOML): plant, sensors, controller, outputs.
+    Sim(sim::SimArgs),
 }
 
 /// Parse the process arguments, run, print, and map errors to exit codes.
@@ -55,7 +58,8 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Kin(cmd)) => kin::run(cmd),
-        None => kin::summary(),
+        Some(Command::Sim(args)) => sim::run_file(&args, cli.json),
+        None => sim::run_default(cli.json),
     };
     match result {
         Ok(out) => {
