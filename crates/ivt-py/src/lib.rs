@@ -13,6 +13,7 @@ mod ctrl;
 mod fields;
 mod gears;
 mod kin;
+mod sim;
 mod vectorize;
 
 /// The native module; the public API is re-exported by the `ivt` package.
@@ -21,5 +22,6 @@ fn _ivt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     kin::register(m)?;
     ctrl::register(m)?;
+    sim::register(m)?;
     Ok(())
 }

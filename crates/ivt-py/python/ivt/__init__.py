@@ -6,12 +6,14 @@ same names and dict keys as its ``--json`` output, SPEC §6):
 
 - :mod:`ivt.kin`   kinematics and plant coefficients (numpy-vectorized)
 - :mod:`ivt.ctrl`  the rig controller (f32, as on the MCU)
+- :mod:`ivt.sim`   scenes of the simulator → numpy arrays and the summary
+- :mod:`ivt.sweep` grid / Monte-Carlo sweeps of scenes on threads or dask
 
 The numerics are the Rust crates of the workspace, reached through the private
 native module ``ivt._ivt``; long calls release the GIL.
 """
 
-from . import ctrl, kin
+from . import ctrl, kin, sim, sweep
 from ._ivt import __version__
 
-__all__ = ["ctrl", "kin", "__version__"]
+__all__ = ["ctrl", "kin", "sim", "sweep", "__version__"]
