@@ -12,6 +12,7 @@ use pyo3::prelude::*;
 mod ctrl;
 mod fields;
 mod gears;
+mod hb;
 mod kin;
 mod sim;
 mod vectorize;
@@ -22,6 +23,7 @@ fn _ivt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     kin::register(m)?;
     ctrl::register(m)?;
+    hb::register(m)?;
     sim::register(m)?;
     Ok(())
 }

@@ -5,6 +5,7 @@ Submodules (each mirrors a command group of the ``ivt`` command line, with the
 same names and dict keys as its ``--json`` output, SPEC §6):
 
 - :mod:`ivt.kin`   kinematics and plant coefficients (numpy-vectorized)
+- :mod:`ivt.hb`    harmonic balance: Duffing, Mathieu–Duffing, user systems
 - :mod:`ivt.ctrl`  the rig controller (f32, as on the MCU)
 - :mod:`ivt.sim`   scenes of the simulator → numpy arrays and the summary
 - :mod:`ivt.sweep` grid / Monte-Carlo sweeps of scenes on threads or dask
@@ -13,7 +14,7 @@ The numerics are the Rust crates of the workspace, reached through the private
 native module ``ivt._ivt``; long calls release the GIL.
 """
 
-from . import ctrl, kin, sim, sweep
+from . import ctrl, hb, kin, sim, sweep
 from ._ivt import __version__
 
-__all__ = ["ctrl", "kin", "sim", "sweep", "__version__"]
+__all__ = ["ctrl", "hb", "kin", "sim", "sweep", "__version__"]
