@@ -4,8 +4,10 @@
 //! | crate | what |
 //! |---|---|
 //! | [`kin`] | kinematics and plant coefficients (no_std) |
+//! | [`ctrl`] | the rig controller (no_std, f32, no heap) |
 #![warn(missing_docs)]
 
+pub use ivt_ctrl as ctrl;
 pub use ivt_kin as kin;
 
 pub mod cli;

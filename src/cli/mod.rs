@@ -8,8 +8,11 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+pub mod ctrl;
 pub mod kin;
 pub mod sim;
+pub mod ol;
+pub mod stability;
 
 /// Result of a command: the JSON object for `--json` and the text for humans.
 pub struct Output {
@@ -51,6 +54,16 @@ enum Command {
     Kin(kin::KinCommand),
     /// Simulate a scene (TOML): plant, sensors, controller, outputs.
     Sim(sim::SimArgs),
+    /// Open-loop law from the model: IHB steady state, grid table, refit (§4.2.1).
+    #[command(subcommand)]
+    Ol(ol::OlCommand),
+    /// Floquet multipliers of the time-delay loop at one point (§4.3).
+    Stability(stability::StabilityArgs),
+    /// Max |multiplier| over a grid (Fig. 42 analogue).
+    StabilityMap(stability::MapArgs),
+    /// The rig controller (ivt-ctrl): offline replay of pulse logs.
+    #[command(subcommand)]
+    Ctrl(ctrl::CtrlCommand),
 }
 
 /// Parse the process arguments, run, print, and map errors to exit codes.
@@ -59,6 +72,10 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Some(Command::Kin(cmd)) => kin::run(cmd),
         Some(Command::Sim(args)) => sim::run_file(&args, cli.json),
+        Some(Command::Ol(cmd)) => ol::run(cmd),
+        Some(Command::Stability(a)) => stability::run(a),
+        Some(Command::StabilityMap(a)) => stability::run_map(a),
+        Some(Command::Ctrl(cmd)) => ctrl::run(cmd),
         None => sim::run_default(cli.json),
     };
     match result {

@@ -35,7 +35,6 @@ impl<F: FnMut(&[f64], &mut [f64])> System for F {
 
 /// Options of the Broyden solver.
 #[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
 pub struct BroydenOptions {
     /// Convergence when ‖F(x)‖₂ ≤ `tol`.
     pub tol: f64,

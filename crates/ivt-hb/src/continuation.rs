@@ -16,7 +16,6 @@ use thiserror::Error;
 
 /// Options of the path follower.
 #[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
 pub struct ContinuationOptions {
     /// Initial arclength step Δη.
     pub ds: f64,

@@ -13,7 +13,6 @@ use faer::c64;
 
 /// Options of a frequency sweep.
 #[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
 pub struct FrcOptions {
     /// Start frequency ω_f.
     pub from: f64,

@@ -17,7 +17,6 @@ use thiserror::Error;
 
 /// Options of the IHB solvers.
 #[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
 pub struct HbOptions {
     /// Harmonics n.
     pub harmonics: usize,
