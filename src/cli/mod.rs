@@ -10,8 +10,8 @@ use std::process::ExitCode;
 
 pub mod ctrl;
 pub mod kin;
-pub mod sim;
 pub mod ol;
+pub mod sim;
 pub mod stability;
 
 /// Result of a command: the JSON object for `--json` and the text for humans.

@@ -547,7 +547,7 @@ fn eval_series<'py>(
     order: u32,
 ) -> PyResult<Bound<'py, PyAny>> {
     let q = coeffs.as_array().to_vec();
-    if q.len() % 2 == 0 {
+    if q.len().is_multiple_of(2) {
         return Err(PyValueError::new_err(format!(
             "argument `coeffs` must have 2n+1 entries, got {}",
             q.len()

@@ -10,6 +10,7 @@
 use pyo3::prelude::*;
 
 mod ctrl;
+mod design;
 mod fields;
 mod gears;
 mod hb;
@@ -25,5 +26,6 @@ fn _ivt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     ctrl::register(m)?;
     hb::register(m)?;
     sim::register(m)?;
+    design::register(m)?;
     Ok(())
 }
