@@ -22,9 +22,11 @@ create_exception!(
     "A harmonic-balance solve that did not converge; `.history` holds ‖r‖ per iteration."
 );
 
-/// Hsu sub-intervals per period for the stability verdict (ivt-hb: 256 is
-/// enough for the flags; the FRC uses the same by default).
-const STABILITY_STEPS: usize = 256;
+/// Hsu sub-intervals per period for n harmonics: max(8n, 256), the rule of
+/// `ivt hb duffing` (ivt-hb: 256 is enough for the flags).
+fn stability_steps(harmonics: usize) -> usize {
+    (8 * harmonics).max(256)
+}
 
 /// Map an ivt-hb error to Python: bad inputs → ValueError, non-convergence →
 /// ConvergenceError carrying the residual history.
@@ -116,11 +118,8 @@ fn solve_problem<P: PeriodicProblem + Clone>(
     };
     let solve_time_s = t0.elapsed().as_secs_f64();
     let floquet = if stability {
-        let mut an = StabilityAnalyzer::new(
-            problem,
-            opts.harmonics,
-            STABILITY_STEPS.max(opts.harmonics + 1),
-        )?;
+        let mut an =
+            StabilityAnalyzer::new(problem, opts.harmonics, stability_steps(opts.harmonics))?;
         Some(an.hsu(problem, &sol, HsuRule::Magnus4))
     } else {
         None
@@ -180,7 +179,8 @@ fn guess_vec(guess: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<f64>>> {
 /// Jacobian, §3.2.1). Returns the dict of `ivt hb duffing --json`: coeffs
 /// [a0, a1..an, b1..bn] (u = a0/2 + Σ a_k cos kτ + b_k sin kτ, τ = ω_f t),
 /// iterations, residual_norm, solve_time_s (the solve alone), floquet
-/// multipliers [[re, im], ...] by Hsu's method (256 Magnus-4 steps), stable.
+/// multipliers [[re, im], ...] by Hsu's method (max(8n, 256) Magnus-4
+/// steps, as the CLI), stable.
 /// `stability=False` skips the multipliers (floquet = [], stable = None).
 /// The GIL is released while solving.
 #[pyfunction]
@@ -309,6 +309,7 @@ fn duffing_frc<'py>(
         e.set_item("amplitude", p.amplitude)?;
         e.set_item("stable", p.stable())?;
         e.set_item("stability", p.kind.name())?;
+        e.set_item("kind", p.kind.name())?;
         points.append(e)?;
     }
     d.set_item("points", points)?;
