@@ -276,7 +276,7 @@ fn mathieu_duffing<'py>(
 #[pyo3(signature = (
     from_ = 0.2, to = 3.0, n = 20, samples = 64, xi = 0.02, alpha = 1.0, eps = 1.0, force = 0.1
 ))]
-#[allow(clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments, clippy::field_reassign_with_default)]
 fn duffing_frc<'py>(
     py: Python<'py>,
     from_: f64,
@@ -295,6 +295,8 @@ fn duffing_frc<'py>(
         finite("eps", eps)?,
         finite("force", force)?,
     );
+    // FrcOptions is #[non_exhaustive]: no struct expression from outside ivt-hb
+    // (hence the clippy allow on this function).
     let mut frc_opts = FrcOptions::default();
     frc_opts.from = finite("from_", from_)?;
     frc_opts.to = finite("to", to)?;
