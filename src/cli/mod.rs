@@ -91,8 +91,8 @@ pub fn main() -> ExitCode {
         Some(Command::StabilityMap(a)) => stability::run_map(a),
         Some(Command::Ctrl(cmd)) => ctrl::run(cmd),
         Some(Command::Rig(cmd)) => rig::run(cmd),
-        None => sim::run_default(cli.json),
         Some(Command::Hb(cmd)) => hb::run(cmd),
+        None => sim::run_default(cli.json),
     };
     match result {
         Ok(out) => {

@@ -1,1 +1,31 @@
-//! Python bindings (pyo3 + numpy, built by maturin). Being built under issue 9; nothing here yet.
+//! Python bindings of the IVT toolkit: the native module `ivt._ivt` behind the
+//! pure-Python package `ivt` (python/ivt). Thin by design: every function
+//! converts arguments, calls the Rust crate, and converts the result; the
+//! numerics live in `ivt-kin`, `ivt-hb`, `ivt-ctrl` and `ivt-sim`.
+//!
+//! Build and install into a virtualenv with `maturin develop --release` (or
+//! `pip install crates/ivt-py`); `scripts/py-test` does it and runs pytest.
+#![doc = include_str!("../README.md")]
+
+use pyo3::prelude::*;
+
+mod ctrl;
+mod design;
+mod fields;
+mod gears;
+mod hb;
+mod kin;
+mod sim;
+mod vectorize;
+
+/// The native module; the public API is re-exported by the `ivt` package.
+#[pymodule]
+fn _ivt(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    kin::register(m)?;
+    ctrl::register(m)?;
+    hb::register(m)?;
+    sim::register(m)?;
+    design::register(m)?;
+    Ok(())
+}

@@ -1,0 +1,14 @@
+"""Controller design from the model (``ivt-hb``'s IVT tools, thesis §4.2–4.3):
+the IHB steady state r̄(V_m, T_U), the open-loop table over a grid, and the
+local stability of the integral time-delay loop. Dict keys follow
+``ivt ol solve``, ``ivt ol table`` and ``ivt stability`` (``--json``)."""
+
+from . import _ivt
+
+_native = _ivt.design
+
+ol_solve = _native.ol_solve
+ol_table = _native.ol_table
+stability = _native.stability
+
+__all__ = ["ol_solve", "ol_table", "stability"]

@@ -1,0 +1,30 @@
+"""Controller design from the model (thesis §4.2–4.3)."""
+
+from typing import Any, Dict, Optional, Tuple
+
+from .kin import Plant
+
+def ol_solve(
+    v_m: float,
+    t_u: float,
+    omega0_rpm: float = 100.0,
+    harmonics: int = 7,
+    plant: Optional[Plant] = None,
+) -> Dict[str, Any]: ...
+def ol_table(
+    v_m: Tuple[float, float, float] = (2.0, 0.4, 12.0),
+    t_u: Tuple[float, float, float] = (1.5, 0.5, 9.0),
+    omega0_rpm: float = 100.0,
+    harmonics: int = 7,
+    plant: Optional[Plant] = None,
+) -> Dict[str, Any]: ...
+def stability(
+    v_m: float,
+    t_u: float,
+    k: float = 0.01,
+    k2: float = 0.02,
+    si: bool = False,
+    n: int = 16,
+    omega0_rpm: float = 100.0,
+    plant: Optional[Plant] = None,
+) -> Dict[str, Any]: ...

@@ -1,0 +1,13 @@
+"""The simulator (``ivt-sim``): run a scene, get numpy arrays and the summary."""
+
+import os
+from typing import Any, Dict, List, Optional, Union
+
+SceneLike = Union[Dict[str, Any], str, "os.PathLike[str]"]
+SUPPORTED_PPR: List[int]
+
+def run(
+    scene: SceneLike, out: Optional[Union[str, "os.PathLike[str]"]] = None
+) -> Dict[str, Any]: ...
+def check_scene(scene: SceneLike) -> Dict[str, Any]: ...
+def scene_dict(scene: SceneLike) -> Dict[str, Any]: ...

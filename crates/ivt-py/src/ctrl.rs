@@ -1,0 +1,625 @@
+//! `ivt.ctrl`: the rig controller of `ivt-ctrl` (f32, the code the firmware
+//! runs), driven from Python pulse by pulse or over whole arrays of encoder
+//! timestamps (GIL released).
+
+use ivt_ctrl::open_loop::{POLY_T_TERMS, POLY_V_TERMS};
+use ivt_ctrl::{
+    units, Config, ControlOutput, Controller as RustController, Fault, Gains, LawKind, OlRegion,
+    OpenLoopCoeffs, StepTick, THESIS,
+};
+use numpy::ndarray::Array1;
+use numpy::{
+    IntoPyArray, PyArray1, PyArrayDescrMethods, PyArrayMethods, PyUntypedArray,
+    PyUntypedArrayMethods,
+};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// A controller for a PPR chosen at run time (`Controller<PPR>` takes it as a
+/// const generic): one variant per supported PPR.
+macro_rules! any_controller {
+    ($($ppr:literal => $var:ident),* $(,)?) => {
+        #[derive(Clone)]
+        enum AnyController { $($var(Box<RustController<$ppr>>)),* }
+
+        /// PPR values with a compiled controller.
+        const SUPPORTED_PPR: &[usize] = &[$($ppr),*];
+
+        impl AnyController {
+            fn new(ppr: usize, config: Config) -> Option<Self> {
+                match ppr {
+                    $($ppr => Some(Self::$var(Box::new(RustController::new(config)))),)*
+                    _ => None,
+                }
+            }
+            fn on_pulse(&mut self, ticks: u32) -> ControlOutput {
+                match self { $(Self::$var(c) => c.on_pulse(ticks)),* }
+            }
+            fn update_inputs(&mut self, v_m: f32, t_u: f32) {
+                match self { $(Self::$var(c) => c.update_inputs(v_m, t_u)),* }
+            }
+            fn step_tick(&mut self, now: u32) -> StepTick {
+                match self { $(Self::$var(c) => c.step_tick(now)),* }
+            }
+            fn output(&self) -> ControlOutput {
+                match self { $(Self::$var(c) => c.output()),* }
+            }
+            fn r_max(&self) -> f32 {
+                match self { $(Self::$var(c) => c.r_max()),* }
+            }
+        }
+    };
+}
+
+any_controller!(
+    16 => P16, 32 => P32, 64 => P64, 80 => P80, 100 => P100, 128 => P128, 200 => P200,
+    256 => P256, 360 => P360, 400 => P400, 500 => P500, 512 => P512, 1000 => P1000,
+    1024 => P1024, 1200 => P1200, 2000 => P2000, 2048 => P2048, 4096 => P4096,
+);
+
+fn law_kind(name: &str) -> PyResult<LawKind> {
+    match name {
+        "delay" => Ok(LawKind::Delay),
+        "nodelay" => Ok(LawKind::NoDelay),
+        "prop" => Ok(LawKind::Prop),
+        "open" => Ok(LawKind::Open),
+        other => Err(PyValueError::new_err(format!(
+            "argument `law` = {other:?} must be one of 'delay', 'nodelay', 'prop', 'open'"
+        ))),
+    }
+}
+
+fn law_name(kind: LawKind) -> &'static str {
+    match kind {
+        LawKind::Delay => "delay",
+        LawKind::NoDelay => "nodelay",
+        LawKind::Prop => "prop",
+        LawKind::Open => "open",
+    }
+}
+
+/// Name of a fault code (the `Fault` enum of ivt-ctrl, lower case).
+fn fault_name(f: Fault) -> &'static str {
+    match f {
+        Fault::None => "none",
+        Fault::Stall => "stall",
+        Fault::IntervalTooShort => "interval_too_short",
+        Fault::InputInvalid => "input_invalid",
+        Fault::Config => "config",
+    }
+}
+
+fn region_name(r: OlRegion) -> &'static str {
+    match r {
+        OlRegion::Normal => "normal",
+        OlRegion::OverDrive => "over_drive",
+        OlRegion::UnderDrive => "under_drive",
+    }
+}
+
+/// Open-loop coefficients from `"thesis"` or a dict with the fields of
+/// `OpenLoopCoeffs` (poly 3×5, boundary 3, r_max, v_m_range 2, t_u_range 2).
+pub fn open_loop_from_py(ob: &Bound<'_, PyAny>) -> PyResult<OpenLoopCoeffs> {
+    if let Ok(name) = ob.extract::<String>() {
+        return match name.as_str() {
+            "thesis" => Ok(THESIS),
+            other => Err(PyValueError::new_err(format!(
+                "argument `open_loop` = {other:?}: known presets are 'thesis' (or pass a dict)"
+            ))),
+        };
+    }
+    let d = ob.cast::<PyDict>().map_err(|_| {
+        PyTypeError::new_err("argument `open_loop` must be 'thesis' or a dict of coefficients")
+    })?;
+    let mut c = THESIS;
+    for (key, value) in d.iter() {
+        let key: String = key.extract()?;
+        let bad = |what: &str| PyTypeError::new_err(format!("open_loop[{key:?}] must be {what}"));
+        match key.as_str() {
+            "poly" => {
+                let (nv, nt) = (POLY_V_TERMS, POLY_T_TERMS);
+                let shape = format!("at most {nv} rows (powers of V_m) of at most {nt} floats");
+                let rows: Vec<Vec<f32>> = value.extract().map_err(|_| bad(&shape))?;
+                if rows.len() > nv || rows.iter().any(|r| r.len() > nt) {
+                    return Err(PyValueError::new_err(format!(
+                        "open_loop[\"poly\"] must have {shape}"
+                    )));
+                }
+                let mut poly = [[0.0f32; POLY_T_TERMS]; POLY_V_TERMS];
+                for (dst, row) in poly.iter_mut().zip(&rows) {
+                    for (d, v) in dst.iter_mut().zip(row) {
+                        *d = *v;
+                    }
+                }
+                c.poly = poly;
+            }
+            "boundary" => c.boundary = value.extract().map_err(|_| bad("3 floats"))?,
+            "r_max" => c.r_max = value.extract().map_err(|_| bad("a float"))?,
+            "v_m_range" => c.v_m_range = value.extract().map_err(|_| bad("2 floats"))?,
+            "t_u_range" => c.t_u_range = value.extract().map_err(|_| bad("2 floats"))?,
+            other => {
+                return Err(PyTypeError::new_err(format!(
+                    "unknown open_loop key {other:?} (poly, boundary, r_max, v_m_range, t_u_range)"
+                )))
+            }
+        }
+    }
+    if !c.is_valid() {
+        return Err(PyValueError::new_err(
+            "argument `open_loop`: coefficients must be finite, ranges ordered, r_max > 0",
+        ));
+    }
+    Ok(c)
+}
+
+fn open_loop_to_py<'py>(py: Python<'py>, c: &OpenLoopCoeffs) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("poly", c.poly.to_vec())?;
+    d.set_item("boundary", c.boundary.to_vec())?;
+    d.set_item("r_max", c.r_max)?;
+    d.set_item("v_m_range", c.v_m_range.to_vec())?;
+    d.set_item("t_u_range", c.t_u_range.to_vec())?;
+    Ok(d)
+}
+
+/// One keyword override of [`Config`]: its Python name and how to apply it.
+type Override = (&'static str, Box<dyn Fn(&mut Config)>);
+
+/// The rig controller of ivt-ctrl (Eq. 158–160 open loop, Eq. 180/181/189
+/// feedback, angle-sampled averaging, stepper output), single precision as on
+/// the MCU.
+///
+/// Every keyword defaults to `ivt-ctrl`'s `Config::default()` (the thesis
+/// setup: 100 rpm, 1 MHz timer, Eq. 180 with k = 0.01, k2 = 0.02 mm·rad⁻¹ read
+/// as SI 1e-5, 2e-5 m·s/rad², the THESIS open-loop preset, 3200 steps/rev).
+/// Gains are SI; `thesis_gains(k, k2)` converts the printed mm·rad⁻¹ values.
+/// `ppr` must be one of `SUPPORTED_PPR`. An invalid setting raises
+/// `ValueError` naming the keyword.
+#[pyclass(name = "Controller", module = "ivt.ctrl")]
+pub struct Controller {
+    inner: AnyController,
+    ppr: usize,
+    config: Config,
+}
+
+/// Dict of one [`ControlOutput`]; keys as `ivt ctrl replay --json` (omega_T).
+fn output_dict<'py>(py: Python<'py>, o: &ControlOutput) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("omega", o.omega)?;
+    d.set_item("omega_a", o.omega_a)?;
+    d.set_item("omega_T", o.omega_t)?;
+    d.set_item("r_ol", o.r_ol)?;
+    d.set_item("r_d", o.r_d)?;
+    d.set_item("r", o.r)?;
+    d.set_item("stepper_target", o.stepper_target)?;
+    d.set_item("saturated", o.saturated)?;
+    d.set_item("fault", o.fault.code())?;
+    d.set_item("fault_name", fault_name(o.fault))?;
+    d.set_item("ready", o.ready)?;
+    d.set_item("inputs_clamped", o.inputs_clamped)?;
+    d.set_item("ol_region", region_name(o.ol_region))?;
+    Ok(d)
+}
+
+/// Timer timestamps as u32 from a uint32 array, an integer array or a
+/// sequence of ints; each must lie in [0, 2³²).
+fn ticks_from_py(ob: &Bound<'_, PyAny>) -> PyResult<Vec<u32>> {
+    if let Ok(a) = ob.cast::<PyArray1<u32>>() {
+        return Ok(a.readonly().as_array().to_vec());
+    }
+    let as_i64: Vec<i64> = if let Ok(arr) = ob.cast::<PyUntypedArray>() {
+        let kind = arr.dtype().kind();
+        if kind != b'i' && kind != b'u' {
+            return Err(PyTypeError::new_err(format!(
+                "argument `ticks` must hold integers (timer counts), got dtype kind {:?}",
+                kind as char
+            )));
+        }
+        let cast = arr.call_method1("astype", ("int64",))?;
+        let a = cast
+            .cast::<PyArray1<i64>>()
+            .map_err(|_| PyValueError::new_err("argument `ticks` must be one-dimensional"))?;
+        a.readonly().as_array().to_vec()
+    } else {
+        ob.extract().map_err(|_| {
+            PyTypeError::new_err("argument `ticks` must be an integer array or sequence of ints")
+        })?
+    };
+    as_i64
+        .iter()
+        .enumerate()
+        .map(|(i, &t)| {
+            u32::try_from(t).map_err(|_| {
+                PyValueError::new_err(format!(
+                    "argument `ticks`[{i}] = {t} is outside the u32 timer range [0, 2^32)"
+                ))
+            })
+        })
+        .collect()
+}
+
+/// Optional per-pulse input array (V_m or T_U): float32 values, same length.
+fn inputs_from_py(
+    name: &str,
+    ob: Option<&Bound<'_, PyAny>>,
+    n: usize,
+) -> PyResult<Option<Vec<f32>>> {
+    let Some(ob) = ob else { return Ok(None) };
+    let v: Vec<f64> =
+        if let Ok(a) = ob.extract::<numpy::PyArrayLike1<'_, f64, numpy::AllowTypeChange>>() {
+            a.as_array().to_vec()
+        } else {
+            return Err(PyTypeError::new_err(format!(
+                "argument `{name}` must be a 1-D array of floats"
+            )));
+        };
+    if v.len() != n {
+        return Err(PyValueError::new_err(format!(
+            "argument `{name}` has {} entries, `ticks` has {n}",
+            v.len()
+        )));
+    }
+    // Non-finite readings are passed through: the controller flags them
+    // (Fault::InputInvalid), which is what a test of that path needs.
+    Ok(Some(v.into_iter().map(|x| x as f32).collect()))
+}
+
+#[pymethods]
+impl Controller {
+    #[new]
+    #[pyo3(signature = (
+        ppr = 1200, *, f_timer_hz = None, omega0 = None, omega0_rpm = None, decimation = None,
+        law = None, k = None, k2 = None, k_prop = None, prop_period_s = None, open_loop = None,
+        feedforward = None, steps_per_metre = None, offset_steps = None, stepper_max_speed = None,
+        stepper_accel = None, stall_timeout_s = None, omega_max = None, safe_r = None,
+        v_m_valid = None, t_u_valid = None, initial_inputs = None
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        ppr: usize,
+        f_timer_hz: Option<f32>,
+        omega0: Option<f32>,
+        omega0_rpm: Option<f32>,
+        decimation: Option<u16>,
+        law: Option<&str>,
+        k: Option<f32>,
+        k2: Option<f32>,
+        k_prop: Option<f32>,
+        prop_period_s: Option<f32>,
+        open_loop: Option<&Bound<'_, PyAny>>,
+        feedforward: Option<bool>,
+        steps_per_metre: Option<f32>,
+        offset_steps: Option<i32>,
+        stepper_max_speed: Option<f32>,
+        stepper_accel: Option<f32>,
+        stall_timeout_s: Option<f32>,
+        omega_max: Option<f32>,
+        safe_r: Option<f32>,
+        v_m_valid: Option<[f32; 2]>,
+        t_u_valid: Option<[f32; 2]>,
+        initial_inputs: Option<[f32; 2]>,
+    ) -> PyResult<Self> {
+        if !SUPPORTED_PPR.contains(&ppr) {
+            return Err(PyValueError::new_err(format!(
+                "argument `ppr` = {ppr} has no compiled controller (supported: {SUPPORTED_PPR:?})"
+            )));
+        }
+        if omega0.is_some() && omega0_rpm.is_some() {
+            return Err(PyTypeError::new_err(
+                "give `omega0` [rad/s] or `omega0_rpm`, not both",
+            ));
+        }
+        let mut overrides: Vec<Override> = Vec::new();
+        macro_rules! set {
+            ($opt:expr, $name:literal, |$c:ident, $v:ident| $body:expr) => {
+                if let Some($v) = $opt {
+                    overrides.push(($name, Box::new(move |$c: &mut Config| $body)));
+                }
+            };
+        }
+        set!(f_timer_hz, "f_timer_hz", |c, v| c.f_timer_hz = v);
+        set!(omega0, "omega0", |c, v| c.omega0 = v);
+        set!(omega0_rpm, "omega0_rpm", |c, v| c.omega0 =
+            units::rpm_to_rad_s(v));
+        set!(decimation, "decimation", |c, v| c.decimation = v);
+        if let Some(name) = law {
+            let kind = law_kind(name)?;
+            overrides.push(("law", Box::new(move |c: &mut Config| c.law = kind)));
+        }
+        set!(k, "k", |c, v| c.gains.k = v);
+        set!(k2, "k2", |c, v| c.gains.k2 = v);
+        set!(k_prop, "k_prop", |c, v| c.gains.k_prop = v);
+        set!(prop_period_s, "prop_period_s", |c, v| c
+            .gains
+            .prop_period_s =
+            v);
+        if let Some(ob) = open_loop {
+            let coeffs = open_loop_from_py(ob)?;
+            overrides.push((
+                "open_loop",
+                Box::new(move |c: &mut Config| c.open_loop = coeffs),
+            ));
+        }
+        set!(feedforward, "feedforward", |c, v| c.feedforward = v);
+        set!(steps_per_metre, "steps_per_metre", |c, v| c
+            .actuator
+            .steps_per_metre =
+            v);
+        set!(offset_steps, "offset_steps", |c, v| c
+            .actuator
+            .offset_steps = v);
+        set!(stepper_max_speed, "stepper_max_speed", |c, v| c
+            .stepper
+            .max_speed =
+            v);
+        set!(stepper_accel, "stepper_accel", |c, v| c.stepper.accel = v);
+        set!(stall_timeout_s, "stall_timeout_s", |c, v| c
+            .stall_timeout_s =
+            v);
+        set!(omega_max, "omega_max", |c, v| c.omega_max = v);
+        set!(safe_r, "safe_r", |c, v| c.safe_r = v);
+        set!(v_m_valid, "v_m_valid", |c, v| c.v_m_valid = v);
+        set!(t_u_valid, "t_u_valid", |c, v| c.t_u_valid = v);
+        set!(initial_inputs, "initial_inputs", |c, v| c.initial_inputs =
+            v);
+
+        let mut config = Config::default();
+        for (_, apply) in &overrides {
+            apply(&mut config);
+        }
+        let inner = AnyController::new(ppr, config).ok_or_else(|| {
+            PyValueError::new_err(format!("argument `ppr` = {ppr} is not supported"))
+        })?;
+        if inner.output().fault == Fault::Config {
+            // ivt-ctrl reports an invalid Config as a whole (permanent safe
+            // state); name the keyword(s) that alone make the default invalid.
+            let culprits: Vec<&str> = overrides
+                .iter()
+                .filter(|(_, apply)| {
+                    let mut c = Config::default();
+                    apply(&mut c);
+                    AnyController::new(ppr, c).is_some_and(|x| x.output().fault == Fault::Config)
+                })
+                .map(|(name, _)| *name)
+                .collect();
+            let which = if culprits.is_empty() {
+                "the combination of the given keywords".to_string()
+            } else {
+                culprits
+                    .iter()
+                    .map(|n| format!("`{n}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            return Err(PyValueError::new_err(format!(
+                "invalid controller configuration ({which}): values must be finite, rates, \
+                 periods and limits > 0, ranges ordered, decimation >= 1"
+            )));
+        }
+        Ok(Self { inner, ppr, config })
+    }
+
+    /// Encoder samples per revolution of θ (the const generic of ivt-ctrl).
+    #[getter]
+    fn ppr(&self) -> usize {
+        self.ppr
+    }
+
+    /// r_max of the open-loop coefficient set [m].
+    #[getter]
+    fn r_max(&self) -> f32 {
+        self.inner.r_max()
+    }
+
+    /// The configuration in effect, as a dict (SI units).
+    fn config<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let c = &self.config;
+        let d = PyDict::new(py);
+        d.set_item("ppr", self.ppr)?;
+        d.set_item("f_timer_hz", c.f_timer_hz)?;
+        d.set_item("omega0", c.omega0)?;
+        d.set_item("decimation", c.decimation)?;
+        d.set_item("law", law_name(c.law))?;
+        d.set_item("k", c.gains.k)?;
+        d.set_item("k2", c.gains.k2)?;
+        d.set_item("k_prop", c.gains.k_prop)?;
+        d.set_item("prop_period_s", c.gains.prop_period_s)?;
+        d.set_item("open_loop", open_loop_to_py(py, &c.open_loop)?)?;
+        d.set_item("feedforward", c.feedforward)?;
+        d.set_item("steps_per_metre", c.actuator.steps_per_metre)?;
+        d.set_item("offset_steps", c.actuator.offset_steps)?;
+        d.set_item("stepper_max_speed", c.stepper.max_speed)?;
+        d.set_item("stepper_accel", c.stepper.accel)?;
+        d.set_item("stall_timeout_s", c.stall_timeout_s)?;
+        d.set_item("omega_max", c.omega_max)?;
+        d.set_item("safe_r", c.safe_r)?;
+        d.set_item("v_m_valid", c.v_m_valid.to_vec())?;
+        d.set_item("t_u_valid", c.t_u_valid.to_vec())?;
+        d.set_item("initial_inputs", c.initial_inputs.to_vec())?;
+        Ok(d)
+    }
+
+    /// One encoder pulse with its timer timestamp (0 ≤ ticks < 2³², wrapping
+    /// is the timer's). Returns the output dict: omega, omega_a, omega_T,
+    /// r_ol, r_d, r, stepper_target, saturated, fault (code), fault_name,
+    /// ready, inputs_clamped, ol_region.
+    fn on_pulse<'py>(&mut self, py: Python<'py>, ticks: u32) -> PyResult<Bound<'py, PyDict>> {
+        let o = self.inner.on_pulse(ticks);
+        output_dict(py, &o)
+    }
+
+    /// Slow readings: motor voltage V_m [V] and brake torque T_U [N·m].
+    /// Invalid readings are ignored by the controller and flagged
+    /// (fault 3, input_invalid); returns the output dict.
+    fn update_inputs<'py>(
+        &mut self,
+        py: Python<'py>,
+        v_m: f32,
+        t_u: f32,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        self.inner.update_inputs(v_m, t_u);
+        output_dict(py, &self.inner.output())
+    }
+
+    /// Step-generator tick at timer count `now`: dict with step, forward,
+    /// position, next_step_at, moving, fault, fault_name.
+    fn step_tick<'py>(&mut self, py: Python<'py>, now: u32) -> PyResult<Bound<'py, PyDict>> {
+        let s = self.inner.step_tick(now);
+        let d = PyDict::new(py);
+        d.set_item("step", s.step)?;
+        d.set_item("forward", s.forward)?;
+        d.set_item("position", s.position)?;
+        d.set_item("next_step_at", s.next_step_at)?;
+        d.set_item("moving", s.moving)?;
+        d.set_item("fault", s.fault.code())?;
+        d.set_item("fault_name", fault_name(s.fault))?;
+        Ok(d)
+    }
+
+    /// The output of the most recent call.
+    fn output<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        output_dict(py, &self.inner.output())
+    }
+
+    /// Feed a whole array of encoder timestamps (one `on_pulse` each, with
+    /// `update_inputs(v_m[i], t_u[i])` before pulse i when the arrays are
+    /// given), the GIL released. Returns a dict of arrays with one entry per
+    /// pulse: the keys of `ivt ctrl replay --json` (omega, omega_a, omega_T,
+    /// r_ol, r_d, r, fault) plus stepper_target, saturated, ready.
+    #[pyo3(signature = (ticks, v_m = None, t_u = None))]
+    fn on_pulses<'py>(
+        &mut self,
+        py: Python<'py>,
+        ticks: &Bound<'py, PyAny>,
+        v_m: Option<&Bound<'py, PyAny>>,
+        t_u: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let ticks = ticks_from_py(ticks)?;
+        let n = ticks.len();
+        let v_m = inputs_from_py("v_m", v_m, n)?;
+        let t_u = inputs_from_py("t_u", t_u, n)?;
+        if v_m.is_some() != t_u.is_some() {
+            return Err(PyTypeError::new_err(
+                "give both `v_m` and `t_u`, or neither",
+            ));
+        }
+        let inputs = v_m.zip(t_u);
+        let inner = &mut self.inner;
+        let outs: Vec<ControlOutput> = py.detach(|| {
+            ticks
+                .iter()
+                .enumerate()
+                .map(|(i, &t)| {
+                    if let Some((v, tu)) = &inputs {
+                        inner.update_inputs(v[i], tu[i]);
+                    }
+                    inner.on_pulse(t)
+                })
+                .collect()
+        });
+        let d = PyDict::new(py);
+        let col_f32 = |f: fn(&ControlOutput) -> f32| -> Bound<'py, PyArray1<f32>> {
+            Array1::from_iter(outs.iter().map(f)).into_pyarray(py)
+        };
+        d.set_item("omega", col_f32(|o| o.omega))?;
+        d.set_item("omega_a", col_f32(|o| o.omega_a))?;
+        d.set_item("omega_T", col_f32(|o| o.omega_t))?;
+        d.set_item("r_ol", col_f32(|o| o.r_ol))?;
+        d.set_item("r_d", col_f32(|o| o.r_d))?;
+        d.set_item("r", col_f32(|o| o.r))?;
+        d.set_item(
+            "fault",
+            Array1::from_iter(outs.iter().map(|o| o.fault.code())).into_pyarray(py),
+        )?;
+        d.set_item(
+            "stepper_target",
+            Array1::from_iter(outs.iter().map(|o| o.stepper_target)).into_pyarray(py),
+        )?;
+        d.set_item(
+            "saturated",
+            Array1::from_iter(outs.iter().map(|o| o.saturated)).into_pyarray(py),
+        )?;
+        d.set_item(
+            "ready",
+            Array1::from_iter(outs.iter().map(|o| o.ready)).into_pyarray(py),
+        )?;
+        Ok(d)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Controller(ppr={}, law={:?}, omega0={} rad/s)",
+            self.ppr,
+            law_name(self.config.law),
+            self.config.omega0
+        )
+    }
+}
+
+/// Gains (k, k2) in SI [m·s/rad²] from the thesis's printed mm·rad⁻¹ values
+/// (e.g. 0.01, 0.02 for Eq. 180); the interpretation is ivt-ctrl's
+/// `units::gain_from_mm_per_rad`.
+#[pyfunction]
+fn thesis_gains(k: f32, k2: f32) -> (f32, f32) {
+    let g = Gains::from_thesis_mm_per_rad(k, k2);
+    (g.k, g.k2)
+}
+
+/// The open-loop coefficient preset `name` ("thesis") as a dict, the form
+/// `Controller(open_loop=...)` accepts.
+#[pyfunction]
+fn open_loop_preset<'py>(
+    py: Python<'py>,
+    name: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyDict>> {
+    open_loop_to_py(py, &open_loop_from_py(name)?)
+}
+
+/// Evaluate an open-loop law (Eq. 158–160) like the controller does:
+/// dict with r_ol [m], ol_region, inputs_clamped, and the raw polynomial r_f
+/// and boundary f_B.
+#[pyfunction]
+#[pyo3(signature = (v_m, t_u, open_loop = None))]
+fn open_loop_eval<'py>(
+    py: Python<'py>,
+    v_m: f32,
+    t_u: f32,
+    open_loop: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let c = match open_loop {
+        Some(ob) => open_loop_from_py(ob)?,
+        None => THESIS,
+    };
+    let v = c.evaluate(v_m, t_u);
+    let d = PyDict::new(py);
+    d.set_item("r_ol", v.r_ol)?;
+    d.set_item("ol_region", region_name(v.region))?;
+    d.set_item("inputs_clamped", v.inputs_clamped)?;
+    d.set_item("r_f", c.r_f(v_m, t_u))?;
+    d.set_item("f_b", c.f_b(v_m, t_u))?;
+    Ok(d)
+}
+
+/// Register `ivt._ivt.ctrl`.
+pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = parent.py();
+    let m = PyModule::new(py, "ctrl")?;
+    m.add_class::<Controller>()?;
+    m.add_function(wrap_pyfunction!(thesis_gains, &m)?)?;
+    m.add_function(wrap_pyfunction!(open_loop_preset, &m)?)?;
+    m.add_function(wrap_pyfunction!(open_loop_eval, &m)?)?;
+    m.add("SUPPORTED_PPR", SUPPORTED_PPR.to_vec())?;
+    let faults = PyDict::new(py);
+    for f in [
+        Fault::None,
+        Fault::Stall,
+        Fault::IntervalTooShort,
+        Fault::InputInvalid,
+        Fault::Config,
+    ] {
+        faults.set_item(f.code(), fault_name(f))?;
+    }
+    m.add("FAULTS", faults)?;
+    parent.add_submodule(&m)
+}

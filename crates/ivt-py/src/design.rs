@@ -1,0 +1,219 @@
+//! `ivt.design`: the controller-design tools of ivt-hb (§4.2–4.3): IHB steady
+//! state and open-loop table, delay-loop stability. Keys follow
+//! `ivt ol solve`, `ivt ol table` and `ivt stability` (`--json`).
+
+use crate::kin::Plant;
+use ivt_hb::ivt::delay::{delay_stability, DelayOptions, FeedbackGains};
+use ivt_hb::ivt::steady::{solve_steady_state, IhbOptions};
+use ivt_hb::ivt::sweep::{self, Grid};
+use ivt_hb::ivt::{rpm_to_rad_s, OperatingPoint, Verdict};
+use ivt_kin::plant::PlantParams;
+use numpy::ndarray::Array2;
+use numpy::IntoPyArray;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::time::Instant;
+
+fn plant_of(plant: Option<PyRef<'_, Plant>>) -> PlantParams {
+    plant.map_or_else(PlantParams::printed, |p| p.params)
+}
+
+fn operating_point(v_m: f64, t_u: f64, omega0_rpm: f64) -> PyResult<OperatingPoint> {
+    if !(omega0_rpm.is_finite() && omega0_rpm > 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "argument `omega0_rpm` = {omega0_rpm} must be finite and > 0"
+        )));
+    }
+    let op = OperatingPoint {
+        v_m,
+        t_u,
+        omega0: rpm_to_rad_s(omega0_rpm),
+    };
+    op.validate()
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(op)
+}
+
+fn ihb_options(harmonics: usize) -> IhbOptions {
+    IhbOptions {
+        harmonics,
+        ..Default::default()
+    }
+}
+
+/// IVT steady state at one operating point by IHB (§4.2.1): the mean
+/// eccentricity r̄ that holds the mean speed ω0 at (V_m, T_U).
+///
+/// Returns the dict of `ivt ol solve --json`: r (unconstrained r̄ [m]),
+/// feasible, verdict ("feasible", "under-drive", "over-drive"), q, omega_min,
+/// omega_max, solve_time_s, iterations, residual_norm, harmonics, r_max,
+/// omega0. `plant` defaults to the printed plant (ivt.kin.Plant()).
+#[pyfunction]
+#[pyo3(signature = (v_m, t_u, omega0_rpm = 100.0, harmonics = 7, plant = None))]
+fn ol_solve<'py>(
+    py: Python<'py>,
+    v_m: f64,
+    t_u: f64,
+    omega0_rpm: f64,
+    harmonics: usize,
+    plant: Option<PyRef<'py, Plant>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let params = plant_of(plant);
+    let op = operating_point(v_m, t_u, omega0_rpm)?;
+    let t0 = Instant::now();
+    let s = py
+        .detach(|| solve_steady_state(&params, &op, ihb_options(harmonics)))
+        .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+    let dt = t0.elapsed().as_secs_f64();
+    let d = PyDict::new(py);
+    d.set_item("r", s.r)?;
+    d.set_item("feasible", s.verdict == Verdict::Feasible)?;
+    d.set_item("verdict", s.verdict.as_str())?;
+    d.set_item("q", s.q.clone().into_pyarray(py))?;
+    d.set_item("omega_min", s.omega_min)?;
+    d.set_item("omega_max", s.omega_max)?;
+    d.set_item("solve_time_s", dt)?;
+    d.set_item("iterations", s.iterations)?;
+    d.set_item("residual_norm", s.residual_norm)?;
+    d.set_item("harmonics", harmonics)?;
+    d.set_item("r_max", params.r_max)?;
+    d.set_item("omega0", op.omega0)?;
+    Ok(d)
+}
+
+/// Open-loop table: the IHB steady state over a grid (rows of fixed T_U run
+/// in parallel on Rust threads, warm starts along V_m), GIL released.
+///
+/// v_m, t_u: (from, step, to) as in `ivt ol table` (thesis grid
+/// 2:0.4:12 V × 1.5:0.5:9 N·m). Returns {"v_m", "t_u", "omega0",
+/// "points": [{"vm", "tu", "r", "verdict", ...} or {"vm", "tu", "error"}]}
+/// like the CLI, plus "r": an array of shape (len(t_u), len(v_m)) with NaN
+/// where a point failed.
+#[pyfunction]
+#[pyo3(signature = (
+    v_m = (2.0, 0.4, 12.0), t_u = (1.5, 0.5, 9.0), omega0_rpm = 100.0, harmonics = 7,
+    plant = None
+))]
+fn ol_table<'py>(
+    py: Python<'py>,
+    v_m: (f64, f64, f64),
+    t_u: (f64, f64, f64),
+    omega0_rpm: f64,
+    harmonics: usize,
+    plant: Option<PyRef<'py, Plant>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let params = plant_of(plant);
+    if !(omega0_rpm.is_finite() && omega0_rpm > 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "argument `omega0_rpm` = {omega0_rpm} must be finite and > 0"
+        )));
+    }
+    let grid = Grid {
+        v_m: sweep::range(v_m.0, v_m.1, v_m.2),
+        t_u: sweep::range(t_u.0, t_u.1, t_u.2),
+        omega0: rpm_to_rad_s(omega0_rpm),
+    };
+    grid.validate()
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let pts = py
+        .detach(|| sweep::sweep(&params, &grid, ihb_options(harmonics), || ()))
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let points = PyList::empty(py);
+    let mut r = Array2::<f64>::from_elem((grid.t_u.len(), grid.v_m.len()), f64::NAN);
+    for (i, p) in pts.iter().enumerate() {
+        let e = PyDict::new(py);
+        e.set_item("vm", p.op.v_m)?;
+        e.set_item("tu", p.op.t_u)?;
+        match &p.result {
+            Ok(s) => {
+                e.set_item("r", s.r)?;
+                e.set_item("verdict", s.verdict.as_str())?;
+                e.set_item("omega_min", s.omega_min)?;
+                e.set_item("omega_max", s.omega_max)?;
+                if let Some(slot) = r.get_mut((i / grid.v_m.len(), i % grid.v_m.len())) {
+                    *slot = s.r;
+                }
+            }
+            Err(msg) => e.set_item("error", msg)?,
+        }
+        points.append(e)?;
+    }
+    let d = PyDict::new(py);
+    d.set_item("v_m", grid.v_m.clone())?;
+    d.set_item("t_u", grid.t_u.clone())?;
+    d.set_item("omega0", grid.omega0)?;
+    d.set_item("points", points)?;
+    d.set_item("r", r.into_pyarray(py))?;
+    Ok(d)
+}
+
+/// Local stability of the integral time-delay loop (Eq. 174–179, Chebyshev
+/// spectral Tau of order `n`, monodromy over θ ∈ [0, 2π]) at (V_m, T_U).
+///
+/// k, k2: gains in the thesis's mm·rad⁻¹ unless `si=True` (m·s/rad²).
+/// Returns the dict of `ivt stability --json` (without "design"):
+/// max_abs_multiplier (excluding the structural unit one), structural,
+/// multipliers [[re, im]...], r_bar, k_si, k2_si, chebyshev_order, stable,
+/// solve_time_s. GIL released.
+#[pyfunction]
+#[pyo3(signature = (
+    v_m, t_u, k = 0.01, k2 = 0.02, si = false, n = 16, omega0_rpm = 100.0, plant = None
+))]
+#[allow(clippy::too_many_arguments)]
+fn stability<'py>(
+    py: Python<'py>,
+    v_m: f64,
+    t_u: f64,
+    k: f64,
+    k2: f64,
+    si: bool,
+    n: usize,
+    omega0_rpm: f64,
+    plant: Option<PyRef<'py, Plant>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let params = plant_of(plant);
+    let op = operating_point(v_m, t_u, omega0_rpm)?;
+    for (name, v) in [("k", k), ("k2", k2)] {
+        if !v.is_finite() {
+            return Err(PyValueError::new_err(format!(
+                "argument `{name}` = {v} must be finite"
+            )));
+        }
+    }
+    let gains = if si {
+        FeedbackGains { k, k2 }
+    } else {
+        FeedbackGains::from_thesis_mm_per_rad(k, k2)
+    };
+    let opts = DelayOptions {
+        chebyshev_order: n,
+        ..Default::default()
+    };
+    let t0 = Instant::now();
+    let s = py
+        .detach(|| delay_stability(&params, &op, gains, &opts))
+        .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+    let dt = t0.elapsed().as_secs_f64();
+    let d = PyDict::new(py);
+    d.set_item("max_abs_multiplier", s.max_abs_multiplier)?;
+    d.set_item("structural", [s.structural.0, s.structural.1])?;
+    let mult: Vec<[f64; 2]> = s.multipliers.iter().map(|m| [m.0, m.1]).collect();
+    d.set_item("multipliers", mult)?;
+    d.set_item("r_bar", s.orbit.r)?;
+    d.set_item("k_si", gains.k)?;
+    d.set_item("k2_si", gains.k2)?;
+    d.set_item("chebyshev_order", n)?;
+    d.set_item("stable", s.max_abs_multiplier < 1.0)?;
+    d.set_item("solve_time_s", dt)?;
+    Ok(d)
+}
+
+/// Register `ivt._ivt.design`.
+pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
+    let m = PyModule::new(parent.py(), "design")?;
+    m.add_function(wrap_pyfunction!(ol_solve, &m)?)?;
+    m.add_function(wrap_pyfunction!(ol_table, &m)?)?;
+    m.add_function(wrap_pyfunction!(stability, &m)?)?;
+    parent.add_submodule(&m)
+}

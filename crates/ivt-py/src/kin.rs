@@ -1,0 +1,401 @@
+//! `ivt.kin`: kinematics of the SGIVT variant (§2.3) and the plant
+//! coefficients of Eq. 151, vectorized over numpy arrays.
+
+use crate::fields::{self, Field};
+use crate::vectorize::{map, map1};
+use ivt_kin::plant::{GravityModel, PlantParams};
+use ivt_kin::variant;
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+
+/// Output gear radius r_u of the printed plant (Table 1), the default of the
+/// speed functions.
+const R_U_PRINTED: f64 = PlantParams::printed().r_u;
+
+/// Noncircular-gear speed ratio f(θ) = π/(2√2)·max(|sin θ|, |cos θ|), Eq. 43.
+///
+/// theta: angle of the driven noncircular gear [rad], float or array.
+/// Returns a float for scalar input, else an array of the broadcast shape.
+#[pyfunction]
+fn f<'py>(py: Python<'py>, theta: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    map1(py, [("theta", theta)], |[t]| variant::f(t))
+}
+
+/// df/dθ, Eq. 139 (discontinuous at θ = π/4 + kπ/2; there the value of the
+/// segment that starts at the corner is returned).
+///
+/// theta: angle of the driven noncircular gear [rad], float or array.
+#[pyfunction]
+fn f_theta<'py>(py: Python<'py>, theta: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    map1(py, [("theta", theta)], |[t]| variant::f_theta(t))
+}
+
+/// Exact mean of f² over a period, (π²/8)(1/2 + 1/π) ≈ 1.0095 (SPEC §5).
+#[pyfunction]
+fn mean_f_squared() -> f64 {
+    variant::mean_f_squared()
+}
+
+/// Ring-gear speeds (ω_r1, ω_r2) of the input-control module, Eq. 44:
+/// ω_ri = (2(d_S + d_P)ω ± d_S ω_c)/(d_S + 2 d_P).
+///
+/// omega: carrier-side input speed [rad/s]; omega_c: control speed [rad/s];
+/// d_s, d_p: sun and planet diameters (only their ratio matters).
+#[pyfunction]
+#[pyo3(signature = (omega, omega_c, d_s = 1.0, d_p = 1.0))]
+fn ring_speeds<'py>(
+    py: Python<'py>,
+    omega: &Bound<'py, PyAny>,
+    omega_c: &Bound<'py, PyAny>,
+    d_s: f64,
+    d_p: f64,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    if !(d_s.is_finite() && d_p.is_finite() && d_s + 2.0 * d_p != 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "arguments `d_s` = {d_s}, `d_p` = {d_p} must be finite with d_s + 2 d_p != 0"
+        )));
+    }
+    let [a, b] = map(py, [("omega", omega), ("omega_c", omega_c)], |[w, wc]| {
+        let (r1, r2) = variant::ring_speeds(w, wc, d_s, d_p);
+        Ok::<_, std::convert::Infallible>([r1, r2])
+    })?;
+    Ok((a, b))
+}
+
+/// Driver speeds (v_d1, v_d2) = (ω r sin θ, ω r cos θ) [m/s], Eq. 45–46.
+#[pyfunction]
+fn driver_speeds<'py>(
+    py: Python<'py>,
+    theta: &Bound<'py, PyAny>,
+    omega: &Bound<'py, PyAny>,
+    r: &Bound<'py, PyAny>,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let [a, b] = map(
+        py,
+        [("theta", theta), ("omega", omega), ("r", r)],
+        |[t, w, r]| {
+            let (v1, v2) = variant::driver_speeds(t, w, r);
+            Ok::<_, std::convert::Infallible>([v1, v2])
+        },
+    )?;
+    Ok((a, b))
+}
+
+fn check_r_u(r_u: f64) -> PyResult<()> {
+    if r_u.is_finite() && r_u > 0.0 {
+        Ok(())
+    } else {
+        Err(PyValueError::new_err(format!(
+            "argument `r_u` = {r_u} must be finite and > 0"
+        )))
+    }
+}
+
+/// Output-shaft speed ω_U = max(|v_d1|, |v_d2|)/r_u [rad/s], Eq. 47.
+///
+/// r_u defaults to the printed output gear radius (Table 1, 0.0222 m).
+#[pyfunction]
+#[pyo3(signature = (theta, omega, r, r_u = R_U_PRINTED))]
+fn output_speed<'py>(
+    py: Python<'py>,
+    theta: &Bound<'py, PyAny>,
+    omega: &Bound<'py, PyAny>,
+    r: &Bound<'py, PyAny>,
+    r_u: f64,
+) -> PyResult<Bound<'py, PyAny>> {
+    check_r_u(r_u)?;
+    map1(
+        py,
+        [("theta", theta), ("omega", omega), ("r", r)],
+        |[t, w, r]| variant::output_speed(t, w, r, r_u),
+    )
+}
+
+/// The constant output-to-motor speed ratio ω_U/ω_m = 2√2 r/(π r_u), Eq. 47.
+#[pyfunction]
+#[pyo3(signature = (r, r_u = R_U_PRINTED))]
+fn output_to_motor_ratio<'py>(
+    py: Python<'py>,
+    r: &Bound<'py, PyAny>,
+    r_u: f64,
+) -> PyResult<Bound<'py, PyAny>> {
+    check_r_u(r_u)?;
+    map1(py, [("r", r)], |[r]| variant::output_to_motor_ratio(r, r_u))
+}
+
+/// The numeric Table 1 parameters by their Rust (and Python) names.
+const FIELDS: &[Field<PlantParams>] = &[
+    ("r_a", |p| p.r_a, |p, v| p.r_a = v),
+    ("k_e", |p| p.k_e, |p, v| p.k_e = v),
+    ("k_t", |p| p.k_t, |p, v| p.k_t = v),
+    ("l_a", |p| p.l_a, |p, v| p.l_a = v),
+    ("j_n1", |p| p.j_n1, |p, v| p.j_n1 = v),
+    ("j_n2", |p| p.j_n2, |p, v| p.j_n2 = v),
+    ("j_inshaft", |p| p.j_inshaft, |p, v| p.j_inshaft = v),
+    ("j_carrier", |p| p.j_carrier, |p, v| p.j_carrier = v),
+    ("j_ring", |p| p.j_ring, |p, v| p.j_ring = v),
+    ("j_crk", |p| p.j_crk, |p, v| p.j_crk = v),
+    ("m_r", |p| p.m_r, |p, v| p.m_r = v),
+    ("m_dr", |p| p.m_dr, |p, v| p.m_dr = v),
+    ("j_u", |p| p.j_u, |p, v| p.j_u = v),
+    ("r_u", |p| p.r_u, |p, v| p.r_u = v),
+    ("g", |p| p.g, |p, v| p.g = v),
+    (
+        "sun_to_planet",
+        |p| p.sun_to_planet,
+        |p, v| p.sun_to_planet = v,
+    ),
+    ("r_max", |p| p.r_max, |p, v| p.r_max = v),
+];
+
+fn gravity_name(g: GravityModel) -> &'static str {
+    match g {
+        GravityModel::Printed => "printed",
+        GravityModel::RollerMass => "roller_mass",
+    }
+}
+
+/// Apply keyword overrides to `params` and validate the result.
+fn apply_overrides(
+    params: &mut PlantParams,
+    overrides: Option<&Bound<'_, PyDict>>,
+) -> PyResult<()> {
+    fields::apply("plant", FIELDS, params, overrides, |p, key, value| {
+        if key != "gravity" {
+            return Ok(false);
+        }
+        let name: String = value.extract().map_err(|_| {
+            PyTypeError::new_err("argument `gravity` must be 'printed' or 'roller_mass'")
+        })?;
+        p.gravity = match name.as_str() {
+            "printed" => GravityModel::Printed,
+            "roller_mass" => GravityModel::RollerMass,
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "argument `gravity` = {other:?} must be 'printed' or 'roller_mass'"
+                )))
+            }
+        };
+        Ok(true)
+    })?;
+    params
+        .validate()
+        .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// The IVT plant of Eq. 151 with the Table 1 parameters.
+///
+/// `Plant()` is the printed plant; keyword arguments override parameters by
+/// name (SI units), e.g. `Plant(r_a=0.3, gravity="roller_mass")`. Invalid
+/// values raise `ValueError` naming the parameter, unknown names `TypeError`.
+#[pyclass(name = "Plant", module = "ivt.kin", frozen)]
+#[derive(Clone)]
+pub struct Plant {
+    /// The wrapped Rust parameters.
+    pub params: PlantParams,
+}
+
+#[pymethods]
+impl Plant {
+    #[new]
+    #[pyo3(signature = (**overrides))]
+    fn new(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        let mut params = PlantParams::printed();
+        apply_overrides(&mut params, overrides)?;
+        Ok(Self { params })
+    }
+
+    /// A copy with some parameters changed (same keywords as the constructor).
+    #[pyo3(signature = (**overrides))]
+    fn replace(&self, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        let mut params = self.params;
+        apply_overrides(&mut params, overrides)?;
+        Ok(Self { params })
+    }
+
+    /// All parameters as a dict (keys are the constructor keywords).
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = fields::to_dict(py, FIELDS, &self.params)?;
+        d.set_item("gravity", gravity_name(self.params.gravity))?;
+        Ok(d)
+    }
+
+    /// Derived constants of §4.1: the keys of `ivt kin plant --json`.
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let p = &self.params;
+        let d = PyDict::new(py);
+        d.set_item("j_a", p.j_a())?;
+        d.set_item("j_b", p.j_b())?;
+        d.set_item("j_c", p.j_c())?;
+        d.set_item("j_d", p.j_d())?;
+        d.set_item("motor_damping", p.motor_damping())?;
+        d.set_item("motor_gain", p.motor_gain())?;
+        d.set_item("load_gain", p.load_gain())?;
+        d.set_item("r_max", p.r_max)?;
+        Ok(d)
+    }
+
+    /// J_a [kg·m²] (§4.1; thesis 0.0237).
+    #[getter]
+    fn j_a(&self) -> f64 {
+        self.params.j_a()
+    }
+    /// J_b = m_r + m_dr [kg] (§4.1; thesis 2.1264).
+    #[getter]
+    fn j_b(&self) -> f64 {
+        self.params.j_b()
+    }
+    /// J_c = J_U·8/(π² r_u²) [kg] (§4.1; thesis 0.3388).
+    #[getter]
+    fn j_c(&self) -> f64 {
+        self.params.j_c()
+    }
+    /// J_d = J_N1 [kg·m²] (§4.1).
+    #[getter]
+    fn j_d(&self) -> f64 {
+        self.params.j_d()
+    }
+    /// k_t k_e/R_a: F_m = this·f² (thesis 2.375).
+    #[getter]
+    fn motor_damping(&self) -> f64 {
+        self.params.motor_damping()
+    }
+    /// k_t/R_a: f1 = this·f·V_m (thesis 3.1667).
+    #[getter]
+    fn motor_gain(&self) -> f64 {
+        self.params.motor_gain()
+    }
+    /// 2√2/(π r_u): f2 = this·f·T_U (thesis 40.5548).
+    #[getter]
+    fn load_gain(&self) -> f64 {
+        self.params.load_gain()
+    }
+    /// Coefficient of (sin θ + cos θ) in G: g, or m_r·g with gravity="roller_mass".
+    #[getter]
+    fn gravity_gain(&self) -> f64 {
+        self.params.gravity_gain()
+    }
+    /// Largest eccentricity r_max [m] (§4.2.1: 0.012).
+    #[getter]
+    fn r_max(&self) -> f64 {
+        self.params.r_max
+    }
+
+    /// Coefficients of Eq. 151 at (θ, r) for inputs (V_m, T_U), broadcast
+    /// over arrays: a dict with keys f, f_theta, j, j_theta, j_r, j_theta_r,
+    /// g, f_m, f1, f2.
+    fn terms<'py>(
+        &self,
+        py: Python<'py>,
+        theta: &Bound<'py, PyAny>,
+        r: &Bound<'py, PyAny>,
+        v_m: &Bound<'py, PyAny>,
+        t_u: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let p = self.params;
+        let outs = map(
+            py,
+            [("theta", theta), ("r", r), ("v_m", v_m), ("t_u", t_u)],
+            |[th, r, vm, tu]| {
+                let t = p.terms(th, r, vm, tu);
+                Ok::<_, std::convert::Infallible>([
+                    t.f,
+                    t.f_theta,
+                    t.j,
+                    t.j_theta,
+                    t.j_r,
+                    t.j_theta_r,
+                    t.g,
+                    t.f_m,
+                    t.f1,
+                    t.f2,
+                ])
+            },
+        )?;
+        let names = [
+            "f",
+            "f_theta",
+            "j",
+            "j_theta",
+            "j_r",
+            "j_theta_r",
+            "g",
+            "f_m",
+            "f1",
+            "f2",
+        ];
+        let d = PyDict::new(py);
+        for (name, v) in names.iter().zip(outs) {
+            d.set_item(name, v)?;
+        }
+        Ok(d)
+    }
+
+    /// θ̈ of Eq. 151 at (θ, ω = θ̇) with eccentricity r and inputs (V_m, T_U),
+    /// broadcast over arrays.
+    fn acceleration<'py>(
+        &self,
+        py: Python<'py>,
+        theta: &Bound<'py, PyAny>,
+        omega: &Bound<'py, PyAny>,
+        r: &Bound<'py, PyAny>,
+        v_m: &Bound<'py, PyAny>,
+        t_u: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let p = self.params;
+        map1(
+            py,
+            [
+                ("theta", theta),
+                ("omega", omega),
+                ("r", r),
+                ("v_m", v_m),
+                ("t_u", t_u),
+            ],
+            |[th, w, r, vm, tu]| p.acceleration(th, w, r, vm, tu),
+        )
+    }
+
+    fn __repr__(&self) -> String {
+        let printed = PlantParams::printed();
+        let changed: Vec<String> = fields::changed(FIELDS, &self.params, &printed)
+            .into_iter()
+            .chain(
+                (self.params.gravity != printed.gravity)
+                    .then(|| format!("gravity={:?}", gravity_name(self.params.gravity))),
+            )
+            .collect();
+        format!("Plant({})", changed.join(", "))
+    }
+
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other
+            .cast::<Plant>()
+            .is_ok_and(|o| o.get().params == self.params)
+    }
+
+    /// Pickle support (for dask workers in other processes): rebuilt from
+    /// `params()` by the constructor.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let rebuild = py.import("ivt.kin")?.getattr("_plant_from_params")?;
+        let args = PyTuple::new(py, [self.params(py)?])?;
+        PyTuple::new(py, [rebuild, args.into_any()])
+    }
+}
+
+/// Register `ivt._ivt.kin`.
+pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
+    let m = PyModule::new(parent.py(), "kin")?;
+    m.add_function(wrap_pyfunction!(f, &m)?)?;
+    m.add_function(wrap_pyfunction!(f_theta, &m)?)?;
+    m.add_function(wrap_pyfunction!(mean_f_squared, &m)?)?;
+    m.add_function(wrap_pyfunction!(ring_speeds, &m)?)?;
+    m.add_function(wrap_pyfunction!(driver_speeds, &m)?)?;
+    m.add_function(wrap_pyfunction!(output_speed, &m)?)?;
+    m.add_function(wrap_pyfunction!(output_to_motor_ratio, &m)?)?;
+    m.add_class::<Plant>()?;
+    m.add("NCG_AMPLITUDE", ivt_kin::NCG_AMPLITUDE)?;
+    crate::gears::register(&m)?;
+    parent.add_submodule(&m)
+}
