@@ -10,6 +10,7 @@ use std::process::ExitCode;
 
 pub mod ctrl;
 pub mod kin;
+pub mod reproduce;
 
 /// Result of a command: the JSON object for `--json` and the text for humans.
 pub struct Output {
@@ -52,6 +53,8 @@ enum Command {
     /// The rig controller (ivt-ctrl): offline replay of pulse logs.
     #[command(subcommand)]
     Ctrl(ctrl::CtrlCommand),
+    /// Regenerate the thesis's computable figures and numbers (REPRODUCTION.md).
+    Reproduce(reproduce::ReproduceArgs),
 }
 
 /// Parse the process arguments, run, print, and map errors to exit codes.
@@ -60,6 +63,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Some(Command::Kin(cmd)) => kin::run(cmd),
         Some(Command::Ctrl(cmd)) => ctrl::run(cmd),
+        Some(Command::Reproduce(args)) => reproduce::run(args, cli.json),
         None => kin::summary(),
     };
     match result {
