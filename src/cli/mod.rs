@@ -10,7 +10,9 @@ use std::process::ExitCode;
 
 pub mod ctrl;
 pub mod kin;
+pub mod ol;
 pub mod reproduce;
+pub mod stability;
 
 /// Result of a command: the JSON object for `--json` and the text for humans.
 pub struct Output {
@@ -50,6 +52,13 @@ enum Command {
     /// Kinematics of the GIVT, SGIVT and its variant (Chapter 2).
     #[command(subcommand)]
     Kin(kin::KinCommand),
+    /// Open-loop law from the model: IHB steady state, grid table, refit (§4.2.1).
+    #[command(subcommand)]
+    Ol(ol::OlCommand),
+    /// Floquet multipliers of the time-delay loop at one point (§4.3).
+    Stability(stability::StabilityArgs),
+    /// Max |multiplier| over a grid (Fig. 42 analogue).
+    StabilityMap(stability::MapArgs),
     /// The rig controller (ivt-ctrl): offline replay of pulse logs.
     #[command(subcommand)]
     Ctrl(ctrl::CtrlCommand),
@@ -62,6 +71,9 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Kin(cmd)) => kin::run(cmd),
+        Some(Command::Ol(cmd)) => ol::run(cmd),
+        Some(Command::Stability(a)) => stability::run(a),
+        Some(Command::StabilityMap(a)) => stability::run_map(a),
         Some(Command::Ctrl(cmd)) => ctrl::run(cmd),
         Some(Command::Reproduce(args)) => reproduce::run(args, cli.json),
         None => kin::summary(),

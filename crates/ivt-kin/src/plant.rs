@@ -159,6 +159,24 @@ impl PlantParams {
         v_m: f64,
         t_u: f64,
     ) -> PlantTerms {
+        let (s, c) = (libm::sin(theta), libm::cos(theta));
+        self.terms_with_trig(s, c, f, f_theta, r, v_m, t_u)
+    }
+
+    /// As [`Self::terms_with_f`] with sin θ and cos θ also known (harmonic
+    /// balance evaluates one `sin_cos` per sample and derives f from it).
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    pub fn terms_with_trig(
+        &self,
+        sin_theta: f64,
+        cos_theta: f64,
+        f: f64,
+        f_theta: f64,
+        r: f64,
+        v_m: f64,
+        t_u: f64,
+    ) -> PlantTerms {
         let (j_c, j_d) = (self.j_c(), self.j_d());
         let r2 = r * r;
         let f2sq = f * f;
@@ -169,7 +187,7 @@ impl PlantParams {
             j_theta: 2.0 * (j_c * r2 + j_d) * f * f_theta,
             j_r: 2.0 * self.j_b() * r + 2.0 * j_c * r * f2sq,
             j_theta_r: 4.0 * j_c * r * f * f_theta,
-            g: self.gravity_gain() * (libm::sin(theta) + libm::cos(theta)),
+            g: self.gravity_gain() * (sin_theta + cos_theta),
             f_m: self.motor_damping() * f2sq,
             f1: self.motor_gain() * f * v_m,
             f2: self.load_gain() * f * t_u,

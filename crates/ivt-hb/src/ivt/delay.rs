@@ -1,0 +1,292 @@
+//! Local stability of the integral time-delay feedback, thesis §4.3.
+//!
+//! Eq. 171 in θ with `z = ∫_{θ−2π}^{θ} dσ/ω` (Eq. 172) is recast as a transport
+//! problem `u(θ, x) = ω(θ − x)`, x ∈ [0, 2π] (Eq. 173), and linearized about
+//! the periodic steady state (ω̄, r̄, z̄ = 2π/ω0), Eq. 174:
+//!
+//! ```text
+//! Δu_x + Δu_θ = 0
+//! Δu_θ(θ,0) = A Δr + B Δu(θ,0)
+//! Δr' = K Δz + k2 [Δu(θ,0) − Δu(θ,2π)],   K = −k ω0²/(2π)
+//! Δz' = C [Δu(θ,0) − Δu(θ,2π)]
+//! ```
+//!
+//! with A, B, C of Appendix B. Δu = Σ q_i T_i(x) on Chebyshev polynomials of
+//! x/π − 1 and the spectral Tau method (Eq. 175–178) give η' = 𝒜(θ) η,
+//! η = {q_0 … q_N, Δr, Δz} (Eq. 179, Appendix C). The monodromy matrix over
+//! θ ∈ [0, 2π] is integrated with the order-6 Runge–Kutta on the smooth pieces
+//! (A, B jump with f_θ at the gear corners); ω̄ is integrated alongside from
+//! Eq. 162 so that A, B, C are exact at every stage. One multiplier is the
+//! structural unit one (Appendix C: it comes from the integral variable z);
+//! the one closest to 1 is set aside and reported separately.
+
+use super::rk6::{pieces, steps_for, Rk6, Segment};
+use super::shooting::{shoot_steady_state, PeriodicOrbit, ShootingOptions};
+use super::{check_plant, IvtError, OperatingPoint};
+use core::f64::consts::PI;
+use ivt_kin::plant::PlantParams;
+use nalgebra::DMatrix;
+
+/// Feedback gains of Eq. 171/180 in SI: `dr/dθ = k(ω_a − ω0) + k2(ω − ω_T)`,
+/// so k and k2 are in m·s/rad² (metres of r per radian of θ per rad/s).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FeedbackGains {
+    /// Integral gain k \[m·s/rad²\].
+    pub k: f64,
+    /// Damping gain k2 \[m·s/rad²\].
+    pub k2: f64,
+}
+
+impl FeedbackGains {
+    /// From the thesis's printed "mm·rad⁻¹" numbers, read (as in
+    /// `ivt_ctrl::units::gain_from_mm_per_rad`) as millimetres of r per radian
+    /// of θ per rad/s of speed error: `k_SI = 1e-3 · k_printed`.
+    pub fn from_thesis_mm_per_rad(k: f64, k2: f64) -> Self {
+        Self {
+            k: 1e-3 * k,
+            k2: 1e-3 * k2,
+        }
+    }
+
+    /// Back to the printed unit (mm·rad⁻¹ per rad/s).
+    pub fn to_thesis_mm_per_rad(self) -> (f64, f64) {
+        (1e3 * self.k, 1e3 * self.k2)
+    }
+}
+
+/// Discretization of the stability analysis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DelayOptions {
+    /// Chebyshev order N (even; thesis uses an even N). 16 is converged to
+    /// ~1e-6 in the max |multiplier| (README).
+    pub chebyshev_order: usize,
+    /// RK6 steps per gear segment for the monodromy; 0 = automatic (grows
+    /// with N² because the Tau transport operator is stiff like N²).
+    pub steps_per_segment: usize,
+    /// Shooting accuracy for the steady state (ω̄(0), r̄).
+    pub shooting: ShootingOptions,
+}
+
+impl Default for DelayOptions {
+    fn default() -> Self {
+        Self {
+            chebyshev_order: 16,
+            steps_per_segment: 0,
+            shooting: ShootingOptions::default(),
+        }
+    }
+}
+
+impl DelayOptions {
+    fn steps(&self) -> usize {
+        if self.steps_per_segment > 0 {
+            self.steps_per_segment
+        } else {
+            let n = self.chebyshev_order as f64;
+            (0.25 * n * n).ceil().max(16.0) as usize
+        }
+    }
+}
+
+/// Floquet multipliers of Eq. 179 at one operating point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DelayStability {
+    /// Largest |multiplier| without the structural unit one.
+    pub max_abs_multiplier: f64,
+    /// The multiplier set aside as the structural one (≈ 1).
+    pub structural: (f64, f64),
+    /// All multipliers (re, im), largest modulus first.
+    pub multipliers: Vec<(f64, f64)>,
+    /// The steady state linearized about.
+    pub orbit: PeriodicOrbit,
+}
+
+/// The constant part of the Tau rows: dq_i/dθ = −Σ_n D[n][i] q_n (Eq. 175),
+/// with d T_n/dx = Σ_i D[n][i] T_i and T_i(x) = cos(i·arccos(x/π − 1)).
+fn tau_rows(n_order: usize) -> DMatrix<f64> {
+    // dt[(i, n)] = coefficient of T_i in dT_n/dx.
+    let mut dt = DMatrix::zeros(n_order, n_order + 1);
+    for n in 1..=n_order {
+        for i in 0..n {
+            if (n - i) % 2 == 1 {
+                let ci = if i == 0 { 2.0 } else { 1.0 };
+                dt[(i, n)] = 2.0 * n as f64 / ci / PI;
+            }
+        }
+    }
+    dt
+}
+
+/// Steady state to linearize about: shooting to the time-mean ω0 (exact to
+/// ~1e-12; the IHB value may seed it).
+///
+/// # Errors
+/// As [`shoot_steady_state`].
+pub fn steady_orbit(
+    plant: &PlantParams,
+    op: &OperatingPoint,
+    r_seed: Option<f64>,
+    opts: &DelayOptions,
+) -> Result<PeriodicOrbit, IvtError> {
+    shoot_steady_state(plant, op, r_seed, &opts.shooting)
+}
+
+/// The monodromy matrix of Eq. 179 over θ ∈ [0, 2π] about `orbit`.
+///
+/// # Errors
+/// Bad inputs, an odd or zero N, or a stall of ω̄.
+pub fn monodromy(
+    plant: &PlantParams,
+    op: &OperatingPoint,
+    gains: FeedbackGains,
+    orbit: &PeriodicOrbit,
+    opts: &DelayOptions,
+) -> Result<DMatrix<f64>, IvtError> {
+    check_plant(plant)?;
+    op.validate()?;
+    let nn = opts.chebyshev_order;
+    if nn == 0 || nn % 2 == 1 {
+        return Err(IvtError::Input {
+            name: "chebyshev_order",
+            value: nn as f64,
+            requirement: "even and >= 2",
+        });
+    }
+    for (name, v) in [("k", gains.k), ("k2", gains.k2)] {
+        if !v.is_finite() {
+            return Err(IvtError::Input {
+                name,
+                value: v,
+                requirement: "finite",
+            });
+        }
+    }
+    let d = nn + 3;
+    let dt = tau_rows(nn);
+    // T_i(x=0) = (−1)^i; T_i(2π) = 1; (T_0 − T_I)_i = (−1)^i − 1.
+    let t0: Vec<f64> = (0..=nn)
+        .map(|i| if i % 2 == 0 { 1.0 } else { -1.0 })
+        .collect();
+    let diff: Vec<f64> = t0.iter().map(|t| t - 1.0).collect();
+    let big_k = -gains.k * op.omega0 * op.omega0 / (2.0 * PI);
+    let r = orbit.r;
+    // State: [ω̄, Φ column-major (d × d)].
+    let mut y = vec![0.0; 1 + d * d];
+    y[0] = orbit.omega_start;
+    for i in 0..d {
+        y[1 + i * d + i] = 1.0;
+    }
+    let mut rk = Rk6::new(y.len());
+    let steps = opts.steps();
+    for (a, b, seg) in pieces(0.0, 2.0 * PI) {
+        let mut rhs = |theta: f64, y: &[f64], dy: &mut [f64]| {
+            let seg: Segment = seg;
+            let (f, ft) = seg.f_and_f_theta(theta);
+            let p = plant.terms_with_f(theta, f, ft, r, op.v_m, op.t_u);
+            let w = y[0];
+            let drive = p.drive(r);
+            let wp = (drive / w - 0.5 * p.j_theta * w - p.f_m) / p.j; // Eq. 162
+            dy[0] = wp;
+            // Appendix B.
+            let a_coef = (-p.j_r * wp - 0.5 * p.j_theta_r * w + (p.g - p.f2) / w) / p.j;
+            let b_coef = -(drive / (w * w) + 0.5 * p.j_theta) / p.j;
+            let c_coef = -1.0 / (w * w);
+            for col in 0..d {
+                let phi = &y[1 + col * d..1 + (col + 1) * d];
+                let out = &mut dy[1 + col * d..1 + (col + 1) * d];
+                let q = &phi[..=nn];
+                let (dr, dz) = (phi[nn + 1], phi[nn + 2]);
+                let mut bound = 0.0; // Σ_{i<N} T0_i q'_i
+                for i in 0..nn {
+                    let mut s = 0.0;
+                    for (nidx, qn) in q.iter().enumerate().skip(i + 1) {
+                        s += dt[(i, nidx)] * qn;
+                    }
+                    out[i] = -s;
+                    bound += t0[i] * out[i];
+                }
+                let u0: f64 = q.iter().zip(&t0).map(|(a, b)| a * b).sum();
+                let jump: f64 = q.iter().zip(&diff).map(|(a, b)| a * b).sum();
+                // Eq. 176 solved for q'_N (T0_N = 1 for even N).
+                out[nn] = a_coef * dr + b_coef * u0 - bound;
+                out[nn + 1] = big_k * dz + gains.k2 * jump; // Eq. 177
+                out[nn + 2] = c_coef * jump; // Eq. 178
+            }
+        };
+        let n = steps_for(b - a, steps);
+        let h = (b - a) / n as f64;
+        for i in 0..n {
+            rk.step(&mut rhs, a + i as f64 * h, h, &mut y);
+            if !(y[0].is_finite() && y[0] > 0.0) {
+                return Err(IvtError::Stall {
+                    theta: a + (i + 1) as f64 * h,
+                    omega: y[0],
+                    r,
+                });
+            }
+        }
+    }
+    Ok(DMatrix::from_column_slice(d, d, &y[1..]))
+}
+
+/// Max |Floquet multiplier| of Eq. 179 at `op` for `gains`, linearized about
+/// the exact steady state (r̄ unconstrained, as in the thesis's Fig. 42).
+///
+/// # Errors
+/// Bad inputs, stall, or no convergence of the steady state.
+pub fn delay_stability(
+    plant: &PlantParams,
+    op: &OperatingPoint,
+    gains: FeedbackGains,
+    opts: &DelayOptions,
+) -> Result<DelayStability, IvtError> {
+    let orbit = steady_orbit(plant, op, None, opts)?;
+    delay_stability_about(plant, op, gains, &orbit, opts)
+}
+
+/// As [`delay_stability`] about a given steady state (reused across gains).
+///
+/// # Errors
+/// As [`monodromy`].
+pub fn delay_stability_about(
+    plant: &PlantParams,
+    op: &OperatingPoint,
+    gains: FeedbackGains,
+    orbit: &PeriodicOrbit,
+    opts: &DelayOptions,
+) -> Result<DelayStability, IvtError> {
+    let m = monodromy(plant, op, gains, orbit, opts)?;
+    let eig = m.complex_eigenvalues();
+    let mut mult: Vec<(f64, f64)> = eig.iter().map(|z| (z.re, z.im)).collect();
+    if mult.iter().any(|(a, b)| !(a.is_finite() && b.is_finite())) {
+        return Err(IvtError::NoConvergence {
+            method: "monodromy eigenvalues",
+            iterations: 0,
+            history: vec![f64::NAN],
+        });
+    }
+    let unit = mult
+        .iter()
+        .enumerate()
+        .min_by(|a, b| {
+            let da = (a.1 .0 - 1.0).hypot(a.1 .1);
+            let db = (b.1 .0 - 1.0).hypot(b.1 .1);
+            da.total_cmp(&db)
+        })
+        .map(|(i, _)| i)
+        .unwrap_or(0);
+    let structural = mult[unit];
+    let max_abs = mult
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| *i != unit)
+        .map(|(_, (a, b))| a.hypot(*b))
+        .fold(0.0, f64::max);
+    mult.sort_by(|a, b| b.0.hypot(b.1).total_cmp(&a.0.hypot(a.1)));
+    Ok(DelayStability {
+        max_abs_multiplier: max_abs,
+        structural,
+        multipliers: mult,
+        orbit: *orbit,
+    })
+}

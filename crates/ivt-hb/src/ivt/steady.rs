@@ -1,0 +1,529 @@
+//! IVT periodic steady state by the modified IHB, Eq. 152–157.
+//!
+//! In the dimensionless time τ = ω0 t the angle is `θ = τ + C_sᵀ q_p`
+//! (Eq. 152), so the time mean of θ̇ is exactly ω0 whatever q_p is; the
+//! residual of Eq. 151,
+//!
+//! ```text
+//! R_p = ω0² [J θ₁'' + ½ J_θ (1 + θ₁')²] + ω0 F_m (1 + θ₁') − G r − f1 + f2 r   (Eq. 155)
+//! ```
+//!
+//! is sampled at `samples` equally spaced τ and projected on
+//! `C̃_s = {½, cos τ … cos nτ, sin τ … sin nτ}` (alternating frequency–time).
+//! The 2n+1 balanced residuals are zeroed in the 2n+1 unknowns `x_p = {r, q_p}`.
+//!
+//! Solver: Newton with the exact Jacobian of the sampled residual (the
+//! Galerkin Jacobian of the classic IHB, §3.2.1). The projection is a direct
+//! sum over precomputed cos/sin tables (a plan made once per (n, samples)):
+//! for n = 7 and 64 samples that is ~1 k multiply–adds, no cheaper by FFT.
+//! Limitation: the thesis solves Eq. 156–157 by Broyden's update; the generic
+//! Broyden of this crate's HB engine was not available when this was written,
+//! and Newton converges in 2–4 iterations from a warm start (see README).
+//!
+//! Accuracy: f_θ (Eq. 139) jumps at the gear corners, so ω̄(θ) has kinks and
+//! θ₁ has Fourier coefficients decaying like k⁻³. The truncation at n
+//! harmonics, not the solver, limits how well r̄ matches the exact (shooting)
+//! value; `tests::converges_in_n` and the README show r̄(n).
+
+use super::rk6::Segment;
+use super::{averaged_r, check_plant, IvtError, OperatingPoint, Verdict};
+use core::f64::consts::PI;
+use ivt_kin::plant::PlantParams;
+use nalgebra::{DMatrix, DVector};
+
+/// Harmonics, sampling and stopping rule of the IHB solve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IhbOptions {
+    /// Harmonics n of θ₁ (thesis: 7).
+    pub harmonics: usize,
+    /// Time samples per period for the projection; 0 = automatic
+    /// (the smallest power of two ≥ max(64, 8n)).
+    pub samples: usize,
+    /// Stop when the Euclidean norm of the balanced residual (N·m) is below this
+    /// (thesis: 1e-10).
+    pub tol: f64,
+    /// Newton iteration limit.
+    pub max_iter: usize,
+    /// How the balanced residual integral is evaluated.
+    pub quadrature: Quadrature,
+}
+
+/// Quadrature of the harmonic-balance integral `(1/π)∫ C̃_s R_p dτ`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Quadrature {
+    /// Equally spaced samples (the thesis's FFT/AFT route). The residual jumps
+    /// where θ(τ) crosses a gear corner, so this sum converges only like
+    /// 1/samples (≈1e-4 relative in r̄ at 1024 samples, see README).
+    Uniform,
+    /// Gauss–Legendre on each smooth piece between the τ where θ(τ) crosses a
+    /// corner (found by Newton on Eq. 152), with the moving-end terms in the
+    /// Jacobian: the integral is exact to round-off, and r̄ converges to the
+    /// shooting value as n grows.
+    #[default]
+    PiecewiseGauss,
+}
+
+impl Default for IhbOptions {
+    fn default() -> Self {
+        Self {
+            harmonics: 7,
+            samples: 0,
+            tol: 1e-10,
+            max_iter: 40,
+            quadrature: Quadrature::default(),
+        }
+    }
+}
+
+impl IhbOptions {
+    fn sample_count(&self) -> usize {
+        match self.quadrature {
+            Quadrature::Uniform if self.samples > 0 => self.samples,
+            Quadrature::Uniform => (8 * self.harmonics).max(64).next_power_of_two(),
+            // Four smooth pieces per period, `gauss_nodes()` nodes each.
+            Quadrature::PiecewiseGauss => 4 * self.gauss_nodes(),
+        }
+    }
+
+    /// Gauss nodes per smooth piece: `samples/4` if given, else n + 8
+    /// (r̄ then agrees with 200 nodes per piece to ≤ 1e-13 relative for n = 7
+    /// and 31 at three grid points; n + 4 gives ~1e-10).
+    fn gauss_nodes(&self) -> usize {
+        if self.samples >= 4 {
+            self.samples / 4
+        } else {
+            self.harmonics + 8
+        }
+    }
+}
+
+/// The IHB steady state at one operating point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SteadyState {
+    /// Operating point solved for.
+    pub op: OperatingPoint,
+    /// Unconstrained r̄ \[m\] (may be < 0 or > r_max; see `verdict`).
+    pub r: f64,
+    /// q_p = {q_c1 … q_cn, q_s1 … q_sn} \[rad\], Eq. 152.
+    pub q: Vec<f64>,
+    /// Smallest ω̄ over 128 equally spaced τ \[rad/s\].
+    pub omega_min: f64,
+    /// Largest ω̄ over 128 equally spaced τ \[rad/s\].
+    pub omega_max: f64,
+    /// Where r̄ lies relative to [0, r_max].
+    pub verdict: Verdict,
+    /// Newton iterations used.
+    pub iterations: usize,
+    /// Final Euclidean norm of the balanced residual \[N·m\].
+    pub residual_norm: f64,
+}
+
+impl SteadyState {
+    /// θ₁(τ) and its τ-derivative.
+    fn theta1(&self, tau: f64) -> (f64, f64) {
+        theta1_of(&self.q, tau)
+    }
+
+    /// θ(τ) = τ + θ₁(τ), Eq. 152.
+    pub fn theta_at_tau(&self, tau: f64) -> f64 {
+        tau + self.theta1(tau).0
+    }
+
+    /// ω̄(τ) = ω0 (1 + θ₁'(τ)), Eq. 153.
+    pub fn omega_at_tau(&self, tau: f64) -> f64 {
+        self.op.omega0 * (1.0 + self.theta1(tau).1)
+    }
+
+    /// ω̄ at the angle θ (inverts Eq. 152 by Newton on τ; θ(τ) is monotone
+    /// because ω̄ > 0).
+    pub fn omega_at_theta(&self, theta: f64) -> f64 {
+        let mut tau = theta;
+        for _ in 0..50 {
+            let (v, d) = self.theta1(tau);
+            let step = (tau + v - theta) / (1.0 + d);
+            tau -= step;
+            if step.abs() < 1e-15 {
+                break;
+            }
+        }
+        self.omega_at_tau(tau)
+    }
+}
+
+/// A plan for one (n, quadrature): node/weight storage, trig tables and the
+/// projection matrix, reused over many solves (a sweep makes one per thread).
+#[derive(Clone, Debug)]
+pub struct IhbSolver {
+    opts: IhbOptions,
+    samples: usize,
+    /// Quadrature nodes τ_j and weights (Σ w = 2π).
+    tau: Vec<f64>,
+    weight: Vec<f64>,
+    /// Gauss–Legendre nodes/weights on [−1, 1] (piecewise quadrature only).
+    gauss: (Vec<f64>, Vec<f64>),
+    /// cos(k τ_j), sin(k τ_j) for k = 1..n, row-major [j][k-1].
+    cos: Vec<f64>,
+    sin: Vec<f64>,
+    /// (2n+1) × samples projection on C̃_s (the integral after Eq. 155).
+    project: DMatrix<f64>,
+    /// samples × (2n+1) derivatives of the sampled residual.
+    dres: DMatrix<f64>,
+    res: DVector<f64>,
+    /// Moving-end (corner-crossing) contributions to the Jacobian.
+    jump_jac: DMatrix<f64>,
+    /// (sin kτ_c, cos kτ_c) at one corner crossing, k = 0..=n.
+    trig_c: Vec<(f64, f64)>,
+}
+
+impl IhbSolver {
+    /// Plan the tables for `opts`.
+    ///
+    /// # Errors
+    /// [`IvtError::Input`] for n = 0 or too few samples (need > 2n).
+    pub fn new(opts: IhbOptions) -> Result<Self, IvtError> {
+        let n = opts.harmonics;
+        let m = opts.sample_count();
+        if n == 0 {
+            return Err(IvtError::Input {
+                name: "harmonics",
+                value: 0.0,
+                requirement: ">= 1",
+            });
+        }
+        if m <= 2 * n {
+            return Err(IvtError::Input {
+                name: "samples",
+                value: m as f64,
+                requirement: "> 2 × harmonics",
+            });
+        }
+        let mut s = Self {
+            opts,
+            samples: m,
+            tau: vec![0.0; m],
+            weight: vec![2.0 * PI / m as f64; m],
+            gauss: gauss_legendre(opts.gauss_nodes()),
+            cos: vec![0.0; m * n],
+            sin: vec![0.0; m * n],
+            project: DMatrix::zeros(2 * n + 1, m),
+            dres: DMatrix::zeros(m, 2 * n + 1),
+            res: DVector::zeros(m),
+            jump_jac: DMatrix::zeros(2 * n + 1, 2 * n + 1),
+            trig_c: vec![(0.0, 1.0); n + 1],
+        };
+        for j in 0..m {
+            s.tau[j] = 2.0 * PI * j as f64 / m as f64;
+        }
+        s.fill_tables();
+        Ok(s)
+    }
+
+    /// The options this plan was made for.
+    pub fn options(&self) -> &IhbOptions {
+        &self.opts
+    }
+
+    /// Trig tables and projection matrix for the current nodes and weights.
+    fn fill_tables(&mut self) {
+        let n = self.opts.harmonics;
+        for j in 0..self.samples {
+            let (w, tau) = (self.weight[j], self.tau[j]);
+            self.project[(0, j)] = w / (2.0 * PI);
+            let (s1, c1) = tau.sin_cos();
+            let (mut s, mut c) = (s1, c1);
+            for k in 1..=n {
+                if k > 1 && k % 8 == 1 {
+                    // Refresh the recurrence now and then against drift.
+                    (s, c) = (k as f64 * tau).sin_cos();
+                }
+                self.cos[j * n + k - 1] = c;
+                self.sin[j * n + k - 1] = s;
+                self.project[(k, j)] = w * c / PI;
+                self.project[(n + k, j)] = w * s / PI;
+                (s, c) = (s * c1 + c * s1, c * c1 - s * s1);
+            }
+        }
+    }
+
+    /// τ where θ(τ) = τ + θ₁(τ) equals `theta` (Newton; θ(τ) is monotone).
+    fn tau_of_theta(q: &[f64], theta: f64) -> f64 {
+        let mut tau = theta;
+        for _ in 0..60 {
+            let (v, d) = theta1_of(q, tau);
+            let step = (tau + v - theta) / (1.0 + d).max(1e-3);
+            tau -= step;
+            // Quadratic convergence: one more step after 1e-9 reaches round-off.
+            if step.abs() < 1e-9 {
+                let (v, d) = theta1_of(q, tau);
+                tau -= (tau + v - theta) / (1.0 + d).max(1e-3);
+                break;
+            }
+        }
+        tau
+    }
+
+    /// Place Gauss nodes on the four smooth pieces between corner crossings.
+    /// Returns the crossing τ's (for the moving-end Jacobian terms).
+    fn place_piecewise_nodes(&mut self, q: &[f64]) -> [f64; 5] {
+        use core::f64::consts::{FRAC_PI_2, FRAC_PI_4};
+        let mut ends = [0.0; 5];
+        for (k, e) in ends.iter_mut().enumerate() {
+            *e = Self::tau_of_theta(q, FRAC_PI_4 + k as f64 * FRAC_PI_2);
+        }
+        let g = self.gauss.0.len();
+        for p in 0..4 {
+            let (a, b) = (ends[p], ends[p + 1]);
+            let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
+            for i in 0..g {
+                self.tau[p * g + i] = mid + half * self.gauss.0[i];
+                self.weight[p * g + i] = half * self.gauss.1[i];
+            }
+        }
+        self.fill_tables();
+        ends
+    }
+
+    /// Sampled residual (and, if `jac`, its derivatives) at x = {r, q_p}.
+    fn sample(&mut self, plant: &PlantParams, op: &OperatingPoint, x: &[f64], jac: bool) {
+        let n = self.opts.harmonics;
+        let (w0, r) = (op.omega0, x[0]);
+        let q = &x[1..];
+        let corners = match self.opts.quadrature {
+            Quadrature::PiecewiseGauss => Some(self.place_piecewise_nodes(q)),
+            Quadrature::Uniform => None,
+        };
+        let (jc, jd) = (plant.j_c(), plant.j_d());
+        let (gg, a, b, c) = (
+            plant.gravity_gain(),
+            plant.motor_gain(),
+            plant.load_gain(),
+            plant.motor_damping(),
+        );
+        for j in 0..self.samples {
+            let tau = self.tau[j];
+            let (cs, sn) = (&self.cos[j * n..(j + 1) * n], &self.sin[j * n..(j + 1) * n]);
+            let (mut t1, mut t1d, mut t1dd) = (0.0, 0.0, 0.0);
+            for k in 0..n {
+                let kk = (k + 1) as f64;
+                let (qc, qs) = (q[k], q[n + k]);
+                t1 += qc * cs[k] + qs * sn[k];
+                t1d += kk * (qs * cs[k] - qc * sn[k]);
+                t1dd -= kk * kk * (qc * cs[k] + qs * sn[k]);
+            }
+            let theta = tau + t1;
+            let seg = Segment::containing(theta);
+            let (st, ct) = theta.sin_cos();
+            let (f, ft) = seg.f_and_f_theta_from(st, ct);
+            let p = plant.terms_with_trig(st, ct, f, ft, r, op.v_m, op.t_u);
+            let s = 1.0 + t1d;
+            self.res[j] =
+                w0 * w0 * (p.j * t1dd + 0.5 * p.j_theta * s * s) + w0 * p.f_m * s - p.drive(r);
+            if jac {
+                // ∂/∂θ of the coefficients on one smooth segment (f_θθ = −f there).
+                let j_tt = 2.0 * (jc * r * r + jd) * (ft * ft - f * f);
+                let fm_t = 2.0 * c * f * ft;
+                let drive_t = gg * (ct - st) * r + a * ft * op.v_m - b * ft * op.t_u * r;
+                let r_theta =
+                    w0 * w0 * (p.j_theta * t1dd + 0.5 * j_tt * s * s) + w0 * fm_t * s - drive_t;
+                let r_s = w0 * w0 * p.j_theta * s + w0 * p.f_m;
+                let r_ss = w0 * w0 * p.j;
+                self.dres[(j, 0)] =
+                    w0 * w0 * (p.j_r * t1dd + 0.5 * p.j_theta_r * s * s) - (p.g - p.f2);
+                for k in 0..n {
+                    let kk = (k + 1) as f64;
+                    let base = r_theta - kk * kk * r_ss;
+                    self.dres[(j, 1 + k)] = base * cs[k] - kk * r_s * sn[k];
+                    self.dres[(j, 1 + n + k)] = base * sn[k] + kk * r_s * cs[k];
+                }
+            }
+        }
+        self.jump_jac.fill(0.0);
+        if let (true, Some(ends)) = (jac, corners) {
+            // d/dx Σ_pieces ∫ w R dτ gains w(τ_c) (R⁻ − R⁺) dτ_c/dx at each corner
+            // crossing τ_c; only J_θ jumps there, so R⁻ − R⁺ = ½ ω0² ΔJ_θ (1+θ₁')².
+            for &tc in &ends[1..] {
+                let (t1, t1d) = theta1_of(q, tc);
+                let (theta_c, s) = (tc + t1, 1.0 + t1d);
+                let left = Segment::containing(theta_c - 1e-9);
+                let right = Segment::containing(theta_c + 1e-9);
+                let jt = |seg: Segment| {
+                    let (f, ft) = seg.f_and_f_theta(theta_c);
+                    plant
+                        .terms_with_f(theta_c, f, ft, r, op.v_m, op.t_u)
+                        .j_theta
+                };
+                let jump = 0.5 * w0 * w0 * (jt(left) - jt(right)) * s * s;
+                // dτ_c/dq = −∂θ₁/∂q (τ_c) / (1 + θ₁'(τ_c)); dτ_c/dr = 0.
+                let (s1, c1) = tc.sin_cos();
+                let (mut sr, mut cr) = (s1, c1);
+                for k in 1..=n {
+                    self.trig_c[k] = (sr, cr);
+                    (sr, cr) = (sr * c1 + cr * s1, cr * c1 - sr * s1);
+                }
+                for row in 0..=2 * n {
+                    let wrow = match row {
+                        0 => 1.0 / (2.0 * PI),
+                        k if k <= n => self.trig_c[k].1 / PI,
+                        k => self.trig_c[k - n].0 / PI,
+                    } * jump
+                        / s;
+                    for k in 1..=n {
+                        let (sk, ck) = self.trig_c[k];
+                        self.jump_jac[(row, k)] -= wrow * ck;
+                        self.jump_jac[(row, n + k)] -= wrow * sk;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Solve Eq. 152–157 at `op`. `warm` = a previous solution {r, q_p} of the
+    /// same n (a neighbouring grid point); otherwise r starts from the
+    /// averaged power balance and q_p from zero.
+    ///
+    /// # Errors
+    /// Bad inputs; [`IvtError::NoConvergence`] with the residual history.
+    pub fn solve(
+        &mut self,
+        plant: &PlantParams,
+        op: &OperatingPoint,
+        warm: Option<(f64, &[f64])>,
+    ) -> Result<SteadyState, IvtError> {
+        check_plant(plant)?;
+        op.validate()?;
+        let n = self.opts.harmonics;
+        let dim = 2 * n + 1;
+        let mut x = vec![0.0; dim];
+        match warm {
+            Some((r, q)) if q.len() == 2 * n => {
+                x[0] = r;
+                x[1..].copy_from_slice(q);
+            }
+            _ => x[0] = averaged_r(plant, op),
+        }
+        let mut history = Vec::new();
+        self.sample(plant, op, &x, true);
+        let mut rb = &self.project * &self.res;
+        let mut norm = rb.norm();
+        history.push(norm);
+        let mut iterations = 0;
+        while norm >= self.opts.tol {
+            if iterations >= self.opts.max_iter || !norm.is_finite() {
+                return Err(IvtError::NoConvergence {
+                    method: "modified IHB (Newton)",
+                    iterations,
+                    history,
+                });
+            }
+            iterations += 1;
+            let jac = &self.project * &self.dres + &self.jump_jac;
+            let Some(step) = jac.lu().solve(&rb) else {
+                return Err(IvtError::NoConvergence {
+                    method: "modified IHB (singular Jacobian)",
+                    iterations,
+                    history,
+                });
+            };
+            // Backtracking keeps the solve robust from a cold start.
+            let mut lambda = 1.0;
+            let x_old = x.clone();
+            loop {
+                for (xi, (xo, si)) in x.iter_mut().zip(x_old.iter().zip(step.iter())) {
+                    *xi = xo - lambda * si;
+                }
+                self.sample(plant, op, &x, true);
+                rb = &self.project * &self.res;
+                let trial = rb.norm();
+                if trial < norm || lambda < 1e-3 {
+                    norm = trial;
+                    break;
+                }
+                lambda *= 0.5;
+            }
+            history.push(norm);
+        }
+        let q = x[1..].to_vec();
+        let mut st = SteadyState {
+            op: *op,
+            r: x[0],
+            q,
+            omega_min: f64::INFINITY,
+            omega_max: f64::NEG_INFINITY,
+            verdict: Verdict::classify(x[0], plant.r_max),
+            iterations,
+            residual_norm: norm,
+        };
+        for j in 0..128 {
+            let w = st.omega_at_tau(2.0 * PI * j as f64 / 128.0);
+            st.omega_min = st.omega_min.min(w);
+            st.omega_max = st.omega_max.max(w);
+        }
+        if st.omega_min <= 0.0 {
+            return Err(IvtError::Stall {
+                theta: f64::NAN,
+                omega: st.omega_min,
+                r: st.r,
+            });
+        }
+        Ok(st)
+    }
+}
+
+/// One-shot convenience: plan and solve with `opts`.
+///
+/// # Errors
+/// As [`IhbSolver::solve`].
+pub fn solve_steady_state(
+    plant: &PlantParams,
+    op: &OperatingPoint,
+    opts: IhbOptions,
+) -> Result<SteadyState, IvtError> {
+    IhbSolver::new(opts)?.solve(plant, op, None)
+}
+
+/// θ₁(τ) = C_sᵀ q_p and θ₁'(τ) = C_sᵀ D_p q_p (Eq. 152–153), one `sin_cos`
+/// and the angle-addition recurrence (error grows like k·ε, negligible for
+/// the n ≤ 500 used here).
+fn theta1_of(q: &[f64], tau: f64) -> (f64, f64) {
+    let n = q.len() / 2;
+    let (s1, c1) = tau.sin_cos();
+    let (mut s, mut c) = (s1, c1);
+    let (mut v, mut d) = (0.0, 0.0);
+    for k in 1..=n {
+        let (qc, qs) = (q[k - 1], q[n + k - 1]);
+        v += qc * c + qs * s;
+        d += k as f64 * (qs * c - qc * s);
+        (s, c) = (s * c1 + c * s1, c * c1 - s * s1);
+    }
+    (v, d)
+}
+
+/// Gauss–Legendre nodes and weights on [−1, 1] (Newton on P_m from the
+/// Chebyshev-like initial guesses; Abramowitz–Stegun 25.4.29).
+pub(crate) fn gauss_legendre(m: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut x = vec![0.0; m];
+    let mut w = vec![0.0; m];
+    for i in 0..m {
+        let mut z = (PI * (i as f64 + 0.75) / (m as f64 + 0.5)).cos();
+        let mut dp = 1.0;
+        for _ in 0..100 {
+            let (mut p0, mut p1) = (1.0, z);
+            for k in 2..=m {
+                let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
+                p0 = p1;
+                p1 = p2;
+            }
+            let pm = if m == 0 { 1.0 } else { p1 };
+            let pm1 = if m <= 1 { 1.0 } else { p0 };
+            dp = m as f64 * (z * pm - pm1) / (z * z - 1.0);
+            let dz = pm / dp;
+            z -= dz;
+            if dz.abs() < 1e-16 {
+                break;
+            }
+        }
+        x[m - 1 - i] = z;
+        w[m - 1 - i] = 2.0 / ((1.0 - z * z) * dp * dp);
+    }
+    (x, w)
+}

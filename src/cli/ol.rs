@@ -1,0 +1,256 @@
+//! `ivt ol ...`: the open-loop law from the model (thesis §4.2.1): one IHB
+//! steady state, the grid table, and the refit (with `--emit-rust`).
+
+use super::{CliError, Output};
+use clap::{Args, Subcommand};
+use ivt_hb::ivt::fit::{self, OpenLoopLaw, PolyForm};
+use ivt_hb::ivt::steady::{solve_steady_state, IhbOptions};
+use ivt_hb::ivt::sweep::{self, Grid, SweepPoint};
+use ivt_hb::ivt::{rad_s_to_rpm, rpm_to_rad_s, OperatingPoint};
+use ivt_kin::plant::PlantParams;
+use serde_json::json;
+
+/// Open-loop design subcommands.
+#[derive(Subcommand)]
+pub enum OlCommand {
+    /// IVT steady state at one point: unconstrained r̄ and the verdict.
+    Solve(SolveArgs),
+    /// r̄ over the grid (thesis Fig. 38(a)).
+    Table(GridArgs),
+    /// Refit the Eq. 158 form (and Eq. 159 boundary) to the feasible grid points.
+    Fit(FitArgs),
+}
+
+/// Arguments of `ivt ol solve`.
+#[derive(Args)]
+pub struct SolveArgs {
+    /// Motor voltage V_m [V].
+    #[arg(long, allow_hyphen_values = true)]
+    vm: f64,
+    /// Brake torque T_U [N·m].
+    #[arg(long, allow_hyphen_values = true)]
+    tu: f64,
+    /// Target mean speed [rpm].
+    #[arg(long, default_value_t = 100.0, allow_hyphen_values = true)]
+    omega0_rpm: f64,
+    /// Harmonics n of the IHB (thesis: 7).
+    #[arg(long, default_value_t = 7)]
+    harmonics: usize,
+}
+
+/// Grid arguments shared by `table` and `fit` (MATLAB-style from:step:to).
+#[derive(Args)]
+pub struct GridArgs {
+    /// V_m from [V].
+    #[arg(long, default_value_t = 2.0)]
+    vm_from: f64,
+    /// V_m step [V].
+    #[arg(long, default_value_t = 0.4)]
+    vm_step: f64,
+    /// V_m to [V].
+    #[arg(long, default_value_t = 12.0)]
+    vm_to: f64,
+    /// T_U from [N·m].
+    #[arg(long, default_value_t = 1.5)]
+    tu_from: f64,
+    /// T_U step [N·m].
+    #[arg(long, default_value_t = 0.5)]
+    tu_step: f64,
+    /// T_U to [N·m].
+    #[arg(long, default_value_t = 9.0)]
+    tu_to: f64,
+    /// Target mean speed [rpm].
+    #[arg(long, default_value_t = 100.0, allow_hyphen_values = true)]
+    omega0_rpm: f64,
+    /// Harmonics n of the IHB.
+    #[arg(long, default_value_t = 7)]
+    harmonics: usize,
+    /// No progress bar on stderr.
+    #[arg(long)]
+    quiet: bool,
+}
+
+/// Arguments of `ivt ol fit`.
+#[derive(Args)]
+pub struct FitArgs {
+    #[command(flatten)]
+    grid: GridArgs,
+    /// Use all 15 terms V^0..2 T^0..4 instead of the 10 of Eq. 158.
+    #[arg(long)]
+    full: bool,
+    /// Write `pub const REFIT: OpenLoopCoeffs` for ivt-ctrl to this file.
+    #[arg(long)]
+    emit_rust: Option<std::path::PathBuf>,
+}
+
+fn input(e: impl std::fmt::Display) -> CliError {
+    CliError::Input(e.to_string())
+}
+
+fn failed(e: impl std::fmt::Display) -> CliError {
+    CliError::Failed(e.to_string())
+}
+
+/// Run an `ol` subcommand.
+///
+/// # Errors
+/// Bad arguments ([`CliError::Input`]) or solver failures ([`CliError::Failed`]).
+pub fn run(cmd: OlCommand) -> Result<Output, CliError> {
+    match cmd {
+        OlCommand::Solve(a) => solve(a),
+        OlCommand::Table(a) => table(a),
+        OlCommand::Fit(a) => fit_cmd(a),
+    }
+}
+
+fn solve(a: SolveArgs) -> Result<Output, CliError> {
+    let plant = PlantParams::printed();
+    let op = OperatingPoint {
+        v_m: a.vm,
+        t_u: a.tu,
+        omega0: rpm_to_rad_s(a.omega0_rpm),
+    };
+    op.validate().map_err(input)?;
+    let opts = IhbOptions {
+        harmonics: a.harmonics,
+        ..Default::default()
+    };
+    let t0 = std::time::Instant::now();
+    let s = solve_steady_state(&plant, &op, opts).map_err(failed)?;
+    let dt = t0.elapsed().as_secs_f64();
+    let json = json!({
+        "r": s.r, "feasible": s.verdict == ivt_hb::ivt::Verdict::Feasible,
+        "verdict": s.verdict.as_str(), "q": s.q, "omega_min": s.omega_min,
+        "omega_max": s.omega_max, "solve_time_s": dt, "iterations": s.iterations,
+        "residual_norm": s.residual_norm, "harmonics": a.harmonics, "r_max": plant.r_max,
+        "omega0": op.omega0,
+    });
+    let human = format!(
+        "V_m = {} V, T_U = {} N·m, ω0 = {} rpm\nr̄ = {:.6} m ({}; r_max = {} m)\nω̄ ∈ [{:.2}, {:.2}] rpm\n{} Newton iterations, |R| = {:.1e}, {:.1} µs\n",
+        a.vm, a.tu, a.omega0_rpm, s.r, s.verdict.as_str(), plant.r_max,
+        rad_s_to_rpm(s.omega_min), rad_s_to_rpm(s.omega_max), s.iterations, s.residual_norm, dt * 1e6
+    );
+    Ok(Output { json, human })
+}
+
+fn run_sweep(a: &GridArgs) -> Result<(Grid, Vec<SweepPoint>), CliError> {
+    if !(a.omega0_rpm.is_finite() && a.omega0_rpm > 0.0) {
+        return Err(CliError::Input(format!(
+            "--omega0-rpm must be finite and > 0, got {}",
+            a.omega0_rpm
+        )));
+    }
+    let grid = Grid {
+        v_m: sweep::range(a.vm_from, a.vm_step, a.vm_to),
+        t_u: sweep::range(a.tu_from, a.tu_step, a.tu_to),
+        omega0: rpm_to_rad_s(a.omega0_rpm),
+    };
+    grid.validate().map_err(input)?;
+    let opts = IhbOptions {
+        harmonics: a.harmonics,
+        ..Default::default()
+    };
+    let bar = if a.quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new(grid.len() as u64)
+    };
+    let pts = sweep::sweep(&PlantParams::printed(), &grid, opts, || bar.inc(1)).map_err(failed)?;
+    bar.finish_and_clear();
+    Ok((grid, pts))
+}
+
+fn point_json(p: &SweepPoint) -> serde_json::Value {
+    match &p.result {
+        Ok(s) => json!({"vm": p.op.v_m, "tu": p.op.t_u, "r": s.r, "verdict": s.verdict.as_str(),
+                        "omega_min": s.omega_min, "omega_max": s.omega_max}),
+        Err(e) => json!({"vm": p.op.v_m, "tu": p.op.t_u, "error": e}),
+    }
+}
+
+fn table(a: GridArgs) -> Result<Output, CliError> {
+    let (grid, pts) = run_sweep(&a)?;
+    let mut human = format!("r̄ [mm] (rows T_U, columns V_m = {:?})\n", grid.v_m);
+    for row in pts.chunks(grid.v_m.len()) {
+        human.push_str(&format!("T_U {:>4}:", row[0].op.t_u));
+        for p in row {
+            match &p.result {
+                Ok(s) => human.push_str(&format!(" {:7.2}", s.r * 1e3)),
+                Err(_) => human.push_str("    fail"),
+            }
+        }
+        human.push('\n');
+    }
+    let json = json!({"v_m": grid.v_m, "t_u": grid.t_u, "omega0": grid.omega0,
+                      "points": pts.iter().map(point_json).collect::<Vec<_>>()});
+    Ok(Output { json, human })
+}
+
+fn fit_cmd(a: FitArgs) -> Result<Output, CliError> {
+    let plant = PlantParams::printed();
+    let (grid, pts) = run_sweep(&a.grid)?;
+    let form = if a.full {
+        PolyForm::Full
+    } else {
+        PolyForm::Eq158
+    };
+    let pf = fit::fit_polynomial(&pts, plant.r_max, form).map_err(failed)?;
+    let opts = IhbOptions {
+        harmonics: a.grid.harmonics,
+        ..Default::default()
+    };
+    let (alpha, beta, b_err) =
+        fit::fit_boundary(&plant, &grid.t_u, grid.omega0, plant.r_max, opts).map_err(failed)?;
+    let (alpha0, beta0, _) =
+        fit::fit_boundary(&plant, &grid.t_u, grid.omega0, 0.0, opts).map_err(failed)?;
+    let law = OpenLoopLaw {
+        poly: pf.poly,
+        boundary: [1.0, -alpha, -beta],
+        r_max: plant.r_max,
+    };
+    let err = fit::law_error(&plant, &law, &pts).map_err(failed)?;
+    let thesis_err = fit::law_error(&plant, &OpenLoopLaw::thesis(), &pts).map_err(failed)?;
+    if let Some(path) = &a.emit_rust {
+        let header = format!(
+            "Open-loop law refitted on the printed plant (Eq. 151 + Table 1) by `ivt ol fit{}`:\n\
+             IHB (n = {}) over V_m ∈ {}:{}:{} V, T_U ∈ {}:{}:{} N·m, ω0 = {} rpm; {} feasible points.\n\
+             Fit error in r: RMS {:.3e} m, max {:.3e} m. ω_a error of the clamped law: max {:.3} rpm, RMS {:.3} rpm.\n\
+             Boundary r̄ = r_max: V_m = {:.4} T_U + {:.4} (max deviation {:.3} V).",
+            if a.full { " --full" } else { "" }, a.grid.harmonics,
+            a.grid.vm_from, a.grid.vm_step, a.grid.vm_to, a.grid.tu_from, a.grid.tu_step, a.grid.tu_to,
+            a.grid.omega0_rpm, pf.points, pf.rms_r, pf.max_r, err.max_abs_rpm, err.rms_rpm, alpha, beta, b_err
+        );
+        std::fs::write(path, fit::emit_rust(&law, "REFIT", &header))
+            .map_err(|e| CliError::Failed(format!("writing {}: {e}", path.display())))?;
+    }
+    let json = json!({
+        "poly": pf.poly, "boundary": law.boundary, "r_max": law.r_max,
+        "form": if a.full { "full" } else { "eq158" }, "points": pf.points,
+        "rms_r": pf.rms_r, "max_r": pf.max_r,
+        "omega_a_error_rpm": {"max_abs": err.max_abs_rpm, "rms": err.rms_rpm},
+        "thesis_omega_a_error_rpm": {"max_abs": thesis_err.max_abs_rpm, "rms": thesis_err.rms_rpm},
+        "boundary_max_dev_v": b_err,
+        "underdrive_boundary": {"alpha": alpha0, "beta": beta0},
+        "emitted": a.emit_rust.as_ref().map(|p| p.display().to_string()),
+    });
+    let human = format!(
+        "feasible points: {}\nfit error in r: RMS {:.3e} m, max {:.3e} m\n\
+         ω_a error of refit law: max {:.3} rpm, RMS {:.3} rpm\n\
+         ω_a error of THESIS law: max {:.3} rpm, RMS {:.3} rpm\n\
+         over-drive boundary (r̄ = r_max): V_m = {:.4}·T_U + {:.4}\n\
+         under-drive boundary (r̄ = 0):    V_m = {:.4}·T_U + {:.4}\npoly[i][j] (V^i T^j): {:?}\n",
+        pf.points,
+        pf.rms_r,
+        pf.max_r,
+        err.max_abs_rpm,
+        err.rms_rpm,
+        thesis_err.max_abs_rpm,
+        thesis_err.rms_rpm,
+        alpha,
+        beta,
+        alpha0,
+        beta0,
+        pf.poly
+    );
+    Ok(Output { json, human })
+}

@@ -1,0 +1,183 @@
+//! `ivt stability` and `ivt stability-map`: Floquet multipliers of the
+//! linearized time-delay loop (thesis §4.3, Eq. 174–179). Gains are given in
+//! the thesis's printed unit (mm·rad⁻¹, read as mm of r per rad of θ per rad/s;
+//! `k_SI = 1e-3 k`, the same reading as ivt-ctrl) unless `--si` is passed.
+
+use super::{CliError, Output};
+use clap::Args;
+use ivt_hb::ivt::delay::{delay_stability, DelayOptions, FeedbackGains};
+use ivt_hb::ivt::gains::stability_map;
+use ivt_hb::ivt::sweep::{range, Grid};
+use ivt_hb::ivt::{rpm_to_rad_s, OperatingPoint};
+use ivt_kin::plant::PlantParams;
+use serde_json::json;
+
+/// Arguments of `ivt stability`.
+#[derive(Args)]
+pub struct StabilityArgs {
+    /// Motor voltage V_m [V].
+    #[arg(long, allow_hyphen_values = true)]
+    vm: f64,
+    /// Brake torque T_U [N·m].
+    #[arg(long, allow_hyphen_values = true)]
+    tu: f64,
+    #[command(flatten)]
+    common: Common,
+}
+
+/// Gains and discretization shared by both commands.
+#[derive(Args)]
+pub struct Common {
+    /// Integral gain k (thesis mm·rad⁻¹ unless --si).
+    #[arg(long, default_value_t = 0.01)]
+    k: f64,
+    /// Damping gain k2 (thesis mm·rad⁻¹ unless --si).
+    #[arg(long, default_value_t = 0.02)]
+    k2: f64,
+    /// Gains are SI (m·s/rad²).
+    #[arg(long)]
+    si: bool,
+    /// Chebyshev order N (even).
+    #[arg(long, default_value_t = 16)]
+    n: usize,
+    /// Target mean speed [rpm].
+    #[arg(long, default_value_t = 100.0, allow_hyphen_values = true)]
+    omega0_rpm: f64,
+}
+
+impl Common {
+    fn gains(&self) -> FeedbackGains {
+        if self.si {
+            FeedbackGains {
+                k: self.k,
+                k2: self.k2,
+            }
+        } else {
+            FeedbackGains::from_thesis_mm_per_rad(self.k, self.k2)
+        }
+    }
+    fn opts(&self) -> DelayOptions {
+        DelayOptions {
+            chebyshev_order: self.n,
+            ..Default::default()
+        }
+    }
+    fn omega0(&self) -> Result<f64, CliError> {
+        if self.omega0_rpm.is_finite() && self.omega0_rpm > 0.0 {
+            Ok(rpm_to_rad_s(self.omega0_rpm))
+        } else {
+            Err(CliError::Input(format!(
+                "--omega0-rpm must be finite and > 0, got {}",
+                self.omega0_rpm
+            )))
+        }
+    }
+}
+
+/// Arguments of `ivt stability-map` (grid as in `ivt ol table`).
+#[derive(Args)]
+pub struct MapArgs {
+    #[command(flatten)]
+    common: Common,
+    /// V_m from:step:to [V].
+    #[arg(long, num_args = 3, default_values_t = [2.0, 0.4, 12.0])]
+    vm: Vec<f64>,
+    /// T_U from:step:to [N·m].
+    #[arg(long, num_args = 3, default_values_t = [1.5, 0.5, 9.0])]
+    tu: Vec<f64>,
+    /// Only points with a feasible r̄ (0 ≤ r̄ ≤ r_max).
+    #[arg(long)]
+    feasible_only: bool,
+}
+
+/// `ivt stability`.
+///
+/// # Errors
+/// Bad input or solver failure.
+pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
+    let op = OperatingPoint {
+        v_m: a.vm,
+        t_u: a.tu,
+        omega0: a.common.omega0()?,
+    };
+    op.validate().map_err(|e| CliError::Input(e.to_string()))?;
+    let g = a.common.gains();
+    let t0 = std::time::Instant::now();
+    let s = delay_stability(&PlantParams::printed(), &op, g, &a.common.opts())
+        .map_err(|e| CliError::Failed(e.to_string()))?;
+    let dt = t0.elapsed().as_secs_f64();
+    let json = json!({
+        "max_abs_multiplier": s.max_abs_multiplier, "structural": [s.structural.0, s.structural.1],
+        "multipliers": s.multipliers.iter().map(|m| [m.0, m.1]).collect::<Vec<_>>(),
+        "r_bar": s.orbit.r, "k_si": g.k, "k2_si": g.k2, "chebyshev_order": a.common.n,
+        "stable": s.max_abs_multiplier < 1.0, "solve_time_s": dt,
+    });
+    let human = format!(
+        "V_m = {} V, T_U = {} N·m, k = {:e}, k2 = {:e} m·s/rad² (N = {})\nr̄ = {:.6} m\nmax |multiplier| = {:.6} (structural one: {:.6}{:+.1e}i)\n",
+        a.vm, a.tu, g.k, g.k2, a.common.n, s.orbit.r, s.max_abs_multiplier, s.structural.0, s.structural.1
+    );
+    Ok(Output { json, human })
+}
+
+/// `ivt stability-map`.
+///
+/// # Errors
+/// Bad input or an empty grid.
+pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
+    let grid = Grid {
+        v_m: range(a.vm[0], a.vm[1], a.vm[2]),
+        t_u: range(a.tu[0], a.tu[1], a.tu[2]),
+        omega0: a.common.omega0()?,
+    };
+    grid.validate()
+        .map_err(|e| CliError::Input(e.to_string()))?;
+    let plant = PlantParams::printed();
+    let mut ops: Vec<OperatingPoint> = grid
+        .t_u
+        .iter()
+        .flat_map(|&t| {
+            grid.v_m.iter().map(move |&v| OperatingPoint {
+                v_m: v,
+                t_u: t,
+                omega0: grid.omega0,
+            })
+        })
+        .collect();
+    if a.feasible_only {
+        let pts = ivt_hb::ivt::sweep::sweep(&plant, &grid, Default::default(), || ())
+            .map_err(|e| CliError::Failed(e.to_string()))?;
+        ops = pts
+            .iter()
+            .filter(|p| {
+                p.result
+                    .as_ref()
+                    .is_ok_and(|s| (0.0..=plant.r_max).contains(&s.r))
+            })
+            .map(|p| p.op)
+            .collect();
+    }
+    let t0 = std::time::Instant::now();
+    let map = stability_map(&plant, &ops, a.common.gains(), &a.common.opts())
+        .map_err(|e| CliError::Input(e.to_string()))?;
+    let dt = t0.elapsed().as_secs_f64();
+    let worst = map
+        .iter()
+        .filter_map(|(_, r)| r.as_ref().ok())
+        .fold(0.0f64, |m, v| m.max(*v));
+    let pts: Vec<_> = map
+        .iter()
+        .map(|(op, r)| match r {
+            Ok(m) => json!({"vm": op.v_m, "tu": op.t_u, "max_abs_multiplier": m}),
+            Err(e) => json!({"vm": op.v_m, "tu": op.t_u, "error": e}),
+        })
+        .collect();
+    let json = json!({"points": pts, "worst": worst, "k_si": a.common.gains().k,
+                      "k2_si": a.common.gains().k2, "solve_time_s": dt});
+    let human = format!(
+        "{} points, worst max |multiplier| = {:.6}, {:.2} s\n",
+        map.len(),
+        worst,
+        dt
+    );
+    Ok(Output { json, human })
+}
