@@ -24,7 +24,11 @@ pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
     steady_row_and_fig39(ctx, &plant)?;
     ctx.step("design: IHB sweep and refit (Eq. 158/159)");
     let grid = if ctx.quick() {
-        Grid { v_m: range(2.0, 0.8, 12.0), t_u: range(1.5, 1.5, 9.0), omega0: thesis_omega0() }
+        Grid {
+            v_m: range(2.0, 0.8, 12.0),
+            t_u: range(1.5, 1.5, 9.0),
+            omega0: thesis_omega0(),
+        }
     } else {
         Grid::thesis()
     };
@@ -49,7 +53,14 @@ pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
 /// θ-domain RK4 of Eq. 151 at constant r, steps landing on the gear
 /// corners θ = π/4 + kπ/2 (8·m steps per revolution): an independent check
 /// of the IHB orbit for Fig. 39.
-fn rk4_orbit(plant: &PlantParams, v: f64, t: f64, r: f64, omega_start: f64, steps: usize) -> Vec<(f64, f64)> {
+fn rk4_orbit(
+    plant: &PlantParams,
+    v: f64,
+    t: f64,
+    r: f64,
+    omega_start: f64,
+    steps: usize,
+) -> Vec<(f64, f64)> {
     let rhs = |th: f64, w: f64| plant.acceleration(th, w, r, v, t) / w;
     let h = 2.0 * PI / steps as f64;
     let mut w = omega_start;
@@ -69,13 +80,29 @@ fn rk4_orbit(plant: &PlantParams, v: f64, t: f64, r: f64, omega_start: f64, step
 
 fn steady_row_and_fig39(ctx: &mut Context, plant: &PlantParams) -> Result<(), ReproError> {
     let op = OperatingPoint::at_100_rpm(6.0, 6.0);
-    let ihb = solve_steady_state(plant, &op, IhbOptions::default());
+    // n = 31: the orbit has four humps per revolution plus corners, so n = 7
+    // keeps only the 4th harmonic (design README: r̄ error 1.8e-5 at n = 31).
+    let ihb = solve_steady_state(
+        plant,
+        &op,
+        IhbOptions {
+            harmonics: 31,
+            ..Default::default()
+        },
+    );
     let shoot = shoot_steady_state(plant, &op, None, &ShootingOptions::default());
-    let at_thesis_r = periodic_at_r(plant, 6.0, 6.0, 0.0067, op.omega0, &ShootingOptions::default());
+    let at_thesis_r = periodic_at_r(
+        plant,
+        6.0,
+        6.0,
+        0.0067,
+        op.omega0,
+        &ShootingOptions::default(),
+    );
     match (&ihb, &shoot) {
         (Ok(s), Ok(o)) => {
             let evidence = format!(
-                "{SPEC5}. Evidence: modified IHB (n = 7) r̄ = {} m, shooting (RK6 + Newton) r̄ = {} m, \
+                "{SPEC5}. Evidence: modified IHB (n = 31) r̄ = {} m, shooting (RK6 + Newton) r̄ = {} m, \
                  averaged power balance {} m — all < 0 (under-drive). Holding r = 0.0067 m instead, the \
                  periodic orbit has ω_a = {} rpm, not 100",
                 fmt_sig(s.r, 5),
@@ -85,18 +112,37 @@ fn steady_row_and_fig39(ctx: &mut Context, plant: &PlantParams) -> Result<(), Re
                     .as_ref()
                     .map_or("?".into(), |p| fmt_sig(rad_s_to_rpm(p.omega_a()), 4))
             );
-            ctx.compare("r̄ at (6 V, 6 N·m) [m]", 0.0067, "Fig. 39, §4.2.1", o.r, 5e-5, 5, "shooting", &evidence);
+            ctx.compare(
+                "r̄ at (6 V, 6 N·m) [m]",
+                0.0067,
+                "Fig. 39, §4.2.1",
+                o.r,
+                5e-5,
+                5,
+                "shooting",
+                &evidence,
+            );
         }
         _ => {
-            let e = ihb.as_ref().err().map(|e| e.to_string()).or(shoot.as_ref().err().map(|e| e.to_string()));
-            ctx.not_computable("r̄ at (6 V, 6 N·m) [m]", "0.0067 (Fig. 39)", &e.unwrap_or_default());
+            let e = ihb
+                .as_ref()
+                .err()
+                .map(|e| e.to_string())
+                .or(shoot.as_ref().err().map(|e| e.to_string()));
+            ctx.not_computable(
+                "r̄ at (6 V, 6 N·m) [m]",
+                "0.0067 (Fig. 39)",
+                &e.unwrap_or_default(),
+            );
         }
     }
     // Fig. 39: ω over one revolution, IHB vs an independent RK4 in θ.
     let mut series_data: Vec<(String, Vec<(f64, f64)>, Style)> = Vec::new();
     let deg = 180.0 / PI;
     let to_rpm = |pts: Vec<(f64, f64)>| -> Vec<(f64, f64)> {
-        pts.into_iter().map(|(t, w)| (t * deg, rad_s_to_rpm(w))).collect()
+        pts.into_iter()
+            .map(|(t, w)| (t * deg, rad_s_to_rpm(w)))
+            .collect()
     };
     if let (Ok(s), Ok(o)) = (&ihb, &shoot) {
         let ihb_pts: Vec<(f64, f64)> = (0..=180)
@@ -105,24 +151,46 @@ fn steady_row_and_fig39(ctx: &mut Context, plant: &PlantParams) -> Result<(), Re
                 (th, s.omega_at_theta(th))
             })
             .collect();
-        series_data.push((format!("modified IHB, r̄ = {:.4} m", s.r), to_rpm(ihb_pts), Style::Line));
+        series_data.push((
+            format!("modified IHB (n = 31), r̄ = {:.4} m", s.r),
+            to_rpm(ihb_pts),
+            Style::Line,
+        ));
         let rk = rk4_orbit(plant, 6.0, 6.0, o.r, o.omega_start, 2048);
         let rk: Vec<(f64, f64)> = rk.into_iter().step_by(16).collect();
-        series_data.push(("RK4 in θ from the shooting ω(0)".into(), to_rpm(rk), Style::Markers));
+        series_data.push((
+            "RK4 in θ from the shooting ω(0)".into(),
+            to_rpm(rk),
+            Style::Markers,
+        ));
     }
     if let Ok(p) = &at_thesis_r {
         let rk = rk4_orbit(plant, 6.0, 6.0, 0.0067, p.omega_start, 2048);
         series_data.push((
-            format!("r = 0.0067 m (thesis r̄): ω_a = {:.1} rpm", rad_s_to_rpm(p.omega_a())),
+            format!(
+                "r = 0.0067 m (thesis r̄): ω_a = {:.1} rpm",
+                rad_s_to_rpm(p.omega_a())
+            ),
             to_rpm(rk),
             Style::Dashed,
         ));
     }
     if series_data.is_empty() {
-        ctx.missing_figure("Fig. 39", "steady-state ω at (6 V, 6 N·m)", "steady-state solvers failed");
+        ctx.missing_figure(
+            "Fig. 39",
+            "steady-state ω at (6 V, 6 N·m)",
+            "steady-state solvers failed",
+        );
         return Ok(());
     }
-    let series = series_data.iter().map(|(l, p, s)| Series { label: l, points: p, style: *s }).collect();
+    let series = series_data
+        .iter()
+        .map(|(l, p, s)| Series {
+            label: l,
+            points: p,
+            style: *s,
+        })
+        .collect();
     ctx.line_figure(
         "Fig. 39",
         &Figure {
@@ -147,7 +215,12 @@ fn poly_str(p: &[[f64; 5]; 3]) -> String {
     terms.join(", ")
 }
 
-fn refit_rows(ctx: &mut Context, plant: &PlantParams, grid: &Grid, pts: &[SweepPoint]) -> Option<OpenLoopLaw> {
+fn refit_rows(
+    ctx: &mut Context,
+    plant: &PlantParams,
+    grid: &Grid,
+    pts: &[SweepPoint],
+) -> Option<OpenLoopLaw> {
     let thesis = OpenLoopLaw::thesis();
     let pf = match fit::fit_polynomial(pts, plant.r_max, PolyForm::Eq158) {
         Ok(pf) => pf,
@@ -158,8 +231,18 @@ fn refit_rows(ctx: &mut Context, plant: &PlantParams, grid: &Grid, pts: &[SweepP
             return None;
         }
     };
-    let boundary = fit::fit_boundary(plant, &grid.t_u, grid.omega0, plant.r_max, IhbOptions::default());
-    let law = boundary.as_ref().ok().map(|&(a, b, _)| OpenLoopLaw { poly: pf.poly, boundary: [1.0, -a, -b], r_max: plant.r_max });
+    let boundary = fit::fit_boundary(
+        plant,
+        &grid.t_u,
+        grid.omega0,
+        plant.r_max,
+        IhbOptions::default(),
+    );
+    let law = boundary.as_ref().ok().map(|&(a, b, _)| OpenLoopLaw {
+        poly: pf.poly,
+        boundary: [1.0, -a, -b],
+        r_max: plant.r_max,
+    });
     let err_thesis = fit::law_error(plant, &thesis, pts);
     let err_refit = law.as_ref().map(|l| fit::law_error(plant, l, pts));
     let evidence = format!(
@@ -222,7 +305,7 @@ fn figs_38_40(
     ctx.heat_figure(
         "Fig. 38(a)",
         &HeatMap {
-            title: "Fig. 38(a): unconstrained r̄ for ω_a = 100 rpm (printed plant, IHB n = 7)",
+            title: "Fig. 38(a): r̄ for ω_a = 100 rpm (IHB)",
             x_label: "V_m [V]",
             y_label: "T_U [N·m]",
             value_label: "r̄ [mm]",
@@ -237,10 +320,24 @@ fn figs_38_40(
     let mut series_data: Vec<(String, Vec<(f64, f64)>, Style)> =
         vec![("f_B = 0 printed (Eq. 159)".into(), printed, Style::Dashed)];
     if let Some(l) = law {
-        let ours: Vec<(f64, f64)> = t_line.iter().map(|&t| (t, -l.boundary[1] * t - l.boundary[2])).collect();
-        series_data.push(("r̄ = r_max, refit on the printed plant".into(), ours, Style::Line));
+        let ours: Vec<(f64, f64)> = t_line
+            .iter()
+            .map(|&t| (t, -l.boundary[1] * t - l.boundary[2]))
+            .collect();
+        series_data.push((
+            "r̄ = r_max, refit on the printed plant".into(),
+            ours,
+            Style::Line,
+        ));
     }
-    let series = series_data.iter().map(|(l, p, s)| Series { label: l, points: p, style: *s }).collect();
+    let series = series_data
+        .iter()
+        .map(|(l, p, s)| Series {
+            label: l,
+            points: p,
+            style: *s,
+        })
+        .collect();
     ctx.line_figure(
         "Fig. 38(b)",
         &Figure {
@@ -255,7 +352,9 @@ fn figs_38_40(
     // Fig. 40: Γ̂ = 0 against f_B = 0, for the printed and the refitted r_f.
     let mut series_data: Vec<(String, Vec<(f64, f64)>, Style)> = Vec::new();
     let laws: Vec<(&str, OpenLoopLaw)> =
-        std::iter::once(("printed r_f (Eq. 158)", OpenLoopLaw::thesis())).chain(law.map(|l| ("refit r_f", *l))).collect();
+        std::iter::once(("printed r_f (Eq. 158)", OpenLoopLaw::thesis()))
+            .chain(law.map(|l| ("refit r_f", *l)))
+            .collect();
     let ts: Vec<f64> = (0..=30).map(|i| 1.5 + 7.5 * i as f64 / 30.0).collect();
     for (name, l) in &laws {
         let zero: Vec<(f64, f64)> = ts
@@ -265,11 +364,21 @@ fn figs_38_40(
         series_data.push((format!("Γ̂ = 0, {name}"), zero, Style::Line));
         series_data.push((
             format!("f_B = 0, {name}"),
-            t_line.iter().map(|&tt| (tt, -l.boundary[1] * tt - l.boundary[2])).collect(),
+            t_line
+                .iter()
+                .map(|&tt| (tt, -l.boundary[1] * tt - l.boundary[2]))
+                .collect(),
             Style::Dashed,
         ));
     }
-    let series = series_data.iter().map(|(l, p, s)| Series { label: l, points: p, style: *s }).collect();
+    let series = series_data
+        .iter()
+        .map(|(l, p, s)| Series {
+            label: l,
+            points: p,
+            style: *s,
+        })
+        .collect();
     ctx.line_figure(
         "Fig. 40",
         &Figure {
@@ -278,10 +387,24 @@ fn figs_38_40(
             y_label: "V_m [V]",
             series,
         },
-        "Γ̂ from the closed form after Eq. 170 with the printed plant constants; a curve is absent \
-         where Γ̂ has no zero in V_m ∈ [2, 12] V",
+        &format!(
+            "Γ̂ from the closed form after Eq. 170 with the printed plant constants. Γ̂ = 0 is drawn only \
+             where Γ̂ changes sign in V_m ∈ [2, 12] V; over the grid Γ̂ ranges {}. The thesis draws Γ̂ = 0 \
+             inside the grid: with the printed constants Γ̂ stays positive there (SPEC §5: the printed \
+             law matches no parameter set in the text)",
+            laws.iter()
+                .map(|(name, l)| {
+                    let vals = grid.t_u.iter().flat_map(|&t| grid.v_m.iter().map(move |&v| (v, t)));
+                    let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (v, t)| {
+                        let g = gamma_hat(plant, l, v, t);
+                        (a.min(g), b.max(g))
+                    });
+                    format!("{lo:.3} … {hi:.3} ({name})")
+                })
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
     )?;
-    let _ = grid;
     Ok(())
 }
 
@@ -309,7 +432,12 @@ fn stability(ctx: &mut Context, plant: &PlantParams, grid: &Grid) -> Result<(), 
     let op = OperatingPoint::at_100_rpm(7.0, 2.0);
     for (k, k2, thesis) in [(0.01, 0.02, 0.7776), (0.06, 0.12, 0.4871)] {
         let q = format!("Fig. 42 multiplier (k = {k}, k2 = {k2})");
-        let ctrl_reading = delay_stability(plant, &op, FeedbackGains::from_thesis_mm_per_rad(k, k2), &opts);
+        let ctrl_reading = delay_stability(
+            plant,
+            &op,
+            FeedbackGains::from_thesis_mm_per_rad(k, k2),
+            &opts,
+        );
         let si_reading = delay_stability(plant, &op, FeedbackGains { k, k2 }, &opts);
         match (&ctrl_reading, &si_reading) {
             (Ok(a), Ok(b)) => {
@@ -322,27 +450,56 @@ fn stability(ctx: &mut Context, plant: &PlantParams, grid: &Grid) -> Result<(), 
                     fmt_sig(b.max_abs_multiplier, 5),
                     opts.chebyshev_order
                 );
-                ctx.compare(&q, thesis, "§4.3, V_m = 7 V, T_U = 2 N·m", a.max_abs_multiplier, 5e-5, 5, "max |multiplier| without the structural one", &why);
+                ctx.compare(
+                    &q,
+                    thesis,
+                    "§4.3, V_m = 7 V, T_U = 2 N·m",
+                    a.max_abs_multiplier,
+                    5e-5,
+                    5,
+                    "max |multiplier| without the structural one",
+                    &why,
+                );
             }
-            (Err(e), _) | (_, Err(e)) => ctx.not_computable(&q, &format!("{thesis} (§4.3)"), &e.to_string()),
+            (Err(e), _) | (_, Err(e)) => {
+                ctx.not_computable(&q, &format!("{thesis} (§4.3)"), &e.to_string())
+            }
         }
     }
     let ops: Vec<OperatingPoint> = grid
         .t_u
         .iter()
-        .flat_map(|&t| grid.v_m.iter().map(move |&v| OperatingPoint { v_m: v, t_u: t, omega0: grid.omega0 }))
+        .flat_map(|&t| {
+            grid.v_m.iter().map(move |&v| OperatingPoint {
+                v_m: v,
+                t_u: t,
+                omega0: grid.omega0,
+            })
+        })
         .collect();
-    match stability_map(plant, &ops, FeedbackGains::from_thesis_mm_per_rad(0.01, 0.02), &opts) {
+    match stability_map(
+        plant,
+        &ops,
+        FeedbackGains::from_thesis_mm_per_rad(0.01, 0.02),
+        &opts,
+    ) {
         Ok(map) => {
-            let values: Vec<f64> = map.iter().map(|(_, r)| r.as_ref().map_or(f64::NAN, |v| *v)).collect();
-            let worst = values.iter().copied().filter(|v| v.is_finite()).fold(0.0f64, f64::max);
+            let values: Vec<f64> = map
+                .iter()
+                .map(|(_, r)| r.as_ref().map_or(f64::NAN, |v| *v))
+                .collect();
+            let worst = values
+                .iter()
+                .copied()
+                .filter(|v| v.is_finite())
+                .fold(0.0f64, f64::max);
             ctx.heat_figure(
                 "Fig. 42",
                 &HeatMap {
-                    title: "Fig. 42: max |Floquet multiplier| of the delay loop, k = 0.01, k2 = 0.02 mm·rad⁻¹",
+                    title: "Fig. 42: k = 0.01, k2 = 0.02 mm/rad",
                     x_label: "V_m [V]",
                     y_label: "T_U [N·m]",
-                    value_label: "max |multiplier| [-]",
+                    value_label: "max |multiplier|",
                     xs: &grid.v_m,
                     ys: &grid.t_u,
                     values: &values,

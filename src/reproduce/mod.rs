@@ -282,7 +282,24 @@ impl Context {
         let stem = Self::file_stem(id);
         let png = format!("{stem}.png");
         let csv_name = format!("{stem}.csv");
-        ivt_plot::line_plot(&self.out.join(&png), figure)?;
+        let (title, x_label, y_label) = (
+            glyphs(figure.title),
+            glyphs(figure.x_label),
+            glyphs(figure.y_label),
+        );
+        let labels: Vec<String> = figure.series.iter().map(|s| glyphs(s.label)).collect();
+        let drawable = Figure {
+            title: &title,
+            x_label: &x_label,
+            y_label: &y_label,
+            series: figure
+                .series
+                .iter()
+                .zip(&labels)
+                .map(|(s, l)| ivt_plot::Series { label: l, ..*s })
+                .collect(),
+        };
+        ivt_plot::line_plot(&self.out.join(&png), &drawable)?;
         let mut csv = format!(
             "series,\"{}\",\"{}\"\n",
             figure.x_label.replace('"', "'"),
@@ -314,7 +331,22 @@ impl Context {
         let stem = Self::file_stem(id);
         let png = format!("{stem}.png");
         let csv_name = format!("{stem}.csv");
-        ivt_plot::heat_map(&self.out.join(&png), map)?;
+        let (title, x_label, y_label, value_label) = (
+            glyphs(map.title),
+            glyphs(map.x_label),
+            glyphs(map.y_label),
+            glyphs(map.value_label),
+        );
+        ivt_plot::heat_map(
+            &self.out.join(&png),
+            &HeatMap {
+                title: &title,
+                x_label: &x_label,
+                y_label: &y_label,
+                value_label: &value_label,
+                ..*map
+            },
+        )?;
         let mut csv = format!(
             "\"{}\",\"{}\",\"{}\"\n",
             map.x_label.replace('"', "'"),
@@ -348,6 +380,16 @@ impl Context {
             note: why.to_string(),
         });
     }
+}
+
+/// Spell out the characters the embedded font subset lacks (combining
+/// accents, §) so that labels never render as gaps.
+fn glyphs(s: &str) -> String {
+    s.replace("r̄", "r_bar")
+        .replace("Γ̂", "Γ^")
+        .replace('§', "Sec. ")
+        .replace('\u{0304}', "_bar")
+        .replace('\u{0302}', "^")
 }
 
 /// The thesis figures the report covers, in order (each appears in
