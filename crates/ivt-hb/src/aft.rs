@@ -1,0 +1,232 @@
+//! Alternating frequency–time (AFT) machinery, Eq. 61–65.
+//!
+//! Coefficient convention (SPEC §6): a real 2π-periodic signal with `n` harmonics is
+//! `u(τ) = a0/2 + Σ_{k=1..n} (a_k cos kτ + b_k sin kτ)`, stored as
+//! `[a0, a1..an, b1..bn]` (length `2n+1`, the vector `A` of §3.2.1). Samples are taken
+//! at `τ_i = 2π i / (2N)`, `i = 0..2N−1`, with `N > n` (Eq. 62). FFT plans (realfft)
+//! and buffers are made once in [`Aft::new`]; the transforms allocate nothing.
+//!
+//! The *Galerkin* residual of Eq. 55/61, `r = (1/π)∫ C_s f dτ` with
+//! `C_s = {1/2, cos τ…, sin τ…}`, equals the Fourier coefficients of `f` except that
+//! its first entry is `a0/2` (the mean): see [`Aft::galerkin`].
+
+use realfft::num_complex::Complex;
+use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
+use std::sync::Arc;
+use thiserror::Error;
+
+/// Invalid AFT sizes.
+#[derive(Debug, Clone, Copy, Error, PartialEq, Eq)]
+pub enum AftError {
+    /// Eq. 62 needs `N > n` (2N samples resolve harmonics below N without aliasing
+    /// of the linear terms).
+    #[error("AFT needs N > n (got N = {n_half}, n = {harmonics})")]
+    TooFewSamples {
+        /// Harmonics n.
+        harmonics: usize,
+        /// Half the number of samples, N.
+        n_half: usize,
+    },
+}
+
+/// Reusable forward/inverse real FFT plans and buffers for `2N` samples, `n` harmonics.
+pub struct Aft {
+    n: usize,
+    n_half: usize,
+    fwd: Arc<dyn RealToComplex<f64>>,
+    inv: Arc<dyn ComplexToReal<f64>>,
+    spectrum: Vec<Complex<f64>>,
+    scratch_fwd: Vec<Complex<f64>>,
+    scratch_inv: Vec<Complex<f64>>,
+    buf: Vec<f64>,
+}
+
+impl std::fmt::Debug for Aft {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Aft")
+            .field("harmonics", &self.n)
+            .field("n_half", &self.n_half)
+            .finish()
+    }
+}
+
+impl Clone for Aft {
+    fn clone(&self) -> Self {
+        Self::new(self.n, self.n_half).expect("sizes were valid")
+    }
+}
+
+impl Aft {
+    /// Plans for `n` harmonics and `2N` samples.
+    ///
+    /// # Errors
+    /// [`AftError::TooFewSamples`] unless `N > n`.
+    pub fn new(harmonics: usize, n_half: usize) -> Result<Self, AftError> {
+        if n_half <= harmonics {
+            return Err(AftError::TooFewSamples { harmonics, n_half });
+        }
+        let len = 2 * n_half;
+        let mut planner = RealFftPlanner::<f64>::new();
+        let fwd = planner.plan_fft_forward(len);
+        let inv = planner.plan_fft_inverse(len);
+        let scratch_fwd = fwd.make_scratch_vec();
+        let scratch_inv = inv.make_scratch_vec();
+        let spectrum = fwd.make_output_vec();
+        Ok(Self {
+            n: harmonics,
+            n_half,
+            fwd,
+            inv,
+            spectrum,
+            scratch_fwd,
+            scratch_inv,
+            buf: vec![0.0; len],
+        })
+    }
+
+    /// Harmonics n.
+    pub fn harmonics(&self) -> usize {
+        self.n
+    }
+
+    /// Number of samples 2N.
+    pub fn n_samples(&self) -> usize {
+        2 * self.n_half
+    }
+
+    /// Length of a coefficient vector, 2n+1.
+    pub fn coeff_len(&self) -> usize {
+        2 * self.n + 1
+    }
+
+    /// Sample abscissa τ_i = 2π i/(2N).
+    pub fn tau(&self, i: usize) -> f64 {
+        std::f64::consts::PI * i as f64 / self.n_half as f64
+    }
+
+    /// Samples of `u = a0/2 + Σ a_k cos kτ + b_k sin kτ` at the 2N points.
+    pub fn synthesize(&mut self, coeffs: &[f64], samples: &mut [f64]) {
+        self.synthesize_derivative(coeffs, 0, samples);
+    }
+
+    /// Samples of the `order`-th τ-derivative of the series `coeffs`.
+    pub fn synthesize_derivative(&mut self, coeffs: &[f64], order: u32, samples: &mut [f64]) {
+        let n = self.n;
+        debug_assert_eq!(coeffs.len(), 2 * n + 1);
+        debug_assert_eq!(samples.len(), 2 * self.n_half);
+        self.spectrum.fill(Complex::new(0.0, 0.0));
+        // realfft's inverse gives x_i = Σ_K X_K e^{+jKτ_i} over the full Hermitian
+        // spectrum, so a_k cos + b_k sin needs X_k = (a_k − j b_k)/2, X_0 = a0/2.
+        self.spectrum[0] = Complex::new(if order == 0 { 0.5 * coeffs[0] } else { 0.0 }, 0.0);
+        for k in 1..=n {
+            let (a, b) = derivative_pair(coeffs[k], coeffs[n + k], k, order);
+            self.spectrum[k] = Complex::new(0.5 * a, -0.5 * b);
+        }
+        self.inv
+            .process_with_scratch(&mut self.spectrum, samples, &mut self.scratch_inv)
+            .expect("sizes fixed at planning; DC and Nyquist imaginary parts are zero");
+    }
+
+    /// Fourier coefficients `[a0, a1..an, b1..bn]` of the 2N samples (DFT, Eq. 62–65;
+    /// exact for trigonometric polynomials of degree < N).
+    pub fn analyze(&mut self, samples: &[f64], coeffs: &mut [f64]) {
+        let n = self.n;
+        debug_assert_eq!(coeffs.len(), 2 * n + 1);
+        self.buf.copy_from_slice(samples);
+        self.fwd
+            .process_with_scratch(&mut self.buf, &mut self.spectrum, &mut self.scratch_fwd)
+            .expect("sizes fixed at planning");
+        let scale = 1.0 / self.n_half as f64;
+        coeffs[0] = self.spectrum[0].re * scale;
+        for k in 1..=n {
+            coeffs[k] = self.spectrum[k].re * scale;
+            coeffs[n + k] = -self.spectrum[k].im * scale;
+        }
+    }
+
+    /// Galerkin projection `(1/π)∫ C_s f dτ` of the samples (Eq. 61): like
+    /// [`Self::analyze`] but the first entry is the mean `a0/2`.
+    pub fn galerkin(&mut self, samples: &[f64], out: &mut [f64]) {
+        self.analyze(samples, out);
+        out[0] *= 0.5;
+    }
+}
+
+/// Coefficients `(a, b)` of the `order`-th τ-derivative of `a cos kτ + b sin kτ`.
+pub fn derivative_pair(a: f64, b: f64, k: usize, order: u32) -> (f64, f64) {
+    let kf = k as f64;
+    let (mut a, mut b) = (a, b);
+    for _ in 0..order {
+        // d/dτ (a cos + b sin) = k b cos − k a sin.
+        (a, b) = (kf * b, -kf * a);
+    }
+    (a, b)
+}
+
+/// Coefficients of the `order`-th τ-derivative of a series (`[a0, a.., b..]`).
+pub fn derivative_coeffs(coeffs: &[f64], order: u32, out: &mut [f64]) {
+    let n = (coeffs.len() - 1) / 2;
+    out[0] = if order == 0 { coeffs[0] } else { 0.0 };
+    for k in 1..=n {
+        let (a, b) = derivative_pair(coeffs[k], coeffs[n + k], k, order);
+        out[k] = a;
+        out[n + k] = b;
+    }
+}
+
+/// Evaluates the series `[a0, a.., b..]` (or its `order`-th derivative) at τ directly
+/// (O(n), for off-grid points such as Hsu's quadrature nodes).
+pub fn eval_series(coeffs: &[f64], tau: f64, order: u32) -> f64 {
+    let n = (coeffs.len() - 1) / 2;
+    let mut s = if order == 0 { 0.5 * coeffs[0] } else { 0.0 };
+    for k in 1..=n {
+        let (a, b) = derivative_pair(coeffs[k], coeffs[n + k], k, order);
+        let (sn, cs) = (k as f64 * tau).sin_cos();
+        s += a * cs + b * sn;
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_and_derivative_against_direct_sums() {
+        let n = 5;
+        let mut aft = Aft::new(n, 8).unwrap();
+        let coeffs = [0.4, 1.0, -0.5, 0.25, 0.1, 0.05, 0.3, 0.2, -0.7, 0.01, 0.02];
+        let mut s = vec![0.0; 16];
+        let mut back = vec![0.0; 11];
+        aft.synthesize(&coeffs, &mut s);
+        for (i, v) in s.iter().enumerate() {
+            assert!((v - eval_series(&coeffs, aft.tau(i), 0)).abs() < 1e-14);
+        }
+        aft.analyze(&s, &mut back);
+        for (a, b) in coeffs.iter().zip(&back) {
+            assert!((a - b).abs() < 1e-14);
+        }
+        aft.synthesize_derivative(&coeffs, 2, &mut s);
+        for (i, v) in s.iter().enumerate() {
+            assert!((v - eval_series(&coeffs, aft.tau(i), 2)).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn galerkin_of_cube_matches_closed_form() {
+        // cos³τ = 3/4 cos τ + 1/4 cos 3τ.
+        let mut aft = Aft::new(4, 8).unwrap();
+        let mut s = vec![0.0; 16];
+        for (i, v) in s.iter_mut().enumerate() {
+            *v = aft.tau(i).cos().powi(3);
+        }
+        let mut r = vec![0.0; 9];
+        aft.galerkin(&s, &mut r);
+        assert!((r[1] - 0.75).abs() < 1e-15 && (r[3] - 0.25).abs() < 1e-15 && r[0].abs() < 1e-15);
+    }
+
+    #[test]
+    fn too_few_samples_is_an_error() {
+        assert!(Aft::new(8, 8).is_err());
+    }
+}

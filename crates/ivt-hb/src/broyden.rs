@@ -1,0 +1,579 @@
+//! Generic Broyden ("good" update, Eq. 66–67) solver for `F(x) = 0`, `x ∈ R^m`.
+//!
+//! The solver keeps both the approximate Jacobian `B` and its inverse `H = B⁻¹`;
+//! each update is rank one, so `H` follows by Sherman–Morrison and an iteration costs
+//! O(m²) with no allocation: everything lives in the caller-owned
+//! [`BroydenWorkspace`]. Rows listed in [`BroydenWorkspace::exact_rows`] are never
+//! changed by the update (the exact augmenting row of the arc-length method, Eq. 77).
+//!
+//! Safeguards: a backtracking line search on ‖F‖ and, when the iteration stalls or
+//! the line search fails, a refresh of `B` by the system's Jacobian (or by forward
+//! finite differences when the system has none).
+
+use crate::linalg::{dot, invert, norm2};
+use thiserror::Error;
+
+/// A nonlinear system `F(x) = 0` with as many equations as unknowns.
+///
+/// Any closure `FnMut(&[f64], &mut [f64])` is a system (Jacobian by finite
+/// differences); implement the trait to supply an analytic Jacobian.
+pub trait System {
+    /// Writes `F(x)` into `r` (`r.len() == x.len()`).
+    fn residual(&mut self, x: &[f64], r: &mut [f64]);
+    /// Writes the Jacobian `∂F/∂x` (row-major `m×m`) into `jac`; returns `false`
+    /// when not available (the solver then uses finite differences).
+    fn jacobian(&mut self, _x: &[f64], _jac: &mut [f64]) -> bool {
+        false
+    }
+}
+
+impl<F: FnMut(&[f64], &mut [f64])> System for F {
+    fn residual(&mut self, x: &[f64], r: &mut [f64]) {
+        self(x, r)
+    }
+}
+
+/// Options of the Broyden solver.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct BroydenOptions {
+    /// Convergence when ‖F(x)‖₂ ≤ `tol`.
+    pub tol: f64,
+    /// Maximum number of (quasi-)Newton steps.
+    pub max_iter: usize,
+    /// Maximum step halvings in the backtracking line search.
+    pub max_backtracks: usize,
+    /// Allow refreshing `B` by the exact/finite-difference Jacobian on stalls.
+    pub jacobian_refresh: bool,
+    /// Maximum number of Jacobian refreshes in one solve.
+    pub max_refreshes: usize,
+    /// A step that reduces ‖F‖ by less than this factor counts as a stall
+    /// (e.g. 0.9: less than 10 % reduction).
+    pub stall_ratio: f64,
+    /// Consecutive stalled steps before the Jacobian is refreshed.
+    pub stall_iters: usize,
+    /// Relative forward-difference step for the finite-difference Jacobian.
+    pub fd_step: f64,
+}
+
+impl Default for BroydenOptions {
+    fn default() -> Self {
+        Self {
+            tol: 1e-10,
+            max_iter: 100,
+            max_backtracks: 8,
+            jacobian_refresh: true,
+            max_refreshes: 5,
+            stall_ratio: 0.9,
+            stall_iters: 4,
+            fd_step: 1e-7,
+        }
+    }
+}
+
+impl BroydenOptions {
+    /// Same options with another tolerance.
+    pub fn with_tol(mut self, tol: f64) -> Self {
+        self.tol = tol;
+        self
+    }
+    /// Same options with another iteration limit.
+    pub fn with_max_iter(mut self, max_iter: usize) -> Self {
+        self.max_iter = max_iter;
+        self
+    }
+}
+
+/// Statistics of a converged solve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BroydenStats {
+    /// Quasi-Newton steps taken.
+    pub iterations: usize,
+    /// Residual evaluations (including line search and finite differences).
+    pub residual_evals: usize,
+    /// Times the Jacobian was refreshed (exact or finite differences).
+    pub jacobian_refreshes: usize,
+    /// Final ‖F(x)‖₂.
+    pub residual_norm: f64,
+}
+
+/// Why a solve failed; every variant carries the residual-norm history.
+#[derive(Debug, Clone, Error, PartialEq)]
+pub enum SolveError {
+    /// The tolerance was not reached within `max_iter` steps or after the
+    /// allowed Jacobian refreshes.
+    #[error("no convergence after {iterations} iterations: ‖F‖ went {first:.3e} → {last:.3e}", first = history.first().copied().unwrap_or(f64::NAN), last = history.last().copied().unwrap_or(f64::NAN))]
+    NonConvergence {
+        /// Steps taken.
+        iterations: usize,
+        /// ‖F‖₂ after each accepted step (first entry: initial guess).
+        history: Vec<f64>,
+    },
+    /// `F` returned NaN/inf at the initial guess, or the inputs were not finite.
+    #[error("non-finite residual or input (iteration {iteration})")]
+    NonFinite {
+        /// Step at which it happened.
+        iteration: usize,
+        /// ‖F‖₂ history so far.
+        history: Vec<f64>,
+    },
+    /// The (approximate) Jacobian became singular and could not be refreshed.
+    #[error("singular Jacobian at iteration {iteration}")]
+    SingularJacobian {
+        /// Step at which it happened.
+        iteration: usize,
+        /// ‖F‖₂ history so far.
+        history: Vec<f64>,
+    },
+    /// Workspace and vector sizes disagree.
+    #[error("dimension mismatch: workspace for {expected} unknowns, got {got}")]
+    Dimension {
+        /// Workspace size.
+        expected: usize,
+        /// Length of the given vector.
+        got: usize,
+    },
+}
+
+impl SolveError {
+    /// The ‖F‖₂ history carried by the error (empty for [`SolveError::Dimension`]).
+    pub fn history(&self) -> &[f64] {
+        match self {
+            Self::NonConvergence { history, .. }
+            | Self::NonFinite { history, .. }
+            | Self::SingularJacobian { history, .. } => history,
+            Self::Dimension { .. } => &[],
+        }
+    }
+}
+
+/// Caller-owned state of the solver: `B`, `H = B⁻¹` and all scratch vectors.
+///
+/// Reuse one workspace across solves of the same size: after a solve, `B`/`H`
+/// hold the last Broyden approximation, which [`broyden_solve`] uses as the next
+/// initial Jacobian (warm start, as in the ε-stepping and continuation of §3.2).
+#[derive(Debug, Clone)]
+pub struct BroydenWorkspace {
+    m: usize,
+    b: Vec<f64>,
+    h: Vec<f64>,
+    has_jacobian: bool,
+    /// Rows of `B` that the Broyden update leaves untouched (their equations are
+    /// linear with an exact Jacobian row, e.g. the arc-length row Eq. 77).
+    pub exact_rows: std::ops::Range<usize>,
+    r: Vec<f64>,
+    r_trial: Vec<f64>,
+    x_trial: Vec<f64>,
+    dx: Vec<f64>,
+    u: Vec<f64>,
+    hu: Vec<f64>,
+    sth: Vec<f64>,
+    lu: Vec<f64>,
+    piv: Vec<usize>,
+    history: Vec<f64>,
+}
+
+impl BroydenWorkspace {
+    /// Workspace for `m` unknowns with no Jacobian yet (the first solve then starts
+    /// from a refreshed Jacobian unless [`Self::set_jacobian`] is called).
+    pub fn new(m: usize) -> Self {
+        Self {
+            m,
+            b: vec![0.0; m * m],
+            h: vec![0.0; m * m],
+            has_jacobian: false,
+            exact_rows: 0..0,
+            r: vec![0.0; m],
+            r_trial: vec![0.0; m],
+            x_trial: vec![0.0; m],
+            dx: vec![0.0; m],
+            u: vec![0.0; m],
+            hu: vec![0.0; m],
+            sth: vec![0.0; m],
+            lu: vec![0.0; m * m],
+            piv: vec![0; m],
+            history: Vec::with_capacity(256),
+        }
+    }
+
+    /// Number of unknowns.
+    pub fn len(&self) -> usize {
+        self.m
+    }
+
+    /// True for a zero-size workspace.
+    pub fn is_empty(&self) -> bool {
+        self.m == 0
+    }
+
+    /// Sets the initial Jacobian `B₀` (row-major `m×m`) and inverts it.
+    ///
+    /// # Errors
+    /// [`SolveError::SingularJacobian`] if `B₀` is singular.
+    pub fn set_jacobian(&mut self, b0: &[f64]) -> Result<(), SolveError> {
+        let m = self.m;
+        if b0.len() != m * m {
+            return Err(SolveError::Dimension {
+                expected: m * m,
+                got: b0.len(),
+            });
+        }
+        self.b.copy_from_slice(b0);
+        self.invert_b()
+    }
+
+    /// Sets `B₀` together with its known inverse (skips the O(m³) inversion, e.g.
+    /// for the block-diagonal linear Jacobian Eq. 60).
+    ///
+    /// # Errors
+    /// [`SolveError::Dimension`] on size mismatch.
+    pub fn set_jacobian_and_inverse(&mut self, b0: &[f64], h0: &[f64]) -> Result<(), SolveError> {
+        let m = self.m;
+        if b0.len() != m * m || h0.len() != m * m {
+            return Err(SolveError::Dimension {
+                expected: m * m,
+                got: b0.len().min(h0.len()),
+            });
+        }
+        self.b.copy_from_slice(b0);
+        self.h.copy_from_slice(h0);
+        self.has_jacobian = true;
+        Ok(())
+    }
+
+    /// Gives mutable access to `B` for the caller to edit (e.g. to replace one
+    /// column); call [`Self::refactor`] afterwards.
+    pub fn jacobian_mut(&mut self) -> &mut [f64] {
+        self.has_jacobian = false;
+        &mut self.b
+    }
+
+    /// Re-inverts `B` after [`Self::jacobian_mut`] edits.
+    ///
+    /// # Errors
+    /// [`SolveError::SingularJacobian`] if `B` is singular.
+    pub fn refactor(&mut self) -> Result<(), SolveError> {
+        self.invert_b()
+    }
+
+    /// Current approximate Jacobian `B` (row-major).
+    pub fn jacobian(&self) -> &[f64] {
+        &self.b
+    }
+
+    /// Current approximate inverse Jacobian `H = B⁻¹` (row-major).
+    pub fn inverse_jacobian(&self) -> &[f64] {
+        &self.h
+    }
+
+    /// Whether a Jacobian is set (otherwise the next solve refreshes first).
+    pub fn has_jacobian(&self) -> bool {
+        self.has_jacobian
+    }
+
+    /// Forgets the Jacobian so the next solve starts with a refresh.
+    pub fn clear_jacobian(&mut self) {
+        self.has_jacobian = false;
+    }
+
+    /// ‖F‖₂ after each accepted step of the last solve (first: initial guess).
+    pub fn history(&self) -> &[f64] {
+        &self.history
+    }
+
+    /// Last residual vector `F(x)` of the last solve.
+    pub fn residual(&self) -> &[f64] {
+        &self.r
+    }
+
+    fn invert_b(&mut self) -> Result<(), SolveError> {
+        let m = self.m;
+        match invert(&self.b, m, &mut self.h, &mut self.lu, &mut self.piv) {
+            Ok(()) => {
+                self.has_jacobian = true;
+                Ok(())
+            }
+            Err(_) => {
+                self.has_jacobian = false;
+                Err(SolveError::SingularJacobian {
+                    iteration: 0,
+                    history: self.history.clone(),
+                })
+            }
+        }
+    }
+
+    /// Refreshes `B` at `x` (whose residual is in `self.r`) from the system's
+    /// Jacobian or by forward differences; returns residual evaluations used.
+    fn refresh<S: System + ?Sized>(&mut self, sys: &mut S, x: &[f64], fd_step: f64) -> usize {
+        let m = self.m;
+        if sys.jacobian(x, &mut self.b) {
+            return 0;
+        }
+        self.x_trial.copy_from_slice(x);
+        for j in 0..m {
+            let h = fd_step * x[j].abs().max(1.0);
+            self.x_trial[j] = x[j] + h;
+            let hh = self.x_trial[j] - x[j];
+            sys.residual(&self.x_trial, &mut self.r_trial);
+            for i in 0..m {
+                self.b[i * m + j] = (self.r_trial[i] - self.r[i]) / hh;
+            }
+            self.x_trial[j] = x[j];
+        }
+        m
+    }
+
+    /// Rank-one "good Broyden" update (Eq. 67) of `B` and Sherman–Morrison update
+    /// of `H`, with `s = dx` and `y = r_trial − r`; rows in `exact_rows` are kept.
+    /// Returns `false` if the update would make `B` singular.
+    fn update(&mut self) -> bool {
+        let m = self.m;
+        let ss = dot(&self.dx, &self.dx);
+        if ss == 0.0 || !ss.is_finite() {
+            return false;
+        }
+        // u = y − B s, masked on the exact rows.
+        for i in 0..m {
+            if self.exact_rows.contains(&i) {
+                self.u[i] = 0.0;
+                continue;
+            }
+            let bs = dot(&self.b[i * m..(i + 1) * m], &self.dx);
+            self.u[i] = (self.r_trial[i] - self.r[i]) - bs;
+        }
+        // B ← B + u sᵀ/ss;  H ← H − (H u)(sᵀ H)/(ss + sᵀ H u).
+        for i in 0..m {
+            self.hu[i] = dot(&self.h[i * m..(i + 1) * m], &self.u);
+        }
+        for j in 0..m {
+            let mut acc = 0.0;
+            for i in 0..m {
+                acc += self.dx[i] * self.h[i * m + j];
+            }
+            self.sth[j] = acc;
+        }
+        let denom = ss + dot(&self.dx, &self.hu);
+        if denom.abs() <= 1e-14 * ss || !denom.is_finite() {
+            return false;
+        }
+        for i in 0..m {
+            let ui = self.u[i] / ss;
+            let hui = self.hu[i] / denom;
+            let brow = &mut self.b[i * m..(i + 1) * m];
+            for (bij, sj) in brow.iter_mut().zip(&self.dx) {
+                *bij += ui * sj;
+            }
+            let hrow = &mut self.h[i * m..(i + 1) * m];
+            for (hij, sthj) in hrow.iter_mut().zip(&self.sth) {
+                *hij -= hui * sthj;
+            }
+        }
+        true
+    }
+}
+
+/// Solves `F(x) = 0` by Broyden's method from the initial guess `x` (overwritten
+/// by the solution), starting from the Jacobian held in `ws` (set with
+/// [`BroydenWorkspace::set_jacobian`] or left from a previous solve; refreshed if
+/// none).
+///
+/// # Errors
+/// [`SolveError`] with the residual history when the tolerance is not reached,
+/// the residual is not finite, or the Jacobian is singular.
+pub fn broyden_solve<S: System + ?Sized>(
+    sys: &mut S,
+    x: &mut [f64],
+    ws: &mut BroydenWorkspace,
+    opts: &BroydenOptions,
+) -> Result<BroydenStats, SolveError> {
+    let m = ws.m;
+    if x.len() != m {
+        return Err(SolveError::Dimension {
+            expected: m,
+            got: x.len(),
+        });
+    }
+    ws.history.clear();
+    if !x.iter().all(|v| v.is_finite()) {
+        return Err(SolveError::NonFinite {
+            iteration: 0,
+            history: Vec::new(),
+        });
+    }
+    let mut stats = BroydenStats {
+        iterations: 0,
+        residual_evals: 1,
+        jacobian_refreshes: 0,
+        residual_norm: 0.0,
+    };
+    sys.residual(x, &mut ws.r);
+    let mut norm = norm2(&ws.r);
+    ws.history.push(norm);
+    if !norm.is_finite() {
+        return Err(SolveError::NonFinite {
+            iteration: 0,
+            history: ws.history.clone(),
+        });
+    }
+    if !ws.has_jacobian {
+        stats.residual_evals += ws.refresh(sys, x, opts.fd_step);
+        stats.jacobian_refreshes += 1;
+        ws.invert_b().map_err(|_| SolveError::SingularJacobian {
+            iteration: 0,
+            history: ws.history.clone(),
+        })?;
+    }
+    let mut stalled = 0usize;
+    while norm > opts.tol {
+        if stats.iterations >= opts.max_iter {
+            stats.residual_norm = norm;
+            return Err(SolveError::NonConvergence {
+                iterations: stats.iterations,
+                history: ws.history.clone(),
+            });
+        }
+        stats.iterations += 1;
+        // Quasi-Newton direction dx = −H r (Eq. 66).
+        for i in 0..m {
+            ws.dx[i] = -dot(&ws.h[i * m..(i + 1) * m], &ws.r);
+        }
+        // Backtracking line search on ‖F‖.
+        let mut t = 1.0;
+        let mut accepted = false;
+        let mut trial_norm = f64::INFINITY;
+        for _ in 0..=opts.max_backtracks {
+            for i in 0..m {
+                ws.x_trial[i] = x[i] + t * ws.dx[i];
+            }
+            sys.residual(&ws.x_trial, &mut ws.r_trial);
+            stats.residual_evals += 1;
+            trial_norm = norm2(&ws.r_trial);
+            if trial_norm.is_finite() && trial_norm < norm {
+                accepted = true;
+                break;
+            }
+            t *= 0.5;
+        }
+        let can_refresh = opts.jacobian_refresh && stats.jacobian_refreshes < opts.max_refreshes;
+        if !accepted {
+            if !can_refresh {
+                return Err(SolveError::NonConvergence {
+                    iterations: stats.iterations,
+                    history: ws.history.clone(),
+                });
+            }
+            stats.residual_evals += ws.refresh(sys, x, opts.fd_step);
+            stats.jacobian_refreshes += 1;
+            stalled = 0;
+            if ws.invert_b().is_err() {
+                return Err(SolveError::SingularJacobian {
+                    iteration: stats.iterations,
+                    history: ws.history.clone(),
+                });
+            }
+            continue;
+        }
+        // Accept the step; s = t·dx.
+        if t != 1.0 {
+            ws.dx.iter_mut().for_each(|v| *v *= t);
+        }
+        let updated = ws.update();
+        x.copy_from_slice(&ws.x_trial);
+        std::mem::swap(&mut ws.r, &mut ws.r_trial);
+        let ratio = trial_norm / norm;
+        norm = trial_norm;
+        ws.history.push(norm);
+        stalled = if ratio > opts.stall_ratio {
+            stalled + 1
+        } else {
+            0
+        };
+        if (!updated || stalled >= opts.stall_iters) && norm > opts.tol {
+            if !can_refresh {
+                if !updated {
+                    return Err(SolveError::SingularJacobian {
+                        iteration: stats.iterations,
+                        history: ws.history.clone(),
+                    });
+                }
+                continue;
+            }
+            stats.residual_evals += ws.refresh(sys, x, opts.fd_step);
+            stats.jacobian_refreshes += 1;
+            stalled = 0;
+            if ws.invert_b().is_err() {
+                return Err(SolveError::SingularJacobian {
+                    iteration: stats.iterations,
+                    history: ws.history.clone(),
+                });
+            }
+        }
+    }
+    stats.residual_norm = norm;
+    Ok(stats)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solves_a_small_nonlinear_system_from_identity() {
+        // x² + y² = 4, x − y = 0  →  x = y = √2.
+        let mut f = |x: &[f64], r: &mut [f64]| {
+            r[0] = x[0] * x[0] + x[1] * x[1] - 4.0;
+            r[1] = x[0] - x[1];
+        };
+        let mut ws = BroydenWorkspace::new(2);
+        ws.set_jacobian(&[2.0, 2.0, 1.0, -1.0]).unwrap();
+        let mut x = [1.0, 1.0];
+        let stats = broyden_solve(&mut f, &mut x, &mut ws, &BroydenOptions::default()).unwrap();
+        assert!((x[0] - 2f64.sqrt()).abs() < 1e-10 && (x[1] - 2f64.sqrt()).abs() < 1e-10);
+        assert!(stats.residual_norm <= 1e-10);
+    }
+
+    #[test]
+    fn finite_difference_start_and_exact_row_is_kept() {
+        // Rosenbrock-like: r0 = 10(y − x²), r1 = 1 − x; the second row is linear.
+        let mut f = |x: &[f64], r: &mut [f64]| {
+            r[0] = 10.0 * (x[1] - x[0] * x[0]);
+            r[1] = 1.0 - x[0];
+        };
+        let mut ws = BroydenWorkspace::new(2);
+        ws.exact_rows = 1..2;
+        let mut x = [-1.2, 1.0];
+        broyden_solve(&mut f, &mut x, &mut ws, &BroydenOptions::default()).unwrap();
+        assert!((x[0] - 1.0).abs() < 1e-9 && (x[1] - 1.0).abs() < 1e-9);
+        // Exact row −1, 0 survives all updates bit-for-bit after the FD start.
+        let b = ws.jacobian();
+        assert!((b[2] + 1.0).abs() < 1e-6 && b[3].abs() < 1e-6);
+    }
+
+    #[test]
+    fn non_convergence_carries_history() {
+        // x² + 1 = 0 has no real root.
+        let mut f = |x: &[f64], r: &mut [f64]| r[0] = x[0] * x[0] + 1.0;
+        let mut ws = BroydenWorkspace::new(1);
+        let mut x = [0.3];
+        let err = broyden_solve(
+            &mut f,
+            &mut x,
+            &mut ws,
+            &BroydenOptions::default().with_max_iter(30),
+        )
+        .unwrap_err();
+        assert!(!err.history().is_empty(), "{err}");
+    }
+
+    #[test]
+    fn nan_input_is_an_error() {
+        let mut f = |x: &[f64], r: &mut [f64]| r[0] = x[0];
+        let mut ws = BroydenWorkspace::new(1);
+        let mut x = [f64::NAN];
+        assert!(matches!(
+            broyden_solve(&mut f, &mut x, &mut ws, &BroydenOptions::default()),
+            Err(SolveError::NonFinite { .. })
+        ));
+    }
+}

@@ -1,0 +1,420 @@
+//! Pseudo-arclength continuation of `R(x) = 0`, `R: R^{m+1} → R^m` (the last entry of
+//! `x` is the path parameter λ, e.g. ω), after §3.2.3 (Eq. 68–77).
+//!
+//! Each step predicts `x₀ = x_p + x_d Δη` along the secant `x_d` (Eq. 71) and
+//! corrects with Broyden on the augmented system `[R(x); x_dᵀ(x − x_p) − Δη] = 0`.
+//! The approximate Jacobian is `B_x = [[B_q, B_λ], [x_dᵀ]]` (Eq. 72): `B_q` is carried
+//! over from the previous point, `B_λ` is refreshed by one finite difference, and
+//! the last row is kept exact through every update ([`BroydenWorkspace::exact_rows`],
+//! Eq. 77). Step length follows the corrector's iteration count; a failed corrector
+//! halves the step and refreshes the Jacobian. A sign change of the secant's λ
+//! component marks a fold (turning point).
+
+use crate::broyden::{broyden_solve, BroydenOptions, BroydenWorkspace, SolveError};
+use crate::linalg::{dot, lu_factor, lu_solve, norm2};
+use thiserror::Error;
+
+/// Options of the path follower.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct ContinuationOptions {
+    /// Initial arclength step Δη.
+    pub ds: f64,
+    /// Smallest step before giving up.
+    pub ds_min: f64,
+    /// Largest step.
+    pub ds_max: f64,
+    /// Maximum number of points (including the start).
+    pub max_points: usize,
+    /// Stop once λ leaves `[lambda_min, lambda_max]` (that point is kept).
+    pub lambda_min: f64,
+    /// See `lambda_min`.
+    pub lambda_max: f64,
+    /// Corrector iterations aimed at; fewer grow the step, more shrink it.
+    pub target_iter: usize,
+    /// Step growth factor after an easy corrector.
+    pub growth: f64,
+    /// Corrector options (tolerance, iteration limit, refresh policy).
+    pub broyden: BroydenOptions,
+}
+
+impl Default for ContinuationOptions {
+    fn default() -> Self {
+        Self {
+            ds: 0.02,
+            ds_min: 1e-7,
+            ds_max: 0.2,
+            max_points: 5000,
+            lambda_min: f64::NEG_INFINITY,
+            lambda_max: f64::INFINITY,
+            target_iter: 6,
+            growth: 1.5,
+            broyden: BroydenOptions {
+                max_iter: 25,
+                ..BroydenOptions::default()
+            },
+        }
+    }
+}
+
+/// One converged point on the path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathPoint {
+    /// The solution `{q, λ}`.
+    pub x: Vec<f64>,
+    /// Corrector iterations used.
+    pub iterations: usize,
+    /// λ component of the unit secant that led here (sign = direction in λ).
+    pub dlambda: f64,
+}
+
+impl PathPoint {
+    /// The path parameter λ (last entry of `x`).
+    pub fn lambda(&self) -> f64 {
+        *self.x.last().expect("non-empty point")
+    }
+}
+
+/// A fold (turning point in λ) between points `index` and `index + 1`… or at
+/// `index`: the secant's λ component changed sign around point `index`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fold {
+    /// Index of the point nearest the turn.
+    pub index: usize,
+    /// λ at the turn from a parabola through the three points around it.
+    pub lambda: f64,
+}
+
+/// Why the path follower stopped (stopping is not failing).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Termination {
+    /// λ left the requested interval.
+    LeftInterval,
+    /// `max_points` reached.
+    MaxPoints,
+    /// The callback asked to stop.
+    Stopped,
+    /// The step fell below `ds_min`; carries the last corrector error.
+    StepTooSmall(SolveError),
+}
+
+/// A traced path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Path {
+    /// Converged points in order.
+    pub points: Vec<PathPoint>,
+    /// Detected folds.
+    pub folds: Vec<Fold>,
+    /// Why tracing stopped.
+    pub termination: Termination,
+}
+
+/// The start point could not be used.
+#[derive(Debug, Clone, Error, PartialEq)]
+pub enum ContinuationError {
+    /// The start point did not converge at fixed λ.
+    #[error("start point does not converge: {0}")]
+    Start(SolveError),
+    /// The tangent at the start is undefined (singular `∂R/∂q`).
+    #[error("singular Jacobian at the start point")]
+    SingularStart,
+    /// Bad sizes or non-finite inputs.
+    #[error("invalid input: {0}")]
+    Input(&'static str),
+}
+
+/// Traces the solution path of `residual` from `start` (`m+1` entries, λ last; it is
+/// first corrected at fixed λ) in the direction of increasing λ if `direction > 0`.
+/// `jac0`, if given, is an initial row-major `m×(m+1)` Jacobian estimate at
+/// `start` (otherwise finite differences). `on_point` sees each converged point and
+/// returns `false` to stop.
+///
+/// # Errors
+/// [`ContinuationError`] if the start cannot be converged or has no tangent;
+/// trouble later on ends the path with a [`Termination`] instead.
+pub fn pseudo_arclength<R, C>(
+    mut residual: R,
+    start: &[f64],
+    jac0: Option<&[f64]>,
+    direction: f64,
+    opts: &ContinuationOptions,
+    mut on_point: C,
+) -> Result<Path, ContinuationError>
+where
+    R: FnMut(&[f64], &mut [f64]),
+    C: FnMut(&PathPoint) -> bool,
+{
+    let n1 = start.len();
+    if n1 < 2 {
+        return Err(ContinuationError::Input(
+            "need at least one unknown and the parameter",
+        ));
+    }
+    if !start.iter().all(|v| v.is_finite()) || !(opts.ds > 0.0) {
+        return Err(ContinuationError::Input("non-finite start or step"));
+    }
+    let m = n1 - 1;
+    // Jacobian estimate J (m × (m+1)).
+    let mut jac = vec![0.0; m * n1];
+    let mut r0 = vec![0.0; m];
+    let mut r1 = vec![0.0; m];
+    let mut xp = start.to_vec();
+    let fd_jac =
+        |res: &mut R, x: &[f64], jac: &mut [f64], r0: &mut [f64], r1: &mut [f64], fd: f64| {
+            let mut xt = x.to_vec();
+            res(x, r0);
+            for j in 0..x.len() {
+                let h = fd * x[j].abs().max(1.0);
+                xt[j] = x[j] + h;
+                res(&xt, r1);
+                for i in 0..r0.len() {
+                    jac[i * x.len() + j] = (r1[i] - r0[i]) / h;
+                }
+                xt[j] = x[j];
+            }
+        };
+    match jac0 {
+        Some(j) if j.len() == m * n1 => jac.copy_from_slice(j),
+        Some(_) => return Err(ContinuationError::Input("jac0 must be m×(m+1)")),
+        None => fd_jac(
+            &mut residual,
+            &xp,
+            &mut jac,
+            &mut r0,
+            &mut r1,
+            opts.broyden.fd_step,
+        ),
+    }
+    // Correct the start at fixed λ.
+    let lam0 = xp[m];
+    let mut wsq = BroydenWorkspace::new(m);
+    let bq: Vec<f64> = (0..m)
+        .flat_map(|i| jac[i * n1..i * n1 + m].to_vec())
+        .collect();
+    if wsq.set_jacobian(&bq).is_err() {
+        wsq.clear_jacobian();
+    }
+    let mut q = xp[..m].to_vec();
+    let mut xfull = xp.clone();
+    {
+        let mut fixed = |qv: &[f64], r: &mut [f64]| {
+            xfull[..m].copy_from_slice(qv);
+            xfull[m] = lam0;
+            residual(&xfull, r);
+        };
+        broyden_solve(&mut fixed, &mut q, &mut wsq, &opts.broyden)
+            .map_err(ContinuationError::Start)?;
+    }
+    xp[..m].copy_from_slice(&q);
+    for i in 0..m {
+        jac[i * n1..i * n1 + m].copy_from_slice(&wsq.jacobian()[i * m..(i + 1) * m]);
+    }
+    // Tangent at the start: B_q z = B_λ, t = [−z; 1].
+    let mut lu = bq;
+    for i in 0..m {
+        lu[i * m..(i + 1) * m].copy_from_slice(&jac[i * n1..i * n1 + m]);
+    }
+    let mut piv = vec![0; m];
+    lu_factor(&mut lu, m, &mut piv).map_err(|_| ContinuationError::SingularStart)?;
+    let mut z: Vec<f64> = (0..m).map(|i| jac[i * n1 + m]).collect();
+    lu_solve(&lu, m, &piv, &mut z);
+    let mut xd: Vec<f64> = z.iter().map(|v| -v).chain(std::iter::once(1.0)).collect();
+    let nt = norm2(&xd);
+    let sign = if direction >= 0.0 { 1.0 } else { -1.0 };
+    xd.iter_mut().for_each(|v| *v *= sign / nt);
+
+    let mut points = vec![PathPoint {
+        x: xp.clone(),
+        iterations: 0,
+        dlambda: xd[m],
+    }];
+    let mut folds = Vec::new();
+    if !on_point(&points[0]) {
+        return Ok(Path {
+            points,
+            folds,
+            termination: Termination::Stopped,
+        });
+    }
+    let mut ws = BroydenWorkspace::new(n1);
+    ws.exact_rows = m..n1;
+    let mut b = vec![0.0; n1 * n1];
+    let mut x = vec![0.0; n1];
+    let mut ds = opts.ds;
+    let termination = loop {
+        if points.len() >= opts.max_points {
+            break Termination::MaxPoints;
+        }
+        // Predictor (Eq. 71) and B_λ by one finite difference at the prediction.
+        for i in 0..n1 {
+            x[i] = xp[i] + xd[i] * ds;
+        }
+        let h = opts.broyden.fd_step * x[m].abs().max(1.0);
+        residual(&x, &mut r0);
+        x[m] += h;
+        residual(&x, &mut r1);
+        x[m] -= h;
+        for i in 0..m {
+            jac[i * n1 + m] = (r1[i] - r0[i]) / h;
+        }
+        // B_x = [[B_q, B_λ], [x_dᵀ]] (Eq. 72).
+        b[..m * n1].copy_from_slice(&jac);
+        b[m * n1..].copy_from_slice(&xd);
+        let set = ws.set_jacobian(&b);
+        let (xp_c, xd_c) = (xp.clone(), xd.clone());
+        let mut aug = |xv: &[f64], r: &mut [f64]| {
+            residual(xv, &mut r[..m]);
+            let mut g = 0.0;
+            for i in 0..n1 {
+                g += xd_c[i] * (xv[i] - xp_c[i]);
+            }
+            r[m] = g - ds;
+        };
+        let outcome = match set {
+            Ok(()) => broyden_solve(&mut aug, &mut x, &mut ws, &opts.broyden),
+            Err(e) => Err(e),
+        };
+        let ok = match &outcome {
+            Ok(_) => {
+                let dist: f64 = x
+                    .iter()
+                    .zip(&xp)
+                    .map(|(a, b)| (a - b) * (a - b))
+                    .sum::<f64>()
+                    .sqrt();
+                dist <= 3.0 * ds
+            }
+            Err(_) => false,
+        };
+        if !ok {
+            ds *= 0.5;
+            if ds < opts.ds_min {
+                let err = outcome.err().unwrap_or(SolveError::NonConvergence {
+                    iterations: 0,
+                    history: ws.history().to_vec(),
+                });
+                break Termination::StepTooSmall(err);
+            }
+            fd_jac(
+                &mut residual,
+                &xp,
+                &mut jac,
+                &mut r0,
+                &mut r1,
+                opts.broyden.fd_step,
+            );
+            continue;
+        }
+        let iters = outcome.map(|s| s.iterations).unwrap_or(0);
+        // Carry B_q forward.
+        for i in 0..m {
+            jac[i * n1..i * n1 + m].copy_from_slice(&ws.jacobian()[i * n1..i * n1 + m]);
+        }
+        // New secant (Eq. 71).
+        let mut new_xd: Vec<f64> = x.iter().zip(&xp).map(|(a, b)| a - b).collect();
+        let nn = norm2(&new_xd);
+        new_xd.iter_mut().for_each(|v| *v /= nn);
+        if dot(&new_xd, &xd) < 0.0 {
+            // The corrector went backwards along the path: treat as a failure.
+            ds *= 0.5;
+            if ds < opts.ds_min {
+                break Termination::StepTooSmall(SolveError::NonConvergence {
+                    iterations: iters,
+                    history: ws.history().to_vec(),
+                });
+            }
+            continue;
+        }
+        let prev_dl = points.last().map(|p| p.dlambda).unwrap_or(new_xd[m]);
+        let point = PathPoint {
+            x: x.clone(),
+            iterations: iters,
+            dlambda: new_xd[m],
+        };
+        if prev_dl * new_xd[m] < 0.0 && points.len() >= 2 {
+            let k = points.len() - 1;
+            folds.push(Fold {
+                index: k,
+                lambda: parabola_extremum(&points[k - 1], &points[k], &point),
+            });
+        }
+        xp.copy_from_slice(&x);
+        xd = new_xd;
+        let lam = point.lambda();
+        points.push(point);
+        if !on_point(points.last().expect("just pushed")) {
+            break Termination::Stopped;
+        }
+        if lam < opts.lambda_min || lam > opts.lambda_max {
+            break Termination::LeftInterval;
+        }
+        if iters * 2 <= opts.target_iter {
+            ds = (ds * opts.growth).min(opts.ds_max);
+        } else if iters > opts.target_iter {
+            ds = (ds * 0.7).max(opts.ds_min);
+        }
+    };
+    Ok(Path {
+        points,
+        folds,
+        termination,
+    })
+}
+
+/// λ at the extremum of the parabola λ(s) through three consecutive points
+/// (s = arclength by chords).
+fn parabola_extremum(a: &PathPoint, b: &PathPoint, c: &PathPoint) -> f64 {
+    let dist = |p: &PathPoint, q: &PathPoint| {
+        p.x.iter()
+            .zip(&q.x)
+            .map(|(u, v)| (u - v) * (u - v))
+            .sum::<f64>()
+            .sqrt()
+    };
+    let (s0, s1, s2) = (0.0, dist(a, b), dist(a, b) + dist(b, c));
+    let (l0, l1, l2) = (a.lambda(), b.lambda(), c.lambda());
+    // Divided differences: λ = l0 + d1 (s − s0) + d2 (s − s0)(s − s1).
+    let d1 = (l1 - l0) / (s1 - s0);
+    let d2 = ((l2 - l1) / (s2 - s1) - d1) / (s2 - s0);
+    if d2 == 0.0 || !d2.is_finite() {
+        return l1;
+    }
+    let s_star = 0.5 * (s0 + s1) - d1 / (2.0 * d2);
+    l0 + d1 * (s_star - s0) + d2 * (s_star - s0) * (s_star - s1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn traces_a_circle_through_both_folds() {
+        // x² + λ² = 1 from (x, λ) = (−1, 0)…: folds at λ = ±1 (x = 0).
+        let res = |x: &[f64], r: &mut [f64]| r[0] = x[0] * x[0] + x[1] * x[1] - 1.0;
+        let opts = ContinuationOptions {
+            ds: 0.05,
+            max_points: 200,
+            lambda_min: -2.0,
+            lambda_max: 2.0,
+            ..Default::default()
+        };
+        let mut n = 0;
+        let path = pseudo_arclength(res, &[-0.6, 0.8], None, 1.0, &opts, |p| {
+            n += 1;
+            assert!((p.x[0] * p.x[0] + p.x[1] * p.x[1] - 1.0).abs() < 1e-9);
+            n < 150
+        })
+        .unwrap();
+        assert!(path.folds.len() >= 2, "{:?}", path.folds);
+        assert!(
+            (path.folds[0].lambda - 1.0).abs() < 1e-3,
+            "{:?}",
+            path.folds
+        );
+        assert!(
+            (path.folds[1].lambda + 1.0).abs() < 1e-3,
+            "{:?}",
+            path.folds
+        );
+    }
+}

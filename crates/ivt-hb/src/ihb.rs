@@ -1,0 +1,502 @@
+//! Shared pieces of both IHB variants: options, the AFT residual of Eq. 52/55/61
+//! for a [`PeriodicProblem`], the linear Jacobian Eq. 60, and the solution type.
+//!
+//! Unknowns: `q = [dof 0: a0, a1..an, b1..bn | dof 1: … ]` (length `n_dof·(2n+1)`)
+//! for `x(τ)`, τ = ωt, ω = ω_f/p. The residual is the Galerkin projection (Eq. 55)
+//!
+//! `r = (1/π)∫ C_s [ω² M x'' + ω C x' + K x + s·g(x, ω x', pτ) − f(pτ)] dτ`,
+//!
+//! with the linear part applied exactly in the frequency domain and `g` by AFT
+//! (Eq. 62–65); `s ∈ [0, 1]` scales the nonlinearity for parameter stepping (§3.2.2).
+
+use crate::aft::{Aft, AftError};
+use crate::broyden::{BroydenOptions, BroydenStats, SolveError};
+use crate::linalg::invert;
+use crate::problem::PeriodicProblem;
+use thiserror::Error;
+
+/// Options of the IHB solvers.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct HbOptions {
+    /// Harmonics n.
+    pub harmonics: usize,
+    /// Half the number of AFT samples, N (> n).
+    pub n_half: usize,
+    /// Sub-harmonic order p (Eq. 52): response period p·2π/ω_f.
+    pub subharmonic: usize,
+    /// Iteration options (tolerance on ‖r‖, default 1e-10).
+    pub broyden: BroydenOptions,
+    /// Parameter steps in the nonlinearity (0: solve directly; on failure the
+    /// solver retries with 8, then 32 steps).
+    pub homotopy_steps: usize,
+}
+
+impl Default for HbOptions {
+    fn default() -> Self {
+        Self {
+            harmonics: 20,
+            n_half: 64,
+            subharmonic: 1,
+            broyden: BroydenOptions::default(),
+            homotopy_steps: 0,
+        }
+    }
+}
+
+impl HbOptions {
+    /// Options with n harmonics and 2N samples.
+    pub fn new(harmonics: usize, n_half: usize) -> Self {
+        Self {
+            harmonics,
+            n_half,
+            ..Self::default()
+        }
+    }
+    /// Same options with sub-harmonic order p.
+    pub fn with_subharmonic(mut self, p: usize) -> Self {
+        self.subharmonic = p;
+        self
+    }
+    /// Same options with another residual tolerance.
+    pub fn with_tol(mut self, tol: f64) -> Self {
+        self.broyden.tol = tol;
+        self
+    }
+}
+
+/// Errors of the harmonic-balance solvers.
+#[derive(Debug, Clone, Error, PartialEq)]
+pub enum HbError {
+    /// Invalid sizes or parameters.
+    #[error("invalid input: {0}")]
+    InvalidInput(String),
+    /// AFT sizes (N ≤ n).
+    #[error(transparent)]
+    Aft(#[from] AftError),
+    /// The iteration did not converge (carries the residual history).
+    #[error("harmonic balance did not converge: {0}")]
+    Solve(#[from] SolveError),
+}
+
+/// A converged periodic solution.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HbSolution {
+    /// Fourier coefficients, `n_dof` blocks of `[a0, a1..an, b1..bn]` in τ.
+    pub coeffs: Vec<f64>,
+    /// Excitation frequency ω_f.
+    pub omega_f: f64,
+    /// Harmonics n.
+    pub harmonics: usize,
+    /// Sub-harmonic order p.
+    pub subharmonic: usize,
+    /// Iteration statistics (summed over parameter steps).
+    pub stats: BroydenStats,
+}
+
+impl HbSolution {
+    /// Fundamental frequency of the response ω = ω_f/p (τ = ωt).
+    pub fn omega(&self) -> f64 {
+        self.omega_f / self.subharmonic as f64
+    }
+    /// Coefficients of DOF `d`.
+    pub fn dof(&self, d: usize) -> &[f64] {
+        let l = 2 * self.harmonics + 1;
+        &self.coeffs[d * l..(d + 1) * l]
+    }
+    /// `x_d` at physical time `t`.
+    pub fn x_at(&self, d: usize, t: f64) -> f64 {
+        crate::aft::eval_series(self.dof(d), self.omega() * t, 0)
+    }
+    /// Amplitude `max_τ |x_d|` sampled at 512 points.
+    pub fn amplitude(&self, d: usize) -> f64 {
+        (0..512)
+            .map(|i| {
+                crate::aft::eval_series(
+                    self.dof(d),
+                    2.0 * std::f64::consts::PI * i as f64 / 512.0,
+                    0,
+                )
+                .abs()
+            })
+            .fold(0.0, f64::max)
+    }
+}
+
+/// Checks sizes and parameters common to both solvers.
+pub(crate) fn validate<P: PeriodicProblem>(problem: &P, opts: &HbOptions) -> Result<(), HbError> {
+    let n = problem.n_dof();
+    if n == 0 {
+        return Err(HbError::InvalidInput("n_dof must be positive".into()));
+    }
+    if opts.subharmonic == 0 {
+        return Err(HbError::InvalidInput(
+            "sub-harmonic order p must be ≥ 1".into(),
+        ));
+    }
+    if opts.harmonics < opts.subharmonic {
+        return Err(HbError::InvalidInput(format!(
+            "n = {} harmonics cannot hold the excitation harmonic p = {}",
+            opts.harmonics, opts.subharmonic
+        )));
+    }
+    for (name, mat) in [
+        ("M", problem.mass()),
+        ("C", problem.damping()),
+        ("K", problem.stiffness()),
+    ] {
+        if mat.len() != n * n {
+            return Err(HbError::InvalidInput(format!("{name} must be {n}×{n}")));
+        }
+        if !mat.iter().all(|v| v.is_finite()) {
+            return Err(HbError::InvalidInput(format!(
+                "{name} has non-finite entries"
+            )));
+        }
+    }
+    if !(opts.broyden.tol > 0.0) {
+        return Err(HbError::InvalidInput("tolerance must be positive".into()));
+    }
+    Ok(())
+}
+
+pub(crate) fn validate_omega(omega_f: f64) -> Result<(), HbError> {
+    if !omega_f.is_finite() || omega_f <= 0.0 {
+        return Err(HbError::InvalidInput(format!(
+            "excitation frequency must be positive and finite, got {omega_f}"
+        )));
+    }
+    Ok(())
+}
+
+/// The AFT residual evaluator with all buffers (allocation-free `eval`).
+#[derive(Debug, Clone)]
+pub struct HbResidual {
+    aft: Aft,
+    n_dof: usize,
+    n: usize,
+    p: usize,
+    velocity: bool,
+    xs: Vec<f64>,
+    vs: Vec<f64>,
+    gs: Vec<f64>,
+    xi: Vec<f64>,
+    vi: Vec<f64>,
+    gi: Vec<f64>,
+    rg: Vec<f64>,
+    exc: Vec<f64>,
+}
+
+impl HbResidual {
+    /// Plans the AFT and precomputes the Galerkin projection of the excitation.
+    ///
+    /// # Errors
+    /// [`HbError`] for invalid sizes (N ≤ n, p = 0, …).
+    pub fn new<P: PeriodicProblem>(problem: &P, opts: &HbOptions) -> Result<Self, HbError> {
+        validate(problem, opts)?;
+        let aft = Aft::new(opts.harmonics, opts.n_half)?;
+        let nd = problem.n_dof();
+        let ns = aft.n_samples();
+        let l = aft.coeff_len();
+        let mut s = Self {
+            n_dof: nd,
+            n: opts.harmonics,
+            p: opts.subharmonic,
+            velocity: problem.velocity_dependent(),
+            xs: vec![0.0; nd * ns],
+            vs: vec![0.0; nd * ns],
+            gs: vec![0.0; nd * ns],
+            xi: vec![0.0; nd],
+            vi: vec![0.0; nd],
+            gi: vec![0.0; nd],
+            rg: vec![0.0; l],
+            exc: vec![0.0; nd * l],
+            aft,
+        };
+        for i in 0..ns {
+            let theta = s.p as f64 * s.aft.tau(i);
+            problem.excitation(theta, &mut s.gi);
+            for d in 0..nd {
+                s.gs[d * ns + i] = s.gi[d];
+            }
+        }
+        if !s.gs.iter().all(|v| v.is_finite()) {
+            return Err(HbError::InvalidInput("excitation is not finite".into()));
+        }
+        for d in 0..nd {
+            s.aft
+                .galerkin(&s.gs[d * ns..(d + 1) * ns], &mut s.exc[d * l..(d + 1) * l]);
+        }
+        Ok(s)
+    }
+
+    /// Number of unknowns `n_dof·(2n+1)`.
+    pub fn len(&self) -> usize {
+        self.n_dof * (2 * self.n + 1)
+    }
+
+    /// True if there are no unknowns (never for a valid problem).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Harmonics n.
+    pub fn harmonics(&self) -> usize {
+        self.n
+    }
+
+    /// Sub-harmonic order p.
+    pub fn subharmonic(&self) -> usize {
+        self.p
+    }
+
+    /// The AFT plans (2N samples).
+    pub fn aft_mut(&mut self) -> &mut Aft {
+        &mut self.aft
+    }
+
+    /// Galerkin projection of the excitation `f(pτ)`.
+    pub fn excitation(&self) -> &[f64] {
+        &self.exc
+    }
+
+    /// `r = L(ω) q` — the exact Galerkin projection of `ω²M x'' + ωC x' + K x`.
+    pub fn apply_linear<P: PeriodicProblem>(
+        &self,
+        problem: &P,
+        q: &[f64],
+        omega: f64,
+        r: &mut [f64],
+    ) {
+        let (nd, n) = (self.n_dof, self.n);
+        let l = 2 * n + 1;
+        let (m, c, k) = (problem.mass(), problem.damping(), problem.stiffness());
+        for d in 0..nd {
+            let mut r0 = 0.0;
+            for e in 0..nd {
+                r0 += k[d * nd + e] * q[e * l];
+            }
+            r[d * l] = 0.5 * r0;
+            for h in 1..=n {
+                let kw = h as f64 * omega;
+                let (mut ra, mut rb) = (0.0, 0.0);
+                for e in 0..nd {
+                    let stiff = k[d * nd + e] - kw * kw * m[d * nd + e];
+                    let damp = kw * c[d * nd + e];
+                    let (a, b) = (q[e * l + h], q[e * l + n + h]);
+                    ra += stiff * a + damp * b;
+                    rb += stiff * b - damp * a;
+                }
+                r[d * l + h] = ra;
+                r[d * l + n + h] = rb;
+            }
+        }
+    }
+
+    /// The HB residual Eq. 61 at coefficients `q`, excitation frequency `omega_f`
+    /// and nonlinearity scale `s`, into `r`. Allocation-free.
+    pub fn eval<P: PeriodicProblem>(
+        &mut self,
+        problem: &P,
+        q: &[f64],
+        omega_f: f64,
+        s: f64,
+        r: &mut [f64],
+    ) {
+        let (nd, n) = (self.n_dof, self.n);
+        let l = 2 * n + 1;
+        let ns = self.aft.n_samples();
+        let omega = omega_f / self.p as f64;
+        self.apply_linear(problem, q, omega, r);
+        for (ri, ei) in r.iter_mut().zip(&self.exc) {
+            *ri -= ei;
+        }
+        if s == 0.0 {
+            return;
+        }
+        for d in 0..nd {
+            let qd = &q[d * l..(d + 1) * l];
+            self.aft.synthesize(qd, &mut self.xs[d * ns..(d + 1) * ns]);
+            if self.velocity {
+                self.aft
+                    .synthesize_derivative(qd, 1, &mut self.vs[d * ns..(d + 1) * ns]);
+            }
+        }
+        for i in 0..ns {
+            for d in 0..nd {
+                self.xi[d] = self.xs[d * ns + i];
+                self.vi[d] = if self.velocity {
+                    omega * self.vs[d * ns + i]
+                } else {
+                    0.0
+                };
+            }
+            problem.nonlinear(
+                &self.xi,
+                &self.vi,
+                self.p as f64 * self.aft.tau(i),
+                &mut self.gi,
+            );
+            for d in 0..nd {
+                self.gs[d * ns + i] = self.gi[d];
+            }
+        }
+        for d in 0..nd {
+            self.aft
+                .galerkin(&self.gs[d * ns..(d + 1) * ns], &mut self.rg);
+            for (ri, gi) in r[d * l..(d + 1) * l].iter_mut().zip(&self.rg) {
+                *ri += s * gi;
+            }
+        }
+    }
+
+    /// The linear Jacobian `B_{q,0} = L(ω)` of Eq. 60 (row-major, `len×len`) and its
+    /// inverse, assembled block by block (harmonic k couples only `a_k`, `b_k` of all
+    /// DOFs). `h0` is `None` if a block is singular (e.g. at a linear resonance).
+    pub fn linear_jacobian<P: PeriodicProblem>(
+        &self,
+        problem: &P,
+        omega: f64,
+        b0: &mut [f64],
+        h0: &mut [f64],
+    ) -> bool {
+        let (nd, n) = (self.n_dof, self.n);
+        let l = 2 * n + 1;
+        let len = nd * l;
+        b0.fill(0.0);
+        h0.fill(0.0);
+        let (m, c, k) = (problem.mass(), problem.damping(), problem.stiffness());
+        // Index lists of each block: k = 0 → {a0 of each dof}; k ≥ 1 → {a_k…, b_k…}.
+        let mut ok = true;
+        let bs = 2 * nd;
+        let mut blk = vec![0.0; bs * bs];
+        let mut inv = vec![0.0; bs * bs];
+        let mut lu = vec![0.0; bs * bs];
+        let mut piv = vec![0; bs];
+        let mut idx = vec![0usize; bs];
+        for h in 0..=n {
+            let size = if h == 0 { nd } else { bs };
+            for d in 0..nd {
+                idx[d] = d * l + h;
+                if h > 0 {
+                    idx[nd + d] = d * l + n + h;
+                }
+            }
+            let kw = h as f64 * omega;
+            for d in 0..nd {
+                for e in 0..nd {
+                    if h == 0 {
+                        blk[d * size + e] = 0.5 * k[d * nd + e];
+                    } else {
+                        let stiff = k[d * nd + e] - kw * kw * m[d * nd + e];
+                        let damp = kw * c[d * nd + e];
+                        blk[d * size + e] = stiff;
+                        blk[d * size + nd + e] = damp;
+                        blk[(nd + d) * size + e] = -damp;
+                        blk[(nd + d) * size + nd + e] = stiff;
+                    }
+                }
+            }
+            for i in 0..size {
+                for j in 0..size {
+                    b0[idx[i] * len + idx[j]] = blk[i * size + j];
+                }
+            }
+            if invert(
+                &blk[..size * size],
+                size,
+                &mut inv[..size * size],
+                &mut lu[..size * size],
+                &mut piv[..size],
+            )
+            .is_ok()
+            {
+                for i in 0..size {
+                    for j in 0..size {
+                        h0[idx[i] * len + idx[j]] = inv[i * size + j];
+                    }
+                }
+            } else {
+                ok = false;
+            }
+        }
+        ok
+    }
+
+    /// Galerkin Jacobian of the nonlinear part by quadrature on the 2N grid (the
+    /// classic IHB's Φ_q minus `L(ω)`, §3.2.1), times `s`, added into `jac`.
+    /// Allocation-free given `dgx`, `dgv` (`n_dof²` each) and `basis` (`2N·(2n+1)`,
+    /// filled by [`Self::fill_basis`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_nonlinear_jacobian<P: PeriodicProblem>(
+        &mut self,
+        problem: &P,
+        q: &[f64],
+        omega_f: f64,
+        s: f64,
+        basis: &[f64],
+        dgx: &mut [f64],
+        dgv: &mut [f64],
+        jac: &mut [f64],
+    ) {
+        let (nd, n) = (self.n_dof, self.n);
+        let l = 2 * n + 1;
+        let len = nd * l;
+        let ns = self.aft.n_samples();
+        let omega = omega_f / self.p as f64;
+        for d in 0..nd {
+            let qd = &q[d * l..(d + 1) * l];
+            self.aft.synthesize(qd, &mut self.xs[d * ns..(d + 1) * ns]);
+            self.aft
+                .synthesize_derivative(qd, 1, &mut self.vs[d * ns..(d + 1) * ns]);
+        }
+        let w = s / self.aft.n_samples() as f64 * 2.0; // (1/π)·(2π/2N)
+        for i in 0..ns {
+            for d in 0..nd {
+                self.xi[d] = self.xs[d * ns + i];
+                self.vi[d] = omega * self.vs[d * ns + i];
+            }
+            let tau = self.aft.tau(i);
+            problem.nonlinear_jacobian(&self.xi, &self.vi, self.p as f64 * tau, dgx, dgv);
+            let cs = &basis[i * l..(i + 1) * l];
+            let ds = &basis[(ns + i) * l..(ns + i + 1) * l];
+            for d in 0..nd {
+                for e in 0..nd {
+                    let gx = w * dgx[d * nd + e];
+                    let gv = w * omega * dgv[d * nd + e];
+                    if gx == 0.0 && gv == 0.0 {
+                        continue;
+                    }
+                    for a in 0..l {
+                        let row =
+                            &mut jac[(d * l + a) * len + e * l..(d * l + a) * len + (e + 1) * l];
+                        let ca = cs[a];
+                        for (bcol, j) in row.iter_mut().zip(0..l) {
+                            *bcol += ca * (gx * cs[j] + gv * ds[j]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Basis table for [`Self::add_nonlinear_jacobian`]: rows `i < 2N` hold
+    /// `C_s(τ_i) = {1/2, cos kτ_i, sin kτ_i}`, rows `2N + i` its τ-derivative.
+    pub fn fill_basis(&self, basis: &mut [f64]) {
+        let n = self.n;
+        let l = 2 * n + 1;
+        let ns = self.aft.n_samples();
+        for i in 0..ns {
+            let tau = self.aft.tau(i);
+            basis[i * l] = 0.5;
+            basis[(ns + i) * l] = 0.0;
+            for k in 1..=n {
+                let (sn, cs) = (k as f64 * tau).sin_cos();
+                basis[i * l + k] = cs;
+                basis[i * l + n + k] = sn;
+                basis[(ns + i) * l + k] = -(k as f64) * sn;
+                basis[(ns + i) * l + n + k] = k as f64 * cs;
+            }
+        }
+    }
+}

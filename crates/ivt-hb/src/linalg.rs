@@ -1,0 +1,148 @@
+//! Small dense row-major linear algebra that allocates nothing: LU with partial
+//! pivoting, solve and inverse. Used inside the Broyden/Newton loops where faer's
+//! allocating front end would break the "no allocation per iteration" rule.
+
+/// A matrix is numerically singular (zero pivot or a non-finite entry).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Singular;
+
+/// LU factorisation in place (row-major `m×m`), partial pivoting; `piv[i]` is the
+/// row swapped into position `i`.
+///
+/// # Errors
+/// [`Singular`] if a pivot is zero or not finite.
+pub fn lu_factor(a: &mut [f64], m: usize, piv: &mut [usize]) -> Result<(), Singular> {
+    debug_assert!(a.len() >= m * m && piv.len() >= m);
+    for k in 0..m {
+        let mut p = k;
+        let mut best = a[k * m + k].abs();
+        for i in k + 1..m {
+            let v = a[i * m + k].abs();
+            if v > best {
+                best = v;
+                p = i;
+            }
+        }
+        if best == 0.0 || !best.is_finite() {
+            return Err(Singular);
+        }
+        piv[k] = p;
+        if p != k {
+            for j in 0..m {
+                a.swap(k * m + j, p * m + j);
+            }
+        }
+        let inv = 1.0 / a[k * m + k];
+        for i in k + 1..m {
+            let l = a[i * m + k] * inv;
+            a[i * m + k] = l;
+            if l != 0.0 {
+                for j in k + 1..m {
+                    a[i * m + j] -= l * a[k * m + j];
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Solves `A x = b` in place with the factors of [`lu_factor`].
+pub fn lu_solve(lu: &[f64], m: usize, piv: &[usize], b: &mut [f64]) {
+    for k in 0..m {
+        b.swap(k, piv[k]);
+    }
+    for i in 0..m {
+        let mut s = b[i];
+        for j in 0..i {
+            s -= lu[i * m + j] * b[j];
+        }
+        b[i] = s;
+    }
+    for i in (0..m).rev() {
+        let mut s = b[i];
+        for j in i + 1..m {
+            s -= lu[i * m + j] * b[j];
+        }
+        b[i] = s / lu[i * m + i];
+    }
+}
+
+/// Inverse of the row-major `m×m` matrix `a` into `inv`, using `lu` (`m*m`) and
+/// `piv` (`m`) as scratch.
+///
+/// # Errors
+/// [`Singular`] if `a` is numerically singular.
+pub fn invert(
+    a: &[f64],
+    m: usize,
+    inv: &mut [f64],
+    lu: &mut [f64],
+    piv: &mut [usize],
+) -> Result<(), Singular> {
+    lu[..m * m].copy_from_slice(&a[..m * m]);
+    lu_factor(lu, m, piv)?;
+    // Solve for the columns of the transpose, i.e. rows of inv^T, then transpose.
+    for j in 0..m {
+        let col = &mut inv[j * m..(j + 1) * m];
+        col.fill(0.0);
+        col[j] = 1.0;
+        lu_solve(lu, m, piv, col);
+    }
+    // inv now holds columns of A^{-1} as rows: transpose in place.
+    for i in 0..m {
+        for j in i + 1..m {
+            inv.swap(i * m + j, j * m + i);
+        }
+    }
+    if inv[..m * m].iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(Singular)
+    }
+}
+
+/// `y = A x` for row-major `A` (`rows×cols`).
+pub fn matvec(a: &[f64], rows: usize, cols: usize, x: &[f64], y: &mut [f64]) {
+    for i in 0..rows {
+        let row = &a[i * cols..(i + 1) * cols];
+        y[i] = row.iter().zip(x).map(|(a, b)| a * b).sum();
+    }
+}
+
+/// Euclidean norm.
+pub fn norm2(x: &[f64]) -> f64 {
+    x.iter().map(|v| v * v).sum::<f64>().sqrt()
+}
+
+/// Dot product.
+pub fn dot(x: &[f64], y: &[f64]) -> f64 {
+    x.iter().zip(y).map(|(a, b)| a * b).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inverse_of_a_known_matrix() {
+        // [[4, 3], [6, 3]]^{-1} = [[-0.5, 0.5], [1, -2/3]] (det = -6).
+        let a = [4.0, 3.0, 6.0, 3.0];
+        let mut inv = [0.0; 4];
+        let mut lu = [0.0; 4];
+        let mut piv = [0; 2];
+        invert(&a, 2, &mut inv, &mut lu, &mut piv).unwrap();
+        let want = [-0.5, 0.5, 1.0, -2.0 / 3.0];
+        for (g, w) in inv.iter().zip(want) {
+            assert!((g - w).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn singular_is_reported() {
+        let a = [1.0, 2.0, 2.0, 4.0];
+        let mut inv = [0.0; 4];
+        let mut lu = [0.0; 4];
+        let mut piv = [0; 2];
+        assert_eq!(invert(&a, 2, &mut inv, &mut lu, &mut piv), Err(Singular));
+    }
+}

@@ -1,0 +1,196 @@
+//! Modified IHB (§3.2.2): AFT residual (Eq. 61–65) and Broyden's method (Eq. 66–67)
+//! seeded with the linear Jacobian Eq. 60 and the linear solution `q₀ = B₀⁻¹ r_F`;
+//! parameter stepping in the nonlinearity (ε from 0 in steps, reusing the last
+//! Broyden matrix) when the direct iteration fails.
+
+use crate::broyden::{broyden_solve, BroydenStats, BroydenWorkspace};
+use crate::ihb::{validate_omega, HbError, HbOptions, HbResidual, HbSolution};
+use crate::linalg::matvec;
+use crate::problem::PeriodicProblem;
+
+/// The modified IHB solver for one problem and one size (plans and buffers reused
+/// across solves; nothing is allocated inside the iteration).
+#[derive(Debug)]
+pub struct ModifiedIhb<P> {
+    problem: P,
+    opts: HbOptions,
+    res: HbResidual,
+    ws: BroydenWorkspace,
+    b0: Vec<f64>,
+    h0: Vec<f64>,
+    q: Vec<f64>,
+}
+
+impl<P: PeriodicProblem> ModifiedIhb<P> {
+    /// Prepares the solver.
+    ///
+    /// # Errors
+    /// [`HbError::InvalidInput`]/[`HbError::Aft`] for bad sizes (N ≤ n, p = 0,
+    /// non-finite matrices or excitation).
+    pub fn new(problem: P, opts: HbOptions) -> Result<Self, HbError> {
+        let res = HbResidual::new(&problem, &opts)?;
+        let m = res.len();
+        Ok(Self {
+            problem,
+            opts,
+            res,
+            ws: BroydenWorkspace::new(m),
+            b0: vec![0.0; m * m],
+            h0: vec![0.0; m * m],
+            q: vec![0.0; m],
+        })
+    }
+
+    /// The problem.
+    pub fn problem(&self) -> &P {
+        &self.problem
+    }
+
+    /// The problem, mutable (e.g. to change a parameter between solves).
+    pub fn problem_mut(&mut self) -> &mut P {
+        &mut self.problem
+    }
+
+    /// The options.
+    pub fn options(&self) -> &HbOptions {
+        &self.opts
+    }
+
+    /// The residual evaluator (for continuation or custom drivers).
+    pub fn residual_evaluator(&mut self) -> &mut HbResidual {
+        &mut self.res
+    }
+
+    /// Residual Eq. 61 of `q` at `omega_f` (full nonlinearity) into `r`.
+    pub fn residual(&mut self, q: &[f64], omega_f: f64, r: &mut [f64]) {
+        self.res.eval(&self.problem, q, omega_f, 1.0, r);
+    }
+
+    /// Solves from the linear solution (Eq. 59) or from `guess`.
+    ///
+    /// # Errors
+    /// [`HbError::InvalidInput`] for a bad frequency or guess;
+    /// [`HbError::Solve`] with the residual history when no attempt converges.
+    pub fn solve(&mut self, omega_f: f64, guess: Option<&[f64]>) -> Result<HbSolution, HbError> {
+        let mut q = std::mem::take(&mut self.q);
+        let out = self.solve_into(omega_f, guess.is_some(), guess, &mut q);
+        let sol = out.map(|stats| HbSolution {
+            coeffs: q.clone(),
+            omega_f,
+            harmonics: self.opts.harmonics,
+            subharmonic: self.opts.subharmonic,
+            stats,
+        });
+        self.q = q;
+        sol
+    }
+
+    /// Allocation-free core of [`Self::solve`]: the solution is written to `q`.
+    /// With `use_guess`, `guess` (or `q` itself when `guess` is `None`) is the start;
+    /// otherwise the linear solution.
+    ///
+    /// # Errors
+    /// As [`Self::solve`].
+    pub fn solve_into(
+        &mut self,
+        omega_f: f64,
+        use_guess: bool,
+        guess: Option<&[f64]>,
+        q: &mut [f64],
+    ) -> Result<BroydenStats, HbError> {
+        validate_omega(omega_f)?;
+        let m = self.res.len();
+        if q.len() != m {
+            return Err(HbError::InvalidInput(format!(
+                "coefficient vector must have {m} entries"
+            )));
+        }
+        if let Some(g) = guess {
+            if g.len() != m || !g.iter().all(|v| v.is_finite()) {
+                return Err(HbError::InvalidInput(format!(
+                    "guess must have {m} finite entries"
+                )));
+            }
+            q.copy_from_slice(g);
+        }
+        let omega = omega_f / self.opts.subharmonic as f64;
+        let invertible = self
+            .res
+            .linear_jacobian(&self.problem, omega, &mut self.b0, &mut self.h0);
+        let seed = |ws: &mut BroydenWorkspace, b0: &[f64], h0: &[f64]| {
+            if invertible {
+                ws.set_jacobian_and_inverse(b0, h0).expect("sizes match");
+            } else {
+                ws.clear_jacobian();
+            }
+        };
+        if !use_guess {
+            if invertible {
+                matvec(&self.h0, m, m, self.res.excitation(), q);
+            } else {
+                q.fill(0.0);
+            }
+        }
+        let start: Vec<f64> = if self.opts.homotopy_steps == 0 {
+            Vec::new()
+        } else {
+            q.to_vec()
+        };
+        let (problem, res, ws, opts) = (&self.problem, &mut self.res, &mut self.ws, &self.opts);
+        let mut last_err = None;
+        if opts.homotopy_steps == 0 {
+            seed(ws, &self.b0, &self.h0);
+            let mut f = |x: &[f64], r: &mut [f64]| res.eval(problem, x, omega_f, 1.0, r);
+            match broyden_solve(&mut f, q, ws, &opts.broyden) {
+                Ok(stats) => return Ok(stats),
+                Err(e) => last_err = Some(e),
+            }
+        }
+        // Parameter stepping s = h/steps (ε^{(h)} = hΔε), warm Broyden matrix.
+        let start = if start.is_empty() {
+            // Restart from the linear solution (or the guess).
+            let mut s = vec![0.0; m];
+            match guess {
+                Some(g) => s.copy_from_slice(g),
+                None if invertible => matvec(&self.h0, m, m, res.excitation(), &mut s),
+                None => {}
+            }
+            s
+        } else {
+            start
+        };
+        let schedules: &[usize] = if opts.homotopy_steps > 0 {
+            &[opts.homotopy_steps, 4 * opts.homotopy_steps]
+        } else {
+            &[8, 32]
+        };
+        'outer: for &steps in schedules {
+            q.copy_from_slice(&start);
+            seed(ws, &self.b0, &self.h0);
+            let mut total = BroydenStats {
+                iterations: 0,
+                residual_evals: 0,
+                jacobian_refreshes: 0,
+                residual_norm: 0.0,
+            };
+            for h in 1..=steps {
+                let s = h as f64 / steps as f64;
+                let mut f = |x: &[f64], r: &mut [f64]| res.eval(problem, x, omega_f, s, r);
+                match broyden_solve(&mut f, q, ws, &opts.broyden) {
+                    Ok(st) => {
+                        total.iterations += st.iterations;
+                        total.residual_evals += st.residual_evals;
+                        total.jacobian_refreshes += st.jacobian_refreshes;
+                        total.residual_norm = st.residual_norm;
+                    }
+                    Err(e) => {
+                        last_err = Some(e);
+                        continue 'outer;
+                    }
+                }
+            }
+            return Ok(total);
+        }
+        Err(HbError::Solve(last_err.expect("at least one attempt ran")))
+    }
+}

@@ -1,0 +1,600 @@
+//! The STHB residual (Eq. 116) and exact Jacobian (Eq. 115–125) of the string.
+
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+use faer::Mat;
+use realfft::num_complex::Complex;
+use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
+use rustdct::{Dct1, DctPlanner, Dst1};
+
+use super::lu::LuWorkspace;
+use super::toeplitz::{add_real_toeplitz, BlockLayout, PeriodicSpectrum};
+use super::{Boundary, SthbError, StringParams};
+
+/// Up to this many modes the spatial balance sums the few needed DST-I/DCT-I
+/// terms directly (`O(N·N_s)` per time sample); rustdct's DST-I/DCT-I of these
+/// odd lengths run a complex FFT of length `2 N_s`, which measured ~10× slower
+/// for `N = 5`, `N_s = 64`. Both give the same numbers (tested).
+const DIRECT_MAX_MODES: usize = 12;
+
+/// Spatial balance (Eq. 94, 97): DST-I on the interior points and DCT-I on the
+/// closed grid, by rustdct or by direct partial sums over a sine table.
+struct Spatial {
+    dst: Arc<dyn Dst1<f64>>,
+    dct: Arc<dyn Dct1<f64>>,
+    scratch: Vec<f64>,
+    /// Rows `sin(π(m+1)(k+1)/N_s)`, `m < 2N`, `k < N_s − 1`.
+    sin_t: Vec<f64>,
+    /// Rows `cos(π m k/N_s)`, `m ≤ 2N`, `k ≤ N_s`.
+    cos_t: Vec<f64>,
+    tmp: Vec<f64>,
+    direct: bool,
+}
+
+impl Spatial {
+    fn new(
+        dst: Arc<dyn Dst1<f64>>,
+        dct: Arc<dyn Dct1<f64>>,
+        ns: usize,
+        modes: usize,
+        direct: bool,
+    ) -> Self {
+        let angle = |j: usize| PI * j as f64 / ns as f64;
+        let mut sin_t = Vec::with_capacity(2 * modes * (ns - 1));
+        for m in 0..2 * modes {
+            sin_t.extend((0..ns - 1).map(|k| angle((m + 1) * (k + 1)).sin()));
+        }
+        let mut cos_t = Vec::with_capacity((2 * modes + 1) * (ns + 1));
+        for m in 0..=2 * modes {
+            cos_t.extend((0..=ns).map(|k| angle(m * k).cos()));
+        }
+        Self {
+            scratch: vec![0.0; dst.get_scratch_len().max(dct.get_scratch_len())],
+            dst,
+            dct,
+            sin_t,
+            cos_t,
+            tmp: vec![0.0; ns + 1],
+            direct,
+        }
+    }
+
+    /// DST-I of `buf` (length `N_s − 1`, `X_r = Σ_k x_k sin(π(k+1)(r+1)/N_s)`) when
+    /// only the first `nin` inputs are nonzero and the first `nout` outputs are used
+    /// (one of them at most `2N`).
+    fn sine(&mut self, buf: &mut [f64], nin: usize, nout: usize) {
+        if !self.direct {
+            self.dst.process_dst1_with_scratch(buf, &mut self.scratch);
+            return;
+        }
+        Self::partial(&self.sin_t, &mut self.tmp, buf, nin, nout);
+    }
+
+    /// DCT-I of `buf` (length `N_s + 1`, half weight at both ends) with the
+    /// first `nin` inputs nonzero and the first `nout` outputs used.
+    fn cosine(&mut self, buf: &mut [f64], nin: usize, nout: usize) {
+        if !self.direct {
+            self.dct.process_dct1_with_scratch(buf, &mut self.scratch);
+            return;
+        }
+        let len = buf.len();
+        if nin == len {
+            buf[0] *= 0.5;
+            buf[len - 1] *= 0.5;
+        }
+        Self::partial(&self.cos_t, &mut self.tmp, buf, nin, nout);
+    }
+
+    /// `buf ← T buf` for the symmetric table `T` (rows of length `buf.len()`).
+    fn partial(table: &[f64], tmp: &mut [f64], buf: &mut [f64], nin: usize, nout: usize) {
+        let len = buf.len();
+        let rows = table.chunks_exact(len);
+        if nin < len {
+            // Synthesis: few inputs, all outputs.
+            tmp[..nin].copy_from_slice(&buf[..nin]);
+            buf.fill(0.0);
+            for (x, row) in tmp[..nin].iter().zip(rows) {
+                buf.iter_mut().zip(row).for_each(|(o, t)| *o += x * t);
+            }
+        } else {
+            // Projection: all inputs, few outputs.
+            tmp[..len].copy_from_slice(buf);
+            for (o, row) in buf[..nout].iter_mut().zip(rows) {
+                *o = row.iter().zip(&tmp[..len]).map(|(t, x)| t * x).sum();
+            }
+        }
+    }
+}
+
+/// Newton–Raphson statistics of one converged solve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SolveStats {
+    /// Newton iterations (Jacobian factorizations).
+    pub iterations: usize,
+    /// Residual norm at each iteration, the last one converged.
+    pub history: Vec<f64>,
+}
+
+/// STHB discretization of Eq. 103 for one parameter set: FFT/DCT/DST plans,
+/// grid buffers and the Jacobian storage, made once and reused.
+///
+/// Unknowns `a` are ordered harmonic-major like the thesis's
+/// `a = {a_{−M} … a_M}`: index `h · n_q + n` with `h = 0` (constant),
+/// `h = 2k − 1` (cos kt), `h = 2k` (sin kt), and coordinate `n` (`n_q = N`, or
+/// `N + 1` with the spring's `e(x) = x` coordinate last).
+pub struct StringHb {
+    p: StringParams,
+    nq: usize,
+    spatial: Spatial,
+    fwd: Arc<dyn RealToComplex<f64>>,
+    inv: Arc<dyn ComplexToReal<f64>>,
+    fft_scratch: Vec<Complex<f64>>,
+    spec: Vec<Complex<f64>>,
+    time: Vec<f64>,
+    q_t: Vec<f64>,
+    wx: Vec<f64>,
+    wxx: Vec<f64>,
+    g: Vec<f64>,
+    g2: Vec<f64>,
+    gamma_t: Vec<f64>,
+    b_t: Vec<f64>,
+    c_t: Vec<f64>,
+    b_hat: Vec<Complex<f64>>,
+    c_hat: Vec<Complex<f64>>,
+    /// `Ŝ_p` of `S(t) = ∂ℒ/∂Q` (Eq. 124–125, `N × n_q`) at the last Jacobian evaluation.
+    pub(crate) s_hat: PeriodicSpectrum,
+    e_proj: Vec<f64>,
+    nl: Vec<f64>,
+    toeplitz_scratch: Vec<Complex<f64>>,
+    pub(crate) lu: LuWorkspace,
+}
+
+impl StringHb {
+    /// Plan the transforms and allocate all buffers for `params`.
+    ///
+    /// # Errors
+    /// [`SthbError::Invalid`] if the parameters fail [`StringParams::validate`].
+    pub fn new(params: StringParams) -> Result<Self, SthbError> {
+        Self::with_spatial(params, None)
+    }
+
+    /// As [`StringHb::new`], forcing rustdct (`Some(false)`) or the direct sums
+    /// (`Some(true)`) for the spatial balance; `None` picks by `N`.
+    ///
+    /// # Errors
+    /// As [`StringHb::new`].
+    pub fn with_spatial(params: StringParams, direct: Option<bool>) -> Result<Self, SthbError> {
+        params.validate()?;
+        let (n, m, ns, ms) = (params.modes, params.harmonics, params.ns, params.ms);
+        let nq = match params.boundary {
+            Boundary::Fixed => n,
+            Boundary::Spring { .. } => n + 1,
+        };
+        let mut dp = DctPlanner::new();
+        let dst = dp.plan_dst1(ns - 1);
+        let dct = dp.plan_dct1(ns + 1);
+        let mut fp = RealFftPlanner::<f64>::new();
+        let fwd = fp.plan_fft_forward(ms);
+        let inv = fp.plan_fft_inverse(ms);
+        let fft_scratch_len = fwd.get_scratch_len().max(inv.get_scratch_len());
+        let p_max = (2 * m).min(ms / 2);
+        // Discrete projection of e(x) = x on sin nπx (spring, Eq. 135).
+        let mut e = (1..ns).map(|k| k as f64 / ns as f64).collect::<Vec<_>>();
+        let mut scr = vec![0.0; dst.get_scratch_len()];
+        dst.process_dst1_with_scratch(&mut e, &mut scr);
+        let e_proj = e[..n].iter().map(|v| 2.0 / ns as f64 * v).collect();
+        let dim = nq * (2 * m + 1);
+        Ok(Self {
+            nq,
+            spatial: Spatial::new(dst, dct, ns, n, direct.unwrap_or(n <= DIRECT_MAX_MODES)),
+            fft_scratch: vec![Complex::new(0.0, 0.0); fft_scratch_len],
+            fwd,
+            inv,
+            spec: vec![Complex::new(0.0, 0.0); ms / 2 + 1],
+            time: vec![0.0; ms],
+            q_t: vec![0.0; nq * ms],
+            wx: vec![0.0; ns + 1],
+            wxx: vec![0.0; ns - 1],
+            g: vec![0.0; ns - 1],
+            g2: vec![0.0; ns + 1],
+            gamma_t: vec![0.0; n * ms],
+            b_t: vec![0.0; 2 * n * ms],
+            c_t: vec![0.0; (2 * n + 1) * ms],
+            b_hat: vec![Complex::new(0.0, 0.0); 2 * n * (p_max + 1)],
+            c_hat: vec![Complex::new(0.0, 0.0); (2 * n + 1) * (p_max + 1)],
+            s_hat: PeriodicSpectrum::zeros(n, nq, ms, p_max),
+            e_proj,
+            nl: vec![0.0; dim],
+            toeplitz_scratch: Vec::new(),
+            lu: LuWorkspace::new(dim),
+            p: params,
+        })
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &StringParams {
+        &self.p
+    }
+
+    /// Number of real unknowns `n_q (2M + 1)`.
+    pub fn dim(&self) -> usize {
+        self.nq * (2 * self.p.harmonics + 1)
+    }
+
+    /// Generalized coordinates per harmonic (`N`, or `N + 1` with the spring).
+    pub fn coords(&self) -> usize {
+        self.nq
+    }
+
+    /// Index of coordinate `n` (0-based) in harmonic slot `h` (0 const, 2k−1 cos, 2k sin).
+    pub fn index(&self, h: usize, n: usize) -> usize {
+        h * self.nq + n
+    }
+
+    /// Euclidean norm of the complex coefficient vector `a` of Eq. 114
+    /// (`|a_0|² + Σ_k 2 |(A^c_k − j A^s_k)/2|²`), the ordinate of Figs. 34–36.
+    pub fn complex_norm(&self, a: &[f64]) -> f64 {
+        let mut s = 0.0;
+        for (i, v) in a.iter().enumerate() {
+            s += if i < self.nq { v * v } else { 0.5 * v * v };
+        }
+        s.sqrt()
+    }
+
+    /// Coordinate `q_n(t)` of the solution `a` at normalized time `t`.
+    pub fn coordinate_at(&self, a: &[f64], n: usize, t: f64) -> f64 {
+        let mut q = a[self.index(0, n)];
+        for k in 1..=self.p.harmonics {
+            let kt = k as f64 * t;
+            q += a[self.index(2 * k - 1, n)] * kt.cos() + a[self.index(2 * k, n)] * kt.sin();
+        }
+        q
+    }
+
+    /// Displacement `w(x, t)` of the solution `a` (Eq. 105 / 133).
+    pub fn displacement(&self, a: &[f64], x: f64, t: f64) -> f64 {
+        let mut w = 0.0;
+        for n in 0..self.p.modes {
+            w += self.coordinate_at(a, n, t) * ((n + 1) as f64 * PI * x).sin();
+        }
+        if self.nq > self.p.modes {
+            w += x * self.coordinate_at(a, self.p.modes, t);
+        }
+        w
+    }
+
+    /// Apply `J_lin(ω)` (Eq. 115, plus the Tau rows of Eq. 134–135) to `a`,
+    /// or its derivative `∂J_lin/∂ω` when `d_omega`.
+    fn apply_linear(&self, a: &[f64], omega: f64, d_omega: bool, out: &mut [f64]) {
+        out.fill(0.0);
+        self.for_each_linear(omega, d_omega, |r, c, v| out[r] += v * a[c]);
+    }
+
+    /// Visit the nonzero entries `(row, col, value)` of `J_lin` or `∂J_lin/∂ω`.
+    fn for_each_linear(&self, omega: f64, d_omega: bool, mut f: impl FnMut(usize, usize, f64)) {
+        let (n, m, cd) = (self.p.modes, self.p.harmonics, self.p.cd);
+        // Per harmonic k: diagonal `κ − ω²k²` (mass + stiffness), coupling `ω c_d k`.
+        let mass = |k: f64| {
+            if d_omega {
+                -2.0 * omega * k * k
+            } else {
+                -omega * omega * k * k
+            }
+        };
+        let damp = |k: f64| if d_omega { cd * k } else { omega * cd * k };
+        let spring_col = self.nq > n;
+        for j in 0..n {
+            let kappa = if d_omega {
+                0.0
+            } else {
+                ((j + 1) as f64 * PI).powi(2)
+            };
+            f(self.index(0, j), self.index(0, j), kappa);
+            for k in 1..=m {
+                let (rc, rs) = (self.index(2 * k - 1, j), self.index(2 * k, j));
+                let kf = k as f64;
+                f(rc, rc, kappa + mass(kf));
+                f(rs, rs, kappa + mass(kf));
+                f(rc, rs, damp(kf));
+                f(rs, rc, -damp(kf));
+                if spring_col {
+                    // ω² e q̈_{N+1} + ω c_d e q̇_{N+1} projected on sin nπx (Eq. 135).
+                    let e = self.e_proj[j];
+                    let (cc, cs) = (self.index(2 * k - 1, n), self.index(2 * k, n));
+                    f(rc, cc, e * mass(kf));
+                    f(rs, cs, e * mass(kf));
+                    f(rc, cs, e * damp(kf));
+                    f(rs, cc, -e * damp(kf));
+                }
+            }
+        }
+        if let (Boundary::Spring { k0 }, false) = (self.p.boundary, d_omega) {
+            // Eq. 134: (k0 − 1) q_{N+1} − Σ nπ (−1)^n q_n = 0 for every harmonic.
+            for h in 0..2 * m + 1 {
+                let row = self.index(h, n);
+                f(row, row, k0 - 1.0);
+                for j in 0..n {
+                    let n1 = (j + 1) as f64;
+                    let sign = if (j + 1) % 2 == 0 { 1.0 } else { -1.0 };
+                    f(row, self.index(h, j), -n1 * PI * sign);
+                }
+            }
+        }
+    }
+
+    /// `∂R/∂ω` at `(a, ω)` (the nonlinear term does not depend on ω).
+    pub fn d_residual_d_omega(&self, a: &[f64], omega: f64, out: &mut [f64]) {
+        self.apply_linear(a, omega, true, out);
+    }
+
+    /// Sample the coordinates in time, balance `Γ = k_d w_x² w_xx` in space
+    /// (DST-I) and time (FFT) into `self.nl` (= `L(a)`, Eq. 117–118) and, with
+    /// `jacobian`, the spectra of `Γ1 = 2 k_d w_x w_xx` (sine basis) and
+    /// `Γ2 = k_d w_x²` (cosine basis), assembled into `Ŝ_p` (Eq. 122–125).
+    fn balance(&mut self, a: &[f64], jacobian: bool) {
+        let (n, m, ns, ms, kd) = (
+            self.p.modes,
+            self.p.harmonics,
+            self.p.ns,
+            self.p.ms,
+            self.p.kd,
+        );
+        let nq = self.nq;
+        let to_err = |r: Result<(), realfft::FftError>| {
+            r.expect("realfft buffer sizes are fixed at construction")
+        };
+        // 1. q_j(t_i) by inverse real FFT (t_i = 2πi/M_s).
+        for j in 0..nq {
+            self.spec.fill(Complex::new(0.0, 0.0));
+            self.spec[0] = Complex::new(a[j], 0.0);
+            for k in 1..=m {
+                self.spec[k] =
+                    Complex::new(0.5 * a[(2 * k - 1) * nq + j], -0.5 * a[2 * k * nq + j]);
+            }
+            to_err(self.inv.process_with_scratch(
+                &mut self.spec,
+                &mut self.time,
+                &mut self.fft_scratch,
+            ));
+            self.q_t[j * ms..(j + 1) * ms].copy_from_slice(&self.time);
+        }
+        // 2. Grid values per time sample, spatial balance by DST-I / DCT-I.
+        let scale = 2.0 / ns as f64;
+        for i in 0..ms {
+            self.wx.fill(0.0);
+            self.wxx.fill(0.0);
+            for j in 0..n {
+                let q = self.q_t[j * ms + i];
+                let k = (j + 1) as f64 * PI;
+                self.wx[j + 1] = k * q;
+                self.wxx[j] = -k * k * q;
+            }
+            // w_x(x_k) = Σ nπ q_n cos(nπk/N_s), k = 0..N_s (DCT-I); w_xx on the interior (DST-I).
+            self.spatial.cosine(&mut self.wx, n + 1, ns + 1);
+            self.spatial.sine(&mut self.wxx, n, ns - 1);
+            if nq > n {
+                let qe = self.q_t[n * ms + i];
+                self.wx.iter_mut().for_each(|v| *v += qe);
+            }
+            for k in 1..ns {
+                self.g[k - 1] = kd * self.wx[k] * self.wx[k] * self.wxx[k - 1];
+            }
+            self.spatial.sine(&mut self.g, ns - 1, n);
+            for j in 0..n {
+                self.gamma_t[j * ms + i] = scale * self.g[j];
+            }
+            if jacobian {
+                for k in 1..ns {
+                    self.g[k - 1] = 2.0 * kd * self.wx[k] * self.wxx[k - 1];
+                }
+                for k in 0..=ns {
+                    self.g2[k] = kd * self.wx[k] * self.wx[k];
+                }
+                self.spatial.sine(&mut self.g, ns - 1, 2 * n);
+                self.spatial.cosine(&mut self.g2, ns + 1, 2 * n + 1);
+                for r in 0..2 * n {
+                    self.b_t[r * ms + i] = scale * self.g[r];
+                }
+                for r in 0..=2 * n {
+                    self.c_t[r * ms + i] = scale * self.g2[r];
+                }
+            }
+        }
+        // 3. Temporal balance of Γ: L(a) in the real basis.
+        let inv_ms = 1.0 / ms as f64;
+        for j in 0..n {
+            self.time
+                .copy_from_slice(&self.gamma_t[j * ms..(j + 1) * ms]);
+            to_err(self.fwd.process_with_scratch(
+                &mut self.time,
+                &mut self.spec,
+                &mut self.fft_scratch,
+            ));
+            self.nl[j] = self.spec[0].re * inv_ms;
+            for k in 1..=m {
+                self.nl[(2 * k - 1) * nq + j] = 2.0 * self.spec[k].re * inv_ms;
+                self.nl[2 * k * nq + j] = -2.0 * self.spec[k].im * inv_ms;
+            }
+        }
+        for j in 0..nq - n {
+            for h in 0..2 * m + 1 {
+                self.nl[h * nq + n + j] = 0.0;
+            }
+        }
+        if !jacobian {
+            return;
+        }
+        let pm = self.s_hat.p_max;
+        for (rows, hat) in [(&self.b_t, &mut self.b_hat), (&self.c_t, &mut self.c_hat)] {
+            for (r, row) in rows.chunks_exact(ms).enumerate() {
+                self.time.copy_from_slice(row);
+                to_err(self.fwd.process_with_scratch(
+                    &mut self.time,
+                    &mut self.spec,
+                    &mut self.fft_scratch,
+                ));
+                for p in 0..=pm {
+                    hat[r * (pm + 1) + p] = self.spec[p] * inv_ms;
+                }
+            }
+        }
+        // 4. Ŝ_p = M1 β1 + M2 β2 G2 (Eq. 122–125) with Γ1 expanded to sine modes 1..2N
+        //    and Γ2 to cosine modes 0..2N, which makes the products exact on the grid.
+        let b = |i: usize, p: usize| -> Complex<f64> {
+            if i == 0 {
+                Complex::new(0.0, 0.0)
+            } else {
+                self.b_hat[(i - 1) * (pm + 1) + p]
+            }
+        };
+        let c = |i: usize, p: usize| self.c_hat[i * (pm + 1) + p];
+        let mut s = std::mem::replace(&mut self.s_hat, PeriodicSpectrum::zeros(0, 0, 1, 0));
+        for p in 0..=pm {
+            for r in 1..=n {
+                for j in 1..=n {
+                    let (sum, dif) = (r + j, r.abs_diff(j));
+                    let sgn = match r.cmp(&j) {
+                        std::cmp::Ordering::Greater => 1.0,
+                        std::cmp::Ordering::Less => -1.0,
+                        std::cmp::Ordering::Equal => 0.0,
+                    };
+                    let jp = j as f64 * PI;
+                    let s1 = (b(sum, p) + b(dif, p) * sgn) * (0.5 * jp);
+                    let s2 = (c(dif, p) - c(sum, p)) * (-0.5 * jp * jp);
+                    *s.at_mut(p, r - 1, j - 1) = s1 + s2;
+                }
+                if nq > n {
+                    // ∂w_x/∂q_{N+1} = e'(x) = 1.
+                    *s.at_mut(p, r - 1, n) = b(r, p);
+                }
+            }
+        }
+        self.s_hat = s;
+    }
+
+    /// Residual `R(a) = J_lin a − L(a) − f̂` (Eq. 116; Tau rows Eq. 134 for the spring).
+    pub fn residual(&mut self, a: &[f64], omega: f64, out: &mut [f64]) {
+        self.balance(a, false);
+        self.finish_residual(a, omega, out);
+    }
+
+    fn finish_residual(&self, a: &[f64], omega: f64, out: &mut [f64]) {
+        self.apply_linear(a, omega, false, out);
+        for (o, l) in out.iter_mut().zip(&self.nl) {
+            *o -= l;
+        }
+        // f̂: y0 cos t on the first sine mode.
+        out[self.index(1, 0)] -= self.p.y0;
+    }
+
+    /// Residual and exact Jacobian `J = J_lin − S_𝒯` (Eq. 115–125) into `jac`
+    /// (`dim × dim`, overwritten).
+    pub fn residual_jacobian(
+        &mut self,
+        a: &[f64],
+        omega: f64,
+        out: &mut [f64],
+        jac: &mut Mat<f64>,
+    ) {
+        self.balance(a, true);
+        self.finish_residual(a, omega, out);
+        self.fill_jacobian(omega, jac);
+    }
+
+    fn fill_jacobian(&mut self, omega: f64, jac: &mut Mat<f64>) {
+        jac.fill(0.0);
+        self.for_each_linear(omega, false, |r, c, v| jac[(r, c)] += v);
+        let layout = BlockLayout {
+            row_block: self.nq,
+            row_off: 0,
+            col_block: self.nq,
+            col_off: 0,
+        };
+        let mut scratch = std::mem::take(&mut self.toeplitz_scratch);
+        add_real_toeplitz(
+            &self.s_hat,
+            self.p.harmonics,
+            -1.0,
+            layout,
+            jac.as_mut(),
+            &mut scratch,
+        );
+        self.toeplitz_scratch = scratch;
+    }
+
+    /// Newton–Raphson (step a6) from the guess in `a`, overwritten by the solution.
+    /// Converged when `‖R‖ ≤ tol (1 + y0)`.
+    ///
+    /// # Errors
+    /// [`SthbError::NoConvergence`] with the residual history after `max_iter`
+    /// iterations, [`SthbError::Singular`] or [`SthbError::NonFinite`].
+    pub fn solve(
+        &mut self,
+        omega: f64,
+        a: &mut [f64],
+        tol: f64,
+        max_iter: usize,
+    ) -> Result<SolveStats, SthbError> {
+        let dim = self.dim();
+        let mut r = vec![0.0; dim];
+        let mut history = Vec::with_capacity(max_iter + 1);
+        let target = tol * (1.0 + self.p.y0.abs());
+        let mut jac = std::mem::replace(&mut self.lu.mat, Mat::zeros(0, 0));
+        let result = (|| {
+            for it in 0..=max_iter {
+                self.balance(a, true);
+                self.finish_residual(a, omega, &mut r);
+                let norm = norm2(&r);
+                history.push(norm);
+                if !norm.is_finite() {
+                    return Err(SthbError::NonFinite { omega });
+                }
+                if norm <= target {
+                    return Ok(SolveStats {
+                        iterations: it,
+                        history: history.clone(),
+                    });
+                }
+                if it == max_iter {
+                    break;
+                }
+                self.fill_jacobian(omega, &mut jac);
+                std::mem::swap(&mut self.lu.mat, &mut jac);
+                let ok = self.lu.factor();
+                if ok {
+                    self.lu.solve(&mut r);
+                }
+                std::mem::swap(&mut self.lu.mat, &mut jac);
+                if !ok {
+                    return Err(SthbError::Singular { omega });
+                }
+                for (x, d) in a.iter_mut().zip(&r) {
+                    *x -= d;
+                }
+            }
+            Err(SthbError::NoConvergence {
+                method: "Newton",
+                omega,
+                history: history.clone(),
+            })
+        })();
+        self.lu.mat = jac;
+        result
+    }
+
+    /// The spectrum `Ŝ_p` of `S(t) = ∂ℒ/∂Q` from the last Jacobian evaluation (Eq. 129).
+    pub fn s_spectrum(&self) -> &PeriodicSpectrum {
+        &self.s_hat
+    }
+
+    /// Evaluate the Jacobian at `a` (filling [`Self::s_spectrum`]) without a residual.
+    pub fn linearize(&mut self, a: &[f64]) {
+        self.balance(a, true);
+    }
+}
+
+/// Euclidean norm.
+pub(crate) fn norm2(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}

@@ -1,0 +1,132 @@
+//! The "traditional route": Galerkin modal ODEs of Eq. 103 derived in closed
+//! form (Eq. 109–110), independent of the DST/FFT machinery of [`super::StringHb`].
+//!
+//! `ω² q̈_n + ω c_d q̇_n + n²π² q_n − ℒ_n(q) − y0 δ_{n1} cos t = 0` with
+//! `ℒ_n = −2 k_d π⁴ Σ_{abc} a b c² q_a q_b q_c I(n,a,b,c)` and
+//! `I = ∫₀¹ sin nπx sin cπx cos aπx cos bπx dx`, evaluated by product-to-sum
+//! identities. Used as the reference in tests (time integration) and as the
+//! hand-derived model for the comparison with a general HB engine.
+
+use std::f64::consts::PI;
+
+use super::StringParams;
+
+/// The cubic Galerkin model of the fixed–fixed string with `N` sine modes.
+#[derive(Clone, Debug)]
+pub struct ModalString {
+    /// Parameters (`modes`, `kd`, `cd`, `y0` are used).
+    pub params: StringParams,
+    /// Nonzero terms `(n, a, b, c, coefficient)` of `ℒ_n = Σ coef q_a q_b q_c`.
+    terms: Vec<(usize, usize, usize, usize, f64)>,
+}
+
+/// `∫₀¹ cos pπx cos rπx dx` for integers `p`, `r`.
+fn cos_cos(p: i64, r: i64) -> f64 {
+    0.5 * (f64::from(u8::from(p == r)) + f64::from(u8::from(p == -r)))
+}
+
+impl ModalString {
+    /// Build the cubic tensor of Eq. 110 for `params.modes` modes.
+    pub fn new(params: StringParams) -> Self {
+        let n = params.modes as i64;
+        let mut terms = Vec::new();
+        for nn in 1..=n {
+            for a in 1..=n {
+                for b in 1..=n {
+                    for c in 1..=n {
+                        // sin n sin c = ½[cos(n−c) − cos(n+c)], cos a cos b = ½[cos(a−b) + cos(a+b)].
+                        let mut i = 0.0;
+                        for (u, su) in [(nn - c, 1.0), (nn + c, -1.0)] {
+                            for v in [a - b, a + b] {
+                                i += 0.25 * su * cos_cos(u, v);
+                            }
+                        }
+                        if i != 0.0 {
+                            let coef = -2.0 * params.kd * PI.powi(4) * (a * b * c * c) as f64 * i;
+                            terms.push((
+                                (nn - 1) as usize,
+                                (a - 1) as usize,
+                                (b - 1) as usize,
+                                (c - 1) as usize,
+                                coef,
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        Self { params, terms }
+    }
+
+    /// `ℒ(q)` into `out`.
+    pub fn nonlinear(&self, q: &[f64], out: &mut [f64]) {
+        out.fill(0.0);
+        for &(n, a, b, c, k) in &self.terms {
+            out[n] += k * q[a] * q[b] * q[c];
+        }
+    }
+
+    /// `∂ℒ/∂q` (row-major `N × N`) into `out`.
+    pub fn nonlinear_jacobian(&self, q: &[f64], out: &mut [f64]) {
+        let n = self.params.modes;
+        out.fill(0.0);
+        for &(r, a, b, c, k) in &self.terms {
+            out[r * n + a] += k * q[b] * q[c];
+            out[r * n + b] += k * q[a] * q[c];
+            out[r * n + c] += k * q[a] * q[b];
+        }
+    }
+
+    /// State derivative of `y = (q, q̇)` at normalized time `t` for frequency `omega`.
+    pub fn rhs(&self, omega: f64, t: f64, y: &[f64], dy: &mut [f64], scratch: &mut [f64]) {
+        let n = self.params.modes;
+        let (q, v) = y.split_at(n);
+        self.nonlinear(q, scratch);
+        for i in 0..n {
+            let kappa = ((i + 1) as f64 * PI).powi(2);
+            let f = if i == 0 {
+                self.params.y0 * t.cos()
+            } else {
+                0.0
+            };
+            dy[i] = v[i];
+            dy[n + i] =
+                (f - omega * self.params.cd * v[i] - kappa * q[i] + scratch[i]) / (omega * omega);
+        }
+    }
+
+    /// Classical RK4 over `periods` periods of `2π` with `steps_per_period`
+    /// steps, from state `y` (overwritten) starting at `t = 0`.
+    pub fn integrate(&self, omega: f64, y: &mut [f64], periods: usize, steps_per_period: usize) {
+        let d = y.len();
+        let h = 2.0 * PI / steps_per_period as f64;
+        let (mut k1, mut k2, mut k3, mut k4, mut tmp, mut scr) = (
+            vec![0.0; d],
+            vec![0.0; d],
+            vec![0.0; d],
+            vec![0.0; d],
+            vec![0.0; d],
+            vec![0.0; d / 2],
+        );
+        for step in 0..periods * steps_per_period {
+            // Time within the period (the forcing is 2π-periodic).
+            let t = (step % steps_per_period) as f64 * h;
+            self.rhs(omega, t, y, &mut k1, &mut scr);
+            for i in 0..d {
+                tmp[i] = y[i] + 0.5 * h * k1[i];
+            }
+            self.rhs(omega, t + 0.5 * h, &tmp, &mut k2, &mut scr);
+            for i in 0..d {
+                tmp[i] = y[i] + 0.5 * h * k2[i];
+            }
+            self.rhs(omega, t + 0.5 * h, &tmp, &mut k3, &mut scr);
+            for i in 0..d {
+                tmp[i] = y[i] + h * k3[i];
+            }
+            self.rhs(omega, t + h, &tmp, &mut k4, &mut scr);
+            for i in 0..d {
+                y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+        }
+    }
+}

@@ -1,0 +1,296 @@
+//! Stability of periodic responses of the fixed–fixed string (Eq. 126–131).
+//!
+//! The linearization `γ̇ = A(t) γ`, `A = [[0, E], [(G2 + S(t))/ω², −c_d/ω E]]`
+//! (Eq. 127), takes `S(t) = ∂ℒ/∂Q` from the same spectrum `Ŝ_p` that builds the
+//! STHB Jacobian (Eq. 129: `∂ℒ/∂Q = Φ̂ᵀ S_T`), so no modal ODE is derived.
+//!
+//! * [`hill`] — eigenvalues of the truncated Hill matrix `A_𝒯 − D` (Eq. 130–131)
+//!   in the fundamental strip. With the period normalized to `2π` the exponents
+//!   repeat with period `j` (not `2πj` as printed under Eq. 131), so the strip is
+//!   `Im λ ∈ (−½, ½]` and the multipliers are `exp(2πλ)`.
+//! * [`monodromy`] — RK4 over one period of the same `A(t)`; `O(N³)` per step,
+//!   cheap enough for every continuation point, with Hill to confirm.
+
+use std::f64::consts::PI;
+
+use faer::Mat;
+use realfft::num_complex::Complex;
+
+use super::toeplitz::{add_real_toeplitz, BlockLayout, PeriodicSpectrum};
+use super::{SthbError, StringHb};
+
+/// How a periodic response is (un)stable; the unstable kinds name the
+/// multiplier that left the unit circle (SPEC: fold +1, period doubling −1,
+/// Neimark–Sacker complex pair).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StabilityKind {
+    /// All multipliers inside the unit circle.
+    Stable,
+    /// A real multiplier `> 1` (the branch between two folds).
+    Fold,
+    /// A real multiplier `< −1`.
+    PeriodDoubling,
+    /// A complex pair outside the unit circle.
+    NeimarkSacker,
+}
+
+/// Which method produced a verdict.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StabilityMethod {
+    /// Eigenvalues of the Hill matrix (Eq. 130–131).
+    Hill,
+    /// Eigenvalues of the RK4 monodromy matrix.
+    Monodromy,
+}
+
+/// Stability verdict of one periodic response.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stability {
+    /// Classification.
+    pub kind: StabilityKind,
+    /// The multiplier of largest modulus.
+    pub critical: Complex<f64>,
+    /// Method used.
+    pub method: StabilityMethod,
+}
+
+impl Stability {
+    /// `true` for [`StabilityKind::Stable`].
+    pub fn is_stable(&self) -> bool {
+        self.kind == StabilityKind::Stable
+    }
+
+    fn from_multiplier(mu: Complex<f64>, method: StabilityMethod) -> Self {
+        let kind = if mu.norm() < 1.0 {
+            StabilityKind::Stable
+        } else if mu.im.abs() <= 1e-7 * mu.norm() {
+            if mu.re > 0.0 {
+                StabilityKind::Fold
+            } else {
+                StabilityKind::PeriodDoubling
+            }
+        } else {
+            StabilityKind::NeimarkSacker
+        };
+        Self {
+            kind,
+            critical: mu,
+            method,
+        }
+    }
+}
+
+fn check_fixed(hb: &StringHb) -> Result<(), SthbError> {
+    if hb.coords() != hb.params().modes {
+        return Err(SthbError::Invalid(
+            "stability is implemented for the fixed–fixed string".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Hill exponents `λ` in the fundamental strip `Im λ ∈ (−½, ½]` at the response
+/// whose Jacobian was evaluated last (after [`StringHb::solve`] or
+/// [`StringHb::linearize`]).
+///
+/// # Errors
+/// [`SthbError::Invalid`] for the spring boundary, [`SthbError::Eigen`] if the
+/// eigenvalue iteration fails.
+pub fn hill_exponents(hb: &StringHb, omega: f64) -> Result<Vec<Complex<f64>>, SthbError> {
+    check_fixed(hb)?;
+    let (n, m, cd) = (hb.params().modes, hb.params().harmonics, hb.params().cd);
+    let blk = 2 * n;
+    let dim = blk * (2 * m + 1);
+    let mut h = Mat::<f64>::zeros(dim, dim);
+    for g in 0..2 * m + 1 {
+        let o = g * blk;
+        for i in 0..n {
+            h[(o + i, o + n + i)] = 1.0;
+            h[(o + n + i, o + i)] = -((i + 1) as f64 * PI).powi(2) / (omega * omega);
+            h[(o + n + i, o + n + i)] = -cd / omega;
+        }
+        if g > 0 && g % 2 == 0 {
+            // −D: d/dt (c cos kt + s sin kt) = k s cos kt − k c sin kt.
+            let k = (g / 2) as f64;
+            let oc = (g - 1) * blk;
+            for i in 0..blk {
+                h[(oc + i, o + i)] -= k;
+                h[(o + i, oc + i)] += k;
+            }
+        }
+    }
+    let layout = BlockLayout {
+        row_block: blk,
+        row_off: n,
+        col_block: blk,
+        col_off: 0,
+    };
+    add_real_toeplitz(
+        hb.s_spectrum(),
+        m,
+        1.0 / (omega * omega),
+        layout,
+        h.as_mut(),
+        &mut Vec::new(),
+    );
+    let ev = h
+        .eigenvalues()
+        .map_err(|e| SthbError::Eigen(format!("{e:?}")))?;
+    let mut strip: Vec<Complex<f64>> = ev
+        .into_iter()
+        .map(|z| Complex::new(z.re, z.im))
+        .filter(|z| z.im > -0.5 - 1e-9 && z.im <= 0.5 + 1e-9)
+        .collect();
+    strip.sort_by(|a, b| b.re.total_cmp(&a.re));
+    Ok(strip)
+}
+
+/// Hill's-method verdict (Eq. 126–131).
+///
+/// # Errors
+/// As [`hill_exponents`].
+pub fn hill(hb: &StringHb, omega: f64) -> Result<Stability, SthbError> {
+    let ex = hill_exponents(hb, omega)?;
+    let lead = ex
+        .first()
+        .copied()
+        .ok_or_else(|| SthbError::Eigen("no Hill exponent in the strip".into()))?;
+    let mu = (lead * (2.0 * PI)).exp();
+    // A real exponent (Im λ = 0) gives a positive multiplier, Im λ = ±½ a negative one;
+    // snap those so the classification does not hinge on rounding.
+    let frac = lead.im.abs();
+    let mu = if frac < 1e-6 || (0.5 - frac).abs() < 1e-6 {
+        Complex::new(mu.re, 0.0)
+    } else {
+        mu
+    };
+    Ok(Stability::from_multiplier(mu, StabilityMethod::Hill))
+}
+
+/// `S(t)` from its spectrum at time `t` (row-major `rows × cols` into `out`).
+fn s_at(s: &PeriodicSpectrum, t: f64, out: &mut [f64]) {
+    let nc = s.rows * s.cols;
+    for (o, z) in out.iter_mut().zip(&s.data[..nc]) {
+        *o = z.re;
+    }
+    let base = Complex::from_polar(1.0, t);
+    let mut rot = Complex::new(1.0, 0.0);
+    for p in 1..=s.p_max {
+        rot *= base;
+        let w = if 2 * p == s.ms { 1.0 } else { 2.0 };
+        let e = rot * w;
+        for (o, z) in out.iter_mut().zip(&s.data[p * nc..(p + 1) * nc]) {
+            *o += (z * e).re;
+        }
+    }
+}
+
+/// Monodromy matrix (`2N × 2N`, column-major) of Eq. 126 by RK4 with `steps`
+/// steps per period.
+///
+/// # Errors
+/// [`SthbError::Invalid`] for the spring boundary.
+pub fn monodromy_matrix(hb: &StringHb, omega: f64, steps: usize) -> Result<Mat<f64>, SthbError> {
+    check_fixed(hb)?;
+    let (n, cd) = (hb.params().modes, hb.params().cd);
+    let s = hb.s_spectrum();
+    let d = 2 * n;
+    let h = 2.0 * PI / steps as f64;
+    let w2 = 1.0 / (omega * omega);
+    // B(t) = (G2 + S(t))/ω² at the 2·steps + 1 half-step nodes.
+    let mut b = vec![0.0; (2 * steps + 1) * n * n];
+    for (node, chunk) in b.chunks_exact_mut(n * n).enumerate() {
+        s_at(s, node as f64 * 0.5 * h, chunk);
+        for i in 0..n {
+            chunk[i * n + i] -= ((i + 1) as f64 * PI).powi(2);
+        }
+        chunk.iter_mut().for_each(|v| *v *= w2);
+    }
+    let damp = cd / omega;
+    // Y = [X; V] column by column; f(Y) = [V; B X − damp V].
+    let mut y = vec![0.0; d * d];
+    for i in 0..d {
+        y[i * d + i] = 1.0;
+    }
+    let f = |bn: &[f64], y: &[f64], out: &mut [f64]| {
+        for col in 0..d {
+            let yc = &y[col * d..(col + 1) * d];
+            let oc = &mut out[col * d..(col + 1) * d];
+            for i in 0..n {
+                oc[i] = yc[n + i];
+                let mut acc = -damp * yc[n + i];
+                for j in 0..n {
+                    acc += bn[i * n + j] * yc[j];
+                }
+                oc[n + i] = acc;
+            }
+        }
+    };
+    let (mut k1, mut k2, mut k3, mut k4, mut tmp) = (
+        vec![0.0; d * d],
+        vec![0.0; d * d],
+        vec![0.0; d * d],
+        vec![0.0; d * d],
+        vec![0.0; d * d],
+    );
+    for st in 0..steps {
+        let node = |k: usize| &b[(2 * st + k) * n * n..(2 * st + k + 1) * n * n];
+        f(node(0), &y, &mut k1);
+        tmp.iter_mut()
+            .zip(&y)
+            .zip(&k1)
+            .for_each(|((t, y), k)| *t = y + 0.5 * h * k);
+        f(node(1), &tmp, &mut k2);
+        tmp.iter_mut()
+            .zip(&y)
+            .zip(&k2)
+            .for_each(|((t, y), k)| *t = y + 0.5 * h * k);
+        f(node(1), &tmp, &mut k3);
+        tmp.iter_mut()
+            .zip(&y)
+            .zip(&k3)
+            .for_each(|((t, y), k)| *t = y + h * k);
+        f(node(2), &tmp, &mut k4);
+        for i in 0..d * d {
+            y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+        }
+    }
+    Ok(Mat::from_fn(d, d, |i, j| y[j * d + i]))
+}
+
+/// RK4 steps that keep `h ρ ≤ 0.5` for the fastest mode (`ρ² ≈ (N²π² + ‖S‖)/ω²`).
+pub fn default_steps(hb: &StringHb, omega: f64) -> usize {
+    let s = hb.s_spectrum();
+    let bound: f64 = s.data.iter().map(|z| 2.0 * z.norm()).sum::<f64>() / (s.rows.max(1) as f64);
+    let n = hb.params().modes as f64;
+    let rho = ((n * n * PI * PI + bound) / (omega * omega)).sqrt();
+    ((2.0 * PI * rho / 0.5).ceil() as usize).clamp(64, 100_000)
+}
+
+/// Floquet multipliers from [`monodromy_matrix`], largest modulus first.
+///
+/// # Errors
+/// As [`monodromy_matrix`], or [`SthbError::Eigen`].
+pub fn monodromy_multipliers(hb: &StringHb, omega: f64) -> Result<Vec<Complex<f64>>, SthbError> {
+    let phi = monodromy_matrix(hb, omega, default_steps(hb, omega))?;
+    let mut mu: Vec<Complex<f64>> = phi
+        .eigenvalues()
+        .map_err(|e| SthbError::Eigen(format!("{e:?}")))?
+        .into_iter()
+        .map(|z| Complex::new(z.re, z.im))
+        .collect();
+    mu.sort_by(|a, b| b.norm().total_cmp(&a.norm()));
+    Ok(mu)
+}
+
+/// Monodromy verdict.
+///
+/// # Errors
+/// As [`monodromy_multipliers`].
+pub fn monodromy(hb: &StringHb, omega: f64) -> Result<Stability, SthbError> {
+    let mu = monodromy_multipliers(hb, omega)?;
+    Ok(Stability::from_multiplier(
+        mu[0],
+        StabilityMethod::Monodromy,
+    ))
+}
