@@ -187,6 +187,35 @@ pub fn eval_series(coeffs: &[f64], tau: f64, order: u32) -> f64 {
     s
 }
 
+/// The series `[a0, a1..an, b1..bn]` with `n_to` harmonics (truncated or
+/// zero-padded), e.g. to seed a solve at another n from a converged solution.
+pub fn resize_harmonics(coeffs: &[f64], n_to: usize) -> Vec<f64> {
+    let n = (coeffs.len() - 1) / 2;
+    let mut out = vec![0.0; 2 * n_to + 1];
+    out[0] = coeffs[0];
+    for k in 1..=n.min(n_to) {
+        out[k] = coeffs[k];
+        out[n_to + k] = coeffs[n + k];
+    }
+    out
+}
+
+/// Re-expresses a series in τ as one in τ/`factor` (period `factor·2π`): harmonic k
+/// moves to `factor·k`, keeping `n_to` harmonics. Used to start period-2p solutions
+/// from period-p ones (§3.2.5: `a_{2j}^{(2)} = a_j^{(1)}`).
+pub fn embed_subharmonic(coeffs: &[f64], factor: usize, n_to: usize) -> Vec<f64> {
+    let n = (coeffs.len() - 1) / 2;
+    let mut out = vec![0.0; 2 * n_to + 1];
+    out[0] = coeffs[0];
+    for k in 1..=n {
+        if factor * k <= n_to {
+            out[factor * k] = coeffs[k];
+            out[n_to + factor * k] = coeffs[n + k];
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -35,7 +35,6 @@ impl<F: FnMut(&[f64], &mut [f64])> System for F {
 
 /// Options of the Broyden solver.
 #[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
 pub struct BroydenOptions {
     /// Convergence when ‖F(x)‖₂ ≤ `tol`.
     pub tol: f64,
@@ -254,6 +253,68 @@ impl BroydenWorkspace {
     /// [`SolveError::SingularJacobian`] if `B` is singular.
     pub fn refactor(&mut self) -> Result<(), SolveError> {
         self.invert_b()
+    }
+
+    /// Replaces row `i` of `B` by `row` and updates `H` by Sherman–Morrison
+    /// (O(m²)); re-inverts if the update is ill-conditioned.
+    ///
+    /// # Errors
+    /// [`SolveError::SingularJacobian`] if the new `B` is singular.
+    pub fn replace_row(&mut self, i: usize, row: &[f64]) -> Result<(), SolveError> {
+        let m = self.m;
+        // B' = B + e_i dᵀ, d = row − B_i;  H' = H − (H e_i)(dᵀ H)/(1 + dᵀ H e_i).
+        for j in 0..m {
+            self.u[j] = row[j] - self.b[i * m + j];
+        }
+        for j in 0..m {
+            self.hu[j] = self.h[j * m + i];
+        }
+        for j in 0..m {
+            let mut acc = 0.0;
+            for k in 0..m {
+                acc += self.u[k] * self.h[k * m + j];
+            }
+            self.sth[j] = acc;
+        }
+        let denom = 1.0 + self.sth[i];
+        self.b[i * m..(i + 1) * m].copy_from_slice(&row[..m]);
+        self.sherman_morrison(denom)
+    }
+
+    /// Replaces column `j` of `B` by `col` and updates `H` by Sherman–Morrison.
+    ///
+    /// # Errors
+    /// [`SolveError::SingularJacobian`] if the new `B` is singular.
+    pub fn replace_col(&mut self, j: usize, col: &[f64]) -> Result<(), SolveError> {
+        let m = self.m;
+        // B' = B + c e_jᵀ, c = col − B_:j;  H' = H − (H c)(e_jᵀ H)/(1 + e_jᵀ H c).
+        for i in 0..m {
+            self.u[i] = col[i] - self.b[i * m + j];
+        }
+        for i in 0..m {
+            self.hu[i] = dot(&self.h[i * m..(i + 1) * m], &self.u);
+        }
+        self.sth.copy_from_slice(&self.h[j * m..(j + 1) * m]);
+        let denom = 1.0 + self.hu[j];
+        for i in 0..m {
+            self.b[i * m + j] = col[i];
+        }
+        self.sherman_morrison(denom)
+    }
+
+    /// `H ← H − hu sthᵀ / denom`, or a full inversion when `denom` is tiny.
+    fn sherman_morrison(&mut self, denom: f64) -> Result<(), SolveError> {
+        let m = self.m;
+        if !self.has_jacobian || denom.abs() < 1e-8 || !denom.is_finite() {
+            return self.invert_b();
+        }
+        for i in 0..m {
+            let f = self.hu[i] / denom;
+            for (hij, s) in self.h[i * m..(i + 1) * m].iter_mut().zip(&self.sth) {
+                *hij -= f * s;
+            }
+        }
+        Ok(())
     }
 
     /// Current approximate Jacobian `B` (row-major).

@@ -16,7 +16,6 @@ use thiserror::Error;
 
 /// Options of the path follower.
 #[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
 pub struct ContinuationOptions {
     /// Initial arclength step Δη.
     pub ds: f64,
@@ -47,7 +46,7 @@ impl Default for ContinuationOptions {
             max_points: 5000,
             lambda_min: f64::NEG_INFINITY,
             lambda_max: f64::INFINITY,
-            target_iter: 6,
+            target_iter: 10,
             growth: 1.5,
             broyden: BroydenOptions {
                 max_iter: 25,
@@ -241,6 +240,7 @@ where
     let mut b = vec![0.0; n1 * n1];
     let mut x = vec![0.0; n1];
     let mut ds = opts.ds;
+    let mut fresh = true;
     let termination = loop {
         if points.len() >= opts.max_points {
             break Termination::MaxPoints;
@@ -257,10 +257,19 @@ where
         for i in 0..m {
             jac[i * n1 + m] = (r1[i] - r0[i]) / h;
         }
-        // B_x = [[B_q, B_λ], [x_dᵀ]] (Eq. 72).
-        b[..m * n1].copy_from_slice(&jac);
-        b[m * n1..].copy_from_slice(&xd);
-        let set = ws.set_jacobian(&b);
+        // B_x = [[B_q, B_λ], [x_dᵀ]] (Eq. 72). After a successful step only the
+        // λ column and the augmenting row change: two Sherman–Morrison updates.
+        let set = if fresh {
+            b[..m * n1].copy_from_slice(&jac);
+            b[m * n1..].copy_from_slice(&xd);
+            ws.set_jacobian(&b)
+        } else {
+            let mut col: Vec<f64> = (0..m).map(|i| jac[i * n1 + m]).collect();
+            col.push(ws.jacobian()[m * n1 + m]);
+            ws.replace_col(m, &col)
+                .and_then(|()| ws.replace_row(m, &xd))
+        };
+        fresh = false;
         let (xp_c, xd_c) = (xp.clone(), xd.clone());
         let mut aug = |xv: &[f64], r: &mut [f64]| {
             residual(xv, &mut r[..m]);
@@ -303,6 +312,7 @@ where
                 &mut r1,
                 opts.broyden.fd_step,
             );
+            fresh = true;
             continue;
         }
         let iters = outcome.map(|s| s.iterations).unwrap_or(0);
@@ -323,6 +333,7 @@ where
                     history: ws.history().to_vec(),
                 });
             }
+            fresh = true;
             continue;
         }
         let prev_dl = points.last().map(|p| p.dlambda).unwrap_or(new_xd[m]);

@@ -27,6 +27,10 @@ pub enum HsuRule {
 /// 1e-18 relative). `scratch` needs `2·dim²` entries; nothing is allocated.
 pub fn expm(a: &[f64], dim: usize, out: &mut [f64], scratch: &mut [f64]) {
     let d2 = dim * dim;
+    if dim == 2 {
+        expm2(a, out);
+        return;
+    }
     let norm1 = (0..dim)
         .map(|j| (0..dim).map(|i| a[i * dim + j].abs()).sum::<f64>())
         .fold(0.0, f64::max);
@@ -56,14 +60,46 @@ pub fn expm(a: &[f64], dim: usize, out: &mut [f64], scratch: &mut [f64]) {
             }
         }
         term[..d2].copy_from_slice(&tmp[..d2]);
+        let mut tmax = 0.0f64;
         for (o, t) in out[..d2].iter_mut().zip(term.iter()) {
             *o += t;
+            tmax = tmax.max(t.abs());
+        }
+        // ‖out‖ ≥ ~1/2 after scaling, so a term below 1e-18 no longer counts.
+        if tmax < 1e-18 {
+            break;
         }
     }
     for _ in 0..s {
         matmul(out, out, dim, tmp);
         out[..d2].copy_from_slice(&tmp[..d2]);
     }
+}
+
+/// Closed-form exponential of a 2×2 matrix: with `μ = tr/2` and `δ² = μ² − det`,
+/// `exp(A) = e^μ [cosh δ · I + (sinh δ/δ)(A − μI)]` (δ imaginary → cos/sin).
+fn expm2(a: &[f64], out: &mut [f64]) {
+    let mu = 0.5 * (a[0] + a[3]);
+    let det = a[0] * a[3] - a[1] * a[2];
+    let d2 = mu * mu - det;
+    let (c, s) = if d2.abs() < 1e-8 {
+        // Series to O(d2³): cosh δ = 1 + d2/2 + d2²/24, sinh δ/δ = 1 + d2/6 + d2²/120.
+        (
+            1.0 + d2 / 2.0 + d2 * d2 / 24.0,
+            1.0 + d2 / 6.0 + d2 * d2 / 120.0,
+        )
+    } else if d2 > 0.0 {
+        let d = d2.sqrt();
+        (d.cosh(), d.sinh() / d)
+    } else {
+        let d = (-d2).sqrt();
+        (d.cos(), d.sin() / d)
+    };
+    let e = mu.exp();
+    out[0] = e * (c + s * (a[0] - mu));
+    out[1] = e * s * a[1];
+    out[2] = e * s * a[2];
+    out[3] = e * (c + s * (a[3] - mu));
 }
 
 /// `c = a·b` for row-major `dim×dim` matrices.
@@ -161,6 +197,27 @@ pub fn monodromy_hsu<F: FnMut(f64, &mut [f64])>(
 /// Eigenvalues of a real row-major `dim×dim` matrix (faer), i.e. the Floquet
 /// multipliers when applied to the monodromy matrix. Sorted by decreasing modulus.
 pub fn eigenvalues(a: &[f64], dim: usize) -> Vec<c64> {
+    if dim == 2 {
+        // Closed form for the single-DOF case (the FRC hot path): λ² − tr λ + det = 0.
+        let (tr, det) = (a[0] + a[3], a[0] * a[3] - a[1] * a[2]);
+        let disc = 0.25 * tr * tr - det;
+        let mut ev = if disc >= 0.0 {
+            let r = disc.sqrt();
+            // Avoid cancellation: larger root first, smaller from the product.
+            let l1 = 0.5 * tr + r.copysign(tr);
+            let l2 = if l1 != 0.0 {
+                det / l1
+            } else {
+                0.5 * tr - r.copysign(tr)
+            };
+            vec![c64::new(l1, 0.0), c64::new(l2, 0.0)]
+        } else {
+            let i = (-disc).sqrt();
+            vec![c64::new(0.5 * tr, i), c64::new(0.5 * tr, -i)]
+        };
+        sort_by_modulus(&mut ev);
+        return ev;
+    }
     let mat = faer::Mat::<f64>::from_fn(dim, dim, |i, j| a[i * dim + j]);
     let mut ev = mat
         .eigenvalues()
@@ -201,6 +258,26 @@ mod tests {
         let want = [3f64.cos(), 3f64.sin(), -3f64.sin(), 3f64.cos()];
         for (o, w) in out.iter().zip(want) {
             assert!((o - w).abs() < 1e-14, "{o} vs {w}");
+        }
+    }
+
+    #[test]
+    fn closed_form_2x2_matches_taylor_path() {
+        // Compare expm2 with the generic path by embedding in a 3×3 block-diagonal.
+        for a in [
+            [0.3, 1.2, -0.7, -0.1],
+            [0.5, 0.2, 0.1, 0.4],
+            [1e-5, 1.0, 0.0, 1e-5],
+        ] {
+            let mut out2 = [0.0; 4];
+            expm2(&a, &mut out2);
+            let big = [a[0], a[1], 0.0, a[2], a[3], 0.0, 0.0, 0.0, 0.2];
+            let mut out3 = [0.0; 9];
+            let mut scratch = [0.0; 18];
+            expm(&big, 3, &mut out3, &mut scratch);
+            for (x, y) in out2.iter().zip([out3[0], out3[1], out3[3], out3[4]]) {
+                assert!((x - y).abs() < 1e-14, "{a:?}: {out2:?} vs {out3:?}");
+            }
         }
     }
 

@@ -17,7 +17,6 @@ use thiserror::Error;
 
 /// Options of the IHB solvers.
 #[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
 pub struct HbOptions {
     /// Harmonics n.
     pub harmonics: usize,
@@ -27,8 +26,9 @@ pub struct HbOptions {
     pub subharmonic: usize,
     /// Iteration options (tolerance on ‖r‖, default 1e-10).
     pub broyden: BroydenOptions,
-    /// Parameter steps in the nonlinearity (0: solve directly; on failure the
-    /// solver retries with 8, then 32 steps).
+    /// Initial number of parameter steps in the nonlinearity (0: first try the
+    /// full problem directly; on failure, or when > 0, step s = 0 → 1 adaptively
+    /// starting from Δs = 1/max(steps, 8)).
     pub homotopy_steps: usize,
 }
 

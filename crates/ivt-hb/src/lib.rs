@@ -5,11 +5,15 @@ pub mod broyden;
 pub mod classic;
 pub mod continuation;
 pub mod floquet;
+pub mod frc;
 pub mod hill;
 pub mod ihb;
 pub mod linalg;
+pub mod mathieu;
 pub mod modified;
+pub mod ode;
 pub mod problem;
+pub mod stability;
 
 pub use aft::{Aft, AftError};
 pub use broyden::{
@@ -21,10 +25,13 @@ pub use continuation::{
 };
 pub use faer::c64;
 pub use floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
+pub use frc::{frequency_response, Frc, FrcOptions, FrcPoint};
 pub use hill::{fourier_blocks, hill_multipliers, HillError, HillResult};
 pub use ihb::{HbError, HbOptions, HbResidual, HbSolution};
+pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;
 pub use problem::{Duffing, GeneralProblem, MathieuDuffing, PeriodicProblem};
+pub use stability::{classify, Floquet, StabilityAnalyzer, StabilityKind};
 
 pub mod ivt;
 pub mod sthb;

@@ -159,36 +159,44 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         } else {
             start
         };
-        let schedules: &[usize] = if opts.homotopy_steps > 0 {
-            &[opts.homotopy_steps, 4 * opts.homotopy_steps]
-        } else {
-            &[8, 32]
+        // Adaptive parameter stepping: s grows by Δs (initially 1/steps), which is
+        // halved on failure (Broyden matrix refreshed) and grown by 1.5 on success.
+        let mut ds = 1.0 / opts.homotopy_steps.max(8) as f64;
+        let mut s_done = 0.0;
+        q.copy_from_slice(&start);
+        seed(ws, &self.b0, &self.h0);
+        let mut q_ok = start;
+        let mut total = BroydenStats {
+            iterations: 0,
+            residual_evals: 0,
+            jacobian_refreshes: 0,
+            residual_norm: 0.0,
         };
-        'outer: for &steps in schedules {
-            q.copy_from_slice(&start);
-            seed(ws, &self.b0, &self.h0);
-            let mut total = BroydenStats {
-                iterations: 0,
-                residual_evals: 0,
-                jacobian_refreshes: 0,
-                residual_norm: 0.0,
-            };
-            for h in 1..=steps {
-                let s = h as f64 / steps as f64;
-                let mut f = |x: &[f64], r: &mut [f64]| res.eval(problem, x, omega_f, s, r);
-                match broyden_solve(&mut f, q, ws, &opts.broyden) {
-                    Ok(st) => {
-                        total.iterations += st.iterations;
-                        total.residual_evals += st.residual_evals;
-                        total.jacobian_refreshes += st.jacobian_refreshes;
-                        total.residual_norm = st.residual_norm;
-                    }
-                    Err(e) => {
-                        last_err = Some(e);
-                        continue 'outer;
+        while s_done < 1.0 {
+            let s = (s_done + ds).min(1.0);
+            let mut f = |x: &[f64], r: &mut [f64]| res.eval(problem, x, omega_f, s, r);
+            match broyden_solve(&mut f, q, ws, &opts.broyden) {
+                Ok(st) => {
+                    total.iterations += st.iterations;
+                    total.residual_evals += st.residual_evals;
+                    total.jacobian_refreshes += st.jacobian_refreshes;
+                    total.residual_norm = st.residual_norm;
+                    s_done = s;
+                    q_ok.copy_from_slice(q);
+                    ds *= 1.5;
+                }
+                Err(e) => {
+                    last_err = Some(e);
+                    ds *= 0.5;
+                    q.copy_from_slice(&q_ok);
+                    ws.clear_jacobian();
+                    if ds < 1e-5 {
+                        break;
                     }
                 }
             }
+        }
+        if s_done >= 1.0 {
             return Ok(total);
         }
         Err(HbError::Solve(last_err.expect("at least one attempt ran")))

@@ -1,0 +1,52 @@
+//! Benchmarks of the hot paths (issue 3): Duffing by modified IHB (n = 20, N = 64,
+//! from the linear guess), the classic Newton IHB beside it, and the full
+//! frequency-response curve 0.2–3.0 with a stability flag at every point.
+
+use ivt_hb::{
+    frequency_response, ClassicIhb, Duffing, FrcOptions, HbOptions, HsuRule, ModifiedIhb,
+    StabilityAnalyzer,
+};
+
+fn main() {
+    divan::main();
+}
+
+/// Fig. 28 point (ω_f = 0.4), modified IHB from the linear solution Eq. 59.
+#[divan::bench]
+fn duffing_modified_n20_n64(bencher: divan::Bencher) {
+    let mut solver = ModifiedIhb::new(Duffing::fig28(), HbOptions::new(20, 64)).unwrap();
+    let mut q = vec![0.0; 41];
+    bencher.bench_local(|| {
+        solver
+            .solve_into(divan::black_box(0.4), false, None, &mut q)
+            .unwrap()
+    });
+}
+
+/// Same point, classic IHB (Newton with the quadrature Galerkin Jacobian).
+#[divan::bench]
+fn duffing_classic_n20_n64(bencher: divan::Bencher) {
+    let mut solver = ClassicIhb::new(Duffing::fig28(), HbOptions::new(20, 64)).unwrap();
+    bencher.bench_local(|| solver.solve(divan::black_box(0.4), None).unwrap());
+}
+
+/// Floquet multipliers by Hsu (256 Magnus-4 steps) at the Fig. 28 point.
+#[divan::bench]
+fn duffing_hsu_256(bencher: divan::Bencher) {
+    let d = Duffing::fig28();
+    let sol = ModifiedIhb::new(d.clone(), HbOptions::new(20, 64))
+        .unwrap()
+        .solve(0.4, None)
+        .unwrap();
+    let mut an = StabilityAnalyzer::new(&d, 20, 256).unwrap();
+    bencher.bench_local(|| an.hsu(&d, &sol, HsuRule::Magnus4));
+}
+
+/// Fig. 29: the whole curve 0.2 → 3.0 with stability at every point.
+#[divan::bench(sample_count = 10)]
+fn duffing_frc_0p2_to_3(bencher: divan::Bencher) {
+    let d = Duffing::fig28();
+    let hb = HbOptions::new(20, 64);
+    let opts = FrcOptions::default();
+    bencher.bench_local(|| frequency_response(&d, &hb, &opts).unwrap());
+}

@@ -1,0 +1,152 @@
+//! Frequency-response curves (Fig. 29): the modified-IHB residual followed in ω_f by
+//! pseudo-arclength continuation ([`crate::continuation`], Eq. 68–77), with the
+//! Floquet multipliers (Hsu, Eq. 80) and stability class at every point.
+
+use crate::continuation::{pseudo_arclength, ContinuationOptions, Fold, Termination};
+use crate::floquet::HsuRule;
+use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
+use crate::modified::ModifiedIhb;
+use crate::problem::PeriodicProblem;
+use crate::stability::{StabilityAnalyzer, StabilityKind};
+use crate::BroydenStats;
+use faer::c64;
+
+/// Options of a frequency sweep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrcOptions {
+    /// Start frequency ω_f.
+    pub from: f64,
+    /// End frequency ω_f (may be below `from` for a downward sweep).
+    pub to: f64,
+    /// Path-following options (λ bounds are set from `from`/`to`).
+    pub continuation: ContinuationOptions,
+    /// Hsu sub-intervals per period for the stability flags.
+    pub stability_steps: usize,
+}
+
+impl Default for FrcOptions {
+    fn default() -> Self {
+        Self {
+            from: 0.2,
+            to: 3.0,
+            continuation: ContinuationOptions {
+                ds: 0.05,
+                ds_max: 0.15,
+                ..ContinuationOptions::default()
+            },
+            stability_steps: 256,
+        }
+    }
+}
+
+/// One point of the curve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrcPoint {
+    /// Excitation frequency ω_f.
+    pub omega_f: f64,
+    /// max |x_0(τ)| over the 2N AFT samples.
+    pub amplitude: f64,
+    /// Stability class from the Floquet multipliers.
+    pub kind: StabilityKind,
+    /// Floquet multipliers (Hsu), decreasing modulus.
+    pub multipliers: Vec<c64>,
+    /// Fourier coefficients.
+    pub coeffs: Vec<f64>,
+}
+
+impl FrcPoint {
+    /// All multipliers inside the unit circle.
+    pub fn stable(&self) -> bool {
+        self.kind == StabilityKind::Stable
+    }
+}
+
+/// A traced frequency-response curve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frc {
+    /// Points in path order.
+    pub points: Vec<FrcPoint>,
+    /// Folds (turning points in ω_f) with their ω_f.
+    pub folds: Vec<Fold>,
+    /// Why tracing stopped.
+    pub termination: Termination,
+}
+
+/// Traces the frequency-response curve of `problem` from `opts.from` to `opts.to`.
+///
+/// # Errors
+/// [`HbError`] if the start point cannot be solved or the sizes are invalid.
+pub fn frequency_response<P: PeriodicProblem + Clone>(
+    problem: &P,
+    hb: &HbOptions,
+    opts: &FrcOptions,
+) -> Result<Frc, HbError> {
+    if !(opts.from.is_finite()
+        && opts.to.is_finite()
+        && opts.from > 0.0
+        && opts.to > 0.0
+        && opts.from != opts.to)
+    {
+        return Err(HbError::InvalidInput(
+            "sweep bounds must be positive, finite and distinct".into(),
+        ));
+    }
+    let start: HbSolution =
+        ModifiedIhb::new(problem.clone(), hb.clone())?.solve(opts.from, None)?;
+    let mut res = HbResidual::new(problem, hb)?;
+    let m = res.len();
+    let mut x0 = start.coeffs.clone();
+    x0.push(opts.from);
+    let mut copts = opts.continuation.clone();
+    copts.lambda_min = opts.from.min(opts.to);
+    copts.lambda_max = opts.from.max(opts.to);
+    let direction = if opts.to > opts.from { 1.0 } else { -1.0 };
+    let path = pseudo_arclength(
+        |x: &[f64], r: &mut [f64]| res.eval(problem, &x[..m], x[m], 1.0, r),
+        &x0,
+        None,
+        direction,
+        &copts,
+        |_| true,
+    )
+    .map_err(|e| HbError::InvalidInput(format!("continuation start: {e}")))?;
+    let mut analyzer = StabilityAnalyzer::new(
+        problem,
+        hb.harmonics,
+        opts.stability_steps.max(hb.harmonics + 1),
+    )?;
+    let mut res = HbResidual::new(problem, hb)?;
+    let ns = res.aft_mut().n_samples();
+    let mut samples = vec![0.0; ns];
+    let mut points = Vec::with_capacity(path.points.len());
+    let l = 2 * hb.harmonics + 1;
+    for p in &path.points {
+        let sol = HbSolution {
+            coeffs: p.x[..m].to_vec(),
+            omega_f: p.lambda(),
+            harmonics: hb.harmonics,
+            subharmonic: hb.subharmonic,
+            stats: BroydenStats {
+                iterations: p.iterations,
+                residual_evals: 0,
+                jacobian_refreshes: 0,
+                residual_norm: 0.0,
+            },
+        };
+        res.aft_mut().synthesize(&sol.coeffs[..l], &mut samples);
+        let amplitude = samples.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let fl = analyzer.hsu(problem, &sol, HsuRule::Magnus4);
+        points.push(FrcPoint {
+            omega_f: sol.omega_f,
+            amplitude,
+            kind: fl.kind,
+            multipliers: fl.multipliers,
+            coeffs: sol.coeffs,
+        });
+    }
+    Ok(Frc {
+        points,
+        folds: path.folds,
+        termination: path.termination,
+    })
+}

@@ -1,0 +1,350 @@
+//! Period-doubling cascade of the Mathieu–Duffing equation (§3.2.5, Eq. 81–85):
+//! period-1 → 2 → 4, returning the critical β where each branch loses stability
+//! through a multiplier −1.
+//!
+//! 1. The period-1 solution at β₀ = 3.6 is solved from the thesis's printed
+//!    coefficients (n = 9) and followed in β by pseudo-arclength continuation
+//!    with Hsu multipliers at every point.
+//! 2. The crossing μ = −1 is located by a secant iteration on the path parameter.
+//! 3. The period-2p branch is entered with the controlled-amplitude scheme of
+//!    Eq. 84–85: the solution is embedded with harmonic k → 2k
+//!    (`a_{2j}^{(2)} = a_j^{(1)}`), the amplitude `a_1` of the new lowest harmonic is
+//!    prescribed (non-zero forces the new branch) and β takes its slot among the
+//!    unknowns; `a_1` is then the continuation parameter.
+
+use crate::aft::{embed_subharmonic, resize_harmonics};
+use crate::broyden::{broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace};
+use crate::continuation::{pseudo_arclength, ContinuationOptions};
+use crate::floquet::HsuRule;
+use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
+use crate::modified::ModifiedIhb;
+use crate::problem::MathieuDuffing;
+use crate::stability::StabilityAnalyzer;
+use faer::c64;
+
+/// The thesis's period-1 coefficients at β₀ = 3.6, n = 9 (§3.2.5; the printed
+/// "=0.0001" is read as −0.0001).
+pub const THESIS_A0: [f64; 19] = [
+    0.7881, -1.3956, 0.2686, 0.1121, -0.0260, 0.0026, -0.0008, -0.0001, -0.0001, 0.0, 1.9884,
+    -0.1693, 0.0471, -0.0175, -0.0042, 0.0021, -0.0003, 0.0, 0.0,
+];
+
+/// Parameters of the cascade.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CascadeOptions {
+    /// Damping ratio ξ̂ (0.125).
+    pub xi: f64,
+    /// Stiffness α̂ (1, enters as −α̂).
+    pub alpha: f64,
+    /// Excitation frequency Ω (2).
+    pub omega: f64,
+    /// Cubic stiffness γ (1).
+    pub gamma: f64,
+    /// Start β₀ (3.6).
+    pub beta0: f64,
+    /// Harmonics of the period-1 solution; period 2^k uses 2^k times as many.
+    pub harmonics: usize,
+    /// Number of period doublings to find (3: β1, β2, β4).
+    pub doublings: usize,
+    /// Hsu sub-intervals per harmonic of the solution (total = this × n).
+    pub hsu_steps_per_harmonic: usize,
+}
+
+impl Default for CascadeOptions {
+    fn default() -> Self {
+        Self {
+            xi: 0.125,
+            alpha: 1.0,
+            omega: 2.0,
+            gamma: 1.0,
+            beta0: 3.6,
+            harmonics: 12,
+            doublings: 3,
+            hsu_steps_per_harmonic: 24,
+        }
+    }
+}
+
+/// One period-doubling point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PeriodDoubling {
+    /// Period (in forcing periods) of the branch that loses stability.
+    pub period: usize,
+    /// Critical β.
+    pub beta: f64,
+    /// The critical multiplier (≈ −1).
+    pub multiplier: c64,
+    /// The solution at the critical point (period-`period` coefficients).
+    pub solution: HbSolution,
+}
+
+/// The most negative real multiplier + 1 (positive when none is ≤ −1 … or when no
+/// multiplier is real and negative): the function whose zero marks a period doubling.
+fn pd_indicator(mu: &[c64]) -> (f64, c64) {
+    mu.iter()
+        .filter(|m| m.im.abs() <= 1e-7 * m.norm().max(1e-300) && m.re < 0.0)
+        .map(|m| (m.re + 1.0, *m))
+        .fold((1.0, c64::new(f64::NAN, 0.0)), |a, b| {
+            if b.0 < a.0 {
+                b
+            } else {
+                a
+            }
+        })
+}
+
+/// Solves the controlled-amplitude system: unknowns `y` = coefficients with slot
+/// `c` holding β, prescribed `q[c] = a_c` (Eq. 85).
+struct Controlled {
+    res: HbResidual,
+    p: MathieuDuffing,
+    c: usize,
+    omega: f64,
+    q: Vec<f64>,
+}
+
+impl Controlled {
+    fn eval(&mut self, y: &[f64], a_c: f64, r: &mut [f64]) {
+        self.q.copy_from_slice(y);
+        self.q[self.c] = a_c;
+        self.p.beta = y[self.c];
+        self.res.eval(&self.p, &self.q, self.omega, 1.0, r);
+    }
+    fn solution(&self, y: &[f64], a_c: f64, harmonics: usize, period: usize) -> (HbSolution, f64) {
+        let mut q = y.to_vec();
+        q[self.c] = a_c;
+        let stats = BroydenStats {
+            iterations: 0,
+            residual_evals: 0,
+            jacobian_refreshes: 0,
+            residual_norm: 0.0,
+        };
+        (
+            HbSolution {
+                coeffs: q,
+                omega_f: self.omega,
+                harmonics,
+                subharmonic: period,
+                stats,
+            },
+            y[self.c],
+        )
+    }
+}
+
+/// Runs the cascade and returns the critical points β1, β2, β4, … in order.
+///
+/// # Errors
+/// [`HbError`] if a solve or a branch switch fails.
+pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubling>, HbError> {
+    let mut out = Vec::new();
+    // --- period 1: continuation in β.
+    let n1 = opts.harmonics;
+    let hb1 = HbOptions::new(n1, 4 * n1);
+    let problem = MathieuDuffing::new(opts.xi, opts.alpha, opts.beta0, opts.gamma);
+    let guess = resize_harmonics(&THESIS_A0, n1);
+    let start = ModifiedIhb::new(problem.clone(), hb1.clone())?.solve(opts.omega, Some(&guess))?;
+    let mut res = HbResidual::new(&problem, &hb1)?;
+    let m = res.len();
+    let mut x0 = start.coeffs.clone();
+    x0.push(opts.beta0);
+    let mut an = StabilityAnalyzer::new(&problem, n1, opts.hsu_steps_per_harmonic * n1)?;
+    let copts = ContinuationOptions {
+        ds: 0.02,
+        ds_max: 0.05,
+        lambda_max: 20.0,
+        max_points: 4000,
+        ..ContinuationOptions::default()
+    };
+    let mut prev: Option<(Vec<f64>, f64)> = None;
+    let mut bracket: Option<((Vec<f64>, f64), (Vec<f64>, f64))> = None;
+    let mut p = problem.clone();
+    let stab = |an: &mut StabilityAnalyzer,
+                p: &MathieuDuffing,
+                coeffs: &[f64],
+                harmonics: usize,
+                period: usize| {
+        let stats = BroydenStats {
+            iterations: 0,
+            residual_evals: 0,
+            jacobian_refreshes: 0,
+            residual_norm: 0.0,
+        };
+        let sol = HbSolution {
+            coeffs: coeffs.to_vec(),
+            omega_f: opts.omega,
+            harmonics,
+            subharmonic: period,
+            stats,
+        };
+        pd_indicator(&an.hsu(p, &sol, HsuRule::Magnus4).multipliers)
+    };
+    pseudo_arclength(
+        |x: &[f64], r: &mut [f64]| {
+            let mut pp = problem.clone();
+            pp.beta = x[m];
+            res.eval(&pp, &x[..m], opts.omega, 1.0, r)
+        },
+        &x0,
+        None,
+        1.0,
+        &copts,
+        |pt| {
+            p.beta = pt.lambda();
+            let (g, _) = stab(&mut an, &p, &pt.x[..m], n1, 1);
+            let cur = (pt.x.clone(), g);
+            if let Some(pr) = prev.take() {
+                if pr.1 > 0.0 && g <= 0.0 {
+                    bracket = Some((pr, cur));
+                    return false;
+                }
+            }
+            prev = Some(cur);
+            true
+        },
+    )
+    .map_err(|e| HbError::InvalidInput(format!("period-1 continuation: {e}")))?;
+    let ((xa, ga), (xb, gb)) = bracket
+        .ok_or_else(|| HbError::InvalidInput("period-1 branch never reached μ = −1".into()))?;
+    // Secant refinement in β with fixed-β solves.
+    let mut solver = ModifiedIhb::new(problem.clone(), hb1.clone())?;
+    let (mut ba, mut bb, mut fa, mut fb) = (xa[m], xb[m], ga, gb);
+    let mut best = (xb[..m].to_vec(), bb, fb, c64::new(f64::NAN, 0.0));
+    for _ in 0..40 {
+        let beta = bb - fb * (bb - ba) / (fb - fa);
+        solver.problem_mut().beta = beta;
+        let sol = solver.solve(opts.omega, Some(&best.0))?;
+        let (g, mu) = stab(&mut an, solver.problem(), &sol.coeffs, n1, 1);
+        (ba, fa) = (bb, fb);
+        bb = beta;
+        fb = g;
+        best = (sol.coeffs, beta, g, mu);
+        if g.abs() < 1e-10 || (bb - ba).abs() < 1e-12 {
+            break;
+        }
+    }
+    let mut crit = PeriodDoubling {
+        period: 1,
+        beta: best.1,
+        multiplier: best.3,
+        solution: HbSolution {
+            coeffs: best.0,
+            omega_f: opts.omega,
+            harmonics: n1,
+            subharmonic: 1,
+            stats: start.stats,
+        },
+    };
+    out.push(crit.clone());
+    // --- period 2, 4, …: controlled amplitude a_1.
+    let mut period = 1;
+    let mut n = n1;
+    while out.len() < opts.doublings {
+        let (new_period, new_n) = (2 * period, 2 * n);
+        let hb = HbOptions::new(new_n, 4 * new_n).with_subharmonic(new_period);
+        let mut y = embed_subharmonic(&crit.solution.coeffs, 2, new_n);
+        let c = 1; // a_1 of the new lowest harmonic
+        y[c] = crit.beta;
+        let l = y.len();
+        let mut pp = MathieuDuffing::new(opts.xi, opts.alpha, crit.beta, opts.gamma);
+        let mut ctl = Controlled {
+            res: HbResidual::new(&pp, &hb)?,
+            p: pp.clone(),
+            c,
+            omega: opts.omega,
+            q: vec![0.0; l],
+        };
+        let mut an2 = StabilityAnalyzer::new(&pp, new_n, opts.hsu_steps_per_harmonic * new_n)?;
+        // First point: a small prescribed a_1 (scaled to the solution size).
+        let amp = crit
+            .solution
+            .coeffs
+            .iter()
+            .fold(0.0f64, |a, v| a.max(v.abs()));
+        let a_start = 1e-3 * amp;
+        let mut ws = BroydenWorkspace::new(l);
+        let bopts = BroydenOptions {
+            max_iter: 200,
+            max_refreshes: 20,
+            ..BroydenOptions::default()
+        };
+        broyden_solve(
+            &mut |yv: &[f64], r: &mut [f64]| ctl.eval(yv, a_start, r),
+            &mut y,
+            &mut ws,
+            &bopts,
+        )?;
+        let mut x0 = y.clone();
+        x0.push(a_start);
+        let copts = ContinuationOptions {
+            ds: 0.01 * amp,
+            ds_max: 0.02 * amp,
+            lambda_min: 0.0,
+            lambda_max: 10.0 * amp,
+            max_points: 4000,
+            ..ContinuationOptions::default()
+        };
+        let mut prev: Option<(Vec<f64>, f64)> = None;
+        let mut bracket: Option<((Vec<f64>, f64), (Vec<f64>, f64))> = None;
+        // Skip the start region where the new branch's multiplier is still ≈ +1.
+        pseudo_arclength(
+            |x: &[f64], r: &mut [f64]| ctl.eval(&x[..l], x[l], r),
+            &x0,
+            None,
+            1.0,
+            &copts,
+            |pt| {
+                pp.beta = pt.x[c];
+                let mut q = pt.x[..l].to_vec();
+                q[c] = pt.lambda();
+                let (g, _) = stab(&mut an2, &pp, &q, new_n, new_period);
+                let cur = (pt.x.clone(), g);
+                if let Some(pr) = prev.take() {
+                    if pr.1 > 0.0 && g <= 0.0 {
+                        bracket = Some((pr, cur));
+                        return false;
+                    }
+                }
+                prev = Some(cur);
+                true
+            },
+        )
+        .map_err(|e| HbError::InvalidInput(format!("period-{new_period} continuation: {e}")))?;
+        let ((xa, ga), (xb, gb)) = bracket.ok_or_else(|| {
+            HbError::InvalidInput(format!("period-{new_period} branch never reached μ = −1"))
+        })?;
+        // Secant on the controlled amplitude.
+        let (mut aa, mut ab, mut fa, mut fb) = (xa[l], xb[l], ga, gb);
+        let mut yb = xb[..l].to_vec();
+        let mut mu_b = c64::new(f64::NAN, 0.0);
+        for _ in 0..40 {
+            let a = ab - fb * (ab - aa) / (fb - fa);
+            let mut yv = yb.clone();
+            broyden_solve(
+                &mut |v: &[f64], r: &mut [f64]| ctl.eval(v, a, r),
+                &mut yv,
+                &mut ws,
+                &bopts,
+            )?;
+            let (sol, beta) = ctl.solution(&yv, a, new_n, new_period);
+            pp.beta = beta;
+            let (g, mu) = stab(&mut an2, &pp, &sol.coeffs, new_n, new_period);
+            (aa, fa) = (ab, fb);
+            (ab, fb, yb, mu_b) = (a, g, yv, mu);
+            if g.abs() < 1e-10 || (ab - aa).abs() < 1e-14 {
+                break;
+            }
+        }
+        let (sol, beta) = ctl.solution(&yb, ab, new_n, new_period);
+        crit = PeriodDoubling {
+            period: new_period,
+            beta,
+            multiplier: mu_b,
+            solution: sol,
+        };
+        out.push(crit.clone());
+        period = new_period;
+        n = new_n;
+    }
+    Ok(out)
+}

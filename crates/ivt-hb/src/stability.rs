@@ -1,0 +1,224 @@
+//! Stability of HB solutions (§3.2.4): the variational equation Eq. 78 in the
+//! state-space form Eq. 79, `V' = Θ(τ) V` with `V = {δx, δx'}` and
+//!
+//! `Θ = [[0, I], [−M⁻¹(K + G_x)/ω², −M⁻¹(C + G_v)/ω]]`,  `G_x = ∂g/∂x`, `G_v = ∂g/∂v`,
+//!
+//! analysed by Hsu's method (Eq. 80) and by Hill's method; the two must agree.
+//! Classification: stable (all |μ| < 1), fold (a real μ > 1), period doubling (a
+//! real μ < −1), Neimark–Sacker (a complex pair outside the unit circle).
+
+use crate::aft::{Aft, AftError};
+use crate::floquet::{eigenvalues, monodromy_uniform, small_inverse, HsuRule};
+use crate::hill::{fourier_blocks, hill_multipliers, HillError};
+use crate::ihb::HbSolution;
+use crate::problem::PeriodicProblem;
+use faer::c64;
+
+/// What the leading multiplier says.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StabilityKind {
+    /// All multipliers inside the unit circle.
+    Stable,
+    /// A real multiplier beyond +1 (saddle-node / fold side).
+    Fold,
+    /// A real multiplier beyond −1 (period doubling).
+    PeriodDoubling,
+    /// A complex pair outside the unit circle (Neimark–Sacker / secondary Hopf).
+    NeimarkSacker,
+}
+
+impl StabilityKind {
+    /// Short lowercase name for tables and JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Stable => "stable",
+            Self::Fold => "fold",
+            Self::PeriodDoubling => "period_doubling",
+            Self::NeimarkSacker => "neimark_sacker",
+        }
+    }
+}
+
+/// Floquet multipliers and their verdict.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Floquet {
+    /// Multipliers sorted by decreasing modulus.
+    pub multipliers: Vec<c64>,
+    /// Classification of the leading multiplier.
+    pub kind: StabilityKind,
+}
+
+impl Floquet {
+    /// From multipliers (sorted here).
+    pub fn new(mut multipliers: Vec<c64>) -> Self {
+        crate::floquet::sort_by_modulus(&mut multipliers);
+        let kind = classify(&multipliers);
+        Self { multipliers, kind }
+    }
+    /// Largest |μ|.
+    pub fn max_modulus(&self) -> f64 {
+        self.multipliers
+            .first()
+            .map(|m| m.norm())
+            .unwrap_or(f64::NAN)
+    }
+    /// All multipliers strictly inside the unit circle.
+    pub fn stable(&self) -> bool {
+        self.kind == StabilityKind::Stable
+    }
+}
+
+/// Classifies multipliers sorted by decreasing modulus (a multiplier counts as real
+/// when |Im μ| ≤ 1e-7·|μ|).
+pub fn classify(sorted: &[c64]) -> StabilityKind {
+    match sorted.first() {
+        Some(m) if m.norm() >= 1.0 => {
+            if m.im.abs() > 1e-7 * m.norm() {
+                StabilityKind::NeimarkSacker
+            } else if m.re > 0.0 {
+                StabilityKind::Fold
+            } else {
+                StabilityKind::PeriodDoubling
+            }
+        }
+        Some(m) if m.norm().is_nan() => StabilityKind::Fold,
+        _ => StabilityKind::Stable,
+    }
+}
+
+/// Reusable buffers to evaluate Θ(τ) of HB solutions on a uniform grid of
+/// `2·steps` points and run Hsu/Hill on it.
+#[derive(Debug, Clone)]
+pub struct StabilityAnalyzer {
+    aft: Aft,
+    steps: usize,
+    nd: usize,
+    minv: Vec<f64>,
+    theta: Vec<f64>,
+    xs: Vec<f64>,
+    vs: Vec<f64>,
+    xi: Vec<f64>,
+    vi: Vec<f64>,
+    dgx: Vec<f64>,
+    dgv: Vec<f64>,
+    q: Vec<f64>,
+}
+
+impl StabilityAnalyzer {
+    /// For solutions with `harmonics` harmonics, Hsu with `steps` sub-intervals
+    /// (`steps > harmonics`; 256 is enough for flags, 4096 for 1e-9 agreement).
+    ///
+    /// # Errors
+    /// [`AftError`] if `steps ≤ harmonics`. A singular mass matrix gives NaN
+    /// multipliers, which classify as unstable.
+    pub fn new<P: PeriodicProblem>(
+        problem: &P,
+        harmonics: usize,
+        steps: usize,
+    ) -> Result<Self, AftError> {
+        let aft = Aft::new(harmonics, steps)?;
+        let nd = problem.n_dof();
+        let minv = small_inverse(problem.mass(), nd).unwrap_or_else(|_| vec![f64::NAN; nd * nd]);
+        let dim = 2 * nd;
+        let ns = 2 * steps;
+        Ok(Self {
+            aft,
+            steps,
+            nd,
+            minv,
+            theta: vec![0.0; ns * dim * dim],
+            xs: vec![0.0; nd * ns],
+            vs: vec![0.0; nd * ns],
+            xi: vec![0.0; nd],
+            vi: vec![0.0; nd],
+            dgx: vec![0.0; nd * nd],
+            dgv: vec![0.0; nd * nd],
+            q: vec![0.0; dim * dim],
+        })
+    }
+
+    /// Θ(τ_j) on the grid τ_j = 2πj/(2·steps), row-major `2n_dof×2n_dof` each.
+    pub fn theta_samples<P: PeriodicProblem>(&mut self, problem: &P, sol: &HbSolution) -> &[f64] {
+        let nd = self.nd;
+        let dim = 2 * nd;
+        let d2 = dim * dim;
+        let ns = 2 * self.steps;
+        let omega = sol.omega();
+        let p = sol.subharmonic as f64;
+        for d in 0..nd {
+            self.aft
+                .synthesize(sol.dof(d), &mut self.xs[d * ns..(d + 1) * ns]);
+            self.aft
+                .synthesize_derivative(sol.dof(d), 1, &mut self.vs[d * ns..(d + 1) * ns]);
+        }
+        let (c, k) = (problem.damping(), problem.stiffness());
+        for j in 0..ns {
+            for d in 0..nd {
+                self.xi[d] = self.xs[d * ns + j];
+                self.vi[d] = omega * self.vs[d * ns + j];
+            }
+            problem.nonlinear_jacobian(
+                &self.xi,
+                &self.vi,
+                p * self.aft.tau(j),
+                &mut self.dgx,
+                &mut self.dgv,
+            );
+            let th = &mut self.theta[j * d2..(j + 1) * d2];
+            th.fill(0.0);
+            for i in 0..nd {
+                th[i * dim + nd + i] = 1.0;
+                for e in 0..nd {
+                    let (mut sk, mut sc) = (0.0, 0.0);
+                    for l in 0..nd {
+                        sk += self.minv[i * nd + l] * (k[l * nd + e] + self.dgx[l * nd + e]);
+                        sc += self.minv[i * nd + l] * (c[l * nd + e] + self.dgv[l * nd + e]);
+                    }
+                    th[(nd + i) * dim + e] = -sk / (omega * omega);
+                    th[(nd + i) * dim + nd + e] = -sc / omega;
+                }
+            }
+        }
+        &self.theta
+    }
+
+    /// Floquet multipliers by Hsu's method (Eq. 80) with the given rule.
+    pub fn hsu<P: PeriodicProblem>(
+        &mut self,
+        problem: &P,
+        sol: &HbSolution,
+        rule: HsuRule,
+    ) -> Floquet {
+        self.theta_samples(problem, sol);
+        let dim = 2 * self.nd;
+        monodromy_uniform(
+            dim,
+            &self.theta,
+            self.steps,
+            2.0 * std::f64::consts::PI,
+            rule,
+            &mut self.q,
+        );
+        Floquet::new(eigenvalues(&self.q, dim))
+    }
+
+    /// Floquet multipliers by Hill's method with `h` harmonics in the perturbation
+    /// (Θ's Fourier blocks up to `2h` from the same grid).
+    ///
+    /// # Errors
+    /// [`HillError`] if the eigen-solver fails or `2·steps ≤ 4h`.
+    pub fn hill<P: PeriodicProblem>(
+        &mut self,
+        problem: &P,
+        sol: &HbSolution,
+        h: usize,
+    ) -> Result<Floquet, HillError> {
+        self.theta_samples(problem, sol);
+        let dim = 2 * self.nd;
+        let ns = 2 * self.steps;
+        let kmax = (2 * h).min((ns - 1) / 2);
+        let blocks = fourier_blocks(dim, &self.theta, ns, kmax);
+        let res = hill_multipliers(dim, &blocks, h)?;
+        Ok(Floquet::new(res.multipliers))
+    }
+}
