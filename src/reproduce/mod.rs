@@ -388,6 +388,7 @@ fn glyphs(s: &str) -> String {
     s.replace("r̄", "r_bar")
         .replace("Γ̂", "Γ^")
         .replace('§', "Sec. ")
+        .replace('‖', "|")
         .replace('\u{0304}', "_bar")
         .replace('\u{0302}', "^")
 }
