@@ -8,14 +8,19 @@ use std::process::Command;
 /// A log of `n` pulses at PPR 80, 1 MHz, 100 rpm with a period-π/2 ripple,
 /// starting just before the u32 wrap; row 250 carries a NaN V_m reading.
 fn write_log(path: &std::path::Path, n: usize) -> Vec<u32> {
+    write_log_ppr(path, n, 80)
+}
+
+/// As [`write_log`] for an encoder of `ppr` lines (NaN on row 250·ppr/80).
+fn write_log_ppr(path: &std::path::Path, n: usize, ppr: usize) -> Vec<u32> {
     let omega = TAU * 100.0 / 60.0;
     let mut text = String::from("ticks,vm,tu\n");
     let mut ticks = Vec::new();
     for k in 0..n {
-        let th = TAU * k as f64 / 80.0;
+        let th = TAU * k as f64 / ppr as f64;
         let t = (th + 0.1 * (1.0 - (4.0 * th).cos()) / 4.0) / omega;
         let tk = (((t * 1e6).floor() as u64 + 4_294_000_000) & 0xFFFF_FFFF) as u32;
-        let vm = if k == 250 { "NaN" } else { "8.0" };
+        let vm = if k == 250 * ppr / 80 { "NaN" } else { "8.0" };
         text.push_str(&format!("{tk},{vm},8.0\n"));
         ticks.push(tk);
     }
@@ -120,5 +125,66 @@ fn replay_rejects_malformed_logs_and_unknown_ppr() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn replay_laws_and_decimation() {
+    let dir = std::env::temp_dir().join(format!("ivt-ctrl-laws-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let log = dir.join("log.csv");
+    write_log(&log, 400);
+    let path = log.to_str().unwrap();
+    // Open loop: r = u_ol on every pulse, r_d = 0.
+    let v = run(&[
+        "--json", "ctrl", "replay", path, "--ppr", "80", "--law", "open",
+    ]);
+    let (r, r_ol) = (floats(&v, "r"), floats(&v, "r_ol"));
+    assert!(r.iter().zip(&r_ol).all(|(a, b)| a == b));
+    // Eq. 189 without feed-forward: r = r_d ≥ 0, r_ol reported as 0.
+    let v = run(&[
+        "--json",
+        "ctrl",
+        "replay",
+        path,
+        "--ppr",
+        "80",
+        "--law",
+        "prop",
+        "--no-feedforward",
+    ]);
+    assert!(floats(&v, "r_ol").iter().all(|&x| x == 0.0));
+    // Decimation: a 160-line encoder read by `--ppr 80 --decimation 2` sees
+    // the same timestamps at the same angles as the 80-line log, so ω_a
+    // agrees exactly on every second pulse.
+    let log160 = dir.join("log160.csv");
+    write_log_ppr(&log160, 800, 160);
+    let full = floats(
+        &run(&[
+            "--json", "ctrl", "replay", path, "--ppr", "80", "--law", "open",
+        ]),
+        "omega_a",
+    );
+    let dec = floats(
+        &run(&[
+            "--json",
+            "ctrl",
+            "replay",
+            log160.to_str().unwrap(),
+            "--ppr",
+            "80",
+            "--decimation",
+            "2",
+            "--law",
+            "open",
+        ]),
+        "omega_a",
+    );
+    let mut compared = 0;
+    for k in 81..400 {
+        assert_eq!(full[k], dec[2 * k], "k={k}");
+        compared += 1;
+    }
+    assert!(compared > 300);
     std::fs::remove_dir_all(&dir).ok();
 }

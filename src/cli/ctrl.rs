@@ -83,6 +83,10 @@ pub struct ReplayArgs {
     /// T_U \[N·m\] when the log has no tu column.
     #[arg(long, default_value_t = 8.0)]
     pub tu: f32,
+    /// Run the law without the open-loop feed-forward (r = r_d), as the
+    /// driving test of §4.4.3 ran Eq. 189.
+    #[arg(long)]
+    pub no_feedforward: bool,
     /// Stall timeout \[s\].
     #[arg(long, default_value_t = 0.5)]
     pub stall_timeout: f32,
@@ -195,6 +199,7 @@ fn replay(a: &ReplayArgs) -> Result<Output, CliError> {
             ..Gains::from_thesis_mm_per_rad(a.k, a.k2)
         },
         open_loop: THESIS,
+        feedforward: !a.no_feedforward,
         stall_timeout_s: a.stall_timeout,
         ..Config::default()
     };

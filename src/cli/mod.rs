@@ -8,10 +8,12 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+pub mod bench;
 pub mod ctrl;
 pub mod kin;
 pub mod ol;
 pub mod reproduce;
+pub mod sim;
 pub mod stability;
 
 /// Result of a command: the JSON object for `--json` and the text for humans.
@@ -59,6 +61,11 @@ enum Command {
     Stability(stability::StabilityArgs),
     /// Max |multiplier| over a grid (Fig. 42 analogue).
     StabilityMap(stability::MapArgs),
+    /// Simulate a scene (TOML): plant, sensors, controller, outputs.
+    Sim(sim::SimArgs),
+    /// Benchmarks (work–precision of the plant integrators).
+    #[command(subcommand)]
+    Bench(bench::BenchCommand),
     /// The rig controller (ivt-ctrl): offline replay of pulse logs.
     #[command(subcommand)]
     Ctrl(ctrl::CtrlCommand),
@@ -76,7 +83,9 @@ pub fn main() -> ExitCode {
         Some(Command::StabilityMap(a)) => stability::run_map(a),
         Some(Command::Ctrl(cmd)) => ctrl::run(cmd),
         Some(Command::Reproduce(args)) => reproduce::run(args, cli.json),
-        None => kin::summary(),
+        Some(Command::Sim(args)) => sim::run_file(&args, cli.json),
+        Some(Command::Bench(cmd)) => bench::run(cmd),
+        None => sim::run_default(cli.json),
     };
     match result {
         Ok(out) => {

@@ -94,6 +94,7 @@ pub struct StepGenerator {
     delay: f32,
     last_step: u32,
     dir: i8,
+    stepped: bool,
     c0: f32,
     c_min: f32,
 }
@@ -103,6 +104,30 @@ impl StepGenerator {
     /// give a generator that never steps (the controller reports the config fault).
     #[must_use]
     pub fn new(limits: StepperLimits, f_timer_hz: f32) -> Self {
+        let mut g = Self::unconfigured();
+        g.configure(limits, f_timer_hz);
+        g
+    }
+
+    /// A generator at position 0 that never steps until [`Self::configure`].
+    #[must_use]
+    pub const fn unconfigured() -> Self {
+        Self {
+            position: 0,
+            target: 0,
+            n: 0,
+            delay: f32::INFINITY,
+            last_step: 0,
+            dir: 0,
+            stepped: false,
+            c0: f32::INFINITY,
+            c_min: f32::INFINITY,
+        }
+    }
+
+    /// Set limits and timer in place; keeps the position and target, drops
+    /// any ramp in progress (the next step starts from rest).
+    pub fn configure(&mut self, limits: StepperLimits, f_timer_hz: f32) {
         let (c0, c_min) = if limits.is_valid() && f_timer_hz.is_finite() && f_timer_hz > 0.0 {
             let c_min = f_timer_hz / limits.max_speed;
             // First delay from rest: 0.676·f·sqrt(2/a) (Austin's correction).
@@ -111,16 +136,12 @@ impl StepGenerator {
         } else {
             (f32::INFINITY, f32::INFINITY)
         };
-        Self {
-            position: 0,
-            target: 0,
-            n: 0,
-            delay: c0,
-            last_step: 0,
-            dir: 0,
-            c0,
-            c_min,
-        }
+        self.c0 = c0;
+        self.c_min = c_min;
+        self.delay = c0;
+        self.n = 0;
+        self.dir = 0;
+        self.stepped = false;
     }
 
     /// Current position \[steps\].
@@ -165,7 +186,13 @@ impl StepGenerator {
             if self.position == self.target {
                 return self.decision(false);
             }
+            // From rest the last step must be at least c0 ago (the start-stop
+            // rate), so a reversal never steps back at speed.
+            if self.stepped && now.wrapping_sub(self.last_step) < self.delay_ticks() {
+                return self.decision(false);
+            }
             // Start from rest: first step now, then wait c0.
+            self.stepped = true;
             self.dir = if self.target > self.position { 1 } else { -1 };
             self.n = 0;
             self.delay = self.c0;

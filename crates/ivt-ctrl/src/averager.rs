@@ -178,6 +178,20 @@ pub struct Targets {
 }
 
 impl Targets {
+    /// Placeholder of an unconfigured controller (errors read 0 for any count).
+    pub const NONE: Self = Self {
+        pulse: TargetTicks {
+            int: 0,
+            frac: 0.0,
+            omega0: 0.0,
+        },
+        revolution: TargetTicks {
+            int: 0,
+            frac: 0.0,
+            omega0: 0.0,
+        },
+    };
+
     /// `ω_a − ω0` for a revolution of `revolution_ticks`.
     #[inline]
     #[must_use]
@@ -197,16 +211,31 @@ impl<const PPR: usize> AngleAverager<PPR> {
     /// An empty averager for a timer of `f_timer_hz`.
     #[must_use]
     pub fn new(f_timer_hz: f32) -> Self {
-        let two_pi_f = core::f32::consts::TAU * f_timer_hz;
+        let mut a = Self::unconfigured();
+        a.configure(f_timer_hz);
+        a
+    }
+
+    /// An empty averager with no timer yet (speeds read 0 until
+    /// [`Self::configure`]); `const` so that it can initialize a `static`.
+    #[must_use]
+    pub const fn unconfigured() -> Self {
         Self {
             ring: [0; PPR],
             head: 0,
             last: 0,
             older: 0,
             seen: 0,
-            two_pi_f,
-            dtheta_f: two_pi_f / Self::ppr_f32(),
+            two_pi_f: 0.0,
+            dtheta_f: 0.0,
         }
+    }
+
+    /// Set the timer frequency and forget all history, in place.
+    pub fn configure(&mut self, f_timer_hz: f32) {
+        self.two_pi_f = core::f32::consts::TAU * f_timer_hz;
+        self.dtheta_f = self.two_pi_f / Self::ppr_f32();
+        self.reset();
     }
 
     fn ppr_f32() -> f32 {

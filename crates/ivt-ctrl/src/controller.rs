@@ -282,54 +282,44 @@ pub struct Controller<const PPR: usize> {
 impl<const PPR: usize> Controller<PPR> {
     /// A controller for `config`. An invalid config gives a controller in the
     /// permanent `Fault::Config` safe state (never a panic).
+    ///
+    /// This returns the ~5 KiB controller by value; firmware that keeps it in
+    /// a `static` should use [`Controller::unconfigured`] as the static's
+    /// initializer and [`Controller::reset`] at boot (no stack copy).
     #[must_use]
     pub fn new(config: Config) -> Self {
-        let config_ok = config.is_valid(PPR);
-        let f = config.f_timer_hz;
-        let samples = PPR as f32 * f32::from(config.decimation.max(1));
-        let dtheta_enc = core::f32::consts::TAU / samples;
-        // Shortest accepted interval: a pulse at omega_max. Longest: the stall
-        // timeout, and at most u32::MAX/(PPR+1)·decimation so one revolution
-        // always spans fewer than 2³² ticks (wrapping differences stay exact).
-        let min_interval = ((f * dtheta_enc / config.omega_max) as u32).max(1);
-        let rev_cap = u32::MAX
-            / (PPR as u32)
-                .saturating_add(1)
-                .saturating_mul(u32::from(config.decimation.max(1)));
-        let stall = (config.stall_timeout_s * f) as u32;
-        let max_interval = stall.min(rev_cap).min(0x7FFF_FFFF).max(min_interval);
-        let period = (config.gains.prop_period_s * f) as u32;
-        let law = match config.law {
-            LawKind::Delay => LawState::Delay(DelayLaw {
-                k: config.gains.k,
-                k2: config.gains.k2,
-            }),
-            LawKind::NoDelay => LawState::NoDelay(NoDelayLaw {
-                k: config.gains.k,
-                k2: config.gains.k2,
-            }),
-            LawKind::Prop => LawState::Prop(PropLaw::new(config.gains.k_prop, period)),
-            LawKind::Open => LawState::Open(NoFeedback),
-        };
-        let mut c = Self {
-            averager: AngleAverager::new(f),
-            law,
-            stepper: StepGenerator::new(config.stepper, f),
-            open_loop: config.open_loop,
-            actuator: config.actuator,
+        let mut c = Self::unconfigured();
+        c.reset(config);
+        c
+    }
+
+    /// A controller with no configuration yet, usable as a `static`
+    /// initializer: it is in the `Fault::Config` safe state (r = 0, no steps)
+    /// until [`Controller::reset`] gives it a valid [`Config`].
+    #[must_use]
+    pub const fn unconfigured() -> Self {
+        Self {
+            averager: AngleAverager::unconfigured(),
+            law: LawState::Open(NoFeedback),
+            stepper: StepGenerator::unconfigured(),
+            open_loop: THESIS,
+            actuator: ActuatorMap {
+                steps_per_metre: 0.0,
+                offset_steps: 0,
+            },
             r_d: 0.0,
             r_d_comp: 0.0,
-            targets: AngleAverager::<PPR>::targets(f, config.omega0),
-            dtheta: core::f32::consts::TAU / (PPR.max(1) as f32),
-            safe_r: config.safe_r,
-            v_m_valid: config.v_m_valid,
-            t_u_valid: config.t_u_valid,
-            min_interval,
-            max_interval,
-            decimation: config.decimation.max(1),
+            targets: Targets::NONE,
+            dtheta: 0.0,
+            safe_r: 0.0,
+            v_m_valid: [0.0; 2],
+            t_u_valid: [0.0; 2],
+            min_interval: 1,
+            max_interval: 1,
+            decimation: 1,
             skip: 0,
-            feedforward: config.feedforward,
-            config_ok,
+            feedforward: false,
+            config_ok: false,
             running: false,
             stalled: false,
             input_fault: false,
@@ -344,20 +334,72 @@ impl<const PPR: usize> Controller<PPR> {
                 r: 0.0,
                 stepper_target: 0,
                 saturated: false,
-                fault: Fault::None,
+                fault: Fault::Config,
                 ready: false,
                 inputs_clamped: false,
                 ol_region: OlRegion::Normal,
             },
-        };
-        let [v, t] = config.initial_inputs;
-        c.set_inputs(v, t);
-        if config_ok {
-            c.command(Fault::None);
-        } else {
-            c.enter_safe(Fault::Config);
         }
-        c
+    }
+
+    /// (Re)configure in place: forget the pulse history, the law state and
+    /// r_d, and start over as [`Controller::new`] would — without building a
+    /// second controller (the timestamp ring is not touched, only marked
+    /// empty). The stepper keeps its physical position but stops its ramp
+    /// (the next move starts from rest).
+    pub fn reset(&mut self, config: Config) {
+        let config_ok = config.is_valid(PPR);
+        let f = config.f_timer_hz;
+        let decimation = config.decimation.max(1);
+        let samples = PPR as f32 * f32::from(decimation);
+        let dtheta_enc = core::f32::consts::TAU / samples;
+        // Shortest accepted interval: a pulse at omega_max. Longest: the stall
+        // timeout, and at most u32::MAX/(PPR+1)·decimation so one revolution
+        // always spans fewer than 2³² ticks (wrapping differences stay exact).
+        let min_interval = ((f * dtheta_enc / config.omega_max) as u32).max(1);
+        let rev_cap = u32::MAX
+            / (PPR as u32)
+                .saturating_add(1)
+                .saturating_mul(u32::from(decimation));
+        let stall = (config.stall_timeout_s * f) as u32;
+        let period = (config.gains.prop_period_s * f) as u32;
+        let (k, k2) = (config.gains.k, config.gains.k2);
+        self.law = match config.law {
+            LawKind::Delay => LawState::Delay(DelayLaw { k, k2 }),
+            LawKind::NoDelay => LawState::NoDelay(NoDelayLaw { k, k2 }),
+            LawKind::Prop => LawState::Prop(PropLaw::new(config.gains.k_prop, period)),
+            LawKind::Open => LawState::Open(NoFeedback),
+        };
+        self.averager.configure(f);
+        self.stepper.configure(config.stepper, f);
+        self.open_loop = config.open_loop;
+        self.actuator = config.actuator;
+        self.r_d = 0.0;
+        self.r_d_comp = 0.0;
+        self.targets = AngleAverager::<PPR>::targets(f, config.omega0);
+        self.dtheta = core::f32::consts::TAU / (PPR.max(1) as f32);
+        self.safe_r = config.safe_r;
+        self.v_m_valid = config.v_m_valid;
+        self.t_u_valid = config.t_u_valid;
+        self.min_interval = min_interval;
+        self.max_interval = stall.min(rev_cap).min(0x7FFF_FFFF).max(min_interval);
+        self.decimation = decimation;
+        self.skip = 0;
+        self.feedforward = config.feedforward;
+        self.config_ok = config_ok;
+        self.running = false;
+        self.stalled = false;
+        self.input_fault = false;
+        self.last_raw = 0;
+        self.omega_prev = 0.0;
+        self.out = Self::unconfigured().out;
+        let [v, t] = config.initial_inputs;
+        self.set_inputs(v, t);
+        if config_ok {
+            self.command(Fault::None);
+        } else {
+            self.enter_safe(Fault::Config);
+        }
     }
 
     /// r_max of the open-loop coefficient set \[m\].

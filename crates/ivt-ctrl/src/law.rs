@@ -25,9 +25,9 @@ pub struct PulseSample {
     /// ω_T, ω one revolution earlier \[rad/s\].
     pub omega_t: f32,
     /// ω_a − ω0 \[rad/s\], formed without the f32 bias of ω_a
-    /// ([`crate::AngleAverager::omega_a_error`]); `.get()` evaluates it.
+    /// ([`crate::Targets::omega_a_error`]); `.get()` evaluates it.
     pub omega_a_err: SpeedError,
-    /// ω − ω0 \[rad/s\], likewise ([`crate::AngleAverager::omega_error`]).
+    /// ω − ω0 \[rad/s\], likewise ([`crate::Targets::omega_error`]).
     pub omega_err: SpeedError,
     /// Angle step of one (decimated) pulse, 2π/PPR \[rad\].
     pub dtheta: f32,

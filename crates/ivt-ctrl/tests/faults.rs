@@ -262,3 +262,30 @@ proptest! {
         }
     }
 }
+
+/// `unconfigured()` is a `const` (a firmware `static` initializer) in the
+/// config-fault safe state; `reset` in place behaves exactly like `new`,
+/// also after the controller has run.
+#[test]
+fn reset_in_place_equals_new() {
+    const IDLE: Controller<80> = Controller::unconfigured();
+    let mut c = IDLE;
+    let o = c.on_pulse(100);
+    assert_eq!((o.fault, o.r), (Fault::Config, 0.0));
+    assert!(!c.step_tick(200).step);
+
+    let mut fresh = Controller::<80>::new(cfg());
+    c.reset(cfg());
+    spin(&mut c, 0, 500);
+    let mut run_a = Vec::new();
+    let mut run_b = Vec::new();
+    // Reset again after running, then compare pulse by pulse with a new one.
+    c.reset(cfg());
+    let mut t = 1_000_000u32;
+    for k in 0..300u32 {
+        t = t.wrapping_add(7000 + (k % 7) * 13);
+        run_a.push(c.on_pulse(t));
+        run_b.push(fresh.on_pulse(t));
+    }
+    assert_eq!(run_a, run_b);
+}

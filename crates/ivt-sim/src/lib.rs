@@ -1,1 +1,14 @@
-//! Plant integration, sensors and actuators, closed loop with ivt-ctrl, scenes and MCAP logs. Being built under issue 6; nothing here yet.
+#![doc = include_str!("../README.md")]
+
+pub mod backend;
+pub mod integrate;
+pub mod ode;
+pub mod output;
+pub mod plant;
+pub mod plot;
+pub mod profile;
+pub mod progress;
+pub mod run;
+pub mod scene;
+pub mod sensors;
+pub mod work_precision;

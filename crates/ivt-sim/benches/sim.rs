@@ -1,0 +1,57 @@
+//! Hot paths of the simulator (divan): the default 60 s drive scene at PPR
+//! 1200 (target: ≥ 1000× real time, i.e. ≤ 60 ms, with MCAP on), and one
+//! open-loop angle-domain solve of the work–precision problem.
+
+use ivt_sim::integrate::Method;
+use ivt_sim::ode::Tolerance;
+use ivt_sim::scene::Scene;
+
+fn main() {
+    divan::main();
+}
+
+fn drive() -> Scene {
+    let src = include_str!("../../../scenes/drive.toml");
+    Scene::parse(src, "drive.toml").expect("shipped scene parses")
+}
+
+/// The closed loop alone (no channels, no files).
+#[divan::bench(sample_count = 10)]
+fn drive_60s_no_outputs(b: divan::Bencher) {
+    let mut s = drive();
+    s.outputs = Default::default();
+    b.bench(|| ivt_sim::run::run(&s, &mut |_| {}).expect("runs"));
+}
+
+/// What `cargo run --release` does: channels recorded, MCAP + summary + PNG written.
+#[divan::bench(sample_count = 10)]
+fn drive_60s_with_mcap_and_png(b: divan::Bencher) {
+    let s = drive();
+    let dir = std::env::temp_dir().join("ivt-sim-bench");
+    b.bench(|| {
+        let r = ivt_sim::run::run(&s, &mut |_| {}).expect("runs");
+        ivt_sim::output::write_all(&dir, &s, &r).expect("writes")
+    });
+}
+
+/// MCAP only (no PNG): the acceptance configuration.
+#[divan::bench(sample_count = 10)]
+fn drive_60s_with_mcap(b: divan::Bencher) {
+    let mut s = drive();
+    s.outputs.plots.clear();
+    let dir = std::env::temp_dir().join("ivt-sim-bench-mcap");
+    b.bench(|| {
+        let r = ivt_sim::run::run(&s, &mut |_| {}).expect("runs");
+        ivt_sim::output::write_all(&dir, &s, &r).expect("writes")
+    });
+}
+
+/// Work–precision problem, DP5 at rtol = atol = 1e-8 (≈ 100 rad of θ).
+#[divan::bench]
+fn open_loop_dp5_1e8() -> (f64, u64) {
+    let tol = Tolerance {
+        rtol: 1e-8,
+        atol: 1e-8,
+    };
+    ivt_sim::work_precision::solve(&ivt_sim::work_precision::PROBLEM, Method::Dp5(tol))
+}
