@@ -3,7 +3,7 @@
 //! (Fig. 38), Γ̂ of §4.2.2 (Fig. 40), and the stability of the time-delay
 //! loop (Fig. 42 and its two example multipliers).
 
-use super::{fmt_sig, Context, ReproError, Verdict};
+use super::{fmt_sig, Context, OwnedSeries, ReproError, Verdict};
 use ivt_hb::ivt::delay::{delay_stability, DelayOptions, FeedbackGains};
 use ivt_hb::ivt::fit::{self, OpenLoopLaw, PolyForm};
 use ivt_hb::ivt::gains::stability_map;
@@ -141,7 +141,7 @@ fn steady_row_and_fig39(ctx: &mut Context, plant: &PlantParams) -> Result<(), Re
         }
     }
     // Fig. 39: ω over one revolution, IHB vs an independent RK4 in θ.
-    let mut series_data: Vec<(String, Vec<(f64, f64)>, Style)> = Vec::new();
+    let mut series_data: Vec<OwnedSeries> = Vec::new();
     let deg = 180.0 / PI;
     let to_rpm = |pts: Vec<(f64, f64)>| -> Vec<(f64, f64)> {
         pts.into_iter()
@@ -321,7 +321,7 @@ fn figs_38_40(
     )?;
     let t_line = [1.5, 9.0];
     let printed: Vec<(f64, f64)> = t_line.iter().map(|&t| (t, 1.579 * t + 0.632)).collect();
-    let mut series_data: Vec<(String, Vec<(f64, f64)>, Style)> =
+    let mut series_data: Vec<OwnedSeries> =
         vec![("f_B = 0 printed (Eq. 159)".into(), printed, Style::Dashed)];
     if let Some(l) = law {
         let ours: Vec<(f64, f64)> = t_line
@@ -354,7 +354,7 @@ fn figs_38_40(
     )?;
 
     // Fig. 40: Γ̂ = 0 against f_B = 0, for the printed and the refitted r_f.
-    let mut series_data: Vec<(String, Vec<(f64, f64)>, Style)> = Vec::new();
+    let mut series_data: Vec<OwnedSeries> = Vec::new();
     let laws: Vec<(&str, OpenLoopLaw)> =
         std::iter::once(("printed r_f (Eq. 158)", OpenLoopLaw::thesis()))
             .chain(law.map(|l| ("refit r_f", *l)))

@@ -1,7 +1,7 @@
 //! Chapter 2 and §4.1: plant constants (Table 1), Eq. 42, R_avg slope
 //! (§4.4.2), and Figs. 9, 10, 11, 23(a), 24, 37, 47, 48 (theoretical curves).
 
-use super::{fmt_sig, Context, ReproError};
+use super::{fmt_sig, Context, OwnedSeries, Points, ReproError};
 use ivt_kin::givt::GivtGeometry;
 use ivt_kin::ncg::{
     fourier_coefficient, fourier_coefficient_eq38, output_ripple, pitch_profile, GearRatio,
@@ -187,7 +187,7 @@ fn givt_figures(ctx: &mut Context) -> Result<(), ReproError> {
 
     // Fig. 10: reduced ratio without and with the gears designed for r_o = 10 mm.
     let ncg = GivtNcg::new(g, 0.010);
-    let mut series_data: Vec<(String, Vec<(f64, f64)>, Style)> = Vec::new();
+    let mut series_data: Vec<OwnedSeries> = Vec::new();
     for r_mm in [10.0, 5.0] {
         let r = r_mm * 1e-3;
         let without = curve(linspace(0.0, PI, n), |t| g.reduced_ratio(t, r), deg, 1.0);
@@ -264,7 +264,7 @@ fn profile_xy<G: GearRatio>(
     d: f64,
     n: usize,
     x_offset: f64,
-) -> Result<(Vec<(f64, f64)>, Vec<(f64, f64)>, ivt_kin::ncg::ProfileCheck), ReproError> {
+) -> Result<(Points, Points, ivt_kin::ncg::ProfileCheck), ReproError> {
     let mut pts = vec![PitchPoint::default(); n];
     let check = pitch_profile(gear, d, &mut pts).map_err(|e| ReproError::Numeric(e.to_string()))?;
     let ng2 = pts

@@ -21,6 +21,13 @@ use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+/// A curve's (x, y) points in plot units.
+pub(crate) type Points = Vec<(f64, f64)>;
+
+/// A series whose label and points the chapter owns (borrowed into
+/// [`ivt_plot::Series`] when drawn).
+pub(crate) type OwnedSeries = (String, Points, ivt_plot::Style);
+
 /// How a thesis number compares with ours.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]

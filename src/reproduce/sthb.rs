@@ -1,7 +1,7 @@
 //! §3.3: frequency–response curves of the nonlinear string by STHB
 //! (Figs. 34–36; c_d = 0.8, y0 = 0.5, M = 19, N_s = 64, M_s = 128).
 
-use super::{Context, ReproError};
+use super::{Context, Points, ReproError};
 use ivt_hb::sthb::continuation::{frequency_response, ContinuationOptions, Frc};
 use ivt_hb::sthb::{Boundary, StringHb, StringParams};
 use ivt_plot::{Figure, Series, Style};
@@ -26,7 +26,7 @@ fn curve(params: StringParams, stability: bool) -> Result<Frc, String> {
 }
 
 /// (all points, unstable points with NaN gaps elsewhere).
-fn split(frc: &Frc) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
+fn split(frc: &Frc) -> (Points, Points) {
     let all = frc.points.iter().map(|p| (p.omega, p.norm)).collect();
     let unstable = frc
         .points
