@@ -11,3 +11,4 @@ pub use ivt_ctrl as ctrl;
 pub use ivt_kin as kin;
 
 pub mod cli;
+pub mod reproduce;

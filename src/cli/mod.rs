@@ -13,6 +13,7 @@ pub mod ctrl;
 pub mod hb;
 pub mod kin;
 pub mod ol;
+pub mod reproduce;
 pub mod rig;
 pub mod sim;
 pub mod stability;
@@ -77,6 +78,8 @@ enum Command {
     /// The rig: record firmware telemetry into MCAP.
     #[command(subcommand)]
     Rig(rig::RigCommand),
+    /// Regenerate the thesis's computable figures and numbers (REPRODUCTION.md).
+    Reproduce(reproduce::ReproduceArgs),
 }
 
 /// Parse the process arguments, run, print, and map errors to exit codes.
@@ -92,6 +95,7 @@ pub fn main() -> ExitCode {
         Some(Command::Ctrl(cmd)) => ctrl::run(cmd),
         Some(Command::Rig(cmd)) => rig::run(cmd),
         Some(Command::Hb(cmd)) => hb::run(cmd),
+        Some(Command::Reproduce(args)) => reproduce::run(args, cli.json),
         None => sim::run_default(cli.json),
     };
     match result {

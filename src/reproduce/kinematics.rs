@@ -1,0 +1,455 @@
+//! Chapter 2 and §4.1: plant constants (Table 1), Eq. 42, R_avg slope
+//! (§4.4.2), and Figs. 9, 10, 11, 23(a), 24, 37, 47, 48 (theoretical curves).
+
+use super::{fmt_sig, Context, OwnedSeries, Points, ReproError};
+use ivt_kin::givt::GivtGeometry;
+use ivt_kin::ncg::{
+    fourier_coefficient, fourier_coefficient_eq38, output_ripple, pitch_profile, GearRatio,
+    GivtNcg, PitchPoint, SgivtNcg, SmoothNcg, EQ42_PRINTED,
+};
+use ivt_kin::plant::PlantParams;
+use ivt_kin::sgivt::{SgivtGeometry, R_AVG_SLOPE_PRINTED_PER_DEG};
+use ivt_kin::units::{deg_to_rad, inch_to_m};
+use ivt_kin::variant;
+use ivt_plot::{Figure, Series, Style};
+use std::f64::consts::PI;
+
+/// Caveat for every GIVT figure: two lengths are not printed.
+const GIVT_CAVEAT: &str = "GIVT l1 and r_output are not printed in the thesis; drawn with the \
+illustrative l1 = 50 mm, r_output = 15 mm (ivt-kin GivtGeometry::illustrative), so the \
+shape follows Eq. 8–17 but the numbers are not the thesis's";
+
+pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
+    ctx.step("kinematics: plant constants, Eq. 42");
+    plant_rows(ctx);
+    eq42_rows(ctx);
+    r_avg_row(ctx);
+    ctx.step("kinematics: figures");
+    givt_figures(ctx)?;
+    sgivt_figures(ctx)?;
+    Ok(())
+}
+
+fn plant_rows(ctx: &mut Context) {
+    let p = PlantParams::printed();
+    let how = "from Table 1 by the §4.1 definitions (ivt-kin PlantParams)";
+    let why = "Table 1 parameters through the §4.1 formulas do not give the printed digit";
+    let rows: [(&str, f64, f64, f64, usize); 6] = [
+        ("J_a [kg·m²]", 0.0237, p.j_a(), 5e-5, 4),
+        ("J_b [kg]", 2.1264, p.j_b(), 5e-5, 5),
+        ("J_c [kg]", 0.3388, p.j_c(), 5e-5, 4),
+        (
+            "F_m / f² = k_t k_e/R_a [N·m·s]",
+            2.375,
+            p.motor_damping(),
+            5e-4,
+            4,
+        ),
+        (
+            "f1 / (f V_m) = k_t/R_a [N·m/V]",
+            3.1667,
+            p.motor_gain(),
+            5e-5,
+            5,
+        ),
+        (
+            "f2 / (f T_U) = 2√2/(π r_u) [1/m]",
+            40.5548,
+            p.load_gain(),
+            5e-5,
+            6,
+        ),
+    ];
+    for (q, thesis, ours, half, sig) in rows {
+        ctx.compare(q, thesis, "§4.1 after Eq. 151", ours, half, sig, how, why);
+    }
+}
+
+fn eq42_rows(ctx: &mut Context) {
+    for k in 1..=4u32 {
+        let printed = EQ42_PRINTED[k as usize - 1];
+        let exact = fourier_coefficient_eq38(k);
+        let quad = fourier_coefficient(&SgivtNcg, k).unwrap_or(f64::NAN);
+        // Half a unit of the last printed digit (0.12 → 0.005, −0.0286 → 5e-5, ...).
+        let half = [0.005, 5e-5, 5e-5, 5e-4][k as usize - 1];
+        let why = format!(
+            "the printed value is 0.9× the Fourier coefficient of Eq. 38: closed form \
+             2(−1)^(k+1)/(16k²−1) = {}, quadrature of Eq. 38 = {} (agree to {:.0e}); \
+             0.9 × exact = {} rounds to the printed digits; the cosine basis is orthogonal, \
+             so no least-squares fit gives the printed numbers",
+            fmt_sig(exact, 6),
+            fmt_sig(quad, 12),
+            (quad - exact).abs().max(1e-16),
+            fmt_sig(0.9 * exact, 4)
+        );
+        ctx.compare(
+            &format!("Eq. 42 a{k} (coefficient of cos {}θ_in)", 4 * k),
+            printed,
+            "Eq. 42",
+            exact,
+            half,
+            6,
+            "Fourier coefficient of Eq. 38",
+            &why,
+        );
+    }
+}
+
+fn r_avg_row(ctx: &mut Context) {
+    let g = SgivtGeometry::prototype();
+    let slope = match g.average_ratio_from_stepper(deg_to_rad(1.0)) {
+        Ok(v) => v,
+        Err(e) => {
+            ctx.not_computable("R_avg slope [1/deg]", "7/27492 (§4.4.2)", &e.to_string());
+            return;
+        }
+    };
+    // 27492 is an integer rounding of 77760/(2√2) = 27492.4: half a unit in
+    // the denominator is the printed precision.
+    let half = 7.0 / 27491.5 - R_AVG_SLOPE_PRINTED_PER_DEG;
+    ctx.compare(
+        "R_avg slope [1/deg]",
+        R_AVG_SLOPE_PRINTED_PER_DEG,
+        "7/27492, §4.4.2",
+        slope,
+        half,
+        6,
+        "(2√2/π)(7π/51840)/r_OG through the gear chain Eq. 182–185; 27492 is 77760/(2√2) = 27492.4 rounded",
+        "slope through the gear chain differs from 7/27492",
+    );
+}
+
+fn linspace(a: f64, b: f64, n: usize) -> impl Iterator<Item = f64> {
+    (0..n).map(move |i| a + (b - a) * i as f64 / (n - 1) as f64)
+}
+
+fn curve(
+    xs: impl Iterator<Item = f64>,
+    f: impl Fn(f64) -> Result<f64, ivt_kin::KinError>,
+    x_scale: f64,
+    y_scale: f64,
+) -> Vec<(f64, f64)> {
+    xs.map(|x| (x * x_scale, f(x).map_or(f64::NAN, |y| y * y_scale)))
+        .collect()
+}
+
+fn givt_figures(ctx: &mut Context) -> Result<(), ReproError> {
+    let g = GivtGeometry::illustrative();
+    let deg = 180.0 / PI;
+    let n = if ctx.quick() { 181 } else { 721 };
+    let r = 0.010;
+    let single = curve(
+        linspace(0.0, 2.0 * PI, n),
+        |t| g.single_ratio(t, r),
+        deg,
+        1.0,
+    );
+    let module = curve(
+        linspace(0.0, 2.0 * PI, n),
+        |t| g.module_ratio(t, r),
+        deg,
+        1.0,
+    );
+    ctx.line_figure(
+        "Fig. 9(a)",
+        &Figure {
+            title: "Fig. 9(a): crank-slider and module speed ratios, r = 10 mm (illustrative l1, r_output)",
+            x_label: "crank angle θ [deg]",
+            y_label: "speed ratio [-]",
+            series: vec![
+                Series { label: "single crank-slider R1 (Eq. 8)", points: &single, style: Style::Dashed },
+                Series { label: "motion conversion module R (Eq. 9)", points: &module, style: Style::Line },
+            ],
+        },
+        GIVT_CAVEAT,
+    )?;
+    let nr = if ctx.quick() { 21 } else { 61 };
+    let avg = curve(
+        linspace(0.0, 0.030, nr),
+        |r| g.average_final_ratio(r),
+        1e3,
+        1.0,
+    );
+    ctx.line_figure(
+        "Fig. 9(b)",
+        &Figure {
+            title: "Fig. 9(b): average speed ratio of the GIVT, F = 3R (illustrative l1, r_output)",
+            x_label: "eccentricity r [mm]",
+            y_label: "average output/input speed ratio [-]",
+            series: vec![Series {
+                label: "⟨F(θ, r)⟩ (Eq. 10)",
+                points: &avg,
+                style: Style::Line,
+            }],
+        },
+        GIVT_CAVEAT,
+    )?;
+
+    // Fig. 10: reduced ratio without and with the gears designed for r_o = 10 mm.
+    let ncg = GivtNcg::new(g, 0.010);
+    let mut series_data: Vec<OwnedSeries> = Vec::new();
+    for r_mm in [10.0, 5.0] {
+        let r = r_mm * 1e-3;
+        let without = curve(linspace(0.0, PI, n), |t| g.reduced_ratio(t, r), deg, 1.0);
+        series_data.push((
+            format!("without gears, r = {r_mm} mm"),
+            without,
+            Style::Dashed,
+        ));
+        if let Ok(ncg) = &ncg {
+            // θ' = θ/3; normalise by the sampled mean over whole periods.
+            let raw: Vec<(f64, f64)> = curve(
+                linspace(0.0, PI, n),
+                |t| ncg.output_to_ng1(t / 3.0, r),
+                deg,
+                1.0,
+            );
+            let m = raw[..n - 1].iter().map(|p| p.1).sum::<f64>() / (n - 1) as f64;
+            let with: Vec<(f64, f64)> = raw.iter().map(|&(x, y)| (x, y / m)).collect();
+            series_data.push((
+                format!("with gears (r_o = 10 mm), r = {r_mm} mm"),
+                with,
+                Style::Line,
+            ));
+        }
+    }
+    let series = series_data
+        .iter()
+        .map(|(l, p, s)| Series {
+            label: l,
+            points: p,
+            style: *s,
+        })
+        .collect();
+    ctx.line_figure(
+        "Fig. 10",
+        &Figure {
+            title: "Fig. 10: reduced speed ratios with and without noncircular gears (illustrative l1, r_output)",
+            x_label: "crank angle θ [deg]",
+            y_label: "speed ratio / its mean [-]",
+            series,
+        },
+        GIVT_CAVEAT,
+    )?;
+
+    match ncg {
+        Ok(ncg) => {
+            let (ng2, ng1, check) = profile_xy(&ncg, 0.010, n, 0.0)?;
+            let note = format!(
+                "{GIVT_CAVEAT}. Profile closure {:.1e} rad, centre-distance error {:.1e} m",
+                check.closure_error, check.max_centre_distance_error
+            );
+            ctx.line_figure(
+                "Fig. 11",
+                &Figure {
+                    title: "Fig. 11: pitch profiles of NG1 and NG2, D = 10 mm (illustrative l1, r_output)",
+                    x_label: "x [mm]",
+                    y_label: "y [mm]",
+                    series: vec![
+                        Series { label: "NG2 (on the GIVT input)", points: &ng2, style: Style::Line },
+                        Series { label: "NG1 (on the engine)", points: &ng1, style: Style::Line },
+                    ],
+                },
+                &note,
+            )?;
+        }
+        Err(e) => ctx.missing_figure("Fig. 11", "pitch profiles of NG1 and NG2", &e.to_string()),
+    }
+    Ok(())
+}
+
+/// Pitch curves in mm: NG2 centred at the origin, NG1 centred at (x_offset, 0).
+fn profile_xy<G: GearRatio>(
+    gear: &G,
+    d: f64,
+    n: usize,
+    x_offset: f64,
+) -> Result<(Points, Points, ivt_kin::ncg::ProfileCheck), ReproError> {
+    let mut pts = vec![PitchPoint::default(); n];
+    let check = pitch_profile(gear, d, &mut pts).map_err(|e| ReproError::Numeric(e.to_string()))?;
+    let ng2 = pts
+        .iter()
+        .map(|p| {
+            (
+                1e3 * p.r_driven * p.theta_driven.cos(),
+                1e3 * p.r_driven * p.theta_driven.sin(),
+            )
+        })
+        .collect();
+    // The driving gear turns the other way: mirror its angle so both curves
+    // touch at the contact point on the line of centres at θ = 0.
+    let ng1 = pts
+        .iter()
+        .map(|p| {
+            let a = PI - p.theta_driving;
+            (
+                1e3 * (x_offset + p.r_driving * a.cos()),
+                1e3 * p.r_driving * a.sin(),
+            )
+        })
+        .collect();
+    Ok((ng2, ng1, check))
+}
+
+fn sgivt_figures(ctx: &mut Context) -> Result<(), ReproError> {
+    let n = if ctx.quick() { 361 } else { 1441 };
+    let deg = 180.0 / PI;
+    let d = inch_to_m(5.25);
+    let (ng2, ng1, check) = profile_xy(&SgivtNcg, d, n, d)?;
+    let (s2, s1, _) = profile_xy(&SmoothNcg::PRINTED, d, n, d)?;
+    let note = format!(
+        "Eq. 38–41, D = 5.25 in; profile closure {:.1e} rad, max |r_NG1 + r_NG2 − D| {:.1e} m; \
+         NG2 radius {:.3}–{:.3} mm, NG1 {:.3}–{:.3} mm. Dashed: the smooth Eq. 42 (printed) pair",
+        check.closure_error,
+        check.max_centre_distance_error,
+        1e3 * check.r_driven_range.0,
+        1e3 * check.r_driven_range.1,
+        1e3 * check.r_driving_range.0,
+        1e3 * check.r_driving_range.1
+    );
+    ctx.line_figure(
+        "Fig. 23(a)",
+        &Figure {
+            title: "Fig. 23(a): theoretical pitch profiles of the SGIVT noncircular gears, D = 5.25 in",
+            x_label: "x [mm]",
+            y_label: "y [mm]",
+            series: vec![
+                Series { label: "NG2 (input), Eq. 38", points: &ng2, style: Style::Line },
+                Series { label: "NG1 (engine), Eq. 38", points: &ng1, style: Style::Line },
+                Series { label: "NG2, smooth Eq. 42", points: &s2, style: Style::Dashed },
+                Series { label: "NG1, smooth Eq. 42", points: &s1, style: Style::Dashed },
+            ],
+        },
+        &note,
+    )?;
+
+    // Fig. 24: output/engine ratio R/R_n at θ_CT = 3600° (e_max).
+    let geo = SgivtGeometry::prototype();
+    let e = geo.crank_length(deg_to_rad(3600.0)).unwrap_or(f64::NAN);
+    let th = || linspace(0.0, 2.0 * PI, n);
+    let exact = curve(
+        th(),
+        |t| geo.output_to_engine_ratio(&SgivtNcg, t, e),
+        deg,
+        1.0,
+    );
+    let printed = curve(
+        th(),
+        |t| geo.output_to_engine_ratio(&SmoothNcg::PRINTED, t, e),
+        deg,
+        1.0,
+    );
+    let fourier = curve(
+        th(),
+        |t| geo.output_to_engine_ratio(&SmoothNcg::fourier(), t, e),
+        deg,
+        1.0,
+    );
+    let ripple = |g: &dyn Fn() -> Result<(f64, f64), ivt_kin::KinError>| {
+        g().map_or("?".to_string(), |(lo, hi)| {
+            format!(
+                "{:.4}–{:.4} of the mean ({:.1} % p-p)",
+                lo,
+                hi,
+                100.0 * (hi - lo)
+            )
+        })
+    };
+    let note = format!(
+        "θ_CT = 3600° (e = {:.4} in). Exact Eq. 38 pair: constant. Printed Eq. 42: {}; Fourier \
+         truncation of Eq. 38: {} — the printed 0.9× softening doubles the ripple",
+        e / 0.0254,
+        ripple(&|| output_ripple(&SmoothNcg::PRINTED, 4000)),
+        ripple(&|| output_ripple(&SmoothNcg::fourier(), 4000)),
+    );
+    ctx.line_figure(
+        "Fig. 24",
+        &Figure {
+            title: "Fig. 24: SGIVT output/engine speed ratio with exact and smooth noncircular gears (θ_CT = 3600°)",
+            x_label: "input angle θ_in [deg]",
+            y_label: "ω_out/ω_eng [-]",
+            series: vec![
+                Series { label: "exact Eq. 38", points: &exact, style: Style::Line },
+                Series { label: "smooth Eq. 42 (printed)", points: &printed, style: Style::Line },
+                Series { label: "smooth, Fourier of Eq. 38", points: &fourier, style: Style::Dashed },
+            ],
+        },
+        &note,
+    )?;
+
+    // Fig. 37: f and f_θ.
+    let f = curve(th(), |t| Ok(variant::f(t)), deg, 1.0);
+    let f_theta = curve(th(), |t| Ok(variant::f_theta(t)), deg, 1.0);
+    ctx.line_figure(
+        "Fig. 37",
+        &Figure {
+            title: "Fig. 37: modulation f (Eq. 43) and f_θ (Eq. 139)",
+            x_label: "θ [deg]",
+            y_label: "f, f_θ [-]",
+            series: vec![
+                Series {
+                    label: "f (Eq. 43)",
+                    points: &f,
+                    style: Style::Line,
+                },
+                Series {
+                    label: "f_θ (Eq. 139)",
+                    points: &f_theta,
+                    style: Style::Line,
+                },
+            ],
+        },
+        "f_θ jumps at θ = π/4 + kπ/2 (the kinks of f); ⟨f⟩ = 1",
+    )?;
+
+    // Fig. 47: theoretical average ratio vs stepper angle.
+    let exact_avg = curve(
+        (0..=36).map(|i| 100.0 * i as f64),
+        |d| geo.average_ratio_from_stepper(deg_to_rad(d)),
+        1.0,
+        1.0,
+    );
+    let line: Vec<(f64, f64)> = [0.0, 3600.0]
+        .iter()
+        .map(|&d| (d, R_AVG_SLOPE_PRINTED_PER_DEG * d))
+        .collect();
+    ctx.line_figure(
+        "Fig. 47",
+        &Figure {
+            title: "Fig. 47 (theory): average SGIVT speed ratio vs stepper angle",
+            x_label: "stepper angle θ_CT [deg]",
+            y_label: "average ω_out/ω_in [-]",
+            series: vec![
+                Series {
+                    label: "Eq. 35 + Eq. 185 at θ_CT = 0, 100, …, 3600°",
+                    points: &exact_avg,
+                    style: Style::Markers,
+                },
+                Series {
+                    label: "7 θ_CT/27492 (§4.4.2)",
+                    points: &line,
+                    style: Style::Line,
+                },
+            ],
+        },
+        "theoretical curve only; the measured points of Fig. 47 are rig data",
+    )?;
+
+    // Fig. 48: theoretical NCG ratio (Eq. 38) and SGIVT ratio without gears (Eq. 35).
+    let rn = curve(th(), |t| Ok(SgivtNcg.ratio(t)), deg, 1.0);
+    let r35 = curve(th(), |t| geo.ratio(t, e), deg, 1.0);
+    ctx.line_figure(
+        "Fig. 48",
+        &Figure {
+            title: "Fig. 48 (theory): noncircular-gear ratio and SGIVT ratio without gears, θ_CT = 3600°",
+            x_label: "input angle θ_in [deg]",
+            y_label: "speed ratio [-]",
+            series: vec![
+                Series { label: "R_n, Eq. 38", points: &rn, style: Style::Line },
+                Series { label: "R without gears, Eq. 35", points: &r35, style: Style::Line },
+            ],
+        },
+        "theoretical curves only; the experimental curves of Fig. 48 are rig data",
+    )?;
+    Ok(())
+}

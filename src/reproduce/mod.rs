@@ -1,0 +1,493 @@
+//! `ivt reproduce`: regenerate the thesis's computable results — figures
+//! (PNG + CSV of the plotted data) and a table of every printed number the
+//! toolkit can compute, each with a verdict — and write `REPRODUCTION.md`.
+//!
+//! One module per chapter; each appends [`Row`]s and figures to a
+//! [`Context`]. The library APIs are called directly (never the CLI). A
+//! chapter whose engine is not in this build reports its rows as
+//! [`Verdict::NotComputable`] and its figures as missing, with the reason —
+//! never a made-up number.
+
+mod closed_loop;
+mod design;
+mod hb;
+mod kinematics;
+mod report;
+mod sthb;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use ivt_plot::{Figure, HeatMap};
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// A curve's (x, y) points in plot units.
+pub(crate) type Points = Vec<(f64, f64)>;
+
+/// A series whose label and points the chapter owns (borrowed into
+/// [`ivt_plot::Series`] when drawn).
+pub(crate) type OwnedSeries = (String, Points, ivt_plot::Style);
+
+/// How a thesis number compares with ours.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Verdict {
+    /// Agrees to the digits the thesis prints.
+    Reproduced,
+    /// Disagrees; the row's note names the cause and its evidence.
+    Differs,
+    /// Cannot be computed from what is printed or built; the note says why.
+    #[serde(rename = "not computable")]
+    NotComputable,
+}
+
+impl Verdict {
+    /// The word used in the report.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Verdict::Reproduced => "reproduced",
+            Verdict::Differs => "differs",
+            Verdict::NotComputable => "not computable",
+        }
+    }
+}
+
+/// One row of the report table.
+#[derive(Clone, Debug, Serialize)]
+pub struct Row {
+    /// Chapter/section id (e.g. `"kinematics"`).
+    pub section: &'static str,
+    /// What is compared, with its unit.
+    pub quantity: String,
+    /// The printed value with its source (Eq./Fig./§), or `—`.
+    pub thesis: String,
+    /// Our value, or `—`.
+    pub ours: String,
+    /// Absolute/relative difference in words, or `—`.
+    pub difference: String,
+    /// The verdict.
+    pub verdict: Verdict,
+    /// Cause and evidence for `differs`, reason for `not computable`, method otherwise.
+    pub note: String,
+}
+
+/// One figure: a PNG and the CSV of its data, or the reason it is missing.
+#[derive(Clone, Debug, Serialize)]
+pub struct FigureEntry {
+    /// Thesis figure id, e.g. `"Fig. 24"`.
+    pub id: String,
+    /// Title drawn on the figure.
+    pub title: String,
+    /// The PNG, relative to the output directory (None if missing).
+    pub png: Option<String>,
+    /// The CSV of the plotted data, relative to the output directory.
+    pub csv: Option<String>,
+    /// What was computed and how it compares with the printed figure, or why it is missing.
+    pub note: String,
+}
+
+/// Options of a reproduction run.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Options {
+    /// Coarser grids and sweeps (for tests); the verdicts use the same numbers.
+    pub quick: bool,
+    /// Show an indicatif progress bar on stderr.
+    pub progress: bool,
+}
+
+/// A failure that stops the whole run (I/O, drawing). Numerical failures of a
+/// single result become rows with the error in the note instead.
+#[derive(Debug, thiserror::Error)]
+pub enum ReproError {
+    /// Writing a file failed.
+    #[error("cannot write {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// A computation behind a figure failed (message of the library error).
+    #[error("{0}")]
+    Numeric(String),
+    /// Drawing a figure failed.
+    #[error(transparent)]
+    Plot(#[from] ivt_plot::PlotError),
+}
+
+/// The finished run: where the report is, what it contains.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Path of `REPRODUCTION.md`.
+    pub report: PathBuf,
+    /// Every figure (produced or missing).
+    pub figures: Vec<FigureEntry>,
+    /// Every table row.
+    pub rows: Vec<Row>,
+    /// Wall-clock time of the run \[s\].
+    pub elapsed_s: f64,
+}
+
+/// What a chapter writes into.
+pub(crate) struct Context {
+    out: PathBuf,
+    opts: Options,
+    rows: Vec<Row>,
+    figures: Vec<FigureEntry>,
+    bar: ProgressBar,
+    section: &'static str,
+}
+
+/// Format a number with `sig` significant digits, plain notation for
+/// moderate magnitudes.
+pub(crate) fn fmt_sig(x: f64, sig: usize) -> String {
+    if !x.is_finite() {
+        return format!("{x}");
+    }
+    if x == 0.0 {
+        return "0".into();
+    }
+    let mag = x.abs().log10().floor() as i32;
+    if !(-4..6).contains(&mag) {
+        return format!("{:.*e}", sig.saturating_sub(1), x);
+    }
+    let decimals = (sig as i32 - 1 - mag).max(0) as usize;
+    format!("{x:.decimals$}")
+}
+
+impl Context {
+    fn new(out: &Path, opts: Options, steps: u64) -> Self {
+        let bar = if opts.progress {
+            let b = ProgressBar::new(steps);
+            if let Ok(style) =
+                ProgressStyle::with_template("{elapsed:>4} [{bar:30}] {pos}/{len} {msg}")
+            {
+                b.set_style(style.progress_chars("=> "));
+            }
+            b
+        } else {
+            ProgressBar::hidden()
+        };
+        Self {
+            out: out.to_path_buf(),
+            opts,
+            rows: Vec::new(),
+            figures: Vec::new(),
+            bar,
+            section: "",
+        }
+    }
+
+    /// Whether the quick (test) grids are wanted.
+    pub(crate) fn quick(&self) -> bool {
+        self.opts.quick
+    }
+
+    /// Advance the progress bar by one step with a message.
+    pub(crate) fn step(&self, msg: &str) {
+        self.bar.set_message(msg.to_string());
+        self.bar.inc(1);
+    }
+
+    /// Add a row in the current section.
+    pub(crate) fn row(
+        &mut self,
+        quantity: impl Into<String>,
+        thesis: impl Into<String>,
+        ours: impl Into<String>,
+        difference: impl Into<String>,
+        verdict: Verdict,
+        note: impl Into<String>,
+    ) {
+        self.rows.push(Row {
+            section: self.section,
+            quantity: quantity.into(),
+            thesis: thesis.into(),
+            ours: ours.into(),
+            difference: difference.into(),
+            verdict,
+            note: note.into(),
+        });
+    }
+
+    /// Compare a printed number with ours: `reproduced` if they agree to
+    /// the printed digits (|ours − thesis| ≤ half a unit of the last printed
+    /// digit, `half_ulp`), otherwise `differs` with `why_differs` as the note.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn compare(
+        &mut self,
+        quantity: &str,
+        thesis: f64,
+        source: &str,
+        ours: f64,
+        half_ulp: f64,
+        sig: usize,
+        how: &str,
+        why_differs: &str,
+    ) {
+        let d = ours - thesis;
+        let rel = if thesis != 0.0 {
+            d / thesis.abs()
+        } else {
+            f64::NAN
+        };
+        let difference = if rel.is_finite() {
+            format!("{} ({:+.2} %)", fmt_sig(d, 2), 100.0 * rel)
+        } else {
+            fmt_sig(d, 2)
+        };
+        let ok = ours.is_finite() && d.abs() <= half_ulp * (1.0 + 1e-9);
+        let (verdict, note) = if ok {
+            (Verdict::Reproduced, how.to_string())
+        } else {
+            (Verdict::Differs, format!("{why_differs} ({how})"))
+        };
+        self.row(
+            quantity,
+            format!("{thesis} ({source})"),
+            fmt_sig(ours, sig),
+            difference,
+            verdict,
+            note,
+        );
+    }
+
+    /// A row that cannot be computed, with the reason.
+    pub(crate) fn not_computable(&mut self, quantity: &str, thesis: &str, why: &str) {
+        self.row(quantity, thesis, "—", "—", Verdict::NotComputable, why);
+    }
+
+    fn file_stem(id: &str) -> String {
+        id.chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() {
+                    c.to_ascii_lowercase()
+                } else {
+                    '_'
+                }
+            })
+            .collect::<String>()
+            .split('_')
+            .filter(|s| !s.is_empty())
+            .collect::<Vec<_>>()
+            .join("_")
+    }
+
+    fn write(&self, name: &str, text: &str) -> Result<(), ReproError> {
+        let path = self.out.join(name);
+        std::fs::write(&path, text).map_err(|source| ReproError::Io { path, source })
+    }
+
+    /// Draw a line figure and save its data as CSV (`series,x,y`, NaN rows
+    /// mark curve breaks).
+    pub(crate) fn line_figure(
+        &mut self,
+        id: &str,
+        figure: &Figure<'_>,
+        note: &str,
+    ) -> Result<(), ReproError> {
+        let stem = Self::file_stem(id);
+        let png = format!("{stem}.png");
+        let csv_name = format!("{stem}.csv");
+        let (title, x_label, y_label) = (
+            glyphs(figure.title),
+            glyphs(figure.x_label),
+            glyphs(figure.y_label),
+        );
+        let labels: Vec<String> = figure.series.iter().map(|s| glyphs(s.label)).collect();
+        let drawable = Figure {
+            title: &title,
+            x_label: &x_label,
+            y_label: &y_label,
+            series: figure
+                .series
+                .iter()
+                .zip(&labels)
+                .map(|(s, l)| ivt_plot::Series { label: l, ..*s })
+                .collect(),
+        };
+        ivt_plot::line_plot(&self.out.join(&png), &drawable)?;
+        let mut csv = format!(
+            "series,\"{}\",\"{}\"\n",
+            figure.x_label.replace('"', "'"),
+            figure.y_label.replace('"', "'")
+        );
+        for s in &figure.series {
+            for &(x, y) in s.points {
+                let _ = writeln!(csv, "\"{}\",{x:e},{y:e}", s.label.replace('"', "'"));
+            }
+        }
+        self.write(&csv_name, &csv)?;
+        self.figures.push(FigureEntry {
+            id: id.to_string(),
+            title: figure.title.to_string(),
+            png: Some(png),
+            csv: Some(csv_name),
+            note: note.to_string(),
+        });
+        Ok(())
+    }
+
+    /// Draw a heat map and save its grid as CSV (`x,y,value`).
+    pub(crate) fn heat_figure(
+        &mut self,
+        id: &str,
+        map: &HeatMap<'_>,
+        note: &str,
+    ) -> Result<(), ReproError> {
+        let stem = Self::file_stem(id);
+        let png = format!("{stem}.png");
+        let csv_name = format!("{stem}.csv");
+        let (title, x_label, y_label, value_label) = (
+            glyphs(map.title),
+            glyphs(map.x_label),
+            glyphs(map.y_label),
+            glyphs(map.value_label),
+        );
+        ivt_plot::heat_map(
+            &self.out.join(&png),
+            &HeatMap {
+                title: &title,
+                x_label: &x_label,
+                y_label: &y_label,
+                value_label: &value_label,
+                ..*map
+            },
+        )?;
+        let mut csv = format!(
+            "\"{}\",\"{}\",\"{}\"\n",
+            map.x_label.replace('"', "'"),
+            map.y_label.replace('"', "'"),
+            map.value_label.replace('"', "'")
+        );
+        for (j, &y) in map.ys.iter().enumerate() {
+            for (i, &x) in map.xs.iter().enumerate() {
+                let v = map.values[j * map.xs.len() + i];
+                let _ = writeln!(csv, "{x:e},{y:e},{v:e}");
+            }
+        }
+        self.write(&csv_name, &csv)?;
+        self.figures.push(FigureEntry {
+            id: id.to_string(),
+            title: map.title.to_string(),
+            png: Some(png),
+            csv: Some(csv_name),
+            note: note.to_string(),
+        });
+        Ok(())
+    }
+
+    /// A figure that cannot be drawn, with the reason.
+    pub(crate) fn missing_figure(&mut self, id: &str, title: &str, why: &str) {
+        self.figures.push(FigureEntry {
+            id: id.to_string(),
+            title: title.to_string(),
+            png: None,
+            csv: None,
+            note: why.to_string(),
+        });
+    }
+}
+
+/// Spell out the characters the embedded font subset lacks (combining
+/// accents, §) so that labels never render as gaps.
+fn glyphs(s: &str) -> String {
+    s.replace("r̄", "r_bar")
+        .replace("Γ̂", "Γ^")
+        .replace('§', "Sec. ")
+        .replace('‖', "|")
+        .replace('\u{0304}', "_bar")
+        .replace('\u{0302}', "^")
+}
+
+/// The thesis figures the report covers, in order (each appears in
+/// [`Report::figures`], drawn or with the reason it is missing).
+pub const FIGURES: &[&str] = &[
+    "Fig. 9(a)",
+    "Fig. 9(b)",
+    "Fig. 10",
+    "Fig. 11",
+    "Fig. 23(a)",
+    "Fig. 24",
+    "Fig. 37",
+    "Fig. 28",
+    "Fig. 29",
+    "Fig. 30",
+    "Fig. 31",
+    "Fig. 32",
+    "Fig. 33",
+    "Fig. 34",
+    "Fig. 35",
+    "Fig. 36",
+    "Fig. 38(a)",
+    "Fig. 38(b)",
+    "Fig. 39",
+    "Fig. 40",
+    "Fig. 42",
+    "Fig. 43",
+    "Fig. 44",
+    "Fig. 45",
+    "Fig. 51",
+    "Fig. 47",
+    "Fig. 48",
+];
+
+/// Quantities (prefixes of [`Row::quantity`]) the report always contains.
+pub const ROWS: &[&str] = &[
+    "J_a",
+    "J_b",
+    "J_c",
+    "F_m",
+    "f1",
+    "f2",
+    "Eq. 42 a1",
+    "Eq. 42 a2",
+    "Eq. 42 a3",
+    "Eq. 42 a4",
+    "R_avg slope",
+    "A0",
+    "β1",
+    "β2",
+    "β4",
+    "IHB time, classic",
+    "IHB time, modified",
+    "r̄ at (6 V, 6 N·m)",
+    "Eq. 158",
+    "Eq. 159",
+    "Fig. 42 multiplier (k = 0.01, k2 = 0.02)",
+    "Fig. 42 multiplier (k = 0.06, k2 = 0.12)",
+];
+
+/// Run every chapter and write `out/REPRODUCTION.md`, the PNGs and CSVs.
+///
+/// # Errors
+/// I/O or drawing failures; numerical failures become rows instead.
+pub fn run(out: &Path, opts: Options) -> Result<Report, ReproError> {
+    let start = std::time::Instant::now();
+    std::fs::create_dir_all(out).map_err(|source| ReproError::Io {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let mut ctx = Context::new(out, opts, 9);
+    ctx.section = "kinematics";
+    kinematics::run(&mut ctx)?;
+    ctx.section = "hb";
+    hb::run(&mut ctx)?;
+    ctx.section = "sthb";
+    sthb::run(&mut ctx)?;
+    ctx.section = "design";
+    design::run(&mut ctx)?;
+    ctx.section = "closed_loop";
+    closed_loop::run(&mut ctx)?;
+    ctx.bar.finish_and_clear();
+    let elapsed_s = start.elapsed().as_secs_f64();
+    let report_path = out.join("REPRODUCTION.md");
+    let text = report::markdown(&ctx.rows, &ctx.figures, elapsed_s, opts.quick);
+    ctx.write("REPRODUCTION.md", &text)?;
+    Ok(Report {
+        report: report_path,
+        figures: ctx.figures,
+        rows: ctx.rows,
+        elapsed_s,
+    })
+}
