@@ -83,8 +83,8 @@ fn periodic_response_matches_modal_time_integration() {
         let mut ys = y.clone();
         for s in 0..sub {
             let t = 2.0 * PI * s as f64 / sub as f64;
-            for n in 0..p.modes {
-                max_err = max_err.max((ys[n] - hb.coordinate_at(a, n, t)).abs());
+            for (n, q) in ys.iter().take(p.modes).enumerate() {
+                max_err = max_err.max((q - hb.coordinate_at(a, n, t)).abs());
             }
             integrate_from(&modal, omega, &mut ys, s * per, per, steps);
         }
