@@ -3,7 +3,7 @@
 //! (Fig. 38), Γ̂ of §4.2.2 (Fig. 40), and the stability of the time-delay
 //! loop (Fig. 42 and its two example multipliers).
 
-use super::{fmt_sig, Context, OwnedSeries, ReproError, Verdict};
+use super::{borrow_series, fmt_sig, Context, OwnedSeries, ReproError, Verdict};
 use ivt_hb::ivt::delay::{delay_stability, DelayOptions, FeedbackGains};
 use ivt_hb::ivt::fit::{self, OpenLoopLaw, PolyForm};
 use ivt_hb::ivt::gains::stability_map;
@@ -12,7 +12,7 @@ use ivt_hb::ivt::steady::{solve_steady_state, IhbOptions};
 use ivt_hb::ivt::sweep::{self, range, Grid, SweepPoint};
 use ivt_hb::ivt::{averaged_r, rad_s_to_rpm, thesis_omega0, OperatingPoint};
 use ivt_kin::plant::PlantParams;
-use ivt_plot::{Figure, HeatMap, Series, Style};
+use ivt_plot::{Figure, HeatMap, Style};
 use std::f64::consts::{PI, SQRT_2};
 
 const SPEC5: &str = "SPEC §5: the printed u_ol (Eq. 158) does not hold 100 rpm on the printed \
@@ -187,14 +187,7 @@ fn steady_row_and_fig39(ctx: &mut Context, plant: &PlantParams) -> Result<(), Re
         );
         return Ok(());
     }
-    let series = series_data
-        .iter()
-        .map(|(l, p, s)| Series {
-            label: l,
-            points: p,
-            style: *s,
-        })
-        .collect();
+    let series = borrow_series(&series_data);
     ctx.line_figure(
         "Fig. 39",
         &Figure {
@@ -334,14 +327,7 @@ fn figs_38_40(
             Style::Line,
         ));
     }
-    let series = series_data
-        .iter()
-        .map(|(l, p, s)| Series {
-            label: l,
-            points: p,
-            style: *s,
-        })
-        .collect();
+    let series = borrow_series(&series_data);
     ctx.line_figure(
         "Fig. 38(b)",
         &Figure {
@@ -375,14 +361,7 @@ fn figs_38_40(
             Style::Dashed,
         ));
     }
-    let series = series_data
-        .iter()
-        .map(|(l, p, s)| Series {
-            label: l,
-            points: p,
-            style: *s,
-        })
-        .collect();
+    let series = borrow_series(&series_data);
     ctx.line_figure(
         "Fig. 40",
         &Figure {

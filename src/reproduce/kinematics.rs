@@ -1,7 +1,7 @@
 //! Chapter 2 and §4.1: plant constants (Table 1), Eq. 42, R_avg slope
 //! (§4.4.2), and Figs. 9, 10, 11, 23(a), 24, 37, 47, 48 (theoretical curves).
 
-use super::{fmt_sig, Context, OwnedSeries, Points, ReproError};
+use super::{borrow_series, fmt_sig, Context, OwnedSeries, Points, ReproError};
 use ivt_kin::givt::GivtGeometry;
 use ivt_kin::ncg::{
     fourier_coefficient, fourier_coefficient_eq38, output_ripple, pitch_profile, GearRatio,
@@ -213,14 +213,7 @@ fn givt_figures(ctx: &mut Context) -> Result<(), ReproError> {
             ));
         }
     }
-    let series = series_data
-        .iter()
-        .map(|(l, p, s)| Series {
-            label: l,
-            points: p,
-            style: *s,
-        })
-        .collect();
+    let series = borrow_series(&series_data);
     ctx.line_figure(
         "Fig. 10",
         &Figure {

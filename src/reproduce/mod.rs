@@ -28,6 +28,17 @@ pub(crate) type Points = Vec<(f64, f64)>;
 /// [`ivt_plot::Series`] when drawn).
 pub(crate) type OwnedSeries = (String, Points, ivt_plot::Style);
 
+/// Borrow owned series as the plot crate's [`ivt_plot::Series`].
+pub(crate) fn borrow_series(data: &[OwnedSeries]) -> Vec<ivt_plot::Series<'_>> {
+    data.iter()
+        .map(|(label, points, style)| ivt_plot::Series {
+            label,
+            points,
+            style: *style,
+        })
+        .collect()
+}
+
 /// How a thesis number compares with ours.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
