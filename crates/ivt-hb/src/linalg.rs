@@ -103,25 +103,70 @@ pub fn invert(
 
 /// `y = A x` for row-major `A` (`rows×cols`).
 pub fn matvec(a: &[f64], rows: usize, cols: usize, x: &[f64], y: &mut [f64]) {
-    for i in 0..rows {
-        let row = &a[i * cols..(i + 1) * cols];
-        y[i] = row.iter().zip(x).map(|(a, b)| a * b).sum();
+    for (yi, row) in y[..rows].iter_mut().zip(a.chunks_exact(cols)) {
+        *yi = dot(row, x);
     }
 }
 
 /// Euclidean norm.
 pub fn norm2(x: &[f64]) -> f64 {
-    x.iter().map(|v| v * v).sum::<f64>().sqrt()
+    dot(x, x).sqrt()
 }
 
-/// Dot product.
+/// Independent partial sums in [`dot`]: enough to hide the add latency and let the
+/// compiler use SIMD lanes (a single running sum serialises every addition).
+const LANES: usize = 8;
+
+/// Dot product over the common length, summed in [`LANES`] interleaved partial sums
+/// (a different, not less accurate, rounding order than a left-to-right sum).
 pub fn dot(x: &[f64], y: &[f64]) -> f64 {
-    x.iter().zip(y).map(|(a, b)| a * b).sum()
+    let n = x.len().min(y.len());
+    let (x, y) = (&x[..n], &y[..n]);
+    let mut acc = [0.0; LANES];
+    let (xc, yc) = (x.chunks_exact(LANES), y.chunks_exact(LANES));
+    let tail: f64 = xc
+        .remainder()
+        .iter()
+        .zip(yc.remainder())
+        .map(|(a, b)| a * b)
+        .sum();
+    for (a, b) in xc.zip(yc) {
+        for k in 0..LANES {
+            acc[k] += a[k] * b[k];
+        }
+    }
+    acc.iter().sum::<f64>() + tail
+}
+
+/// `y ← y + alpha·x` over the common length.
+pub fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi += alpha * xi;
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lane_split_dot_matches_the_plain_sum_at_every_length() {
+        // Lengths 0…20 cover empty, tail-only, whole chunks and chunk + tail; the
+        // integer-valued data make every partial sum exact, so equality is exact.
+        for n in 0usize..=20 {
+            let x: Vec<f64> = (0..n).map(|i| (i % 5) as f64 - 2.0).collect();
+            let y: Vec<f64> = (0..n).map(|i| (i * 3 % 7) as f64).collect();
+            let plain: f64 = x.iter().zip(&y).map(|(a, b)| a * b).sum();
+            assert_eq!(dot(&x, &y), plain, "n = {n}");
+            assert_eq!(
+                dot(&x, &y[..n.saturating_sub(1)]),
+                dot(&x[..n.saturating_sub(1)], &y)
+            );
+        }
+        let mut y = vec![1.0; 9];
+        axpy(2.0, &[1.0; 9], &mut y);
+        assert!(y.iter().all(|&v| v == 3.0));
+    }
 
     #[test]
     fn inverse_of_a_known_matrix() {

@@ -36,7 +36,12 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
             problem,
             opts,
             res,
-            ws: BroydenWorkspace::new(m),
+            ws: {
+                // One-shot solves never read B: iterate on H alone.
+                let mut ws = BroydenWorkspace::new(m);
+                ws.track_jacobian = false;
+                ws
+            },
             b0: vec![0.0; m * m],
             h0: vec![0.0; m * m],
             q: vec![0.0; m],
@@ -119,9 +124,9 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         let invertible = self
             .res
             .linear_jacobian(&self.problem, omega, &mut self.b0, &mut self.h0);
-        let seed = |ws: &mut BroydenWorkspace, b0: &[f64], h0: &[f64]| {
+        let seed = |ws: &mut BroydenWorkspace, h0: &[f64]| {
             if invertible {
-                ws.set_jacobian_and_inverse(b0, h0).expect("sizes match");
+                ws.set_inverse_jacobian(h0).expect("sizes match");
             } else {
                 ws.clear_jacobian();
             }
@@ -141,7 +146,7 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         let (problem, res, ws, opts) = (&self.problem, &mut self.res, &mut self.ws, &self.opts);
         let mut last_err = None;
         if opts.homotopy_steps == 0 {
-            seed(ws, &self.b0, &self.h0);
+            seed(ws, &self.h0);
             let mut f = |x: &[f64], r: &mut [f64]| res.eval(problem, x, omega_f, 1.0, r);
             match broyden_solve(&mut f, q, ws, &opts.broyden) {
                 Ok(stats) => return Ok(stats),
@@ -166,7 +171,7 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         let mut ds = 1.0 / opts.homotopy_steps.max(8) as f64;
         let mut s_done = 0.0;
         q.copy_from_slice(&start);
-        seed(ws, &self.b0, &self.h0);
+        seed(ws, &self.h0);
         let mut q_ok = start;
         let mut total = BroydenStats {
             iterations: 0,
