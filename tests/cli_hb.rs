@@ -122,4 +122,9 @@ fn string_spring_boundary_reports_stability() {
     assert!(pts.iter().all(|p| p["stable"].is_boolean()));
     assert!(pts.iter().any(|p| p["stable"] == false));
     assert!(pts.iter().any(|p| p["stable"] == true));
+    // Eq. 132 as printed is a negative spring for k0 > 1: said so in the output.
+    assert!(v["boundary_note"]
+        .as_str()
+        .unwrap()
+        .contains("negative spring"));
 }

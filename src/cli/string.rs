@@ -120,8 +120,21 @@ pub fn run(args: StringArgs) -> Result<Output, CliError> {
                    "method": format!("{:?}", s.method)})
         })
         .collect();
-    let extra = json!({"factorizations": frc.factorizations, "hill_calls": frc.hill_calls,
+    let mut extra = json!({"factorizations": frc.factorizations, "hill_calls": frc.hill_calls,
                        "stop": format!("{:?}", frc.stop)});
+    if let Boundary::Spring { k0 } = boundary {
+        if k0 > 1.0 {
+            let note = format!(
+                "Eq. 132 as printed (k0 w = +w_x) is a negative spring: for k0 > 1 the continuous \
+                 string has a growing mode (tanh γ = γ/k0). `stable` is the verdict of the \
+                 {}-mode Tau model, which resolves that mode only when N > (k0 − 1)/2; \
+                 a restoring spring of stiffness k is --k0=-k",
+                args.modes
+            );
+            let _ = writeln!(human, "# note: {note}");
+            extra["boundary_note"] = json!(note);
+        }
+    }
     if let Some(path) = &args.plot {
         let title = format!(
             "STHB string, k_d = {}, N = {}, M = {}, {}",

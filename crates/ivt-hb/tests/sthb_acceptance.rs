@@ -4,7 +4,9 @@
 use ivt_hb::sthb::continuation::{frequency_response, ContinuationOptions};
 use ivt_hb::sthb::modal::ModalString;
 use ivt_hb::sthb::spring::spring_frequency_response;
-use ivt_hb::sthb::stability::{hill, monodromy, monodromy_multipliers, StabilityKind};
+use ivt_hb::sthb::stability::{
+    hill, hill_exponents, monodromy, monodromy_multipliers, StabilityKind,
+};
 use ivt_hb::sthb::{Boundary, SthbError, StringHb, StringParams};
 use realfft::num_complex::Complex;
 use std::f64::consts::PI;
@@ -326,6 +328,89 @@ fn spring_k0_1e4_stability_matches_fixed() {
         compared >= 30 && near >= 10,
         "{compared} / {near} points compared"
     );
+}
+
+/// Root of `g(x) = 0` by Newton from `x`.
+fn newton_root(mut x: f64, g: impl Fn(f64) -> (f64, f64)) -> f64 {
+    for _ in 0..100 {
+        let (f, df) = g(x);
+        x -= f / df;
+    }
+    x
+}
+
+#[test]
+fn spring_linear_stability_converges_to_the_exact_string() {
+    // Outside check of the Tau elimination in the stability code. At k_d = 0 the
+    // linearization is the damped linear string with k0 w(1) = w_x(1) (Eq. 132 as
+    // printed), solvable in closed form: oscillatory modes sin βx with
+    // tan β = β/k0, exponents −c_d/(2ω) ± j√(β² − c_d²/4)/ω; and, for k0 > 1, a
+    // growing mode sinh γx with tanh γ = γ/k0 (the printed sign is a *negative*
+    // spring), exponent (−c_d + √(c_d² + 4γ²))/(2ω). k0 < 0 is a restoring
+    // spring of stiffness −k0: no growing mode. The Tau model must converge to
+    // these as N grows (measured O(1/N): it expands sin βx, β ≠ nπ, in sine modes).
+    let omega = 8.0; // arg μ1 < π: the first mode's multiplier does not wrap
+    for k0 in [10.0, -10.0] {
+        let beta = newton_root(if k0 > 0.0 { 3.3 } else { 2.9 }, |b| {
+            (b.tan() - b / k0, 1.0 / b.cos().powi(2) - 1.0 / k0)
+        });
+        let mut prev: Option<(f64, f64)> = None;
+        for modes in [5usize, 10, 20, 40] {
+            let p = StringParams {
+                kd: 0.0,
+                modes,
+                ns: 128,
+                harmonics: 3,
+                ms: 16,
+                boundary: Boundary::Spring { k0 },
+                ..Default::default()
+            };
+            let cd = p.cd;
+            let mut hb = StringHb::new(p).unwrap();
+            let mut a = vec![0.0; hb.dim()];
+            hb.solve(omega, &mut a, 1e-12, 5).unwrap();
+            let mu1 = (Complex::new(
+                -cd / (2.0 * omega),
+                (beta * beta - cd * cd / 4.0).sqrt() / omega,
+            ) * (2.0 * PI))
+                .exp();
+            let d_mu1 = monodromy_multipliers(&hb, omega)
+                .unwrap()
+                .iter()
+                .map(|m| (m - mu1).norm())
+                .fold(f64::INFINITY, f64::min);
+            let lead = hill_exponents(&hb, omega).unwrap()[0];
+            let d_lead = if k0 > 1.0 {
+                let gamma = newton_root(k0, |g| {
+                    (g.tanh() - g / k0, 1.0 / g.cosh().powi(2) - 1.0 / k0)
+                });
+                let grow = (-cd + (cd * cd + 4.0 * gamma * gamma).sqrt()) / (2.0 * omega);
+                assert!(lead.im.abs() < 1e-9, "growing exponent {lead} not real");
+                (lead.re - grow).abs() / grow
+            } else {
+                // Proportional damping: every oscillatory mode decays at c_d/(2ω).
+                (lead.re + cd / (2.0 * omega)).abs()
+            };
+            eprintln!("k0 {k0}, N {modes}: |μ1 − exact| {d_mu1:.2e}, lead exponent {lead:.4} (error {d_lead:.2e})");
+            if let Some((pm, pl)) = prev {
+                // Doubling N at least ~halves the first mode's error (measured 0.51–0.54).
+                assert!(d_mu1 <= 0.6 * pm, "N = {modes}: {d_mu1:e} after {pm:e}");
+                if k0 > 1.0 {
+                    // The growing mode converges too (measured 2.1, 0.33, 0.13, 0.06 relative).
+                    assert!(
+                        d_lead <= 0.6 * pl,
+                        "N = {modes}: growth error {d_lead:e} after {pl:e}"
+                    );
+                }
+            }
+            if k0 < 0.0 {
+                assert!(d_lead < 1e-9, "restoring spring: lead exponent {lead}");
+            }
+            prev = Some((d_mu1, d_lead));
+        }
+        let (d_mu1, d_lead) = prev.unwrap();
+        assert!(d_mu1 < 2e-3 && (k0 < 0.0 || d_lead < 0.1));
+    }
 }
 
 #[test]
