@@ -63,3 +63,68 @@ fn frc_and_mathieu_json_keys() {
         assert!((b.as_f64().unwrap() - want).abs() <= 0.005);
     }
 }
+
+#[test]
+fn string_json_keys_and_png_plot() {
+    // SPEC §6: points [{omega, norm, stable}]; --plot writes a PNG.
+    let png = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_hb_string.png");
+    let _ = std::fs::remove_file(&png);
+    let (code, v) = run(&[
+        "--json",
+        "hb",
+        "string",
+        "--kd",
+        "30",
+        "--from",
+        "3",
+        "--to",
+        "5",
+        "--plot",
+        png.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{v}");
+    let pts = v["points"].as_array().unwrap();
+    assert!(pts.len() > 10);
+    for p in pts {
+        assert!(p["omega"].is_f64() && p["norm"].is_f64() && p["stable"].is_boolean());
+    }
+    // k_d = 30: the middle branch between the folds is unstable (Fig. 35).
+    assert!(pts.iter().any(|p| p["stable"] == false));
+    let bytes = std::fs::read(&png).expect("plot written");
+    assert!(bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "not a PNG");
+    // IHDR: width and height as drawn by ivt-plot (1000 × 640).
+    assert_eq!(&bytes[12..16], b"IHDR");
+    assert_eq!(u32::from_be_bytes(bytes[16..20].try_into().unwrap()), 1000);
+    assert_eq!(u32::from_be_bytes(bytes[20..24].try_into().unwrap()), 640);
+}
+
+#[test]
+fn string_spring_boundary_reports_stability() {
+    // The spring boundary is no longer `"stable": null`; k0 = 1e4 behaves like
+    // fixed–fixed (unstable points between the folds of the k_d = 30 curve).
+    let (code, v) = run(&[
+        "--json",
+        "hb",
+        "string",
+        "--boundary",
+        "spring",
+        "--k0",
+        "10000",
+        "--kd",
+        "30",
+        "--from",
+        "3",
+        "--to",
+        "5",
+    ]);
+    assert_eq!(code, 0, "{v}");
+    let pts = v["points"].as_array().unwrap();
+    assert!(pts.iter().all(|p| p["stable"].is_boolean()));
+    assert!(pts.iter().any(|p| p["stable"] == false));
+    assert!(pts.iter().any(|p| p["stable"] == true));
+    // Eq. 132 as printed is a negative spring for k0 > 1: said so in the output.
+    assert!(v["boundary_note"]
+        .as_str()
+        .unwrap()
+        .contains("negative spring"));
+}

@@ -3,17 +3,20 @@
 
 use super::{CliError, Output};
 use clap::{Args, ValueEnum};
+use ivt_hb::sthb::continuation::FrcPoint;
 use ivt_hb::sthb::continuation::{frequency_response, ContinuationOptions};
 use ivt_hb::sthb::{Boundary, StringHb, StringParams};
 use serde_json::json;
 use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
 
 /// Boundary at `x = 1`.
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum BoundaryArg {
     /// Fixed–fixed, Eq. 104 (Newton + Hill/monodromy stability).
     Fixed,
-    /// Spring `k0 w(1) = w_x(1)`, Eq. 132 (Tau method; no stability).
+    /// Spring `k0 w(1) = w_x(1)`, Eq. 132 (Tau method; stability with the
+    /// boundary row eliminated).
     Spring,
 }
 
@@ -56,6 +59,9 @@ pub struct StringArgs {
     /// Largest arclength step.
     #[arg(long, default_value_t = 0.05)]
     step_max: f64,
+    /// Draw ‖a‖ against ω into this PNG (stable solid, unstable dashed).
+    #[arg(long)]
+    plot: Option<PathBuf>,
 }
 
 /// Trace the curve and report `{"points": [{"omega", "norm", "stable"}...]}`.
@@ -92,56 +98,102 @@ pub fn run(args: StringArgs) -> Result<Output, CliError> {
         "# STHB string, k_d = {}, N = {}, M = {}, {:?}\n# omega norm stable\n",
         args.kd, args.modes, args.harmonics, args.boundary
     );
-    let (points, extra) = match boundary {
-        Boundary::Fixed => {
-            let mut hb = StringHb::new(params).map_err(|e| CliError::Input(e.to_string()))?;
-            let opts = ContinuationOptions {
-                step_max: args.step_max,
-                ..Default::default()
-            };
-            let frc = frequency_response(&mut hb, args.from, args.to, &opts)
-                .map_err(|e| CliError::Failed(e.to_string()))?;
-            let pts: Vec<_> = frc
-                .points
-                .iter()
-                .map(|p| {
-                    let s = p.stability.expect("stability requested");
-                    let _ = writeln!(human, "{:.6} {:.6e} {}", p.omega, p.norm, s.is_stable());
-                    json!({"omega": p.omega, "norm": p.norm, "stable": s.is_stable(),
-                           "kind": format!("{:?}", s.kind), "max_multiplier": s.critical.norm(),
-                           "method": format!("{:?}", s.method)})
-                })
-                .collect();
-            (
-                pts,
-                json!({"factorizations": frc.factorizations, "hill_calls": frc.hill_calls, "stop": format!("{:?}", frc.stop)}),
-            )
-        }
-        Boundary::Spring { .. } => {
-            // Newton arclength with the exact Tau Jacobian; the engine's Broyden
-            // continuation (`spring_frequency_response`, §3.3.5) is ~50× slower here.
-            let mut hb = StringHb::new(params).map_err(|e| CliError::Input(e.to_string()))?;
-            let opts = ContinuationOptions {
-                step_max: args.step_max,
-                stability: false,
-                ..Default::default()
-            };
-            let frc = frequency_response(&mut hb, args.from, args.to, &opts)
-                .map_err(|e| CliError::Failed(e.to_string()))?;
-            let pts: Vec<_> = frc
-                .points
-                .iter()
-                .map(|p| {
-                    let _ = writeln!(human, "{:.6} {:.6e} -", p.omega, p.norm);
-                    json!({"omega": p.omega, "norm": p.norm, "stable": null})
-                })
-                .collect();
-            (pts, json!({}))
-        }
+    // Both boundaries: Newton arclength with the exact (Tau) Jacobian. The
+    // engine's Broyden continuation (`spring_frequency_response`, §3.3.5) gives
+    // the same spring curve but ~50× slower (crates/ivt-hb/README.md, STHB).
+    let mut hb = StringHb::new(params).map_err(|e| CliError::Input(e.to_string()))?;
+    let opts = ContinuationOptions {
+        step_max: args.step_max,
+        ..Default::default()
     };
-    let mut obj = json!({"points": points, "solve_time_s": t0.elapsed().as_secs_f64()});
+    let frc = frequency_response(&mut hb, args.from, args.to, &opts)
+        .map_err(|e| CliError::Failed(e.to_string()))?;
+    let solve_time_s = t0.elapsed().as_secs_f64();
+    let points: Vec<_> = frc
+        .points
+        .iter()
+        .map(|p| {
+            let s = p.stability.expect("stability requested");
+            let _ = writeln!(human, "{:.6} {:.6e} {}", p.omega, p.norm, s.is_stable());
+            json!({"omega": p.omega, "norm": p.norm, "stable": s.is_stable(),
+                   "kind": format!("{:?}", s.kind), "max_multiplier": s.critical.norm(),
+                   "method": format!("{:?}", s.method)})
+        })
+        .collect();
+    let mut extra = json!({"factorizations": frc.factorizations, "hill_calls": frc.hill_calls,
+                       "stop": format!("{:?}", frc.stop)});
+    if let Boundary::Spring { k0 } = boundary {
+        if k0 > 1.0 {
+            let note = format!(
+                "Eq. 132 as printed (k0 w = +w_x) is a negative spring: for k0 > 1 the continuous \
+                 string has a growing mode (tanh γ = γ/k0). `stable` is the verdict of the \
+                 {}-mode Tau model, which resolves that mode only when N > (k0 − 1)/2; \
+                 a restoring spring of stiffness k is --k0=-k",
+                args.modes
+            );
+            let _ = writeln!(human, "# note: {note}");
+            extra["boundary_note"] = json!(note);
+        }
+    }
+    if let Some(path) = &args.plot {
+        let title = format!(
+            "STHB string, k_d = {}, N = {}, M = {}, {}",
+            args.kd,
+            args.modes,
+            args.harmonics,
+            match boundary {
+                Boundary::Fixed => "fixed–fixed".to_string(),
+                Boundary::Spring { k0 } => format!("spring k0 = {k0}"),
+            }
+        );
+        plot(path, &title, &frc.points)?;
+        let _ = writeln!(human, "# plot: {}", path.display());
+    }
+    let mut obj = json!({"points": points, "solve_time_s": solve_time_s});
     if let (Some(o), Some(e)) = (obj.as_object_mut(), extra.as_object()) {
         o.extend(e.clone());
     }
     Ok(Output { json: obj, human })
+}
+
+/// ‖a‖(ω) with the stable stretches solid and the unstable ones dashed; each
+/// change of verdict repeats the boundary point in both series so the curve
+/// stays connected (NaN breaks the other series there).
+fn plot(path: &Path, title: &str, points: &[FrcPoint]) -> Result<(), CliError> {
+    let stable = |p: &FrcPoint| p.stability.is_none_or(|s| s.is_stable());
+    let (mut solid, mut dashed) = (Vec::new(), Vec::new());
+    for (i, p) in points.iter().enumerate() {
+        let xy = (p.omega, p.norm);
+        let gap = (f64::NAN, f64::NAN);
+        let (own, other) = if stable(p) {
+            (&mut solid, &mut dashed)
+        } else {
+            (&mut dashed, &mut solid)
+        };
+        own.push(xy);
+        if i > 0 && stable(&points[i - 1]) != stable(p) {
+            // Close the other style's stretch at this point, then break it.
+            other.push(xy);
+        }
+        other.push(gap);
+    }
+    let mut series = vec![ivt_plot::Series {
+        label: "stable",
+        points: &solid,
+        style: ivt_plot::Style::Line,
+    }];
+    if dashed.iter().any(|p| p.0.is_finite()) {
+        series.push(ivt_plot::Series {
+            label: "unstable",
+            points: &dashed,
+            style: ivt_plot::Style::Dashed,
+        });
+    }
+    let figure = ivt_plot::Figure {
+        title,
+        x_label: "ω (normalized excitation frequency)",
+        y_label: "||a|| (Eq. 114)",
+        series,
+    };
+    ivt_plot::line_plot(path, &figure).map_err(|e| CliError::Failed(e.to_string()))
 }

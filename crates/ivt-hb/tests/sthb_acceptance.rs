@@ -4,8 +4,11 @@
 use ivt_hb::sthb::continuation::{frequency_response, ContinuationOptions};
 use ivt_hb::sthb::modal::ModalString;
 use ivt_hb::sthb::spring::spring_frequency_response;
-use ivt_hb::sthb::stability::{hill, monodromy, StabilityKind};
+use ivt_hb::sthb::stability::{
+    hill, hill_exponents, monodromy, monodromy_multipliers, StabilityKind,
+};
 use ivt_hb::sthb::{Boundary, SthbError, StringHb, StringParams};
+use realfft::num_complex::Complex;
 use std::f64::consts::PI;
 
 /// Arclength curve without stability (the k_d = 10 branch is too steep near
@@ -172,6 +175,12 @@ fn kd30_has_unstable_middle_branch_without_period_doubling() {
     };
     let mut hb = StringHb::new(p).unwrap();
     let frc = frequency_response(&mut hb, 1.0, 6.0, &ContinuationOptions::default()).unwrap();
+    assert_unstable_exactly_between_folds(&frc);
+}
+
+/// Fig. 35's pattern: ≥ 5 unstable points, all of fold type (no period doubling or
+/// Neimark–Sacker), exactly where ω runs backwards (between the folds).
+fn assert_unstable_exactly_between_folds(frc: &ivt_hb::sthb::continuation::Frc) {
     let kinds: Vec<StabilityKind> = frc
         .points
         .iter()
@@ -209,6 +218,198 @@ fn kd30_has_unstable_middle_branch_without_period_doubling() {
                 w[i]
             );
         }
+    }
+}
+
+#[test]
+fn spring_k0_1e4_stability_matches_fixed() {
+    // The spring boundary's stability (Tau row eliminated, see sthb::stability)
+    // on the k_d = 30 curve: k0 = 1e4 must look like fixed–fixed (Fig. 35).
+    let fixed = StringParams {
+        kd: 30.0,
+        ..Default::default()
+    };
+    let spring = StringParams {
+        boundary: Boundary::Spring { k0: 10_000.0 },
+        ..fixed.clone()
+    };
+    let trace = |p: &StringParams| {
+        let mut hb = StringHb::new(p.clone()).unwrap();
+        let frc = frequency_response(&mut hb, 1.0, 6.0, &ContinuationOptions::default()).unwrap();
+        (hb, frc)
+    };
+    let (mut hf, ff) = trace(&fixed);
+    let (mut hs, fs) = trace(&spring);
+    assert_unstable_exactly_between_folds(&fs);
+    // The unstable stretch spans the same ω interval (between the folds).
+    let span = |frc: &ivt_hb::sthb::continuation::Frc| {
+        frc.points
+            .iter()
+            .filter(|p| !p.stability.unwrap().is_stable())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.omega), hi.max(p.omega))
+            })
+    };
+    let (sf, ss) = (span(&ff), span(&fs));
+    eprintln!("unstable ω span: fixed {sf:?}, spring k0 = 1e4 {ss:?}");
+    // Folds at ω ≈ 4.32 and 4.43 (the ends of the span); the spring moves them by
+    // O(1/k0) times the curve's sensitivity: measured 3.7e-3 and 1.5e-3, 1e-2 asserted (less
+    // than one arclength step near the folds, where the points are ~0.01 apart).
+    assert!((sf.0 - ss.0).abs() < 1e-2 && (sf.1 - ss.1).abs() < 1e-2);
+    // Multipliers at equal ω on all three branches: Newton for the spring from the
+    // fixed solution (q_(N+1) = 0), then all 2N monodromy multipliers of each.
+    //
+    // Tolerance off the folds: k0 = 1e4 raises each linear eigenfrequency from nπ
+    // to β_n with tan β_n = β_n/k0, i.e. by nπ/k0; over one period 2π/ω that turns
+    // every multiplier (|μ| = e^(−π c_d/ω) for all modes) by 2π nπ/(k0 ω) radians,
+    // so |Δμ| ≤ |μ| 2π Nπ/(k0 ω) to first order (measured 0.4–0.6 of it); twice
+    // that is asserted. Within 0.1 of a fold the solution at fixed ω is
+    // square-root sensitive (‖a‖ moves by up to 2.3e-3) and the leading real
+    // multiplier with it: there the verdict must agree and |μ|max within 1e-2
+    // (measured ≤ 5.2e-3).
+    let folds = [sf.0, sf.1];
+    let (mut compared, mut near) = (0, 0);
+    for pt in ff.points.iter().step_by(3) {
+        let nq = hs.coords();
+        let mut a = vec![0.0; hs.dim()];
+        for h in 0..2 * fixed.harmonics + 1 {
+            for n in 0..fixed.modes {
+                a[h * nq + n] = pt.a[h * fixed.modes + n];
+            }
+        }
+        let near_fold = folds.iter().any(|f| (pt.omega - f).abs() < 0.1);
+        if let Err(e) = hs.solve(pt.omega, &mut a, 1e-10, 20) {
+            // Between the fixed and the spring fold (≤ 4e-3 apart) the branch has
+            // no spring counterpart at this ω.
+            assert!(near_fold, "spring Newton at ω = {}: {e}", pt.omega);
+            continue;
+        }
+        hf.linearize(&pt.a);
+        let (mf, ms) = (
+            monodromy_multipliers(&hf, pt.omega).unwrap(),
+            monodromy_multipliers(&hs, pt.omega).unwrap(),
+        );
+        assert_eq!(
+            mf[0].norm() < 1.0,
+            ms[0].norm() < 1.0,
+            "verdicts differ at ω = {}",
+            pt.omega
+        );
+        if near_fold {
+            let d = (mf[0].norm() - ms[0].norm()).abs();
+            assert!(
+                d <= 1e-2,
+                "ω = {} (near a fold): |μ|max differ by {d:e}",
+                pt.omega
+            );
+            near += 1;
+            continue;
+        }
+        // Distance between the multiplier sets (each to its nearest partner, both ways).
+        let one_way = |x: &[Complex<f64>], y: &[Complex<f64>]| {
+            x.iter()
+                .map(|u| {
+                    y.iter()
+                        .map(|v| (u - v).norm())
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .fold(0.0, f64::max)
+        };
+        let d = one_way(&mf, &ms).max(one_way(&ms, &mf));
+        let bound = mf[0].norm() * 2.0 * PI * fixed.modes as f64 * PI / (1e4 * pt.omega);
+        assert!(
+            d <= 2.0 * bound,
+            "ω = {}: multipliers differ by {d:e} (first-order bound {bound:e})",
+            pt.omega
+        );
+        compared += 1;
+    }
+    assert!(
+        compared >= 30 && near >= 10,
+        "{compared} / {near} points compared"
+    );
+}
+
+/// Root of `g(x) = 0` by Newton from `x`.
+fn newton_root(mut x: f64, g: impl Fn(f64) -> (f64, f64)) -> f64 {
+    for _ in 0..100 {
+        let (f, df) = g(x);
+        x -= f / df;
+    }
+    x
+}
+
+#[test]
+fn spring_linear_stability_converges_to_the_exact_string() {
+    // Outside check of the Tau elimination in the stability code. At k_d = 0 the
+    // linearization is the damped linear string with k0 w(1) = w_x(1) (Eq. 132 as
+    // printed), solvable in closed form: oscillatory modes sin βx with
+    // tan β = β/k0, exponents −c_d/(2ω) ± j√(β² − c_d²/4)/ω; and, for k0 > 1, a
+    // growing mode sinh γx with tanh γ = γ/k0 (the printed sign is a *negative*
+    // spring), exponent (−c_d + √(c_d² + 4γ²))/(2ω). k0 < 0 is a restoring
+    // spring of stiffness −k0: no growing mode. The Tau model must converge to
+    // these as N grows (measured O(1/N): it expands sin βx, β ≠ nπ, in sine modes).
+    let omega = 8.0; // arg μ1 < π: the first mode's multiplier does not wrap
+    for k0 in [10.0, -10.0] {
+        let beta = newton_root(if k0 > 0.0 { 3.3 } else { 2.9 }, |b| {
+            (b.tan() - b / k0, 1.0 / b.cos().powi(2) - 1.0 / k0)
+        });
+        let mut prev: Option<(f64, f64)> = None;
+        for modes in [5usize, 10, 20, 40] {
+            let p = StringParams {
+                kd: 0.0,
+                modes,
+                ns: 128,
+                harmonics: 3,
+                ms: 16,
+                boundary: Boundary::Spring { k0 },
+                ..Default::default()
+            };
+            let cd = p.cd;
+            let mut hb = StringHb::new(p).unwrap();
+            let mut a = vec![0.0; hb.dim()];
+            hb.solve(omega, &mut a, 1e-12, 5).unwrap();
+            let mu1 = (Complex::new(
+                -cd / (2.0 * omega),
+                (beta * beta - cd * cd / 4.0).sqrt() / omega,
+            ) * (2.0 * PI))
+                .exp();
+            let d_mu1 = monodromy_multipliers(&hb, omega)
+                .unwrap()
+                .iter()
+                .map(|m| (m - mu1).norm())
+                .fold(f64::INFINITY, f64::min);
+            let lead = hill_exponents(&hb, omega).unwrap()[0];
+            let d_lead = if k0 > 1.0 {
+                let gamma = newton_root(k0, |g| {
+                    (g.tanh() - g / k0, 1.0 / g.cosh().powi(2) - 1.0 / k0)
+                });
+                let grow = (-cd + (cd * cd + 4.0 * gamma * gamma).sqrt()) / (2.0 * omega);
+                assert!(lead.im.abs() < 1e-9, "growing exponent {lead} not real");
+                (lead.re - grow).abs() / grow
+            } else {
+                // Proportional damping: every oscillatory mode decays at c_d/(2ω).
+                (lead.re + cd / (2.0 * omega)).abs()
+            };
+            eprintln!("k0 {k0}, N {modes}: |μ1 − exact| {d_mu1:.2e}, lead exponent {lead:.4} (error {d_lead:.2e})");
+            if let Some((pm, pl)) = prev {
+                // Doubling N at least ~halves the first mode's error (measured 0.51–0.54).
+                assert!(d_mu1 <= 0.6 * pm, "N = {modes}: {d_mu1:e} after {pm:e}");
+                if k0 > 1.0 {
+                    // The growing mode converges too (measured 2.1, 0.33, 0.13, 0.06 relative).
+                    assert!(
+                        d_lead <= 0.6 * pl,
+                        "N = {modes}: growth error {d_lead:e} after {pl:e}"
+                    );
+                }
+            }
+            if k0 < 0.0 {
+                assert!(d_lead < 1e-9, "restoring spring: lead exponent {lead}");
+            }
+            prev = Some((d_mu1, d_lead));
+        }
+        let (d_mu1, d_lead) = prev.unwrap();
+        assert!(d_mu1 < 2e-3 && (k0 < 0.0 || d_lead < 0.1));
     }
 }
 

@@ -326,6 +326,28 @@ impl StringHb {
         }
     }
 
+    /// The Tau method's constant couplings (spring boundary only, `None` when
+    /// fixed): `e_j`, the projection of `e(x) = x` on `sin jπx` that multiplies
+    /// `q̈_{N+1}` and `q̇_{N+1}` in row `j` (Eq. 135), and `c_j` with
+    /// `q_{N+1} = Σ_j c_j q_j`, the boundary row Eq. 134 solved for `q_{N+1}`
+    /// (read off the assembled row, so the two cannot disagree).
+    pub(crate) fn tau_coupling(&self) -> Option<(Vec<f64>, Vec<f64>)> {
+        let n = self.p.modes;
+        if self.nq == n {
+            return None;
+        }
+        // Row of the constant harmonic: columns index(0, j) = j, j ≤ N.
+        let row = self.index(0, n);
+        let mut b = vec![0.0; n + 1];
+        self.for_each_linear(1.0, false, |r, c, v| {
+            if r == row {
+                b[c] += v;
+            }
+        });
+        let c = b[..n].iter().map(|v| -v / b[n]).collect();
+        Some((self.e_proj.clone(), c))
+    }
+
     /// `∂R/∂ω` at `(a, ω)` (the nonlinear term does not depend on ω).
     pub fn d_residual_d_omega(&self, a: &[f64], omega: f64, out: &mut [f64]) {
         self.apply_linear(a, omega, true, out);

@@ -4,12 +4,15 @@
 //! `ω² q̈_n + ω c_d q̇_n + n²π² q_n − ℒ_n(q) − y0 δ_{n1} cos t = 0` with
 //! `ℒ_n = −2 k_d π⁴ Σ_{abc} a b c² q_a q_b q_c I(n,a,b,c)` and
 //! `I = ∫₀¹ sin nπx sin cπx cos aπx cos bπx dx`, evaluated by product-to-sum
-//! identities. Used as the reference in tests (time integration) and as the
-//! hand-derived model for the comparison with a general HB engine.
+//! identities. Used as the reference in tests (time integration) and, as a
+//! [`PeriodicProblem`] of the general engine (`M = I`, `C = c_d I`,
+//! `K = diag(n²π²)`, `g = −ℒ(q)`, `f = y0 cos θ` on mode 1), for the
+//! "traditional route": the same curve by the modified IHB + continuation.
 
 use std::f64::consts::PI;
 
 use super::StringParams;
+use crate::problem::PeriodicProblem;
 
 /// The cubic Galerkin model of the fixed–fixed string with `N` sine modes.
 #[derive(Clone, Debug)]
@@ -18,6 +21,10 @@ pub struct ModalString {
     pub params: StringParams,
     /// Nonzero terms `(n, a, b, c, coefficient)` of `ℒ_n = Σ coef q_a q_b q_c`.
     terms: Vec<(usize, usize, usize, usize, f64)>,
+    /// `M = I`, `C = c_d I`, `K = diag(n²π²)` (row-major `N × N`) for the engine.
+    mass: Vec<f64>,
+    damping: Vec<f64>,
+    stiffness: Vec<f64>,
 }
 
 /// `∫₀¹ cos pπx cos rπx dx` for integers `p`, `r`.
@@ -55,7 +62,51 @@ impl ModalString {
                 }
             }
         }
-        Self { params, terms }
+        let nm = params.modes;
+        let diag = |f: &dyn Fn(usize) -> f64| {
+            let mut m = vec![0.0; nm * nm];
+            (0..nm).for_each(|i| m[i * nm + i] = f(i));
+            m
+        };
+        Self {
+            mass: diag(&|_| 1.0),
+            damping: diag(&|_| params.cd),
+            stiffness: diag(&|i| ((i + 1) as f64 * PI).powi(2)),
+            params,
+            terms,
+        }
+    }
+
+    /// The engine's coefficient vector (`N` blocks `[a0, a1..aM, b1..bM]` with
+    /// `x = a0/2 + Σ a_k cos kτ + b_k sin kτ`) of an STHB solution `a`
+    /// (harmonic-major, [`super::StringHb::index`], constant term without the ½).
+    pub fn engine_coeffs(&self, a: &[f64]) -> Vec<f64> {
+        let (n, m) = (self.params.modes, self.params.harmonics);
+        let l = 2 * m + 1;
+        let mut q = vec![0.0; n * l];
+        for d in 0..n {
+            q[d * l] = 2.0 * a[d];
+            for k in 1..=m {
+                q[d * l + k] = a[(2 * k - 1) * n + d];
+                q[d * l + m + k] = a[2 * k * n + d];
+            }
+        }
+        q
+    }
+
+    /// Inverse of [`Self::engine_coeffs`].
+    pub fn sthb_coeffs(&self, q: &[f64]) -> Vec<f64> {
+        let (n, m) = (self.params.modes, self.params.harmonics);
+        let l = 2 * m + 1;
+        let mut a = vec![0.0; n * l];
+        for d in 0..n {
+            a[d] = 0.5 * q[d * l];
+            for k in 1..=m {
+                a[(2 * k - 1) * n + d] = q[d * l + k];
+                a[2 * k * n + d] = q[d * l + m + k];
+            }
+        }
+        a
     }
 
     /// `ℒ(q)` into `out`.
@@ -128,5 +179,46 @@ impl ModalString {
                 y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
             }
         }
+    }
+}
+
+/// The hand-derived model as a problem of the general engine: `M q̈ + C q̇ + K q
+/// + g(q) = f(θ)` with `g = −ℒ(q)` (cubic, velocity independent) and its exact
+/// Jacobian `−∂ℒ/∂q`.
+impl PeriodicProblem for ModalString {
+    fn n_dof(&self) -> usize {
+        self.params.modes
+    }
+    fn mass(&self) -> &[f64] {
+        &self.mass
+    }
+    fn damping(&self) -> &[f64] {
+        &self.damping
+    }
+    fn stiffness(&self) -> &[f64] {
+        &self.stiffness
+    }
+    fn nonlinear(&self, x: &[f64], _v: &[f64], _theta: f64, out: &mut [f64]) {
+        ModalString::nonlinear(self, x, out);
+        out.iter_mut().for_each(|g| *g = -*g);
+    }
+    fn excitation(&self, theta: f64, out: &mut [f64]) {
+        out.fill(0.0);
+        out[0] = self.params.y0 * theta.cos();
+    }
+    fn velocity_dependent(&self) -> bool {
+        false
+    }
+    fn nonlinear_jacobian(
+        &self,
+        x: &[f64],
+        _v: &[f64],
+        _theta: f64,
+        dg_dx: &mut [f64],
+        dg_dv: &mut [f64],
+    ) {
+        ModalString::nonlinear_jacobian(self, x, dg_dx);
+        dg_dx.iter_mut().for_each(|g| *g = -*g);
+        dg_dv.fill(0.0);
     }
 }

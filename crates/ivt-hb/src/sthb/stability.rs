@@ -1,4 +1,6 @@
-//! Stability of periodic responses of the fixed–fixed string (Eq. 126–131).
+//! Stability of periodic responses of the string (Eq. 126–131), fixed–fixed
+//! or with the spring boundary (the Tau constraint eliminated, see
+//! `Linearization`).
 //!
 //! The linearization `γ̇ = A(t) γ`, `A = [[0, E], [(G2 + S(t))/ω², −c_d/ω E]]`
 //! (Eq. 127), takes `S(t) = ∂ℒ/∂Q` from the same spectrum `Ŝ_p` that builds the
@@ -80,13 +82,76 @@ impl Stability {
     }
 }
 
-fn check_fixed(hb: &StringHb) -> Result<(), SthbError> {
-    if hb.coords() != hb.params().modes {
-        return Err(SthbError::Invalid(
-            "stability is implemented for the fixed–fixed string".into(),
-        ));
+/// The linearization about a response in second-order form
+/// `γ̈ = −(c_d/ω) γ̇ + (S̃(t) − K̃) γ / ω²` (Eq. 127), `N` coordinates.
+///
+/// Fixed–fixed: `K̃ = diag(n²π²)`, `S̃ = S = ∂ℒ/∂Q` (Eq. 129). Spring (Tau,
+/// Eq. 133–136): the boundary row is algebraic and constant in time, so
+/// `q_{N+1} = cᵀq` eliminates it exactly; the rows then read
+/// `ω² M q̈ + ω c_d M q̇ + K q − ℒ(q, cᵀq) = f` with `M = I + e cᵀ`, hence
+/// `K̃ = M⁻¹K`, `S̃ = M⁻¹(S_{:,1..N} + S_{:,N+1} cᵀ)`, the damping staying
+/// `c_d/ω` because `C = c_d M`. `M⁻¹ = I − e cᵀ/(1 + cᵀe)` (Sherman–Morrison).
+struct Linearization {
+    /// `K̃`, row-major `N × N`.
+    stiffness: Vec<f64>,
+    /// Spectrum of `S̃(t)`, `N × N`.
+    s: PeriodicSpectrum,
+}
+
+impl Linearization {
+    fn of(hb: &StringHb) -> Result<Self, SthbError> {
+        let n = hb.params().modes;
+        let spec = hb.s_spectrum();
+        let mut stiffness = vec![0.0; n * n];
+        for i in 0..n {
+            stiffness[i * n + i] = ((i + 1) as f64 * PI).powi(2);
+        }
+        let Some((e, c)) = hb.tau_coupling() else {
+            return Ok(Self {
+                stiffness,
+                s: spec.clone(),
+            });
+        };
+        let denom = 1.0 + c.iter().zip(&e).map(|(a, b)| a * b).sum::<f64>();
+        if denom.abs() < 1e-12 {
+            return Err(SthbError::Invalid(
+                "spring boundary: singular Tau mass matrix (1 + cᵀe = 0)".into(),
+            ));
+        }
+        // M⁻¹ X = X − e (cᵀX)/(1 + cᵀe), applied column by column.
+        let apply_minv = |col: &mut dyn FnMut(usize) -> Complex<f64>, out: &mut [Complex<f64>]| {
+            let mut ctx = Complex::new(0.0, 0.0);
+            for i in 0..n {
+                out[i] = col(i);
+                ctx += out[i] * c[i];
+            }
+            for i in 0..n {
+                out[i] -= ctx * (e[i] / denom);
+            }
+        };
+        let mut col = vec![Complex::new(0.0, 0.0); n];
+        let mut k_new = vec![0.0; n * n];
+        for j in 0..n {
+            apply_minv(&mut |i| Complex::new(stiffness[i * n + j], 0.0), &mut col);
+            for i in 0..n {
+                k_new[i * n + j] = col[i].re;
+            }
+        }
+        let mut s = PeriodicSpectrum::zeros(n, n, spec.ms, spec.p_max);
+        for p in 0..=spec.p_max {
+            let at = |i: usize, j: usize| spec.data[(p * spec.rows + i) * spec.cols + j];
+            for j in 0..n {
+                apply_minv(&mut |i| at(i, j) + at(i, n) * c[j], &mut col);
+                for i in 0..n {
+                    *s.at_mut(p, i, j) = col[i];
+                }
+            }
+        }
+        Ok(Self {
+            stiffness: k_new,
+            s,
+        })
     }
-    Ok(())
 }
 
 /// Hill exponents `λ` in the fundamental strip `Im λ ∈ (−½, ½]` at the response
@@ -94,10 +159,10 @@ fn check_fixed(hb: &StringHb) -> Result<(), SthbError> {
 /// [`StringHb::linearize`]).
 ///
 /// # Errors
-/// [`SthbError::Invalid`] for the spring boundary, [`SthbError::Eigen`] if the
-/// eigenvalue iteration fails.
+/// [`SthbError::Invalid`] if the spring's Tau mass matrix is singular,
+/// [`SthbError::Eigen`] if the eigenvalue iteration fails.
 pub fn hill_exponents(hb: &StringHb, omega: f64) -> Result<Vec<Complex<f64>>, SthbError> {
-    check_fixed(hb)?;
+    let lin = Linearization::of(hb)?;
     let (n, m, cd) = (hb.params().modes, hb.params().harmonics, hb.params().cd);
     let blk = 2 * n;
     let dim = blk * (2 * m + 1);
@@ -106,7 +171,9 @@ pub fn hill_exponents(hb: &StringHb, omega: f64) -> Result<Vec<Complex<f64>>, St
         let o = g * blk;
         for i in 0..n {
             h[(o + i, o + n + i)] = 1.0;
-            h[(o + n + i, o + i)] = -((i + 1) as f64 * PI).powi(2) / (omega * omega);
+            for j in 0..n {
+                h[(o + n + i, o + j)] = -lin.stiffness[i * n + j] / (omega * omega);
+            }
             h[(o + n + i, o + n + i)] = -cd / omega;
         }
         if g > 0 && g % 2 == 0 {
@@ -126,7 +193,7 @@ pub fn hill_exponents(hb: &StringHb, omega: f64) -> Result<Vec<Complex<f64>>, St
         col_off: 0,
     };
     add_real_toeplitz(
-        hb.s_spectrum(),
+        &lin.s,
         m,
         1.0 / (omega * omega),
         layout,
@@ -189,22 +256,21 @@ fn s_at(s: &PeriodicSpectrum, t: f64, out: &mut [f64]) {
 /// steps per period.
 ///
 /// # Errors
-/// [`SthbError::Invalid`] for the spring boundary.
+/// As [`hill_exponents`].
 pub fn monodromy_matrix(hb: &StringHb, omega: f64, steps: usize) -> Result<Mat<f64>, SthbError> {
-    check_fixed(hb)?;
+    let lin = Linearization::of(hb)?;
     let (n, cd) = (hb.params().modes, hb.params().cd);
-    let s = hb.s_spectrum();
+    let s = &lin.s;
     let d = 2 * n;
     let h = 2.0 * PI / steps as f64;
     let w2 = 1.0 / (omega * omega);
-    // B(t) = (G2 + S(t))/ω² at the 2·steps + 1 half-step nodes.
+    // B(t) = (S̃(t) − K̃)/ω² at the 2·steps + 1 half-step nodes.
     let mut b = vec![0.0; (2 * steps + 1) * n * n];
     for (node, chunk) in b.chunks_exact_mut(n * n).enumerate() {
         s_at(s, node as f64 * 0.5 * h, chunk);
-        for i in 0..n {
-            chunk[i * n + i] -= ((i + 1) as f64 * PI).powi(2);
+        for (v, k) in chunk.iter_mut().zip(&lin.stiffness) {
+            *v = (*v - k) * w2;
         }
-        chunk.iter_mut().for_each(|v| *v *= w2);
     }
     let damp = cd / omega;
     // Y = [X; V] column by column; f(Y) = [V; B X − damp V].
