@@ -4,7 +4,7 @@
 //! against (thesis: 0.25 s vs 0.003 s).
 
 use crate::broyden::{BroydenStats, SolveError};
-use crate::ihb::{validate_omega, HbError, HbOptions, HbResidual, HbSolution};
+use crate::ihb::{validate_omega, GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution};
 use crate::linalg::{lu_factor, lu_solve, matvec, norm2};
 use crate::problem::PeriodicProblem;
 
@@ -14,7 +14,7 @@ pub struct ClassicIhb<P> {
     problem: P,
     opts: HbOptions,
     res: HbResidual,
-    basis: Vec<f64>,
+    galerkin: GalerkinJacobian,
     jac: Vec<f64>,
     h0: Vec<f64>,
     piv: Vec<usize>,
@@ -22,8 +22,6 @@ pub struct ClassicIhb<P> {
     r_trial: Vec<f64>,
     q_trial: Vec<f64>,
     dq: Vec<f64>,
-    dgx: Vec<f64>,
-    dgv: Vec<f64>,
     history: Vec<f64>,
 }
 
@@ -35,16 +33,12 @@ impl<P: PeriodicProblem> ClassicIhb<P> {
     pub fn new(problem: P, opts: HbOptions) -> Result<Self, HbError> {
         let res = HbResidual::new(&problem, &opts)?;
         let m = res.len();
-        let l = 2 * opts.harmonics + 1;
-        let ns = 2 * opts.n_half;
-        let nd = problem.n_dof();
-        let mut basis = vec![0.0; 2 * ns * l];
-        res.fill_basis(&mut basis);
+        let galerkin = GalerkinJacobian::new(&res);
         Ok(Self {
             problem,
             opts,
             res,
-            basis,
+            galerkin,
             jac: vec![0.0; m * m],
             h0: vec![0.0; m * m],
             piv: vec![0; m],
@@ -52,8 +46,6 @@ impl<P: PeriodicProblem> ClassicIhb<P> {
             r_trial: vec![0.0; m],
             q_trial: vec![0.0; m],
             dq: vec![0.0; m],
-            dgx: vec![0.0; nd * nd],
-            dgv: vec![0.0; nd * nd],
             history: Vec::with_capacity(64),
         })
     }
@@ -117,16 +109,12 @@ impl<P: PeriodicProblem> ClassicIhb<P> {
             }
             stats.iterations += 1;
             // Φ_q = L(ω) + (1/π)∫ C_s (G_x C_sᵀ + ω G_v C_s'ᵀ) dτ (Eq. 56).
-            self.res
-                .linear_jacobian(&self.problem, omega, &mut self.jac, &mut self.h0);
-            self.res.add_nonlinear_jacobian(
+            self.galerkin.assemble(
+                &mut self.res,
                 &self.problem,
                 &q,
                 omega_f,
                 1.0,
-                &self.basis,
-                &mut self.dgx,
-                &mut self.dgv,
                 &mut self.jac,
             );
             stats.jacobian_refreshes += 1;

@@ -500,3 +500,56 @@ impl HbResidual {
         }
     }
 }
+
+/// The exact Galerkin Jacobian `Φ_q = L(ω) + s·(1/π)∫ C_s (G_x C_sᵀ + ω G_v C_s'ᵀ) dτ`
+/// (Eq. 56) of the residual at nonlinearity scale `s`, with its quadrature scratch:
+/// the classic IHB's Newton matrix, and the modified IHB's refresh when Broyden stalls.
+#[derive(Debug, Clone)]
+pub struct GalerkinJacobian {
+    basis: Vec<f64>,
+    dgx: Vec<f64>,
+    dgv: Vec<f64>,
+    h_scratch: Vec<f64>,
+}
+
+impl GalerkinJacobian {
+    /// Scratch for `res`'s size and `n_dof` of the problem it evaluates.
+    pub fn new(res: &HbResidual) -> Self {
+        let (nd, l, m) = (res.n_dof, 2 * res.n + 1, res.len());
+        let mut basis = vec![0.0; 2 * res.aft.n_samples() * l];
+        res.fill_basis(&mut basis);
+        Self {
+            basis,
+            dgx: vec![0.0; nd * nd],
+            dgv: vec![0.0; nd * nd],
+            h_scratch: vec![0.0; m * m],
+        }
+    }
+
+    /// Writes `Φ_q(q)` (row-major `m×m`) into `jac`; allocation-free when the problem
+    /// supplies `nonlinear_jacobian` (its default central differences allocate).
+    pub fn assemble<P: PeriodicProblem>(
+        &mut self,
+        res: &mut HbResidual,
+        problem: &P,
+        q: &[f64],
+        omega_f: f64,
+        s: f64,
+        jac: &mut [f64],
+    ) {
+        let omega = omega_f / res.p as f64;
+        res.linear_jacobian(problem, omega, jac, &mut self.h_scratch);
+        if s != 0.0 {
+            res.add_nonlinear_jacobian(
+                problem,
+                q,
+                omega_f,
+                s,
+                &self.basis,
+                &mut self.dgx,
+                &mut self.dgv,
+                jac,
+            );
+        }
+    }
+}

@@ -31,7 +31,7 @@ pub use faer::c64;
 pub use floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
 pub use frc::{frequency_response, Frc, FrcOptions, FrcPoint};
 pub use hill::{fourier_blocks, hill_multipliers, HillError, HillResult};
-pub use ihb::{HbError, HbOptions, HbResidual, HbSolution};
+pub use ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution};
 pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;
 pub use problem::{Duffing, GeneralProblem, MathieuDuffing, PeriodicProblem};

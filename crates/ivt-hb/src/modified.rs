@@ -4,9 +4,9 @@
 //! Broyden matrix) when the direct iteration fails, and pseudo-arclength in the
 //! stepping parameter when that path folds.
 
-use crate::broyden::{broyden_solve, BroydenStats, BroydenWorkspace};
+use crate::broyden::{broyden_solve, BroydenStats, BroydenWorkspace, System};
 use crate::continuation::{pseudo_arclength, ContinuationOptions};
-use crate::ihb::{validate_omega, HbError, HbOptions, HbResidual, HbSolution};
+use crate::ihb::{validate_omega, GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution};
 use crate::linalg::matvec;
 use crate::problem::PeriodicProblem;
 
@@ -17,6 +17,7 @@ pub struct ModifiedIhb<P> {
     problem: P,
     opts: HbOptions,
     res: HbResidual,
+    galerkin: GalerkinJacobian,
     ws: BroydenWorkspace,
     b0: Vec<f64>,
     h0: Vec<f64>,
@@ -35,6 +36,7 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         Ok(Self {
             problem,
             opts,
+            galerkin: GalerkinJacobian::new(&res),
             res,
             ws: {
                 // One-shot solves never read B: iterate on H alone.
@@ -143,12 +145,18 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         } else {
             q.to_vec()
         };
-        let (problem, res, ws, opts) = (&self.problem, &mut self.res, &mut self.ws, &self.opts);
+        let (problem, ws, opts) = (&self.problem, &mut self.ws, &self.opts);
+        let mut sys = HbSystem {
+            problem,
+            res: &mut self.res,
+            galerkin: &mut self.galerkin,
+            omega_f,
+            s: 1.0,
+        };
         let mut last_err = None;
         if opts.homotopy_steps == 0 {
             seed(ws, &self.h0);
-            let mut f = |x: &[f64], r: &mut [f64]| res.eval(problem, x, omega_f, 1.0, r);
-            match broyden_solve(&mut f, q, ws, &opts.broyden) {
+            match broyden_solve(&mut sys, q, ws, &opts.broyden) {
                 Ok(stats) => return Ok(stats),
                 Err(e) => last_err = Some(e),
             }
@@ -159,7 +167,7 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
             let mut s = vec![0.0; m];
             match guess {
                 Some(g) => s.copy_from_slice(g),
-                None if invertible => matvec(&self.h0, m, m, res.excitation(), &mut s),
+                None if invertible => matvec(&self.h0, m, m, sys.res.excitation(), &mut s),
                 None => {}
             }
             s
@@ -181,8 +189,8 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         };
         while s_done < 1.0 {
             let s = (s_done + ds).min(1.0);
-            let mut f = |x: &[f64], r: &mut [f64]| res.eval(problem, x, omega_f, s, r);
-            match broyden_solve(&mut f, q, ws, &opts.broyden) {
+            sys.s = s;
+            match broyden_solve(&mut sys, q, ws, &opts.broyden) {
                 Ok(st) => {
                     total.iterations += st.iterations;
                     total.residual_evals += st.residual_evals;
@@ -223,6 +231,7 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         let mut crossing: Option<(Vec<f64>, Vec<f64>)> = None;
         let mut prev: Option<Vec<f64>> = None;
         let m1 = m;
+        let res = &mut *sys.res;
         let traced = pseudo_arclength(
             |x: &[f64], r: &mut [f64]| res.eval(problem, &x[..m1], omega_f, x[m1], r),
             &x0,
@@ -249,12 +258,36 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
                 q[i] = a[i] + t * (b[i] - a[i]);
             }
             ws.clear_jacobian();
-            let mut f = |x: &[f64], r: &mut [f64]| res.eval(problem, x, omega_f, 1.0, r);
-            match broyden_solve(&mut f, q, ws, &opts.broyden) {
+            sys.s = 1.0;
+            match broyden_solve(&mut sys, q, ws, &opts.broyden) {
                 Ok(st) => return Ok(st),
                 Err(e) => last_err = Some(e),
             }
         }
         Err(HbError::Solve(last_err.expect("at least one attempt ran")))
+    }
+}
+
+/// The residual Eq. 61 at nonlinearity scale `s` as a Broyden [`System`] whose
+/// Jacobian (used when Broyden stalls or starts cold) is the exact Galerkin one,
+/// Eq. 56: O(N·m²) instead of the m residual evaluations of finite differences,
+/// and exact, so the refreshed step is a Newton step.
+struct HbSystem<'a, P> {
+    problem: &'a P,
+    res: &'a mut HbResidual,
+    galerkin: &'a mut GalerkinJacobian,
+    omega_f: f64,
+    s: f64,
+}
+
+impl<P: PeriodicProblem> System for HbSystem<'_, P> {
+    fn residual(&mut self, q: &[f64], r: &mut [f64]) {
+        self.res.eval(self.problem, q, self.omega_f, self.s, r);
+    }
+
+    fn jacobian(&mut self, q: &[f64], jac: &mut [f64]) -> bool {
+        self.galerkin
+            .assemble(self.res, self.problem, q, self.omega_f, self.s, jac);
+        jac.iter().all(|v| v.is_finite())
     }
 }
