@@ -316,15 +316,18 @@ where
     let wanted = CHANNELS.map(|name| scene.outputs.channels.iter().any(|c| c.name == name));
     let log = McapLog::create(&path, scene, wanted)?;
     let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<Sample>>(IN_FLIGHT);
-    let writer = std::thread::spawn(move || -> Result<(), OutputError> {
-        let mut log = log;
-        for batch in rx {
-            for s in &batch {
-                log.write(s)?;
+    let writer = std::thread::Builder::new()
+        .name("mcap-writer".into())
+        .spawn(move || -> Result<(), OutputError> {
+            let mut log = log;
+            for batch in rx {
+                for s in &batch {
+                    log.write(s)?;
+                }
             }
-        }
-        log.finish()
-    });
+            log.finish()
+        })
+        .map_err(io(&path))?;
     let mut batch = Vec::with_capacity(BATCH);
     let ran = run(&mut |s| {
         batch.push(s);
