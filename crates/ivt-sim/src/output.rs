@@ -1,6 +1,10 @@
 //! Writing what a scene asked for: an MCAP log (one JSON-schema channel per
 //! signal group, zstd chunks, Foxglove-readable), CSV files, the summary JSON
 //! and a PNG with one panel per requested plot.
+//!
+//! [`write_all`] writes them from a finished run; [`run_and_write`] (what
+//! `ivt sim` uses) writes the MCAP log on a second thread while the loop
+//! runs — on two cores it costs little more than the loop alone.
 
 use crate::record::{Record, Sample, CHANNELS};
 use crate::run::{Channels, RunResult, SimError};
