@@ -4,7 +4,7 @@
 //! The MCAP log of the default scene holds ≈ 24 000 JSON messages; through
 //! serde_json's generic path (a fresh `Vec` per message, the `Serializer`
 //! state machine) they cost more than a third of the whole run. Here each
-//! sample type lists its fields once ([`record!`]): that list gives the JSON
+//! sample type lists its fields once (the `record!` macro): that list gives the JSON
 //! schema of the channel, the JSON object and the CSV row. Numbers are
 //! formatted by the same crates serde_json uses (`zmij` for floats, `itoa` for
 //! integers), so the bytes are identical to `serde_json::to_vec` of the
