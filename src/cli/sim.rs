@@ -2,9 +2,9 @@
 
 use super::{CliError, Output};
 use clap::Args;
-use ivt_sim::output::write_all;
+use ivt_sim::output::{run_and_write, write_all};
 use ivt_sim::progress::Progress;
-use ivt_sim::run::run;
+use ivt_sim::run::run_to;
 use ivt_sim::scene::Scene;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -47,14 +47,22 @@ pub fn run_default(json: bool) -> Result<Output, CliError> {
 
 fn run_scene(scene: &Scene, out: &Path, json: bool, pil: bool) -> Result<Output, CliError> {
     let mut bar = Progress::new(!json && scene.duration_s >= 5.0, &scene.name);
-    let result = if pil {
-        ivt_sim::pil::run_pil(scene, &mut |f| bar.update(f))
+    let failed = |e: &dyn std::fmt::Display| CliError::Failed(e.to_string());
+    let (result, paths) = if pil {
+        let result =
+            ivt_sim::pil::run_pil(scene, &mut |f| bar.update(f)).map_err(|e| failed(&e))?;
+        bar.finish();
+        let paths = write_all(out, scene, &result).map_err(|e| failed(&e))?;
+        (result, paths)
     } else {
-        run(scene, &mut |f| bar.update(f))
-    }
-    .map_err(|e| CliError::Failed(e.to_string()))?;
-    bar.finish();
-    let paths = write_all(out, scene, &result).map_err(|e| CliError::Failed(e.to_string()))?;
+        // the MCAP log is written by a thread while the loop runs
+        run_and_write(out, scene, |sink| {
+            let r = run_to(scene, &mut |f| bar.update(f), sink);
+            bar.finish();
+            r
+        })
+        .map_err(|e| failed(&e))?
+    };
     let outputs: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
     let s = &result.summary;
     let rpm = 60.0 / std::f64::consts::TAU;

@@ -9,6 +9,7 @@ pub mod plant;
 pub mod plot;
 pub mod profile;
 pub mod progress;
+pub mod record;
 pub mod run;
 pub mod scene;
 pub mod sensors;

@@ -1,13 +1,17 @@
 //! Writing what a scene asked for: an MCAP log (one JSON-schema channel per
 //! signal group, zstd chunks, Foxglove-readable), CSV files, the summary JSON
 //! and a PNG with one panel per requested plot.
+//!
+//! [`write_all`] writes them from a finished run; [`run_and_write`] (what
+//! `ivt sim` uses) writes the MCAP log on a second thread while the loop
+//! runs — on two cores it costs little more than the loop alone.
 
-use crate::run::{Channels, RunResult, Timed};
+use crate::record::{Record, Sample, CHANNELS};
+use crate::run::{Channels, RunResult, SimError};
 use crate::scene::Scene;
-use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 /// An output failure.
@@ -46,43 +50,7 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
     }
 }
 
-/// Field names and JSON-schema types of each channel, in column order.
-pub fn channel_fields(name: &str) -> &'static [(&'static str, &'static str)] {
-    match name {
-        "plant" => &[
-            ("t", "number"),
-            ("theta", "number"),
-            ("omega", "number"),
-            ("omega_a", "number"),
-            ("r", "number"),
-            ("v_m", "number"),
-            ("t_u", "number"),
-            ("i_a", "number"),
-        ],
-        "control" => &[
-            ("t", "number"),
-            ("ticks", "integer"),
-            ("omega", "number"),
-            ("omega_a", "number"),
-            ("omega_t", "number"),
-            ("r_ol", "number"),
-            ("r_d", "number"),
-            ("r", "number"),
-            ("stepper_target", "integer"),
-            ("saturated", "boolean"),
-            ("fault", "integer"),
-        ],
-        "stepper" => &[
-            ("t", "number"),
-            ("target", "integer"),
-            ("commanded", "integer"),
-            ("position", "integer"),
-            ("missed", "integer"),
-        ],
-        "sensors" => &[("t", "number"), ("v_m", "number"), ("t_u", "number")],
-        _ => &[],
-    }
-}
+pub use crate::record::channel_fields;
 
 /// The JSON schema of a channel (`ivt.<name>`), as written into MCAP logs.
 pub fn json_schema(name: &str) -> String {
@@ -98,80 +66,119 @@ pub fn json_schema(name: &str) -> String {
     .to_string()
 }
 
-/// Non-finite numbers (ω_a before the first revolution) are written as
-/// `null` in JSON and as empty cells in CSV.
-/// (time, JSON bytes) of each sample of one channel.
-type Messages = Vec<(f64, Vec<u8>)>;
-
-fn samples_as_json<T: Serialize + Timed>(v: &[T]) -> Messages {
-    v.iter()
-        .map(|s| (s.time(), serde_json::to_vec(s).unwrap_or_default()))
-        .collect()
+/// An MCAP log being written: one JSON-schema channel per recorded signal
+/// group, zstd chunks.
+struct McapLog {
+    path: PathBuf,
+    w: mcap::Writer<BufWriter<File>>,
+    /// MCAP channel id and next sequence number per entry of [`CHANNELS`].
+    channels: [Option<(u16, u32)>; 4],
+    /// The JSON text of the message being written (reused).
+    buf: Vec<u8>,
 }
 
-fn channel_messages(ch: &Channels) -> Vec<(&'static str, Messages)> {
-    let mut out = vec![];
-    if let Some(v) = &ch.plant {
-        out.push(("plant", samples_as_json(v)));
+impl McapLog {
+    /// Creates `path` with the channels of [`CHANNELS`] marked in `wanted`.
+    fn create(path: &Path, scene: &Scene, wanted: [bool; 4]) -> Result<Self, OutputError> {
+        let err = mcap_error(path);
+        let file = File::create(path).map_err(io(path))?;
+        let mut w = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            // level 1: ~3× faster than the default 3 on these JSON logs, files ~10 % larger
+            .compression_level(1)
+            // no zstd worker threads: the whole log runs on its own writer thread
+            // (`run_and_write`) already, and chunks are small
+            .compression_threads(0)
+            .profile("")
+            .create(BufWriter::new(file))
+            .map_err(&err)?;
+        let mut meta = BTreeMap::new();
+        meta.insert("scene".to_string(), scene.name.clone());
+        meta.insert("description".to_string(), scene.description.clone());
+        let mut channels = [None; 4];
+        for (k, name) in CHANNELS.iter().enumerate() {
+            if !wanted[k] {
+                continue;
+            }
+            let schema = w
+                .add_schema(
+                    &format!("ivt.{name}"),
+                    "jsonschema",
+                    json_schema(name).as_bytes(),
+                )
+                .map_err(&err)?;
+            let id = w
+                .add_channel(schema, &format!("/{name}"), "json", &meta)
+                .map_err(&err)?;
+            channels[k] = Some((id, 0));
+        }
+        Ok(Self {
+            path: path.to_path_buf(),
+            w,
+            channels,
+            buf: Vec::with_capacity(512),
+        })
     }
-    if let Some(v) = &ch.control {
-        out.push(("control", samples_as_json(v)));
+
+    /// Appends one message (ignored if its channel was not created).
+    fn write(&mut self, s: &Sample) -> Result<(), OutputError> {
+        let Some((id, seq)) = self.channels[s.channel()].as_mut() else {
+            return Ok(());
+        };
+        let ns = (s.time().max(0.0) * 1e9).round() as u64;
+        let header = mcap::records::MessageHeader {
+            channel_id: *id,
+            sequence: *seq,
+            log_time: ns,
+            publish_time: ns,
+        };
+        *seq = seq.wrapping_add(1);
+        self.buf.clear();
+        s.write_json(&mut self.buf);
+        self.w
+            .write_to_known_channel(&header, &self.buf)
+            .map_err(mcap_error(&self.path))
     }
-    if let Some(v) = &ch.stepper {
-        out.push(("stepper", samples_as_json(v)));
+
+    /// Writes the summary section and closes the file.
+    fn finish(mut self) -> Result<(), OutputError> {
+        self.w.finish().map_err(mcap_error(&self.path))?;
+        Ok(())
     }
-    if let Some(v) = &ch.sensors {
-        out.push(("sensors", samples_as_json(v)));
-    }
-    out
 }
 
-/// Write the MCAP log of the recorded channels to `path`.
+fn mcap_error(path: &Path) -> impl Fn(mcap::McapError) -> OutputError + '_ {
+    move |e| OutputError::Mcap {
+        path: path.to_path_buf(),
+        msg: e.to_string(),
+    }
+}
+
+/// The recorded channels in [`CHANNELS`] order, as samples.
+fn recorded(ch: &Channels) -> [Option<Vec<Sample>>; 4] {
+    fn wrap<T: Copy>(v: &Option<Vec<T>>, f: fn(T) -> Sample) -> Option<Vec<Sample>> {
+        v.as_ref().map(|v| v.iter().map(|&s| f(s)).collect())
+    }
+    [
+        wrap(&ch.plant, Sample::Plant),
+        wrap(&ch.control, Sample::Control),
+        wrap(&ch.stepper, Sample::Stepper),
+        wrap(&ch.sensors, Sample::Sensors),
+    ]
+}
+
+/// Write the MCAP log of the recorded channels to `path` (channel after
+/// channel; [`run_and_write`] streams them in time order instead).
 ///
 /// # Errors
 /// I/O or MCAP errors.
 pub fn write_mcap(path: &Path, result: &RunResult, scene: &Scene) -> Result<(), OutputError> {
-    let err = |e: mcap::McapError| OutputError::Mcap {
-        path: path.to_path_buf(),
-        msg: e.to_string(),
-    };
-    let file = File::create(path).map_err(io(path))?;
-    let mut w = mcap::WriteOptions::new()
-        .compression(Some(mcap::Compression::Zstd))
-        // level 1: ~3× faster than the default 3 on these JSON logs, files ~10 % larger
-        .compression_level(1)
-        // no worker threads: chunks are small, and threads only add overhead
-        .compression_threads(0)
-        .profile("")
-        .create(BufWriter::new(file))
-        .map_err(err)?;
-    let mut meta = BTreeMap::new();
-    meta.insert("scene".to_string(), scene.name.clone());
-    meta.insert("description".to_string(), scene.description.clone());
-    for (name, msgs) in channel_messages(&result.channels) {
-        let schema = w
-            .add_schema(
-                &format!("ivt.{name}"),
-                "jsonschema",
-                json_schema(name).as_bytes(),
-            )
-            .map_err(err)?;
-        let id = w
-            .add_channel(schema, &format!("/{name}"), "json", &meta)
-            .map_err(err)?;
-        for (seq, (t, data)) in msgs.iter().enumerate() {
-            let ns = (t.max(0.0) * 1e9).round() as u64;
-            let header = mcap::records::MessageHeader {
-                channel_id: id,
-                sequence: seq as u32,
-                log_time: ns,
-                publish_time: ns,
-            };
-            w.write_to_known_channel(&header, data).map_err(err)?;
-        }
+    let channels = recorded(&result.channels);
+    let mut log = McapLog::create(path, scene, channels.each_ref().map(Option::is_some))?;
+    for s in channels.iter().flatten().flatten() {
+        log.write(s)?;
     }
-    w.finish().map_err(err)?;
-    Ok(())
+    log.finish()
 }
 
 /// Write one CSV per recorded channel; returns the paths.
@@ -179,31 +186,36 @@ pub fn write_mcap(path: &Path, result: &RunResult, scene: &Scene) -> Result<(), 
 /// # Errors
 /// I/O errors.
 pub fn write_csv(dir: &Path, stem: &str, ch: &Channels) -> Result<Vec<PathBuf>, OutputError> {
-    let mut paths = vec![];
-    for (name, msgs) in channel_messages(ch) {
-        let path = dir.join(format!("{stem}_{name}.csv"));
-        let mut f = BufWriter::new(File::create(&path).map_err(io(&path))?);
-        let fields = channel_fields(name);
-        let header: Vec<&str> = fields.iter().map(|(n, _)| *n).collect();
-        writeln!(f, "{}", header.join(",")).map_err(io(&path))?;
-        for (_, data) in msgs {
-            let v: serde_json::Value = serde_json::from_slice(&data).unwrap_or_default();
-            let row: Vec<String> = fields
-                .iter()
-                .map(|(n, _)| match v.get(*n) {
-                    Some(serde_json::Value::Null) | None => String::new(),
-                    Some(x) => x.to_string(),
-                })
-                .collect();
-            writeln!(f, "{}", row.join(",")).map_err(io(&path))?;
+    fn one<T: Record>(
+        dir: &Path,
+        stem: &str,
+        samples: &Option<Vec<T>>,
+        paths: &mut Vec<PathBuf>,
+    ) -> Result<(), OutputError> {
+        let Some(samples) = samples else {
+            return Ok(());
+        };
+        let path = dir.join(format!("{stem}_{}.csv", T::CHANNEL));
+        let header: Vec<&str> = T::FIELDS.iter().map(|(n, _)| *n).collect();
+        let mut text = header.join(",").into_bytes();
+        text.push(b'\n');
+        for s in samples {
+            s.write_csv(&mut text);
         }
-        f.flush().map_err(io(&path))?;
+        std::fs::write(&path, text).map_err(io(&path))?;
         paths.push(path);
+        Ok(())
     }
+    let mut paths = vec![];
+    one(dir, stem, &ch.plant, &mut paths)?;
+    one(dir, stem, &ch.control, &mut paths)?;
+    one(dir, stem, &ch.stepper, &mut paths)?;
+    one(dir, stem, &ch.sensors, &mut paths)?;
     Ok(paths)
 }
 
-/// Everything the scene asked for, under `dir`; returns the written paths.
+/// Everything the scene asked for, under `dir`, from a finished run;
+/// returns the written paths.
 ///
 /// # Errors
 /// I/O, MCAP or plot errors.
@@ -219,10 +231,22 @@ pub fn write_all(
     std::fs::create_dir_all(dir).map_err(io(dir))?;
     let mut paths = vec![];
     if o.mcap {
-        let p = dir.join(format!("{}.mcap", scene.name));
+        let p = mcap_path(dir, scene);
         write_mcap(&p, result, scene)?;
         paths.push(p);
     }
+    paths.extend(write_rest(dir, scene, result)?);
+    Ok(paths)
+}
+
+fn mcap_path(dir: &Path, scene: &Scene) -> PathBuf {
+    dir.join(format!("{}.mcap", scene.name))
+}
+
+/// The outputs other than the MCAP log: CSV, summary, plots.
+fn write_rest(dir: &Path, scene: &Scene, result: &RunResult) -> Result<Vec<PathBuf>, OutputError> {
+    let o = &scene.outputs;
+    let mut paths = vec![];
     if o.csv {
         paths.extend(write_csv(dir, &scene.name, &result.channels)?);
     }
@@ -246,4 +270,96 @@ pub fn write_all(
         }
     }
     Ok(paths)
+}
+
+/// A run or its outputs failed.
+#[derive(Debug, thiserror::Error)]
+pub enum RunWriteError {
+    /// The run failed (no files are left behind).
+    #[error(transparent)]
+    Sim(#[from] SimError),
+    /// Writing an output failed.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+}
+
+/// Samples per message of the writer thread's channel: large enough that
+/// the hand-over costs nothing per sample, small enough to start writing early.
+const BATCH: usize = 256;
+/// Batches in flight: a writer that falls behind stalls the run loop
+/// instead of buffering the whole log twice.
+const IN_FLIGHT: usize = 32;
+
+/// Runs a scene and writes everything it asks for under `dir`, as
+/// `ivt sim` does: the MCAP log is written *while* the loop runs, by a
+/// writer thread fed through a bounded channel (JSON + zstd of a 60 s run
+/// take about as long as the simulation, so on two cores they overlap);
+/// CSV, summary and plots follow the run. `run` is the closed loop with a
+/// sample sink, e.g. `|sink| run::run_to(scene, progress, sink)`.
+///
+/// Messages are in time order across channels (each channel's sequence
+/// counts from 0), the same channels and counts as [`write_all`].
+///
+/// # Errors
+/// The run's error (then the partial log is removed), or an output error.
+pub fn run_and_write<F>(
+    dir: &Path,
+    scene: &Scene,
+    run: F,
+) -> Result<(RunResult, Vec<PathBuf>), RunWriteError>
+where
+    F: FnOnce(&mut dyn FnMut(Sample)) -> Result<RunResult, SimError>,
+{
+    if !scene.outputs.mcap {
+        let result = run(&mut |_| {})?;
+        let paths = write_all(dir, scene, &result)?;
+        return Ok((result, paths));
+    }
+    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    let path = mcap_path(dir, scene);
+    let wanted = CHANNELS.map(|name| scene.outputs.channels.iter().any(|c| c.name == name));
+    let log = McapLog::create(&path, scene, wanted)?;
+    let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<Sample>>(IN_FLIGHT);
+    let writer = std::thread::Builder::new()
+        .name("mcap-writer".into())
+        .spawn(move || -> Result<(), OutputError> {
+            let mut log = log;
+            for batch in rx {
+                for s in &batch {
+                    log.write(s)?;
+                }
+            }
+            log.finish()
+        })
+        .map_err(io(&path))?;
+    let mut batch = Vec::with_capacity(BATCH);
+    let ran = run(&mut |s| {
+        batch.push(s);
+        if batch.len() == BATCH {
+            // a send fails only when the writer stopped on an error, which
+            // `join` reports below
+            let _ = tx.send(std::mem::replace(&mut batch, Vec::with_capacity(BATCH)));
+        }
+    });
+    if !batch.is_empty() {
+        let _ = tx.send(batch);
+    }
+    drop(tx);
+    let written = writer.join().unwrap_or_else(|_| {
+        Err(OutputError::Mcap {
+            path: path.clone(),
+            msg: "writer thread panicked".into(),
+        })
+    });
+    let result = match ran {
+        Ok(r) => r,
+        Err(e) => {
+            let _ = std::fs::remove_file(&path);
+            return Err(e.into());
+        }
+    };
+    written?;
+    let mut paths = vec![path];
+    paths.extend(write_rest(dir, scene, &result)?);
+    Ok((result, paths))
 }

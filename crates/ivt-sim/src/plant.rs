@@ -10,7 +10,7 @@
 //! J θ̈     = G r − ½ J_θ ω² + f k_t i_a − f2 r             (Eq. 151 with f1 − F_m ω → f k_t i_a)
 //! ```
 //!
-//! The coefficients come from [`ivt_kin::plant::PlantParams::terms_with_f`];
+//! The coefficients come from [`ivt_kin::plant::PlantParams::terms_with_trig`];
 //! this module only chooses *which smooth branch* of f(θ) is used. f has
 //! corners at θ = π/4 + kπ/2 (Eq. 43) where f_θ jumps (Eq. 139). On segment
 //! `k`, f(θ) = A cos(θ − kπ/2) exactly; evaluating that analytic branch for
@@ -44,6 +44,39 @@ pub fn f_on_segment(theta: f64, k: i64) -> (f64, f64) {
     let phi = theta - k as f64 * FRAC_PI_2;
     let (s, c) = libm::sincos(phi);
     (NCG_AMPLITUDE * c, -NCG_AMPLITUDE * s)
+}
+
+/// The terms of the right-hand side that depend on θ alone (on one gear
+/// segment): f, f_θ (Eq. 43, 139) and sin θ, cos θ of the gravity term —
+/// the three transcendental calls of an RHS evaluation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AngleTerms {
+    /// f(θ) on the segment's analytic branch.
+    pub f: f64,
+    /// f_θ(θ) on the same branch.
+    pub f_theta: f64,
+    /// sin θ.
+    pub sin_theta: f64,
+    /// cos θ.
+    pub cos_theta: f64,
+}
+
+impl AngleTerms {
+    /// The terms at θ on segment `seg`.
+    #[inline]
+    pub fn new(theta: f64, seg: i64) -> Self {
+        let (f, f_theta) = f_on_segment(theta, seg);
+        // θ only enters G(θ) here (f is given), which is 2π-periodic: reducing θ
+        // to [0, 2π) first lets sin/cos skip their slow argument reduction at
+        // large θ; the reduction error, ≤ |θ/2π|·ulp(2π), is ~1e-14 rad.
+        let theta_g = theta - TAU * libm::floor(theta / TAU);
+        Self {
+            f,
+            f_theta,
+            sin_theta: libm::sin(theta_g),
+            cos_theta: libm::cos(theta_g),
+        }
+    }
 }
 
 /// The slowly varying inputs seen by the plant during one step.
@@ -80,23 +113,28 @@ impl Plant {
     /// gear segment `seg`. Every integrator (time or angle domain) calls this.
     #[inline]
     pub fn derivatives(&self, seg: i64, y: &[f64; DIM], u: &Inputs) -> [f64; DIM] {
-        let (theta, omega) = (y[0], y[1]);
-        let (f, f_theta) = f_on_segment(theta, seg);
+        self.derivatives_with(&AngleTerms::new(y[0], seg), y, u)
+    }
+
+    /// [`Self::derivatives`] with the θ-only terms `a` = `AngleTerms::new(y[0], seg)`
+    /// already known: in the angle domain θ is the independent variable, so
+    /// RK4's two middle stages and the end of one step / start of the next
+    /// share them (the caller caches them; the result is bit-identical).
+    #[inline(always)]
+    pub fn derivatives_with(&self, a: &AngleTerms, y: &[f64; DIM], u: &Inputs) -> [f64; DIM] {
+        let omega = y[1];
+        let (f, f_theta) = (a.f, a.f_theta);
         let p = &self.params;
-        // θ only enters G(θ) here (f is given), which is 2π-periodic: reducing θ
-        // to [0, 2π) first lets sin/cos skip their slow argument reduction at
-        // large θ; the reduction error, ≤ |θ/2π|·ulp(2π), is ~1e-14 rad.
-        let theta_g = theta - TAU * libm::floor(theta / TAU);
+        let terms = |v_m| p.terms_with_trig(a.sin_theta, a.cos_theta, f, f_theta, u.r, v_m, u.t_u);
         if self.has_inductance() {
-            let t = p.terms_with_f(theta_g, f, f_theta, u.r, 0.0, u.t_u);
+            let t = terms(0.0);
             let i_a = y[2];
             let torque = t.g * u.r - t.f2 * u.r + f * p.k_t * i_a;
             let accel = (torque - 0.5 * t.j_theta * omega * omega) / t.j;
             let di = (u.v_m - p.r_a * i_a - p.k_e * f * omega) / p.l_a;
             [omega, accel, di]
         } else {
-            let t = p.terms_with_f(theta_g, f, f_theta, u.r, u.v_m, u.t_u);
-            [omega, t.acceleration(omega, u.r), 0.0]
+            [omega, terms(u.v_m).acceleration(omega, u.r), 0.0]
         }
     }
 

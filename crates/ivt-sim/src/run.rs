@@ -17,6 +17,7 @@ use crate::integrate::{IntegrateError, Method, PlantIntegrator, Reached};
 use crate::ode::Tolerance;
 use crate::plant::Plant;
 use crate::profile::{Drive, Pwl};
+use crate::record::Sample;
 use crate::scene::Scene;
 use crate::sensors::{Encoder, Reading, Rng, Stepper};
 use ivt_ctrl::{units, ActuatorMap, Config, Gains, LawKind, StepperLimits, THESIS};
@@ -110,17 +111,6 @@ pub struct SensorSample {
     /// T_U reading \[N·m\].
     pub t_u: f64,
 }
-
-/// A logged sample with its simulation time.
-pub trait Timed {
-    /// Time \[s\].
-    fn time(&self) -> f64;
-}
-
-macro_rules! timed {
-    ($($t:ty),*) => {$(impl Timed for $t { fn time(&self) -> f64 { self.t } })*};
-}
-timed!(PlantSample, ControlSample, StepperSample, SensorSample);
 
 /// The channels that were asked for (None = not recorded at all).
 #[derive(Clone, Debug, Default)]
@@ -299,6 +289,20 @@ fn pwl(knots: &[[f64; 2]]) -> Pwl {
 /// # Errors
 /// Integration or backend failures.
 pub fn run(scene: &Scene, progress: &mut dyn FnMut(f64)) -> Result<RunResult, SimError> {
+    run_to(scene, progress, &mut |_| {})
+}
+
+/// [`run`], handing every recorded channel sample to `sink` as soon as it
+/// is recorded (the MCAP writer thread of [`crate::output::run_and_write`]
+/// serializes and compresses them while the loop goes on).
+///
+/// # Errors
+/// Integration or backend failures.
+pub fn run_to(
+    scene: &Scene,
+    progress: &mut dyn FnMut(f64),
+    sink: &mut dyn FnMut(Sample),
+) -> Result<RunResult, SimError> {
     let params = scene
         .plant_params()
         .map_err(|(k, m)| SimError::Scene(format!("`{k}` {m}")))?;
@@ -307,7 +311,7 @@ pub fn run(scene: &Scene, progress: &mut dyn FnMut(f64)) -> Result<RunResult, Si
         Some(cfg) => Some(backend::sil(scene.encoder.ppr, cfg)?),
         None => None,
     };
-    run_with_backend(scene, backend, progress)
+    run_with_backend_to(scene, backend, progress, sink)
 }
 
 /// Run a scene with a given controller backend (SIL or PIL); `None` runs
@@ -317,8 +321,21 @@ pub fn run(scene: &Scene, progress: &mut dyn FnMut(f64)) -> Result<RunResult, Si
 /// Integration or backend failures.
 pub fn run_with_backend(
     scene: &Scene,
+    backend: Option<Box<dyn ControllerBackend>>,
+    progress: &mut dyn FnMut(f64),
+) -> Result<RunResult, SimError> {
+    run_with_backend_to(scene, backend, progress, &mut |_| {})
+}
+
+/// [`run_with_backend`] with a streaming `sink` as in [`run_to`].
+///
+/// # Errors
+/// Integration or backend failures.
+pub fn run_with_backend_to(
+    scene: &Scene,
     mut backend: Option<Box<dyn ControllerBackend>>,
     progress: &mut dyn FnMut(f64),
+    sink: &mut dyn FnMut(Sample),
 ) -> Result<RunResult, SimError> {
     let wall = Instant::now();
     let params = scene
@@ -445,11 +462,13 @@ pub fn run_with_backend(
             }
             if let (Some(buf), Some(e)) = (ch.sensors.as_mut(), ev_sensors) {
                 if n_sensor.is_multiple_of(e as u64) {
-                    buf.push(SensorSample {
+                    let s = SensorSample {
                         t: integ.t,
                         v_m: rv,
                         t_u: rt,
-                    });
+                    };
+                    buf.push(s);
+                    sink(Sample::Sensors(s));
                 }
             }
             n_sensor += 1;
@@ -485,7 +504,7 @@ pub fn run_with_backend(
             target = i64::from(out.stepper_target);
             if let (Some(buf), Some(e)) = (ch.control.as_mut(), ev_control) {
                 if n_pulse.is_multiple_of(e as u64) {
-                    buf.push(ControlSample {
+                    let s = ControlSample {
                         t,
                         ticks,
                         omega: out.omega,
@@ -497,7 +516,9 @@ pub fn run_with_backend(
                         stepper_target: out.stepper_target,
                         saturated: out.saturated,
                         fault: out.fault.code(),
-                    });
+                    };
+                    buf.push(s);
+                    sink(Sample::Control(s));
                 }
             }
             (f64::from(out.r), out.saturated, out.fault.code() != 0)
@@ -512,7 +533,7 @@ pub fn run_with_backend(
         if let (Some(buf), Some(e)) = (ch.plant.as_mut(), ev_plant) {
             if n_pulse.is_multiple_of(e as u64) {
                 let (v, tu) = drive.at_time(t);
-                buf.push(PlantSample {
+                let s = PlantSample {
                     t,
                     theta: integ.theta(),
                     omega: integ.omega(),
@@ -521,18 +542,22 @@ pub fn run_with_backend(
                     v_m: v,
                     t_u: tu,
                     i_a: integ.y[2],
-                });
+                };
+                buf.push(s);
+                sink(Sample::Plant(s));
             }
         }
         if let (Some(buf), Some(e)) = (ch.stepper.as_mut(), ev_stepper) {
             if n_pulse.is_multiple_of(e as u64) {
-                buf.push(StepperSample {
+                let s = StepperSample {
                     t,
                     target,
                     commanded: stepper.commanded,
                     position: stepper.position,
                     missed: stepper.missed,
-                });
+                };
+                buf.push(s);
+                sink(Sample::Stepper(s));
             }
         }
         if let Some(buf) = ch.plot.as_mut() {

@@ -217,13 +217,64 @@ fn mcap_has_exactly_the_requested_channels() {
     let mut lines = plant_csv.lines();
     assert_eq!(lines.next().unwrap(), "t,theta,omega,omega_a,r,v_m,t_u,i_a");
     assert_eq!(lines.count(), n_plant);
-    let _ = std::fs::remove_dir_all(&dir);
     let expected: std::collections::BTreeMap<String, usize> = [
         ("/plant".to_string(), n_plant),
         ("/sensors".to_string(), n_sensors),
     ]
     .into();
     assert_eq!(counts, expected);
+
+    // Streamed while the loop runs (what `ivt sim` does): the same messages,
+    // byte for byte and in each channel's order, only interleaved in time.
+    let streamed_dir = dir.join("streamed");
+    let (res2, paths2) = ivt_sim::output::run_and_write(&streamed_dir, &s, |sink| {
+        ivt_sim::run::run_to(&s, &mut |_| {}, sink)
+    })
+    .unwrap();
+    assert_eq!(res2.summary.pulses, res.summary.pulses);
+    assert_eq!(paths2.len(), 1);
+    let by_topic = |bytes: &[u8]| {
+        let mut m: std::collections::BTreeMap<String, Vec<(u32, u64, Vec<u8>)>> =
+            Default::default();
+        let (mut last_time, mut in_time_order) = (0, true);
+        for msg in mcap::MessageStream::new(bytes).unwrap() {
+            let msg = msg.unwrap();
+            m.entry(msg.channel.topic.clone()).or_default().push((
+                msg.sequence,
+                msg.log_time,
+                msg.data.to_vec(),
+            ));
+            in_time_order &= msg.log_time >= last_time;
+            last_time = msg.log_time;
+        }
+        (m, in_time_order)
+    };
+    let (serial, _) = by_topic(&bytes);
+    let (streamed, in_time_order) = by_topic(&std::fs::read(&paths2[0]).unwrap());
+    assert_eq!(streamed, serial);
+    assert!(in_time_order);
+    for msgs in streamed.values() {
+        assert!(msgs.iter().enumerate().all(|(k, m)| m.0 == k as u32));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A run that fails while its MCAP log is being streamed leaves no log.
+#[test]
+fn failed_streamed_run_leaves_no_log() {
+    let mut s = scene("load_step_delay");
+    s.duration_s = 1.0;
+    s.outputs.plots.clear();
+    let dir = std::env::temp_dir().join(format!("ivt-sim-mcap-fail-{}", std::process::id()));
+    let err = ivt_sim::output::run_and_write(&dir, &s, |sink| {
+        let r = ivt_sim::run::run_to(&s, &mut |_| {}, sink)?;
+        assert!(r.summary.pulses > 0);
+        Err(ivt_sim::run::SimError::Scene("stopped on purpose".into()))
+    })
+    .unwrap_err();
+    assert!(err.to_string().contains("stopped on purpose"), "{err}");
+    assert!(!dir.join(format!("{}.mcap", s.name)).exists());
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// The open-loop schedule (law "none") follows r(t) exactly and needs no
