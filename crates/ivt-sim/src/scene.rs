@@ -5,6 +5,7 @@
 //! the crate README for the full key list.
 
 use crate::backend::SUPPORTED_PPR;
+use ivt_ctrl::OpenLoopPreset;
 use ivt_kin::plant::{GravityModel, PlantParams};
 use serde::Deserialize;
 
@@ -299,7 +300,8 @@ pub struct ControllerSection {
     /// Add u_ol (Eq. 160) to r.
     #[serde(default = "default_true")]
     pub feedforward: bool,
-    /// Open-loop coefficients: `"thesis"` (Eq. 158–160 as printed).
+    /// Open-loop coefficients: `"refit"` (default: refitted on the printed
+    /// plant by `ivt ol fit`, SPEC §5) or `"thesis"` (Eq. 158–160 as printed).
     #[serde(default = "default_open_loop")]
     pub open_loop: String,
     /// r(t) for `law = "none"`: `[[t, r], ...]` \[s, m\].
@@ -329,7 +331,7 @@ fn default_true() -> bool {
     true
 }
 fn default_open_loop() -> String {
-    "thesis".into()
+    OpenLoopPreset::default().name().into()
 }
 
 impl Default for ControllerSection {
@@ -732,9 +734,12 @@ impl Scene {
             format!("must be > 0 s, got {}", c.prop_period_s),
         )?;
         check(
-            c.open_loop == "thesis",
+            OpenLoopPreset::from_name(&c.open_loop).is_some(),
             "controller.open_loop",
-            format!("must be \"thesis\", got \"{}\"", c.open_loop),
+            format!(
+                "must be \"refit\" (the default) or \"thesis\", got \"{}\"",
+                c.open_loop
+            ),
         )?;
         if c.law == "none" {
             check(
@@ -859,6 +864,7 @@ t_u = [[0.0, 4.0]]
         let s = Scene::parse(OK, "s.toml").unwrap();
         assert_eq!(s.encoder.ppr, 1200);
         assert_eq!(s.controller.law, "delay");
+        assert_eq!(s.controller.open_loop, "refit");
         assert!(!s.outputs.mcap && s.outputs.channels.is_empty());
     }
 
@@ -880,6 +886,11 @@ t_u = [[0.0, 4.0]]
         assert!(e.contains("plant.r_a"), "{e}");
         let e = err(&format!("{OK}\n[controller]\nlaw = \"pid\"\n"));
         assert!(e.contains("controller.law"), "{e}");
+        let e = err(&format!("{OK}\n[controller]\nopen_loop = \"printed\"\n"));
+        assert!(
+            e.contains("s.toml:8") && e.contains("controller.open_loop") && e.contains("refit"),
+            "{e}"
+        );
         let e = err(&format!(
             "{OK}\n[[outputs.channels]]\nname = \"plant\"\n[[outputs.channels]]\nname = \"nope\"\n"
         ));
