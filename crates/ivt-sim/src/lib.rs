@@ -12,5 +12,6 @@ pub mod progress;
 pub mod run;
 pub mod scene;
 pub mod sensors;
+pub mod steady;
 pub mod telemetry;
 pub mod work_precision;
