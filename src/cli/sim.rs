@@ -2,10 +2,9 @@
 
 use super::{CliError, Output};
 use clap::{Args, ValueEnum};
-use ivt_sim::output::write_all;
 use ivt_sim::progress::Progress;
 use ivt_sim::scene::Scene;
-use ivt_sim::steady::{run_scene as answer, Route, SceneRun};
+use ivt_sim::steady::{run_scene as answer, write_outputs, Route, SceneRun};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -102,27 +101,8 @@ fn run_scene(
     };
     bar.finish();
     let summary = answered.summary_json(scene);
-    let mut paths = match &answered.run {
-        Some(result) => {
-            write_all(out, scene, result).map_err(|e| CliError::Failed(e.to_string()))?
-        }
-        None => vec![],
-    };
-    if scene.outputs.summary {
-        // The summary file carries the route and the steady-state metrics too.
-        let p = out.join(format!("{}_summary.json", scene.name));
-        std::fs::create_dir_all(out)
-            .and_then(|()| {
-                std::fs::write(
-                    &p,
-                    serde_json::to_string_pretty(&summary).unwrap_or_default(),
-                )
-            })
-            .map_err(|e| CliError::Failed(format!("{}: {e}", p.display())))?;
-        if !paths.contains(&p) {
-            paths.push(p);
-        }
-    }
+    let paths =
+        write_outputs(out, scene, &answered).map_err(|e| CliError::Failed(e.to_string()))?;
     let outputs: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
     let route_line = format!(
         "route: {} ({})\n",

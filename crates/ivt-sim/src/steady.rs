@@ -33,6 +33,7 @@
 //!   last revolution of θ (per-pulse plant and control samples are recorded
 //!   for that and decimated back to what the scene asked for).
 
+use crate::output::{write_all, OutputError};
 use crate::run::{run, RunResult, SimError};
 use crate::scene::{ChannelSpec, Scene};
 use ivt_ctrl::{units, ActuatorMap, OpenLoopPreset};
@@ -41,6 +42,7 @@ use ivt_hb::ivt::shooting::{omega_at_angles, periodic_at_r, ShootingOptions};
 use ivt_hb::ivt::steady::{IhbOptions, IhbSolver};
 use ivt_hb::ivt::{IvtError, OperatingPoint, Verdict};
 use serde::Serialize;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// How a scene was answered.
@@ -221,6 +223,37 @@ impl SceneRun {
         }
         v
     }
+}
+
+/// Everything the scene asked for under `dir` ([`write_all`] for the time
+/// route's files); the summary file is [`SceneRun::summary_json`], so it
+/// names the route on both routes. Returns the written paths.
+///
+/// # Errors
+/// I/O, MCAP or plot errors.
+pub fn write_outputs(
+    dir: &Path,
+    scene: &Scene,
+    answer: &SceneRun,
+) -> Result<Vec<PathBuf>, OutputError> {
+    let mut paths = match &answer.run {
+        Some(result) => write_all(dir, scene, result)?,
+        None => vec![],
+    };
+    if scene.outputs.summary {
+        let p = dir.join(format!("{}_summary.json", scene.name));
+        let io = |source| OutputError::Io {
+            path: p.clone(),
+            source,
+        };
+        std::fs::create_dir_all(dir).map_err(io)?;
+        let text = serde_json::to_string_pretty(&answer.summary_json(scene)).unwrap_or_default();
+        std::fs::write(&p, text + "\n").map_err(io)?;
+        if !paths.contains(&p) {
+            paths.push(p);
+        }
+    }
+    Ok(paths)
 }
 
 /// ω0 as the controller holds it (f32 rpm → rad/s, like [`crate::run`]).
