@@ -95,9 +95,11 @@ def test_delay_law_against_float64_reference(ppr: int) -> None:
 def test_pulse_by_pulse_equals_batch_and_step_tick() -> None:
     ticks = pulse_ticks(100, 400, 10.0, 0.05)
     a, b = ctrl.Controller(100), ctrl.Controller(100)
-    batch = b.on_pulses(ticks, v_m=np.full(400, 7.0), t_u=np.full(400, 5.0))
+    # (8.4 V, 6 N·m) lies inside the band at 100 rpm: the default (REFIT)
+    # u_ol is 6.85 mm there (7 V would be under-drive: u_ol = 0, no move).
+    batch = b.on_pulses(ticks, v_m=np.full(400, 8.4), t_u=np.full(400, 6.0))
     for i, tk in enumerate(ticks):
-        a.update_inputs(7.0, 5.0)
+        a.update_inputs(8.4, 6.0)
         o = a.on_pulse(int(tk))
         assert o["r"] == batch["r"][i] and o["omega_a"] == batch["omega_a"][i]
     st = a.step_tick(int(ticks[-1]) + 10)
