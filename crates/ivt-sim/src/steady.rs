@@ -28,7 +28,9 @@
 //!   For the delay law inside the band the route also checks that the loop
 //!   reaches that orbit: the max |Floquet multiplier| of the linearized delay
 //!   system (Eq. 174–179, `ivt_hb::ivt::delay`) for the scene's gains. If it
-//!   is ≥ 1, `"auto"` falls back to time integration.
+//!   is ≥ 1, `"auto"` falls back to time integration. The check assumes an
+//!   ideal actuator: a stepper rate limit can still turn a linearly stable
+//!   loop into a limit cycle (README: k2 = 4 at the shipped point).
 //! - [`Route::TimeIntegration`]: the closed-loop simulation ([`crate::run`]).
 //!   If the scene asks for steady-state metrics, they are measured on the
 //!   last revolution of θ (per-pulse plant and control samples are recorded

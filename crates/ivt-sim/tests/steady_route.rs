@@ -177,3 +177,21 @@ fn ihb_summary_names_the_route() {
     assert!(j["steady_state"]["r_bar_m"].as_f64().unwrap() > 0.0);
     assert!(j.get("pulses").is_none());
 }
+
+/// With gains whose linearized delay loop is unstable there (k = 20,
+/// k2 = 1 mm·rad⁻¹: max |multiplier| 1.73 at 8.4 V / 6 N·m), "auto" does not
+/// report the IHB orbit the loop would never reach: it falls back to the
+/// time integration and says why; forcing the IHB route still answers, with
+/// the multiplier in the metrics.
+#[test]
+fn unstable_gains_fall_back_to_time_integration() {
+    let mut s = scene("steady_state");
+    s.controller.k_mm_per_rad = 20.0;
+    s.duration_s = 2.0;
+    let r = answer(&s, None);
+    assert_eq!(r.route, Route::TimeIntegration);
+    assert!(r.route_reason.contains("unstable"), "{}", r.route_reason);
+    let forced = answer(&s, Some(Route::IhbSteadyState));
+    let m = forced.steady.unwrap().max_abs_multiplier.unwrap();
+    assert!(m > 1.0, "{m}");
+}
