@@ -188,3 +188,31 @@ fn replay_laws_and_decimation() {
     assert!(compared > 300);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `--open-loop` picks the coefficient set: at (8 V, 8 N·m) — inside the
+/// band at 100 rpm (V_m ∈ [7.869, 9.099] V there) — the default refitted law
+/// gives u_ol = 1.1891 mm and the printed Eq. 158 6.9900 mm (both summed term
+/// by term in f64 from the coefficients; Eq. 159's f_B = −5.26 < 0). The f32
+/// evaluation is within 1e-6 m (ivt-ctrl's rounding-bound test).
+#[test]
+fn open_loop_flag_selects_refit_or_thesis() {
+    let dir = std::env::temp_dir().join(format!("ivt-ctrl-replay-ol-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let log = dir.join("log.csv");
+    write_log(&log, 100);
+    let path = log.to_str().unwrap();
+    let base = [
+        "--json", "ctrl", "replay", path, "--ppr", "80", "--law", "open",
+    ];
+    let refit = floats(&run(&base), "r_ol")[0];
+    let mut with_thesis = base.to_vec();
+    with_thesis.extend(["--open-loop", "thesis"]);
+    let thesis = floats(&run(&with_thesis), "r_ol")[0];
+    let mut with_refit = base.to_vec();
+    with_refit.extend(["--open-loop", "refit"]);
+    assert_eq!(floats(&run(&with_refit), "r_ol")[0], refit);
+    eprintln!("u_ol(8, 8): refit {refit}, thesis {thesis}");
+    assert!((refit - 1.1891158e-3).abs() < 1e-6, "{refit}");
+    assert!((thesis - 6.99e-3).abs() < 1e-6, "{thesis}");
+    std::fs::remove_dir_all(&dir).ok();
+}

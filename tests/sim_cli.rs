@@ -78,3 +78,45 @@ fn scene_errors_are_one_line_with_status_2() {
     assert!(stderr.contains("/nonexistent/scene.toml"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The shipped steady-state scene takes the IHB route (no transient) and says
+/// so in the JSON and in the summary file; `--route time_integration` forces
+/// the simulation of the same scene; a scene that logs channels cannot be
+/// forced onto the IHB route (exit status 1 with a one-line reason).
+#[test]
+fn steady_state_scene_reports_its_route() {
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/steady_state.toml");
+    let dir = tmp("steady");
+    let out = dir.to_str().unwrap();
+    let (code, stdout, _) = ivt(&["--json", "sim", scene, "--out", out]);
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(v["summary"]["route"], "ihb_steady_state");
+    assert_eq!(v["summary"]["steady_state"]["verdict"], "feasible");
+    let file: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("steady_state_summary.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(file["route"], "ihb_steady_state");
+    let (code, stdout, _) = ivt(&[
+        "--json",
+        "sim",
+        scene,
+        "--out",
+        out,
+        "--route",
+        "time_integration",
+    ]);
+    assert_eq!(code, 0);
+    let t: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(t["summary"]["route"], "time_integration");
+    assert!(t["summary"]["pulses"].as_u64().unwrap() > 30_000);
+    let other = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/load_step_delay.toml");
+    let (code, _, stderr) = ivt(&["sim", other, "--out", out, "--route", "ihb_steady_state"]);
+    assert_ne!(code, 0);
+    assert!(
+        stderr.contains("ihb_steady_state") && stderr.lines().count() == 1,
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

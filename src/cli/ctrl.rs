@@ -7,7 +7,7 @@
 
 use super::{CliError, Output};
 use clap::{Args, Subcommand, ValueEnum};
-use ivt_ctrl::{units, Config, ControlOutput, Controller, Gains, LawKind, THESIS};
+use ivt_ctrl::{units, Config, ControlOutput, Controller, Gains, LawKind, OpenLoopPreset};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -39,6 +39,25 @@ impl From<LawArg> for LawKind {
             LawArg::Nodelay => LawKind::NoDelay,
             LawArg::Prop => LawKind::Prop,
             LawArg::Open => LawKind::Open,
+        }
+    }
+}
+
+/// Open-loop coefficient set on the command line.
+#[derive(Clone, Copy, Debug, Default, ValueEnum)]
+pub enum OpenLoopArg {
+    /// Refitted on the printed plant by `ivt ol fit` (SPEC §5, the default).
+    #[default]
+    Refit,
+    /// Eq. 158–160 as printed.
+    Thesis,
+}
+
+impl From<OpenLoopArg> for OpenLoopPreset {
+    fn from(o: OpenLoopArg) -> Self {
+        match o {
+            OpenLoopArg::Refit => OpenLoopPreset::Refit,
+            OpenLoopArg::Thesis => OpenLoopPreset::Thesis,
         }
     }
 }
@@ -83,6 +102,9 @@ pub struct ReplayArgs {
     /// T_U \[N·m\] when the log has no tu column.
     #[arg(long, default_value_t = 8.0)]
     pub tu: f32,
+    /// Open-loop law u_ol (Eq. 158–160 form): the refitted set or the printed one.
+    #[arg(long, value_enum, default_value_t = OpenLoopArg::Refit)]
+    pub open_loop: OpenLoopArg,
     /// Run the law without the open-loop feed-forward (r = r_d), as the
     /// driving test of §4.4.3 ran Eq. 189.
     #[arg(long)]
@@ -198,7 +220,7 @@ fn replay(a: &ReplayArgs) -> Result<Output, CliError> {
             prop_period_s: a.prop_period,
             ..Gains::from_thesis_mm_per_rad(a.k, a.k2)
         },
-        open_loop: THESIS,
+        open_loop: OpenLoopPreset::from(a.open_loop).coeffs(),
         feedforward: !a.no_feedforward,
         stall_timeout_s: a.stall_timeout,
         ..Config::default()

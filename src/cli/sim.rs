@@ -1,11 +1,12 @@
 //! `ivt sim SCENE.toml [--out DIR]` and the no-argument default run.
 
 use super::{CliError, Output};
-use clap::Args;
-use ivt_sim::output::{run_and_write, write_all};
+use clap::{Args, ValueEnum};
+use ivt_sim::output::run_and_write;
 use ivt_sim::progress::Progress;
 use ivt_sim::run::run_to;
 use ivt_sim::scene::Scene;
+use ivt_sim::steady::{run_scene as answer, write_outputs, write_summary, Route, SceneRun};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -24,6 +25,29 @@ pub struct SimArgs {
     /// (`firmware/run-qemu.sh build` first; `$IVT_FW_ELF` overrides the image).
     #[arg(long)]
     pub pil: bool,
+    /// Override the scene's `outputs.route`: answer a steady-state-only
+    /// scene by the IHB steady state or force the time integration.
+    #[arg(long, value_enum)]
+    pub route: Option<RouteArg>,
+}
+
+/// `--route` on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+#[value(rename_all = "snake_case")]
+pub enum RouteArg {
+    /// The periodic steady state by the modified IHB (no transient).
+    IhbSteadyState,
+    /// Closed-loop time integration.
+    TimeIntegration,
+}
+
+impl From<RouteArg> for Route {
+    fn from(r: RouteArg) -> Self {
+        match r {
+            RouteArg::IhbSteadyState => Route::IhbSteadyState,
+            RouteArg::TimeIntegration => Route::TimeIntegration,
+        }
+    }
 }
 
 /// Run a scene file.
@@ -32,7 +56,17 @@ pub struct SimArgs {
 /// Scene errors as [`CliError::Input`], run/output failures as [`CliError::Failed`].
 pub fn run_file(args: &SimArgs, json: bool) -> Result<Output, CliError> {
     let scene = Scene::load(&args.scene).map_err(|e| CliError::Input(e.to_string()))?;
-    run_scene(&scene, &args.out, json, args.pil)
+    let route = if args.pil {
+        if matches!(args.route, Some(RouteArg::IhbSteadyState)) {
+            return Err(CliError::Input(
+                "--pil runs the firmware in the loop: it needs --route time_integration".into(),
+            ));
+        }
+        Some(Route::TimeIntegration)
+    } else {
+        args.route.map(Route::from)
+    };
+    run_scene(&scene, &args.out, json, args.pil, route)
 }
 
 /// `ivt` with no arguments: the default drive scene into `out/`.
@@ -42,28 +76,93 @@ pub fn run_file(args: &SimArgs, json: bool) -> Result<Output, CliError> {
 pub fn run_default(json: bool) -> Result<Output, CliError> {
     let scene = Scene::parse(DEFAULT_SCENE, "scenes/drive.toml")
         .map_err(|e| CliError::Input(e.to_string()))?;
-    run_scene(&scene, Path::new("out"), json, false)
+    run_scene(&scene, Path::new("out"), json, false, None)
 }
 
-fn run_scene(scene: &Scene, out: &Path, json: bool, pil: bool) -> Result<Output, CliError> {
+fn run_scene(
+    scene: &Scene,
+    out: &Path,
+    json: bool,
+    pil: bool,
+    route: Option<Route>,
+) -> Result<Output, CliError> {
     let mut bar = Progress::new(!json && scene.duration_s >= 5.0, &scene.name);
     let failed = |e: &dyn std::fmt::Display| CliError::Failed(e.to_string());
-    let (result, paths) = if pil {
-        let result =
-            ivt_sim::pil::run_pil(scene, &mut |f| bar.update(f)).map_err(|e| failed(&e))?;
+    let t0 = std::time::Instant::now();
+    let time_run = |run, route_reason: String| SceneRun {
+        route: Route::TimeIntegration,
+        route_reason,
+        steady: None,
+        run: Some(run),
+        wall_time_s: t0.elapsed().as_secs_f64(),
+    };
+    let (answered, paths) = if pil {
+        let r = ivt_sim::pil::run_pil(scene, &mut |f| bar.update(f)).map_err(|e| failed(&e))?;
         bar.finish();
-        let paths = write_all(out, scene, &result).map_err(|e| failed(&e))?;
-        (result, paths)
-    } else {
-        // the MCAP log is written by a thread while the loop runs
-        run_and_write(out, scene, |sink| {
+        let answered = time_run(r, "processor in the loop".into());
+        let paths = write_outputs(out, scene, &answered).map_err(|e| failed(&e))?;
+        (answered, paths)
+    } else if !scene.outputs.steady_state && route != Some(Route::IhbSteadyState) {
+        // A transient is asked for: the MCAP log is written by a thread while
+        // the loop runs; the summary is rewritten with the route afterwards.
+        let (r, mut paths) = run_and_write(out, scene, |sink| {
             let r = run_to(scene, &mut |f| bar.update(f), sink);
             bar.finish();
             r
         })
-        .map_err(|e| failed(&e))?
+        .map_err(|e| failed(&e))?;
+        let reason = match route {
+            Some(_) => "forced".to_string(),
+            None => scene.ihb_route_blocker().unwrap_or_default(),
+        };
+        let answered = time_run(r, reason);
+        if let Some(p) = write_summary(out, scene, &answered).map_err(|e| failed(&e))? {
+            if !paths.contains(&p) {
+                paths.push(p);
+            }
+        }
+        (answered, paths)
+    } else {
+        let answered = answer(scene, route, &mut |f| bar.update(f)).map_err(|e| failed(&e))?;
+        bar.finish();
+        let paths = write_outputs(out, scene, &answered).map_err(|e| failed(&e))?;
+        (answered, paths)
     };
+    let summary = answered.summary_json(scene);
     let outputs: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    let route_line = format!(
+        "route: {} ({})\n",
+        answered.route.as_str(),
+        answered.route_reason
+    );
+    let Some(result) = &answered.run else {
+        let m = answered.steady.as_ref();
+        let rpm = 60.0 / std::f64::consts::TAU;
+        let mut human = format!("scene `{}`: {route_line}", scene.name);
+        if let Some(m) = m {
+            human.push_str(&format!(
+                "steady state in {:.2} ms: ω_a {:.4} rpm (target {:.4}, error {:.2e} rad/s), ω ∈ [{:.4}, {:.4}] rpm, r = {:.6} mm, r̄ = {} mm, {}{}\n  method: {}\n",
+                1e3 * answered.wall_time_s,
+                m.omega_a_rad_s * rpm,
+                m.omega0_rad_s * rpm,
+                m.static_error_rad_s,
+                m.omega_min_rad_s * rpm,
+                m.omega_max_rad_s * rpm,
+                1e3 * m.r_m,
+                m.r_bar_m.map_or("—".into(), |r| format!("{:.6}", 1e3 * r)),
+                m.verdict.unwrap_or("—"),
+                m.max_abs_multiplier.map_or(String::new(), |x| format!(", delay loop max |multiplier| {x:.4}")),
+                m.method,
+            ));
+        }
+        for p in &outputs {
+            human.push_str(&format!("wrote {p}\n"));
+        }
+        return Ok(Output {
+            json: json!({ "summary": summary, "outputs": outputs }),
+            human,
+        });
+    };
     let s = &result.summary;
     let rpm = 60.0 / std::f64::consts::TAU;
     let mut human = format!(
@@ -85,6 +184,16 @@ fn run_scene(scene: &Scene, out: &Path, json: bool, pil: bool) -> Result<Output,
         s.max_abs_dr_dt_m_per_s,
         100.0 * s.saturated_fraction,
     );
+    human.push_str(&route_line);
+    if let Some(m) = &answered.steady {
+        human.push_str(&format!(
+            "steady state (last revolution): ω_a {:.4} rpm, ω ∈ [{:.4}, {:.4}] rpm, r = {:.6} mm\n",
+            m.omega_a_rad_s * rpm,
+            m.omega_min_rad_s * rpm,
+            m.omega_max_rad_s * rpm,
+            1e3 * m.r_m
+        ));
+    }
     if outputs.is_empty() {
         human.push_str("no outputs requested\n");
     } else {
@@ -94,7 +203,7 @@ fn run_scene(scene: &Scene, out: &Path, json: bool, pil: bool) -> Result<Output,
         }
     }
     Ok(Output {
-        json: json!({ "summary": s, "outputs": outputs }),
+        json: json!({ "summary": summary, "outputs": outputs }),
         human,
     })
 }

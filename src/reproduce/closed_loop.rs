@@ -96,7 +96,8 @@ pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
                         Series { label: "without time delay, Eq. 181", points: &rb, style: Style::Line },
                     ],
                 },
-                "the delay law's r is much smoother (ivt-sim test delay_law_is_smoother_than_no_delay_law)",
+                "both with the refitted feed-forward u_ol (REFIT), which steps r by the same amount at the load step; \
+                 the delay law's feedback part is much smoother (ivt-sim test delay_law_is_smoother_than_no_delay_law)",
             )?;
         }
         (Err(e), _) | (_, Err(e)) => {

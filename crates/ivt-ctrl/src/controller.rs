@@ -31,7 +31,7 @@
 use crate::actuator::{ActuatorMap, StepGenerator, StepperLimits};
 use crate::averager::{AngleAverager, Targets};
 use crate::law::{DelayLaw, FeedbackLaw, LawState, NoDelayLaw, NoFeedback, PropLaw, PulseSample};
-use crate::open_loop::{clamp_f32, OlRegion, OpenLoopCoeffs, THESIS};
+use crate::open_loop::{clamp_f32, OlRegion, OpenLoopCoeffs, REFIT};
 use crate::units;
 
 /// Fault codes (see the module doc for the safe state of each).
@@ -116,7 +116,9 @@ impl Default for Gains {
 
 /// Everything a controller needs; `Config::default()` is the thesis setup
 /// (100 rpm, PPR from the type, 1 MHz timer, Eq. 180 with the Fig. 42 gains,
-/// the `THESIS` open-loop preset, SGIVT actuator map with 3200 steps/rev).
+/// SGIVT actuator map with 3200 steps/rev) with the open-loop law refitted on
+/// the printed plant ([`REFIT`], SPEC §5: the printed `THESIS` polynomial does
+/// not hold ω0 on the printed plant and stays selectable as a preset).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Config {
     /// Timer frequency of the timestamps \[Hz\].
@@ -163,7 +165,7 @@ impl Default for Config {
             decimation: 1,
             law: LawKind::Delay,
             gains: Gains::default(),
-            open_loop: THESIS,
+            open_loop: REFIT,
             feedforward: true,
             actuator: ActuatorMap::sgivt(3200.0),
             stepper: StepperLimits {
@@ -302,7 +304,7 @@ impl<const PPR: usize> Controller<PPR> {
             averager: AngleAverager::unconfigured(),
             law: LawState::Open(NoFeedback),
             stepper: StepGenerator::unconfigured(),
-            open_loop: THESIS,
+            open_loop: REFIT,
             actuator: ActuatorMap {
                 steps_per_metre: 0.0,
                 offset_steps: 0,

@@ -25,4 +25,4 @@ pub use actuator::{ActuatorMap, StepGenerator, StepperLimits};
 pub use averager::{AngleAverager, SpeedError, TargetTicks, Targets};
 pub use controller::{Config, ControlOutput, Controller, Fault, Gains, LawKind, StepTick};
 pub use law::FeedbackLaw;
-pub use open_loop::{OlRegion, OpenLoopCoeffs, THESIS};
+pub use open_loop::{OlRegion, OpenLoopCoeffs, OpenLoopPreset, REFIT, THESIS};

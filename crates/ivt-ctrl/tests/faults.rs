@@ -3,7 +3,7 @@
 //! r in [0, r_max] (issue 5).
 #![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
-use ivt_ctrl::{ActuatorMap, Config, Controller, Fault, Gains, LawKind, StepperLimits, THESIS};
+use ivt_ctrl::{ActuatorMap, Config, Controller, Fault, Gains, LawKind, StepperLimits, REFIT};
 use proptest::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -226,15 +226,15 @@ proptest! {
         let mut ready = 0u32;
         for op in ops {
             match op {
-                Op::Pulse(x) => { t = x; check_output(c.on_pulse(x), THESIS.r_max)?; }
+                Op::Pulse(x) => { t = x; check_output(c.on_pulse(x), REFIT.r_max)?; }
                 Op::PulseAfter(d) => {
                     t = t.wrapping_add(d);
                     let o = c.on_pulse(t);
                     ready += u32::from(o.ready);
-                    check_output(o, THESIS.r_max)?;
+                    check_output(o, REFIT.r_max)?;
                 }
-                Op::Inputs(v, tu) => { c.update_inputs(v, tu); check_output(c.output(), THESIS.r_max)?; }
-                Op::Tick(d) => { let _ = c.step_tick(t.wrapping_add(d)); check_output(c.output(), THESIS.r_max)?; }
+                Op::Inputs(v, tu) => { c.update_inputs(v, tu); check_output(c.output(), REFIT.r_max)?; }
+                Op::Tick(d) => { let _ = c.step_tick(t.wrapping_add(d)); check_output(c.output(), REFIT.r_max)?; }
             }
         }
         READY_PULSES.fetch_add(ready, Ordering::Relaxed);
@@ -257,7 +257,7 @@ proptest! {
         let mut t = 0u32;
         for p in pulses {
             t = t.wrapping_add(p);
-            check_output(c.on_pulse(t), THESIS.r_max)?;
+            check_output(c.on_pulse(t), REFIT.r_max)?;
             let _ = c.step_tick(t);
         }
     }

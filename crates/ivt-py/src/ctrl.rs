@@ -5,7 +5,7 @@
 use ivt_ctrl::open_loop::{POLY_T_TERMS, POLY_V_TERMS};
 use ivt_ctrl::{
     units, Config, ControlOutput, Controller as RustController, Fault, Gains, LawKind, OlRegion,
-    OpenLoopCoeffs, StepTick, THESIS,
+    OpenLoopCoeffs, OpenLoopPreset, StepTick,
 };
 use numpy::ndarray::Array1;
 use numpy::{
@@ -98,21 +98,26 @@ fn region_name(r: OlRegion) -> &'static str {
     }
 }
 
-/// Open-loop coefficients from `"thesis"` or a dict with the fields of
-/// `OpenLoopCoeffs` (poly 3×5, boundary 3, r_max, v_m_range 2, t_u_range 2).
+/// Open-loop coefficients from a preset name (`"refit"`, the default set
+/// refitted on the printed plant, or `"thesis"`, Eq. 158–160 as printed) or a
+/// dict with the fields of `OpenLoopCoeffs` (poly 3×5, boundary 3, r_max,
+/// v_m_range 2, t_u_range 2; missing fields are taken from `"refit"`).
 pub fn open_loop_from_py(ob: &Bound<'_, PyAny>) -> PyResult<OpenLoopCoeffs> {
     if let Ok(name) = ob.extract::<String>() {
-        return match name.as_str() {
-            "thesis" => Ok(THESIS),
-            other => Err(PyValueError::new_err(format!(
-                "argument `open_loop` = {other:?}: known presets are 'thesis' (or pass a dict)"
-            ))),
-        };
+        return OpenLoopPreset::from_name(&name)
+            .map(OpenLoopPreset::coeffs)
+            .ok_or_else(|| {
+                PyValueError::new_err(format!(
+                    "argument `open_loop` = {name:?}: known presets are 'refit' (the default) and 'thesis' (or pass a dict)"
+                ))
+            });
     }
     let d = ob.cast::<PyDict>().map_err(|_| {
-        PyTypeError::new_err("argument `open_loop` must be 'thesis' or a dict of coefficients")
+        PyTypeError::new_err(
+            "argument `open_loop` must be 'refit', 'thesis' or a dict of coefficients",
+        )
     })?;
-    let mut c = THESIS;
+    let mut c = OpenLoopPreset::default().coeffs();
     for (key, value) in d.iter() {
         let key: String = key.extract()?;
         let bad = |what: &str| PyTypeError::new_err(format!("open_loop[{key:?}] must be {what}"));
@@ -172,7 +177,9 @@ type Override = (&'static str, Box<dyn Fn(&mut Config)>);
 ///
 /// Every keyword defaults to `ivt-ctrl`'s `Config::default()` (the thesis
 /// setup: 100 rpm, 1 MHz timer, Eq. 180 with k = 0.01, k2 = 0.02 mm·rad⁻¹ read
-/// as SI 1e-5, 2e-5 m·s/rad², the THESIS open-loop preset, 3200 steps/rev).
+/// as SI 1e-5, 2e-5 m·s/rad², the open-loop law refitted on the printed
+/// plant (`open_loop="refit"`; `"thesis"` selects Eq. 158–160 as printed),
+/// 3200 steps/rev).
 /// Gains are SI; `thesis_gains(k, k2)` converts the printed mm·rad⁻¹ values.
 /// `ppr` must be one of `SUPPORTED_PPR`. An invalid setting raises
 /// `ValueError` naming the keyword.
@@ -566,7 +573,7 @@ fn thesis_gains(k: f32, k2: f32) -> (f32, f32) {
     (g.k, g.k2)
 }
 
-/// The open-loop coefficient preset `name` ("thesis") as a dict, the form
+/// The open-loop coefficient preset `name` ("refit" or "thesis") as a dict, the form
 /// `Controller(open_loop=...)` accepts.
 #[pyfunction]
 fn open_loop_preset<'py>(
@@ -578,7 +585,8 @@ fn open_loop_preset<'py>(
 
 /// Evaluate an open-loop law (Eq. 158–160) like the controller does:
 /// dict with r_ol [m], ol_region, inputs_clamped, and the raw polynomial r_f
-/// and boundary f_B.
+/// and boundary f_B. `open_loop` defaults to the controller's default set
+/// ("refit").
 #[pyfunction]
 #[pyo3(signature = (v_m, t_u, open_loop = None))]
 fn open_loop_eval<'py>(
@@ -589,7 +597,7 @@ fn open_loop_eval<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let c = match open_loop {
         Some(ob) => open_loop_from_py(ob)?,
-        None => THESIS,
+        None => OpenLoopPreset::default().coeffs(),
     };
     let v = c.evaluate(v_m, t_u);
     let d = PyDict::new(py);

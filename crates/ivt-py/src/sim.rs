@@ -1,9 +1,8 @@
 //! `ivt.sim`: run ivt-sim scenes (TOML path, TOML text or a dict) and get
 //! the recorded channels as numpy arrays plus the summary of `ivt sim --json`.
 
-use ivt_sim::output::write_all;
-use ivt_sim::run::run as run_scene;
 use ivt_sim::scene::Scene;
+use ivt_sim::steady::{run_scene, write_outputs, Route};
 use numpy::ndarray::{Array1, Array2};
 use numpy::IntoPyArray;
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
@@ -105,30 +104,44 @@ fn columns<'py, T: Serialize>(py: Python<'py>, samples: &[T]) -> PyResult<Bound<
 /// nothing. Returns a dict with "summary" (the keys of `ivt sim --json`),
 /// "channels" (each logged channel as a dict of numpy arrays: plant, control,
 /// stepper, sensors; "plot" as an n×6 array) and "outputs" (written paths).
+/// The summary names the route taken ("ihb_steady_state" for a scene that
+/// asks only for steady-state metrics at constant inputs, else
+/// "time_integration"; `route=` forces one) and carries "steady_state" when
+/// the scene asks for it.
 /// Scene errors raise ValueError with ivt-sim's one-line message; a failed
 /// integration or controller backend raises RuntimeError.
 #[pyfunction]
-#[pyo3(signature = (scene, out = None))]
+#[pyo3(signature = (scene, out = None, route = None))]
 fn run<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
     out: Option<PathBuf>,
+    route: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let scene = scene_from_py(scene)?;
-    let (result, paths) = py
+    let force = match route.as_deref() {
+        None => None,
+        Some(name) => Some(Route::from_name(name).ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "argument `route` = {name:?}: must be 'ihb_steady_state' or 'time_integration'"
+            ))
+        })?),
+    };
+    let (answer, paths) = py
         .detach(|| -> Result<_, String> {
-            let result = run_scene(&scene, &mut |_| {}).map_err(|e| e.to_string())?;
+            let answer = run_scene(&scene, force, &mut |_| {}).map_err(|e| e.to_string())?;
             let paths = match &out {
-                Some(dir) => write_all(dir, &scene, &result).map_err(|e| e.to_string())?,
+                Some(dir) => write_outputs(dir, &scene, &answer).map_err(|e| e.to_string())?,
                 None => vec![],
             };
-            Ok((result, paths))
+            Ok((answer, paths))
         })
         .map_err(PyRuntimeError::new_err)?;
     let d = PyDict::new(py);
-    d.set_item("summary", json_to_py(py, &result.summary)?)?;
+    d.set_item("summary", json_to_py(py, &answer.summary_json(&scene))?)?;
     let ch = PyDict::new(py);
-    let c = &result.channels;
+    let empty = ivt_sim::run::Channels::default();
+    let c = answer.run.as_ref().map_or(&empty, |r| &r.channels);
     if let Some(v) = &c.plant {
         ch.set_item("plant", columns(py, v)?)?;
     }

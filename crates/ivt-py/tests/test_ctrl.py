@@ -19,12 +19,14 @@ def pulse_ticks(ppr: int, n: int, omega0: float, depth: float) -> np.ndarray:
     return np.round(t * F_TIMER).astype(np.int64)
 
 
-def thesis_r_ol(v_m: float, t_u: float) -> float:
-    """Eq. 158–160 with the printed coefficients, float64, no clamping of inputs
+def r_ol_ref(preset: str, v_m: float, t_u: float) -> float:
+    """Eq. 158–160 in float64 on a preset's coefficients, no clamping of inputs
     (test points lie inside 2 ≤ V_m ≤ 12, 1.5 ≤ T_U ≤ 9)."""
-    poly = np.array(ctrl.open_loop_preset("thesis")["poly"], dtype=np.float64)
+    c = ctrl.open_loop_preset(preset)
+    poly = np.array(c["poly"], dtype=np.float64)
     r_f = sum(poly[i, j] * v_m**i * t_u**j for i in range(poly.shape[0]) for j in range(poly.shape[1]))
-    f_b = v_m - 1.579 * t_u - 0.632
+    b = c["boundary"]
+    f_b = b[0] * v_m + b[1] * t_u + b[2]
     if f_b > 0 or r_f > 0.012:
         return 0.012
     return max(r_f, 0.0)
@@ -33,11 +35,24 @@ def thesis_r_ol(v_m: float, t_u: float) -> float:
 def test_open_loop_eval_matches_eq158_160() -> None:
     # f32 evaluation of a polynomial with terms up to ~0.1: abs error ~1e-8 m.
     for v_m, t_u in [(8.0, 8.0), (6.0, 6.0), (4.0, 2.0), (11.0, 3.0), (3.0, 9.0)]:
-        got = ctrl.open_loop_eval(v_m, t_u)
-        assert got["r_ol"] == pytest.approx(thesis_r_ol(v_m, t_u), abs=2e-8), (v_m, t_u)
+        got = ctrl.open_loop_eval(v_m, t_u, "thesis")
+        assert got["r_ol"] == pytest.approx(r_ol_ref("thesis", v_m, t_u), abs=2e-8), (v_m, t_u)
         assert got["f_b"] == pytest.approx(v_m - 1.579 * t_u - 0.632, abs=1e-5)
-    assert ctrl.open_loop_eval(11.0, 3.0)["ol_region"] == "over_drive"
+    assert ctrl.open_loop_eval(11.0, 3.0, "thesis")["ol_region"] == "over_drive"
     assert ctrl.open_loop_eval(20.0, 3.0)["inputs_clamped"] is True
+
+
+def test_refit_is_the_default_open_loop_law() -> None:
+    # REFIT's terms reach ~1 and cancel to ~1e-2 (ivt-ctrl's rounding-bound
+    # test: f32 error < 1e-6 m over the grid); inside the band at 100 rpm
+    # (V_m ∈ [7.87, 7.87 + 0.154·T_U]) the law is between 0 and r_max.
+    for v_m, t_u in [(8.0, 2.0), (8.4, 6.0), (8.9, 8.0), (8.6, 7.0)]:
+        got = ctrl.open_loop_eval(v_m, t_u)
+        assert got["r_ol"] == pytest.approx(r_ol_ref("refit", v_m, t_u), abs=1e-6), (v_m, t_u)
+        assert got["ol_region"] == "normal" and 0.0 < got["r_ol"] < 0.012
+    assert ctrl.Controller(100).config()["open_loop"] == ctrl.open_loop_preset("refit")
+    with pytest.raises(ValueError, match="'refit'"):
+        ctrl.open_loop_eval(8.0, 6.0, "printed")
 
 
 @pytest.mark.parametrize("ppr", [100, 1200])
@@ -64,7 +79,7 @@ def test_delay_law_against_float64_reference(ppr: int) -> None:
     assert np.all(out["omega_a"][~ready][: ppr] == 0.0)
 
     # Eq. 180 integrated per pulse with the anti-windup clamp of ivt-ctrl's docs.
-    r_ol = thesis_r_ol(8.0, 8.0)  # Config.initial_inputs
+    r_ol = ctrl.open_loop_eval(8.0, 8.0)["r_ol"]  # default law at Config.initial_inputs
     r_d, ref = 0.0, []
     for w, wa, wt in zip(omega, omega_a, omega_t):
         r_d += (k * (wa - omega0) + k2 * (w - wt)) * dth
@@ -80,9 +95,11 @@ def test_delay_law_against_float64_reference(ppr: int) -> None:
 def test_pulse_by_pulse_equals_batch_and_step_tick() -> None:
     ticks = pulse_ticks(100, 400, 10.0, 0.05)
     a, b = ctrl.Controller(100), ctrl.Controller(100)
-    batch = b.on_pulses(ticks, v_m=np.full(400, 7.0), t_u=np.full(400, 5.0))
+    # (8.4 V, 6 N·m) lies inside the band at 100 rpm: the default (REFIT)
+    # u_ol is 6.85 mm there (7 V would be under-drive: u_ol = 0, no move).
+    batch = b.on_pulses(ticks, v_m=np.full(400, 8.4), t_u=np.full(400, 6.0))
     for i, tk in enumerate(ticks):
-        a.update_inputs(7.0, 5.0)
+        a.update_inputs(8.4, 6.0)
         o = a.on_pulse(int(tk))
         assert o["r"] == batch["r"][i] and o["omega_a"] == batch["omega_a"][i]
     st = a.step_tick(int(ticks[-1]) + 10)

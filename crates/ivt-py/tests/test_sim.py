@@ -89,3 +89,21 @@ def test_scene_errors() -> None:
         ivt.sim.run(42)  # type: ignore[arg-type]
     assert ivt.sim.check_scene(SCENE)["name"] == "load_step_delay"
     assert 1200 in ivt.sim.SUPPORTED_PPR
+
+
+def test_steady_state_scene_takes_the_ihb_route() -> None:
+    scene = REPO / "scenes" / "steady_state.toml"
+    ihb = ivt.sim.run(scene)["summary"]
+    assert ihb["route"] == "ihb_steady_state"
+    assert ihb["steady_state"]["verdict"] == "feasible"
+    time = ivt.sim.run(scene, route="time_integration")["summary"]
+    assert time["route"] == "time_integration"
+    # crates/ivt-sim/tests/steady_route.rs derives these bounds: the loop
+    # dithers over ±1 stepper step (≈ 1.6e-4 rad/s in ω_a) around r̄.
+    a, b = ihb["steady_state"], time["steady_state"]
+    assert abs(a["omega_a_rad_s"] - b["omega_a_rad_s"]) < 2e-4
+    assert abs(a["omega_max_rad_s"] / b["omega_max_rad_s"] - 1.0) < 1e-4
+    with pytest.raises(RuntimeError, match="route"):
+        ivt.sim.run(REPO / "scenes" / "load_step_delay.toml", route="ihb_steady_state")
+    with pytest.raises(ValueError, match="route"):
+        ivt.sim.run(scene, route="fast")

@@ -13,5 +13,6 @@ pub mod record;
 pub mod run;
 pub mod scene;
 pub mod sensors;
+pub mod steady;
 pub mod telemetry;
 pub mod work_precision;

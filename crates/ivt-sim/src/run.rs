@@ -20,7 +20,7 @@ use crate::profile::{Drive, Pwl};
 use crate::record::Sample;
 use crate::scene::Scene;
 use crate::sensors::{Encoder, Reading, Rng, Stepper};
-use ivt_ctrl::{units, ActuatorMap, Config, Gains, LawKind, StepperLimits, THESIS};
+use ivt_ctrl::{units, ActuatorMap, Config, Gains, LawKind, OpenLoopPreset, StepperLimits};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -255,7 +255,10 @@ fn law_kind(name: &str) -> Option<LawKind> {
 pub fn controller_config(scene: &Scene, r_max: f64) -> Option<Config> {
     let c = &scene.controller;
     let law = law_kind(&c.law)?;
-    let mut open_loop = THESIS;
+    // Validated by `Scene::parse`; an unknown name cannot reach here.
+    let mut open_loop = OpenLoopPreset::from_name(&c.open_loop)
+        .unwrap_or_default()
+        .coeffs();
     open_loop.r_max = r_max as f32;
     Some(Config {
         f_timer_hz: scene.encoder.f_timer_hz as f32,

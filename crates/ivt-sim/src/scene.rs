@@ -5,6 +5,7 @@
 //! the crate README for the full key list.
 
 use crate::backend::SUPPORTED_PPR;
+use ivt_ctrl::OpenLoopPreset;
 use ivt_kin::plant::{GravityModel, PlantParams};
 use serde::Deserialize;
 
@@ -299,7 +300,8 @@ pub struct ControllerSection {
     /// Add u_ol (Eq. 160) to r.
     #[serde(default = "default_true")]
     pub feedforward: bool,
-    /// Open-loop coefficients: `"thesis"` (Eq. 158–160 as printed).
+    /// Open-loop coefficients: `"refit"` (default: refitted on the printed
+    /// plant by `ivt ol fit`, SPEC §5) or `"thesis"` (Eq. 158–160 as printed).
     #[serde(default = "default_open_loop")]
     pub open_loop: String,
     /// r(t) for `law = "none"`: `[[t, r], ...]` \[s, m\].
@@ -329,7 +331,7 @@ fn default_true() -> bool {
     true
 }
 fn default_open_loop() -> String {
-    "thesis".into()
+    OpenLoopPreset::default().name().into()
 }
 
 impl Default for ControllerSection {
@@ -397,7 +399,7 @@ fn default_every() -> usize {
 }
 
 /// `[outputs]`: only what is named here is computed and written.
-#[derive(Clone, Debug, Deserialize, PartialEq, Default)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct OutputsSection {
     /// Write `<name>.mcap` with the channels.
@@ -416,7 +418,39 @@ pub struct OutputsSection {
     /// Logged channel groups.
     #[serde(default)]
     pub channels: Vec<ChannelSpec>,
+    /// Ask for the steady-state metrics at the scene's (constant) inputs:
+    /// mean speed ω_a, min/max ω over a revolution, the r held, r̄ and the
+    /// feasibility verdict (see [`crate::steady`]).
+    #[serde(default)]
+    pub steady_state: bool,
+    /// How the scene is answered: `"auto"` (default: the IHB steady state when
+    /// the scene asks only for steady-state metrics, see
+    /// [`Scene::ihb_route_blocker`], else time integration),
+    /// `"ihb_steady_state"` or `"time_integration"` (forced).
+    #[serde(default = "default_route")]
+    pub route: String,
 }
+
+fn default_route() -> String {
+    "auto".into()
+}
+
+impl Default for OutputsSection {
+    fn default() -> Self {
+        Self {
+            mcap: false,
+            csv: false,
+            summary: false,
+            plots: vec![],
+            channels: vec![],
+            steady_state: false,
+            route: default_route(),
+        }
+    }
+}
+
+/// Values of `outputs.route`.
+pub const ROUTES: [&str; 3] = ["auto", "ihb_steady_state", "time_integration"];
 
 /// Channel groups a scene may log.
 pub const CHANNELS: [&str; 4] = ["plant", "control", "stepper", "sensors"];
@@ -583,6 +617,46 @@ impl Scene {
         Ok(params)
     }
 
+    /// Why the scene cannot be answered by the IHB steady state (None: it
+    /// can). The IHB route (thesis §4.2.1: the periodic steady state without
+    /// the transient) answers exactly what the time integration would settle
+    /// to only when the scene asks for nothing but steady-state metrics at
+    /// constant inputs, with a law whose equilibrium is the periodic orbit at
+    /// constant r, and without random disturbances.
+    #[must_use]
+    pub fn ihb_route_blocker(&self) -> Option<String> {
+        let constant = |p: &[[f64; 2]]| p.iter().all(|k| k[1] == p[0][1]);
+        let o = &self.outputs;
+        let c = &self.controller;
+        let s = &self.sensors;
+        if !o.steady_state {
+            Some("the scene does not ask for steady-state metrics (outputs.steady_state)".into())
+        } else if o.mcap || o.csv || !o.plots.is_empty() || !o.channels.is_empty() {
+            Some("the scene asks for channels, plots, MCAP or CSV (a transient)".into())
+        } else if !constant(&self.inputs.v_m) || !constant(&self.inputs.t_u) {
+            Some("the inputs V_m, T_U are not constant".into())
+        } else if c.law == "nodelay" || c.law == "prop" {
+            Some(format!(
+                "law \"{}\": its equilibrium is not the periodic orbit at constant r (Eq. 181 holds the θ-mean of ω, Eq. 189 samples in time)",
+                c.law
+            ))
+        } else if c.law == "none" && !constant(&c.r_schedule) {
+            Some("the r schedule is not constant".into())
+        } else if s.v_m_noise > 0.0
+            || s.t_u_noise > 0.0
+            || s.v_m_quantum > 0.0
+            || s.t_u_quantum > 0.0
+            || self.encoder.jitter_s > 0.0
+            || self.stepper.miss_prob > 0.0
+        {
+            Some("sensor noise/quantization, encoder jitter or missed steps are set".into())
+        } else if self.plant.l_a.is_some_and(|l| l > 0.0) {
+            Some("the motor inductance L_a > 0 (the IHB model is Eq. 151 with L_a = 0)".into())
+        } else {
+            None
+        }
+    }
+
     /// All range and consistency checks; `Err((key, message))`.
     fn validate(&self) -> Result<(), (&'static str, String)> {
         fn check(ok: bool, key: &'static str, msg: String) -> Result<(), (&'static str, String)> {
@@ -732,9 +806,12 @@ impl Scene {
             format!("must be > 0 s, got {}", c.prop_period_s),
         )?;
         check(
-            c.open_loop == "thesis",
+            OpenLoopPreset::from_name(&c.open_loop).is_some(),
             "controller.open_loop",
-            format!("must be \"thesis\", got \"{}\"", c.open_loop),
+            format!(
+                "must be \"refit\" (the default) or \"thesis\", got \"{}\"",
+                c.open_loop
+            ),
         )?;
         if c.law == "none" {
             check(
@@ -763,6 +840,19 @@ impl Scene {
             format!("must be > 0 s, got {}", m.static_window_s),
         )?;
         let o = &self.outputs;
+        check(
+            ROUTES.contains(&o.route.as_str()),
+            "outputs.route",
+            format!("must be one of {ROUTES:?}, got \"{}\"", o.route),
+        )?;
+        if o.route == "ihb_steady_state" {
+            if let Some(why) = self.ihb_route_blocker() {
+                return Err((
+                    "outputs.route",
+                    format!("= \"ihb_steady_state\" is not possible: {why}"),
+                ));
+            }
+        }
         for p in &o.plots {
             check(
                 PLOTS.contains(&p.as_str()),
@@ -859,6 +949,7 @@ t_u = [[0.0, 4.0]]
         let s = Scene::parse(OK, "s.toml").unwrap();
         assert_eq!(s.encoder.ppr, 1200);
         assert_eq!(s.controller.law, "delay");
+        assert_eq!(s.controller.open_loop, "refit");
         assert!(!s.outputs.mcap && s.outputs.channels.is_empty());
     }
 
@@ -880,6 +971,11 @@ t_u = [[0.0, 4.0]]
         assert!(e.contains("plant.r_a"), "{e}");
         let e = err(&format!("{OK}\n[controller]\nlaw = \"pid\"\n"));
         assert!(e.contains("controller.law"), "{e}");
+        let e = err(&format!("{OK}\n[controller]\nopen_loop = \"printed\"\n"));
+        assert!(
+            e.contains("s.toml:8") && e.contains("controller.open_loop") && e.contains("refit"),
+            "{e}"
+        );
         let e = err(&format!(
             "{OK}\n[[outputs.channels]]\nname = \"plant\"\n[[outputs.channels]]\nname = \"nope\"\n"
         ));

@@ -29,14 +29,15 @@ fn keep_all(s: &mut Scene) {
     ];
 }
 
-/// RMS over pulses after `from` of the commanded dr/dθ (Δr between
-/// consecutive pulses / Δθ).
+/// RMS over pulses after `from` of the feedback part's dr_d/dθ (Δr_d between
+/// consecutive pulses / Δθ): the law's own output, without the open-loop
+/// step u_ol adds to r under either law.
 fn rms_dr_dtheta(res: &RunResult, from: f64, dtheta: f64) -> f64 {
     let c = res.channels.control.as_ref().unwrap();
     let (mut s, mut n) = (0.0, 0);
     for w in c.windows(2) {
         if w[0].t >= from {
-            let d = f64::from(w[1].r - w[0].r) / dtheta;
+            let d = f64::from(w[1].r_d - w[0].r_d) / dtheta;
             s += d * d;
             n += 1;
         }
@@ -67,8 +68,9 @@ fn settling_to_final(res: &RunResult, from: f64, band: f64) -> (f64, f64) {
 /// to ω0 with no static error. Bound 1e-4 rad/s (1e-5 relative): the 1 MHz
 /// timer resolves ω_a of one revolution (≈ 0.6 s) to 1.7e-6 relative, and the
 /// stepper's 1.2 µm steps move ω_a by ≈ 1.6e-4 rad/s, which the integral
-/// dithers around; the measured mean error is ≈ 6e-7 rad/s. Without feedback
-/// (the printed u_ol, law "open") the error is more than 1000× larger.
+/// dithers around; the measured mean error is ≈ 6e-8 rad/s. Without feedback
+/// (the refitted u_ol alone, law "open") the error is the fit error of the
+/// law at 8.6 V / 8 N·m, more than 1000× larger.
 #[test]
 fn delay_law_has_no_static_error_inside_the_band() {
     let s = scene("load_step_delay");
@@ -91,15 +93,16 @@ fn delay_law_has_no_static_error_inside_the_band() {
     );
 }
 
-/// Fig. 45's claim, quantified on the load step: with the same integral gain
-/// k = 2 mm·rad⁻¹ both laws converge alike (settling to their own final ω_a
-/// within ±0.05 rad/s in 0.89 s each; the test allows a factor 3), and the
-/// delay law's control signal is much smoother: measured RMS dr/dθ 7.3e-5 vs
-/// 1.8e-3 m/rad (25×); asserted ≥ 10×. (A scan of the no-delay k2 ∈ {0, 0.1,
-/// 0.25} only makes r rougher, and k = 4 no longer settles.) The no-delay law
-/// integrates ω itself, so r follows its 4-per-revolution ripple; it also
-/// regulates the θ-mean of ω instead of ω_a (the harmonic mean), leaving a
-/// static error in ω_a of ≈ −0.08 rad/s.
+/// Fig. 45's claim, quantified on the load step (both scenes with the
+/// refitted feed-forward, the same integral gain k = 2 mm·rad⁻¹): the delay
+/// law's feedback part is much smoother — measured RMS dr_d/dθ 7.7e-5 vs
+/// 1.8e-3 m/rad (24×; asserted ≥ 10×). The no-delay law integrates ω itself,
+/// so r_d follows its 4-per-revolution ripple; it also regulates the θ-mean
+/// of ω instead of ω_a (the harmonic mean), leaving a static error in ω_a of
+/// ≈ −0.08 rad/s, and it settles to its own final value later (measured
+/// 3.8 s vs 1.2 s within ±0.05 rad/s; asserted: not earlier than the delay
+/// law). (Without feed-forward both settled alike in 0.89 s, with the same
+/// 25× smoothness ratio: u_ol adds the same step to r under both laws.)
 #[test]
 fn delay_law_is_smoother_than_no_delay_law() {
     let mut d = scene("load_step_delay");
@@ -115,10 +118,7 @@ fn delay_law_is_smoother_than_no_delay_law() {
         rms_dr_dtheta(&rn, 10.0, dtheta),
     );
     eprintln!("delay: settle {sd:.2} s → {fd:.5}, RMS dr/dθ {qd:.3e}; nodelay: settle {sn:.2} s → {fn_:.5}, RMS dr/dθ {qn:.3e}");
-    assert!(
-        sd < 3.0 * sn.max(0.3) && sn < 3.0 * sd.max(0.3),
-        "convergence not similar: {sd} vs {sn}"
-    );
+    assert!(sd <= sn, "convergence: {sd} vs {sn}");
     assert!(qn > 10.0 * qd, "RMS dr/dθ delay {qd:e} vs nodelay {qn:e}");
     let w0 = rd.summary.omega0_rad_s;
     assert!(

@@ -2,7 +2,7 @@
 //! Pins, timers and scaling are constants here; the wiring table is in
 //! README.md.
 
-use ivt_ctrl::Config;
+use ivt_ctrl::{Config, REFIT};
 
 /// SYSCLK \[Hz\].
 pub const SYSCLK_HZ: u32 = 100_000_000;
@@ -51,10 +51,13 @@ pub const T_U_SCALE: AdcScale = AdcScale {
 };
 
 /// The controller configuration of the rig image: the library defaults
-/// (thesis setup) on this board's timer.
+/// (thesis setup) on this board's timer, with the open-loop law refitted on
+/// the printed plant (`REFIT`, also the library default; named here so that
+/// the flashed law is visible in the board file — SPEC §5).
 pub fn config() -> Config {
     Config {
         f_timer_hz: F_TIMER_HZ as f32,
+        open_loop: REFIT,
         ..Config::default()
     }
 }

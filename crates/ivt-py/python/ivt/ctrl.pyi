@@ -11,7 +11,7 @@ SUPPORTED_PPR: List[int]
 FAULTS: Dict[int, str]
 
 Law = Literal["delay", "nodelay", "prop", "open"]
-OpenLoop = Union[Literal["thesis"], Dict[str, Any]]
+OpenLoop = Union[Literal["refit", "thesis"], Dict[str, Any]]
 
 class Controller:
     """The rig controller of ivt-ctrl for ``ppr`` samples per revolution."""
@@ -59,7 +59,7 @@ class Controller:
     ) -> Dict[str, npt.NDArray[Any]]: ...
 
 def thesis_gains(k: float, k2: float) -> Tuple[float, float]: ...
-def open_loop_preset(name: Literal["thesis"]) -> Dict[str, Any]: ...
+def open_loop_preset(name: Literal["refit", "thesis"]) -> Dict[str, Any]: ...
 def open_loop_eval(
     v_m: float, t_u: float, open_loop: Optional[OpenLoop] = None
 ) -> Dict[str, Any]: ...

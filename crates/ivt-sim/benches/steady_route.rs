@@ -1,0 +1,53 @@
+//! The two routes to `scenes/steady_state.toml` (issue 7, item 7): the IHB
+//! periodic steady state (with and without the delay-loop stability check it
+//! makes inside the band) against the closed-loop time integration of the
+//! same scene (20 s from ω = 10 rad/s, last revolution measured). Also the
+//! saturated case (V_m = 7 V, T_U = 8 N·m), where the route adds a secant
+//! on ω0 over IHB solves.
+
+use ivt_sim::scene::Scene;
+use ivt_sim::steady::{ihb_steady_state, run_scene, Route};
+
+fn main() {
+    divan::main();
+}
+
+fn scene() -> Scene {
+    let src = include_str!("../../../scenes/steady_state.toml");
+    Scene::parse(src, "steady_state.toml").expect("shipped scene parses")
+}
+
+fn saturated() -> Scene {
+    let mut s = scene();
+    s.inputs.v_m = vec![[0.0, 7.0]];
+    s.inputs.t_u = vec![[0.0, 8.0]];
+    s
+}
+
+/// What `ivt sim scenes/steady_state.toml` computes (route "auto" → IHB).
+#[divan::bench(sample_count = 20)]
+fn ihb_route(b: divan::Bencher) {
+    let s = scene();
+    b.bench(|| run_scene(&s, None, &mut |_| {}).expect("answers"));
+}
+
+/// The same scene forced through the time integration.
+#[divan::bench(sample_count = 10)]
+fn time_route(b: divan::Bencher) {
+    let s = scene();
+    b.bench(|| run_scene(&s, Some(Route::TimeIntegration), &mut |_| {}).expect("runs"));
+}
+
+/// Under-drive: r = 0 held, mean speed by secant over IHB solves.
+#[divan::bench(sample_count = 20)]
+fn ihb_route_saturated(b: divan::Bencher) {
+    let s = saturated();
+    b.bench(|| ihb_steady_state(&s).expect("answers"));
+}
+
+/// Under-drive through the time integration (20 s).
+#[divan::bench(sample_count = 10)]
+fn time_route_saturated(b: divan::Bencher) {
+    let s = saturated();
+    b.bench(|| run_scene(&s, Some(Route::TimeIntegration), &mut |_| {}).expect("runs"));
+}
