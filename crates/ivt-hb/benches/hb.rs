@@ -23,6 +23,17 @@ fn duffing_modified_n20_n64(bencher: divan::Bencher) {
     });
 }
 
+/// Same point including the solver's setup (FFT plans, buffers, linear Jacobian):
+/// what a caller pays for one solve with a fresh solver, e.g. one Python call.
+#[divan::bench]
+fn duffing_modified_with_setup(bencher: divan::Bencher) {
+    bencher.bench_local(|| {
+        ModifiedIhb::new(Duffing::fig28(), HbOptions::new(20, 64))
+            .and_then(|mut s| s.solve(divan::black_box(0.4), None))
+            .unwrap()
+    });
+}
+
 /// Same point, classic IHB (Newton with the quadrature Galerkin Jacobian).
 #[divan::bench]
 fn duffing_classic_n20_n64(bencher: divan::Bencher) {

@@ -486,12 +486,14 @@ impl HbResidual {
         let n = self.n;
         let l = 2 * n + 1;
         let ns = self.aft.n_samples();
+        // k·τ_i = 2π·(k·i mod 2N)/2N: one sin/cos table of the 2N grid angles
+        // serves every harmonic (and reduces the angle exactly).
+        let table: Vec<(f64, f64)> = (0..ns).map(|j| self.aft.tau(j).sin_cos()).collect();
         for i in 0..ns {
-            let tau = self.aft.tau(i);
             basis[i * l] = 0.5;
             basis[(ns + i) * l] = 0.0;
             for k in 1..=n {
-                let (sn, cs) = (k as f64 * tau).sin_cos();
+                let (sn, cs) = table[(k * i) % ns];
                 basis[i * l + k] = cs;
                 basis[i * l + n + k] = sn;
                 basis[(ns + i) * l + k] = -(k as f64) * sn;

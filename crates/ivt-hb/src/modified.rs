@@ -11,13 +11,15 @@ use crate::linalg::matvec;
 use crate::problem::PeriodicProblem;
 
 /// The modified IHB solver for one problem and one size (plans and buffers reused
-/// across solves; nothing is allocated inside the iteration).
+/// across solves; nothing is allocated inside the iteration, except the Galerkin
+/// quadrature table, built once on the solver's first stalled-Broyden refresh).
 #[derive(Debug)]
 pub struct ModifiedIhb<P> {
     problem: P,
     opts: HbOptions,
     res: HbResidual,
-    galerkin: GalerkinJacobian,
+    /// Built on the first Broyden refresh (most solves never need it).
+    galerkin: Option<GalerkinJacobian>,
     ws: BroydenWorkspace,
     b0: Vec<f64>,
     h0: Vec<f64>,
@@ -36,7 +38,7 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         Ok(Self {
             problem,
             opts,
-            galerkin: GalerkinJacobian::new(&res),
+            galerkin: None,
             res,
             ws: {
                 // One-shot solves never read B: iterate on H alone.
@@ -275,7 +277,7 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
 struct HbSystem<'a, P> {
     problem: &'a P,
     res: &'a mut HbResidual,
-    galerkin: &'a mut GalerkinJacobian,
+    galerkin: &'a mut Option<GalerkinJacobian>,
     omega_f: f64,
     s: f64,
 }
@@ -286,8 +288,10 @@ impl<P: PeriodicProblem> System for HbSystem<'_, P> {
     }
 
     fn jacobian(&mut self, q: &[f64], jac: &mut [f64]) -> bool {
+        let res = &mut *self.res;
         self.galerkin
-            .assemble(self.res, self.problem, q, self.omega_f, self.s, jac);
+            .get_or_insert_with(|| GalerkinJacobian::new(res))
+            .assemble(res, self.problem, q, self.omega_f, self.s, jac);
         jac.iter().all(|v| v.is_finite())
     }
 }
