@@ -128,3 +128,31 @@ fn string_spring_boundary_reports_stability() {
         .unwrap()
         .contains("negative spring"));
 }
+
+#[test]
+fn string_cold_start_inside_the_hysteresis_range_says_how_to_start() {
+    // k_d = 30: ω = 4 is on the flank of the hardening peak (folds near 4.29
+    // and 4.44), where Newton from a = 0 does not reach the large-amplitude
+    // solution; the error carries the residual history and the remedy.
+    let (code, v) = run(&[
+        "--json",
+        "hb",
+        "string",
+        "--kd",
+        "30",
+        "--modes",
+        "5",
+        "--harmonics",
+        "19",
+        "--from",
+        "4",
+        "--to",
+        "4.6",
+    ]);
+    assert_eq!(code, 2, "{v}");
+    let msg = v["error"].as_str().unwrap();
+    assert!(
+        msg.contains("residual norms") && msg.contains("--from 1"),
+        "{msg}"
+    );
+}
