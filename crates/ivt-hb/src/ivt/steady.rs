@@ -516,6 +516,8 @@ impl IhbSolver {
         if !warm {
             ws = BroydenWorkspace::new(dim); // cold: seed with the exact Jacobian
         }
+        // Warm starts carry H forward; B is never read, so it is not updated.
+        ws.track_jacobian = false;
         let bopts = BroydenOptions {
             tol: self.opts.tol,
             max_iter: self.opts.max_iter,
