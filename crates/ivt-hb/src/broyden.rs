@@ -241,29 +241,10 @@ impl BroydenWorkspace {
         self.invert_b()
     }
 
-    /// Sets `B₀` together with its known inverse (skips the O(m³) inversion, e.g.
-    /// for the block-diagonal linear Jacobian Eq. 60).
-    ///
-    /// # Errors
-    /// [`SolveError::Dimension`] on size mismatch.
-    pub fn set_jacobian_and_inverse(&mut self, b0: &[f64], h0: &[f64]) -> Result<(), SolveError> {
-        let m = self.m;
-        if b0.len() != m * m || h0.len() != m * m {
-            return Err(SolveError::Dimension {
-                expected: m * m,
-                got: b0.len().min(h0.len()),
-            });
-        }
-        self.b.copy_from_slice(b0);
-        self.h.copy_from_slice(h0);
-        self.b_current = true;
-        self.has_jacobian = true;
-        self.dx_next_ready = false;
-        Ok(())
-    }
-
-    /// Sets only the inverse `H₀ = B₀⁻¹` (row-major `m×m`): for a solve that does
-    /// not read `B` ([`Self::track_jacobian`] off); `B` is rebuilt from `H` if asked.
+    /// Sets only the inverse `H₀ = B₀⁻¹` (row-major `m×m`), e.g. of the
+    /// block-diagonal linear Jacobian Eq. 60, skipping the O(m³) inversion; for a
+    /// solve that does not read `B` ([`Self::track_jacobian`] off). `B` is rebuilt
+    /// from `H` if asked.
     ///
     /// # Errors
     /// [`SolveError::Dimension`] on size mismatch.

@@ -350,9 +350,36 @@ impl HbResidual {
         }
     }
 
-    /// The linear Jacobian `B_{q,0} = L(ω)` of Eq. 60 (row-major, `len×len`) and its
-    /// inverse, assembled block by block (harmonic k couples only `a_k`, `b_k` of all
-    /// DOFs). `h0` is `None` if a block is singular (e.g. at a linear resonance).
+    /// The linear Jacobian `B_{q,0} = L(ω)` of Eq. 60 (row-major, `len×len`),
+    /// written straight into `b0`: harmonic k couples only `a_k`, `b_k` of all DOFs.
+    /// Allocation-free (the classic Newton loop and the Broyden refresh call it).
+    pub fn linear_matrix<P: PeriodicProblem>(&self, problem: &P, omega: f64, b0: &mut [f64]) {
+        let (nd, n) = (self.n_dof, self.n);
+        let l = 2 * n + 1;
+        let len = nd * l;
+        b0.fill(0.0);
+        let (m, c, k) = (problem.mass(), problem.damping(), problem.stiffness());
+        for d in 0..nd {
+            for e in 0..nd {
+                b0[d * l * len + e * l] = 0.5 * k[d * nd + e];
+                for h in 1..=n {
+                    let kw = h as f64 * omega;
+                    let stiff = k[d * nd + e] - kw * kw * m[d * nd + e];
+                    let damp = kw * c[d * nd + e];
+                    let (ra, rb) = ((d * l + h) * len, (d * l + n + h) * len);
+                    let (ca, cb) = (e * l + h, e * l + n + h);
+                    b0[ra + ca] = stiff;
+                    b0[ra + cb] = damp;
+                    b0[rb + ca] = -damp;
+                    b0[rb + cb] = stiff;
+                }
+            }
+        }
+    }
+
+    /// [`Self::linear_matrix`] and its inverse `h0`, inverted block by block (one
+    /// `2·n_dof` block per harmonic). Returns `false` (and leaves `h0` incomplete) if
+    /// a block is singular, e.g. at a linear resonance.
     pub fn linear_jacobian<P: PeriodicProblem>(
         &self,
         problem: &P,
@@ -360,21 +387,20 @@ impl HbResidual {
         b0: &mut [f64],
         h0: &mut [f64],
     ) -> bool {
+        self.linear_matrix(problem, omega, b0);
         let (nd, n) = (self.n_dof, self.n);
         let l = 2 * n + 1;
         let len = nd * l;
-        b0.fill(0.0);
         h0.fill(0.0);
-        let (m, c, k) = (problem.mass(), problem.damping(), problem.stiffness());
-        // Index lists of each block: k = 0 → {a0 of each dof}; k ≥ 1 → {a_k…, b_k…}.
-        let mut ok = true;
         let bs = 2 * nd;
         let mut blk = vec![0.0; bs * bs];
         let mut inv = vec![0.0; bs * bs];
         let mut lu = vec![0.0; bs * bs];
         let mut piv = vec![0; bs];
         let mut idx = vec![0usize; bs];
+        let mut ok = true;
         for h in 0..=n {
+            // Index list of the block: h = 0 → {a0 of each dof}; h ≥ 1 → {a_h…, b_h…}.
             let size = if h == 0 { nd } else { bs };
             for d in 0..nd {
                 idx[d] = d * l + h;
@@ -382,24 +408,9 @@ impl HbResidual {
                     idx[nd + d] = d * l + n + h;
                 }
             }
-            let kw = h as f64 * omega;
-            for d in 0..nd {
-                for e in 0..nd {
-                    if h == 0 {
-                        blk[d * size + e] = 0.5 * k[d * nd + e];
-                    } else {
-                        let stiff = k[d * nd + e] - kw * kw * m[d * nd + e];
-                        let damp = kw * c[d * nd + e];
-                        blk[d * size + e] = stiff;
-                        blk[d * size + nd + e] = damp;
-                        blk[(nd + d) * size + e] = -damp;
-                        blk[(nd + d) * size + nd + e] = stiff;
-                    }
-                }
-            }
             for i in 0..size {
                 for j in 0..size {
-                    b0[idx[i] * len + idx[j]] = blk[i * size + j];
+                    blk[i * size + j] = b0[idx[i] * len + idx[j]];
                 }
             }
             if invert(
@@ -511,20 +522,18 @@ pub struct GalerkinJacobian {
     basis: Vec<f64>,
     dgx: Vec<f64>,
     dgv: Vec<f64>,
-    h_scratch: Vec<f64>,
 }
 
 impl GalerkinJacobian {
     /// Scratch for `res`'s size and `n_dof` of the problem it evaluates.
     pub fn new(res: &HbResidual) -> Self {
-        let (nd, l, m) = (res.n_dof, 2 * res.n + 1, res.len());
+        let (nd, l) = (res.n_dof, 2 * res.n + 1);
         let mut basis = vec![0.0; 2 * res.aft.n_samples() * l];
         res.fill_basis(&mut basis);
         Self {
             basis,
             dgx: vec![0.0; nd * nd],
             dgv: vec![0.0; nd * nd],
-            h_scratch: vec![0.0; m * m],
         }
     }
 
@@ -539,8 +548,7 @@ impl GalerkinJacobian {
         s: f64,
         jac: &mut [f64],
     ) {
-        let omega = omega_f / res.p as f64;
-        res.linear_jacobian(problem, omega, jac, &mut self.h_scratch);
+        res.linear_matrix(problem, omega_f / res.p as f64, jac);
         if s != 0.0 {
             res.add_nonlinear_jacobian(
                 problem,
