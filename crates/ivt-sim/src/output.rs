@@ -317,7 +317,7 @@ where
     }
     std::fs::create_dir_all(dir).map_err(io(dir))?;
     let path = mcap_path(dir, scene);
-    let wanted = CHANNELS.map(|name| scene.outputs.channels.iter().any(|c| c.name == name));
+    let wanted = CHANNELS.map(|name| scene.outputs.every(name).is_some());
     let log = McapLog::create(&path, scene, wanted)?;
     let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<Sample>>(IN_FLIGHT);
     let writer = std::thread::Builder::new()

@@ -402,14 +402,7 @@ pub fn run_with_backend_to(
     integ.omega_handover = g.omega_handover;
 
     // channel buffers: only what is asked for
-    let every = |name: &str| {
-        scene
-            .outputs
-            .channels
-            .iter()
-            .find(|c| c.name == name)
-            .map(|c| c.every)
-    };
+    let every = |name: &str| scene.outputs.every(name);
     let (ev_plant, ev_control, ev_stepper, ev_sensors) = (
         every("plant"),
         every("control"),

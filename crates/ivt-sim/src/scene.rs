@@ -435,6 +435,17 @@ fn default_route() -> String {
     "auto".into()
 }
 
+impl OutputsSection {
+    /// Decimation of channel `name` (`every` n-th sample), `None` if not logged.
+    #[must_use]
+    pub fn every(&self, name: &str) -> Option<usize> {
+        self.channels
+            .iter()
+            .find(|c| c.name == name)
+            .map(|c| c.every)
+    }
+}
+
 impl Default for OutputsSection {
     fn default() -> Self {
         Self {

@@ -400,15 +400,8 @@ fn time_route(
     if !scene.outputs.steady_state {
         return Ok((run(scene, progress)?, None));
     }
-    let asked = |name: &str| {
-        scene
-            .outputs
-            .channels
-            .iter()
-            .find(|c| c.name == name)
-            .map(|c| c.every)
-    };
-    let (every_plant, every_control) = (asked("plant"), asked("control"));
+    let (every_plant, every_control) =
+        (scene.outputs.every("plant"), scene.outputs.every("control"));
     let mut s = scene.clone();
     s.outputs
         .channels
