@@ -130,7 +130,7 @@ fn string_spring_boundary_reports_stability() {
 }
 
 #[test]
-fn string_cold_start_inside_the_hysteresis_range_says_how_to_start() {
+fn string_cold_start_on_the_peak_flank_says_how_to_start() {
     // k_d = 30: ω = 4 is on the flank of the hardening peak (folds near 4.29
     // and 4.44), where Newton from a = 0 does not reach the large-amplitude
     // solution; the error carries the residual history and the remedy.
@@ -152,7 +152,7 @@ fn string_cold_start_inside_the_hysteresis_range_says_how_to_start() {
     assert_eq!(code, 2, "{v}");
     let msg = v["error"].as_str().unwrap();
     assert!(
-        msg.contains("residual norms") && msg.contains("--from 1"),
+        msg.contains("residual norms") && msg.contains("start below the resonance"),
         "{msg}"
     );
 }

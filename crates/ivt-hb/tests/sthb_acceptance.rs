@@ -572,7 +572,9 @@ fn stress_converges_or_fails_clearly() {
                 assert!(
                     matches!(
                         e,
-                        SthbError::Stalled { .. } | SthbError::NoConvergence { .. }
+                        SthbError::Stalled { .. }
+                            | SthbError::NoConvergence { .. }
+                            | SthbError::ColdStart { .. }
                     ),
                     "{msg}"
                 );

@@ -4,7 +4,7 @@
 //! the STHB route on the same curve (N = 5, k_d = 10, c_d = 0.8, y0 = 0.5, M = 19).
 
 use ivt_hb::frc::{frequency_response as engine_frc, FrcOptions};
-use ivt_hb::sthb::continuation::{frequency_response, ContinuationOptions};
+use ivt_hb::sthb::continuation::{frequency_response, ContinuationOptions, Frc};
 use ivt_hb::sthb::modal::ModalString;
 use ivt_hb::sthb::{StringHb, StringParams};
 use ivt_hb::{HbOptions, HbResidual, ModifiedIhb};
@@ -13,6 +13,22 @@ use std::time::Instant;
 /// The engine's options matching the STHB grid: M = 19 harmonics, 2·64 = M_s samples.
 fn engine_options(p: &StringParams) -> HbOptions {
     HbOptions::new(p.harmonics, p.ms / 2)
+}
+
+/// The STHB arclength curve 1 ≤ ω ≤ 6 without stability (the reference of both
+/// curve tests).
+fn sthb_curve(p: &StringParams) -> Frc {
+    let mut hb = StringHb::new(p.clone()).unwrap();
+    frequency_response(
+        &mut hb,
+        1.0,
+        6.0,
+        &ContinuationOptions {
+            stability: false,
+            ..Default::default()
+        },
+    )
+    .unwrap()
 }
 
 fn max_abs(v: &[f64]) -> f64 {
@@ -86,18 +102,8 @@ fn residuals_are_the_same_algebraic_system() {
 #[test]
 fn engine_route_matches_sthb_on_the_curve() {
     let p = StringParams::default();
-    let mut hb = StringHb::new(p.clone()).unwrap();
     let t0 = Instant::now();
-    let frc = frequency_response(
-        &mut hb,
-        1.0,
-        6.0,
-        &ContinuationOptions {
-            stability: false,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let frc = sthb_curve(&p);
     let t_sthb = t0.elapsed();
     let modal = ModalString::new(p.clone());
     let mut ihb = ModifiedIhb::new(modal.clone(), engine_options(&p)).unwrap();
@@ -156,17 +162,8 @@ fn engine_arclength_curve_is_the_sthb_curve() {
     );
     assert!(eng.points.last().unwrap().omega_f >= 6.0);
     assert!(eng.points.iter().all(|pt| pt.stable()));
+    let frc = sthb_curve(&p);
     let mut hb = StringHb::new(p.clone()).unwrap();
-    let frc = frequency_response(
-        &mut hb,
-        1.0,
-        6.0,
-        &ContinuationOptions {
-            stability: false,
-            ..Default::default()
-        },
-    )
-    .unwrap();
     let mut worst: f64 = 0.0;
     for pt in &eng.points {
         let near = frc

@@ -111,7 +111,15 @@ pub fn frequency_response(
     let n = hb.dim();
     let dir = if omega_to >= omega_from { 1.0 } else { -1.0 };
     let mut a = vec![0.0; n];
-    let first = hb.solve(omega_from, &mut a, opts.tol, 50)?;
+    let first = hb
+        .solve(omega_from, &mut a, opts.tol, 50)
+        .map_err(|e| match e {
+            SthbError::NoConvergence { .. } => SthbError::ColdStart {
+                omega: omega_from,
+                cause: Box::new(e),
+            },
+            e => e,
+        })?;
     let mut factorizations = first.iterations;
     let mut aug = LuWorkspace::new(n + 1);
     let mut jac = Mat::<f64>::zeros(n, n);

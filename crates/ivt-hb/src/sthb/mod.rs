@@ -165,6 +165,15 @@ pub enum SthbError {
         /// The last corrector failure.
         cause: Box<SthbError>,
     },
+    /// The curve's first point, solved from rest (a = 0), did not converge: near a
+    /// resonance the start lies outside Newton's basin.
+    #[error("the curve starts from rest at omega = {omega} and that solve failed ({cause}); start below the resonance (e.g. at half its frequency) and continue through it")]
+    ColdStart {
+        /// Start frequency.
+        omega: f64,
+        /// The start solve's failure (with its residual history).
+        cause: Box<SthbError>,
+    },
     /// An error from the general HB engine (Broyden, continuation).
     #[error("HB engine: {0}")]
     Engine(String),
