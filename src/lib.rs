@@ -1,14 +1,24 @@
-//! The IVT toolkit facade: one dependency that re-exports the crates of the
-//! workspace, plus the `ivt` command line (`cli`).
+//! The IVT toolkit facade: one dependency that re-exports every library crate
+//! of the workspace under a short name.
 //!
-//! | crate | what |
-//! |---|---|
-//! | [`kin`] | kinematics and plant coefficients (no_std) |
-//! | [`ctrl`] | the rig controller (no_std, f32, no heap) |
+//! | module | crate | what |
+//! |---|---|---|
+//! | [`kin`] | `ivt-kin` | kinematics and plant coefficients (Ch. 2, §4.1; no_std) |
+//! | [`ctrl`] | `ivt-ctrl` | the rig controller (§4.2–4.4; no_std, f32, no heap) |
+//! | [`hb`] | `ivt-hb` | periodic orbits: harmonic balance, continuation, Floquet/Hill, STHB (Ch. 3) |
+//! | [`design`] | `ivt-design` | IVT steady state, open-loop law, delay-loop stability (§4.2–4.3) |
+//! | [`sim`] | `ivt-sim` | plant integration, closed loop, scenes, MCAP logs |
+//! | [`plot`] | `ivt-plot` | PNG figures with an embedded font |
+//! | [`wire`] | `ivt-wire` | byte frames shared by the firmware and the host |
+//!
+//! The `ivt` command line and `ivt reproduce` are the binary of this package
+//! (`src/main.rs`), not part of the library.
 #![warn(missing_docs)]
 
 pub use ivt_ctrl as ctrl;
+pub use ivt_design as design;
+pub use ivt_hb as hb;
 pub use ivt_kin as kin;
-
-pub mod cli;
-pub mod reproduce;
+pub use ivt_plot as plot;
+pub use ivt_sim as sim;
+pub use ivt_wire as wire;

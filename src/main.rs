@@ -1,5 +1,8 @@
 //! The `ivt` command line. See `ivt --help` and SPEC §6 for the JSON contract.
 
+mod cli;
+mod reproduce;
+
 fn main() -> std::process::ExitCode {
-    ivt::cli::main()
+    cli::main()
 }

@@ -3,10 +3,10 @@
 
 use super::{CliError, Output};
 use clap::{Args, Subcommand};
-use ivt_hb::ivt::fit::{self, OpenLoopLaw, PolyForm};
-use ivt_hb::ivt::steady::{solve_steady_state, IhbOptions};
-use ivt_hb::ivt::sweep::{self, Grid, SweepPoint};
-use ivt_hb::ivt::{rad_s_to_rpm, rpm_to_rad_s, OperatingPoint};
+use ivt_design::fit::{self, OpenLoopLaw, PolyForm};
+use ivt_design::steady::{solve_steady_state, IhbOptions};
+use ivt_design::sweep::{self, Grid, SweepPoint};
+use ivt_design::{rad_s_to_rpm, rpm_to_rad_s, OperatingPoint};
 use ivt_kin::plant::PlantParams;
 use serde_json::json;
 
@@ -119,7 +119,7 @@ fn solve(a: SolveArgs) -> Result<Output, CliError> {
     let s = solve_steady_state(&plant, &op, opts).map_err(failed)?;
     let dt = t0.elapsed().as_secs_f64();
     let json = json!({
-        "r": s.r, "feasible": s.verdict == ivt_hb::ivt::Verdict::Feasible,
+        "r": s.r, "feasible": s.verdict == ivt_design::Verdict::Feasible,
         "verdict": s.verdict.as_str(), "q": s.q, "omega_min": s.omega_min,
         "omega_max": s.omega_max, "solve_time_s": dt, "iterations": s.iterations,
         "residual_norm": s.residual_norm, "harmonics": a.harmonics, "r_max": plant.r_max,

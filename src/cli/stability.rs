@@ -5,10 +5,10 @@
 
 use super::{CliError, Output};
 use clap::Args;
-use ivt_hb::ivt::delay::{delay_stability, DelayOptions, FeedbackGains};
-use ivt_hb::ivt::gains::stability_map;
-use ivt_hb::ivt::sweep::{range, Grid};
-use ivt_hb::ivt::{rpm_to_rad_s, OperatingPoint};
+use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
+use ivt_design::gains::stability_map;
+use ivt_design::sweep::{range, Grid};
+use ivt_design::{rpm_to_rad_s, OperatingPoint};
 use ivt_kin::plant::PlantParams;
 use serde_json::json;
 
@@ -120,7 +120,7 @@ pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
     let design = match &a.design {
         Some(b) => {
             let scale = if a.common.si { 1.0 } else { 1e-3 };
-            let c = ivt_hb::ivt::gains::best_gains(
+            let c = ivt_design::gains::best_gains(
                 &PlantParams::printed(),
                 &op,
                 (0.0, b[0] * scale),
@@ -174,7 +174,7 @@ pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
         })
         .collect();
     if a.feasible_only {
-        let pts = ivt_hb::ivt::sweep::sweep(&plant, &grid, Default::default(), || ())
+        let pts = ivt_design::sweep::sweep(&plant, &grid, Default::default(), || ())
             .map_err(|e| CliError::Failed(e.to_string()))?;
         ops = pts
             .iter()

@@ -4,13 +4,13 @@
 //! loop (Fig. 42 and its two example multipliers).
 
 use super::{borrow_series, fmt_sig, Context, OwnedSeries, ReproError, Verdict};
-use ivt_hb::ivt::delay::{delay_stability, DelayOptions, FeedbackGains};
-use ivt_hb::ivt::fit::{self, OpenLoopLaw, PolyForm};
-use ivt_hb::ivt::gains::stability_map;
-use ivt_hb::ivt::shooting::{periodic_at_r, shoot_steady_state, ShootingOptions};
-use ivt_hb::ivt::steady::{solve_steady_state, IhbOptions};
-use ivt_hb::ivt::sweep::{self, range, Grid, SweepPoint};
-use ivt_hb::ivt::{averaged_r, rad_s_to_rpm, thesis_omega0, OperatingPoint};
+use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
+use ivt_design::fit::{self, OpenLoopLaw, PolyForm};
+use ivt_design::gains::stability_map;
+use ivt_design::shooting::{periodic_at_r, shoot_steady_state, ShootingOptions};
+use ivt_design::steady::{solve_steady_state, IhbOptions};
+use ivt_design::sweep::{self, range, Grid, SweepPoint};
+use ivt_design::{averaged_r, rad_s_to_rpm, thesis_omega0, OperatingPoint};
 use ivt_kin::plant::PlantParams;
 use ivt_plot::{Figure, HeatMap, Style};
 use std::f64::consts::{PI, SQRT_2};

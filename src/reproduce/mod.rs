@@ -411,64 +411,6 @@ fn glyphs(s: &str) -> String {
         .replace('\u{0302}', "^")
 }
 
-/// The thesis figures the report covers, in order (each appears in
-/// [`Report::figures`], drawn or with the reason it is missing).
-pub const FIGURES: &[&str] = &[
-    "Fig. 9(a)",
-    "Fig. 9(b)",
-    "Fig. 10",
-    "Fig. 11",
-    "Fig. 23(a)",
-    "Fig. 24",
-    "Fig. 37",
-    "Fig. 28",
-    "Fig. 29",
-    "Fig. 30",
-    "Fig. 31",
-    "Fig. 32",
-    "Fig. 33",
-    "Fig. 34",
-    "Fig. 35",
-    "Fig. 36",
-    "Fig. 38(a)",
-    "Fig. 38(b)",
-    "Fig. 39",
-    "Fig. 40",
-    "Fig. 42",
-    "Fig. 43",
-    "Fig. 44",
-    "Fig. 45",
-    "Fig. 51",
-    "Fig. 47",
-    "Fig. 48",
-];
-
-/// Quantities (prefixes of [`Row::quantity`]) the report always contains.
-pub const ROWS: &[&str] = &[
-    "J_a",
-    "J_b",
-    "J_c",
-    "F_m",
-    "f1",
-    "f2",
-    "Eq. 42 a1",
-    "Eq. 42 a2",
-    "Eq. 42 a3",
-    "Eq. 42 a4",
-    "R_avg slope",
-    "A0",
-    "β1",
-    "β2",
-    "β4",
-    "IHB time, classic",
-    "IHB time, modified",
-    "r̄ at (6 V, 6 N·m)",
-    "Eq. 158",
-    "Eq. 159",
-    "Fig. 42 multiplier (k = 0.01, k2 = 0.02)",
-    "Fig. 42 multiplier (k = 0.06, k2 = 0.12)",
-];
-
 /// Run every chapter and write `out/REPRODUCTION.md`, the PNGs and CSVs.
 ///
 /// # Errors

@@ -11,7 +11,6 @@ pub mod floquet;
 pub mod frc;
 pub mod hill;
 pub mod ihb;
-pub mod ivt;
 pub mod linalg;
 pub mod mathieu;
 pub mod modified;

@@ -3,10 +3,10 @@
 //! `ivt ol solve`, `ivt ol table` and `ivt stability` (`--json`).
 
 use crate::kin::Plant;
-use ivt_hb::ivt::delay::{delay_stability, DelayOptions, FeedbackGains};
-use ivt_hb::ivt::steady::{solve_steady_state, IhbOptions};
-use ivt_hb::ivt::sweep::{self, Grid};
-use ivt_hb::ivt::{rpm_to_rad_s, OperatingPoint, Verdict};
+use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
+use ivt_design::steady::{solve_steady_state, IhbOptions};
+use ivt_design::sweep::{self, Grid};
+use ivt_design::{rpm_to_rad_s, OperatingPoint, Verdict};
 use ivt_kin::plant::PlantParams;
 use numpy::ndarray::Array2;
 use numpy::IntoPyArray;

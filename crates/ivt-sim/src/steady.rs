@@ -27,7 +27,7 @@
 //!
 //!   For the delay law inside the band the route also checks that the loop
 //!   reaches that orbit: the max |Floquet multiplier| of the linearized delay
-//!   system (Eq. 174–179, `ivt_hb::ivt::delay`) for the scene's gains. If it
+//!   system (Eq. 174–179, `ivt_design::delay`) for the scene's gains. If it
 //!   is ≥ 1, `"auto"` falls back to time integration. The check assumes an
 //!   ideal actuator: a stepper rate limit can still turn a linearly stable
 //!   loop into a limit cycle (README: k2 = 4 at the shipped point).
@@ -40,10 +40,10 @@ use crate::output::{write_all, OutputError};
 use crate::run::{run, RunResult, SimError};
 use crate::scene::{ChannelSpec, Scene};
 use ivt_ctrl::{units, ActuatorMap, OpenLoopPreset};
-use ivt_hb::ivt::delay::{delay_stability_about, steady_orbit, DelayOptions, FeedbackGains};
-use ivt_hb::ivt::shooting::{omega_at_angles, periodic_at_r, ShootingOptions};
-use ivt_hb::ivt::steady::{IhbOptions, IhbSolver};
-use ivt_hb::ivt::{IvtError, OperatingPoint, Verdict};
+use ivt_design::delay::{delay_stability_about, steady_orbit, DelayOptions, FeedbackGains};
+use ivt_design::shooting::{omega_at_angles, periodic_at_r, ShootingOptions};
+use ivt_design::steady::{IhbOptions, IhbSolver};
+use ivt_design::{IvtError, OperatingPoint, Verdict};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;

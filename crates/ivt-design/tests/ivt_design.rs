@@ -1,11 +1,11 @@
 //! Acceptance tests of the IVT design tools (issue 7): IHB vs shooting,
 //! convergence in n and in N, bad inputs.
 
-use ivt_hb::ivt::delay::{delay_stability, DelayOptions, FeedbackGains};
-use ivt_hb::ivt::shooting::{shoot_steady_state, ShootingOptions};
-use ivt_hb::ivt::steady::{solve_steady_state, IhbOptions};
-use ivt_hb::ivt::sweep::{sweep_serial, Grid};
-use ivt_hb::ivt::{IvtError, OperatingPoint, Verdict};
+use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
+use ivt_design::shooting::{shoot_steady_state, ShootingOptions};
+use ivt_design::steady::{solve_steady_state, IhbOptions};
+use ivt_design::sweep::{sweep_serial, Grid};
+use ivt_design::{IvtError, OperatingPoint, Verdict};
 use ivt_kin::plant::PlantParams;
 use rayon::prelude::*;
 
@@ -187,7 +187,7 @@ fn thesis_grid_solves_everywhere() {
 /// fourth case uses the thesis's 0.01/0.02 (λ ≈ 0.996).
 #[test]
 fn predicted_multiplier_matches_simulated_contraction() {
-    use ivt_hb::ivt::delay_sim::{simulate_contraction, DelaySimOptions};
+    use ivt_design::delay_sim::{simulate_contraction, DelaySimOptions};
     let plant = PlantParams::printed();
     let cases = [
         (8.4, 4.0, 1.0, 2.0),
@@ -216,7 +216,7 @@ fn predicted_multiplier_matches_simulated_contraction() {
 /// truncation error; 1e-9 relative is asserted.
 #[test]
 fn broyden_and_newton_agree() {
-    use ivt_hb::ivt::steady::IhbMethod;
+    use ivt_design::steady::IhbMethod;
     let plant = PlantParams::printed();
     for (v, t) in [(8.4, 1.5), (6.0, 6.0), (12.0, 9.0)] {
         let op = OperatingPoint::at_100_rpm(v, t);

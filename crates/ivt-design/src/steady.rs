@@ -13,7 +13,7 @@
 //! The 2n+1 balanced residuals are zeroed in the 2n+1 unknowns `x_p = {r, q_p}`.
 //!
 //! Solver: Broyden's update (Eq. 156–157, [`IhbMethod::Broyden`], default)
-//! through [`crate::broyden`], seeded on a cold start by the exact Jacobian of
+//! through [`ivt_hb::broyden`], seeded on a cold start by the exact Jacobian of
 //! the sampled residual and along a sweep by the previous point's matrix; or
 //! Newton with that exact Jacobian at every step ([`IhbMethod::Newton`], the
 //! classic IHB of §3.2.1). The projection is a direct sum over cos/sin tables
@@ -27,8 +27,8 @@
 
 use super::rk6::Segment;
 use super::{averaged_r, check_plant, IvtError, OperatingPoint, Verdict};
-use crate::broyden::{broyden_solve, BroydenOptions, BroydenWorkspace, System};
 use core::f64::consts::PI;
+use ivt_hb::broyden::{broyden_solve, BroydenOptions, BroydenWorkspace, System};
 use ivt_kin::plant::PlantParams;
 use nalgebra::{DMatrix, DVector};
 
@@ -55,7 +55,7 @@ pub struct IhbOptions {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum IhbMethod {
     /// Broyden's update, Eq. 156–157 (the thesis's modified IHB), via
-    /// [`crate::broyden::broyden_solve`]: the exact Jacobian seeds it on a cold
+    /// [`ivt_hb::broyden::broyden_solve`]: the exact Jacobian seeds it on a cold
     /// start, and along a sweep the matrix left by the previous point seeds
     /// the next, so most points need no Jacobian at all.
     #[default]

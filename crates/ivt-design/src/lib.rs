@@ -1,3 +1,7 @@
+#![doc = include_str!("../README.md")]
+// Dense kernels index several arrays with the same row/column counters; iterator
+// chains would hide the matrix structure the equations are written in.
+#![allow(clippy::needless_range_loop)]
 //! IVT design tools (thesis §4.2–4.3): the periodic steady state of Eq. 151
 //! at a prescribed mean speed ω0, the open-loop law `u_ol(V_m, T_U)` built from
 //! it, and the local stability of the integral time-delay feedback Eq. 171.

@@ -1,6 +1,6 @@
 //! Profile helper: the 416-point IHB grid, repeated (for `perf record`).
-use ivt_hb::ivt::steady::IhbOptions;
-use ivt_hb::ivt::sweep::{sweep_serial, Grid};
+use ivt_design::steady::IhbOptions;
+use ivt_design::sweep::{sweep_serial, Grid};
 use ivt_kin::plant::PlantParams;
 fn main() {
     let t0 = std::time::Instant::now();

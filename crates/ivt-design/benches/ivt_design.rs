@@ -2,11 +2,11 @@
 //! ≤ 50 ms single thread; one stability evaluation at N = 16 ≤ 5 ms; the
 //! whole stability map ≤ 2 s on 2 cores).
 
-use ivt_hb::ivt::delay::{delay_stability_about, steady_orbit, DelayOptions, FeedbackGains};
-use ivt_hb::ivt::gains::stability_map;
-use ivt_hb::ivt::steady::IhbOptions;
-use ivt_hb::ivt::sweep::{sweep_serial, Grid};
-use ivt_hb::ivt::OperatingPoint;
+use ivt_design::delay::{delay_stability_about, steady_orbit, DelayOptions, FeedbackGains};
+use ivt_design::gains::stability_map;
+use ivt_design::steady::IhbOptions;
+use ivt_design::sweep::{sweep_serial, Grid};
+use ivt_design::OperatingPoint;
 use ivt_kin::plant::PlantParams;
 
 fn main() {
