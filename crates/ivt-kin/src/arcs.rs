@@ -14,7 +14,7 @@
 //! the tolerance. Because every biarc starts and ends on the curve with the
 //! curve's tangent, consecutive arcs are tangent at every joint.
 
-use crate::error::{positive, KinError};
+use crate::error::{positive, push, KinError};
 use crate::ncg::{driven_angle, driving_angle, GearRatio};
 use core::f64::consts::PI;
 
@@ -114,14 +114,7 @@ impl<G: GearRatio> GearProfile<'_, G> {
                     Member::Driving => driving_angle(self.gear, t2)?,
                 };
                 let psi = wrap_2pi(psi);
-                if n == out.len() {
-                    return Err(KinError::BufferTooSmall {
-                        needed: n + 1,
-                        capacity: out.len(),
-                    });
-                }
-                out[n] = psi;
-                n += 1;
+                push(out, &mut n, psi)?;
             }
         }
         // sorted by construction for Driven; NG1's map is monotone too.
@@ -505,6 +498,15 @@ mod tests {
         (smooth, corner)
     }
 
+    /// One SGIVT gear (Eq. 38) at the prototype's centre distance D.
+    fn sgivt(member: Member) -> GearProfile<'static, SgivtNcg> {
+        GearProfile {
+            gear: &SgivtNcg,
+            centre_distance: D,
+            member,
+        }
+    }
+
     /// §2.2.4 for both SGIVT gears: tangent-continuous closed chains with the
     /// 1 % bound away from corners; the corner deviation stays within the
     /// thesis's 5 % for δ = 2°, and the construction's own report agrees with
@@ -513,11 +515,7 @@ mod tests {
     fn sgivt_arcs_tangent_continuous_within_one_percent() {
         let opts = ArcOptions::default();
         for member in [Member::Driven, Member::Driving] {
-            let prof = GearProfile {
-                gear: &SgivtNcg,
-                centre_distance: D,
-                member,
-            };
+            let prof = sgivt(member);
             let mut arcs = [Arc::default(); 512];
             let fit = fit_arcs(&prof, &opts, &mut arcs).unwrap();
             assert_eq!(fit.corners, 4);
@@ -540,11 +538,7 @@ mod tests {
     /// construction); the smooth Eq. 42 profile needs no fillets.
     #[test]
     fn tighter_tolerance_more_arcs() {
-        let prof = GearProfile {
-            gear: &SgivtNcg,
-            centre_distance: D,
-            member: Member::Driven,
-        };
+        let prof = sgivt(Member::Driven);
         let mut arcs = [Arc::default(); 4096];
         let mut prev = 0;
         for tol in [1e-2, 1e-3, 1e-4, 1e-5] {
@@ -611,11 +605,7 @@ mod tests {
 
     #[test]
     fn bad_options_are_errors() {
-        let prof = GearProfile {
-            gear: &SgivtNcg,
-            centre_distance: D,
-            member: Member::Driven,
-        };
+        let prof = sgivt(Member::Driven);
         let mut arcs = [Arc::default(); 4];
         assert!(matches!(
             fit_arcs(&prof, &ArcOptions::default(), &mut arcs),

@@ -72,6 +72,20 @@ pub(crate) fn finite(name: &'static str, x: f64) -> Result<f64, KinError> {
     }
 }
 
+/// Write `value` at `out[*count]` and advance `count`, or report how large
+/// the caller's buffer must be.
+#[inline]
+pub(crate) fn push<T>(out: &mut [T], count: &mut usize, value: T) -> Result<(), KinError> {
+    let capacity = out.len();
+    let slot = out.get_mut(*count).ok_or(KinError::BufferTooSmall {
+        needed: *count + 1,
+        capacity,
+    })?;
+    *slot = value;
+    *count += 1;
+    Ok(())
+}
+
 /// `Ok(x)` if `x` is finite and `lo <= x < hi` (pass `f64::INFINITY` for no
 /// upper bound), else the matching error.
 #[inline]

@@ -8,7 +8,7 @@
 //! radius) for the GIVT; [`GivtGeometry::illustrative`] picks values scaled
 //! from the design eccentricity r_o = 10 mm of §2.1.5 and says so.
 
-use crate::error::{finite, in_range, positive, KinError};
+use crate::error::{finite, in_range, positive, push, KinError};
 use crate::quad::{relative_tolerance, simpson};
 use core::f64::consts::FRAC_PI_2;
 
@@ -232,14 +232,7 @@ impl GivtGeometry {
                 if c >= MODULE_PERIOD * (1.0 - 1e-12) {
                     c = 0.0; // a corner at the period boundary found from below
                 }
-                if count == out.len() {
-                    return Err(KinError::BufferTooSmall {
-                        needed: count + 1,
-                        capacity: out.len(),
-                    });
-                }
-                out[count] = c;
-                count += 1;
+                push(out, &mut count, c)?;
             }
             prev = k;
         }

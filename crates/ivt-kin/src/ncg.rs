@@ -9,7 +9,7 @@
 //! The designs here: [`SgivtNcg`] (Eq. 38, mean 1: a 1:1 pair), [`SmoothNcg`]
 //! (Eq. 42 and its refits), [`GivtNcg`] (Eq. 13, mean 3).
 
-use crate::error::{finite, positive, KinError};
+use crate::error::{finite, in_range, positive, KinError};
 use crate::givt::{GivtGeometry, MAX_CORNERS, MODULE_PERIOD};
 use crate::quad::simpson;
 use crate::variant;
@@ -211,14 +211,7 @@ fn integrate_pieces<G: GearRatio, F: Fn(f64) -> f64>(
 /// # Errors
 /// θ₂ must be finite and ≥ 0; `NotConverged` if the quadrature fails.
 pub fn driving_angle<G: GearRatio>(gear: &G, theta2: f64) -> Result<f64, KinError> {
-    let th = finite("theta2", theta2)?;
-    if th < 0.0 {
-        return Err(KinError::OutOfDomain {
-            name: "theta2",
-            value: th,
-            requirement: "theta2 >= 0",
-        });
-    }
+    let th = in_range("theta2", theta2, 0.0, f64::INFINITY, "theta2 >= 0")?;
     let p = gear.period();
     let whole = libm::floor(th / p);
     let rem = th - whole * p;
@@ -240,14 +233,7 @@ pub fn driving_angle<G: GearRatio>(gear: &G, theta2: f64) -> Result<f64, KinErro
 /// # Errors
 /// φ must be finite and ≥ 0; `NotConverged` if Newton stalls.
 pub fn driven_angle<G: GearRatio>(gear: &G, phi: f64) -> Result<f64, KinError> {
-    let ph = finite("phi", phi)?;
-    if ph < 0.0 {
-        return Err(KinError::OutOfDomain {
-            name: "phi",
-            value: ph,
-            requirement: "phi >= 0",
-        });
-    }
+    let ph = in_range("phi", phi, 0.0, f64::INFINITY, "phi >= 0")?;
     let p = gear.period();
     let per = gear.turns_ratio() * p; // φ advance per period of R_n
     let whole = libm::floor(ph / per);

@@ -231,15 +231,6 @@ impl PlantParams {
             ("r_max", self.r_max),
             ("sun_to_planet", self.sun_to_planet),
         ];
-        for (name, v) in positive {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(ParamError {
-                    name,
-                    value: v,
-                    requirement: "finite and > 0",
-                });
-            }
-        }
         let non_negative = [
             ("l_a", self.l_a),
             ("j_inshaft", self.j_inshaft),
@@ -250,16 +241,27 @@ impl PlantParams {
             ("j_u", self.j_u),
             ("g", self.g),
         ];
-        for (name, v) in non_negative {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(ParamError {
-                    name,
-                    value: v,
-                    requirement: "finite and >= 0",
-                });
-            }
-        }
-        Ok(())
+        check_all(&positive, "finite and > 0", |v| v > 0.0)?;
+        check_all(&non_negative, "finite and >= 0", |v| v >= 0.0)
+    }
+}
+
+/// The first of `values` that is not finite or fails `ok`, as a [`ParamError`].
+fn check_all(
+    values: &[(&'static str, f64)],
+    requirement: &'static str,
+    ok: impl Fn(f64) -> bool,
+) -> Result<(), ParamError> {
+    match values
+        .iter()
+        .find(|(_, v)| !(v.is_finite() && ok(*v)))
+    {
+        Some(&(name, value)) => Err(ParamError {
+            name,
+            value,
+            requirement,
+        }),
+        None => Ok(()),
     }
 }
 
