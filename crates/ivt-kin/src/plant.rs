@@ -252,10 +252,7 @@ fn check_all(
     requirement: &'static str,
     ok: impl Fn(f64) -> bool,
 ) -> Result<(), ParamError> {
-    match values
-        .iter()
-        .find(|(_, v)| !(v.is_finite() && ok(*v)))
-    {
+    match values.iter().find(|(_, v)| !(v.is_finite() && ok(*v))) {
         Some(&(name, value)) => Err(ParamError {
             name,
             value,
