@@ -211,6 +211,6 @@ pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, &m)?)?;
     m.add_function(wrap_pyfunction!(check_scene, &m)?)?;
     m.add_function(wrap_pyfunction!(scene_dict, &m)?)?;
-    m.add("SUPPORTED_PPR", ivt_sim::backend::SUPPORTED_PPR.to_vec())?;
+    m.add("SUPPORTED_PPR", ivt_ctrl::SUPPORTED_PPR.to_vec())?;
     parent.add_submodule(&m)
 }

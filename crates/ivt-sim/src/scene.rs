@@ -4,8 +4,8 @@
 //! names the file position and the key. See `scenes/*.toml` for examples and
 //! the crate README for the full key list.
 
-use crate::backend::SUPPORTED_PPR;
 use ivt_ctrl::OpenLoopPreset;
+use ivt_ctrl::SUPPORTED_PPR;
 use ivt_kin::plant::{GravityModel, PlantParams};
 use serde::Deserialize;
 
