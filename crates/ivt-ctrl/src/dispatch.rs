@@ -106,12 +106,12 @@ impl core::fmt::Display for UnsupportedPpr {
 /// check its fixed resolution at compile time.
 #[must_use]
 pub const fn is_supported_ppr(ppr: usize) -> bool {
-    let mut k = 0;
-    while k < SUPPORTED_PPR.len() {
-        if SUPPORTED_PPR[k] == ppr {
+    let mut rest = SUPPORTED_PPR;
+    while let [first, tail @ ..] = rest {
+        if *first == ppr {
             return true;
         }
-        k += 1;
+        rest = tail;
     }
     false
 }

@@ -350,3 +350,6 @@ impl crate::profile::Drive {
         (self.v_m.at(t), self.t_u.at(t))
     }
 }
+
+#[cfg(test)]
+mod tests;
