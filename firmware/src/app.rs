@@ -9,6 +9,10 @@ use ivt_wire::{frame::Decoder, msg, ErrorCode, Reply, Request, MAX_FRAME};
 /// Samples per revolution of θ the firmware is built for (the encoder of the
 /// rig has `PPR · config.decimation` edges per revolution).
 pub const PPR: usize = 1200;
+const _: () = assert!(
+    ivt_ctrl::is_supported_ppr(PPR),
+    "the firmware's PPR must be one of ivt_ctrl::SUPPORTED_PPR"
+);
 
 /// The controller type of this firmware.
 pub type Ctrl = Controller<PPR>;

@@ -7,7 +7,7 @@
 
 use super::{CliError, Output};
 use clap::{Args, Subcommand, ValueEnum};
-use ivt_ctrl::{units, Config, ControlOutput, Controller, Gains, LawKind, OpenLoopPreset};
+use ivt_ctrl::{units, AnyController, Config, ControlOutput, Gains, LawKind, OpenLoopPreset};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -68,7 +68,8 @@ pub struct ReplayArgs {
     /// Pulse log: CSV with columns `ticks[,vm,tu]` (timer captures, V, N·m).
     pub log: PathBuf,
     /// Controller samples per revolution (see `--decimation`); supported:
-    /// 80 100 200 256 360 400 500 512 1000 1024 1200 2000 2048 2400 4096.
+    /// `ivt_ctrl::SUPPORTED_PPR` (16 … 4096; an unsupported value is refused
+    /// with the list).
     #[arg(long, default_value_t = 1200)]
     pub ppr: usize,
     /// Encoder pulses per controller sample (encoder lines = ppr·decimation).
@@ -171,12 +172,9 @@ fn parse_log(text: &str) -> Result<Vec<Row>, CliError> {
     Ok(rows)
 }
 
-fn simulate<const P: usize>(
-    config: Config,
-    rows: &[Row],
-    default_inputs: (f32, f32),
-) -> Vec<ControlOutput> {
-    let mut c = Controller::<P>::new(config);
+/// The controller's outputs for every logged pulse, inputs replayed as
+/// logged (`default_inputs` until the first logged reading).
+fn simulate(mut c: AnyController, rows: &[Row], default_inputs: (f32, f32)) -> Vec<ControlOutput> {
     c.update_inputs(default_inputs.0, default_inputs.1);
     let mut last = None;
     rows.iter()
@@ -192,18 +190,6 @@ fn simulate<const P: usize>(
             c.on_pulse(row.ticks)
         })
         .collect()
-}
-
-macro_rules! dispatch_ppr {
-    ($ppr:expr, $cfg:expr, $rows:expr, $inp:expr; $($n:literal)*) => {
-        match $ppr {
-            $($n => Ok(simulate::<$n>($cfg, $rows, $inp)),)*
-            other => Err(CliError::Input(format!(
-                "--ppr {other} is not compiled in; supported: {}",
-                [$($n.to_string()),*].join(" ")
-            ))),
-        }
-    };
 }
 
 fn replay(a: &ReplayArgs) -> Result<Output, CliError> {
@@ -225,8 +211,9 @@ fn replay(a: &ReplayArgs) -> Result<Output, CliError> {
         stall_timeout_s: a.stall_timeout,
         ..Config::default()
     };
-    let outs = dispatch_ppr!(a.ppr, config, &rows, (a.vm, a.tu);
-        80 100 200 256 360 400 500 512 1000 1024 1200 2000 2048 2400 4096)?;
+    let controller =
+        AnyController::new(a.ppr, config).map_err(|e| CliError::Input(format!("--ppr: {e}")))?;
+    let outs = simulate(controller, &rows, (a.vm, a.tu));
 
     let mut csv = String::from(
         "ticks,omega,omega_a,omega_T,r_ol,r_d,r,stepper_target,saturated,ready,fault\n",

@@ -4,9 +4,9 @@ use super::{CliError, Output};
 use clap::{Args, ValueEnum};
 use ivt_sim::output::run_and_write;
 use ivt_sim::progress::Progress;
-use ivt_sim::run::run_to;
+use ivt_sim::run::Simulation;
 use ivt_sim::scene::Scene;
-use ivt_sim::steady::{run_scene as answer, write_outputs, write_summary, Route, SceneRun};
+use ivt_sim::steady::{write_outputs, write_summary, Route, SceneRun};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -106,7 +106,10 @@ fn run_scene(
         // A transient is asked for: the MCAP log is written by a thread while
         // the loop runs; the summary is rewritten with the route afterwards.
         let (r, mut paths) = run_and_write(out, scene, |sink| {
-            let r = run_to(scene, &mut |f| bar.update(f), sink);
+            let r = Simulation::new(scene)
+                .progress(&mut |f| bar.update(f))
+                .sink(sink)
+                .run();
             bar.finish();
             r
         })
@@ -123,7 +126,11 @@ fn run_scene(
         }
         (answered, paths)
     } else {
-        let answered = answer(scene, route, &mut |f| bar.update(f)).map_err(|e| failed(&e))?;
+        let answered = Simulation::new(scene)
+            .route(route)
+            .progress(&mut |f| bar.update(f))
+            .answer()
+            .map_err(|e| failed(&e))?;
         bar.finish();
         let paths = write_outputs(out, scene, &answered).map_err(|e| failed(&e))?;
         (answered, paths)
@@ -174,7 +181,7 @@ fn run_scene(
         s.wall_time_s,
         s.realtime_factor,
         s.pulses,
-        s.law,
+        s.law.name(),
         s.settling_time_s.map_or("never".to_string(), |t| format!("{t:.2} s")),
         s.overshoot_pct,
         s.static_error_rad_s,

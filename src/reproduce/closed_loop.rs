@@ -9,7 +9,7 @@
 
 use super::{Context, ReproError};
 use ivt_plot::{Figure, Series, Style};
-use ivt_sim::run::run as run_scene;
+use ivt_sim::run::Simulation;
 use ivt_sim::scene::Scene;
 
 const RAD_S_TO_RPM: f64 = 60.0 / (2.0 * std::f64::consts::PI);
@@ -17,7 +17,7 @@ const RAD_S_TO_RPM: f64 = 60.0 / (2.0 * std::f64::consts::PI);
 /// (t, ω, ω_a, r, V_m, T_U) samples of a shipped scene, or why not.
 fn simulate(name: &str, src: &str) -> Result<Vec<[f64; 6]>, String> {
     let scene = Scene::parse(src, name).map_err(|e| e.to_string())?;
-    let res = run_scene(&scene, &mut |_| ()).map_err(|e| e.to_string())?;
+    let res = Simulation::new(&scene).run().map_err(|e| e.to_string())?;
     res.channels
         .plot
         .ok_or_else(|| format!("{name}: the scene records no plot series"))

@@ -234,6 +234,25 @@ pub struct ControlOutput {
     pub ol_region: OlRegion,
 }
 
+impl ControlOutput {
+    /// The output before any pulse: everything zero, no fault, not ready
+    /// (what a firmware shows before its first encoder edge).
+    pub const IDLE: Self = Self {
+        omega: 0.0,
+        omega_a: 0.0,
+        omega_t: 0.0,
+        r_ol: 0.0,
+        r_d: 0.0,
+        r: 0.0,
+        stepper_target: 0,
+        saturated: false,
+        fault: Fault::None,
+        ready: false,
+        inputs_clamped: false,
+        ol_region: OlRegion::Normal,
+    };
+}
+
 /// What one step-generator tick produces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct StepTick {
@@ -328,18 +347,8 @@ impl<const PPR: usize> Controller<PPR> {
             last_raw: 0,
             omega_prev: 0.0,
             out: ControlOutput {
-                omega: 0.0,
-                omega_a: 0.0,
-                omega_t: 0.0,
-                r_ol: 0.0,
-                r_d: 0.0,
-                r: 0.0,
-                stepper_target: 0,
-                saturated: false,
                 fault: Fault::Config,
-                ready: false,
-                inputs_clamped: false,
-                ol_region: OlRegion::Normal,
+                ..ControlOutput::IDLE
             },
         }
     }
@@ -456,11 +465,23 @@ impl<const PPR: usize> Controller<PPR> {
         self.out.r = r;
         self.out.saturated = saturated;
         self.set_target(r);
-        self.out.fault = if fault == Fault::None && self.input_fault {
+        self.out.fault = self.reported_fault(fault);
+    }
+
+    /// Fault precedence, the one rule every call reports by: the call's own
+    /// event (a stall seen by this pulse, a too-short interval, an invalid
+    /// reading just given, a bad config) first; else a held stall; else a
+    /// held invalid reading; else none.
+    fn reported_fault(&self, event: Fault) -> Fault {
+        if event != Fault::None {
+            event
+        } else if self.stalled {
+            Fault::Stall
+        } else if self.input_fault {
             Fault::InputInvalid
         } else {
-            fault
-        };
+            Fault::None
+        }
     }
 
     fn set_target(&mut self, r: f32) {
@@ -513,11 +534,7 @@ impl<const PPR: usize> Controller<PPR> {
         self.last_raw = ticks;
         if self.skip > 0 {
             self.skip -= 1;
-            self.out.fault = if event == Fault::None && self.input_fault {
-                Fault::InputInvalid
-            } else {
-                event
-            };
+            self.out.fault = self.reported_fault(event);
             return self.out;
         }
         self.skip = self.decimation - 1;
@@ -566,20 +583,18 @@ impl<const PPR: usize> Controller<PPR> {
             return;
         }
         let inside = |x: f32, r: [f32; 2]| x.is_finite() && x >= r[0] && x <= r[1];
-        if inside(v_m, self.v_m_valid) && inside(t_u, self.t_u_valid) {
+        let event = if inside(v_m, self.v_m_valid) && inside(t_u, self.t_u_valid) {
             self.input_fault = false;
             self.set_inputs(v_m, t_u);
+            Fault::None
         } else {
             self.input_fault = true;
-        }
+            Fault::InputInvalid
+        };
         if self.stalled {
-            self.out.fault = if self.input_fault {
-                Fault::InputInvalid
-            } else {
-                Fault::Stall
-            };
+            self.out.fault = self.reported_fault(event);
         } else {
-            self.command(Fault::None);
+            self.command(event);
         }
     }
 
@@ -601,6 +616,7 @@ impl<const PPR: usize> Controller<PPR> {
             position: d.position,
             next_step_at: d.next_step_at,
             moving: d.moving,
+            // A stall detected here or held outranks the last call's fault.
             fault: if self.stalled {
                 Fault::Stall
             } else {

@@ -4,8 +4,8 @@
 
 use ivt_ctrl::open_loop::{POLY_T_TERMS, POLY_V_TERMS};
 use ivt_ctrl::{
-    units, Config, ControlOutput, Controller as RustController, Fault, Gains, LawKind, OlRegion,
-    OpenLoopCoeffs, OpenLoopPreset, StepTick,
+    units, AnyController, Config, ControlOutput, Fault, Gains, LawKind, OlRegion, OpenLoopCoeffs,
+    OpenLoopPreset, SUPPORTED_PPR,
 };
 use numpy::ndarray::Array1;
 use numpy::{
@@ -15,48 +15,6 @@ use numpy::{
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-
-/// A controller for a PPR chosen at run time (`Controller<PPR>` takes it as a
-/// const generic): one variant per supported PPR.
-macro_rules! any_controller {
-    ($($ppr:literal => $var:ident),* $(,)?) => {
-        #[derive(Clone)]
-        enum AnyController { $($var(Box<RustController<$ppr>>)),* }
-
-        /// PPR values with a compiled controller.
-        const SUPPORTED_PPR: &[usize] = &[$($ppr),*];
-
-        impl AnyController {
-            fn new(ppr: usize, config: Config) -> Option<Self> {
-                match ppr {
-                    $($ppr => Some(Self::$var(Box::new(RustController::new(config)))),)*
-                    _ => None,
-                }
-            }
-            fn on_pulse(&mut self, ticks: u32) -> ControlOutput {
-                match self { $(Self::$var(c) => c.on_pulse(ticks)),* }
-            }
-            fn update_inputs(&mut self, v_m: f32, t_u: f32) {
-                match self { $(Self::$var(c) => c.update_inputs(v_m, t_u)),* }
-            }
-            fn step_tick(&mut self, now: u32) -> StepTick {
-                match self { $(Self::$var(c) => c.step_tick(now)),* }
-            }
-            fn output(&self) -> ControlOutput {
-                match self { $(Self::$var(c) => c.output()),* }
-            }
-            fn r_max(&self) -> f32 {
-                match self { $(Self::$var(c) => c.r_max()),* }
-            }
-        }
-    };
-}
-
-any_controller!(
-    16 => P16, 32 => P32, 64 => P64, 80 => P80, 100 => P100, 128 => P128, 200 => P200,
-    256 => P256, 360 => P360, 400 => P400, 500 => P500, 512 => P512, 1000 => P1000,
-    1024 => P1024, 1200 => P1200, 2000 => P2000, 2048 => P2048, 4096 => P4096,
-);
 
 fn law_kind(name: &str) -> PyResult<LawKind> {
     match name {
@@ -185,7 +143,7 @@ type Override = (&'static str, Box<dyn Fn(&mut Config)>);
 /// `ValueError` naming the keyword.
 #[pyclass(name = "Controller", module = "ivt.ctrl")]
 pub struct Controller {
-    inner: AnyController,
+    inner: Box<AnyController>,
     ppr: usize,
     config: Config,
 }
@@ -375,9 +333,10 @@ impl Controller {
         for (_, apply) in &overrides {
             apply(&mut config);
         }
-        let inner = AnyController::new(ppr, config).ok_or_else(|| {
-            PyValueError::new_err(format!("argument `ppr` = {ppr} is not supported"))
-        })?;
+        let inner = Box::new(
+            AnyController::new(ppr, config)
+                .map_err(|e| PyValueError::new_err(format!("argument `ppr`: {e}")))?,
+        );
         if inner.output().fault == Fault::Config {
             // ivt-ctrl reports an invalid Config as a whole (permanent safe
             // state); name the keyword(s) that alone make the default invalid.
@@ -386,7 +345,7 @@ impl Controller {
                 .filter(|(_, apply)| {
                     let mut c = Config::default();
                     apply(&mut c);
-                    AnyController::new(ppr, c).is_some_and(|x| x.output().fault == Fault::Config)
+                    AnyController::new(ppr, c).is_ok_and(|x| x.output().fault == Fault::Config)
                 })
                 .map(|(name, _)| *name)
                 .collect();

@@ -1,8 +1,9 @@
 //! `ivt.sim`: run ivt-sim scenes (TOML path, TOML text or a dict) and get
 //! the recorded channels as numpy arrays plus the summary of `ivt sim --json`.
 
+use ivt_sim::run::Simulation;
 use ivt_sim::scene::Scene;
-use ivt_sim::steady::{run_scene, write_outputs, Route};
+use ivt_sim::steady::{write_outputs, Route};
 use numpy::ndarray::{Array1, Array2};
 use numpy::IntoPyArray;
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
@@ -129,7 +130,10 @@ fn run<'py>(
     };
     let (answer, paths) = py
         .detach(|| -> Result<_, String> {
-            let answer = run_scene(&scene, force, &mut |_| {}).map_err(|e| e.to_string())?;
+            let answer = Simulation::new(&scene)
+                .route(force)
+                .answer()
+                .map_err(|e| e.to_string())?;
             let paths = match &out {
                 Some(dir) => write_outputs(dir, &scene, &answer).map_err(|e| e.to_string())?,
                 None => vec![],
@@ -172,7 +176,7 @@ fn run<'py>(
 fn check_scene<'py>(py: Python<'py>, scene: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
     let s = scene_from_py(scene)?;
     s.plant_params()
-        .map_err(|(k, m)| PyValueError::new_err(format!("`{k}` {m}")))?;
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
     let d = PyDict::new(py);
     d.set_item("name", &s.name)?;
     d.set_item("duration_s", s.duration_s)?;
@@ -211,6 +215,6 @@ pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, &m)?)?;
     m.add_function(wrap_pyfunction!(check_scene, &m)?)?;
     m.add_function(wrap_pyfunction!(scene_dict, &m)?)?;
-    m.add("SUPPORTED_PPR", ivt_sim::backend::SUPPORTED_PPR.to_vec())?;
+    m.add("SUPPORTED_PPR", ivt_ctrl::SUPPORTED_PPR.to_vec())?;
     parent.add_submodule(&m)
 }

@@ -20,7 +20,7 @@ fn drive() -> Scene {
 fn drive_60s_no_outputs(b: divan::Bencher) {
     let mut s = drive();
     s.outputs = Default::default();
-    b.bench(|| ivt_sim::run::run(&s, &mut |_| {}).expect("runs"));
+    b.bench(|| ivt_sim::run::Simulation::new(&s).run().expect("runs"));
 }
 
 /// What `cargo run --release` does (minus process start): the run with the
@@ -49,15 +49,17 @@ fn drive_60s_with_mcap_serial(b: divan::Bencher) {
     s.outputs.plots.clear();
     let dir = std::env::temp_dir().join("ivt-sim-bench-mcap-serial");
     b.bench(|| {
-        let r = ivt_sim::run::run(&s, &mut |_| {}).expect("runs");
+        let r = ivt_sim::run::Simulation::new(&s).run().expect("runs");
         ivt_sim::output::write_all(&dir, &s, &r).expect("writes")
     });
 }
 
 fn write(dir: &std::path::Path, s: &Scene) -> Vec<std::path::PathBuf> {
-    ivt_sim::output::run_and_write(dir, s, |sink| ivt_sim::run::run_to(s, &mut |_| {}, sink))
-        .expect("runs and writes")
-        .1
+    ivt_sim::output::run_and_write(dir, s, |sink| {
+        ivt_sim::run::Simulation::new(s).sink(sink).run()
+    })
+    .expect("runs and writes")
+    .1
 }
 
 /// Work–precision problem, DP5 at rtol = atol = 1e-8 (≈ 100 rad of θ).

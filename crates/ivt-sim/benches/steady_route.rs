@@ -5,8 +5,9 @@
 //! saturated case (V_m = 7 V, T_U = 8 N·m), where the route adds a secant
 //! on ω0 over IHB solves.
 
+use ivt_sim::run::Simulation;
 use ivt_sim::scene::Scene;
-use ivt_sim::steady::{ihb_steady_state, run_scene, Route};
+use ivt_sim::steady::{ihb_steady_state, Route};
 
 fn main() {
     divan::main();
@@ -28,14 +29,19 @@ fn saturated() -> Scene {
 #[divan::bench(sample_count = 20)]
 fn ihb_route(b: divan::Bencher) {
     let s = scene();
-    b.bench(|| run_scene(&s, None, &mut |_| {}).expect("answers"));
+    b.bench(|| Simulation::new(&s).answer().expect("answers"));
 }
 
 /// The same scene forced through the time integration.
 #[divan::bench(sample_count = 10)]
 fn time_route(b: divan::Bencher) {
     let s = scene();
-    b.bench(|| run_scene(&s, Some(Route::TimeIntegration), &mut |_| {}).expect("runs"));
+    b.bench(|| {
+        Simulation::new(&s)
+            .route(Some(Route::TimeIntegration))
+            .answer()
+            .expect("runs")
+    });
 }
 
 /// Under-drive: r = 0 held, mean speed by secant over IHB solves.
@@ -49,5 +55,10 @@ fn ihb_route_saturated(b: divan::Bencher) {
 #[divan::bench(sample_count = 10)]
 fn time_route_saturated(b: divan::Bencher) {
     let s = saturated();
-    b.bench(|| run_scene(&s, Some(Route::TimeIntegration), &mut |_| {}).expect("runs"));
+    b.bench(|| {
+        Simulation::new(&s)
+            .route(Some(Route::TimeIntegration))
+            .answer()
+            .expect("runs")
+    });
 }

@@ -5,7 +5,7 @@ fn main() {
     let path = args.next().expect("scene path");
     let every: usize = args.next().map_or(0, |s| s.parse().unwrap());
     let scene = ivt_sim::scene::Scene::load(std::path::Path::new(&path)).unwrap();
-    let res = ivt_sim::run::run(&scene, &mut |_| {}).unwrap();
+    let res = ivt_sim::run::Simulation::new(&scene).run().unwrap();
     if every > 0 {
         if let (Some(p), Some(c)) = (&res.channels.plant, &res.channels.control) {
             for (a, b) in p.iter().zip(c).step_by(every) {

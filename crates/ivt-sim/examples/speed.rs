@@ -11,6 +11,7 @@
 //! best CPU time of the loop's thread, and the mean CPU time of the whole process
 //! per run (so the writer thread's share is `process − loop`).
 
+use ivt_sim::run::Simulation;
 use ivt_sim::scene::Scene;
 use std::path::Path;
 use std::time::Instant;
@@ -67,23 +68,22 @@ fn main() {
 }
 
 fn one(mode: &str, scene: &Scene, dir: &Path) {
-    let quiet = &mut |_| {};
     match mode {
         "loop" => {
             let mut s = scene.clone();
             s.outputs = Default::default();
-            ivt_sim::run::run(&s, quiet).expect("runs");
+            Simulation::new(&s).run().expect("runs");
         }
         "record" => {
-            ivt_sim::run::run(scene, quiet).expect("runs");
+            Simulation::new(scene).run().expect("runs");
         }
         "serial" => {
-            let r = ivt_sim::run::run(scene, quiet).expect("runs");
+            let r = Simulation::new(scene).run().expect("runs");
             ivt_sim::output::write_all(dir, scene, &r).expect("writes");
         }
         _ => {
             ivt_sim::output::run_and_write(dir, scene, |sink| {
-                ivt_sim::run::run_to(scene, &mut |_| {}, sink)
+                Simulation::new(scene).sink(sink).run()
             })
             .expect("runs and writes");
         }

@@ -1,17 +1,17 @@
 //! The controller as the closed loop sees it: software in the loop (the
-//! in-process `ivt-ctrl` [`Controller`]) or, later, processor in the loop (the
-//! QEMU firmware over a UART, `pil.rs`). The step generator runs inside the
+//! in-process `ivt-ctrl` controller) or processor in the loop (the QEMU
+//! firmware over a UART, `pil.rs`). The step generator runs inside the
 //! backend; the simulator reads `stepper_target` and moves its own stepper
 //! model (with rate limits and missed steps) towards it.
 
-use ivt_ctrl::{Config, ControlOutput, Controller};
+use ivt_ctrl::{AnyController, Config, ControlOutput, UnsupportedPpr};
 
 /// A backend failure (transport, protocol, a dead firmware...).
 #[derive(Debug, thiserror::Error, Clone, PartialEq, Eq)]
 pub enum BackendError {
     /// The requested encoder resolution has no compiled controller.
-    #[error("no SIL controller compiled for PPR {0} (supported: {SUPPORTED_PPR:?})")]
-    UnsupportedPpr(usize),
+    #[error("{0}")]
+    UnsupportedPpr(UnsupportedPpr),
     /// The backend's link failed.
     #[error("controller backend I/O: {0}")]
     Io(String),
@@ -20,20 +20,21 @@ pub enum BackendError {
     Protocol(String),
 }
 
-/// What the closed loop calls; implemented by the in-process ivt-ctrl Controller (SIL)
-/// and by the QEMU firmware over a UART (PIL, written by the `fw` helper in
-/// crates/ivt-sim/src/pil.rs).
+/// What the closed loop calls; implemented by the in-process ivt-ctrl
+/// controller (SIL, [`Sil`]) and by the QEMU firmware over a UART (PIL,
+/// [`crate::pil::Pil`]).
 pub trait ControllerBackend {
     /// One encoder pulse with its timer timestamp.
-    fn on_pulse(&mut self, ticks: u32) -> Result<ivt_ctrl::ControlOutput, BackendError>;
+    fn on_pulse(&mut self, ticks: u32) -> Result<ControlOutput, BackendError>;
     /// Slow readings V_m \[V\], T_U \[N·m\].
     fn update_inputs(&mut self, v_m: f32, t_u: f32) -> Result<(), BackendError>;
 }
 
-/// Software in the loop: the `ivt-ctrl` controller in this process.
-pub struct Sil<const PPR: usize>(pub Controller<PPR>);
+/// Software in the loop: the `ivt-ctrl` controller in this process, for a
+/// PPR chosen at run time (one of [`ivt_ctrl::SUPPORTED_PPR`]).
+pub struct Sil(pub Box<AnyController>);
 
-impl<const PPR: usize> ControllerBackend for Sil<PPR> {
+impl ControllerBackend for Sil {
     fn on_pulse(&mut self, ticks: u32) -> Result<ControlOutput, BackendError> {
         Ok(self.0.on_pulse(ticks))
     }
@@ -43,22 +44,12 @@ impl<const PPR: usize> ControllerBackend for Sil<PPR> {
     }
 }
 
-/// Controller resolutions (samples per revolution of θ) with a compiled SIL
-/// controller; `Controller<PPR>` takes PPR as a const generic.
-pub const SUPPORTED_PPR: [usize; 12] = [16, 32, 64, 100, 128, 256, 360, 500, 512, 1000, 1024, 1200];
-
 /// A boxed SIL backend for a run-time PPR.
 ///
 /// # Errors
-/// [`BackendError::UnsupportedPpr`] if `ppr` is not in [`SUPPORTED_PPR`].
+/// [`BackendError::UnsupportedPpr`] if `ppr` is not in
+/// [`ivt_ctrl::SUPPORTED_PPR`].
 pub fn sil(ppr: usize, config: Config) -> Result<Box<dyn ControllerBackend>, BackendError> {
-    macro_rules! pick {
-        ($($n:literal),*) => {
-            match ppr {
-                $($n => Ok(Box::new(Sil::<$n>(Controller::<$n>::new(config)))),)*
-                _ => Err(BackendError::UnsupportedPpr(ppr)),
-            }
-        };
-    }
-    pick!(16, 32, 64, 100, 128, 256, 360, 500, 512, 1000, 1024, 1200)
+    let c = AnyController::new(ppr, config).map_err(BackendError::UnsupportedPpr)?;
+    Ok(Box::new(Sil(Box::new(c))))
 }

@@ -79,26 +79,29 @@ impl ControllerBackend for Pil {
 }
 
 /// Runs a scene with the QEMU firmware as the controller (`ivt sim SCENE
-/// --pil`): the same closed loop as [`crate::run::run`] with the [`Pil`]
+/// --pil`): the same closed loop as [`crate::run::Simulation::run`] with the [`Pil`]
 /// backend in place of the in-process one. The QEMU session is ended cleanly
 /// afterwards (a firmware that died mid-run surfaces as a backend error).
 ///
 /// # Errors
-/// Scene, integration and backend failures, as [`crate::run::run`].
+/// Scene, integration and backend failures, as [`crate::run::Simulation::run`].
 pub fn run_pil(
     scene: &crate::scene::Scene,
     progress: &mut dyn FnMut(f64),
 ) -> Result<crate::run::RunResult, crate::run::SimError> {
     let params = scene
         .plant_params()
-        .map_err(|(k, m)| crate::run::SimError::Scene(format!("`{k}` {m}")))?;
+        .map_err(|e| crate::run::SimError::Scene(e.to_string()))?;
     let Some(config) = crate::run::controller_config(scene, params.r_max) else {
         return Err(crate::run::SimError::Scene(
             "`controller.law = \"none\"` has no controller to put in the loop".into(),
         ));
     };
     let backend = Shared::new(Pil::start(scene.encoder.ppr, &config)?);
-    let result = crate::run::run_with_backend(scene, Some(Box::new(backend.clone())), progress)?;
+    let result = crate::run::Simulation::new(scene)
+        .backend(Box::new(backend.clone()))
+        .progress(progress)
+        .run()?;
     backend.finish()?;
     Ok(result)
 }

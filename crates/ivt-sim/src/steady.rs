@@ -31,15 +31,15 @@
 //!   is ≥ 1, `"auto"` falls back to time integration. The check assumes an
 //!   ideal actuator: a stepper rate limit can still turn a linearly stable
 //!   loop into a limit cycle (README: k2 = 4 at the shipped point).
-//! - [`Route::TimeIntegration`]: the closed-loop simulation ([`crate::run`]).
+//! - [`Route::TimeIntegration`]: the closed-loop simulation ([`Simulation::run`]).
 //!   If the scene asks for steady-state metrics, they are measured on the
 //!   last revolution of θ (per-pulse plant and control samples are recorded
 //!   for that and decimated back to what the scene asked for).
 
 use crate::output::{write_all, OutputError};
-use crate::run::{run, RunResult, SimError};
-use crate::scene::{ChannelSpec, Scene};
-use ivt_ctrl::{units, ActuatorMap, OpenLoopPreset};
+use crate::run::{RunResult, SimError, Simulation};
+use crate::scene::{ChannelSpec, Law, Scene};
+use ivt_ctrl::{ActuatorMap, OpenLoopPreset};
 use ivt_design::delay::{delay_stability_about, steady_orbit, DelayOptions, FeedbackGains};
 use ivt_design::shooting::{omega_at_angles, periodic_at_r, ShootingOptions};
 use ivt_design::steady::{IhbOptions, IhbSolver};
@@ -48,36 +48,7 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// How a scene was answered.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Route {
-    /// The periodic steady state by the modified IHB, no transient.
-    IhbSteadyState,
-    /// Closed-loop time integration of the scene.
-    TimeIntegration,
-}
-
-impl Route {
-    /// The name used in scenes, the CLI and the summary.
-    #[must_use]
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Self::IhbSteadyState => "ihb_steady_state",
-            Self::TimeIntegration => "time_integration",
-        }
-    }
-
-    /// The route with this name (`"auto"` and unknown names give None).
-    #[must_use]
-    pub fn from_name(name: &str) -> Option<Self> {
-        match name {
-            "ihb_steady_state" => Some(Self::IhbSteadyState),
-            "time_integration" => Some(Self::TimeIntegration),
-            _ => None,
-        }
-    }
-}
+pub use crate::scene::Route;
 
 /// Steady-state metrics of a scene at its constant inputs.
 #[derive(Clone, Debug, Serialize, PartialEq)]
@@ -141,21 +112,27 @@ pub enum SteadyError {
     Scene(String),
 }
 
-/// Answer a scene by the route its `outputs.route` asks for, or `force`
-/// (e.g. the CLI's `--route`). `"auto"` takes the IHB route when
-/// [`Scene::ihb_route_blocker`] finds nothing in the way and the delay loop
-/// is stable there.
-///
-/// # Errors
-/// A forced IHB route on a scene that cannot take it, or a failure of the
-/// route taken.
-pub fn run_scene(
+impl Simulation<'_> {
+    /// Answer the scene by the route its `outputs.route` asks for, or the
+    /// one forced by [`Simulation::route`] (e.g. the CLI's `--route`).
+    /// `"auto"` takes the IHB route when [`Scene::ihb_route_blocker`] finds
+    /// nothing in the way and the delay loop is stable there.
+    ///
+    /// # Errors
+    /// A forced IHB route on a scene that cannot take it, or a failure of
+    /// the route taken.
+    pub fn answer(self) -> Result<SceneRun, SteadyError> {
+        answer(self.scene, self.route, self.progress)
+    }
+}
+
+fn answer(
     scene: &Scene,
     force: Option<Route>,
-    progress: &mut dyn FnMut(f64),
+    progress: Option<&mut dyn FnMut(f64)>,
 ) -> Result<SceneRun, SteadyError> {
     let wall = Instant::now();
-    let asked = force.or_else(|| Route::from_name(&scene.outputs.route));
+    let asked = force.or_else(|| scene.outputs.route.forced());
     let blocker = scene.ihb_route_blocker();
     let (route, mut reason) = match (asked, blocker) {
         (Some(Route::TimeIntegration), _) => (Route::TimeIntegration, "forced".to_string()),
@@ -213,7 +190,7 @@ impl SceneRun {
                 "scene": scene.name,
                 "law": scene.controller.law,
                 "ppr": scene.encoder.ppr,
-                "omega0_rad_s": omega0_of(scene),
+                "omega0_rad_s": scene.omega0_rad_s(),
             }),
         };
         if let Some(m) = v.as_object_mut() {
@@ -277,11 +254,6 @@ pub fn write_summary(
     Ok(Some(p))
 }
 
-/// ω0 as the controller holds it (f32 rpm → rad/s, like [`crate::run`]).
-fn omega0_of(scene: &Scene) -> f64 {
-    f64::from(units::rpm_to_rad_s(scene.controller.omega0_rpm as f32))
-}
-
 /// The IHB route (module doc). The scene must pass
 /// [`Scene::ihb_route_blocker`].
 ///
@@ -294,12 +266,12 @@ pub fn ihb_steady_state(scene: &Scene) -> Result<SteadyMetrics, SteadyError> {
     }
     let params = scene
         .plant_params()
-        .map_err(|(k, m)| SteadyError::Scene(format!("`{k}` {m}")))?;
+        .map_err(|e| SteadyError::Scene(e.to_string()))?;
     let c = &scene.controller;
     let op = OperatingPoint {
         v_m: scene.inputs.v_m[0][1],
         t_u: scene.inputs.t_u[0][1],
-        omega0: omega0_of(scene),
+        omega0: scene.omega0_rad_s(),
     };
     let ihb = IhbSolver::new(IhbOptions::default())?.solve(&params, &op, None)?;
     // Polish r̄ by shooting (the n = 7 IHB r̄ is ~1e-3 relative off: ω̄ has
@@ -312,8 +284,8 @@ pub fn ihb_steady_state(scene: &Scene) -> Result<SteadyMetrics, SteadyError> {
     let map = ActuatorMap::sgivt(scene.stepper.steps_per_rev as f32);
     let on_step = |r: f64| f64::from(map.steps(r as f32)) / f64::from(map.steps_per_metre);
     let n = IhbOptions::default().harmonics;
-    let (held, what) = match c.law.as_str() {
-        "delay" => match verdict {
+    let (held, what) = match c.law {
+        Law::Delay => match verdict {
             Verdict::Feasible => (None, "Eq. 180 holds ω_a = ω0 with r = r̄".to_string()),
             Verdict::UnderDrive => (
                 Some(on_step(0.0)),
@@ -324,8 +296,8 @@ pub fn ihb_steady_state(scene: &Scene) -> Result<SteadyMetrics, SteadyError> {
                 "delay law saturated at r = r_max (anti-windup)".into(),
             ),
         },
-        "open" => {
-            let preset = OpenLoopPreset::from_name(&c.open_loop).unwrap_or_default();
+        Law::Open => {
+            let preset = OpenLoopPreset::from(c.open_loop);
             let mut coeffs = preset.coeffs();
             coeffs.r_max = params.r_max as f32;
             let u = if c.feedforward {
@@ -349,7 +321,7 @@ pub fn ihb_steady_state(scene: &Scene) -> Result<SteadyMetrics, SteadyError> {
         (None, None) => steady_orbit(&params, &op, Some(ihb.r), &DelayOptions::default())?,
         (Some(r), _) => periodic_at_r(&params, op.v_m, op.t_u, r, op.omega0, &shooting)?,
     };
-    let max_abs_multiplier = if held.is_none() && c.law == "delay" {
+    let max_abs_multiplier = if held.is_none() && c.law == Law::Delay {
         let gains = FeedbackGains::from_thesis_mm_per_rad(c.k_mm_per_rad, c.k2_mm_per_rad);
         let s = delay_stability_about(&params, &op, gains, &orbit, &DelayOptions::default())?;
         Some(s.max_abs_multiplier)
@@ -395,8 +367,12 @@ pub fn ihb_steady_state(scene: &Scene) -> Result<SteadyMetrics, SteadyError> {
 /// first, as [`crate::run`] records them).
 fn time_route(
     scene: &Scene,
-    progress: &mut dyn FnMut(f64),
+    progress: Option<&mut dyn FnMut(f64)>,
 ) -> Result<(RunResult, Option<SteadyMetrics>), SteadyError> {
+    let run = |s: &Scene, progress: Option<&mut dyn FnMut(f64)>| match progress {
+        Some(p) => Simulation::new(s).progress(p).run(),
+        None => Simulation::new(s).run(),
+    };
     if !scene.outputs.steady_state {
         return Ok((run(scene, progress)?, None));
     }
@@ -443,18 +419,15 @@ fn last_revolution(scene: &Scene, result: &RunResult) -> Option<SteadyMetrics> {
         });
     let r_m = rev.iter().map(|p| p.r).sum::<f64>() / ppr as f64;
     let r_max = scene.plant_params().ok()?.r_max;
-    let verdict = match (
-        scene.controller.law.as_str(),
-        control.and_then(|c| c.last()),
-    ) {
-        ("delay", Some(c)) if c.saturated && c.r <= 0.0 => Some(Verdict::UnderDrive),
-        ("delay", Some(c)) if c.saturated && f64::from(c.r) >= r_max * (1.0 - 1e-6) => {
+    let verdict = match (scene.controller.law, control.and_then(|c| c.last())) {
+        (Law::Delay, Some(c)) if c.saturated && c.r <= 0.0 => Some(Verdict::UnderDrive),
+        (Law::Delay, Some(c)) if c.saturated && f64::from(c.r) >= r_max * (1.0 - 1e-6) => {
             Some(Verdict::OverDrive)
         }
-        ("delay", Some(_)) => Some(Verdict::Feasible),
+        (Law::Delay, Some(_)) => Some(Verdict::Feasible),
         _ => None,
     };
-    let omega0 = omega0_of(scene);
+    let omega0 = scene.omega0_rad_s();
     Some(SteadyMetrics {
         omega0_rad_s: omega0,
         omega_a_rad_s: last.omega_a,

@@ -1,8 +1,8 @@
 //! Closed loop through the SIL backend (the `ivt-ctrl` controller), scenes
 //! and outputs. Scenes come from `scenes/` so that what is tested is what ships.
 
-use ivt_sim::run::{run, RunResult};
-use ivt_sim::scene::{ChannelSpec, Scene};
+use ivt_sim::run::{RunResult, Simulation};
+use ivt_sim::scene::{ChannelSpec, Law, Scene};
 use std::path::PathBuf;
 
 fn scene(name: &str) -> Scene {
@@ -13,7 +13,7 @@ fn scene(name: &str) -> Scene {
 }
 
 fn go(s: &Scene) -> RunResult {
-    run(s, &mut |_| {}).unwrap()
+    Simulation::new(s).run().unwrap()
 }
 
 fn keep_all(s: &mut Scene) {
@@ -84,7 +84,7 @@ fn delay_law_has_no_static_error_inside_the_band() {
     );
     assert_eq!(res.summary.saturated_fraction, 0.0);
     let mut open = s.clone();
-    open.controller.law = "open".into();
+    open.controller.law = Law::Open;
     open.controller.feedforward = true;
     let e_open = go(&open).summary.static_error_rad_s;
     assert!(
@@ -228,7 +228,7 @@ fn mcap_has_exactly_the_requested_channels() {
     // byte for byte and in each channel's order, only interleaved in time.
     let streamed_dir = dir.join("streamed");
     let (res2, paths2) = ivt_sim::output::run_and_write(&streamed_dir, &s, |sink| {
-        ivt_sim::run::run_to(&s, &mut |_| {}, sink)
+        Simulation::new(&s).sink(sink).run()
     })
     .unwrap();
     assert_eq!(res2.summary.pulses, res.summary.pulses);
@@ -267,7 +267,7 @@ fn failed_streamed_run_leaves_no_log() {
     s.outputs.plots.clear();
     let dir = std::env::temp_dir().join(format!("ivt-sim-mcap-fail-{}", std::process::id()));
     let err = ivt_sim::output::run_and_write(&dir, &s, |sink| {
-        let r = ivt_sim::run::run_to(&s, &mut |_| {}, sink)?;
+        let r = Simulation::new(&s).sink(sink).run()?;
         assert!(r.summary.pulses > 0);
         Err(ivt_sim::run::SimError::Scene("stopped on purpose".into()))
     })

@@ -10,18 +10,18 @@
 //! must travel the whole Δr̄ at the loop's rate — the transient of the
 //! no-feed-forward loop. Same gains (k = 2, k2 = 1 mm·rad⁻¹), same stepper.
 
-use ivt_sim::run::{run, RunResult};
-use ivt_sim::scene::{ChannelSpec, Scene};
+use ivt_sim::run::{RunResult, Simulation};
+use ivt_sim::scene::{ChannelSpec, OpenLoopLaw, Scene};
 use std::path::PathBuf;
 
-fn load_step(v_m: f64, t_from: f64, t_to: f64, open_loop: &str, gains: (f64, f64)) -> Scene {
+fn load_step(v_m: f64, t_from: f64, t_to: f64, open_loop: OpenLoopLaw, gains: (f64, f64)) -> Scene {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/load_step_delay.toml");
     let mut s = Scene::load(&p).unwrap();
     s.duration_s = 12.0;
     s.inputs.v_m = vec![[0.0, v_m]];
     s.inputs.t_u = vec![[0.0, t_from], [6.0, t_from], [6.01, t_to]];
     s.controller.feedforward = true;
-    s.controller.open_loop = open_loop.into();
+    s.controller.open_loop = open_loop;
     (s.controller.k_mm_per_rad, s.controller.k2_mm_per_rad) = gains;
     s.metrics.from_s = 6.0;
     s.metrics.static_window_s = 2.0;
@@ -72,8 +72,12 @@ fn transient(res: &RunResult) -> (f64, f64) {
 fn refit_feedforward_shrinks_the_step_transient() {
     for (gains, min_iae_ratio) in [((2.0, 1.0), None), ((0.01, 0.02), Some(2.0))] {
         for (v, a, b) in [(8.6, 6.0, 8.0), (8.3, 3.0, 5.0), (8.0, 1.5, 3.0)] {
-            let refit = run(&load_step(v, a, b, "refit", gains), &mut |_| {}).unwrap();
-            let thesis = run(&load_step(v, a, b, "thesis", gains), &mut |_| {}).unwrap();
+            let refit = Simulation::new(&load_step(v, a, b, OpenLoopLaw::Refit, gains))
+                .run()
+                .unwrap();
+            let thesis = Simulation::new(&load_step(v, a, b, OpenLoopLaw::Thesis, gains))
+                .run()
+                .unwrap();
             let (iae_r, peak_r) = transient(&refit);
             let (iae_t, peak_t) = transient(&thesis);
             eprintln!(

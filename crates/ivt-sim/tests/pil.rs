@@ -124,10 +124,10 @@ every = 1
 #[test]
 #[ignore = "needs qemu-system-arm and the firmware image; run by firmware/run-qemu.sh test"]
 fn pil_scene_with_load_step_gives_the_sil_r_sequence_bit_for_bit() {
-    use ivt_sim::run::run;
+    use ivt_sim::run::Simulation;
     use ivt_sim::scene::Scene;
     let scene = Scene::parse(SHORT_LOAD_STEP, "pil_load_step").unwrap();
-    let sil = run(&scene, &mut |_| {}).unwrap();
+    let sil = Simulation::new(&scene).run().unwrap();
     let pil = ivt_sim::pil::run_pil(&scene, &mut |_| {}).unwrap();
     let a = sil.channels.control.as_ref().unwrap();
     let b = pil.channels.control.as_ref().unwrap();

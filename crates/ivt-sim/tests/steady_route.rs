@@ -5,8 +5,10 @@
 //! rest through the real controller, measured on its last revolution).
 //! Timing belongs to `benches/steady_route.rs`.
 
+use ivt_sim::run::Simulation;
+use ivt_sim::scene::Law;
 use ivt_sim::scene::{ChannelSpec, Scene};
-use ivt_sim::steady::{run_scene, Route, SceneRun, SteadyMetrics};
+use ivt_sim::steady::{Route, SceneRun, SteadyMetrics};
 use std::path::PathBuf;
 
 fn scene(name: &str) -> Scene {
@@ -17,7 +19,7 @@ fn scene(name: &str) -> Scene {
 }
 
 fn answer(s: &Scene, force: Option<Route>) -> SceneRun {
-    run_scene(s, force, &mut |_| {}).unwrap()
+    Simulation::new(s).route(force).answer().unwrap()
 }
 
 /// Both routes on `s`; returns (IHB metrics, time-route metrics).
@@ -95,7 +97,7 @@ fn ihb_route_agrees_with_time_integration_when_saturated() {
 #[test]
 fn ihb_route_agrees_with_time_integration_open_loop() {
     let mut s = scene("steady_state");
-    s.controller.law = "open".into();
+    s.controller.law = Law::Open;
     s.duration_s = 10.0;
     let (a, b) = both(&s);
     // Both hold u_ol on the same stepper step (steps/steps_per_metre vs
@@ -140,8 +142,11 @@ fn scenes_that_need_a_transient_take_the_time_route() {
     assert!(j["steady_state"]["omega_a_rad_s"].is_number());
 
     let mut n = scene("steady_state");
-    n.controller.law = "nodelay".into();
-    assert!(run_scene(&n, Some(Route::IhbSteadyState), &mut |_| {}).is_err());
+    n.controller.law = Law::NoDelay;
+    assert!(Simulation::new(&n)
+        .route(Some(Route::IhbSteadyState))
+        .answer()
+        .is_err());
     let mut ramp = scene("steady_state");
     ramp.inputs.v_m = vec![[0.0, 8.4], [1.0, 8.5]];
     assert!(ramp.ihb_route_blocker().unwrap().contains("constant"));

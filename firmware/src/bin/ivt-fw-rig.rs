@@ -130,7 +130,7 @@ fn main() -> ! {
             Some((s.last, s.position, s.overcaptures))
         });
         if let Some((last, position, overcaptures)) = snapshot {
-            let out = last.unwrap_or_else(ivt_fw_output_idle);
+            let out = last.unwrap_or(ControlOutput::IDLE);
             if out.fault == Fault::None && overcaptures == 0 {
                 led.set_high();
             } else {
@@ -147,24 +147,6 @@ fn main() -> ! {
             }
         }
         delay.delay_ms(rig::INPUT_PERIOD_MS);
-    }
-}
-
-/// Output shown before the first pulse (everything zero, no fault).
-fn ivt_fw_output_idle() -> ControlOutput {
-    ControlOutput {
-        omega: 0.0,
-        omega_a: 0.0,
-        omega_t: 0.0,
-        r_ol: 0.0,
-        r_d: 0.0,
-        r: 0.0,
-        stepper_target: 0,
-        saturated: false,
-        fault: Fault::None,
-        ready: false,
-        inputs_clamped: false,
-        ol_region: ivt_ctrl::OlRegion::Normal,
     }
 }
 

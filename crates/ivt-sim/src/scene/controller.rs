@@ -1,0 +1,224 @@
+//! `[controller]` (law, gains, feed-forward) and `[metrics]`.
+
+use super::inputs::profile_ok;
+use super::Invalid;
+use ivt_ctrl::{LawKind, OpenLoopPreset};
+use serde::{Deserialize, Serialize};
+
+/// `[controller] law`.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Law {
+    /// Integral law with the one-revolution delay, Eq. 180.
+    #[default]
+    Delay,
+    /// Integral law without the delay, Eq. 181.
+    #[serde(rename = "nodelay")]
+    NoDelay,
+    /// Sampled proportional law, Eq. 189.
+    Prop,
+    /// u_ol only, Eq. 160.
+    Open,
+    /// No controller: r follows `r_schedule`.
+    None,
+}
+
+impl Law {
+    /// The name used in scenes and summaries.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Delay => "delay",
+            Self::NoDelay => "nodelay",
+            Self::Prop => "prop",
+            Self::Open => "open",
+            Self::None => "none",
+        }
+    }
+
+    /// The ivt-ctrl law (None for `"none"`: no controller runs).
+    #[must_use]
+    pub fn kind(self) -> Option<LawKind> {
+        match self {
+            Self::Delay => Some(LawKind::Delay),
+            Self::NoDelay => Some(LawKind::NoDelay),
+            Self::Prop => Some(LawKind::Prop),
+            Self::Open => Some(LawKind::Open),
+            Self::None => None,
+        }
+    }
+}
+
+/// `[controller] open_loop`: the coefficient set of u_ol (Eq. 158–160).
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum OpenLoopLaw {
+    /// Refitted on the printed plant by `ivt ol fit` (SPEC §5).
+    #[default]
+    Refit,
+    /// Eq. 158–160 as printed.
+    Thesis,
+}
+
+impl From<OpenLoopLaw> for OpenLoopPreset {
+    fn from(o: OpenLoopLaw) -> Self {
+        match o {
+            OpenLoopLaw::Refit => Self::Refit,
+            OpenLoopLaw::Thesis => Self::Thesis,
+        }
+    }
+}
+
+/// `[controller]`.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ControllerSection {
+    /// `"delay"` (Eq. 180), `"nodelay"` (Eq. 181), `"prop"` (Eq. 189),
+    /// `"open"` (u_ol only, Eq. 160) or `"none"` (r from `r_schedule`, no controller).
+    #[serde(default)]
+    pub law: Law,
+    /// Target ω0 \[rpm\].
+    #[serde(default = "default_omega0")]
+    pub omega0_rpm: f64,
+    /// k of Eq. 180/181 in the thesis's "mm·rad⁻¹" (ivt-ctrl `units`: ×1e-3 → m·s/rad²).
+    #[serde(default = "default_k")]
+    pub k_mm_per_rad: f64,
+    /// k2 of Eq. 180/181 in "mm·rad⁻¹".
+    #[serde(default = "default_k2")]
+    pub k2_mm_per_rad: f64,
+    /// K of Eq. 189 \[deg of stepper per rpm\].
+    #[serde(default = "default_k_prop")]
+    pub k_prop_deg_per_rpm: f64,
+    /// Sample period of Eq. 189 \[s\].
+    #[serde(default = "default_prop_period")]
+    pub prop_period_s: f64,
+    /// Add u_ol (Eq. 160) to r.
+    #[serde(default = "default_true")]
+    pub feedforward: bool,
+    /// Open-loop coefficients: `"refit"` (default) or `"thesis"`.
+    #[serde(default)]
+    pub open_loop: OpenLoopLaw,
+    /// r(t) for `law = "none"`: `[[t, r], ...]` \[s, m\].
+    #[serde(default)]
+    pub r_schedule: Vec<[f64; 2]>,
+}
+
+fn default_omega0() -> f64 {
+    100.0
+}
+fn default_k() -> f64 {
+    1.0
+}
+fn default_k2() -> f64 {
+    2.0
+}
+fn default_k_prop() -> f64 {
+    50.0
+}
+fn default_prop_period() -> f64 {
+    0.1
+}
+fn default_true() -> bool {
+    true
+}
+
+impl Default for ControllerSection {
+    fn default() -> Self {
+        Self {
+            law: Law::default(),
+            omega0_rpm: default_omega0(),
+            k_mm_per_rad: default_k(),
+            k2_mm_per_rad: default_k2(),
+            k_prop_deg_per_rpm: default_k_prop(),
+            prop_period_s: default_prop_period(),
+            feedforward: true,
+            open_loop: OpenLoopLaw::default(),
+            r_schedule: vec![],
+        }
+    }
+}
+
+impl ControllerSection {
+    pub(super) fn validate(&self, r_max: f64) -> Result<(), Invalid> {
+        Invalid::check(
+            self.omega0_rpm.is_finite() && self.omega0_rpm > 0.0 && self.omega0_rpm < 1e4,
+            "controller.omega0_rpm",
+            || format!("must be in (0, 1e4) rpm, got {}", self.omega0_rpm),
+        )?;
+        for (v, key) in [
+            (self.k_mm_per_rad, "controller.k_mm_per_rad"),
+            (self.k2_mm_per_rad, "controller.k2_mm_per_rad"),
+            (self.k_prop_deg_per_rpm, "controller.k_prop_deg_per_rpm"),
+        ] {
+            Invalid::check(v.is_finite(), key, || format!("must be finite, got {v}"))?;
+        }
+        Invalid::check(
+            self.prop_period_s.is_finite() && self.prop_period_s > 0.0,
+            "controller.prop_period_s",
+            || format!("must be > 0 s, got {}", self.prop_period_s),
+        )?;
+        if self.law == Law::None {
+            Invalid::check(!self.r_schedule.is_empty(), "controller.r_schedule", || {
+                "is required when law = \"none\"".into()
+            })?;
+        }
+        if !self.r_schedule.is_empty() {
+            profile_ok(&self.r_schedule, "controller.r_schedule", 0.0, r_max)?;
+        }
+        Ok(())
+    }
+}
+
+/// `[metrics]`: how the summary is measured on ω_a (exact, from the
+/// simulated pulse times).
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MetricsSection {
+    /// Metrics use t ≥ from_s only \[s\] (at or past `duration_s` the
+    /// window is empty and the summary's metrics are null with a reason).
+    #[serde(default)]
+    pub from_s: f64,
+    /// Settling band, relative to ω0.
+    #[serde(default = "default_band")]
+    pub band: f64,
+    /// Static error = mean(ω_a − ω0) over the last `static_window_s` \[s\].
+    #[serde(default = "default_static_window")]
+    pub static_window_s: f64,
+}
+
+fn default_band() -> f64 {
+    0.02
+}
+fn default_static_window() -> f64 {
+    2.0
+}
+
+impl Default for MetricsSection {
+    fn default() -> Self {
+        Self {
+            from_s: 0.0,
+            band: default_band(),
+            static_window_s: default_static_window(),
+        }
+    }
+}
+
+impl MetricsSection {
+    pub(super) fn validate(&self) -> Result<(), Invalid> {
+        Invalid::check(
+            self.from_s.is_finite() && self.from_s >= 0.0,
+            "metrics.from_s",
+            || format!("must be ≥ 0 s, got {}", self.from_s),
+        )?;
+        Invalid::check(
+            self.band.is_finite() && self.band > 0.0 && self.band < 1.0,
+            "metrics.band",
+            || format!("must be in (0, 1), got {}", self.band),
+        )?;
+        Invalid::check(
+            self.static_window_s.is_finite() && self.static_window_s > 0.0,
+            "metrics.static_window_s",
+            || format!("must be > 0 s, got {}", self.static_window_s),
+        )
+    }
+}
