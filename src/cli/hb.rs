@@ -170,6 +170,17 @@ fn duffing(a: DuffingArgs) -> Result<Output, CliError> {
     let floquet = StabilityAnalyzer::new(&problem, a.params.n, steps)
         .map_err(|e| CliError::Input(e.to_string()))?
         .hsu(&problem, &sol, HsuRule::Magnus4);
+    if !floquet
+        .multipliers
+        .iter()
+        .all(|m| m.re.is_finite() && m.im.is_finite())
+    {
+        return Err(CliError::Failed(format!(
+            "the Floquet multipliers at ω_f = {} are not finite (Hsu's method over {steps} steps \
+             of one period 2π/ω_f); the stability of this solution is unknown",
+            a.omega_f
+        )));
+    }
     let mults: Vec<[f64; 2]> = floquet.multipliers.iter().map(|m| [m.re, m.im]).collect();
     let json = json!({
         "coeffs": sol.coeffs,
