@@ -313,8 +313,8 @@ fn mathieu(a: MathieuArgs) -> Result<Output, CliError> {
         let names = ["period 1 at β1", "period 2 at β2", "period 4 at β4"];
         let series: Vec<_> = pds
             .iter()
-            .enumerate()
-            .map(|(i, p)| {
+            .zip(names)
+            .map(|(p, name)| {
                 let pts = (0..=800)
                     .map(|j| {
                         let tau = 2.0 * PI * j as f64 / 800.0;
@@ -324,7 +324,7 @@ fn mathieu(a: MathieuArgs) -> Result<Output, CliError> {
                         )
                     })
                     .collect();
-                (names[i.min(2)], pts)
+                (name, pts)
             })
             .collect();
         draw(

@@ -102,8 +102,13 @@ fn input(e: impl std::fmt::Display) -> CliError {
     CliError::Input(e.to_string())
 }
 
-fn failed(e: impl std::fmt::Display) -> CliError {
-    CliError::Failed(e.to_string())
+/// A design-crate error: bad inputs are `input`, solver failures `failed`.
+fn failed(e: ivt_design::IvtError) -> CliError {
+    use ivt_design::IvtError as E;
+    match e {
+        E::Input { .. } | E::Plant(_) | E::EmptyGrid(_) => CliError::Input(e.to_string()),
+        _ => CliError::Failed(e.to_string()),
+    }
 }
 
 /// Run an `ol` subcommand.
@@ -261,7 +266,8 @@ fn table(a: GridArgs) -> Result<Output, CliError> {
     let (grid, pts) = run_sweep(&a)?;
     let mut human = format!("r̄ [mm] (rows T_U, columns V_m = {:?})\n", grid.v_m);
     for row in pts.chunks(grid.v_m.len()) {
-        human.push_str(&format!("T_U {:>4}:", row[0].op.t_u));
+        let t_u = row.first().map_or(f64::NAN, |p| p.op.t_u);
+        human.push_str(&format!("T_U {t_u:>4}:"));
         for p in row {
             match &p.result {
                 Ok(s) => human.push_str(&format!(" {:7.2}", s.r * 1e3)),

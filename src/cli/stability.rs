@@ -130,7 +130,7 @@ pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
                 &a.common.opts(),
             )
             .map_err(|e| CliError::Failed(e.to_string()))?;
-            if !(c.max_abs_multiplier < 1.0) {
+            if c.max_abs_multiplier.is_nan() || c.max_abs_multiplier >= 1.0 {
                 return Err(CliError::Failed(format!(
                     "no gains with k ≤ {k_max:e}, k2 ≤ {k2_max:e} give max |multiplier| < 1 \
                      (best found: k = {:e}, k2 = {:e}, max |multiplier| = {})",

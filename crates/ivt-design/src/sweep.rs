@@ -114,7 +114,7 @@ pub fn axis(name: &'static str, from: f64, step: f64, to: f64) -> Result<Vec<f64
         return Err(bad(step, "finite and > 0 (range step)"));
     }
     let steps = ((to - from) / step + 1e-9).floor();
-    if !(steps < MAX_AXIS_POINTS as f64) {
+    if steps.is_nan() || steps >= MAX_AXIS_POINTS as f64 {
         return Err(bad(
             step,
             "large enough for at most 10000 values (MAX_AXIS_POINTS; range step)",
