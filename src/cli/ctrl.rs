@@ -135,6 +135,45 @@ struct Row {
     inputs: Option<(f32, f32)>,
 }
 
+/// Most pulses of one replayed log: about 3 h at 100 rpm and 1200 PPR, and
+/// ~200 MB of JSON output.
+const MAX_PULSES: usize = 1_000_000;
+
+/// Refuse, by name, options that would make the replay meaningless: a zero
+/// or non-finite timer frequency, decimation, stall timeout or sample
+/// period, and non-finite gains or set points.
+fn check_args(a: &ReplayArgs) -> Result<(), CliError> {
+    let positive = [
+        ("--f-timer", a.f_timer),
+        ("--omega0-rpm", a.omega0_rpm),
+        ("--stall-timeout", a.stall_timeout),
+        ("--prop-period", a.prop_period),
+    ];
+    for (name, v) in positive {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(CliError::Input(format!(
+                "{name} must be finite and > 0, got {v}"
+            )));
+        }
+    }
+    let finite = [
+        ("--k", a.k),
+        ("--k2", a.k2),
+        ("--k-prop", a.k_prop),
+        ("--vm", a.vm),
+        ("--tu", a.tu),
+    ];
+    for (name, v) in finite {
+        if !v.is_finite() {
+            return Err(CliError::Input(format!("{name} must be finite, got {v}")));
+        }
+    }
+    if a.decimation == 0 {
+        return Err(CliError::Input("--decimation must be ≥ 1".into()));
+    }
+    Ok(())
+}
+
 fn parse_log(text: &str) -> Result<Vec<Row>, CliError> {
     let mut rows = Vec::new();
     for (n, line) in text.lines().enumerate() {
@@ -153,17 +192,22 @@ fn parse_log(text: &str) -> Result<Vec<Row>, CliError> {
             .map_err(|_| bad("ticks is not an unsigned integer"))?;
         let ticks =
             u32::try_from(ticks).map_err(|_| bad("ticks exceeds u32 (log raw timer captures)"))?;
-        let inputs = match cols.len() {
-            1 => None,
-            3 => {
+        let inputs = match cols.as_slice() {
+            [_] => None,
+            [_, v, t] => {
                 // Readings are passed through unchanged (NaN included): the
                 // controller's own validation is what is being replayed.
-                let v: f32 = cols[1].parse().map_err(|_| bad("vm is not a number"))?;
-                let t: f32 = cols[2].parse().map_err(|_| bad("tu is not a number"))?;
+                let v: f32 = v.parse().map_err(|_| bad("vm is not a number"))?;
+                let t: f32 = t.parse().map_err(|_| bad("tu is not a number"))?;
                 Some((v, t))
             }
             _ => return Err(bad("expected columns ticks[,vm,tu]")),
         };
+        if rows.len() == MAX_PULSES {
+            return Err(CliError::Input(format!(
+                "the log has more than {MAX_PULSES} pulses (the JSON of more is hundreds of MB); split it"
+            )));
+        }
         rows.push(Row { ticks, inputs });
     }
     if rows.is_empty() {
@@ -193,8 +237,8 @@ fn simulate(mut c: AnyController, rows: &[Row], default_inputs: (f32, f32)) -> V
 }
 
 fn replay(a: &ReplayArgs) -> Result<Output, CliError> {
-    let text = std::fs::read_to_string(&a.log)
-        .map_err(|e| CliError::Input(format!("cannot read {}: {e}", a.log.display())))?;
+    check_args(a)?;
+    let text = std::fs::read_to_string(&a.log).map_err(|e| CliError::io(&a.log, e))?;
     let rows = parse_log(&text)?;
     let config = Config {
         f_timer_hz: a.f_timer,
@@ -239,8 +283,7 @@ fn replay(a: &ReplayArgs) -> Result<Output, CliError> {
     let last = outs.last().copied();
     let mut human = String::new();
     if let Some(path) = &a.out {
-        std::fs::write(path, &csv)
-            .map_err(|e| CliError::Failed(format!("cannot write {}: {e}", path.display())))?;
+        super::write_atomic(path, csv.as_bytes())?;
         if let Some(o) = last {
             human = format!(
                 "{} pulses, {faults} with a fault code; last: ω_a = {:.4} rad/s ({:.2} rpm), r = {:.6} m → {}\n",

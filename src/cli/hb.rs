@@ -170,6 +170,17 @@ fn duffing(a: DuffingArgs) -> Result<Output, CliError> {
     let floquet = StabilityAnalyzer::new(&problem, a.params.n, steps)
         .map_err(|e| CliError::Input(e.to_string()))?
         .hsu(&problem, &sol, HsuRule::Magnus4);
+    if !floquet
+        .multipliers
+        .iter()
+        .all(|m| m.re.is_finite() && m.im.is_finite())
+    {
+        return Err(CliError::Failed(format!(
+            "the Floquet multipliers at ω_f = {} are not finite (Hsu's method over {steps} steps \
+             of one period 2π/ω_f); the stability of this solution is unknown",
+            a.omega_f
+        )));
+    }
     let mults: Vec<[f64; 2]> = floquet.multipliers.iter().map(|m| [m.re, m.im]).collect();
     let json = json!({
         "coeffs": sol.coeffs,
@@ -302,8 +313,8 @@ fn mathieu(a: MathieuArgs) -> Result<Output, CliError> {
         let names = ["period 1 at β1", "period 2 at β2", "period 4 at β4"];
         let series: Vec<_> = pds
             .iter()
-            .enumerate()
-            .map(|(i, p)| {
+            .zip(names)
+            .map(|(p, name)| {
                 let pts = (0..=800)
                     .map(|j| {
                         let tau = 2.0 * PI * j as f64 / 800.0;
@@ -313,7 +324,7 @@ fn mathieu(a: MathieuArgs) -> Result<Output, CliError> {
                         )
                     })
                     .collect();
-                (names[i.min(2)], pts)
+                (name, pts)
             })
             .collect();
         draw(

@@ -105,6 +105,21 @@ impl Design {
     }
 }
 
+/// Most `--points` of a sampled curve: 100 000 points are ~10 MB of JSON and
+/// a second of work; beyond that the output is neither readable nor useful.
+const MAX_POINTS: usize = 100_000;
+
+/// `--points` in 2..=[`MAX_POINTS`], checked before anything is allocated.
+fn check_points(points: usize) -> Result<(), CliError> {
+    if (2..=MAX_POINTS).contains(&points) {
+        Ok(())
+    } else {
+        Err(CliError::Input(format!(
+            "--points must be in 2..={MAX_POINTS} (the JSON of more is tens of MB), got {points}"
+        )))
+    }
+}
+
 fn kin_err(e: KinError) -> CliError {
     CliError::Input(e.to_string())
 }
@@ -162,6 +177,7 @@ pub fn summary() -> Result<Output, CliError> {
 }
 
 fn sgivt_ratio(theta_ct_deg: f64, points: usize) -> Result<Output, CliError> {
+    check_points(points)?;
     let g = SgivtGeometry::prototype();
     let th = deg_to_rad(theta_ct_deg);
     let e = g.crank_length(th).map_err(kin_err)?;
@@ -200,6 +216,7 @@ fn sgivt_ratio(theta_ct_deg: f64, points: usize) -> Result<Output, CliError> {
 }
 
 fn givt_ratio(r_mm: f64, l1_mm: f64, r_output_mm: f64, points: usize) -> Result<Output, CliError> {
+    check_points(points)?;
     let g = GivtGeometry {
         l1: l1_mm * 1e-3,
         r_output: r_output_mm * 1e-3,
@@ -209,6 +226,7 @@ fn givt_ratio(r_mm: f64, l1_mm: f64, r_output_mm: f64, points: usize) -> Result<
     let avg = g.average_module_ratio(r).map_err(kin_err)?;
     let mut c = [0.0; MAX_CORNERS];
     let nc = g.module_corners(r, &mut c).map_err(kin_err)?;
+    let corners = c.get(..nc).unwrap_or(&c);
     let period = ivt_kin::givt::MODULE_PERIOD;
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     let n_scan = points.max(2048);
@@ -249,7 +267,7 @@ fn givt_ratio(r_mm: f64, l1_mm: f64, r_output_mm: f64, points: usize) -> Result<
         "average_final_ratio": g.crank_to_input() * avg,
         "reduced_ratio_min": if avg > 0.0 { lo / avg } else { f64::NAN },
         "reduced_ratio_max": if avg > 0.0 { hi / avg } else { f64::NAN },
-        "corners": &c[..nc],
+        "corners": corners,
         "with_ncg_r_o": 0.010,
         "with_ncg_reduced_min": nlo / nmean,
         "with_ncg_reduced_max": nhi / nmean,
@@ -263,7 +281,7 @@ fn givt_ratio(r_mm: f64, l1_mm: f64, r_output_mm: f64, points: usize) -> Result<
         3.0 * avg,
         lo / avg,
         hi / avg,
-        c[..nc].iter().map(|x| rad_to_deg(*x)).collect::<Vec<_>>(),
+        corners.iter().map(|x| rad_to_deg(*x)).collect::<Vec<_>>(),
         nlo / nmean,
         nhi / nmean
     );
@@ -327,9 +345,7 @@ impl<G: GearRatio> DynGear for G {
 }
 
 fn profile(design: Design, g: &dyn DynGear, d: f64, points: usize) -> Result<Output, CliError> {
-    if !(2..=1_000_000).contains(&points) {
-        return Err(CliError::Input("--points must be in 2..=1000000".into()));
-    }
+    check_points(points)?;
     let mut pts = vec![PitchPoint::default(); points];
     let c = g.profile(d, &mut pts).map_err(kin_err)?;
     let json = json!({
@@ -387,8 +403,9 @@ fn arcs(
     for (key, member) in [("driven", Member::Driven), ("driving", Member::Driving)] {
         let mut buf = vec![Arc::default(); 1 << 16];
         let fit = g.arcs(d, member, &opts, &mut buf).map_err(kin_err)?;
-        let list: Vec<Value> = buf[..fit.count]
+        let list: Vec<Value> = buf
             .iter()
+            .take(fit.count)
             .map(|a| {
                 json!({
                     "start": a.start, "end": a.end(), "center": a.center(),
@@ -436,7 +453,7 @@ fn fourier(harmonics: u32) -> Result<Output, CliError> {
         let numeric = fourier_coefficient(&SgivtNcg, k).map_err(kin_err)?;
         let printed = match k {
             0 => Some(1.0),
-            1..=4 => Some(EQ42_PRINTED[k as usize - 1]),
+            1..=4 => EQ42_PRINTED.get(k as usize - 1).copied(),
             _ => None,
         };
         rows.push(json!({

@@ -4,6 +4,7 @@
 use super::{CliError, Output};
 use clap::{Args, Subcommand};
 use ivt_design::fit::{self, OpenLoopLaw, PolyForm};
+use ivt_design::shooting::{shoot_steady_state, ShootingOptions};
 use ivt_design::steady::{solve_steady_state, IhbOptions};
 use ivt_design::sweep::{self, Grid, SweepPoint};
 use ivt_design::{rad_s_to_rpm, rpm_to_rad_s, OperatingPoint};
@@ -30,12 +31,26 @@ pub struct SolveArgs {
     /// Brake torque T_U [N·m].
     #[arg(long, allow_hyphen_values = true)]
     tu: f64,
+    /// How r̄ is computed: `polish` (default) refines the IHB by θ-shooting
+    /// (≤ 1e-9 relative); `ihb` reports the n-harmonic IHB alone (n = 7, the
+    /// thesis's choice, is ~3 % off), with |r̄(n) − r̄(2n+1)| as its error estimate.
+    #[arg(long, value_enum, default_value_t = SolveMethod::Polish)]
+    method: SolveMethod,
     /// Target mean speed [rpm].
     #[arg(long, default_value_t = 100.0, allow_hyphen_values = true)]
     omega0_rpm: f64,
     /// Harmonics n of the IHB (thesis: 7).
     #[arg(long, default_value_t = 7)]
     harmonics: usize,
+}
+
+/// How `ivt ol solve` computes r̄.
+#[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
+pub enum SolveMethod {
+    /// IHB seed polished by θ-shooting (Eq. 162 integrated in θ by RK6).
+    Polish,
+    /// The n-harmonic IHB alone (§4.2.1).
+    Ihb,
 }
 
 /// Grid arguments shared by `table` and `fit` (MATLAB-style from:step:to).
@@ -87,8 +102,13 @@ fn input(e: impl std::fmt::Display) -> CliError {
     CliError::Input(e.to_string())
 }
 
-fn failed(e: impl std::fmt::Display) -> CliError {
-    CliError::Failed(e.to_string())
+/// A design-crate error: bad inputs are `input`, solver failures `failed`.
+fn failed(e: ivt_design::IvtError) -> CliError {
+    use ivt_design::IvtError as E;
+    match e {
+        E::Input { .. } | E::Plant(_) | E::EmptyGrid(_) => CliError::Input(e.to_string()),
+        _ => CliError::Failed(e.to_string()),
+    }
 }
 
 /// Run an `ol` subcommand.
@@ -117,20 +137,94 @@ fn solve(a: SolveArgs) -> Result<Output, CliError> {
     };
     let t0 = std::time::Instant::now();
     let s = solve_steady_state(&plant, &op, opts).map_err(failed)?;
+    let acc = accurate_r(&plant, &op, &s, a.method, opts)?;
     let dt = t0.elapsed().as_secs_f64();
+    let verdict = ivt_design::Verdict::classify(acc.r, plant.r_max);
     let json = json!({
-        "r": s.r, "feasible": s.verdict == ivt_design::Verdict::Feasible,
-        "verdict": s.verdict.as_str(), "q": s.q, "omega_min": s.omega_min,
-        "omega_max": s.omega_max, "solve_time_s": dt, "iterations": s.iterations,
+        "r": acc.r, "feasible": verdict == ivt_design::Verdict::Feasible,
+        "verdict": verdict.as_str(), "q": s.q, "omega_min": acc.omega_min,
+        "omega_max": acc.omega_max, "solve_time_s": dt, "iterations": s.iterations,
         "residual_norm": s.residual_norm, "harmonics": a.harmonics, "r_max": plant.r_max,
-        "omega0": op.omega0,
+        "omega0": op.omega0, "method": acc.method, "r_ihb": s.r,
+        "error_estimate": {"r_abs": acc.error_abs, "r_rel": acc.error_abs / acc.r.abs(),
+                           "how": acc.how},
+        "thesis_choice": a.method == SolveMethod::Ihb && a.harmonics == 7,
     });
+    let label = if a.method == SolveMethod::Ihb && a.harmonics == 7 {
+        " — n = 7, the thesis's choice"
+    } else {
+        ""
+    };
     let human = format!(
-        "V_m = {} V, T_U = {} N·m, ω0 = {} rpm\nr̄ = {:.6} m ({}; r_max = {} m)\nω̄ ∈ [{:.2}, {:.2}] rpm\n{} Newton iterations, |R| = {:.1e}, {:.1} µs\n",
-        a.vm, a.tu, a.omega0_rpm, s.r, s.verdict.as_str(), plant.r_max,
-        rad_s_to_rpm(s.omega_min), rad_s_to_rpm(s.omega_max), s.iterations, s.residual_norm, dt * 1e6
+        "V_m = {} V, T_U = {} N·m, ω0 = {} rpm\nr̄ = {:.7} m ± {:.1e} ({}{label}; {}; r_max = {} m)\nω̄ ∈ [{:.2}, {:.2}] rpm\n{} Newton iterations, |R| = {:.1e}, {:.1} µs\n",
+        a.vm, a.tu, a.omega0_rpm, acc.r, acc.error_abs, acc.method, verdict.as_str(), plant.r_max,
+        rad_s_to_rpm(acc.omega_min), rad_s_to_rpm(acc.omega_max), s.iterations, s.residual_norm, dt * 1e6
     );
     Ok(Output { json, human })
+}
+
+/// r̄ of `ol solve` with an error estimate.
+struct AccurateR {
+    r: f64,
+    omega_min: f64,
+    omega_max: f64,
+    error_abs: f64,
+    method: &'static str,
+    how: &'static str,
+}
+
+/// θ-shooting polish of the IHB r̄ (its error estimated by halving the RK6
+/// steps: 6th order, so the estimate bounds the 48-step error ~60-fold), or
+/// the IHB alone with |r̄(n) − r̄(2n+1)| (r̄(n) converges like n⁻³ on this
+/// plant, crates/ivt-design/README.md).
+fn accurate_r(
+    plant: &PlantParams,
+    op: &OperatingPoint,
+    s: &ivt_design::steady::SteadyState,
+    method: SolveMethod,
+    opts: IhbOptions,
+) -> Result<AccurateR, CliError> {
+    match method {
+        SolveMethod::Polish => {
+            let fine = ShootingOptions::default();
+            let coarse = ShootingOptions {
+                steps_per_segment: fine.steps_per_segment / 2,
+                ..fine
+            };
+            let orbit = shoot_steady_state(plant, op, Some(s.r), &fine).map_err(failed)?;
+            let check = shoot_steady_state(plant, op, Some(orbit.r), &coarse).map_err(failed)?;
+            Ok(AccurateR {
+                r: orbit.r,
+                omega_min: orbit.omega_min,
+                omega_max: orbit.omega_max,
+                error_abs: (orbit.r - check.r).abs(),
+                method: "ihb+shooting",
+                how: "θ-shooting with 48 vs 24 RK6 steps per gear segment",
+            })
+        }
+        SolveMethod::Ihb => {
+            // The other resolution: 2n+1 harmonics, or n/2 at the limit
+            // (then an overestimate).
+            let n = opts.harmonics;
+            let other = IhbOptions {
+                harmonics: if 2 * n < ivt_design::steady::MAX_HARMONICS {
+                    2 * n + 1
+                } else {
+                    n / 2
+                },
+                ..opts
+            };
+            let finer = solve_steady_state(plant, op, other).map_err(failed)?;
+            Ok(AccurateR {
+                r: s.r,
+                omega_min: s.omega_min,
+                omega_max: s.omega_max,
+                error_abs: (s.r - finer.r).abs(),
+                method: "ihb",
+                how: "|r̄(n) − r̄(2n+1)| of the IHB (n/2 instead of 2n+1 at the limit)",
+            })
+        }
+    }
 }
 
 fn run_sweep(a: &GridArgs) -> Result<(Grid, Vec<SweepPoint>), CliError> {
@@ -141,8 +235,8 @@ fn run_sweep(a: &GridArgs) -> Result<(Grid, Vec<SweepPoint>), CliError> {
         )));
     }
     let grid = Grid {
-        v_m: sweep::range(a.vm_from, a.vm_step, a.vm_to),
-        t_u: sweep::range(a.tu_from, a.tu_step, a.tu_to),
+        v_m: sweep::axis("--vm-step", a.vm_from, a.vm_step, a.vm_to).map_err(input)?,
+        t_u: sweep::axis("--tu-step", a.tu_from, a.tu_step, a.tu_to).map_err(input)?,
         omega0: rpm_to_rad_s(a.omega0_rpm),
     };
     grid.validate().map_err(input)?;
@@ -172,7 +266,8 @@ fn table(a: GridArgs) -> Result<Output, CliError> {
     let (grid, pts) = run_sweep(&a)?;
     let mut human = format!("r̄ [mm] (rows T_U, columns V_m = {:?})\n", grid.v_m);
     for row in pts.chunks(grid.v_m.len()) {
-        human.push_str(&format!("T_U {:>4}:", row[0].op.t_u));
+        let t_u = row.first().map_or(f64::NAN, |p| p.op.t_u);
+        human.push_str(&format!("T_U {t_u:>4}:"));
         for p in row {
             match &p.result {
                 Ok(s) => human.push_str(&format!(" {:7.2}", s.r * 1e3)),
@@ -220,8 +315,7 @@ fn fit_cmd(a: FitArgs) -> Result<Output, CliError> {
             a.grid.vm_from, a.grid.vm_step, a.grid.vm_to, a.grid.tu_from, a.grid.tu_step, a.grid.tu_to,
             a.grid.omega0_rpm, pf.points, pf.rms_r, pf.max_r, err.max_abs_rpm, err.rms_rpm, alpha, beta, b_err
         );
-        std::fs::write(path, fit::emit_rust(&law, "REFIT", &header))
-            .map_err(|e| CliError::Failed(format!("writing {}: {e}", path.display())))?;
+        super::write_atomic(path, fit::emit_rust(&law, "REFIT", &header).as_bytes())?;
     }
     let json = json!({
         "poly": pf.poly, "boundary": law.boundary, "r_max": law.r_max,

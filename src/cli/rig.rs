@@ -48,23 +48,31 @@ pub fn run(cmd: RigCommand) -> Result<Output, CliError> {
     }
 }
 
+/// Longest `--idle-timeout-s`: one day (a recorder idle longer is stopped
+/// with Ctrl-C, which closes the MCAP cleanly).
+const MAX_IDLE_TIMEOUT: Duration = Duration::from_secs(86_400);
+
 fn record_cmd(a: &RecordArgs) -> Result<Output, CliError> {
-    if !(a.idle_timeout_s.is_finite() && a.idle_timeout_s > 0.0) {
-        return Err(CliError::Input(format!(
-            "--idle-timeout-s must be positive, got {}",
-            a.idle_timeout_s
-        )));
-    }
+    let idle_timeout = Duration::try_from_secs_f64(a.idle_timeout_s)
+        .ok()
+        .filter(|d| !d.is_zero() && *d <= MAX_IDLE_TIMEOUT)
+        .ok_or_else(|| {
+            CliError::Input(format!(
+                "--idle-timeout-s must be in (0, {}] s, got {:?}",
+                MAX_IDLE_TIMEOUT.as_secs(),
+                a.idle_timeout_s
+            ))
+        })?;
     let port = serialport::new(&a.port, a.baud)
         .timeout(Duration::from_millis(100))
         .open()
         .map_err(|e| CliError::Failed(format!("{}: {e}", a.port)))?;
     // Tell whoever waits (a test driving the firmware) that the port is open.
-    eprintln!("recording from {}", a.port);
+    super::note(&format!("recording from {}", a.port));
     let opts = RecordOptions {
         f_timer_hz: a.f_timer_hz,
         max_frames: a.frames,
-        idle_timeout: Duration::from_secs_f64(a.idle_timeout_s),
+        idle_timeout,
     };
     let s = record(port, &a.out, &opts).map_err(|e| CliError::Failed(e.to_string()))?;
     let human = format!(

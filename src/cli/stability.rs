@@ -7,7 +7,7 @@ use super::{CliError, Output};
 use clap::Args;
 use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
 use ivt_design::gains::stability_map;
-use ivt_design::sweep::{range, Grid};
+use ivt_design::sweep::{axis, Grid};
 use ivt_design::{rpm_to_rad_s, OperatingPoint};
 use ivt_kin::plant::PlantParams;
 use serde_json::json;
@@ -120,15 +120,25 @@ pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
     let design = match &a.design {
         Some(b) => {
             let scale = if a.common.si { 1.0 } else { 1e-3 };
+            let (k_max, k2_max) = design_box(b, a.design_steps)?;
             let c = ivt_design::gains::best_gains(
                 &PlantParams::printed(),
                 &op,
-                (0.0, b[0] * scale),
-                (0.0, b[1] * scale),
+                (0.0, k_max * scale),
+                (0.0, k2_max * scale),
                 a.design_steps,
                 &a.common.opts(),
             )
             .map_err(|e| CliError::Failed(e.to_string()))?;
+            if c.max_abs_multiplier.is_nan() || c.max_abs_multiplier >= 1.0 {
+                return Err(CliError::Failed(format!(
+                    "no gains with k ≤ {k_max:e}, k2 ≤ {k2_max:e} give max |multiplier| < 1 \
+                     (best found: k = {:e}, k2 = {:e}, max |multiplier| = {})",
+                    c.gains.k / scale,
+                    c.gains.k2 / scale,
+                    c.max_abs_multiplier
+                )));
+            }
             Some(json!({"k_si": c.gains.k, "k2_si": c.gains.k2,
                         "k": c.gains.k / scale, "k2": c.gains.k2 / scale,
                         "max_abs_multiplier": c.max_abs_multiplier}))
@@ -155,8 +165,8 @@ pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
 /// Bad input or an empty grid.
 pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
     let grid = Grid {
-        v_m: range(a.vm[0], a.vm[1], a.vm[2]),
-        t_u: range(a.tu[0], a.tu[1], a.tu[2]),
+        v_m: grid_axis("--vm", &a.vm)?,
+        t_u: grid_axis("--tu", &a.tu)?,
         omega0: a.common.omega0()?,
     };
     grid.validate()
@@ -190,10 +200,20 @@ pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
     let map = stability_map(&plant, &ops, a.common.gains(), &a.common.opts())
         .map_err(|e| CliError::Input(e.to_string()))?;
     let dt = t0.elapsed().as_secs_f64();
-    let worst = map
+    let solved: Vec<f64> = map
         .iter()
-        .filter_map(|(_, r)| r.as_ref().ok())
-        .fold(0.0f64, |m, v| m.max(*v));
+        .filter_map(|(_, r)| r.as_ref().ok().copied())
+        .collect();
+    if solved.is_empty() {
+        let first = map.iter().find_map(|(_, r)| r.as_ref().err());
+        return Err(CliError::Failed(format!(
+            "every one of the {} points failed (first: {})",
+            map.len(),
+            first.map_or("no reason given", String::as_str)
+        )));
+    }
+    let worst = solved.iter().fold(0.0f64, |m, v| m.max(*v));
+    let failed = map.len() - solved.len();
     let pts: Vec<_> = map
         .iter()
         .map(|(op, r)| match r {
@@ -201,7 +221,7 @@ pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
             Err(e) => json!({"vm": op.v_m, "tu": op.t_u, "error": e}),
         })
         .collect();
-    let json = json!({"points": pts, "worst": worst, "k_si": a.common.gains().k,
+    let json = json!({"points": pts, "worst": worst, "failed": failed, "k_si": a.common.gains().k,
                       "k2_si": a.common.gains().k2, "solve_time_s": dt});
     if let Some(path) = &a.plot {
         let value = |v: f64, t: f64| {
@@ -233,10 +253,44 @@ pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
         ivt_plot::heat_map(path, &heat).map_err(|e| CliError::Failed(e.to_string()))?;
     }
     let human = format!(
-        "{} points, worst max |multiplier| = {:.6}, {:.2} s\n",
+        "{} points ({} failed), worst max |multiplier| = {:.6}, {:.2} s\n",
         map.len(),
+        failed,
         worst,
         dt
     );
     Ok(Output { json, human })
+}
+
+/// One `FROM STEP TO` axis of `stability-map`, refused by name when it is not
+/// finite, not increasing or longer than [`ivt_design::sweep::MAX_AXIS_POINTS`].
+fn grid_axis(name: &'static str, v: &[f64]) -> Result<Vec<f64>, CliError> {
+    let &[from, step, to] = v else {
+        return Err(CliError::Input(format!("{name} takes FROM STEP TO")));
+    };
+    axis(name, from, step, to).map_err(|e| CliError::Input(e.to_string()))
+}
+
+/// Most grid values per gain axis of `--design` (steps² solves per round).
+const MAX_DESIGN_STEPS: usize = 64;
+
+/// The `--design K_MAX K2_MAX` box, refused by name unless both bounds are
+/// finite and > 0 and `--design-steps` is in 2..=[`MAX_DESIGN_STEPS`].
+fn design_box(b: &[f64], steps: usize) -> Result<(f64, f64), CliError> {
+    let &[k_max, k2_max] = b else {
+        return Err(CliError::Input("--design takes K_MAX K2_MAX".into()));
+    };
+    for (name, v) in [("K_MAX", k_max), ("K2_MAX", k2_max)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(CliError::Input(format!(
+                "--design {name} must be finite and > 0, got {v}"
+            )));
+        }
+    }
+    if !(2..=MAX_DESIGN_STEPS).contains(&steps) {
+        return Err(CliError::Input(format!(
+            "--design-steps must be in 2..={MAX_DESIGN_STEPS} (steps² stability solves per round), got {steps}"
+        )));
+    }
+    Ok((k_max, k2_max))
 }

@@ -113,13 +113,17 @@ pub fn run(args: StringArgs) -> Result<Output, CliError> {
         .points
         .iter()
         .map(|p| {
-            let s = p.stability.expect("stability requested");
+            let s = p.stability.as_ref().ok_or_else(|| {
+                CliError::Failed(format!("no stability result at ω = {}", p.omega))
+            })?;
             let _ = writeln!(human, "{:.6} {:.6e} {}", p.omega, p.norm, s.is_stable());
-            json!({"omega": p.omega, "norm": p.norm, "stable": s.is_stable(),
+            Ok(
+                json!({"omega": p.omega, "norm": p.norm, "stable": s.is_stable(),
                    "kind": format!("{:?}", s.kind), "max_multiplier": s.critical.norm(),
-                   "method": format!("{:?}", s.method)})
+                   "method": format!("{:?}", s.method)}),
+            )
         })
-        .collect();
+        .collect::<Result<_, CliError>>()?;
     let mut extra = json!({"factorizations": frc.factorizations, "hill_calls": frc.hill_calls,
                        "stop": format!("{:?}", frc.stop)});
     if let Boundary::Spring { k0 } = boundary {
@@ -132,7 +136,9 @@ pub fn run(args: StringArgs) -> Result<Output, CliError> {
                 args.modes
             );
             let _ = writeln!(human, "# note: {note}");
-            extra["boundary_note"] = json!(note);
+            if let Some(o) = extra.as_object_mut() {
+                o.insert("boundary_note".into(), json!(note));
+            }
         }
     }
     if let Some(path) = &args.plot {
@@ -162,7 +168,8 @@ pub fn run(args: StringArgs) -> Result<Output, CliError> {
 fn plot(path: &Path, title: &str, points: &[FrcPoint]) -> Result<(), CliError> {
     let stable = |p: &FrcPoint| p.stability.is_none_or(|s| s.is_stable());
     let (mut solid, mut dashed) = (Vec::new(), Vec::new());
-    for (i, p) in points.iter().enumerate() {
+    let mut previous: Option<&FrcPoint> = None;
+    for p in points {
         let xy = (p.omega, p.norm);
         let gap = (f64::NAN, f64::NAN);
         let (own, other) = if stable(p) {
@@ -171,11 +178,12 @@ fn plot(path: &Path, title: &str, points: &[FrcPoint]) -> Result<(), CliError> {
             (&mut dashed, &mut solid)
         };
         own.push(xy);
-        if i > 0 && stable(&points[i - 1]) != stable(p) {
+        if previous.is_some_and(|q| stable(q) != stable(p)) {
             // Close the other style's stretch at this point, then break it.
             other.push(xy);
         }
         other.push(gap);
+        previous = Some(p);
     }
     let mut series = vec![ivt_plot::Series {
         label: "stable",

@@ -134,7 +134,7 @@ impl Verdict {
 #[derive(Debug, thiserror::Error)]
 pub enum IvtError {
     /// An input that is NaN/inf or out of its range.
-    #[error("invalid input `{name}` = {value}: must be {requirement}")]
+    #[error("invalid input `{name}` = {value:?}: must be {requirement}")]
     Input {
         /// Name of the argument.
         name: &'static str,

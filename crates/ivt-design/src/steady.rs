@@ -114,6 +114,14 @@ impl IhbOptions {
     }
 }
 
+/// Most harmonics of the IVT IHB: r̄(n) converges like n⁻³ (8.7e-9 relative
+/// at n = 383, crates/ivt-design/README.md), and the tables grow like n²
+/// (~50 MB and seconds per solve at 511), so more buys nothing.
+pub const MAX_HARMONICS: usize = 511;
+
+/// Most explicit quadrature samples per period (tables of samples × n).
+pub const MAX_SAMPLES: usize = 65_536;
+
 /// The IHB steady state at one operating point.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SteadyState {
@@ -201,14 +209,22 @@ impl IhbSolver {
     /// [`IvtError::Input`] for n = 0 or too few samples (need > 2n).
     pub fn new(opts: IhbOptions) -> Result<Self, IvtError> {
         let n = opts.harmonics;
-        let m = opts.sample_count();
-        if n == 0 {
+        if n == 0 || n > MAX_HARMONICS {
             return Err(IvtError::Input {
                 name: "harmonics",
-                value: 0.0,
-                requirement: ">= 1",
+                value: n as f64,
+                requirement:
+                    "in 1..=511 (MAX_HARMONICS: ~5e-9 relative in r̄, seconds and ~50 MB per solve)",
             });
         }
+        if opts.samples > MAX_SAMPLES {
+            return Err(IvtError::Input {
+                name: "samples",
+                value: opts.samples as f64,
+                requirement: "at most 65536 (MAX_SAMPLES)",
+            });
+        }
+        let m = opts.sample_count();
         if m <= 2 * n {
             return Err(IvtError::Input {
                 name: "samples",

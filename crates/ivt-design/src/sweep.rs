@@ -38,11 +38,19 @@ impl Grid {
         self.len() == 0
     }
 
-    /// Reject empty axes and non-finite entries.
+    /// Reject empty axes, non-finite entries and grids of more than
+    /// [`MAX_GRID_POINTS`] points.
     ///
     /// # Errors
     /// [`IvtError::EmptyGrid`] or [`IvtError::Input`].
     pub fn validate(&self) -> Result<(), IvtError> {
+        if self.len() > MAX_GRID_POINTS {
+            return Err(IvtError::Input {
+                name: "grid",
+                value: self.len() as f64,
+                requirement: "at most 100000 points (MAX_GRID_POINTS)",
+            });
+        }
         if self.v_m.is_empty() {
             return Err(IvtError::EmptyGrid("no V_m values"));
         }
@@ -69,14 +77,51 @@ impl Grid {
     }
 }
 
+/// Most values one grid axis may hold. A stability-map or sweep point costs
+/// 0.1–10 ms, so 10 000 values along one axis are already minutes of work;
+/// the limit is checked before the axis is allocated, so a step such as
+/// 1e-300 is refused instead of asking for 10^300 values.
+pub const MAX_AXIS_POINTS: usize = 10_000;
+
+/// Most points of a whole grid (both axes): 100 000 solves, minutes to an hour.
+pub const MAX_GRID_POINTS: usize = 100_000;
+
 /// `from:step:to` inclusive (MATLAB style), robust to rounding at the end.
-/// Empty if step ≤ 0 or to < from.
+/// Empty if step ≤ 0, to < from, any value is not finite, or the axis would
+/// hold more than [`MAX_AXIS_POINTS`] values (use [`axis`] for the reason).
 pub fn range(from: f64, step: f64, to: f64) -> Vec<f64> {
-    if !(step > 0.0 && to >= from && from.is_finite() && to.is_finite()) {
-        return Vec::new();
+    axis("range", from, step, to).unwrap_or_default()
+}
+
+/// `from:step:to` inclusive, or why not: non-finite ends, step ≤ 0, to < from,
+/// or more than [`MAX_AXIS_POINTS`] values. `name` is the argument reported.
+///
+/// # Errors
+/// [`IvtError::Input`] naming `name`.
+pub fn axis(name: &'static str, from: f64, step: f64, to: f64) -> Result<Vec<f64>, IvtError> {
+    let bad = |value, requirement| IvtError::Input {
+        name,
+        value,
+        requirement,
+    };
+    if !from.is_finite() {
+        return Err(bad(from, "finite (range start)"));
     }
-    let n = ((to - from) / step + 1e-9).floor() as usize;
-    (0..=n).map(|i| from + i as f64 * step).collect()
+    if !to.is_finite() || to < from {
+        return Err(bad(to, "finite and ≥ the range start (range end)"));
+    }
+    if !(step.is_finite() && step > 0.0) {
+        return Err(bad(step, "finite and > 0 (range step)"));
+    }
+    let steps = ((to - from) / step + 1e-9).floor();
+    if steps.is_nan() || steps >= MAX_AXIS_POINTS as f64 {
+        return Err(bad(
+            step,
+            "large enough for at most 10000 values (MAX_AXIS_POINTS; range step)",
+        ));
+    }
+    let n = steps as usize;
+    Ok((0..=n).map(|i| from + i as f64 * step).collect())
 }
 
 /// One grid point's result.

@@ -27,6 +27,12 @@ pub enum AftError {
         /// Half the number of samples, N.
         n_half: usize,
     },
+    /// More than [`crate::limits::MAX_SAMPLES`] samples (2N ≤ 2^22: 32 MiB per buffer).
+    #[error("AFT needs 2N ≤ 2^22 samples (got N = {n_half})")]
+    TooManySamples {
+        /// Half the number of samples, N.
+        n_half: usize,
+    },
 }
 
 /// Reusable forward/inverse real FFT plans and buffers for `2N` samples, `n` harmonics.
@@ -64,6 +70,9 @@ impl Aft {
     pub fn new(harmonics: usize, n_half: usize) -> Result<Self, AftError> {
         if n_half <= harmonics {
             return Err(AftError::TooFewSamples { harmonics, n_half });
+        }
+        if crate::limits::samples_error(n_half).is_some() {
+            return Err(AftError::TooManySamples { n_half });
         }
         let len = 2 * n_half;
         let mut planner = RealFftPlanner::<f64>::new();

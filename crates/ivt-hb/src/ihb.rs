@@ -134,6 +134,12 @@ pub(crate) fn validate<P: PeriodicProblem>(problem: &P, opts: &HbOptions) -> Res
             "sub-harmonic order p must be ≥ 1".into(),
         ));
     }
+    if let Some(why) = crate::limits::unknowns_error(n, opts.harmonics) {
+        return Err(HbError::InvalidInput(why));
+    }
+    if let Some(why) = crate::limits::samples_error(opts.n_half) {
+        return Err(HbError::InvalidInput(why));
+    }
     if opts.harmonics < opts.subharmonic {
         return Err(HbError::InvalidInput(format!(
             "n = {} harmonics cannot hold the excitation harmonic p = {}",
@@ -154,8 +160,11 @@ pub(crate) fn validate<P: PeriodicProblem>(problem: &P, opts: &HbOptions) -> Res
             )));
         }
     }
-    if opts.broyden.tol.is_nan() || opts.broyden.tol <= 0.0 {
-        return Err(HbError::InvalidInput("tolerance must be positive".into()));
+    if !(opts.broyden.tol.is_finite() && opts.broyden.tol > 0.0) {
+        return Err(HbError::InvalidInput(format!(
+            "tol must be finite and > 0, got {}",
+            opts.broyden.tol
+        )));
     }
     Ok(())
 }

@@ -11,6 +11,7 @@ pub mod floquet;
 pub mod frc;
 pub mod hill;
 pub mod ihb;
+pub mod limits;
 pub mod linalg;
 pub mod mathieu;
 pub mod modified;

@@ -5,7 +5,12 @@
 //! [`write_all`] writes them from a finished run; [`run_and_write`] (what
 //! `ivt sim` uses) writes the MCAP log on a second thread while the loop
 //! runs — on two cores it costs little more than the loop alone.
+//!
+//! Every file is written under a temporary name and the set is renamed into
+//! place only when all of it is complete ([`crate::atomic::Staged`]): a failed
+//! run, a failed plot or an interrupted run leaves the directory as it was.
 
+use crate::atomic::Staged;
 use crate::record::{Record, Sample, CHANNELS};
 use crate::run::{Channels, RunResult, SimError};
 use crate::scene::Scene;
@@ -78,10 +83,16 @@ struct McapLog {
 }
 
 impl McapLog {
-    /// Creates `path` with the channels of [`CHANNELS`] marked in `wanted`.
-    fn create(path: &Path, scene: &Scene, wanted: [bool; 4]) -> Result<Self, OutputError> {
+    /// Creates the log of `path` at the staged name `tmp`, with the channels
+    /// of [`CHANNELS`] marked in `wanted`.
+    fn create(
+        tmp: &Path,
+        path: &Path,
+        scene: &Scene,
+        wanted: [bool; 4],
+    ) -> Result<Self, OutputError> {
         let err = mcap_error(path);
-        let file = File::create(path).map_err(io(path))?;
+        let file = File::create(tmp).map_err(io(path))?;
         let mut w = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
             // level 1: ~3× faster than the default 3 on these JSON logs, files ~10 % larger
@@ -173,8 +184,21 @@ fn recorded(ch: &Channels) -> [Option<Vec<Sample>>; 4] {
 /// # Errors
 /// I/O or MCAP errors.
 pub fn write_mcap(path: &Path, result: &RunResult, scene: &Scene) -> Result<(), OutputError> {
+    let mut staged = Staged::new();
+    stage_mcap(&mut staged, path, result, scene)?;
+    staged.commit().map_err(io(path))?;
+    Ok(())
+}
+
+fn stage_mcap(
+    staged: &mut Staged,
+    path: &Path,
+    result: &RunResult,
+    scene: &Scene,
+) -> Result<(), OutputError> {
     let channels = recorded(&result.channels);
-    let mut log = McapLog::create(path, scene, channels.each_ref().map(Option::is_some))?;
+    let tmp = staged.path(path);
+    let mut log = McapLog::create(&tmp, path, scene, channels.each_ref().map(Option::is_some))?;
     for s in channels.iter().flatten().flatten() {
         log.write(s)?;
     }
@@ -186,11 +210,22 @@ pub fn write_mcap(path: &Path, result: &RunResult, scene: &Scene) -> Result<(), 
 /// # Errors
 /// I/O errors.
 pub fn write_csv(dir: &Path, stem: &str, ch: &Channels) -> Result<Vec<PathBuf>, OutputError> {
+    let mut staged = Staged::new();
+    stage_csv(&mut staged, dir, stem, ch)?;
+    staged.commit().map_err(io(dir))
+}
+
+fn stage_csv(
+    staged: &mut Staged,
+    dir: &Path,
+    stem: &str,
+    ch: &Channels,
+) -> Result<(), OutputError> {
     fn one<T: Record>(
+        staged: &mut Staged,
         dir: &Path,
         stem: &str,
         samples: &Option<Vec<T>>,
-        paths: &mut Vec<PathBuf>,
     ) -> Result<(), OutputError> {
         let Some(samples) = samples else {
             return Ok(());
@@ -202,16 +237,12 @@ pub fn write_csv(dir: &Path, stem: &str, ch: &Channels) -> Result<Vec<PathBuf>, 
         for s in samples {
             s.write_csv(&mut text);
         }
-        std::fs::write(&path, text).map_err(io(&path))?;
-        paths.push(path);
-        Ok(())
+        std::fs::write(staged.path(&path), text).map_err(io(&path))
     }
-    let mut paths = vec![];
-    one(dir, stem, &ch.plant, &mut paths)?;
-    one(dir, stem, &ch.control, &mut paths)?;
-    one(dir, stem, &ch.stepper, &mut paths)?;
-    one(dir, stem, &ch.sensors, &mut paths)?;
-    Ok(paths)
+    one(staged, dir, stem, &ch.plant)?;
+    one(staged, dir, stem, &ch.control)?;
+    one(staged, dir, stem, &ch.stepper)?;
+    one(staged, dir, stem, &ch.sensors)
 }
 
 /// Everything the scene asked for, under `dir`, from a finished run;
@@ -228,48 +259,69 @@ pub fn write_all(
     if !(o.mcap || o.csv || o.summary || !o.plots.is_empty()) {
         return Ok(vec![]);
     }
-    std::fs::create_dir_all(dir).map_err(io(dir))?;
-    let mut paths = vec![];
-    if o.mcap {
-        let p = mcap_path(dir, scene);
-        write_mcap(&p, result, scene)?;
-        paths.push(p);
-    }
-    paths.extend(write_rest(dir, scene, result)?);
+    let ((), paths) = in_dir(dir, |staged| -> Result<(), OutputError> {
+        if o.mcap {
+            stage_mcap(staged, &mcap_path(dir, scene), result, scene)?;
+        }
+        stage_rest(staged, dir, scene, result)
+    })?;
     Ok(paths)
+}
+
+/// Create `dir` if needed, stage files into it with `write`, and commit them
+/// all; on any failure the staged files are removed, and so is `dir` when
+/// this call created it (if it is still empty).
+fn in_dir<T, E, F>(dir: &Path, write: F) -> Result<(T, Vec<PathBuf>), E>
+where
+    E: From<OutputError>,
+    F: FnOnce(&mut Staged) -> Result<T, E>,
+{
+    let created = !dir.exists();
+    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    let mut staged = Staged::new();
+    let done = write(&mut staged).and_then(|value| {
+        let paths = staged.commit().map_err(io(dir))?;
+        Ok((value, paths))
+    });
+    if done.is_err() && created {
+        let _ = std::fs::remove_dir(dir);
+    }
+    done
 }
 
 fn mcap_path(dir: &Path, scene: &Scene) -> PathBuf {
     dir.join(format!("{}.mcap", scene.name))
 }
 
-/// The outputs other than the MCAP log: CSV, summary, plots.
-fn write_rest(dir: &Path, scene: &Scene, result: &RunResult) -> Result<Vec<PathBuf>, OutputError> {
+/// Stage the outputs other than the MCAP log: CSV, summary, plots.
+fn stage_rest(
+    staged: &mut Staged,
+    dir: &Path,
+    scene: &Scene,
+    result: &RunResult,
+) -> Result<(), OutputError> {
     let o = &scene.outputs;
-    let mut paths = vec![];
     if o.csv {
-        paths.extend(write_csv(dir, &scene.name, &result.channels)?);
+        stage_csv(staged, dir, &scene.name, &result.channels)?;
     }
     if o.summary {
         let p = dir.join(format!("{}_summary.json", scene.name));
         let text = serde_json::to_string_pretty(&result.summary).unwrap_or_default();
-        std::fs::write(&p, text + "\n").map_err(io(&p))?;
-        paths.push(p);
+        std::fs::write(staged.path(&p), text + "\n").map_err(io(&p))?;
     }
     if !o.plots.is_empty() {
         if let Some(series) = &result.channels.plot {
             let p = dir.join(format!("{}.png", scene.name));
             crate::plot::draw(
-                &p,
+                &staged.path(&p),
                 &scene.name,
                 &o.plots,
                 series,
                 result.summary.omega0_rad_s,
             )?;
-            paths.push(p);
         }
     }
-    Ok(paths)
+    Ok(())
 }
 
 /// A run or its outputs failed.
@@ -301,7 +353,7 @@ const IN_FLIGHT: usize = 32;
 /// counts from 0), the same channels and counts as [`write_all`].
 ///
 /// # Errors
-/// The run's error (then the partial log is removed), or an output error.
+/// The run's error or an output error; either way no file is left behind.
 pub fn run_and_write<F>(
     dir: &Path,
     scene: &Scene,
@@ -315,10 +367,26 @@ where
         let paths = write_all(dir, scene, &result)?;
         return Ok((result, paths));
     }
-    std::fs::create_dir_all(dir).map_err(io(dir))?;
-    let path = mcap_path(dir, scene);
+    in_dir(dir, |staged| -> Result<RunResult, RunWriteError> {
+        let result = stream_mcap(staged, &mcap_path(dir, scene), scene, run)?;
+        stage_rest(staged, dir, scene, &result)?;
+        Ok(result)
+    })
+}
+
+/// Run the loop while a writer thread streams its samples into the staged
+/// MCAP log at `path`.
+fn stream_mcap<F>(
+    staged: &mut Staged,
+    path: &Path,
+    scene: &Scene,
+    run: F,
+) -> Result<RunResult, RunWriteError>
+where
+    F: FnOnce(&mut dyn FnMut(Sample)) -> Result<RunResult, SimError>,
+{
     let wanted = CHANNELS.map(|name| scene.outputs.every(name).is_some());
-    let log = McapLog::create(&path, scene, wanted)?;
+    let log = McapLog::create(&staged.path(path), path, scene, wanted)?;
     let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<Sample>>(IN_FLIGHT);
     let writer = std::thread::Builder::new()
         .name("mcap-writer".into())
@@ -331,7 +399,7 @@ where
             }
             log.finish()
         })
-        .map_err(io(&path))?;
+        .map_err(io(path))?;
     let mut batch = Vec::with_capacity(BATCH);
     let ran = run(&mut |s| {
         batch.push(s);
@@ -347,19 +415,11 @@ where
     drop(tx);
     let written = writer.join().unwrap_or_else(|_| {
         Err(OutputError::Mcap {
-            path: path.clone(),
+            path: path.to_path_buf(),
             msg: "writer thread panicked".into(),
         })
     });
-    let result = match ran {
-        Ok(r) => r,
-        Err(e) => {
-            let _ = std::fs::remove_file(&path);
-            return Err(e.into());
-        }
-    };
+    let result = ran?;
     written?;
-    let mut paths = vec![path];
-    paths.extend(write_rest(dir, scene, &result)?);
-    Ok((result, paths))
+    Ok(result)
 }

@@ -76,7 +76,8 @@ pub enum RecordError {
 }
 
 /// Reads telemetry frames from `src` until `opts` says stop (frame count,
-/// end of stream, an I/O error of a closed pty, or idling) and writes them to
+/// end of stream, an I/O error of a closed pty, idling, or SIGINT/SIGTERM
+/// through [`crate::atomic::on_interrupt`]) and writes them to
 /// `out` as MCAP.
 ///
 /// # Errors
@@ -94,7 +95,11 @@ pub fn record<R: Read>(
         path: out.to_path_buf(),
         msg: e.to_string(),
     };
-    let file = File::create(out).map_err(|source| RecordError::Create {
+    // Written under a temporary name and renamed once the footer is on; a
+    // SIGINT/SIGTERM stops the reading like the end of the stream does.
+    let _listener = crate::atomic::listen();
+    let mut staged = crate::atomic::Staged::new();
+    let file = File::create(staged.path(out)).map_err(|source| RecordError::Create {
         path: out.to_path_buf(),
         source,
     })?;
@@ -126,6 +131,9 @@ pub fn record<R: Read>(
     let mut last_byte = Instant::now();
     let mut t_last = 0.0;
     'read: loop {
+        if crate::atomic::interrupted() {
+            break;
+        }
         if opts.max_frames.is_some_and(|m| frames >= m) {
             break;
         }
@@ -181,6 +189,11 @@ pub fn record<R: Read>(
         }
     }
     w.finish().map_err(mcap_err)?;
+    drop(w);
+    staged.commit().map_err(|source| RecordError::Create {
+        path: out.to_path_buf(),
+        source,
+    })?;
     Ok(RecordSummary {
         frames,
         bad_frames: bad,

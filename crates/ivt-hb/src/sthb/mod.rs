@@ -97,6 +97,18 @@ impl StringParams {
         if self.modes == 0 || self.harmonics == 0 {
             return bad("modes and harmonics must be at least 1".into());
         }
+        if let Some(why) = crate::limits::unknowns_error(self.modes, self.harmonics) {
+            return bad(why);
+        }
+        // The space–time grid holds ns·ms samples.
+        if self.ns.saturating_mul(self.ms) > crate::limits::MAX_SAMPLES {
+            return bad(format!(
+                "ns·ms = {}·{} exceeds the limit of {} space–time samples",
+                self.ns,
+                self.ms,
+                crate::limits::MAX_SAMPLES
+            ));
+        }
         if self.ns <= 2 * self.modes + 1 {
             return bad(format!(
                 "ns = {} must exceed 2·modes + 1 = {} (spatial products of the Jacobian)",
