@@ -26,14 +26,30 @@ pil() {
     cargo test --release --test rig_record -- --include-ignored)
 }
 
+# Checks are chained with && (not left to `set -e`): `test` calls them in a
+# `||` list, where errexit is off inside the function.
 panic_check() {
-  python3 panic_reach.py "$out/ivt-fw-bench" --root ivt_fw_pulse --must-reach ivt_fw_canary
-  python3 panic_reach.py "$out/ivt-fw-qemu" --root ivt_fw_pulse
-  python3 panic_reach.py "$out/ivt-fw-rig" --root ivt_fw_pulse --root TIM2 --root TIM3
+  python3 panic_reach.py "$out/ivt-fw-bench" --root ivt_fw_pulse --must-reach ivt_fw_canary &&
+    python3 panic_reach.py "$out/ivt-fw-qemu" --root ivt_fw_pulse &&
+    python3 panic_reach.py "$out/ivt-fw-rig" --root ivt_fw_pulse --root TIM2 --root TIM3
 }
 
 budgets() {
   python3 budgets.py "$out"
+}
+
+# Build, then every check even if an earlier one fails (a budget overrun must
+# not hide the PIL results); fail at the end, naming the failed checks.
+all_checks() {
+  build
+  local failed=()
+  panic_check || failed+=(panic)
+  budgets || failed+=(budgets)
+  pil || failed+=(pil)
+  if [ ${#failed[@]} -gt 0 ]; then
+    echo "firmware checks failed: ${failed[*]}" >&2
+    return 1
+  fi
 }
 
 case "${1:-test}" in
@@ -41,7 +57,7 @@ case "${1:-test}" in
   pil) pil ;;
   panic) panic_check ;;
   budgets) budgets ;;
-  test) build; panic_check; budgets; pil ;;
+  test) all_checks ;;
   run) exec qemu-system-arm -cpu cortex-m4 -machine mps2-an386 -display none -monitor none \
          -semihosting-config enable=on,target=native -serial stdio -serial null \
          -kernel "${2:-$out/ivt-fw-bench}" ;;

@@ -59,8 +59,15 @@ fn frc_and_mathieu_json_keys() {
     assert_eq!(code, 0);
     let betas = v["period_doubling_beta"].as_array().unwrap();
     assert_eq!(betas.len(), 3);
-    for (b, want) in betas.iter().zip([4.825, 5.194, 5.253]) {
-        assert!((b.as_f64().unwrap() - want).abs() <= 0.005);
+    // Thesis §3.2.5 to its printed digits: β2, β4 within half a unit, β1
+    // (4.82577) within one (crates/ivt-hb/tests/mathieu.rs).
+    for ((b, want), tol) in betas
+        .iter()
+        .zip([4.825, 5.194, 5.253])
+        .zip([1e-3, 5e-4, 5e-4])
+    {
+        let b = b.as_f64().unwrap();
+        assert!((b - want).abs() <= tol, "β = {b} vs thesis {want}");
     }
 }
 

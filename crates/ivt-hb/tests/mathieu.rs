@@ -14,10 +14,14 @@ fn cascade_matches_thesis_and_is_converged_in_n() {
             "period {} loses stability at β = {:.6} (μ = {:.10})",
             pd.period, pd.beta, pd.multiplier.re
         );
-        // The thesis prints three decimals from a 0.0005 / 0.0001 amplitude grid.
+        // The thesis prints three decimals (§3.2.5: the first grid point of
+        // the controlled amplitude, steps 0.0005 / 0.0001, past the
+        // bifurcation). β2 and β4 round to the printed digits (half a unit,
+        // 5e-4); β1 = 4.82577 is one unit off (4.826), within 1e-3.
+        let tol = if pd.period == 1 { 1e-3 } else { 5e-4 };
         assert!(
-            (pd.beta - want).abs() <= 0.005,
-            "β = {} vs thesis {want}",
+            (pd.beta - want).abs() <= tol,
+            "β = {} vs thesis {want} (±{tol})",
             pd.beta
         );
         assert!((pd.multiplier.re + 1.0).abs() < 1e-6);
@@ -53,8 +57,12 @@ fn period1_defect(beta: f64, x0: f64, v0: f64) -> f64 {
 
 /// Independent check of β1 by time integration: just below β1 the attractor
 /// reached from the period-1 orbit is period 1, just above it is period 2.
+/// The bracket β1 ± 5e-4 is half the thesis's printed unit either side, so
+/// the RK run alone places β1 to the accuracy the thesis prints (measured
+/// defects: 2.6e-5 below, 8.0e-2 above).
 #[test]
 fn rk_confirms_first_period_doubling() {
+    const BRACKET: f64 = 5e-4;
     let pds = period_doubling_cascade(&CascadeOptions {
         doublings: 1,
         ..CascadeOptions::default()
@@ -64,11 +72,11 @@ fn rk_confirms_first_period_doubling() {
     let sol = &pds[0].solution;
     let x0 = ivt_hb::aft::eval_series(sol.dof(0), 0.0, 0);
     let v0 = 2.0 * ivt_hb::aft::eval_series(sol.dof(0), 0.0, 1);
-    let below = period1_defect(b1 - 0.02, x0, v0);
-    let above = period1_defect(b1 + 0.02, x0 + 1e-3, v0);
-    eprintln!("RK: period-1 defect at β1 − 0.02: {below:.2e}; at β1 + 0.02: {above:.2e}");
+    let below = period1_defect(b1 - BRACKET, x0, v0);
+    let above = period1_defect(b1 + BRACKET, x0 + 1e-3, v0);
+    eprintln!("RK: period-1 defect at β1 − {BRACKET}: {below:.2e}; at β1 + {BRACKET}: {above:.2e}");
     // Near β1 the critical multiplier is close to −1, so the approach is slow; the
-    // two regimes still differ by more than four orders of magnitude.
+    // two regimes still differ by more than three orders of magnitude.
     assert!(below < 1e-4, "{below:e}");
     assert!(above > 1e-2, "{above:e}");
 }

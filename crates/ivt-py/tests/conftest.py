@@ -5,7 +5,7 @@ import json
 import os
 import pathlib
 import subprocess
-from typing import Any, Callable, Dict
+from typing import Any, Callable, Dict, List
 
 import pytest
 
@@ -36,3 +36,33 @@ def cli() -> Callable[..., Dict[str, Any]]:
         return obj
 
     return run
+
+
+# No silent skips: scripts/py-test runs pytest with `-rs --fail-on-skip`, so a
+# skipped test is listed with its reason and fails the run.
+_SKIPPED: List[str] = []
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    parser.addoption(
+        "--fail-on-skip",
+        action="store_true",
+        help="fail the session if any test is skipped (CI: every test must run)",
+    )
+
+
+def pytest_runtest_logreport(report: pytest.TestReport) -> None:
+    if report.skipped and not hasattr(report, "wasxfail"):
+        _SKIPPED.append(report.nodeid)
+
+
+def pytest_terminal_summary(terminalreporter: Any) -> None:
+    if _SKIPPED and terminalreporter.config.getoption("--fail-on-skip"):
+        terminalreporter.write_line(
+            f"--fail-on-skip: {len(_SKIPPED)} skipped test(s): {', '.join(_SKIPPED)}", red=True
+        )
+
+
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    if _SKIPPED and session.config.getoption("--fail-on-skip") and exitstatus == 0:
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED

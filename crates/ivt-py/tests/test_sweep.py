@@ -34,7 +34,7 @@ def test_grid_sweep_matches_single_runs() -> None:
 
 
 def test_dask_local_cluster_equals_local_run() -> None:
-    distributed = pytest.importorskip("distributed")
+    import distributed  # installed by scripts/py-test (dask[distributed]); no silent skip
     d = short_scene(2.0)
     spread = {"plant.k_t": 0.2, "plant.r_a": 0.2, "plant.j_u": 0.2}
     local = ivt.sweep.sweep(d, spread=spread, n=4, seed=11, max_workers=2)
