@@ -60,16 +60,17 @@ def timed(fn, budget=0.5, max_runs=5):
 def one_term_guess(omega, branch):
     """Closed-form one-harmonic HB: x = a cos ωt + b sin ωt with amplitude A from
     [(α − ω² + ¾εA²)² + (2ξω)²] A² = F²; branch 'lower' / 'upper' picks the
-    smallest / largest real root. The common starting guess of every method."""
+    smallest / largest real root. The common starting guess of every method.
+    Returns (a, b, number of branches at this ω)."""
     c = 2 * XI * omega
     d = ALPHA - omega * omega
     # cubic in s = A²: (9/16)ε² s³ + (3/2)ε d s² + (d² + c²) s − F² = 0
     roots = np.roots([9 / 16 * EPS**2, 1.5 * EPS * d, d * d + c * c, -FORCE**2])
-    s = sorted(r.real for r in roots if abs(r.imag) < 1e-12 and r.real > 0)
-    s = s[0] if branch == "lower" else s[-1]
+    roots_pos = sorted(r.real for r in roots if abs(r.imag) < 1e-12 and r.real > 0)
+    s = roots_pos[0] if branch == "lower" else roots_pos[-1]
     kappa = d + 0.75 * EPS * s
     den = kappa * kappa + c * c
-    return FORCE * kappa / den, FORCE * c / den
+    return FORCE * kappa / den, FORCE * c / den, len(roots_pos)
 
 
 def duffing_rhs(t, z, omega):
@@ -121,13 +122,13 @@ def orbit_on_grid(omega, z0, rtol, segments=GRID):
 
 def reference(omega, branch):
     """Shooting reference on GRID points and its estimated error (rtol 1e-13 vs 1e-12)."""
-    a1, b1 = one_term_guess(omega, branch)
+    a1, b1, n_branches = one_term_guess(omega, branch)
     z_guess = [a1, omega * b1]
     z13 = shoot(omega, z_guess, 1e-13)
     z12 = shoot(omega, z_guess, 1e-12)
     x13 = orbit_on_grid(omega, z13, 1e-13)
     x12 = orbit_on_grid(omega, z12, 1e-12)
-    return dict(omega=omega, branch=branch, z0=z13.tolist(), x=x13, guess=(a1, b1),
+    return dict(omega=omega, branch=branch if n_branches > 1 else "only", z0=z13.tolist(), x=x13, guess=(a1, b1),
                 amplitude=float(np.max(np.abs(x13))), self_error=float(np.max(np.abs(x13 - x12))))
 
 
@@ -198,7 +199,8 @@ def ivt_rows(ref, ns, tols, method):
             except ivt.hb.ConvergenceError as e:
                 print(f"ivt {method} n={n} tol={tol:.0e}: {e}", file=sys.stderr)
                 continue
-            rows.append(dict(method=f"ivt {method} IHB", n=n, tol=tol, time=t, err=series_error(ref, out["coeffs"])))
+            rows.append(dict(method=f"ivt {method} IHB", n=n, tol=tol, time=t, err=series_error(ref, out["coeffs"]),
+                             iterations=out["iterations"]))
     return rows
 
 
@@ -331,6 +333,11 @@ def pyharm_curve(m, c, k, cubic, n, omega_from, omega_to, ds_max):
 # FRC comparisons
 
 
+def fold_omegas(folds):
+    """ω of each fold: plain floats (duffing_frc) or dicts with "omega" (SPEC §6 frc)."""
+    return [float(f["omega"]) if isinstance(f, dict) else float(f) for f in folds]
+
+
 def duffing_frc_rows(n, ds_max):
     """Thesis Duffing 0.2–3.0: ivt.hb.duffing_frc (its own step control, Hsu
     stability at every point) against pyHarm's continuation (no stability)."""
@@ -338,7 +345,7 @@ def duffing_frc_rows(n, ds_max):
                                                   alpha=ALPHA, eps=EPS, force=FORCE), budget=1.0)
     ph = pyharm_curve(1.0, 2 * XI, ALPHA, EPS, n, 0.2, 3.0, ds_max)
     return dict(problem="Duffing FRC 0.2–3.0", n=n, samples=hb_samples(n),
-                ivt=dict(time=t_ivt, points=len(out["points"]), folds=[f["omega"] for f in out["folds"]],
+                ivt=dict(time=t_ivt, points=len(out["points"]), folds=fold_omegas(out["folds"]),
                          peak=max(p["amplitude"] for p in out["points"]), stability=True),
                 pyharm=dict(time=ph["time"], points=ph["points"], folds=ph["folds"], peak=ph["peak"],
                             ds_max=ds_max, stability=False))
@@ -363,6 +370,13 @@ def chain_f(theta):
     return [FORCE * math.cos(theta), 0.0]
 
 
+def chain_diff(coeffs, x, n):
+    """Max coefficient difference between an ivt orbit (DOF-major [a0, a.., b..]
+    per DOF) and a pyHarm one."""
+    q = np.asarray(coeffs).reshape(2, 2 * n + 1)
+    return max(float(np.max(np.abs(q[d] - pyharm_to_ivt(x, n, 2, d)))) for d in range(2))
+
+
 def chain_rows(n, ds_max, omega_from, omega_to):
     """2-DOF cubic chain. With ivt.hb.frc: whole curves side by side. Without it:
     ivt.hb.solve (Python per-sample g) at every ω of pyHarm's path, in path order,
@@ -375,10 +389,10 @@ def chain_rows(n, ds_max, omega_from, omega_to):
         out, t = timed(lambda: ivt.hb.frc(CHAIN_M, CHAIN_C, CHAIN_K, chain_g_vec, chain_f, omega_from, omega_to,
                                           n=n, samples=hb_samples(n), vectorized=True), budget=1.0)
         row["ivt"] = dict(mode="ivt.hb.frc, vectorized g", time=t, points=len(out["points"]),
-                          folds=[f["omega"] for f in out["folds"]],
+                          folds=fold_omegas(out["folds"]),
                           peak=max(p["amplitude"] for p in out["points"]), stability=True)
         return row
-    guess, diffs, t_total, solved = None, [], 0.0, 0
+    guess, diffs, t_total, solved, other_branch = None, [], 0.0, 0, []
     for omega, x in zip(ph["omegas"], ph["xs"]):
         t0 = time.perf_counter()
         try:
@@ -391,12 +405,24 @@ def chain_rows(n, ds_max, omega_from, omega_to):
         t_total += time.perf_counter() - t0
         solved += 1
         guess = sol["coeffs"]
-        q = np.asarray(sol["coeffs"]).reshape(2, 2 * n + 1)  # per DOF [a0, a.., b..]
-        diffs.append(max(float(np.max(np.abs(q[d] - pyharm_to_ivt(x, n, 2, d)))) for d in range(2)))
+        diffs.append(chain_diff(sol["coeffs"], x, n))
+        if diffs[-1] >= 1e-6:
+            other_branch.append((float(omega), x))
+    # Where the warm-started sweep landed elsewhere, is pyHarm's orbit an ivt orbit too?
+    # Untimed: solve again from pyHarm's orbit and compare.
+    same_when_seeded = 0
+    for omega, x in other_branch:
+        seed = np.concatenate([pyharm_to_ivt(x, n, 2, d) for d in range(2)])
+        try:
+            sol = ivt.hb.solve(CHAIN_M, CHAIN_C, CHAIN_K, chain_g, omega, f=chain_f, n=n, samples=hb_samples(n),
+                               guess=seed, stability=False, velocity_dependent=False)
+        except ivt.hb.ConvergenceError:
+            continue
+        same_when_seeded += chain_diff(sol["coeffs"], x, n) < 1e-6
     row["ivt"] = dict(mode="ivt.hb.solve per ω (no ivt.hb.frc on this build), Python per-sample g", time=t_total,
                       points=solved, folds=[], peak=None, stability=False,
                       max_coeff_diff_vs_pyharm=max(diffs) if diffs else None,
-                      agree_1e6=sum(d < 1e-6 for d in diffs))
+                      agree_1e6=sum(d < 1e-6 for d in diffs), agree_when_seeded=int(same_when_seeded))
     return row
 
 
@@ -463,7 +489,9 @@ def print_report(refs, rows, frcs, pyharm_error):
             if row["ivt"].get("max_coeff_diff_vs_pyharm") is not None:
                 print(f"ivt orbits agreeing with pyHarm's to 1e-6: {row['ivt']['agree_1e6']} of "
                       f"{row['pyharm']['points']} (max coefficient difference "
-                      f"{row['ivt']['max_coeff_diff_vs_pyharm']:.1e})")
+                      f"{row['ivt']['max_coeff_diff_vs_pyharm']:.1e}); of the others, "
+                      f"{row['ivt']['agree_when_seeded']} are ivt orbits too when ivt starts from pyHarm's "
+                      "(another branch of the same ω, reached by the warm-started sweep past a fold)")
 
 
 def plot(refs, rows, png):
