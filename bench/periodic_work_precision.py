@@ -2,12 +2,14 @@
 
 Run by hand (not in CI), through bench/periodic_work_precision.sh, or directly:
     python bench/periodic_work_precision.py [--quick] [--json OUT] [--png OUT]
-``--quick`` (a few seconds) checks that every solver family runs, with one ω and
-a few n; the full run writes the figure and the raw numbers.
+``--quick`` (≈ 15 s, most of it importing pyHarm's jax and numba) checks that
+every solver family runs, with one ω and a few n and no FRC; the full run (a few
+minutes) adds the FRCs and writes the figure and the raw numbers.
 
 Problems (SPEC §6):
 - the thesis Duffing, Eq. 49: x'' + 2ξx' + αx + εx³ = F cos ωt, ξ = 0.02, α = ε = 1,
-  F = 0.1, at a few ω (lower branch and upper branch near the upper fold 1.6548);
+  F = 0.1, at a few ω (lower branch and upper branch near the upper fold 1.6548)
+  and its FRC over ω = 0.2–3.0;
 - the 2-DOF cubic chain M = I, K = [[2, -1], [-1, 2]], C = 0.02 I, g = [0.5 x1³, 0],
   f = [0.1 cos ωt, 0].
 
@@ -16,9 +18,10 @@ initial state with the variational equations; the orbit is sampled on a grid of
 one period by integrating segment by segment (no dense-output interpolation),
 and its own error is estimated against the same at rtol = 1e-12.
 
-Error of a method = max over the grid of |x(t) − x_ref(t)| (first DOF); run
-time = best of a few repeats (min of wall time), setup included (each call
-builds its own solver, as a user's call would).
+Error of a method = max over the grid of |x(t) − x_ref(t)|; run time = best of
+a few repeats (min of wall time). ivt and the scipy HB build their solver in
+every call, as a user's call would; pyHarm's system build (Maestro) is excluded
+and its numba kernels are compiled before any timing.
 """
 
 import argparse
