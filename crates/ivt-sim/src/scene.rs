@@ -6,7 +6,7 @@
 
 use crate::backend::SUPPORTED_PPR;
 use ivt_ctrl::OpenLoopPreset;
-use ivt_kin::plant::{GravityModel, PlantParams};
+use ivt_kin::plant::{GravityModel, PlantParams, PlantPreset};
 use serde::Deserialize;
 
 /// A scene error: one line, naming the key and (when known) the line.
@@ -559,16 +559,15 @@ impl Scene {
     /// An unknown preset/gravity or an invalid parameter.
     pub fn plant_params(&self) -> Result<PlantParams, (&'static str, String)> {
         let p = &self.plant;
-        match p.preset.as_deref() {
-            None | Some("printed") => {}
-            Some(other) => {
-                return Err((
+        let mut params = match p.preset.as_deref() {
+            None => PlantParams::printed(),
+            Some(name) => PlantPreset::from_name(name)
+                .map(PlantPreset::params)
+                .ok_or((
                     "plant.preset",
-                    format!("must be \"printed\", got \"{other}\""),
-                ))
-            }
-        }
-        let mut params = PlantParams::printed();
+                    format!("must be \"printed\" or \"thesis-ch4\", got \"{name}\""),
+                ))?,
+        };
         params.gravity = match p.gravity.as_deref() {
             None | Some("printed") => GravityModel::Printed,
             Some("roller_mass") => GravityModel::RollerMass,
