@@ -151,3 +151,46 @@ fn every_plant_command_echoes_the_plant() {
         .expect("run ivt");
     assert_eq!(bad.status.code(), Some(2));
 }
+
+/// Fig. 42's example point (7 V, 2 N·m) on thesis-ch4: with the gains read as
+/// mm·rad⁻¹ (k_SI = 1e-3 k) the Floquet multipliers are 0.787 (k = 0.01,
+/// k2 = 0.02; printed 0.7776) and 0.604 (k = 0.06, k2 = 0.12; printed 0.4871),
+/// each confirmed by simulating the delay loop (contraction per revolution)
+/// to 1e-3; read as SI the loop is unstable (3.5 and 22), unlike the thesis.
+#[test]
+fn fig42_multipliers_on_thesis_ch4_confirmed_by_simulation() {
+    use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
+    use ivt_design::delay_sim::{simulate_contraction, DelaySimOptions};
+    let plant = PlantPreset::ThesisCh4.params();
+    let op = OperatingPoint::at_100_rpm(7.0, 2.0);
+    for (k, k2, want) in [(0.01, 0.02, 0.7866), (0.06, 0.12, 0.6044)] {
+        let g = FeedbackGains::from_thesis_mm_per_rad(k, k2);
+        let s = delay_stability(&plant, &op, g, &DelayOptions::default()).unwrap();
+        assert!(
+            (s.max_abs_multiplier - want).abs() < 1e-3,
+            "{k}: {}",
+            s.max_abs_multiplier
+        );
+        let c =
+            simulate_contraction(&plant, &op, g, &s.orbit, &DelaySimOptions::default()).unwrap();
+        let rel = (c.measured - s.max_abs_multiplier).abs() / s.max_abs_multiplier;
+        assert!(
+            rel < 1e-3,
+            "{k}: predicted {} simulated {}",
+            s.max_abs_multiplier,
+            c.measured
+        );
+        let si = delay_stability(
+            &plant,
+            &op,
+            FeedbackGains { k, k2 },
+            &DelayOptions::default(),
+        )
+        .unwrap();
+        assert!(
+            si.max_abs_multiplier > 3.0,
+            "{k}: SI {}",
+            si.max_abs_multiplier
+        );
+    }
+}

@@ -1,7 +1,7 @@
 //! §3.2: Duffing (Fig. 28 against RK4, Fig. 29 FRC, the IHB timings of
 //! §3.2.3) and Mathieu–Duffing (A0 and β1/β2/β4 of §3.2.5, Figs. 30–33).
 
-use super::{fmt_sig, Context, ReproError, Verdict};
+use super::{fmt_sig, Cause, Context, ReproError, Verdict};
 use ivt_hb::aft::eval_series;
 use ivt_hb::mathieu::THESIS_A0;
 use ivt_hb::ode::{first_order, rk4};
@@ -72,10 +72,10 @@ fn duffing(ctx: &mut Context) -> Result<(), ReproError> {
                 format!("{thesis} s (§3.2.3, Duffing n = 20, N = 64)"),
                 format!("{} s", fmt_sig(t, 3)),
                 format!("×{:.3}", t / thesis),
-                Verdict::Differs,
+                Verdict::NotComputable,
                 format!(
-                    "wall-clock times are not portable (the thesis's machine and language are not stated; ours: Rust \
-                     release build, median of {reps} solves on a shared, loaded 2-core machine). The thesis's claim is \
+                    "a wall-clock time is not comparable: the thesis's machine and language are not stated (ours, \
+                     measured, not asserted: Rust release build, median of {reps} solves). The thesis's claim is \
                      the ratio classic/modified ≈ 83; ours is {ratio}"
                 ),
             ),
@@ -292,9 +292,12 @@ fn mathieu(ctx: &mut Context) -> Result<(), ReproError> {
                         "continuation in β with Hsu multipliers, secant on μ = −1 (μ = {:.8}), n = 12·period",
                         pd.multiplier.re
                     ),
-                    "the thesis located β by stepping the controlled amplitude on a 0.0005/0.0001 grid, which resolves \
-                     β only to a few 1e-3; ours is the converged crossing (unchanged to 1e-6 from n = 12 to 20, \
-                     ivt-hb tests/mathieu.rs) and agrees with RK4 time integration on either side of β1",
+                    Some(Cause {
+                        why: "the thesis located β by stepping the controlled amplitude on a 0.0005/0.0001 grid, \
+                              which resolves β only to a few 1e-3; ours is the converged crossing (unchanged to 1e-6 \
+                              from n = 12 to 20) and agrees with RK4 time integration on either side of β1",
+                        test: "crates/ivt-hb/tests/mathieu.rs::cascade_matches_thesis_and_is_converged_in_n",
+                    }),
                 );
             }
             pds.iter().map(|p| p.beta).collect()
