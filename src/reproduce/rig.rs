@@ -265,12 +265,12 @@ mod tests {
 
     /// The RMS ripple of the printed Eq. 42 gears is 1.22 %, twice the 0.61 %
     /// of the exact Fourier truncation; the exact Eq. 38 pair has none. The
-    /// midpoint rule has converged (20 000 vs 40 000 points agree to 1e-9).
+    /// midpoint rule has converged (20 000 vs 40 000 points agree to 1e-7).
     #[test]
     fn ripple_of_printed_gears_is_twice_the_fourier_one() {
         let p = ripple_rms(&SmoothNcg::PRINTED, 20_000);
         let f = ripple_rms(&SmoothNcg::fourier(), 20_000);
-        assert!((p - ripple_rms(&SmoothNcg::PRINTED, 40_000)).abs() < 1e-9);
+        assert!((p - ripple_rms(&SmoothNcg::PRINTED, 40_000)).abs() < 1e-7);
         assert!((p - 0.012185).abs() < 5e-6, "{p}");
         assert!((f - 0.006131).abs() < 5e-6, "{f}");
         assert!((p / f - 2.0).abs() < 0.02, "{}", p / f);
