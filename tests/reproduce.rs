@@ -1,8 +1,299 @@
-//! `ivt reproduce --quick --json` end to end: every listed figure and table
-//! row is produced, every verdict is one of the three words, every
-//! "differs" carries a cause, and every drawn figure has its PNG and CSV.
+//! `ivt reproduce --quick --json` end to end, every row pinned: its verdict,
+//! a window for our value, and for each "differs" the test that demonstrates
+//! the cause (which must exist). A row that is not listed here, a listed row
+//! that is missing, or a "not computable" row that is not declared fails.
+//! Every listed figure is drawn (PNG + CSV) or says why not.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const R: &str = "reproduced";
+const D: &str = "differs";
+const NC: &str = "not computable";
+
+/// One pinned row: section, quantity prefix, verdict, window [lo, hi] on the
+/// first number of `ours` (None where `ours` is not a single number), and the
+/// demonstrating test of a "differs" (`file::fn`).
+struct Pin(
+    &'static str,
+    &'static str,
+    &'static str,
+    Option<(f64, f64)>,
+    Option<&'static str>,
+);
+
+const NCG: &str = "crates/ivt-kin/src/ncg.rs::fourier_fit_of_eq38";
+const BAND: &str = "crates/ivt-design/tests/ivt_design.rs::verdicts_follow_the_band";
+const BETA: &str = "crates/ivt-hb/tests/mathieu.rs::cascade_matches_thesis_and_is_converged_in_n";
+const AUDIT: &str = "tests/ch4_plant.rs::thesis_ch4_r_bar_matches_the_audit_values";
+const DIGITS: &str = "src/reproduce/design.rs::printed_digits_limit_eq158";
+const FIG42: &str = "tests/ch4_plant.rs::fig42_multipliers_on_thesis_ch4_confirmed_by_simulation";
+
+/// Reproduced rows carry the thesis value ± half a printed unit (the
+/// reproduce criterion itself); "differs" rows a window around ours that
+/// excludes the printed value.
+const PINS: &[Pin] = &[
+    Pin("kinematics", "J_a", R, Some((0.02365, 0.02375)), None),
+    Pin("kinematics", "J_b", R, Some((2.12635, 2.12645)), None),
+    Pin("kinematics", "J_c", R, Some((0.33875, 0.33885)), None),
+    Pin("kinematics", "F_m", R, Some((2.3745, 2.3755)), None),
+    Pin("kinematics", "f1", R, Some((3.16665, 3.16675)), None),
+    Pin("kinematics", "f2", R, Some((40.55475, 40.55485)), None),
+    Pin(
+        "kinematics",
+        "Eq. 42 a1",
+        D,
+        Some((0.13333, 0.13334)),
+        Some(NCG),
+    ),
+    Pin(
+        "kinematics",
+        "Eq. 42 a2",
+        D,
+        Some((-0.031747, -0.031745)),
+        Some(NCG),
+    ),
+    Pin(
+        "kinematics",
+        "Eq. 42 a3",
+        D,
+        Some((0.013985, 0.013987)),
+        Some(NCG),
+    ),
+    Pin(
+        "kinematics",
+        "Eq. 42 a4",
+        D,
+        Some((-0.0078432, -0.007843)),
+        Some(NCG),
+    ),
+    Pin(
+        "kinematics",
+        "R_avg slope",
+        R,
+        Some((2.5461e-4, 2.5463e-4)),
+        None,
+    ),
+    // Wall-clock times: the thesis's machine is unknown (declared).
+    Pin("hb", "IHB time, classic", NC, None, None),
+    Pin("hb", "IHB time, modified", NC, None, None),
+    Pin(
+        "hb",
+        "A0",
+        D,
+        None,
+        Some("src/reproduce/hb.rs::a0_differs_in_a8_sign_and_b3"),
+    ),
+    Pin("hb", "β1", D, Some((4.8255, 4.8260)), Some(BETA)),
+    Pin("hb", "β2", R, Some((5.1935, 5.1945)), None),
+    Pin("hb", "β4", R, Some((5.2525, 5.2535)), None),
+    // Chapter 4 on the printed plant: the SPEC §5 band.
+    Pin(
+        "design/printed",
+        "r̄ at (6 V",
+        D,
+        Some((-0.0245, -0.0242)),
+        Some(BAND),
+    ),
+    Pin(
+        "design/printed",
+        "r̄ at (7 V",
+        D,
+        Some((-0.0342, -0.0339)),
+        Some(BAND),
+    ),
+    Pin(
+        "design/printed",
+        "r̄ at (8 V",
+        D,
+        Some((0.00126, 0.00129)),
+        Some(BAND),
+    ),
+    Pin("design/printed", "Eq. 158", D, None, Some(BAND)),
+    Pin(
+        "design/printed",
+        "Eq. 159",
+        D,
+        Some((0.153, 0.155)),
+        Some(BAND),
+    ),
+    Pin(
+        "design/printed",
+        "Γ̂ = 0",
+        D,
+        None,
+        Some("src/reproduce/design.rs::gamma_hat_crosses_only_on_thesis_ch4"),
+    ),
+    Pin(
+        "design/printed",
+        "Fig. 42 multiplier (k = 0.01, k2 = 0.02), mm",
+        D,
+        Some((0.997, 0.999)),
+        Some(BAND),
+    ),
+    Pin(
+        "design/printed",
+        "Fig. 42 multiplier (k = 0.01, k2 = 0.02), printed",
+        D,
+        Some((0.72, 0.74)),
+        Some(BAND),
+    ),
+    Pin(
+        "design/printed",
+        "Fig. 42 multiplier (k = 0.06, k2 = 0.12), mm",
+        D,
+        Some((0.985, 0.99)),
+        Some(BAND),
+    ),
+    Pin(
+        "design/printed",
+        "Fig. 42 multiplier (k = 0.06, k2 = 0.12), printed",
+        D,
+        Some((1.01, 1.03)),
+        Some(BAND),
+    ),
+    // Chapter 4 on thesis-ch4 (k_t, k_e ÷ 10).
+    Pin(
+        "design/thesis-ch4",
+        "r̄ at (6 V",
+        D,
+        Some((0.006775, 0.00678)),
+        Some(AUDIT),
+    ),
+    Pin(
+        "design/thesis-ch4",
+        "r̄ at (7 V",
+        R,
+        Some((0.02415, 0.02425)),
+        None,
+    ),
+    Pin(
+        "design/thesis-ch4",
+        "r̄ at (8 V",
+        D,
+        Some((0.007033, 0.007037)),
+        Some(DIGITS),
+    ),
+    Pin("design/thesis-ch4", "Eq. 158", D, None, Some(DIGITS)),
+    Pin(
+        "design/thesis-ch4",
+        "Eq. 159",
+        D,
+        Some((1.53, 1.545)),
+        Some("src/reproduce/design.rs::eq159_is_the_thesis_ch4_boundary_to_the_grid_step"),
+    ),
+    Pin("design/thesis-ch4", "Γ̂ = 0", R, None, None),
+    Pin(
+        "design/thesis-ch4",
+        "Fig. 42 multiplier (k = 0.01, k2 = 0.02), mm",
+        D,
+        Some((0.7856, 0.7876)),
+        Some(FIG42),
+    ),
+    Pin(
+        "design/thesis-ch4",
+        "Fig. 42 multiplier (k = 0.01, k2 = 0.02), printed",
+        D,
+        Some((3.0, 4.0)),
+        Some(FIG42),
+    ),
+    Pin(
+        "design/thesis-ch4",
+        "Fig. 42 multiplier (k = 0.06, k2 = 0.12), mm",
+        D,
+        Some((0.6034, 0.6054)),
+        Some(FIG42),
+    ),
+    Pin(
+        "design/thesis-ch4",
+        "Fig. 42 multiplier (k = 0.06, k2 = 0.12), printed",
+        D,
+        Some((20.0, 25.0)),
+        Some(FIG42),
+    ),
+    // Findings on the printed text.
+    Pin(
+        "design",
+        "inf f",
+        D,
+        Some((0.785397, 0.785399)),
+        Some("src/reproduce/ch4_findings.rs::inf_f_is_pi_over_4"),
+    ),
+    Pin(
+        "design",
+        "f_B(7 V, 2 N·m)",
+        D,
+        Some((3.205, 3.215)),
+        Some("src/reproduce/ch4_findings.rs::seven_volts_two_nm_is_over_drive"),
+    ),
+    Pin(
+        "design",
+        "Eq. 158 r_f at (6 V",
+        D,
+        Some((0.007437, 0.007439)),
+        Some(DIGITS),
+    ),
+    // The printed controller on thesis-ch4 (scenes/ch4_*.toml).
+    Pin(
+        "closed_loop/thesis-ch4",
+        "static error of ω_a after V_m 8 → 7 V",
+        R,
+        Some((-0.01, 0.01)),
+        None,
+    ),
+    Pin(
+        "closed_loop/thesis-ch4",
+        "static error of ω_a with the printed u_ol alone at V_m = 7 V",
+        R,
+        Some((0.5, 1.5)),
+        None,
+    ),
+    Pin(
+        "closed_loop/thesis-ch4",
+        "static error of ω_a with the printed u_ol alone at V_m = 8 V",
+        D,
+        Some((0.3, 1.0)),
+        Some(AUDIT),
+    ),
+    Pin(
+        "closed_loop/thesis-ch4",
+        "RMS dr/dt",
+        R,
+        Some((100.0, 2000.0)),
+        None,
+    ),
+    // §4.4, the rig.
+    Pin(
+        "rig",
+        "speed-ratio ripple",
+        D,
+        Some((1.2175, 1.2195)),
+        Some("src/reproduce/rig.rs::ripple_of_printed_gears_is_twice_the_fourier_one"),
+    ),
+    Pin(
+        "rig",
+        "sampling interval",
+        D,
+        Some((4.5, 4.5)),
+        Some("src/reproduce/rig.rs::sampling_interval_is_4_5_degrees"),
+    ),
+    Pin("rig", "K = 1/(K₂T_out)", R, Some((77.5, 78.5)), None),
+    Pin("rig", "stability bound on K", R, Some((155.5, 156.5)), None),
+    Pin(
+        "rig",
+        "error contraction per sample",
+        R,
+        Some((0.355, 0.365)),
+        None,
+    ),
+    Pin(
+        "rig",
+        "Eq. 192",
+        D,
+        None,
+        Some("src/reproduce/rig.rs::eq192_needs_exponent_k_plus_1"),
+    ),
+];
 
 /// Figures `ivt reproduce` always lists (drawn, or with the reason they are not).
 const FIGURES: &[&str] = &[
@@ -27,43 +318,46 @@ const FIGURES: &[&str] = &[
     "Fig. 39",
     "Fig. 40",
     "Fig. 42",
+    "Fig. 38(a) (thesis-ch4)",
+    "Fig. 38(b) (thesis-ch4)",
+    "Fig. 39 (thesis-ch4)",
+    "Fig. 40 (thesis-ch4)",
+    "Fig. 42 (thesis-ch4)",
     "Fig. 43",
     "Fig. 44",
     "Fig. 45",
+    "Fig. 43 (thesis-ch4)",
+    "Fig. 44 (thesis-ch4)",
+    "Fig. 45 (thesis-ch4)",
     "Fig. 51",
+    "Fig. 51 (Eq. 187)",
     "Fig. 47",
     "Fig. 48",
 ];
 
-/// Quantities (prefixes of a row's `quantity`) the report always contains.
-const ROWS: &[&str] = &[
-    "J_a",
-    "J_b",
-    "J_c",
-    "F_m",
-    "f1",
-    "f2",
-    "Eq. 42 a1",
-    "Eq. 42 a2",
-    "Eq. 42 a3",
-    "Eq. 42 a4",
-    "R_avg slope",
-    "A0",
-    "β1",
-    "β2",
-    "β4",
-    "IHB time, classic",
-    "IHB time, modified",
-    "r̄ at (6 V, 6 N·m)",
-    "Eq. 158",
-    "Eq. 159",
-    "Fig. 42 multiplier (k = 0.01, k2 = 0.02)",
-    "Fig. 42 multiplier (k = 0.06, k2 = 0.12)",
-];
-use std::process::Command;
+/// The first number in `s` (optionally signed, decimal or exponent form).
+fn first_number(s: &str) -> Option<f64> {
+    let start = s.find(|c: char| c.is_ascii_digit() || c == '-' || c == '+')?;
+    let tail = &s[start..];
+    let end = tail
+        .char_indices()
+        .skip(1)
+        .find(|&(_, c)| !(c.is_ascii_digit() || c == '.' || c == 'e' || c == '-' || c == '+'))
+        .map_or(tail.len(), |(i, _)| i);
+    tail[..end].parse().ok()
+}
+
+/// `file::fn_name` names a test function that exists in the repository.
+fn test_exists(root: &Path, cause: &str) -> bool {
+    let Some((file, name)) = cause.split_once("::") else {
+        return false;
+    };
+    std::fs::read_to_string(root.join(file)).is_ok_and(|src| src.contains(&format!("fn {name}(")))
+}
 
 #[test]
-fn reproduce_quick_produces_every_row_and_figure() {
+fn reproduce_quick_pins_every_row_and_figure() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let out: PathBuf = std::env::temp_dir().join(format!("ivt-repro-test-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     let res = Command::new(env!("CARGO_BIN_EXE_ivt"))
@@ -76,41 +370,57 @@ fn reproduce_quick_produces_every_row_and_figure() {
         "stderr: {}",
         String::from_utf8_lossy(&res.stderr)
     );
-    let stdout = String::from_utf8(res.stdout).expect("utf-8");
     // --json prints exactly one JSON object (no progress bar on stdout).
-    let v: serde_json::Value = serde_json::from_str(stdout.trim()).expect("one JSON object");
+    let v: serde_json::Value = serde_json::from_slice(&res.stdout).expect("one JSON object");
     let report = PathBuf::from(v["report"].as_str().expect("report path"));
     assert!(report.ends_with("REPRODUCTION.md") && report.exists());
     let md = std::fs::read_to_string(&report).expect("report text");
 
     let rows = v["rows"].as_array().expect("rows");
-    for want in ROWS {
-        let row = rows
-            .iter()
-            .find(|r| r["quantity"].as_str().is_some_and(|q| q.starts_with(want)))
-            .unwrap_or_else(|| panic!("row {want} missing"));
-        for key in ["thesis", "ours", "difference", "verdict", "note"] {
-            assert!(row[key].is_string(), "row {want}: key {key}");
-        }
-        assert!(
-            md.contains(row["quantity"].as_str().unwrap()),
-            "row {want} not in the report"
-        );
-    }
+    let pin_of = |r: &serde_json::Value| -> Option<&Pin> {
+        let (s, q) = (r["section"].as_str()?, r["quantity"].as_str()?);
+        let mut hits = PINS.iter().filter(|p| p.0 == s && q.starts_with(p.1));
+        let hit = hits.next();
+        assert!(hits.next().is_none(), "{s} / {q} matches two pins");
+        hit
+    };
     for r in rows {
-        let verdict = r["verdict"].as_str().unwrap();
-        assert!(
-            ["reproduced", "differs", "not computable"].contains(&verdict),
-            "{verdict}"
-        );
-        if verdict != "reproduced" {
+        let q = r["quantity"].as_str().unwrap();
+        let pin = pin_of(r).unwrap_or_else(|| panic!("unpinned row: {r}"));
+        assert_eq!(r["verdict"], pin.2, "{q}: {r}");
+        // The markdown table escapes `|` inside a cell.
+        assert!(md.contains(&q.replace('|', "\\|")), "{q} not in the report");
+        if let Some((lo, hi)) = pin.3 {
+            let ours = first_number(r["ours"].as_str().unwrap())
+                .unwrap_or_else(|| panic!("{q}: no number in {}", r["ours"]));
             assert!(
-                r["note"].as_str().unwrap().len() > 20,
-                "{} needs a cause: {r}",
-                r["quantity"]
+                (lo..=hi).contains(&ours),
+                "{q}: ours {ours} outside [{lo}, {hi}]"
             );
         }
+        match pin.4 {
+            Some(cause) => {
+                assert_eq!(r["cause_test"], cause, "{q}");
+                assert!(test_exists(root, cause), "{q}: no test {cause}");
+                assert!(r["note"].as_str().unwrap().contains(cause), "{q}");
+            }
+            None => assert!(r["cause_test"].is_null(), "{q}: {r}"),
+        }
     }
+    for p in PINS {
+        assert!(
+            rows.iter()
+                .any(|r| pin_of(r).is_some_and(|q| std::ptr::eq(q, p))),
+            "pinned row missing: {} / {}",
+            p.0,
+            p.1
+        );
+    }
+    let count = |w: &str| rows.iter().filter(|r| r["verdict"] == w).count();
+    assert_eq!(rows.len(), PINS.len());
+    assert_eq!(count(R), 17);
+    assert_eq!(count(D), 31);
+    assert_eq!(count(NC), 2);
 
     let figures = v["figures"].as_array().expect("figures");
     for want in FIGURES {
@@ -118,45 +428,21 @@ fn reproduce_quick_produces_every_row_and_figure() {
             .iter()
             .find(|f| f["id"] == *want)
             .unwrap_or_else(|| panic!("figure {want} missing"));
-        match (f["png"].as_str(), f["csv"].as_str()) {
-            (Some(png), Some(csv)) => {
-                let png = out.join(png);
-                let bytes = std::fs::read(&png).expect("png");
-                assert!(
-                    bytes.starts_with(b"\x89PNG"),
-                    "{} is not a PNG",
-                    png.display()
-                );
-                let csv = std::fs::read_to_string(out.join(csv)).expect("csv");
-                assert!(csv.lines().count() > 2, "{want}: CSV has no data");
-            }
-            _ => assert!(
-                f["note"].as_str().unwrap().contains("not"),
-                "{want} is neither drawn nor explained"
-            ),
-        }
-    }
-    // The kinematics and plant rows do not depend on any unfinished engine.
-    for want in ["J_a", "J_b", "J_c", "F_m", "f1", "f2", "R_avg slope"] {
-        let r = rows
-            .iter()
-            .find(|r| r["quantity"].as_str().unwrap().starts_with(want))
-            .unwrap();
-        assert_eq!(r["verdict"], "reproduced", "{r}");
-    }
-    // Eq. 42: the printed coefficients are 0.9× the exact Fourier ones.
-    for k in 1..=4 {
-        let r = rows
-            .iter()
-            .find(|r| {
-                r["quantity"]
-                    .as_str()
-                    .unwrap()
-                    .starts_with(&format!("Eq. 42 a{k}"))
-            })
-            .unwrap();
-        assert_eq!(r["verdict"], "differs");
-        assert!(r["note"].as_str().unwrap().contains("0.9"));
+        let (png, csv) = (f["png"].as_str(), f["csv"].as_str());
+        let (png, csv) = (png.expect(want), csv.expect(want));
+        let bytes = std::fs::read(out.join(png)).expect("png");
+        assert!(bytes.starts_with(b"\x89PNG"), "{png} is not a PNG");
+        let csv = std::fs::read_to_string(out.join(csv)).expect("csv");
+        assert!(csv.lines().count() > 2, "{want}: CSV has no data");
     }
     let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn first_number_reads_signed_and_exponent_forms() {
+    assert_eq!(first_number("+0.620"), Some(0.62));
+    assert_eq!(first_number("-0.0317460"), Some(-0.031746));
+    assert_eq!(first_number("2.2e-5"), Some(2.2e-5));
+    assert_eq!(first_number("α = 1.537, β = 0.79 V"), Some(1.537));
+    assert_eq!(first_number("—"), None);
 }

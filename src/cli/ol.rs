@@ -8,8 +8,26 @@ use ivt_design::shooting::{shoot_steady_state, ShootingOptions};
 use ivt_design::steady::{solve_steady_state, IhbOptions};
 use ivt_design::sweep::{self, Grid, SweepPoint};
 use ivt_design::{rad_s_to_rpm, rpm_to_rad_s, OperatingPoint};
-use ivt_kin::plant::PlantParams;
+use ivt_kin::plant::PlantPreset;
 use serde_json::json;
+
+/// `--plant printed|thesis-ch4` (SPEC §6), shared by `ivt ol` and `ivt stability(-map)`.
+#[derive(Args, Clone, Copy)]
+pub struct PlantArg {
+    /// Plant parameter set: `printed` (Table 1) or `thesis-ch4` (k_t, k_e ÷ 10).
+    #[arg(long = "plant", default_value = "printed", value_parser = parse_plant)]
+    pub preset: PlantPreset,
+}
+
+fn parse_plant(name: &str) -> Result<PlantPreset, String> {
+    PlantPreset::from_name(name).ok_or_else(|| {
+        let names: Vec<_> = PlantPreset::ALL.iter().map(|p| p.name()).collect();
+        format!(
+            "unknown plant `{name}`, expected one of {}",
+            names.join(", ")
+        )
+    })
+}
 
 /// Open-loop design subcommands.
 #[derive(Subcommand)]
@@ -42,6 +60,8 @@ pub struct SolveArgs {
     /// Harmonics n of the IHB (thesis: 7).
     #[arg(long, default_value_t = 7)]
     harmonics: usize,
+    #[command(flatten)]
+    plant: PlantArg,
 }
 
 /// How `ivt ol solve` computes r̄.
@@ -83,6 +103,8 @@ pub struct GridArgs {
     /// No progress bar on stderr.
     #[arg(long)]
     quiet: bool,
+    #[command(flatten)]
+    plant: PlantArg,
 }
 
 /// Arguments of `ivt ol fit`.
@@ -124,7 +146,7 @@ pub fn run(cmd: OlCommand) -> Result<Output, CliError> {
 }
 
 fn solve(a: SolveArgs) -> Result<Output, CliError> {
-    let plant = PlantParams::printed();
+    let plant = a.plant.preset.params();
     let op = OperatingPoint {
         v_m: a.vm,
         t_u: a.tu,
@@ -149,6 +171,7 @@ fn solve(a: SolveArgs) -> Result<Output, CliError> {
         "error_estimate": {"r_abs": acc.error_abs, "r_rel": acc.error_abs / acc.r.abs(),
                            "how": acc.how},
         "thesis_choice": a.method == SolveMethod::Ihb && a.harmonics == 7,
+        "plant": a.plant.preset.name(),
     });
     let label = if a.method == SolveMethod::Ihb && a.harmonics == 7 {
         " — n = 7, the thesis's choice"
@@ -249,7 +272,7 @@ fn run_sweep(a: &GridArgs) -> Result<(Grid, Vec<SweepPoint>), CliError> {
     } else {
         indicatif::ProgressBar::new(grid.len() as u64)
     };
-    let pts = sweep::sweep(&PlantParams::printed(), &grid, opts, || bar.inc(1)).map_err(failed)?;
+    let pts = sweep::sweep(&a.plant.preset.params(), &grid, opts, || bar.inc(1)).map_err(failed)?;
     bar.finish_and_clear();
     Ok((grid, pts))
 }
@@ -277,12 +300,13 @@ fn table(a: GridArgs) -> Result<Output, CliError> {
         human.push('\n');
     }
     let json = json!({"v_m": grid.v_m, "t_u": grid.t_u, "omega0": grid.omega0,
+                      "plant": a.plant.preset.name(),
                       "points": pts.iter().map(point_json).collect::<Vec<_>>()});
     Ok(Output { json, human })
 }
 
 fn fit_cmd(a: FitArgs) -> Result<Output, CliError> {
-    let plant = PlantParams::printed();
+    let plant = a.grid.plant.preset.params();
     let (grid, pts) = run_sweep(&a.grid)?;
     let form = if a.full {
         PolyForm::Full
@@ -307,11 +331,11 @@ fn fit_cmd(a: FitArgs) -> Result<Output, CliError> {
     let thesis_err = fit::law_error(&plant, &OpenLoopLaw::thesis(), &pts).map_err(failed)?;
     if let Some(path) = &a.emit_rust {
         let header = format!(
-            "Open-loop law refitted on the printed plant (Eq. 151 + Table 1) by `ivt ol fit{}`:\n\
+            "Open-loop law refitted on the {} plant (Eq. 151) by `ivt ol fit{}`:\n\
              IHB (n = {}) over V_m ∈ {}:{}:{} V, T_U ∈ {}:{}:{} N·m, ω0 = {} rpm; {} feasible points.\n\
              Fit error in r: RMS {:.3e} m, max {:.3e} m. ω_a error of the clamped law: max {:.3} rpm, RMS {:.3} rpm.\n\
              Boundary r̄ = r_max: V_m = {:.4} T_U + {:.4} (max deviation {:.3} V).",
-            if a.full { " --full" } else { "" }, a.grid.harmonics,
+            a.grid.plant.preset.name(), if a.full { " --full" } else { "" }, a.grid.harmonics,
             a.grid.vm_from, a.grid.vm_step, a.grid.vm_to, a.grid.tu_from, a.grid.tu_step, a.grid.tu_to,
             a.grid.omega0_rpm, pf.points, pf.rms_r, pf.max_r, err.max_abs_rpm, err.rms_rpm, alpha, beta, b_err
         );
@@ -320,6 +344,7 @@ fn fit_cmd(a: FitArgs) -> Result<Output, CliError> {
     let json = json!({
         "poly": pf.poly, "boundary": law.boundary, "r_max": law.r_max,
         "form": if a.full { "full" } else { "eq158" }, "points": pf.points,
+        "plant": a.grid.plant.preset.name(),
         "rms_r": pf.rms_r, "max_r": pf.max_r,
         "omega_a_error_rpm": {"max_abs": err.max_abs_rpm, "rms": err.rms_rpm},
         "thesis_omega_a_error_rpm": {"max_abs": thesis_err.max_abs_rpm, "rms": thesis_err.rms_rpm},

@@ -3,13 +3,13 @@
 //! the thesis's printed unit (mm·rad⁻¹, read as mm of r per rad of θ per rad/s;
 //! `k_SI = 1e-3 k`, the same reading as ivt-ctrl) unless `--si` is passed.
 
+use super::ol::PlantArg;
 use super::{CliError, Output};
 use clap::Args;
 use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
 use ivt_design::gains::stability_map;
 use ivt_design::sweep::{axis, Grid};
 use ivt_design::{rpm_to_rad_s, OperatingPoint};
-use ivt_kin::plant::PlantParams;
 use serde_json::json;
 
 /// Arguments of `ivt stability`.
@@ -50,6 +50,8 @@ pub struct Common {
     /// Target mean speed [rpm].
     #[arg(long, default_value_t = 100.0, allow_hyphen_values = true)]
     omega0_rpm: f64,
+    #[command(flatten)]
+    plant: PlantArg,
 }
 
 impl Common {
@@ -113,8 +115,9 @@ pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
     };
     op.validate().map_err(|e| CliError::Input(e.to_string()))?;
     let g = a.common.gains();
+    let plant = a.common.plant.preset.params();
     let t0 = std::time::Instant::now();
-    let s = delay_stability(&PlantParams::printed(), &op, g, &a.common.opts())
+    let s = delay_stability(&plant, &op, g, &a.common.opts())
         .map_err(|e| CliError::Failed(e.to_string()))?;
     let dt = t0.elapsed().as_secs_f64();
     let design = match &a.design {
@@ -122,7 +125,7 @@ pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
             let scale = if a.common.si { 1.0 } else { 1e-3 };
             let (k_max, k2_max) = design_box(b, a.design_steps)?;
             let c = ivt_design::gains::best_gains(
-                &PlantParams::printed(),
+                &plant,
                 &op,
                 (0.0, k_max * scale),
                 (0.0, k2_max * scale),
@@ -151,6 +154,7 @@ pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
         "multipliers": s.multipliers.iter().map(|m| [m.0, m.1]).collect::<Vec<_>>(),
         "r_bar": s.orbit.r, "k_si": g.k, "k2_si": g.k2, "chebyshev_order": a.common.n,
         "stable": s.max_abs_multiplier < 1.0, "solve_time_s": dt,
+        "plant": a.common.plant.preset.name(),
     });
     let human = format!(
         "V_m = {} V, T_U = {} N·m, k = {:e}, k2 = {:e} m·s/rad² (N = {})\nr̄ = {:.6} m\nmax |multiplier| = {:.6} (structural one: {:.6}{:+.1e}i)\n",
@@ -171,7 +175,7 @@ pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
     };
     grid.validate()
         .map_err(|e| CliError::Input(e.to_string()))?;
-    let plant = PlantParams::printed();
+    let plant = a.common.plant.preset.params();
     let mut ops: Vec<OperatingPoint> = grid
         .t_u
         .iter()
@@ -222,7 +226,8 @@ pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
         })
         .collect();
     let json = json!({"points": pts, "worst": worst, "failed": failed, "k_si": a.common.gains().k,
-                      "k2_si": a.common.gains().k2, "solve_time_s": dt});
+                      "k2_si": a.common.gains().k2, "solve_time_s": dt,
+                      "plant": a.common.plant.preset.name()});
     if let Some(path) = &a.plot {
         let value = |v: f64, t: f64| {
             map.iter()

@@ -8,11 +8,14 @@
 //! [`Verdict::NotComputable`] and its figures as missing, with the reason —
 //! never a made-up number.
 
+mod ch4_findings;
 mod closed_loop;
+mod closed_loop_ch4;
 mod design;
 mod hb;
 mod kinematics;
 mod report;
+mod rig;
 mod sthb;
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -80,6 +83,18 @@ pub struct Row {
     pub verdict: Verdict,
     /// Cause and evidence for `differs`, reason for `not computable`, method otherwise.
     pub note: String,
+    /// For `differs`: the test that demonstrates the cause (`file::name`).
+    pub cause_test: Option<&'static str>,
+}
+
+/// Why a printed number differs from ours: the cause in words and the test
+/// that demonstrates it (named in the row, so the claim can be checked).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Cause<'a> {
+    /// The cause with its evidence.
+    pub why: &'a str,
+    /// `file::test_name` of the demonstrating test.
+    pub test: &'static str,
 }
 
 /// One figure: a PNG and the CSV of its data, or the reason it is missing.
@@ -218,12 +233,37 @@ impl Context {
             difference: difference.into(),
             verdict,
             note: note.into(),
+            cause_test: None,
         });
+    }
+
+    /// A `differs` row with its cause and the test that demonstrates it.
+    pub(crate) fn differs(
+        &mut self,
+        quantity: impl Into<String>,
+        thesis: impl Into<String>,
+        ours: impl Into<String>,
+        difference: impl Into<String>,
+        cause: Cause<'_>,
+    ) {
+        self.row(
+            quantity,
+            thesis,
+            ours,
+            difference,
+            Verdict::Differs,
+            format!("{} (demonstrated by `{}`)", cause.why, cause.test),
+        );
+        if let Some(r) = self.rows.last_mut() {
+            r.cause_test = Some(cause.test);
+        }
     }
 
     /// Compare a printed number with ours: `reproduced` if they agree to
     /// the printed digits (|ours − thesis| ≤ half a unit of the last printed
-    /// digit, `half_ulp`), otherwise `differs` with `why_differs` as the note.
+    /// digit, `half_ulp`), otherwise `differs` with the expected `cause`
+    /// (`None` where agreement is expected: a difference then says that no
+    /// cause is known, and the pinning test in tests/reproduce.rs fails).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn compare(
         &mut self,
@@ -234,7 +274,7 @@ impl Context {
         half_ulp: f64,
         sig: usize,
         how: &str,
-        why_differs: &str,
+        cause: Option<Cause<'_>>,
     ) {
         let d = ours - thesis;
         let rel = if thesis != 0.0 {
@@ -248,19 +288,20 @@ impl Context {
             fmt_sig(d, 2)
         };
         let ok = ours.is_finite() && d.abs() <= half_ulp * (1.0 + 1e-9);
-        let (verdict, note) = if ok {
-            (Verdict::Reproduced, how.to_string())
+        let (thesis, ours) = (format!("{thesis} ({source})"), fmt_sig(ours, sig));
+        if ok {
+            self.row(quantity, thesis, ours, difference, Verdict::Reproduced, how);
+        } else if let Some(cause) = cause {
+            let why = format!("{}; {how}", cause.why);
+            let cause = Cause {
+                why: &why,
+                test: cause.test,
+            };
+            self.differs(quantity, thesis, ours, difference, cause);
         } else {
-            (Verdict::Differs, format!("{why_differs} ({how})"))
-        };
-        self.row(
-            quantity,
-            format!("{thesis} ({source})"),
-            fmt_sig(ours, sig),
-            difference,
-            verdict,
-            note,
-        );
+            let note = format!("no cause identified; {how}");
+            self.row(quantity, thesis, ours, difference, Verdict::Differs, note);
+        }
     }
 
     /// A row that cannot be computed, with the reason.
@@ -421,7 +462,7 @@ pub fn run(out: &Path, opts: Options) -> Result<Report, ReproError> {
         path: out.to_path_buf(),
         source,
     })?;
-    let mut ctx = Context::new(out, opts, 9);
+    let mut ctx = Context::new(out, opts, 17);
     ctx.section = "kinematics";
     kinematics::run(&mut ctx)?;
     ctx.section = "hb";
@@ -432,6 +473,10 @@ pub fn run(out: &Path, opts: Options) -> Result<Report, ReproError> {
     design::run(&mut ctx)?;
     ctx.section = "closed_loop";
     closed_loop::run(&mut ctx)?;
+    ctx.section = "closed_loop/thesis-ch4";
+    closed_loop_ch4::run(&mut ctx)?;
+    ctx.section = "rig";
+    rig::run(&mut ctx)?;
     ctx.bar.finish_and_clear();
     let elapsed_s = start.elapsed().as_secs_f64();
     let report_path = out.join("REPRODUCTION.md");

@@ -229,10 +229,16 @@ pub fn fit_boundary(
 }
 
 /// ω_a error of a law at grid points (open-loop periodic orbit at r = u_ol).
+///
+/// A point where u_ol is so large that the motion started at ω(0) = ω0 stalls
+/// (Eq. 162 reaches ω = 0, [`IvtError::Stall`]) stops the IVT: it counts with
+/// ω_a = 0, an error of −ω0, and in [`LawError::stalled`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct LawError {
     /// (V_m, T_U, u_ol, ω_a − ω0 \[rpm\]) per evaluated point.
     pub points: Vec<(f64, f64, f64, f64)>,
+    /// How many of those points stall (ω_a = 0).
+    pub stalled: usize,
     /// Max |ω_a − ω0| \[rpm\] over points whose r̄ is feasible.
     pub max_abs_rpm: f64,
     /// RMS of ω_a − ω0 \[rpm\] over those points.
@@ -242,7 +248,7 @@ pub struct LawError {
 /// Simulate `law` open loop at each feasible sweep point and measure ω_a − ω0.
 ///
 /// # Errors
-/// A stall or no convergence at some point.
+/// No convergence at some point.
 pub fn law_error(
     plant: &PlantParams,
     law: &OpenLoopLaw,
@@ -250,22 +256,26 @@ pub fn law_error(
 ) -> Result<LawError, IvtError> {
     let opts = ShootingOptions::default();
     let mut out = Vec::new();
+    let mut stalled = 0;
     for p in points {
         let Ok(s) = p.result.as_ref() else { continue };
         if !(0.0..=plant.r_max).contains(&s.r) {
             continue;
         }
         let r = law.u_ol(p.op.v_m, p.op.t_u);
-        let o = periodic_at_r(plant, p.op.v_m, p.op.t_u, r, p.op.omega0, &opts)?;
-        out.push((
-            p.op.v_m,
-            p.op.t_u,
-            r,
-            rad_s_to_rpm(o.omega_a() - p.op.omega0),
-        ));
+        let omega_a = match periodic_at_r(plant, p.op.v_m, p.op.t_u, r, p.op.omega0, &opts) {
+            Ok(o) => o.omega_a(),
+            Err(IvtError::Stall { .. }) => {
+                stalled += 1;
+                0.0
+            }
+            Err(e) => return Err(e),
+        };
+        out.push((p.op.v_m, p.op.t_u, r, rad_s_to_rpm(omega_a - p.op.omega0)));
     }
     let n = out.len().max(1) as f64;
     Ok(LawError {
+        stalled,
         max_abs_rpm: out.iter().map(|p| p.3.abs()).fold(0.0, f64::max),
         rms_rpm: (out.iter().map(|p| p.3 * p.3).sum::<f64>() / n).sqrt(),
         points: out,

@@ -7,7 +7,7 @@ use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
 use ivt_design::steady::{solve_steady_state, IhbOptions};
 use ivt_design::sweep::{self, Grid};
 use ivt_design::{rpm_to_rad_s, OperatingPoint, Verdict};
-use ivt_kin::plant::PlantParams;
+use ivt_kin::plant::{PlantParams, PlantPreset};
 use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -15,8 +15,29 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::time::Instant;
 
-fn plant_of(plant: Option<PyRef<'_, Plant>>) -> PlantParams {
-    plant.map_or_else(PlantParams::printed, |p| p.params)
+/// The plant of a `plant=` argument: a preset name (`"printed"`,
+/// `"thesis-ch4"`), an `ivt.kin.Plant`, or None (printed), with the name the
+/// result echoes (`"custom"` for a Plant matching no preset).
+fn plant_of(plant: Option<&Bound<'_, PyAny>>) -> PyResult<(PlantParams, &'static str)> {
+    let Some(obj) = plant else {
+        return Ok((PlantParams::printed(), PlantPreset::Printed.name()));
+    };
+    if let Ok(name) = obj.extract::<String>() {
+        let preset = PlantPreset::from_name(&name).ok_or_else(|| {
+            let names: Vec<_> = PlantPreset::ALL.iter().map(|p| p.name()).collect();
+            PyValueError::new_err(format!(
+                "argument `plant` = \"{name}\" must be one of {}",
+                names.join(", ")
+            ))
+        })?;
+        return Ok((preset.params(), preset.name()));
+    }
+    let params = obj.extract::<PyRef<'_, Plant>>()?.params;
+    let name = PlantPreset::ALL
+        .into_iter()
+        .find(|p| p.params() == params)
+        .map_or("custom", PlantPreset::name);
+    Ok((params, name))
 }
 
 fn operating_point(v_m: f64, t_u: f64, omega0_rpm: f64) -> PyResult<OperatingPoint> {
@@ -48,7 +69,8 @@ fn ihb_options(harmonics: usize) -> IhbOptions {
 /// Returns the dict of `ivt ol solve --json`: r (unconstrained r̄ [m]),
 /// feasible, verdict ("feasible", "under-drive", "over-drive"), q, omega_min,
 /// omega_max, solve_time_s, iterations, residual_norm, harmonics, r_max,
-/// omega0. `plant` defaults to the printed plant (ivt.kin.Plant()).
+/// omega0, plant. `plant`: "printed" (default), "thesis-ch4" or an
+/// ivt.kin.Plant.
 #[pyfunction]
 #[pyo3(signature = (v_m, t_u, omega0_rpm = 100.0, harmonics = 7, plant = None))]
 fn ol_solve<'py>(
@@ -57,9 +79,9 @@ fn ol_solve<'py>(
     t_u: f64,
     omega0_rpm: f64,
     harmonics: usize,
-    plant: Option<PyRef<'py, Plant>>,
+    plant: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let params = plant_of(plant);
+    let (params, plant_name) = plant_of(plant)?;
     let op = operating_point(v_m, t_u, omega0_rpm)?;
     let t0 = Instant::now();
     let s = py
@@ -79,6 +101,7 @@ fn ol_solve<'py>(
     d.set_item("harmonics", harmonics)?;
     d.set_item("r_max", params.r_max)?;
     d.set_item("omega0", op.omega0)?;
+    d.set_item("plant", plant_name)?;
     Ok(d)
 }
 
@@ -88,7 +111,7 @@ fn ol_solve<'py>(
 /// v_m, t_u: (from, step, to) as in `ivt ol table` (thesis grid
 /// 2:0.4:12 V × 1.5:0.5:9 N·m). Returns {"v_m", "t_u", "omega0",
 /// "points": [{"vm", "tu", "r", "verdict", ...} or {"vm", "tu", "error"}]}
-/// like the CLI, plus "r": an array of shape (len(t_u), len(v_m)) with NaN
+/// and "plant" like the CLI, plus "r": an array of shape (len(t_u), len(v_m)) with NaN
 /// where a point failed.
 #[pyfunction]
 #[pyo3(signature = (
@@ -101,9 +124,9 @@ fn ol_table<'py>(
     t_u: (f64, f64, f64),
     omega0_rpm: f64,
     harmonics: usize,
-    plant: Option<PyRef<'py, Plant>>,
+    plant: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let params = plant_of(plant);
+    let (params, plant_name) = plant_of(plant)?;
     if !(omega0_rpm.is_finite() && omega0_rpm > 0.0) {
         return Err(PyValueError::new_err(format!(
             "argument `omega0_rpm` = {omega0_rpm} must be finite and > 0"
@@ -145,6 +168,7 @@ fn ol_table<'py>(
     d.set_item("omega0", grid.omega0)?;
     d.set_item("points", points)?;
     d.set_item("r", r.into_pyarray(py))?;
+    d.set_item("plant", plant_name)?;
     Ok(d)
 }
 
@@ -155,7 +179,7 @@ fn ol_table<'py>(
 /// Returns the dict of `ivt stability --json` (without "design"):
 /// max_abs_multiplier (excluding the structural unit one), structural,
 /// multipliers [[re, im]...], r_bar, k_si, k2_si, chebyshev_order, stable,
-/// solve_time_s. GIL released.
+/// solve_time_s, plant. GIL released.
 #[pyfunction]
 #[pyo3(signature = (
     v_m, t_u, k = 0.01, k2 = 0.02, si = false, n = 16, omega0_rpm = 100.0, plant = None
@@ -170,9 +194,9 @@ fn stability<'py>(
     si: bool,
     n: usize,
     omega0_rpm: f64,
-    plant: Option<PyRef<'py, Plant>>,
+    plant: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let params = plant_of(plant);
+    let (params, plant_name) = plant_of(plant)?;
     let op = operating_point(v_m, t_u, omega0_rpm)?;
     for (name, v) in [("k", k), ("k2", k2)] {
         if !v.is_finite() {
@@ -206,6 +230,7 @@ fn stability<'py>(
     d.set_item("chebyshev_order", n)?;
     d.set_item("stable", s.max_abs_multiplier < 1.0)?;
     d.set_item("solve_time_s", dt)?;
+    d.set_item("plant", plant_name)?;
     Ok(d)
 }
 

@@ -55,3 +55,19 @@ def test_design_errors() -> None:
         design.ol_solve(float("nan"), 6.0)
     with pytest.raises(ValueError, match="`k`"):
         design.stability(8.6, 6.0, k=float("inf"))
+
+
+def test_plant_presets_equal_cli(cli) -> None:  # type: ignore[no-untyped-def]
+    """plant="thesis-ch4" is `--plant thesis-ch4` (k_t, k_e ÷ 10); a Plant with
+    the printed constants is named "printed"; an unknown name is a ValueError."""
+    ref = cli("ol", "solve", "--plant", "thesis-ch4", "--vm", "6", "--tu", "6")
+    got = design.ol_solve(6.0, 6.0, plant="thesis-ch4")
+    assert got["plant"] == "thesis-ch4" and got["r"] == ref["r"]
+    assert abs(got["r"] - 0.0067775) < 1e-6  # the thesis's Fig. 39 orbit (0.0067)
+    st = design.stability(8.0, 8.0, plant="thesis-ch4")
+    assert st["plant"] == "thesis-ch4"
+    assert st["max_abs_multiplier"] == cli("stability", "--plant", "thesis-ch4", "--vm", "8", "--tu", "8")["max_abs_multiplier"]
+    assert design.ol_solve(8.6, 6.0, plant=kin.Plant())["plant"] == "printed"
+    assert design.ol_table(v_m=(6.0, 1.0, 6.0), t_u=(6.0, 1.0, 6.0), plant="thesis-ch4")["plant"] == "thesis-ch4"
+    with pytest.raises(ValueError):
+        design.ol_solve(8.0, 6.0, plant="roller")

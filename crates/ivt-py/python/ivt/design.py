@@ -1,7 +1,12 @@
 """Controller design from the model (``ivt-hb``'s IVT tools, thesis §4.2–4.3):
 the IHB steady state r̄(V_m, T_U), the open-loop table over a grid, and the
 local stability of the integral time-delay loop. Dict keys follow
-``ivt ol solve``, ``ivt ol table`` and ``ivt stability`` (``--json``)."""
+``ivt ol solve``, ``ivt ol table`` and ``ivt stability`` (``--json``).
+
+Every function takes ``plant="printed"`` (Table 1, the default),
+``plant="thesis-ch4"`` (Table 1 with k_t and k_e divided by 10, the
+calibration Chapter 4's computations reproduce on) or an ``ivt.kin.Plant``;
+the result's ``"plant"`` names it (``"custom"`` for a Plant matching no preset)."""
 
 from . import _ivt
 

@@ -1,22 +1,25 @@
 """Controller design from the model (thesis §4.2–4.3)."""
 
-from typing import Any, Dict, Optional, Tuple
+from typing import Any, Dict, Literal, Optional, Tuple, Union
 
 from .kin import Plant
+
+# A preset name (Table 1, or Table 1 with k_t and k_e divided by 10) or a Plant.
+PlantArg = Union[Literal["printed", "thesis-ch4"], Plant]
 
 def ol_solve(
     v_m: float,
     t_u: float,
     omega0_rpm: float = 100.0,
     harmonics: int = 7,
-    plant: Optional[Plant] = None,
+    plant: Optional[PlantArg] = None,
 ) -> Dict[str, Any]: ...
 def ol_table(
     v_m: Tuple[float, float, float] = (2.0, 0.4, 12.0),
     t_u: Tuple[float, float, float] = (1.5, 0.5, 9.0),
     omega0_rpm: float = 100.0,
     harmonics: int = 7,
-    plant: Optional[Plant] = None,
+    plant: Optional[PlantArg] = None,
 ) -> Dict[str, Any]: ...
 def stability(
     v_m: float,
@@ -26,5 +29,5 @@ def stability(
     si: bool = False,
     n: int = 16,
     omega0_rpm: float = 100.0,
-    plant: Optional[Plant] = None,
+    plant: Optional[PlantArg] = None,
 ) -> Dict[str, Any]: ...
