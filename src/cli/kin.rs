@@ -109,13 +109,13 @@ impl Design {
 /// a second of work; beyond that the output is neither readable nor useful.
 const MAX_POINTS: usize = 100_000;
 
-/// `--points` in 2..=[`MAX_POINTS`], checked before anything is allocated.
-fn check_points(points: usize) -> Result<(), CliError> {
-    if (2..=MAX_POINTS).contains(&points) {
+/// `--points` in `min..=`[`MAX_POINTS`], checked before anything is allocated.
+fn check_points(points: usize, min: usize) -> Result<(), CliError> {
+    if (min..=MAX_POINTS).contains(&points) {
         Ok(())
     } else {
         Err(CliError::Input(format!(
-            "--points must be in 2..={MAX_POINTS} (the JSON of more is tens of MB), got {points}"
+            "--points must be in {min}..={MAX_POINTS} (the JSON of more is tens of MB), got {points}"
         )))
     }
 }
@@ -177,7 +177,7 @@ pub fn summary() -> Result<Output, CliError> {
 }
 
 fn sgivt_ratio(theta_ct_deg: f64, points: usize) -> Result<Output, CliError> {
-    check_points(points)?;
+    check_points(points, 0)?;
     let g = SgivtGeometry::prototype();
     let th = deg_to_rad(theta_ct_deg);
     let e = g.crank_length(th).map_err(kin_err)?;
@@ -216,7 +216,7 @@ fn sgivt_ratio(theta_ct_deg: f64, points: usize) -> Result<Output, CliError> {
 }
 
 fn givt_ratio(r_mm: f64, l1_mm: f64, r_output_mm: f64, points: usize) -> Result<Output, CliError> {
-    check_points(points)?;
+    check_points(points, 0)?;
     let g = GivtGeometry {
         l1: l1_mm * 1e-3,
         r_output: r_output_mm * 1e-3,
@@ -345,7 +345,7 @@ impl<G: GearRatio> DynGear for G {
 }
 
 fn profile(design: Design, g: &dyn DynGear, d: f64, points: usize) -> Result<Output, CliError> {
-    check_points(points)?;
+    check_points(points, 2)?;
     let mut pts = vec![PitchPoint::default(); points];
     let c = g.profile(d, &mut pts).map_err(kin_err)?;
     let json = json!({

@@ -274,6 +274,14 @@ fn run_sweep(a: &GridArgs) -> Result<(Grid, Vec<SweepPoint>), CliError> {
     };
     let pts = sweep::sweep(&a.plant.preset.params(), &grid, opts, || bar.inc(1)).map_err(failed)?;
     bar.finish_and_clear();
+    if let Some(Err(first)) = pts.first().map(|p| &p.result) {
+        if pts.iter().all(|p| p.result.is_err()) {
+            return Err(CliError::Failed(format!(
+                "every one of the {} grid points failed (first: {first})",
+                pts.len()
+            )));
+        }
+    }
     Ok((grid, pts))
 }
 

@@ -51,6 +51,14 @@ fn options(n: usize, samples: usize, subharmonic: usize, tol: f64) -> PyResult<H
             "argument `n` (harmonics) must be >= 1",
         ));
     }
+    if let Some(why) = ivt_hb::limits::unknowns_error(1, n) {
+        return Err(PyValueError::new_err(format!("argument `n` = {n}: {why}")));
+    }
+    if let Some(why) = ivt_hb::limits::samples_error(samples) {
+        return Err(PyValueError::new_err(format!(
+            "argument `samples` = {samples}: {why}"
+        )));
+    }
     if samples <= n {
         return Err(PyValueError::new_err(format!(
             "argument `samples` = {samples} must exceed `n` = {n} (2N > 2n AFT samples)"

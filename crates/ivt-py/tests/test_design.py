@@ -11,7 +11,7 @@ from ivt import design, kin
 
 
 def test_ol_solve_equals_cli_and_band(cli) -> None:  # type: ignore[no-untyped-def]
-    ref = cli("ol", "solve", "--vm", "8.6", "--tu", "6")
+    ref = cli("ol", "solve", "--vm", "8.6", "--tu", "6", "--method", "ihb")  # the n = 7 IHB, as ol_solve
     got = design.ol_solve(8.6, 6.0)
     for key in ["r", "feasible", "verdict", "omega_min", "omega_max", "iterations", "residual_norm", "r_max", "omega0"]:
         assert got[key] == ref[key], key

@@ -139,6 +139,13 @@ def test_errors() -> None:
         hb.duffing(n=20, samples=20)
     with pytest.raises(ValueError, match="`xi`"):
         hb.duffing(xi=float("nan"))
+    # limits before allocation: a ValueError naming the argument, not SIGABRT
+    with pytest.raises(ValueError, match="`n` = 100000"):
+        hb.duffing(n=100000, samples=200002)
+    with pytest.raises(ValueError, match="`samples` = 4294967296"):
+        hb.duffing(samples=4294967296)
+    with pytest.raises(ValueError, match="`tol`"):
+        hb.duffing(tol=float("inf"))
     with pytest.raises(ValueError, match="`method`"):
         hb.duffing(method="newton")  # type: ignore[arg-type]
     with pytest.raises(ValueError):
