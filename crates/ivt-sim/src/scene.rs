@@ -70,7 +70,7 @@ fn default_name() -> String {
 #[serde(deny_unknown_fields)]
 #[allow(missing_docs)]
 pub struct PlantSection {
-    /// Only `"printed"` (Table 1) exists.
+    /// `"printed"` (Table 1, the default) or `"thesis-ch4"` (k_t, k_e ÷ 10): [`PlantPreset`].
     #[serde(default)]
     pub preset: Option<String>,
     /// `"printed"` (G = g(sin θ + cos θ)) or `"roller_mass"` (m_r g, SPEC §5).
