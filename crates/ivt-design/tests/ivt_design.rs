@@ -180,8 +180,10 @@ fn thesis_grid_solves_everywhere() {
 /// Issue 7 acceptance: the predicted max |multiplier| (Chebyshev Tau, N = 16)
 /// matches the contraction per revolution of a direct simulation of the
 /// nonlinear delay loop Eq. 172 started 1 µm off r̄, at three feasible points.
-/// The issue asks for 5 %; the two routes share only the plant model and
-/// agree to ~1e-4, so 1e-3 is asserted. Gains k = 1, k2 = 2 mm·rad⁻¹ (ctrl
+/// The two routes share only the plant model; they agree to 1e-4 relative
+/// (largest measured 9.8e-5 at (9.2, 8)), asserted at 2e-4: the simulated
+/// contraction is read from 200 revolutions of RK4 (64 steps per segment)
+/// and carries an error of that order. Gains k = 1, k2 = 2 mm·rad⁻¹ (ctrl
 /// reading, k_SI = 1e-3, 2e-3) make the dominant multiplier 0.7–0.85, well
 /// separated from the others (|λ| < 0.4), so 200 revolutions resolve it; the
 /// fourth case uses the thesis's 0.01/0.02 (λ ≈ 0.996).
@@ -203,8 +205,8 @@ fn predicted_multiplier_matches_simulated_contraction() {
             simulate_contraction(&plant, &op, g, &s.orbit, &DelaySimOptions::default()).unwrap();
         let rel = (c.measured - s.max_abs_multiplier).abs() / s.max_abs_multiplier;
         assert!(
-            rel < 1e-3,
-            "({v},{t}) k={k}: predicted {} simulated {}",
+            rel < 2e-4,
+            "({v},{t}) k={k}: predicted {} simulated {} (relative {rel:.1e})",
             s.max_abs_multiplier,
             c.measured
         );
@@ -229,5 +231,83 @@ fn broyden_and_newton_agree() {
         };
         let (b, n) = (solve(IhbMethod::Broyden), solve(IhbMethod::Newton));
         assert!((b - n).abs() <= 1e-9 * n.abs(), "({v},{t}): {b} vs {n}");
+    }
+}
+
+/// The root README's "Where the thesis and the printed model disagree",
+/// open-loop law: by θ-shooting (direct integration, independent of the IHB
+/// route) r̄(6 V, 6 N·m) = −0.02435 m to the printed digits, and the band at
+/// 100 rpm is V_m ∈ [7.869, 7.869 + 0.1537·T_U]: r̄ changes sign across
+/// 7.869 ± 5e-4 V, and reaches r_max = 0.012 m across 7.869 + 0.1537·8 V
+/// ± 1e-3 V (the rounding of both printed coefficients at T_U = 8 N·m).
+#[test]
+fn readme_r_bar_and_band_by_shooting() {
+    let r66 = shoot(6.0, 6.0);
+    assert!((r66 + 0.02435).abs() <= 5e-6, "r̄(6, 6) = {r66}");
+    // Near the lower edge r̄ ≈ ±1e-5 m: the default relative tolerance
+    // (1e-13 of max(|r̄|, 1 µm)) is below the rounding floor there, so these
+    // sign checks stop at 1e-6 (Newton's last step; the error is its square).
+    let sign_check = |v: f64, t: f64| {
+        let o = ShootingOptions {
+            tol: 1e-6,
+            ..ShootingOptions::default()
+        };
+        shoot_steady_state(
+            &PlantParams::printed(),
+            &OperatingPoint::at_100_rpm(v, t),
+            None,
+            &o,
+        )
+        .unwrap()
+        .r
+    };
+    let (lo_below, lo_above) = (sign_check(7.8685, 4.0), sign_check(7.8695, 4.0));
+    assert!(lo_below < 0.0 && lo_above > 0.0, "{lo_below} {lo_above}");
+    let v_hi = 7.869 + 0.1537 * 8.0;
+    let (hi_below, hi_above) = (sign_check(v_hi - 1e-3, 8.0), sign_check(v_hi + 1e-3, 8.0));
+    let r_max = 0.012;
+    assert!(
+        hi_below < r_max && hi_above > r_max,
+        "{hi_below} {hi_above}"
+    );
+}
+
+/// The root README's Fig. 42 row: at (7 V, 2 N·m) the thesis prints 0.4871
+/// (k, k2 = 0.06, 0.12) and 0.7776 (0.01, 0.02). We state 0.988 / 0.998 with
+/// k_SI = 1e-3·k and 1.020 / 0.729 reading the numbers as SI, at the default
+/// Chebyshev order N = 16 (to half a printed unit, 5e-4); N = 32 moves none
+/// of them by more than 1e-3, so the digits are not a discretization
+/// artefact; and each differs from the thesis by more than 0.04 (40 printed
+/// units), so neither reading reproduces it. The point is under-drive (r̄ < 0 by shooting).
+#[test]
+fn readme_fig42_multipliers() {
+    assert!(shoot(7.0, 2.0) < 0.0);
+    let plant = PlantParams::printed();
+    let op = OperatingPoint::at_100_rpm(7.0, 2.0);
+    let m = |g: FeedbackGains, n: usize| {
+        let o = DelayOptions {
+            chebyshev_order: n,
+            ..Default::default()
+        };
+        delay_stability(&plant, &op, g, &o)
+            .unwrap()
+            .max_abs_multiplier
+    };
+    let mm = FeedbackGains::from_thesis_mm_per_rad;
+    let si = |k, k2| FeedbackGains { k, k2 };
+    for (g, stated, thesis) in [
+        (mm(0.06, 0.12), 0.988, 0.4871),
+        (mm(0.01, 0.02), 0.998, 0.7776),
+        (si(0.06, 0.12), 1.020, 0.4871),
+        (si(0.01, 0.02), 0.729, 0.7776),
+    ] {
+        let (m16, m32) = (m(g, 16), m(g, 32));
+        eprintln!("{g:?}: N = 16 {m16:.6}, N = 32 {m32:.6}");
+        assert!((m16 - stated).abs() <= 5e-4, "{g:?}: {m16} vs {stated}");
+        assert!((m32 - m16).abs() < 1e-3, "{g:?}: {m16} vs N = 32 {m32}");
+        assert!(
+            (stated - thesis).abs() > 0.04,
+            "{stated} vs thesis {thesis}"
+        );
     }
 }

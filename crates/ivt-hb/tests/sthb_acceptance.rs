@@ -530,8 +530,8 @@ fn spring_boundary_fig36() {
 }
 
 #[test]
-fn stress_converges_or_fails_clearly() {
-    // k_d = 100, M = 40 and N = 20 (rustdct path): a curve or a clear error, never NaN or a panic.
+fn stress_cases_trace_the_whole_curve() {
+    // k_d = 100, M = 40 and N = 20 (rustdct path): each traces the whole curve.
     for p in [
         StringParams {
             kd: 100.0,
@@ -554,31 +554,26 @@ fn stress_converges_or_fails_clearly() {
             step_max: 0.1,
             ..Default::default()
         };
-        match frequency_response(&mut hb, 2.5, 4.5, &opts) {
-            Ok(frc) => {
-                let mut r = vec![0.0; hb.dim()];
-                for pt in &frc.points {
-                    hb.residual(&pt.a, pt.omega, &mut r);
-                    let n = r.iter().map(|v| v * v).sum::<f64>().sqrt();
-                    assert!(
-                        n < 1e-8 && pt.norm.is_finite(),
-                        "{p:?} at ω = {}: ‖R‖ = {n:e}",
-                        pt.omega
-                    );
-                }
-            }
-            Err(e) => {
-                let msg = e.to_string();
-                assert!(
-                    matches!(
-                        e,
-                        SthbError::Stalled { .. }
-                            | SthbError::NoConvergence { .. }
-                            | SthbError::ColdStart { .. }
-                    ),
-                    "{msg}"
-                );
-            }
+        // Each of the three converges over the whole range (measured: 42, 87
+        // and 138 points); an error, even a clean one, is a regression here.
+        let frc =
+            frequency_response(&mut hb, 2.5, 4.5, &opts).unwrap_or_else(|e| panic!("{p:?}: {e}"));
+        let (first, last) = (&frc.points[0], &frc.points[frc.points.len() - 1]);
+        assert!(
+            (first.omega - 2.5).abs() < 1e-9 && (last.omega - 4.5).abs() < 1e-9,
+            "{p:?}: ω from {} to {}",
+            first.omega,
+            last.omega
+        );
+        let mut r = vec![0.0; hb.dim()];
+        for pt in &frc.points {
+            hb.residual(&pt.a, pt.omega, &mut r);
+            let n = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+            assert!(
+                n < 1e-8 && pt.norm.is_finite(),
+                "{p:?} at ω = {}: ‖R‖ = {n:e}",
+                pt.omega
+            );
         }
     }
     // Nonsense input is rejected, not computed.
