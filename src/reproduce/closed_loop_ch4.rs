@@ -5,7 +5,7 @@
 
 use super::{fmt_sig, Cause, Context, ReproError, Verdict};
 use ivt_plot::{Figure, Series, Style};
-use ivt_sim::run::{run as run_scene, Summary};
+use ivt_sim::run::{Simulation, Summary};
 use ivt_sim::scene::Scene;
 
 const RAD_S_TO_RPM: f64 = 60.0 / (2.0 * std::f64::consts::PI);
@@ -13,7 +13,7 @@ const RAD_S_TO_RPM: f64 = 60.0 / (2.0 * std::f64::consts::PI);
 /// The run summary and its (t, ω, ω_a, r, V_m, T_U) samples.
 fn simulate(name: &str, src: &str) -> Result<(Summary, Vec<[f64; 6]>), String> {
     let scene = Scene::parse(src, name).map_err(|e| e.to_string())?;
-    let res = run_scene(&scene, &mut |_| ()).map_err(|e| e.to_string())?;
+    let res = Simulation::new(&scene).run().map_err(|e| e.to_string())?;
     let plot = res
         .channels
         .plot

@@ -347,7 +347,7 @@ const IN_FLIGHT: usize = 32;
 /// writer thread fed through a bounded channel (JSON + zstd of a 60 s run
 /// take about as long as the simulation, so on two cores they overlap);
 /// CSV, summary and plots follow the run. `run` is the closed loop with a
-/// sample sink, e.g. `|sink| run::run_to(scene, progress, sink)`.
+/// sample sink, e.g. `|sink| Simulation::new(scene).sink(sink).run()`.
 ///
 /// Messages are in time order across channels (each channel's sequence
 /// counts from 0), the same channels and counts as [`write_all`].

@@ -2,7 +2,7 @@
 
 use indicatif::{ProgressBar, ProgressStyle};
 
-/// A progress callback for [`crate::run::run`]: a bar on stderr when
+/// A progress callback for [`crate::run::Simulation::progress`]: a bar on stderr when
 /// `show`, else a no-op (e.g. under `--json`). Call `finish` afterwards.
 pub struct Progress(Option<ProgressBar>);
 
