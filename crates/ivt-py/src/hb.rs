@@ -40,6 +40,7 @@ fn hb_err(py: Python<'_>, e: HbError) -> PyErr {
             }
             err
         }
+        HbError::Continuation(_) => ConvergenceError::new_err(e.to_string()),
         _ => PyValueError::new_err(e.to_string()),
     }
 }
@@ -266,6 +267,42 @@ fn mathieu_duffing<'py>(
     solved_dict(py, &solved)
 }
 
+/// Multipliers as `[[re, im], ...]`.
+fn pairs(mu: &[ivt_hb::c64]) -> Vec<[f64; 2]> {
+    mu.iter().map(|m| [m.re, m.im]).collect()
+}
+
+/// The dict of a traced curve: "points" [{"omega", "amplitude", "stable",
+/// "stability", "kind", "coeffs", "multipliers"}...], "termination", and the
+/// arrays omega, amplitude, stable for plotting ("folds" is set by the caller).
+fn frc_dict<'py>(py: Python<'py>, frc: &ivt_hb::Frc) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let points = PyList::empty(py);
+    for p in &frc.points {
+        let e = PyDict::new(py);
+        e.set_item("omega", p.omega_f)?;
+        e.set_item("amplitude", p.amplitude)?;
+        e.set_item("stable", p.stable())?;
+        e.set_item("stability", p.kind.name())?;
+        e.set_item("kind", p.kind.name())?;
+        e.set_item("coeffs", p.coeffs.clone().into_pyarray(py))?;
+        e.set_item("multipliers", pairs(&p.multipliers))?;
+        points.append(e)?;
+    }
+    d.set_item("points", points)?;
+    d.set_item("termination", format!("{:?}", frc.termination))?;
+    let col = |f: fn(&ivt_hb::FrcPoint) -> f64| -> Bound<'py, PyArray1<f64>> {
+        Array1::from_iter(frc.points.iter().map(f)).into_pyarray(py)
+    };
+    d.set_item("omega", col(|p| p.omega_f))?;
+    d.set_item("amplitude", col(|p| p.amplitude))?;
+    d.set_item(
+        "stable",
+        Array1::from_iter(frc.points.iter().map(|p| p.stable())).into_pyarray(py),
+    )?;
+    Ok(d)
+}
+
 /// Frequency-response curve of Duffing's equation by pseudo-arclength
 /// continuation in ω_f from `from_` to `to` (Fig. 29), with the Floquet
 /// verdict at every point. Returns {"points": [{"omega", "amplitude",
@@ -303,30 +340,9 @@ fn duffing_frc<'py>(
     let frc = py
         .detach(|| frequency_response(&problem, &opts, &frc_opts))
         .map_err(|e| hb_err(py, e))?;
-    let d = PyDict::new(py);
-    let points = PyList::empty(py);
-    for p in &frc.points {
-        let e = PyDict::new(py);
-        e.set_item("omega", p.omega_f)?;
-        e.set_item("amplitude", p.amplitude)?;
-        e.set_item("stable", p.stable())?;
-        e.set_item("stability", p.kind.name())?;
-        e.set_item("kind", p.kind.name())?;
-        points.append(e)?;
-    }
-    d.set_item("points", points)?;
-    let folds: Vec<f64> = frc.folds.iter().map(|f| f.lambda).collect();
+    let d = frc_dict(py, &frc)?;
+    let folds: Vec<f64> = frc.folds.iter().map(|f| f.omega_f).collect();
     d.set_item("folds", folds)?;
-    d.set_item("termination", format!("{:?}", frc.termination))?;
-    let col = |f: fn(&ivt_hb::FrcPoint) -> f64| -> Bound<'py, PyArray1<f64>> {
-        Array1::from_iter(frc.points.iter().map(f)).into_pyarray(py)
-    };
-    d.set_item("omega", col(|p| p.omega_f))?;
-    d.set_item("amplitude", col(|p| p.amplitude))?;
-    d.set_item(
-        "stable",
-        Array1::from_iter(frc.points.iter().map(|p| p.stable())).into_pyarray(py),
-    )?;
     Ok(d)
 }
 
@@ -341,6 +357,8 @@ struct PyProblem {
     g: Arc<Py<PyAny>>,
     f: Option<Arc<Py<PyAny>>>,
     velocity_dependent: bool,
+    /// `g` takes (N, n_dof) arrays and a (N,) phase array, returns (N, n_dof).
+    vectorized: bool,
     /// The first exception raised by a callback (the solver then sees NaN).
     error: Arc<Mutex<Option<PyErr>>>,
 }
@@ -385,6 +403,42 @@ impl PyProblem {
     }
 }
 
+impl PyProblem {
+    /// One call of a vectorized `g` on `theta.len()` samples (sample-major).
+    fn call_vectorized(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+        let (n, ns) = (self.n, theta.len());
+        let r = Python::attach(|py| -> PyResult<()> {
+            let shape = |a: &[f64]| {
+                numpy::ndarray::Array2::from_shape_vec((ns, n), a.to_vec())
+                    .map(|a| a.into_pyarray(py))
+                    .map_err(|e| PyValueError::new_err(e.to_string()))
+            };
+            let args = (shape(x)?, shape(v)?, theta.to_vec().into_pyarray(py));
+            let res = self.g.bind(py).call1(args)?;
+            let arr = res
+                .extract::<numpy::PyArrayLikeDyn<'_, f64, numpy::AllowTypeChange>>()
+                .map_err(|_| {
+                    PyTypeError::new_err("vectorized `g` must return an array of floats")
+                })?;
+            let a = arr.as_array();
+            if a.len() != ns * n || (a.ndim() == 2 && a.shape() != [ns, n]) {
+                return Err(PyValueError::new_err(format!(
+                    "vectorized `g` returned shape {:?}, expected ({ns}, {n})",
+                    a.shape()
+                )));
+            }
+            for (o, val) in out.iter_mut().zip(a.iter()) {
+                *o = *val;
+            }
+            Ok(())
+        });
+        if let Err(e) = r {
+            self.record(e);
+            out.fill(f64::NAN);
+        }
+    }
+}
+
 impl PeriodicProblem for PyProblem {
     fn n_dof(&self) -> usize {
         self.n
@@ -398,7 +452,22 @@ impl PeriodicProblem for PyProblem {
     fn stiffness(&self) -> &[f64] {
         &self.k
     }
+    fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+        if self.vectorized {
+            self.call_vectorized(x, v, theta, out);
+        } else {
+            let n = self.n;
+            for (i, &th) in theta.iter().enumerate() {
+                let s = i * n..(i + 1) * n;
+                self.nonlinear(&x[s.clone()], &v[s.clone()], th, &mut out[s]);
+            }
+        }
+    }
     fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
+        if self.vectorized {
+            self.call_vectorized(x, v, &[theta], out);
+            return;
+        }
         let g = Arc::clone(&self.g);
         self.call_into(
             &g,
@@ -458,44 +527,17 @@ fn matrix(name: &str, ob: &Bound<'_, PyAny>) -> PyResult<(usize, Vec<f64>)> {
     Ok((n, data))
 }
 
-/// Periodic solution of a user system `M x'' + C x' + K x + g(x, v, θ) = f(θ)`
-/// (θ = ω_f t, v = dx/dt) by the modified IHB (or classic), with Floquet
-/// multipliers.
-///
-/// m, c, k: n_dof×n_dof matrices (a float for one DOF). g(x, v, theta) →
-/// n_dof floats (x, v numpy arrays of n_dof); f(theta) → n_dof floats (None:
-/// unforced). `velocity_dependent=False` when g ignores v (saves work).
-/// Speed cost: g and f are Python callables called once per AFT sample and
-/// residual evaluation (2·samples calls per iteration, plus central
-/// differences for the stability Jacobian), each costing ~1–3 µs of
-/// interpreter time against ~10 ns for a Rust g, so a Duffing-size problem
-/// takes milliseconds instead of tens of µs. The GIL is released between
-/// callbacks, so other Python threads run. An exception in a callback
-/// aborts the solve and is re-raised. Same dict as `duffing`.
-#[pyfunction]
-#[pyo3(signature = (
-    m, c, k, g, omega_f, f = None, n = 20, samples = 64, subharmonic = 1,
-    method = "modified", guess = None, tol = 1e-10, stability = true,
-    velocity_dependent = true
-))]
+/// The user system of `solve`, `frc` and `limit_cycle` from its Python arguments.
 #[allow(clippy::too_many_arguments)]
-fn solve<'py>(
-    py: Python<'py>,
-    m: &Bound<'py, PyAny>,
-    c: &Bound<'py, PyAny>,
-    k: &Bound<'py, PyAny>,
-    g: &Bound<'py, PyAny>,
-    omega_f: f64,
-    f: Option<&Bound<'py, PyAny>>,
-    n: usize,
-    samples: usize,
-    subharmonic: usize,
-    method: &str,
-    guess: Option<&Bound<'py, PyAny>>,
-    tol: f64,
-    stability: bool,
+fn user_problem(
+    m: &Bound<'_, PyAny>,
+    c: &Bound<'_, PyAny>,
+    k: &Bound<'_, PyAny>,
+    g: &Bound<'_, PyAny>,
+    f: Option<&Bound<'_, PyAny>>,
     velocity_dependent: bool,
-) -> PyResult<Bound<'py, PyDict>> {
+    vectorized: bool,
+) -> PyResult<PyProblem> {
     let (nm, m) = matrix("m", m)?;
     let (nc, c) = matrix("c", c)?;
     let (nk, k) = matrix("k", k)?;
@@ -516,10 +558,7 @@ fn solve<'py>(
             ));
         }
     }
-    let opts = options(n, samples, subharmonic, tol)?;
-    let meth = self::method(method)?;
-    let guess = guess_vec(guess)?;
-    let problem = PyProblem {
+    Ok(PyProblem {
         n: nm,
         m,
         c,
@@ -527,38 +566,233 @@ fn solve<'py>(
         g: Arc::new(g.clone().unbind()),
         f: f.map(|f| Arc::new(f.clone().unbind())),
         velocity_dependent,
+        vectorized,
         error: Arc::new(Mutex::new(None)),
-    };
+    })
+}
+
+/// The first exception a callback raised during a run, if any.
+fn callback_error(problem: &PyProblem) -> Option<PyErr> {
+    problem.error.lock().ok().and_then(|mut s| s.take())
+}
+
+/// Periodic solution of a user system `M x'' + C x' + K x + g(x, v, θ) = f(θ)`
+/// (θ = ω_f t, v = dx/dt) by the modified IHB (or classic), with Floquet
+/// multipliers.
+///
+/// m, c, k: n_dof×n_dof matrices (a float for one DOF). g(x, v, theta) →
+/// n_dof floats (x, v numpy arrays of n_dof); f(theta) → n_dof floats (None:
+/// unforced). `velocity_dependent=False` when g ignores v (saves work).
+/// `vectorized=True`: g(x, v, theta) is called once per residual with x, v of
+/// shape (N, n_dof) and theta of shape (N,) for all N = 2·samples AFT
+/// samples, and returns (N, n_dof).
+/// Speed cost: g and f are Python callables called once per AFT sample and
+/// residual evaluation (2·samples calls per iteration, plus central
+/// differences for the stability Jacobian), each costing ~1–3 µs of
+/// interpreter time against ~10 ns for a Rust g, so a Duffing-size problem
+/// takes milliseconds instead of tens of µs. The GIL is released between
+/// callbacks, so other Python threads run. An exception in a callback
+/// aborts the solve and is re-raised. Same dict as `duffing`.
+#[pyfunction]
+#[pyo3(signature = (
+    m, c, k, g, omega_f, f = None, n = 20, samples = 64, subharmonic = 1,
+    method = "modified", guess = None, tol = 1e-10, stability = true,
+    velocity_dependent = true, vectorized = false
+))]
+#[allow(clippy::too_many_arguments)]
+fn solve<'py>(
+    py: Python<'py>,
+    m: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+    k: &Bound<'py, PyAny>,
+    g: &Bound<'py, PyAny>,
+    omega_f: f64,
+    f: Option<&Bound<'py, PyAny>>,
+    n: usize,
+    samples: usize,
+    subharmonic: usize,
+    method: &str,
+    guess: Option<&Bound<'py, PyAny>>,
+    tol: f64,
+    stability: bool,
+    velocity_dependent: bool,
+    vectorized: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let problem = user_problem(m, c, k, g, f, velocity_dependent, vectorized)?;
+    let opts = options(n, samples, subharmonic, tol)?;
+    let meth = self::method(method)?;
+    let guess = guess_vec(guess)?;
     let result =
         py.detach(|| solve_problem(&problem, &opts, meth, omega_f, guess.as_deref(), stability));
-    if let Some(e) = problem.error.lock().ok().and_then(|mut s| s.take()) {
+    if let Some(e) = callback_error(&problem) {
         return Err(e);
     }
     let solved = result.map_err(|e| hb_err(py, e))?;
     solved_dict(py, &solved)
 }
 
+/// Frequency-response curve of a user system `M x'' + C x' + K x + g(x, v, θ)
+/// = f(θ)` (θ = ω_f t) by pseudo-arclength continuation in ω_f from
+/// `omega_from` to `omega_to`, Floquet multipliers (Hsu) at every point, and
+/// each fold located by Newton on the extended system (not bracketed).
+///
+/// m, c, k, g, f, velocity_dependent as in `solve` (f may be None);
+/// `vectorized=True`: g(x, v, theta) gets x, v of shape (N, n_dof) and theta
+/// of shape (N,) (all 2·samples AFT samples at once) and returns (N, n_dof).
+/// Returns {"points": [{"omega", "coeffs", "amplitude", "multipliers",
+/// "stable", "stability"}...], "folds": [{"omega", "amplitude", "coeffs",
+/// "located", "index" (path point nearest the turn)}...], "bifurcations": [{"kind": "fold", "omega"}...],
+/// "termination"} and the arrays omega, amplitude, stable. amplitude is
+/// max |x_0| over the AFT samples (DOF 0). GIL released between callbacks.
+#[pyfunction]
+#[pyo3(signature = (
+    m, c, k, g, f, omega_from, omega_to, n = 20, samples = 64, tol = 1e-10,
+    velocity_dependent = true, vectorized = false
+))]
+#[allow(clippy::too_many_arguments, clippy::field_reassign_with_default)]
+fn frc<'py>(
+    py: Python<'py>,
+    m: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+    k: &Bound<'py, PyAny>,
+    g: &Bound<'py, PyAny>,
+    f: Option<&Bound<'py, PyAny>>,
+    omega_from: f64,
+    omega_to: f64,
+    n: usize,
+    samples: usize,
+    tol: f64,
+    velocity_dependent: bool,
+    vectorized: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let problem = user_problem(m, c, k, g, f, velocity_dependent, vectorized)?;
+    let opts = options(n, samples, 1, tol)?;
+    let mut frc_opts = FrcOptions::default();
+    frc_opts.from = finite("omega_from", omega_from)?;
+    frc_opts.to = finite("omega_to", omega_to)?;
+    frc_opts.stability_steps = stability_steps(n);
+    let result = py.detach(|| frequency_response(&problem, &opts, &frc_opts));
+    if let Some(e) = callback_error(&problem) {
+        return Err(e);
+    }
+    let frc = result.map_err(|e| hb_err(py, e))?;
+    let d = frc_dict(py, &frc)?;
+    let folds = PyList::empty(py);
+    let bifurcations = PyList::empty(py);
+    for fold in &frc.folds {
+        let e = PyDict::new(py);
+        e.set_item("omega", fold.omega_f)?;
+        e.set_item("amplitude", fold.amplitude)?;
+        e.set_item("coeffs", fold.coeffs.clone().into_pyarray(py))?;
+        e.set_item("located", fold.located)?;
+        e.set_item("index", fold.index)?;
+        folds.append(e)?;
+        let b = PyDict::new(py);
+        b.set_item("kind", "fold")?;
+        b.set_item("omega", fold.omega_f)?;
+        bifurcations.append(b)?;
+    }
+    d.set_item("folds", folds)?;
+    d.set_item("bifurcations", bifurcations)?;
+    Ok(d)
+}
+
+/// Limit cycle of an autonomous user system `M x'' + C x' + K x + g(x, v) = 0`
+/// by harmonic balance with the response frequency ω as an unknown and the
+/// phase condition b1 = 0 on DOF 0 (Newton with the Galerkin Jacobian).
+///
+/// The start is `guess` (coefficients, n_dof blocks of [a0, a1..an, b1..bn])
+/// or, by default, x_0 = `amplitude`·cos τ. g(x, v, theta): theta is the
+/// phase ω t (an autonomous g ignores it); `vectorized` as in `frc`.
+/// Returns {"omega", "period", "coeffs", "multipliers" ([[re, im], ...],
+/// the trivial +1 included), "stable" (all others inside the unit circle),
+/// "stability", "iterations", "residual_norm"}.
+#[pyfunction]
+#[pyo3(signature = (
+    m, c, k, g, omega_guess, amplitude = 1.0, guess = None, n = 20, samples = 64,
+    tol = 1e-10, velocity_dependent = true, vectorized = false
+))]
+#[allow(clippy::too_many_arguments)]
+fn limit_cycle<'py>(
+    py: Python<'py>,
+    m: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+    k: &Bound<'py, PyAny>,
+    g: &Bound<'py, PyAny>,
+    omega_guess: f64,
+    amplitude: f64,
+    guess: Option<&Bound<'py, PyAny>>,
+    n: usize,
+    samples: usize,
+    tol: f64,
+    velocity_dependent: bool,
+    vectorized: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let problem = user_problem(m, c, k, g, None, velocity_dependent, vectorized)?;
+    let opts = options(n, samples, 1, tol)?;
+    let start = match guess_vec(guess)? {
+        Some(q) => q,
+        None => {
+            let mut q = vec![0.0; problem.n * (2 * n + 1)];
+            q[1] = finite("amplitude", amplitude)?;
+            q
+        }
+    };
+    let result =
+        py.detach(|| ivt_hb::limit_cycle(&problem, &opts, omega_guess, &start, stability_steps(n)));
+    if let Some(e) = callback_error(&problem) {
+        return Err(e);
+    }
+    let lc = result.map_err(|e| hb_err(py, e))?;
+    let d = PyDict::new(py);
+    d.set_item("omega", lc.omega())?;
+    d.set_item("period", lc.period())?;
+    d.set_item("coeffs", lc.solution.coeffs.clone().into_pyarray(py))?;
+    d.set_item("multipliers", pairs(&lc.multipliers))?;
+    d.set_item("stable", lc.stable())?;
+    d.set_item("stability", lc.kind.name())?;
+    d.set_item("iterations", lc.solution.stats.iterations)?;
+    d.set_item("residual_norm", lc.solution.stats.residual_norm)?;
+    Ok(d)
+}
+
 /// Evaluate the Fourier series u(τ) = a0/2 + Σ a_k cos kτ + b_k sin kτ of
 /// coefficients [a0, a1..an, b1..bn] at τ (array-like), or its `order`-th
-/// τ-derivative.
+/// τ-derivative. With `n_dof` > 1, `coeffs` holds n_dof such blocks (the
+/// layout of every multi-DOF result) and the result gains a last axis of
+/// length n_dof (u_d(τ) for each DOF).
 #[pyfunction]
-#[pyo3(signature = (coeffs, tau, order = 0))]
+#[pyo3(signature = (coeffs, tau, order = 0, n_dof = 1))]
 fn eval_series<'py>(
     py: Python<'py>,
     coeffs: numpy::PyArrayLike1<'py, f64, numpy::AllowTypeChange>,
     tau: &Bound<'py, PyAny>,
     order: u32,
+    n_dof: usize,
 ) -> PyResult<Bound<'py, PyAny>> {
     let q = coeffs.as_array().to_vec();
-    if q.len().is_multiple_of(2) {
+    if n_dof == 0 || !q.len().is_multiple_of(n_dof) || (q.len() / n_dof).is_multiple_of(2) {
         return Err(PyValueError::new_err(format!(
-            "argument `coeffs` must have 2n+1 entries, got {}",
+            "argument `coeffs` must have n_dof·(2n+1) entries for n_dof = {n_dof}, got {}",
             q.len()
         )));
     }
-    crate::vectorize::map1(py, [("tau", tau)], |[t]| {
-        ivt_hb::aft::eval_series(&q, t, order)
-    })
+    if n_dof == 1 {
+        return crate::vectorize::map1(py, [("tau", tau)], |[t]| {
+            ivt_hb::aft::eval_series(&q, t, order)
+        });
+    }
+    let l = q.len() / n_dof;
+    let per_dof = (0..n_dof)
+        .map(|d| {
+            let block = &q[d * l..(d + 1) * l];
+            crate::vectorize::map1(py, [("tau", tau)], |[t]| {
+                ivt_hb::aft::eval_series(block, t, order)
+            })
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    let np = py.import("numpy")?;
+    np.call_method1("stack", (per_dof, -1))
 }
 
 /// Register `ivt._ivt.hb`.
@@ -569,6 +803,8 @@ pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(duffing_frc, &m)?)?;
     m.add_function(wrap_pyfunction!(mathieu_duffing, &m)?)?;
     m.add_function(wrap_pyfunction!(solve, &m)?)?;
+    m.add_function(wrap_pyfunction!(frc, &m)?)?;
+    m.add_function(wrap_pyfunction!(limit_cycle, &m)?)?;
     m.add_function(wrap_pyfunction!(eval_series, &m)?)?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     parent.add_submodule(&m)
