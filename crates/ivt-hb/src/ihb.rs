@@ -85,6 +85,22 @@ pub enum HbError {
     Continuation(#[from] crate::continuation::ContinuationError),
 }
 
+/// A harmonic-balance solver for one problem and one size, reusable across
+/// solves: the modified IHB ([`crate::ModifiedIhb`], Broyden on the AFT
+/// residual) and the classic IHB ([`crate::ClassicIhb`], Newton with the
+/// Galerkin Jacobian) behind one interface.
+pub trait HbSolver {
+    /// Solves at excitation frequency `omega_f` from `guess`, or from the linear
+    /// solution (Eq. 59) when `None`.
+    ///
+    /// # Errors
+    /// [`HbError::InvalidInput`] for a bad frequency or guess, [`HbError::Solve`]
+    /// with the residual history when the iteration fails.
+    fn solve(&mut self, omega_f: f64, guess: Option<&[f64]>) -> Result<HbSolution, HbError>;
+    /// The options the solver was built with.
+    fn options(&self) -> &HbOptions;
+}
+
 /// A converged periodic solution.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HbSolution {

@@ -35,7 +35,7 @@ pub use floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
 pub use fold::{locate_fold, Branch, FoldLocation, FoldOptions, HbBranch};
 pub use frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
 pub use hill::{fourier_blocks, hill_multipliers, HillError, HillResult};
-pub use ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution};
+pub use ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution, HbSolver};
 pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;
 pub use problem::{Duffing, GeneralProblem, MathieuDuffing, PeriodicProblem};

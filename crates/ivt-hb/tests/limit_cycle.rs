@@ -4,12 +4,10 @@
 
 use ivt_hb::aft::eval_series;
 use ivt_hb::ode::rk4;
-use ivt_hb::{limit_cycle, GeneralProblem, HbError, HbOptions, StabilityKind};
+use ivt_hb::{limit_cycle, GeneralProblem, HbError, HbOptions, PeriodicProblem, StabilityKind};
 use std::f64::consts::PI;
 
-fn van_der_pol(
-    mu: f64,
-) -> GeneralProblem<impl Fn(&[f64], &[f64], f64, &mut [f64]), impl Fn(f64, &mut [f64])> {
+fn van_der_pol(mu: f64) -> impl PeriodicProblem {
     GeneralProblem::new(
         1,
         vec![1.0],

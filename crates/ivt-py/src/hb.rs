@@ -4,7 +4,7 @@
 
 use ivt_hb::{
     frequency_response, ClassicIhb, Duffing, Floquet, FrcOptions, HbError, HbOptions, HbSolution,
-    HsuRule, MathieuDuffing, ModifiedIhb, PeriodicProblem, StabilityAnalyzer,
+    HbSolver, HsuRule, MathieuDuffing, ModifiedIhb, PeriodicProblem, StabilityAnalyzer,
 };
 use numpy::ndarray::Array1;
 use numpy::{IntoPyArray, PyArray1, PyUntypedArrayMethods};
@@ -102,7 +102,7 @@ struct Solved {
 }
 
 /// Solve `problem` at `omega_f` and (optionally) its Floquet multipliers.
-fn solve_problem<P: PeriodicProblem + Clone>(
+fn solve_problem<P: PeriodicProblem>(
     problem: &P,
     opts: &HbOptions,
     method: Method,
@@ -111,12 +111,11 @@ fn solve_problem<P: PeriodicProblem + Clone>(
     stability: bool,
 ) -> Result<Solved, HbError> {
     let t0 = Instant::now();
-    let sol = match method {
-        Method::Modified => {
-            ModifiedIhb::new(problem.clone(), opts.clone())?.solve(omega_f, guess)?
-        }
-        Method::Classic => ClassicIhb::new(problem.clone(), opts.clone())?.solve(omega_f, guess)?,
+    let mut solver: Box<dyn HbSolver + '_> = match method {
+        Method::Modified => Box::new(ModifiedIhb::new(problem, opts.clone())?),
+        Method::Classic => Box::new(ClassicIhb::new(problem, opts.clone())?),
     };
+    let sol = solver.solve(omega_f, guess)?;
     let solve_time_s = t0.elapsed().as_secs_f64();
     let floquet = if stability {
         let mut an =
