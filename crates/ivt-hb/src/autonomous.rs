@@ -5,12 +5,17 @@
 //!
 //! `[R(q, ω); b₁(q)] = 0`,  Jacobian `[[Φ_q, ∂R/∂ω], [e_{b₁}ᵀ, 0]]`,
 //!
-//! with `R` the HB residual Eq. 61 (p = 1, `f` ignored by an autonomous problem),
+//! with `R` the HB residual Eq. 61 (p = 1; the problem's excitation must be zero),
 //! `Φ_q` the exact Galerkin Jacobian Eq. 56 and `∂R/∂ω` by a central difference
 //! relative to ω. Stability: Hsu's monodromy (Eq. 80) has the trivial multiplier
 //! +1 (the phase shift); the orbit is classified by the others.
+//!
+//! [`limit_cycle_branch`] follows a limit cycle in a parameter μ of a family of
+//! problems by the engine's pseudo-arclength continuation ([`pseudo_arclength`],
+//! Eq. 68–77) on `[R(q, ω; μ); b₁] = 0` with unknowns `{q, ω, μ}`.
 
 use crate::broyden::{BroydenStats, SolveError};
+use crate::continuation::{pseudo_arclength, ContinuationOptions, Termination};
 use crate::dense::{norm2, solve_dense};
 use crate::floquet::HsuRule;
 use crate::ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution};
@@ -42,6 +47,119 @@ impl LimitCycle {
     pub fn stable(&self) -> bool {
         self.kind == StabilityKind::Stable
     }
+}
+
+/// A limit-cycle branch traced in a parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LimitCycleBranch {
+    /// `(μ, cycle)` in path order.
+    pub points: Vec<(f64, LimitCycle)>,
+    /// Why tracing stopped.
+    pub termination: Termination,
+}
+
+/// Follows the limit cycle `start` of `family(mu_from)` in μ up to `mu_to`
+/// (pseudo-arclength, `opts`; its λ bounds are set from `mu_from`/`mu_to`),
+/// with the multipliers of every point (`stability_steps` Hsu sub-intervals).
+/// `family(μ)` must build an autonomous problem of the same size for every μ.
+///
+/// # Errors
+/// [`HbError::InvalidInput`] for sizes or bounds, [`HbError::Continuation`]
+/// when the start does not converge; trouble later on ends the branch with a
+/// [`Termination`].
+pub fn limit_cycle_branch<P, F>(
+    family: F,
+    hb: &HbOptions,
+    start: &LimitCycle,
+    mu_from: f64,
+    mu_to: f64,
+    opts: &ContinuationOptions,
+    stability_steps: usize,
+) -> Result<LimitCycleBranch, HbError>
+where
+    P: PeriodicProblem,
+    F: Fn(f64) -> P,
+{
+    if !(mu_from.is_finite() && mu_to.is_finite() && mu_from != mu_to) {
+        return Err(HbError::InvalidInput(
+            "parameter bounds must be finite and distinct".into(),
+        ));
+    }
+    let mut res = HbResidual::new(&family(mu_from), hb)?;
+    let m = res.len();
+    if start.solution.coeffs.len() != m {
+        return Err(HbError::InvalidInput(format!(
+            "start cycle must have {m} coefficients"
+        )));
+    }
+    let phase = hb.harmonics + 1;
+    let mut x0 = start.solution.coeffs.clone();
+    x0.extend([start.omega(), mu_from]);
+    let mut copts = opts.clone();
+    copts.lambda_min = mu_from.min(mu_to);
+    copts.lambda_max = mu_from.max(mu_to);
+    let path = pseudo_arclength(
+        |x: &[f64], r: &mut [f64]| {
+            let problem = family(x[m + 1]);
+            res.eval(&problem, &x[..m], x[m], 1.0, &mut r[..m]);
+            r[m] = x[phase];
+        },
+        &x0,
+        None,
+        mu_to - mu_from,
+        &copts,
+        |_| true,
+    )?;
+    let mut points = Vec::with_capacity(path.points.len());
+    for p in &path.points {
+        let mu = p.lambda();
+        let problem = family(mu);
+        let solution = HbSolution {
+            coeffs: p.x[..m].to_vec(),
+            omega_f: p.x[m],
+            harmonics: hb.harmonics,
+            subharmonic: 1,
+            stats: BroydenStats {
+                iterations: p.iterations,
+                residual_evals: 0,
+                jacobian_refreshes: 0,
+                residual_norm: 0.0,
+            },
+        };
+        points.push((mu, classify_cycle(&problem, solution, stability_steps)?));
+    }
+    Ok(LimitCycleBranch {
+        points,
+        termination: path.termination,
+    })
+}
+
+/// Multipliers of an autonomous orbit and its class by the non-trivial ones.
+fn classify_cycle<P: PeriodicProblem>(
+    problem: &P,
+    solution: HbSolution,
+    stability_steps: usize,
+) -> Result<LimitCycle, HbError> {
+    let mut analyzer = StabilityAnalyzer::new(problem, solution.harmonics, stability_steps)?;
+    let multipliers = analyzer
+        .hsu(problem, &solution, HsuRule::Magnus4)
+        .multipliers;
+    let trivial = multipliers
+        .iter()
+        .enumerate()
+        .min_by(|a, b| (a.1 - 1.0).norm().total_cmp(&(b.1 - 1.0).norm()))
+        .map(|(i, _)| i);
+    let others: Vec<c64> = multipliers
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| Some(*i) != trivial)
+        .map(|(_, m)| *m)
+        .collect();
+    Ok(LimitCycle {
+        solution,
+        kind: classify(&others),
+        multipliers,
+    })
 }
 
 /// Finds the limit cycle of the autonomous `problem` near the orbit `guess`
@@ -179,23 +297,5 @@ pub fn limit_cycle<P: PeriodicProblem>(
         subharmonic: 1,
         stats,
     };
-    let mut analyzer = StabilityAnalyzer::new(problem, n, stability_steps)?;
-    let floquet = analyzer.hsu(problem, &solution, HsuRule::Magnus4);
-    let multipliers = floquet.multipliers;
-    let trivial = multipliers
-        .iter()
-        .enumerate()
-        .min_by(|a, b| (a.1 - 1.0).norm().total_cmp(&(b.1 - 1.0).norm()))
-        .map(|(i, _)| i);
-    let others: Vec<c64> = multipliers
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| Some(*i) != trivial)
-        .map(|(_, m)| *m)
-        .collect();
-    Ok(LimitCycle {
-        solution,
-        kind: classify(&others),
-        multipliers,
-    })
+    classify_cycle(problem, solution, stability_steps)
 }

@@ -575,6 +575,11 @@ impl GalerkinJacobian {
         }
     }
 
+    /// The quadrature basis table ([`HbResidual::fill_basis`]).
+    pub(crate) fn basis(&self) -> &[f64] {
+        &self.basis
+    }
+
     /// Writes `Φ_q(q)` (row-major `m×m`) into `jac`; allocation-free when the problem
     /// supplies `nonlinear_jacobian` (its default central differences allocate).
     pub fn assemble<P: PeriodicProblem>(

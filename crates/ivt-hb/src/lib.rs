@@ -22,7 +22,7 @@ pub mod problem;
 pub mod stability;
 
 pub use aft::{Aft, AftError};
-pub use autonomous::{limit_cycle, LimitCycle};
+pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
 pub use broyden::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
 };

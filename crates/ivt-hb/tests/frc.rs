@@ -208,3 +208,40 @@ fn duffing_frc_through_both_folds_with_flags_switching_at_them() {
         assert!((mu - 1.0).abs() < 0.2, "|μ| = {mu} at fold {f:?}");
     }
 }
+
+#[test]
+fn chain_2dof_folds_are_located_with_a_finite_difference_jacobian() {
+    // The 2-DOF cubic chain through its first resonance, g given as a closure
+    // (so ∂g comes from the default central differences): both turns must be
+    // located (ivt-py's tests/test_hb.py checks the values against scipy shooting).
+    use ivt_hb::GeneralProblem;
+    let chain = GeneralProblem::new(
+        2,
+        vec![1.0, 0.0, 0.0, 1.0],
+        vec![0.02, 0.0, 0.0, 0.02],
+        vec![2.0, -1.0, -1.0, 2.0],
+        |x: &[f64], _v: &[f64], _th: f64, g: &mut [f64]| {
+            g[0] = 0.5 * x[0] * x[0] * x[0];
+            g[1] = 0.0;
+        },
+        |th: f64, f: &mut [f64]| {
+            f[0] = 0.1 * th.cos();
+            f[1] = 0.0;
+        },
+    );
+    let opts = FrcOptions {
+        from: 0.5,
+        to: 1.6,
+        ..FrcOptions::default()
+    };
+    let frc = frequency_response(&chain, &HbOptions::new(15, 64), &opts).unwrap();
+    eprintln!(
+        "chain folds: {:?}",
+        frc.folds
+            .iter()
+            .map(|f| (f.omega_f, f.located))
+            .collect::<Vec<_>>()
+    );
+    assert_eq!(frc.folds.len(), 2);
+    assert!(frc.folds.iter().all(|f| f.located));
+}
