@@ -55,6 +55,13 @@ fn frc_and_mathieu_json_keys() {
     assert_eq!(code, 0);
     let p = &v["points"][0];
     assert!(p.get("omega").is_some() && p.get("amplitude").is_some() && p.get("stable").is_some());
+    // Folds located by the extended system: the shooting values (ivt-hb
+    // tests/frc.rs checks them against its own shooting to 1e-8).
+    let folds = v["folds"].as_array().unwrap();
+    assert_eq!(folds.len(), 2, "{folds:?}");
+    for (f, want) in folds.iter().zip([1.6548121, 1.1687244]) {
+        assert!((f.as_f64().unwrap() - want).abs() < 1e-7, "{f} vs {want}");
+    }
     let (code, v) = run(&["--json", "hb", "mathieu-duffing"]);
     assert_eq!(code, 0);
     let betas = v["period_doubling_beta"].as_array().unwrap();

@@ -148,6 +148,7 @@ fn hb_err(e: ivt_hb::HbError) -> CliError {
         ivt_hb::HbError::Solve(s) => {
             CliError::Failed(format!("{s}; ‖r‖ history {:?}", s.history()))
         }
+        e @ ivt_hb::HbError::Continuation(_) => CliError::Failed(e.to_string()),
         other => CliError::Input(other.to_string()),
     }
 }
@@ -237,7 +238,7 @@ fn duffing_frc(a: FrcArgs) -> Result<Output, CliError> {
         .iter()
         .map(|p| json!({"omega": p.omega_f, "amplitude": p.amplitude, "stable": p.stable(), "kind": p.kind.name()}))
         .collect();
-    let folds: Vec<f64> = frc.folds.iter().map(|f| f.lambda).collect();
+    let folds: Vec<f64> = frc.folds.iter().map(|f| f.omega_f).collect();
     let json = json!({ "points": points, "folds": folds, "time_s": time, "termination": format!("{:?}", frc.termination) });
     if let Some(path) = &a.plot {
         // One curve per stability; a NaN point breaks a curve where the other

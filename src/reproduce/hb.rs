@@ -169,7 +169,7 @@ fn duffing(ctx: &mut Context) -> Result<(), ReproError> {
             let folds: Vec<String> = frc
                 .folds
                 .iter()
-                .map(|f| format!("{:.4}", f.lambda))
+                .map(|f| format!("{:.4}", f.omega_f))
                 .collect();
             ctx.line_figure(
                 "Fig. 29",

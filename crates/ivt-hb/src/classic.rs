@@ -166,3 +166,12 @@ impl<P: PeriodicProblem> ClassicIhb<P> {
         })
     }
 }
+
+impl<P: PeriodicProblem> crate::ihb::HbSolver for ClassicIhb<P> {
+    fn solve(&mut self, omega_f: f64, guess: Option<&[f64]>) -> Result<HbSolution, HbError> {
+        ClassicIhb::solve(self, omega_f, guess)
+    }
+    fn options(&self) -> &HbOptions {
+        &self.opts
+    }
+}

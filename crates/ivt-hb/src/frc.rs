@@ -1,9 +1,12 @@
 //! Frequency-response curves (Fig. 29): the modified-IHB residual followed in ω_f by
 //! pseudo-arclength continuation ([`crate::continuation`], Eq. 68–77), with the
-//! Floquet multipliers (Hsu, Eq. 80) and stability class at every point.
+//! Floquet multipliers (Hsu, Eq. 80) and stability class at every point. Each
+//! turn of the path is then located by Newton on the extended system of
+//! [`crate::fold`] (the fold itself, not a bracket between two points).
 
-use crate::continuation::{pseudo_arclength, ContinuationOptions, Fold, Termination};
+use crate::continuation::{pseudo_arclength, ContinuationOptions, Termination};
 use crate::floquet::HsuRule;
+use crate::fold::{locate_fold, FoldOptions, HbBranch};
 use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
 use crate::modified::ModifiedIhb;
 use crate::problem::PeriodicProblem;
@@ -65,13 +68,30 @@ impl FrcPoint {
     }
 }
 
+/// A fold (turning point in ω_f) of the curve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrcFold {
+    /// Index of the path point nearest the turn (the Newton start).
+    pub index: usize,
+    /// ω_f at the fold.
+    pub omega_f: f64,
+    /// max |x_0(τ)| of the fold orbit over the 2N AFT samples.
+    pub amplitude: f64,
+    /// Fourier coefficients of the fold orbit.
+    pub coeffs: Vec<f64>,
+    /// `true` when Newton on the extended system converged; `false` leaves the
+    /// parabola through the three points around the turn in `omega_f` and the
+    /// nearest point's orbit in `coeffs` (accurate to the step, ~1e-3).
+    pub located: bool,
+}
+
 /// A traced frequency-response curve.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frc {
     /// Points in path order.
     pub points: Vec<FrcPoint>,
-    /// Folds (turning points in ω_f) with their ω_f.
-    pub folds: Vec<Fold>,
+    /// Folds (turning points in ω_f) in path order.
+    pub folds: Vec<FrcFold>,
     /// Why tracing stopped.
     pub termination: Termination,
 }
@@ -80,7 +100,7 @@ pub struct Frc {
 ///
 /// # Errors
 /// [`HbError`] if the start point cannot be solved or the sizes are invalid.
-pub fn frequency_response<P: PeriodicProblem + Clone>(
+pub fn frequency_response<P: PeriodicProblem>(
     problem: &P,
     hb: &HbOptions,
     opts: &FrcOptions,
@@ -95,8 +115,7 @@ pub fn frequency_response<P: PeriodicProblem + Clone>(
             "sweep bounds must be positive, finite and distinct".into(),
         ));
     }
-    let start: HbSolution =
-        ModifiedIhb::new(problem.clone(), hb.clone())?.solve(opts.from, None)?;
+    let start: HbSolution = ModifiedIhb::new(problem, hb.clone())?.solve(opts.from, None)?;
     let mut res = HbResidual::new(problem, hb)?;
     let m = res.len();
     let mut x0 = start.coeffs.clone();
@@ -112,8 +131,7 @@ pub fn frequency_response<P: PeriodicProblem + Clone>(
         direction,
         &copts,
         |_| true,
-    )
-    .map_err(|e| HbError::InvalidInput(format!("continuation start: {e}")))?;
+    )?;
     let mut analyzer = StabilityAnalyzer::new(
         problem,
         hb.harmonics,
@@ -148,9 +166,40 @@ pub fn frequency_response<P: PeriodicProblem + Clone>(
             coeffs: sol.coeffs,
         });
     }
+    let mut branch = HbBranch::new(problem, hb)?;
+    let mut folds = Vec::with_capacity(path.folds.len());
+    for turn in &path.folds {
+        let near = &points[turn.index];
+        let fold = match locate_fold(
+            &mut branch,
+            &near.coeffs,
+            near.omega_f,
+            &FoldOptions::default(),
+        ) {
+            Ok(f) => {
+                let (coeffs, omega_f) = (f.q, f.lambda);
+                res.aft_mut().synthesize(&coeffs[..l], &mut samples);
+                FrcFold {
+                    index: turn.index,
+                    omega_f,
+                    amplitude: samples.iter().fold(0.0f64, |a, v| a.max(v.abs())),
+                    coeffs,
+                    located: true,
+                }
+            }
+            Err(_) => FrcFold {
+                index: turn.index,
+                omega_f: turn.lambda,
+                amplitude: near.amplitude,
+                coeffs: near.coeffs.clone(),
+                located: false,
+            },
+        };
+        folds.push(fold);
+    }
     Ok(Frc {
         points,
-        folds: path.folds,
+        folds,
         termination: path.termination,
     })
 }

@@ -77,6 +77,28 @@ pub enum HbError {
     /// The iteration did not converge (carries the residual history).
     #[error("harmonic balance did not converge: {0}")]
     Solve(#[from] SolveError),
+    /// A limit-cycle iteration collapsed onto the equilibrium `x = 0`.
+    #[error("the iteration collapsed onto the equilibrium x = 0 (no limit cycle near the guess)")]
+    Equilibrium,
+    /// A continuation could not start (its first point or tangent failed).
+    #[error("continuation: {0}")]
+    Continuation(#[from] crate::continuation::ContinuationError),
+}
+
+/// A harmonic-balance solver for one problem and one size, reusable across
+/// solves: the modified IHB ([`crate::ModifiedIhb`], Broyden on the AFT
+/// residual) and the classic IHB ([`crate::ClassicIhb`], Newton with the
+/// Galerkin Jacobian) behind one interface.
+pub trait HbSolver {
+    /// Solves at excitation frequency `omega_f` from `guess`, or from the linear
+    /// solution (Eq. 59) when `None`.
+    ///
+    /// # Errors
+    /// [`HbError::InvalidInput`] for a bad frequency or guess, [`HbError::Solve`]
+    /// with the residual history when the iteration fails.
+    fn solve(&mut self, omega_f: f64, guess: Option<&[f64]>) -> Result<HbSolution, HbError>;
+    /// The options the solver was built with.
+    fn options(&self) -> &HbOptions;
 }
 
 /// A converged periodic solution.
@@ -194,6 +216,12 @@ pub struct HbResidual {
     gi: Vec<f64>,
     rg: Vec<f64>,
     exc: Vec<f64>,
+    /// Excitation phase θ = pτ of each sample.
+    thetas: Vec<f64>,
+    /// Sample-major copies for `nonlinear_samples` (multi-DOF only).
+    xt: Vec<f64>,
+    vt: Vec<f64>,
+    gt: Vec<f64>,
 }
 
 impl HbResidual {
@@ -220,6 +248,12 @@ impl HbResidual {
             gi: vec![0.0; nd],
             rg: vec![0.0; l],
             exc: vec![0.0; nd * l],
+            thetas: (0..ns)
+                .map(|i| opts.subharmonic as f64 * aft.tau(i))
+                .collect(),
+            xt: vec![0.0; if nd > 1 { nd * ns } else { 0 }],
+            vt: vec![0.0; if nd > 1 { nd * ns } else { 0 }],
+            gt: vec![0.0; if nd > 1 { nd * ns } else { 0 }],
             aft,
         };
         for i in 0..ns {
@@ -331,23 +365,27 @@ impl HbResidual {
                     .synthesize_derivative(qd, 1, &mut self.vs[d * ns..(d + 1) * ns]);
             }
         }
-        for i in 0..ns {
+        // g at all samples in one call, sample-major (`ns×n_dof`); for one DOF
+        // that is the synthesis layout itself.
+        if self.velocity {
+            self.vs.iter_mut().for_each(|v| *v *= omega);
+        } else {
+            self.vs.fill(0.0);
+        }
+        if nd == 1 {
+            problem.nonlinear_samples(&self.xs, &self.vs, &self.thetas, &mut self.gs);
+        } else {
             for d in 0..nd {
-                self.xi[d] = self.xs[d * ns + i];
-                self.vi[d] = if self.velocity {
-                    omega * self.vs[d * ns + i]
-                } else {
-                    0.0
-                };
+                for i in 0..ns {
+                    self.xt[i * nd + d] = self.xs[d * ns + i];
+                    self.vt[i * nd + d] = self.vs[d * ns + i];
+                }
             }
-            problem.nonlinear(
-                &self.xi,
-                &self.vi,
-                self.p as f64 * self.aft.tau(i),
-                &mut self.gi,
-            );
+            problem.nonlinear_samples(&self.xt, &self.vt, &self.thetas, &mut self.gt);
             for d in 0..nd {
-                self.gs[d * ns + i] = self.gi[d];
+                for i in 0..ns {
+                    self.gs[d * ns + i] = self.gt[i * nd + d];
+                }
             }
         }
         for d in 0..nd {
@@ -544,6 +582,11 @@ impl GalerkinJacobian {
             dgx: vec![0.0; nd * nd],
             dgv: vec![0.0; nd * nd],
         }
+    }
+
+    /// The quadrature basis table ([`HbResidual::fill_basis`]).
+    pub(crate) fn basis(&self) -> &[f64] {
+        &self.basis
     }
 
     /// Writes `Φ_q(q)` (row-major `m×m`) into `jac`; allocation-free when the problem

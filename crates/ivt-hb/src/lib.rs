@@ -4,10 +4,13 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod aft;
+pub mod autonomous;
 pub mod broyden;
 pub mod classic;
 pub mod continuation;
+mod dense;
 pub mod floquet;
+pub mod fold;
 pub mod frc;
 pub mod hill;
 pub mod ihb;
@@ -20,6 +23,7 @@ pub mod problem;
 pub mod stability;
 
 pub use aft::{Aft, AftError};
+pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
 pub use broyden::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
 };
@@ -29,9 +33,10 @@ pub use continuation::{
 };
 pub use faer::c64;
 pub use floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
-pub use frc::{frequency_response, Frc, FrcOptions, FrcPoint};
+pub use fold::{locate_fold, Branch, FoldLocation, FoldOptions, HbBranch};
+pub use frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
 pub use hill::{fourier_blocks, hill_multipliers, HillError, HillResult};
-pub use ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution};
+pub use ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution, HbSolver};
 pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;
 pub use problem::{Duffing, GeneralProblem, MathieuDuffing, PeriodicProblem};

@@ -6,7 +6,9 @@
 
 use crate::broyden::{broyden_solve, BroydenStats, BroydenWorkspace, System};
 use crate::continuation::{pseudo_arclength, ContinuationOptions};
-use crate::ihb::{validate_omega, GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution};
+use crate::ihb::{
+    validate_omega, GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution, HbSolver,
+};
 use crate::linalg::matvec;
 use crate::problem::PeriodicProblem;
 
@@ -293,5 +295,13 @@ impl<P: PeriodicProblem> System for HbSystem<'_, P> {
             .get_or_insert_with(|| GalerkinJacobian::new(res))
             .assemble(res, self.problem, q, self.omega_f, self.s, jac);
         jac.iter().all(|v| v.is_finite())
+    }
+}
+impl<P: PeriodicProblem> HbSolver for ModifiedIhb<P> {
+    fn solve(&mut self, omega_f: f64, guess: Option<&[f64]>) -> Result<HbSolution, HbError> {
+        ModifiedIhb::solve(self, omega_f, guess)
+    }
+    fn options(&self) -> &HbOptions {
+        &self.opts
     }
 }

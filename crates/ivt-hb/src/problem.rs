@@ -20,6 +20,17 @@ pub trait PeriodicProblem {
     /// Nonlinear and parametric forces `g(x, v, θ)` with `v = dx/dt` (physical
     /// time) and θ the excitation phase; written into `out` (`n_dof`).
     fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]);
+    /// `g` at `theta.len()` samples at once: `x`, `v` and `out` sample-major
+    /// (`samples×n_dof`, row-major), `theta` one phase per sample. The HB residual
+    /// calls this once per evaluation. Default: one [`Self::nonlinear`] call per
+    /// sample; override to vectorise (e.g. one call into an interpreter).
+    fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+        let n = self.n_dof();
+        for (i, &th) in theta.iter().enumerate() {
+            let s = i * n..(i + 1) * n;
+            self.nonlinear(&x[s.clone()], &v[s.clone()], th, &mut out[s]);
+        }
+    }
     /// External excitation `f(θ)` (right-hand side). Default: none.
     fn excitation(&self, _theta: f64, out: &mut [f64]) {
         out.fill(0.0);
@@ -277,6 +288,9 @@ impl<P: PeriodicProblem + ?Sized> PeriodicProblem for &P {
     }
     fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
         (**self).nonlinear(x, v, theta, out)
+    }
+    fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+        (**self).nonlinear_samples(x, v, theta, out)
     }
     fn excitation(&self, theta: f64, out: &mut [f64]) {
         (**self).excitation(theta, out)

@@ -112,7 +112,7 @@ fn near_the_folds() {
             .zip(&p.coeffs)
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
-        assert!(gap < 1e-7, "fold at {}: {gap:e}", f.lambda);
+        assert!(gap < 1e-7, "fold at {}: {gap:e}", f.omega_f);
     }
 }
 

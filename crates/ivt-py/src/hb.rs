@@ -1,19 +1,21 @@
-//! `ivt.hb`: the harmonic-balance engine of ivt-hb (modified/classic IHB,
-//! Floquet stability by Hsu's method, frequency-response curves) for Duffing,
-//! Mathieu–Duffing and user systems `M x'' + C x' + K x + g(x, x', θ) = f(θ)`.
+//! `ivt.hb`: the harmonic-balance engine of ivt-hb (modified/classic IHB, limit
+//! cycles, Floquet stability by Hsu's method, frequency-response curves with
+//! located folds) for Duffing, Mathieu–Duffing and user systems
+//! `M x'' + C x' + K x + g(x, x', θ) = f(θ)`.
 
 use ivt_hb::{
     frequency_response, ClassicIhb, Duffing, Floquet, FrcOptions, HbError, HbOptions, HbSolution,
-    HsuRule, MathieuDuffing, ModifiedIhb, PeriodicProblem, StabilityAnalyzer,
+    HbSolver, HsuRule, MathieuDuffing, ModifiedIhb, PeriodicProblem, StabilityAnalyzer,
 };
 use numpy::ndarray::Array1;
-use numpy::{IntoPyArray, PyArray1, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArray1};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use std::sync::{Arc, Mutex};
 use std::time::Instant;
+
+use crate::user_problem::{callback_error, user_problem};
 
 create_exception!(
     ivt,
@@ -40,6 +42,7 @@ fn hb_err(py: Python<'_>, e: HbError) -> PyErr {
             }
             err
         }
+        HbError::Continuation(_) => ConvergenceError::new_err(e.to_string()),
         _ => PyValueError::new_err(e.to_string()),
     }
 }
@@ -109,7 +112,7 @@ struct Solved {
 }
 
 /// Solve `problem` at `omega_f` and (optionally) its Floquet multipliers.
-fn solve_problem<P: PeriodicProblem + Clone>(
+fn solve_problem<P: PeriodicProblem>(
     problem: &P,
     opts: &HbOptions,
     method: Method,
@@ -118,12 +121,11 @@ fn solve_problem<P: PeriodicProblem + Clone>(
     stability: bool,
 ) -> Result<Solved, HbError> {
     let t0 = Instant::now();
-    let sol = match method {
-        Method::Modified => {
-            ModifiedIhb::new(problem.clone(), opts.clone())?.solve(omega_f, guess)?
-        }
-        Method::Classic => ClassicIhb::new(problem.clone(), opts.clone())?.solve(omega_f, guess)?,
+    let mut solver: Box<dyn HbSolver + '_> = match method {
+        Method::Modified => Box::new(ModifiedIhb::new(problem, opts.clone())?),
+        Method::Classic => Box::new(ClassicIhb::new(problem, opts.clone())?),
     };
+    let sol = solver.solve(omega_f, guess)?;
     let solve_time_s = t0.elapsed().as_secs_f64();
     let floquet = if stability {
         let mut an =
@@ -274,6 +276,42 @@ fn mathieu_duffing<'py>(
     solved_dict(py, &solved)
 }
 
+/// Multipliers as `[[re, im], ...]`.
+fn pairs(mu: &[ivt_hb::c64]) -> Vec<[f64; 2]> {
+    mu.iter().map(|m| [m.re, m.im]).collect()
+}
+
+/// The dict of a traced curve: "points" [{"omega", "amplitude", "stable",
+/// "stability", "kind", "coeffs", "multipliers"}...], "termination", and the
+/// arrays omega, amplitude, stable for plotting ("folds" is set by the caller).
+fn frc_dict<'py>(py: Python<'py>, frc: &ivt_hb::Frc) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let points = PyList::empty(py);
+    for p in &frc.points {
+        let e = PyDict::new(py);
+        e.set_item("omega", p.omega_f)?;
+        e.set_item("amplitude", p.amplitude)?;
+        e.set_item("stable", p.stable())?;
+        e.set_item("stability", p.kind.name())?;
+        e.set_item("kind", p.kind.name())?;
+        e.set_item("coeffs", p.coeffs.clone().into_pyarray(py))?;
+        e.set_item("multipliers", pairs(&p.multipliers))?;
+        points.append(e)?;
+    }
+    d.set_item("points", points)?;
+    d.set_item("termination", format!("{:?}", frc.termination))?;
+    let col = |f: fn(&ivt_hb::FrcPoint) -> f64| -> Bound<'py, PyArray1<f64>> {
+        Array1::from_iter(frc.points.iter().map(f)).into_pyarray(py)
+    };
+    d.set_item("omega", col(|p| p.omega_f))?;
+    d.set_item("amplitude", col(|p| p.amplitude))?;
+    d.set_item(
+        "stable",
+        Array1::from_iter(frc.points.iter().map(|p| p.stable())).into_pyarray(py),
+    )?;
+    Ok(d)
+}
+
 /// Frequency-response curve of Duffing's equation by pseudo-arclength
 /// continuation in ω_f from `from_` to `to` (Fig. 29), with the Floquet
 /// verdict at every point. Returns {"points": [{"omega", "amplitude",
@@ -311,159 +349,10 @@ fn duffing_frc<'py>(
     let frc = py
         .detach(|| frequency_response(&problem, &opts, &frc_opts))
         .map_err(|e| hb_err(py, e))?;
-    let d = PyDict::new(py);
-    let points = PyList::empty(py);
-    for p in &frc.points {
-        let e = PyDict::new(py);
-        e.set_item("omega", p.omega_f)?;
-        e.set_item("amplitude", p.amplitude)?;
-        e.set_item("stable", p.stable())?;
-        e.set_item("stability", p.kind.name())?;
-        e.set_item("kind", p.kind.name())?;
-        points.append(e)?;
-    }
-    d.set_item("points", points)?;
-    let folds: Vec<f64> = frc.folds.iter().map(|f| f.lambda).collect();
+    let d = frc_dict(py, &frc)?;
+    let folds: Vec<f64> = frc.folds.iter().map(|f| f.omega_f).collect();
     d.set_item("folds", folds)?;
-    d.set_item("termination", format!("{:?}", frc.termination))?;
-    let col = |f: fn(&ivt_hb::FrcPoint) -> f64| -> Bound<'py, PyArray1<f64>> {
-        Array1::from_iter(frc.points.iter().map(f)).into_pyarray(py)
-    };
-    d.set_item("omega", col(|p| p.omega_f))?;
-    d.set_item("amplitude", col(|p| p.amplitude))?;
-    d.set_item(
-        "stable",
-        Array1::from_iter(frc.points.iter().map(|p| p.stable())).into_pyarray(py),
-    )?;
     Ok(d)
-}
-
-/// A user system whose nonlinearity g (and optional forcing f) are Python
-/// callables, called once per AFT sample with the GIL re-acquired.
-#[derive(Clone)]
-struct PyProblem {
-    n: usize,
-    m: Vec<f64>,
-    c: Vec<f64>,
-    k: Vec<f64>,
-    g: Arc<Py<PyAny>>,
-    f: Option<Arc<Py<PyAny>>>,
-    velocity_dependent: bool,
-    /// The first exception raised by a callback (the solver then sees NaN).
-    error: Arc<Mutex<Option<PyErr>>>,
-}
-
-impl PyProblem {
-    fn record(&self, e: PyErr) {
-        if let Ok(mut slot) = self.error.lock() {
-            if slot.is_none() {
-                *slot = Some(e);
-            }
-        }
-    }
-
-    /// Call `func(*args)` and write its n floats into `out` (NaN on error).
-    fn call_into(
-        &self,
-        func: &Py<PyAny>,
-        args: impl FnOnce(Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyTuple>>,
-        out: &mut [f64],
-    ) {
-        let n = self.n;
-        let r = Python::attach(|py| -> PyResult<()> {
-            let res = func.bind(py).call1(args(py)?)?;
-            let v: Vec<f64> = if let Ok(x) = res.extract::<f64>() {
-                vec![x]
-            } else {
-                res.extract()?
-            };
-            if v.len() != n {
-                return Err(PyValueError::new_err(format!(
-                    "callback returned {} values for n_dof = {n}",
-                    v.len()
-                )));
-            }
-            out.copy_from_slice(&v);
-            Ok(())
-        });
-        if let Err(e) = r {
-            self.record(e);
-            out.fill(f64::NAN);
-        }
-    }
-}
-
-impl PeriodicProblem for PyProblem {
-    fn n_dof(&self) -> usize {
-        self.n
-    }
-    fn mass(&self) -> &[f64] {
-        &self.m
-    }
-    fn damping(&self) -> &[f64] {
-        &self.c
-    }
-    fn stiffness(&self) -> &[f64] {
-        &self.k
-    }
-    fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
-        let g = Arc::clone(&self.g);
-        self.call_into(
-            &g,
-            |py| {
-                pyo3::types::PyTuple::new(
-                    py,
-                    [
-                        x.to_vec().into_pyarray(py).into_any(),
-                        v.to_vec().into_pyarray(py).into_any(),
-                        pyo3::types::PyFloat::new(py, theta).into_any(),
-                    ],
-                )
-            },
-            out,
-        );
-    }
-    fn excitation(&self, theta: f64, out: &mut [f64]) {
-        match &self.f {
-            Some(f) => {
-                let f = Arc::clone(f);
-                self.call_into(&f, |py| pyo3::types::PyTuple::new(py, [theta]), out);
-            }
-            None => out.fill(0.0),
-        }
-    }
-    fn velocity_dependent(&self) -> bool {
-        self.velocity_dependent
-    }
-}
-
-/// An n×n float64 matrix (array-like) as row-major data.
-fn matrix(name: &str, ob: &Bound<'_, PyAny>) -> PyResult<(usize, Vec<f64>)> {
-    // A scalar is a 1×1 matrix (single DOF).
-    let (n, data) = if let Ok(x) = ob.extract::<f64>() {
-        (1, vec![x])
-    } else {
-        let a = ob
-            .extract::<numpy::PyArrayLike2<'_, f64, numpy::AllowTypeChange>>()
-            .map_err(|_| {
-                PyTypeError::new_err(format!(
-                    "argument `{name}` must be a square matrix of floats"
-                ))
-            })?;
-        let shape = a.shape().to_vec();
-        if shape[0] != shape[1] || shape[0] == 0 {
-            return Err(PyValueError::new_err(format!(
-                "argument `{name}` must be square and non-empty, got shape {shape:?}"
-            )));
-        }
-        (shape[0], a.as_array().iter().copied().collect())
-    };
-    if let Some(bad) = data.iter().find(|v| !v.is_finite()) {
-        return Err(PyValueError::new_err(format!(
-            "argument `{name}` has a non-finite entry ({bad})"
-        )));
-    }
-    Ok((n, data))
 }
 
 /// Periodic solution of a user system `M x'' + C x' + K x + g(x, v, θ) = f(θ)`
@@ -473,6 +362,9 @@ fn matrix(name: &str, ob: &Bound<'_, PyAny>) -> PyResult<(usize, Vec<f64>)> {
 /// m, c, k: n_dof×n_dof matrices (a float for one DOF). g(x, v, theta) →
 /// n_dof floats (x, v numpy arrays of n_dof); f(theta) → n_dof floats (None:
 /// unforced). `velocity_dependent=False` when g ignores v (saves work).
+/// `vectorized=True`: g(x, v, theta) is called once per residual with x, v of
+/// shape (N, n_dof) and theta of shape (N,) for all N = 2·samples AFT
+/// samples, and returns (N, n_dof).
 /// Speed cost: g and f are Python callables called once per AFT sample and
 /// residual evaluation (2·samples calls per iteration, plus central
 /// differences for the stability Jacobian), each costing ~1–3 µs of
@@ -484,7 +376,7 @@ fn matrix(name: &str, ob: &Bound<'_, PyAny>) -> PyResult<(usize, Vec<f64>)> {
 #[pyo3(signature = (
     m, c, k, g, omega_f, f = None, n = 20, samples = 64, subharmonic = 1,
     method = "modified", guess = None, tol = 1e-10, stability = true,
-    velocity_dependent = true
+    velocity_dependent = true, vectorized = false
 ))]
 #[allow(clippy::too_many_arguments)]
 fn solve<'py>(
@@ -503,70 +395,183 @@ fn solve<'py>(
     tol: f64,
     stability: bool,
     velocity_dependent: bool,
+    vectorized: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (nm, m) = matrix("m", m)?;
-    let (nc, c) = matrix("c", c)?;
-    let (nk, k) = matrix("k", k)?;
-    if nm != nc || nm != nk {
-        return Err(PyValueError::new_err(format!(
-            "`m`, `c`, `k` must have the same size, got {nm}, {nc}, {nk}"
-        )));
-    }
-    if !g.is_callable() {
-        return Err(PyTypeError::new_err(
-            "argument `g` must be callable g(x, v, theta)",
-        ));
-    }
-    if let Some(f) = f {
-        if !f.is_callable() {
-            return Err(PyTypeError::new_err(
-                "argument `f` must be callable f(theta) or None",
-            ));
-        }
-    }
+    let problem = user_problem(m, c, k, g, f, velocity_dependent, vectorized)?;
     let opts = options(n, samples, subharmonic, tol)?;
     let meth = self::method(method)?;
     let guess = guess_vec(guess)?;
-    let problem = PyProblem {
-        n: nm,
-        m,
-        c,
-        k,
-        g: Arc::new(g.clone().unbind()),
-        f: f.map(|f| Arc::new(f.clone().unbind())),
-        velocity_dependent,
-        error: Arc::new(Mutex::new(None)),
-    };
     let result =
         py.detach(|| solve_problem(&problem, &opts, meth, omega_f, guess.as_deref(), stability));
-    if let Some(e) = problem.error.lock().ok().and_then(|mut s| s.take()) {
+    if let Some(e) = callback_error(&problem) {
         return Err(e);
     }
     let solved = result.map_err(|e| hb_err(py, e))?;
     solved_dict(py, &solved)
 }
 
+/// Frequency-response curve of a user system `M x'' + C x' + K x + g(x, v, θ)
+/// = f(θ)` (θ = ω_f t) by pseudo-arclength continuation in ω_f from
+/// `omega_from` to `omega_to`, Floquet multipliers (Hsu) at every point, and
+/// each fold located by Newton on the extended system (not bracketed).
+///
+/// m, c, k, g, f, velocity_dependent as in `solve` (f may be None);
+/// `vectorized=True`: g(x, v, theta) gets x, v of shape (N, n_dof) and theta
+/// of shape (N,) (all 2·samples AFT samples at once) and returns (N, n_dof).
+/// Returns {"points": [{"omega", "coeffs", "amplitude", "multipliers",
+/// "stable", "stability"}...], "folds": [{"omega", "amplitude", "coeffs",
+/// "located", "index" (path point nearest the turn)}...], "bifurcations": [{"kind": "fold", "omega"}...],
+/// "termination"} and the arrays omega, amplitude, stable. amplitude is
+/// max |x_0| over the AFT samples (DOF 0). GIL released between callbacks.
+#[pyfunction]
+#[pyo3(signature = (
+    m, c, k, g, f, omega_from, omega_to, n = 20, samples = 64, tol = 1e-10,
+    velocity_dependent = true, vectorized = false
+))]
+#[allow(clippy::too_many_arguments, clippy::field_reassign_with_default)]
+fn frc<'py>(
+    py: Python<'py>,
+    m: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+    k: &Bound<'py, PyAny>,
+    g: &Bound<'py, PyAny>,
+    f: Option<&Bound<'py, PyAny>>,
+    omega_from: f64,
+    omega_to: f64,
+    n: usize,
+    samples: usize,
+    tol: f64,
+    velocity_dependent: bool,
+    vectorized: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let problem = user_problem(m, c, k, g, f, velocity_dependent, vectorized)?;
+    let opts = options(n, samples, 1, tol)?;
+    let mut frc_opts = FrcOptions::default();
+    frc_opts.from = finite("omega_from", omega_from)?;
+    frc_opts.to = finite("omega_to", omega_to)?;
+    frc_opts.stability_steps = stability_steps(n);
+    let result = py.detach(|| frequency_response(&problem, &opts, &frc_opts));
+    if let Some(e) = callback_error(&problem) {
+        return Err(e);
+    }
+    let frc = result.map_err(|e| hb_err(py, e))?;
+    let d = frc_dict(py, &frc)?;
+    let folds = PyList::empty(py);
+    let bifurcations = PyList::empty(py);
+    for fold in &frc.folds {
+        let e = PyDict::new(py);
+        e.set_item("omega", fold.omega_f)?;
+        e.set_item("amplitude", fold.amplitude)?;
+        e.set_item("coeffs", fold.coeffs.clone().into_pyarray(py))?;
+        e.set_item("located", fold.located)?;
+        e.set_item("index", fold.index)?;
+        folds.append(e)?;
+        let b = PyDict::new(py);
+        b.set_item("kind", "fold")?;
+        b.set_item("omega", fold.omega_f)?;
+        bifurcations.append(b)?;
+    }
+    d.set_item("folds", folds)?;
+    d.set_item("bifurcations", bifurcations)?;
+    Ok(d)
+}
+
+/// Limit cycle of an autonomous user system `M x'' + C x' + K x + g(x, v) = 0`
+/// by harmonic balance with the response frequency ω as an unknown and the
+/// phase condition b1 = 0 on DOF 0 (Newton with the Galerkin Jacobian).
+///
+/// The start is `guess` (coefficients, n_dof blocks of [a0, a1..an, b1..bn])
+/// or, by default, x_0 = `amplitude`·cos τ. g(x, v, theta): theta is the
+/// phase ω t (an autonomous g ignores it); `vectorized` as in `frc`.
+/// Returns {"omega", "period", "coeffs", "multipliers" ([[re, im], ...],
+/// the trivial +1 included), "stable" (all others inside the unit circle),
+/// "stability", "iterations", "residual_norm"}.
+#[pyfunction]
+#[pyo3(signature = (
+    m, c, k, g, omega_guess, amplitude = 1.0, guess = None, n = 20, samples = 64,
+    tol = 1e-10, velocity_dependent = true, vectorized = false
+))]
+#[allow(clippy::too_many_arguments)]
+fn limit_cycle<'py>(
+    py: Python<'py>,
+    m: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+    k: &Bound<'py, PyAny>,
+    g: &Bound<'py, PyAny>,
+    omega_guess: f64,
+    amplitude: f64,
+    guess: Option<&Bound<'py, PyAny>>,
+    n: usize,
+    samples: usize,
+    tol: f64,
+    velocity_dependent: bool,
+    vectorized: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let problem = user_problem(m, c, k, g, None, velocity_dependent, vectorized)?;
+    let opts = options(n, samples, 1, tol)?;
+    let start = match guess_vec(guess)? {
+        Some(q) => q,
+        None => {
+            let mut q = vec![0.0; problem.n * (2 * n + 1)];
+            q[1] = finite("amplitude", amplitude)?;
+            q
+        }
+    };
+    let result =
+        py.detach(|| ivt_hb::limit_cycle(&problem, &opts, omega_guess, &start, stability_steps(n)));
+    if let Some(e) = callback_error(&problem) {
+        return Err(e);
+    }
+    let lc = result.map_err(|e| hb_err(py, e))?;
+    let d = PyDict::new(py);
+    d.set_item("omega", lc.omega())?;
+    d.set_item("period", lc.period())?;
+    d.set_item("coeffs", lc.solution.coeffs.clone().into_pyarray(py))?;
+    d.set_item("multipliers", pairs(&lc.multipliers))?;
+    d.set_item("stable", lc.stable())?;
+    d.set_item("stability", lc.kind.name())?;
+    d.set_item("iterations", lc.solution.stats.iterations)?;
+    d.set_item("residual_norm", lc.solution.stats.residual_norm)?;
+    Ok(d)
+}
+
 /// Evaluate the Fourier series u(τ) = a0/2 + Σ a_k cos kτ + b_k sin kτ of
 /// coefficients [a0, a1..an, b1..bn] at τ (array-like), or its `order`-th
-/// τ-derivative.
+/// τ-derivative. With `n_dof` > 1, `coeffs` holds n_dof such blocks (the
+/// layout of every multi-DOF result) and the result gains a last axis of
+/// length n_dof (u_d(τ) for each DOF).
 #[pyfunction]
-#[pyo3(signature = (coeffs, tau, order = 0))]
+#[pyo3(signature = (coeffs, tau, order = 0, n_dof = 1))]
 fn eval_series<'py>(
     py: Python<'py>,
     coeffs: numpy::PyArrayLike1<'py, f64, numpy::AllowTypeChange>,
     tau: &Bound<'py, PyAny>,
     order: u32,
+    n_dof: usize,
 ) -> PyResult<Bound<'py, PyAny>> {
     let q = coeffs.as_array().to_vec();
-    if q.len().is_multiple_of(2) {
+    if n_dof == 0 || !q.len().is_multiple_of(n_dof) || (q.len() / n_dof).is_multiple_of(2) {
         return Err(PyValueError::new_err(format!(
-            "argument `coeffs` must have 2n+1 entries, got {}",
+            "argument `coeffs` must have n_dof·(2n+1) entries for n_dof = {n_dof}, got {}",
             q.len()
         )));
     }
-    crate::vectorize::map1(py, [("tau", tau)], |[t]| {
-        ivt_hb::aft::eval_series(&q, t, order)
-    })
+    if n_dof == 1 {
+        return crate::vectorize::map1(py, [("tau", tau)], |[t]| {
+            ivt_hb::aft::eval_series(&q, t, order)
+        });
+    }
+    let l = q.len() / n_dof;
+    let per_dof = (0..n_dof)
+        .map(|d| {
+            let block = &q[d * l..(d + 1) * l];
+            crate::vectorize::map1(py, [("tau", tau)], |[t]| {
+                ivt_hb::aft::eval_series(block, t, order)
+            })
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    let np = py.import("numpy")?;
+    np.call_method1("stack", (per_dof, -1))
 }
 
 /// Register `ivt._ivt.hb`.
@@ -577,6 +582,8 @@ pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(duffing_frc, &m)?)?;
     m.add_function(wrap_pyfunction!(mathieu_duffing, &m)?)?;
     m.add_function(wrap_pyfunction!(solve, &m)?)?;
+    m.add_function(wrap_pyfunction!(frc, &m)?)?;
+    m.add_function(wrap_pyfunction!(limit_cycle, &m)?)?;
     m.add_function(wrap_pyfunction!(eval_series, &m)?)?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     parent.add_submodule(&m)

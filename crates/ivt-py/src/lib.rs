@@ -16,6 +16,7 @@ mod gears;
 mod hb;
 mod kin;
 mod sim;
+mod user_problem;
 mod vectorize;
 
 /// The native module; the public API is re-exported by the `ivt` package.

@@ -123,6 +123,8 @@ def test_frc_folds_and_flags() -> None:
     # Hardening peak: the path turns twice (two folds), and the branch between
     # them is unstable (a multiplier crosses +1 at each fold).
     assert len(frc["folds"]) == 2
+    # Located by the extended system: the shooting folds (ivt-hb tests/frc.rs).
+    assert frc["folds"] == pytest.approx([1.6548121, 1.1687244], abs=1e-7)
     assert (~stable).sum() > 0 and stable[0] and stable[-1]
     # Far below resonance, two-term perturbation balance: (α − ω²)A1 + ¾εA1³ = F and
     # (α − 9ω²)A3 = −εA1³/4 (cos³ = ¾cos + ¼cos 3); peak A1 + A3. The neglected
@@ -196,3 +198,132 @@ def test_gil_released_during_a_solve() -> None:
 # scheduling latency of a loaded machine) for the handshake above.
 GIL_CALL_N = 30
 GIL_CALL_SAMPLES = 128
+
+
+def chain_2dof():  # type: ignore[no-untyped-def]
+    """The 2-DOF cubic chain: M = I, K = [[2, −1], [−1, 2]], C = 0.02 I,
+    g = [0.5 x1³, 0], f = [0.1 cos θ, 0]."""
+    m = np.eye(2)
+    c = 0.02 * np.eye(2)
+    k = np.array([[2.0, -1.0], [-1.0, 2.0]])
+
+    def g(x: np.ndarray, v: np.ndarray, th: np.ndarray) -> np.ndarray:
+        out = np.zeros_like(x)
+        out[:, 0] = 0.5 * x[:, 0] ** 3
+        return out
+
+    def f(th: float) -> list:  # type: ignore[type-arg]
+        return [0.1 * np.cos(th), 0.0]
+
+    return m, c, k, g, f
+
+
+def shooting_fold_2dof(y0: np.ndarray, w0: float) -> float:
+    """ω_f of the fold of the 2-DOF chain by shooting on scipy's DOP853
+    (rtol 1e-12): unknowns (x(0), v(0), ω_f), residual [y(T) − y(0),
+    det(Φ(T) − I)] with Φ the variational matrix; Newton with central
+    differences, started from `y0`, `w0`."""
+    m, c, k, _, _ = chain_2dof()
+
+    def rhs(t: float, y: np.ndarray, w: float) -> np.ndarray:
+        x, v, phi = y[:2], y[2:4], y[4:].reshape(4, 4)
+        gx = np.array([0.5 * x[0] ** 3, 0.0])
+        acc = np.array([0.1 * np.cos(w * t), 0.0]) - c @ v - k @ x - gx
+        dg = np.array([[1.5 * x[0] ** 2, 0.0], [0.0, 0.0]])
+        a = np.block([[np.zeros((2, 2)), np.eye(2)], [-(k + dg), -c]])
+        return np.concatenate([v, acc, (a @ phi).ravel()])
+
+    def residual(z: np.ndarray) -> np.ndarray:
+        w = z[4]
+        sol = solve_ivp(
+            rhs, (0.0, 2 * np.pi / w), np.concatenate([z[:4], np.eye(4).ravel()]),
+            method="DOP853", rtol=1e-12, atol=1e-14, args=(w,),
+        )
+        yt = sol.y[:, -1]
+        phi = yt[4:].reshape(4, 4)
+        return np.concatenate([yt[:4] - z[:4], [np.linalg.det(phi - np.eye(4))]])
+
+    z = np.concatenate([y0, [w0]])
+    for _ in range(20):
+        r = residual(z)
+        jac = np.empty((5, 5))
+        for j in range(5):
+            h = 1e-6 * max(abs(z[j]), 1e-2)
+            zp, zm = z.copy(), z.copy()
+            zp[j] += h
+            zm[j] -= h
+            jac[:, j] = (residual(zp) - residual(zm)) / (2 * h)
+        step = np.linalg.solve(jac, -r)
+        z += step
+        if np.abs(step).max() < 1e-11:
+            return float(z[4])
+    raise AssertionError(f"shooting fold did not converge: {z}")
+
+
+def test_2dof_chain_frc_folds_match_shooting_with_vectorized_g() -> None:
+    m, c, k, g, f = chain_2dof()
+    calls = {"n": 0}
+
+    def g_counted(x: np.ndarray, v: np.ndarray, th: np.ndarray) -> np.ndarray:
+        calls["n"] += 1
+        assert x.shape == (128, 2) or x.shape == (1, 2), x.shape
+        assert th.shape == (x.shape[0],)
+        return g(x, v, th)  # type: ignore[no-any-return]
+
+    frc = hb.frc(m, c, k, g_counted, f, 0.5, 1.6, n=15, samples=64,
+                 velocity_dependent=False, vectorized=True)
+    folds = frc["folds"]
+    assert len(folds) == 2, [fd["omega"] for fd in folds]
+    assert all(fd["located"] for fd in folds)
+    assert [b["kind"] for b in frc["bifurcations"]] == ["fold", "fold"]
+    p0 = frc["points"][0]
+    assert set(p0) >= {"omega", "coeffs", "amplitude", "multipliers", "stable"}
+    assert len(p0["coeffs"]) == 2 * 31
+    for fd in folds:
+        q = fd["coeffs"]
+        x0 = hb.eval_series(q, 0.0, n_dof=2)
+        v0 = fd["omega"] * hb.eval_series(q, 0.0, order=1, n_dof=2)
+        ref = shooting_fold_2dof(np.concatenate([x0, v0]), fd["omega"])
+        assert abs(fd["omega"] - ref) < 1e-6, (fd["omega"], ref)
+    # Stability flips exactly at the folds: each change of the flag is at one
+    # of the two path points next to a fold's turn.
+    stable = frc["stable"]
+    switches = [i for i in range(1, len(stable)) if stable[i] != stable[i - 1]]
+    assert len(switches) == 2, switches
+    for s, fd in zip(switches, folds):
+        assert s in (fd["index"], fd["index"] + 1), (s, fd["index"])
+
+
+def test_van_der_pol_limit_cycle_period_against_time_integration() -> None:
+    mu = 1.0
+
+    def g(x: np.ndarray, v: np.ndarray, th: np.ndarray) -> np.ndarray:
+        return mu * x**2 * v  # type: ignore[no-any-return]
+
+    lc = hb.limit_cycle(1.0, -mu, 1.0, g, 1.0, amplitude=2.0, n=30, samples=120, vectorized=True)
+
+    # Period from time integration: successive upward zero crossings of x on the
+    # attracting cycle (DOP853, rtol 1e-12, events located by scipy).
+    def rhs(t: float, y: np.ndarray) -> np.ndarray:
+        return np.array([y[1], mu * (1 - y[0] ** 2) * y[1] - y[0]])
+
+    def up(t: float, y: np.ndarray) -> float:
+        return float(y[0])
+
+    up.direction = 1  # type: ignore[attr-defined]
+    sol = solve_ivp(rhs, (0.0, 200.0), [2.0, 0.0], method="DOP853", rtol=1e-12, atol=1e-14, events=up)
+    crossings = sol.t_events[0]
+    period = crossings[-1] - crossings[-2]
+    assert lc["period"] == pytest.approx(period, rel=1e-8)
+    assert lc["stable"] and lc["stability"] == "stable"
+    mu0 = complex(*lc["multipliers"][0])
+    assert abs(mu0 - 1) < 1e-6
+
+
+def test_eval_series_multi_dof_layout() -> None:
+    # Two DOFs, n = 1: x0 = 1/2 + cos τ, x1 = −sin τ.
+    q = np.array([1.0, 1.0, 0.0, 0.0, 0.0, -1.0])
+    got = hb.eval_series(q, np.array([0.0, np.pi / 2]), n_dof=2)
+    np.testing.assert_allclose(got, [[1.5, 0.0], [0.5, -1.0]], atol=1e-15)
+    with pytest.raises(ValueError, match="n_dof"):
+        hb.eval_series(q, 0.0, n_dof=4)

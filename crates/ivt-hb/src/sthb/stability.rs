@@ -21,20 +21,10 @@ use realfft::num_complex::Complex;
 use super::toeplitz::{add_real_toeplitz, BlockLayout, PeriodicSpectrum};
 use super::{SthbError, StringHb};
 
-/// How a periodic response is (un)stable; the unstable kinds name the
-/// multiplier that left the unit circle (SPEC: fold +1, period doubling −1,
-/// Neimark–Sacker complex pair).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum StabilityKind {
-    /// All multipliers inside the unit circle.
-    Stable,
-    /// A real multiplier `> 1` (the branch between two folds).
-    Fold,
-    /// A real multiplier `< −1`.
-    PeriodDoubling,
-    /// A complex pair outside the unit circle.
-    NeimarkSacker,
-}
+/// The stability classes of the engine ([`crate::stability::classify`]): the
+/// unstable kinds name the multiplier that left the unit circle (fold +1,
+/// period doubling −1, Neimark–Sacker complex pair).
+pub use crate::stability::StabilityKind;
 
 /// Which method produced a verdict.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -63,19 +53,8 @@ impl Stability {
     }
 
     fn from_multiplier(mu: Complex<f64>, method: StabilityMethod) -> Self {
-        let kind = if mu.norm() < 1.0 {
-            StabilityKind::Stable
-        } else if mu.im.abs() <= 1e-7 * mu.norm() {
-            if mu.re > 0.0 {
-                StabilityKind::Fold
-            } else {
-                StabilityKind::PeriodDoubling
-            }
-        } else {
-            StabilityKind::NeimarkSacker
-        };
         Self {
-            kind,
+            kind: crate::stability::classify(&[mu]),
             critical: mu,
             method,
         }

@@ -11,6 +11,7 @@ from ._types import ArrayLike, FloatArray
 Method = Literal["modified", "classic"]
 Matrix = Union[float, npt.ArrayLike]
 Callback = Callable[[FloatArray, FloatArray, float], Union[float, Sequence[float], FloatArray]]
+VectorizedCallback = Callable[[FloatArray, FloatArray, FloatArray], npt.ArrayLike]
 Forcing = Callable[[float], Union[float, Sequence[float], FloatArray]]
 
 class ConvergenceError(RuntimeError):
@@ -69,8 +70,37 @@ def solve(
     tol: float = 1e-10,
     stability: bool = True,
     velocity_dependent: bool = True,
+    vectorized: bool = False,
+) -> Dict[str, Any]: ...
+def frc(
+    m: Matrix,
+    c: Matrix,
+    k: Matrix,
+    g: Union[Callback, VectorizedCallback],
+    f: Optional[Forcing],
+    omega_from: float,
+    omega_to: float,
+    n: int = 20,
+    samples: int = 64,
+    tol: float = 1e-10,
+    velocity_dependent: bool = True,
+    vectorized: bool = False,
+) -> Dict[str, Any]: ...
+def limit_cycle(
+    m: Matrix,
+    c: Matrix,
+    k: Matrix,
+    g: Union[Callback, VectorizedCallback],
+    omega_guess: float,
+    amplitude: float = 1.0,
+    guess: Optional[ArrayLike] = None,
+    n: int = 20,
+    samples: int = 64,
+    tol: float = 1e-10,
+    velocity_dependent: bool = True,
+    vectorized: bool = False,
 ) -> Dict[str, Any]: ...
 @overload
-def eval_series(coeffs: ArrayLike, tau: float, order: int = 0) -> float: ...
+def eval_series(coeffs: ArrayLike, tau: float, order: int = 0, n_dof: Literal[1] = 1) -> float: ...
 @overload
-def eval_series(coeffs: ArrayLike, tau: ArrayLike, order: int = 0) -> FloatArray: ...
+def eval_series(coeffs: ArrayLike, tau: ArrayLike, order: int = 0, n_dof: int = 1) -> FloatArray: ...

@@ -1,0 +1,118 @@
+//! Unit tests of the Broyden solver and its workspace updates.
+
+use super::*;
+
+#[test]
+fn solves_a_small_nonlinear_system_from_identity() {
+    // x² + y² = 4, x − y = 0  →  x = y = √2.
+    let mut f = |x: &[f64], r: &mut [f64]| {
+        r[0] = x[0] * x[0] + x[1] * x[1] - 4.0;
+        r[1] = x[0] - x[1];
+    };
+    let mut ws = BroydenWorkspace::new(2);
+    ws.set_jacobian(&[2.0, 2.0, 1.0, -1.0]).unwrap();
+    let mut x = [1.0, 1.0];
+    let stats = broyden_solve(&mut f, &mut x, &mut ws, &BroydenOptions::default()).unwrap();
+    assert!((x[0] - 2f64.sqrt()).abs() < 1e-10 && (x[1] - 2f64.sqrt()).abs() < 1e-10);
+    assert!(stats.residual_norm <= 1e-10);
+}
+
+#[test]
+fn finite_difference_start_and_exact_row_is_kept() {
+    // Rosenbrock-like: r0 = 10(y − x²), r1 = 1 − x; the second row is linear.
+    let mut f = |x: &[f64], r: &mut [f64]| {
+        r[0] = 10.0 * (x[1] - x[0] * x[0]);
+        r[1] = 1.0 - x[0];
+    };
+    let mut ws = BroydenWorkspace::new(2);
+    ws.exact_rows = 1..2;
+    let mut x = [-1.2, 1.0];
+    broyden_solve(&mut f, &mut x, &mut ws, &BroydenOptions::default()).unwrap();
+    assert!((x[0] - 1.0).abs() < 1e-9 && (x[1] - 1.0).abs() < 1e-9);
+    // Exact row −1, 0 survives all updates bit-for-bit after the FD start.
+    let b = ws.jacobian();
+    assert!((b[2] + 1.0).abs() < 1e-6 && b[3].abs() < 1e-6);
+}
+
+/// A 6-unknown cubic system with a known root (x = 1): diagonally dominant
+/// linear part plus cubic coupling, solved from an identity-scaled start so
+/// that Broyden needs several updates and some damped steps.
+fn cubic_system(x: &[f64], r: &mut [f64]) {
+    let n = x.len();
+    for i in 0..n {
+        let lin = 4.0 * x[i] - x[(i + 1) % n] - x[(i + n - 1) % n];
+        let cub = 0.5 * (x[i] * x[i] * x[i] - 1.0) + 0.2 * (x[i] * x[(i + 1) % n] - 1.0);
+        r[i] = lin - 2.0 + cub;
+    }
+}
+
+#[test]
+fn untracked_mode_matches_tracked_and_rebuilds_b_on_demand() {
+    // The untracked update uses B s = −t r instead of the product with B; in exact
+    // arithmetic both modes take identical steps, so the iterates, the step
+    // count and the final B agree to rounding (tolerances: 1e-12 on x at a
+    // 1e-13 residual, 1e-8 relative on B after a dozen rank-one updates).
+    let solve = |track: bool| {
+        let mut ws = BroydenWorkspace::new(6);
+        ws.track_jacobian = track;
+        let b0: Vec<f64> = (0..36)
+            .map(|k| if k % 7 == 0 { 5.0 } else { 0.0 })
+            .collect();
+        ws.set_jacobian(&b0).unwrap();
+        // x − 1 = 3·(1, −1, ½, 1, −0.7, 0.3): far enough for damped steps.
+        let mut x = [4.0, -2.0, 2.5, 4.0, -1.1, 1.9];
+        let opts = BroydenOptions::default().with_tol(1e-13);
+        let stats = broyden_solve(&mut cubic_system, &mut x, &mut ws, &opts).unwrap();
+        (x, stats, ws.jacobian().to_vec())
+    };
+    let (x_t, st_t, b_t) = solve(true);
+    let (x_u, st_u, b_u) = solve(false);
+    // Several updates, and at least one damped (t < 1) step among them.
+    assert!(
+        st_t.iterations >= 6,
+        "too easy to test the update: {st_t:?}"
+    );
+    assert!(
+        st_t.residual_evals > st_t.iterations + 1,
+        "no damped step: {st_t:?}"
+    );
+    assert_eq!(st_t.iterations, st_u.iterations);
+    assert_eq!(st_t.jacobian_refreshes, 0);
+    for (a, b) in x_t.iter().zip(&x_u) {
+        assert!(
+            (a - 1.0).abs() < 1e-12 && (b - 1.0).abs() < 1e-12,
+            "{x_t:?} {x_u:?}"
+        );
+    }
+    let scale = b_t.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for (a, b) in b_t.iter().zip(&b_u) {
+        assert!((a - b).abs() <= 1e-8 * scale, "B differs: {a} vs {b}");
+    }
+}
+
+#[test]
+fn non_convergence_carries_history() {
+    // x² + 1 = 0 has no real root.
+    let mut f = |x: &[f64], r: &mut [f64]| r[0] = x[0] * x[0] + 1.0;
+    let mut ws = BroydenWorkspace::new(1);
+    let mut x = [0.3];
+    let err = broyden_solve(
+        &mut f,
+        &mut x,
+        &mut ws,
+        &BroydenOptions::default().with_max_iter(30),
+    )
+    .unwrap_err();
+    assert!(!err.history().is_empty(), "{err}");
+}
+
+#[test]
+fn nan_input_is_an_error() {
+    let mut f = |x: &[f64], r: &mut [f64]| r[0] = x[0];
+    let mut ws = BroydenWorkspace::new(1);
+    let mut x = [f64::NAN];
+    assert!(matches!(
+        broyden_solve(&mut f, &mut x, &mut ws, &BroydenOptions::default()),
+        Err(SolveError::NonFinite { .. })
+    ));
+}

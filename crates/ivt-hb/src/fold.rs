@@ -1,0 +1,564 @@
+//! Folds (turning points) of a solution branch `R(q, λ) = 0`, located by Newton's
+//! method on the minimally extended system (Govaerts' bordering)
+//!
+//! `R(q, λ) = 0`,  `g(q, λ) = 0`,  where  `[[J, b], [cᵀ, 0]] [v; g] = [0; 1]`,
+//!
+//! `J = ∂R/∂q`. `g` vanishes exactly where `J` is singular, and for borders `b`, `c`
+//! near the left and right null vectors the bordered matrix stays regular there, so
+//! Newton on `{q, λ}` converges quadratically to the fold itself (not to a bracket
+//! between two path points). `∂g/∂(q, λ) = −wᵀ J_(q, λ) v` with `w` from the
+//! transposed bordered system ([`Branch::jacobian_gradient`], and a central
+//! difference of [`Branch::bilinear`] in λ); `∂R/∂λ` by central differences. One
+//! Jacobian per Newton step.
+//!
+//! [`HbBranch`] is the harmonic-balance residual (Eq. 61) in λ = ω_f with the exact
+//! Galerkin Jacobian (Eq. 56), the branch of a frequency-response curve.
+
+use crate::broyden::SolveError;
+use crate::dense::{norm2, solve_dense};
+use crate::ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual};
+use crate::problem::PeriodicProblem;
+
+/// A one-parameter family of square systems `R(q, λ) = 0` with `∂R/∂q`.
+pub trait Branch {
+    /// Number of unknowns `m` (λ excluded).
+    fn len(&self) -> usize;
+    /// True for a branch without unknowns.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// `R(q, λ)` into `r` (`m`).
+    fn residual(&mut self, q: &[f64], lambda: f64, r: &mut [f64]);
+    /// `∂R/∂q` at `(q, λ)`, row-major `m×m`, into `jac`.
+    fn jacobian(&mut self, q: &[f64], lambda: f64, jac: &mut [f64]);
+    /// `wᵀ J(q, λ) v`. Default: from an assembled [`Self::jacobian`].
+    fn bilinear(&mut self, q: &[f64], lambda: f64, w: &[f64], v: &[f64]) -> f64 {
+        let m = q.len();
+        let mut jac = vec![0.0; m * m];
+        self.jacobian(q, lambda, &mut jac);
+        bilinear_form(&jac, w, v)
+    }
+    /// `∂/∂q (wᵀ J(q, λ) v)` into `out` (`m`): the gradient of the fold test
+    /// function is `−` this at the bordered solutions `v`, `w`. Default:
+    /// [`fd_jacobian_gradient`] (2m Jacobians); override with a cheaper form.
+    fn jacobian_gradient(&mut self, q: &[f64], lambda: f64, w: &[f64], v: &[f64], out: &mut [f64])
+    where
+        Self: Sized,
+    {
+        fd_jacobian_gradient(self, q, lambda, w, v, 1e-6, out);
+    }
+}
+
+/// `wᵀ A v` for a row-major square `A`.
+fn bilinear_form(a: &[f64], w: &[f64], v: &[f64]) -> f64 {
+    a.chunks_exact(v.len())
+        .zip(w)
+        .map(|(row, wi)| wi * row.iter().zip(v).map(|(x, y)| x * y).sum::<f64>())
+        .sum()
+}
+
+/// `∂/∂q (wᵀ J v)` by central differences of [`Branch::jacobian`], steps
+/// `fd_step·max(|q_k|, ‖q‖∞)`.
+pub fn fd_jacobian_gradient<B: Branch>(
+    branch: &mut B,
+    q: &[f64],
+    lambda: f64,
+    w: &[f64],
+    v: &[f64],
+    fd_step: f64,
+    out: &mut [f64],
+) {
+    let m = q.len();
+    let mut jac = vec![0.0; m * m];
+    let mut qt = q.to_vec();
+    let q_scale = q.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    let mut wjv = |branch: &mut B, qt: &[f64]| {
+        branch.jacobian(qt, lambda, &mut jac);
+        bilinear_form(&jac, w, v)
+    };
+    for k in 0..m {
+        let h = fd_step * q[k].abs().max(q_scale).max(f64::MIN_POSITIVE);
+        qt[k] = q[k] + h;
+        let plus = wjv(branch, &qt);
+        qt[k] = q[k] - h;
+        let minus = wjv(branch, &qt);
+        qt[k] = q[k];
+        out[k] = (plus - minus) / (2.0 * h);
+    }
+}
+
+/// The HB residual Eq. 61 of `problem` as a branch in the excitation frequency ω_f.
+pub struct HbBranch<'a, P> {
+    problem: &'a P,
+    res: HbResidual,
+    galerkin: GalerkinJacobian,
+}
+
+impl<'a, P: PeriodicProblem> HbBranch<'a, P> {
+    /// Plans the residual and the Galerkin quadrature.
+    ///
+    /// # Errors
+    /// As [`HbResidual::new`].
+    pub fn new(problem: &'a P, opts: &HbOptions) -> Result<Self, HbError> {
+        let res = HbResidual::new(problem, opts)?;
+        let galerkin = GalerkinJacobian::new(&res);
+        Ok(Self {
+            problem,
+            res,
+            galerkin,
+        })
+    }
+}
+
+impl<P: PeriodicProblem> Branch for HbBranch<'_, P> {
+    fn len(&self) -> usize {
+        self.res.len()
+    }
+    fn residual(&mut self, q: &[f64], lambda: f64, r: &mut [f64]) {
+        self.res.eval(self.problem, q, lambda, 1.0, r);
+    }
+    fn jacobian(&mut self, q: &[f64], lambda: f64, jac: &mut [f64]) {
+        self.galerkin
+            .assemble(&mut self.res, self.problem, q, lambda, 1.0, jac);
+    }
+    /// `wᵀL(ω)v` exactly plus the quadrature of the nonlinear part (see
+    /// [`HbBranch::quadrature`]): no `J` is assembled.
+    fn bilinear(&mut self, q: &[f64], lambda: f64, w: &[f64], v: &[f64]) -> f64 {
+        let omega = lambda / self.res.subharmonic() as f64;
+        let mut lv = vec![0.0; v.len()];
+        self.res.apply_linear(self.problem, v, omega, &mut lv);
+        let linear: f64 = w.iter().zip(&lv).map(|(a, b)| a * b).sum();
+        linear + self.quadrature(q, lambda, w, v, None)
+    }
+    /// `L` does not depend on `q`: the gradient is that of the quadrature.
+    fn jacobian_gradient(&mut self, q: &[f64], lambda: f64, w: &[f64], v: &[f64], out: &mut [f64]) {
+        self.quadrature(q, lambda, w, v, Some(out));
+    }
+}
+
+impl<P: PeriodicProblem> HbBranch<'_, P> {
+    /// The nonlinear part of `wᵀJv` without assembling `J`: `(2/2N) Σᵢ ψᵢ` with
+    /// `ψᵢ = w̃ᵀ(G_x ṽ + ω G_v ṽ')` at sample τᵢ (`w̃`, `ṽ`, `ṽ'` the syntheses of
+    /// `w`, `v` and `v'`, Eq. 56's quadrature). With `grad`, also its gradient in
+    /// `q`: `∂ψᵢ/∂x`, `∂ψᵢ/∂ẋ` by central differences of `∂g` (steps relative to
+    /// the orbit's scale) projected back on the basis — O(2N·m), where
+    /// differencing assembled Jacobians would cost 2m assemblies.
+    fn quadrature(
+        &mut self,
+        q: &[f64],
+        lambda: f64,
+        w: &[f64],
+        v: &[f64],
+        mut grad: Option<&mut [f64]>,
+    ) -> f64 {
+        let nd = self.problem.n_dof();
+        let l = q.len() / nd;
+        let basis = self.galerkin.basis();
+        let ns = basis.len() / (2 * l);
+        let p = self.res.subharmonic() as f64;
+        let omega = lambda / p;
+        let velocity = self.problem.velocity_dependent();
+        let synth = |c: &[f64], row: &[f64]| c.iter().zip(row).map(|(a, b)| a * b).sum::<f64>();
+        // Orbit samples x(τᵢ), ẋ(τᵢ) and their scales.
+        let mut xs = vec![0.0; ns * nd];
+        let mut vs = vec![0.0; ns * nd];
+        for i in 0..ns {
+            let (cs, ds) = basis_rows(basis, l, ns, i);
+            for d in 0..nd {
+                xs[i * nd + d] = synth(&q[d * l..(d + 1) * l], cs);
+                vs[i * nd + d] = omega * synth(&q[d * l..(d + 1) * l], ds);
+            }
+        }
+        let scale = |u: &[f64]| u.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let (x_scale, v_scale) = (scale(&xs), scale(&vs));
+        let (mut dgx, mut dgv) = (vec![0.0; nd * nd], vec![0.0; nd * nd]);
+        let (mut wt, mut vt, mut vdt) = (vec![0.0; nd], vec![0.0; nd], vec![0.0; nd]);
+        let (mut xi, mut vi) = (vec![0.0; nd], vec![0.0; nd]);
+        if let Some(g) = grad.as_deref_mut() {
+            g.fill(0.0);
+        }
+        let weight = 2.0 / ns as f64;
+        let mut total = 0.0;
+        for i in 0..ns {
+            let (cs, ds) = basis_rows(basis, l, ns, i);
+            for d in 0..nd {
+                wt[d] = synth(&w[d * l..(d + 1) * l], cs);
+                vt[d] = synth(&v[d * l..(d + 1) * l], cs);
+                vdt[d] = synth(&v[d * l..(d + 1) * l], ds);
+            }
+            let theta = p * 2.0 * std::f64::consts::PI * i as f64 / ns as f64;
+            let mut psi = |x: &[f64], xv: &[f64]| {
+                self.problem
+                    .nonlinear_jacobian(x, xv, theta, &mut dgx, &mut dgv);
+                let mut acc = 0.0;
+                for d in 0..nd {
+                    for e in 0..nd {
+                        acc += wt[d] * (dgx[d * nd + e] * vt[e] + omega * dgv[d * nd + e] * vdt[e]);
+                    }
+                }
+                acc
+            };
+            xi.copy_from_slice(&xs[i * nd..(i + 1) * nd]);
+            vi.copy_from_slice(&vs[i * nd..(i + 1) * nd]);
+            total += weight * psi(&xi, &vi);
+            let Some(out) = grad.as_deref_mut() else {
+                continue;
+            };
+            for f in 0..nd {
+                let (x0, v0) = (xi[f], vi[f]);
+                let h = 1e-6 * x0.abs().max(x_scale).max(f64::MIN_POSITIVE);
+                xi[f] = x0 + h;
+                let plus = psi(&xi, &vi);
+                xi[f] = x0 - h;
+                let minus = psi(&xi, &vi);
+                xi[f] = x0;
+                let d_x = weight * (plus - minus) / (2.0 * h);
+                let target = &mut out[f * l..(f + 1) * l];
+                target.iter_mut().zip(cs).for_each(|(o, c)| *o += d_x * c);
+                if velocity {
+                    let h = 1e-6 * v0.abs().max(v_scale).max(f64::MIN_POSITIVE);
+                    vi[f] = v0 + h;
+                    let plus = psi(&xi, &vi);
+                    vi[f] = v0 - h;
+                    let minus = psi(&xi, &vi);
+                    vi[f] = v0;
+                    let d_v = weight * omega * (plus - minus) / (2.0 * h);
+                    target.iter_mut().zip(ds).for_each(|(o, c)| *o += d_v * c);
+                }
+            }
+        }
+        total
+    }
+}
+
+/// `C_s(τ_i)` and `C_s'(τ_i)` from the quadrature table of `ns` samples.
+fn basis_rows(basis: &[f64], l: usize, ns: usize, i: usize) -> (&[f64], &[f64]) {
+    (
+        &basis[i * l..(i + 1) * l],
+        &basis[(ns + i) * l..(ns + i + 1) * l],
+    )
+}
+
+/// Options of the fold Newton iteration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FoldOptions {
+    /// Stop when the Newton step is below `step_tol` relative to the scale of `q`
+    /// (‖q‖∞) and of λ.
+    pub step_tol: f64,
+    /// Also stop when the step is below `noise_tol` (relative) and ‖(R, g)‖ no
+    /// longer falls by 4× per step: the noise floor of a finite-difference `∂g`
+    /// (a user `g` without analytic Jacobian) is reached.
+    pub noise_tol: f64,
+    /// Maximum Newton steps.
+    pub max_iter: usize,
+    /// Relative central-difference step for `∂g/∂λ` and `∂R/∂λ`.
+    pub fd_step: f64,
+}
+
+impl Default for FoldOptions {
+    fn default() -> Self {
+        Self {
+            step_tol: 1e-12,
+            noise_tol: 1e-8,
+            max_iter: 25,
+            fd_step: 1e-6,
+        }
+    }
+}
+
+/// A located fold.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FoldLocation {
+    /// The solution at the fold.
+    pub q: Vec<f64>,
+    /// The parameter at the fold.
+    pub lambda: f64,
+    /// Newton steps taken.
+    pub iterations: usize,
+    /// ‖R(q, λ)‖₂ at the fold.
+    pub residual_norm: f64,
+}
+
+/// Scratch of the bordered solves.
+struct Bordered {
+    m: usize,
+    jac: Vec<f64>,
+    big: Vec<f64>,
+    rhs: Vec<f64>,
+    b: Vec<f64>,
+    c: Vec<f64>,
+}
+
+impl Bordered {
+    /// Assembles `J` at `(q, λ)` and solves `[[J, b], [cᵀ, 0]] [v; g] = e` and
+    /// `[[Jᵀ, c], [bᵀ, 0]] [w; g] = e`; returns `g` (NaN if singular), `J` stays
+    /// in `self.jac`.
+    fn solve_pair<B: Branch>(
+        &mut self,
+        branch: &mut B,
+        q: &[f64],
+        lambda: f64,
+        v: &mut [f64],
+        w: &mut [f64],
+    ) -> f64 {
+        let m = self.m;
+        let n1 = m + 1;
+        branch.jacobian(q, lambda, &mut self.jac);
+        for i in 0..m {
+            self.big[i * n1..i * n1 + m].copy_from_slice(&self.jac[i * m..(i + 1) * m]);
+            self.big[i * n1 + m] = self.b[i];
+        }
+        self.big[m * n1..m * n1 + m].copy_from_slice(&self.c);
+        self.big[m * n1 + m] = 0.0;
+        self.rhs.fill(0.0);
+        self.rhs[m] = 1.0;
+        if !solve_dense(&self.big, n1, &mut self.rhs, false) {
+            return f64::NAN;
+        }
+        v.copy_from_slice(&self.rhs[..m]);
+        let g = self.rhs[m];
+        self.rhs.fill(0.0);
+        self.rhs[m] = 1.0;
+        if !solve_dense(&self.big, n1, &mut self.rhs, true) {
+            return f64::NAN;
+        }
+        w.copy_from_slice(&self.rhs[..m]);
+        g
+    }
+}
+
+/// Two steps of inverse iteration with `J` (or `Jᵀ`) from `v`, normalised.
+fn null_vector(jac: &[f64], m: usize, v: &mut [f64], transpose: bool) -> bool {
+    for _ in 0..2 {
+        if !solve_dense(jac, m, v, transpose) {
+            return false;
+        }
+        let n = norm2(v);
+        if n == 0.0 || !n.is_finite() {
+            return false;
+        }
+        v.iter_mut().for_each(|x| *x /= n);
+    }
+    true
+}
+
+/// Locates the fold of `branch` nearest the converged point `(q0, λ0)`.
+///
+/// # Errors
+/// [`HbError::Solve`]: [`SolveError::SingularJacobian`] if the bordered or extended
+/// matrix is singular (e.g. a branch point rather than a fold),
+/// [`SolveError::NonConvergence`] (with the ‖(R, g)‖ history) when Newton does
+/// not settle within `max_iter` steps, [`SolveError::NonFinite`] for NaN.
+pub fn locate_fold<B: Branch>(
+    branch: &mut B,
+    q0: &[f64],
+    lambda0: f64,
+    opts: &FoldOptions,
+) -> Result<FoldLocation, HbError> {
+    let m = branch.len();
+    if q0.len() != m {
+        return Err(HbError::InvalidInput(format!(
+            "fold start must have {m} entries, got {}",
+            q0.len()
+        )));
+    }
+    if !(lambda0.is_finite() && q0.iter().all(|v| v.is_finite())) {
+        return Err(HbError::Solve(SolveError::NonFinite {
+            iteration: 0,
+            history: Vec::new(),
+        }));
+    }
+    let n1 = m + 1;
+    let mut bd = Bordered {
+        m,
+        jac: vec![0.0; m * m],
+        big: vec![0.0; n1 * n1],
+        rhs: vec![0.0; n1],
+        b: vec![1.0 / (m as f64).sqrt(); m],
+        c: vec![1.0 / (m as f64).sqrt(); m],
+    };
+    let singular = |iteration, history: &[f64]| {
+        HbError::Solve(SolveError::SingularJacobian {
+            iteration,
+            history: history.to_vec(),
+        })
+    };
+    // Borders: the approximate left/right null vectors of J at the start.
+    branch.jacobian(q0, lambda0, &mut bd.jac);
+    if !null_vector(&bd.jac, m, &mut bd.c, false) || !null_vector(&bd.jac, m, &mut bd.b, true) {
+        return Err(singular(0, &[]));
+    }
+    let mut q = q0.to_vec();
+    let mut lambda = lambda0;
+    let mut r = vec![0.0; m];
+    let mut rp = vec![0.0; m];
+    let mut rm = vec![0.0; m];
+    let (mut v, mut w, mut grad) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+    let mut newton = vec![0.0; n1 * n1];
+    let mut step = vec![0.0; n1];
+    let mut history = Vec::with_capacity(opts.max_iter + 1);
+    for it in 0..=opts.max_iter {
+        branch.residual(&q, lambda, &mut r);
+        let g = bd.solve_pair(branch, &q, lambda, &mut v, &mut w);
+        let norm = (norm2(&r).powi(2) + g * g).sqrt();
+        history.push(norm);
+        if !norm.is_finite() {
+            return Err(HbError::Solve(SolveError::NonFinite {
+                iteration: it,
+                history,
+            }));
+        }
+        if it == opts.max_iter {
+            break;
+        }
+        // Newton matrix [[J, R_λ], [g_q, g_λ]]: J from the bordered solve, and
+        // g_(q, λ) = −wᵀ J_(q, λ) v (Govaerts) with [v; g], [w; g] its solutions.
+        for i in 0..m {
+            newton[i * n1..i * n1 + m].copy_from_slice(&bd.jac[i * m..(i + 1) * m]);
+        }
+        let q_scale = q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let h_lambda = opts.fd_step * lambda.abs().max(f64::MIN_POSITIVE);
+        branch.residual(&q, lambda + h_lambda, &mut rp);
+        branch.residual(&q, lambda - h_lambda, &mut rm);
+        for i in 0..m {
+            newton[i * n1 + m] = (rp[i] - rm[i]) / (2.0 * h_lambda);
+        }
+        let bp = branch.bilinear(&q, lambda + h_lambda, &w, &v);
+        let bm = branch.bilinear(&q, lambda - h_lambda, &w, &v);
+        newton[m * n1 + m] = -(bp - bm) / (2.0 * h_lambda);
+        branch.jacobian_gradient(&q, lambda, &w, &v, &mut grad);
+        for k in 0..m {
+            newton[m * n1 + k] = -grad[k];
+        }
+        for i in 0..m {
+            step[i] = -r[i];
+        }
+        step[m] = -g;
+        if !solve_dense(&newton, n1, &mut step, false) {
+            return Err(singular(it, &history));
+        }
+        for i in 0..m {
+            q[i] += step[i];
+        }
+        lambda += step[m];
+        let dq = step[..m].iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let below = |tol: f64| {
+            dq <= tol * q_scale.max(f64::MIN_POSITIVE) && step[m].abs() <= tol * lambda.abs()
+        };
+        let stalled = it > 0 && norm > 0.25 * history[it - 1];
+        if below(opts.step_tol) || (stalled && below(opts.noise_tol)) {
+            branch.residual(&q, lambda, &mut r);
+            return Ok(FoldLocation {
+                q,
+                lambda,
+                iterations: it + 1,
+                residual_norm: norm2(&r),
+            });
+        }
+    }
+    Err(HbError::Solve(SolveError::NonConvergence {
+        iterations: opts.max_iter,
+        history,
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `R = (q₀² − 2q₀ + 2 − λ, q₁ − q₀³)`: along the branch `λ = (q₀ − 1)² + 1`,
+    /// a fold at `q = (1, 1)`, `λ = 1`.
+    struct Parabola;
+
+    impl Branch for Parabola {
+        fn len(&self) -> usize {
+            2
+        }
+        fn residual(&mut self, q: &[f64], lambda: f64, r: &mut [f64]) {
+            r[0] = q[0] * q[0] - 2.0 * q[0] + 2.0 - lambda;
+            r[1] = q[1] - q[0] * q[0] * q[0];
+        }
+        fn jacobian(&mut self, q: &[f64], _lambda: f64, jac: &mut [f64]) {
+            jac.copy_from_slice(&[2.0 * q[0] - 2.0, 0.0, -3.0 * q[0] * q[0], 1.0]);
+        }
+    }
+
+    /// `g = [0.5x₀³ + 0.1x₀²v₁ + 0.2 sin θ x₁, 0.3v₁²x₁]`, `f = [cos θ, 0]`.
+    struct Coupled;
+
+    impl PeriodicProblem for Coupled {
+        fn n_dof(&self) -> usize {
+            2
+        }
+        fn mass(&self) -> &[f64] {
+            &[1.0, 0.0, 0.0, 1.0]
+        }
+        fn damping(&self) -> &[f64] {
+            &[0.05, 0.0, 0.0, 0.05]
+        }
+        fn stiffness(&self) -> &[f64] {
+            &[2.0, -1.0, -1.0, 2.0]
+        }
+        fn nonlinear(&self, x: &[f64], v: &[f64], th: f64, g: &mut [f64]) {
+            g[0] = 0.5 * x[0].powi(3) + 0.1 * x[0] * x[0] * v[1] + 0.2 * th.sin() * x[1];
+            g[1] = 0.3 * v[1] * v[1] * x[1];
+        }
+        fn excitation(&self, th: f64, f: &mut [f64]) {
+            f[0] = th.cos();
+            f[1] = 0.0;
+        }
+        fn nonlinear_jacobian(
+            &self,
+            x: &[f64],
+            v: &[f64],
+            th: f64,
+            dg_dx: &mut [f64],
+            dg_dv: &mut [f64],
+        ) {
+            dg_dx.copy_from_slice(&[
+                1.5 * x[0] * x[0] + 0.2 * x[0] * v[1],
+                0.2 * th.sin(),
+                0.0,
+                0.3 * v[1] * v[1],
+            ]);
+            dg_dv.copy_from_slice(&[0.0, 0.1 * x[0] * x[0], 0.0, 0.6 * v[1] * x[1]]);
+        }
+    }
+
+    #[test]
+    fn hb_gradient_matches_differences_of_the_assembled_jacobian() {
+        // 2 DOF, cubic and velocity-dependent coupling, θ-dependent term, with
+        // analytic ∂g: the quadrature form of ∂(wᵀJv)/∂q against 2m assembled
+        // Jacobians (central differences, error ~1e-10 relative).
+        let problem = Coupled;
+        let opts = HbOptions::new(4, 16);
+        let mut branch = HbBranch::new(&problem, &opts).unwrap();
+        let m = branch.len();
+        let pattern = |k: usize, a: f64| (a * (k as f64 + 1.0)).sin() / (1.0 + k as f64);
+        let q: Vec<f64> = (0..m).map(|k| pattern(k, 1.3)).collect();
+        let w: Vec<f64> = (0..m).map(|k| pattern(k, 0.7)).collect();
+        let v: Vec<f64> = (0..m).map(|k| pattern(k, 2.1)).collect();
+        let (mut fast, mut slow) = (vec![0.0; m], vec![0.0; m]);
+        branch.jacobian_gradient(&q, 1.2, &w, &v, &mut fast);
+        fd_jacobian_gradient(&mut branch, &q, 1.2, &w, &v, 1e-5, &mut slow);
+        let scale = slow.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        assert!(scale > 0.01, "{slow:?}");
+        for (a, b) in fast.iter().zip(&slow) {
+            assert!((a - b).abs() < 1e-7 * scale, "{fast:?}\n{slow:?}");
+        }
+    }
+
+    #[test]
+    fn newton_lands_on_the_turning_point_of_a_parabola() {
+        // Start on the branch at q₀ = 1.3 (λ = 1.09): the fold is 0.3 away.
+        let q0 = [1.3, 1.3f64.powi(3)];
+        let f = locate_fold(&mut Parabola, &q0, 1.09, &FoldOptions::default()).unwrap();
+        assert!((f.lambda - 1.0).abs() < 1e-13, "{f:?}");
+        // The extended system is regular at the fold: q converges as fast as λ.
+        assert!(
+            (f.q[0] - 1.0).abs() < 1e-12 && (f.q[1] - 1.0).abs() < 1e-12,
+            "{f:?}"
+        );
+        assert!(f.residual_norm < 1e-12 && f.iterations <= 8, "{f:?}");
+    }
+}

@@ -1,0 +1,239 @@
+//! User systems for `ivt.hb`: `M x'' + C x' + K x + g(x, v, θ) = f(θ)` with `g`
+//! and `f` Python callables (per sample, or vectorized over all AFT samples).
+
+use ivt_hb::PeriodicProblem;
+use numpy::{IntoPyArray, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use std::sync::{Arc, Mutex};
+
+/// A user system whose nonlinearity g (and optional forcing f) are Python
+/// callables, called once per AFT sample with the GIL re-acquired.
+#[derive(Clone)]
+pub(crate) struct PyProblem {
+    /// Number of degrees of freedom.
+    pub(crate) n: usize,
+    m: Vec<f64>,
+    c: Vec<f64>,
+    k: Vec<f64>,
+    g: Arc<Py<PyAny>>,
+    f: Option<Arc<Py<PyAny>>>,
+    velocity_dependent: bool,
+    /// `g` takes (N, n_dof) arrays and a (N,) phase array, returns (N, n_dof).
+    vectorized: bool,
+    /// The first exception raised by a callback (the solver then sees NaN).
+    error: Arc<Mutex<Option<PyErr>>>,
+}
+
+impl PyProblem {
+    fn record(&self, e: PyErr) {
+        if let Ok(mut slot) = self.error.lock() {
+            if slot.is_none() {
+                *slot = Some(e);
+            }
+        }
+    }
+
+    /// Call `func(*args)` and write its n floats into `out` (NaN on error).
+    fn call_into(
+        &self,
+        func: &Py<PyAny>,
+        args: impl FnOnce(Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyTuple>>,
+        out: &mut [f64],
+    ) {
+        let n = self.n;
+        let r = Python::attach(|py| -> PyResult<()> {
+            let res = func.bind(py).call1(args(py)?)?;
+            let v: Vec<f64> = if let Ok(x) = res.extract::<f64>() {
+                vec![x]
+            } else {
+                res.extract()?
+            };
+            if v.len() != n {
+                return Err(PyValueError::new_err(format!(
+                    "callback returned {} values for n_dof = {n}",
+                    v.len()
+                )));
+            }
+            out.copy_from_slice(&v);
+            Ok(())
+        });
+        if let Err(e) = r {
+            self.record(e);
+            out.fill(f64::NAN);
+        }
+    }
+}
+
+impl PyProblem {
+    /// One call of a vectorized `g` on `theta.len()` samples (sample-major).
+    fn call_vectorized(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+        let (n, ns) = (self.n, theta.len());
+        let r = Python::attach(|py| -> PyResult<()> {
+            let shape = |a: &[f64]| {
+                numpy::ndarray::Array2::from_shape_vec((ns, n), a.to_vec())
+                    .map(|a| a.into_pyarray(py))
+                    .map_err(|e| PyValueError::new_err(e.to_string()))
+            };
+            let args = (shape(x)?, shape(v)?, theta.to_vec().into_pyarray(py));
+            let res = self.g.bind(py).call1(args)?;
+            let arr = res
+                .extract::<numpy::PyArrayLikeDyn<'_, f64, numpy::AllowTypeChange>>()
+                .map_err(|_| {
+                    PyTypeError::new_err("vectorized `g` must return an array of floats")
+                })?;
+            let a = arr.as_array();
+            if a.len() != ns * n || (a.ndim() == 2 && a.shape() != [ns, n]) {
+                return Err(PyValueError::new_err(format!(
+                    "vectorized `g` returned shape {:?}, expected ({ns}, {n})",
+                    a.shape()
+                )));
+            }
+            for (o, val) in out.iter_mut().zip(a.iter()) {
+                *o = *val;
+            }
+            Ok(())
+        });
+        if let Err(e) = r {
+            self.record(e);
+            out.fill(f64::NAN);
+        }
+    }
+}
+
+impl PeriodicProblem for PyProblem {
+    fn n_dof(&self) -> usize {
+        self.n
+    }
+    fn mass(&self) -> &[f64] {
+        &self.m
+    }
+    fn damping(&self) -> &[f64] {
+        &self.c
+    }
+    fn stiffness(&self) -> &[f64] {
+        &self.k
+    }
+    fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+        if self.vectorized {
+            self.call_vectorized(x, v, theta, out);
+        } else {
+            let n = self.n;
+            for (i, &th) in theta.iter().enumerate() {
+                let s = i * n..(i + 1) * n;
+                self.nonlinear(&x[s.clone()], &v[s.clone()], th, &mut out[s]);
+            }
+        }
+    }
+    fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
+        if self.vectorized {
+            self.call_vectorized(x, v, &[theta], out);
+            return;
+        }
+        let g = Arc::clone(&self.g);
+        self.call_into(
+            &g,
+            |py| {
+                pyo3::types::PyTuple::new(
+                    py,
+                    [
+                        x.to_vec().into_pyarray(py).into_any(),
+                        v.to_vec().into_pyarray(py).into_any(),
+                        pyo3::types::PyFloat::new(py, theta).into_any(),
+                    ],
+                )
+            },
+            out,
+        );
+    }
+    fn excitation(&self, theta: f64, out: &mut [f64]) {
+        match &self.f {
+            Some(f) => {
+                let f = Arc::clone(f);
+                self.call_into(&f, |py| pyo3::types::PyTuple::new(py, [theta]), out);
+            }
+            None => out.fill(0.0),
+        }
+    }
+    fn velocity_dependent(&self) -> bool {
+        self.velocity_dependent
+    }
+}
+
+/// An n×n float64 matrix (array-like) as row-major data.
+fn matrix(name: &str, ob: &Bound<'_, PyAny>) -> PyResult<(usize, Vec<f64>)> {
+    // A scalar is a 1×1 matrix (single DOF).
+    let (n, data) = if let Ok(x) = ob.extract::<f64>() {
+        (1, vec![x])
+    } else {
+        let a = ob
+            .extract::<numpy::PyArrayLike2<'_, f64, numpy::AllowTypeChange>>()
+            .map_err(|_| {
+                PyTypeError::new_err(format!(
+                    "argument `{name}` must be a square matrix of floats"
+                ))
+            })?;
+        let shape = a.shape().to_vec();
+        if shape[0] != shape[1] || shape[0] == 0 {
+            return Err(PyValueError::new_err(format!(
+                "argument `{name}` must be square and non-empty, got shape {shape:?}"
+            )));
+        }
+        (shape[0], a.as_array().iter().copied().collect())
+    };
+    if let Some(bad) = data.iter().find(|v| !v.is_finite()) {
+        return Err(PyValueError::new_err(format!(
+            "argument `{name}` has a non-finite entry ({bad})"
+        )));
+    }
+    Ok((n, data))
+}
+
+/// The user system of `solve`, `frc` and `limit_cycle` from its Python arguments.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn user_problem(
+    m: &Bound<'_, PyAny>,
+    c: &Bound<'_, PyAny>,
+    k: &Bound<'_, PyAny>,
+    g: &Bound<'_, PyAny>,
+    f: Option<&Bound<'_, PyAny>>,
+    velocity_dependent: bool,
+    vectorized: bool,
+) -> PyResult<PyProblem> {
+    let (nm, m) = matrix("m", m)?;
+    let (nc, c) = matrix("c", c)?;
+    let (nk, k) = matrix("k", k)?;
+    if nm != nc || nm != nk {
+        return Err(PyValueError::new_err(format!(
+            "`m`, `c`, `k` must have the same size, got {nm}, {nc}, {nk}"
+        )));
+    }
+    if !g.is_callable() {
+        return Err(PyTypeError::new_err(
+            "argument `g` must be callable g(x, v, theta)",
+        ));
+    }
+    if let Some(f) = f {
+        if !f.is_callable() {
+            return Err(PyTypeError::new_err(
+                "argument `f` must be callable f(theta) or None",
+            ));
+        }
+    }
+    Ok(PyProblem {
+        n: nm,
+        m,
+        c,
+        k,
+        g: Arc::new(g.clone().unbind()),
+        f: f.map(|f| Arc::new(f.clone().unbind())),
+        velocity_dependent,
+        vectorized,
+        error: Arc::new(Mutex::new(None)),
+    })
+}
+
+/// The first exception a callback raised during a run, if any.
+pub(crate) fn callback_error(problem: &PyProblem) -> Option<PyErr> {
+    problem.error.lock().ok().and_then(|mut s| s.take())
+}
