@@ -1,0 +1,21 @@
+//! The numerics layer shared by ivt-hb, ivt-design and ivt-sim.
+//!
+//! The rule: every Runge–Kutta integration in the workspace — the simulator's
+//! time- and angle-domain integrators, the steady-state shooting, the Floquet
+//! and monodromy integrations and every time-domain reference check in the
+//! tests — goes through the one explicit stepper [`rk::ExplicitRk`], driven
+//! by a [`tableau::Tableau`] given as data ([`tableau::RK4`],
+//! [`tableau::RK6`], [`tableau::DP5`]). A new method is a new tableau, not a
+//! new kernel.
+//!
+//! One job per module:
+//! - [`tableau`]: the Butcher tableaux (nodes, weights, embedded error
+//!   weights, dense-output weights);
+//! - [`rk`]: the stepper — fixed steps, tentative steps with an embedded
+//!   error estimate and the step-size controller, dense output.
+
+pub mod rk;
+pub mod tableau;
+
+pub use rk::{ExplicitRk, Tolerance};
+pub use tableau::{Tableau, DP5, RK4, RK6};
