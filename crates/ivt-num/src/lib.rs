@@ -1,3 +1,4 @@
+#![doc = include_str!("../README.md")]
 //! The numerics layer shared by ivt-hb, ivt-design and ivt-sim.
 //!
 //! The rule: every Runge–Kutta integration in the workspace — the simulator's
@@ -12,10 +13,18 @@
 //! - [`tableau`]: the Butcher tableaux (nodes, weights, embedded error
 //!   weights, dense-output weights);
 //! - [`rk`]: the stepper — fixed steps, tentative steps with an embedded
-//!   error estimate and the step-size controller, dense output.
+//!   error estimate and the step-size controller, dense output;
+//! - [`lu`]: dense LU on faer with caller-owned scratch, factor once per
+//!   Jacobian refresh and solve many without allocating.
+//!
+//! The rule for linear algebra: faer for dense LU and eigenvalues
+//! (workspace-based, no allocation in loops); nalgebra only for small
+//! fixed-size algebra and `expm`.
 
+pub mod lu;
 pub mod rk;
 pub mod tableau;
 
+pub use lu::LuWorkspace;
 pub use rk::{ExplicitRk, Tolerance};
 pub use tableau::{Tableau, DP5, RK4, RK6};

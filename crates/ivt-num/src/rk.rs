@@ -133,6 +133,9 @@ impl<const S: usize, V: Storage> ExplicitRk<S, V> {
     ///
     /// # Panics
     /// If the tableau has no error weights.
+    // The inputs of one step (x, y, F(x, y), h, tolerances, output) are
+    // distinct; bundling them would only rename them.
+    #[allow(clippy::too_many_arguments)]
     #[inline]
     pub fn try_step<F>(
         &mut self,
@@ -195,6 +198,11 @@ impl<const S: usize, V: Storage> ExplicitRk<S, V> {
             }
         }
         s
+    }
+
+    /// Stage `i` of the last step (stage 0 is F at its start).
+    pub fn stage(&self, i: usize) -> &[f64] {
+        self.k[i].as_ref()
     }
 
     /// The last stage of the last step: F(x + h, y1) for an FSAL method, the
