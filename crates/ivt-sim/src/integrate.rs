@@ -12,10 +12,8 @@
 //! output and the step is retaken to end there. Each step uses the analytic
 //! branch of f of its own segment, so the error control sees a smooth problem.
 
-use crate::ode::{as_rhs, OdeSystem, Tolerance};
+use crate::ode::{dp5_step, initial_step, rk4_step, OdeSystem, Tolerance};
 use crate::plant::{segment_end, AngleTerms, Inputs, Plant, DIM};
-use ivt_num::rk::step_factor;
-use ivt_num::{ExplicitRk, DP5, RK4};
 use std::cell::Cell;
 
 /// V_m(t) and T_U(t) as seen by the plant.
@@ -234,10 +232,6 @@ pub struct PlantIntegrator {
     fsal: Option<Fsal>,
     /// θ-only terms of the last angles evaluated (angle domain).
     angle_cache: AngleCache,
-    /// Stage storage of the fixed-step method.
-    rk4: ExplicitRk<4, [f64; DIM]>,
-    /// Stage storage of the adaptive method.
-    dp5: ExplicitRk<7, [f64; DIM]>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -281,8 +275,6 @@ impl PlantIntegrator {
             h_angle: 0.0,
             fsal: None,
             angle_cache: AngleCache::default(),
-            rk4: ExplicitRk::new(&RK4),
-            dp5: ExplicitRk::new(&DP5),
         }
     }
 
@@ -366,8 +358,7 @@ impl PlantIntegrator {
         match self.method {
             Method::Rk4 { dtheta, .. } => {
                 let h = representable_step(theta, dtheta.min(bp - theta));
-                let mut z1 = z;
-                self.rk4.step(&mut as_rhs(&sys), theta, h, &mut z1);
+                let z1 = rk4_step(&sys, theta, &z, h);
                 self.commit_angle(if h == bp - theta { bp } else { theta + h }, z1);
                 Ok(())
             }
@@ -386,9 +377,7 @@ impl PlantIntegrator {
                     _ => sys.rhs(theta, &z),
                 };
                 if self.h_angle <= 0.0 {
-                    self.h_angle = self
-                        .dp5
-                        .initial_step(&mut as_rhs(&sys), theta, &z, &k1, &tol);
+                    self.h_angle = initial_step(&sys, theta, &z, &k1, &tol);
                 }
                 loop {
                     let lands = self.h_angle >= bp - theta;
@@ -397,43 +386,31 @@ impl PlantIntegrator {
                     } else {
                         representable_step(theta, self.h_angle)
                     };
-                    let mut z1 = [0.0; DIM];
-                    let err = self.dp5.try_step(
-                        &mut as_rhs(&sys),
-                        theta,
-                        &z,
-                        Some(&k1),
-                        h,
-                        &tol,
-                        &mut z1,
-                    );
-                    let factor = step_factor(err, DP5.order);
-                    if err <= 1.0 {
+                    let st = dp5_step(&sys, theta, &z, &k1, h, &tol);
+                    if st.err <= 1.0 {
                         // A landing step that was cut short says nothing about the
                         // next h, except that it may grow; the factor is ≤ 5, so
                         // skip its powf when even 5h would not exceed h_angle.
                         if !lands || 5.0 * h > self.h_angle {
-                            let hn = h * factor;
+                            let hn = h * st.factor();
                             if !lands || hn > self.h_angle {
                                 self.h_angle = hn;
                             }
                         }
                         let theta1 = if lands { bp } else { theta + h };
-                        self.commit_angle(theta1, z1);
-                        let mut k = [0.0; DIM];
-                        k.copy_from_slice(self.dp5.last_stage());
+                        self.commit_angle(theta1, st.y1);
                         self.fsal = Some(Fsal {
                             theta: theta1,
-                            z: z1,
+                            z: st.y1,
                             seg,
                             r,
-                            inputs: prof.at(z1[0]),
-                            k,
+                            inputs: prof.at(st.y1[0]),
+                            k: st.k7,
                         });
                         return Ok(());
                     }
                     self.stats.rejected += 1;
-                    self.h_angle = h * factor;
+                    self.h_angle = h * st.factor();
                     if self.h_angle < 1e-14 * theta.abs().max(1.0) {
                         return Err(self.underflow(self.h_angle));
                     }
@@ -491,10 +468,7 @@ impl PlantIntegrator {
         };
         let k1 = sys.rhs(self.t, &self.y);
         if self.h_time <= 0.0 {
-            self.h_time = self
-                .dp5
-                .initial_step(&mut as_rhs(&sys), self.t, &self.y, &k1, &tol)
-                .min(1e-3);
+            self.h_time = initial_step(&sys, self.t, &self.y, &k1, &tol).min(1e-3);
         }
         loop {
             let lands = self.h_time >= t_max - self.t;
@@ -503,18 +477,9 @@ impl PlantIntegrator {
             } else {
                 representable_step(self.t, self.h_time)
             };
-            let mut y1 = [0.0; DIM];
-            let err = self.dp5.try_step(
-                &mut as_rhs(&sys),
-                self.t,
-                &self.y,
-                Some(&k1),
-                h,
-                &tol,
-                &mut y1,
-            );
-            let fac = step_factor(err, DP5.order);
-            if err > 1.0 {
+            let st = dp5_step(&sys, self.t, &self.y, &k1, h, &tol);
+            let fac = st.factor();
+            if st.err > 1.0 {
                 self.stats.rejected += 1;
                 self.h_time = h * fac;
                 if self.h_time < 1e-14 * self.t.abs().max(1.0) {
@@ -525,7 +490,7 @@ impl PlantIntegrator {
             if !lands || h * fac > self.h_time {
                 self.h_time = h * fac;
             }
-            let th1 = y1[0];
+            let th1 = st.y1[0];
             let boundary = if th1 >= hi {
                 Some(hi)
             } else if th1 <= lo {
@@ -536,17 +501,15 @@ impl PlantIntegrator {
             match boundary {
                 None => {
                     self.t += h;
-                    self.y = y1;
+                    self.y = st.y1;
                 }
                 Some(b) => {
                     // crossing time on the dense output (bisection: θ is monotone
                     // within a step because ω keeps its sign), then retake the step
                     let (mut a, mut c) = (0.0, 1.0);
-                    let mut at = [0.0; DIM];
                     for _ in 0..60 {
                         let m = 0.5 * (a + c);
-                        self.dp5.dense(&self.y, &y1, h, m, &mut at);
-                        let thm = at[0];
+                        let thm = st.interpolate(m)[0];
                         if (thm - b) * (th1 - b) > 0.0 {
                             c = m;
                         } else {
@@ -554,17 +517,9 @@ impl PlantIntegrator {
                         }
                     }
                     let hs = c * h;
-                    let y0 = self.y;
-                    self.dp5.try_step(
-                        &mut as_rhs(&sys),
-                        self.t,
-                        &y0,
-                        Some(&k1),
-                        hs,
-                        &tol,
-                        &mut self.y,
-                    );
+                    let st2 = dp5_step(&sys, self.t, &self.y, &k1, hs, &tol);
                     self.t += hs;
+                    self.y = st2.y1;
                     self.y[0] = b;
                 }
             }
