@@ -13,6 +13,8 @@ use ivt_design::steady::{solve_steady_state, IhbOptions};
 use ivt_design::sweep::{self, range, Grid, SweepPoint};
 use ivt_design::{averaged_r, rad_s_to_rpm, thesis_omega0, OperatingPoint};
 use ivt_kin::plant::{PlantParams, PlantPreset};
+use ivt_kin::variant::{f_on_segment, segment_of};
+use ivt_num::{ExplicitRk, RK4};
 use ivt_plot::{Figure, HeatMap, Style};
 use std::f64::consts::{PI, SQRT_2};
 
@@ -101,19 +103,24 @@ fn rk4_orbit(
     omega_start: f64,
     steps: usize,
 ) -> Vec<(f64, f64)> {
-    let rhs = |th: f64, w: f64| plant.acceleration(th, w, r, v, t) / w;
     let h = 2.0 * PI / steps as f64;
-    let mut w = omega_start;
-    let mut out = vec![(0.0, w)];
+    let mut rk = ExplicitRk::<4, [f64; 1]>::new(&RK4);
+    let mut w = [omega_start];
+    let mut out = vec![(0.0, w[0])];
     for i in 0..steps {
-        // Evaluate inside the step so that f_θ's jump at a corner never sits inside it.
+        // The analytic branch of the step's own gear segment, so that f_θ's
+        // jump at a corner (a step end) never sits inside a step.
         let th = i as f64 * h;
-        let k1 = rhs(th + 1e-14, w);
-        let k2 = rhs(th + 0.5 * h, w + 0.5 * h * k1);
-        let k3 = rhs(th + 0.5 * h, w + 0.5 * h * k2);
-        let k4 = rhs(th + h - 1e-14, w + h * k3);
-        w += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-        out.push((th + h, w));
+        let seg = segment_of(th + 0.5 * h);
+        let mut rhs = |th: f64, w: &[f64], dw: &mut [f64]| {
+            let (f, f_theta) = f_on_segment(th, seg);
+            dw[0] = plant
+                .terms_with_f(th, f, f_theta, r, v, t)
+                .acceleration(w[0], r)
+                / w[0];
+        };
+        rk.step(&mut rhs, th, h, &mut w);
+        out.push((th + h, w[0]));
     }
     out
 }

@@ -20,11 +20,12 @@
 //! structural unit one (Appendix C: it comes from the integral variable z);
 //! the one closest to 1 is set aside and reported separately.
 
-use super::rk6::{pieces, steps_for, Rk6, Segment};
+use super::pieces::{pieces, rk6, steps_for};
 use super::shooting::{shoot_steady_state, PeriodicOrbit, ShootingOptions};
 use super::{check_plant, IvtError, OperatingPoint};
 use core::f64::consts::PI;
 use ivt_kin::plant::PlantParams;
+use ivt_kin::variant::f_on_segment;
 use nalgebra::DMatrix;
 
 /// Feedback gains of Eq. 171/180 in SI: `dr/dθ = k(ω_a − ω0) + k2(ω − ω_T)`,
@@ -216,11 +217,10 @@ fn monodromy_with_steps(
     for i in 0..d {
         y[1 + i * d + i] = 1.0;
     }
-    let mut rk = Rk6::new(y.len());
+    let mut rk = rk6(y.len());
     for (a, b, seg) in pieces(0.0, 2.0 * PI) {
         let mut rhs = |theta: f64, y: &[f64], dy: &mut [f64]| {
-            let seg: Segment = seg;
-            let (f, ft) = seg.f_and_f_theta(theta);
+            let (f, ft) = f_on_segment(theta, seg);
             let p = plant.terms_with_f(theta, f, ft, r, op.v_m, op.t_u);
             let w = y[0];
             let drive = p.drive(r);
@@ -295,7 +295,8 @@ pub fn delay_stability_about(
     opts: &DelayOptions,
 ) -> Result<DelayStability, IvtError> {
     let m = monodromy(plant, op, gains, orbit, opts)?;
-    let eig = m.complex_eigenvalues();
+    // Row-major storage of M is the column-major storage of Mᵀ.
+    let eig = ivt_hb::eigenvalues(m.transpose().as_slice(), m.nrows());
     let mut mult: Vec<(f64, f64)> = eig.iter().map(|z| (z.re, z.im)).collect();
     if mult.iter().any(|(a, b)| !(a.is_finite() && b.is_finite())) {
         return Err(IvtError::NoConvergence {

@@ -9,17 +9,18 @@
 //! steady state with a small offset in r, the deviation of ω_a = 2π/z from ω0
 //! must contract per revolution by the predicted max |multiplier|.
 //!
-//! Classical RK4 with a fixed step h = π/(2M) (M even), so that every gear
-//! corner is a step end. The history holds ω at every half step (the RK4
+//! Classical RK4 ([`ivt_num::RK4`]) with a fixed step h = π/(2M) (M even),
+//! so that every gear corner is a step end. The history holds ω at every half step (the RK4
 //! stage points); the mid-step value is the cubic Hermite interpolant of the
 //! step's end values and slopes (error O(h⁴), like the method).
 
 use super::delay::FeedbackGains;
-use super::rk6::Segment;
 use super::shooting::PeriodicOrbit;
 use super::{check_plant, IvtError, OperatingPoint};
 use core::f64::consts::{FRAC_PI_2, PI};
 use ivt_kin::plant::PlantParams;
+use ivt_kin::variant::{f_on_segment, segment_of};
+use ivt_num::{ExplicitRk, RK4};
 
 /// Discretization and length of the simulation.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -62,8 +63,8 @@ struct Loop<'a> {
 }
 
 impl Loop<'_> {
-    fn omega_dot(&self, seg: Segment, theta: f64, w: f64, r: f64) -> f64 {
-        let (f, ft) = seg.f_and_f_theta(theta);
+    fn omega_dot(&self, seg: i64, theta: f64, w: f64, r: f64) -> f64 {
+        let (f, ft) = f_on_segment(theta, seg);
         let p = self
             .plant
             .terms_with_f(theta, f, ft, r, self.op.v_m, self.op.t_u);
@@ -71,7 +72,7 @@ impl Loop<'_> {
     }
 
     /// dy/dθ for y = [ω, r, z] with ω_T given.
-    fn rhs(&self, seg: Segment, theta: f64, y: [f64; 3], w_t: f64) -> [f64; 3] {
+    fn rhs(&self, seg: i64, theta: f64, y: &[f64], w_t: f64) -> [f64; 3] {
         let (w, r, z) = (y[0], y[1], y[2]);
         [
             self.omega_dot(seg, theta, w, r),
@@ -112,21 +113,26 @@ pub fn simulate_contraction(
                          // hist[2i] = ω at step i, hist[2i+1] = ω at step i + ½ (one revolution, circular).
     let mut hist = vec![0.0; 2 * per_rev];
     // Segment of step i: the corner-aligned grid puts each step inside one segment.
-    let seg_of = |i: usize| Segment::containing((i as f64 + 0.5) * h);
+    let seg_of = |i: usize| segment_of((i as f64 + 0.5) * h);
     let hermite_mid = |w0: f64, w1: f64, d0: f64, d1: f64| 0.5 * (w0 + w1) + h * (d0 - d1) / 8.0;
 
     // Revolution 0: the open-loop steady state at r̄ fills the history and z.
     let (mut w, r_bar) = (orbit.omega_start, orbit.r);
+    let mut rk_open = ExplicitRk::<4, [f64; 1]>::new(&RK4);
+    let mut rk = ExplicitRk::<4, [f64; 3]>::new(&RK4);
     let mut z = 0.0;
     for i in 0..per_rev {
         let (seg, th) = (seg_of(i), i as f64 * h);
-        let f = |t: f64, w: f64| sys.omega_dot(seg, t, w, r_bar);
-        let k1 = f(th, w);
-        let k2 = f(th + 0.5 * h, w + 0.5 * h * k1);
-        let k3 = f(th + 0.5 * h, w + 0.5 * h * k2);
-        let k4 = f(th + h, w + h * k3);
-        let w1 = w + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-        let mid = hermite_mid(w, w1, k1, f(th + h, w1));
+        let mut f = |t: f64, w: &[f64], dw: &mut [f64]| dw[0] = sys.omega_dot(seg, t, w[0], r_bar);
+        let mut w1 = [w];
+        rk_open.step(&mut f, th, h, &mut w1);
+        let w1 = w1[0];
+        let mid = hermite_mid(
+            w,
+            w1,
+            rk_open.stage(0)[0],
+            sys.omega_dot(seg, th + h, w1, r_bar),
+        );
         hist[2 * i] = w;
         hist[2 * i + 1] = mid;
         z += h / 6.0 * (1.0 / w + 4.0 / mid + 1.0 / w1); // Simpson on the same nodes
@@ -139,18 +145,14 @@ pub fn simulate_contraction(
             let (seg, th) = (seg_of(i), i as f64 * h);
             let (wt0, wth) = (hist[2 * i], hist[2 * i + 1]);
             let wt1 = hist[(2 * i + 2) % (2 * per_rev)];
-            let add = |a: [f64; 3], b: [f64; 3], s: f64| {
-                [a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2]]
+            // The RK4 stages sit at θ, θ + h/2 and θ + h: the history nodes 0, 1, 2.
+            let mut f = |t: f64, y: &[f64], dy: &mut [f64]| {
+                let node = (2.0 * (t - th) / h).round() as usize;
+                dy.copy_from_slice(&sys.rhs(seg, t, y, [wt0, wth, wt1][node]));
             };
-            let k1 = sys.rhs(seg, th, y, wt0);
-            let k2 = sys.rhs(seg, th + 0.5 * h, add(y, k1, 0.5 * h), wth);
-            let k3 = sys.rhs(seg, th + 0.5 * h, add(y, k2, 0.5 * h), wth);
-            let k4 = sys.rhs(seg, th + h, add(y, k3, h), wt1);
             let mut y1 = y;
-            for c in 0..2 {
-                y1[c] += h / 6.0 * (k1[c] + 2.0 * k2[c] + 2.0 * k3[c] + k4[c]);
-            }
-            if !(y1[0].is_finite() && y1[0] > 0.0 && y1[2] > 0.0) {
+            rk.step(&mut f, th, h, &mut y1);
+            if !(y1[0].is_finite() && y1[0] > 0.0 && y[2] > 0.0) {
                 return Err(IvtError::Stall {
                     theta: th + h,
                     omega: y1[0],
@@ -158,7 +160,7 @@ pub fn simulate_contraction(
                 });
             }
             let d1 = sys.omega_dot(seg, th + h, y1[0], y1[1]);
-            let mid = hermite_mid(y[0], y1[0], k1[0], d1);
+            let mid = hermite_mid(y[0], y1[0], rk.stage(0)[0], d1);
             // z by Simpson on exactly the values that enter and leave the
             // history, so z ≡ Simpson ∫_{θ−2π}^{θ} dσ/ω to round-off. (RK4 on
             // z' = 1/ω − 1/ω_T would drift by O(h⁴) per revolution along the

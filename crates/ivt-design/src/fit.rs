@@ -56,17 +56,26 @@ pub struct OpenLoopLaw {
 }
 
 impl OpenLoopLaw {
-    /// The printed law (Eq. 158, 159, r_max = 0.012 m), for comparison
-    /// (the same numbers as `ivt_ctrl::THESIS`).
+    /// The printed law (Eq. 158, 159, r_max = 0.012 m), for comparison:
+    /// the controller's [`ivt_ctrl::open_loop::THESIS`] preset, the one source.
     pub fn thesis() -> Self {
+        Self::from_coeffs(&ivt_ctrl::open_loop::THESIS)
+    }
+
+    /// A law from the controller's f32 coefficient set. Each f32 is widened
+    /// through its shortest round-trip decimal, so a printed coefficient
+    /// (≤ 7 significant digits, e.g. 6.43e-3) becomes exactly the f64 of
+    /// that decimal, not the f64 of its f32 rounding.
+    pub fn from_coeffs(c: &ivt_ctrl::open_loop::OpenLoopCoeffs) -> Self {
+        let widen = |x: f32| -> f64 {
+            x.to_string()
+                .parse()
+                .expect("an f32's Display output parses as f64")
+        };
         Self {
-            poly: [
-                [6.43e-3, -1.17e-2, 4.6e-3, -6.65e-4, 3.2e-5],
-                [8.85e-3, -3.23e-3, 4.7e-4, -2.3e-5, 0.0],
-                [-2.1e-5, 0.0, 0.0, 0.0, 0.0],
-            ],
-            boundary: [1.0, -1.579, -0.632],
-            r_max: 0.012,
+            poly: c.poly.map(|row| row.map(widen)),
+            boundary: c.boundary.map(widen),
+            r_max: widen(c.r_max),
         }
     }
 
@@ -312,4 +321,26 @@ pub fn emit_rust(law: &OpenLoopLaw, name: &str, header: &str) -> String {
     s.push_str(&format!("    r_max: {:e},\n", law.r_max as f32));
     s.push_str("    v_m_range: [2.0, 12.0],\n    t_u_range: [1.5, 9.0],\n};\n");
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The thesis law widened from the controller's f32 preset is exactly
+    /// the printed decimals of Eq. 158–159 and r_max = 0.012 m (§4.2.1).
+    #[test]
+    fn thesis_law_is_the_printed_decimals() {
+        let law = OpenLoopLaw::thesis();
+        assert_eq!(
+            law.poly,
+            [
+                [6.43e-3, -1.17e-2, 4.6e-3, -6.65e-4, 3.2e-5],
+                [8.85e-3, -3.23e-3, 4.7e-4, -2.3e-5, 0.0],
+                [-2.1e-5, 0.0, 0.0, 0.0, 0.0],
+            ]
+        );
+        assert_eq!(law.boundary, [1.0, -1.579, -0.632]);
+        assert_eq!(law.r_max, 0.012);
+    }
 }

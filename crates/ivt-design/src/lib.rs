@@ -7,8 +7,8 @@
 //! it, and the local stability of the integral time-delay feedback Eq. 171.
 //!
 //! One job per module:
-//! - [`rk6`]: order-6 Runge–Kutta on the smooth pieces of θ (the corners of
-//!   `f` at π/4 + kπ/2 are step ends);
+//! - [`pieces`]: the smooth pieces of θ for the order-6 Runge–Kutta of
+//!   [`ivt_num`] (the corners of `f` at π/4 + kπ/2 are step ends);
 //! - [`shooting`]: the independent reference — Eq. 162 integrated in θ with
 //!   Newton on (ω(0), r) through the variational equations;
 //! - [`steady`]: the modified IHB of Eq. 152–157, unknowns {r, q_p};
@@ -24,22 +24,14 @@ pub mod delay;
 pub mod delay_sim;
 pub mod fit;
 pub mod gains;
-pub mod rk6;
+pub mod pieces;
 pub mod shooting;
 pub mod steady;
 pub mod sweep;
 
 use ivt_kin::plant::{ParamError, PlantParams};
 
-/// rpm → rad/s.
-pub fn rpm_to_rad_s(rpm: f64) -> f64 {
-    rpm * core::f64::consts::PI / 30.0
-}
-
-/// rad/s → rpm.
-pub fn rad_s_to_rpm(w: f64) -> f64 {
-    w * 30.0 / core::f64::consts::PI
-}
+pub use ivt_kin::units::{rad_s_to_rpm, rpm_to_rad_s};
 
 /// The thesis's target mean speed, ω0 = 100 rpm (§4.2.1), in rad/s.
 pub fn thesis_omega0() -> f64 {

@@ -4,7 +4,7 @@
 //! J ω ω' = Γ − ½ J_θ ω² − F_m ω,   t' = 1/ω,   Γ = G r + f1 − f2 r,
 //! ```
 //!
-//! with the order-6 Runge–Kutta of [`super::rk6`] on the smooth pieces between
+//! with the order-6 Runge–Kutta of [`ivt_num::RK6`] on the smooth pieces between
 //! the gear corners. For a fixed r, the periodic ω̄(θ) is the fixed point of the
 //! map ω(0) ↦ ω(2π) (unique and attracting by Theorem 2); its period in time is
 //! T = ∫₀^{2π} dθ/ω, so the time mean of ω is ω_a = 2π/T (the quantity the
@@ -12,10 +12,11 @@
 //! Both conditions are solved together by Newton on (ω(0), r), with the exact
 //! Jacobian from the variational equations integrated alongside.
 
-use super::rk6::{pieces, steps_for, Rk6, Segment};
+use super::pieces::{pieces, rk6, steps_for, Rk6};
 use super::{averaged_r, check_plant, IvtError, OperatingPoint};
 use core::f64::consts::PI;
 use ivt_kin::plant::PlantParams;
+use ivt_kin::variant::f_on_segment;
 
 /// Accuracy and iteration limits of the shooting route.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -68,12 +69,12 @@ struct Variational<'a> {
     v_m: f64,
     t_u: f64,
     r: f64,
-    seg: Segment,
+    seg: i64,
 }
 
 impl Variational<'_> {
     fn rhs(&self, theta: f64, y: &[f64], dy: &mut [f64]) {
-        let (f, ft) = self.seg.f_and_f_theta(theta);
+        let (f, ft) = f_on_segment(theta, self.seg);
         let p = self
             .plant
             .terms_with_f(theta, f, ft, self.r, self.v_m, self.t_u);
@@ -155,7 +156,7 @@ pub fn periodic_at_r(
         omega0: omega_guess,
     }
     .validate()?;
-    let mut rk = Rk6::new(6);
+    let mut rk = rk6(6);
     let mut w0 = omega_guess;
     let mut history = Vec::new();
     for _ in 0..opts.max_iter {
@@ -212,7 +213,7 @@ pub fn omega_at_angles(
         return Err(IvtError::EmptyGrid("samples"));
     }
     let dtheta = 2.0 * PI / samples as f64;
-    let mut rk = Rk6::new(1);
+    let mut rk = rk6(1);
     let mut y = [omega_start];
     let mut out = Vec::with_capacity(samples);
     out.push(omega_start);
@@ -220,7 +221,7 @@ pub fn omega_at_angles(
         let (a0, b0) = (k as f64 * dtheta, (k + 1) as f64 * dtheta);
         for (a, b, seg) in pieces(a0, b0) {
             let mut rhs = |theta: f64, y: &[f64], dy: &mut [f64]| {
-                let (f, ft) = seg.f_and_f_theta(theta);
+                let (f, ft) = f_on_segment(theta, seg);
                 let p = plant.terms_with_f(theta, f, ft, r, v_m, t_u);
                 let w = y[0];
                 dy[0] = (p.drive(r) / w - 0.5 * p.j_theta * w - p.f_m) / p.j;
@@ -253,7 +254,7 @@ pub fn shoot_steady_state(
     check_plant(plant)?;
     op.validate()?;
     let t_target = 2.0 * PI / op.omega0;
-    let mut rk = Rk6::new(6);
+    let mut rk = rk6(6);
     let mut w0 = op.omega0;
     let mut r = r_seed.unwrap_or_else(|| averaged_r(plant, op));
     let mut history = Vec::new();

@@ -25,11 +25,12 @@
 //! harmonics, not the solver, limits how well r̄ matches the exact (shooting)
 //! value; `tests::converges_in_n` and the README show r̄(n).
 
-use super::rk6::Segment;
 use super::{averaged_r, check_plant, IvtError, OperatingPoint, Verdict};
 use core::f64::consts::PI;
 use ivt_hb::broyden::{broyden_solve, BroydenOptions, BroydenWorkspace, System};
 use ivt_kin::plant::PlantParams;
+use ivt_kin::variant::{f_on_segment, f_on_segment_from_trig, segment_of};
+use ivt_num::LuWorkspace;
 use nalgebra::{DMatrix, DVector};
 
 /// Harmonics, sampling and stopping rule of the IHB solve.
@@ -200,6 +201,8 @@ pub struct IhbSolver {
     trig_c: Vec<(f64, f64)>,
     /// Broyden matrices, kept between solves (warm start along a sweep).
     broyden: BroydenWorkspace,
+    /// LU of the Newton Jacobian (faer, no allocation per iteration).
+    lu: LuWorkspace,
 }
 
 impl IhbSolver {
@@ -246,6 +249,7 @@ impl IhbSolver {
             jump_jac: DMatrix::zeros(2 * n + 1, 2 * n + 1),
             trig_c: vec![(0.0, 1.0); n + 1],
             broyden: BroydenWorkspace::new(2 * n + 1),
+            lu: LuWorkspace::new(2 * n + 1),
         };
         for j in 0..m {
             s.tau[j] = 2.0 * PI * j as f64 / m as f64;
@@ -347,9 +351,9 @@ impl IhbSolver {
                 t1dd -= kk * kk * (qc * cs[k] + qs * sn[k]);
             }
             let theta = tau + t1;
-            let seg = Segment::containing(theta);
+            let seg = segment_of(theta);
             let (st, ct) = theta.sin_cos();
-            let (f, ft) = seg.f_and_f_theta_from(st, ct);
+            let (f, ft) = f_on_segment_from_trig(st, ct, seg);
             let p = plant.terms_with_trig(st, ct, f, ft, r, op.v_m, op.t_u);
             let s = 1.0 + t1d;
             self.res[j] =
@@ -380,10 +384,10 @@ impl IhbSolver {
             for &tc in &ends[1..] {
                 let (t1, t1d) = theta1_of(q, tc);
                 let (theta_c, s) = (tc + t1, 1.0 + t1d);
-                let left = Segment::containing(theta_c - 1e-9);
-                let right = Segment::containing(theta_c + 1e-9);
-                let jt = |seg: Segment| {
-                    let (f, ft) = seg.f_and_f_theta(theta_c);
+                let left = segment_of(theta_c - 1e-9);
+                let right = segment_of(theta_c + 1e-9);
+                let jt = |seg: i64| {
+                    let (f, ft) = f_on_segment(theta_c, seg);
                     plant
                         .terms_with_f(theta_c, f, ft, r, op.v_m, op.t_u)
                         .j_theta
@@ -411,6 +415,21 @@ impl IhbSolver {
                 }
             }
         }
+    }
+
+    /// Solve `jac · x = b` in place; `false` if `jac` is numerically singular.
+    fn lu_solve(&mut self, jac: &DMatrix<f64>, b: &mut [f64]) -> bool {
+        let n = jac.nrows();
+        for j in 0..n {
+            for i in 0..n {
+                self.lu.mat[(i, j)] = jac[(i, j)];
+            }
+        }
+        if !self.lu.factor() {
+            return false;
+        }
+        self.lu.solve(b);
+        true
     }
 
     /// Solve Eq. 152–157 at `op`. `warm` = a previous solution {r, q_p} of the
@@ -456,13 +475,14 @@ impl IhbSolver {
             }
             iterations += 1;
             let jac = &self.project * &self.dres + &self.jump_jac;
-            let Some(step) = jac.lu().solve(&rb) else {
+            let mut step = rb.clone();
+            if !self.lu_solve(&jac, step.as_mut_slice()) {
                 return Err(IvtError::NoConvergence {
                     method: "modified IHB (singular Jacobian)",
                     iterations,
                     history,
                 });
-            };
+            }
             // Backtracking keeps the solve robust from a cold start.
             let mut lambda = 1.0;
             let x_old = x.clone();

@@ -7,7 +7,7 @@
 //! step `Ω = (h/6)(Θ₀ + 4Θ_½ + Θ₁) − (h²/12)[Θ₀, Θ₁]` on the same uniform grid,
 //! which reaches 1e-9 agreement with Hill's method at a few thousand steps.
 
-use crate::linalg::{invert, Singular};
+use crate::linalg::Singular;
 use faer::c64;
 
 /// Quadrature rule of one Hsu sub-interval.
@@ -237,11 +237,7 @@ pub fn sort_by_modulus(v: &mut [c64]) {
 /// # Errors
 /// [`Singular`] if `a` is singular.
 pub fn small_inverse(a: &[f64], dim: usize) -> Result<Vec<f64>, Singular> {
-    let mut inv = vec![0.0; dim * dim];
-    let mut lu = vec![0.0; dim * dim];
-    let mut piv = vec![0; dim];
-    invert(a, dim, &mut inv, &mut lu, &mut piv)?;
-    Ok(inv)
+    ivt_num::lu::inverse(a, dim).ok_or(Singular)
 }
 
 #[cfg(test)]

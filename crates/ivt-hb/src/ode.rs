@@ -1,11 +1,13 @@
-//! A plain fixed-step classical Runge–Kutta integrator: the independent time-domain
+//! A plain fixed-step classical Runge–Kutta integration: the independent time-domain
 //! reference for the HB tests and the Mathieu–Duffing check (it shares no code with
 //! the harmonic-balance path).
 
 use crate::floquet::small_inverse;
 use crate::problem::PeriodicProblem;
+use ivt_num::{ExplicitRk, RK4};
 
-/// Integrates `y' = f(t, y)` with `steps` RK4 steps of size `dt` from `t0`, in place.
+/// Integrates `y' = f(t, y)` with `steps` classical RK4 steps of size `dt`
+/// from `t0`, in place (the one stepper of [`ivt_num`]).
 pub fn rk4<F: FnMut(f64, &[f64], &mut [f64])>(
     mut f: F,
     t0: f64,
@@ -13,34 +15,7 @@ pub fn rk4<F: FnMut(f64, &[f64], &mut [f64])>(
     dt: f64,
     steps: usize,
 ) {
-    let n = y.len();
-    let (mut k1, mut k2, mut k3, mut k4, mut yt) = (
-        vec![0.0; n],
-        vec![0.0; n],
-        vec![0.0; n],
-        vec![0.0; n],
-        vec![0.0; n],
-    );
-    let mut t = t0;
-    for _ in 0..steps {
-        f(t, y, &mut k1);
-        for i in 0..n {
-            yt[i] = y[i] + 0.5 * dt * k1[i];
-        }
-        f(t + 0.5 * dt, &yt, &mut k2);
-        for i in 0..n {
-            yt[i] = y[i] + 0.5 * dt * k2[i];
-        }
-        f(t + 0.5 * dt, &yt, &mut k3);
-        for i in 0..n {
-            yt[i] = y[i] + dt * k3[i];
-        }
-        f(t + dt, &yt, &mut k4);
-        for i in 0..n {
-            y[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-        }
-        t += dt;
-    }
+    ExplicitRk::with_dim(&RK4, y.len()).fixed_steps(&mut f, t0, dt, steps, y);
 }
 
 /// First-order form `y = [x, ẋ]` of a [`PeriodicProblem`] in physical time with

@@ -8,6 +8,7 @@ use ivt_hb::sthb::stability::{
     hill, hill_exponents, monodromy, monodromy_multipliers, StabilityKind,
 };
 use ivt_hb::sthb::{Boundary, SthbError, StringHb, StringParams};
+use ivt_num::{ExplicitRk, RK4};
 use realfft::num_complex::Complex;
 use std::f64::consts::PI;
 
@@ -107,26 +108,12 @@ fn integrate_from(
     count: usize,
     steps: usize,
 ) {
-    let d = y.len();
     let h = 2.0 * PI / steps as f64;
-    let (mut k1, mut k2, mut k3, mut k4, mut tmp, mut scr) = (
-        vec![0.0; d],
-        vec![0.0; d],
-        vec![0.0; d],
-        vec![0.0; d],
-        vec![0.0; d],
-        vec![0.0; d / 2],
-    );
+    let mut scr = vec![0.0; y.len() / 2];
+    let mut rhs = |t: f64, y: &[f64], dy: &mut [f64]| m.rhs(omega, t, y, dy, &mut scr);
+    let mut rk = ExplicitRk::with_dim(&RK4, y.len());
     for i in start..start + count {
-        let t = i as f64 * h;
-        m.rhs(omega, t, y, &mut k1, &mut scr);
-        (0..d).for_each(|j| tmp[j] = y[j] + 0.5 * h * k1[j]);
-        m.rhs(omega, t + 0.5 * h, &tmp, &mut k2, &mut scr);
-        (0..d).for_each(|j| tmp[j] = y[j] + 0.5 * h * k2[j]);
-        m.rhs(omega, t + 0.5 * h, &tmp, &mut k3, &mut scr);
-        (0..d).for_each(|j| tmp[j] = y[j] + h * k3[j]);
-        m.rhs(omega, t + h, &tmp, &mut k4, &mut scr);
-        (0..d).for_each(|j| y[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]));
+        rk.step(&mut rhs, i as f64 * h, h, y);
     }
 }
 

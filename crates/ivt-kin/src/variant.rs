@@ -37,26 +37,53 @@ pub fn output_to_motor_ratio_checked(r: f64, r_u: f64) -> Result<f64, crate::Kin
 /// there the value of the segment starting at the corner is returned.
 #[inline]
 pub fn f_theta(theta: f64) -> f64 {
-    -NCG_AMPLITUDE * libm::sin(wrapped_phase(theta))
+    f_and_f_theta(theta).1
 }
 
 /// f and df/dθ from one phase reduction (cheaper in the plant right-hand side).
 #[inline]
 pub fn f_and_f_theta(theta: f64) -> (f64, f64) {
-    let phi = wrapped_phase(theta);
-    // On each segment f = A·cos(φ) with φ ∈ [−π/4, π/4): the max of |sin|, |cos|.
-    (
-        NCG_AMPLITUDE * libm::cos(phi),
-        -NCG_AMPLITUDE * libm::sin(phi),
-    )
+    f_on_segment(theta, segment_of(theta))
 }
 
-/// φ = mod(θ + π/4, π/2) − π/4 ∈ [−π/4, π/4), the phase inside one gear segment.
+/// Index k of the gear segment that contains θ: θ − kπ/2 ∈ [−π/4, π/4).
+///
+/// The segments are the smooth pieces of f: f = A cos(θ − kπ/2) on segment k
+/// (the max of |sin θ|, |cos θ| of Eq. 43), with corners at π/4 + kπ/2 where
+/// f_θ jumps (Eq. 139). Every integrator that must keep its order across the
+/// corners steps segment by segment with [`f_on_segment`].
 #[inline]
-fn wrapped_phase(theta: f64) -> f64 {
-    let x = theta + FRAC_PI_4;
-    let m = x - FRAC_PI_2 * libm::floor(x / FRAC_PI_2);
-    m - FRAC_PI_4
+pub fn segment_of(theta: f64) -> i64 {
+    libm::floor((theta + FRAC_PI_4) / FRAC_PI_2) as i64
+}
+
+/// The corner (kink of f) that ends segment `k` going forward: π/4 + kπ/2.
+#[inline]
+pub fn segment_end(k: i64) -> f64 {
+    FRAC_PI_4 + k as f64 * FRAC_PI_2
+}
+
+/// f and f_θ on the analytic branch of segment `k` (Eq. 43 and Eq. 139 inside
+/// the segment, their smooth continuation just outside it, so a stage
+/// evaluated exactly at a corner uses the one-sided value of its own piece).
+#[inline]
+pub fn f_on_segment(theta: f64, k: i64) -> (f64, f64) {
+    let (s, c) = libm::sincos(theta - k as f64 * FRAC_PI_2);
+    (NCG_AMPLITUDE * c, -NCG_AMPLITUDE * s)
+}
+
+/// [`f_on_segment`] from sin θ and cos θ (no trig call): the branch of
+/// segment k rotates (sin θ, cos θ) by k quarter turns.
+#[inline]
+pub fn f_on_segment_from_trig(sin_theta: f64, cos_theta: f64, k: i64) -> (f64, f64) {
+    // (sin φ, cos φ) with φ = θ − kπ/2.
+    let (s, c) = match k.rem_euclid(4) {
+        0 => (sin_theta, cos_theta),
+        1 => (-cos_theta, sin_theta),
+        2 => (-sin_theta, -cos_theta),
+        _ => (cos_theta, -sin_theta),
+    };
+    (NCG_AMPLITUDE * c, -NCG_AMPLITUDE * s)
 }
 
 /// Exact mean of f² over a period: (π²/8)(1/2 + 1/π) ≈ 1.0095 (SPEC §5).
@@ -131,7 +158,7 @@ mod tests {
         let h = 1e-6;
         for k in 0..1000 {
             let theta = 0.0123 + 2.0 * PI * k as f64 / 1000.0;
-            let phi = wrapped_phase(theta);
+            let phi = theta - segment_of(theta) as f64 * FRAC_PI_2;
             if (phi.abs() - FRAC_PI_4).abs() < 1e-4 {
                 continue; // within h of a corner
             }
@@ -139,6 +166,27 @@ mod tests {
             assert!((fd - f_theta(theta)).abs() < 1e-8, "θ={theta}");
             let (fv, ft) = f_and_f_theta(theta);
             assert!((fv - f(theta)).abs() < 1e-15 && (ft - f_theta(theta)).abs() < 1e-15);
+        }
+    }
+
+    /// The segments tile the axis between the corners π/4 + kπ/2; inside
+    /// each, the analytic branch is Eq. 43 (the max form of [`f`]), and the
+    /// trig-free rotation gives the same branch.
+    #[test]
+    fn segment_branches_match_eq43() {
+        assert_eq!(segment_of(segment_end(3) + 1e-12), 4);
+        assert_eq!(segment_of(segment_end(3) - 1e-12), 3);
+        assert_eq!(segment_of(-FRAC_PI_4), 0);
+        for k in 0..4000 {
+            let th = -20.0 + k as f64 * 0.01037;
+            let seg = segment_of(th);
+            let (fv, ft) = f_on_segment(th, seg);
+            assert!((fv - f(th)).abs() < 1e-14, "θ={th}");
+            let (f2, ft2) = f_on_segment_from_trig(libm::sin(th), libm::cos(th), seg);
+            assert!(
+                (f2 - fv).abs() < 1e-14 && (ft2 - ft).abs() < 1e-14,
+                "θ={th}"
+            );
         }
     }
 

@@ -18,33 +18,12 @@
 //! every step integrate a smooth ODE, so the integrators keep their order.
 
 use ivt_kin::plant::PlantParams;
-use ivt_kin::NCG_AMPLITUDE;
-use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, TAU};
+use std::f64::consts::TAU;
 
 /// Dimension of the plant state `[θ, ω, i_a]`.
 pub const DIM: usize = 3;
 
-/// Index of the gear segment that contains θ: segment k is
-/// θ − kπ/2 ∈ [−π/4, π/4).
-#[inline]
-pub fn segment_of(theta: f64) -> i64 {
-    libm::floor((theta + FRAC_PI_4) / FRAC_PI_2) as i64
-}
-
-/// The corner (kink of f) that ends segment `k` going forward: π/4 + kπ/2.
-#[inline]
-pub fn segment_end(k: i64) -> f64 {
-    FRAC_PI_4 + k as f64 * FRAC_PI_2
-}
-
-/// f and f_θ on the analytic branch of segment `k` (Eq. 43 and Eq. 139 inside
-/// the segment; their smooth continuation just outside it).
-#[inline]
-pub fn f_on_segment(theta: f64, k: i64) -> (f64, f64) {
-    let phi = theta - k as f64 * FRAC_PI_2;
-    let (s, c) = libm::sincos(phi);
-    (NCG_AMPLITUDE * c, -NCG_AMPLITUDE * s)
-}
+pub use ivt_kin::variant::{f_on_segment, segment_end, segment_of};
 
 /// The terms of the right-hand side that depend on θ alone (on one gear
 /// segment): f, f_θ (Eq. 43, 139) and sin θ, cos θ of the gravity term —
@@ -168,6 +147,7 @@ impl Plant {
 mod tests {
     use super::*;
     use ivt_kin::variant;
+    use std::f64::consts::FRAC_PI_4;
 
     /// The segment branch equals Eq. 43/139 inside each segment.
     #[test]

@@ -9,6 +9,7 @@
 //! `K = diag(n²π²)`, `g = −ℒ(q)`, `f = y0 cos θ` on mode 1), for the
 //! "traditional route": the same curve by the modified IHB + continuation.
 
+use ivt_num::{ExplicitRk, RK4};
 use std::f64::consts::PI;
 
 use super::StringParams;
@@ -149,35 +150,13 @@ impl ModalString {
     /// Classical RK4 over `periods` periods of `2π` with `steps_per_period`
     /// steps, from state `y` (overwritten) starting at `t = 0`.
     pub fn integrate(&self, omega: f64, y: &mut [f64], periods: usize, steps_per_period: usize) {
-        let d = y.len();
         let h = 2.0 * PI / steps_per_period as f64;
-        let (mut k1, mut k2, mut k3, mut k4, mut tmp, mut scr) = (
-            vec![0.0; d],
-            vec![0.0; d],
-            vec![0.0; d],
-            vec![0.0; d],
-            vec![0.0; d],
-            vec![0.0; d / 2],
-        );
-        for step in 0..periods * steps_per_period {
-            // Time within the period (the forcing is 2π-periodic).
-            let t = (step % steps_per_period) as f64 * h;
-            self.rhs(omega, t, y, &mut k1, &mut scr);
-            for i in 0..d {
-                tmp[i] = y[i] + 0.5 * h * k1[i];
-            }
-            self.rhs(omega, t + 0.5 * h, &tmp, &mut k2, &mut scr);
-            for i in 0..d {
-                tmp[i] = y[i] + 0.5 * h * k2[i];
-            }
-            self.rhs(omega, t + 0.5 * h, &tmp, &mut k3, &mut scr);
-            for i in 0..d {
-                tmp[i] = y[i] + h * k3[i];
-            }
-            self.rhs(omega, t + h, &tmp, &mut k4, &mut scr);
-            for i in 0..d {
-                y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-            }
+        let mut scr = vec![0.0; y.len() / 2];
+        let mut rhs = |t: f64, y: &[f64], dy: &mut [f64]| self.rhs(omega, t, y, dy, &mut scr);
+        let mut rk = ExplicitRk::with_dim(&RK4, y.len());
+        // Time restarts at 0 every period (the forcing is 2π-periodic).
+        for _ in 0..periods {
+            rk.fixed_steps(&mut rhs, 0.0, h, steps_per_period, y);
         }
     }
 }

@@ -16,6 +16,7 @@
 use std::f64::consts::PI;
 
 use faer::Mat;
+use ivt_num::{ExplicitRk, RK4};
 use realfft::num_complex::Complex;
 
 use super::toeplitz::{add_real_toeplitz, BlockLayout, PeriodicSpectrum};
@@ -271,35 +272,12 @@ pub fn monodromy_matrix(hb: &StringHb, omega: f64, steps: usize) -> Result<Mat<f
             }
         }
     };
-    let (mut k1, mut k2, mut k3, mut k4, mut tmp) = (
-        vec![0.0; d * d],
-        vec![0.0; d * d],
-        vec![0.0; d * d],
-        vec![0.0; d * d],
-        vec![0.0; d * d],
-    );
-    for st in 0..steps {
-        let node = |k: usize| &b[(2 * st + k) * n * n..(2 * st + k + 1) * n * n];
-        f(node(0), &y, &mut k1);
-        tmp.iter_mut()
-            .zip(&y)
-            .zip(&k1)
-            .for_each(|((t, y), k)| *t = y + 0.5 * h * k);
-        f(node(1), &tmp, &mut k2);
-        tmp.iter_mut()
-            .zip(&y)
-            .zip(&k2)
-            .for_each(|((t, y), k)| *t = y + 0.5 * h * k);
-        f(node(1), &tmp, &mut k3);
-        tmp.iter_mut()
-            .zip(&y)
-            .zip(&k3)
-            .for_each(|((t, y), k)| *t = y + h * k);
-        f(node(2), &tmp, &mut k4);
-        for i in 0..d * d {
-            y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-        }
-    }
+    // Stage times are multiples of h/2: the node index of B.
+    let mut rhs = |t: f64, y: &[f64], out: &mut [f64]| {
+        let k = (2.0 * t / h).round() as usize;
+        f(&b[k * n * n..(k + 1) * n * n], y, out);
+    };
+    ExplicitRk::with_dim(&RK4, d * d).fixed_steps(&mut rhs, 0.0, h, steps, &mut y);
     Ok(Mat::from_fn(d, d, |i, j| y[j * d + i]))
 }
 

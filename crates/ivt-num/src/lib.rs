@@ -1,0 +1,33 @@
+#![doc = include_str!("../README.md")]
+//! The numerics layer shared by ivt-hb, ivt-design and the `ivt` binary.
+//!
+//! The rule: every Runge–Kutta integration in the workspace — the
+//! steady-state shooting, the delay-loop simulation, the Floquet and
+//! monodromy integrations and every time-domain reference check in the
+//! tests — goes through the one explicit stepper [`rk::ExplicitRk`], driven
+//! by a [`tableau::Tableau`] given as data ([`tableau::RK4`],
+//! [`tableau::RK6`], [`tableau::DP5`]). A new method is a new tableau, not a
+//! new kernel. One exception: the simulator's plant integrator
+//! (`ivt_sim::ode`) keeps RK4/DP5 kernels specialized to its 3-state plant,
+//! because this stepper ran its closed-loop benchmark 13–20 % slower
+//! (measured, not asserted).
+//!
+//! One job per module:
+//! - [`tableau`]: the Butcher tableaux (nodes, weights, embedded error
+//!   weights, dense-output weights);
+//! - [`rk`]: the stepper — fixed steps, tentative steps with an embedded
+//!   error estimate and the step-size controller, dense output;
+//! - [`lu`]: dense LU on faer with caller-owned scratch, factor once per
+//!   Jacobian refresh and solve many without allocating.
+//!
+//! The rule for linear algebra: faer for dense LU and eigenvalues
+//! (workspace-based, no allocation in loops); nalgebra only for small
+//! fixed-size algebra and `expm`.
+
+pub mod lu;
+pub mod rk;
+pub mod tableau;
+
+pub use lu::LuWorkspace;
+pub use rk::{ExplicitRk, Tolerance};
+pub use tableau::{Tableau, DP5, RK4, RK6};
