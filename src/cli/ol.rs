@@ -8,7 +8,7 @@ use ivt_design::shooting::{shoot_steady_state, ShootingOptions};
 use ivt_design::steady::{solve_steady_state, IhbOptions};
 use ivt_design::sweep::{self, Grid, SweepPoint};
 use ivt_design::{rad_s_to_rpm, rpm_to_rad_s, OperatingPoint};
-use ivt_kin::plant::PlantPreset;
+use ivt_kin::plant::{PlantParams, PlantPreset};
 use serde_json::json;
 
 /// `--plant printed|thesis-ch4` (SPEC §6), shared by `ivt ol` and `ivt stability(-map)`.
