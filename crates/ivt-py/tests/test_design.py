@@ -60,7 +60,7 @@ def test_design_errors() -> None:
 def test_plant_presets_equal_cli(cli) -> None:  # type: ignore[no-untyped-def]
     """plant="thesis-ch4" is `--plant thesis-ch4` (k_t, k_e ÷ 10); a Plant with
     the printed constants is named "printed"; an unknown name is a ValueError."""
-    ref = cli("ol", "solve", "--plant", "thesis-ch4", "--vm", "6", "--tu", "6")
+    ref = cli("ol", "solve", "--plant", "thesis-ch4", "--vm", "6", "--tu", "6", "--method", "ihb")
     got = design.ol_solve(6.0, 6.0, plant="thesis-ch4")
     assert got["plant"] == "thesis-ch4" and got["r"] == ref["r"]
     assert abs(got["r"] - 0.0067775) < 1e-6  # the thesis's Fig. 39 orbit (0.0067)
