@@ -4,10 +4,9 @@
 //! its two example multipliers). `printed` is Table 1 (SPEC §5: Chapter 4
 //! does not reproduce on it); `thesis-ch4` divides k_t and k_e by 10.
 
-use super::{borrow_series, fmt_sig, Cause, Context, OwnedSeries, ReproError, Verdict};
-use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
+use super::design_maps::{figs_38_40, stability};
+use super::{borrow_series, fmt_sig, Cause, Context, OwnedSeries, ReproError};
 use ivt_design::fit::{self, OpenLoopLaw, PolyForm};
-use ivt_design::gains::stability_map;
 use ivt_design::shooting::{periodic_at_r, shoot_steady_state, ShootingOptions};
 use ivt_design::steady::{solve_steady_state, IhbOptions};
 use ivt_design::sweep::{self, range, Grid, SweepPoint};
@@ -15,23 +14,25 @@ use ivt_design::{averaged_r, rad_s_to_rpm, thesis_omega0, OperatingPoint};
 use ivt_kin::plant::{PlantParams, PlantPreset};
 use ivt_kin::variant::{f_on_segment, segment_of};
 use ivt_num::{ExplicitRk, RK4};
-use ivt_plot::{Figure, HeatMap, Style};
-use std::f64::consts::{PI, SQRT_2};
+use ivt_plot::{Figure, Style};
+use std::f64::consts::PI;
 
-const SPEC5: &str = "SPEC §5: the printed u_ol (Eq. 158) does not hold 100 rpm on the printed \
+pub(super) const SPEC5: &str =
+    "SPEC §5: the printed u_ol (Eq. 158) does not hold 100 rpm on the printed \
 plant (Eq. 151 + Table 1); 100 rpm needs V_m in the band [7.87, 7.87 + 0.154 T_U] V";
 
 /// The test showing that the printed plant's 100-rpm band excludes the thesis's points.
-const BAND_TEST: &str = "crates/ivt-design/tests/ivt_design.rs::verdicts_follow_the_band";
+pub(super) const BAND_TEST: &str =
+    "crates/ivt-design/tests/ivt_design.rs::verdicts_follow_the_band";
 /// The test showing how far Eq. 158's printed digits can represent a fit.
 const DIGITS_TEST: &str = "src/reproduce/design.rs::printed_digits_limit_eq158";
 
 /// The test confirming the thesis-ch4 multipliers of Fig. 42 by simulation.
-const FIG42_TEST: &str =
+pub(super) const FIG42_TEST: &str =
     "tests/ch4_plant.rs::fig42_multipliers_on_thesis_ch4_confirmed_by_simulation";
 
 /// Figure id of a thesis figure on a preset (`printed` keeps the bare id).
-fn fig_id(base: &str, preset: PlantPreset) -> String {
+pub(super) fn fig_id(base: &str, preset: PlantPreset) -> String {
     match preset {
         PlantPreset::Printed => base.to_string(),
         _ => format!("{base} ({})", preset.name()),
@@ -458,293 +459,9 @@ fn refit_rows(
     law
 }
 
-fn gamma_hat(plant: &PlantParams, law: &OpenLoopLaw, v: f64, t: f64) -> f64 {
-    // §4.2.2, the equation after Eq. 170: Γ̂ = −9.8√2 r_f + (k_t/R_a V_m − 2√2 T_U r_f/(π r_u))/√2.
-    let rf = law.r_f(v, t);
-    -9.8 * SQRT_2 * rf + (plant.motor_gain() * v - plant.load_gain() * t * rf) / SQRT_2
-}
-
-fn figs_38_40(
-    ctx: &mut Context,
-    plant: &PlantParams,
-    preset: PlantPreset,
-    grid: &Grid,
-    pts: &[SweepPoint],
-    law: Option<&OpenLoopLaw>,
-) -> Result<(), ReproError> {
-    let values: Vec<f64> = pts
-        .iter()
-        .map(|p| p.result.as_ref().map_or(f64::NAN, |s| 1e3 * s.r))
-        .collect();
-    let feasible = values
-        .iter()
-        .filter(|r| (0.0..=1e3 * plant.r_max).contains(*r))
-        .count();
-    let plant_note = match preset {
-        PlantPreset::Printed => SPEC5.to_string(),
-        _ => "thesis-ch4 plant (k_t, k_e ÷ 10)".to_string(),
-    };
-    // Grid order: rows of T_U, V_m fastest (as the sweep returns them).
-    ctx.heat_figure(
-        &fig_id("Fig. 38(a)", preset),
-        &HeatMap {
-            title: "Fig. 38(a): r̄ for ω_a = 100 rpm (IHB)",
-            x_label: "V_m [V]",
-            y_label: "T_U [N·m]",
-            value_label: "r̄ [mm]",
-            xs: &grid.v_m,
-            ys: &grid.t_u,
-            values: &values,
-        },
-        &format!(
-            "{plant_note}; r̄ < 0: under-drive, r̄ > 12 mm: over-drive; feasible region: {feasible} of {} grid points",
-            values.len()
-        ),
-    )?;
-    let t_line = [1.5, 9.0];
-    let printed: Vec<(f64, f64)> = t_line.iter().map(|&t| (t, 1.579 * t + 0.632)).collect();
-    let mut series_data: Vec<OwnedSeries> =
-        vec![("f_B = 0 printed (Eq. 159)".into(), printed, Style::Dashed)];
-    if let Some(l) = law {
-        let ours: Vec<(f64, f64)> = t_line
-            .iter()
-            .map(|&t| (t, -l.boundary[1] * t - l.boundary[2]))
-            .collect();
-        series_data.push((
-            format!("r̄ = r_max, refit on the {} plant", preset.name()),
-            ours,
-            Style::Line,
-        ));
-    }
-    let series = borrow_series(&series_data);
-    ctx.line_figure(
-        &fig_id("Fig. 38(b)", preset),
-        &Figure {
-            title: "Fig. 38(b): boundary r̄ = 0.012 m of the open-loop law",
-            x_label: "T_U [N·m]",
-            y_label: "V_m [V]",
-            series,
-        },
-        &plant_note,
-    )?;
-
-    // Fig. 40: Γ̂ = 0 against f_B = 0, for the printed and the refitted r_f.
-    let mut series_data: Vec<OwnedSeries> = Vec::new();
-    let laws: Vec<(&str, OpenLoopLaw)> =
-        std::iter::once(("printed r_f (Eq. 158)", OpenLoopLaw::thesis()))
-            .chain(law.map(|l| ("refit r_f", *l)))
-            .collect();
-    let ts: Vec<f64> = (0..=30).map(|i| 1.5 + 7.5 * i as f64 / 30.0).collect();
-    for (name, l) in &laws {
-        let zero: Vec<(f64, f64)> = ts
-            .iter()
-            .map(|&t| (t, bisect_v(|v| gamma_hat(plant, l, v, t), 2.0, 12.0)))
-            .collect();
-        series_data.push((format!("Γ̂ = 0, {name}"), zero, Style::Line));
-        series_data.push((
-            format!("f_B = 0, {name}"),
-            t_line
-                .iter()
-                .map(|&tt| (tt, -l.boundary[1] * tt - l.boundary[2]))
-                .collect(),
-            Style::Dashed,
-        ));
-    }
-    let series = borrow_series(&series_data);
-    gamma_row(ctx, plant, grid);
-    ctx.line_figure(
-        &fig_id("Fig. 40", preset),
-        &Figure {
-            title: "Fig. 40: boundary Γ̂ = 0 (§4.2.2) compared with f_B = 0",
-            x_label: "T_U [N·m]",
-            y_label: "V_m [V]",
-            series,
-        },
-        &format!(
-            "Γ̂ from the closed form after Eq. 170 with the {} plant's constants. Γ̂ = 0 is drawn only \
-             where Γ̂ changes sign in V_m ∈ [2, 12] V; over the grid Γ̂ ranges {}",
-            preset.name(),
-            laws.iter()
-                .map(|(name, l)| {
-                    let vals = grid.t_u.iter().flat_map(|&t| grid.v_m.iter().map(move |&v| (v, t)));
-                    let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (v, t)| {
-                        let g = gamma_hat(plant, l, v, t);
-                        (a.min(g), b.max(g))
-                    });
-                    format!("{lo:.3} … {hi:.3} ({name})")
-                })
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
-    )?;
-    Ok(())
-}
-
-/// Fig. 40's claim as a row: Γ̂ = 0 (printed r_f) crosses the thesis grid.
-fn gamma_row(ctx: &mut Context, plant: &PlantParams, grid: &Grid) {
-    let law = OpenLoopLaw::thesis();
-    let crossings: Vec<f64> = grid
-        .t_u
-        .iter()
-        .copied()
-        .filter(|&t| bisect_v(|v| gamma_hat(plant, &law, v, t), 2.0, 12.0).is_finite())
-        .collect();
-    let q = "Γ̂ = 0 (§4.2.2, printed r_f) inside the grid V_m ∈ [2, 12] V";
-    let thesis = "crosses the grid (Fig. 40)";
-    match (crossings.first(), crossings.last()) {
-        (Some(lo), Some(hi)) => ctx.row(
-            q,
-            thesis,
-            format!("crosses for T_U ∈ [{lo}, {hi}] N·m"),
-            "—",
-            Verdict::Reproduced,
-            "sign change of Γ̂ in V_m along every grid T_U (bisection)",
-        ),
-        _ => ctx.differs(
-            q,
-            thesis,
-            "no crossing: Γ̂ > 0 over the grid",
-            "—",
-            Cause {
-                why: "Γ̂'s motor term k_t V_m/(R_a √2) is 10× larger with Table 1's k_t than with thesis-ch4's, \
-                      so Γ̂ stays positive; with k_t ÷ 10 the zero appears beside f_B = 0",
-                test: "src/reproduce/design.rs::gamma_hat_crosses_only_on_thesis_ch4",
-            },
-        ),
-    }
-}
-
-/// Root of g on [a, b] by bisection, NaN if g does not change sign.
-fn bisect_v(g: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
-    let (mut ga, gb) = (g(a), g(b));
-    if !(ga.is_finite() && gb.is_finite()) || ga * gb > 0.0 {
-        return f64::NAN;
-    }
-    for _ in 0..60 {
-        let m = 0.5 * (a + b);
-        let gm = g(m);
-        if gm * ga <= 0.0 {
-            b = m;
-        } else {
-            a = m;
-            ga = gm;
-        }
-    }
-    0.5 * (a + b)
-}
-
-fn stability(
-    ctx: &mut Context,
-    plant: &PlantParams,
-    preset: PlantPreset,
-    grid: &Grid,
-) -> Result<(), ReproError> {
-    let opts = DelayOptions::default();
-    let op = OperatingPoint::at_100_rpm(7.0, 2.0);
-    for (k, k2, thesis) in [(0.01, 0.02, 0.7776), (0.06, 0.12, 0.4871)] {
-        let readings = [
-            (
-                "mm·rad⁻¹ read as k_SI = 1e-3·k",
-                FeedbackGains::from_thesis_mm_per_rad(k, k2),
-            ),
-            ("printed numbers read as SI", FeedbackGains { k, k2 }),
-        ];
-        for (reading, gains) in readings {
-            let q = format!("Fig. 42 multiplier (k = {k}, k2 = {k2}), {reading}");
-            match delay_stability(plant, &op, gains, &opts) {
-                Ok(a) => {
-                    let why = match preset {
-                        PlantPreset::Printed => format!(
-                            "{SPEC5}: (7 V, 2 N·m) is under-drive on the printed plant (r̄ = {} m < 0), so the \
-                             linearization is about a different orbit than the thesis's",
-                            fmt_sig(a.orbit.r, 4)
-                        ),
-                        _ if gains.k == k => "read as SI the loop is unstable here (|μ| > 1) where the thesis \
-                                              finds it stable: the printed unit is mm·rad⁻¹ (k_SI = 1e-3·k)"
-                            .to_string(),
-                        _ => "cause not identified: ours is confirmed by simulating the delay loop (contraction per \
-                              revolution agrees to 1e-3); the thesis linearizes at a point its own Eq. 160 puts in \
-                              over-drive (u_ol = r_max), about the unconstrained orbit r̄ > r_max"
-                            .to_string(),
-                    };
-                    let test = match preset {
-                        PlantPreset::Printed => BAND_TEST,
-                        _ => FIG42_TEST,
-                    };
-                    let cause = Some(Cause { why: &why, test });
-                    ctx.compare(
-                        &q,
-                        thesis,
-                        "§4.3, V_m = 7 V, T_U = 2 N·m",
-                        a.max_abs_multiplier,
-                        5e-5,
-                        5,
-                        &format!(
-                            "max |multiplier| without the structural one, about the unconstrained orbit r̄ = {} m \
-                             (Chebyshev Tau N = {})",
-                            fmt_sig(a.orbit.r, 4),
-                            opts.chebyshev_order
-                        ),
-                        cause,
-                    );
-                }
-                Err(e) => ctx.not_computable(&q, &format!("{thesis} (§4.3)"), &e.to_string()),
-            }
-        }
-    }
-    let ops: Vec<OperatingPoint> = grid
-        .t_u
-        .iter()
-        .flat_map(|&t| {
-            grid.v_m.iter().map(move |&v| OperatingPoint {
-                v_m: v,
-                t_u: t,
-                omega0: grid.omega0,
-            })
-        })
-        .collect();
-    match stability_map(
-        plant,
-        &ops,
-        FeedbackGains::from_thesis_mm_per_rad(0.01, 0.02),
-        &opts,
-    ) {
-        Ok(map) => {
-            let values: Vec<f64> = map
-                .iter()
-                .map(|(_, r)| r.as_ref().map_or(f64::NAN, |v| *v))
-                .collect();
-            let worst = values
-                .iter()
-                .copied()
-                .filter(|v| v.is_finite())
-                .fold(0.0f64, f64::max);
-            ctx.heat_figure(
-                &fig_id("Fig. 42", preset),
-                &HeatMap {
-                    title: "Fig. 42: k = 0.01, k2 = 0.02 mm/rad",
-                    x_label: "V_m [V]",
-                    y_label: "T_U [N·m]",
-                    value_label: "max |multiplier|",
-                    xs: &grid.v_m,
-                    ys: &grid.t_u,
-                    values: &values,
-                },
-                &format!(
-                    "{} plant, linearized about the unconstrained 100-rpm orbit at every grid point (as the \
-                     thesis); worst {worst:.5} ({})",
-                    preset.name(),
-                    if worst < 1.0 { "< 1: stable everywhere, as the thesis finds" } else { "≥ 1 somewhere: not the thesis's finding" }
-                ),
-            )?;
-        }
-        Err(e) => ctx.missing_figure(&fig_id("Fig. 42", preset), "stability map", &e.to_string()),
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
+    use super::super::design_maps::{bisect_v, gamma_hat};
     use super::*;
 
     fn sweep_on(preset: PlantPreset) -> Vec<SweepPoint> {

@@ -12,6 +12,7 @@ mod ch4_findings;
 mod closed_loop;
 mod closed_loop_ch4;
 mod design;
+mod design_maps;
 mod hb;
 mod kinematics;
 mod report;
