@@ -117,8 +117,10 @@ pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
     let g = a.common.gains();
     let plant = a.common.plant.preset.params();
     let t0 = std::time::Instant::now();
-    let s = delay_stability(&plant, &op, g, &a.common.opts())
-        .map_err(|e| CliError::Failed(e.to_string()))?;
+    let s = delay_stability(&plant, &op, g, &a.common.opts()).map_err(|e| match e {
+        ivt_design::IvtError::Input { .. } => CliError::Input(e.to_string()),
+        _ => CliError::Failed(e.to_string()),
+    })?;
     let dt = t0.elapsed().as_secs_f64();
     let design = match &a.design {
         Some(b) => {

@@ -141,6 +141,10 @@ impl Controlled {
 /// [`HbError`] if a solve or a branch switch fails.
 pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubling>, HbError> {
     let mut out = Vec::new();
+    // The period-4 branch carries 4n harmonics: refuse before any allocation.
+    if let Some(why) = crate::limits::unknowns_error(1, opts.harmonics.saturating_mul(4)) {
+        return Err(HbError::InvalidInput(why));
+    }
     // --- period 1: continuation in β.
     let n1 = opts.harmonics;
     let hb1 = HbOptions::new(n1, 4 * n1);
