@@ -178,17 +178,7 @@ pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
     grid.validate()
         .map_err(|e| CliError::Input(e.to_string()))?;
     let plant = a.common.plant.preset.params();
-    let mut ops: Vec<OperatingPoint> = grid
-        .t_u
-        .iter()
-        .flat_map(|&t| {
-            grid.v_m.iter().map(move |&v| OperatingPoint {
-                v_m: v,
-                t_u: t,
-                omega0: grid.omega0,
-            })
-        })
-        .collect();
+    let mut ops: Vec<OperatingPoint> = grid.operating_points();
     if a.feasible_only {
         let pts = ivt_design::sweep::sweep(&plant, &grid, Default::default(), || ())
             .map_err(|e| CliError::Failed(e.to_string()))?;

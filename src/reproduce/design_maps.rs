@@ -247,17 +247,7 @@ pub(super) fn stability(
             }
         }
     }
-    let ops: Vec<OperatingPoint> = grid
-        .t_u
-        .iter()
-        .flat_map(|&t| {
-            grid.v_m.iter().map(move |&v| OperatingPoint {
-                v_m: v,
-                t_u: t,
-                omega0: grid.omega0,
-            })
-        })
-        .collect();
+    let ops: Vec<OperatingPoint> = grid.operating_points();
     match stability_map(
         plant,
         &ops,

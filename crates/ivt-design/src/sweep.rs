@@ -19,6 +19,20 @@ pub struct Grid {
 }
 
 impl Grid {
+    /// Every (V_m, T_U) point at ω0, V_m fastest (row by row in T_U).
+    pub fn operating_points(&self) -> Vec<OperatingPoint> {
+        self.t_u
+            .iter()
+            .flat_map(|&t_u| {
+                self.v_m.iter().map(move |&v_m| OperatingPoint {
+                    v_m,
+                    t_u,
+                    omega0: self.omega0,
+                })
+            })
+            .collect()
+    }
+
     /// The thesis grid: V_m ∈ 2:0.4:12 (26), T_U ∈ 1.5:0.5:9 (16), ω0 = 100 rpm.
     pub fn thesis() -> Self {
         Self {
