@@ -30,6 +30,17 @@ pub struct Tolerance {
     pub atol: f64,
 }
 
+impl Tolerance {
+    /// The same relative and absolute tolerance `tol`.
+    #[must_use]
+    pub const fn uniform(tol: f64) -> Self {
+        Self {
+            rtol: tol,
+            atol: tol,
+        }
+    }
+}
+
 /// An explicit Runge–Kutta method with its stage storage.
 #[derive(Clone, Debug)]
 pub struct ExplicitRk<const S: usize, V> {
@@ -68,7 +79,7 @@ impl<const S: usize, V: Storage> ExplicitRk<S, V> {
 
     /// Evaluate the stages k_i = F(x + c_i h, y + h Σ_j a_ij k_j), from
     /// stage `first` on (stage 0 may already hold F(x, y)).
-    #[inline]
+    #[inline(always)]
     fn stages<F>(&mut self, rhs: &mut F, x: f64, y: &[f64], h: f64, first: usize)
     where
         F: FnMut(f64, &[f64], &mut [f64]),
@@ -90,7 +101,7 @@ impl<const S: usize, V: Storage> ExplicitRk<S, V> {
     }
 
     /// One fixed step of size `h` from `(x, y)`, in place: `y ← y + h Σ b_i k_i`.
-    #[inline]
+    #[inline(always)]
     pub fn step<F>(&mut self, rhs: &mut F, x: f64, h: f64, y: &mut [f64])
     where
         F: FnMut(f64, &[f64], &mut [f64]),
@@ -136,7 +147,7 @@ impl<const S: usize, V: Storage> ExplicitRk<S, V> {
     // The inputs of one step (x, y, F(x, y), h, tolerances, output) are
     // distinct; bundling them would only rename them.
     #[allow(clippy::too_many_arguments)]
-    #[inline]
+    #[inline(always)]
     pub fn try_step<F>(
         &mut self,
         rhs: &mut F,
@@ -189,7 +200,7 @@ impl<const S: usize, V: Storage> ExplicitRk<S, V> {
     }
 
     /// Σ_j w_j k_j[i] over the nonzero weights, in stage order.
-    #[inline]
+    #[inline(always)]
     fn weighted(&self, w: &[f64; S], i: usize) -> f64 {
         let mut s = 0.0;
         for (wj, kj) in w.iter().zip(&self.k) {

@@ -2,8 +2,7 @@
 //! 1200 (target: ≥ 1000× real time, i.e. ≤ 60 ms, with MCAP on), and one
 //! open-loop angle-domain solve of the work–precision problem.
 
-use ivt_sim::integrate::Method;
-use ivt_sim::ode::Tolerance;
+use ivt_sim::integrate::{Method, Tolerance};
 use ivt_sim::scene::Scene;
 
 fn main() {

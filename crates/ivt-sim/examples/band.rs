@@ -2,8 +2,7 @@
 //! T_U, the V_m at which the steady ω_a equals ω0 = 100 rpm with r = 0 and
 //! with r = r_max (bisection on V_m; steady ω_a from the angle-domain run).
 use ivt_kin::plant::PlantParams;
-use ivt_sim::integrate::{ConstantInputs, Method, PlantIntegrator};
-use ivt_sim::ode::Tolerance;
+use ivt_sim::integrate::{ConstantInputs, Method, PlantIntegrator, Tolerance};
 use ivt_sim::plant::Plant;
 use std::f64::consts::TAU;
 

@@ -6,15 +6,30 @@
 //! - time domain: `y = [θ, ω, i_a]`, `y' = F(y)`;
 //! - angle domain: `z = [t, ω, i_a]`, `dz/dθ = [1, ω̇, i̇_a]/ω`.
 //!
+//! Every step is a step of the one Runge–Kutta stepper of the workspace,
+//! [`ivt_num::ExplicitRk`] with the [`RK4`] or [`DP5`] tableau on the
+//! fixed-size state `[f64; 3]`, built for each step so that the tableau is a
+//! constant the compiler folds into the stages. Each stepper call gets its
+//! own right-hand-side closure: a closure called from one place only is
+//! inlined into the stages, as the hand-written kernels were (one closure
+//! shared by four calls was not, and cost ≈ 10 % of a DP5 run; measured, not
+//! asserted).
+//!
 //! Steps never straddle a corner of f (θ = π/4 + kπ/2) or the requested target
 //! angle (the next encoder pulse): in the angle domain the step is shortened to
 //! land on it; in the time domain the crossing time is found on the dense
 //! output and the step is retaken to end there. Each step uses the analytic
 //! branch of f of its own segment, so the error control sees a smooth problem.
 
-use crate::ode::{dp5_step, initial_step, rk4_step, OdeSystem, Tolerance};
 use crate::plant::{segment_end, AngleTerms, Inputs, Plant, DIM};
+use ivt_num::rk::step_factor;
+use ivt_num::{ExplicitRk, DP5, RK4};
 use std::cell::Cell;
+
+pub use ivt_num::Tolerance;
+
+/// The Dormand–Prince 5(4) stepper on the plant state.
+type Dp5 = ExplicitRk<7, [f64; DIM]>;
 
 /// V_m(t) and T_U(t) as seen by the plant.
 pub trait InputProfile {
@@ -119,19 +134,20 @@ struct TimeSys<'a, P> {
     prof: &'a P,
 }
 
-impl<P: InputProfile> OdeSystem<DIM> for TimeSys<'_, P> {
-    #[inline]
-    fn rhs(&self, t: f64, y: &[f64; DIM]) -> [f64; DIM] {
+impl<P: InputProfile> TimeSys<'_, P> {
+    /// `dy = F(t, y)` with `y = [θ, ω, i_a]`.
+    #[inline(always)]
+    fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
         let (v_m, t_u) = self.prof.at(t);
-        self.plant.derivatives(
+        dy.copy_from_slice(&self.plant.derivatives(
             self.seg,
-            y,
+            &[y[0], y[1], y[2]],
             &Inputs {
                 r: self.r,
                 v_m,
                 t_u,
             },
-        )
+        ));
     }
 }
 
@@ -191,9 +207,10 @@ impl AngleCache {
     }
 }
 
-impl<P: InputProfile> OdeSystem<DIM> for AngleSys<'_, P> {
+impl<P: InputProfile> AngleSys<'_, P> {
+    /// `dz = dz/dθ` with `z = [t, ω, i_a]` (Eq. 162).
     #[inline(always)]
-    fn rhs(&self, theta: f64, z: &[f64; DIM]) -> [f64; DIM] {
+    fn rhs(&self, theta: f64, z: &[f64], dz: &mut [f64]) {
         let (v_m, t_u) = self.prof.at(z[0]);
         let d = self.plant.derivatives_with(
             &self.cache.get(theta, self.seg),
@@ -205,7 +222,7 @@ impl<P: InputProfile> OdeSystem<DIM> for AngleSys<'_, P> {
             },
         );
         let inv = 1.0 / z[1];
-        [inv, d[1] * inv, d[2] * inv]
+        dz.copy_from_slice(&[inv, d[1] * inv, d[2] * inv]);
     }
 }
 
@@ -358,11 +375,18 @@ impl PlantIntegrator {
         match self.method {
             Method::Rk4 { dtheta, .. } => {
                 let h = representable_step(theta, dtheta.min(bp - theta));
-                let z1 = rk4_step(&sys, theta, &z, h);
+                let mut z1 = z;
+                ExplicitRk::<4, [f64; DIM]>::new(&RK4).step(
+                    &mut |x, y, dy| sys.rhs(x, y, dy),
+                    theta,
+                    h,
+                    &mut z1,
+                );
                 self.commit_angle(if h == bp - theta { bp } else { theta + h }, z1);
                 Ok(())
             }
             Method::Dp5(tol) => {
+                let mut rk = Dp5::new(&DP5);
                 let inputs = prof.at(z[0]);
                 let k1 = match self.fsal {
                     Some(c)
@@ -374,10 +398,15 @@ impl PlantIntegrator {
                     {
                         c.k
                     }
-                    _ => sys.rhs(theta, &z),
+                    _ => {
+                        let mut k = [0.0; DIM];
+                        sys.rhs(theta, &z, &mut k);
+                        k
+                    }
                 };
                 if self.h_angle <= 0.0 {
-                    self.h_angle = initial_step(&sys, theta, &z, &k1, &tol);
+                    self.h_angle =
+                        rk.initial_step(&mut |x, y, dy| sys.rhs(x, y, dy), theta, &z, &k1, &tol);
                 }
                 loop {
                     let lands = self.h_angle >= bp - theta;
@@ -386,31 +415,42 @@ impl PlantIntegrator {
                     } else {
                         representable_step(theta, self.h_angle)
                     };
-                    let st = dp5_step(&sys, theta, &z, &k1, h, &tol);
-                    if st.err <= 1.0 {
+                    let mut z1 = [0.0; DIM];
+                    let err = rk.try_step(
+                        &mut |x, y, dy| sys.rhs(x, y, dy),
+                        theta,
+                        &z,
+                        Some(&k1),
+                        h,
+                        &tol,
+                        &mut z1,
+                    );
+                    if err <= 1.0 {
                         // A landing step that was cut short says nothing about the
                         // next h, except that it may grow; the factor is ≤ 5, so
                         // skip its powf when even 5h would not exceed h_angle.
                         if !lands || 5.0 * h > self.h_angle {
-                            let hn = h * st.factor();
+                            let hn = h * step_factor(err, DP5.order);
                             if !lands || hn > self.h_angle {
                                 self.h_angle = hn;
                             }
                         }
                         let theta1 = if lands { bp } else { theta + h };
-                        self.commit_angle(theta1, st.y1);
+                        self.commit_angle(theta1, z1);
+                        let mut k = [0.0; DIM];
+                        k.copy_from_slice(rk.last_stage());
                         self.fsal = Some(Fsal {
                             theta: theta1,
-                            z: st.y1,
+                            z: z1,
                             seg,
                             r,
-                            inputs: prof.at(st.y1[0]),
-                            k: st.k7,
+                            inputs: prof.at(z1[0]),
+                            k,
                         });
                         return Ok(());
                     }
                     self.stats.rejected += 1;
-                    self.h_angle = h * st.factor();
+                    self.h_angle = h * step_factor(err, DP5.order);
                     if self.h_angle < 1e-14 * theta.abs().max(1.0) {
                         return Err(self.underflow(self.h_angle));
                     }
@@ -466,9 +506,19 @@ impl PlantIntegrator {
             r,
             prof,
         };
-        let k1 = sys.rhs(self.t, &self.y);
+        let mut rk = Dp5::new(&DP5);
+        let mut k1 = [0.0; DIM];
+        sys.rhs(self.t, &self.y, &mut k1);
         if self.h_time <= 0.0 {
-            self.h_time = initial_step(&sys, self.t, &self.y, &k1, &tol).min(1e-3);
+            self.h_time = rk
+                .initial_step(
+                    &mut |x, y, dy| sys.rhs(x, y, dy),
+                    self.t,
+                    &self.y,
+                    &k1,
+                    &tol,
+                )
+                .min(1e-3);
         }
         loop {
             let lands = self.h_time >= t_max - self.t;
@@ -477,9 +527,18 @@ impl PlantIntegrator {
             } else {
                 representable_step(self.t, self.h_time)
             };
-            let st = dp5_step(&sys, self.t, &self.y, &k1, h, &tol);
-            let fac = st.factor();
-            if st.err > 1.0 {
+            let mut y1 = [0.0; DIM];
+            let err = rk.try_step(
+                &mut |x, y, dy| sys.rhs(x, y, dy),
+                self.t,
+                &self.y,
+                Some(&k1),
+                h,
+                &tol,
+                &mut y1,
+            );
+            let fac = step_factor(err, DP5.order);
+            if err > 1.0 {
                 self.stats.rejected += 1;
                 self.h_time = h * fac;
                 if self.h_time < 1e-14 * self.t.abs().max(1.0) {
@@ -490,7 +549,7 @@ impl PlantIntegrator {
             if !lands || h * fac > self.h_time {
                 self.h_time = h * fac;
             }
-            let th1 = st.y1[0];
+            let th1 = y1[0];
             let boundary = if th1 >= hi {
                 Some(hi)
             } else if th1 <= lo {
@@ -501,15 +560,17 @@ impl PlantIntegrator {
             match boundary {
                 None => {
                     self.t += h;
-                    self.y = st.y1;
+                    self.y = y1;
                 }
                 Some(b) => {
                     // crossing time on the dense output (bisection: θ is monotone
                     // within a step because ω keeps its sign), then retake the step
                     let (mut a, mut c) = (0.0, 1.0);
+                    let mut at = [0.0; DIM];
                     for _ in 0..60 {
                         let m = 0.5 * (a + c);
-                        let thm = st.interpolate(m)[0];
+                        rk.dense(&self.y, &y1, h, m, &mut at);
+                        let thm = at[0];
                         if (thm - b) * (th1 - b) > 0.0 {
                             c = m;
                         } else {
@@ -517,9 +578,18 @@ impl PlantIntegrator {
                         }
                     }
                     let hs = c * h;
-                    let st2 = dp5_step(&sys, self.t, &self.y, &k1, hs, &tol);
+                    let mut y2 = [0.0; DIM];
+                    rk.try_step(
+                        &mut |x, y, dy| sys.rhs(x, y, dy),
+                        self.t,
+                        &self.y,
+                        Some(&k1),
+                        hs,
+                        &tol,
+                        &mut y2,
+                    );
                     self.t += hs;
-                    self.y = st2.y1;
+                    self.y = y2;
                     self.y[0] = b;
                 }
             }

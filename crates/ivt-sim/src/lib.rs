@@ -3,7 +3,6 @@
 pub mod atomic;
 pub mod backend;
 pub mod integrate;
-pub mod ode;
 pub mod output;
 pub mod pil;
 pub mod plant;

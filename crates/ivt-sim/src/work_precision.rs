@@ -11,8 +11,7 @@
 //! `bench/work_precision.py` runs the same problem through scipy's
 //! `solve_ivp` (RK45, DOP853, LSODA) in the same angle-domain form.
 
-use crate::integrate::{ConstantInputs, Method, PlantIntegrator};
-use crate::ode::Tolerance;
+use crate::integrate::{ConstantInputs, Method, PlantIntegrator, Tolerance};
 use crate::plant::Plant;
 use ivt_kin::plant::PlantParams;
 use serde::Serialize;

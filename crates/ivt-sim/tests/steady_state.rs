@@ -4,8 +4,8 @@
 //! built here (shooting with fixed-step RK4 in the angle domain, Eq. 162).
 
 use ivt_kin::plant::PlantParams;
-use ivt_sim::integrate::{ConstantInputs, Method, PlantIntegrator};
-use ivt_sim::ode::{rk4_step, OdeSystem, Tolerance};
+use ivt_num::{ExplicitRk, RK4};
+use ivt_sim::integrate::{ConstantInputs, Method, PlantIntegrator, Tolerance};
 use ivt_sim::plant::{segment_of, Inputs, Plant};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
@@ -22,20 +22,20 @@ struct WithEnergy<'a> {
     seg: i64,
 }
 
-impl OdeSystem<6> for WithEnergy<'_> {
-    fn rhs(&self, theta: f64, z: &[f64; 6]) -> [f64; 6] {
+impl WithEnergy<'_> {
+    fn rhs(&self, theta: f64, z: &[f64], dz: &mut [f64]) {
         let y = [theta, z[1], z[2]];
         let d = self.plant.derivatives(self.seg, &y, &U);
         let p = self.plant.powers(self.seg, &y, &U);
         let inv = 1.0 / z[1];
-        [
+        dz.copy_from_slice(&[
             inv,
             d[1] * inv,
             d[2] * inv,
             p[0] * inv,
             p[1] * inv,
             p[2] * inv,
-        ]
+        ]);
     }
 }
 
@@ -45,6 +45,7 @@ fn rk4_period(plant: &Plant, theta0: f64, omega0: f64, n: usize) -> ([f64; 6], V
     let mut z = [0.0, omega0, 0.0, 0.0, 0.0, 0.0];
     let h = FRAC_PI_2 / n as f64;
     let mut samples = vec![(theta0, omega0)];
+    let mut rk = ExplicitRk::<4, [f64; 6]>::new(&RK4);
     for q in 0..4 {
         let start = theta0 + q as f64 * FRAC_PI_2;
         let sys = WithEnergy {
@@ -52,7 +53,12 @@ fn rk4_period(plant: &Plant, theta0: f64, omega0: f64, n: usize) -> ([f64; 6], V
             seg: segment_of(start + 0.5 * h),
         };
         for k in 0..n {
-            z = rk4_step(&sys, start + k as f64 * h, &z, h);
+            rk.step(
+                &mut |x, z, dz| sys.rhs(x, z, dz),
+                start + k as f64 * h,
+                h,
+                &mut z,
+            );
             samples.push((start + (k + 1) as f64 * h, z[1]));
         }
     }

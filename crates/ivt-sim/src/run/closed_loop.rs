@@ -21,8 +21,7 @@ use super::{
     Channels, ControlSample, PlantSample, RunResult, SensorSample, SimError, StepperSample,
 };
 use crate::backend::ControllerBackend;
-use crate::integrate::{Method, PlantIntegrator, Reached};
-use crate::ode::Tolerance;
+use crate::integrate::{Method, PlantIntegrator, Reached, Tolerance};
 use crate::plant::Plant;
 use crate::profile::{Drive, Pwl};
 use crate::record::Sample;
