@@ -64,9 +64,6 @@ fn write(dir: &std::path::Path, s: &Scene) -> Vec<std::path::PathBuf> {
 /// Work–precision problem, DP5 at rtol = atol = 1e-8 (≈ 100 rad of θ).
 #[divan::bench]
 fn open_loop_dp5_1e8() -> (f64, u64) {
-    let tol = Tolerance {
-        rtol: 1e-8,
-        atol: 1e-8,
-    };
+    let tol = Tolerance::uniform(1e-8);
     ivt_sim::work_precision::solve(&ivt_sim::work_precision::PROBLEM, Method::Dp5(tol))
 }

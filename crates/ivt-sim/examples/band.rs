@@ -8,10 +8,7 @@ use std::f64::consts::TAU;
 
 fn omega_a(v_m: f64, t_u: f64, r: f64) -> f64 {
     let plant = Plant::new(PlantParams::printed());
-    let tol = Tolerance {
-        rtol: 1e-9,
-        atol: 1e-9,
-    };
+    let tol = Tolerance::uniform(1e-9);
     let mut it = PlantIntegrator::new(plant, Method::Dp5(tol), 0.0, 0.0, 10.0, 0.0);
     let prof = ConstantInputs { v_m, t_u };
     it.advance(&prof, r, 10.0 * TAU, 1e9).unwrap();

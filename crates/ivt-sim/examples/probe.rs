@@ -11,7 +11,15 @@ fn main() {
             for (a, b) in p.iter().zip(c).step_by(every) {
                 println!(
                     "{:8.3} wa={:9.5} w={:9.5} r={:.6} rol={:.6} rd={:.6} V={:.3} T={:.2} sat={}",
-                    a.t, a.omega_a, a.omega, a.r, b.r_ol, b.r_d, a.v_m, a.t_u, b.saturated
+                    a.t,
+                    a.omega_a,
+                    a.omega,
+                    a.r,
+                    b.out.r_ol,
+                    b.out.r_d,
+                    a.v_m,
+                    a.t_u,
+                    b.out.saturated
                 );
             }
         }

@@ -4,30 +4,17 @@
 //! backend; the simulator reads `stepper_target` and moves its own stepper
 //! model (with rate limits and missed steps) towards it.
 
-use ivt_ctrl::{AnyController, Config, ControlOutput, UnsupportedPpr};
-
-/// A backend failure (transport, protocol, a dead firmware...).
-#[derive(Debug, thiserror::Error, Clone, PartialEq, Eq)]
-pub enum BackendError {
-    /// The requested encoder resolution has no compiled controller.
-    #[error("{0}")]
-    UnsupportedPpr(UnsupportedPpr),
-    /// The backend's link failed.
-    #[error("controller backend I/O: {0}")]
-    Io(String),
-    /// The backend answered something that is not a valid reply.
-    #[error("controller backend protocol: {0}")]
-    Protocol(String),
-}
+use crate::error::SimError;
+use ivt_ctrl::{AnyController, Config, ControlOutput};
 
 /// What the closed loop calls; implemented by the in-process ivt-ctrl
 /// controller (SIL, [`Sil`]) and by the QEMU firmware over a UART (PIL,
 /// [`crate::pil::Pil`]).
 pub trait ControllerBackend {
     /// One encoder pulse with its timer timestamp.
-    fn on_pulse(&mut self, ticks: u32) -> Result<ControlOutput, BackendError>;
+    fn on_pulse(&mut self, ticks: u32) -> Result<ControlOutput, SimError>;
     /// Slow readings V_m \[V\], T_U \[N·m\].
-    fn update_inputs(&mut self, v_m: f32, t_u: f32) -> Result<(), BackendError>;
+    fn update_inputs(&mut self, v_m: f32, t_u: f32) -> Result<(), SimError>;
 }
 
 /// Software in the loop: the `ivt-ctrl` controller in this process, for a
@@ -35,10 +22,10 @@ pub trait ControllerBackend {
 pub struct Sil(pub Box<AnyController>);
 
 impl ControllerBackend for Sil {
-    fn on_pulse(&mut self, ticks: u32) -> Result<ControlOutput, BackendError> {
+    fn on_pulse(&mut self, ticks: u32) -> Result<ControlOutput, SimError> {
         Ok(self.0.on_pulse(ticks))
     }
-    fn update_inputs(&mut self, v_m: f32, t_u: f32) -> Result<(), BackendError> {
+    fn update_inputs(&mut self, v_m: f32, t_u: f32) -> Result<(), SimError> {
         self.0.update_inputs(v_m, t_u);
         Ok(())
     }
@@ -47,9 +34,9 @@ impl ControllerBackend for Sil {
 /// A boxed SIL backend for a run-time PPR.
 ///
 /// # Errors
-/// [`BackendError::UnsupportedPpr`] if `ppr` is not in
+/// [`SimError::UnsupportedPpr`] if `ppr` is not in
 /// [`ivt_ctrl::SUPPORTED_PPR`].
-pub fn sil(ppr: usize, config: Config) -> Result<Box<dyn ControllerBackend>, BackendError> {
-    let c = AnyController::new(ppr, config).map_err(BackendError::UnsupportedPpr)?;
+pub fn sil(ppr: usize, config: Config) -> Result<Box<dyn ControllerBackend>, SimError> {
+    let c = AnyController::new(ppr, config).map_err(SimError::UnsupportedPpr)?;
     Ok(Box::new(Sil(Box::new(c))))
 }

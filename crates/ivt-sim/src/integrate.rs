@@ -21,6 +21,7 @@
 //! output and the step is retaken to end there. Each step uses the analytic
 //! branch of f of its own segment, so the error control sees a smooth problem.
 
+use crate::error::SimError;
 use crate::plant::{segment_end, AngleTerms, Inputs, Plant, DIM};
 use ivt_num::rk::step_factor;
 use ivt_num::{ExplicitRk, DP5, RK4};
@@ -76,44 +77,6 @@ pub enum Reached {
     /// t reached the time limit (only checked in the time domain and between
     /// angle-domain steps).
     Time,
-}
-
-/// Integration failures.
-#[derive(Debug, thiserror::Error, Clone, PartialEq)]
-pub enum IntegrateError {
-    /// The adaptive step fell below the resolution of x.
-    #[error("step size underflow at t = {t} s, θ = {theta} rad, ω = {omega} rad/s (h = {h:e})")]
-    StepUnderflow {
-        /// Time.
-        t: f64,
-        /// Angle.
-        theta: f64,
-        /// Speed.
-        omega: f64,
-        /// Last tried step.
-        h: f64,
-    },
-    /// An `advance` call needed more steps than [`MAX_STEPS_PER_ADVANCE`]
-    /// (a very stiff plant, e.g. a tiny L_a, or an absurd tolerance).
-    #[error("no progress: {steps} steps without reaching the next event at t = {t} s, θ = {theta} rad, ω = {omega} rad/s (stiff plant or tolerance too tight?)")]
-    TooManySteps {
-        /// Time.
-        t: f64,
-        /// Angle.
-        theta: f64,
-        /// Speed.
-        omega: f64,
-        /// The budget that ran out.
-        steps: u64,
-    },
-    /// The state became NaN or infinite.
-    #[error("state not finite at t = {t} s: {state:?}")]
-    NotFinite {
-        /// Time.
-        t: f64,
-        /// `[θ, ω, i_a]`.
-        state: [f64; DIM],
-    },
 }
 
 /// Counters for benchmarks and reports.
@@ -316,7 +279,7 @@ impl PlantIntegrator {
         r: f64,
         theta_target: f64,
         t_max: f64,
-    ) -> Result<Reached, IntegrateError> {
+    ) -> Result<Reached, SimError> {
         for _ in 0..MAX_STEPS_PER_ADVANCE {
             if self.y[0] >= theta_target {
                 return Ok(Reached::Angle);
@@ -330,13 +293,13 @@ impl PlantIntegrator {
                 self.time_step(prof, r, theta_target, t_max)?;
             }
             if !(self.y.iter().all(|v| v.is_finite()) && self.t.is_finite()) {
-                return Err(IntegrateError::NotFinite {
+                return Err(SimError::NotFinite {
                     t: self.t,
                     state: self.y,
                 });
             }
         }
-        Err(IntegrateError::TooManySteps {
+        Err(SimError::TooManySteps {
             t: self.t,
             theta: self.y[0],
             omega: self.y[1],
@@ -360,7 +323,7 @@ impl PlantIntegrator {
         prof: &P,
         r: f64,
         theta_target: f64,
-    ) -> Result<(), IntegrateError> {
+    ) -> Result<(), SimError> {
         let theta = self.y[0];
         let (seg, corner) = Self::forward_segment(theta);
         let bp = corner.min(theta_target);
@@ -465,8 +428,8 @@ impl PlantIntegrator {
         self.stats.angle_steps += 1;
     }
 
-    fn underflow(&self, h: f64) -> IntegrateError {
-        IntegrateError::StepUnderflow {
+    fn underflow(&self, h: f64) -> SimError {
+        SimError::StepUnderflow {
             t: self.t,
             theta: self.y[0],
             omega: self.y[1],
@@ -480,7 +443,7 @@ impl PlantIntegrator {
         r: f64,
         theta_target: f64,
         t_max: f64,
-    ) -> Result<(), IntegrateError> {
+    ) -> Result<(), SimError> {
         let tol = match self.method {
             Method::Dp5(tol) => tol,
             Method::Rk4 { startup, .. } => startup,
@@ -610,7 +573,7 @@ mod tests {
     use std::f64::consts::PI;
 
     fn dp5(rtol: f64) -> Method {
-        Method::Dp5(Tolerance { rtol, atol: rtol })
+        Method::Dp5(Tolerance::uniform(rtol))
     }
 
     /// The angle cache returns exactly `AngleTerms::new` for every (θ, segment)

@@ -2,6 +2,7 @@
 
 pub mod atomic;
 pub mod backend;
+pub mod error;
 pub mod integrate;
 pub mod output;
 pub mod pil;
@@ -16,3 +17,5 @@ pub mod sensors;
 pub mod steady;
 pub mod telemetry;
 pub mod work_precision;
+
+pub use error::SimError;

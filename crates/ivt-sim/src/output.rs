@@ -11,49 +11,14 @@
 //! run, a failed plot or an interrupted run leaves the directory as it was.
 
 use crate::atomic::Staged;
+use crate::error::{io_at as io, mcap_at as mcap_error, SimError};
 use crate::record::{Record, Sample, CHANNELS};
-use crate::run::{Channels, RunResult, SimError};
+use crate::run::{Channels, RunResult};
 use crate::scene::Scene;
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
-
-/// An output failure.
-#[derive(Debug, thiserror::Error)]
-pub enum OutputError {
-    /// File system.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The error.
-        source: std::io::Error,
-    },
-    /// MCAP writer.
-    #[error("{path}: MCAP: {msg}")]
-    Mcap {
-        /// The file.
-        path: PathBuf,
-        /// The error.
-        msg: String,
-    },
-    /// Plot drawing.
-    #[error("{path}: plot: {msg}")]
-    Plot {
-        /// The file.
-        path: PathBuf,
-        /// The error.
-        msg: String,
-    },
-}
-
-fn io(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
-    move |source| OutputError::Io {
-        path: path.to_path_buf(),
-        source,
-    }
-}
 
 pub use crate::record::channel_fields;
 
@@ -71,6 +36,20 @@ pub fn json_schema(name: &str) -> String {
     .to_string()
 }
 
+/// Adds the channel `/name` with the JSON schema `ivt.name` to an MCAP log.
+pub(crate) fn add_json_channel<W: std::io::Write + std::io::Seek>(
+    w: &mut mcap::Writer<W>,
+    name: &str,
+    meta: &BTreeMap<String, String>,
+) -> Result<u16, mcap::McapError> {
+    let schema = w.add_schema(
+        &format!("ivt.{name}"),
+        "jsonschema",
+        json_schema(name).as_bytes(),
+    )?;
+    w.add_channel(schema, &format!("/{name}"), "json", meta)
+}
+
 /// An MCAP log being written: one JSON-schema channel per recorded signal
 /// group, zstd chunks.
 struct McapLog {
@@ -85,12 +64,7 @@ struct McapLog {
 impl McapLog {
     /// Creates the log of `path` at the staged name `tmp`, with the channels
     /// of [`CHANNELS`] marked in `wanted`.
-    fn create(
-        tmp: &Path,
-        path: &Path,
-        scene: &Scene,
-        wanted: [bool; 4],
-    ) -> Result<Self, OutputError> {
+    fn create(tmp: &Path, path: &Path, scene: &Scene, wanted: [bool; 4]) -> Result<Self, SimError> {
         let err = mcap_error(path);
         let file = File::create(tmp).map_err(io(path))?;
         let mut w = mcap::WriteOptions::new()
@@ -111,16 +85,7 @@ impl McapLog {
             if !wanted[k] {
                 continue;
             }
-            let schema = w
-                .add_schema(
-                    &format!("ivt.{name}"),
-                    "jsonschema",
-                    json_schema(name).as_bytes(),
-                )
-                .map_err(&err)?;
-            let id = w
-                .add_channel(schema, &format!("/{name}"), "json", &meta)
-                .map_err(&err)?;
+            let id = add_json_channel(&mut w, name, &meta).map_err(&err)?;
             channels[k] = Some((id, 0));
         }
         Ok(Self {
@@ -132,7 +97,7 @@ impl McapLog {
     }
 
     /// Appends one message (ignored if its channel was not created).
-    fn write(&mut self, s: &Sample) -> Result<(), OutputError> {
+    fn write(&mut self, s: &Sample) -> Result<(), SimError> {
         let Some((id, seq)) = self.channels[s.channel()].as_mut() else {
             return Ok(());
         };
@@ -152,16 +117,9 @@ impl McapLog {
     }
 
     /// Writes the summary section and closes the file.
-    fn finish(mut self) -> Result<(), OutputError> {
+    fn finish(mut self) -> Result<(), SimError> {
         self.w.finish().map_err(mcap_error(&self.path))?;
         Ok(())
-    }
-}
-
-fn mcap_error(path: &Path) -> impl Fn(mcap::McapError) -> OutputError + '_ {
-    move |e| OutputError::Mcap {
-        path: path.to_path_buf(),
-        msg: e.to_string(),
     }
 }
 
@@ -183,7 +141,7 @@ fn recorded(ch: &Channels) -> [Option<Vec<Sample>>; 4] {
 ///
 /// # Errors
 /// I/O or MCAP errors.
-pub fn write_mcap(path: &Path, result: &RunResult, scene: &Scene) -> Result<(), OutputError> {
+pub fn write_mcap(path: &Path, result: &RunResult, scene: &Scene) -> Result<(), SimError> {
     let mut staged = Staged::new();
     stage_mcap(&mut staged, path, result, scene)?;
     staged.commit().map_err(io(path))?;
@@ -195,7 +153,7 @@ fn stage_mcap(
     path: &Path,
     result: &RunResult,
     scene: &Scene,
-) -> Result<(), OutputError> {
+) -> Result<(), SimError> {
     let channels = recorded(&result.channels);
     let tmp = staged.path(path);
     let mut log = McapLog::create(&tmp, path, scene, channels.each_ref().map(Option::is_some))?;
@@ -209,24 +167,19 @@ fn stage_mcap(
 ///
 /// # Errors
 /// I/O errors.
-pub fn write_csv(dir: &Path, stem: &str, ch: &Channels) -> Result<Vec<PathBuf>, OutputError> {
+pub fn write_csv(dir: &Path, stem: &str, ch: &Channels) -> Result<Vec<PathBuf>, SimError> {
     let mut staged = Staged::new();
     stage_csv(&mut staged, dir, stem, ch)?;
     staged.commit().map_err(io(dir))
 }
 
-fn stage_csv(
-    staged: &mut Staged,
-    dir: &Path,
-    stem: &str,
-    ch: &Channels,
-) -> Result<(), OutputError> {
+fn stage_csv(staged: &mut Staged, dir: &Path, stem: &str, ch: &Channels) -> Result<(), SimError> {
     fn one<T: Record>(
         staged: &mut Staged,
         dir: &Path,
         stem: &str,
         samples: &Option<Vec<T>>,
-    ) -> Result<(), OutputError> {
+    ) -> Result<(), SimError> {
         let Some(samples) = samples else {
             return Ok(());
         };
@@ -250,16 +203,12 @@ fn stage_csv(
 ///
 /// # Errors
 /// I/O, MCAP or plot errors.
-pub fn write_all(
-    dir: &Path,
-    scene: &Scene,
-    result: &RunResult,
-) -> Result<Vec<PathBuf>, OutputError> {
+pub fn write_all(dir: &Path, scene: &Scene, result: &RunResult) -> Result<Vec<PathBuf>, SimError> {
     let o = &scene.outputs;
     if !(o.mcap || o.csv || o.summary || !o.plots.is_empty()) {
         return Ok(vec![]);
     }
-    let ((), paths) = in_dir(dir, |staged| -> Result<(), OutputError> {
+    let ((), paths) = in_dir(dir, |staged| -> Result<(), SimError> {
         if o.mcap {
             stage_mcap(staged, &mcap_path(dir, scene), result, scene)?;
         }
@@ -273,7 +222,7 @@ pub fn write_all(
 /// this call created it (if it is still empty).
 fn in_dir<T, E, F>(dir: &Path, write: F) -> Result<(T, Vec<PathBuf>), E>
 where
-    E: From<OutputError>,
+    E: From<SimError>,
     F: FnOnce(&mut Staged) -> Result<T, E>,
 {
     let created = !dir.exists();
@@ -299,7 +248,7 @@ fn stage_rest(
     dir: &Path,
     scene: &Scene,
     result: &RunResult,
-) -> Result<(), OutputError> {
+) -> Result<(), SimError> {
     let o = &scene.outputs;
     if o.csv {
         stage_csv(staged, dir, &scene.name, &result.channels)?;
@@ -322,17 +271,6 @@ fn stage_rest(
         }
     }
     Ok(())
-}
-
-/// A run or its outputs failed.
-#[derive(Debug, thiserror::Error)]
-pub enum RunWriteError {
-    /// The run failed (no files are left behind).
-    #[error(transparent)]
-    Sim(#[from] SimError),
-    /// Writing an output failed.
-    #[error(transparent)]
-    Output(#[from] OutputError),
 }
 
 /// Samples per message of the writer thread's channel: large enough that
@@ -358,7 +296,7 @@ pub fn run_and_write<F>(
     dir: &Path,
     scene: &Scene,
     run: F,
-) -> Result<(RunResult, Vec<PathBuf>), RunWriteError>
+) -> Result<(RunResult, Vec<PathBuf>), SimError>
 where
     F: FnOnce(&mut dyn FnMut(Sample)) -> Result<RunResult, SimError>,
 {
@@ -367,7 +305,7 @@ where
         let paths = write_all(dir, scene, &result)?;
         return Ok((result, paths));
     }
-    in_dir(dir, |staged| -> Result<RunResult, RunWriteError> {
+    in_dir(dir, |staged| -> Result<RunResult, SimError> {
         let result = stream_mcap(staged, &mcap_path(dir, scene), scene, run)?;
         stage_rest(staged, dir, scene, &result)?;
         Ok(result)
@@ -381,7 +319,7 @@ fn stream_mcap<F>(
     path: &Path,
     scene: &Scene,
     run: F,
-) -> Result<RunResult, RunWriteError>
+) -> Result<RunResult, SimError>
 where
     F: FnOnce(&mut dyn FnMut(Sample)) -> Result<RunResult, SimError>,
 {
@@ -390,7 +328,7 @@ where
     let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<Sample>>(IN_FLIGHT);
     let writer = std::thread::Builder::new()
         .name("mcap-writer".into())
-        .spawn(move || -> Result<(), OutputError> {
+        .spawn(move || -> Result<(), SimError> {
             let mut log = log;
             for batch in rx {
                 for s in &batch {
@@ -414,7 +352,7 @@ where
     }
     drop(tx);
     let written = writer.join().unwrap_or_else(|_| {
-        Err(OutputError::Mcap {
+        Err(SimError::Mcap {
             path: path.to_path_buf(),
             msg: "writer thread panicked".into(),
         })

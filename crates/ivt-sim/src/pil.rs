@@ -8,7 +8,8 @@
 use ivt_ctrl::{Config, ControlOutput};
 use ivt_wire::host::{PilError, QemuOptions, QemuPil};
 
-use crate::backend::{BackendError, ControllerBackend};
+use crate::backend::ControllerBackend;
+use crate::error::SimError;
 
 /// The QEMU firmware as a controller backend.
 pub struct Pil {
@@ -20,9 +21,9 @@ impl Pil {
     /// the image built by `firmware/run-qemu.sh build`) and loads `config`.
     ///
     /// # Errors
-    /// [`BackendError::Io`] if QEMU or the image is missing or does not
-    /// answer; [`BackendError::Protocol`] if the firmware's PPR differs.
-    pub fn start(ppr: usize, config: &Config) -> Result<Self, BackendError> {
+    /// [`SimError::BackendIo`] if QEMU or the image is missing or does not
+    /// answer; [`SimError::BackendProtocol`] if the firmware's PPR differs.
+    pub fn start(ppr: usize, config: &Config) -> Result<Self, SimError> {
         Self::start_with(&QemuOptions::from_env(), ppr, config)
     }
 
@@ -30,20 +31,16 @@ impl Pil {
     ///
     /// # Errors
     /// As [`Pil::start`].
-    pub fn start_with(
-        opts: &QemuOptions,
-        ppr: usize,
-        config: &Config,
-    ) -> Result<Self, BackendError> {
+    pub fn start_with(opts: &QemuOptions, ppr: usize, config: &Config) -> Result<Self, SimError> {
         let mut link = QemuPil::start(opts, ppr as u32).map_err(to_backend)?;
         link.configure(config).map_err(to_backend)?;
         Ok(Self { link: Some(link) })
     }
 
-    fn link(&mut self) -> Result<&mut QemuPil, BackendError> {
+    fn link(&mut self) -> Result<&mut QemuPil, SimError> {
         self.link
             .as_mut()
-            .ok_or_else(|| BackendError::Io("PIL session already finished".into()))
+            .ok_or_else(|| SimError::BackendIo("PIL session already finished".into()))
     }
 
     /// Ends the session cleanly (QEMU exits 0) and returns the firmware's
@@ -51,29 +48,29 @@ impl Pil {
     ///
     /// # Errors
     /// As [`Pil::start`].
-    pub fn finish(&mut self) -> Result<ivt_wire::host::FirmwareReport, BackendError> {
+    pub fn finish(&mut self) -> Result<ivt_wire::host::FirmwareReport, SimError> {
         match self.link.take() {
             Some(link) => link.finish().map_err(to_backend),
-            None => Err(BackendError::Io("PIL session already finished".into())),
+            None => Err(SimError::BackendIo("PIL session already finished".into())),
         }
     }
 }
 
-fn to_backend(e: PilError) -> BackendError {
+fn to_backend(e: PilError) -> SimError {
     match e {
         PilError::Protocol { .. } | PilError::Incompatible { .. } | PilError::Wire(_) => {
-            BackendError::Protocol(e.to_string())
+            SimError::BackendProtocol(e.to_string())
         }
-        _ => BackendError::Io(e.to_string()),
+        _ => SimError::BackendIo(e.to_string()),
     }
 }
 
 impl ControllerBackend for Pil {
-    fn on_pulse(&mut self, ticks: u32) -> Result<ControlOutput, BackendError> {
+    fn on_pulse(&mut self, ticks: u32) -> Result<ControlOutput, SimError> {
         self.link()?.on_pulse(ticks).map_err(to_backend)
     }
 
-    fn update_inputs(&mut self, v_m: f32, t_u: f32) -> Result<(), BackendError> {
+    fn update_inputs(&mut self, v_m: f32, t_u: f32) -> Result<(), SimError> {
         self.link()?.update_inputs(v_m, t_u).map_err(to_backend)
     }
 }
@@ -88,12 +85,12 @@ impl ControllerBackend for Pil {
 pub fn run_pil(
     scene: &crate::scene::Scene,
     progress: &mut dyn FnMut(f64),
-) -> Result<crate::run::RunResult, crate::run::SimError> {
+) -> Result<crate::run::RunResult, SimError> {
     let params = scene
         .plant_params()
-        .map_err(|e| crate::run::SimError::Scene(e.to_string()))?;
+        .map_err(|e| SimError::Scene(e.to_string()))?;
     let Some(config) = crate::run::controller_config(scene, params.r_max) else {
-        return Err(crate::run::SimError::Scene(
+        return Err(SimError::Scene(
             "`controller.law = \"none\"` has no controller to put in the loop".into(),
         ));
     };
@@ -116,17 +113,17 @@ impl Shared {
         Self(std::rc::Rc::new(std::cell::RefCell::new(pil)))
     }
 
-    fn finish(&self) -> Result<ivt_wire::host::FirmwareReport, BackendError> {
+    fn finish(&self) -> Result<ivt_wire::host::FirmwareReport, SimError> {
         self.0.borrow_mut().finish()
     }
 }
 
 impl ControllerBackend for Shared {
-    fn on_pulse(&mut self, ticks: u32) -> Result<ControlOutput, BackendError> {
+    fn on_pulse(&mut self, ticks: u32) -> Result<ControlOutput, SimError> {
         self.0.borrow_mut().on_pulse(ticks)
     }
 
-    fn update_inputs(&mut self, v_m: f32, t_u: f32) -> Result<(), BackendError> {
+    fn update_inputs(&mut self, v_m: f32, t_u: f32) -> Result<(), SimError> {
         self.0.borrow_mut().update_inputs(v_m, t_u)
     }
 }

@@ -2,7 +2,7 @@
 //! plotters' bitmap backend with the font that `ivt-plot` embeds and
 //! registers at run time (one font setup for the whole toolkit).
 
-use crate::output::OutputError;
+use crate::error::SimError;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -27,9 +27,9 @@ pub fn draw(
     plots: &[String],
     series: &[[f64; 6]],
     omega0: f64,
-) -> Result<(), OutputError> {
+) -> Result<(), SimError> {
     ivt_plot::ensure_font();
-    let err = |e: String| OutputError::Plot {
+    let err = |e: String| SimError::Plot {
         path: path.to_path_buf(),
         msg: e,
     };

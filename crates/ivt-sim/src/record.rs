@@ -1,62 +1,90 @@
 //! Channel samples as JSON objects and CSV rows, written straight into a
-//! reused byte buffer.
+//! reused byte buffer, and serialized through serde (the Python bindings'
+//! columns).
 //!
 //! The MCAP log of the default scene holds ≈ 24 000 JSON messages; through
 //! serde_json's generic path (a fresh `Vec` per message, the `Serializer`
 //! state machine) they cost more than a third of the whole run. Here each
 //! sample type lists its fields once (the `record!` macro): that list gives the JSON
-//! schema of the channel, the JSON object and the CSV row. Numbers are
+//! schema of the channel, the JSON object, the CSV row and the serde
+//! `Serialize` impl; a field may sit in a member (`omega in out`: the
+//! control sample logs the controller's `ControlOutput` as it is). Numbers are
 //! formatted by the same crates serde_json uses (`zmij` for floats, `itoa` for
 //! integers), so the bytes are identical to `serde_json::to_vec` of the
 //! sample (test `json_is_byte_identical_to_serde_json`): non-finite floats
 //! (ω_a before the first revolution) are `null` in JSON and empty CSV cells.
 
 use crate::run::{ControlSample, PlantSample, SensorSample, StepperSample};
+use ivt_ctrl::Fault;
+use serde::ser::{Serialize, SerializeStruct, Serializer};
 
 /// A field value: its JSON-schema type and its text.
 pub trait Value: Copy {
     /// JSON-schema `type` of the field.
     const JSON_TYPE: &'static str;
+    /// What serde serializes for the value.
+    type Serde: Serialize;
+    /// The value as serde serializes it.
+    fn serde(self) -> Self::Serde;
     /// Appends the value's JSON text to `out`, or `null` when it has none
     /// (a non-finite float).
     fn write(self, out: &mut Vec<u8>, null: &[u8]);
 }
 
-macro_rules! float_value {
-    ($($t:ty),*) => {$(
+/// Implements [`Value`] for types serde serializes as they are, from the
+/// JSON-schema type and the text written for a value `x` (`null`: the text
+/// of a value that has none).
+macro_rules! value {
+    ($json:literal, |$x:ident, $out:ident, $null:ident| $write:expr, $($t:ty),*) => {$(
         impl Value for $t {
-            const JSON_TYPE: &'static str = "number";
+            const JSON_TYPE: &'static str = $json;
+            type Serde = Self;
+            fn serde(self) -> Self {
+                self
+            }
             #[inline]
-            fn write(self, out: &mut Vec<u8>, null: &[u8]) {
-                if self.is_finite() {
-                    out.extend_from_slice(zmij::Buffer::new().format_finite(self).as_bytes());
-                } else {
-                    out.extend_from_slice(null);
-                }
+            fn write(self, $out: &mut Vec<u8>, $null: &[u8]) {
+                let $x = self;
+                $write
             }
         }
     )*};
 }
-float_value!(f32, f64);
+value!(
+    "number",
+    |x, out, null| if x.is_finite() {
+        out.extend_from_slice(zmij::Buffer::new().format_finite(x).as_bytes());
+    } else {
+        out.extend_from_slice(null);
+    },
+    f32,
+    f64
+);
+value!(
+    "integer",
+    |x, out, _null| out.extend_from_slice(itoa::Buffer::new().format(x).as_bytes()),
+    u8,
+    u32,
+    i32,
+    i64,
+    u64
+);
+value!(
+    "boolean",
+    |x, out, _null| out.extend_from_slice(if x { b"true" } else { b"false" }),
+    bool
+);
 
-macro_rules! int_value {
-    ($($t:ty),*) => {$(
-        impl Value for $t {
-            const JSON_TYPE: &'static str = "integer";
-            #[inline]
-            fn write(self, out: &mut Vec<u8>, _null: &[u8]) {
-                out.extend_from_slice(itoa::Buffer::new().format(self).as_bytes());
-            }
-        }
-    )*};
-}
-int_value!(u8, u32, i32, i64, u64);
-
-impl Value for bool {
-    const JSON_TYPE: &'static str = "boolean";
+/// A fault is logged as its numeric code.
+impl Value for Fault {
+    const JSON_TYPE: &'static str = "integer";
+    type Serde = u8;
+    fn serde(self) -> u8 {
+        self.code()
+    }
     #[inline]
-    fn write(self, out: &mut Vec<u8>, _null: &[u8]) {
-        out.extend_from_slice(if self { b"true" } else { b"false" });
+    fn write(self, out: &mut Vec<u8>, null: &[u8]) {
+        self.code().write(out, null);
     }
 }
 
@@ -74,10 +102,11 @@ pub trait Record: Copy {
     fn write_csv(&self, out: &mut Vec<u8>);
 }
 
-/// Implements [`Record`] from the field list `name: type, …` (the struct's
-/// field order; a type that does not match the field does not compile).
+/// Implements [`Record`] and `Serialize` from the field list `name: type, …`
+/// (the struct's field order; `name in member: type` for a field of a
+/// member; a type that does not match the field does not compile).
 macro_rules! record {
-    ($ty:ty, $channel:literal, $first:ident: $fty:ty $(, $f:ident: $t:ty)* $(,)?) => {
+    ($ty:ty, $channel:literal, $first:ident: $fty:ty $(, $f:ident $(in $m:ident)?: $t:ty)* $(,)?) => {
         impl Record for $ty {
             const CHANNEL: &'static str = $channel;
             const FIELDS: &'static [(&'static str, &'static str)] = &[
@@ -85,14 +114,14 @@ macro_rules! record {
                 $((stringify!($f), <$t as Value>::JSON_TYPE),)*
             ];
             fn time(&self) -> f64 {
-                self.t
+                self.$first
             }
             fn write_json(&self, out: &mut Vec<u8>) {
                 out.extend_from_slice(concat!("{\"", stringify!($first), "\":").as_bytes());
                 <$fty as Value>::write(self.$first, out, b"null");
                 $(
                     out.extend_from_slice(concat!(",\"", stringify!($f), "\":").as_bytes());
-                    <$t as Value>::write(self.$f, out, b"null");
+                    <$t as Value>::write(self$(.$m)?.$f, out, b"null");
                 )*
                 out.push(b'}');
             }
@@ -100,9 +129,20 @@ macro_rules! record {
                 <$fty as Value>::write(self.$first, out, b"");
                 $(
                     out.push(b',');
-                    <$t as Value>::write(self.$f, out, b"");
+                    <$t as Value>::write(self$(.$m)?.$f, out, b"");
                 )*
                 out.push(b'\n');
+            }
+        }
+
+        impl Serialize for $ty {
+            fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+                let mut st = s.serialize_struct(stringify!($ty), Self::FIELDS.len())?;
+                st.serialize_field(stringify!($first), &<$fty as Value>::serde(self.$first))?;
+                $(
+                    st.serialize_field(stringify!($f), &<$t as Value>::serde(self$(.$m)?.$f))?;
+                )*
+                st.end()
             }
         }
     };
@@ -125,15 +165,15 @@ record!(
     "control",
     t: f64,
     ticks: u32,
-    omega: f32,
-    omega_a: f32,
-    omega_t: f32,
-    r_ol: f32,
-    r_d: f32,
-    r: f32,
-    stepper_target: i32,
-    saturated: bool,
-    fault: u8,
+    omega in out: f32,
+    omega_a in out: f32,
+    omega_t in out: f32,
+    r_ol in out: f32,
+    r_d in out: f32,
+    r in out: f32,
+    stepper_target in out: i32,
+    saturated in out: bool,
+    fault in out: Fault,
 );
 record!(
     StepperSample,
@@ -215,7 +255,7 @@ pub fn channel_fields(name: &str) -> &'static [(&'static str, &'static str)] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use serde::Serialize;
+    use ivt_ctrl::ControlOutput;
 
     fn same_as_serde<T: Record + Serialize>(s: T) {
         let mut ours = vec![];
@@ -269,15 +309,18 @@ mod tests {
             same_as_serde(ControlSample {
                 t: x,
                 ticks: [0, 1, u32::MAX][k % 3],
-                omega: x as f32,
-                omega_a: y as f32,
-                omega_t: (x * 1e-3) as f32,
-                r_ol: (y * 3.3) as f32,
-                r_d: f32::MIN_POSITIVE,
-                r: -1e-7,
-                stepper_target: [i32::MIN, -1, 0, i32::MAX][k % 4],
-                saturated: k % 2 == 0,
-                fault: [0, 7, u8::MAX][k % 3],
+                out: ControlOutput {
+                    omega: x as f32,
+                    omega_a: y as f32,
+                    omega_t: (x * 1e-3) as f32,
+                    r_ol: (y * 3.3) as f32,
+                    r_d: f32::MIN_POSITIVE,
+                    r: -1e-7,
+                    stepper_target: [i32::MIN, -1, 0, i32::MAX][k % 4],
+                    saturated: k % 2 == 0,
+                    fault: [Fault::None, Fault::InputInvalid, Fault::Config][k % 3],
+                    ..ControlOutput::IDLE
+                },
             });
             same_as_serde(StepperSample {
                 t: y,

@@ -36,14 +36,15 @@
 //!   last revolution of θ (per-pulse plant and control samples are recorded
 //!   for that and decimated back to what the scene asked for).
 
-use crate::output::{write_all, OutputError};
-use crate::run::{RunResult, SimError, Simulation};
+use crate::error::{io_at, SimError};
+use crate::output::write_all;
+use crate::run::{RunResult, Simulation};
 use crate::scene::{ChannelSpec, Law, Scene};
 use ivt_ctrl::{ActuatorMap, OpenLoopPreset};
 use ivt_design::delay::{delay_stability_about, steady_orbit, DelayOptions, FeedbackGains};
 use ivt_design::shooting::{omega_at_angles, periodic_at_r, ShootingOptions};
 use ivt_design::steady::{IhbOptions, IhbSolver};
-use ivt_design::{IvtError, OperatingPoint, Verdict};
+use ivt_design::{OperatingPoint, Verdict};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -98,20 +99,6 @@ pub struct SceneRun {
     pub wall_time_s: f64,
 }
 
-/// Failures of either route.
-#[derive(Debug, thiserror::Error)]
-pub enum SteadyError {
-    /// The time integration failed.
-    #[error(transparent)]
-    Sim(#[from] SimError),
-    /// The harmonic-balance solve failed (with its residual history).
-    #[error("IHB steady state: {0}")]
-    Ihb(#[from] IvtError),
-    /// The scene is inconsistent.
-    #[error("scene: {0}")]
-    Scene(String),
-}
-
 impl Simulation<'_> {
     /// Answer the scene by the route its `outputs.route` asks for, or the
     /// one forced by [`Simulation::route`] (e.g. the CLI's `--route`).
@@ -121,7 +108,7 @@ impl Simulation<'_> {
     /// # Errors
     /// A forced IHB route on a scene that cannot take it, or a failure of
     /// the route taken.
-    pub fn answer(self) -> Result<SceneRun, SteadyError> {
+    pub fn answer(self) -> Result<SceneRun, SimError> {
         answer(self.scene, self.route, self.progress)
     }
 }
@@ -130,14 +117,14 @@ fn answer(
     scene: &Scene,
     force: Option<Route>,
     progress: Option<&mut dyn FnMut(f64)>,
-) -> Result<SceneRun, SteadyError> {
+) -> Result<SceneRun, SimError> {
     let wall = Instant::now();
     let asked = force.or_else(|| scene.outputs.route.forced());
     let blocker = scene.ihb_route_blocker();
     let (route, mut reason) = match (asked, blocker) {
         (Some(Route::TimeIntegration), _) => (Route::TimeIntegration, "forced".to_string()),
         (Some(Route::IhbSteadyState), Some(why)) => {
-            return Err(SteadyError::Scene(format!(
+            return Err(SimError::Scene(format!(
                 "route \"ihb_steady_state\" is not possible: {why}"
             )))
         }
@@ -216,7 +203,7 @@ pub fn write_outputs(
     dir: &Path,
     scene: &Scene,
     answer: &SceneRun,
-) -> Result<Vec<PathBuf>, OutputError> {
+) -> Result<Vec<PathBuf>, SimError> {
     let mut paths = match &answer.run {
         Some(result) => write_all(dir, scene, result)?,
         None => vec![],
@@ -234,23 +221,19 @@ pub fn write_outputs(
 /// summary; returns its path.
 ///
 /// # Errors
-/// [`OutputError::Io`] when the file cannot be written.
+/// [`SimError::Io`] when the file cannot be written.
 pub fn write_summary(
     dir: &Path,
     scene: &Scene,
     answer: &SceneRun,
-) -> Result<Option<PathBuf>, OutputError> {
+) -> Result<Option<PathBuf>, SimError> {
     if !scene.outputs.summary {
         return Ok(None);
     }
     let p = dir.join(format!("{}_summary.json", scene.name));
-    let io = |source| OutputError::Io {
-        path: p.clone(),
-        source,
-    };
-    std::fs::create_dir_all(dir).map_err(io)?;
+    std::fs::create_dir_all(dir).map_err(io_at(&p))?;
     let text = serde_json::to_string_pretty(&answer.summary_json(scene)).unwrap_or_default();
-    std::fs::write(&p, text + "\n").map_err(io)?;
+    std::fs::write(&p, text + "\n").map_err(io_at(&p))?;
     Ok(Some(p))
 }
 
@@ -260,13 +243,13 @@ pub fn write_summary(
 /// # Errors
 /// An IHB or shooting solve that does not converge (with its residual
 /// history), a stall, or a plant the solver refuses.
-pub fn ihb_steady_state(scene: &Scene) -> Result<SteadyMetrics, SteadyError> {
+pub fn ihb_steady_state(scene: &Scene) -> Result<SteadyMetrics, SimError> {
     if let Some(why) = scene.ihb_route_blocker() {
-        return Err(SteadyError::Scene(why));
+        return Err(SimError::Scene(why));
     }
     let params = scene
         .plant_params()
-        .map_err(|e| SteadyError::Scene(e.to_string()))?;
+        .map_err(|e| SimError::Scene(e.to_string()))?;
     let c = &scene.controller;
     let op = OperatingPoint {
         v_m: scene.inputs.v_m[0][1],
@@ -368,7 +351,7 @@ pub fn ihb_steady_state(scene: &Scene) -> Result<SteadyMetrics, SteadyError> {
 fn time_route(
     scene: &Scene,
     progress: Option<&mut dyn FnMut(f64)>,
-) -> Result<(RunResult, Option<SteadyMetrics>), SteadyError> {
+) -> Result<(RunResult, Option<SteadyMetrics>), SimError> {
     let run = |s: &Scene, progress: Option<&mut dyn FnMut(f64)>| match progress {
         Some(p) => Simulation::new(s).progress(p).run(),
         None => Simulation::new(s).run(),
@@ -420,8 +403,8 @@ fn last_revolution(scene: &Scene, result: &RunResult) -> Option<SteadyMetrics> {
     let r_m = rev.iter().map(|p| p.r).sum::<f64>() / ppr as f64;
     let r_max = scene.plant_params().ok()?.r_max;
     let verdict = match (scene.controller.law, control.and_then(|c| c.last())) {
-        (Law::Delay, Some(c)) if c.saturated && c.r <= 0.0 => Some(Verdict::UnderDrive),
-        (Law::Delay, Some(c)) if c.saturated && f64::from(c.r) >= r_max * (1.0 - 1e-6) => {
+        (Law::Delay, Some(c)) if c.out.saturated && c.out.r <= 0.0 => Some(Verdict::UnderDrive),
+        (Law::Delay, Some(c)) if c.out.saturated && f64::from(c.out.r) >= r_max * (1.0 - 1e-6) => {
             Some(Verdict::OverDrive)
         }
         (Law::Delay, Some(_)) => Some(Verdict::Feasible),

@@ -20,7 +20,8 @@ use std::time::{Duration, Instant};
 use ivt_wire::frame::Decoder;
 use ivt_wire::msg::Telemetry;
 
-use crate::output::json_schema;
+use crate::error::{io_at, mcap_at, SimError};
+use crate::output::add_json_channel;
 
 /// When to stop and how to read time.
 #[derive(Clone, Debug)]
@@ -48,33 +49,6 @@ pub struct RecordSummary {
     pub out: PathBuf,
 }
 
-/// Recording failures.
-#[derive(Debug, thiserror::Error)]
-pub enum RecordError {
-    /// Reading the source failed.
-    #[error("reading telemetry: {0}")]
-    Read(std::io::Error),
-    /// Creating the output failed.
-    #[error("{path}: {source}")]
-    Create {
-        /// The file.
-        path: PathBuf,
-        /// The error.
-        source: std::io::Error,
-    },
-    /// Writing the MCAP failed.
-    #[error("{path}: MCAP: {msg}")]
-    Mcap {
-        /// The file.
-        path: PathBuf,
-        /// The error.
-        msg: String,
-    },
-    /// The timer rate is not a positive finite number.
-    #[error("f_timer_hz must be positive and finite, got {0}")]
-    BadTimer(f64),
-}
-
 /// Reads telemetry frames from `src` until `opts` says stop (frame count,
 /// end of stream, an I/O error of a closed pty, idling, or SIGINT/SIGTERM
 /// through [`crate::atomic::on_interrupt`]) and writes them to
@@ -87,42 +61,25 @@ pub fn record<R: Read>(
     mut src: R,
     out: &Path,
     opts: &RecordOptions,
-) -> Result<RecordSummary, RecordError> {
+) -> Result<RecordSummary, SimError> {
     if !(opts.f_timer_hz.is_finite() && opts.f_timer_hz > 0.0) {
-        return Err(RecordError::BadTimer(opts.f_timer_hz));
+        return Err(SimError::BadTimer(opts.f_timer_hz));
     }
-    let mcap_err = |e: mcap::McapError| RecordError::Mcap {
-        path: out.to_path_buf(),
-        msg: e.to_string(),
-    };
+    let mcap_err = mcap_at(out);
     // Written under a temporary name and renamed once the footer is on; a
     // SIGINT/SIGTERM stops the reading like the end of the stream does.
     let _listener = crate::atomic::listen();
     let mut staged = crate::atomic::Staged::new();
-    let file = File::create(staged.path(out)).map_err(|source| RecordError::Create {
-        path: out.to_path_buf(),
-        source,
-    })?;
+    let file = File::create(staged.path(out)).map_err(io_at(out))?;
     let mut w = mcap::WriteOptions::new()
         .compression(Some(mcap::Compression::Zstd))
         .profile("")
         .create(BufWriter::new(file))
-        .map_err(mcap_err)?;
+        .map_err(&mcap_err)?;
     let mut meta = BTreeMap::new();
     meta.insert("source".to_string(), "rig telemetry".to_string());
-    let mut channel = |name: &str| -> Result<u16, RecordError> {
-        let schema = w
-            .add_schema(
-                &format!("ivt.{name}"),
-                "jsonschema",
-                json_schema(name).as_bytes(),
-            )
-            .map_err(mcap_err)?;
-        w.add_channel(schema, &format!("/{name}"), "json", &meta)
-            .map_err(mcap_err)
-    };
-    let control = channel("control")?;
-    let stepper = channel("stepper")?;
+    let control = add_json_channel(&mut w, "control", &meta).map_err(&mcap_err)?;
+    let stepper = add_json_channel(&mut w, "stepper", &meta).map_err(&mcap_err)?;
 
     let mut dec = Decoder::new();
     let mut buf = [0u8; 512];
@@ -155,7 +112,7 @@ pub fn record<R: Read>(
             {
                 break
             }
-            Err(e) => return Err(RecordError::Read(e)),
+            Err(e) => return Err(SimError::TelemetryRead(e)),
         };
         last_byte = Instant::now();
         for &b in &buf[..n] {
@@ -180,7 +137,7 @@ pub fn record<R: Read>(
                     publish_time: ns,
                 };
                 w.write_to_known_channel(&header, msg.to_string().as_bytes())
-                    .map_err(mcap_err)?;
+                    .map_err(&mcap_err)?;
             }
             frames += 1;
             if opts.max_frames.is_some_and(|m| frames >= m) {
@@ -188,12 +145,9 @@ pub fn record<R: Read>(
             }
         }
     }
-    w.finish().map_err(mcap_err)?;
+    w.finish().map_err(&mcap_err)?;
     drop(w);
-    staged.commit().map_err(|source| RecordError::Create {
-        path: out.to_path_buf(),
-        source,
-    })?;
+    staged.commit().map_err(io_at(out))?;
     Ok(RecordSummary {
         frames,
         bad_frames: bad,

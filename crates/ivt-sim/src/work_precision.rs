@@ -113,18 +113,25 @@ pub struct Study {
     pub rows: Vec<Row>,
 }
 
+/// ω at the end of `p` by DP5 at rtol = atol = 1e-14 (the reference) and by
+/// RK4 with 16 000 steps per gear segment (its check).
+fn reference_and_check(p: &Problem) -> (f64, f64) {
+    let (reference, _) = solve(p, Method::Dp5(Tolerance::uniform(1e-14)));
+    let (check, _) = solve(
+        p,
+        Method::Rk4 {
+            dtheta: FRAC_PI_2 / 16_000.0,
+            startup: Tolerance::uniform(1e-12),
+        },
+    );
+    (reference, check)
+}
+
 /// Run the study; `budget_s` is the timing budget per row.
 pub fn study(budget_s: f64) -> Study {
     let p = PROBLEM;
-    let tol = |x: f64| Tolerance { rtol: x, atol: x };
-    let (reference, _) = solve(&p, Method::Dp5(tol(1e-14)));
-    let (check, _) = solve(
-        &p,
-        Method::Rk4 {
-            dtheta: FRAC_PI_2 / 16_000.0,
-            startup: tol(1e-12),
-        },
-    );
+    let tol = Tolerance::uniform;
+    let (reference, check) = reference_and_check(&p);
     let mut rows = vec![];
     for e in 3..=12 {
         let x = 10f64.powi(-e);
@@ -181,15 +188,8 @@ mod tests {
     #[test]
     fn errors_fall_with_tolerance_and_step() {
         let p = PROBLEM;
-        let tol = |x: f64| Tolerance { rtol: x, atol: x };
-        let (w_ref, _) = solve(&p, Method::Dp5(tol(1e-14)));
-        let (w_rk, _) = solve(
-            &p,
-            Method::Rk4 {
-                dtheta: FRAC_PI_2 / 16_000.0,
-                startup: tol(1e-12),
-            },
-        );
+        let tol = Tolerance::uniform;
+        let (w_ref, w_rk) = reference_and_check(&p);
         assert!((w_ref - w_rk).abs() < 1e-11, "{w_ref} vs {w_rk}");
         let e = |x: f64| (solve(&p, Method::Dp5(tol(x))).0 - w_ref).abs();
         assert!(e(1e-10) < 1e-7 && e(1e-6) < 1e-3 && e(1e-10) < e(1e-6));

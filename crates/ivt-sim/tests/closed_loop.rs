@@ -37,7 +37,7 @@ fn rms_dr_dtheta(res: &RunResult, from: f64, dtheta: f64) -> f64 {
     let (mut s, mut n) = (0.0, 0);
     for w in c.windows(2) {
         if w[0].t >= from {
-            let d = f64::from(w[1].r_d - w[0].r_d) / dtheta;
+            let d = f64::from(w[1].out.r_d - w[0].out.r_d) / dtheta;
             s += d * d;
             n += 1;
         }
@@ -145,9 +145,9 @@ fn saturation_and_recovery() {
         .zip(p)
         .filter(|(c, _)| c.t > 15.0 && c.t < 20.0)
         .collect();
-    assert!(late.iter().all(|(c, _)| c.saturated && c.r == 0.0));
+    assert!(late.iter().all(|(c, _)| c.out.saturated && c.out.r == 0.0));
     assert!(late.iter().all(|(_, p)| p.omega_a < 0.95 * w0));
-    assert!(late.iter().all(|(c, _)| c.r_d.abs() < 1e-3), "wind-up");
+    assert!(late.iter().all(|(c, _)| c.out.r_d.abs() < 1e-3), "wind-up");
     let st = res.summary.settling_time_s.expect("recovers");
     assert!(st < 5.0, "recovery took {st} s");
     assert!(
@@ -269,7 +269,7 @@ fn failed_streamed_run_leaves_no_log() {
     let err = ivt_sim::output::run_and_write(&dir, &s, |sink| {
         let r = Simulation::new(&s).sink(sink).run()?;
         assert!(r.summary.pulses > 0);
-        Err(ivt_sim::run::SimError::Scene("stopped on purpose".into()))
+        Err(ivt_sim::SimError::Scene("stopped on purpose".into()))
     })
     .unwrap_err();
     assert!(err.to_string().contains("stopped on purpose"), "{err}");

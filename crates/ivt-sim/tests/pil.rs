@@ -8,8 +8,9 @@
 //! (scripts/test does), hence `#[ignore]` in a plain `cargo test`.
 
 use ivt_ctrl::{Config, ControlOutput, LawKind};
-use ivt_sim::backend::{sil, BackendError, ControllerBackend};
+use ivt_sim::backend::{sil, ControllerBackend};
 use ivt_sim::pil::Pil;
+use ivt_sim::SimError;
 
 const PPR: usize = 1200;
 
@@ -73,7 +74,7 @@ fn pil_backend_matches_sil_backend_bit_for_bit() {
 #[ignore = "needs qemu-system-arm and the firmware image; run by firmware/run-qemu.sh test"]
 fn pil_refuses_a_ppr_the_firmware_was_not_built_for() {
     match Pil::start(360, &Config::default()) {
-        Err(BackendError::Protocol(msg)) => assert!(msg.contains("PPR 1200"), "{msg}"),
+        Err(SimError::BackendProtocol(msg)) => assert!(msg.contains("PPR 1200"), "{msg}"),
         Err(e) => panic!("wrong error {e}"),
         Ok(_) => panic!("PIL accepted PPR 360 on a PPR-1200 firmware"),
     }
@@ -86,7 +87,7 @@ fn pil_without_an_image_is_a_clear_error() {
         ..ivt_wire::host::QemuOptions::from_env()
     };
     match Pil::start_with(&opts, PPR, &Config::default()) {
-        Err(BackendError::Io(msg)) => assert!(msg.contains("run-qemu.sh build"), "{msg}"),
+        Err(SimError::BackendIo(msg)) => assert!(msg.contains("run-qemu.sh build"), "{msg}"),
         Err(e) => panic!("wrong error {e}"),
         Ok(_) => panic!("started without an image"),
     }
@@ -132,23 +133,26 @@ fn pil_scene_with_load_step_gives_the_sil_r_sequence_bit_for_bit() {
     let a = sil.channels.control.as_ref().unwrap();
     let b = pil.channels.control.as_ref().unwrap();
     assert_eq!(a.len(), b.len(), "pulse counts differ");
-    let ready_after_step = a.iter().filter(|s| s.t > 1.5 && s.omega_t != 0.0).count();
+    let ready_after_step = a
+        .iter()
+        .filter(|s| s.t > 1.5 && s.out.omega_t != 0.0)
+        .count();
     assert!(
         ready_after_step > 500,
         "feedback active on only {ready_after_step} pulses after the step"
     );
     for (k, (x, y)) in a.iter().zip(b).enumerate() {
         assert_eq!(
-            x.r.to_bits(),
-            y.r.to_bits(),
+            x.out.r.to_bits(),
+            y.out.r.to_bits(),
             "r differs at pulse {k} (t = {} s)",
             x.t
         );
         assert_eq!(x, y, "pulse {k}");
     }
     // The load step must have moved r, or the comparison proves little.
-    let r_before = a.iter().rev().find(|s| s.t < 1.5).unwrap().r;
-    let r_end = a.last().unwrap().r;
+    let r_before = a.iter().rev().find(|s| s.t < 1.5).unwrap().out.r;
+    let r_end = a.last().unwrap().out.r;
     assert_ne!(
         r_before.to_bits(),
         r_end.to_bits(),

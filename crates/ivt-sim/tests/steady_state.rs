@@ -15,6 +15,12 @@ const U: Inputs = Inputs {
     t_u: 6.0,
 };
 
+/// The constant inputs of [`U`].
+const PROFILE: ConstantInputs = ConstantInputs {
+    v_m: U.v_m,
+    t_u: U.t_u,
+};
+
 /// Eq. 162 in the angle domain with the running integrals of the three powers
 /// appended: `[t, ω, i_a, E_motor, E_load, E_loss]`.
 struct WithEnergy<'a> {
@@ -92,14 +98,8 @@ fn reference_periodic(plant: &Plant, theta0: f64, n: usize) -> (f64, Vec<(f64, f
 #[test]
 fn power_balance_closes_over_a_steady_period() {
     let plant = Plant::new(PlantParams::printed());
-    let prof = ConstantInputs {
-        v_m: U.v_m,
-        t_u: U.t_u,
-    };
-    let tol = Tolerance {
-        rtol: 1e-12,
-        atol: 1e-12,
-    };
+    let prof = PROFILE;
+    let tol = Tolerance::uniform(1e-12);
     let mut it = PlantIntegrator::new(plant, Method::Dp5(tol), 0.0, 0.0, 0.0, 0.0);
     let theta0 = FRAC_PI_4 + 20.0 * PI; // a corner, ten revolutions in
     it.advance(&prof, U.r, theta0, 1e9).unwrap();
@@ -141,14 +141,8 @@ fn start_up_converges_to_the_unique_periodic_solution() {
         (w_ref - w_half).abs() < 1e-11,
         "reference not converged: {w_ref} vs {w_half}"
     );
-    let prof = ConstantInputs {
-        v_m: U.v_m,
-        t_u: U.t_u,
-    };
-    let tol = Tolerance {
-        rtol: 1e-11,
-        atol: 1e-11,
-    };
+    let prof = PROFILE;
+    let tol = Tolerance::uniform(1e-11);
     for omega_start in [0.0, 30.0] {
         let mut it = PlantIntegrator::new(plant, Method::Dp5(tol), 0.0, 0.0, omega_start, 0.0);
         let base = theta0 + 30.0 * 2.0 * PI; // 30 revolutions of transient
@@ -177,14 +171,8 @@ fn start_up_converges_to_the_unique_periodic_solution() {
 /// decade, and the current ends near its quasi-static value.
 #[test]
 fn inductance_tends_to_the_quasi_static_motor() {
-    let prof = ConstantInputs {
-        v_m: U.v_m,
-        t_u: U.t_u,
-    };
-    let tol = Tolerance {
-        rtol: 1e-10,
-        atol: 1e-10,
-    };
+    let prof = PROFILE;
+    let tol = Tolerance::uniform(1e-10);
     let omega_a = |l_a: f64| {
         let mut params = PlantParams::printed();
         params.l_a = l_a;

@@ -17,10 +17,9 @@
 //! [`ClosedLoop::finish`] forms the summary.
 
 use super::metrics::Metrics;
-use super::{
-    Channels, ControlSample, PlantSample, RunResult, SensorSample, SimError, StepperSample,
-};
+use super::{Channels, ControlSample, PlantSample, RunResult, SensorSample, StepperSample};
 use crate::backend::ControllerBackend;
+use crate::error::SimError;
 use crate::integrate::{Method, PlantIntegrator, Reached, Tolerance};
 use crate::plant::Plant;
 use crate::profile::{Drive, Pwl};
@@ -276,7 +275,11 @@ impl<'s> ClosedLoop<'s> {
         self.target = i64::from(out.stepper_target);
         if let (Some(buf), Some(e)) = (self.ch.control.as_mut(), self.every.control) {
             if self.n_pulse.is_multiple_of(e as u64) {
-                let s = ControlSample::new(p.t, p.ticks, &out);
+                let s = ControlSample {
+                    t: p.t,
+                    ticks: p.ticks,
+                    out,
+                };
                 buf.push(s);
                 sink(Sample::Control(s));
             }

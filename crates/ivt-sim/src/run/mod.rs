@@ -12,8 +12,9 @@
 mod closed_loop;
 mod metrics;
 
-use crate::backend::{self, BackendError, ControllerBackend};
-use crate::integrate::{IntegrateError, Reached};
+use crate::backend::{self, ControllerBackend};
+use crate::error::SimError;
+use crate::integrate::Reached;
 use crate::record::Sample;
 use crate::scene::{Law, Route, Scene};
 use closed_loop::ClosedLoop;
@@ -21,22 +22,8 @@ use ivt_ctrl::{units, ActuatorMap, Config, ControlOutput, Gains, OpenLoopPreset,
 use serde::Serialize;
 use std::time::Instant;
 
-/// A failed run.
-#[derive(Debug, thiserror::Error)]
-pub enum SimError {
-    /// The scene is inconsistent.
-    #[error("scene: {0}")]
-    Scene(String),
-    /// The integrator failed.
-    #[error(transparent)]
-    Integrate(#[from] IntegrateError),
-    /// The controller backend failed.
-    #[error(transparent)]
-    Backend(#[from] BackendError),
-}
-
 /// One `plant` channel sample (at a pulse).
-#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlantSample {
     /// Time \[s\].
     pub t: f64,
@@ -57,58 +44,21 @@ pub struct PlantSample {
     pub i_a: f64,
 }
 
-/// One `control` channel sample: the backend's [`ControlOutput`] at a pulse
-/// (the fields the MCAP/CSV `control` channel carries; built only by
-/// [`ControlSample::new`]).
-#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+/// One `control` channel sample: the backend's [`ControlOutput`] for the
+/// pulse at `t` with timer capture `ticks`, as the controller returned it
+/// (the `control` channel logs its fields listed in [`crate::record`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ControlSample {
     /// Time \[s\].
     pub t: f64,
     /// Timer capture \[ticks\].
     pub ticks: u32,
-    /// ω \[rad/s\].
-    pub omega: f32,
-    /// ω_a \[rad/s\].
-    pub omega_a: f32,
-    /// ω_T \[rad/s\].
-    pub omega_t: f32,
-    /// u_ol \[m\].
-    pub r_ol: f32,
-    /// r_d \[m\].
-    pub r_d: f32,
-    /// Commanded r \[m\].
-    pub r: f32,
-    /// Stepper target \[steps\].
-    pub stepper_target: i32,
-    /// r at a bound.
-    pub saturated: bool,
-    /// Fault code.
-    pub fault: u8,
-}
-
-impl ControlSample {
-    /// The sample of `out`, the answer to the pulse at `t` with timer
-    /// capture `ticks`.
-    #[must_use]
-    pub fn new(t: f64, ticks: u32, out: &ControlOutput) -> Self {
-        Self {
-            t,
-            ticks,
-            omega: out.omega,
-            omega_a: out.omega_a,
-            omega_t: out.omega_t,
-            r_ol: out.r_ol,
-            r_d: out.r_d,
-            r: out.r,
-            stepper_target: out.stepper_target,
-            saturated: out.saturated,
-            fault: out.fault.code(),
-        }
-    }
+    /// The controller's answer to the pulse.
+    pub out: ControlOutput,
 }
 
 /// One `stepper` channel sample.
-#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepperSample {
     /// Time \[s\].
     pub t: f64,
@@ -123,7 +73,7 @@ pub struct StepperSample {
 }
 
 /// One `sensors` channel sample (what the controller was given).
-#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SensorSample {
     /// Time \[s\].
     pub t: f64,
