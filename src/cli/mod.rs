@@ -59,6 +59,18 @@ impl CliError {
     }
 }
 
+/// A design-crate error: bad inputs (out-of-range or non-finite arguments,
+/// plant parameters, empty grids) are `input`, solver failures `failed`.
+impl From<ivt_design::IvtError> for CliError {
+    fn from(e: ivt_design::IvtError) -> Self {
+        use ivt_design::IvtError as E;
+        match e {
+            E::Input { .. } | E::Plant(_) | E::EmptyGrid(_) => CliError::Input(e.to_string()),
+            E::Stall { .. } | E::NoConvergence { .. } => CliError::Failed(e.to_string()),
+        }
+    }
+}
+
 #[derive(Parser)]
 #[command(
     name = "ivt",

@@ -4,11 +4,11 @@
 use super::{CliError, Output};
 use clap::{Args, Subcommand};
 use ivt_design::fit::{self, OpenLoopLaw, PolyForm};
-use ivt_design::shooting::{shoot_steady_state, ShootingOptions};
-use ivt_design::steady::{solve_steady_state, IhbOptions};
+use ivt_design::polish::{self, accurate_r};
+use ivt_design::steady::IhbOptions;
 use ivt_design::sweep::{self, Grid, SweepPoint};
 use ivt_design::{rad_s_to_rpm, rpm_to_rad_s, OperatingPoint};
-use ivt_kin::plant::{PlantParams, PlantPreset};
+use ivt_kin::plant::PlantPreset;
 use serde_json::json;
 
 /// `--plant printed|thesis-ch4` (SPEC §6), shared by `ivt ol` and `ivt stability(-map)`.
@@ -52,8 +52,8 @@ pub struct SolveArgs {
     /// How r̄ is computed: `polish` (default) refines the IHB by θ-shooting
     /// (≤ 1e-9 relative); `ihb` reports the n-harmonic IHB alone (n = 7, the
     /// thesis's choice, is ~3 % off), with |r̄(n) − r̄(2n+1)| as its error estimate.
-    #[arg(long, value_enum, default_value_t = SolveMethod::Polish)]
-    method: SolveMethod,
+    #[arg(long, value_enum, default_value_t = MethodArg::Polish)]
+    method: MethodArg,
     /// Target mean speed [rpm].
     #[arg(long, default_value_t = 100.0, allow_hyphen_values = true)]
     omega0_rpm: f64,
@@ -64,13 +64,22 @@ pub struct SolveArgs {
     plant: PlantArg,
 }
 
-/// How `ivt ol solve` computes r̄.
+/// How `ivt ol solve` computes r̄ ([`polish::SolveMethod`]).
 #[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
-pub enum SolveMethod {
+pub enum MethodArg {
     /// IHB seed polished by θ-shooting (Eq. 162 integrated in θ by RK6).
     Polish,
     /// The n-harmonic IHB alone (§4.2.1).
     Ihb,
+}
+
+impl From<MethodArg> for polish::SolveMethod {
+    fn from(m: MethodArg) -> Self {
+        match m {
+            MethodArg::Polish => polish::SolveMethod::Polish,
+            MethodArg::Ihb => polish::SolveMethod::Ihb,
+        }
+    }
 }
 
 /// Grid arguments shared by `table` and `fit` (MATLAB-style from:step:to).
@@ -120,19 +129,6 @@ pub struct FitArgs {
     emit_rust: Option<std::path::PathBuf>,
 }
 
-fn input(e: impl std::fmt::Display) -> CliError {
-    CliError::Input(e.to_string())
-}
-
-/// A design-crate error: bad inputs are `input`, solver failures `failed`.
-fn failed(e: ivt_design::IvtError) -> CliError {
-    use ivt_design::IvtError as E;
-    match e {
-        E::Input { .. } | E::Plant(_) | E::EmptyGrid(_) => CliError::Input(e.to_string()),
-        _ => CliError::Failed(e.to_string()),
-    }
-}
-
 /// Run an `ol` subcommand.
 ///
 /// # Errors
@@ -152,102 +148,39 @@ fn solve(a: SolveArgs) -> Result<Output, CliError> {
         t_u: a.tu,
         omega0: rpm_to_rad_s(a.omega0_rpm),
     };
-    op.validate().map_err(input)?;
+    op.validate()?;
     let opts = IhbOptions {
         harmonics: a.harmonics,
         ..Default::default()
     };
     let t0 = std::time::Instant::now();
-    let s = solve_steady_state(&plant, &op, opts).map_err(failed)?;
-    let acc = accurate_r(&plant, &op, &s, a.method, opts)?;
+    let acc = accurate_r(&plant, &op, opts, a.method.into())?;
     let dt = t0.elapsed().as_secs_f64();
+    let s = &acc.ihb;
     let verdict = ivt_design::Verdict::classify(acc.r, plant.r_max);
+    let thesis_choice = a.method == MethodArg::Ihb && a.harmonics == 7;
     let json = json!({
         "r": acc.r, "feasible": verdict == ivt_design::Verdict::Feasible,
         "verdict": verdict.as_str(), "q": s.q, "omega_min": acc.omega_min,
         "omega_max": acc.omega_max, "solve_time_s": dt, "iterations": s.iterations,
         "residual_norm": s.residual_norm, "harmonics": a.harmonics, "r_max": plant.r_max,
-        "omega0": op.omega0, "method": acc.method, "r_ihb": s.r,
+        "omega0": op.omega0, "method": acc.method.label(), "r_ihb": s.r,
         "error_estimate": {"r_abs": acc.error_abs, "r_rel": acc.error_abs / acc.r.abs(),
                            "how": acc.how},
-        "thesis_choice": a.method == SolveMethod::Ihb && a.harmonics == 7,
+        "thesis_choice": thesis_choice,
         "plant": a.plant.preset.name(),
     });
-    let label = if a.method == SolveMethod::Ihb && a.harmonics == 7 {
+    let label = if thesis_choice {
         " — n = 7, the thesis's choice"
     } else {
         ""
     };
     let human = format!(
         "V_m = {} V, T_U = {} N·m, ω0 = {} rpm\nr̄ = {:.7} m ± {:.1e} ({}{label}; {}; r_max = {} m)\nω̄ ∈ [{:.2}, {:.2}] rpm\n{} Newton iterations, |R| = {:.1e}, {:.1} µs\n",
-        a.vm, a.tu, a.omega0_rpm, acc.r, acc.error_abs, acc.method, verdict.as_str(), plant.r_max,
+        a.vm, a.tu, a.omega0_rpm, acc.r, acc.error_abs, acc.method.label(), verdict.as_str(), plant.r_max,
         rad_s_to_rpm(acc.omega_min), rad_s_to_rpm(acc.omega_max), s.iterations, s.residual_norm, dt * 1e6
     );
     Ok(Output { json, human })
-}
-
-/// r̄ of `ol solve` with an error estimate.
-struct AccurateR {
-    r: f64,
-    omega_min: f64,
-    omega_max: f64,
-    error_abs: f64,
-    method: &'static str,
-    how: &'static str,
-}
-
-/// θ-shooting polish of the IHB r̄ (its error estimated by halving the RK6
-/// steps: 6th order, so the estimate bounds the 48-step error ~60-fold), or
-/// the IHB alone with |r̄(n) − r̄(2n+1)| (r̄(n) converges like n⁻³ on this
-/// plant, crates/ivt-design/README.md).
-fn accurate_r(
-    plant: &PlantParams,
-    op: &OperatingPoint,
-    s: &ivt_design::steady::SteadyState,
-    method: SolveMethod,
-    opts: IhbOptions,
-) -> Result<AccurateR, CliError> {
-    match method {
-        SolveMethod::Polish => {
-            let fine = ShootingOptions::default();
-            let coarse = ShootingOptions {
-                steps_per_segment: fine.steps_per_segment / 2,
-                ..fine
-            };
-            let orbit = shoot_steady_state(plant, op, Some(s.r), &fine).map_err(failed)?;
-            let check = shoot_steady_state(plant, op, Some(orbit.r), &coarse).map_err(failed)?;
-            Ok(AccurateR {
-                r: orbit.r,
-                omega_min: orbit.omega_min,
-                omega_max: orbit.omega_max,
-                error_abs: (orbit.r - check.r).abs(),
-                method: "ihb+shooting",
-                how: "θ-shooting with 48 vs 24 RK6 steps per gear segment",
-            })
-        }
-        SolveMethod::Ihb => {
-            // The other resolution: 2n+1 harmonics, or n/2 at the limit
-            // (then an overestimate).
-            let n = opts.harmonics;
-            let other = IhbOptions {
-                harmonics: if 2 * n < ivt_design::steady::MAX_HARMONICS {
-                    2 * n + 1
-                } else {
-                    n / 2
-                },
-                ..opts
-            };
-            let finer = solve_steady_state(plant, op, other).map_err(failed)?;
-            Ok(AccurateR {
-                r: s.r,
-                omega_min: s.omega_min,
-                omega_max: s.omega_max,
-                error_abs: (s.r - finer.r).abs(),
-                method: "ihb",
-                how: "|r̄(n) − r̄(2n+1)| of the IHB (n/2 instead of 2n+1 at the limit)",
-            })
-        }
-    }
 }
 
 fn run_sweep(a: &GridArgs) -> Result<(Grid, Vec<SweepPoint>), CliError> {
@@ -258,11 +191,11 @@ fn run_sweep(a: &GridArgs) -> Result<(Grid, Vec<SweepPoint>), CliError> {
         )));
     }
     let grid = Grid {
-        v_m: sweep::axis("--vm-step", a.vm_from, a.vm_step, a.vm_to).map_err(input)?,
-        t_u: sweep::axis("--tu-step", a.tu_from, a.tu_step, a.tu_to).map_err(input)?,
+        v_m: sweep::axis("--vm-step", a.vm_from, a.vm_step, a.vm_to)?,
+        t_u: sweep::axis("--tu-step", a.tu_from, a.tu_step, a.tu_to)?,
         omega0: rpm_to_rad_s(a.omega0_rpm),
     };
-    grid.validate().map_err(input)?;
+    grid.validate()?;
     let opts = IhbOptions {
         harmonics: a.harmonics,
         ..Default::default()
@@ -272,7 +205,7 @@ fn run_sweep(a: &GridArgs) -> Result<(Grid, Vec<SweepPoint>), CliError> {
     } else {
         indicatif::ProgressBar::new(grid.len() as u64)
     };
-    let pts = sweep::sweep(&a.plant.preset.params(), &grid, opts, || bar.inc(1)).map_err(failed)?;
+    let pts = sweep::sweep(&a.plant.preset.params(), &grid, opts, || bar.inc(1))?;
     bar.finish_and_clear();
     if let Some(Err(first)) = pts.first().map(|p| &p.result) {
         if pts.iter().all(|p| p.result.is_err()) {
@@ -321,22 +254,21 @@ fn fit_cmd(a: FitArgs) -> Result<Output, CliError> {
     } else {
         PolyForm::Eq158
     };
-    let pf = fit::fit_polynomial(&pts, plant.r_max, form).map_err(failed)?;
+    let pf = fit::fit_polynomial(&pts, plant.r_max, form)?;
     let opts = IhbOptions {
         harmonics: a.grid.harmonics,
         ..Default::default()
     };
     let (alpha, beta, b_err) =
-        fit::fit_boundary(&plant, &grid.t_u, grid.omega0, plant.r_max, opts).map_err(failed)?;
-    let (alpha0, beta0, _) =
-        fit::fit_boundary(&plant, &grid.t_u, grid.omega0, 0.0, opts).map_err(failed)?;
+        fit::fit_boundary(&plant, &grid.t_u, grid.omega0, plant.r_max, opts)?;
+    let (alpha0, beta0, _) = fit::fit_boundary(&plant, &grid.t_u, grid.omega0, 0.0, opts)?;
     let law = OpenLoopLaw {
         poly: pf.poly,
         boundary: [1.0, -alpha, -beta],
         r_max: plant.r_max,
     };
-    let err = fit::law_error(&plant, &law, &pts).map_err(failed)?;
-    let thesis_err = fit::law_error(&plant, &OpenLoopLaw::thesis(), &pts).map_err(failed)?;
+    let err = fit::law_error(&plant, &law, &pts)?;
+    let thesis_err = fit::law_error(&plant, &OpenLoopLaw::thesis(), &pts)?;
     if let Some(path) = &a.emit_rust {
         let header = format!(
             "Open-loop law refitted on the {} plant (Eq. 151) by `ivt ol fit{}`:\n\

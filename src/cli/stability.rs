@@ -65,11 +65,14 @@ impl Common {
             FeedbackGains::from_thesis_mm_per_rad(self.k, self.k2)
         }
     }
-    fn opts(&self) -> DelayOptions {
-        DelayOptions {
+    /// The discretization, validated ([`DelayOptions::validate`]).
+    fn opts(&self) -> Result<DelayOptions, CliError> {
+        let opts = DelayOptions {
             chebyshev_order: self.n,
             ..Default::default()
-        }
+        };
+        opts.validate()?;
+        Ok(opts)
     }
     fn omega0(&self) -> Result<f64, CliError> {
         if self.omega0_rpm.is_finite() && self.omega0_rpm > 0.0 {
@@ -113,14 +116,11 @@ pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
         t_u: a.tu,
         omega0: a.common.omega0()?,
     };
-    op.validate().map_err(|e| CliError::Input(e.to_string()))?;
+    op.validate()?;
     let g = a.common.gains();
     let plant = a.common.plant.preset.params();
     let t0 = std::time::Instant::now();
-    let s = delay_stability(&plant, &op, g, &a.common.opts()).map_err(|e| match e {
-        ivt_design::IvtError::Input { .. } => CliError::Input(e.to_string()),
-        _ => CliError::Failed(e.to_string()),
-    })?;
+    let s = delay_stability(&plant, &op, g, &a.common.opts()?)?;
     let dt = t0.elapsed().as_secs_f64();
     let design = match &a.design {
         Some(b) => {
@@ -132,9 +132,8 @@ pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
                 (0.0, k_max * scale),
                 (0.0, k2_max * scale),
                 a.design_steps,
-                &a.common.opts(),
-            )
-            .map_err(|e| CliError::Failed(e.to_string()))?;
+                &a.common.opts()?,
+            )?;
             if c.max_abs_multiplier.is_nan() || c.max_abs_multiplier >= 1.0 {
                 return Err(CliError::Failed(format!(
                     "no gains with k ≤ {k_max:e}, k2 ≤ {k2_max:e} give max |multiplier| < 1 \
@@ -175,13 +174,11 @@ pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
         t_u: grid_axis("--tu", &a.tu)?,
         omega0: a.common.omega0()?,
     };
-    grid.validate()
-        .map_err(|e| CliError::Input(e.to_string()))?;
+    grid.validate()?;
     let plant = a.common.plant.preset.params();
     let mut ops: Vec<OperatingPoint> = grid.operating_points();
     if a.feasible_only {
-        let pts = ivt_design::sweep::sweep(&plant, &grid, Default::default(), || ())
-            .map_err(|e| CliError::Failed(e.to_string()))?;
+        let pts = ivt_design::sweep::sweep(&plant, &grid, Default::default(), || ())?;
         ops = pts
             .iter()
             .filter(|p| {
@@ -193,8 +190,7 @@ pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
             .collect();
     }
     let t0 = std::time::Instant::now();
-    let map = stability_map(&plant, &ops, a.common.gains(), &a.common.opts())
-        .map_err(|e| CliError::Input(e.to_string()))?;
+    let map = stability_map(&plant, &ops, a.common.gains(), &a.common.opts()?)?;
     let dt = t0.elapsed().as_secs_f64();
     let solved: Vec<f64> = map
         .iter()
@@ -265,7 +261,7 @@ fn grid_axis(name: &'static str, v: &[f64]) -> Result<Vec<f64>, CliError> {
     let &[from, step, to] = v else {
         return Err(CliError::Input(format!("{name} takes FROM STEP TO")));
     };
-    axis(name, from, step, to).map_err(|e| CliError::Input(e.to_string()))
+    Ok(axis(name, from, step, to)?)
 }
 
 /// Most grid values per gain axis of `--design` (steps² solves per round).

@@ -21,6 +21,7 @@ mod sthb;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use ivt_plot::{Figure, HeatMap};
+use ivt_sim::atomic::Staged;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -158,6 +159,9 @@ pub struct Report {
 /// What a chapter writes into.
 pub(crate) struct Context {
     out: PathBuf,
+    /// Every file of the run, under temporary names until the report is
+    /// complete ([`ivt_sim::atomic::Staged`]): a failed run leaves none.
+    staged: Staged,
     opts: Options,
     rows: Vec<Row>,
     figures: Vec<FigureEntry>,
@@ -197,6 +201,7 @@ impl Context {
         };
         Self {
             out: out.to_path_buf(),
+            staged: Staged::new(),
             opts,
             rows: Vec::new(),
             figures: Vec::new(),
@@ -326,9 +331,19 @@ impl Context {
             .join("_")
     }
 
-    fn write(&self, name: &str, text: &str) -> Result<(), ReproError> {
-        let path = self.out.join(name);
-        std::fs::write(&path, text).map_err(|source| ReproError::Io { path, source })
+    /// Write `text` as `name` in the output directory (staged).
+    fn write(&mut self, name: &str, text: &str) -> Result<(), ReproError> {
+        let path = self.staging(name);
+        std::fs::write(&path, text).map_err(|source| ReproError::Io {
+            path: self.out.join(name),
+            source,
+        })
+    }
+
+    /// The temporary path that becomes `name` in the output directory when
+    /// the run completes.
+    fn staging(&mut self, name: &str) -> PathBuf {
+        self.staged.path(&self.out.join(name))
     }
 
     /// Draw a line figure and save its data as CSV (`series,x,y`, NaN rows
@@ -359,7 +374,7 @@ impl Context {
                 .map(|(s, l)| ivt_plot::Series { label: l, ..*s })
                 .collect(),
         };
-        ivt_plot::line_plot(&self.out.join(&png), &drawable)?;
+        ivt_plot::line_plot(&self.staging(&png), &drawable)?;
         let mut csv = format!(
             "series,\"{}\",\"{}\"\n",
             figure.x_label.replace('"', "'"),
@@ -398,7 +413,7 @@ impl Context {
             glyphs(map.value_label),
         );
         ivt_plot::heat_map(
-            &self.out.join(&png),
+            &self.staging(&png),
             &HeatMap {
                 title: &title,
                 x_label: &x_label,
@@ -458,11 +473,23 @@ fn glyphs(s: &str) -> String {
 /// # Errors
 /// I/O or drawing failures; numerical failures become rows instead.
 pub fn run(out: &Path, opts: Options) -> Result<Report, ReproError> {
-    let start = std::time::Instant::now();
+    let existed = out.is_dir();
     std::fs::create_dir_all(out).map_err(|source| ReproError::Io {
         path: out.to_path_buf(),
         source,
     })?;
+    let result = run_in(out, opts);
+    if result.is_err() && !existed {
+        // Only succeeds while empty: the staged files are already removed.
+        let _ = std::fs::remove_dir(out);
+    }
+    result
+}
+
+/// Every chapter into the staged set of `out`, renamed into place once the
+/// report is written.
+fn run_in(out: &Path, opts: Options) -> Result<Report, ReproError> {
+    let start = std::time::Instant::now();
     let mut ctx = Context::new(out, opts, 17);
     ctx.section = "kinematics";
     kinematics::run(&mut ctx)?;
@@ -483,10 +510,20 @@ pub fn run(out: &Path, opts: Options) -> Result<Report, ReproError> {
     let report_path = out.join("REPRODUCTION.md");
     let text = report::markdown(&ctx.rows, &ctx.figures, elapsed_s, opts.quick);
     ctx.write("REPRODUCTION.md", &text)?;
+    let Context {
+        staged,
+        figures,
+        rows,
+        ..
+    } = ctx;
+    staged.commit().map_err(|source| ReproError::Io {
+        path: out.to_path_buf(),
+        source,
+    })?;
     Ok(Report {
         report: report_path,
-        figures: ctx.figures,
-        rows: ctx.rows,
+        figures,
+        rows,
         elapsed_s,
     })
 }

@@ -86,6 +86,24 @@ impl Default for DelayOptions {
 }
 
 impl DelayOptions {
+    /// Refuse a Chebyshev order that is odd, zero or above
+    /// [`MAX_CHEBYSHEV_ORDER`], before anything is allocated. Every entry point
+    /// (CLI, Python, reproduce) calls it; [`monodromy`] does too.
+    ///
+    /// # Errors
+    /// [`IvtError::Input`] naming `chebyshev_order` and the limit.
+    pub fn validate(&self) -> Result<(), IvtError> {
+        let nn = self.chebyshev_order;
+        if nn == 0 || nn % 2 == 1 || nn > MAX_CHEBYSHEV_ORDER {
+            return Err(IvtError::Input {
+                name: "chebyshev_order",
+                value: nn as f64,
+                requirement: "even, >= 2 and <= 64 (MAX_CHEBYSHEV_ORDER: the cost grows like N^5)",
+            });
+        }
+        Ok(())
+    }
+
     fn steps(&self) -> usize {
         if self.steps_per_segment > 0 {
             self.steps_per_segment
@@ -190,14 +208,8 @@ fn monodromy_with_steps(
 ) -> Result<DMatrix<f64>, IvtError> {
     check_plant(plant)?;
     op.validate()?;
+    opts.validate()?;
     let nn = opts.chebyshev_order;
-    if nn == 0 || nn % 2 == 1 || nn > MAX_CHEBYSHEV_ORDER {
-        return Err(IvtError::Input {
-            name: "chebyshev_order",
-            value: nn as f64,
-            requirement: "even, >= 2 and <= 64 (MAX_CHEBYSHEV_ORDER: the cost grows like N^5)",
-        });
-    }
     for (name, v) in [("k", gains.k), ("k2", gains.k2)] {
         if !v.is_finite() {
             return Err(IvtError::Input {
@@ -284,6 +296,7 @@ pub fn delay_stability(
     gains: FeedbackGains,
     opts: &DelayOptions,
 ) -> Result<DelayStability, IvtError> {
+    opts.validate()?;
     let orbit = steady_orbit(plant, op, None, opts)?;
     delay_stability_about(plant, op, gains, &orbit, opts)
 }

@@ -12,6 +12,8 @@
 //! - [`shooting`]: the independent reference — Eq. 162 integrated in θ with
 //!   Newton on (ω(0), r) through the variational equations;
 //! - [`steady`]: the modified IHB of Eq. 152–157, unknowns {r, q_p};
+//! - [`polish`]: r̄ accurate by default (IHB seed, θ-shooting polish) with an
+//!   error estimate;
 //! - [`sweep`]: r̄ over a (V_m, T_U) grid, warm starts along rows, rayon across rows;
 //! - [`fit`]: least-squares refit of the Eq. 158 form and of the Eq. 159 boundary;
 //! - [`delay`]: Eq. 174 (Appendix B) discretized by the Chebyshev spectral Tau
@@ -25,6 +27,7 @@ pub mod delay_sim;
 pub mod fit;
 pub mod gains;
 pub mod pieces;
+pub mod polish;
 pub mod shooting;
 pub mod steady;
 pub mod sweep;

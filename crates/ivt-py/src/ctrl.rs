@@ -14,6 +14,8 @@ use numpy::{
 };
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
+
+use crate::args::{count, int64, opt_int64};
 use pyo3::types::PyDict;
 
 fn law_kind(name: &str) -> PyResult<LawKind> {
@@ -167,14 +169,18 @@ fn output_dict<'py>(py: Python<'py>, o: &ControlOutput) -> PyResult<Bound<'py, P
     Ok(d)
 }
 
-/// Timer timestamps as u32 from a uint32 array, an integer array or a
-/// sequence of ints; each must lie in [0, 2³²).
+/// Timer timestamps as u32 from a uint32 array, an integer array, a float
+/// array whose values are whole numbers, or a sequence of ints; each must
+/// lie in [0, 2³²).
 fn ticks_from_py(ob: &Bound<'_, PyAny>) -> PyResult<Vec<u32>> {
     if let Ok(a) = ob.cast::<PyArray1<u32>>() {
         return Ok(a.readonly().as_array().to_vec());
     }
     let as_i64: Vec<i64> = if let Ok(arr) = ob.cast::<PyUntypedArray>() {
         let kind = arr.dtype().kind();
+        if kind == b'f' {
+            return whole_ticks(ob);
+        }
         if kind != b'i' && kind != b'u' {
             return Err(PyTypeError::new_err(format!(
                 "argument `ticks` must hold integers (timer counts), got dtype kind {:?}",
@@ -204,21 +210,44 @@ fn ticks_from_py(ob: &Bound<'_, PyAny>) -> PyResult<Vec<u32>> {
         .collect()
 }
 
-/// Optional per-pulse input array (V_m or T_U): float32 values, same length.
+/// Timer counts from a float array: each value must be a whole number in
+/// [0, 2³²) (a float array of counts, as `numpy.loadtxt` returns).
+fn whole_ticks(ob: &Bound<'_, PyAny>) -> PyResult<Vec<u32>> {
+    let a = ob
+        .extract::<numpy::PyArrayLike1<'_, f64, numpy::AllowTypeChange>>()
+        .map_err(|_| PyValueError::new_err("argument `ticks` must be one-dimensional"))?;
+    a.as_array()
+        .iter()
+        .enumerate()
+        .map(|(i, &t)| {
+            if t.fract() == 0.0 && (0.0..4_294_967_296.0).contains(&t) {
+                Ok(t as u32)
+            } else {
+                Err(PyValueError::new_err(format!(
+                    "argument `ticks`[{i}] = {t} is not a whole timer count in [0, 2^32)"
+                )))
+            }
+        })
+        .collect()
+}
+
+/// Optional per-pulse input (V_m or T_U): a float (held for every pulse) or
+/// an array of floats with one entry per pulse, as float32.
 fn inputs_from_py(
     name: &str,
     ob: Option<&Bound<'_, PyAny>>,
     n: usize,
 ) -> PyResult<Option<Vec<f32>>> {
     let Some(ob) = ob else { return Ok(None) };
-    let v: Vec<f64> =
-        if let Ok(a) = ob.extract::<numpy::PyArrayLike1<'_, f64, numpy::AllowTypeChange>>() {
-            a.as_array().to_vec()
-        } else {
-            return Err(PyTypeError::new_err(format!(
-                "argument `{name}` must be a 1-D array of floats"
-            )));
-        };
+    let v: Vec<f64> = if let Ok(x) = ob.extract::<f64>() {
+        vec![x; n]
+    } else if let Ok(a) = ob.extract::<numpy::PyArrayLike1<'_, f64, numpy::AllowTypeChange>>() {
+        a.as_array().to_vec()
+    } else {
+        return Err(PyTypeError::new_err(format!(
+            "argument `{name}` must be a float or a 1-D array of floats"
+        )));
+    };
     if v.len() != n {
         return Err(PyValueError::new_err(format!(
             "argument `{name}` has {} entries, `ticks` has {n}",
@@ -242,11 +271,11 @@ impl Controller {
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
-        ppr: usize,
+        #[pyo3(from_py_with = int64)] ppr: i64,
         f_timer_hz: Option<f32>,
         omega0: Option<f32>,
         omega0_rpm: Option<f32>,
-        decimation: Option<u16>,
+        #[pyo3(from_py_with = opt_int64)] decimation: Option<i64>,
         law: Option<&str>,
         k: Option<f32>,
         k2: Option<f32>,
@@ -265,6 +294,8 @@ impl Controller {
         t_u_valid: Option<[f32; 2]>,
         initial_inputs: Option<[f32; 2]>,
     ) -> PyResult<Self> {
+        let ppr: usize = count("ppr", ppr)?;
+        let decimation: Option<u16> = decimation.map(|d| count("decimation", d)).transpose()?;
         if !SUPPORTED_PPR.contains(&ppr) {
             return Err(PyValueError::new_err(format!(
                 "argument `ppr` = {ppr} has no compiled controller (supported: {SUPPORTED_PPR:?})"
@@ -410,8 +441,12 @@ impl Controller {
     /// is the timer's). Returns the output dict: omega, omega_a, omega_T,
     /// r_ol, r_d, r, stepper_target, saturated, fault (code), fault_name,
     /// ready, inputs_clamped, ol_region.
-    fn on_pulse<'py>(&mut self, py: Python<'py>, ticks: u32) -> PyResult<Bound<'py, PyDict>> {
-        let o = self.inner.on_pulse(ticks);
+    fn on_pulse<'py>(
+        &mut self,
+        py: Python<'py>,
+        #[pyo3(from_py_with = int64)] ticks: i64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let o = self.inner.on_pulse(count("ticks", ticks)?);
         output_dict(py, &o)
     }
 
@@ -430,8 +465,12 @@ impl Controller {
 
     /// Step-generator tick at timer count `now`: dict with step, forward,
     /// position, next_step_at, moving, fault, fault_name.
-    fn step_tick<'py>(&mut self, py: Python<'py>, now: u32) -> PyResult<Bound<'py, PyDict>> {
-        let s = self.inner.step_tick(now);
+    fn step_tick<'py>(
+        &mut self,
+        py: Python<'py>,
+        #[pyo3(from_py_with = int64)] now: i64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let s = self.inner.step_tick(count("now", now)?);
         let d = PyDict::new(py);
         d.set_item("step", s.step)?;
         d.set_item("forward", s.forward)?;
@@ -573,9 +612,7 @@ pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = parent.py();
     let m = PyModule::new(py, "ctrl")?;
     m.add_class::<Controller>()?;
-    m.add_function(wrap_pyfunction!(thesis_gains, &m)?)?;
-    m.add_function(wrap_pyfunction!(open_loop_preset, &m)?)?;
-    m.add_function(wrap_pyfunction!(open_loop_eval, &m)?)?;
+    add_functions!(&m, [thesis_gains, open_loop_preset, open_loop_eval]);
     m.add("SUPPORTED_PPR", SUPPORTED_PPR.to_vec())?;
     let faults = PyDict::new(py);
     for f in [

@@ -2,11 +2,13 @@
 //! state and open-loop table, delay-loop stability. Keys follow
 //! `ivt ol solve`, `ivt ol table` and `ivt stability` (`--json`).
 
+use crate::args::{count, int64};
 use crate::kin::Plant;
 use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
-use ivt_design::steady::{solve_steady_state, IhbOptions};
+use ivt_design::polish::{accurate_r, SolveMethod};
+use ivt_design::steady::IhbOptions;
 use ivt_design::sweep::{self, Grid};
-use ivt_design::{rpm_to_rad_s, OperatingPoint, Verdict};
+use ivt_design::{rpm_to_rad_s, IvtError, OperatingPoint, Verdict};
 use ivt_kin::plant::{PlantParams, PlantPreset};
 use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
@@ -51,56 +53,96 @@ fn operating_point(v_m: f64, t_u: f64, omega0_rpm: f64) -> PyResult<OperatingPoi
         t_u,
         omega0: rpm_to_rad_s(omega0_rpm),
     };
-    op.validate()
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    op.validate().map_err(design_err)?;
     Ok(op)
 }
 
-fn ihb_options(harmonics: usize) -> IhbOptions {
-    IhbOptions {
-        harmonics,
+fn ihb_options(harmonics: i64) -> PyResult<IhbOptions> {
+    Ok(IhbOptions {
+        harmonics: count("harmonics", harmonics)?,
         ..Default::default()
+    })
+}
+
+/// A design-crate error: bad inputs → `ValueError`, solver failures (stall,
+/// no convergence) → `RuntimeError` (the CLI's `input` and `failed`).
+fn design_err(e: IvtError) -> PyErr {
+    match e {
+        IvtError::Input { .. } | IvtError::Plant(_) | IvtError::EmptyGrid(_) => {
+            PyValueError::new_err(e.to_string())
+        }
+        IvtError::Stall { .. } | IvtError::NoConvergence { .. } => {
+            PyRuntimeError::new_err(e.to_string())
+        }
     }
 }
 
-/// IVT steady state at one operating point by IHB (§4.2.1): the mean
-/// eccentricity r̄ that holds the mean speed ω0 at (V_m, T_U).
+/// IVT steady state at one operating point (§4.2.1): the mean eccentricity r̄
+/// that holds the mean speed ω0 at (V_m, T_U), accurate by default.
 ///
-/// Returns the dict of `ivt ol solve --json`: r (unconstrained r̄ [m]),
-/// feasible, verdict ("feasible", "under-drive", "over-drive"), q, omega_min,
-/// omega_max, solve_time_s, iterations, residual_norm, harmonics, r_max,
-/// omega0, plant. `plant`: "printed" (default), "thesis-ch4" or an
+/// `method="polish"` (default) refines the n-harmonic IHB by θ-shooting
+/// (≤ 1e-9 relative); `method="ihb"` reports the IHB alone (n = 7, the
+/// thesis's choice, is ~3 % off r̄), with |r̄(n) − r̄(2n+1)| as its error
+/// estimate. Returns the dict of `ivt ol solve --json`: r, feasible, verdict
+/// ("feasible", "under-drive", "over-drive"), q, omega_min, omega_max,
+/// solve_time_s, iterations, residual_norm, harmonics, r_max, omega0, method
+/// ("ihb+shooting" or "ihb"), r_ihb, error_estimate {r_abs, r_rel, how},
+/// thesis_choice, plant. `plant`: "printed" (default), "thesis-ch4" or an
 /// ivt.kin.Plant.
 #[pyfunction]
-#[pyo3(signature = (v_m, t_u, omega0_rpm = 100.0, harmonics = 7, plant = None))]
+#[pyo3(signature = (v_m, t_u, omega0_rpm = 100.0, harmonics = 7, plant = None, method = "polish"))]
 fn ol_solve<'py>(
     py: Python<'py>,
     v_m: f64,
     t_u: f64,
     omega0_rpm: f64,
-    harmonics: usize,
+    #[pyo3(from_py_with = int64)] harmonics: i64,
     plant: Option<&Bound<'py, PyAny>>,
+    method: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (params, plant_name) = plant_of(plant)?;
     let op = operating_point(v_m, t_u, omega0_rpm)?;
+    let opts = ihb_options(harmonics)?;
+    let method = match method {
+        "polish" => SolveMethod::Polish,
+        "ihb" => SolveMethod::Ihb,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "argument `method` = {other:?} must be 'polish' or 'ihb'"
+            )))
+        }
+    };
     let t0 = Instant::now();
-    let s = py
-        .detach(|| solve_steady_state(&params, &op, ihb_options(harmonics)))
-        .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+    let acc = py
+        .detach(|| accurate_r(&params, &op, opts, method))
+        .map_err(design_err)?;
     let dt = t0.elapsed().as_secs_f64();
+    let s = &acc.ihb;
+    let verdict = Verdict::classify(acc.r, params.r_max);
     let d = PyDict::new(py);
-    d.set_item("r", s.r)?;
-    d.set_item("feasible", s.verdict == Verdict::Feasible)?;
-    d.set_item("verdict", s.verdict.as_str())?;
+    d.set_item("r", acc.r)?;
+    d.set_item("feasible", verdict == Verdict::Feasible)?;
+    d.set_item("verdict", verdict.as_str())?;
     d.set_item("q", s.q.clone().into_pyarray(py))?;
-    d.set_item("omega_min", s.omega_min)?;
-    d.set_item("omega_max", s.omega_max)?;
+    d.set_item("omega_min", acc.omega_min)?;
+    d.set_item("omega_max", acc.omega_max)?;
     d.set_item("solve_time_s", dt)?;
     d.set_item("iterations", s.iterations)?;
     d.set_item("residual_norm", s.residual_norm)?;
-    d.set_item("harmonics", harmonics)?;
+    d.set_item("harmonics", opts.harmonics)?;
     d.set_item("r_max", params.r_max)?;
     d.set_item("omega0", op.omega0)?;
+    d.set_item("method", method.label())?;
+    d.set_item("r_ihb", s.r)?;
+    let e = PyDict::new(py);
+    e.set_item("r_abs", acc.error_abs)?;
+    e.set_item("r_rel", acc.error_abs / acc.r.abs())?;
+    e.set_item("how", acc.how)?;
+    d.set_item("error_estimate", e)?;
+    d.set_item(
+        "thesis_choice",
+        method == SolveMethod::Ihb && opts.harmonics == 7,
+    )?;
     d.set_item("plant", plant_name)?;
     Ok(d)
 }
@@ -123,10 +165,11 @@ fn ol_table<'py>(
     v_m: (f64, f64, f64),
     t_u: (f64, f64, f64),
     omega0_rpm: f64,
-    harmonics: usize,
+    #[pyo3(from_py_with = int64)] harmonics: i64,
     plant: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (params, plant_name) = plant_of(plant)?;
+    let opts = ihb_options(harmonics)?;
     if !(omega0_rpm.is_finite() && omega0_rpm > 0.0) {
         return Err(PyValueError::new_err(format!(
             "argument `omega0_rpm` = {omega0_rpm} must be finite and > 0"
@@ -137,11 +180,10 @@ fn ol_table<'py>(
         t_u: sweep::range(t_u.0, t_u.1, t_u.2),
         omega0: rpm_to_rad_s(omega0_rpm),
     };
-    grid.validate()
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    grid.validate().map_err(design_err)?;
     let pts = py
-        .detach(|| sweep::sweep(&params, &grid, ihb_options(harmonics), || ()))
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        .detach(|| sweep::sweep(&params, &grid, opts, || ()))
+        .map_err(design_err)?;
     let points = PyList::empty(py);
     let mut r = Array2::<f64>::from_elem((grid.t_u.len(), grid.v_m.len()), f64::NAN);
     for (i, p) in pts.iter().enumerate() {
@@ -192,7 +234,7 @@ fn stability<'py>(
     k: f64,
     k2: f64,
     si: bool,
-    n: usize,
+    #[pyo3(from_py_with = int64)] n: i64,
     omega0_rpm: f64,
     plant: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -211,13 +253,14 @@ fn stability<'py>(
         FeedbackGains::from_thesis_mm_per_rad(k, k2)
     };
     let opts = DelayOptions {
-        chebyshev_order: n,
+        chebyshev_order: count("n", n)?,
         ..Default::default()
     };
+    opts.validate().map_err(design_err)?;
     let t0 = Instant::now();
     let s = py
         .detach(|| delay_stability(&params, &op, gains, &opts))
-        .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+        .map_err(design_err)?;
     let dt = t0.elapsed().as_secs_f64();
     let d = PyDict::new(py);
     d.set_item("max_abs_multiplier", s.max_abs_multiplier)?;
@@ -237,8 +280,6 @@ fn stability<'py>(
 /// Register `ivt._ivt.design`.
 pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     let m = PyModule::new(parent.py(), "design")?;
-    m.add_function(wrap_pyfunction!(ol_solve, &m)?)?;
-    m.add_function(wrap_pyfunction!(ol_table, &m)?)?;
-    m.add_function(wrap_pyfunction!(stability, &m)?)?;
+    add_functions!(&m, [ol_solve, ol_table, stability]);
     parent.add_submodule(&m)
 }

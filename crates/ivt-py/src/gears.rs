@@ -1,6 +1,7 @@
 //! `ivt.kin` continued: the GIVT (§2.1) and SGIVT (§2.2) mechanisms, the
 //! noncircular-gear pitch profiles (Eq. 13–17, 38–42) and unit helpers.
 
+use crate::args::int64;
 use crate::fields::{self, Field};
 use crate::vectorize::{map, map1};
 use ivt_kin::givt::{DirectionMode, DirectionModule, GivtGeometry};
@@ -17,25 +18,32 @@ fn kin_err(e: KinError) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
-/// Apply `f` to one array-like argument, raising the Rust error with its index.
-fn vec1<'py>(
-    py: Python<'py>,
-    name: &'static str,
-    x: &Bound<'py, PyAny>,
-    f: impl Fn(f64) -> Result<f64, KinError>,
-) -> PyResult<Bound<'py, PyAny>> {
-    let [y] = map(py, [(name, x)], |[x]| f(x).map(|v| [v]))?;
-    Ok(y)
-}
-
-/// Apply `f` to two broadcast array-like arguments.
-fn vec2<'py>(
-    py: Python<'py>,
-    args: [(&'static str, &Bound<'py, PyAny>); 2],
-    f: impl Fn(f64, f64) -> Result<f64, KinError>,
-) -> PyResult<Bound<'py, PyAny>> {
-    let [y] = map(py, args, |[a, b]| f(a, b).map(|v| [v]))?;
-    Ok(y)
+/// The `#[pymethods]` block of a geometry class (`self.geometry`): the
+/// `items` as written, then one method per `fn name(a[, b]);` entry that
+/// broadcasts `self.geometry.name(a[, b])` over numpy array-likes like a ufunc
+/// (scalar in → float out), raising the Rust error with the flat index.
+macro_rules! geometry_methods {
+    ($ty:ident { $($items:tt)* } $( $(#[$doc:meta])* fn $name:ident($a:ident $(, $b:ident)?); )*) => {
+        #[pymethods]
+        impl $ty {
+            $($items)*
+            $(
+                $(#[$doc])*
+                fn $name<'py>(
+                    &self,
+                    py: Python<'py>,
+                    $a: &Bound<'py, PyAny>,
+                    $($b: &Bound<'py, PyAny>,)?
+                ) -> PyResult<Bound<'py, PyAny>> {
+                    let g = self.geometry;
+                    let [y] = map(py, [(stringify!($a), $a) $(, (stringify!($b), $b))?], |[$a $(, $b)?]| {
+                        g.$name($a $(, $b)?).map(|v| [v])
+                    })?;
+                    Ok(y)
+                }
+            )*
+        }
+    };
 }
 
 const GIVT_FIELDS: &[Field<GivtGeometry>] = &[
@@ -62,8 +70,8 @@ pub struct Givt {
     geometry: GivtGeometry,
 }
 
-#[pymethods]
-impl Givt {
+geometry_methods! {
+Givt {
     #[new]
     #[pyo3(signature = (**overrides))]
     fn new(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
@@ -78,89 +86,6 @@ impl Givt {
     /// The dimensions as a dict (constructor keywords).
     fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         fields::to_dict(py, GIVT_FIELDS, &self.geometry)
-    }
-
-    /// Single crank-slider ratio R1(θ, r), Eq. 8.
-    fn single_ratio<'py>(
-        &self,
-        py: Python<'py>,
-        theta: &Bound<'py, PyAny>,
-        r: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let g = self.geometry;
-        vec2(py, [("theta", theta), ("r", r)], |t, r| {
-            g.single_ratio(t, r)
-        })
-    }
-
-    /// Module ratio R(θ, r): max over the four phases, Eq. 9.
-    fn module_ratio<'py>(
-        &self,
-        py: Python<'py>,
-        theta: &Bound<'py, PyAny>,
-        r: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let g = self.geometry;
-        vec2(py, [("theta", theta), ("r", r)], |t, r| {
-            g.module_ratio(t, r)
-        })
-    }
-
-    /// dR/dθ of the module ratio (the value of the piece starting at a corner).
-    fn module_ratio_derivative<'py>(
-        &self,
-        py: Python<'py>,
-        theta: &Bound<'py, PyAny>,
-        r: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let g = self.geometry;
-        vec2(py, [("theta", theta), ("r", r)], |t, r| {
-            g.module_ratio_derivative(t, r)
-        })
-    }
-
-    /// Final ratio F = 3R, Eq. 10 (crank_to_input × module ratio).
-    fn final_ratio<'py>(
-        &self,
-        py: Python<'py>,
-        theta: &Bound<'py, PyAny>,
-        r: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let g = self.geometry;
-        vec2(py, [("theta", theta), ("r", r)], |t, r| g.final_ratio(t, r))
-    }
-
-    /// Reduced ratio R(θ, r)/R̄(r) (§2.1.5); r = 0 is an error (zero mean).
-    fn reduced_ratio<'py>(
-        &self,
-        py: Python<'py>,
-        theta: &Bound<'py, PyAny>,
-        r: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let g = self.geometry;
-        vec2(py, [("theta", theta), ("r", r)], |t, r| {
-            g.reduced_ratio(t, r)
-        })
-    }
-
-    /// Average module ratio R̄(r) over a period (adaptive quadrature between corners).
-    fn average_module_ratio<'py>(
-        &self,
-        py: Python<'py>,
-        r: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let g = self.geometry;
-        vec1(py, "r", r, |r| g.average_module_ratio(r))
-    }
-
-    /// Average final ratio 3R̄(r).
-    fn average_final_ratio<'py>(
-        &self,
-        py: Python<'py>,
-        r: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let g = self.geometry;
-        vec1(py, "r", r, |r| g.average_final_ratio(r))
     }
 
     /// Corners (kinks) of R(θ, r) in one period [rad].
@@ -219,6 +144,21 @@ impl Givt {
         format!("Givt({})", changed.join(", "))
     }
 }
+    /// Single crank-slider ratio R1(θ, r), Eq. 8.
+    fn single_ratio(theta, r);
+    /// Module ratio R(θ, r): max over the four phases, Eq. 9.
+    fn module_ratio(theta, r);
+    /// dR/dθ of the module ratio (the value of the piece starting at a corner).
+    fn module_ratio_derivative(theta, r);
+    /// Final ratio F = 3R, Eq. 10 (crank_to_input × module ratio).
+    fn final_ratio(theta, r);
+    /// Reduced ratio R(θ, r)/R̄(r) (§2.1.5); r = 0 is an error (zero mean).
+    fn reduced_ratio(theta, r);
+    /// Average module ratio R̄(r) over a period (adaptive quadrature between corners).
+    fn average_module_ratio(r);
+    /// Average final ratio 3R̄(r).
+    fn average_final_ratio(r);
+}
 
 const SGIVT_FIELDS: &[Field<SgivtGeometry>] = &[
     ("d_sg", |g| g.d_sg, |g, v| g.d_sg = v),
@@ -256,8 +196,8 @@ pub struct Sgivt {
     geometry: SgivtGeometry,
 }
 
-#[pymethods]
-impl Sgivt {
+geometry_methods! {
+Sgivt {
     #[new]
     #[pyo3(signature = (**overrides))]
     fn new(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
@@ -285,59 +225,6 @@ impl Sgivt {
         fields::to_dict(py, SGIVT_FIELDS, &self.geometry)
     }
 
-    /// Crank length e [m] for a stepper angle θ_CT [rad] ∈ [0, theta_ct_max], Eq. 182–185.
-    fn crank_length<'py>(
-        &self,
-        py: Python<'py>,
-        theta_ct: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let g = self.geometry;
-        vec1(py, "theta_ct", theta_ct, |t| g.crank_length(t))
-    }
-
-    /// Stepper angle θ_CT [rad] for a crank length e [m] (inverse of crank_length).
-    fn stepper_angle<'py>(
-        &self,
-        py: Python<'py>,
-        e: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let g = self.geometry;
-        vec1(py, "e", e, |e| g.stepper_angle(e))
-    }
-
-    /// Instantaneous ratio ω_out/ω_in at input angle θ_in and crank length e, Eq. 35.
-    fn ratio<'py>(
-        &self,
-        py: Python<'py>,
-        theta_in: &Bound<'py, PyAny>,
-        e: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let g = self.geometry;
-        vec2(py, [("theta_in", theta_in), ("e", e)], |t, e| g.ratio(t, e))
-    }
-
-    /// Average ratio over a revolution for crank length e.
-    fn average_ratio<'py>(
-        &self,
-        py: Python<'py>,
-        e: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let g = self.geometry;
-        vec1(py, "e", e, |e| g.average_ratio(e))
-    }
-
-    /// Average ratio for a stepper angle θ_CT [rad] (§4.4.2: ≈ 7 θ_CT[deg]/27492).
-    fn average_ratio_from_stepper<'py>(
-        &self,
-        py: Python<'py>,
-        theta_ct: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let g = self.geometry;
-        vec1(py, "theta_ct", theta_ct, |t| {
-            g.average_ratio_from_stepper(t)
-        })
-    }
-
     /// v_CRK/ω_CT = 7 r_CG/288 [m/rad] through the gear chain, Eq. 184.
     #[getter]
     fn crank_length_per_stepper_rad(&self) -> f64 {
@@ -348,6 +235,17 @@ impl Sgivt {
         let changed = fields::changed(SGIVT_FIELDS, &self.geometry, &SgivtGeometry::prototype());
         format!("Sgivt({})", changed.join(", "))
     }
+}
+    /// Crank length e [m] for a stepper angle θ_CT [rad] ∈ [0, theta_ct_max], Eq. 182–185.
+    fn crank_length(theta_ct);
+    /// Stepper angle θ_CT [rad] for a crank length e [m] (inverse of crank_length).
+    fn stepper_angle(e);
+    /// Instantaneous ratio ω_out/ω_in at input angle θ_in and crank length e, Eq. 35.
+    fn ratio(theta_in, e);
+    /// Average ratio over a revolution for crank length e.
+    fn average_ratio(e);
+    /// Average ratio for a stepper angle θ_CT [rad] (§4.4.2: ≈ 7 θ_CT[deg]/27492).
+    fn average_ratio_from_stepper(theta_ct);
 }
 
 /// Pitch profiles of a noncircular gear pair by integrating Eq. 17/41.
@@ -364,8 +262,9 @@ impl Sgivt {
 fn pitch_profile<'py>(
     py: Python<'py>,
     design: &str,
-    points: usize,
+    #[pyo3(from_py_with = int64)] points: i64,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let points: usize = crate::args::count("points", points)?;
     if !(2..=1_000_000).contains(&points) {
         return Err(PyValueError::new_err(format!(
             "argument `points` = {points} must be in 2..=1000000"
@@ -414,8 +313,8 @@ fn pitch_profile<'py>(
 /// Exact Fourier coefficient a_k of Eq. 38 in R_n = 1 + Σ a_k cos(4kθ):
 /// 2(−1)^(k+1)/(16k² − 1) (k ≥ 1; a_0 = 1).
 #[pyfunction]
-fn fourier_coefficient_eq38(k: u32) -> f64 {
-    ncg::fourier_coefficient_eq38(k)
+fn fourier_coefficient_eq38(#[pyo3(from_py_with = int64)] k: i64) -> PyResult<f64> {
+    Ok(ncg::fourier_coefficient_eq38(crate::args::count("k", k)?))
 }
 
 /// Ratio of the SGIVT noncircular pair, Eq. 38 (= f(θ) of Eq. 43), or the
@@ -466,36 +365,41 @@ fn rectified_shape<'py>(py: Python<'py>, theta: &Bound<'py, PyAny>) -> PyResult<
 }
 
 macro_rules! unit_fn {
-    ($name:ident, $arg:literal, $doc:literal) => {
+    ($name:ident, $arg:ident, $doc:literal) => {
         #[doc = $doc]
         #[pyfunction]
-        fn $name<'py>(py: Python<'py>, x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
-            map1(py, [($arg, x)], |[v]| units::$name(v))
+        fn $name<'py>(py: Python<'py>, $arg: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+            map1(py, [(stringify!($arg), $arg)], |[v]| units::$name(v))
         }
     };
 }
-unit_fn!(inch_to_m, "inch", "Inches → metres.");
-unit_fn!(m_to_inch, "m", "Metres → inches.");
-unit_fn!(deg_to_rad, "deg", "Degrees → radians.");
-unit_fn!(rad_to_deg, "rad", "Radians → degrees.");
-unit_fn!(rpm_to_rad_s, "rpm", "Revolutions per minute → rad/s.");
-unit_fn!(rad_s_to_rpm, "rad_s", "rad/s → revolutions per minute.");
+unit_fn!(inch_to_m, inch, "Inches → metres.");
+unit_fn!(m_to_inch, m, "Metres → inches.");
+unit_fn!(deg_to_rad, deg, "Degrees → radians.");
+unit_fn!(rad_to_deg, rad, "Radians → degrees.");
+unit_fn!(rpm_to_rad_s, rpm, "Revolutions per minute → rad/s.");
+unit_fn!(rad_s_to_rpm, rad_s, "rad/s → revolutions per minute.");
 
 /// Add the gear functions and classes to `ivt._ivt.kin`.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Givt>()?;
     m.add_class::<Sgivt>()?;
-    m.add_function(wrap_pyfunction!(pitch_profile, m)?)?;
-    m.add_function(wrap_pyfunction!(fourier_coefficient_eq38, m)?)?;
-    m.add_function(wrap_pyfunction!(ncg_ratio, m)?)?;
-    m.add_function(wrap_pyfunction!(direction, m)?)?;
-    m.add_function(wrap_pyfunction!(rectified_shape, m)?)?;
-    m.add_function(wrap_pyfunction!(inch_to_m, m)?)?;
-    m.add_function(wrap_pyfunction!(m_to_inch, m)?)?;
-    m.add_function(wrap_pyfunction!(deg_to_rad, m)?)?;
-    m.add_function(wrap_pyfunction!(rad_to_deg, m)?)?;
-    m.add_function(wrap_pyfunction!(rpm_to_rad_s, m)?)?;
-    m.add_function(wrap_pyfunction!(rad_s_to_rpm, m)?)?;
+    add_functions!(
+        m,
+        [
+            pitch_profile,
+            fourier_coefficient_eq38,
+            ncg_ratio,
+            direction,
+            rectified_shape,
+            inch_to_m,
+            m_to_inch,
+            deg_to_rad,
+            rad_to_deg,
+            rpm_to_rad_s,
+            rad_s_to_rpm
+        ]
+    );
     m.add("EQ42_PRINTED", ncg::EQ42_PRINTED.to_vec())?;
     m.add(
         "R_AVG_SLOPE_PRINTED_PER_DEG",

@@ -4,8 +4,9 @@
 //! `M x'' + C x' + K x + g(x, x', θ) = f(θ)`.
 
 use ivt_hb::{
-    frequency_response, ClassicIhb, Duffing, Floquet, FrcOptions, HbError, HbOptions, HbSolution,
-    HbSolver, HsuRule, MathieuDuffing, ModifiedIhb, PeriodicProblem, StabilityAnalyzer,
+    frequency_response, period_doubling_cascade, CascadeOptions, ClassicIhb, Duffing, Floquet,
+    FrcOptions, HbError, HbOptions, HbSolution, HbSolver, HsuRule, MathieuDuffing, ModifiedIhb,
+    PeriodicProblem, StabilityAnalyzer,
 };
 use numpy::ndarray::Array1;
 use numpy::{IntoPyArray, PyArray1};
@@ -15,6 +16,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::time::Instant;
 
+use crate::args::{count, int64};
 use crate::user_problem::{callback_error, user_problem};
 
 create_exception!(
@@ -48,7 +50,9 @@ fn hb_err(py: Python<'_>, e: HbError) -> PyErr {
 }
 
 /// Options from the Python keywords: n harmonics, `samples` = N (2N AFT samples).
-fn options(n: usize, samples: usize, subharmonic: usize, tol: f64) -> PyResult<HbOptions> {
+fn options(n: i64, samples: i64, subharmonic: i64, tol: f64) -> PyResult<HbOptions> {
+    let (n, samples): (usize, usize) = (count("n", n)?, count("samples", samples)?);
+    let subharmonic: usize = count("subharmonic", subharmonic)?;
     if n == 0 {
         return Err(PyValueError::new_err(
             "argument `n` (harmonics) must be >= 1",
@@ -201,8 +205,8 @@ fn guess_vec(guess: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<f64>>> {
 #[allow(clippy::too_many_arguments)]
 fn duffing<'py>(
     py: Python<'py>,
-    n: usize,
-    samples: usize,
+    #[pyo3(from_py_with = int64)] n: i64,
+    #[pyo3(from_py_with = int64)] samples: i64,
     xi: f64,
     alpha: f64,
     eps: f64,
@@ -242,13 +246,13 @@ fn duffing<'py>(
 fn mathieu_duffing<'py>(
     py: Python<'py>,
     beta: f64,
-    n: usize,
-    samples: usize,
+    #[pyo3(from_py_with = int64)] n: i64,
+    #[pyo3(from_py_with = int64)] samples: i64,
     xi: f64,
     alpha: f64,
     gamma: f64,
     omega: f64,
-    subharmonic: usize,
+    #[pyo3(from_py_with = int64)] subharmonic: i64,
     guess: Option<&Bound<'py, PyAny>>,
     tol: f64,
     stability: bool,
@@ -274,6 +278,52 @@ fn mathieu_duffing<'py>(
         })
         .map_err(|e| hb_err(py, e))?;
     solved_dict(py, &solved)
+}
+
+/// The period-doubling cascade of the Mathieu–Duffing equation Eq. 81
+/// (§3.2.5): β at the first three period doublings, located by Floquet
+/// multipliers crossing −1 along the branch, with `n` harmonics per period.
+/// Returns the dict of `ivt hb mathieu-duffing --json`:
+/// period_doubling_beta, periods, multipliers ([[re, im]...] at each
+/// doubling), thesis ([4.825, 5.194, 5.253]), time_s. GIL released.
+#[pyfunction]
+#[pyo3(signature = (xi = 0.125, alpha = 1.0, omega = 2.0, gamma = 1.0, n = 12))]
+fn mathieu_cascade<'py>(
+    py: Python<'py>,
+    xi: f64,
+    alpha: f64,
+    omega: f64,
+    gamma: f64,
+    #[pyo3(from_py_with = int64)] n: i64,
+) -> PyResult<Bound<'py, PyDict>> {
+    if !(omega.is_finite() && omega > 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "argument `omega` = {omega} must be finite and > 0"
+        )));
+    }
+    let opts = CascadeOptions {
+        xi: finite("xi", xi)?,
+        alpha: finite("alpha", alpha)?,
+        omega,
+        gamma: finite("gamma", gamma)?,
+        harmonics: count("n", n)?,
+        ..CascadeOptions::default()
+    };
+    let t0 = Instant::now();
+    let pds = py
+        .detach(|| period_doubling_cascade(&opts))
+        .map_err(|e| hb_err(py, e))?;
+    let d = PyDict::new(py);
+    d.set_item("time_s", t0.elapsed().as_secs_f64())?;
+    d.set_item(
+        "period_doubling_beta",
+        pds.iter().map(|p| p.beta).collect::<Vec<_>>(),
+    )?;
+    d.set_item("periods", pds.iter().map(|p| p.period).collect::<Vec<_>>())?;
+    let mu: Vec<_> = pds.iter().map(|p| p.multiplier).collect();
+    d.set_item("multipliers", pairs(&mu))?;
+    d.set_item("thesis", [4.825, 5.194, 5.253])?;
+    Ok(d)
 }
 
 /// Multipliers as `[[re, im], ...]`.
@@ -327,8 +377,8 @@ fn duffing_frc<'py>(
     py: Python<'py>,
     from_: f64,
     to: f64,
-    n: usize,
-    samples: usize,
+    #[pyo3(from_py_with = int64)] n: i64,
+    #[pyo3(from_py_with = int64)] samples: i64,
     xi: f64,
     alpha: f64,
     eps: f64,
@@ -387,9 +437,9 @@ fn solve<'py>(
     g: &Bound<'py, PyAny>,
     omega_f: f64,
     f: Option<&Bound<'py, PyAny>>,
-    n: usize,
-    samples: usize,
-    subharmonic: usize,
+    #[pyo3(from_py_with = int64)] n: i64,
+    #[pyo3(from_py_with = int64)] samples: i64,
+    #[pyo3(from_py_with = int64)] subharmonic: i64,
     method: &str,
     guess: Option<&Bound<'py, PyAny>>,
     tol: f64,
@@ -438,8 +488,8 @@ fn frc<'py>(
     f: Option<&Bound<'py, PyAny>>,
     omega_from: f64,
     omega_to: f64,
-    n: usize,
-    samples: usize,
+    #[pyo3(from_py_with = int64)] n: i64,
+    #[pyo3(from_py_with = int64)] samples: i64,
     tol: f64,
     velocity_dependent: bool,
     vectorized: bool,
@@ -449,7 +499,7 @@ fn frc<'py>(
     let mut frc_opts = FrcOptions::default();
     frc_opts.from = finite("omega_from", omega_from)?;
     frc_opts.to = finite("omega_to", omega_to)?;
-    frc_opts.stability_steps = stability_steps(n);
+    frc_opts.stability_steps = stability_steps(opts.harmonics);
     let result = py.detach(|| frequency_response(&problem, &opts, &frc_opts));
     if let Some(e) = callback_error(&problem) {
         return Err(e);
@@ -501,8 +551,8 @@ fn limit_cycle<'py>(
     omega_guess: f64,
     amplitude: f64,
     guess: Option<&Bound<'py, PyAny>>,
-    n: usize,
-    samples: usize,
+    #[pyo3(from_py_with = int64)] n: i64,
+    #[pyo3(from_py_with = int64)] samples: i64,
     tol: f64,
     velocity_dependent: bool,
     vectorized: bool,
@@ -512,13 +562,20 @@ fn limit_cycle<'py>(
     let start = match guess_vec(guess)? {
         Some(q) => q,
         None => {
-            let mut q = vec![0.0; problem.n * (2 * n + 1)];
+            let mut q = vec![0.0; problem.n * (2 * opts.harmonics + 1)];
             q[1] = finite("amplitude", amplitude)?;
             q
         }
     };
-    let result =
-        py.detach(|| ivt_hb::limit_cycle(&problem, &opts, omega_guess, &start, stability_steps(n)));
+    let result = py.detach(|| {
+        ivt_hb::limit_cycle(
+            &problem,
+            &opts,
+            omega_guess,
+            &start,
+            stability_steps(opts.harmonics),
+        )
+    });
     if let Some(e) = callback_error(&problem) {
         return Err(e);
     }
@@ -546,9 +603,11 @@ fn eval_series<'py>(
     py: Python<'py>,
     coeffs: numpy::PyArrayLike1<'py, f64, numpy::AllowTypeChange>,
     tau: &Bound<'py, PyAny>,
-    order: u32,
-    n_dof: usize,
+    #[pyo3(from_py_with = int64)] order: i64,
+    #[pyo3(from_py_with = int64)] n_dof: i64,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let n_dof: usize = count("n_dof", n_dof)?;
+    let order: u32 = count("order", order)?;
     let q = coeffs.as_array().to_vec();
     if n_dof == 0 || !q.len().is_multiple_of(n_dof) || (q.len() / n_dof).is_multiple_of(2) {
         return Err(PyValueError::new_err(format!(
@@ -578,13 +637,19 @@ fn eval_series<'py>(
 pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = parent.py();
     let m = PyModule::new(py, "hb")?;
-    m.add_function(wrap_pyfunction!(duffing, &m)?)?;
-    m.add_function(wrap_pyfunction!(duffing_frc, &m)?)?;
-    m.add_function(wrap_pyfunction!(mathieu_duffing, &m)?)?;
-    m.add_function(wrap_pyfunction!(solve, &m)?)?;
-    m.add_function(wrap_pyfunction!(frc, &m)?)?;
-    m.add_function(wrap_pyfunction!(limit_cycle, &m)?)?;
-    m.add_function(wrap_pyfunction!(eval_series, &m)?)?;
+    add_functions!(
+        &m,
+        [
+            duffing,
+            duffing_frc,
+            mathieu_duffing,
+            mathieu_cascade,
+            solve,
+            frc,
+            limit_cycle,
+            eval_series
+        ]
+    );
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     parent.add_submodule(&m)
 }

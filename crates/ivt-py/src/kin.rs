@@ -387,13 +387,18 @@ impl Plant {
 /// Register `ivt._ivt.kin`.
 pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     let m = PyModule::new(parent.py(), "kin")?;
-    m.add_function(wrap_pyfunction!(f, &m)?)?;
-    m.add_function(wrap_pyfunction!(f_theta, &m)?)?;
-    m.add_function(wrap_pyfunction!(mean_f_squared, &m)?)?;
-    m.add_function(wrap_pyfunction!(ring_speeds, &m)?)?;
-    m.add_function(wrap_pyfunction!(driver_speeds, &m)?)?;
-    m.add_function(wrap_pyfunction!(output_speed, &m)?)?;
-    m.add_function(wrap_pyfunction!(output_to_motor_ratio, &m)?)?;
+    add_functions!(
+        &m,
+        [
+            f,
+            f_theta,
+            mean_f_squared,
+            ring_speeds,
+            driver_speeds,
+            output_speed,
+            output_to_motor_ratio
+        ]
+    );
     m.add_class::<Plant>()?;
     m.add("NCG_AMPLITUDE", ivt_kin::NCG_AMPLITUDE)?;
     crate::gears::register(&m)?;

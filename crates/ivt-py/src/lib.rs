@@ -9,6 +9,15 @@
 
 use pyo3::prelude::*;
 
+/// Add each `#[pyfunction]` named in the list to the module `m` (inside a
+/// function returning `PyResult`).
+macro_rules! add_functions {
+    ($m:expr, [$($f:ident),* $(,)?]) => {
+        $( $m.add_function(wrap_pyfunction!($f, $m)?)?; )*
+    };
+}
+
+mod args;
 mod ctrl;
 mod design;
 mod fields;

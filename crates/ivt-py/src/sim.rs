@@ -212,9 +212,7 @@ fn scene_dict<'py>(py: Python<'py>, scene: &Bound<'py, PyAny>) -> PyResult<Bound
 /// Register `ivt._ivt.sim`.
 pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     let m = PyModule::new(parent.py(), "sim")?;
-    m.add_function(wrap_pyfunction!(run, &m)?)?;
-    m.add_function(wrap_pyfunction!(check_scene, &m)?)?;
-    m.add_function(wrap_pyfunction!(scene_dict, &m)?)?;
+    add_functions!(&m, [run, check_scene, scene_dict]);
     m.add("SUPPORTED_PPR", ivt_ctrl::SUPPORTED_PPR.to_vec())?;
     parent.add_submodule(&m)
 }

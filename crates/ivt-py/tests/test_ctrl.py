@@ -131,14 +131,35 @@ def test_config_errors_name_the_keyword() -> None:
         ctrl.Controller(100, open_loop={"r_max": -1.0})
     with pytest.raises(TypeError, match="unknown open_loop key"):
         ctrl.Controller(100, open_loop={"rmax": 0.01})
-    with pytest.raises(TypeError, match="`ticks`"):
+    with pytest.raises(ValueError, match=r"`ticks`\[0\] = 0.5 is not a whole timer count"):
         ctrl.Controller(100).on_pulses(np.array([0.5, 1.5]))
+    with pytest.raises(TypeError, match="`ticks`"):
+        ctrl.Controller(100).on_pulses(np.array(["a", "b"]))
     with pytest.raises(ValueError, match=r"`ticks`\[1\] = -3"):
         ctrl.Controller(100).on_pulses([0, -3])
     with pytest.raises(ValueError, match="`v_m` has 1 entries"):
         ctrl.Controller(100).on_pulses([0, 1], v_m=[1.0], t_u=[1.0])
-    with pytest.raises(OverflowError):
+    # Counts out of range are ValueErrors naming the argument (not pyo3's
+    # unnamed OverflowError).
+    with pytest.raises(ValueError, match="`ticks` = 4294967296"):
         ctrl.Controller(100).on_pulse(2**32)
+    with pytest.raises(ValueError, match="`ppr` = -1"):
+        ctrl.Controller(-1)
+    with pytest.raises(ValueError, match="`decimation` = -1"):
+        ctrl.Controller(100, decimation=-1)
+    with pytest.raises(ValueError, match="`now` = -1"):
+        ctrl.Controller(100).step_tick(-1)
+
+
+def test_on_pulses_takes_float_inputs_and_whole_float_ticks() -> None:
+    """`v_m`/`t_u` as floats are held for every pulse (the stub's ArrayLike);
+    ticks as a float array of whole counts (numpy.loadtxt) are the same
+    counts: both equal the integer/array call exactly."""
+    ticks = pulse_ticks(100, 200, 10.0, 0.05)
+    ref = ctrl.Controller(100).on_pulses(ticks, v_m=np.full(200, 8.4), t_u=np.full(200, 6.0))
+    got = ctrl.Controller(100).on_pulses(ticks.astype(np.float64), v_m=8.4, t_u=6.0)
+    for key in ref:
+        np.testing.assert_array_equal(got[key], ref[key], err_msg=key)
 
 
 def test_config_roundtrip_and_presets() -> None:

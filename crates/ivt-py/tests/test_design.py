@@ -11,9 +11,10 @@ from ivt import design, kin
 
 
 def test_ol_solve_equals_cli_and_band(cli) -> None:  # type: ignore[no-untyped-def]
-    ref = cli("ol", "solve", "--vm", "8.6", "--tu", "6", "--method", "ihb")  # the n = 7 IHB, as ol_solve
-    got = design.ol_solve(8.6, 6.0)
-    for key in ["r", "feasible", "verdict", "omega_min", "omega_max", "iterations", "residual_norm", "r_max", "omega0"]:
+    ref = cli("ol", "solve", "--vm", "8.6", "--tu", "6", "--method", "ihb")  # the n = 7 IHB
+    got = design.ol_solve(8.6, 6.0, method="ihb")
+    for key in ["r", "feasible", "verdict", "omega_min", "omega_max", "iterations", "residual_norm",
+                "r_max", "omega0", "method", "r_ihb", "error_estimate", "thesis_choice"]:
         assert got[key] == ref[key], key
     np.testing.assert_array_equal(got["q"], ref["q"])
     # SPEC §5 averaged balance: V_m = (c ω0 + b T_U r̄)/a, so r̄ ≈ (a V_m − c ω0)/(b T_U)
@@ -25,6 +26,31 @@ def test_ol_solve_equals_cli_and_band(cli) -> None:  # type: ignore[no-untyped-d
     assert got["r"] == pytest.approx(r_avg, rel=0.15)
     assert got["verdict"] == "feasible"
     assert design.ol_solve(6.0, 6.0)["verdict"] == "under-drive"  # below the band (SPEC §5)
+
+
+def test_ol_solve_is_accurate_by_default_like_cli(cli) -> None:  # type: ignore[no-untyped-def]
+    """The default polishes the n = 7 IHB by θ-shooting, as `ivt ol solve`:
+    the same r̄ as the CLI's JSON to 1e-12 (the same Rust function; the
+    margin covers nothing but float formatting), an error estimate ≤ 1e-6
+    relative (the issue's acceptance bound), and r̄ ≈ 0.0068038 m at
+    (8 V, 1.5 N·m), where the n = 7 IHB alone gives 0.0065958 m (3.1 % off)."""
+    ref = cli("ol", "solve", "--vm", "8", "--tu", "1.5")
+    got = design.ol_solve(8.0, 1.5)
+    assert got["method"] == ref["method"] == "ihb+shooting"
+    assert got["r"] == pytest.approx(ref["r"], rel=1e-12, abs=0)
+    assert got["r_ihb"] == pytest.approx(ref["r_ihb"], rel=1e-12, abs=0)
+    est = got["error_estimate"]
+    assert est["r_abs"] == pytest.approx(ref["error_estimate"]["r_abs"], rel=1e-6, abs=1e-15)
+    assert est["r_rel"] <= 1e-6 and est["how"] == ref["error_estimate"]["how"]
+    assert got["r"] == pytest.approx(0.0068038, abs=5e-8)
+    assert got["r_ihb"] == pytest.approx(0.0065958, abs=5e-8)
+    assert got["thesis_choice"] is False
+    ihb = design.ol_solve(8.0, 1.5, method="ihb")
+    assert ihb["thesis_choice"] is True and ihb["r"] == got["r_ihb"]
+    # Its estimate |r̄(7) − r̄(15)| is of the size of the true 3 % error.
+    assert 0.3 < ihb["error_estimate"]["r_abs"] / abs(got["r"] - ihb["r"]) < 3.0
+    with pytest.raises(ValueError, match="`method`"):
+        design.ol_solve(8.0, 1.5, method="newton")  # type: ignore[arg-type]
 
 
 def test_ol_table_equals_cli(cli) -> None:  # type: ignore[no-untyped-def]
@@ -55,13 +81,22 @@ def test_design_errors() -> None:
         design.ol_solve(float("nan"), 6.0)
     with pytest.raises(ValueError, match="`k`"):
         design.stability(8.6, 6.0, k=float("inf"))
+    # Counts: a negative value names the argument (not pyo3's bare OverflowError),
+    # the Chebyshev order is checked by DelayOptions::validate before any solve.
+    with pytest.raises(ValueError, match="`harmonics` = -1"):
+        design.ol_solve(8.0, 6.0, harmonics=-1)
+    with pytest.raises(ValueError, match="`n` = -1"):
+        design.stability(8.6, 6.0, n=-1)
+    for n in [0, 3, 66]:
+        with pytest.raises(ValueError, match="chebyshev_order"):
+            design.stability(8.6, 6.0, n=n)
 
 
 def test_plant_presets_equal_cli(cli) -> None:  # type: ignore[no-untyped-def]
     """plant="thesis-ch4" is `--plant thesis-ch4` (k_t, k_e ÷ 10); a Plant with
     the printed constants is named "printed"; an unknown name is a ValueError."""
     ref = cli("ol", "solve", "--plant", "thesis-ch4", "--vm", "6", "--tu", "6", "--method", "ihb")
-    got = design.ol_solve(6.0, 6.0, plant="thesis-ch4")
+    got = design.ol_solve(6.0, 6.0, plant="thesis-ch4", method="ihb")
     assert got["plant"] == "thesis-ch4" and got["r"] == ref["r"]
     assert abs(got["r"] - 0.0067775) < 1e-6  # the thesis's Fig. 39 orbit (0.0067)
     st = design.stability(8.0, 8.0, plant="thesis-ch4")

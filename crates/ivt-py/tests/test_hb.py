@@ -148,6 +148,13 @@ def test_errors() -> None:
         hb.duffing(samples=4294967296)
     with pytest.raises(ValueError, match="`tol`"):
         hb.duffing(tol=float("inf"))
+    # a negative count names its argument (pyo3's usize gave a bare OverflowError)
+    with pytest.raises(ValueError, match="`n` = -1 must be >= 0"):
+        hb.duffing(n=-1)
+    with pytest.raises(ValueError, match="`subharmonic` = -2"):
+        hb.mathieu_duffing(0.5, subharmonic=-2)
+    with pytest.raises(ValueError, match="`order` = -1"):
+        hb.eval_series([0.0, 1.0, 0.0], 0.5, order=-1)
     with pytest.raises(ValueError, match="`method`"):
         hb.duffing(method="newton")  # type: ignore[arg-type]
     with pytest.raises(ValueError):
@@ -327,3 +334,19 @@ def test_eval_series_multi_dof_layout() -> None:
     np.testing.assert_allclose(got, [[1.5, 0.0], [0.5, -1.0]], atol=1e-15)
     with pytest.raises(ValueError, match="n_dof"):
         hb.eval_series(q, 0.0, n_dof=4)
+
+
+def test_mathieu_cascade_equals_cli(cli) -> None:  # type: ignore[no-untyped-def]
+    """The period-doubling cascade (§3.2.5) is `ivt hb mathieu-duffing`: the
+    same β values to 1e-12 (the same Rust function; the margin covers JSON
+    float formatting only), within 1e-3 of the thesis's 4.825, 5.194, 5.253."""
+    ref = cli("hb", "mathieu-duffing")
+    got = hb.mathieu_cascade()
+    assert got["periods"] == ref["periods"] == [1, 2, 4]
+    np.testing.assert_allclose(got["period_doubling_beta"], ref["period_doubling_beta"], rtol=1e-12, atol=0)
+    np.testing.assert_allclose(got["multipliers"], ref["multipliers"], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(got["period_doubling_beta"], got["thesis"], atol=1e-3)
+    with pytest.raises(ValueError, match="`n` = -1"):
+        hb.mathieu_cascade(n=-1)
+    with pytest.raises(ValueError, match="`omega`"):
+        hb.mathieu_cascade(omega=0.0)

@@ -7,17 +7,8 @@ pulse by pulse (:meth:`Controller.on_pulse`) or as an array
 """
 
 from . import _ivt
+from ._reexport import reexport
 
-_native = _ivt.ctrl
-
-Controller = _native.Controller
-thesis_gains = _native.thesis_gains
-open_loop_preset = _native.open_loop_preset
-open_loop_eval = _native.open_loop_eval
-#: PPR values with a compiled controller (Controller<PPR> is a const generic).
-SUPPORTED_PPR = _native.SUPPORTED_PPR
-#: Fault code → name (ivt-ctrl's ``Fault`` enum).
-FAULTS = _native.FAULTS
 
 __all__ = [
     "FAULTS",
@@ -27,3 +18,5 @@ __all__ = [
     "open_loop_preset",
     "thesis_gains",
 ]
+
+reexport(globals(), _ivt.ctrl, __all__)

@@ -9,11 +9,9 @@ calibration Chapter 4's computations reproduce on) or an ``ivt.kin.Plant``;
 the result's ``"plant"`` names it (``"custom"`` for a Plant matching no preset)."""
 
 from . import _ivt
+from ._reexport import reexport
 
-_native = _ivt.design
-
-ol_solve = _native.ol_solve
-ol_table = _native.ol_table
-stability = _native.stability
 
 __all__ = ["ol_solve", "ol_table", "stability"]
+
+reexport(globals(), _ivt.design, __all__)

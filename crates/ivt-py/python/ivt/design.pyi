@@ -13,6 +13,7 @@ def ol_solve(
     omega0_rpm: float = 100.0,
     harmonics: int = 7,
     plant: Optional[PlantArg] = None,
+    method: Literal["polish", "ihb"] = "polish",
 ) -> Dict[str, Any]: ...
 def ol_table(
     v_m: Tuple[float, float, float] = (2.0, 0.4, 12.0),

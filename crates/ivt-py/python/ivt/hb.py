@@ -14,17 +14,8 @@ whose ``history`` attribute is the residual norm per iteration.
 """
 
 from . import _ivt
+from ._reexport import reexport
 
-_native = _ivt.hb
-
-duffing = _native.duffing
-duffing_frc = _native.duffing_frc
-mathieu_duffing = _native.mathieu_duffing
-solve = _native.solve
-frc = _native.frc
-limit_cycle = _native.limit_cycle
-eval_series = _native.eval_series
-ConvergenceError = _native.ConvergenceError
 
 __all__ = [
     "ConvergenceError",
@@ -33,6 +24,9 @@ __all__ = [
     "eval_series",
     "frc",
     "limit_cycle",
+    "mathieu_cascade",
     "mathieu_duffing",
     "solve",
 ]
+
+reexport(globals(), _ivt.hb, __all__)

@@ -7,13 +7,9 @@ several scenes run in parallel on threads (see :mod:`ivt.sweep`).
 """
 
 from . import _ivt
+from ._reexport import reexport
 
-_native = _ivt.sim
-
-run = _native.run
-check_scene = _native.check_scene
-scene_dict = _native.scene_dict
-#: PPR values the simulator's software-in-the-loop controller supports.
-SUPPORTED_PPR = _native.SUPPORTED_PPR
 
 __all__ = ["SUPPORTED_PPR", "check_scene", "run", "scene_dict"]
+
+reexport(globals(), _ivt.sim, __all__)
