@@ -26,9 +26,7 @@ fn drive_60s_no_outputs(b: divan::Bencher) {
 /// MCAP log streamed to a file by the writer thread, then summary + PNG.
 #[divan::bench(sample_count = 10)]
 fn drive_60s_with_mcap_and_png(b: divan::Bencher) {
-    let s = drive();
-    let dir = std::env::temp_dir().join("ivt-sim-bench");
-    b.bench(|| write(&dir, &s));
+    bench_write(b, &drive(), "ivt-sim-bench");
 }
 
 /// MCAP (+ summary) only, no PNG: the acceptance configuration (≤ 60 ms).
@@ -36,8 +34,7 @@ fn drive_60s_with_mcap_and_png(b: divan::Bencher) {
 fn drive_60s_with_mcap(b: divan::Bencher) {
     let mut s = drive();
     s.outputs.plots.clear();
-    let dir = std::env::temp_dir().join("ivt-sim-bench-mcap");
-    b.bench(|| write(&dir, &s));
+    bench_write(b, &s, "ivt-sim-bench-mcap");
 }
 
 /// The MCAP log written after the run from the recorded channels (no writer
@@ -53,12 +50,16 @@ fn drive_60s_with_mcap_serial(b: divan::Bencher) {
     });
 }
 
-fn write(dir: &std::path::Path, s: &Scene) -> Vec<std::path::PathBuf> {
-    ivt_sim::output::run_and_write(dir, s, |sink| {
-        ivt_sim::run::Simulation::new(s).sink(sink).run()
-    })
-    .expect("runs and writes")
-    .1
+/// Times `run_and_write` of `s` into the temporary directory `dir_name`.
+fn bench_write(b: divan::Bencher, s: &Scene, dir_name: &str) {
+    let dir = std::env::temp_dir().join(dir_name);
+    b.bench(|| {
+        ivt_sim::output::run_and_write(&dir, s, |sink| {
+            ivt_sim::run::Simulation::new(s).sink(sink).run()
+        })
+        .expect("runs and writes")
+        .1
+    });
 }
 
 /// Work–precision problem, DP5 at rtol = atol = 1e-8 (≈ 100 rad of θ).

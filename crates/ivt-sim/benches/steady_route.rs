@@ -35,13 +35,7 @@ fn ihb_route(b: divan::Bencher) {
 /// The same scene forced through the time integration.
 #[divan::bench(sample_count = 10)]
 fn time_route(b: divan::Bencher) {
-    let s = scene();
-    b.bench(|| {
-        Simulation::new(&s)
-            .route(Some(Route::TimeIntegration))
-            .answer()
-            .expect("runs")
-    });
+    bench_time_route(b, &scene());
 }
 
 /// Under-drive: r = 0 held, mean speed by secant over IHB solves.
@@ -54,9 +48,13 @@ fn ihb_route_saturated(b: divan::Bencher) {
 /// Under-drive through the time integration (20 s).
 #[divan::bench(sample_count = 10)]
 fn time_route_saturated(b: divan::Bencher) {
-    let s = saturated();
+    bench_time_route(b, &saturated());
+}
+
+/// Times the answer of `s` forced through the time integration.
+fn bench_time_route(b: divan::Bencher, s: &Scene) {
     b.bench(|| {
-        Simulation::new(&s)
+        Simulation::new(s)
             .route(Some(Route::TimeIntegration))
             .answer()
             .expect("runs")
