@@ -441,11 +441,7 @@ impl Controller {
     /// is the timer's). Returns the output dict: omega, omega_a, omega_T,
     /// r_ol, r_d, r, stepper_target, saturated, fault (code), fault_name,
     /// ready, inputs_clamped, ol_region.
-    fn on_pulse<'py>(
-        &mut self,
-        py: Python<'py>,
-        #[pyo3(from_py_with = int64)] ticks: i64,
-    ) -> PyResult<Bound<'py, PyDict>> {
+    fn on_pulse<'py>(&mut self, py: Python<'py>, ticks: i64) -> PyResult<Bound<'py, PyDict>> {
         let o = self.inner.on_pulse(count("ticks", ticks)?);
         output_dict(py, &o)
     }
@@ -465,11 +461,7 @@ impl Controller {
 
     /// Step-generator tick at timer count `now`: dict with step, forward,
     /// position, next_step_at, moving, fault, fault_name.
-    fn step_tick<'py>(
-        &mut self,
-        py: Python<'py>,
-        #[pyo3(from_py_with = int64)] now: i64,
-    ) -> PyResult<Bound<'py, PyDict>> {
+    fn step_tick<'py>(&mut self, py: Python<'py>, now: i64) -> PyResult<Bound<'py, PyDict>> {
         let s = self.inner.step_tick(count("now", now)?);
         let d = PyDict::new(py);
         d.set_item("step", s.step)?;

@@ -46,11 +46,7 @@ def mathieu_duffing(
     stability: bool = True,
 ) -> Dict[str, Any]: ...
 def mathieu_cascade(
-    xi: float = 0.125,
-    alpha: float = 1.0,
-    omega: float = 2.0,
-    gamma: float = 1.0,
-    n: int = 12,
+    xi: float = 0.125, alpha: float = 1.0, omega: float = 2.0, gamma: float = 1.0, n: int = 12
 ) -> Dict[str, Any]: ...
 def duffing_frc(
     from_: float = 0.2,
