@@ -10,6 +10,18 @@ use std::process::Command;
 mod common;
 use common::ivt_json;
 
+/// The 100-rpm steady state of thesis-ch4 at (V_m, T_U) by θ-shooting of
+/// Eq. 151 (RK6 + Newton), independent of the IHB.
+fn r_bar_by_shooting(vm: f64, tu: f64) -> ivt_design::shooting::PeriodicOrbit {
+    shoot_steady_state(
+        &PlantPreset::ThesisCh4.params(),
+        &OperatingPoint::at_100_rpm(vm, tu),
+        None,
+        &ShootingOptions::default(),
+    )
+    .expect("shooting converges")
+}
+
 /// Ten feasible points spread over the thesis grid (V_m 2–12 V, T_U 1.5–9 N·m)
 /// of the thesis-ch4 plant, 0 ≤ r̄ ≤ r_max at each (checked below).
 const POINTS: [(f64, f64); 10] = [
@@ -30,7 +42,6 @@ const POINTS: [(f64, f64); 10] = [
 /// met with margin (the default n = 7 is ~2e-5 off at (5 V, 3 N·m)).
 #[test]
 fn ol_solve_on_thesis_ch4_agrees_with_shooting() {
-    let plant = PlantPreset::ThesisCh4.params();
     for (vm, tu) in POINTS {
         let (vs, ts) = (vm.to_string(), tu.to_string());
         let v = ivt_json(&[
@@ -48,13 +59,7 @@ fn ol_solve_on_thesis_ch4_agrees_with_shooting() {
         assert_eq!(v["plant"], "thesis-ch4");
         assert_eq!(v["verdict"], "feasible", "({vm}, {tu}): {v}");
         let r_ihb = v["r"].as_f64().expect("r");
-        let shot = shoot_steady_state(
-            &plant,
-            &OperatingPoint::at_100_rpm(vm, tu),
-            None,
-            &ShootingOptions::default(),
-        )
-        .expect("shooting converges");
+        let shot = r_bar_by_shooting(vm, tu);
         let rel = (r_ihb - shot.r).abs() / shot.r;
         assert!(
             rel <= 1e-5,
@@ -68,19 +73,12 @@ fn ol_solve_on_thesis_ch4_agrees_with_shooting() {
 /// 0.00704 m) by shooting, to the digits quoted.
 #[test]
 fn thesis_ch4_r_bar_matches_the_audit_values() {
-    let plant = PlantPreset::ThesisCh4.params();
     for (vm, tu, want, half_ulp) in [
         (6.0, 6.0, 0.0068, 5e-5),
         (7.0, 2.0, 0.02422, 5e-6),
         (8.0, 8.0, 0.00704, 5e-6),
     ] {
-        let o = shoot_steady_state(
-            &plant,
-            &OperatingPoint::at_100_rpm(vm, tu),
-            None,
-            &ShootingOptions::default(),
-        )
-        .expect("shooting converges");
+        let o = r_bar_by_shooting(vm, tu);
         assert!((o.r - want).abs() <= half_ulp, "({vm}, {tu}): {}", o.r);
     }
 }

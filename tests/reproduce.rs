@@ -33,6 +33,17 @@ const DES: &str = "design";
 const CL4: &str = "closed_loop/thesis-ch4";
 const RIG: &str = "rig";
 
+// Row prefixes too long for one pinned line.
+const MU1_MM: &str = "Fig. 42 multiplier (k = 0.01, k2 = 0.02), mm";
+const MU1_SI: &str = "Fig. 42 multiplier (k = 0.01, k2 = 0.02), printed";
+const MU2_MM: &str = "Fig. 42 multiplier (k = 0.06, k2 = 0.12), mm";
+const MU2_SI: &str = "Fig. 42 multiplier (k = 0.06, k2 = 0.12), printed";
+const STEP_ERR: &str = "static error of ω_a after V_m 8 → 7 V";
+const OPEN_7V: &str = "static error of ω_a with the printed u_ol alone at V_m = 7 V";
+const OPEN_8V: &str = "static error of ω_a with the printed u_ol alone at V_m = 8 V";
+const ARC_SMOOTH: &str = "Fig. 23(b) arc profiles: max radial deviation away";
+const ARC_CORNER: &str = "Fig. 23(b) arc profiles: max radial deviation at";
+
 // The tests that demonstrate each "differs" row's cause.
 const NCG: &str = "crates/ivt-kin/src/ncg.rs::fourier_fit_of_eq38";
 const BAND: &str = "crates/ivt-design/tests/ivt_design.rs::verdicts_follow_the_band";
@@ -53,6 +64,7 @@ const FLOOR: &str = "tests/ch4_plant.rs::fig42_gap_is_not_gain_scale_order_or_po
 /// Reproduced rows carry the thesis value ± half a printed unit (the
 /// reproduce criterion itself); "differs" rows a window around ours that
 /// excludes the printed value.
+#[rustfmt::skip]
 const PINS: &[Pin] = &[
     Pin(KIN, "J_a", R, Some((0.02365, 0.02375)), None),
     Pin(KIN, "J_b", R, Some((2.12635, 2.12645)), None),
@@ -63,29 +75,11 @@ const PINS: &[Pin] = &[
     Pin(KIN, "Eq. 42 a1", D, Some((0.13333, 0.13334)), Some(NCG)),
     Pin(KIN, "Eq. 42 a2", D, Some((-0.031747, -0.031745)), Some(NCG)),
     Pin(KIN, "Eq. 42 a3", D, Some((0.013985, 0.013987)), Some(NCG)),
-    Pin(
-        KIN,
-        "Eq. 42 a4",
-        D,
-        Some((-0.0078432, -0.007843)),
-        Some(NCG),
-    ),
+    Pin(KIN, "Eq. 42 a4", D, Some((-0.0078432, -0.007843)), Some(NCG)),
     Pin(KIN, "R_avg slope", R, Some((2.5461e-4, 2.5463e-4)), None),
     // §2.2.4's bounds on the arc-approximated profiles (Fig. 23(b)).
-    Pin(
-        KIN,
-        "Fig. 23(b) arc profiles: max radial deviation away",
-        R,
-        Some((0.0, 1.0)),
-        None,
-    ),
-    Pin(
-        KIN,
-        "Fig. 23(b) arc profiles: max radial deviation at",
-        R,
-        Some((0.0, 5.0)),
-        None,
-    ),
+    Pin(KIN, ARC_SMOOTH, R, Some((0.0, 1.0)), None),
+    Pin(KIN, ARC_CORNER, R, Some((0.0, 5.0)), None),
     // Wall-clock times: the thesis's machine is unknown (declared).
     Pin(HB, "IHB time, classic", NC, None, None),
     Pin(HB, "IHB time, modified", NC, None, None),
@@ -103,138 +97,36 @@ const PINS: &[Pin] = &[
     Pin(PR, "Eq. 158", D, None, Some(BAND)),
     Pin(PR, "Eq. 159", D, Some((0.153, 0.155)), Some(BAND)),
     Pin(PR, "Γ̂ = 0", D, None, Some(GAMMA)),
-    Pin(
-        PR,
-        "Fig. 42 multiplier (k = 0.01, k2 = 0.02), mm",
-        D,
-        Some((0.997, 0.999)),
-        Some(BAND),
-    ),
-    Pin(
-        PR,
-        "Fig. 42 multiplier (k = 0.01, k2 = 0.02), printed",
-        D,
-        Some((0.72, 0.74)),
-        Some(BAND),
-    ),
-    Pin(
-        PR,
-        "Fig. 42 multiplier (k = 0.06, k2 = 0.12), mm",
-        D,
-        Some((0.985, 0.99)),
-        Some(BAND),
-    ),
-    Pin(
-        PR,
-        "Fig. 42 multiplier (k = 0.06, k2 = 0.12), printed",
-        D,
-        Some((1.01, 1.03)),
-        Some(BAND),
-    ),
+    Pin(PR, MU1_MM, D, Some((0.997, 0.999)), Some(BAND)),
+    Pin(PR, MU1_SI, D, Some((0.72, 0.74)), Some(BAND)),
+    Pin(PR, MU2_MM, D, Some((0.985, 0.99)), Some(BAND)),
+    Pin(PR, MU2_SI, D, Some((1.01, 1.03)), Some(BAND)),
     // Chapter 4 on thesis-ch4 (k_t, k_e ÷ 10).
     Pin(CH4, "r̄ at (6 V", D, Some((0.006775, 0.00678)), Some(AUDIT)),
     Pin(CH4, "r̄ at (7 V", R, Some((0.02415, 0.02425)), None),
-    Pin(
-        CH4,
-        "r̄ at (8 V",
-        D,
-        Some((0.007033, 0.007037)),
-        Some(DIGITS),
-    ),
+    Pin(CH4, "r̄ at (8 V", D, Some((0.007033, 0.007037)), Some(DIGITS)),
     Pin(CH4, "Eq. 158", D, None, Some(DIGITS)),
     Pin(CH4, "Eq. 159", D, Some((1.53, 1.545)), Some(EQ159)),
     Pin(CH4, "Γ̂ = 0", R, None, None),
-    Pin(
-        CH4,
-        "Fig. 42 multiplier (k = 0.01, k2 = 0.02), mm",
-        D,
-        Some((0.7856, 0.7876)),
-        Some(FLOOR),
-    ),
-    Pin(
-        CH4,
-        "Fig. 42 multiplier (k = 0.01, k2 = 0.02), printed",
-        D,
-        Some((3.0, 4.0)),
-        Some(FIG42),
-    ),
-    Pin(
-        CH4,
-        "Fig. 42 multiplier (k = 0.06, k2 = 0.12), mm",
-        D,
-        Some((0.6034, 0.6054)),
-        Some(FLOOR),
-    ),
-    Pin(
-        CH4,
-        "Fig. 42 multiplier (k = 0.06, k2 = 0.12), printed",
-        D,
-        Some((20.0, 25.0)),
-        Some(FIG42),
-    ),
+    Pin(CH4, MU1_MM, D, Some((0.7856, 0.7876)), Some(FLOOR)),
+    Pin(CH4, MU1_SI, D, Some((3.0, 4.0)), Some(FIG42)),
+    Pin(CH4, MU2_MM, D, Some((0.6034, 0.6054)), Some(FLOOR)),
+    Pin(CH4, MU2_SI, D, Some((20.0, 25.0)), Some(FIG42)),
     // Findings on the printed text.
     Pin(DES, "inf f", D, Some((0.785397, 0.785399)), Some(INF_F)),
-    Pin(
-        DES,
-        "f_B(7 V, 2 N·m)",
-        D,
-        Some((3.205, 3.215)),
-        Some(OVER_DRIVE),
-    ),
-    Pin(
-        DES,
-        "Eq. 158 r_f at (6 V",
-        D,
-        Some((0.007437, 0.007439)),
-        Some(DIGITS),
-    ),
+    Pin(DES, "f_B(7 V, 2 N·m)", D, Some((3.205, 3.215)), Some(OVER_DRIVE)),
+    Pin(DES, "Eq. 158 r_f at (6 V", D, Some((0.007437, 0.007439)), Some(DIGITS)),
     // The printed controller on thesis-ch4 (scenes/ch4_*.toml).
-    Pin(
-        CL4,
-        "static error of ω_a after V_m 8 → 7 V",
-        R,
-        Some((-0.01, 0.01)),
-        None,
-    ),
-    Pin(
-        CL4,
-        "static error of ω_a with the printed u_ol alone at V_m = 7 V",
-        R,
-        Some((0.5, 1.5)),
-        None,
-    ),
-    Pin(
-        CL4,
-        "static error of ω_a with the printed u_ol alone at V_m = 8 V",
-        D,
-        Some((0.3, 1.0)),
-        Some(AUDIT),
-    ),
+    Pin(CL4, STEP_ERR, R, Some((-0.01, 0.01)), None),
+    Pin(CL4, OPEN_7V, R, Some((0.5, 1.5)), None),
+    Pin(CL4, OPEN_8V, D, Some((0.3, 1.0)), Some(AUDIT)),
     Pin(CL4, "RMS dr/dt", R, Some((100.0, 2000.0)), None),
     // §4.4, the rig.
-    Pin(
-        RIG,
-        "speed-ratio ripple",
-        D,
-        Some((1.2175, 1.2195)),
-        Some(RIPPLE),
-    ),
-    Pin(
-        RIG,
-        "sampling interval",
-        D,
-        Some((4.5, 4.5)),
-        Some(SAMPLING),
-    ),
+    Pin(RIG, "speed-ratio ripple", D, Some((1.2175, 1.2195)), Some(RIPPLE)),
+    Pin(RIG, "sampling interval", D, Some((4.5, 4.5)), Some(SAMPLING)),
     Pin(RIG, "K = 1/(K₂T_out)", R, Some((77.5, 78.5)), None),
     Pin(RIG, "stability bound on K", R, Some((155.5, 156.5)), None),
-    Pin(
-        RIG,
-        "error contraction per sample",
-        R,
-        Some((0.355, 0.365)),
-        None,
-    ),
+    Pin(RIG, "error contraction per sample", R, Some((0.355, 0.365)), None),
     Pin(RIG, "Eq. 192", D, None, Some(EQ192)),
 ];
 
