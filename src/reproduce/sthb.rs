@@ -192,7 +192,7 @@ fn fig36(ctx: &mut Context) -> Result<(), ReproError> {
         .max(((stiff.1 - fixed.1) / fixed.1).abs());
     ctx.row(
         FIG36_STIFF,
-        "almost the same as fixed–fixed (Fig. 36, §3.3.4)",
+        "almost the same as fixed–fixed (Fig. 36, §3.3.5)",
         format!("{:.2e}", stiff_gap),
         format!(
             "peak ω {:.4} vs {:.4}, ‖a‖ {:.4} vs {:.4}",
@@ -208,7 +208,7 @@ fn fig36(ctx: &mut Context) -> Result<(), ReproError> {
     let shift = (soft.0 - fixed.0) / fixed.0;
     ctx.row(
         FIG36_SOFT,
-        "shifted (Fig. 36, §3.3.4)",
+        "shifted (Fig. 36, §3.3.5)",
         format!("{:+.3}", shift),
         format!(
             "peak ω {:.4} vs {:.4} (restoring k0 = −10: {:.4})",
