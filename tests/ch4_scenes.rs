@@ -2,26 +2,21 @@
 //! shipped scenes run the printed open-loop law (Eq. 158–160) with the
 //! thesis's gains and hold 100 rpm (Figs. 43–45).
 
+mod common;
+
 use std::path::PathBuf;
-use std::process::Command;
 
 /// `ivt --json sim scenes/<name>.toml`: the run summary.
 fn summary(name: &str) -> serde_json::Value {
     let out: PathBuf = std::env::temp_dir().join(format!("ivt-ch4-{name}-{}", std::process::id()));
-    let res = Command::new(env!("CARGO_BIN_EXE_ivt"))
-        .args(["--json", "sim"])
-        .arg(format!("{}/scenes/{name}.toml", env!("CARGO_MANIFEST_DIR")))
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .expect("run ivt");
-    assert!(
-        res.status.success(),
-        "{name}: {}",
-        String::from_utf8_lossy(&res.stdout)
-    );
+    let scene = format!("{}/scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+    let v = common::ivt_json(&[
+        "sim".as_ref(),
+        scene.as_ref(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
     let _ = std::fs::remove_dir_all(&out);
-    let v: serde_json::Value = serde_json::from_slice(&res.stdout).expect("one JSON object");
     v["summary"].clone()
 }
 

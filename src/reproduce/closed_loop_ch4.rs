@@ -3,27 +3,10 @@
 //! shipped scenes `scenes/ch4_fig43_*.toml` and `scenes/ch4_fig44_*.toml`
 //! (Figs. 43–45 and the claims made about them in §4.3).
 
-use super::{fmt_sig, Cause, Context, ReproError, Verdict};
-use ivt_plot::{Figure, Series, Style};
-use ivt_sim::run::{Simulation, Summary};
-use ivt_sim::scene::Scene;
-
-const RAD_S_TO_RPM: f64 = 60.0 / (2.0 * std::f64::consts::PI);
-
-/// The run summary and its (t, ω, ω_a, r, V_m, T_U) samples.
-fn simulate(name: &str, src: &str) -> Result<(Summary, Vec<[f64; 6]>), String> {
-    let scene = Scene::parse(src, name).map_err(|e| e.to_string())?;
-    let res = Simulation::new(&scene).run().map_err(|e| e.to_string())?;
-    let plot = res
-        .channels
-        .plot
-        .ok_or_else(|| format!("{name}: the scene records no plot series"))?;
-    Ok((res.summary, plot))
-}
-
-fn column(samples: &[[f64; 6]], j: usize, scale: f64) -> Vec<(f64, f64)> {
-    samples.iter().map(|s| (s[0], s[j] * scale)).collect()
-}
+use super::closed_loop::{column, fig43_panel, shipped_scene, RAD_S_TO_RPM};
+use super::{fmt_sig, series, Cause, Context, ReproError, Verdict};
+use ivt_plot::{Figure, Style};
+use ivt_sim::run::Summary;
 
 /// Mean of ω_a − ω0 over t ∈ [from, to) \[rad/s\].
 fn mean_error(samples: &[[f64; 6]], omega0: f64, from: f64, to: f64) -> f64 {
@@ -37,28 +20,16 @@ fn mean_error(samples: &[[f64; 6]], omega0: f64, from: f64, to: f64) -> f64 {
 
 pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
     ctx.step("closed loop: Figs. 43-45 on thesis-ch4");
-    let delay = simulate(
-        "scenes/ch4_fig43_delay.toml",
-        include_str!("../../scenes/ch4_fig43_delay.toml"),
-    );
-    let open = simulate(
-        "scenes/ch4_fig43_open.toml",
-        include_str!("../../scenes/ch4_fig43_open.toml"),
-    );
+    let delay = shipped_scene!("ch4_fig43_delay");
+    let open = shipped_scene!("ch4_fig43_open");
     match (&delay, &open) {
         (Ok((sd, d)), Ok((so, o))) => fig43(ctx, (sd, d), (so, o))?,
         (Err(e), _) | (_, Err(e)) => {
             ctx.missing_figure("Fig. 43 (thesis-ch4)", "V_m step 8 → 7 V", e)
         }
     }
-    let delay = simulate(
-        "scenes/ch4_fig44_delay.toml",
-        include_str!("../../scenes/ch4_fig44_delay.toml"),
-    );
-    let nodelay = simulate(
-        "scenes/ch4_fig44_nodelay.toml",
-        include_str!("../../scenes/ch4_fig44_nodelay.toml"),
-    );
+    let delay = shipped_scene!("ch4_fig44_delay");
+    let nodelay = shipped_scene!("ch4_fig44_nodelay");
     match (&delay, &nodelay) {
         (Ok((sd, d)), Ok((sn, n))) => figs_44_45(ctx, (sd, d), (sn, n))?,
         (Err(e), _) | (_, Err(e)) => {
@@ -126,20 +97,12 @@ fn fig43(
             test: "tests/ch4_plant.rs::thesis_ch4_r_bar_matches_the_audit_values",
         },
     );
-    let (wd, wo) = (column(d, 2, RAD_S_TO_RPM), column(o, 2, RAD_S_TO_RPM));
-    let v = column(d, 4, 10.0);
-    ctx.line_figure(
+    fig43_panel(
+        ctx,
         "Fig. 43 (thesis-ch4)",
-        &Figure {
-            title: "Fig. 43 on thesis-ch4: ω_a with and without the time-delay feedback, V_m 8 → 7 V at T_U = 8 N·m",
-            x_label: "t [s]",
-            y_label: "ω_a [rpm]; V_m [V]×10",
-            series: vec![
-                Series { label: "printed u_ol alone", points: &wo, style: Style::Line },
-                Series { label: "u_ol + delay law, k = 0.01, k2 = 0.02", points: &wd, style: Style::Line },
-                Series { label: "V_m × 10", points: &v, style: Style::Dashed },
-            ],
-        },
+        "Fig. 43 on thesis-ch4: ω_a with and without the time-delay feedback, V_m 8 → 7 V at T_U = 8 N·m",
+        ("printed u_ol alone", o),
+        ("u_ol + delay law, k = 0.01, k2 = 0.02", d),
         &format!(
             "the thesis's own scene and gains: static error {} rad/s with the feedback, {:+.3} (8 V) and {:+.3} \
              (7 V) rad/s without; settling {settle} after the step",
@@ -189,18 +152,10 @@ fn figs_44_45(
             title: "Fig. 44 on thesis-ch4: ω_a with and without time delay, V_m = 8 V, T_U = 8 N·m",
             x_label: "t [s]",
             y_label: "ω_a [rpm]",
-            series: vec![
-                Series {
-                    label: "delay law, k = 0.01, k2 = 0.02",
-                    points: &wd,
-                    style: Style::Line,
-                },
-                Series {
-                    label: "no-delay law, k = 0.04, k2 = 0.15",
-                    points: &wn,
-                    style: Style::Dashed,
-                },
-            ],
+            series: series(&[
+                ("delay law, k = 0.01, k2 = 0.02", &wd, Style::Line),
+                ("no-delay law, k = 0.04, k2 = 0.15", &wn, Style::Dashed),
+            ]),
         },
         &format!(
             "settling into ±0.5 %: {} (delay) and {} (no delay); static errors {} and {} rad/s",
@@ -217,18 +172,10 @@ fn figs_44_45(
             title: "Fig. 45 on thesis-ch4: control variable r with and without time delay",
             x_label: "t [s]",
             y_label: "r [mm]",
-            series: vec![
-                Series {
-                    label: "delay law",
-                    points: &rd,
-                    style: Style::Line,
-                },
-                Series {
-                    label: "no-delay law",
-                    points: &rn,
-                    style: Style::Line,
-                },
-            ],
+            series: series(&[
+                ("delay law", &rd, Style::Line),
+                ("no-delay law", &rn, Style::Line),
+            ]),
         },
         &format!("RMS dr/dt {ratio:.0}× smaller with the delay law (tests/ch4_scenes.rs)"),
     )

@@ -31,6 +31,11 @@ const DIGITS_TEST: &str = "src/reproduce/design.rs::printed_digits_limit_eq158";
 pub(super) const FIG42_TEST: &str =
     "tests/ch4_plant.rs::fig42_multipliers_on_thesis_ch4_confirmed_by_simulation";
 
+/// The test ruling out gain scale, Chebyshev order and operating point as
+/// the cause of the thesis-ch4 Fig. 42 gap.
+pub(super) const FIG42_FLOOR_TEST: &str =
+    "tests/ch4_plant.rs::fig42_gap_is_not_gain_scale_order_or_point";
+
 /// Figure id of a thesis figure on a preset (`printed` keeps the bare id).
 pub(super) fn fig_id(base: &str, preset: PlantPreset) -> String {
     match preset {

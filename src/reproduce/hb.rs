@@ -1,7 +1,7 @@
 //! §3.2: Duffing (Fig. 28 against RK4, Fig. 29 FRC, the IHB timings of
 //! §3.2.3) and Mathieu–Duffing (A0 and β1/β2/β4 of §3.2.5, Figs. 30–33).
 
-use super::{fmt_sig, Cause, Context, ReproError, Verdict};
+use super::{fmt_sig, series, Cause, Context, ReproError, Verdict};
 use ivt_hb::aft::eval_series;
 use ivt_hb::mathieu::THESIS_A0;
 use ivt_hb::ode::{first_order, rk4};
@@ -9,12 +9,15 @@ use ivt_hb::{
     frequency_response, period_doubling_cascade, CascadeOptions, ClassicIhb, Duffing, FrcOptions,
     HbOptions, MathieuDuffing, ModifiedIhb,
 };
-use ivt_plot::{Figure, Series, Style};
+use ivt_plot::{Figure, Style};
 use std::f64::consts::PI;
 use std::time::Instant;
 
 /// The test behind the A0 row's note.
 const A0_TEST: &str = "src/reproduce/hb.rs::a0_differs_in_a8_sign_and_b3";
+
+/// The test ruling out β, n and truncation as the cause of A0's b3.
+const A0_RULED_OUT: &str = "src/reproduce/hb.rs::a0_b3_is_not_beta_n_or_truncation";
 
 /// Fig. 28 forcing frequency (n = 20, N = 64, ξ = 0.02, α = 1, ε = 1, F = 0.1).
 const OMEGA_F: f64 = 0.4;
@@ -45,22 +48,20 @@ fn duffing(ctx: &mut Context) -> Result<(), ReproError> {
     let opts = HbOptions::new(20, 64);
     // Timings of §3.2.3: one solve from the default start, setup included.
     let reps = if ctx.quick() { 3 } else { 11 };
-    let t_mod = median_time(
-        || {
-            ModifiedIhb::new(problem.clone(), opts.clone())
-                .and_then(|mut s| s.solve(OMEGA_F, None))
-                .is_ok()
-        },
-        reps,
-    );
-    let t_cls = median_time(
-        || {
-            ClassicIhb::new(problem.clone(), opts.clone())
-                .and_then(|mut s| s.solve(OMEGA_F, None))
-                .is_ok()
-        },
-        reps,
-    );
+    // One timed solve with either solver type (same problem, options, start).
+    macro_rules! timed {
+        ($solver:ident) => {
+            median_time(
+                || {
+                    $solver::new(problem.clone(), opts.clone())
+                        .and_then(|mut s| s.solve(OMEGA_F, None))
+                        .is_ok()
+                },
+                reps,
+            )
+        };
+    }
+    let (t_mod, t_cls) = (timed!(ModifiedIhb), timed!(ClassicIhb));
     let ratio = match (t_cls, t_mod) {
         (Some(c), Some(m)) => format!("{:.0}", c / m),
         _ => "?".into(),
@@ -126,10 +127,7 @@ fn duffing(ctx: &mut Context) -> Result<(), ReproError> {
                     title: "Fig. 28: Duffing, n = 20, N = 64, ξ = 0.02, α = 1, ε = 1, ω_f = 0.4, F = 0.1",
                     x_label: "t [s]",
                     y_label: "x [-]",
-                    series: vec![
-                        Series { label: "modified IHB", points: &hb, style: Style::Line },
-                        Series { label: "Runge–Kutta (RK4, 150 periods from rest)", points: &rk, style: Style::Markers },
-                    ],
+                    series: series(&[("modified IHB", &hb, Style::Line), ("Runge–Kutta (RK4, 150 periods from rest)", &rk, Style::Markers)]),
                 },
                 &format!(
                     "max |x_IHB − x_RK| over 65 points = {max_diff:.1e}; IHB residual {:.1e} in {} Broyden iterations",
@@ -177,10 +175,7 @@ fn duffing(ctx: &mut Context) -> Result<(), ReproError> {
                     title: "Fig. 29: Duffing amplitude–frequency response (n = 20, N = 64) with stability",
                     x_label: "ω_f [rad/s]",
                     y_label: "amplitude max |x| [-]",
-                    series: vec![
-                        Series { label: "stable", points: &stable, style: Style::Line },
-                        Series { label: "unstable (Hsu multipliers)", points: &unstable, style: Style::Markers },
-                    ],
+                    series: series(&[("stable", &stable, Style::Line), ("unstable (Hsu multipliers)", &unstable, Style::Markers)]),
                 },
                 &format!(
                     "pseudo-arclength continuation, {} points; folds at ω_f = {}; the stability flag switches at the folds",
@@ -267,8 +262,10 @@ fn mathieu(ctx: &mut Context) -> Result<(), ReproError> {
                         "modified IHB (n = 9, N = 64) from the printed A0 converges (residual {:.1e}) to a solution that \
                          differs beyond half a printed unit only in {}. a8: the printed \"=0.0001\" is a garbled sign, \
                          and read as +0.0001 it agrees; b3: ours is 0.04718 also when stopped at the thesis's residual \
-                         tolerance 1e-6 and for AFT sizes N = 10…64, so neither explains the printed 0.0471 (cause not \
-                         identified) (demonstrated by `{A0_TEST}`)",
+                         tolerance 1e-6, for AFT sizes N = 10…64 and with n = 20 harmonics; a β off 3.6 that gives \
+                         0.0471 moves a1 off its printed digits (db3/dβ ≈ −0.28, da1/dβ ≈ 1.7), and truncating instead \
+                         of rounding would print a0 = 0.7880, not 0.7881: all ruled out (`{A0_RULED_OUT}`); what remains, a \
+                         slip in the last printed digit, no computation can show (demonstrated by `{A0_TEST}`)",
                         sol.stats.residual_norm,
                         off.join("; ")
                     )
@@ -345,7 +342,7 @@ fn mathieu(ctx: &mut Context) -> Result<(), ReproError> {
                 title: &title,
                 x_label: "u [-]",
                 y_label: "du/dt [1/s]",
-                series: vec![Series { label: "last 4 forcing periods", points: &phase, style: Style::Line }],
+                series: series(&[("last 4 forcing periods", &phase, Style::Line)]),
             },
             &format!(
                 "period of the attractor from the stroboscopic samples u(kπ): {distinct} (thesis: period {expect}); \
@@ -382,10 +379,7 @@ fn mathieu(ctx: &mut Context) -> Result<(), ReproError> {
             title: "Fig. 33: Mathieu–Duffing bifurcation diagram (stroboscopic u(kπ) by RK4)",
             x_label: "β [-]",
             y_label: "u(kπ) [-]",
-            series: vec![
-                Series { label: "RK4 attractor samples", points: &diagram, style: Style::Markers },
-                Series { label: "β1, β2, β4 from HB + Hsu", points: &marks, style: Style::Dashed },
-            ],
+            series: series(&[("RK4 attractor samples", &diagram, Style::Markers), ("β1, β2, β4 from HB + Hsu", &marks, Style::Dashed)]),
         },
         "each β continues from the previous attractor; the dashed lines are the HB period-doubling points",
     )?;
@@ -441,5 +435,41 @@ mod tests {
             assert!((c[8] - 1e-4).abs() < 5e-5, "a8 = {}", c[8]);
             assert!((c[12] - 0.04718).abs() < 1e-5, "b3 = {}", c[12]);
         }
+    }
+
+    /// What does not explain the printed b3 = 0.0471 (ours 0.047179):
+    /// - β: a β that brings b3 within half a unit of 0.0471 moves a1 beyond
+    ///   half a unit of the printed −1.3956 (b3 and a1 move together);
+    /// - n: with n = 20 harmonics b3 is still 0.04718 (to 1e-5);
+    /// - truncating instead of rounding: a0 = 0.78806 would print 0.7880,
+    ///   not 0.7881, while b3 would print 0.0471.
+    #[test]
+    fn a0_b3_is_not_beta_n_or_truncation() {
+        let solve = |beta: f64, n: usize| {
+            let mut start = vec![0.0; 2 * n + 1];
+            start[..=9].copy_from_slice(&THESIS_A0[..=9]);
+            start[n + 1..=n + 9].copy_from_slice(&THESIS_A0[10..]);
+            let c = ModifiedIhb::new(MathieuDuffing::thesis(beta), HbOptions::new(n, 64))
+                .and_then(|mut s| s.solve(2.0, Some(&start)))
+                .unwrap()
+                .coeffs;
+            (c[0], c[1], c[n + 3])
+        };
+        for i in 0..=200 {
+            let beta = 3.59 + 1e-4 * i as f64;
+            let (_, a1, b3) = solve(beta, 9);
+            if (b3 - 0.0471).abs() <= 5e-5 {
+                assert!(
+                    (a1 - THESIS_A0[1]).abs() > 5e-5,
+                    "β = {beta}: a1 {a1}, b3 {b3}"
+                );
+            }
+        }
+        let (_, _, b3) = solve(3.6, 20);
+        assert!((b3 - 0.04718).abs() < 1e-5, "n = 20: b3 = {b3}");
+        let (a0, _, b3) = solve(3.6, 9);
+        let trunc = |x: f64| (x * 1e4).trunc() / 1e4;
+        assert_eq!(trunc(b3), 0.0471);
+        assert!((trunc(a0) - 0.7880).abs() < 1e-12 && (THESIS_A0[0] - 0.7881).abs() < 1e-12);
     }
 }

@@ -1,7 +1,11 @@
 //! Chapter 2 and §4.1: plant constants (Table 1), Eq. 42, R_avg slope
 //! (§4.4.2), and Figs. 9, 10, 11, 23(a), 24, 37, 47, 48 (theoretical curves).
 
-use super::{borrow_series, fmt_sig, Cause, Context, OwnedSeries, Points, ReproError};
+use super::gear_arcs::ArcProfile;
+use super::{
+    borrow_series, fmt_sig, series, Cause, Context, OwnedSeries, Points, ReproError, Verdict,
+};
+use ivt_kin::arcs::Member;
 use ivt_kin::givt::GivtGeometry;
 use ivt_kin::ncg::{
     fourier_coefficient, fourier_coefficient_eq38, output_ripple, pitch_profile, GearRatio,
@@ -11,7 +15,7 @@ use ivt_kin::plant::PlantParams;
 use ivt_kin::sgivt::{SgivtGeometry, R_AVG_SLOPE_PRINTED_PER_DEG};
 use ivt_kin::units::{deg_to_rad, inch_to_m};
 use ivt_kin::variant;
-use ivt_plot::{Figure, Series, Style};
+use ivt_plot::{Figure, Style};
 use std::f64::consts::PI;
 
 /// Caveat for every GIVT figure: two lengths are not printed.
@@ -158,10 +162,7 @@ fn givt_figures(ctx: &mut Context) -> Result<(), ReproError> {
             title: "Fig. 9(a): crank-slider and module speed ratios, r = 10 mm (illustrative l1, r_output)",
             x_label: "crank angle θ [deg]",
             y_label: "speed ratio [-]",
-            series: vec![
-                Series { label: "single crank-slider R1 (Eq. 8)", points: &single, style: Style::Dashed },
-                Series { label: "motion conversion module R (Eq. 9)", points: &module, style: Style::Line },
-            ],
+            series: series(&[("single crank-slider R1 (Eq. 8)", &single, Style::Dashed), ("motion conversion module R (Eq. 9)", &module, Style::Line)]),
         },
         GIVT_CAVEAT,
     )?;
@@ -178,11 +179,7 @@ fn givt_figures(ctx: &mut Context) -> Result<(), ReproError> {
             title: "Fig. 9(b): average speed ratio of the GIVT, F = 3R (illustrative l1, r_output)",
             x_label: "eccentricity r [mm]",
             y_label: "average output/input speed ratio [-]",
-            series: vec![Series {
-                label: "⟨F(θ, r)⟩ (Eq. 10)",
-                points: &avg,
-                style: Style::Line,
-            }],
+            series: series(&[("⟨F(θ, r)⟩ (Eq. 10)", &avg, Style::Line)]),
         },
         GIVT_CAVEAT,
     )?;
@@ -215,14 +212,14 @@ fn givt_figures(ctx: &mut Context) -> Result<(), ReproError> {
             ));
         }
     }
-    let series = borrow_series(&series_data);
+    let fig10 = borrow_series(&series_data);
     ctx.line_figure(
         "Fig. 10",
         &Figure {
             title: "Fig. 10: reduced speed ratios with and without noncircular gears (illustrative l1, r_output)",
             x_label: "crank angle θ [deg]",
             y_label: "speed ratio / its mean [-]",
-            series,
+            series: fig10,
         },
         GIVT_CAVEAT,
     )?;
@@ -240,10 +237,7 @@ fn givt_figures(ctx: &mut Context) -> Result<(), ReproError> {
                     title: "Fig. 11: pitch profiles of NG1 and NG2, D = 10 mm (illustrative l1, r_output)",
                     x_label: "x [mm]",
                     y_label: "y [mm]",
-                    series: vec![
-                        Series { label: "NG2 (on the GIVT input)", points: &ng2, style: Style::Line },
-                        Series { label: "NG1 (on the engine)", points: &ng1, style: Style::Line },
-                    ],
+                    series: series(&[("NG2 (on the GIVT input)", &ng2, Style::Line), ("NG1 (on the engine)", &ng1, Style::Line)]),
                 },
                 &note,
             )?;
@@ -308,15 +302,12 @@ fn sgivt_figures(ctx: &mut Context) -> Result<(), ReproError> {
             title: "Fig. 23(a): theoretical pitch profiles of the SGIVT noncircular gears, D = 5.25 in",
             x_label: "x [mm]",
             y_label: "y [mm]",
-            series: vec![
-                Series { label: "NG2 (input), Eq. 38", points: &ng2, style: Style::Line },
-                Series { label: "NG1 (engine), Eq. 38", points: &ng1, style: Style::Line },
-                Series { label: "NG2, smooth Eq. 42", points: &s2, style: Style::Dashed },
-                Series { label: "NG1, smooth Eq. 42", points: &s1, style: Style::Dashed },
-            ],
+            series: series(&[("NG2 (input), Eq. 38", &ng2, Style::Line), ("NG1 (engine), Eq. 38", &ng1, Style::Line), ("NG2, smooth Eq. 42", &s2, Style::Dashed), ("NG1, smooth Eq. 42", &s1, Style::Dashed)]),
         },
         &note,
     )?;
+
+    let arcs = fig_23b(ctx, &ng2, &ng1)?;
 
     // Fig. 24: output/engine ratio R/R_n at θ_CT = 3600° (e_max).
     let geo = SgivtGeometry::prototype();
@@ -340,6 +331,15 @@ fn sgivt_figures(ctx: &mut Context) -> Result<(), ReproError> {
         deg,
         1.0,
     );
+    let arc_curve: Points = match &arcs {
+        Some(a) => th()
+            .map(|t| {
+                let r = geo.ratio(t, e).map_or(f64::NAN, |r| r / a.ratio(t));
+                (t * deg, r)
+            })
+            .collect(),
+        None => Vec::new(),
+    };
     let ripple = |g: &dyn Fn() -> Result<(f64, f64), ivt_kin::KinError>| {
         g().map_or("?".to_string(), |(lo, hi)| {
             format!(
@@ -353,10 +353,12 @@ fn sgivt_figures(ctx: &mut Context) -> Result<(), ReproError> {
     let note = format!(
         "θ_CT = 3600° (e = {:.4} in). Exact Eq. 38 pair: constant. Printed Eq. 42: {}; Fourier \
          truncation of Eq. 38: {} — the printed 0.9× softening makes the peak-to-peak ripple 1.5× and the RMS \
-         ripple 2.0× that of the Fourier truncation (rig rows)",
+         ripple 2.0× that of the Fourier truncation (rig rows). Arc-approximated Eq. 38 (NG2 the arc chain of \
+         Fig. 23(b), NG1 its conjugate): {}",
         e / 0.0254,
         ripple(&|| output_ripple(&SmoothNcg::PRINTED, 4000)),
         ripple(&|| output_ripple(&SmoothNcg::fourier(), 4000)),
+        arcs.as_ref().map_or("not computed".to_string(), |a| ripple(&|| Ok(arc_ripple(a)))),
     );
     ctx.line_figure(
         "Fig. 24",
@@ -364,11 +366,7 @@ fn sgivt_figures(ctx: &mut Context) -> Result<(), ReproError> {
             title: "Fig. 24: SGIVT output/engine speed ratio with exact and smooth noncircular gears (θ_CT = 3600°)",
             x_label: "input angle θ_in [deg]",
             y_label: "ω_out/ω_eng [-]",
-            series: vec![
-                Series { label: "exact Eq. 38", points: &exact, style: Style::Line },
-                Series { label: "smooth Eq. 42 (printed)", points: &printed, style: Style::Line },
-                Series { label: "smooth, Fourier of Eq. 38", points: &fourier, style: Style::Dashed },
-            ],
+            series: series(&[("exact Eq. 38", &exact, Style::Line), ("smooth Eq. 42 (printed)", &printed, Style::Line), ("smooth, Fourier of Eq. 38", &fourier, Style::Dashed), ("arc-approximated Eq. 38 (§2.2.4, Fig. 23(b))", &arc_curve, Style::Line)]),
         },
         &note,
     )?;
@@ -382,18 +380,10 @@ fn sgivt_figures(ctx: &mut Context) -> Result<(), ReproError> {
             title: "Fig. 37: modulation f (Eq. 43) and f_θ (Eq. 139)",
             x_label: "θ [deg]",
             y_label: "f, f_θ [-]",
-            series: vec![
-                Series {
-                    label: "f (Eq. 43)",
-                    points: &f,
-                    style: Style::Line,
-                },
-                Series {
-                    label: "f_θ (Eq. 139)",
-                    points: &f_theta,
-                    style: Style::Line,
-                },
-            ],
+            series: series(&[
+                ("f (Eq. 43)", &f, Style::Line),
+                ("f_θ (Eq. 139)", &f_theta, Style::Line),
+            ]),
         },
         "f_θ jumps at θ = π/4 + kπ/2 (the kinks of f); ⟨f⟩ = 1",
     )?;
@@ -415,18 +405,14 @@ fn sgivt_figures(ctx: &mut Context) -> Result<(), ReproError> {
             title: "Fig. 47 (theory): average SGIVT speed ratio vs stepper angle",
             x_label: "stepper angle θ_CT [deg]",
             y_label: "average ω_out/ω_in [-]",
-            series: vec![
-                Series {
-                    label: "Eq. 35 + Eq. 185 at θ_CT = 0, 100, …, 3600°",
-                    points: &exact_avg,
-                    style: Style::Markers,
-                },
-                Series {
-                    label: "7 θ_CT/27492 (§4.4.2)",
-                    points: &line,
-                    style: Style::Line,
-                },
-            ],
+            series: series(&[
+                (
+                    "Eq. 35 + Eq. 185 at θ_CT = 0, 100, …, 3600°",
+                    &exact_avg,
+                    Style::Markers,
+                ),
+                ("7 θ_CT/27492 (§4.4.2)", &line, Style::Line),
+            ]),
         },
         "theoretical curve only; the measured points of Fig. 47 are rig data",
     )?;
@@ -440,12 +426,119 @@ fn sgivt_figures(ctx: &mut Context) -> Result<(), ReproError> {
             title: "Fig. 48 (theory): noncircular-gear ratio and SGIVT ratio without gears, θ_CT = 3600°",
             x_label: "input angle θ_in [deg]",
             y_label: "speed ratio [-]",
-            series: vec![
-                Series { label: "R_n, Eq. 38", points: &rn, style: Style::Line },
-                Series { label: "R without gears, Eq. 35", points: &r35, style: Style::Line },
-            ],
+            series: series(&[("R_n, Eq. 38", &rn, Style::Line), ("R without gears, Eq. 35", &r35, Style::Line)]),
         },
         "theoretical curves only; the experimental curves of Fig. 48 are rig data",
     )?;
     Ok(())
 }
+
+/// (min, max) of the SGIVT output/engine ratio over its mean with the
+/// arc-approximated pair, as [`output_ripple`] does for a smooth ratio.
+fn arc_ripple(arcs: &ArcProfile) -> (f64, f64) {
+    let n = 4000;
+    let v: Vec<f64> = (0..n)
+        .map(|j| {
+            let t = 0.5 * PI * (j as f64 + 0.5) / n as f64;
+            ivt_kin::sgivt::rectified_shape(t) / arcs.ratio(t)
+        })
+        .collect();
+    let mean = v.iter().sum::<f64>() / n as f64;
+    let (lo, hi) = v
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    (lo / mean, hi / mean)
+}
+
+/// Fig. 23(b): the arc-approximated pitch profiles over the theoretical ones,
+/// and the two deviation rows of §2.2.4 (≤ 1 % away from the corners, ≤ 5 %
+/// at the rounded corners). Returns NG2's arc profile for Fig. 24.
+fn fig_23b(
+    ctx: &mut Context,
+    ng2: &Points,
+    ng1: &Points,
+) -> Result<Option<ArcProfile>, ReproError> {
+    let (driven, driving) = match (
+        ArcProfile::sgivt(Member::Driven),
+        ArcProfile::sgivt(Member::Driving),
+    ) {
+        (Ok(a), Ok(b)) => (a, b),
+        (Err(e), _) | (_, Err(e)) => {
+            ctx.missing_figure(
+                "Fig. 23(b)",
+                "arc-approximated pitch profiles",
+                &e.to_string(),
+            );
+            for q in [ARC_DEV_SMOOTH, ARC_DEV_CORNER] {
+                ctx.not_computable(q, "§2.2.4", &e.to_string());
+            }
+            return Ok(None);
+        }
+    };
+    let d = ivt_kin::sgivt::SgivtGeometry::prototype().ncg_centre_distance;
+    // Each arc sampled in mm; NG1 mirrored about the y axis and moved to x = D
+    // as in Fig. 23(a) (profile_xy), so both chains touch on the line of centres.
+    let chain = |p: &ArcProfile, mirror: bool| -> Points {
+        p.arcs
+            .iter()
+            .flat_map(|a| (0..=16).map(move |j| a.point_at(a.length * j as f64 / 16.0)))
+            .map(|q| {
+                if mirror {
+                    (1e3 * (d - q[0]), 1e3 * q[1])
+                } else {
+                    (1e3 * q[0], 1e3 * q[1])
+                }
+            })
+            .collect()
+    };
+    let (c2, c1) = (chain(&driven, false), chain(&driving, true));
+    let fits = [driven.fit, driving.fit];
+    let dev = fits.iter().map(|f| f.max_deviation).fold(0.0, f64::max);
+    let corner = fits
+        .iter()
+        .map(|f| f.max_corner_deviation)
+        .fold(0.0, f64::max);
+    ctx.line_figure(
+        "Fig. 23(b)",
+        &Figure {
+            title: "Fig. 23(b): SGIVT pitch profiles approximated by tangent circular arcs, D = 5.25 in",
+            x_label: "x [mm]",
+            y_label: "y [mm]",
+            series: series(&[("NG2, arcs", &c2, Style::Line), ("NG1, arcs", &c1, Style::Line), ("NG2, Eq. 38", ng2, Style::Dashed), ("NG1, Eq. 38", ng1, Style::Dashed)]),
+        },
+        &format!(
+            "ivt_kin::arcs::fit_arcs (biarcs, tangent at every joint; corners rounded over ±2°): NG2 {} arcs, \
+             NG1 {} arcs; max radial deviation {:.3} % away from the corners, {:.2} % at the corners",
+            driven.fit.count,
+            driving.fit.count,
+            100.0 * dev,
+            100.0 * corner
+        ),
+    )?;
+    let how = "largest sampled radial deviation of NG1's and NG2's arc chains from the theoretical radius \
+               (ivt_kin::arcs, checked against the closed-form radius in its tests)";
+    for (q, bound, ours) in [(ARC_DEV_SMOOTH, 1.0, dev), (ARC_DEV_CORNER, 5.0, corner)] {
+        let ok = 100.0 * ours <= bound;
+        ctx.row(
+            q,
+            format!("≤ {bound} % (§2.2.4)"),
+            format!("{:.3}", 100.0 * ours),
+            "—",
+            if ok {
+                Verdict::Reproduced
+            } else {
+                Verdict::Differs
+            },
+            how,
+        );
+    }
+    Ok(Some(driven))
+}
+
+/// Row names of the two §2.2.4 deviation bounds.
+const ARC_DEV_SMOOTH: &str =
+    "Fig. 23(b) arc profiles: max radial deviation away from the corners [%]";
+const ARC_DEV_CORNER: &str =
+    "Fig. 23(b) arc profiles: max radial deviation at the rounded corners [%]";

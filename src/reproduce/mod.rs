@@ -13,6 +13,7 @@ mod closed_loop;
 mod closed_loop_ch4;
 mod design;
 mod design_maps;
+mod gear_arcs;
 mod hb;
 mod kinematics;
 mod report;
@@ -33,15 +34,27 @@ pub(crate) type Points = Vec<(f64, f64)>;
 /// [`ivt_plot::Series`] when drawn).
 pub(crate) type OwnedSeries = (String, Points, ivt_plot::Style);
 
-/// Borrow owned series as the plot crate's [`ivt_plot::Series`].
-pub(crate) fn borrow_series(data: &[OwnedSeries]) -> Vec<ivt_plot::Series<'_>> {
-    data.iter()
-        .map(|(label, points, style)| ivt_plot::Series {
+/// A series as (label, points, style).
+pub(crate) type SeriesSpec<'a> = (&'a str, &'a [(f64, f64)], ivt_plot::Style);
+
+/// A figure's series from (label, points, style) triples.
+pub(crate) fn series<'a>(list: &[SeriesSpec<'a>]) -> Vec<ivt_plot::Series<'a>> {
+    list.iter()
+        .map(|&(label, points, style)| ivt_plot::Series {
             label,
             points,
-            style: *style,
+            style,
         })
         .collect()
+}
+
+/// Borrow owned series as the plot crate's [`ivt_plot::Series`].
+pub(crate) fn borrow_series(data: &[OwnedSeries]) -> Vec<ivt_plot::Series<'_>> {
+    let list: Vec<_> = data
+        .iter()
+        .map(|(label, points, style)| (label.as_str(), points.as_slice(), *style))
+        .collect();
+    series(&list)
 }
 
 /// How a thesis number compares with ours.

@@ -4,11 +4,11 @@
 //! slope, its stability bound, the contraction at K = 50, Eq. 192 itself, and
 //! the Fig. 51 drive test on the averaged model Eq. 187.
 
-use super::{fmt_sig, Cause, Context, ReproError};
+use super::{fmt_sig, series, Cause, Context, ReproError};
 use ivt_kin::ncg::{GearRatio, SgivtNcg, SmoothNcg};
 use ivt_kin::plant::PlantParams;
 use ivt_kin::sgivt::rectified_shape;
-use ivt_plot::{Figure, Series, Style};
+use ivt_plot::{Figure, Style};
 use std::f64::consts::FRAC_PI_2;
 
 /// Fig. 50: fitted slope K₂T_out of ω_m against θ_CT (§4.4.3).
@@ -241,11 +241,7 @@ fn fig51(ctx: &mut Context) -> Result<(), ReproError> {
             title: "Fig. 51 on the averaged SGIVT model Eq. 187: proportional law K = 50, ω_r = 60 rpm, idle 50 rpm",
             x_label: "sample k",
             y_label: "ω_m [rpm]; θ_CT [deg]/60; T_out/T_max [%]",
-            series: vec![
-                Series { label: "ω_m", points: &w, style: Style::Line },
-                Series { label: "θ_CT / 60", points: &th, style: Style::Line },
-                Series { label: "T_out / T_max [%]", points: &load, style: Style::Dashed },
-            ],
+            series: series(&[("ω_m", &w, Style::Line), ("θ_CT / 60", &th, Style::Line), ("T_out / T_max [%]", &load, Style::Dashed)]),
         },
         &format!(
             "Eq. 188–189 with K₂T_out = 0.0128 at T_max, θ_CT ∈ [0, 3600°]; stages: idle (θ_CT held at 0, ω_m = 50 rpm), \
