@@ -2,7 +2,7 @@
 //! (Figs. 34–36; c_d = 0.8, y0 = 0.5, M = 19, N_s = 64, M_s = 128).
 
 use super::{Context, Points, ReproError};
-use ivt_hb::sthb::continuation::{frequency_response, ContinuationOptions, Frc};
+use ivt_hb::sthb::frc::{frequency_response, trace, StringFrcOptions};
 use ivt_hb::sthb::{Boundary, StringHb, StringParams};
 use ivt_plot::{Figure, Series, Style};
 
@@ -11,32 +11,40 @@ use ivt_plot::{Figure, Series, Style};
 const FROM: f64 = 1.0;
 const TO: f64 = 8.0;
 
-fn curve(params: StringParams, stability: bool) -> Result<Frc, String> {
+/// (all points, unstable points with NaN gaps elsewhere; none without `stability`).
+fn curve(params: StringParams, stability: bool) -> Result<(Points, Points), String> {
     let mut hb = StringHb::new(params).map_err(|e| e.to_string())?;
-    frequency_response(
-        &mut hb,
-        FROM,
-        TO,
-        &ContinuationOptions {
-            stability,
-            ..Default::default()
-        },
-    )
-    .map_err(|e| e.to_string())
-}
-
-/// (all points, unstable points with NaN gaps elsewhere).
-fn split(frc: &Frc) -> (Points, Points) {
-    let all = frc.points.iter().map(|p| (p.omega, p.norm)).collect();
+    let opts = StringFrcOptions::default();
+    if !stability {
+        let path = trace(&mut hb, FROM, TO, &opts.continuation).map_err(|e| e.to_string())?;
+        let n = hb.dim();
+        let all = path
+            .points
+            .iter()
+            .map(|p| (p.lambda(), hb.complex_norm(&p.x[..n])))
+            .collect();
+        return Ok((all, Vec::new()));
+    }
+    let frc = frequency_response(&mut hb, FROM, TO, &opts)
+        .map_err(|e| e.to_string())?
+        .frc;
+    let all = frc
+        .points
+        .iter()
+        .map(|p| (p.omega_f, p.amplitude))
+        .collect();
     let unstable = frc
         .points
         .iter()
-        .map(|p| match &p.stability {
-            Some(s) if !s.is_stable() => (p.omega, p.norm),
-            _ => (f64::NAN, f64::NAN),
+        .map(|p| {
+            if p.stable() {
+                (f64::NAN, f64::NAN)
+            } else {
+                (p.omega_f, p.amplitude)
+            }
         })
         .collect();
-    (all, unstable)
+    Ok((all, unstable))
 }
 
 pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
@@ -59,11 +67,9 @@ pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
             false,
         );
         match (n5, n10) {
-            (Ok(a), Ok(b)) => {
-                let (all5, unstable5) = split(&a);
-                let (all10, _) = split(&b);
+            (Ok((all5, unstable5)), Ok((all10, _))) => {
                 let n_unstable = unstable5.iter().filter(|p| p.0.is_finite()).count();
-                let peak = |f: &Frc| f.points.iter().map(|p| p.norm).fold(0.0, f64::max);
+                let peak = |f: &Points| f.iter().map(|p| p.1).fold(0.0, f64::max);
                 let title = format!(
                     "{id}: string frequency response, k_d = {kd}, N = 5 and 10 (STHB, M = 19)"
                 );
@@ -82,9 +88,9 @@ pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
                     &format!(
                         "peak ‖a‖ {:.4} (N = 5) vs {:.4} (N = 10): the curves overlap as in the thesis; {n_unstable} of {} \
                          N = 5 points unstable (thesis: none for k_d = 10, some for k_d = 30)",
-                        peak(&a),
-                        peak(&b),
-                        a.points.len()
+                        peak(&all5),
+                        peak(&all10),
+                        all5.len()
                     ),
                 )?;
             }
@@ -106,7 +112,7 @@ pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
             },
             false,
         ) {
-            Ok(f) => curves.push((label, split(&f).0)),
+            Ok((all, _)) => curves.push((label, all)),
             Err(e) => {
                 ctx.missing_figure(
                     "Fig. 36",
