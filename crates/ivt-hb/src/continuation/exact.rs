@@ -41,7 +41,7 @@ const NEWTON_WEIGHT: usize = 2;
 /// iteration may take three times as many while it contracts by ½ or better).
 /// Step control: a point whose corrector took at most `target_iter / 2`
 /// chord iterations (a Newton iteration counts as two) grows the step by
-/// `growth`, more than `target_iter` shrinks it by 0.7, a failed corrector
+/// `growth`, `target_iter` or more shrinks it by 0.7, a failed corrector
 /// halves it. `PathPoint::dlambda` is the λ component of the unit tangent.
 ///
 /// `on_point` is called once the point's tangent is computed, so the last
@@ -130,8 +130,14 @@ where
             } else {
                 None
             };
+            let pred = Prediction {
+                u_pred: &u_pred,
+                tangent: &tangent,
+                fix: clip,
+            };
+            corrector.start(&pred);
             let chord = if chord_ok {
-                corrector.chord(system, &u_pred, &tangent, clip)
+                corrector.chord(system, &pred)
             } else {
                 Err(SolveError::NonConvergence {
                     iterations: 0,
@@ -142,8 +148,9 @@ where
                 Ok(its) => Ok(its),
                 Err(_) => {
                     chord_ok = false;
+                    corrector.start(&pred);
                     corrector
-                        .newton(system, &u_pred, &tangent, clip)
+                        .newton(system, &pred)
                         .map(|its| its * NEWTON_WEIGHT)
                 }
             };
@@ -158,7 +165,7 @@ where
                     };
                     if weighted * 2 <= opts.target_iter {
                         step = (step * opts.growth).min(opts.ds_max);
-                    } else if weighted > opts.target_iter {
+                    } else if weighted >= opts.target_iter {
                         step *= 0.7;
                     }
                     break None;
@@ -254,54 +261,30 @@ impl Corrector {
         norm.is_finite()
     }
 
-    /// The constraint `tᵀ(u − u_pred)`, or `λ − λ_fix`.
-    fn constraint(u: &[f64], u_pred: &[f64], tangent: &[f64], fix: Option<f64>) -> f64 {
-        match fix {
-            Some(l) => u[u.len() - 1] - l,
-            None => tangent
-                .iter()
-                .zip(u.iter().zip(u_pred))
-                .map(|(t, (a, b))| t * (a - b))
-                .sum(),
-        }
-    }
-
     /// The start of a corrector: `u_pred`, on `λ = fix` if given.
-    fn start(&mut self, u_pred: &[f64], fix: Option<f64>) {
-        self.u.copy_from_slice(u_pred);
-        if let Some(l) = fix {
+    fn start(&mut self, pred: &Prediction<'_>) {
+        self.u.copy_from_slice(pred.u_pred);
+        if let Some(l) = pred.fix {
             let m = self.u.len() - 1;
             self.u[m] = l;
         }
     }
 
-    /// Chord iteration on the tangent's factorization; fails fast when the
+    /// Chord iteration from [`Self::start`] on the tangent's factorization; fails fast when the
     /// contraction is worse than ½ per iteration. Returns the iteration count.
     fn chord<S: PathSystem>(
         &mut self,
-        system: &mut S,
-        u_pred: &[f64],
-        tangent: &[f64],
-        fix: Option<f64>,
+        sys: &mut S,
+        pred: &Prediction,
     ) -> Result<usize, SolveError> {
-        let m = self.jac.nrows();
-        self.start(u_pred, fix);
-        let mut history: Vec<f64> = Vec::new();
+        let (m, mut history) = (self.jac.nrows(), Vec::new());
         for it in 0..=3 * self.max_newton {
-            system.residual(&self.u[..m], self.u[m], &mut self.rhs[..m]);
-            self.rhs[m] = Self::constraint(&self.u, u_pred, tangent, fix);
-            let norm = norm2(&self.rhs);
-            history.push(norm);
-            if !norm.is_finite() {
-                return Err(SolveError::NonFinite {
-                    iteration: it,
-                    history,
-                });
+            sys.residual(&self.u[..m], self.u[m], &mut self.rhs[..m]);
+            self.rhs[m] = pred.constraint(&self.u);
+            if let Some(done) = settle(&mut history, norm2(&self.rhs), self.tol) {
+                return done;
             }
-            if norm <= self.tol {
-                return Ok(it);
-            }
-            if it >= 1 && norm > 0.5 * history[it - 1] {
+            if it >= 1 && history[it] > 0.5 * history[it - 1] {
                 break;
             }
             self.aug.solve(&mut self.rhs);
@@ -315,44 +298,34 @@ impl Corrector {
         })
     }
 
-    /// Newton on `[R(u); constraint] = 0`, refactoring each iteration.
+    /// Newton on `[R(u); constraint] = 0` from [`Self::start`], refactoring each
+    /// iteration.
     /// Returns the iteration count.
     fn newton<S: PathSystem>(
         &mut self,
-        system: &mut S,
-        u_pred: &[f64],
-        tangent: &[f64],
-        fix: Option<f64>,
+        sys: &mut S,
+        pred: &Prediction,
     ) -> Result<usize, SolveError> {
         let m = self.jac.nrows();
-        self.start(u_pred, fix);
-        let mut row = tangent.to_vec();
-        if fix.is_some() {
+        let mut row = pred.tangent.to_vec();
+        if pred.fix.is_some() {
             row.fill(0.0);
             row[m] = 1.0;
         }
         let mut history = Vec::new();
         for it in 0..=self.max_newton {
             let u = std::mem::take(&mut self.u);
-            self.assemble(system, &u);
+            self.assemble(sys, &u);
             self.u = u;
-            let constraint = Self::constraint(&self.u, u_pred, tangent, fix);
-            let norm = norm2(&self.r).hypot(constraint);
-            history.push(norm);
-            if !norm.is_finite() {
-                return Err(SolveError::NonFinite {
-                    iteration: it,
-                    history,
-                });
+            let constraint = pred.constraint(&self.u);
+            if let Some(done) = settle(&mut history, norm2(&self.r).hypot(constraint), self.tol) {
+                return done;
             }
-            if norm <= self.tol {
-                return Ok(it);
-            }
-            if it == self.max_newton || (it >= 2 && norm > history[it - 1]) {
+            if it == self.max_newton || (it >= 2 && history[it] > history[it - 1]) {
                 break;
             }
             let u = std::mem::take(&mut self.u);
-            let factored = self.factor(system, &u, &row);
+            let factored = self.factor(sys, &u, &row);
             self.u = u;
             if !factored {
                 return Err(SolveError::SingularJacobian {
@@ -374,6 +347,41 @@ impl Corrector {
     }
 }
 
+/// A predicted point and the constraint that closes the corrector's system.
+struct Prediction<'a> {
+    u_pred: &'a [f64],
+    tangent: &'a [f64],
+    /// Correct on `λ = fix` (landing on a bound) instead of `tᵀ(u − u_pred) = 0`.
+    fix: Option<f64>,
+}
+
+impl Prediction<'_> {
+    /// The constraint `tᵀ(u − u_pred)`, or `λ − λ_fix`.
+    fn constraint(&self, u: &[f64]) -> f64 {
+        match self.fix {
+            Some(l) => u[u.len() - 1] - l,
+            None => self
+                .tangent
+                .iter()
+                .zip(u.iter().zip(self.u_pred))
+                .map(|(t, (a, b))| t * (a - b))
+                .sum(),
+        }
+    }
+}
+
+/// Records a corrector's residual norm; `Some` once it is done: converged
+/// (the iteration count) or non-finite (the error with the history).
+fn settle(history: &mut Vec<f64>, norm: f64, tol: f64) -> Option<Result<usize, SolveError>> {
+    let iteration = history.len();
+    history.push(norm);
+    if !norm.is_finite() {
+        let history = std::mem::take(history);
+        return Some(Err(SolveError::NonFinite { iteration, history }));
+    }
+    (norm <= tol).then_some(Ok(iteration))
+}
+
 fn norm2(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
@@ -382,27 +390,8 @@ fn norm2(v: &[f64]) -> f64 {
 mod tests {
     use super::*;
 
-    /// `u² + λ² = 1`: a circle with folds at λ = ±1.
-    struct Circle;
-
-    impl PathSystem for Circle {
-        fn dim(&self) -> usize {
-            1
-        }
-        fn residual(&mut self, u: &[f64], lambda: f64, r: &mut [f64]) {
-            r[0] = u[0] * u[0] + lambda * lambda - 1.0;
-        }
-        fn residual_jacobian(&mut self, u: &[f64], lambda: f64, r: &mut [f64], jac: &mut Mat<f64>) {
-            self.residual(u, lambda, r);
-            jac[(0, 0)] = 2.0 * u[0];
-        }
-        fn d_residual_d_lambda(&mut self, _u: &[f64], lambda: f64, r_lambda: &mut [f64]) {
-            r_lambda[0] = 2.0 * lambda;
-        }
-    }
-
     #[test]
-    fn traces_a_circle_through_both_folds_and_lands_on_the_bound() {
+    fn traces_a_circle_over_its_fold_onto_the_bound() {
         let opts = ContinuationOptions {
             ds: 0.05,
             ds_max: 0.1,
@@ -427,5 +416,24 @@ mod tests {
             "{:?}",
             path.folds
         );
+    }
+
+    /// `u² + λ² = 1`: a circle with folds at λ = ±1.
+    struct Circle;
+
+    impl PathSystem for Circle {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn residual(&mut self, u: &[f64], lambda: f64, r: &mut [f64]) {
+            r[0] = u[0] * u[0] + lambda * lambda - 1.0;
+        }
+        fn residual_jacobian(&mut self, u: &[f64], lambda: f64, r: &mut [f64], jac: &mut Mat<f64>) {
+            self.residual(u, lambda, r);
+            jac[(0, 0)] = 2.0 * u[0];
+        }
+        fn d_residual_d_lambda(&mut self, _u: &[f64], lambda: f64, r_lambda: &mut [f64]) {
+            r_lambda[0] = 2.0 * lambda;
+        }
     }
 }
