@@ -3,9 +3,9 @@
 
 use super::{CliError, Output};
 use clap::{Args, ValueEnum};
-use ivt_hb::sthb::continuation::FrcPoint;
-use ivt_hb::sthb::continuation::{frequency_response, ContinuationOptions};
+use ivt_hb::sthb::frc::{frequency_response, StringFrcOptions};
 use ivt_hb::sthb::{Boundary, StringHb, StringParams};
+use ivt_hb::FrcPoint;
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -102,30 +102,25 @@ pub fn run(args: StringArgs) -> Result<Output, CliError> {
     // engine's Broyden continuation (`spring_frequency_response`, §3.3.5) gives
     // the same spring curve but ~50× slower (crates/ivt-hb/README.md, STHB).
     let mut hb = StringHb::new(params).map_err(|e| CliError::Input(e.to_string()))?;
-    let opts = ContinuationOptions {
-        step_max: args.step_max,
-        ..Default::default()
-    };
-    let frc = frequency_response(&mut hb, args.from, args.to, &opts)
+    let mut opts = StringFrcOptions::default();
+    opts.continuation.ds_max = args.step_max;
+    let curve = frequency_response(&mut hb, args.from, args.to, &opts)
         .map_err(|e| CliError::Failed(e.to_string()))?;
     let solve_time_s = t0.elapsed().as_secs_f64();
+    let frc = &curve.frc;
     let points: Vec<_> = frc
         .points
         .iter()
-        .map(|p| {
-            let s = p.stability.as_ref().ok_or_else(|| {
-                CliError::Failed(format!("no stability result at ω = {}", p.omega))
-            })?;
-            let _ = writeln!(human, "{:.6} {:.6e} {}", p.omega, p.norm, s.is_stable());
-            Ok(
-                json!({"omega": p.omega, "norm": p.norm, "stable": s.is_stable(),
-                   "kind": format!("{:?}", s.kind), "max_multiplier": s.critical.norm(),
-                   "method": format!("{:?}", s.method)}),
-            )
+        .zip(&curve.methods)
+        .map(|(p, method)| {
+            let _ = writeln!(human, "{:.6} {:.6e} {}", p.omega_f, p.amplitude, p.stable());
+            json!({"omega": p.omega_f, "norm": p.amplitude, "stable": p.stable(),
+                   "kind": format!("{:?}", p.kind), "max_multiplier": p.multipliers[0].norm(),
+                   "method": format!("{method:?}")})
         })
-        .collect::<Result<_, CliError>>()?;
-    let mut extra = json!({"factorizations": frc.factorizations, "hill_calls": frc.hill_calls,
-                       "stop": format!("{:?}", frc.stop)});
+        .collect();
+    let mut extra = json!({"jacobians": curve.jacobians, "hill_calls": curve.hill_calls,
+                       "stop": format!("{:?}", frc.termination)});
     if let Boundary::Spring { k0 } = boundary {
         if k0 > 1.0 {
             let note = format!(
@@ -166,11 +161,11 @@ pub fn run(args: StringArgs) -> Result<Output, CliError> {
 /// change of verdict repeats the boundary point in both series so the curve
 /// stays connected (NaN breaks the other series there).
 fn plot(path: &Path, title: &str, points: &[FrcPoint]) -> Result<(), CliError> {
-    let stable = |p: &FrcPoint| p.stability.is_none_or(|s| s.is_stable());
+    let stable = FrcPoint::stable;
     let (mut solid, mut dashed) = (Vec::new(), Vec::new());
     let mut previous: Option<&FrcPoint> = None;
     for p in points {
-        let xy = (p.omega, p.norm);
+        let xy = (p.omega_f, p.amplitude);
         let gap = (f64::NAN, f64::NAN);
         let (own, other) = if stable(p) {
             (&mut solid, &mut dashed)

@@ -2,7 +2,8 @@
 //! (Figs. 34–36; c_d = 0.8, y0 = 0.5, M = 19, N_s = 64, M_s = 128).
 
 use super::{series, Context, Points, ReproError, SeriesSpec, Verdict};
-use ivt_hb::sthb::continuation::{frequency_response, ContinuationOptions, Frc};
+use ivt_hb::frc::Frc;
+use ivt_hb::sthb::frc::{frequency_response, trace, StringFrcOptions};
 use ivt_hb::sthb::{Boundary, StringHb, StringParams};
 use ivt_plot::{Figure, Style};
 
@@ -11,29 +12,40 @@ use ivt_plot::{Figure, Style};
 const FROM: f64 = 1.0;
 const TO: f64 = 8.0;
 
-fn curve(params: StringParams, stability: bool) -> Result<Frc, String> {
+/// The curve with a stability verdict per point (monodromy, confirmed by Hill
+/// near |μ| = 1, at folds and where the verdict changes).
+fn curve(params: StringParams) -> Result<Frc, String> {
     let mut hb = StringHb::new(params).map_err(|e| e.to_string())?;
-    frequency_response(
-        &mut hb,
-        FROM,
-        TO,
-        &ContinuationOptions {
-            stability,
-            ..Default::default()
-        },
-    )
-    .map_err(|e| e.to_string())
+    frequency_response(&mut hb, FROM, TO, &StringFrcOptions::default())
+        .map(|f| f.frc)
+        .map_err(|e| e.to_string())
+}
+
+/// The curve's (ω, ‖a‖) points without stability.
+fn curve_points(params: StringParams) -> Result<Points, String> {
+    let mut hb = StringHb::new(params).map_err(|e| e.to_string())?;
+    let opts = StringFrcOptions::default();
+    let path = trace(&mut hb, FROM, TO, &opts.continuation).map_err(|e| e.to_string())?;
+    let n = hb.dim();
+    Ok(path
+        .points
+        .iter()
+        .map(|p| (p.lambda(), hb.complex_norm(&p.x[..n])))
+        .collect())
 }
 
 /// (all points, unstable points with NaN gaps elsewhere).
 fn split(frc: &Frc) -> (Points, Points) {
-    let all = frc.points.iter().map(|p| (p.omega, p.norm)).collect();
+    let all = frc.points.iter().map(|p| (p.omega_f, p.amplitude)).collect();
     let unstable = frc
         .points
         .iter()
-        .map(|p| match &p.stability {
-            Some(s) if !s.is_stable() => (p.omega, p.norm),
-            _ => (f64::NAN, f64::NAN),
+        .map(|p| {
+            if p.stable() {
+                (f64::NAN, f64::NAN)
+            } else {
+                (p.omega_f, p.amplitude)
+            }
         })
         .collect();
     (all, unstable)
@@ -42,28 +54,21 @@ fn split(frc: &Frc) -> (Points, Points) {
 pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
     ctx.step("sthb: string FRCs");
     for (id, kd) in [("Fig. 34", 10.0), ("Fig. 35", 30.0)] {
-        let n5 = curve(
-            StringParams {
-                kd,
-                modes: 5,
-                ..Default::default()
-            },
-            true,
-        );
-        let n10 = curve(
-            StringParams {
-                kd,
-                modes: 10,
-                ..Default::default()
-            },
-            false,
-        );
+        let n5 = curve(StringParams {
+            kd,
+            modes: 5,
+            ..Default::default()
+        });
+        let n10 = curve_points(StringParams {
+            kd,
+            modes: 10,
+            ..Default::default()
+        });
         match (n5, n10) {
-            (Ok(a), Ok(b)) => {
+            (Ok(a), Ok(all10)) => {
                 let (all5, unstable5) = split(&a);
-                let (all10, _) = split(&b);
                 let n_unstable = unstable5.iter().filter(|p| p.0.is_finite()).count();
-                let peak = |f: &Frc| f.points.iter().map(|p| p.norm).fold(0.0, f64::max);
+                let peak = |f: &Points| f.iter().map(|p| p.1).fold(0.0, f64::max);
                 let title = format!(
                     "{id}: string frequency response, k_d = {kd}, N = 5 and 10 (STHB, M = 19)"
                 );
@@ -73,13 +78,13 @@ pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
                         title: &title,
                         x_label: "ω [rad/s]",
                         y_label: "‖a‖ [-]",
-                        series: series(&[("N = 5", &all5, Style::Line), ("N = 10", &all10, Style::Dashed), ("unstable, N = 5 (Hill)", &unstable5, Style::Markers)]),
+                        series: series(&[("N = 5", &all5, Style::Line), ("N = 10", &all10, Style::Dashed), ("unstable, N = 5", &unstable5, Style::Markers)]),
                     },
                     &format!(
                         "peak ‖a‖ {:.4} (N = 5) vs {:.4} (N = 10): the curves overlap as in the thesis; {n_unstable} of {} \
                          N = 5 points unstable (thesis: none for k_d = 10, some for k_d = 30)",
-                        peak(&a),
-                        peak(&b),
+                        peak(&all5),
+                        peak(&all10),
                         a.points.len()
                     ),
                 )?;
@@ -109,32 +114,25 @@ const FIG36_BOUNDARIES: [(&str, Boundary); 4] = [
 fn peak(frc: &Frc) -> (f64, f64) {
     frc.points
         .iter()
-        .map(|p| (p.omega, p.norm))
+        .map(|p| (p.omega_f, p.amplitude))
         .fold((f64::NAN, 0.0), |a, b| if b.1 > a.1 { b } else { a })
 }
 
-/// How many points of a curve Hill's method finds stable, of how many.
+/// How many points of a curve are stable, of how many.
 fn stable_count(frc: &Frc) -> (usize, usize) {
-    let n = frc
-        .points
-        .iter()
-        .filter(|p| p.stability.as_ref().is_some_and(|s| s.is_stable()))
-        .count();
+    let n = frc.points.iter().filter(|p| p.stable()).count();
     (n, frc.points.len())
 }
 
-/// Fig. 36 with stability (Hill) on every curve, and its two rows: the
+/// Fig. 36 with a stability verdict on every curve, and its two rows: the
 /// k0 = 10000 peak on the fixed–fixed one, the k0 = 10 peak shifted.
 fn fig36(ctx: &mut Context) -> Result<(), ReproError> {
     let mut curves = Vec::new();
     for (label, boundary) in FIG36_BOUNDARIES {
-        match curve(
-            StringParams {
-                boundary,
-                ..Default::default()
-            },
-            true,
-        ) {
+        match curve(StringParams {
+            boundary,
+            ..Default::default()
+        }) {
             Ok(f) => curves.push((label, f)),
             Err(e) => {
                 let why = format!("STHB sweep failed ({label}): {e}");
@@ -156,7 +154,7 @@ fn fig36(ctx: &mut Context) -> Result<(), ReproError> {
         .zip(styles)
         .map(|(((l, _), (all, _)), s)| (*l, all.as_slice(), s))
         .collect();
-    list.push(("unstable (Hill)", &unstable, Style::Markers));
+    list.push(("unstable", &unstable, Style::Markers));
     let peaks: Vec<(f64, f64)> = curves.iter().map(|(_, f)| peak(f)).collect();
     let stability: Vec<String> = curves
         .iter()
@@ -246,13 +244,10 @@ mod tests {
         let frc: Vec<Frc> = FIG36_BOUNDARIES
             .iter()
             .map(|&(_, boundary)| {
-                curve(
-                    StringParams {
-                        boundary,
-                        ..Default::default()
-                    },
-                    true,
-                )
+                curve(StringParams {
+                    boundary,
+                    ..Default::default()
+                })
                 .unwrap()
             })
             .collect();

@@ -8,7 +8,7 @@ use divan::Bencher;
 use faer::linalg::solvers::Solve;
 use faer::Mat;
 use ivt_hb::frc::{frequency_response as engine_frc, FrcOptions};
-use ivt_hb::sthb::continuation::{frequency_response, ContinuationOptions};
+use ivt_hb::sthb::frc::{frequency_response, trace, StringFrcOptions};
 use ivt_hb::sthb::modal::ModalString;
 use ivt_hb::sthb::stability::{hill, monodromy};
 use ivt_hb::sthb::{StringHb, StringParams};
@@ -35,7 +35,7 @@ fn solved(modes: usize, harmonics: usize, omega: f64) -> (StringHb, Vec<f64>) {
 fn frc_kd10_n5(bencher: Bencher) {
     bencher.bench_local(|| {
         let mut hb = StringHb::new(StringParams::default()).unwrap();
-        frequency_response(&mut hb, 1.0, 6.0, &ContinuationOptions::default()).unwrap()
+        frequency_response(&mut hb, 1.0, 6.0, &StringFrcOptions::default()).unwrap()
     });
 }
 
@@ -155,28 +155,21 @@ fn point_warm_peak_engine(bencher: Bencher) {
 
 fn sthb_curve_points() -> Vec<f64> {
     let mut hb = StringHb::new(StringParams::default()).unwrap();
-    let opts = ContinuationOptions {
-        stability: false,
-        ..Default::default()
-    };
-    frequency_response(&mut hb, 1.0, 6.0, &opts)
+    trace(&mut hb, 1.0, 6.0, &StringFrcOptions::default().continuation)
         .unwrap()
         .points
         .iter()
-        .map(|p| p.omega)
+        .map(|p| p.lambda())
         .collect()
 }
 
 /// Fig. 34 curve by STHB without stability (173 points, ω ∈ [1, 6]).
 #[divan::bench(sample_count = 5)]
 fn curve_sthb_no_stability(bencher: Bencher) {
-    let opts = ContinuationOptions {
-        stability: false,
-        ..Default::default()
-    };
+    let opts = StringFrcOptions::default().continuation;
     bencher.bench_local(|| {
         let mut hb = StringHb::new(StringParams::default()).unwrap();
-        frequency_response(&mut hb, 1.0, 6.0, &opts).unwrap()
+        trace(&mut hb, 1.0, 6.0, &opts).unwrap()
     });
 }
 

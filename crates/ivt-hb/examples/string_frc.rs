@@ -1,6 +1,6 @@
 //! Frequency–response curve of the nonlinear string (Figs. 34–35):
 //! `cargo run --release -p ivt-hb --example string_frc -- KD N FROM TO`.
-use ivt_hb::sthb::continuation::{frequency_response, ContinuationOptions};
+use ivt_hb::sthb::frc::{frequency_response, trace, StringFrcOptions};
 use ivt_hb::sthb::{StringHb, StringParams};
 
 fn main() {
@@ -16,39 +16,38 @@ fn main() {
     })
     .expect("params");
     let t0 = std::time::Instant::now();
-    let stability = args.get(4).is_none_or(|v| *v != 0.0);
-    let frc = frequency_response(
-        &mut hb,
-        from,
-        to,
-        &ContinuationOptions {
-            stability,
-            ..Default::default()
-        },
-    )
-    .expect("frc");
+    if args.get(4).is_some_and(|v| *v == 0.0) {
+        let opts = StringFrcOptions::default().continuation;
+        let path = trace(&mut hb, from, to, &opts).expect("path");
+        let dt = t0.elapsed().as_secs_f64();
+        let dim = hb.dim();
+        for p in &path.points {
+            println!("{:.5} {:.6}", p.lambda(), hb.complex_norm(&p.x[..dim]));
+        }
+        eprintln!(
+            "points {} time {dt:.3} s stop {:?}",
+            path.points.len(),
+            path.termination
+        );
+        return;
+    }
+    let curve = frequency_response(&mut hb, from, to, &StringFrcOptions::default()).expect("frc");
     let dt = t0.elapsed().as_secs_f64();
-    for p in &frc.points {
-        let Some(s) = p.stability else {
-            println!("{:.5} {:.6}", p.omega, p.norm);
-            continue;
-        };
+    for (p, method) in curve.frc.points.iter().zip(&curve.methods) {
         println!(
-            "{:.5} {:.6} {:?} {:.4} {:?} {}",
-            p.omega,
-            p.norm,
-            s.kind,
-            s.critical.norm(),
-            s.method,
-            p.iterations
+            "{:.5} {:.6} {:?} {:.4} {:?}",
+            p.omega_f,
+            p.amplitude,
+            p.kind,
+            p.multipliers[0].norm(),
+            method
         );
     }
     eprintln!(
-        "points {} factorizations {} hill {} time {:.3} s stop {:?}",
-        frc.points.len(),
-        frc.factorizations,
-        frc.hill_calls,
-        dt,
-        frc.stop
+        "points {} jacobians {} hill {} time {dt:.3} s stop {:?}",
+        curve.frc.points.len(),
+        curve.jacobians,
+        curve.hill_calls,
+        curve.frc.termination
     );
 }

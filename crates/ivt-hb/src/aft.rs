@@ -10,30 +10,10 @@
 //! `C_s = {1/2, cos τ…, sin τ…}`, equals the Fourier coefficients of `f` except that
 //! its first entry is `a0/2` (the mean): see [`Aft::galerkin`].
 
+use crate::error::HbError;
 use realfft::num_complex::Complex;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use std::sync::Arc;
-use thiserror::Error;
-
-/// Invalid AFT sizes.
-#[derive(Debug, Clone, Copy, Error, PartialEq, Eq)]
-pub enum AftError {
-    /// Eq. 62 needs `N > n` (2N samples resolve harmonics below N without aliasing
-    /// of the linear terms).
-    #[error("AFT needs N > n (got N = {n_half}, n = {harmonics})")]
-    TooFewSamples {
-        /// Harmonics n.
-        harmonics: usize,
-        /// Half the number of samples, N.
-        n_half: usize,
-    },
-    /// More than [`crate::limits::MAX_SAMPLES`] samples (2N ≤ 2^22: 32 MiB per buffer).
-    #[error("AFT needs 2N ≤ 2^22 samples (got N = {n_half})")]
-    TooManySamples {
-        /// Half the number of samples, N.
-        n_half: usize,
-    },
-}
 
 /// Reusable forward/inverse real FFT plans and buffers for `2N` samples, `n` harmonics.
 pub struct Aft {
@@ -66,13 +46,14 @@ impl Aft {
     /// Plans for `n` harmonics and `2N` samples.
     ///
     /// # Errors
-    /// [`AftError::TooFewSamples`] unless `N > n`.
-    pub fn new(harmonics: usize, n_half: usize) -> Result<Self, AftError> {
+    /// [`HbError::AftTooFewSamples`] unless `N > n`, [`HbError::AftTooManySamples`]
+    /// beyond [`crate::limits::MAX_SAMPLES`].
+    pub fn new(harmonics: usize, n_half: usize) -> Result<Self, HbError> {
         if n_half <= harmonics {
-            return Err(AftError::TooFewSamples { harmonics, n_half });
+            return Err(HbError::AftTooFewSamples { harmonics, n_half });
         }
         if crate::limits::samples_error(n_half).is_some() {
-            return Err(AftError::TooManySamples { n_half });
+            return Err(HbError::AftTooManySamples { n_half });
         }
         let len = 2 * n_half;
         let mut planner = RealFftPlanner::<f64>::new();

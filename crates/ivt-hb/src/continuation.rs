@@ -14,6 +14,9 @@ use crate::broyden::{broyden_solve, BroydenOptions, BroydenWorkspace, SolveError
 use crate::linalg::{dot, lu_factor, lu_solve, norm2};
 use thiserror::Error;
 
+mod exact;
+pub use exact::{pseudo_arclength_exact, PathSystem};
+
 /// Options of the path follower.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContinuationOptions {

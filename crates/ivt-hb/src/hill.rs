@@ -7,25 +7,9 @@
 //! eigenvectors are most centred in the harmonic index (the weighted mean index of
 //! `|c_k|²` closest to 0). Multipliers are `μ = exp(2πλ)`.
 
+use crate::error::HbError;
 use faer::c64;
 use realfft::RealFftPlanner;
-use thiserror::Error;
-
-/// Hill's method failed.
-#[derive(Debug, Clone, Error, PartialEq)]
-pub enum HillError {
-    /// The eigenvalue solver did not converge.
-    #[error("eigenvalue decomposition of the Hill matrix failed")]
-    Eigen,
-    /// Inputs have inconsistent sizes.
-    #[error("Fourier blocks hold {got} entries, expected (2K+1)·dim² = {expected}")]
-    Dimension {
-        /// Expected length.
-        expected: usize,
-        /// Given length.
-        got: usize,
-    },
-}
 
 /// Result of Hill's method.
 #[derive(Debug, Clone, PartialEq)]
@@ -69,14 +53,16 @@ pub fn fourier_blocks(dim: usize, samples: &[f64], m: usize, kmax: usize) -> Vec
 /// has that many harmonics.
 ///
 /// # Errors
-/// [`HillError`] on inconsistent sizes or eigen-solver failure.
-pub fn hill_multipliers(dim: usize, theta_hat: &[c64], h: usize) -> Result<HillResult, HillError> {
+/// [`HbError::InvalidInput`] on inconsistent sizes, [`HbError::Eigen`] on
+/// eigen-solver failure.
+pub fn hill_multipliers(dim: usize, theta_hat: &[c64], h: usize) -> Result<HillResult, HbError> {
     let d2 = dim * dim;
     if d2 == 0 || !theta_hat.len().is_multiple_of(d2) || (theta_hat.len() / d2).is_multiple_of(2) {
-        return Err(HillError::Dimension {
-            expected: d2 * (2 * h + 1),
-            got: theta_hat.len(),
-        });
+        return Err(HbError::InvalidInput(format!(
+            "Fourier blocks hold {} entries, expected (2K+1)·dim² = {}",
+            theta_hat.len(),
+            d2 * (2 * h + 1)
+        )));
     }
     let kmax = (theta_hat.len() / d2 - 1) / 2;
     let nb = 2 * h + 1;
@@ -95,7 +81,9 @@ pub fn hill_multipliers(dim: usize, theta_hat: &[c64], h: usize) -> Result<HillR
         }
         v
     });
-    let eig = hill.eigen().map_err(|_| HillError::Eigen)?;
+    let eig = hill
+        .eigen()
+        .map_err(|e| HbError::Eigen(format!("Hill matrix: {e:?}")))?;
     let s = eig.S();
     let u = eig.U();
     let mut scored: Vec<(f64, c64)> = (0..size)

@@ -9,11 +9,11 @@
 //! with the linear part applied exactly in the frequency domain and `g` by AFT
 //! (Eq. 62–65); `s ∈ [0, 1]` scales the nonlinearity for parameter stepping (§3.2.2).
 
-use crate::aft::{Aft, AftError};
-use crate::broyden::{BroydenOptions, BroydenStats, SolveError};
+use crate::aft::Aft;
+use crate::broyden::{BroydenOptions, BroydenStats};
+pub(crate) use crate::error::HbError;
 use crate::linalg::invert;
 use crate::problem::PeriodicProblem;
-use thiserror::Error;
 
 /// Options of the IHB solvers.
 #[derive(Debug, Clone, PartialEq)]
@@ -63,26 +63,6 @@ impl HbOptions {
         self.broyden.tol = tol;
         self
     }
-}
-
-/// Errors of the harmonic-balance solvers.
-#[derive(Debug, Clone, Error, PartialEq)]
-pub enum HbError {
-    /// Invalid sizes or parameters.
-    #[error("invalid input: {0}")]
-    InvalidInput(String),
-    /// AFT sizes (N ≤ n).
-    #[error(transparent)]
-    Aft(#[from] AftError),
-    /// The iteration did not converge (carries the residual history).
-    #[error("harmonic balance did not converge: {0}")]
-    Solve(#[from] SolveError),
-    /// A limit-cycle iteration collapsed onto the equilibrium `x = 0`.
-    #[error("the iteration collapsed onto the equilibrium x = 0 (no limit cycle near the guess)")]
-    Equilibrium,
-    /// A continuation could not start (its first point or tangent failed).
-    #[error("continuation: {0}")]
-    Continuation(#[from] crate::continuation::ContinuationError),
 }
 
 /// A harmonic-balance solver for one problem and one size, reusable across

@@ -9,6 +9,7 @@ pub mod broyden;
 pub mod classic;
 pub mod continuation;
 mod dense;
+mod error;
 pub mod floquet;
 pub mod fold;
 pub mod frc;
@@ -22,21 +23,23 @@ pub mod ode;
 pub mod problem;
 pub mod stability;
 
-pub use aft::{Aft, AftError};
+pub use aft::Aft;
 pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
 pub use broyden::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
 };
 pub use classic::ClassicIhb;
 pub use continuation::{
-    pseudo_arclength, ContinuationError, ContinuationOptions, Fold, Path, PathPoint, Termination,
+    pseudo_arclength, pseudo_arclength_exact, ContinuationError, ContinuationOptions, Fold, Path,
+    PathPoint, PathSystem, Termination,
 };
+pub use error::HbError;
 pub use faer::c64;
 pub use floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
 pub use fold::{locate_fold, Branch, FoldLocation, FoldOptions, HbBranch};
 pub use frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
-pub use hill::{fourier_blocks, hill_multipliers, HillError, HillResult};
-pub use ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution, HbSolver};
+pub use hill::{fourier_blocks, hill_multipliers, HillResult};
+pub use ihb::{GalerkinJacobian, HbOptions, HbResidual, HbSolution, HbSolver};
 pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;
 pub use problem::{Duffing, GeneralProblem, MathieuDuffing, PeriodicProblem};

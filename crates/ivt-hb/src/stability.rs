@@ -7,9 +7,10 @@
 //! Classification: stable (all |μ| < 1), fold (a real μ > 1), period doubling (a
 //! real μ < −1), Neimark–Sacker (a complex pair outside the unit circle).
 
-use crate::aft::{Aft, AftError};
+use crate::aft::Aft;
+use crate::error::HbError;
 use crate::floquet::{eigenvalues, monodromy_uniform, small_inverse, HsuRule};
-use crate::hill::{fourier_blocks, hill_multipliers, HillError};
+use crate::hill::{fourier_blocks, hill_multipliers};
 use crate::ihb::HbSolution;
 use crate::problem::PeriodicProblem;
 use faer::c64;
@@ -109,13 +110,13 @@ impl StabilityAnalyzer {
     /// (`steps > harmonics`; 256 is enough for flags, 4096 for 1e-9 agreement).
     ///
     /// # Errors
-    /// [`AftError`] if `steps ≤ harmonics`. A singular mass matrix gives NaN
+    /// [`HbError::AftTooFewSamples`] if `steps ≤ harmonics`. A singular mass matrix gives NaN
     /// multipliers, which classify as unstable.
     pub fn new<P: PeriodicProblem>(
         problem: &P,
         harmonics: usize,
         steps: usize,
-    ) -> Result<Self, AftError> {
+    ) -> Result<Self, HbError> {
         let aft = Aft::new(harmonics, steps)?;
         let nd = problem.n_dof();
         let minv = small_inverse(problem.mass(), nd).unwrap_or_else(|_| vec![f64::NAN; nd * nd]);
@@ -206,13 +207,14 @@ impl StabilityAnalyzer {
     /// (Θ's Fourier blocks up to `2h` from the same grid).
     ///
     /// # Errors
-    /// [`HillError`] if the eigen-solver fails or `2·steps ≤ 4h`.
+    /// [`HbError::Eigen`] if the eigen-solver fails, [`HbError::InvalidInput`] if
+    /// `2·steps ≤ 4h`.
     pub fn hill<P: PeriodicProblem>(
         &mut self,
         problem: &P,
         sol: &HbSolution,
         h: usize,
-    ) -> Result<Floquet, HillError> {
+    ) -> Result<Floquet, HbError> {
         self.theta_samples(problem, sol);
         let dim = 2 * self.nd;
         let ns = 2 * self.steps;

@@ -1,13 +1,15 @@
 //! STHB acceptance (issue 4): independent Galerkin time integration, Hill
 //! against monodromy, Figs. 34–36 behaviour, stress.
 
-use ivt_hb::sthb::continuation::{frequency_response, ContinuationOptions};
+use ivt_hb::sthb::frc::{frequency_response, trace, StringFrcOptions};
 use ivt_hb::sthb::modal::ModalString;
 use ivt_hb::sthb::spring::spring_frequency_response;
 use ivt_hb::sthb::stability::{
     hill, hill_exponents, monodromy, monodromy_multipliers, StabilityKind,
 };
-use ivt_hb::sthb::{Boundary, SthbError, StringHb, StringParams};
+use ivt_hb::sthb::{Boundary, StringHb, StringParams};
+use ivt_hb::Frc;
+use ivt_hb::HbError;
 use ivt_num::{ExplicitRk, RK4};
 use realfft::num_complex::Complex;
 use std::f64::consts::PI;
@@ -21,19 +23,16 @@ fn curve(
     step_max: f64,
 ) -> (StringHb, Vec<(f64, f64, Vec<f64>)>) {
     let mut hb = StringHb::new(p.clone()).unwrap();
-    let opts = ContinuationOptions {
-        stability: false,
-        step_max,
-        ..Default::default()
-    };
-    let frc = frequency_response(&mut hb, from, to, &opts).unwrap();
-    (
-        hb,
-        frc.points
-            .into_iter()
-            .map(|p| (p.omega, p.norm, p.a))
-            .collect(),
-    )
+    let mut opts = StringFrcOptions::default().continuation;
+    opts.ds_max = step_max;
+    let path = trace(&mut hb, from, to, &opts).unwrap();
+    let n = hb.dim();
+    let points = path
+        .points
+        .iter()
+        .map(|p| (p.lambda(), hb.complex_norm(&p.x[..n]), p.x[..n].to_vec()))
+        .collect();
+    (hb, points)
 }
 
 /// Largest distance from the points of `b` to the polyline `a`, in axis units
@@ -124,11 +123,12 @@ fn kd10_curve_all_stable_and_n5_n10_overlap() {
         &mut StringHb::new(StringParams::default()).unwrap(),
         1.0,
         6.0,
-        &ContinuationOptions::default(),
+        &StringFrcOptions::default(),
     )
-    .unwrap();
-    assert!(frc.points.iter().all(|p| p.stability.unwrap().is_stable()));
-    assert!((frc.points.last().unwrap().omega - 6.0).abs() < 1e-12);
+    .unwrap()
+    .frc;
+    assert!(frc.points.iter().all(|p| p.stable()));
+    assert!((frc.points.last().unwrap().omega_f - 6.0).abs() < 1e-12);
     let (_, c5) = curve(
         &StringParams {
             modes: 5,
@@ -161,18 +161,14 @@ fn kd30_has_unstable_middle_branch_without_period_doubling() {
         ..Default::default()
     };
     let mut hb = StringHb::new(p).unwrap();
-    let frc = frequency_response(&mut hb, 1.0, 6.0, &ContinuationOptions::default()).unwrap();
-    assert_unstable_exactly_between_folds(&frc);
+    let frc = frequency_response(&mut hb, 1.0, 6.0, &StringFrcOptions::default()).unwrap();
+    assert_unstable_exactly_between_folds(&frc.frc);
 }
 
 /// Fig. 35's pattern: ≥ 5 unstable points, all of fold type (no period doubling or
 /// Neimark–Sacker), exactly where ω runs backwards (between the folds).
-fn assert_unstable_exactly_between_folds(frc: &ivt_hb::sthb::continuation::Frc) {
-    let kinds: Vec<StabilityKind> = frc
-        .points
-        .iter()
-        .map(|p| p.stability.unwrap().kind)
-        .collect();
+fn assert_unstable_exactly_between_folds(frc: &Frc) {
+    let kinds: Vec<StabilityKind> = frc.points.iter().map(|p| p.kind).collect();
     let unstable = kinds
         .iter()
         .filter(|k| **k != StabilityKind::Stable)
@@ -185,7 +181,7 @@ fn assert_unstable_exactly_between_folds(frc: &ivt_hb::sthb::continuation::Frc) 
         .iter()
         .all(|k| matches!(k, StabilityKind::Stable | StabilityKind::Fold)));
     // The unstable points are exactly where ω runs backwards (between the folds).
-    let w: Vec<f64> = frc.points.iter().map(|p| p.omega).collect();
+    let w: Vec<f64> = frc.points.iter().map(|p| p.omega_f).collect();
     for i in 1..w.len() - 1 {
         let backwards = w[i + 1] < w[i] && w[i] < w[i - 1];
         let forwards = w[i + 1] > w[i] && w[i] > w[i - 1];
@@ -222,19 +218,19 @@ fn spring_k0_1e4_stability_matches_fixed() {
     };
     let trace = |p: &StringParams| {
         let mut hb = StringHb::new(p.clone()).unwrap();
-        let frc = frequency_response(&mut hb, 1.0, 6.0, &ContinuationOptions::default()).unwrap();
-        (hb, frc)
+        let frc = frequency_response(&mut hb, 1.0, 6.0, &StringFrcOptions::default()).unwrap();
+        (hb, frc.frc)
     };
     let (mut hf, ff) = trace(&fixed);
     let (mut hs, fs) = trace(&spring);
     assert_unstable_exactly_between_folds(&fs);
     // The unstable stretch spans the same ω interval (between the folds).
-    let span = |frc: &ivt_hb::sthb::continuation::Frc| {
+    let span = |frc: &Frc| {
         frc.points
             .iter()
-            .filter(|p| !p.stability.unwrap().is_stable())
+            .filter(|p| !p.stable())
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                (lo.min(p.omega), hi.max(p.omega))
+                (lo.min(p.omega_f), hi.max(p.omega_f))
             })
     };
     let (sf, ss) = (span(&ff), span(&fs));
@@ -261,33 +257,33 @@ fn spring_k0_1e4_stability_matches_fixed() {
         let mut a = vec![0.0; hs.dim()];
         for h in 0..2 * fixed.harmonics + 1 {
             for n in 0..fixed.modes {
-                a[h * nq + n] = pt.a[h * fixed.modes + n];
+                a[h * nq + n] = pt.coeffs[h * fixed.modes + n];
             }
         }
-        let near_fold = folds.iter().any(|f| (pt.omega - f).abs() < 0.1);
-        if let Err(e) = hs.solve(pt.omega, &mut a, 1e-10, 20) {
+        let near_fold = folds.iter().any(|f| (pt.omega_f - f).abs() < 0.1);
+        if let Err(e) = hs.solve(pt.omega_f, &mut a, 1e-10, 20) {
             // Between the fixed and the spring fold (≤ 4e-3 apart) the branch has
             // no spring counterpart at this ω.
-            assert!(near_fold, "spring Newton at ω = {}: {e}", pt.omega);
+            assert!(near_fold, "spring Newton at ω = {}: {e}", pt.omega_f);
             continue;
         }
-        hf.linearize(&pt.a);
+        hf.linearize(&pt.coeffs);
         let (mf, ms) = (
-            monodromy_multipliers(&hf, pt.omega).unwrap(),
-            monodromy_multipliers(&hs, pt.omega).unwrap(),
+            monodromy_multipliers(&hf, pt.omega_f).unwrap(),
+            monodromy_multipliers(&hs, pt.omega_f).unwrap(),
         );
         assert_eq!(
             mf[0].norm() < 1.0,
             ms[0].norm() < 1.0,
             "verdicts differ at ω = {}",
-            pt.omega
+            pt.omega_f
         );
         if near_fold {
             let d = (mf[0].norm() - ms[0].norm()).abs();
             assert!(
                 d <= 1e-2,
                 "ω = {} (near a fold): |μ|max differ by {d:e}",
-                pt.omega
+                pt.omega_f
             );
             near += 1;
             continue;
@@ -303,11 +299,11 @@ fn spring_k0_1e4_stability_matches_fixed() {
                 .fold(0.0, f64::max)
         };
         let d = one_way(&mf, &ms).max(one_way(&ms, &mf));
-        let bound = mf[0].norm() * 2.0 * PI * fixed.modes as f64 * PI / (1e4 * pt.omega);
+        let bound = mf[0].norm() * 2.0 * PI * fixed.modes as f64 * PI / (1e4 * pt.omega_f);
         assert!(
             d <= 2.0 * bound,
             "ω = {}: multipliers differ by {d:e} (first-order bound {bound:e})",
-            pt.omega
+            pt.omega_f
         );
         compared += 1;
     }
@@ -409,30 +405,19 @@ fn hill_agrees_with_monodromy() {
         ..Default::default()
     };
     let mut hb = StringHb::new(p).unwrap();
-    let frc = frequency_response(
-        &mut hb,
-        3.0,
-        5.0,
-        &ContinuationOptions {
-            stability: false,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let path = trace(&mut hb, 3.0, 5.0, &StringFrcOptions::default().continuation).unwrap();
+    let n = hb.dim();
     let mut checked_unstable = 0;
-    for (i, pt) in frc.points.iter().enumerate().filter(|(i, _)| i % 7 == 0) {
-        hb.linearize(&pt.a);
-        let (h, m) = (
-            hill(&hb, pt.omega).unwrap(),
-            monodromy(&hb, pt.omega).unwrap(),
-        );
-        assert_eq!(h.kind, m.kind, "point {i} at ω = {}", pt.omega);
+    for (i, pt) in path.points.iter().enumerate().filter(|(i, _)| i % 7 == 0) {
+        let omega = pt.lambda();
+        hb.linearize(&pt.x[..n]);
+        let (h, m) = (hill(&hb, omega).unwrap(), monodromy(&hb, omega).unwrap());
+        assert_eq!(h.kind, m.kind, "point {i} at ω = {omega}");
         // RK4 with h·ρ ≤ 0.3 over one period: |μ| to a few 1e-4 (measured 3e-3 at h·ρ ≤ 0.5).
-        let (a, b) = (h.critical.norm(), m.critical.norm());
+        let (a, b) = (h.critical().norm(), m.critical().norm());
         assert!(
             (a - b).abs() <= 1e-3 * a.max(1.0),
-            "ω = {}: Hill {a} vs monodromy {b}",
-            pt.omega
+            "ω = {omega}: Hill {a} vs monodromy {b}"
         );
         checked_unstable += usize::from(!h.is_stable());
     }
@@ -488,24 +473,7 @@ fn spring_boundary_fig36() {
         boundary: Boundary::Spring { k0: 10.0 },
         ..base.clone()
     });
-    let frc = frequency_response(
-        &mut StringHb::new(base).unwrap(),
-        2.0,
-        5.0,
-        &ContinuationOptions {
-            stability: false,
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    let w_fixed = frc
-        .points
-        .iter()
-        .fold(
-            (0.0, 0.0),
-            |m, p| if p.norm > m.1 { (p.omega, p.norm) } else { m },
-        )
-        .0;
+    let (w_fixed, _) = peak(base);
     assert!(
         (w_stiff - w_fixed).abs() < 0.06,
         "peak k0 = 1e4 at {w_stiff}, fixed at {w_fixed}"
@@ -536,30 +504,27 @@ fn stress_cases_trace_the_whole_curve() {
         },
     ] {
         let mut hb = StringHb::new(p.clone()).unwrap();
-        let opts = ContinuationOptions {
-            stability: false,
-            step_max: 0.1,
-            ..Default::default()
-        };
+        let mut opts = StringFrcOptions::default().continuation;
+        opts.ds_max = 0.1;
         // Each of the three converges over the whole range (measured: 42, 87
         // and 138 points); an error, even a clean one, is a regression here.
-        let frc =
-            frequency_response(&mut hb, 2.5, 4.5, &opts).unwrap_or_else(|e| panic!("{p:?}: {e}"));
-        let (first, last) = (&frc.points[0], &frc.points[frc.points.len() - 1]);
+        let path = trace(&mut hb, 2.5, 4.5, &opts).unwrap_or_else(|e| panic!("{p:?}: {e}"));
+        let (first, last) = (&path.points[0], &path.points[path.points.len() - 1]);
         assert!(
-            (first.omega - 2.5).abs() < 1e-9 && (last.omega - 4.5).abs() < 1e-9,
+            (first.lambda() - 2.5).abs() < 1e-9 && (last.lambda() - 4.5).abs() < 1e-9,
             "{p:?}: ω from {} to {}",
-            first.omega,
-            last.omega
+            first.lambda(),
+            last.lambda()
         );
-        let mut r = vec![0.0; hb.dim()];
-        for pt in &frc.points {
-            hb.residual(&pt.a, pt.omega, &mut r);
+        let dim = hb.dim();
+        let mut r = vec![0.0; dim];
+        for pt in &path.points {
+            hb.residual(&pt.x[..dim], pt.lambda(), &mut r);
             let n = r.iter().map(|v| v * v).sum::<f64>().sqrt();
             assert!(
-                n < 1e-8 && pt.norm.is_finite(),
+                n < 1e-8 && hb.complex_norm(&pt.x[..dim]).is_finite(),
                 "{p:?} at ω = {}: ‖R‖ = {n:e}",
-                pt.omega
+                pt.lambda()
             );
         }
     }
@@ -570,19 +535,19 @@ fn stress_cases_trace_the_whole_curve() {
             modes: 5,
             ..Default::default()
         }),
-        Err(SthbError::Invalid(_))
+        Err(HbError::InvalidInput(_))
     ));
     assert!(matches!(
         StringHb::new(StringParams {
             kd: f64::NAN,
             ..Default::default()
         }),
-        Err(SthbError::Invalid(_))
+        Err(HbError::InvalidInput(_))
     ));
     let mut hb = StringHb::new(StringParams::default()).unwrap();
     let mut a = vec![f64::NAN; hb.dim()];
     assert!(matches!(
         hb.solve(3.0, &mut a, 1e-10, 5),
-        Err(SthbError::NonFinite { .. })
+        Err(HbError::NonFinite { .. })
     ));
 }

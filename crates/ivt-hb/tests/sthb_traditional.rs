@@ -4,10 +4,10 @@
 //! the STHB route on the same curve (N = 5, k_d = 10, c_d = 0.8, y0 = 0.5, M = 19).
 
 use ivt_hb::frc::{frequency_response as engine_frc, FrcOptions};
-use ivt_hb::sthb::continuation::{frequency_response, ContinuationOptions, Frc};
+use ivt_hb::sthb::frc::{trace, StringFrcOptions};
 use ivt_hb::sthb::modal::ModalString;
 use ivt_hb::sthb::{StringHb, StringParams};
-use ivt_hb::{HbOptions, HbResidual, ModifiedIhb};
+use ivt_hb::{HbOptions, HbResidual, ModifiedIhb, Path};
 use std::time::Instant;
 
 /// The engine's options matching the STHB grid: M = 19 harmonics, 2·64 = M_s samples.
@@ -17,18 +17,10 @@ fn engine_options(p: &StringParams) -> HbOptions {
 
 /// The STHB arclength curve 1 ≤ ω ≤ 6 without stability (the reference of both
 /// curve tests).
-fn sthb_curve(p: &StringParams) -> Frc {
+/// Points hold the coefficients, then ω.
+fn sthb_curve(p: &StringParams) -> Path {
     let mut hb = StringHb::new(p.clone()).unwrap();
-    frequency_response(
-        &mut hb,
-        1.0,
-        6.0,
-        &ContinuationOptions {
-            stability: false,
-            ..Default::default()
-        },
-    )
-    .unwrap()
+    trace(&mut hb, 1.0, 6.0, &StringFrcOptions::default().continuation).unwrap()
 }
 
 fn max_abs(v: &[f64]) -> f64 {
@@ -112,16 +104,17 @@ fn engine_route_matches_sthb_on_the_curve() {
     let mut worst: f64 = 0.0;
     let mut iters = 0;
     for pt in &frc.points {
+        let (omega, coeffs) = (pt.lambda(), &pt.x[..pt.x.len() - 1]);
         let sol = ihb
-            .solve(pt.omega, prev.as_deref())
-            .unwrap_or_else(|e| panic!("engine at ω = {}: {e}", pt.omega));
+            .solve(omega, prev.as_deref())
+            .unwrap_or_else(|e| panic!("engine at ω = {omega}: {e}"));
         iters += sol.stats.iterations;
         let a = modal.sthb_coeffs(&sol.coeffs);
         let err = a
             .iter()
-            .zip(&pt.a)
+            .zip(coeffs)
             .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
-        worst = worst.max(err / max_abs(&pt.a));
+        worst = worst.max(err / max_abs(coeffs));
         prev = Some(sol.coeffs);
     }
     let t_engine = t0.elapsed();
@@ -170,12 +163,12 @@ fn engine_arclength_curve_is_the_sthb_curve() {
             .points
             .iter()
             .min_by(|x, y| {
-                (x.omega - pt.omega_f)
+                (x.lambda() - pt.omega_f)
                     .abs()
-                    .total_cmp(&(y.omega - pt.omega_f).abs())
+                    .total_cmp(&(y.lambda() - pt.omega_f).abs())
             })
             .unwrap();
-        let mut a = near.a.clone();
+        let mut a = near.x[..near.x.len() - 1].to_vec();
         hb.solve(pt.omega_f, &mut a, 1e-10, 50).unwrap();
         let b = modal.sthb_coeffs(&pt.coeffs);
         let err = a

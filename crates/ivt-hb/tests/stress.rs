@@ -122,11 +122,11 @@ fn bad_inputs_are_errors() {
     // N ≤ n.
     assert!(matches!(
         ModifiedIhb::new(d.clone(), HbOptions::new(20, 20)),
-        Err(HbError::Aft(_))
+        Err(HbError::AftTooFewSamples { .. })
     ));
     assert!(matches!(
         ClassicIhb::new(d.clone(), HbOptions::new(20, 10)),
-        Err(HbError::Aft(_))
+        Err(HbError::AftTooFewSamples { .. })
     ));
     // No harmonics (n < p) and p = 0.
     assert!(matches!(

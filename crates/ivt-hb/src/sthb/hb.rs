@@ -10,7 +10,8 @@ use rustdct::{Dct1, DctPlanner, Dst1};
 
 use super::lu::LuWorkspace;
 use super::toeplitz::{add_real_toeplitz, BlockLayout, PeriodicSpectrum};
-use super::{Boundary, SthbError, StringParams};
+use super::{Boundary, StringParams};
+use crate::error::HbError;
 
 /// Up to this many modes the spatial balance sums the few needed DST-I/DCT-I
 /// terms directly (`O(N·N_s)` per time sample); rustdct's DST-I/DCT-I of these
@@ -154,8 +155,8 @@ impl StringHb {
     /// Plan the transforms and allocate all buffers for `params`.
     ///
     /// # Errors
-    /// [`SthbError::Invalid`] if the parameters fail [`StringParams::validate`].
-    pub fn new(params: StringParams) -> Result<Self, SthbError> {
+    /// [`HbError::InvalidInput`] if the parameters fail [`StringParams::validate`].
+    pub fn new(params: StringParams) -> Result<Self, HbError> {
         Self::with_spatial(params, None)
     }
 
@@ -164,7 +165,7 @@ impl StringHb {
     ///
     /// # Errors
     /// As [`StringHb::new`].
-    pub fn with_spatial(params: StringParams, direct: Option<bool>) -> Result<Self, SthbError> {
+    pub fn with_spatial(params: StringParams, direct: Option<bool>) -> Result<Self, HbError> {
         params.validate()?;
         let (n, m, ns, ms) = (params.modes, params.harmonics, params.ns, params.ms);
         let nq = match params.boundary {
@@ -553,15 +554,15 @@ impl StringHb {
     /// Converged when `‖R‖ ≤ tol (1 + y0)`.
     ///
     /// # Errors
-    /// [`SthbError::NoConvergence`] with the residual history after `max_iter`
-    /// iterations, [`SthbError::Singular`] or [`SthbError::NonFinite`].
+    /// [`HbError::NoConvergence`] with the residual history after `max_iter`
+    /// iterations, [`HbError::Singular`] or [`HbError::NonFinite`].
     pub fn solve(
         &mut self,
         omega: f64,
         a: &mut [f64],
         tol: f64,
         max_iter: usize,
-    ) -> Result<SolveStats, SthbError> {
+    ) -> Result<SolveStats, HbError> {
         let dim = self.dim();
         let (mut r, mut step, mut trial) = (vec![0.0; dim], vec![0.0; dim], vec![0.0; dim]);
         let mut history = Vec::with_capacity(max_iter + 1);
@@ -574,7 +575,7 @@ impl StringHb {
                 let norm = norm2(&r);
                 history.push(norm);
                 if !norm.is_finite() {
-                    return Err(SthbError::NonFinite { omega });
+                    return Err(HbError::NonFinite { omega });
                 }
                 if norm <= target {
                     return Ok(SolveStats {
@@ -593,7 +594,7 @@ impl StringHb {
                 }
                 std::mem::swap(&mut self.lu.mat, &mut jac);
                 if !ok {
-                    return Err(SthbError::Singular { omega });
+                    return Err(HbError::Singular { omega });
                 }
                 // Backtracking: halve the Newton step while ‖R‖ does not decrease
                 // (the full step is kept if no halving helps; the history shows it).
@@ -617,7 +618,7 @@ impl StringHb {
                     *x -= lambda * d;
                 }
             }
-            Err(SthbError::NoConvergence {
+            Err(HbError::NoConvergence {
                 method: "Newton",
                 omega,
                 history: history.clone(),

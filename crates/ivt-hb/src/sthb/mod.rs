@@ -14,7 +14,8 @@
 //! * [`stability`] — Hill's method (Eq. 126–131) and a monodromy matrix of the
 //!   same linearization, with the classification stable / fold / period
 //!   doubling / Neimark–Sacker.
-//! * [`continuation`] — pseudo-arclength curves ‖a‖(ω) (Figs. 34–36).
+//! * [`frc`] — curves ‖a‖(ω) (Figs. 34–36) traced by the engine's
+//!   exact-Jacobian pseudo-arclength, as the engine's [`crate::Frc`].
 //! * [`modal`] — the "traditional route": the Galerkin modal ODEs derived in
 //!   closed form, used as an independent reference in tests and benches.
 //!
@@ -27,7 +28,7 @@
 //! blocks in [`toeplitz`]. The norm reported for Figs. 34–35 is the Euclidean
 //! norm of the complex `a` (Eq. 114), see [`StringHb::complex_norm`].
 
-pub mod continuation;
+pub mod frc;
 mod hb;
 mod lu;
 pub mod modal;
@@ -36,6 +37,8 @@ pub mod stability;
 pub mod toeplitz;
 
 pub use hb::StringHb;
+
+use crate::error::HbError;
 
 /// Boundary condition at `x = 1` (`w(0, t) = 0` always).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -91,9 +94,9 @@ impl StringParams {
     /// Check sizes and values; STHB needs `N_s > 2N` and `M_s > 2M`.
     ///
     /// # Errors
-    /// [`SthbError::Invalid`] naming the offending parameter.
-    pub fn validate(&self) -> Result<(), SthbError> {
-        let bad = |m: String| Err(SthbError::Invalid(m));
+    /// [`HbError::InvalidInput`] naming the offending parameter.
+    pub fn validate(&self) -> Result<(), HbError> {
+        let bad = |m: String| Err(HbError::InvalidInput(m));
         if self.modes == 0 || self.harmonics == 0 {
             return bad("modes and harmonics must be at least 1".into());
         }
@@ -137,59 +140,4 @@ impl StringParams {
         }
         Ok(())
     }
-}
-
-/// Failures of the STHB solvers.
-#[derive(Debug, thiserror::Error)]
-pub enum SthbError {
-    /// A parameter is out of range.
-    #[error("invalid STHB parameters: {0}")]
-    Invalid(String),
-    /// Newton or Broyden did not reach the tolerance.
-    #[error("{method} did not converge at omega = {omega}: residual norms {history:?}")]
-    NoConvergence {
-        /// Which solver.
-        method: &'static str,
-        /// Excitation frequency.
-        omega: f64,
-        /// Residual norm at each iteration.
-        history: Vec<f64>,
-    },
-    /// The (augmented) Jacobian is singular.
-    #[error("singular Jacobian at omega = {omega}")]
-    Singular {
-        /// Excitation frequency.
-        omega: f64,
-    },
-    /// The residual became NaN or infinite.
-    #[error("non-finite residual at omega = {omega}")]
-    NonFinite {
-        /// Excitation frequency.
-        omega: f64,
-    },
-    /// Continuation could not step on (step below its minimum).
-    #[error("continuation stalled at omega = {omega} (step {step:e}): {cause}")]
-    Stalled {
-        /// Last converged frequency.
-        omega: f64,
-        /// Step length at the failure.
-        step: f64,
-        /// The last corrector failure.
-        cause: Box<SthbError>,
-    },
-    /// The curve's first point, solved from rest (a = 0), did not converge: near a
-    /// resonance the start lies outside Newton's basin.
-    #[error("the curve starts from rest at omega = {omega} and that solve failed ({cause}); start below the resonance (e.g. at half its frequency) and continue through it")]
-    ColdStart {
-        /// Start frequency.
-        omega: f64,
-        /// The start solve's failure (with its residual history).
-        cause: Box<SthbError>,
-    },
-    /// An error from the general HB engine (Broyden, continuation).
-    #[error("HB engine: {0}")]
-    Engine(String),
-    /// Hill or monodromy eigenvalues could not be computed.
-    #[error("eigenvalue computation failed: {0}")]
-    Eigen(String),
 }

@@ -12,7 +12,8 @@ use faer::Mat;
 
 use crate::continuation::{pseudo_arclength, ContinuationOptions, Termination};
 
-use super::{SthbError, StringHb, StringParams};
+use super::{StringHb, StringParams};
+use crate::error::HbError;
 
 /// One point `(ω, ‖a‖)` of a spring-boundary curve, with the solution.
 #[derive(Clone, Debug, PartialEq)]
@@ -28,16 +29,16 @@ pub struct SpringPoint {
 /// Trace ‖a‖(ω) from `omega_from` to `omega_to` (`omega_from < omega_to`).
 ///
 /// # Errors
-/// [`SthbError::Invalid`] for bad parameters, [`SthbError::NoConvergence`] if
-/// the start does not converge, [`SthbError::Stalled`] if the path stops short.
+/// [`HbError::InvalidInput`] for bad parameters, [`HbError::NoConvergence`] if
+/// the start does not converge, [`HbError::Stalled`] if the path stops short.
 pub fn spring_frequency_response(
     params: StringParams,
     omega_from: f64,
     omega_to: f64,
     step_max: f64,
-) -> Result<Vec<SpringPoint>, SthbError> {
+) -> Result<Vec<SpringPoint>, HbError> {
     if !(omega_from > 0.0 && omega_to > omega_from && omega_to.is_finite()) {
-        return Err(SthbError::Invalid(format!(
+        return Err(HbError::InvalidInput(format!(
             "need 0 < from < to, got {omega_from} .. {omega_to}"
         )));
     }
@@ -72,8 +73,7 @@ pub fn spring_frequency_response(
             eprintln!("spring point ω = {:.5} its {}", p.lambda(), p.iterations);
         }
         true
-    })
-    .map_err(|e| SthbError::Engine(e.to_string()))?;
+    })?;
     let points: Vec<SpringPoint> = path
         .points
         .iter()
@@ -85,10 +85,10 @@ pub fn spring_frequency_response(
         .collect();
     if let Termination::StepTooSmall(e) = path.termination {
         let last = points.last().map_or(omega_from, |p| p.omega);
-        return Err(SthbError::Stalled {
+        return Err(HbError::Stalled {
             omega: last,
             step: opts.ds_min,
-            cause: Box::new(SthbError::Engine(e.to_string())),
+            cause: Box::new(HbError::Solve(e)),
         });
     }
     Ok(points)

@@ -20,7 +20,8 @@ use ivt_num::{ExplicitRk, RK4};
 use realfft::num_complex::Complex;
 
 use super::toeplitz::{add_real_toeplitz, BlockLayout, PeriodicSpectrum};
-use super::{SthbError, StringHb};
+use super::StringHb;
+use crate::error::HbError;
 
 /// The stability classes of the engine ([`crate::stability::classify`]): the
 /// unstable kinds name the multiplier that left the unit circle (fold +1,
@@ -37,12 +38,13 @@ pub enum StabilityMethod {
 }
 
 /// Stability verdict of one periodic response.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Stability {
     /// Classification.
     pub kind: StabilityKind,
-    /// The multiplier of largest modulus.
-    pub critical: Complex<f64>,
+    /// Floquet multipliers, decreasing modulus (monodromy: all `2N`; Hill:
+    /// `exp(2πλ)` of the exponents in the fundamental strip).
+    pub multipliers: Vec<Complex<f64>>,
     /// Method used.
     pub method: StabilityMethod,
 }
@@ -53,10 +55,17 @@ impl Stability {
         self.kind == StabilityKind::Stable
     }
 
-    fn from_multiplier(mu: Complex<f64>, method: StabilityMethod) -> Self {
+    /// The multiplier of largest modulus.
+    pub fn critical(&self) -> Complex<f64> {
+        self.multipliers[0]
+    }
+
+    /// Classifies by the leading multiplier of `multipliers` (non-empty,
+    /// decreasing modulus).
+    fn from_multipliers(multipliers: Vec<Complex<f64>>, method: StabilityMethod) -> Self {
         Self {
-            kind: crate::stability::classify(&[mu]),
-            critical: mu,
+            kind: crate::stability::classify(&multipliers[..1]),
+            multipliers,
             method,
         }
     }
@@ -79,7 +88,7 @@ struct Linearization {
 }
 
 impl Linearization {
-    fn of(hb: &StringHb) -> Result<Self, SthbError> {
+    fn of(hb: &StringHb) -> Result<Self, HbError> {
         let n = hb.params().modes;
         let spec = hb.s_spectrum();
         let mut stiffness = vec![0.0; n * n];
@@ -94,7 +103,7 @@ impl Linearization {
         };
         let denom = 1.0 + c.iter().zip(&e).map(|(a, b)| a * b).sum::<f64>();
         if denom.abs() < 1e-12 {
-            return Err(SthbError::Invalid(
+            return Err(HbError::InvalidInput(
                 "spring boundary: singular Tau mass matrix (1 + cᵀe = 0)".into(),
             ));
         }
@@ -139,9 +148,9 @@ impl Linearization {
 /// [`StringHb::linearize`]).
 ///
 /// # Errors
-/// [`SthbError::Invalid`] if the spring's Tau mass matrix is singular,
-/// [`SthbError::Eigen`] if the eigenvalue iteration fails.
-pub fn hill_exponents(hb: &StringHb, omega: f64) -> Result<Vec<Complex<f64>>, SthbError> {
+/// [`HbError::InvalidInput`] if the spring's Tau mass matrix is singular,
+/// [`HbError::Eigen`] if the eigenvalue iteration fails.
+pub fn hill_exponents(hb: &StringHb, omega: f64) -> Result<Vec<Complex<f64>>, HbError> {
     let lin = Linearization::of(hb)?;
     let (n, m, cd) = (hb.params().modes, hb.params().harmonics, hb.params().cd);
     let blk = 2 * n;
@@ -182,7 +191,7 @@ pub fn hill_exponents(hb: &StringHb, omega: f64) -> Result<Vec<Complex<f64>>, St
     );
     let ev = h
         .eigenvalues()
-        .map_err(|e| SthbError::Eigen(format!("{e:?}")))?;
+        .map_err(|e| HbError::Eigen(format!("{e:?}")))?;
     let mut strip: Vec<Complex<f64>> = ev
         .into_iter()
         .map(|z| Complex::new(z.re, z.im))
@@ -196,22 +205,30 @@ pub fn hill_exponents(hb: &StringHb, omega: f64) -> Result<Vec<Complex<f64>>, St
 ///
 /// # Errors
 /// As [`hill_exponents`].
-pub fn hill(hb: &StringHb, omega: f64) -> Result<Stability, SthbError> {
+pub fn hill(hb: &StringHb, omega: f64) -> Result<Stability, HbError> {
     let ex = hill_exponents(hb, omega)?;
-    let lead = ex
-        .first()
-        .copied()
-        .ok_or_else(|| SthbError::Eigen("no Hill exponent in the strip".into()))?;
-    let mu = (lead * (2.0 * PI)).exp();
+    if ex.is_empty() {
+        return Err(HbError::Eigen("no Hill exponent in the strip".into()));
+    }
     // A real exponent (Im λ = 0) gives a positive multiplier, Im λ = ±½ a negative one;
-    // snap those so the classification does not hinge on rounding.
-    let frac = lead.im.abs();
-    let mu = if frac < 1e-6 || (0.5 - frac).abs() < 1e-6 {
-        Complex::new(mu.re, 0.0)
-    } else {
-        mu
-    };
-    Ok(Stability::from_multiplier(mu, StabilityMethod::Hill))
+    // snap those so the classification does not hinge on rounding. The exponents
+    // are sorted by decreasing real part, so the multipliers by decreasing modulus.
+    let multipliers = ex
+        .iter()
+        .map(|&lambda| {
+            let mu = (lambda * (2.0 * PI)).exp();
+            let frac = lambda.im.abs();
+            if frac < 1e-6 || (0.5 - frac).abs() < 1e-6 {
+                Complex::new(mu.re, 0.0)
+            } else {
+                mu
+            }
+        })
+        .collect();
+    Ok(Stability::from_multipliers(
+        multipliers,
+        StabilityMethod::Hill,
+    ))
 }
 
 /// `S(t)` from its spectrum at time `t` (row-major `rows × cols` into `out`).
@@ -237,7 +254,7 @@ fn s_at(s: &PeriodicSpectrum, t: f64, out: &mut [f64]) {
 ///
 /// # Errors
 /// As [`hill_exponents`].
-pub fn monodromy_matrix(hb: &StringHb, omega: f64, steps: usize) -> Result<Mat<f64>, SthbError> {
+pub fn monodromy_matrix(hb: &StringHb, omega: f64, steps: usize) -> Result<Mat<f64>, HbError> {
     let lin = Linearization::of(hb)?;
     let (n, cd) = (hb.params().modes, hb.params().cd);
     let s = &lin.s;
@@ -293,12 +310,12 @@ pub fn default_steps(hb: &StringHb, omega: f64) -> usize {
 /// Floquet multipliers from [`monodromy_matrix`], largest modulus first.
 ///
 /// # Errors
-/// As [`monodromy_matrix`], or [`SthbError::Eigen`].
-pub fn monodromy_multipliers(hb: &StringHb, omega: f64) -> Result<Vec<Complex<f64>>, SthbError> {
+/// As [`monodromy_matrix`], or [`HbError::Eigen`].
+pub fn monodromy_multipliers(hb: &StringHb, omega: f64) -> Result<Vec<Complex<f64>>, HbError> {
     let phi = monodromy_matrix(hb, omega, default_steps(hb, omega))?;
     let mut mu: Vec<Complex<f64>> = phi
         .eigenvalues()
-        .map_err(|e| SthbError::Eigen(format!("{e:?}")))?
+        .map_err(|e| HbError::Eigen(format!("{e:?}")))?
         .into_iter()
         .map(|z| Complex::new(z.re, z.im))
         .collect();
@@ -310,10 +327,9 @@ pub fn monodromy_multipliers(hb: &StringHb, omega: f64) -> Result<Vec<Complex<f6
 ///
 /// # Errors
 /// As [`monodromy_multipliers`].
-pub fn monodromy(hb: &StringHb, omega: f64) -> Result<Stability, SthbError> {
-    let mu = monodromy_multipliers(hb, omega)?;
-    Ok(Stability::from_multiplier(
-        mu[0],
+pub fn monodromy(hb: &StringHb, omega: f64) -> Result<Stability, HbError> {
+    Ok(Stability::from_multipliers(
+        monodromy_multipliers(hb, omega)?,
         StabilityMethod::Monodromy,
     ))
 }

@@ -1,0 +1,439 @@
+//! Pseudo-arclength continuation with an exact Jacobian (§3.2.3, Eq. 68–77 with
+//! Newton in place of Broyden), for systems that can assemble `∂R/∂u` cheaply
+//! (the STHB string, Eq. 115–125), where the secant model of
+//! [`super::pseudo_arclength`] degrades and forces small steps.
+//!
+//! Each point's tangent solves `[J R_λ; t_prevᵀ] t = e_{m+1}` (oriented along the
+//! previous one); the predictor is `u + s t`; the corrector solves
+//! `[R(u); tᵀ(u − u_pred)] = 0`, first as a chord iteration on the tangent's LU
+//! (no new factorization), falling back to full Newton. A step about to leave
+//! `[lambda_min, lambda_max]` is corrected on `λ = bound` instead, so the path
+//! ends exactly on the bound. A sign change of the tangent's λ component marks
+//! a fold.
+
+use faer::Mat;
+use ivt_num::LuWorkspace;
+
+use super::{parabola_extremum, ContinuationError, ContinuationOptions, Fold, Path, PathPoint};
+use super::{SolveError, Termination};
+
+/// `R(u, λ) = 0`, `R: R^m × R → R^m`, with its exact Jacobian.
+pub trait PathSystem {
+    /// Number of unknowns `m` (without λ).
+    fn dim(&self) -> usize;
+    /// `R(u, λ)` into `r`.
+    fn residual(&mut self, u: &[f64], lambda: f64, r: &mut [f64]);
+    /// `R(u, λ)` into `r` and `∂R/∂u` into `jac` (`m × m`, overwritten).
+    fn residual_jacobian(&mut self, u: &[f64], lambda: f64, r: &mut [f64], jac: &mut Mat<f64>);
+    /// `∂R/∂λ` at `(u, λ)` into `r_lambda`.
+    fn d_residual_d_lambda(&mut self, u: &[f64], lambda: f64, r_lambda: &mut [f64]);
+}
+
+/// Corrector iterations counted as this many chord iterations per full Newton
+/// step (a Newton step assembles and factors the Jacobian).
+const NEWTON_WEIGHT: usize = 2;
+
+/// Traces the path of `system` from the converged point `start` (`u` then λ)
+/// in the direction of increasing λ if `direction > 0`.
+///
+/// Uses `opts.broyden.tol` as the absolute tolerance on `‖[R; constraint]‖₂`
+/// and `opts.broyden.max_iter` as the Newton iteration limit (the chord
+/// iteration may take three times as many while it contracts by ½ or better).
+/// Step control: a point whose corrector took at most `target_iter / 2`
+/// chord iterations (a Newton iteration counts as two) grows the step by
+/// `growth`, `target_iter` or more shrinks it by 0.7, a failed corrector
+/// halves it. `PathPoint::dlambda` is the λ component of the unit tangent.
+///
+/// `on_point` is called once the point's tangent is computed, so the last
+/// Jacobian `system` assembled is the one at that point; it returns `false`
+/// to stop.
+///
+/// # Errors
+/// [`ContinuationError::Input`] for bad sizes or non-finite inputs,
+/// [`ContinuationError::SingularStart`] when the start has no tangent.
+pub fn pseudo_arclength_exact<S, C>(
+    system: &mut S,
+    start: &[f64],
+    start_iterations: usize,
+    direction: f64,
+    opts: &ContinuationOptions,
+    mut on_point: C,
+) -> Result<Path, ContinuationError>
+where
+    S: PathSystem,
+    C: FnMut(&mut S, &PathPoint) -> bool,
+{
+    let m = system.dim();
+    if start.len() != m + 1 {
+        return Err(ContinuationError::Input("start must hold m unknowns and λ"));
+    }
+    if !start.iter().all(|v| v.is_finite()) || !(opts.ds > 0.0 && opts.ds_min > 0.0) {
+        return Err(ContinuationError::Input("non-finite start or step"));
+    }
+    let mut corrector = Corrector::new(m, opts);
+    let mut x = start.to_vec();
+    let mut tangent = vec![0.0; m + 1];
+    tangent[m] = if direction >= 0.0 { 1.0 } else { -1.0 };
+    let mut points: Vec<PathPoint> = Vec::new();
+    let mut folds = Vec::new();
+    let mut step = opts.ds;
+    let mut iterations = start_iterations;
+    let mut landed = false;
+    let mut u_pred = vec![0.0; m + 1];
+    let termination = loop {
+        if !corrector.tangent(system, &x, &mut tangent) {
+            if points.is_empty() {
+                return Err(ContinuationError::SingularStart);
+            }
+            break Termination::StepTooSmall(SolveError::SingularJacobian {
+                iteration: 0,
+                history: Vec::new(),
+            });
+        }
+        let point = PathPoint {
+            x: x.clone(),
+            iterations,
+            dlambda: tangent[m],
+        };
+        let k = points.len();
+        if k >= 2 && points[k - 1].dlambda * point.dlambda < 0.0 {
+            let near = if points[k - 1].dlambda.abs() <= point.dlambda.abs() {
+                k - 1
+            } else {
+                k
+            };
+            folds.push(Fold {
+                index: near,
+                lambda: parabola_extremum(&points[k - 2], &points[k - 1], &point),
+            });
+        }
+        points.push(point);
+        if !on_point(system, &points[k]) {
+            break Termination::Stopped;
+        }
+        if landed || x[m] < opts.lambda_min || x[m] > opts.lambda_max {
+            break Termination::LeftInterval;
+        }
+        if points.len() >= opts.max_points {
+            break Termination::MaxPoints;
+        }
+        // Predictor–corrector with step halving.
+        let mut chord_ok = true;
+        let err = loop {
+            for (p, (xi, ti)) in u_pred.iter_mut().zip(x.iter().zip(&tangent)) {
+                *p = xi + step * ti;
+            }
+            let clip = if tangent[m] > 0.0 && u_pred[m] > opts.lambda_max {
+                Some(opts.lambda_max)
+            } else if tangent[m] < 0.0 && u_pred[m] < opts.lambda_min {
+                Some(opts.lambda_min)
+            } else {
+                None
+            };
+            let pred = Prediction {
+                u_pred: &u_pred,
+                tangent: &tangent,
+                fix: clip,
+            };
+            corrector.start(&pred);
+            let chord = if chord_ok {
+                corrector.chord(system, &pred)
+            } else {
+                Err(SolveError::NonConvergence {
+                    iterations: 0,
+                    history: Vec::new(),
+                })
+            };
+            let attempt = match chord {
+                Ok(its) => Ok(its),
+                Err(_) => {
+                    chord_ok = false;
+                    corrector.start(&pred);
+                    corrector
+                        .newton(system, &pred)
+                        .map(|its| its * NEWTON_WEIGHT)
+                }
+            };
+            match attempt {
+                Ok(weighted) => {
+                    landed = clip.is_some();
+                    x.copy_from_slice(&corrector.u);
+                    iterations = if chord_ok {
+                        weighted
+                    } else {
+                        weighted / NEWTON_WEIGHT
+                    };
+                    if weighted * 2 <= opts.target_iter {
+                        step = (step * opts.growth).min(opts.ds_max);
+                    } else if weighted >= opts.target_iter {
+                        step *= 0.7;
+                    }
+                    break None;
+                }
+                Err(e) => {
+                    step *= 0.5;
+                    if step < opts.ds_min {
+                        break Some(e);
+                    }
+                }
+            }
+        };
+        if let Some(e) = err {
+            break Termination::StepTooSmall(e);
+        }
+    };
+    Ok(Path {
+        points,
+        folds,
+        termination,
+    })
+}
+
+/// Buffers of the tangent and the correctors; `aug` holds the LU of the last
+/// bordered matrix `[J R_λ; rowᵀ]`.
+struct Corrector {
+    aug: LuWorkspace,
+    jac: Mat<f64>,
+    r: Vec<f64>,
+    r_lambda: Vec<f64>,
+    rhs: Vec<f64>,
+    /// The corrected point.
+    u: Vec<f64>,
+    tol: f64,
+    max_newton: usize,
+}
+
+impl Corrector {
+    fn new(m: usize, opts: &ContinuationOptions) -> Self {
+        Self {
+            aug: LuWorkspace::new(m + 1),
+            jac: Mat::zeros(m, m),
+            r: vec![0.0; m],
+            r_lambda: vec![0.0; m],
+            rhs: vec![0.0; m + 1],
+            u: vec![0.0; m + 1],
+            tol: opts.broyden.tol,
+            max_newton: opts.broyden.max_iter,
+        }
+    }
+
+    /// `R` and `J` at `x` into `r`, `jac`.
+    fn assemble<S: PathSystem>(&mut self, system: &mut S, x: &[f64]) {
+        let m = self.jac.nrows();
+        system.residual_jacobian(&x[..m], x[m], &mut self.r, &mut self.jac);
+    }
+
+    /// Factors `[J R_λ; rowᵀ]` with the `J` of the last [`Self::assemble`] at `x`;
+    /// `false` if singular.
+    fn factor<S: PathSystem>(&mut self, system: &mut S, x: &[f64], row: &[f64]) -> bool {
+        let m = self.jac.nrows();
+        system.d_residual_d_lambda(&x[..m], x[m], &mut self.r_lambda);
+        let a = &mut self.aug.mat;
+        for j in 0..m {
+            for i in 0..m {
+                a[(i, j)] = self.jac[(i, j)];
+            }
+            a[(j, m)] = self.r_lambda[j];
+            a[(m, j)] = row[j];
+        }
+        a[(m, m)] = row[m];
+        self.aug.factor()
+    }
+
+    /// The unit tangent at `x`, oriented along the previous `tangent` (which
+    /// also borders the matrix); leaves its LU in `aug` for the chord corrector.
+    fn tangent<S: PathSystem>(&mut self, system: &mut S, x: &[f64], tangent: &mut [f64]) -> bool {
+        let m = self.jac.nrows();
+        self.assemble(system, x);
+        if !self.factor(system, x, tangent) {
+            return false;
+        }
+        let z = &mut self.rhs;
+        z.fill(0.0);
+        z[m] = 1.0;
+        self.aug.solve(z);
+        let norm = norm2(z);
+        let along: f64 = z.iter().zip(tangent.iter()).map(|(a, b)| a * b).sum();
+        let sign = if along < 0.0 { -1.0 } else { 1.0 };
+        for (t, v) in tangent.iter_mut().zip(z.iter()) {
+            *t = sign * v / norm;
+        }
+        norm.is_finite()
+    }
+
+    /// The start of a corrector: `u_pred`, on `λ = fix` if given.
+    fn start(&mut self, pred: &Prediction<'_>) {
+        self.u.copy_from_slice(pred.u_pred);
+        if let Some(l) = pred.fix {
+            let m = self.u.len() - 1;
+            self.u[m] = l;
+        }
+    }
+
+    /// Chord iteration from [`Self::start`] on the tangent's factorization; fails fast when the
+    /// contraction is worse than ½ per iteration. Returns the iteration count.
+    fn chord<S: PathSystem>(
+        &mut self,
+        sys: &mut S,
+        pred: &Prediction,
+    ) -> Result<usize, SolveError> {
+        let (m, mut history) = (self.jac.nrows(), Vec::new());
+        for it in 0..=3 * self.max_newton {
+            sys.residual(&self.u[..m], self.u[m], &mut self.rhs[..m]);
+            self.rhs[m] = pred.constraint(&self.u);
+            if let Some(done) = settle(&mut history, norm2(&self.rhs), self.tol) {
+                return done;
+            }
+            if it >= 1 && history[it] > 0.5 * history[it - 1] {
+                break;
+            }
+            self.aug.solve(&mut self.rhs);
+            for (x, d) in self.u.iter_mut().zip(&self.rhs) {
+                *x -= d;
+            }
+        }
+        Err(SolveError::NonConvergence {
+            iterations: history.len() - 1,
+            history,
+        })
+    }
+
+    /// Newton on `[R(u); constraint] = 0` from [`Self::start`], refactoring each
+    /// iteration.
+    /// Returns the iteration count.
+    fn newton<S: PathSystem>(
+        &mut self,
+        sys: &mut S,
+        pred: &Prediction,
+    ) -> Result<usize, SolveError> {
+        let m = self.jac.nrows();
+        let mut row = pred.tangent.to_vec();
+        if pred.fix.is_some() {
+            row.fill(0.0);
+            row[m] = 1.0;
+        }
+        let mut history = Vec::new();
+        for it in 0..=self.max_newton {
+            let u = std::mem::take(&mut self.u);
+            self.assemble(sys, &u);
+            self.u = u;
+            let constraint = pred.constraint(&self.u);
+            if let Some(done) = settle(&mut history, norm2(&self.r).hypot(constraint), self.tol) {
+                return done;
+            }
+            if it == self.max_newton || (it >= 2 && history[it] > history[it - 1]) {
+                break;
+            }
+            let u = std::mem::take(&mut self.u);
+            let factored = self.factor(sys, &u, &row);
+            self.u = u;
+            if !factored {
+                return Err(SolveError::SingularJacobian {
+                    iteration: it,
+                    history,
+                });
+            }
+            self.rhs[..m].copy_from_slice(&self.r);
+            self.rhs[m] = constraint;
+            self.aug.solve(&mut self.rhs);
+            for (x, d) in self.u.iter_mut().zip(&self.rhs) {
+                *x -= d;
+            }
+        }
+        Err(SolveError::NonConvergence {
+            iterations: history.len() - 1,
+            history,
+        })
+    }
+}
+
+/// A predicted point and the constraint that closes the corrector's system.
+struct Prediction<'a> {
+    u_pred: &'a [f64],
+    tangent: &'a [f64],
+    /// Correct on `λ = fix` (landing on a bound) instead of `tᵀ(u − u_pred) = 0`.
+    fix: Option<f64>,
+}
+
+impl Prediction<'_> {
+    /// The constraint `tᵀ(u − u_pred)`, or `λ − λ_fix`.
+    fn constraint(&self, u: &[f64]) -> f64 {
+        match self.fix {
+            Some(l) => u[u.len() - 1] - l,
+            None => self
+                .tangent
+                .iter()
+                .zip(u.iter().zip(self.u_pred))
+                .map(|(t, (a, b))| t * (a - b))
+                .sum(),
+        }
+    }
+}
+
+/// Records a corrector's residual norm; `Some` once it is done: converged
+/// (the iteration count) or non-finite (the error with the history).
+fn settle(history: &mut Vec<f64>, norm: f64, tol: f64) -> Option<Result<usize, SolveError>> {
+    let iteration = history.len();
+    history.push(norm);
+    if !norm.is_finite() {
+        let history = std::mem::take(history);
+        return Some(Err(SolveError::NonFinite { iteration, history }));
+    }
+    (norm <= tol).then_some(Ok(iteration))
+}
+
+fn norm2(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn traces_a_circle_over_its_fold_onto_the_bound() {
+        let opts = ContinuationOptions {
+            ds: 0.05,
+            ds_max: 0.1,
+            max_points: 400,
+            lambda_min: -0.99,
+            lambda_max: 2.0,
+            ..Default::default()
+        };
+        // From (u, λ) = (−0.6, 0.8) upwards: over the fold at λ = 1 and back down
+        // to the bound λ = −0.99, where the path must end exactly.
+        let path = pseudo_arclength_exact(&mut Circle, &[-0.6, 0.8], 0, 1.0, &opts, |_, p| {
+            assert!((p.x[0] * p.x[0] + p.x[1] * p.x[1] - 1.0).abs() <= 1e-10);
+            true
+        })
+        .unwrap();
+        assert_eq!(path.termination, Termination::LeftInterval);
+        assert_eq!(path.points.last().unwrap().lambda(), -0.99);
+        assert_eq!(path.folds.len(), 1, "{:?}", path.folds);
+        // The parabola through three points 0.1 apart on the unit circle.
+        assert!(
+            (path.folds[0].lambda - 1.0).abs() < 1e-3,
+            "{:?}",
+            path.folds
+        );
+    }
+
+    /// `u² + λ² = 1`: a circle with folds at λ = ±1.
+    struct Circle;
+
+    impl PathSystem for Circle {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn residual(&mut self, u: &[f64], lambda: f64, r: &mut [f64]) {
+            r[0] = u[0] * u[0] + lambda * lambda - 1.0;
+        }
+        fn residual_jacobian(&mut self, u: &[f64], lambda: f64, r: &mut [f64], jac: &mut Mat<f64>) {
+            self.residual(u, lambda, r);
+            jac[(0, 0)] = 2.0 * u[0];
+        }
+        fn d_residual_d_lambda(&mut self, _u: &[f64], lambda: f64, r_lambda: &mut [f64]) {
+            r_lambda[0] = 2.0 * lambda;
+        }
+    }
+}

@@ -1,0 +1,84 @@
+//! The crate's error type. The solver-level outcomes of Broyden
+//! ([`SolveError`]) and of the path followers ([`ContinuationError`]) nest in it
+//! by `#[from]`, so a failed path or solve keeps its residual history.
+
+use crate::broyden::SolveError;
+use crate::continuation::ContinuationError;
+use thiserror::Error;
+
+/// Errors of the harmonic-balance engine, its AFT, Hill's method and STHB.
+#[derive(Debug, Clone, Error, PartialEq)]
+pub enum HbError {
+    /// Invalid sizes or parameters.
+    #[error("invalid input: {0}")]
+    InvalidInput(String),
+    /// Eq. 62 needs `N > n` (2N samples resolve harmonics below N without
+    /// aliasing of the linear terms).
+    #[error("AFT needs N > n (got N = {n_half}, n = {harmonics})")]
+    AftTooFewSamples {
+        /// Harmonics n.
+        harmonics: usize,
+        /// Half the number of samples, N.
+        n_half: usize,
+    },
+    /// More than [`crate::limits::MAX_SAMPLES`] AFT samples (2N ≤ 2^22: 32 MiB
+    /// per buffer).
+    #[error("AFT needs 2N ≤ 2^22 samples (got N = {n_half})")]
+    AftTooManySamples {
+        /// Half the number of samples, N.
+        n_half: usize,
+    },
+    /// The iteration did not converge (carries the residual history).
+    #[error("harmonic balance did not converge: {0}")]
+    Solve(#[from] SolveError),
+    /// A limit-cycle iteration collapsed onto the equilibrium `x = 0`.
+    #[error("the iteration collapsed onto the equilibrium x = 0 (no limit cycle near the guess)")]
+    Equilibrium,
+    /// A continuation could not start (its first point or tangent failed).
+    #[error("continuation: {0}")]
+    Continuation(#[from] ContinuationError),
+    /// A Newton iteration at a fixed frequency did not reach the tolerance.
+    #[error("{method} did not converge at omega = {omega}: residual norms {history:?}")]
+    NoConvergence {
+        /// Which solver.
+        method: &'static str,
+        /// Excitation frequency.
+        omega: f64,
+        /// Residual norm at each iteration.
+        history: Vec<f64>,
+    },
+    /// The Jacobian at a fixed frequency is singular.
+    #[error("singular Jacobian at omega = {omega}")]
+    Singular {
+        /// Excitation frequency.
+        omega: f64,
+    },
+    /// The residual at a fixed frequency became NaN or infinite.
+    #[error("non-finite residual at omega = {omega}")]
+    NonFinite {
+        /// Excitation frequency.
+        omega: f64,
+    },
+    /// A path could not step on (step below its minimum).
+    #[error("continuation stalled at omega = {omega} (step {step:e}): {cause}")]
+    Stalled {
+        /// Last converged frequency.
+        omega: f64,
+        /// Step length at the failure.
+        step: f64,
+        /// The last corrector failure.
+        cause: Box<HbError>,
+    },
+    /// A curve's first point, solved from rest (a = 0), did not converge: near a
+    /// resonance the start lies outside Newton's basin.
+    #[error("the curve starts from rest at omega = {omega} and that solve failed ({cause}); start below the resonance (e.g. at half its frequency) and continue through it")]
+    ColdStart {
+        /// Start frequency.
+        omega: f64,
+        /// The start solve's failure (with its residual history).
+        cause: Box<HbError>,
+    },
+    /// An eigenvalue computation (Hill matrix, monodromy matrix) failed.
+    #[error("eigenvalue computation failed: {0}")]
+    Eigen(String),
+}

@@ -1,0 +1,244 @@
+//! Frequency–response curves ‖a‖(ω) of the string (Figs. 34–36): the STHB
+//! residual followed in ω by the engine's exact-Jacobian pseudo-arclength
+//! ([`pseudo_arclength_exact`], Eq. 68–77 with the exact `J` of Eq. 115–125),
+//! with a stability verdict per point.
+//!
+//! Stability per point: the RK4 monodromy matrix (cheap, `O(N³)` per step);
+//! Hill's method (Eq. 126–131) confirms where a multiplier is within
+//! [`StringFrcOptions::hill_band`] of the unit circle, where the verdict
+//! changes, or where `dω/ds` changes sign (a fold).
+
+use faer::Mat;
+
+use super::stability::{hill, monodromy, Stability, StabilityMethod};
+use super::StringHb;
+use crate::broyden::BroydenOptions;
+use crate::continuation::{
+    pseudo_arclength_exact, ContinuationOptions, Path, PathPoint, PathSystem, Termination,
+};
+use crate::error::HbError;
+use crate::frc::{Frc, FrcFold, FrcPoint};
+
+/// Settings of a string curve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StringFrcOptions {
+    /// Path following (λ = ω; its bounds are set from the sweep). The tolerance
+    /// `broyden.tol` is relative to the forcing, `‖R‖ ≤ tol (1 + |y0|)`, and
+    /// `broyden.max_iter` bounds the Newton corrector.
+    pub continuation: ContinuationOptions,
+    /// Confirm by Hill when `| |μ| − 1 | <` this.
+    pub hill_band: f64,
+}
+
+impl Default for StringFrcOptions {
+    fn default() -> Self {
+        Self {
+            // Steps up to 0.05 in (a, ω) give 173 points over 1 ≤ ω ≤ 6 (k_d = 10)
+            // with one factorization per point on the flanks.
+            continuation: ContinuationOptions {
+                ds: 0.02,
+                ds_min: 1e-6,
+                ds_max: 0.05,
+                max_points: 2000,
+                target_iter: 12,
+                broyden: BroydenOptions {
+                    tol: 1e-10,
+                    max_iter: 8,
+                    ..BroydenOptions::default()
+                },
+                ..ContinuationOptions::default()
+            },
+            hill_band: 0.02,
+        }
+    }
+}
+
+/// A string curve in the engine's [`Frc`] form, with how it was obtained.
+///
+/// `FrcPoint::amplitude` is `‖a‖`, the Euclidean norm of the complex
+/// coefficients (Eq. 114, the ordinate of Figs. 34–36); `multipliers` are those
+/// of the method in `methods`, decreasing modulus; folds are the parabola
+/// through the points around each turn (`located = false`).
+#[derive(Clone, Debug)]
+pub struct StringFrc {
+    /// The curve.
+    pub frc: Frc,
+    /// The method behind each point's verdict.
+    pub methods: Vec<StabilityMethod>,
+    /// Jacobian assemblies (each `O(N² M²)`, most followed by one LU).
+    pub jacobians: usize,
+    /// How many points Hill's method assessed.
+    pub hill_calls: usize,
+}
+
+/// [`StringHb`] as a path in ω, counting Jacobian assemblies.
+struct StringPath<'a> {
+    hb: &'a mut StringHb,
+    jacobians: usize,
+}
+
+impl PathSystem for StringPath<'_> {
+    fn dim(&self) -> usize {
+        self.hb.dim()
+    }
+    fn residual(&mut self, u: &[f64], lambda: f64, r: &mut [f64]) {
+        self.hb.residual(u, lambda, r);
+    }
+    fn residual_jacobian(&mut self, u: &[f64], lambda: f64, r: &mut [f64], jac: &mut Mat<f64>) {
+        self.jacobians += 1;
+        self.hb.residual_jacobian(u, lambda, r, jac);
+    }
+    fn d_residual_d_lambda(&mut self, u: &[f64], lambda: f64, r_lambda: &mut [f64]) {
+        self.hb.d_residual_d_omega(u, lambda, r_lambda);
+    }
+}
+
+/// Follows the branch of periodic responses from `omega_from` to `omega_to`
+/// (either direction), starting from rest at `omega_from`, calling `on_point`
+/// with the problem linearized at each point. Returns the path and the Jacobian
+/// count.
+fn follow<C>(
+    hb: &mut StringHb,
+    omega_from: f64,
+    omega_to: f64,
+    opts: &ContinuationOptions,
+    on_point: C,
+) -> Result<(Path, usize), HbError>
+where
+    C: FnMut(&mut StringPath<'_>, &PathPoint) -> bool,
+{
+    if !(omega_from.is_finite() && omega_to.is_finite() && omega_from > 0.0 && omega_to > 0.0) {
+        return Err(HbError::InvalidInput(format!(
+            "frequencies must be positive: {omega_from} .. {omega_to}"
+        )));
+    }
+    let tol = opts.broyden.tol;
+    let mut start = vec![0.0; hb.dim()];
+    let first = hb
+        .solve(omega_from, &mut start, tol, 50)
+        .map_err(|e| match e {
+            HbError::NoConvergence { .. } => HbError::ColdStart {
+                omega: omega_from,
+                cause: Box::new(e),
+            },
+            e => e,
+        })?;
+    start.push(omega_from);
+    let mut copts = opts.clone();
+    copts.broyden.tol = tol * (1.0 + hb.params().y0.abs());
+    copts.lambda_min = omega_from.min(omega_to);
+    copts.lambda_max = omega_from.max(omega_to);
+    let direction = if omega_to >= omega_from { 1.0 } else { -1.0 };
+    let mut system = StringPath { hb, jacobians: 0 };
+    let path = pseudo_arclength_exact(
+        &mut system,
+        &start,
+        first.iterations,
+        direction,
+        &copts,
+        on_point,
+    )?;
+    if let Termination::StepTooSmall(e) = &path.termination {
+        return Err(HbError::Stalled {
+            omega: path.points.last().map_or(omega_from, PathPoint::lambda),
+            step: copts.ds_min,
+            cause: Box::new(HbError::Solve(e.clone())),
+        });
+    }
+    // `solve` assembles once more than it iterates (the converged check).
+    Ok((path, first.iterations + 1 + system.jacobians))
+}
+
+/// The path from `omega_from` to `omega_to` without stability (`x` = coefficients
+/// then ω; ‖a‖ by [`StringHb::complex_norm`]).
+///
+/// # Errors
+/// [`HbError::ColdStart`] if the first solve fails, [`HbError::Stalled`]
+/// if the step falls below `ds_min`, [`HbError::InvalidInput`] for bad frequencies.
+pub fn trace(
+    hb: &mut StringHb,
+    omega_from: f64,
+    omega_to: f64,
+    opts: &ContinuationOptions,
+) -> Result<Path, HbError> {
+    Ok(follow(hb, omega_from, omega_to, opts, |_, _| true)?.0)
+}
+
+/// The curve from `omega_from` to `omega_to` with a stability verdict per point.
+///
+/// # Errors
+/// As [`trace`], or a stability failure ([`HbError::Eigen`]).
+pub fn frequency_response(
+    hb: &mut StringHb,
+    omega_from: f64,
+    omega_to: f64,
+    opts: &StringFrcOptions,
+) -> Result<StringFrc, HbError> {
+    let mut verdicts: Vec<Stability> = Vec::new();
+    let mut hill_calls = 0;
+    let mut failure = None;
+    let mut prev_dlambda = if omega_to >= omega_from { 1.0 } else { -1.0 };
+    let (path, jacobians) = follow(hb, omega_from, omega_to, &opts.continuation, |sys, p| {
+        let omega = p.lambda();
+        let fold = p.dlambda.signum() != f64::signum(prev_dlambda);
+        prev_dlambda = p.dlambda;
+        let verdict = monodromy(sys.hb, omega).and_then(|s| {
+            let near = (s.critical().norm() - 1.0).abs() < opts.hill_band;
+            let changed = verdicts.last().is_some_and(|v| v.kind != s.kind);
+            if near || changed || fold {
+                hill_calls += 1;
+                hill(sys.hb, omega)
+            } else {
+                Ok(s)
+            }
+        });
+        match verdict {
+            Ok(s) => {
+                verdicts.push(s);
+                true
+            }
+            Err(e) => {
+                failure = Some(e);
+                false
+            }
+        }
+    })?;
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    let n = hb.dim();
+    let methods = verdicts.iter().map(|s| s.method).collect();
+    let points = path
+        .points
+        .iter()
+        .zip(verdicts)
+        .map(|(p, s)| FrcPoint {
+            omega_f: p.lambda(),
+            amplitude: hb.complex_norm(&p.x[..n]),
+            kind: s.kind,
+            multipliers: s.multipliers,
+            coeffs: p.x[..n].to_vec(),
+        })
+        .collect::<Vec<_>>();
+    let folds = path
+        .folds
+        .iter()
+        .map(|f| FrcFold {
+            index: f.index,
+            omega_f: f.lambda,
+            amplitude: points[f.index].amplitude,
+            coeffs: points[f.index].coeffs.clone(),
+            located: false,
+        })
+        .collect();
+    Ok(StringFrc {
+        frc: Frc {
+            points,
+            folds,
+            termination: path.termination,
+        },
+        methods,
+        jacobians,
+        hill_calls,
+    })
+}
