@@ -208,20 +208,17 @@ pub struct HbResidual {
     n: usize,
     p: usize,
     velocity: bool,
+    /// `x`, `v = dx/dt` and `g` at the 2N samples, sample-major (`2N×n_dof`, the
+    /// layout of [`PeriodicProblem::nonlinear_samples`]).
     xs: Vec<f64>,
     vs: Vec<f64>,
     gs: Vec<f64>,
-    xi: Vec<f64>,
-    vi: Vec<f64>,
-    gi: Vec<f64>,
+    /// One DOF's 2N samples (scratch of the sample-major transforms).
+    column: Vec<f64>,
     rg: Vec<f64>,
     exc: Vec<f64>,
     /// Excitation phase θ = pτ of each sample.
     thetas: Vec<f64>,
-    /// Sample-major copies for `nonlinear_samples` (multi-DOF only).
-    xt: Vec<f64>,
-    vt: Vec<f64>,
-    gt: Vec<f64>,
 }
 
 impl HbResidual {
@@ -243,34 +240,38 @@ impl HbResidual {
             xs: vec![0.0; nd * ns],
             vs: vec![0.0; nd * ns],
             gs: vec![0.0; nd * ns],
-            xi: vec![0.0; nd],
-            vi: vec![0.0; nd],
-            gi: vec![0.0; nd],
+            column: vec![0.0; ns],
             rg: vec![0.0; l],
             exc: vec![0.0; nd * l],
             thetas: (0..ns)
                 .map(|i| opts.subharmonic as f64 * aft.tau(i))
                 .collect(),
-            xt: vec![0.0; if nd > 1 { nd * ns } else { 0 }],
-            vt: vec![0.0; if nd > 1 { nd * ns } else { 0 }],
-            gt: vec![0.0; if nd > 1 { nd * ns } else { 0 }],
             aft,
         };
-        for i in 0..ns {
-            let theta = s.p as f64 * s.aft.tau(i);
-            problem.excitation(theta, &mut s.gi);
-            for d in 0..nd {
-                s.gs[d * ns + i] = s.gi[d];
-            }
+        for (i, &theta) in s.thetas.iter().enumerate() {
+            problem.excitation(theta, &mut s.gs[i * nd..(i + 1) * nd]);
         }
         if !s.gs.iter().all(|v| v.is_finite()) {
             return Err(HbError::InvalidInput("excitation is not finite".into()));
         }
         for d in 0..nd {
             s.aft
-                .galerkin(&s.gs[d * ns..(d + 1) * ns], &mut s.exc[d * l..(d + 1) * l]);
+                .galerkin_state(&s.gs, nd, d, &mut s.exc[d * l..(d + 1) * l], &mut s.column);
         }
         Ok(s)
+    }
+
+    /// Fills the sample-major `x` and `v = ω dx/dτ` of `q` (`v` only if `velocity`).
+    fn synthesize_states(&mut self, q: &[f64], omega: f64, velocity: bool) {
+        let nd = self.n_dof;
+        self.aft
+            .synthesize_states(q, nd, 0, 1.0, &mut self.xs, &mut self.column);
+        if velocity {
+            self.aft
+                .synthesize_states(q, nd, 1, omega, &mut self.vs, &mut self.column);
+        } else {
+            self.vs.fill(0.0);
+        }
     }
 
     /// Number of unknowns `n_dof·(2n+1)`.
@@ -348,7 +349,6 @@ impl HbResidual {
     ) {
         let (nd, n) = (self.n_dof, self.n);
         let l = 2 * n + 1;
-        let ns = self.aft.n_samples();
         let omega = omega_f / self.p as f64;
         self.apply_linear(problem, q, omega, r);
         for (ri, ei) in r.iter_mut().zip(&self.exc) {
@@ -357,40 +357,12 @@ impl HbResidual {
         if s == 0.0 {
             return;
         }
-        for d in 0..nd {
-            let qd = &q[d * l..(d + 1) * l];
-            self.aft.synthesize(qd, &mut self.xs[d * ns..(d + 1) * ns]);
-            if self.velocity {
-                self.aft
-                    .synthesize_derivative(qd, 1, &mut self.vs[d * ns..(d + 1) * ns]);
-            }
-        }
-        // g at all samples in one call, sample-major (`ns×n_dof`); for one DOF
-        // that is the synthesis layout itself.
-        if self.velocity {
-            self.vs.iter_mut().for_each(|v| *v *= omega);
-        } else {
-            self.vs.fill(0.0);
-        }
-        if nd == 1 {
-            problem.nonlinear_samples(&self.xs, &self.vs, &self.thetas, &mut self.gs);
-        } else {
-            for d in 0..nd {
-                for i in 0..ns {
-                    self.xt[i * nd + d] = self.xs[d * ns + i];
-                    self.vt[i * nd + d] = self.vs[d * ns + i];
-                }
-            }
-            problem.nonlinear_samples(&self.xt, &self.vt, &self.thetas, &mut self.gt);
-            for d in 0..nd {
-                for i in 0..ns {
-                    self.gs[d * ns + i] = self.gt[i * nd + d];
-                }
-            }
-        }
+        // g at all samples in one call, sample-major (`2N×n_dof`).
+        self.synthesize_states(q, omega, self.velocity);
+        problem.nonlinear_samples(&self.xs, &self.vs, &self.thetas, &mut self.gs);
         for d in 0..nd {
             self.aft
-                .galerkin(&self.gs[d * ns..(d + 1) * ns], &mut self.rg);
+                .galerkin_state(&self.gs, nd, d, &mut self.rg, &mut self.column);
             for (ri, gi) in r[d * l..(d + 1) * l].iter_mut().zip(&self.rg) {
                 *ri += s * gi;
             }
@@ -482,9 +454,11 @@ impl HbResidual {
     }
 
     /// Galerkin Jacobian of the nonlinear part by quadrature on the 2N grid (the
-    /// classic IHB's Φ_q minus `L(ω)`, §3.2.1), times `s`, added into `jac`.
-    /// Allocation-free given `dgx`, `dgv` (`n_dof²` each) and `basis` (`2N·(2n+1)`,
-    /// filled by [`Self::fill_basis`]).
+    /// classic IHB's Φ_q minus `L(ω)`, §3.2.1), times `s`, added into `jac`. `∂g`
+    /// at all samples come from one [`PeriodicProblem::nonlinear_jacobian_samples`]
+    /// call into `dgx`, `dgv` (`2N·n_dof²` each); `basis` (`2·2N·(2n+1)`) is
+    /// filled by [`Self::fill_basis`]. Allocation-free if the problem's
+    /// `nonlinear_jacobian_samples` is.
     #[allow(clippy::too_many_arguments)]
     pub fn add_nonlinear_jacobian<P: PeriodicProblem>(
         &mut self,
@@ -502,26 +476,17 @@ impl HbResidual {
         let len = nd * l;
         let ns = self.aft.n_samples();
         let omega = omega_f / self.p as f64;
-        for d in 0..nd {
-            let qd = &q[d * l..(d + 1) * l];
-            self.aft.synthesize(qd, &mut self.xs[d * ns..(d + 1) * ns]);
-            self.aft
-                .synthesize_derivative(qd, 1, &mut self.vs[d * ns..(d + 1) * ns]);
-        }
-        let w = s / self.aft.n_samples() as f64 * 2.0; // (1/π)·(2π/2N)
+        self.synthesize_states(q, omega, true);
+        problem.nonlinear_jacobian_samples(&self.xs, &self.vs, &self.thetas, dgx, dgv);
+        let w = s / ns as f64 * 2.0; // (1/π)·(2π/2N)
+        let n2 = nd * nd;
         for i in 0..ns {
-            for d in 0..nd {
-                self.xi[d] = self.xs[d * ns + i];
-                self.vi[d] = omega * self.vs[d * ns + i];
-            }
-            let tau = self.aft.tau(i);
-            problem.nonlinear_jacobian(&self.xi, &self.vi, self.p as f64 * tau, dgx, dgv);
             let cs = &basis[i * l..(i + 1) * l];
             let ds = &basis[(ns + i) * l..(ns + i + 1) * l];
             for d in 0..nd {
                 for e in 0..nd {
-                    let gx = w * dgx[d * nd + e];
-                    let gv = w * omega * dgv[d * nd + e];
+                    let gx = w * dgx[i * n2 + d * nd + e];
+                    let gv = w * omega * dgv[i * n2 + d * nd + e];
                     if gx == 0.0 && gv == 0.0 {
                         continue;
                     }
@@ -574,13 +539,13 @@ pub struct GalerkinJacobian {
 impl GalerkinJacobian {
     /// Scratch for `res`'s size and `n_dof` of the problem it evaluates.
     pub fn new(res: &HbResidual) -> Self {
-        let (nd, l) = (res.n_dof, 2 * res.n + 1);
-        let mut basis = vec![0.0; 2 * res.aft.n_samples() * l];
+        let (nd, l, ns) = (res.n_dof, 2 * res.n + 1, res.aft.n_samples());
+        let mut basis = vec![0.0; 2 * ns * l];
         res.fill_basis(&mut basis);
         Self {
             basis,
-            dgx: vec![0.0; nd * nd],
-            dgv: vec![0.0; nd * nd],
+            dgx: vec![0.0; ns * nd * nd],
+            dgv: vec![0.0; ns * nd * nd],
         }
     }
 
@@ -590,7 +555,7 @@ impl GalerkinJacobian {
     }
 
     /// Writes `Φ_q(q)` (row-major `m×m`) into `jac`; allocation-free when the problem
-    /// supplies `nonlinear_jacobian` (its default central differences allocate).
+    /// supplies an analytic Jacobian (central differences allocate their scratch).
     pub fn assemble<P: PeriodicProblem>(
         &mut self,
         res: &mut HbResidual,

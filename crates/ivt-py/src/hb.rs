@@ -512,7 +512,7 @@ fn limit_cycle<'py>(
     let start = match guess_vec(guess)? {
         Some(q) => q,
         None => {
-            let mut q = vec![0.0; problem.n * (2 * n + 1)];
+            let mut q = vec![0.0; problem.n_dof() * (2 * n + 1)];
             q[1] = finite("amplitude", amplitude)?;
             q
         }
