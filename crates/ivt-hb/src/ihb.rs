@@ -16,6 +16,13 @@ use crate::problem::PeriodicProblem;
 use thiserror::Error;
 
 /// Options of the IHB solvers.
+///
+/// Convergence: `‖r‖₂ ≤ atol + rtol·S` with `atol = broyden.tol`, the residual
+/// `r` of Eq. 61 (a force) and the force scale `S` = ‖f̂‖₂, the norm of the
+/// excitation's Galerkin projection, or for an unforced problem ‖L(ω)q₀‖₂, the
+/// linear force of the start ([`HbResidual::force_scale`]). The defaults
+/// (`atol = 0`, `rtol = 1e-9`; ‖r‖₂ ≤ 1e-10 for Fig. 28's F = 0.1) make the test
+/// invariant under a change of length unit: `x = L·u` scales r and S alike.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HbOptions {
     /// Harmonics n.
@@ -24,8 +31,11 @@ pub struct HbOptions {
     pub n_half: usize,
     /// Sub-harmonic order p (Eq. 52): response period p·2π/ω_f.
     pub subharmonic: usize,
-    /// Iteration options (tolerance on ‖r‖, default 1e-10).
+    /// Iteration options; `broyden.tol` is the absolute tolerance `atol` on ‖r‖₂
+    /// (default 0) and `broyden.max_iter` the iteration limit (default 100).
     pub broyden: BroydenOptions,
+    /// Relative tolerance on ‖r‖₂, relative to the force scale (default 1e-9).
+    pub rtol: f64,
     /// Initial number of parameter steps in the nonlinearity (0: first try the
     /// full problem directly; on failure, or when > 0, step s = 0 → 1 adaptively
     /// starting from Δs = 1/max(steps, 8)).
@@ -38,7 +48,8 @@ impl Default for HbOptions {
             harmonics: 20,
             n_half: 64,
             subharmonic: 1,
-            broyden: BroydenOptions::default(),
+            broyden: BroydenOptions::default().with_tol(0.0),
+            rtol: 1e-9,
             homotopy_steps: 0,
         }
     }
@@ -58,10 +69,24 @@ impl HbOptions {
         self.subharmonic = p;
         self
     }
-    /// Same options with another residual tolerance.
-    pub fn with_tol(mut self, tol: f64) -> Self {
-        self.broyden.tol = tol;
+    /// Same options with a purely absolute tolerance: ‖r‖₂ ≤ `tol` (`rtol = 0`).
+    pub fn with_tol(self, tol: f64) -> Self {
+        self.with_tolerances(0.0, tol)
+    }
+    /// Same options with ‖r‖₂ ≤ `atol + rtol·S` (see the type's docs).
+    pub fn with_tolerances(mut self, rtol: f64, atol: f64) -> Self {
+        self.rtol = rtol;
+        self.broyden.tol = atol;
         self
+    }
+    /// Same options with another iteration limit.
+    pub fn with_max_iter(mut self, max_iter: usize) -> Self {
+        self.broyden.max_iter = max_iter;
+        self
+    }
+    /// The residual tolerance `atol + rtol·S` for the force scale `S`.
+    pub fn residual_tol(&self, force_scale: f64) -> f64 {
+        self.broyden.tol + self.rtol * force_scale
     }
 }
 
@@ -182,11 +207,14 @@ pub(crate) fn validate<P: PeriodicProblem>(problem: &P, opts: &HbOptions) -> Res
             )));
         }
     }
-    if !(opts.broyden.tol.is_finite() && opts.broyden.tol > 0.0) {
+    let (atol, rtol) = (opts.broyden.tol, opts.rtol);
+    if !(atol.is_finite() && rtol.is_finite() && atol >= 0.0 && rtol >= 0.0 && atol + rtol > 0.0) {
         return Err(HbError::InvalidInput(format!(
-            "tol must be finite and > 0, got {}",
-            opts.broyden.tol
+            "tolerances must be finite, ≥ 0 and not both 0, got rtol = {rtol}, atol = {atol}"
         )));
+    }
+    if opts.broyden.max_iter == 0 {
+        return Err(HbError::InvalidInput("max_iter must be ≥ 1".into()));
     }
     Ok(())
 }
@@ -272,6 +300,24 @@ impl HbResidual {
         } else {
             self.vs.fill(0.0);
         }
+    }
+
+    /// The force scale `S` of the tolerance ([`HbOptions`]): ‖f̂‖₂, the Galerkin
+    /// projection of the excitation, or if that is zero (an unforced problem)
+    /// ‖L(ω)q₀‖₂ at the start `q0`, written through `scratch` (`len()`).
+    pub fn force_scale<P: PeriodicProblem>(
+        &self,
+        problem: &P,
+        q0: &[f64],
+        omega: f64,
+        scratch: &mut [f64],
+    ) -> f64 {
+        let forcing = crate::linalg::norm2(&self.exc);
+        if forcing > 0.0 {
+            return forcing;
+        }
+        self.apply_linear(problem, q0, omega, scratch);
+        crate::linalg::norm2(scratch)
     }
 
     /// Number of unknowns `n_dof·(2n+1)`.
@@ -456,7 +502,7 @@ impl HbResidual {
     /// Galerkin Jacobian of the nonlinear part by quadrature on the 2N grid (the
     /// classic IHB's Φ_q minus `L(ω)`, §3.2.1), times `s`, added into `jac`. `∂g`
     /// at all samples come from one [`PeriodicProblem::nonlinear_jacobian_samples`]
-    /// call into `dgx`, `dgv` (`2N·n_dof²` each); `basis` (`2·2N·(2n+1)`) is
+    /// call into `dg` (`2N·2n_dof²`); `basis` (`2·2N·(2n+1)`) is
     /// filled by [`Self::fill_basis`]. Allocation-free if the problem's
     /// `nonlinear_jacobian_samples` is.
     #[allow(clippy::too_many_arguments)]
@@ -467,8 +513,7 @@ impl HbResidual {
         omega_f: f64,
         s: f64,
         basis: &[f64],
-        dgx: &mut [f64],
-        dgv: &mut [f64],
+        dg: &mut [f64],
         jac: &mut [f64],
     ) {
         let (nd, n) = (self.n_dof, self.n);
@@ -477,7 +522,7 @@ impl HbResidual {
         let ns = self.aft.n_samples();
         let omega = omega_f / self.p as f64;
         self.synthesize_states(q, omega, true);
-        problem.nonlinear_jacobian_samples(&self.xs, &self.vs, &self.thetas, dgx, dgv);
+        problem.nonlinear_jacobian_samples(&self.xs, &self.vs, &self.thetas, dg);
         let w = s / ns as f64 * 2.0; // (1/π)·(2π/2N)
         let n2 = nd * nd;
         for i in 0..ns {
@@ -485,8 +530,8 @@ impl HbResidual {
             let ds = &basis[(ns + i) * l..(ns + i + 1) * l];
             for d in 0..nd {
                 for e in 0..nd {
-                    let gx = w * dgx[i * n2 + d * nd + e];
-                    let gv = w * omega * dgv[i * n2 + d * nd + e];
+                    let gx = w * dg[2 * i * n2 + d * nd + e];
+                    let gv = w * omega * dg[2 * i * n2 + n2 + d * nd + e];
                     if gx == 0.0 && gv == 0.0 {
                         continue;
                     }
@@ -532,8 +577,8 @@ impl HbResidual {
 #[derive(Debug, Clone)]
 pub struct GalerkinJacobian {
     basis: Vec<f64>,
-    dgx: Vec<f64>,
-    dgv: Vec<f64>,
+    /// `[∂g/∂x | ∂g/∂v]` at every sample.
+    dg: Vec<f64>,
 }
 
 impl GalerkinJacobian {
@@ -544,8 +589,7 @@ impl GalerkinJacobian {
         res.fill_basis(&mut basis);
         Self {
             basis,
-            dgx: vec![0.0; ns * nd * nd],
-            dgv: vec![0.0; ns * nd * nd],
+            dg: vec![0.0; 2 * ns * nd * nd],
         }
     }
 
@@ -567,16 +611,7 @@ impl GalerkinJacobian {
     ) {
         res.linear_matrix(problem, omega_f / res.p as f64, jac);
         if s != 0.0 {
-            res.add_nonlinear_jacobian(
-                problem,
-                q,
-                omega_f,
-                s,
-                &self.basis,
-                &mut self.dgx,
-                &mut self.dgv,
-                jac,
-            );
+            res.add_nonlinear_jacobian(problem, q, omega_f, s, &self.basis, &mut self.dg, jac);
         }
     }
 }

@@ -75,31 +75,19 @@ pub trait PeriodicProblem {
         }
     }
     /// `∂g/∂x` and `∂g/∂v` at `theta.len()` samples at once: `x`, `v` sample-major as
-    /// in [`Self::nonlinear_samples`], `dg_dx`, `dg_dv` one row-major `n_dof×n_dof`
-    /// block per sample (`samples·n_dof²`). The Galerkin Jacobian (Eq. 56) and the
-    /// stability matrix Θ (Eq. 79) call this once per assembly. Default:
-    /// [`Self::nonlinear_jacobian`] per sample (right for an analytic Jacobian;
-    /// a problem without one should use [`central_difference_samples`], as
-    /// [`GeneralProblem`] does).
-    fn nonlinear_jacobian_samples(
-        &self,
-        x: &[f64],
-        v: &[f64],
-        theta: &[f64],
-        dg_dx: &mut [f64],
-        dg_dv: &mut [f64],
-    ) {
+    /// in [`Self::nonlinear_samples`]; `dg` holds per sample the row-major blocks
+    /// `[∂g/∂x | ∂g/∂v]` (`2·n_dof²` per sample). The Galerkin Jacobian (Eq. 56),
+    /// the stability matrix Θ (Eq. 79) and the fold locator call this once per
+    /// assembly. Default: [`Self::nonlinear_jacobian`] per sample (right for an
+    /// analytic Jacobian; a problem without one should use
+    /// [`central_difference_samples`], as [`GeneralProblem`] does).
+    fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
         let n = self.n_dof();
         let n2 = n * n;
         for (i, &th) in theta.iter().enumerate() {
-            let (s, b) = (i * n..(i + 1) * n, i * n2..(i + 1) * n2);
-            self.nonlinear_jacobian(
-                &x[s.clone()],
-                &v[s],
-                th,
-                &mut dg_dx[b.clone()],
-                &mut dg_dv[b],
-            );
+            let s = i * n..(i + 1) * n;
+            let (gx, gv) = dg[2 * i * n2..2 * (i + 1) * n2].split_at_mut(n2);
+            self.nonlinear_jacobian(&x[s.clone()], &v[s], th, gx, gv);
         }
     }
 }
@@ -136,18 +124,20 @@ pub fn central_difference_samples<P: PeriodicProblem + ?Sized>(
     x: &[f64],
     v: &[f64],
     theta: &[f64],
-    dg_dx: &mut [f64],
-    dg_dv: &mut [f64],
+    dg: &mut [f64],
 ) {
-    difference_columns(problem, x, v, theta, false, dg_dx);
+    difference_columns(problem, x, v, theta, false, dg);
     if problem.velocity_dependent() {
-        difference_columns(problem, x, v, theta, true, dg_dv);
+        difference_columns(problem, x, v, theta, true, dg);
     } else {
-        dg_dv.fill(0.0);
+        let n2 = problem.n_dof() * problem.n_dof();
+        for block in dg.chunks_mut(2 * n2) {
+            block[n2..].fill(0.0);
+        }
     }
 }
 
-/// The columns `∂g/∂x_j` (or `∂g/∂v_j` with `wrt_v`) of every sample's block.
+/// The columns `∂g/∂x_j` (or `∂g/∂v_j` with `wrt_v`) of every sample's blocks.
 fn difference_columns<P: PeriodicProblem + ?Sized>(
     problem: &P,
     x: &[f64],
@@ -178,9 +168,10 @@ fn difference_columns<P: PeriodicProblem + ?Sized>(
         for (m, b) in moved.iter_mut().zip(base).skip(j).step_by(n) {
             *m = *b;
         }
+        let block = if wrt_v { n * n } else { 0 };
         for i in 0..theta.len() {
             for r in 0..n {
-                dg[i * n * n + r * n + j] = (gp[i * n + r] - gm[i * n + r]) / (2.0 * h);
+                dg[2 * i * n * n + block + r * n + j] = (gp[i * n + r] - gm[i * n + r]) / (2.0 * h);
             }
         }
     }
@@ -443,15 +434,8 @@ where
     fn velocity_dependent(&self) -> bool {
         self.velocity_dependent
     }
-    fn nonlinear_jacobian_samples(
-        &self,
-        x: &[f64],
-        v: &[f64],
-        theta: &[f64],
-        dg_dx: &mut [f64],
-        dg_dv: &mut [f64],
-    ) {
-        central_difference_samples(self, x, v, theta, dg_dx, dg_dv)
+    fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
+        central_difference_samples(self, x, v, theta, dg)
     }
 }
 
@@ -492,14 +476,7 @@ impl<P: PeriodicProblem + ?Sized> PeriodicProblem for &P {
     ) {
         (**self).nonlinear_jacobian(x, v, theta, dg_dx, dg_dv)
     }
-    fn nonlinear_jacobian_samples(
-        &self,
-        x: &[f64],
-        v: &[f64],
-        theta: &[f64],
-        dg_dx: &mut [f64],
-        dg_dv: &mut [f64],
-    ) {
-        (**self).nonlinear_jacobian_samples(x, v, theta, dg_dx, dg_dv)
+    fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
+        (**self).nonlinear_jacobian_samples(x, v, theta, dg)
     }
 }

@@ -101,9 +101,8 @@ pub struct StabilityAnalyzer {
     column: Vec<f64>,
     /// Excitation phase of each grid point (set per solution: it depends on p).
     phases: Vec<f64>,
-    /// `∂g/∂x`, `∂g/∂v` at every grid point (`2·steps·n_dof²`).
-    dgx: Vec<f64>,
-    dgv: Vec<f64>,
+    /// `[∂g/∂x | ∂g/∂v]` at every grid point (`2·steps·2n_dof²`).
+    dg: Vec<f64>,
     q: Vec<f64>,
 }
 
@@ -134,8 +133,7 @@ impl StabilityAnalyzer {
             vs: vec![0.0; nd * ns],
             column: vec![0.0; ns],
             phases: vec![0.0; ns],
-            dgx: vec![0.0; ns * nd * nd],
-            dgv: vec![0.0; ns * nd * nd],
+            dg: vec![0.0; 2 * ns * nd * nd],
             q: vec![0.0; dim * dim],
         })
     }
@@ -156,17 +154,11 @@ impl StabilityAnalyzer {
         for (j, phase) in self.phases.iter_mut().enumerate() {
             *phase = p * self.aft.tau(j);
         }
-        problem.nonlinear_jacobian_samples(
-            &self.xs,
-            &self.vs,
-            &self.phases,
-            &mut self.dgx,
-            &mut self.dgv,
-        );
+        problem.nonlinear_jacobian_samples(&self.xs, &self.vs, &self.phases, &mut self.dg);
         let (c, k) = (problem.damping(), problem.stiffness());
         let n2 = nd * nd;
         for j in 0..ns {
-            let (dgx, dgv) = (&self.dgx[j * n2..], &self.dgv[j * n2..]);
+            let (dgx, dgv) = self.dg[2 * j * n2..2 * (j + 1) * n2].split_at(n2);
             let th = &mut self.theta[j * d2..(j + 1) * d2];
             th.fill(0.0);
             for i in 0..nd {

@@ -4,7 +4,7 @@
 //! calls and the capture of the first exception a callback raises.
 
 use ivt_hb::problem::{per_sample, Nonlinearity};
-use ivt_hb::GeneralProblem;
+use ivt_hb::{GeneralProblem, HbOptions};
 use numpy::{IntoPyArray, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -223,4 +223,24 @@ pub(crate) fn callback_error(problem: &PyProblem) -> Option<PyErr> {
         .lock()
         .ok()
         .and_then(|mut s| s.take())
+}
+
+/// The tolerance keywords of `solve`, `frc` and `limit_cycle` applied to `opts`:
+/// ‖r‖₂ ≤ `tol + rtol·S` (`tol` absolute, S the force scale of ivt-hb's
+/// `HbOptions`); `max_iter` caps the iterations of one solve.
+pub(crate) fn with_tolerances(
+    opts: HbOptions,
+    tol: f64,
+    rtol: f64,
+    max_iter: usize,
+) -> PyResult<HbOptions> {
+    if !(rtol.is_finite() && tol.is_finite() && rtol >= 0.0 && tol >= 0.0 && rtol + tol > 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "tolerances must be finite, >= 0 and not both 0, got tol = {tol}, rtol = {rtol}"
+        )));
+    }
+    if max_iter == 0 {
+        return Err(PyValueError::new_err("argument `max_iter` must be >= 1"));
+    }
+    Ok(opts.with_tolerances(rtol, tol).with_max_iter(max_iter))
 }
