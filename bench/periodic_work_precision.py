@@ -4,7 +4,9 @@ Run by hand (not in CI), through bench/periodic_work_precision.sh, or directly:
     python bench/periodic_work_precision.py [--quick] [--json OUT] [--png OUT]
 ``--quick`` (≈ 15 s, most of it importing pyHarm's jax and numba) checks that
 every solver family runs, with one ω and a few n and no FRC; the full run (a few
-minutes) adds the FRCs and writes the figure and the raw numbers.
+minutes) adds the FRCs and writes the figure and the raw numbers; ``--frc-only``
+measures just the FRCs (and the per-point ratio of the 2-DOF chain from Python
+to the built-in Duffing FRC).
 
 Problems (SPEC §6):
 - the thesis Duffing, Eq. 49: x'' + 2ξx' + αx + εx³ = F cos ωt, ξ = 0.02, α = ε = 1,
@@ -477,6 +479,11 @@ def print_report(refs, rows, frcs, pyharm_error):
             print(f"| {fam} | " + " | ".join(fmt_run(fastest(sub, fam, lv)) for lv in LEVELS) + f" | {best:.1e} |")
     if pyharm_error:
         print(f"\npyHarm not measured: {pyharm_error}")
+    per_point = {row["problem"]: row["ivt"]["time"] / max(row["ivt"]["points"], 1) for row in frcs if "ivt" in row}
+    duffing = [t for name, t in per_point.items() if name.startswith("Duffing")]
+    for name, t in per_point.items():
+        if duffing and not name.startswith("Duffing"):
+            print(f"\nper point, ivt {name} / ivt Duffing FRC: {t / duffing[0]:.2f}×")
     for row in frcs:
         print(f"\n### {row['problem']} (n = {row['n']}, {2 * row['samples']} time samples)\n")
         print("| code | run time [s] | points | per point [ms] | folds (ω turns) | peak amplitude | stability |")
@@ -555,6 +562,8 @@ def main():
     ap.add_argument("--quick", action="store_true", help="one ω, a few n: checks every family runs (seconds)")
     ap.add_argument("--json", help="write the raw numbers here")
     ap.add_argument("--png", help="write the work–precision figure here")
+    ap.add_argument("--frc-only", action="store_true",
+                    help="only the FRC comparisons (Duffing, 2-DOF chain); with --json, replaces that file's frc entry")
     args = ap.parse_args()
 
     import logging
@@ -572,7 +581,9 @@ def main():
     except Exception as e:  # report exactly why, measure the rest
         pyharm_error = f"{type(e).__name__}: {e}"
 
-    if args.quick:
+    if args.frc_only:
+        cases, ns, ns_py, tols, rtols = [], [], [], [], []
+    elif args.quick:
         cases, ns, ns_py, tols, rtols = [(1.64, "upper")], [4, 8], [4], [1e-10], [1e-6]
     else:
         cases = [(0.4, "lower"), (1.4, "lower"), (1.64, "upper")]
@@ -606,6 +617,13 @@ def main():
         frcs.append(chain_rows(20, 0.05, 0.2, 3.0))
 
     print_report(refs, rows, frcs, pyharm_error)
+    if args.frc_only:
+        if args.json:
+            with open(args.json) as fh:
+                payload = json.load(fh)
+            payload.update(frc=frcs, ivt_has_frc=hasattr(ivt.hb, "frc"))
+            write_json(args.json, payload)
+        return
     if args.json:
         write_json(args.json, dict(
             problem=dict(xi=XI, alpha=ALPHA, eps=EPS, force=FORCE, grid=GRID),

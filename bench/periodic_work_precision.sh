@@ -6,6 +6,8 @@
 #                                               bench/periodic_work_precision.json,
 #                                               docs/figures/work_precision_periodic.png
 #   bench/periodic_work_precision.sh --quick    seconds: one ω, a few n, no FRC
+#   bench/periodic_work_precision.sh --frc-only the FRC comparisons only (≈ 2 min),
+#                                               their entry of the JSON replaced
 # Uses the repository's .venv (as ./scripts/py-test does), adds pyharm-os and
 # matplotlib to it and builds the `ivt` extension in release.
 set -euo pipefail
@@ -19,6 +21,9 @@ VIRTUAL_ENV=$venv PATH=$venv/bin:$PATH \
   "$venv/bin/maturin" develop --release -m crates/ivt-py/Cargo.toml 2>&1 | tail -n 1 >&2
 if [ "${1:-}" = "--quick" ]; then
   exec "$venv/bin/python" bench/periodic_work_precision.py --quick
+fi
+if [ "${1:-}" = "--frc-only" ]; then
+  exec "$venv/bin/python" bench/periodic_work_precision.py --frc-only --json bench/periodic_work_precision.json
 fi
 mkdir -p docs/figures
 "$venv/bin/python" bench/periodic_work_precision.py \

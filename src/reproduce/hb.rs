@@ -401,8 +401,7 @@ mod tests {
     use super::*;
 
     fn a0_with(tol: f64, n_half: usize) -> Vec<f64> {
-        let mut opts = HbOptions::new(9, n_half);
-        opts.broyden.tol = tol;
+        let opts = HbOptions::new(9, n_half).with_tol(tol);
         ModifiedIhb::new(MathieuDuffing::thesis(3.6), opts)
             .and_then(|mut s| s.solve(2.0, Some(&THESIS_A0)))
             .unwrap()

@@ -117,6 +117,54 @@ impl Aft {
             .expect("sizes fixed at planning; DC and Nyquist imaginary parts are zero");
     }
 
+    /// Samples of the `order`-th τ-derivative of `n_dof` series (`q`: `n_dof` blocks
+    /// `[a0, a.., b..]`) times `scale`, sample-major into `out` (`2N·n_dof`, sample
+    /// i's values at `i·n_dof`: the layout of `PeriodicProblem::nonlinear_samples`).
+    /// `column` (2N) is scratch.
+    pub fn synthesize_states(
+        &mut self,
+        q: &[f64],
+        n_dof: usize,
+        order: u32,
+        scale: f64,
+        out: &mut [f64],
+        column: &mut [f64],
+    ) {
+        let l = self.coeff_len();
+        for d in 0..n_dof {
+            let qd = &q[d * l..(d + 1) * l];
+            if n_dof == 1 {
+                self.synthesize_derivative(qd, order, out);
+                out.iter_mut().for_each(|u| *u *= scale);
+            } else {
+                self.synthesize_derivative(qd, order, column);
+                for (o, c) in out.iter_mut().skip(d).step_by(n_dof).zip(column.iter()) {
+                    *o = scale * c;
+                }
+            }
+        }
+    }
+
+    /// [`Self::galerkin`] of DOF `d` of sample-major states (layout of
+    /// [`Self::synthesize_states`]); `column` (2N) is scratch.
+    pub fn galerkin_state(
+        &mut self,
+        samples: &[f64],
+        n_dof: usize,
+        d: usize,
+        out: &mut [f64],
+        column: &mut [f64],
+    ) {
+        if n_dof == 1 {
+            self.galerkin(samples, out);
+        } else {
+            for (c, s) in column.iter_mut().zip(samples.iter().skip(d).step_by(n_dof)) {
+                *c = *s;
+            }
+            self.galerkin(column, out);
+        }
+    }
+
     /// Fourier coefficients `[a0, a1..an, b1..bn]` of the 2N samples (DFT, Eq. 62–65;
     /// exact for trigonometric polynomials of degree < N).
     pub fn analyze(&mut self, samples: &[f64], coeffs: &mut [f64]) {

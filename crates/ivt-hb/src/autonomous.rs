@@ -164,7 +164,8 @@ fn classify_cycle<P: PeriodicProblem>(
 
 /// Finds the limit cycle of the autonomous `problem` near the orbit `guess`
 /// (coefficients, `n_dof·(2n+1)`, not all zero) at frequency `omega_guess`.
-/// Convergence: ‖[R; b₁]‖₂ ≤ `hb.broyden.tol` and a last Newton step below 1e-10
+/// Convergence: ‖[R; b₁]‖₂ ≤ `atol + rtol·S` ([`HbOptions`], S = ‖L(ω)q₀‖₂ of the
+/// guess) and a last Newton step below 1e-10
 /// relative to ‖q‖∞ and ω. `stability_steps` Hsu sub-intervals (> n).
 ///
 /// # Errors
@@ -205,6 +206,7 @@ pub fn limit_cycle<P: PeriodicProblem>(
     let mut step = vec![0.0; n1];
     let (mut q_trial, mut r_trial) = (vec![0.0; m], vec![0.0; m]);
     let norm_f = |r: &[f64], q: &[f64]| (norm2(r).powi(2) + q[phase] * q[phase]).sqrt();
+    let tol = hb.residual_tol(res.force_scale(problem, &q, omega, &mut r));
     res.eval(problem, &q, omega, 1.0, &mut r);
     let mut norm = norm_f(&r, &q);
     let mut history = vec![norm];
@@ -222,7 +224,7 @@ pub fn limit_cycle<P: PeriodicProblem>(
                 history,
             }));
         }
-        if norm <= hb.broyden.tol && last_step <= 1e-10 {
+        if norm <= tol && last_step <= 1e-10 {
             break;
         }
         if stats.iterations >= hb.broyden.max_iter {
@@ -264,7 +266,7 @@ pub fn limit_cycle<P: PeriodicProblem>(
                 res.eval(problem, &q_trial, w, 1.0, &mut r_trial);
                 stats.residual_evals += 1;
                 let nt = norm_f(&r_trial, &q_trial);
-                if nt.is_finite() && (nt < norm || nt <= hb.broyden.tol) {
+                if nt.is_finite() && (nt < norm || nt <= tol) {
                     accepted = true;
                     norm = nt;
                     break;

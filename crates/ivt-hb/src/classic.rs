@@ -81,7 +81,10 @@ impl<P: PeriodicProblem> ClassicIhb<P> {
             }
         }
         self.history.clear();
-        let tol = self.opts.broyden.tol;
+        let scale = self
+            .res
+            .force_scale(&self.problem, &q, omega, &mut self.r_trial);
+        let tol = self.opts.residual_tol(scale);
         self.res.eval(&self.problem, &q, omega_f, 1.0, &mut self.r);
         let mut norm = norm2(&self.r);
         self.history.push(norm);

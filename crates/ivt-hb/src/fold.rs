@@ -142,14 +142,16 @@ impl<P: PeriodicProblem> HbBranch<'_, P> {
     /// `w`, `v` and `v'`, Eq. 56's quadrature). With `grad`, also its gradient in
     /// `q`: `∂ψᵢ/∂x`, `∂ψᵢ/∂ẋ` by central differences of `∂g` (steps relative to
     /// the orbit's scale) projected back on the basis — O(2N·m), where
-    /// differencing assembled Jacobians would cost 2m assemblies.
+    /// differencing assembled Jacobians would cost 2m assemblies. `∂g` is taken
+    /// at all samples per call (`nonlinear_jacobian_samples`): 1 + 2·n_dof calls
+    /// (twice that with velocity dependence) whatever the number of samples.
     fn quadrature(
         &mut self,
         q: &[f64],
         lambda: f64,
         w: &[f64],
         v: &[f64],
-        mut grad: Option<&mut [f64]>,
+        grad: Option<&mut [f64]>,
     ) -> f64 {
         let nd = self.problem.n_dof();
         let l = q.len() / nd;
@@ -159,71 +161,91 @@ impl<P: PeriodicProblem> HbBranch<'_, P> {
         let omega = lambda / p;
         let velocity = self.problem.velocity_dependent();
         let synth = |c: &[f64], row: &[f64]| c.iter().zip(row).map(|(a, b)| a * b).sum::<f64>();
-        // Orbit samples x(τᵢ), ẋ(τᵢ) and their scales.
+        // Sample-major x(τᵢ), ẋ(τᵢ) of the orbit and the syntheses of w, v, v'.
         let mut xs = vec![0.0; ns * nd];
         let mut vs = vec![0.0; ns * nd];
+        let (mut wt, mut vt, mut vdt) =
+            (vec![0.0; ns * nd], vec![0.0; ns * nd], vec![0.0; ns * nd]);
         for i in 0..ns {
             let (cs, ds) = basis_rows(basis, l, ns, i);
             for d in 0..nd {
-                xs[i * nd + d] = synth(&q[d * l..(d + 1) * l], cs);
-                vs[i * nd + d] = omega * synth(&q[d * l..(d + 1) * l], ds);
+                let (k, dof) = (i * nd + d, d * l..(d + 1) * l);
+                xs[k] = synth(&q[dof.clone()], cs);
+                vs[k] = omega * synth(&q[dof.clone()], ds);
+                wt[k] = synth(&w[dof.clone()], cs);
+                vt[k] = synth(&v[dof.clone()], cs);
+                vdt[k] = synth(&v[dof], ds);
             }
         }
-        let scale = |u: &[f64]| u.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        let (x_scale, v_scale) = (scale(&xs), scale(&vs));
-        let (mut dgx, mut dgv) = (vec![0.0; nd * nd], vec![0.0; nd * nd]);
-        let (mut wt, mut vt, mut vdt) = (vec![0.0; nd], vec![0.0; nd], vec![0.0; nd]);
-        let (mut xi, mut vi) = (vec![0.0; nd], vec![0.0; nd]);
-        if let Some(g) = grad.as_deref_mut() {
-            g.fill(0.0);
-        }
-        let weight = 2.0 / ns as f64;
-        let mut total = 0.0;
-        for i in 0..ns {
-            let (cs, ds) = basis_rows(basis, l, ns, i);
-            for d in 0..nd {
-                wt[d] = synth(&w[d * l..(d + 1) * l], cs);
-                vt[d] = synth(&v[d * l..(d + 1) * l], cs);
-                vdt[d] = synth(&v[d * l..(d + 1) * l], ds);
-            }
-            let theta = p * 2.0 * std::f64::consts::PI * i as f64 / ns as f64;
-            let mut psi = |x: &[f64], xv: &[f64]| {
-                self.problem
-                    .nonlinear_jacobian(x, xv, theta, &mut dgx, &mut dgv);
+        let thetas: Vec<f64> = (0..ns)
+            .map(|i| p * 2.0 * std::f64::consts::PI * i as f64 / ns as f64)
+            .collect();
+        let n2 = nd * nd;
+        let mut dg = vec![0.0; 2 * ns * n2];
+        let problem = &self.problem;
+        // ψᵢ of every sample at the states (x, ẋ) from one batched ∂g.
+        let mut psi = |x: &[f64], xv: &[f64], out: &mut [f64]| {
+            problem.nonlinear_jacobian_samples(x, xv, &thetas, &mut dg);
+            for (i, o) in out.iter_mut().enumerate() {
                 let mut acc = 0.0;
                 for d in 0..nd {
                     for e in 0..nd {
-                        acc += wt[d] * (dgx[d * nd + e] * vt[e] + omega * dgv[d * nd + e] * vdt[e]);
+                        let (gx, gv) = (
+                            dg[2 * i * n2 + d * nd + e],
+                            dg[2 * i * n2 + n2 + d * nd + e],
+                        );
+                        acc +=
+                            wt[i * nd + d] * (gx * vt[i * nd + e] + omega * gv * vdt[i * nd + e]);
                     }
                 }
-                acc
-            };
-            xi.copy_from_slice(&xs[i * nd..(i + 1) * nd]);
-            vi.copy_from_slice(&vs[i * nd..(i + 1) * nd]);
-            total += weight * psi(&xi, &vi);
-            let Some(out) = grad.as_deref_mut() else {
-                continue;
-            };
-            for f in 0..nd {
-                let (x0, v0) = (xi[f], vi[f]);
-                let h = 1e-6 * x0.abs().max(x_scale).max(f64::MIN_POSITIVE);
-                xi[f] = x0 + h;
-                let plus = psi(&xi, &vi);
-                xi[f] = x0 - h;
-                let minus = psi(&xi, &vi);
-                xi[f] = x0;
-                let d_x = weight * (plus - minus) / (2.0 * h);
+                *o = acc;
+            }
+        };
+        let weight = 2.0 / ns as f64;
+        let mut at = vec![0.0; ns];
+        psi(&xs, &vs, &mut at);
+        let total = weight * at.iter().sum::<f64>();
+        let Some(out) = grad else {
+            return total;
+        };
+        out.fill(0.0);
+        let scale = |u: &[f64]| u.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let (x_scale, v_scale) = (scale(&xs), scale(&vs));
+        let (mut plus, mut minus) = (vec![0.0; ns], vec![0.0; ns]);
+        for f in 0..nd {
+            for wrt_v in [false, true] {
+                if wrt_v && !velocity {
+                    continue;
+                }
+                let (base, u_scale) = if wrt_v {
+                    (&vs, v_scale)
+                } else {
+                    (&xs, x_scale)
+                };
+                let h: Vec<f64> = (0..ns)
+                    .map(|i| 1e-6 * base[i * nd + f].abs().max(u_scale).max(f64::MIN_POSITIVE))
+                    .collect();
+                let mut moved = base.clone();
+                for (sign, dst) in [(1.0, &mut plus), (-1.0, &mut minus)] {
+                    for i in 0..ns {
+                        moved[i * nd + f] = base[i * nd + f] + sign * h[i];
+                    }
+                    if wrt_v {
+                        psi(&xs, &moved, dst)
+                    } else {
+                        psi(&moved, &vs, dst)
+                    }
+                }
+                let factor = if wrt_v { weight * omega } else { weight };
                 let target = &mut out[f * l..(f + 1) * l];
-                target.iter_mut().zip(cs).for_each(|(o, c)| *o += d_x * c);
-                if velocity {
-                    let h = 1e-6 * v0.abs().max(v_scale).max(f64::MIN_POSITIVE);
-                    vi[f] = v0 + h;
-                    let plus = psi(&xi, &vi);
-                    vi[f] = v0 - h;
-                    let minus = psi(&xi, &vi);
-                    vi[f] = v0;
-                    let d_v = weight * omega * (plus - minus) / (2.0 * h);
-                    target.iter_mut().zip(ds).for_each(|(o, c)| *o += d_v * c);
+                for i in 0..ns {
+                    let d_psi = factor * (plus[i] - minus[i]) / (2.0 * h[i]);
+                    let (cs, ds) = basis_rows(basis, l, ns, i);
+                    let row = if wrt_v { ds } else { cs };
+                    target
+                        .iter_mut()
+                        .zip(row)
+                        .for_each(|(o, c)| *o += d_psi * c);
                 }
             }
         }

@@ -16,6 +16,13 @@ use crate::linalg::invert;
 use crate::problem::PeriodicProblem;
 
 /// Options of the IHB solvers.
+///
+/// Convergence: `‖r‖₂ ≤ atol + rtol·S` with `atol = broyden.tol`, the residual
+/// `r` of Eq. 61 (a force) and the force scale `S` = ‖f̂‖₂, the norm of the
+/// excitation's Galerkin projection, or for an unforced problem ‖L(ω)q₀‖₂, the
+/// linear force of the start ([`HbResidual::force_scale`]). The defaults
+/// (`atol = 0`, `rtol = 1e-9`; ‖r‖₂ ≤ 1e-10 for Fig. 28's F = 0.1) make the test
+/// invariant under a change of length unit: `x = L·u` scales r and S alike.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HbOptions {
     /// Harmonics n.
@@ -24,8 +31,11 @@ pub struct HbOptions {
     pub n_half: usize,
     /// Sub-harmonic order p (Eq. 52): response period p·2π/ω_f.
     pub subharmonic: usize,
-    /// Iteration options (tolerance on ‖r‖, default 1e-10).
+    /// Iteration options; `broyden.tol` is the absolute tolerance `atol` on ‖r‖₂
+    /// (default 0) and `broyden.max_iter` the iteration limit (default 100).
     pub broyden: BroydenOptions,
+    /// Relative tolerance on ‖r‖₂, relative to the force scale (default 1e-9).
+    pub rtol: f64,
     /// Initial number of parameter steps in the nonlinearity (0: first try the
     /// full problem directly; on failure, or when > 0, step s = 0 → 1 adaptively
     /// starting from Δs = 1/max(steps, 8)).
@@ -38,7 +48,8 @@ impl Default for HbOptions {
             harmonics: 20,
             n_half: 64,
             subharmonic: 1,
-            broyden: BroydenOptions::default(),
+            broyden: BroydenOptions::default().with_tol(0.0),
+            rtol: 1e-9,
             homotopy_steps: 0,
         }
     }
@@ -58,10 +69,24 @@ impl HbOptions {
         self.subharmonic = p;
         self
     }
-    /// Same options with another residual tolerance.
-    pub fn with_tol(mut self, tol: f64) -> Self {
-        self.broyden.tol = tol;
+    /// Same options with a purely absolute tolerance: ‖r‖₂ ≤ `tol` (`rtol = 0`).
+    pub fn with_tol(self, tol: f64) -> Self {
+        self.with_tolerances(0.0, tol)
+    }
+    /// Same options with ‖r‖₂ ≤ `atol + rtol·S` (see the type's docs).
+    pub fn with_tolerances(mut self, rtol: f64, atol: f64) -> Self {
+        self.rtol = rtol;
+        self.broyden.tol = atol;
         self
+    }
+    /// Same options with another iteration limit.
+    pub fn with_max_iter(mut self, max_iter: usize) -> Self {
+        self.broyden.max_iter = max_iter;
+        self
+    }
+    /// The residual tolerance `atol + rtol·S` for the force scale `S`.
+    pub fn residual_tol(&self, force_scale: f64) -> f64 {
+        self.broyden.tol + self.rtol * force_scale
     }
 }
 
@@ -162,11 +187,14 @@ pub(crate) fn validate<P: PeriodicProblem>(problem: &P, opts: &HbOptions) -> Res
             )));
         }
     }
-    if !(opts.broyden.tol.is_finite() && opts.broyden.tol > 0.0) {
+    let (atol, rtol) = (opts.broyden.tol, opts.rtol);
+    if !(atol.is_finite() && rtol.is_finite() && atol >= 0.0 && rtol >= 0.0 && atol + rtol > 0.0) {
         return Err(HbError::InvalidInput(format!(
-            "tol must be finite and > 0, got {}",
-            opts.broyden.tol
+            "tolerances must be finite, ≥ 0 and not both 0, got rtol = {rtol}, atol = {atol}"
         )));
+    }
+    if opts.broyden.max_iter == 0 {
+        return Err(HbError::InvalidInput("max_iter must be ≥ 1".into()));
     }
     Ok(())
 }
@@ -188,20 +216,17 @@ pub struct HbResidual {
     n: usize,
     p: usize,
     velocity: bool,
+    /// `x`, `v = dx/dt` and `g` at the 2N samples, sample-major (`2N×n_dof`, the
+    /// layout of [`PeriodicProblem::nonlinear_samples`]).
     xs: Vec<f64>,
     vs: Vec<f64>,
     gs: Vec<f64>,
-    xi: Vec<f64>,
-    vi: Vec<f64>,
-    gi: Vec<f64>,
+    /// One DOF's 2N samples (scratch of the sample-major transforms).
+    column: Vec<f64>,
     rg: Vec<f64>,
     exc: Vec<f64>,
     /// Excitation phase θ = pτ of each sample.
     thetas: Vec<f64>,
-    /// Sample-major copies for `nonlinear_samples` (multi-DOF only).
-    xt: Vec<f64>,
-    vt: Vec<f64>,
-    gt: Vec<f64>,
 }
 
 impl HbResidual {
@@ -223,34 +248,56 @@ impl HbResidual {
             xs: vec![0.0; nd * ns],
             vs: vec![0.0; nd * ns],
             gs: vec![0.0; nd * ns],
-            xi: vec![0.0; nd],
-            vi: vec![0.0; nd],
-            gi: vec![0.0; nd],
+            column: vec![0.0; ns],
             rg: vec![0.0; l],
             exc: vec![0.0; nd * l],
             thetas: (0..ns)
                 .map(|i| opts.subharmonic as f64 * aft.tau(i))
                 .collect(),
-            xt: vec![0.0; if nd > 1 { nd * ns } else { 0 }],
-            vt: vec![0.0; if nd > 1 { nd * ns } else { 0 }],
-            gt: vec![0.0; if nd > 1 { nd * ns } else { 0 }],
             aft,
         };
-        for i in 0..ns {
-            let theta = s.p as f64 * s.aft.tau(i);
-            problem.excitation(theta, &mut s.gi);
-            for d in 0..nd {
-                s.gs[d * ns + i] = s.gi[d];
-            }
+        for (i, &theta) in s.thetas.iter().enumerate() {
+            problem.excitation(theta, &mut s.gs[i * nd..(i + 1) * nd]);
         }
         if !s.gs.iter().all(|v| v.is_finite()) {
             return Err(HbError::InvalidInput("excitation is not finite".into()));
         }
         for d in 0..nd {
             s.aft
-                .galerkin(&s.gs[d * ns..(d + 1) * ns], &mut s.exc[d * l..(d + 1) * l]);
+                .galerkin_state(&s.gs, nd, d, &mut s.exc[d * l..(d + 1) * l], &mut s.column);
         }
         Ok(s)
+    }
+
+    /// Fills the sample-major `x` and `v = ω dx/dτ` of `q` (`v` only if `velocity`).
+    fn synthesize_states(&mut self, q: &[f64], omega: f64, velocity: bool) {
+        let nd = self.n_dof;
+        self.aft
+            .synthesize_states(q, nd, 0, 1.0, &mut self.xs, &mut self.column);
+        if velocity {
+            self.aft
+                .synthesize_states(q, nd, 1, omega, &mut self.vs, &mut self.column);
+        } else {
+            self.vs.fill(0.0);
+        }
+    }
+
+    /// The force scale `S` of the tolerance ([`HbOptions`]): ‖f̂‖₂, the Galerkin
+    /// projection of the excitation, or if that is zero (an unforced problem)
+    /// ‖L(ω)q₀‖₂ at the start `q0`, written through `scratch` (`len()`).
+    pub fn force_scale<P: PeriodicProblem>(
+        &self,
+        problem: &P,
+        q0: &[f64],
+        omega: f64,
+        scratch: &mut [f64],
+    ) -> f64 {
+        let forcing = crate::linalg::norm2(&self.exc);
+        if forcing > 0.0 {
+            return forcing;
+        }
+        self.apply_linear(problem, q0, omega, scratch);
+        crate::linalg::norm2(scratch)
     }
 
     /// Number of unknowns `n_dof·(2n+1)`.
@@ -328,7 +375,6 @@ impl HbResidual {
     ) {
         let (nd, n) = (self.n_dof, self.n);
         let l = 2 * n + 1;
-        let ns = self.aft.n_samples();
         let omega = omega_f / self.p as f64;
         self.apply_linear(problem, q, omega, r);
         for (ri, ei) in r.iter_mut().zip(&self.exc) {
@@ -337,40 +383,12 @@ impl HbResidual {
         if s == 0.0 {
             return;
         }
-        for d in 0..nd {
-            let qd = &q[d * l..(d + 1) * l];
-            self.aft.synthesize(qd, &mut self.xs[d * ns..(d + 1) * ns]);
-            if self.velocity {
-                self.aft
-                    .synthesize_derivative(qd, 1, &mut self.vs[d * ns..(d + 1) * ns]);
-            }
-        }
-        // g at all samples in one call, sample-major (`ns×n_dof`); for one DOF
-        // that is the synthesis layout itself.
-        if self.velocity {
-            self.vs.iter_mut().for_each(|v| *v *= omega);
-        } else {
-            self.vs.fill(0.0);
-        }
-        if nd == 1 {
-            problem.nonlinear_samples(&self.xs, &self.vs, &self.thetas, &mut self.gs);
-        } else {
-            for d in 0..nd {
-                for i in 0..ns {
-                    self.xt[i * nd + d] = self.xs[d * ns + i];
-                    self.vt[i * nd + d] = self.vs[d * ns + i];
-                }
-            }
-            problem.nonlinear_samples(&self.xt, &self.vt, &self.thetas, &mut self.gt);
-            for d in 0..nd {
-                for i in 0..ns {
-                    self.gs[d * ns + i] = self.gt[i * nd + d];
-                }
-            }
-        }
+        // g at all samples in one call, sample-major (`2N×n_dof`).
+        self.synthesize_states(q, omega, self.velocity);
+        problem.nonlinear_samples(&self.xs, &self.vs, &self.thetas, &mut self.gs);
         for d in 0..nd {
             self.aft
-                .galerkin(&self.gs[d * ns..(d + 1) * ns], &mut self.rg);
+                .galerkin_state(&self.gs, nd, d, &mut self.rg, &mut self.column);
             for (ri, gi) in r[d * l..(d + 1) * l].iter_mut().zip(&self.rg) {
                 *ri += s * gi;
             }
@@ -462,9 +480,11 @@ impl HbResidual {
     }
 
     /// Galerkin Jacobian of the nonlinear part by quadrature on the 2N grid (the
-    /// classic IHB's Φ_q minus `L(ω)`, §3.2.1), times `s`, added into `jac`.
-    /// Allocation-free given `dgx`, `dgv` (`n_dof²` each) and `basis` (`2N·(2n+1)`,
-    /// filled by [`Self::fill_basis`]).
+    /// classic IHB's Φ_q minus `L(ω)`, §3.2.1), times `s`, added into `jac`. `∂g`
+    /// at all samples come from one [`PeriodicProblem::nonlinear_jacobian_samples`]
+    /// call into `dg` (`2N·2n_dof²`); `basis` (`2·2N·(2n+1)`) is
+    /// filled by [`Self::fill_basis`]. Allocation-free if the problem's
+    /// `nonlinear_jacobian_samples` is.
     #[allow(clippy::too_many_arguments)]
     pub fn add_nonlinear_jacobian<P: PeriodicProblem>(
         &mut self,
@@ -473,8 +493,7 @@ impl HbResidual {
         omega_f: f64,
         s: f64,
         basis: &[f64],
-        dgx: &mut [f64],
-        dgv: &mut [f64],
+        dg: &mut [f64],
         jac: &mut [f64],
     ) {
         let (nd, n) = (self.n_dof, self.n);
@@ -482,26 +501,17 @@ impl HbResidual {
         let len = nd * l;
         let ns = self.aft.n_samples();
         let omega = omega_f / self.p as f64;
-        for d in 0..nd {
-            let qd = &q[d * l..(d + 1) * l];
-            self.aft.synthesize(qd, &mut self.xs[d * ns..(d + 1) * ns]);
-            self.aft
-                .synthesize_derivative(qd, 1, &mut self.vs[d * ns..(d + 1) * ns]);
-        }
-        let w = s / self.aft.n_samples() as f64 * 2.0; // (1/π)·(2π/2N)
+        self.synthesize_states(q, omega, true);
+        problem.nonlinear_jacobian_samples(&self.xs, &self.vs, &self.thetas, dg);
+        let w = s / ns as f64 * 2.0; // (1/π)·(2π/2N)
+        let n2 = nd * nd;
         for i in 0..ns {
-            for d in 0..nd {
-                self.xi[d] = self.xs[d * ns + i];
-                self.vi[d] = omega * self.vs[d * ns + i];
-            }
-            let tau = self.aft.tau(i);
-            problem.nonlinear_jacobian(&self.xi, &self.vi, self.p as f64 * tau, dgx, dgv);
             let cs = &basis[i * l..(i + 1) * l];
             let ds = &basis[(ns + i) * l..(ns + i + 1) * l];
             for d in 0..nd {
                 for e in 0..nd {
-                    let gx = w * dgx[d * nd + e];
-                    let gv = w * omega * dgv[d * nd + e];
+                    let gx = w * dg[2 * i * n2 + d * nd + e];
+                    let gv = w * omega * dg[2 * i * n2 + n2 + d * nd + e];
                     if gx == 0.0 && gv == 0.0 {
                         continue;
                     }
@@ -547,20 +557,19 @@ impl HbResidual {
 #[derive(Debug, Clone)]
 pub struct GalerkinJacobian {
     basis: Vec<f64>,
-    dgx: Vec<f64>,
-    dgv: Vec<f64>,
+    /// `[∂g/∂x | ∂g/∂v]` at every sample.
+    dg: Vec<f64>,
 }
 
 impl GalerkinJacobian {
     /// Scratch for `res`'s size and `n_dof` of the problem it evaluates.
     pub fn new(res: &HbResidual) -> Self {
-        let (nd, l) = (res.n_dof, 2 * res.n + 1);
-        let mut basis = vec![0.0; 2 * res.aft.n_samples() * l];
+        let (nd, l, ns) = (res.n_dof, 2 * res.n + 1, res.aft.n_samples());
+        let mut basis = vec![0.0; 2 * ns * l];
         res.fill_basis(&mut basis);
         Self {
             basis,
-            dgx: vec![0.0; nd * nd],
-            dgv: vec![0.0; nd * nd],
+            dg: vec![0.0; 2 * ns * nd * nd],
         }
     }
 
@@ -570,7 +579,7 @@ impl GalerkinJacobian {
     }
 
     /// Writes `Φ_q(q)` (row-major `m×m`) into `jac`; allocation-free when the problem
-    /// supplies `nonlinear_jacobian` (its default central differences allocate).
+    /// supplies an analytic Jacobian (central differences allocate their scratch).
     pub fn assemble<P: PeriodicProblem>(
         &mut self,
         res: &mut HbResidual,
@@ -582,16 +591,7 @@ impl GalerkinJacobian {
     ) {
         res.linear_matrix(problem, omega_f / res.p as f64, jac);
         if s != 0.0 {
-            res.add_nonlinear_jacobian(
-                problem,
-                q,
-                omega_f,
-                s,
-                &self.basis,
-                &mut self.dgx,
-                &mut self.dgv,
-                jac,
-            );
+            res.add_nonlinear_jacobian(problem, q, omega_f, s, &self.basis, &mut self.dg, jac);
         }
     }
 }

@@ -42,7 +42,10 @@ pub use hill::{fourier_blocks, hill_multipliers, HillResult};
 pub use ihb::{GalerkinJacobian, HbOptions, HbResidual, HbSolution, HbSolver};
 pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;
-pub use problem::{Duffing, GeneralProblem, MathieuDuffing, PeriodicProblem};
+pub use problem::{
+    central_difference_samples, Duffing, GeneralProblem, MathieuDuffing, Nonlinearity,
+    PeriodicProblem,
+};
 pub use stability::{classify, Floquet, StabilityAnalyzer, StabilityKind};
 
 pub mod sthb;

@@ -144,6 +144,14 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
                 q.fill(0.0);
             }
         }
+        // Tolerance atol + rtol·S (HbOptions), S from the forcing or the start.
+        let scale = self
+            .res
+            .force_scale(&self.problem, q, omega, &mut self.b0[..m]);
+        let broyden = crate::BroydenOptions {
+            tol: self.opts.residual_tol(scale),
+            ..self.opts.broyden.clone()
+        };
         let start: Vec<f64> = if self.opts.homotopy_steps == 0 {
             Vec::new()
         } else {
@@ -160,7 +168,7 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         let mut last_err = None;
         if opts.homotopy_steps == 0 {
             seed(ws, &self.h0);
-            match broyden_solve(&mut sys, q, ws, &opts.broyden) {
+            match broyden_solve(&mut sys, q, ws, &broyden) {
                 Ok(stats) => return Ok(stats),
                 Err(e) => last_err = Some(e),
             }
@@ -194,7 +202,7 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         while s_done < 1.0 {
             let s = (s_done + ds).min(1.0);
             sys.s = s;
-            match broyden_solve(&mut sys, q, ws, &opts.broyden) {
+            match broyden_solve(&mut sys, q, ws, &broyden) {
                 Ok(st) => {
                     total.iterations += st.iterations;
                     total.residual_evals += st.residual_evals;
@@ -229,7 +237,7 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
             lambda_min: -1.0,
             lambda_max: 1.0,
             max_points: 2000,
-            broyden: opts.broyden.clone(),
+            broyden: broyden.clone(),
             ..ContinuationOptions::default()
         };
         let mut crossing: Option<(Vec<f64>, Vec<f64>)> = None;
@@ -263,7 +271,7 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
             }
             ws.clear_jacobian();
             sys.s = 1.0;
-            match broyden_solve(&mut sys, q, ws, &opts.broyden) {
+            match broyden_solve(&mut sys, q, ws, &broyden) {
                 Ok(st) => return Ok(st),
                 Err(e) => last_err = Some(e),
             }

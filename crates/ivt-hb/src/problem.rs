@@ -25,11 +25,9 @@ pub trait PeriodicProblem {
     /// calls this once per evaluation. Default: one [`Self::nonlinear`] call per
     /// sample; override to vectorise (e.g. one call into an interpreter).
     fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
-        let n = self.n_dof();
-        for (i, &th) in theta.iter().enumerate() {
-            let s = i * n..(i + 1) * n;
-            self.nonlinear(&x[s.clone()], &v[s.clone()], th, &mut out[s]);
-        }
+        per_sample(self.n_dof(), x, v, theta, out, |x, v, th, out| {
+            self.nonlinear(x, v, th, out)
+        });
     }
     /// External excitation `f(θ)` (right-hand side). Default: none.
     fn excitation(&self, _theta: f64, out: &mut [f64]) {
@@ -39,8 +37,9 @@ pub trait PeriodicProblem {
     fn velocity_dependent(&self) -> bool {
         true
     }
-    /// `∂g/∂x` and `∂g/∂v` (row-major `n_dof×n_dof`). Default: central differences
-    /// with a relative step of 1e-6 (allocates; not used in the modified IHB loop).
+    /// `∂g/∂x` and `∂g/∂v` at one sample (row-major `n_dof×n_dof`). Default: central
+    /// differences with the step `1e-6·max(|x_j|, 1)` (one sample carries no orbit
+    /// scale; the engine's assemblies call [`Self::nonlinear_jacobian_samples`]).
     fn nonlinear_jacobian(
         &self,
         x: &[f64],
@@ -75,6 +74,121 @@ pub trait PeriodicProblem {
             }
         }
     }
+    /// `∂g/∂x` and `∂g/∂v` at `theta.len()` samples at once: `x`, `v` sample-major as
+    /// in [`Self::nonlinear_samples`]; `dg` holds per sample the row-major blocks
+    /// `[∂g/∂x | ∂g/∂v]` (`2·n_dof²` per sample). The Galerkin Jacobian (Eq. 56),
+    /// the stability matrix Θ (Eq. 79) and the fold locator call this once per
+    /// assembly. Default: [`Self::nonlinear_jacobian`] per sample (right for an
+    /// analytic Jacobian; a problem without one should use
+    /// [`central_difference_samples`], as [`GeneralProblem`] does).
+    fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
+        let n = self.n_dof();
+        let n2 = n * n;
+        for (i, &th) in theta.iter().enumerate() {
+            let s = i * n..(i + 1) * n;
+            let (gx, gv) = dg[2 * i * n2..2 * (i + 1) * n2].split_at_mut(n2);
+            self.nonlinear_jacobian(&x[s.clone()], &v[s], th, gx, gv);
+        }
+    }
+}
+
+/// Calls a one-sample `g` on each of `theta.len()` sample-major samples (`x`, `v`,
+/// `out`: `samples×n`), the default way to evaluate all AFT samples.
+pub fn per_sample(
+    n: usize,
+    x: &[f64],
+    v: &[f64],
+    theta: &[f64],
+    out: &mut [f64],
+    mut g: impl FnMut(&[f64], &[f64], f64, &mut [f64]),
+) {
+    for (i, &th) in theta.iter().enumerate() {
+        let s = i * n..(i + 1) * n;
+        g(&x[s.clone()], &v[s.clone()], th, &mut out[s]);
+    }
+}
+
+/// Relative step of [`central_difference_samples`]: central differences err by
+/// O(h²) in truncation and O(ε/h) in rounding, both ≈ 1e-11…1e-10 here.
+const FD_STEP: f64 = 1e-6;
+
+/// `∂g/∂x`, `∂g/∂v` at all samples (layout of
+/// [`PeriodicProblem::nonlinear_jacobian_samples`]) by central differences of
+/// [`PeriodicProblem::nonlinear_samples`]: one call per perturbed DOF and sign, so
+/// 4·n_dof calls (2·n_dof without velocity dependence) whatever the number of
+/// samples. DOF j is stepped by `1e-6·max_i |x_ij|` (`v` likewise), relative to the
+/// orbit's own scale: an orbit of micrometres is differenced like one of metres,
+/// where a floor of 1 would step by its whole amplitude. Allocates its scratch.
+pub fn central_difference_samples<P: PeriodicProblem + ?Sized>(
+    problem: &P,
+    x: &[f64],
+    v: &[f64],
+    theta: &[f64],
+    dg: &mut [f64],
+) {
+    difference_columns(problem, x, v, theta, false, dg);
+    if problem.velocity_dependent() {
+        difference_columns(problem, x, v, theta, true, dg);
+    } else {
+        let n2 = problem.n_dof() * problem.n_dof();
+        for block in dg.chunks_mut(2 * n2) {
+            block[n2..].fill(0.0);
+        }
+    }
+}
+
+/// The columns `∂g/∂x_j` (or `∂g/∂v_j` with `wrt_v`) of every sample's blocks.
+fn difference_columns<P: PeriodicProblem + ?Sized>(
+    problem: &P,
+    x: &[f64],
+    v: &[f64],
+    theta: &[f64],
+    wrt_v: bool,
+    dg: &mut [f64],
+) {
+    let n = problem.n_dof();
+    let base = if wrt_v { v } else { x };
+    let mut moved = base.to_vec();
+    let (mut gp, mut gm) = (vec![0.0; base.len()], vec![0.0; base.len()]);
+    let eval = |moved: &[f64], out: &mut [f64]| {
+        if wrt_v {
+            problem.nonlinear_samples(x, moved, theta, out)
+        } else {
+            problem.nonlinear_samples(moved, v, theta, out)
+        }
+    };
+    for j in 0..n {
+        let h = FD_STEP * orbit_scale(base, n, j);
+        for (dst, sign) in [(&mut gp, 1.0), (&mut gm, -1.0)] {
+            for (m, b) in moved.iter_mut().zip(base).skip(j).step_by(n) {
+                *m = b + sign * h;
+            }
+            eval(&moved, dst);
+        }
+        for (m, b) in moved.iter_mut().zip(base).skip(j).step_by(n) {
+            *m = *b;
+        }
+        let block = if wrt_v { n * n } else { 0 };
+        for i in 0..theta.len() {
+            for r in 0..n {
+                dg[2 * i * n * n + block + r * n + j] = (gp[i * n + r] - gm[i * n + r]) / (2.0 * h);
+            }
+        }
+    }
+}
+
+/// `max_i |u_ij|` of DOF j over the samples; that of all DOFs if DOF j is
+/// identically zero, and 1 if everything is.
+fn orbit_scale(u: &[f64], n: usize, j: usize) -> f64 {
+    let max = |it: &mut dyn Iterator<Item = &f64>| it.fold(0.0f64, |a, b| a.max(b.abs()));
+    [
+        max(&mut u.iter().skip(j).step_by(n)),
+        max(&mut u.iter()),
+        1.0,
+    ]
+    .into_iter()
+    .find(|s| *s > 0.0 && s.is_finite())
+    .unwrap_or(1.0)
 }
 
 /// Duffing's equation Eq. 49: `ü + 2ξ u̇ + α u + ε u³ = F cos(ω_f t)`.
@@ -217,8 +331,32 @@ impl PeriodicProblem for MathieuDuffing {
     }
 }
 
-/// A general multi-DOF problem built from matrices and closures (for users who do
-/// not want to implement the trait).
+/// The force `g(x, v, θ)` of a [`GeneralProblem`]: any closure
+/// `Fn(&[f64], &[f64], f64, &mut [f64])` (one sample per call), or a type that
+/// also evaluates all AFT samples in one call (e.g. one call into an interpreter).
+pub trait Nonlinearity {
+    /// `g` at one sample (see [`PeriodicProblem::nonlinear`]).
+    fn eval(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]);
+    /// `g` at `theta.len()` samples, sample-major (see
+    /// [`PeriodicProblem::nonlinear_samples`]). Default: [`Self::eval`] per sample.
+    fn eval_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+        let n = x.len() / theta.len().max(1);
+        per_sample(n, x, v, theta, out, |x, v, th, out| {
+            self.eval(x, v, th, out)
+        });
+    }
+}
+
+impl<G: Fn(&[f64], &[f64], f64, &mut [f64])> Nonlinearity for G {
+    fn eval(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
+        self(x, v, theta, out)
+    }
+}
+
+/// A general multi-DOF problem built from matrices, a [`Nonlinearity`] (e.g. a
+/// closure) and an excitation closure, for users who do not want to implement the
+/// trait. Its `∂g` are central differences over all samples at once, with steps
+/// relative to the orbit ([`central_difference_samples`]).
 pub struct GeneralProblem<G, F> {
     n: usize,
     m: Vec<f64>,
@@ -226,11 +364,12 @@ pub struct GeneralProblem<G, F> {
     k: Vec<f64>,
     g: G,
     f: F,
+    velocity_dependent: bool,
 }
 
 impl<G, F> GeneralProblem<G, F>
 where
-    G: Fn(&[f64], &[f64], f64, &mut [f64]),
+    G: Nonlinearity,
     F: Fn(f64, &mut [f64]),
 {
     /// `M`, `C`, `K` row-major `n×n`; `g(x, v, θ, out)`, `f(θ, out)`.
@@ -242,13 +381,33 @@ where
             m.len() == n * n && c.len() == n * n && k.len() == n * n,
             "M, C, K must be n×n"
         );
-        Self { n, m, c, k, g, f }
+        Self {
+            n,
+            m,
+            c,
+            k,
+            g,
+            f,
+            velocity_dependent: true,
+        }
+    }
+
+    /// Declares whether `g` reads `v` (default `true`; `false` saves an inverse FFT
+    /// per DOF in the residual and the `v` differences of the Jacobian).
+    pub fn with_velocity_dependent(mut self, velocity_dependent: bool) -> Self {
+        self.velocity_dependent = velocity_dependent;
+        self
+    }
+
+    /// The nonlinearity `g`.
+    pub fn nonlinearity(&self) -> &G {
+        &self.g
     }
 }
 
 impl<G, F> PeriodicProblem for GeneralProblem<G, F>
 where
-    G: Fn(&[f64], &[f64], f64, &mut [f64]),
+    G: Nonlinearity,
     F: Fn(f64, &mut [f64]),
 {
     fn n_dof(&self) -> usize {
@@ -264,10 +423,19 @@ where
         &self.k
     }
     fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
-        (self.g)(x, v, theta, out)
+        self.g.eval(x, v, theta, out)
+    }
+    fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+        self.g.eval_samples(x, v, theta, out)
     }
     fn excitation(&self, theta: f64, out: &mut [f64]) {
         (self.f)(theta, out)
+    }
+    fn velocity_dependent(&self) -> bool {
+        self.velocity_dependent
+    }
+    fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
+        central_difference_samples(self, x, v, theta, dg)
     }
 }
 
@@ -307,5 +475,8 @@ impl<P: PeriodicProblem + ?Sized> PeriodicProblem for &P {
         dg_dv: &mut [f64],
     ) {
         (**self).nonlinear_jacobian(x, v, theta, dg_dx, dg_dv)
+    }
+    fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
+        (**self).nonlinear_jacobian_samples(x, v, theta, dg)
     }
 }

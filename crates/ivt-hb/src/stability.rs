@@ -96,12 +96,14 @@ pub struct StabilityAnalyzer {
     nd: usize,
     minv: Vec<f64>,
     theta: Vec<f64>,
+    /// `x`, `v = dx/dt` at the grid, sample-major (`2·steps×n_dof`).
     xs: Vec<f64>,
     vs: Vec<f64>,
-    xi: Vec<f64>,
-    vi: Vec<f64>,
-    dgx: Vec<f64>,
-    dgv: Vec<f64>,
+    column: Vec<f64>,
+    /// Excitation phase of each grid point (set per solution: it depends on p).
+    phases: Vec<f64>,
+    /// `[∂g/∂x | ∂g/∂v]` at every grid point (`2·steps·2n_dof²`).
+    dg: Vec<f64>,
     q: Vec<f64>,
 }
 
@@ -130,10 +132,9 @@ impl StabilityAnalyzer {
             theta: vec![0.0; ns * dim * dim],
             xs: vec![0.0; nd * ns],
             vs: vec![0.0; nd * ns],
-            xi: vec![0.0; nd],
-            vi: vec![0.0; nd],
-            dgx: vec![0.0; nd * nd],
-            dgv: vec![0.0; nd * nd],
+            column: vec![0.0; ns],
+            phases: vec![0.0; ns],
+            dg: vec![0.0; 2 * ns * nd * nd],
             q: vec![0.0; dim * dim],
         })
     }
@@ -146,25 +147,19 @@ impl StabilityAnalyzer {
         let ns = 2 * self.steps;
         let omega = sol.omega();
         let p = sol.subharmonic as f64;
-        for d in 0..nd {
-            self.aft
-                .synthesize(sol.dof(d), &mut self.xs[d * ns..(d + 1) * ns]);
-            self.aft
-                .synthesize_derivative(sol.dof(d), 1, &mut self.vs[d * ns..(d + 1) * ns]);
+        let q = &sol.coeffs;
+        self.aft
+            .synthesize_states(q, nd, 0, 1.0, &mut self.xs, &mut self.column);
+        self.aft
+            .synthesize_states(q, nd, 1, omega, &mut self.vs, &mut self.column);
+        for (j, phase) in self.phases.iter_mut().enumerate() {
+            *phase = p * self.aft.tau(j);
         }
+        problem.nonlinear_jacobian_samples(&self.xs, &self.vs, &self.phases, &mut self.dg);
         let (c, k) = (problem.damping(), problem.stiffness());
+        let n2 = nd * nd;
         for j in 0..ns {
-            for d in 0..nd {
-                self.xi[d] = self.xs[d * ns + j];
-                self.vi[d] = omega * self.vs[d * ns + j];
-            }
-            problem.nonlinear_jacobian(
-                &self.xi,
-                &self.vi,
-                p * self.aft.tau(j),
-                &mut self.dgx,
-                &mut self.dgv,
-            );
+            let (dgx, dgv) = self.dg[2 * j * n2..2 * (j + 1) * n2].split_at(n2);
             let th = &mut self.theta[j * d2..(j + 1) * d2];
             th.fill(0.0);
             for i in 0..nd {
@@ -172,8 +167,8 @@ impl StabilityAnalyzer {
                 for e in 0..nd {
                     let (mut sk, mut sc) = (0.0, 0.0);
                     for l in 0..nd {
-                        sk += self.minv[i * nd + l] * (k[l * nd + e] + self.dgx[l * nd + e]);
-                        sc += self.minv[i * nd + l] * (c[l * nd + e] + self.dgv[l * nd + e]);
+                        sk += self.minv[i * nd + l] * (k[l * nd + e] + dgx[l * nd + e]);
+                        sc += self.minv[i * nd + l] * (c[l * nd + e] + dgv[l * nd + e]);
                     }
                     th[(nd + i) * dim + e] = -sk / (omega * omega);
                     th[(nd + i) * dim + nd + e] = -sc / omega;

@@ -17,7 +17,7 @@ use pyo3::types::{PyDict, PyList};
 use std::time::Instant;
 
 use crate::args::{count, int64};
-use crate::user_problem::{callback_error, user_problem};
+use crate::user_problem::{callback_error, user_problem, with_tolerances};
 
 create_exception!(
     ivt,
@@ -415,18 +415,24 @@ fn duffing_frc<'py>(
 /// `vectorized=True`: g(x, v, theta) is called once per residual with x, v of
 /// shape (N, n_dof) and theta of shape (N,) for all N = 2·samples AFT
 /// samples, and returns (N, n_dof).
-/// Speed cost: g and f are Python callables called once per AFT sample and
-/// residual evaluation (2·samples calls per iteration, plus central
-/// differences for the stability Jacobian), each costing ~1–3 µs of
-/// interpreter time against ~10 ns for a Rust g, so a Duffing-size problem
-/// takes milliseconds instead of tens of µs. The GIL is released between
-/// callbacks, so other Python threads run. An exception in a callback
-/// aborts the solve and is re-raised. Same dict as `duffing`.
+/// Convergence: ‖r‖₂ ≤ tol + rtol·S, r the Galerkin residual (a force), S
+/// the norm of the forcing's projection (for f = None: of the guess's linear
+/// force): `tol` is absolute (default 0), `rtol` relative (default 1e-9), so
+/// by default a change of length unit changes nothing. `max_iter` caps the
+/// iterations. ∂g (stability, Jacobian refreshes) is differenced over all
+/// samples at once with steps relative to the orbit's amplitude.
+/// Speed cost: a per-sample g is called once per AFT sample and residual
+/// evaluation (2·samples calls per iteration), each costing ~1–3 µs of
+/// interpreter time against ~10 ns for a Rust g; with `vectorized=True` it is
+/// one call per residual and 2 (4 with velocity dependence) per DOF for ∂g.
+/// The GIL is released between callbacks, so other Python threads run. An
+/// exception in a callback aborts the solve and is re-raised. Same dict as
+/// `duffing`.
 #[pyfunction]
 #[pyo3(signature = (
     m, c, k, g, omega_f, f = None, n = 20, samples = 64, subharmonic = 1,
-    method = "modified", guess = None, tol = 1e-10, stability = true,
-    velocity_dependent = true, vectorized = false
+    method = "modified", guess = None, tol = 0.0, stability = true,
+    velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
 ))]
 #[allow(clippy::too_many_arguments)]
 fn solve<'py>(
@@ -446,9 +452,11 @@ fn solve<'py>(
     stability: bool,
     velocity_dependent: bool,
     vectorized: bool,
+    rtol: f64,
+    max_iter: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let problem = user_problem(m, c, k, g, f, velocity_dependent, vectorized)?;
-    let opts = options(n, samples, subharmonic, tol)?;
+    let opts = with_tolerances(options(n, samples, subharmonic, 1.0)?, tol, rtol, max_iter)?;
     let meth = self::method(method)?;
     let guess = guess_vec(guess)?;
     let result =
@@ -475,8 +483,8 @@ fn solve<'py>(
 /// max |x_0| over the AFT samples (DOF 0). GIL released between callbacks.
 #[pyfunction]
 #[pyo3(signature = (
-    m, c, k, g, f, omega_from, omega_to, n = 20, samples = 64, tol = 1e-10,
-    velocity_dependent = true, vectorized = false
+    m, c, k, g, f, omega_from, omega_to, n = 20, samples = 64, tol = 0.0,
+    velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
 ))]
 #[allow(clippy::too_many_arguments, clippy::field_reassign_with_default)]
 fn frc<'py>(
@@ -493,9 +501,11 @@ fn frc<'py>(
     tol: f64,
     velocity_dependent: bool,
     vectorized: bool,
+    rtol: f64,
+    max_iter: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let problem = user_problem(m, c, k, g, f, velocity_dependent, vectorized)?;
-    let opts = options(n, samples, 1, tol)?;
+    let opts = with_tolerances(options(n, samples, 1, 1.0)?, tol, rtol, max_iter)?;
     let mut frc_opts = FrcOptions::default();
     frc_opts.from = finite("omega_from", omega_from)?;
     frc_opts.to = finite("omega_to", omega_to)?;
@@ -539,7 +549,7 @@ fn frc<'py>(
 #[pyfunction]
 #[pyo3(signature = (
     m, c, k, g, omega_guess, amplitude = 1.0, guess = None, n = 20, samples = 64,
-    tol = 1e-10, velocity_dependent = true, vectorized = false
+    tol = 0.0, velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
 ))]
 #[allow(clippy::too_many_arguments)]
 fn limit_cycle<'py>(
@@ -556,13 +566,15 @@ fn limit_cycle<'py>(
     tol: f64,
     velocity_dependent: bool,
     vectorized: bool,
+    rtol: f64,
+    max_iter: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let problem = user_problem(m, c, k, g, None, velocity_dependent, vectorized)?;
-    let opts = options(n, samples, 1, tol)?;
+    let opts = with_tolerances(options(n, samples, 1, 1.0)?, tol, rtol, max_iter)?;
     let start = match guess_vec(guess)? {
         Some(q) => q,
         None => {
-            let mut q = vec![0.0; problem.n * (2 * opts.harmonics + 1)];
+            let mut q = vec![0.0; problem.n_dof() * (2 * opts.harmonics + 1)];
             q[1] = finite("amplitude", amplitude)?;
             q
         }

@@ -1,71 +1,73 @@
 //! User systems for `ivt.hb`: `M x'' + C x' + K x + g(x, v, θ) = f(θ)` with `g`
 //! and `f` Python callables (per sample, or vectorized over all AFT samples).
+//! The system is an ivt-hb [`GeneralProblem`]; this module adds only the Python
+//! calls and the capture of the first exception a callback raises.
 
-use ivt_hb::PeriodicProblem;
+use ivt_hb::problem::{per_sample, Nonlinearity};
+use ivt_hb::{GeneralProblem, HbOptions};
 use numpy::{IntoPyArray, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use std::sync::{Arc, Mutex};
 
-/// A user system whose nonlinearity g (and optional forcing f) are Python
-/// callables, called once per AFT sample with the GIL re-acquired.
-#[derive(Clone)]
-pub(crate) struct PyProblem {
-    /// Number of degrees of freedom.
-    pub(crate) n: usize,
-    m: Vec<f64>,
-    c: Vec<f64>,
-    k: Vec<f64>,
-    g: Arc<Py<PyAny>>,
-    f: Option<Arc<Py<PyAny>>>,
-    velocity_dependent: bool,
-    /// `g` takes (N, n_dof) arrays and a (N,) phase array, returns (N, n_dof).
+/// The first exception raised by a callback (the solver then sees NaN).
+type ErrorSlot = Arc<Mutex<Option<PyErr>>>;
+
+/// The excitation `f(θ)` of a user system (a Python callable or none).
+type PyExcitation = Box<dyn Fn(f64, &mut [f64]) + Send + Sync>;
+
+/// A user system: the ivt-hb general problem with Python `g` and `f`.
+pub(crate) type PyProblem = GeneralProblem<PyNonlinearity, PyExcitation>;
+
+/// The Python `g(x, v, theta)`: per sample, or (`vectorized`) once for all
+/// samples with (N, n_dof) arrays and a (N,) phase array, returning (N, n_dof).
+pub(crate) struct PyNonlinearity {
+    g: Py<PyAny>,
+    n: usize,
     vectorized: bool,
-    /// The first exception raised by a callback (the solver then sees NaN).
-    error: Arc<Mutex<Option<PyErr>>>,
+    error: ErrorSlot,
 }
 
-impl PyProblem {
-    fn record(&self, e: PyErr) {
-        if let Ok(mut slot) = self.error.lock() {
-            if slot.is_none() {
-                *slot = Some(e);
-            }
-        }
-    }
-
-    /// Call `func(*args)` and write its n floats into `out` (NaN on error).
-    fn call_into(
-        &self,
-        func: &Py<PyAny>,
-        args: impl FnOnce(Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyTuple>>,
-        out: &mut [f64],
-    ) {
-        let n = self.n;
-        let r = Python::attach(|py| -> PyResult<()> {
-            let res = func.bind(py).call1(args(py)?)?;
-            let v: Vec<f64> = if let Ok(x) = res.extract::<f64>() {
-                vec![x]
-            } else {
-                res.extract()?
-            };
-            if v.len() != n {
-                return Err(PyValueError::new_err(format!(
-                    "callback returned {} values for n_dof = {n}",
-                    v.len()
-                )));
-            }
-            out.copy_from_slice(&v);
-            Ok(())
-        });
-        if let Err(e) = r {
-            self.record(e);
-            out.fill(f64::NAN);
+fn record(slot: &ErrorSlot, e: PyErr) {
+    if let Ok(mut slot) = slot.lock() {
+        if slot.is_none() {
+            *slot = Some(e);
         }
     }
 }
 
-impl PyProblem {
+/// Calls `func(*args)` and writes its `out.len()` floats into `out` (NaN and the
+/// exception recorded on error).
+fn call_into(
+    slot: &ErrorSlot,
+    func: &Py<PyAny>,
+    args: impl FnOnce(Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyTuple>>,
+    out: &mut [f64],
+) {
+    let n = out.len();
+    let r = Python::attach(|py| -> PyResult<()> {
+        let res = func.bind(py).call1(args(py)?)?;
+        let v: Vec<f64> = if let Ok(x) = res.extract::<f64>() {
+            vec![x]
+        } else {
+            res.extract()?
+        };
+        if v.len() != n {
+            return Err(PyValueError::new_err(format!(
+                "callback returned {} values for n_dof = {n}",
+                v.len()
+            )));
+        }
+        out.copy_from_slice(&v);
+        Ok(())
+    });
+    if let Err(e) = r {
+        record(slot, e);
+        out.fill(f64::NAN);
+    }
+}
+
+impl PyNonlinearity {
     /// One call of a vectorized `g` on `theta.len()` samples (sample-major).
     fn call_vectorized(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
         let (n, ns) = (self.n, theta.len());
@@ -95,44 +97,21 @@ impl PyProblem {
             Ok(())
         });
         if let Err(e) = r {
-            self.record(e);
+            record(&self.error, e);
             out.fill(f64::NAN);
         }
     }
 }
 
-impl PeriodicProblem for PyProblem {
-    fn n_dof(&self) -> usize {
-        self.n
-    }
-    fn mass(&self) -> &[f64] {
-        &self.m
-    }
-    fn damping(&self) -> &[f64] {
-        &self.c
-    }
-    fn stiffness(&self) -> &[f64] {
-        &self.k
-    }
-    fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
-        if self.vectorized {
-            self.call_vectorized(x, v, theta, out);
-        } else {
-            let n = self.n;
-            for (i, &th) in theta.iter().enumerate() {
-                let s = i * n..(i + 1) * n;
-                self.nonlinear(&x[s.clone()], &v[s.clone()], th, &mut out[s]);
-            }
-        }
-    }
-    fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
+impl Nonlinearity for PyNonlinearity {
+    fn eval(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
         if self.vectorized {
             self.call_vectorized(x, v, &[theta], out);
             return;
         }
-        let g = Arc::clone(&self.g);
-        self.call_into(
-            &g,
+        call_into(
+            &self.error,
+            &self.g,
             |py| {
                 pyo3::types::PyTuple::new(
                     py,
@@ -146,17 +125,14 @@ impl PeriodicProblem for PyProblem {
             out,
         );
     }
-    fn excitation(&self, theta: f64, out: &mut [f64]) {
-        match &self.f {
-            Some(f) => {
-                let f = Arc::clone(f);
-                self.call_into(&f, |py| pyo3::types::PyTuple::new(py, [theta]), out);
-            }
-            None => out.fill(0.0),
+    fn eval_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+        if self.vectorized {
+            self.call_vectorized(x, v, theta, out);
+        } else {
+            per_sample(self.n, x, v, theta, out, |x, v, th, out| {
+                self.eval(x, v, th, out)
+            });
         }
-    }
-    fn velocity_dependent(&self) -> bool {
-        self.velocity_dependent
     }
 }
 
@@ -220,20 +196,51 @@ pub(crate) fn user_problem(
             ));
         }
     }
-    Ok(PyProblem {
+    let error = ErrorSlot::default();
+    let excitation: PyExcitation = match f {
+        Some(f) => {
+            let (f, slot) = (f.clone().unbind(), Arc::clone(&error));
+            Box::new(move |theta, out| {
+                call_into(&slot, &f, |py| pyo3::types::PyTuple::new(py, [theta]), out)
+            })
+        }
+        None => Box::new(|_, out| out.fill(0.0)),
+    };
+    let g = PyNonlinearity {
+        g: g.clone().unbind(),
         n: nm,
-        m,
-        c,
-        k,
-        g: Arc::new(g.clone().unbind()),
-        f: f.map(|f| Arc::new(f.clone().unbind())),
-        velocity_dependent,
         vectorized,
-        error: Arc::new(Mutex::new(None)),
-    })
+        error,
+    };
+    Ok(GeneralProblem::new(nm, m, c, k, g, excitation).with_velocity_dependent(velocity_dependent))
 }
 
 /// The first exception a callback raised during a run, if any.
 pub(crate) fn callback_error(problem: &PyProblem) -> Option<PyErr> {
-    problem.error.lock().ok().and_then(|mut s| s.take())
+    problem
+        .nonlinearity()
+        .error
+        .lock()
+        .ok()
+        .and_then(|mut s| s.take())
+}
+
+/// The tolerance keywords of `solve`, `frc` and `limit_cycle` applied to `opts`:
+/// ‖r‖₂ ≤ `tol + rtol·S` (`tol` absolute, S the force scale of ivt-hb's
+/// `HbOptions`); `max_iter` caps the iterations of one solve.
+pub(crate) fn with_tolerances(
+    opts: HbOptions,
+    tol: f64,
+    rtol: f64,
+    max_iter: usize,
+) -> PyResult<HbOptions> {
+    if !(rtol.is_finite() && tol.is_finite() && rtol >= 0.0 && tol >= 0.0 && rtol + tol > 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "tolerances must be finite, >= 0 and not both 0, got tol = {tol}, rtol = {rtol}"
+        )));
+    }
+    if max_iter == 0 {
+        return Err(PyValueError::new_err("argument `max_iter` must be >= 1"));
+    }
+    Ok(opts.with_tolerances(rtol, tol).with_max_iter(max_iter))
 }

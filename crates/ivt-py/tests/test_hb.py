@@ -273,7 +273,9 @@ def test_2dof_chain_frc_folds_match_shooting_with_vectorized_g() -> None:
 
     def g_counted(x: np.ndarray, v: np.ndarray, th: np.ndarray) -> np.ndarray:
         calls["n"] += 1
-        assert x.shape == (128, 2) or x.shape == (1, 2), x.shape
+        # 128 residual samples, 512 on the stability grid (256 Hsu steps), 1 per
+        # call of the fold locator's one-sample ∂g.
+        assert x.shape in ((128, 2), (512, 2), (1, 2)), x.shape
         assert th.shape == (x.shape[0],)
         return g(x, v, th)  # type: ignore[no-any-return]
 
@@ -299,6 +301,46 @@ def test_2dof_chain_frc_folds_match_shooting_with_vectorized_g() -> None:
     assert len(switches) == 2, switches
     for s, fd in zip(switches, folds):
         assert s in (fd["index"], fd["index"] + 1), (s, fd["index"])
+
+
+def test_scaled_duffing_same_orbit_and_verdict() -> None:
+    """x = L·u maps Duffing Eq. 49 to ẍ + 0.04ẋ + x + x³/L² = 0.1·L cos θ: the
+    orbit is L times the unit one and the multipliers are the same. The middle
+    (saddle) branch at ω ≈ 1.4, in micrometres and 10 nm, then a 1e8 scale."""
+    ref = hb.duffing_frc(from_=0.2, to=3.0)
+    mid = min((p for p in ref["points"] if p["stability"] == "fold"), key=lambda p: abs(p["omega"] - 1.4))
+    mu_ref = mid["multipliers"][0]
+    assert mu_ref[0] > 1.0
+
+    def solve(scale: float, omega: float, guess=None):  # type: ignore[no-untyped-def]
+        def g(x: np.ndarray, v: np.ndarray, th: np.ndarray) -> np.ndarray:
+            return x**3 / scale**2  # type: ignore[no-any-return]
+
+        return hb.solve(1.0, 0.04, 1.0, g, omega, f=lambda th: 0.1 * scale * np.cos(th), guess=guess,
+                        velocity_dependent=False, vectorized=True)
+
+    for scale in (1.0, 1e-6, 1e-8):
+        got = solve(scale, mid["omega"], 1.001 * scale * np.asarray(mid["coeffs"]))
+        dist = np.max(np.abs(got["coeffs"] / scale - mid["coeffs"])) / np.max(np.abs(mid["coeffs"]))
+        assert dist < 1e-7, (scale, dist)  # both stop at ‖r‖ ≤ 1e-9·‖f̂‖
+        assert got["stable"] is False and got["stability"] == "fold", (scale, got["stability"])
+        np.testing.assert_allclose(got["floquet"][0], mu_ref, rtol=0, atol=1e-6)
+    unit = hb.duffing(omega_f=0.4)
+    for scale in (1e8, 1e-8):
+        got = solve(scale, 0.4)  # from the linear solution
+        np.testing.assert_allclose(got["coeffs"] / scale, unit["coeffs"], rtol=0, atol=1e-9 * np.max(np.abs(unit["coeffs"])))
+        assert got["residual_norm"] <= 1e-9 * 0.1 * scale and got["stable"] is True
+    # ‖r‖ ≤ tol + rtol·‖f̂‖: a loose rtol stops earlier; max_iter caps the iterations.
+    assert solve(1.0, 0.4)["iterations"] > hb.solve(
+        1.0, 0.04, 1.0, lambda x, v, th: x**3, 0.4, f=lambda th: 0.1 * np.cos(th), rtol=1e-4,
+        velocity_dependent=False)["iterations"]
+    with pytest.raises(hb.ConvergenceError):
+        hb.solve(1.0, 0.04, 1.0, lambda x, v, th: x**3, 1.6, f=lambda th: 0.1 * np.cos(th), max_iter=1,
+                 method="classic", velocity_dependent=False)
+    with pytest.raises(ValueError, match="tolerances"):
+        hb.solve(1.0, 0.04, 1.0, lambda x, v, th: x**3, 0.4, rtol=0.0, tol=0.0)
+    with pytest.raises(ValueError, match="`max_iter`"):
+        hb.solve(1.0, 0.04, 1.0, lambda x, v, th: x**3, 0.4, max_iter=0)
 
 
 def test_van_der_pol_limit_cycle_period_against_time_integration() -> None:

@@ -70,10 +70,12 @@ def solve(
     subharmonic: int = 1,
     method: Method = "modified",
     guess: Optional[ArrayLike] = None,
-    tol: float = 1e-10,
+    tol: float = 0.0,
     stability: bool = True,
     velocity_dependent: bool = True,
     vectorized: bool = False,
+    rtol: float = 1e-9,
+    max_iter: int = 100,
 ) -> Dict[str, Any]: ...
 def frc(
     m: Matrix,
@@ -85,9 +87,11 @@ def frc(
     omega_to: float,
     n: int = 20,
     samples: int = 64,
-    tol: float = 1e-10,
+    tol: float = 0.0,
     velocity_dependent: bool = True,
     vectorized: bool = False,
+    rtol: float = 1e-9,
+    max_iter: int = 100,
 ) -> Dict[str, Any]: ...
 def limit_cycle(
     m: Matrix,
@@ -99,9 +103,11 @@ def limit_cycle(
     guess: Optional[ArrayLike] = None,
     n: int = 20,
     samples: int = 64,
-    tol: float = 1e-10,
+    tol: float = 0.0,
     velocity_dependent: bool = True,
     vectorized: bool = False,
+    rtol: float = 1e-9,
+    max_iter: int = 100,
 ) -> Dict[str, Any]: ...
 @overload
 def eval_series(coeffs: ArrayLike, tau: float, order: int = 0, n_dof: Literal[1] = 1) -> float: ...
