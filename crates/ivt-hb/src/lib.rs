@@ -5,10 +5,13 @@
 
 pub mod aft;
 pub mod autonomous;
+pub mod bifurcation;
 pub mod broyden;
 pub mod classic;
 pub mod continuation;
 mod dense;
+pub mod events;
+pub mod family;
 pub mod floquet;
 pub mod fold;
 pub mod frc;
@@ -24,6 +27,10 @@ pub mod stability;
 
 pub use aft::{Aft, AftError};
 pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
+pub use bifurcation::{
+    locate_branch_point, locate_multiplier_crossing, period_doubled_start, switch_branch,
+    Bifurcation, BifurcationError, BifurcationKind, BifurcationOptions,
+};
 pub use broyden::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
 };
@@ -31,7 +38,9 @@ pub use classic::ClassicIhb;
 pub use continuation::{
     pseudo_arclength, ContinuationError, ContinuationOptions, Fold, Path, PathPoint, Termination,
 };
+pub use events::{trace, Event, Trace, TraceOptions, TracedPoint};
 pub use faer::c64;
+pub use family::{Family, FamilyBranch};
 pub use floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
 pub use fold::{locate_fold, Branch, FoldLocation, FoldOptions, HbBranch};
 pub use frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
