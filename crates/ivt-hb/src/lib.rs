@@ -24,12 +24,13 @@ pub mod modified;
 pub mod ode;
 pub mod problem;
 pub mod stability;
+pub mod switching;
 
 pub use aft::{Aft, AftError};
 pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
 pub use bifurcation::{
-    locate_branch_point, locate_multiplier_crossing, period_doubled_start, switch_branch,
-    Bifurcation, BifurcationError, BifurcationKind, BifurcationOptions,
+    locate_branch_point, locate_multiplier_crossing, Bifurcation, BifurcationError,
+    BifurcationKind, BifurcationOptions,
 };
 pub use broyden::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
@@ -50,5 +51,6 @@ pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;
 pub use problem::{Duffing, GeneralProblem, MathieuDuffing, PeriodicProblem};
 pub use stability::{classify, Floquet, StabilityAnalyzer, StabilityKind};
+pub use switching::{period_doubled_start, switch_branch};
 
 pub mod sthb;
