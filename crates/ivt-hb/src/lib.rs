@@ -5,11 +5,13 @@
 
 pub mod aft;
 pub mod autonomous;
+pub mod backbone;
 pub mod bifurcation;
 pub mod broyden;
 pub mod classic;
 pub mod continuation;
 mod dense;
+pub mod elements;
 pub mod events;
 pub mod family;
 pub mod floquet;
@@ -28,6 +30,7 @@ pub mod switching;
 
 pub use aft::{Aft, AftError};
 pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
+pub use backbone::{backbone, Backbone, BackboneOptions, BackbonePoint};
 pub use bifurcation::{
     locate_branch_point, locate_multiplier_crossing, Bifurcation, BifurcationError,
     BifurcationKind, BifurcationOptions,
@@ -39,6 +42,7 @@ pub use classic::ClassicIhb;
 pub use continuation::{
     pseudo_arclength, ContinuationError, ContinuationOptions, Fold, Path, PathPoint, Termination,
 };
+pub use elements::{Element, ElementProblem, Harmonic, Law};
 pub use events::{trace, Event, Trace, TraceOptions, TracedPoint};
 pub use faer::c64;
 pub use family::{Family, FamilyBranch};
