@@ -350,7 +350,7 @@ impl Bordered {
 }
 
 /// Two steps of inverse iteration with `J` (or `Jᵀ`) from `v`, normalised.
-fn null_vector(jac: &[f64], m: usize, v: &mut [f64], transpose: bool) -> bool {
+pub(crate) fn null_vector(jac: &[f64], m: usize, v: &mut [f64], transpose: bool) -> bool {
     for _ in 0..2 {
         if !solve_dense(jac, m, v, transpose) {
             return false;

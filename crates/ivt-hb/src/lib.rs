@@ -5,11 +5,16 @@
 
 pub mod aft;
 pub mod autonomous;
+pub mod backbone;
+pub mod bifurcation;
 pub mod broyden;
 pub mod classic;
 pub mod continuation;
 mod dense;
 mod error;
+pub mod elements;
+pub mod events;
+pub mod family;
 pub mod floquet;
 pub mod fold;
 pub mod frc;
@@ -22,9 +27,15 @@ pub mod modified;
 pub mod ode;
 pub mod problem;
 pub mod stability;
+pub mod switching;
 
 pub use aft::Aft;
 pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
+pub use backbone::{backbone, Backbone, BackboneOptions, BackbonePoint};
+pub use bifurcation::{
+    locate_branch_point, locate_multiplier_crossing, Bifurcation, BifurcationError,
+    BifurcationKind, BifurcationOptions,
+};
 pub use broyden::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
 };
@@ -34,7 +45,10 @@ pub use continuation::{
     PathPoint, PathSystem, Termination,
 };
 pub use error::HbError;
+pub use elements::{Element, ElementProblem, Harmonic, Law};
+pub use events::{trace, Event, Trace, TraceOptions, TracedPoint};
 pub use faer::c64;
+pub use family::{Family, FamilyBranch};
 pub use floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
 pub use fold::{locate_fold, Branch, FoldLocation, FoldOptions, HbBranch};
 pub use frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
@@ -47,5 +61,6 @@ pub use problem::{
     PeriodicProblem,
 };
 pub use stability::{classify, Floquet, StabilityAnalyzer, StabilityKind};
+pub use switching::{period_doubled_start, switch_branch};
 
 pub mod sthb;

@@ -1,0 +1,615 @@
+//! Period doubling, Neimark–Sacker and branch points of a periodic-orbit branch
+//! `R(q, λ) = 0` (the HB residual Eq. 61 of a [`Family`]), each located by Newton's
+//! method on a minimally extended system, and branch switching at them.
+//!
+//! A bifurcation is a common zero of `R` and of bordered test functions
+//! (Govaerts' bordering, as [`crate::fold`] does for folds): for a matrix `A(q, λ)`
+//! that turns singular there, `[[A, b], [cᵀ, 0]] [v; g] = [0; 1]` gives a smooth `g`
+//! that vanishes exactly where `A` is singular while the bordered matrix stays
+//! regular (`b`, `c` near its left and right null vectors at the start).
+//!
+//! - **Period doubling**: `A = Φ + I`, `Φ` the monodromy matrix of the orbit
+//!   (Hsu's method, Eq. 80): a multiplier −1.
+//! - **Neimark–Sacker**: `A = Φ⊙Φ − I`, `Φ⊙Φ` the second compound (bialternate
+//!   product) of `Φ`, whose eigenvalues are the products `μᵢμⱼ`, `i < j`: a complex
+//!   pair on the unit circle (`μμ̄ = 1`). A real pair `μ, 1/μ` (neutral saddle)
+//!   is also a zero and is reported as an error.
+//! - **Branch point** (simple): `[∂R/∂q, ∂R/∂λ]` (m × (m+1)) loses rank; two
+//!   test functions from the two-column bordering `[[R_x, b], [Cᵀ, 0]]`, and an
+//!   unfolding `R + μ b = 0` with μ unknown make the system square and regular.
+//!
+//! `∂R/∂q` is the exact Galerkin Jacobian (Eq. 56); `∂R/∂λ` and the derivatives of
+//! the test functions are central differences. Branch switching at the located
+//! points is in [`crate::switching`].
+
+use crate::broyden::SolveError;
+use crate::dense::{norm2, solve_dense};
+use crate::family::{Family, FamilyBranch};
+use crate::floquet::{eigenvalues, monodromy_uniform, HsuRule};
+use crate::fold::{null_vector, Branch};
+use crate::ihb::HbError;
+use crate::stability::StabilityAnalyzer;
+use faer::c64;
+use thiserror::Error;
+
+/// The kind of a located bifurcation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BifurcationKind {
+    /// A turning point in λ (a real multiplier through +1), located by
+    /// [`crate::fold::locate_fold`].
+    Fold,
+    /// A real Floquet multiplier through −1.
+    PeriodDoubling,
+    /// A complex pair of multipliers through the unit circle.
+    NeimarkSacker,
+    /// Two branches cross (rank loss of `[∂R/∂q, ∂R/∂λ]`).
+    BranchPoint,
+}
+
+/// Options of the extended-system Newton iterations.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BifurcationOptions {
+    /// Hsu sub-intervals of the monodromy matrix (Magnus4; > harmonics).
+    pub stability_steps: usize,
+    /// Stop when the Newton step is below this, relative to ‖q‖∞ and |λ|.
+    pub step_tol: f64,
+    /// Also stop when the step is below this (relative) and the residual no
+    /// longer falls by 4× per step (the noise floor of the differences).
+    pub noise_tol: f64,
+    /// Maximum Newton steps.
+    pub max_iter: usize,
+    /// Relative central-difference step for `∂R/∂λ` and the test functions.
+    pub fd_step: f64,
+}
+
+impl Default for BifurcationOptions {
+    fn default() -> Self {
+        Self {
+            stability_steps: 2048,
+            step_tol: 1e-11,
+            noise_tol: 1e-8,
+            max_iter: 30,
+            fd_step: 1e-6,
+        }
+    }
+}
+
+/// A located bifurcation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bifurcation {
+    /// What it is.
+    pub kind: BifurcationKind,
+    /// The orbit at the bifurcation.
+    pub q: Vec<f64>,
+    /// The parameter at the bifurcation.
+    pub lambda: f64,
+    /// Floquet multipliers there (Hsu), decreasing modulus.
+    pub multipliers: Vec<c64>,
+    /// Branch point only: an orthonormal basis of the null space of
+    /// `[∂R/∂q, ∂R/∂λ]` (two vectors of `m + 1` entries); empty otherwise.
+    pub null_vectors: Vec<Vec<f64>>,
+    /// Newton steps taken.
+    pub iterations: usize,
+    /// ‖R(q, λ)‖₂ at the result.
+    pub residual_norm: f64,
+}
+
+impl Bifurcation {
+    /// Branch point: the unit direction of the null space orthogonal to
+    /// `tangent` (the tangent of the branch that was followed, `m + 1`
+    /// entries): the initial direction of the other branch. `None` for other
+    /// kinds.
+    pub fn second_direction(&self, tangent: &[f64]) -> Option<Vec<f64>> {
+        let [v1, v2] = self.null_vectors.as_slice() else {
+            return None;
+        };
+        let (a, b) = (dot(tangent, v1), dot(tangent, v2));
+        // In span{v1, v2} the direction orthogonal to (a, b) is (−b, a).
+        let mut d: Vec<f64> = v1.iter().zip(v2).map(|(x, y)| -b * x + a * y).collect();
+        let n = norm2(&d);
+        if n == 0.0 || !n.is_finite() {
+            return None;
+        }
+        d.iter_mut().for_each(|x| *x /= n);
+        Some(d)
+    }
+}
+
+/// Errors of bifurcation location.
+#[derive(Debug, Clone, Error, PartialEq)]
+pub enum BifurcationError {
+    /// Sizes, solves or Newton failures (with the residual history).
+    #[error(transparent)]
+    Hb(#[from] HbError),
+    /// The Neimark–Sacker test converged to a real pair `μ, 1/μ`.
+    #[error(
+        "neutral saddle at λ = {lambda} (real multipliers μ and 1/μ), not a Neimark–Sacker point"
+    )]
+    NeutralSaddle {
+        /// Where.
+        lambda: f64,
+    },
+}
+
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+pub(crate) fn solve_error(e: SolveError) -> BifurcationError {
+    BifurcationError::Hb(HbError::Solve(e))
+}
+
+/// The monodromy matrix Φ of the orbit `q` at λ (Hsu, Magnus4, `steps` steps).
+pub(crate) struct Monodromy {
+    analyzer: StabilityAnalyzer,
+    steps: usize,
+    dim: usize,
+    phi: Vec<f64>,
+}
+
+impl Monodromy {
+    pub(crate) fn new<F: Family>(
+        branch: &FamilyBranch<F>,
+        lambda: f64,
+        steps: usize,
+    ) -> Result<Self, HbError> {
+        let problem = branch.family().at(lambda).0;
+        let analyzer = StabilityAnalyzer::new(&problem, branch.options().harmonics, steps)?;
+        let dim = 2 * crate::PeriodicProblem::n_dof(&problem);
+        Ok(Self {
+            analyzer,
+            steps,
+            dim,
+            phi: vec![0.0; dim * dim],
+        })
+    }
+
+    fn eval<F: Family>(&mut self, branch: &FamilyBranch<F>, q: &[f64], lambda: f64) -> &[f64] {
+        let (problem, sol) = branch.solution(q, lambda);
+        let theta = self.analyzer.theta_samples(&problem, &sol);
+        let period = 2.0 * std::f64::consts::PI;
+        monodromy_uniform(
+            self.dim,
+            theta,
+            self.steps,
+            period,
+            HsuRule::Magnus4,
+            &mut self.phi,
+        );
+        &self.phi
+    }
+
+    pub(crate) fn multipliers<F: Family>(
+        &mut self,
+        branch: &FamilyBranch<F>,
+        q: &[f64],
+        lambda: f64,
+    ) -> Vec<c64> {
+        let dim = self.dim;
+        eigenvalues(self.eval(branch, q, lambda), dim)
+    }
+}
+
+/// `Φ + I` (period doubling) or `Φ⊙Φ − I` (Neimark–Sacker) into `a`; returns its size.
+fn test_matrix(kind: BifurcationKind, phi: &[f64], dim: usize, a: &mut Vec<f64>) -> usize {
+    a.clear();
+    if kind == BifurcationKind::PeriodDoubling {
+        a.extend_from_slice(phi);
+        for i in 0..dim {
+            a[i * dim + i] += 1.0;
+        }
+        return dim;
+    }
+    // Second compound: rows/columns are the pairs i < j, entries the 2×2 minors.
+    let pairs: Vec<(usize, usize)> = (0..dim)
+        .flat_map(|i| (i + 1..dim).map(move |j| (i, j)))
+        .collect();
+    let s = pairs.len();
+    for &(i, j) in &pairs {
+        for &(k, l) in &pairs {
+            a.push(phi[i * dim + k] * phi[j * dim + l] - phi[i * dim + l] * phi[j * dim + k]);
+        }
+    }
+    for d in 0..s {
+        a[d * s + d] -= 1.0;
+    }
+    s
+}
+
+/// `g` of `[[A, b], [cᵀ, 0]] [v; g] = [0; 1]` (NaN if singular).
+fn bordered_scalar(a: &[f64], s: usize, b: &[f64], c: &[f64]) -> f64 {
+    let n1 = s + 1;
+    let mut big = vec![0.0; n1 * n1];
+    for i in 0..s {
+        big[i * n1..i * n1 + s].copy_from_slice(&a[i * s..(i + 1) * s]);
+        big[i * n1 + s] = b[i];
+    }
+    big[s * n1..s * n1 + s].copy_from_slice(c);
+    let mut rhs = vec![0.0; n1];
+    rhs[s] = 1.0;
+    if solve_dense(&big, n1, &mut rhs, false) {
+        rhs[s]
+    } else {
+        f64::NAN
+    }
+}
+
+/// Central difference of the residual in λ.
+pub(crate) fn residual_lambda<B: Branch>(
+    branch: &mut B,
+    q: &[f64],
+    lambda: f64,
+    h: f64,
+    out: &mut [f64],
+) {
+    let m = q.len();
+    let (mut rp, mut rm) = (vec![0.0; m], vec![0.0; m]);
+    branch.residual(q, lambda + h, &mut rp);
+    branch.residual(q, lambda - h, &mut rm);
+    for i in 0..m {
+        out[i] = (rp[i] - rm[i]) / (2.0 * h);
+    }
+}
+
+pub(crate) fn lambda_step(opts: &BifurcationOptions, lambda: f64) -> f64 {
+    opts.fd_step * lambda.abs().max(1e-3)
+}
+
+/// Result of [`extended_newton`]: `(q, λ, iterations)`.
+type Converged = (Vec<f64>, f64, usize);
+
+/// Newton on `[R(q, λ) + Σⱼ μⱼ bⱼ; ψ(q, λ)] = 0`, unknowns `{q, λ, μ}` with
+/// `k = unfold.len() + 1` test functions `ψ` (the unfoldings `μ` make it square).
+fn extended_newton<B, T>(
+    branch: &mut B,
+    q0: &[f64],
+    lambda0: f64,
+    unfold: &[Vec<f64>],
+    mut tests: T,
+    opts: &BifurcationOptions,
+) -> Result<Converged, BifurcationError>
+where
+    B: Branch,
+    T: FnMut(&mut B, &[f64], f64, &mut [f64]),
+{
+    let m = branch.len();
+    let k = unfold.len() + 1;
+    let n = m + k;
+    let (mut q, mut lambda, mut mu) = (q0.to_vec(), lambda0, vec![0.0; k - 1]);
+    let (mut r, mut psi) = (vec![0.0; m], vec![0.0; k]);
+    let (mut psi_p, mut psi_m) = (vec![0.0; k], vec![0.0; k]);
+    let mut jac = vec![0.0; m * m];
+    let mut r_lambda = vec![0.0; m];
+    let mut newton = vec![0.0; n * n];
+    let mut step = vec![0.0; n];
+    let mut history: Vec<f64> = Vec::with_capacity(opts.max_iter + 1);
+    for it in 0..=opts.max_iter {
+        branch.residual(&q, lambda, &mut r);
+        for (b, mu_j) in unfold.iter().zip(&mu) {
+            r.iter_mut().zip(b).for_each(|(ri, bi)| *ri += mu_j * bi);
+        }
+        tests(branch, &q, lambda, &mut psi);
+        let norm = (norm2(&r).powi(2) + norm2(&psi).powi(2)).sqrt();
+        history.push(norm);
+        if !norm.is_finite() {
+            return Err(solve_error(SolveError::NonFinite {
+                iteration: it,
+                history,
+            }));
+        }
+        if it == opts.max_iter {
+            break;
+        }
+        branch.jacobian(&q, lambda, &mut jac);
+        let h_lambda = lambda_step(opts, lambda);
+        residual_lambda(branch, &q, lambda, h_lambda, &mut r_lambda);
+        newton.fill(0.0);
+        for i in 0..m {
+            newton[i * n..i * n + m].copy_from_slice(&jac[i * m..(i + 1) * m]);
+            newton[i * n + m] = r_lambda[i];
+            for (j, b) in unfold.iter().enumerate() {
+                newton[i * n + m + 1 + j] = b[i];
+            }
+        }
+        // Test-function rows by central differences in q and λ.
+        let q_scale = q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let mut qt = q.clone();
+        for col in 0..=m {
+            let h = if col < m {
+                opts.fd_step * q[col].abs().max(q_scale).max(f64::MIN_POSITIVE)
+            } else {
+                h_lambda
+            };
+            if col < m {
+                qt[col] = q[col] + h;
+                tests(branch, &qt, lambda, &mut psi_p);
+                qt[col] = q[col] - h;
+                tests(branch, &qt, lambda, &mut psi_m);
+                qt[col] = q[col];
+            } else {
+                tests(branch, &q, lambda + h, &mut psi_p);
+                tests(branch, &q, lambda - h, &mut psi_m);
+            }
+            for t in 0..k {
+                newton[(m + t) * n + col] = (psi_p[t] - psi_m[t]) / (2.0 * h);
+            }
+        }
+        for i in 0..m {
+            step[i] = -r[i];
+        }
+        for t in 0..k {
+            step[m + t] = -psi[t];
+        }
+        if !solve_dense(&newton, n, &mut step, false) {
+            return Err(solve_error(SolveError::SingularJacobian {
+                iteration: it,
+                history,
+            }));
+        }
+        q.iter_mut().zip(&step).for_each(|(x, d)| *x += d);
+        lambda += step[m];
+        mu.iter_mut().zip(&step[m + 1..]).for_each(|(x, d)| *x += d);
+        let dq = step[..m].iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let below = |tol: f64| {
+            dq <= tol * q_scale.max(f64::MIN_POSITIVE)
+                && step[m].abs() <= tol * lambda.abs().max(1e-3)
+        };
+        let stalled = it > 0 && norm > 0.25 * history[it - 1];
+        if below(opts.step_tol) || (stalled && below(opts.noise_tol)) {
+            return Ok((q, lambda, it + 1));
+        }
+    }
+    Err(solve_error(SolveError::NonConvergence {
+        iterations: opts.max_iter,
+        history,
+    }))
+}
+
+/// Locates the period doubling (multiplier −1) or Neimark–Sacker point (complex
+/// pair on the unit circle) nearest the converged orbit `(q0, λ0)` of `branch`.
+///
+/// # Errors
+/// [`BifurcationError::Hb`] for sizes, a singular bordered or extended system
+/// (with the history), non-convergence; [`BifurcationError::NeutralSaddle`] when
+/// a Neimark–Sacker search ends on a real pair `μ, 1/μ`.
+pub fn locate_multiplier_crossing<F: Family>(
+    branch: &mut FamilyBranch<F>,
+    kind: BifurcationKind,
+    q0: &[f64],
+    lambda0: f64,
+    opts: &BifurcationOptions,
+) -> Result<Bifurcation, BifurcationError> {
+    if !matches!(
+        kind,
+        BifurcationKind::PeriodDoubling | BifurcationKind::NeimarkSacker
+    ) {
+        return Err(HbError::InvalidInput(
+            "locate_multiplier_crossing takes period doubling or Neimark–Sacker".into(),
+        )
+        .into());
+    }
+    check_start(branch, q0, lambda0)?;
+    let mut mono = Monodromy::new(branch, lambda0, opts.stability_steps)?;
+    let dim = mono.dim;
+    let mut a = Vec::new();
+    let s = test_matrix(kind, mono.eval(branch, q0, lambda0), dim, &mut a);
+    let (mut b, mut c) = (
+        vec![1.0 / (s as f64).sqrt(); s],
+        vec![1.0 / (s as f64).sqrt(); s],
+    );
+    if !null_vector(&a, s, &mut c, false) || !null_vector(&a, s, &mut b, true) {
+        return Err(solve_error(SolveError::SingularJacobian {
+            iteration: 0,
+            history: Vec::new(),
+        }));
+    }
+    let (q, lambda, iterations) = extended_newton(
+        branch,
+        q0,
+        lambda0,
+        &[],
+        |br: &mut FamilyBranch<F>, q: &[f64], l: f64, out: &mut [f64]| {
+            let size = test_matrix(kind, mono.eval(br, q, l), dim, &mut a);
+            out[0] = bordered_scalar(&a, size, &b, &c);
+        },
+        opts,
+    )?;
+    let mut mono = Monodromy::new(branch, lambda, opts.stability_steps)?;
+    let multipliers = mono.multipliers(branch, &q, lambda);
+    if kind == BifurcationKind::NeimarkSacker {
+        let on_circle = multipliers
+            .iter()
+            .any(|z| (z.norm() - 1.0).abs() < 1e-6 && z.im.abs() > 1e-6);
+        if !on_circle {
+            return Err(BifurcationError::NeutralSaddle { lambda });
+        }
+    }
+    finish(branch, kind, q, lambda, multipliers, Vec::new(), iterations)
+}
+
+pub(crate) fn check_start<B: Branch>(branch: &B, q0: &[f64], lambda0: f64) -> Result<(), HbError> {
+    if q0.len() != branch.len() {
+        return Err(HbError::InvalidInput(format!(
+            "start must have {} entries, got {}",
+            branch.len(),
+            q0.len()
+        )));
+    }
+    if !(lambda0.is_finite() && q0.iter().all(|v| v.is_finite())) {
+        return Err(HbError::Solve(SolveError::NonFinite {
+            iteration: 0,
+            history: Vec::new(),
+        }));
+    }
+    Ok(())
+}
+
+pub(crate) fn finish<B: Branch>(
+    branch: &mut B,
+    kind: BifurcationKind,
+    q: Vec<f64>,
+    lambda: f64,
+    multipliers: Vec<c64>,
+    null_vectors: Vec<Vec<f64>>,
+    iterations: usize,
+) -> Result<Bifurcation, BifurcationError> {
+    let mut r = vec![0.0; q.len()];
+    branch.residual(&q, lambda, &mut r);
+    Ok(Bifurcation {
+        kind,
+        q,
+        lambda,
+        multipliers,
+        null_vectors,
+        iterations,
+        residual_norm: norm2(&r),
+    })
+}
+
+/// The two-column bordering of `[R_q, R_λ]` for branch points.
+struct BranchPointTest {
+    m: usize,
+    /// Border column (m).
+    b: Vec<f64>,
+    /// Border rows (2 × (m+1)).
+    c: [Vec<f64>; 2],
+    jac: Vec<f64>,
+    r_lambda: Vec<f64>,
+    big: Vec<f64>,
+    /// The last null-space columns `V` (2 × (m+1)).
+    v: [Vec<f64>; 2],
+}
+
+impl BranchPointTest {
+    /// `(g₁, g₂)` at `(q, λ)`; keeps `V` (NaN if singular).
+    fn eval<B: Branch>(&mut self, branch: &mut B, q: &[f64], lambda: f64, h: f64, out: &mut [f64]) {
+        let m = self.m;
+        let n = m + 2;
+        branch.jacobian(q, lambda, &mut self.jac);
+        residual_lambda(branch, q, lambda, h, &mut self.r_lambda);
+        self.big.fill(0.0);
+        for i in 0..m {
+            self.big[i * n..i * n + m].copy_from_slice(&self.jac[i * m..(i + 1) * m]);
+            self.big[i * n + m] = self.r_lambda[i];
+            self.big[i * n + m + 1] = self.b[i];
+        }
+        for t in 0..2 {
+            self.big[(m + t) * n..(m + t) * n + m + 1].copy_from_slice(&self.c[t]);
+        }
+        for t in 0..2 {
+            let mut rhs = vec![0.0; n];
+            rhs[m + t] = 1.0;
+            if !solve_dense(&self.big, n, &mut rhs, false) {
+                out.fill(f64::NAN);
+                return;
+            }
+            out[t] = rhs[m + 1];
+            self.v[t].copy_from_slice(&rhs[..m + 1]);
+        }
+    }
+}
+
+/// Locates the simple branch point nearest the converged orbit `(q0, λ0)` of
+/// `branch`, where the followed branch has unit tangent `tangent` (`m + 1`
+/// entries, λ last, e.g. the secant between two path points). The result
+/// carries the null space of `[R_q, R_λ]` there ([`Bifurcation::second_direction`]).
+///
+/// # Errors
+/// As [`locate_multiplier_crossing`] (no neutral-saddle case).
+pub fn locate_branch_point<F: Family>(
+    branch: &mut FamilyBranch<F>,
+    q0: &[f64],
+    lambda0: f64,
+    tangent: &[f64],
+    opts: &BifurcationOptions,
+) -> Result<Bifurcation, BifurcationError> {
+    check_start(branch, q0, lambda0)?;
+    let m = branch.len();
+    if tangent.len() != m + 1 || norm2(tangent) == 0.0 {
+        return Err(HbError::InvalidInput(format!(
+            "tangent must have {} entries, not all zero",
+            m + 1
+        ))
+        .into());
+    }
+    // Borders from the augmented matrix [[R_q, R_λ], [tᵀ]] at the start: its
+    // near-null vectors are the second branch direction (right) and the
+    // unfolding direction (left).
+    let n1 = m + 1;
+    let mut jac = vec![0.0; m * m];
+    let mut r_lambda = vec![0.0; m];
+    branch.jacobian(q0, lambda0, &mut jac);
+    residual_lambda(
+        branch,
+        q0,
+        lambda0,
+        lambda_step(opts, lambda0),
+        &mut r_lambda,
+    );
+    let t1: Vec<f64> = tangent.iter().map(|x| x / norm2(tangent)).collect();
+    let mut aug = vec![0.0; n1 * n1];
+    for i in 0..m {
+        aug[i * n1..i * n1 + m].copy_from_slice(&jac[i * m..(i + 1) * m]);
+        aug[i * n1 + m] = r_lambda[i];
+    }
+    aug[m * n1..].copy_from_slice(&t1);
+    let seed: Vec<f64> = (0..n1).map(|i| 1.0 + 0.1 * (i as f64).sin()).collect();
+    let (mut right, mut left) = (seed.clone(), seed);
+    if !null_vector(&aug, n1, &mut right, false) || !null_vector(&aug, n1, &mut left, true) {
+        return Err(solve_error(SolveError::SingularJacobian {
+            iteration: 0,
+            history: Vec::new(),
+        }));
+    }
+    let along = dot(&right, &t1);
+    right.iter_mut().zip(&t1).for_each(|(r, t)| *r -= along * t);
+    let nr = norm2(&right);
+    right.iter_mut().for_each(|r| *r /= nr);
+    let mut b = left[..m].to_vec();
+    let nb = norm2(&b);
+    b.iter_mut().for_each(|x| *x /= nb);
+    let mut test = BranchPointTest {
+        m,
+        b: b.clone(),
+        c: [t1, right],
+        jac,
+        r_lambda,
+        big: vec![0.0; (m + 2) * (m + 2)],
+        v: [vec![0.0; n1], vec![0.0; n1]],
+    };
+    let h = lambda_step(opts, lambda0);
+    let (q, lambda, iterations) = extended_newton(
+        branch,
+        q0,
+        lambda0,
+        &[b],
+        |br: &mut FamilyBranch<F>, q: &[f64], l: f64, out: &mut [f64]| test.eval(br, q, l, h, out),
+        opts,
+    )?;
+    let mut g = [0.0; 2];
+    test.eval(branch, &q, lambda, h, &mut g);
+    let null_vectors = orthonormal_pair(&test.v);
+    let mut mono = Monodromy::new(branch, lambda, opts.stability_steps)?;
+    let multipliers = mono.multipliers(branch, &q, lambda);
+    finish(
+        branch,
+        BifurcationKind::BranchPoint,
+        q,
+        lambda,
+        multipliers,
+        null_vectors,
+        iterations,
+    )
+}
+
+/// Gram–Schmidt on two vectors.
+fn orthonormal_pair(v: &[Vec<f64>; 2]) -> Vec<Vec<f64>> {
+    let mut a = v[0].clone();
+    let na = norm2(&a);
+    a.iter_mut().for_each(|x| *x /= na);
+    let along = dot(&v[1], &a);
+    let mut b: Vec<f64> = v[1].iter().zip(&a).map(|(x, y)| x - along * y).collect();
+    let nb = norm2(&b);
+    b.iter_mut().for_each(|x| *x /= nb);
+    vec![a, b]
+}

@@ -1,0 +1,157 @@
+//! Branch switching at a located bifurcation ([`crate::bifurcation`]):
+//! [`switch_branch`] steps from the bifurcation along a direction transversal to
+//! the known branch and corrects onto the new one (the second null vector at a
+//! branch point, [`crate::Bifurcation::second_direction`]; at a period doubling
+//! the odd-harmonic null vector of the period-2 Galerkin Jacobian,
+//! [`period_doubled_start`]).
+
+use crate::bifurcation::{
+    check_start, dot, lambda_step, residual_lambda, solve_error, Bifurcation, BifurcationError,
+    BifurcationKind, BifurcationOptions,
+};
+use crate::broyden::SolveError;
+use crate::dense::{norm2, solve_dense};
+use crate::family::{Family, FamilyBranch};
+use crate::fold::{null_vector, Branch};
+use crate::ihb::{HbError, HbOptions};
+
+/// A first point on a new branch: Newton on `[R(q, λ); dᵀ(x − x*) − h] = 0`
+/// (`x = {q, λ}`) from the predictor `x* + h d`, where `x* = {q, λ}` is the
+/// bifurcation and `d` a unit direction (`m + 1` entries) transversal to the
+/// known branch. Returns `(q, λ)`.
+///
+/// # Errors
+/// [`BifurcationError::Hb`] for sizes, a singular matrix or non-convergence.
+pub fn switch_branch<B: Branch>(
+    branch: &mut B,
+    q: &[f64],
+    lambda: f64,
+    direction: &[f64],
+    h: f64,
+    opts: &BifurcationOptions,
+) -> Result<(Vec<f64>, f64), BifurcationError> {
+    check_start(branch, q, lambda)?;
+    let m = branch.len();
+    let n1 = m + 1;
+    if direction.len() != n1 || !(h.is_finite() && h != 0.0) {
+        return Err(HbError::InvalidInput(format!(
+            "direction must have {n1} entries and h be finite and non-zero"
+        ))
+        .into());
+    }
+    let star: Vec<f64> = q.iter().copied().chain([lambda]).collect();
+    let mut x: Vec<f64> = star.iter().zip(direction).map(|(s, d)| s + h * d).collect();
+    let mut r = vec![0.0; m];
+    let mut jac = vec![0.0; m * m];
+    let mut r_lambda = vec![0.0; m];
+    let mut big = vec![0.0; n1 * n1];
+    let mut step = vec![0.0; n1];
+    let mut history = Vec::new();
+    for it in 0..=opts.max_iter {
+        branch.residual(&x[..m], x[m], &mut r);
+        let arc = dot(direction, &x) - dot(direction, &star) - h;
+        let norm = (norm2(&r).powi(2) + arc * arc).sqrt();
+        history.push(norm);
+        if !norm.is_finite() {
+            return Err(solve_error(SolveError::NonFinite {
+                iteration: it,
+                history,
+            }));
+        }
+        if it == opts.max_iter {
+            break;
+        }
+        branch.jacobian(&x[..m], x[m], &mut jac);
+        residual_lambda(
+            branch,
+            &x[..m],
+            x[m],
+            lambda_step(opts, x[m]),
+            &mut r_lambda,
+        );
+        for i in 0..m {
+            big[i * n1..i * n1 + m].copy_from_slice(&jac[i * m..(i + 1) * m]);
+            big[i * n1 + m] = r_lambda[i];
+            step[i] = -r[i];
+        }
+        big[m * n1..].copy_from_slice(direction);
+        step[m] = -arc;
+        if !solve_dense(&big, n1, &mut step, false) {
+            return Err(solve_error(SolveError::SingularJacobian {
+                iteration: it,
+                history,
+            }));
+        }
+        x.iter_mut().zip(&step).for_each(|(a, d)| *a += d);
+        let scale = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if step.iter().fold(0.0f64, |a, v| a.max(v.abs())) <= opts.step_tol * scale {
+            let lambda = x[m];
+            x.truncate(m);
+            return Ok((x, lambda));
+        }
+    }
+    Err(solve_error(SolveError::NonConvergence {
+        iterations: opts.max_iter,
+        history,
+    }))
+}
+
+/// The period-doubled branch at a located period doubling `pd` of the branch
+/// planned with `hb`: the orbit is re-expressed with period 2 (harmonic k → 2k,
+/// `2n` harmonics, subharmonic order `2p`, `2N` samples), where the period
+/// doubling is a branch point whose new direction is the odd-harmonic null
+/// vector of the period-2 Galerkin Jacobian; [`switch_branch`] then steps `h`
+/// along it. `family` must be the family of `pd`'s branch. Returns the period-2
+/// branch and its first point `(q, λ)`.
+///
+/// # Errors
+/// [`BifurcationError::Hb`] if `pd` is not a period doubling, for sizes, or when
+/// the null vector or the corrector fails.
+pub fn period_doubled_start<F: Family>(
+    family: F,
+    hb: &HbOptions,
+    pd: &Bifurcation,
+    h: f64,
+    opts: &BifurcationOptions,
+) -> Result<(FamilyBranch<F>, Vec<f64>, f64), BifurcationError> {
+    if pd.kind != BifurcationKind::PeriodDoubling {
+        return Err(HbError::InvalidInput("not a period-doubling point".into()).into());
+    }
+    let n = hb.harmonics;
+    let l = 2 * n + 1;
+    if !pd.q.len().is_multiple_of(l) {
+        return Err(HbError::InvalidInput("orbit size does not match the options".into()).into());
+    }
+    let mut hb2 = hb.clone();
+    hb2.harmonics = 2 * n;
+    hb2.n_half = 2 * hb.n_half;
+    hb2.subharmonic = 2 * hb.subharmonic;
+    let mut branch = FamilyBranch::new(family, &hb2, pd.lambda)?;
+    let l2 = 4 * n + 1;
+    let q2: Vec<f64> =
+        pd.q.chunks_exact(l)
+            .flat_map(|c| crate::aft::embed_subharmonic(c, 2, 2 * n))
+            .collect();
+    let m2 = q2.len();
+    let mut jac = vec![0.0; m2 * m2];
+    branch.jacobian(&q2, pd.lambda, &mut jac);
+    // Odd harmonics (a_k, b_k, k odd) of every DOF: the period-doubling mode.
+    let odd = |i: usize| {
+        let k = i % l2;
+        let h = if k > 2 * n { k - 2 * n } else { k };
+        k != 0 && h % 2 == 1
+    };
+    let mut v: Vec<f64> = (0..m2).map(|i| if odd(i) { 1.0 } else { 0.0 }).collect();
+    if !null_vector(&jac, m2, &mut v, false) {
+        return Err(solve_error(SolveError::SingularJacobian {
+            iteration: 0,
+            history: Vec::new(),
+        }));
+    }
+    let mut d: Vec<f64> = (0..m2).map(|i| if odd(i) { v[i] } else { 0.0 }).collect();
+    let nd = norm2(&d);
+    d.iter_mut().for_each(|x| *x /= nd);
+    d.push(0.0);
+    let (q, lambda) = switch_branch(&mut branch, &q2, pd.lambda, &d, h, opts)?;
+    Ok((branch, q, lambda))
+}
