@@ -36,7 +36,11 @@ fn curve_points(params: StringParams) -> Result<Points, String> {
 
 /// (all points, unstable points with NaN gaps elsewhere).
 fn split(frc: &Frc) -> (Points, Points) {
-    let all = frc.points.iter().map(|p| (p.omega_f, p.amplitude)).collect();
+    let all = frc
+        .points
+        .iter()
+        .map(|p| (p.omega_f, p.amplitude))
+        .collect();
     let unstable = frc
         .points
         .iter()

@@ -11,8 +11,8 @@ pub mod broyden;
 pub mod classic;
 pub mod continuation;
 mod dense;
-mod error;
 pub mod elements;
+mod error;
 pub mod events;
 pub mod family;
 pub mod floquet;
@@ -44,8 +44,8 @@ pub use continuation::{
     pseudo_arclength, pseudo_arclength_exact, ContinuationError, ContinuationOptions, Fold, Path,
     PathPoint, PathSystem, Termination,
 };
-pub use error::HbError;
 pub use elements::{Element, ElementProblem, Harmonic, Law};
+pub use error::HbError;
 pub use events::{trace, Event, Trace, TraceOptions, TracedPoint};
 pub use faer::c64;
 pub use family::{Family, FamilyBranch};
