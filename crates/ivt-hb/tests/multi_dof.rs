@@ -58,20 +58,19 @@ fn coupled_two_dof_orbit_and_stability() {
     let mut an = StabilityAnalyzer::new(&problem, 24, 4096).unwrap();
     let hsu = an.hsu(&problem, &sol, HsuRule::Magnus4);
     let hill = an.hill(&problem, &sol, 24).unwrap();
-    // Sorted by modulus, the two members of a conjugate pair tie: compare as
-    // sets (each multiplier against the nearest of the other method, both ways).
-    let nearest = |a: &[ivt_hb::c64], b: &[ivt_hb::c64]| {
-        a.iter()
-            .map(|x| {
-                b.iter()
-                    .map(|y| (x - y).norm())
-                    .fold(f64::INFINITY, f64::min)
-            })
-            .fold(0.0, f64::max)
+    // Sorted by modulus, the two members of a conjugate pair tie and may come in
+    // either order: pair them by imaginary part instead (all four are distinct).
+    let by_im = |mu: &[ivt_hb::c64]| {
+        let mut v = mu.to_vec();
+        v.sort_by(|a, b| a.im.total_cmp(&b.im));
+        v
     };
     assert_eq!(hsu.multipliers.len(), hill.multipliers.len());
-    let d = nearest(&hsu.multipliers, &hill.multipliers)
-        .max(nearest(&hill.multipliers, &hsu.multipliers));
+    let d = by_im(&hsu.multipliers)
+        .iter()
+        .zip(&by_im(&hill.multipliers))
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
     eprintln!("Hsu {:?}\nHill {:?}", hsu.multipliers, hill.multipliers);
     eprintln!("Hsu vs Hill {d:.2e}");
     assert!(d < 1e-12, "{d:e}");
