@@ -6,7 +6,9 @@
 
 use ivt_hb::{frequency_response, Element, ElementProblem, FrcOptions, Harmonic, HbOptions, Law};
 
-fn main() {
+/// `ẍ + 0.01ẋ + x + 0.05 tanh(ẋ/0.1) = 0.2 cos ω_f t` (also the model of
+/// `tests/elements.rs`).
+pub fn damper() -> ElementProblem {
     let friction = Element {
         a: 0,
         b: None,
@@ -20,15 +22,17 @@ fn main() {
         amplitude: 0.2,
         phase: 0.0,
     };
-    let damper = ElementProblem::new(
+    ElementProblem::new(
         1,
-        vec![1.0],
-        vec![0.01],
-        vec![1.0],
+        [vec![1.0], vec![0.01], vec![1.0]],
         vec![friction],
         vec![forcing],
     )
-    .expect("valid model");
+    .expect("valid model")
+}
+
+fn main() {
+    let damper = damper();
     let opts = FrcOptions {
         from: 0.6,
         to: 1.4,

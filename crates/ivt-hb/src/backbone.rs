@@ -9,8 +9,8 @@
 //! system becomes square and regular. With the frequency ω unknown, the phase
 //! condition `b₁ = 0` on the reference DOF (as [`crate::autonomous`]) and the
 //! amplitude `a₁` of that DOF prescribed, the unknowns are `{q, ω, κ}` and `a₁`
-//! is the continuation parameter ([`pseudo_arclength`], Eq. 68–77). The damping
-//! `C` and excitation `f` of the given problem are not used.
+//! is the continuation parameter ([`pseudo_arclength`], Eq. 68–77). The problem
+//! must be undamped and unforced (`C = 0`, `f = 0`; checked).
 
 use crate::continuation::{pseudo_arclength, ContinuationOptions, Termination};
 use crate::ihb::{HbError, HbOptions, HbResidual};
@@ -63,50 +63,20 @@ pub struct Backbone {
     pub termination: Termination,
 }
 
-/// The undamped, unforced `problem` with the unfolding damping `κ M`.
-struct Unfolded<'a, P> {
-    inner: &'a P,
-    damping: Vec<f64>,
-}
-
-impl<'a, P: PeriodicProblem> Unfolded<'a, P> {
-    fn new(inner: &'a P, kappa: f64) -> Self {
-        let damping = inner.mass().iter().map(|m| kappa * m).collect();
-        Self { inner, damping }
-    }
-}
-
-impl<P: PeriodicProblem> PeriodicProblem for Unfolded<'_, P> {
-    fn n_dof(&self) -> usize {
-        self.inner.n_dof()
-    }
-    fn mass(&self) -> &[f64] {
-        self.inner.mass()
-    }
-    fn damping(&self) -> &[f64] {
-        &self.damping
-    }
-    fn stiffness(&self) -> &[f64] {
-        self.inner.stiffness()
-    }
-    fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
-        self.inner.nonlinear(x, v, theta, out)
-    }
-    fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
-        self.inner.nonlinear_samples(x, v, theta, out)
-    }
-    fn velocity_dependent(&self) -> bool {
-        self.inner.velocity_dependent()
-    }
-    fn nonlinear_jacobian(
-        &self,
-        x: &[f64],
-        v: &[f64],
-        theta: f64,
-        dg_dx: &mut [f64],
-        dg_dv: &mut [f64],
-    ) {
-        self.inner.nonlinear_jacobian(x, v, theta, dg_dx, dg_dv)
+/// Adds the Galerkin projection of the unfolding damping `κ M ẋ` (τ = ωt) to
+/// `r`: harmonic h gives `κhω M b_h` to the cosine rows and `−κhω M a_h` to the
+/// sine rows (the damping part of Eq. 60 with `C = κM`).
+fn add_unfolding(mass: &[f64], nd: usize, n: usize, q: &[f64], kappa_omega: f64, r: &mut [f64]) {
+    let l = 2 * n + 1;
+    for d in 0..nd {
+        for e in 0..nd {
+            let me = mass[d * nd + e] * kappa_omega;
+            for h in 1..=n {
+                let s = h as f64 * me;
+                r[d * l + h] += s * q[e * l + n + h];
+                r[d * l + n + h] -= s * q[e * l + h];
+            }
+        }
     }
 }
 
@@ -116,8 +86,8 @@ impl<P: PeriodicProblem> PeriodicProblem for Unfolded<'_, P> {
 /// must be 1.
 ///
 /// # Errors
-/// [`HbError::InvalidInput`] for sizes, a zero reference entry of `mode`, or
-/// bad amplitudes; [`HbError::Continuation`] when the start does not converge.
+/// [`HbError::InvalidInput`] for sizes, a zero reference entry of `mode`, bad
+/// amplitudes, or a problem with damping or excitation; [`HbError::Continuation`] when the start does not converge.
 pub fn backbone<P: PeriodicProblem>(
     problem: &P,
     hb: &HbOptions,
@@ -142,7 +112,17 @@ pub fn backbone<P: PeriodicProblem>(
             "amplitudes must be finite and distinct, ω₀ positive".into(),
         ));
     }
-    let mut res = HbResidual::new(&Unfolded::new(problem, 0.0), hb)?;
+    let mut res = HbResidual::new(problem, hb)?;
+    if problem
+        .damping()
+        .iter()
+        .chain(res.excitation())
+        .any(|v| *v != 0.0)
+    {
+        return Err(HbError::InvalidInput(
+            "a backbone needs an undamped, unforced problem (C = 0, f = 0)".into(),
+        ));
+    }
     let m = res.len();
     let l = 2 * hb.harmonics + 1;
     let (a1, b1) = (opts.dof * l + 1, opts.dof * l + hb.harmonics + 1);
@@ -158,8 +138,15 @@ pub fn backbone<P: PeriodicProblem>(
     copts.lambda_max = a_from.max(a_to);
     let path = pseudo_arclength(
         |x: &[f64], r: &mut [f64]| {
-            let unfolded = Unfolded::new(problem, x[m + 1]);
-            res.eval(&unfolded, &x[..m], x[m], 1.0, &mut r[..m]);
+            res.eval(problem, &x[..m], x[m], 1.0, &mut r[..m]);
+            add_unfolding(
+                problem.mass(),
+                nd,
+                hb.harmonics,
+                &x[..m],
+                x[m + 1] * x[m],
+                r,
+            );
             r[m] = x[b1];
             r[m + 1] = x[a1] - x[m + 2];
         },

@@ -234,6 +234,29 @@ fn bordered_scalar(a: &[f64], s: usize, b: &[f64], c: &[f64]) -> f64 {
     }
 }
 
+/// Writes `[J | R_λ]` (`m` rows) into the first `m + 1` columns of the row-major
+/// matrix `dst` with row stride `stride`.
+pub(crate) fn put_jacobian(dst: &mut [f64], stride: usize, jac: &[f64], r_lambda: &[f64]) {
+    let m = r_lambda.len();
+    for i in 0..m {
+        dst[i * stride..i * stride + m].copy_from_slice(&jac[i * m..(i + 1) * m]);
+        dst[i * stride + m] = r_lambda[i];
+    }
+}
+
+/// Appends ‖F‖ to the Newton history; a non-finite norm ends the iteration
+/// with the history.
+pub(crate) fn record(history: &mut Vec<f64>, norm: f64) -> Result<(), BifurcationError> {
+    history.push(norm);
+    if norm.is_finite() {
+        return Ok(());
+    }
+    Err(solve_error(SolveError::NonFinite {
+        iteration: history.len() - 1,
+        history: std::mem::take(history),
+    }))
+}
+
 /// Central difference of the residual in λ.
 pub(crate) fn residual_lambda<B: Branch>(
     branch: &mut B,
@@ -289,14 +312,10 @@ where
             r.iter_mut().zip(b).for_each(|(ri, bi)| *ri += mu_j * bi);
         }
         tests(branch, &q, lambda, &mut psi);
-        let norm = (norm2(&r).powi(2) + norm2(&psi).powi(2)).sqrt();
-        history.push(norm);
-        if !norm.is_finite() {
-            return Err(solve_error(SolveError::NonFinite {
-                iteration: it,
-                history,
-            }));
-        }
+        record(
+            &mut history,
+            (norm2(&r).powi(2) + norm2(&psi).powi(2)).sqrt(),
+        )?;
         if it == opts.max_iter {
             break;
         }
@@ -304,9 +323,8 @@ where
         let h_lambda = lambda_step(opts, lambda);
         residual_lambda(branch, &q, lambda, h_lambda, &mut r_lambda);
         newton.fill(0.0);
+        put_jacobian(&mut newton, n, &jac, &r_lambda);
         for i in 0..m {
-            newton[i * n..i * n + m].copy_from_slice(&jac[i * m..(i + 1) * m]);
-            newton[i * n + m] = r_lambda[i];
             for (j, b) in unfold.iter().enumerate() {
                 newton[i * n + m + 1 + j] = b[i];
             }
@@ -354,7 +372,7 @@ where
             dq <= tol * q_scale.max(f64::MIN_POSITIVE)
                 && step[m].abs() <= tol * lambda.abs().max(1e-3)
         };
-        let stalled = it > 0 && norm > 0.25 * history[it - 1];
+        let stalled = it > 0 && history[it] > 0.25 * history[it - 1];
         if below(opts.step_tol) || (stalled && below(opts.noise_tol)) {
             return Ok((q, lambda, it + 1));
         }
@@ -488,9 +506,8 @@ impl BranchPointTest {
         branch.jacobian(q, lambda, &mut self.jac);
         residual_lambda(branch, q, lambda, h, &mut self.r_lambda);
         self.big.fill(0.0);
+        put_jacobian(&mut self.big, n, &self.jac, &self.r_lambda);
         for i in 0..m {
-            self.big[i * n..i * n + m].copy_from_slice(&self.jac[i * m..(i + 1) * m]);
-            self.big[i * n + m] = self.r_lambda[i];
             self.big[i * n + m + 1] = self.b[i];
         }
         for t in 0..2 {
@@ -548,10 +565,7 @@ pub fn locate_branch_point<F: Family>(
     );
     let t1: Vec<f64> = tangent.iter().map(|x| x / norm2(tangent)).collect();
     let mut aug = vec![0.0; n1 * n1];
-    for i in 0..m {
-        aug[i * n1..i * n1 + m].copy_from_slice(&jac[i * m..(i + 1) * m]);
-        aug[i * n1 + m] = r_lambda[i];
-    }
+    put_jacobian(&mut aug, n1, &jac, &r_lambda);
     aug[m * n1..].copy_from_slice(&t1);
     let seed: Vec<f64> = (0..n1).map(|i| 1.0 + 0.1 * (i as f64).sin()).collect();
     let (mut right, mut left) = (seed.clone(), seed);

@@ -5,7 +5,7 @@
 //! the relative displacement `δ = x_a − x_b` and velocity `δ̇ = v_a − v_b`; its
 //! force `F(δ, δ̇)` is added to `g_a` and subtracted from `g_b`.
 
-use crate::problem::PeriodicProblem;
+use crate::problem::{matrix_getters, PeriodicProblem};
 
 /// The force law of one element.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -62,20 +62,13 @@ impl Law {
                 (force * t, 0.0, force * (1.0 - t * t) / v_reg)
             }
             Law::Clearance { gap, k } => {
-                if d > gap {
-                    (k * (d - gap), k, 0.0)
-                } else if d < -gap {
-                    (k * (d + gap), k, 0.0)
-                } else {
-                    (0.0, 0.0, 0.0)
-                }
+                let (push, push_x) = one_sided(d, gap, k);
+                let (pull, pull_x) = one_sided(-d, gap, k);
+                (push - pull, push_x + pull_x, 0.0)
             }
             Law::Unilateral { gap, k } => {
-                if d > gap {
-                    (k * (d - gap), k, 0.0)
-                } else {
-                    (0.0, 0.0, 0.0)
-                }
+                let (f, fx) = one_sided(d, gap, k);
+                (f, fx, 0.0)
             }
         }
     }
@@ -86,6 +79,15 @@ impl Law {
             self,
             Law::QuadraticDamper { .. } | Law::CubicDamper { .. } | Law::Coulomb { .. }
         )
+    }
+}
+
+/// `(k (δ − gap), k)` beyond the gap, `(0, 0)` before it.
+fn one_sided(d: f64, gap: f64, k: f64) -> (f64, f64) {
+    if d > gap {
+        (k * (d - gap), k)
+    } else {
+        (0.0, 0.0)
     }
 }
 
@@ -123,7 +125,7 @@ pub struct ElementProblem {
 }
 
 impl ElementProblem {
-    /// `M`, `C`, `K` row-major `n×n`, the elements and the forcing.
+    /// `[M, C, K]` row-major `n×n`, the elements and the forcing.
     ///
     /// # Errors
     /// A message naming the first bad input: matrix sizes, a DOF ≥ n, an element
@@ -131,9 +133,7 @@ impl ElementProblem {
     /// negative gap or stiffness).
     pub fn new(
         n: usize,
-        m: Vec<f64>,
-        c: Vec<f64>,
-        k: Vec<f64>,
+        [m, c, k]: [Vec<f64>; 3],
         elements: Vec<Element>,
         forcing: Vec<Harmonic>,
     ) -> Result<Self, String> {
@@ -183,18 +183,7 @@ impl ElementProblem {
 }
 
 impl PeriodicProblem for ElementProblem {
-    fn n_dof(&self) -> usize {
-        self.n
-    }
-    fn mass(&self) -> &[f64] {
-        &self.m
-    }
-    fn damping(&self) -> &[f64] {
-        &self.c
-    }
-    fn stiffness(&self) -> &[f64] {
-        &self.k
-    }
+    matrix_getters!();
     fn nonlinear(&self, x: &[f64], v: &[f64], _theta: f64, out: &mut [f64]) {
         out.fill(0.0);
         for e in &self.elements {
@@ -277,7 +266,7 @@ mod tests {
             })
             .collect();
         let eye = vec![1.0, 0.0, 0.0, 1.0];
-        let p = ElementProblem::new(2, eye.clone(), eye.clone(), eye, elements, vec![]).unwrap();
+        let p = ElementProblem::new(2, [eye.clone(), eye.clone(), eye], elements, vec![]).unwrap();
         let (x, v) = ([0.9, -0.35], [0.3, -0.4]);
         let (mut jx, mut jv) = ([0.0; 4], [0.0; 4]);
         p.nonlinear_jacobian(&x, &v, 0.0, &mut jx, &mut jv);
@@ -315,9 +304,7 @@ mod tests {
         let bad = |law| {
             ElementProblem::new(
                 1,
-                eye.clone(),
-                eye.clone(),
-                eye.clone(),
+                [eye.clone(), eye.clone(), eye.clone()],
                 vec![Element { a: 0, b: None, law }],
                 vec![],
             )
@@ -336,9 +323,7 @@ mod tests {
         };
         assert!(ElementProblem::new(
             1,
-            eye.clone(),
-            eye.clone(),
-            eye.clone(),
+            [eye.clone(), eye.clone(), eye.clone()],
             vec![self_loop],
             vec![]
         )

@@ -7,6 +7,35 @@
 //! the nonlinear/parametric part `g` in the time domain, the excitation `f`, and
 //! optionally the derivatives of `g` (default: central differences).
 
+/// `n_dof` (the field `n`, or a literal), `mass`, `damping`, `stiffness` of a
+/// problem that stores the row-major matrices `m`, `c`, `k` as fields.
+macro_rules! matrix_getters {
+    () => {
+        fn n_dof(&self) -> usize {
+            self.n
+        }
+        matrix_getters!(@mck);
+    };
+    ($n:literal) => {
+        fn n_dof(&self) -> usize {
+            $n
+        }
+        matrix_getters!(@mck);
+    };
+    (@mck) => {
+        fn mass(&self) -> &[f64] {
+            &self.m
+        }
+        fn damping(&self) -> &[f64] {
+            &self.c
+        }
+        fn stiffness(&self) -> &[f64] {
+            &self.k
+        }
+    };
+}
+pub(crate) use matrix_getters;
+
 /// A periodically forced second-order system (see the module docs).
 pub trait PeriodicProblem {
     /// Number of degrees of freedom.
@@ -235,18 +264,7 @@ impl Duffing {
 }
 
 impl PeriodicProblem for Duffing {
-    fn n_dof(&self) -> usize {
-        1
-    }
-    fn mass(&self) -> &[f64] {
-        &self.m
-    }
-    fn damping(&self) -> &[f64] {
-        &self.c
-    }
-    fn stiffness(&self) -> &[f64] {
-        &self.k
-    }
+    matrix_getters!(1);
     fn nonlinear(&self, x: &[f64], _v: &[f64], _theta: f64, out: &mut [f64]) {
         out[0] = self.eps * x[0] * x[0] * x[0];
     }
@@ -300,18 +318,7 @@ impl MathieuDuffing {
 }
 
 impl PeriodicProblem for MathieuDuffing {
-    fn n_dof(&self) -> usize {
-        1
-    }
-    fn mass(&self) -> &[f64] {
-        &self.m
-    }
-    fn damping(&self) -> &[f64] {
-        &self.c
-    }
-    fn stiffness(&self) -> &[f64] {
-        &self.k
-    }
+    matrix_getters!(1);
     fn nonlinear(&self, x: &[f64], _v: &[f64], theta: f64, out: &mut [f64]) {
         out[0] = -self.beta * theta.sin() * x[0] + self.gamma * x[0] * x[0] * x[0];
     }
@@ -410,18 +417,7 @@ where
     G: Nonlinearity,
     F: Fn(f64, &mut [f64]),
 {
-    fn n_dof(&self) -> usize {
-        self.n
-    }
-    fn mass(&self) -> &[f64] {
-        &self.m
-    }
-    fn damping(&self) -> &[f64] {
-        &self.c
-    }
-    fn stiffness(&self) -> &[f64] {
-        &self.k
-    }
+    matrix_getters!();
     fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
         self.g.eval(x, v, theta, out)
     }

@@ -6,8 +6,8 @@
 //! [`period_doubled_start`]).
 
 use crate::bifurcation::{
-    check_start, dot, lambda_step, residual_lambda, solve_error, Bifurcation, BifurcationError,
-    BifurcationKind, BifurcationOptions,
+    check_start, dot, lambda_step, put_jacobian, record, residual_lambda, solve_error, Bifurcation,
+    BifurcationError, BifurcationKind, BifurcationOptions,
 };
 use crate::broyden::SolveError;
 use crate::dense::{norm2, solve_dense};
@@ -50,14 +50,7 @@ pub fn switch_branch<B: Branch>(
     for it in 0..=opts.max_iter {
         branch.residual(&x[..m], x[m], &mut r);
         let arc = dot(direction, &x) - dot(direction, &star) - h;
-        let norm = (norm2(&r).powi(2) + arc * arc).sqrt();
-        history.push(norm);
-        if !norm.is_finite() {
-            return Err(solve_error(SolveError::NonFinite {
-                iteration: it,
-                history,
-            }));
-        }
+        record(&mut history, (norm2(&r).powi(2) + arc * arc).sqrt())?;
         if it == opts.max_iter {
             break;
         }
@@ -69,9 +62,8 @@ pub fn switch_branch<B: Branch>(
             lambda_step(opts, x[m]),
             &mut r_lambda,
         );
+        put_jacobian(&mut big, n1, &jac, &r_lambda);
         for i in 0..m {
-            big[i * n1..i * n1 + m].copy_from_slice(&jac[i * m..(i + 1) * m]);
-            big[i * n1 + m] = r_lambda[i];
             step[i] = -r[i];
         }
         big[m * n1..].copy_from_slice(direction);

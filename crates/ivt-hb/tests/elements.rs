@@ -1,38 +1,15 @@
 //! The element library in use: the friction-damper FRC of
-//! `examples/friction_damper.rs` against long time integration.
+//! `examples/friction_damper.rs` against time integration.
 
 use ivt_hb::aft::eval_series;
 use ivt_hb::ode::{first_order, rk4};
-use ivt_hb::{
-    frequency_response, Element, ElementProblem, FrcOptions, Harmonic, HbOptions, HbSolution, Law,
-    ModifiedIhb,
-};
+use ivt_hb::{frequency_response, FrcOptions, HbOptions, HbSolution, ModifiedIhb};
 
-/// `ẍ + 0.01ẋ + x + 0.05 tanh(ẋ/0.1) = 0.2 cos ω_f t` (the example's model).
-fn damper() -> ElementProblem {
-    let friction = Element {
-        a: 0,
-        b: None,
-        law: Law::Coulomb {
-            force: 0.05,
-            v_reg: 0.1,
-        },
-    };
-    let forcing = Harmonic {
-        dof: 0,
-        amplitude: 0.2,
-        phase: 0.0,
-    };
-    ElementProblem::new(
-        1,
-        vec![1.0],
-        vec![0.01],
-        vec![1.0],
-        vec![friction],
-        vec![forcing],
-    )
-    .unwrap()
-}
+// The example's model, shared so that the test checks exactly what it shows.
+#[path = "../examples/friction_damper.rs"]
+#[allow(dead_code)]
+mod example;
+use example::damper;
 
 #[test]
 fn friction_damper_frc_matches_time_integration() {
