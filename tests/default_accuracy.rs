@@ -27,14 +27,20 @@ fn duffing_multipliers(omega_f: f64, steps: usize) -> Vec<c64> {
         .multipliers
 }
 
-/// Largest distance from a multiplier of `a` to the nearest one of `b`.
+/// Largest |μ_i − ν_i| with both sets sorted by (Im, Re): a conjugate pair
+/// is split by the sign of Im, a real pair by Re, and the two step counts
+/// agree far more closely than any two multipliers of one set differ.
 fn multiplier_distance(a: &[c64], b: &[c64]) -> f64 {
-    a.iter()
-        .map(|x| {
-            b.iter()
-                .map(|y| (x - y).norm())
-                .fold(f64::INFINITY, f64::min)
-        })
+    assert_eq!(a.len(), b.len());
+    let sorted = |m: &[c64]| {
+        let mut v = m.to_vec();
+        v.sort_by(|x, y| x.im.total_cmp(&y.im).then(x.re.total_cmp(&y.re)));
+        v
+    };
+    sorted(a)
+        .iter()
+        .zip(&sorted(b))
+        .map(|(x, y)| (x - y).norm())
         .fold(0.0, f64::max)
 }
 
