@@ -2,9 +2,12 @@
 //! corpus ends in exit 2 with exactly one `{"error", "kind"}` object under
 //! `--json` (or a correct answer), closed pipes and full disks end in exit 2
 //! without a panic, failed or interrupted commands leave no file behind, and
-//! `ol solve` is accurate by default. A bounded proptest over argument
-//! vectors keeps it so (`IVT_FUZZ_CASES` sets the number of cases; the
-//! default 48 runs in well under two minutes).
+//! `ol solve` is accurate by default. Bounded proptests keep it so: over
+//! argument vectors, over shipped scenes with values replaced or deleted
+//! (counted: an eighth must pass validation and run), and over hostile pulse
+//! logs for `ctrl replay` (`IVT_FUZZ_CASES` sets the number of argument
+//! vectors, default 48, and half as many scenes and logs; well under two
+//! minutes together).
 
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
@@ -186,14 +189,16 @@ fn help_and_version_succeed() {
 #[test]
 fn closed_pipe_and_full_disk_exit_2() {
     let _serial = serial();
-    let mut child = Command::new(IVT)
+    // The reader end is closed before the spawn, so the answer is always
+    // written into a pipe without a reader (EPIPE), whatever the timing.
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = Command::new(IVT)
         .args(["--json", "hb", "duffing"])
-        .stdout(Stdio::piped())
+        .stdout(writer)
         .stderr(Stdio::piped())
-        .spawn()
+        .output()
         .unwrap();
-    drop(child.stdout.take()); // the reader closes before the answer is written
-    let out = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(!err.contains("panicked"), "{err}");
@@ -244,6 +249,36 @@ fn failed_write_leaves_the_directory_as_it_was() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Run `args` (which write into `out`), send SIGINT as soon as the first
+/// staged (temporary) file exists in `out`, and return the exit code and what
+/// is left in `out`.
+fn interrupt_once_staged(args: &[&str], out: &Path) -> (Option<i32>, Vec<String>) {
+    let child = Command::new(IVT)
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let t0 = Instant::now();
+    while !out.exists() || listing(out).is_empty() {
+        assert!(t0.elapsed() < Duration::from_secs(60), "no staged output");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    assert!(
+        listing(out).iter().all(|f| f.starts_with(".tmp-")),
+        "{:?}",
+        listing(out)
+    );
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let res = child.wait_with_output().unwrap();
+    let left = if out.exists() { listing(out) } else { vec![] };
+    (res.status.code(), left)
+}
+
 /// Ctrl-C during a simulation: exit 130 and no output (the partial MCAP and
 /// the output directory this run created are removed).
 #[test]
@@ -258,37 +293,25 @@ fn interrupted_sim_leaves_nothing() {
         .replace("duration_s = 60.0", "duration_s = 1800.0");
     let scene = dir.join("long_drive.toml");
     std::fs::write(&scene, drive).unwrap();
-    let child = Command::new(IVT)
-        .args([
-            "--json",
-            "sim",
-            scene.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    // wait until the staged MCAP exists, then interrupt
-    let t0 = Instant::now();
-    while !out.exists() || listing(&out).is_empty() {
-        assert!(t0.elapsed() < Duration::from_secs(60), "no staged output");
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    assert!(
-        listing(&out).iter().all(|f| f.starts_with(".tmp-")),
-        "{:?}",
-        listing(&out)
-    );
-    let status = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(status.success());
-    let res = child.wait_with_output().unwrap();
-    assert_eq!(res.status.code(), Some(130));
-    let left: Vec<String> = if out.exists() { listing(&out) } else { vec![] };
+    let (scene, out_arg) = (scene.to_str().unwrap(), out.to_str().unwrap());
+    let (code, left) = interrupt_once_staged(&["--json", "sim", scene, "--out", out_arg], &out);
+    assert_eq!(code, Some(130));
+    assert!(left.is_empty(), "left behind: {left:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Ctrl-C during `reproduce`: every figure and CSV is staged until the report
+/// is written, so an interrupted run leaves none of them (it used to leave
+/// 20 files and no report).
+#[test]
+fn interrupted_reproduce_leaves_nothing() {
+    let _serial = serial();
+    let dir = tmp("sigint-reproduce");
+    let out = dir.join("out");
+    let out_arg = out.to_str().unwrap();
+    let (code, left) =
+        interrupt_once_staged(&["--json", "reproduce", "--quick", "--out", out_arg], &out);
+    assert_eq!(code, Some(130));
     assert!(left.is_empty(), "left behind: {left:?}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -449,6 +472,193 @@ proptest! {
         }
         let argv: Vec<&str> = argv.iter().map(String::as_str).collect();
         if let Err(e) = contract(&argv, QUICK) {
+            prop_assert!(false, "{}", e);
+        }
+    }
+}
+
+/// Hostile replacements for one value of a scene file (TOML literals).
+fn scene_value() -> impl Strategy<Value = &'static str> {
+    prop::sample::select(vec![
+        "0",
+        "-1",
+        "0.5",
+        "2",
+        "1e-300",
+        "1e308",
+        "-1e308",
+        "nan",
+        "inf",
+        "-inf",
+        "4294967296",
+        "\"abc\"",
+        "\"\"",
+        "[]",
+        "[[0.0, 1.0]]",
+        "true",
+        "{}",
+        // Type-preserving edits: the number scaled (an integer stays one).
+        "*0.5",
+        "*2",
+        "*1.1",
+        "*0.1",
+        "*3",
+    ])
+}
+
+/// `value` with a `*factor` edit applied: a number scaled (integers stay
+/// integers); anything else unchanged.
+fn scaled(value: &str, edit: &str) -> Option<String> {
+    let factor: f64 = edit.strip_prefix('*')?.parse().ok()?;
+    let number = value.split('#').next()?.trim();
+    if let Ok(i) = number.parse::<i64>() {
+        return Some(format!("{}", (i as f64 * factor).round() as i64));
+    }
+    number
+        .parse::<f64>()
+        .ok()
+        .map(|x| format!("{:?}", x * factor))
+}
+
+/// A shipped scene with `edits` of its `key = value` lines replaced (or, for
+/// `None`, deleted): structure-aware mutations that keep the TOML mostly
+/// parseable, so that they reach the scene validation and the run.
+fn mutated_scene(name: &str, edits: &[(prop::sample::Index, Option<&str>)]) -> String {
+    let path = format!("{}/scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let assignments: Vec<usize> = lines
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| !l.trim_start().starts_with('#') && l.contains(" = "))
+        .map(|(i, _)| i)
+        .collect();
+    for (at, value) in edits {
+        let i = assignments[at.index(assignments.len())];
+        let key = lines[i].split(" = ").next().unwrap().to_string();
+        let old_value = lines[i].split(" = ").nth(1).unwrap_or("").to_string();
+        lines[i] = match value {
+            Some(v) if v.starts_with('*') => match scaled(&old_value, v) {
+                Some(x) => format!("{key} = {x}"),
+                None => lines[i].clone(),
+            },
+            Some(v) => format!("{key} = {v}"),
+            None => String::new(),
+        };
+    }
+    lines.join("\n")
+}
+
+/// Hostile pulse-log rows: a tick column (numbers out of range, negative,
+/// non-numbers, decreasing) with optional V_m and T_U columns.
+fn csv_cell() -> impl Strategy<Value = String> {
+    prop_oneof![
+        (0u64..5_000_000u64).prop_map(|t| t.to_string()),
+        prop::sample::select(vec![
+            "-1",
+            "4294967296",
+            "1e308",
+            "nan",
+            "inf",
+            "abc",
+            "",
+            "0.5",
+            "8.4",
+            "6.0",
+            " 12 ",
+        ])
+        .prop_map(str::to_string),
+    ]
+}
+
+/// A shipped scene with one to three values replaced or deleted: exit 0 or
+/// 2 within 60 s, one JSON object, and a refused scene writes nothing. The
+/// cases are counted: at least an eighth must pass validation and run (half
+/// the edits keep the type: a number scaled), so that the mutations reach the
+/// simulator and not only the TOML parser.
+#[test]
+fn mutated_scenes_keep_the_contract() {
+    use proptest::test_runner::{Config, TestRunner};
+    let strategy = (
+        prop::sample::select(vec![
+            "drive",
+            "steady_state",
+            "load_step_delay",
+            "saturation",
+            "voltage_step_open",
+        ]),
+        prop::collection::vec(
+            (
+                any::<prop::sample::Index>(),
+                prop::option::weighted(0.85, scene_value()),
+            ),
+            1..3,
+        ),
+    );
+    let config = Config {
+        cases: cases() / 2,
+        rng_seed: seed(),
+        failure_persistence: None,
+        ..Config::default()
+    };
+    let (ran, refused) = (std::cell::Cell::new(0u32), std::cell::Cell::new(0u32));
+    let dir = tmp("scene");
+    TestRunner::new(config)
+        .run(&strategy, |(name, edits)| {
+            let _serial = serial();
+            let scene = dir.join("scene.toml");
+            std::fs::write(&scene, mutated_scene(name, &edits)).unwrap();
+            let out = dir.join("out");
+            let _ = std::fs::remove_dir_all(&out);
+            let argv = [
+                "--json",
+                "sim",
+                scene.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ];
+            match contract(&argv, QUICK) {
+                Err(e) => prop_assert!(false, "{}", e),
+                Ok((2, _)) => {
+                    let left = if out.exists() { listing(&out) } else { vec![] };
+                    prop_assert!(left.is_empty(), "refused scene left {:?}", left);
+                    refused.set(refused.get() + 1);
+                }
+                Ok(_) => ran.set(ran.get() + 1),
+            }
+            Ok(())
+        })
+        .unwrap();
+    eprintln!(
+        "mutated scenes: {} ran, {} refused",
+        ran.get(),
+        refused.get()
+    );
+    assert!(
+        8 * ran.get() >= ran.get() + refused.get(),
+        "{} ran, {} refused",
+        ran.get(),
+        refused.get()
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: cases() / 2, rng_seed: seed(), failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// A pulse log of hostile rows: exit 0 or 2, one JSON object, no panic.
+    #[test]
+    fn hostile_replay_logs_keep_the_contract(
+        header in prop::sample::select(vec!["ticks", "ticks,vm,tu", "t", ""]),
+        rows in prop::collection::vec(prop::collection::vec(csv_cell(), 1..4), 0..40),
+    ) {
+        let _serial = serial();
+        let dir = std::env::temp_dir().join(format!("ivt-hardening-{}-csv", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let log = dir.join("log.csv");
+        let body: Vec<String> = rows.iter().map(|r| r.join(",")).collect();
+        std::fs::write(&log, format!("{header}\n{}\n", body.join("\n"))).unwrap();
+        if let Err(e) = contract(&["--json", "ctrl", "replay", log.to_str().unwrap()], QUICK) {
             prop_assert!(false, "{}", e);
         }
     }

@@ -253,6 +253,15 @@ fn reproduce_quick_pins_every_row_and_figure() {
     assert_eq!(count(D), 31);
     assert_eq!(count(NC), 2);
 
+    // Outputs are staged and renamed once the report is complete: no
+    // temporary file is left after a successful run.
+    let names: Vec<String> = std::fs::read_dir(&out)
+        .expect("out dir")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(names.iter().all(|n| !n.starts_with(".tmp-")), "{names:?}");
+    assert!(names.iter().any(|n| n == "REPRODUCTION.md"), "{names:?}");
+
     let figures = v["figures"].as_array().expect("figures");
     for want in FIGURES {
         let f = figures
