@@ -8,7 +8,6 @@ pub mod autonomous;
 pub mod broyden;
 pub mod classic;
 pub mod continuation;
-mod dense;
 pub mod floquet;
 pub mod fold;
 pub mod frc;

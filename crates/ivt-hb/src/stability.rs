@@ -8,7 +8,7 @@
 //! real μ < −1), Neimark–Sacker (a complex pair outside the unit circle).
 
 use crate::aft::{Aft, AftError};
-use crate::floquet::{eigenvalues, monodromy_uniform, small_inverse, HsuRule};
+use crate::floquet::{eigenvalues, monodromy_uniform, HsuRule};
 use crate::hill::{fourier_blocks, hill_multipliers, HillError};
 use crate::ihb::HbSolution;
 use crate::problem::PeriodicProblem;
@@ -118,7 +118,8 @@ impl StabilityAnalyzer {
     ) -> Result<Self, AftError> {
         let aft = Aft::new(harmonics, steps)?;
         let nd = problem.n_dof();
-        let minv = small_inverse(problem.mass(), nd).unwrap_or_else(|_| vec![f64::NAN; nd * nd]);
+        let minv =
+            ivt_num::lu::inverse(problem.mass(), nd).unwrap_or_else(|| vec![f64::NAN; nd * nd]);
         let dim = 2 * nd;
         let ns = 2 * steps;
         Ok(Self {

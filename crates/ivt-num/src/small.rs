@@ -47,7 +47,8 @@ pub fn inverse_into(a: &[f64], dim: usize, out: &mut [f64]) -> bool {
 mod tests {
     use super::*;
 
-    /// `[[1, 2], [3, 4]]² = [[7, 10], [15, 22]]` exactly; the inverse of the
+    /// `[[1, 2], [3, 4]]² = [[7, 10], [15, 22]]` and a non-commuting
+    /// product exactly; the inverse of the
     /// non-symmetric `[[4, 3], [6, 3]]` is `[[−½, ½], [1, −⅔]]` (det −6); a
     /// 5×5 (faer route) and a 3×3 (closed form) times their inverses give
     /// the identity to 1e-14; singular matrices are refused by both routes.
@@ -57,6 +58,9 @@ mod tests {
         let mut c = [0.0; 4];
         matmul(&a, &a, 2, &mut c);
         assert_eq!(c, [7.0, 10.0, 15.0, 22.0]);
+        // [[1, 2], [3, 4]]·[[0, 1], [5, 2]] = [[10, 5], [20, 11]] (order matters).
+        matmul(&a, &[0.0, 1.0, 5.0, 2.0], 2, &mut c);
+        assert_eq!(c, [10.0, 5.0, 20.0, 11.0]);
         let mut inv = [0.0; 4];
         assert!(inverse_into(&[4.0, 3.0, 6.0, 3.0], 2, &mut inv));
         for (g, w) in inv.iter().zip([-0.5, 0.5, 1.0, -2.0 / 3.0]) {
