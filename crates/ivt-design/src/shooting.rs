@@ -306,7 +306,7 @@ impl NewtonSystem for ReturnMap<'_> {
     /// A trial with ω(0) ≤ 0 is outside the domain (NaN residual: the step
     /// is halved); a revolution that stalls is an error.
     fn residual(&mut self, x: &[f64], res: &mut [f64]) -> Result<(), IvtError> {
-        if !(x[0] > 0.0) {
+        if x[0].is_nan() || x[0] <= 0.0 {
             res.fill(f64::NAN);
             return Ok(());
         }

@@ -19,7 +19,7 @@
 //!   error estimate and the step-size controller, dense output;
 //! - [`lu`]: dense LU on faer with caller-owned scratch, factor once per
 //!   Jacobian refresh and solve many without allocating;
-//! - [`small`]: products and inverses of small row-major blocks on nalgebra;
+//! - [`small`]: products of small row-major matrices on nalgebra;
 //! - [`newton`]: the one damped Newton method (dense Jacobian through
 //!   [`lu::LuWorkspace`], backtracking, residual and step tests).
 //!
