@@ -9,14 +9,16 @@
 //! map ω(0) ↦ ω(2π) (unique and attracting by Theorem 2); its period in time is
 //! T = ∫₀^{2π} dθ/ω, so the time mean of ω is ω_a = 2π/T (the quantity the
 //! controller measures, §4.3). The design point r̄ solves `ω_a(r̄) = ω0`.
-//! Both conditions are solved together by Newton on (ω(0), r), with the exact
-//! Jacobian from the variational equations integrated alongside.
+//! Both conditions are solved together by Newton ([`ivt_num::newton`]) on
+//! (ω(0), r), with the exact Jacobian from the variational equations
+//! integrated alongside.
 
 use super::pieces::{pieces, rk6, steps_for, Rk6};
 use super::{averaged_r, check_plant, IvtError, OperatingPoint};
 use core::f64::consts::PI;
 use ivt_kin::plant::PlantParams;
 use ivt_kin::variant::f_on_segment;
+use ivt_num::{newton, NewtonError, NewtonOptions, NewtonSystem, NewtonWorkspace};
 
 /// Accuracy and iteration limits of the shooting route.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -156,30 +158,16 @@ pub fn periodic_at_r(
         omega0: omega_guess,
     }
     .validate()?;
-    let mut rk = rk6(6);
-    let mut w0 = omega_guess;
-    let mut history = Vec::new();
-    for _ in 0..opts.max_iter {
-        let (y, lo, hi) = revolution(plant, v_m, t_u, r, w0, opts.steps_per_segment, &mut rk)?;
-        let res = y[0] - w0;
-        history.push(res.abs());
-        let step = res / (1.0 - y[2]);
-        // The map is a contraction (Theorem 2): keep ω(0) positive if Newton overshoots.
-        w0 = if w0 + step > 0.0 { w0 + step } else { 0.5 * w0 };
-        if step.abs() <= opts.tol * w0 {
-            return Ok(PeriodicOrbit {
-                r,
-                omega_start: w0,
-                period: y[1] + y[4] * step,
-                omega_min: lo,
-                omega_max: hi,
-            });
-        }
-    }
-    Err(IvtError::NoConvergence {
-        method: "periodic orbit (shooting in θ)",
-        iterations: opts.max_iter,
-        history,
+    let mut map = ReturnMap::new(plant, v_m, t_u, Unknowns::OmegaStart { r }, opts);
+    let mut x = [omega_guess];
+    solve(&mut map, &mut x, opts, "periodic orbit (shooting in θ)")?;
+    let (y, lo, hi) = map.last;
+    Ok(PeriodicOrbit {
+        r,
+        omega_start: x[0],
+        period: y[1],
+        omega_min: lo,
+        omega_max: hi,
     })
 }
 
@@ -253,50 +241,136 @@ pub fn shoot_steady_state(
 ) -> Result<PeriodicOrbit, IvtError> {
     check_plant(plant)?;
     op.validate()?;
-    let t_target = 2.0 * PI / op.omega0;
-    let mut rk = rk6(6);
-    let mut w0 = op.omega0;
-    let mut r = r_seed.unwrap_or_else(|| averaged_r(plant, op));
-    let mut history = Vec::new();
-    for _ in 0..opts.max_iter {
-        let (y, lo, hi) = revolution(
+    let unknowns = Unknowns::OmegaStartAndR {
+        omega0: op.omega0,
+        t_target: 2.0 * PI / op.omega0,
+    };
+    let mut map = ReturnMap::new(plant, op.v_m, op.t_u, unknowns, opts);
+    let mut x = [op.omega0, r_seed.unwrap_or_else(|| averaged_r(plant, op))];
+    solve(&mut map, &mut x, opts, "steady state (shooting in θ)")?;
+    let (y, lo, hi) = map.last;
+    Ok(PeriodicOrbit {
+        r: x[1],
+        omega_start: x[0],
+        period: y[1],
+        omega_min: lo,
+        omega_max: hi,
+    })
+}
+
+/// The unknowns of a shooting problem.
+#[derive(Clone, Copy)]
+enum Unknowns {
+    /// ω(0) at a fixed r: residual ω(2π) − ω(0).
+    OmegaStart { r: f64 },
+    /// (ω(0), r): residuals (ω(2π) − ω(0))/ω0 and (T − 2π/ω0)/(2π/ω0), each
+    /// relative so that the line search weighs them alike.
+    OmegaStartAndR { omega0: f64, t_target: f64 },
+}
+
+/// The return map of one revolution as a Newton system; the Jacobian comes
+/// from the variational equations of the last revolution, which is kept
+/// (with its ω extremes) for the caller.
+struct ReturnMap<'a> {
+    plant: &'a PlantParams,
+    v_m: f64,
+    t_u: f64,
+    unknowns: Unknowns,
+    steps_per_segment: usize,
+    rk: Rk6,
+    last: ([f64; 6], f64, f64),
+}
+
+impl<'a> ReturnMap<'a> {
+    fn new(
+        plant: &'a PlantParams,
+        v_m: f64,
+        t_u: f64,
+        unknowns: Unknowns,
+        opts: &ShootingOptions,
+    ) -> Self {
+        Self {
             plant,
-            op.v_m,
-            op.t_u,
-            r,
-            w0,
-            opts.steps_per_segment,
-            &mut rk,
-        )?;
-        let p1 = y[0] - w0; // periodicity
-        let p2 = y[1] - t_target; // time mean = ω0
-        history.push((p1 / op.omega0).hypot(p2 / t_target));
-        // [[S_ω − 1, S_r], [T_ω, T_r]] · (dω, dr) = −(p1, p2)
-        let (a, b, c, d) = (y[2] - 1.0, y[3], y[4], y[5]);
-        let det = a * d - b * c;
-        let dw = -(p1 * d - b * p2) / det;
-        let dr = -(a * p2 - c * p1) / det;
-        if !(dw.is_finite() && dr.is_finite()) {
-            break;
-        }
-        w0 = if w0 + dw > 0.0 { w0 + dw } else { 0.5 * w0 };
-        r += dr;
-        let scale_r = r.abs().max(1e-6);
-        if dw.abs() <= opts.tol * w0 && dr.abs() <= opts.tol * scale_r {
-            return Ok(PeriodicOrbit {
-                r,
-                omega_start: w0,
-                period: t_target,
-                omega_min: lo,
-                omega_max: hi,
-            });
+            v_m,
+            t_u,
+            unknowns,
+            steps_per_segment: opts.steps_per_segment,
+            rk: rk6(6),
+            last: ([f64::NAN; 6], f64::NAN, f64::NAN),
         }
     }
-    Err(IvtError::NoConvergence {
-        method: "steady state (shooting in θ)",
-        iterations: opts.max_iter,
-        history,
-    })
+}
+
+impl NewtonSystem for ReturnMap<'_> {
+    type Error = IvtError;
+    /// A trial with ω(0) ≤ 0 is outside the domain (NaN residual: the step
+    /// is halved); a revolution that stalls is an error.
+    fn residual(&mut self, x: &[f64], res: &mut [f64]) -> Result<(), IvtError> {
+        if x[0].is_nan() || x[0] <= 0.0 {
+            res.fill(f64::NAN);
+            return Ok(());
+        }
+        let r = match self.unknowns {
+            Unknowns::OmegaStart { r } => r,
+            Unknowns::OmegaStartAndR { .. } => x[1],
+        };
+        let (v_m, t_u, steps) = (self.v_m, self.t_u, self.steps_per_segment);
+        self.last = revolution(self.plant, v_m, t_u, r, x[0], steps, &mut self.rk)?;
+        let y = &self.last.0;
+        res[0] = y[0] - x[0];
+        if let Unknowns::OmegaStartAndR { omega0, t_target } = self.unknowns {
+            res[0] /= omega0;
+            res[1] = (y[1] - t_target) / t_target;
+        }
+        Ok(())
+    }
+
+    /// `[[S_ω − 1, S_r], [T_ω, T_r]]` (scaled as the residual) from the
+    /// variational state of the last revolution, which ran at this `x`.
+    fn jacobian(&mut self, _x: &[f64], jac: &mut [f64]) -> Result<(), IvtError> {
+        let y = &self.last.0;
+        match self.unknowns {
+            Unknowns::OmegaStart { .. } => jac[0] = y[2] - 1.0,
+            Unknowns::OmegaStartAndR { omega0, t_target } => {
+                jac.copy_from_slice(&[
+                    (y[2] - 1.0) / omega0,
+                    y[3] / omega0,
+                    y[4] / t_target,
+                    y[5] / t_target,
+                ]);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Newton on the return map ([`ivt_num::newton`]): stops when every update
+/// is below `tol` relative (r: relative to max(|r|, 1e-6 m)); a step
+/// without descent is taken (the map contracts, Theorem 2).
+fn solve(
+    map: &mut ReturnMap<'_>,
+    x: &mut [f64],
+    opts: &ShootingOptions,
+    method: &'static str,
+) -> Result<(), IvtError> {
+    let nopts = NewtonOptions {
+        ftol: 0.0,
+        rtol: opts.tol,
+        atol: opts.tol * 1e-6,
+        max_iter: opts.max_iter,
+        accept_no_descent: true,
+        ..NewtonOptions::default()
+    };
+    let mut ws = NewtonWorkspace::new(x.len());
+    match newton(map, x, &mut ws, &nopts) {
+        Ok(_) => Ok(()),
+        Err(NewtonError::Eval(e)) => Err(e),
+        Err(e) => Err(IvtError::NoConvergence {
+            method,
+            iterations: e.history().len().saturating_sub(1),
+            history: e.history().to_vec(),
+        }),
+    }
 }
 
 #[cfg(test)]

@@ -30,8 +30,9 @@ use core::f64::consts::PI;
 use ivt_hb::broyden::{broyden_solve, BroydenOptions, BroydenWorkspace, System};
 use ivt_kin::plant::PlantParams;
 use ivt_kin::variant::{f_on_segment, f_on_segment_from_trig, segment_of};
-use ivt_num::LuWorkspace;
+use ivt_num::{newton, NewtonError, NewtonOptions, NewtonSystem, NewtonWorkspace};
 use nalgebra::{DMatrix, DVector};
+use std::convert::Infallible;
 
 /// Harmonics, sampling and stopping rule of the IHB solve.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -201,8 +202,6 @@ pub struct IhbSolver {
     trig_c: Vec<(f64, f64)>,
     /// Broyden matrices, kept between solves (warm start along a sweep).
     broyden: BroydenWorkspace,
-    /// LU of the Newton Jacobian (faer, no allocation per iteration).
-    lu: LuWorkspace,
 }
 
 impl IhbSolver {
@@ -249,7 +248,6 @@ impl IhbSolver {
             jump_jac: DMatrix::zeros(2 * n + 1, 2 * n + 1),
             trig_c: vec![(0.0, 1.0); n + 1],
             broyden: BroydenWorkspace::new(2 * n + 1),
-            lu: LuWorkspace::new(2 * n + 1),
         };
         for j in 0..m {
             s.tau[j] = 2.0 * PI * j as f64 / m as f64;
@@ -417,21 +415,6 @@ impl IhbSolver {
         }
     }
 
-    /// Solve `jac · x = b` in place; `false` if `jac` is numerically singular.
-    fn lu_solve(&mut self, jac: &DMatrix<f64>, b: &mut [f64]) -> bool {
-        let n = jac.nrows();
-        for j in 0..n {
-            for i in 0..n {
-                self.lu.mat[(i, j)] = jac[(i, j)];
-            }
-        }
-        if !self.lu.factor() {
-            return false;
-        }
-        self.lu.solve(b);
-        true
-    }
-
     /// Solve Eq. 152–157 at `op`. `warm` = a previous solution {r, q_p} of the
     /// same n (a neighbouring grid point); otherwise r starts from the
     /// averaged power balance and q_p from zero.
@@ -459,49 +442,27 @@ impl IhbSolver {
         if self.opts.method == IhbMethod::Broyden {
             return self.solve_broyden(plant, op, x, warm.is_some());
         }
-        let mut history = Vec::new();
-        self.sample(plant, op, &x, true);
-        let mut rb = &self.project * &self.res;
-        let mut norm = rb.norm();
-        history.push(norm);
-        let mut iterations = 0;
-        while norm >= self.opts.tol {
-            if iterations >= self.opts.max_iter || !norm.is_finite() {
-                return Err(IvtError::NoConvergence {
-                    method: "modified IHB (Newton)",
-                    iterations,
-                    history,
-                });
-            }
-            iterations += 1;
-            let jac = &self.project * &self.dres + &self.jump_jac;
-            let mut step = rb.clone();
-            if !self.lu_solve(&jac, step.as_mut_slice()) {
-                return Err(IvtError::NoConvergence {
-                    method: "modified IHB (singular Jacobian)",
-                    iterations,
-                    history,
-                });
-            }
-            // Backtracking keeps the solve robust from a cold start.
-            let mut lambda = 1.0;
-            let x_old = x.clone();
-            loop {
-                for (xi, (xo, si)) in x.iter_mut().zip(x_old.iter().zip(step.iter())) {
-                    *xi = xo - lambda * si;
-                }
-                self.sample(plant, op, &x, true);
-                rb = &self.project * &self.res;
-                let trial = rb.norm();
-                if trial < norm || lambda < 1e-3 {
-                    norm = trial;
-                    break;
-                }
-                lambda *= 0.5;
-            }
-            history.push(norm);
-        }
-        self.finish(plant, op, &x, iterations, norm)
+        // Newton with the exact Jacobian; from a cold start the step may be
+        // taken without descent after 10 halvings (λ < 1e-3) to leave a
+        // shallow minimum of the residual norm.
+        let nopts = NewtonOptions {
+            ftol: self.opts.tol,
+            max_iter: self.opts.max_iter,
+            max_halvings: 10,
+            accept_no_descent: true,
+            ..NewtonOptions::default()
+        };
+        let mut ws = NewtonWorkspace::new(dim);
+        self.run(plant, op, x, |sys, x| {
+            newton(sys, x, &mut ws, &nopts)
+                .map(|s| (s.iterations, s.residual_norm))
+                .map_err(|e| match e {
+                    NewtonError::SingularJacobian { history, .. } => {
+                        ("modified IHB (singular Jacobian)", history)
+                    }
+                    e => ("modified IHB (Newton)", e.history().to_vec()),
+                })
+        })
     }
 
     /// Package a converged {r, q_p} with min/max ω̄ and the verdict.
@@ -544,7 +505,7 @@ impl IhbSolver {
         &mut self,
         plant: &PlantParams,
         op: &OperatingPoint,
-        mut x: Vec<f64>,
+        x: Vec<f64>,
         warm: bool,
     ) -> Result<SteadyState, IvtError> {
         let dim = x.len();
@@ -559,29 +520,51 @@ impl IhbSolver {
             max_iter: self.opts.max_iter,
             ..Default::default()
         };
+        let result = self.run(plant, op, x, |sys, x| {
+            broyden_solve(sys, x, &mut ws, &bopts)
+                .map(|s| (s.iterations, s.residual_norm))
+                .map_err(|e| ("modified IHB (Broyden, Eq. 156-157)", e.history().to_vec()))
+        });
+        // A failed solve leaves no matrix worth carrying to the next point.
+        self.broyden = if result.is_ok() {
+            ws
+        } else {
+            BroydenWorkspace::new(dim)
+        };
+        result
+    }
+
+    /// Runs `solver` on the balanced residual from `x`: a convergence
+    /// (iterations, ‖R‖) is packaged by [`Self::finish`], a failure (method,
+    /// ‖R‖ history) becomes [`IvtError::NoConvergence`].
+    fn run(
+        &mut self,
+        plant: &PlantParams,
+        op: &OperatingPoint,
+        mut x: Vec<f64>,
+        solver: impl FnOnce(
+            &mut BalancedResidual<'_>,
+            &mut [f64],
+        ) -> Result<(usize, f64), (&'static str, Vec<f64>)>,
+    ) -> Result<SteadyState, IvtError> {
         let mut sys = BalancedResidual {
             solver: self,
             plant,
             op,
         };
-        let result = broyden_solve(&mut sys, &mut x, &mut ws, &bopts);
-        self.broyden = ws;
-        match result {
-            Ok(stats) => self.finish(plant, op, &x, stats.iterations, stats.residual_norm),
-            Err(e) => {
-                self.broyden = BroydenWorkspace::new(dim);
-                Err(IvtError::NoConvergence {
-                    method: "modified IHB (Broyden, Eq. 156-157)",
-                    iterations: e.history().len(),
-                    history: e.history().to_vec(),
-                })
-            }
+        match solver(&mut sys, &mut x) {
+            Ok((iterations, norm)) => self.finish(plant, op, &x, iterations, norm),
+            Err((method, history)) => Err(IvtError::NoConvergence {
+                method,
+                iterations: history.len().saturating_sub(1),
+                history,
+            }),
         }
     }
 }
 
-/// The harmonic-balanced residual R_p as a [`System`] for the Broyden solver,
-/// with the exact Jacobian for (re)seeding.
+/// The harmonic-balanced residual R_p with its exact Jacobian: a [`System`]
+/// for the Broyden solver (the Jacobian (re)seeds it) and a [`NewtonSystem`].
 struct BalancedResidual<'a> {
     solver: &'a mut IhbSolver,
     plant: &'a PlantParams,
@@ -605,6 +588,18 @@ impl System for BalancedResidual<'_> {
             }
         }
         true
+    }
+}
+
+impl NewtonSystem for BalancedResidual<'_> {
+    type Error = Infallible;
+    fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
+        System::residual(self, x, r);
+        Ok(())
+    }
+    fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> Result<(), Infallible> {
+        System::jacobian(self, x, jac);
+        Ok(())
     }
 }
 

@@ -16,12 +16,13 @@
 
 use crate::broyden::{BroydenStats, SolveError};
 use crate::continuation::{pseudo_arclength, ContinuationOptions, Termination};
-use crate::dense::{norm2, solve_dense};
 use crate::floquet::HsuRule;
 use crate::ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution};
+use crate::linalg::norm2;
 use crate::problem::PeriodicProblem;
 use crate::stability::{classify, StabilityAnalyzer, StabilityKind};
 use faer::c64;
+use ivt_num::LuWorkspace;
 
 /// A converged limit cycle.
 #[derive(Debug, Clone, PartialEq)]
@@ -203,6 +204,7 @@ pub fn limit_cycle<P: PeriodicProblem>(
     let (mut r, mut rp, mut rm) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
     let mut jac = vec![0.0; m * m];
     let mut big = vec![0.0; n1 * n1];
+    let mut lu = LuWorkspace::new(n1);
     let mut step = vec![0.0; n1];
     let (mut q_trial, mut r_trial) = (vec![0.0; m], vec![0.0; m]);
     let norm_f = |r: &[f64], q: &[f64]| (norm2(r).powi(2) + q[phase] * q[phase]).sqrt();
@@ -248,12 +250,13 @@ pub fn limit_cycle<P: PeriodicProblem>(
         big[m * n1 + phase] = 1.0;
         step[..m].iter_mut().zip(&r).for_each(|(s, r)| *s = -r);
         step[m] = -q[phase];
-        if !solve_dense(&big, n1, &mut step, false) {
+        if !lu.factor_row_major(&big) {
             return Err(HbError::Solve(SolveError::SingularJacobian {
                 iteration: stats.iterations,
                 history,
             }));
         }
+        lu.solve(&mut step);
         // Damped step: halve while ‖F‖ does not decrease (or ω would turn ≤ 0).
         let mut t = 1.0;
         let mut accepted = false;

@@ -23,13 +23,15 @@
 //! points is in [`crate::switching`].
 
 use crate::broyden::SolveError;
-use crate::dense::{norm2, solve_dense};
 use crate::family::{Family, FamilyBranch};
 use crate::floquet::{eigenvalues, monodromy_uniform, HsuRule};
 use crate::fold::{null_vector, Branch};
 use crate::ihb::HbError;
+use crate::linalg::norm2;
 use crate::stability::StabilityAnalyzer;
 use faer::c64;
+use ivt_num::lu::solve_once;
+use ivt_num::LuWorkspace;
 use thiserror::Error;
 
 /// The kind of a located bifurcation.
@@ -227,7 +229,7 @@ fn bordered_scalar(a: &[f64], s: usize, b: &[f64], c: &[f64]) -> f64 {
     big[s * n1..s * n1 + s].copy_from_slice(c);
     let mut rhs = vec![0.0; n1];
     rhs[s] = 1.0;
-    if solve_dense(&big, n1, &mut rhs, false) {
+    if solve_once(&big, n1, &mut rhs, false) {
         rhs[s]
     } else {
         f64::NAN
@@ -358,7 +360,7 @@ where
         for t in 0..k {
             step[m + t] = -psi[t];
         }
-        if !solve_dense(&newton, n, &mut step, false) {
+        if !solve_once(&newton, n, &mut step, false) {
             return Err(solve_error(SolveError::SingularJacobian {
                 iteration: it,
                 history,
@@ -415,7 +417,10 @@ pub fn locate_multiplier_crossing<F: Family>(
         vec![1.0 / (s as f64).sqrt(); s],
         vec![1.0 / (s as f64).sqrt(); s],
     );
-    if !null_vector(&a, s, &mut c, false) || !null_vector(&a, s, &mut b, true) {
+    // `a` is near-singular here: only a non-finite factor is refused.
+    let mut lu = LuWorkspace::new(s);
+    lu.factor_row_major(&a);
+    if !null_vector(&mut lu, &mut c, false) || !null_vector(&mut lu, &mut b, true) {
         return Err(solve_error(SolveError::SingularJacobian {
             iteration: 0,
             history: Vec::new(),
@@ -516,7 +521,7 @@ impl BranchPointTest {
         for t in 0..2 {
             let mut rhs = vec![0.0; n];
             rhs[m + t] = 1.0;
-            if !solve_dense(&self.big, n, &mut rhs, false) {
+            if !solve_once(&self.big, n, &mut rhs, false) {
                 out.fill(f64::NAN);
                 return;
             }
@@ -569,7 +574,10 @@ pub fn locate_branch_point<F: Family>(
     aug[m * n1..].copy_from_slice(&t1);
     let seed: Vec<f64> = (0..n1).map(|i| 1.0 + 0.1 * (i as f64).sin()).collect();
     let (mut right, mut left) = (seed.clone(), seed);
-    if !null_vector(&aug, n1, &mut right, false) || !null_vector(&aug, n1, &mut left, true) {
+    // `aug` is near-singular here: only a non-finite factor is refused.
+    let mut lu = LuWorkspace::new(n1);
+    lu.factor_row_major(&aug);
+    if !null_vector(&mut lu, &mut right, false) || !null_vector(&mut lu, &mut left, true) {
         return Err(solve_error(SolveError::SingularJacobian {
             iteration: 0,
             history: Vec::new(),

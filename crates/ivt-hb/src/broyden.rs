@@ -153,6 +153,32 @@ impl SolveError {
     }
 }
 
+/// A failed [`ivt_num::newton`] on an infallible system, in this crate's
+/// terms: a line search without descent is a non-convergence.
+impl From<ivt_num::NewtonError<std::convert::Infallible>> for SolveError {
+    fn from(e: ivt_num::NewtonError<std::convert::Infallible>) -> Self {
+        use ivt_num::NewtonError as N;
+        match e {
+            N::NonConvergence {
+                iterations,
+                history,
+            }
+            | N::NoDescent {
+                iteration: iterations,
+                history,
+            } => Self::NonConvergence {
+                iterations,
+                history,
+            },
+            N::SingularJacobian { iteration, history } => {
+                Self::SingularJacobian { iteration, history }
+            }
+            N::NonFinite { iteration, history } => Self::NonFinite { iteration, history },
+            N::Eval(never) => match never {},
+        }
+    }
+}
+
 /// Caller-owned state of the solver: `B`, `H = B⁻¹` and all scratch vectors.
 ///
 /// Reuse one workspace across solves of the same size: after a solve, `B`/`H`
@@ -230,14 +256,7 @@ impl BroydenWorkspace {
     /// # Errors
     /// [`SolveError::SingularJacobian`] if `B₀` is singular.
     pub fn set_jacobian(&mut self, b0: &[f64]) -> Result<(), SolveError> {
-        let m = self.m;
-        if b0.len() != m * m {
-            return Err(SolveError::Dimension {
-                expected: m * m,
-                got: b0.len(),
-            });
-        }
-        self.b.copy_from_slice(b0);
+        copy_square(b0, &mut self.b)?;
         self.invert_b()
     }
 
@@ -249,14 +268,7 @@ impl BroydenWorkspace {
     /// # Errors
     /// [`SolveError::Dimension`] on size mismatch.
     pub fn set_inverse_jacobian(&mut self, h0: &[f64]) -> Result<(), SolveError> {
-        let m = self.m;
-        if h0.len() != m * m {
-            return Err(SolveError::Dimension {
-                expected: m * m,
-                got: h0.len(),
-            });
-        }
-        self.h.copy_from_slice(h0);
+        copy_square(h0, &mut self.h)?;
         self.b_current = false;
         self.has_jacobian = true;
         self.dx_next_ready = false;
@@ -386,21 +398,17 @@ impl BroydenWorkspace {
     }
 
     fn invert_b(&mut self) -> Result<(), SolveError> {
-        let m = self.m;
         self.b_current = true;
         self.dx_next_ready = false;
-        match invert(&self.b, m, &mut self.h, &mut self.lu, &mut self.piv) {
-            Ok(()) => {
-                self.has_jacobian = true;
-                Ok(())
-            }
-            Err(_) => {
-                self.has_jacobian = false;
-                Err(SolveError::SingularJacobian {
-                    iteration: 0,
-                    history: self.history.clone(),
-                })
-            }
+        self.has_jacobian =
+            invert(&self.b, self.m, &mut self.h, &mut self.lu, &mut self.piv).is_ok();
+        if self.has_jacobian {
+            Ok(())
+        } else {
+            Err(SolveError::SingularJacobian {
+                iteration: 0,
+                history: self.history.clone(),
+            })
         }
     }
 
@@ -478,6 +486,21 @@ impl BroydenWorkspace {
         }
         true
     }
+}
+
+/// Copies the `m×m` matrix `from` into `to` (`m²` entries).
+///
+/// # Errors
+/// [`SolveError::Dimension`] if the lengths differ.
+fn copy_square(from: &[f64], to: &mut [f64]) -> Result<(), SolveError> {
+    if from.len() != to.len() {
+        return Err(SolveError::Dimension {
+            expected: to.len(),
+            got: from.len(),
+        });
+    }
+    to.copy_from_slice(from);
+    Ok(())
 }
 
 /// Solves `F(x) = 0` by Broyden's method from the initial guess `x` (overwritten

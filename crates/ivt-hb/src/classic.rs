@@ -1,12 +1,14 @@
-//! Classic IHB (§3.2.1, Eq. 53–57): Newton's method with the exact Galerkin
+//! Classic IHB (§3.2.1, Eq. 53–57): damped Newton with the exact Galerkin
 //! Jacobian Φ_q, the nonlinear part integrated by quadrature on the 2N grid
 //! (O(N·m²) per iteration plus an LU) — the baseline the modified IHB is timed
 //! against (thesis: 0.25 s vs 0.003 s).
 
 use crate::broyden::{BroydenStats, SolveError};
 use crate::ihb::{validate_omega, GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution};
-use crate::linalg::{lu_factor, lu_solve, matvec, norm2};
+use crate::linalg::matvec;
 use crate::problem::PeriodicProblem;
+use ivt_num::{newton, NewtonOptions, NewtonSystem, NewtonWorkspace};
+use std::convert::Infallible;
 
 /// Newton–Galerkin solver with reusable buffers.
 #[derive(Debug)]
@@ -15,14 +17,34 @@ pub struct ClassicIhb<P> {
     opts: HbOptions,
     res: HbResidual,
     galerkin: GalerkinJacobian,
-    jac: Vec<f64>,
+    b0: Vec<f64>,
     h0: Vec<f64>,
-    piv: Vec<usize>,
-    r: Vec<f64>,
-    r_trial: Vec<f64>,
-    q_trial: Vec<f64>,
-    dq: Vec<f64>,
-    history: Vec<f64>,
+    /// Scratch for the force scale of the tolerance.
+    scratch: Vec<f64>,
+    newton: NewtonWorkspace,
+}
+
+/// The HB residual (Eq. 61) at fixed ω_f with its Galerkin Jacobian Φ_q
+/// (Eq. 56) as a Newton system.
+struct Galerkin<'a, P> {
+    problem: &'a P,
+    res: &'a mut HbResidual,
+    galerkin: &'a mut GalerkinJacobian,
+    omega_f: f64,
+}
+
+impl<P: PeriodicProblem> NewtonSystem for Galerkin<'_, P> {
+    type Error = Infallible;
+    fn residual(&mut self, q: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
+        self.res.eval(self.problem, q, self.omega_f, 1.0, r);
+        Ok(())
+    }
+    /// Φ_q = L(ω) + (1/π)∫ C_s (G_x C_sᵀ + ω G_v C_s'ᵀ) dτ (Eq. 56).
+    fn jacobian(&mut self, q: &[f64], jac: &mut [f64]) -> Result<(), Infallible> {
+        self.galerkin
+            .assemble(self.res, self.problem, q, self.omega_f, 1.0, jac);
+        Ok(())
+    }
 }
 
 impl<P: PeriodicProblem> ClassicIhb<P> {
@@ -39,14 +61,10 @@ impl<P: PeriodicProblem> ClassicIhb<P> {
             opts,
             res,
             galerkin,
-            jac: vec![0.0; m * m],
+            b0: vec![0.0; m * m],
             h0: vec![0.0; m * m],
-            piv: vec![0; m],
-            r: vec![0.0; m],
-            r_trial: vec![0.0; m],
-            q_trial: vec![0.0; m],
-            dq: vec![0.0; m],
-            history: Vec::with_capacity(64),
+            scratch: vec![0.0; m],
+            newton: NewtonWorkspace::new(m),
         })
     }
 
@@ -55,7 +73,8 @@ impl<P: PeriodicProblem> ClassicIhb<P> {
         &self.problem
     }
 
-    /// Solves by Newton from the linear solution or from `guess`.
+    /// Solves by damped Newton (Eq. 57, [`ivt_num::newton`]: step halving while
+    /// ‖R‖ does not fall) from the linear solution or from `guess`.
     ///
     /// # Errors
     /// [`HbError::Solve`] with the residual history when Newton fails.
@@ -74,98 +93,40 @@ impl<P: PeriodicProblem> ClassicIhb<P> {
             None => {
                 if self
                     .res
-                    .linear_jacobian(&self.problem, omega, &mut self.jac, &mut self.h0)
+                    .linear_jacobian(&self.problem, omega, &mut self.b0, &mut self.h0)
                 {
                     matvec(&self.h0, m, m, self.res.excitation(), &mut q);
                 }
             }
         }
-        self.history.clear();
         let scale = self
             .res
-            .force_scale(&self.problem, &q, omega, &mut self.r_trial);
-        let tol = self.opts.residual_tol(scale);
-        self.res.eval(&self.problem, &q, omega_f, 1.0, &mut self.r);
-        let mut norm = norm2(&self.r);
-        self.history.push(norm);
-        let mut stats = BroydenStats {
-            iterations: 0,
-            residual_evals: 1,
-            jacobian_refreshes: 0,
-            residual_norm: norm,
+            .force_scale(&self.problem, &q, omega, &mut self.scratch);
+        let b = &self.opts.broyden;
+        let opts = NewtonOptions {
+            ftol: self.opts.residual_tol(scale),
+            max_iter: b.max_iter,
+            max_halvings: b.max_backtracks,
+            ..NewtonOptions::default()
         };
-        let fail = |h: &Vec<f64>, it| {
-            HbError::Solve(SolveError::NonConvergence {
-                iterations: it,
-                history: h.clone(),
-            })
+        let mut sys = Galerkin {
+            problem: &self.problem,
+            res: &mut self.res,
+            galerkin: &mut self.galerkin,
+            omega_f,
         };
-        if !norm.is_finite() {
-            return Err(HbError::Solve(SolveError::NonFinite {
-                iteration: 0,
-                history: self.history.clone(),
-            }));
-        }
-        while norm > tol {
-            if stats.iterations >= self.opts.broyden.max_iter {
-                return Err(fail(&self.history, stats.iterations));
-            }
-            stats.iterations += 1;
-            // Φ_q = L(ω) + (1/π)∫ C_s (G_x C_sᵀ + ω G_v C_s'ᵀ) dτ (Eq. 56).
-            self.galerkin.assemble(
-                &mut self.res,
-                &self.problem,
-                &q,
-                omega_f,
-                1.0,
-                &mut self.jac,
-            );
-            stats.jacobian_refreshes += 1;
-            if lu_factor(&mut self.jac, m, &mut self.piv).is_err() {
-                return Err(HbError::Solve(SolveError::SingularJacobian {
-                    iteration: stats.iterations,
-                    history: self.history.clone(),
-                }));
-            }
-            self.dq.iter_mut().zip(&self.r).for_each(|(d, r)| *d = -r);
-            lu_solve(&self.jac, m, &self.piv, &mut self.dq);
-            // Newton step (Eq. 57) with step halving if ‖r‖ grows.
-            let mut t = 1.0;
-            let mut accepted = false;
-            for _ in 0..=self.opts.broyden.max_backtracks {
-                for i in 0..m {
-                    self.q_trial[i] = q[i] + t * self.dq[i];
-                }
-                self.res.eval(
-                    &self.problem,
-                    &self.q_trial,
-                    omega_f,
-                    1.0,
-                    &mut self.r_trial,
-                );
-                stats.residual_evals += 1;
-                let nt = norm2(&self.r_trial);
-                if nt.is_finite() && nt < norm {
-                    norm = nt;
-                    accepted = true;
-                    break;
-                }
-                t *= 0.5;
-            }
-            if !accepted {
-                return Err(fail(&self.history, stats.iterations));
-            }
-            q.copy_from_slice(&self.q_trial);
-            std::mem::swap(&mut self.r, &mut self.r_trial);
-            self.history.push(norm);
-        }
-        stats.residual_norm = norm;
+        let stats = newton(&mut sys, &mut q, &mut self.newton, &opts).map_err(SolveError::from)?;
         Ok(HbSolution {
             coeffs: q,
             omega_f,
             harmonics: self.opts.harmonics,
             subharmonic: self.opts.subharmonic,
-            stats,
+            stats: BroydenStats {
+                iterations: stats.iterations,
+                residual_evals: stats.residual_evals,
+                jacobian_refreshes: stats.jacobian_evals,
+                residual_norm: stats.residual_norm,
+            },
         })
     }
 }

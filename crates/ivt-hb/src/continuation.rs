@@ -77,14 +77,16 @@ impl PathPoint {
     }
 }
 
-/// A fold (turning point in λ) between points `index` and `index + 1`… or at
-/// `index`: the secant's λ component changed sign around point `index`.
+/// A fold (turning point in λ): the secant's λ component changed sign between
+/// the points `bracket`, `bracket + 1` and `bracket + 2`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Fold {
-    /// Index of the point nearest the turn.
+    /// Index of the point nearest the turn (in arclength along the parabola).
     pub index: usize,
     /// λ at the turn from a parabola through the three points around it.
     pub lambda: f64,
+    /// Index of the first of the three points around the turn.
+    pub bracket: usize,
 }
 
 /// Why the path follower stopped (stopping is not failing).
@@ -163,31 +165,26 @@ where
     let mut r0 = vec![0.0; m];
     let mut r1 = vec![0.0; m];
     let mut xp = start.to_vec();
-    let fd_jac =
-        |res: &mut R, x: &[f64], jac: &mut [f64], r0: &mut [f64], r1: &mut [f64], fd: f64| {
-            let mut xt = x.to_vec();
-            res(x, r0);
-            for j in 0..x.len() {
-                let h = fd * x[j].abs().max(1.0);
-                xt[j] = x[j] + h;
-                res(&xt, r1);
-                for i in 0..r0.len() {
-                    jac[i * x.len() + j] = (r1[i] - r0[i]) / h;
-                }
-                xt[j] = x[j];
+    // Forward-difference Jacobian with its own scratch (no allocation per call).
+    let (mut f0, mut f1, mut xt) = (vec![0.0; m], vec![0.0; m], vec![0.0; n1]);
+    let fd = opts.broyden.fd_step;
+    let mut fd_jac = |res: &mut R, x: &[f64], jac: &mut [f64]| {
+        xt.copy_from_slice(x);
+        res(x, &mut f0);
+        for j in 0..n1 {
+            let h = fd * x[j].abs().max(1.0);
+            xt[j] = x[j] + h;
+            res(&xt, &mut f1);
+            for i in 0..m {
+                jac[i * n1 + j] = (f1[i] - f0[i]) / h;
             }
-        };
+            xt[j] = x[j];
+        }
+    };
     match jac0 {
         Some(j) if j.len() == m * n1 => jac.copy_from_slice(j),
         Some(_) => return Err(ContinuationError::Input("jac0 must be m×(m+1)")),
-        None => fd_jac(
-            &mut residual,
-            &xp,
-            &mut jac,
-            &mut r0,
-            &mut r1,
-            opts.broyden.fd_step,
-        ),
+        None => fd_jac(&mut residual, &xp, &mut jac),
     }
     // Correct the start at fixed λ.
     let lam0 = xp[m];
@@ -309,14 +306,7 @@ where
                 });
                 break Termination::StepTooSmall(err);
             }
-            fd_jac(
-                &mut residual,
-                &xp,
-                &mut jac,
-                &mut r0,
-                &mut r1,
-                opts.broyden.fd_step,
-            );
+            fd_jac(&mut residual, &xp, &mut jac);
             fresh = true;
             continue;
         }
@@ -349,9 +339,11 @@ where
         };
         if prev_dl * new_xd[m] < 0.0 && points.len() >= 2 {
             let k = points.len() - 1;
+            let (x, nearest) = turn(&points[k - 1], &points[k], &point);
             folds.push(Fold {
-                index: k,
-                lambda: parabola_extremum(&points[k - 1], &points[k], &point),
+                index: k - 1 + nearest,
+                lambda: x[m],
+                bracket: k - 1,
             });
         }
         xp.copy_from_slice(&x);
@@ -377,9 +369,18 @@ where
     })
 }
 
-/// λ at the extremum of the parabola λ(s) through three consecutive points
-/// (s = arclength by chords).
-fn parabola_extremum(a: &PathPoint, b: &PathPoint, c: &PathPoint) -> f64 {
+/// The state `{q, λ}` at the turn between three consecutive points `a`, `b`,
+/// `c` around a fold: the quadratic through them in chord arclength s,
+/// evaluated where its λ(s) is extremal (`b` itself if λ(s) is straight).
+/// Off the path by O(Δη³) rather than the O(Δη) of the nearest point: the
+/// start for [`crate::fold::locate_fold`].
+pub fn turn_estimate(a: &PathPoint, b: &PathPoint, c: &PathPoint) -> Vec<f64> {
+    turn(a, b, c).0
+}
+
+/// [`turn_estimate`] and which of the three points (0, 1, 2) lies nearest
+/// the turn in arclength.
+fn turn(a: &PathPoint, b: &PathPoint, c: &PathPoint) -> (Vec<f64>, usize) {
     let dist = |p: &PathPoint, q: &PathPoint| {
         p.x.iter()
             .zip(&q.x)
@@ -392,11 +393,27 @@ fn parabola_extremum(a: &PathPoint, b: &PathPoint, c: &PathPoint) -> f64 {
     // Divided differences: λ = l0 + d1 (s − s0) + d2 (s − s0)(s − s1).
     let d1 = (l1 - l0) / (s1 - s0);
     let d2 = ((l2 - l1) / (s2 - s1) - d1) / (s2 - s0);
-    if d2 == 0.0 || !d2.is_finite() {
-        return l1;
+    let s = 0.5 * (s0 + s1) - d1 / (2.0 * d2);
+    if d2 == 0.0 || !s.is_finite() {
+        return (b.x.clone(), 1);
     }
-    let s_star = 0.5 * (s0 + s1) - d1 / (2.0 * d2);
-    l0 + d1 * (s_star - s0) + d2 * (s_star - s0) * (s_star - s1)
+    let nearest = [s0, s1, s2]
+        .iter()
+        .map(|si| (si - s).abs())
+        .enumerate()
+        .min_by(|x, y| x.1.total_cmp(&y.1))
+        .map_or(1, |(i, _)| i);
+    // Lagrange weights of the three points at s.
+    let w0 = (s - s1) * (s - s2) / ((s0 - s1) * (s0 - s2));
+    let w1 = (s - s0) * (s - s2) / ((s1 - s0) * (s1 - s2));
+    let w2 = (s - s0) * (s - s1) / ((s2 - s0) * (s2 - s1));
+    let x =
+        a.x.iter()
+            .zip(&b.x)
+            .zip(&c.x)
+            .map(|((u, v), w)| w0 * u + w1 * v + w2 * w)
+            .collect();
+    (x, nearest)
 }
 
 #[cfg(test)]

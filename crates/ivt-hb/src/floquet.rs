@@ -7,8 +7,8 @@
 //! step `Ω = (h/6)(Θ₀ + 4Θ_½ + Θ₁) − (h²/12)[Θ₀, Θ₁]` on the same uniform grid,
 //! which reaches 1e-9 agreement with Hill's method at a few thousand steps.
 
-use crate::linalg::Singular;
 use faer::c64;
+use ivt_num::small::matmul;
 
 /// Quadrature rule of one Hsu sub-interval.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -50,16 +50,10 @@ pub fn expm(a: &[f64], dim: usize, out: &mut [f64], scratch: &mut [f64]) {
     for k in 1..=16 {
         // term = term · (a·scale) / k
         let f = scale / k as f64;
-        for i in 0..dim {
-            for j in 0..dim {
-                let mut acc = 0.0;
-                for l in 0..dim {
-                    acc += term[i * dim + l] * a[l * dim + j];
-                }
-                tmp[i * dim + j] = acc * f;
-            }
-        }
-        term[..d2].copy_from_slice(&tmp[..d2]);
+        matmul(term, a, dim, tmp);
+        term.iter_mut()
+            .zip(&tmp[..d2])
+            .for_each(|(t, p)| *t = p * f);
         let mut tmax = 0.0f64;
         for (o, t) in out[..d2].iter_mut().zip(term.iter()) {
             *o += t;
@@ -100,19 +94,6 @@ fn expm2(a: &[f64], out: &mut [f64]) {
     out[1] = e * s * a[1];
     out[2] = e * s * a[2];
     out[3] = e * (c + s * (a[3] - mu));
-}
-
-/// `c = a·b` for row-major `dim×dim` matrices.
-pub fn matmul(a: &[f64], b: &[f64], dim: usize, c: &mut [f64]) {
-    for i in 0..dim {
-        for j in 0..dim {
-            let mut acc = 0.0;
-            for l in 0..dim {
-                acc += a[i * dim + l] * b[l * dim + j];
-            }
-            c[i * dim + j] = acc;
-        }
-    }
 }
 
 /// Monodromy matrix (Eq. 80) from Θ sampled on a uniform grid: `theta` holds
@@ -226,18 +207,21 @@ pub fn eigenvalues(a: &[f64], dim: usize) -> Vec<c64> {
     ev
 }
 
-/// Sorts complex numbers by decreasing modulus, then by argument (stable order for
-/// comparisons between methods).
+/// Sorts complex numbers by decreasing modulus, then by imaginary part (stable
+/// order for comparisons between methods). The modulus is compared to 10
+/// significant digits: the two members of a conjugate pair have equal moduli,
+/// and rounding must not decide which comes first.
 pub fn sort_by_modulus(v: &mut [c64]) {
-    v.sort_by(|a, b| b.norm().total_cmp(&a.norm()).then(a.im.total_cmp(&b.im)));
-}
-
-/// Inverse of a small matrix (used to form `M⁻¹` for the state-space Θ).
-///
-/// # Errors
-/// [`Singular`] if `a` is singular.
-pub fn small_inverse(a: &[f64], dim: usize) -> Result<Vec<f64>, Singular> {
-    ivt_num::lu::inverse(a, dim).ok_or(Singular)
+    let key = |z: &c64| {
+        let r = z.norm();
+        if r > 0.0 && r.is_finite() {
+            let scale = 10f64.powi(9 - r.log10().floor() as i32);
+            (r * scale).round() / scale
+        } else {
+            r
+        }
+    };
+    v.sort_by(|a, b| key(b).total_cmp(&key(a)).then(a.im.total_cmp(&b.im)));
 }
 
 #[cfg(test)]

@@ -15,9 +15,10 @@
 //! Galerkin Jacobian (Eq. 56), the branch of a frequency-response curve.
 
 use crate::broyden::SolveError;
-use crate::dense::{norm2, solve_dense};
 use crate::ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual};
+use crate::linalg::norm2;
 use crate::problem::PeriodicProblem;
+use ivt_num::LuWorkspace;
 
 /// A one-parameter family of square systems `R(q, λ) = 0` with `∂R/∂q`.
 pub trait Branch {
@@ -301,11 +302,13 @@ pub struct FoldLocation {
     pub residual_norm: f64,
 }
 
-/// Scratch of the bordered solves.
+/// Scratch of the bordered solves: one LU of the bordered matrix serves both
+/// the plain and the transposed system.
 struct Bordered {
     m: usize,
     jac: Vec<f64>,
     big: Vec<f64>,
+    lu: LuWorkspace,
     rhs: Vec<f64>,
     b: Vec<f64>,
     c: Vec<f64>,
@@ -332,28 +335,34 @@ impl Bordered {
         }
         self.big[m * n1..m * n1 + m].copy_from_slice(&self.c);
         self.big[m * n1 + m] = 0.0;
-        self.rhs.fill(0.0);
-        self.rhs[m] = 1.0;
-        if !solve_dense(&self.big, n1, &mut self.rhs, false) {
+        if !self.lu.factor_row_major(&self.big) {
             return f64::NAN;
         }
+        self.rhs.fill(0.0);
+        self.rhs[m] = 1.0;
+        self.lu.solve(&mut self.rhs);
         v.copy_from_slice(&self.rhs[..m]);
         let g = self.rhs[m];
         self.rhs.fill(0.0);
         self.rhs[m] = 1.0;
-        if !solve_dense(&self.big, n1, &mut self.rhs, true) {
-            return f64::NAN;
-        }
+        self.lu.solve_transpose(&mut self.rhs);
         w.copy_from_slice(&self.rhs[..m]);
-        g
+        if v.iter().chain(w.iter()).all(|x| x.is_finite()) {
+            g
+        } else {
+            f64::NAN
+        }
     }
 }
 
-/// Two steps of inverse iteration with `J` (or `Jᵀ`) from `v`, normalised.
-pub(crate) fn null_vector(jac: &[f64], m: usize, v: &mut [f64], transpose: bool) -> bool {
+/// Two steps of inverse iteration with the factored `J` (or `Jᵀ`) from `v`,
+/// normalised.
+pub(crate) fn null_vector(lu: &mut LuWorkspace, v: &mut [f64], transpose: bool) -> bool {
     for _ in 0..2 {
-        if !solve_dense(jac, m, v, transpose) {
-            return false;
+        if transpose {
+            lu.solve_transpose(v);
+        } else {
+            lu.solve(v);
         }
         let n = norm2(v);
         if n == 0.0 || !n.is_finite() {
@@ -395,6 +404,7 @@ pub fn locate_fold<B: Branch>(
         m,
         jac: vec![0.0; m * m],
         big: vec![0.0; n1 * n1],
+        lu: LuWorkspace::new(n1),
         rhs: vec![0.0; n1],
         b: vec![1.0 / (m as f64).sqrt(); m],
         c: vec![1.0 / (m as f64).sqrt(); m],
@@ -407,7 +417,10 @@ pub fn locate_fold<B: Branch>(
     };
     // Borders: the approximate left/right null vectors of J at the start.
     branch.jacobian(q0, lambda0, &mut bd.jac);
-    if !null_vector(&bd.jac, m, &mut bd.c, false) || !null_vector(&bd.jac, m, &mut bd.b, true) {
+    let mut lu = LuWorkspace::new(m);
+    // J is near-singular at a fold: only a non-finite factor is refused here.
+    lu.factor_row_major(&bd.jac);
+    if !null_vector(&mut lu, &mut bd.c, false) || !null_vector(&mut lu, &mut bd.b, true) {
         return Err(singular(0, &[]));
     }
     let mut q = q0.to_vec();
@@ -417,6 +430,7 @@ pub fn locate_fold<B: Branch>(
     let mut rm = vec![0.0; m];
     let (mut v, mut w, mut grad) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
     let mut newton = vec![0.0; n1 * n1];
+    let mut newton_lu = LuWorkspace::new(n1);
     let mut step = vec![0.0; n1];
     let mut history = Vec::with_capacity(opts.max_iter + 1);
     for it in 0..=opts.max_iter {
@@ -456,9 +470,10 @@ pub fn locate_fold<B: Branch>(
             step[i] = -r[i];
         }
         step[m] = -g;
-        if !solve_dense(&newton, n1, &mut step, false) {
+        if !newton_lu.factor_row_major(&newton) {
             return Err(singular(it, &history));
         }
+        newton_lu.solve(&mut step);
         for i in 0..m {
             q[i] += step[i];
         }

@@ -2,9 +2,11 @@
 //! pseudo-arclength continuation ([`crate::continuation`], Eq. 68–77), with the
 //! Floquet multipliers (Hsu, Eq. 80) and stability class at every point. Each
 //! turn of the path is then located by Newton on the extended system of
-//! [`crate::fold`] (the fold itself, not a bracket between two points).
+//! [`crate::fold`] (the fold itself, not a bracket between two points),
+//! started from the quadratic through the three path points around the turn
+//! ([`crate::continuation::turn_estimate`]).
 
-use crate::continuation::{pseudo_arclength, ContinuationOptions, Termination};
+use crate::continuation::{pseudo_arclength, turn_estimate, ContinuationOptions, Termination};
 use crate::floquet::HsuRule;
 use crate::fold::{locate_fold, FoldOptions, HbBranch};
 use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
@@ -71,7 +73,7 @@ impl FrcPoint {
 /// A fold (turning point in ω_f) of the curve.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrcFold {
-    /// Index of the path point nearest the turn (the Newton start).
+    /// Index of the path point nearest the turn.
     pub index: usize,
     /// ω_f at the fold.
     pub omega_f: f64,
@@ -170,12 +172,10 @@ pub fn frequency_response<P: PeriodicProblem>(
     let mut folds = Vec::with_capacity(path.folds.len());
     for turn in &path.folds {
         let near = &points[turn.index];
-        let fold = match locate_fold(
-            &mut branch,
-            &near.coeffs,
-            near.omega_f,
-            &FoldOptions::default(),
-        ) {
+        // Start from the quadratic through the three points around the turn.
+        let around = &path.points[turn.bracket..turn.bracket + 3];
+        let start = turn_estimate(&around[0], &around[1], &around[2]);
+        let fold = match locate_fold(&mut branch, &start[..m], start[m], &FoldOptions::default()) {
             Ok(f) => {
                 let (coeffs, omega_f) = (f.q, f.lambda);
                 res.aft_mut().synthesize(&coeffs[..l], &mut samples);

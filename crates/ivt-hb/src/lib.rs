@@ -10,7 +10,6 @@ pub mod bifurcation;
 pub mod broyden;
 pub mod classic;
 pub mod continuation;
-mod dense;
 pub mod elements;
 mod error;
 pub mod events;

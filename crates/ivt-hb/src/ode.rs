@@ -2,7 +2,6 @@
 //! reference for the HB tests and the Mathieu–Duffing check (it shares no code with
 //! the harmonic-balance path).
 
-use crate::floquet::small_inverse;
 use crate::problem::PeriodicProblem;
 use ivt_num::{ExplicitRk, RK4};
 
@@ -28,7 +27,7 @@ pub fn first_order<P: PeriodicProblem>(
     omega_f: f64,
 ) -> impl FnMut(f64, &[f64], &mut [f64]) + '_ {
     let nd = problem.n_dof();
-    let minv = small_inverse(problem.mass(), nd).expect("mass matrix must be invertible");
+    let minv = ivt_num::lu::inverse(problem.mass(), nd).expect("mass matrix must be invertible");
     let (mut g, mut f, mut acc) = (vec![0.0; nd], vec![0.0; nd], vec![0.0; nd]);
     move |t, y, dy| {
         let (x, v) = y.split_at(nd);

@@ -9,7 +9,7 @@
 
 use crate::aft::Aft;
 use crate::error::HbError;
-use crate::floquet::{eigenvalues, monodromy_uniform, small_inverse, HsuRule};
+use crate::floquet::{eigenvalues, monodromy_uniform, HsuRule};
 use crate::hill::{fourier_blocks, hill_multipliers};
 use crate::ihb::HbSolution;
 use crate::problem::PeriodicProblem;
@@ -121,7 +121,8 @@ impl StabilityAnalyzer {
     ) -> Result<Self, HbError> {
         let aft = Aft::new(harmonics, steps)?;
         let nd = problem.n_dof();
-        let minv = small_inverse(problem.mass(), nd).unwrap_or_else(|_| vec![f64::NAN; nd * nd]);
+        let minv =
+            ivt_num::lu::inverse(problem.mass(), nd).unwrap_or_else(|| vec![f64::NAN; nd * nd]);
         let dim = 2 * nd;
         let ns = 2 * steps;
         Ok(Self {

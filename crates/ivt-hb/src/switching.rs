@@ -10,10 +10,12 @@ use crate::bifurcation::{
     BifurcationError, BifurcationKind, BifurcationOptions,
 };
 use crate::broyden::SolveError;
-use crate::dense::{norm2, solve_dense};
 use crate::family::{Family, FamilyBranch};
 use crate::fold::{null_vector, Branch};
 use crate::ihb::{HbError, HbOptions};
+use crate::linalg::norm2;
+use ivt_num::lu::solve_once;
+use ivt_num::LuWorkspace;
 
 /// A first point on a new branch: Newton on `[R(q, λ); dᵀ(x − x*) − h] = 0`
 /// (`x = {q, λ}`) from the predictor `x* + h d`, where `x* = {q, λ}` is the
@@ -68,7 +70,7 @@ pub fn switch_branch<B: Branch>(
         }
         big[m * n1..].copy_from_slice(direction);
         step[m] = -arc;
-        if !solve_dense(&big, n1, &mut step, false) {
+        if !solve_once(&big, n1, &mut step, false) {
             return Err(solve_error(SolveError::SingularJacobian {
                 iteration: it,
                 history,
@@ -134,7 +136,10 @@ pub fn period_doubled_start<F: Family>(
         k != 0 && h % 2 == 1
     };
     let mut v: Vec<f64> = (0..m2).map(|i| if odd(i) { 1.0 } else { 0.0 }).collect();
-    if !null_vector(&jac, m2, &mut v, false) {
+    // `jac` is singular at the period doubling: only a non-finite factor is refused.
+    let mut lu = LuWorkspace::new(m2);
+    lu.factor_row_major(&jac);
+    if !null_vector(&mut lu, &mut v, false) {
         return Err(solve_error(SolveError::SingularJacobian {
             iteration: 0,
             history: Vec::new(),

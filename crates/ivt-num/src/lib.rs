@@ -19,16 +19,22 @@
 //! - [`rk`]: the stepper — fixed steps, tentative steps with an embedded
 //!   error estimate and the step-size controller, dense output;
 //! - [`lu`]: dense LU on faer with caller-owned scratch, factor once per
-//!   Jacobian refresh and solve many without allocating.
+//!   Jacobian refresh and solve many without allocating;
+//! - [`small`]: products of small row-major matrices on nalgebra;
+//! - [`newton`]: the one damped Newton method (dense Jacobian through
+//!   [`lu::LuWorkspace`], backtracking, residual and step tests).
 //!
 //! The rule for linear algebra: faer for dense LU and eigenvalues
 //! (workspace-based, no allocation in loops); nalgebra only for small
 //! fixed-size algebra and `expm`.
 
 pub mod lu;
+pub mod newton;
 pub mod rk;
+pub mod small;
 pub mod tableau;
 
 pub use lu::LuWorkspace;
+pub use newton::{newton, NewtonError, NewtonOptions, NewtonStats, NewtonSystem, NewtonWorkspace};
 pub use rk::{ExplicitRk, Tolerance};
 pub use tableau::{Tableau, DP5, RK4, RK6};

@@ -1,10 +1,12 @@
 //! Dense LU with partial pivoting on faer, on caller-owned storage: the
 //! factor, the permutation and faer's scratch are allocated once per problem
 //! size, so a Newton or continuation loop that refactors and solves
-//! allocates nothing (faer's `*_scratch` requirements + `MemStack`).
+//! allocates nothing (faer's `*_scratch` requirements + `MemStack`). The
+//! scratch covers a solve with up to `n` right-hand sides and the explicit
+//! inverse, so [`LuWorkspace::inverse_into`] allocates nothing either.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::linalg::lu::partial_pivoting::{factor, solve};
+use faer::linalg::lu::partial_pivoting::{factor, inverse as lu_inverse, solve};
 use faer::perm::PermRef;
 use faer::{Conj, Mat, MatMut, Par};
 
@@ -44,7 +46,9 @@ impl LuWorkspace {
     pub fn new(n: usize) -> Self {
         let req = StackReq::any_of(&[
             factor::lu_in_place_scratch::<usize, f64>(n, n, Par::Seq, Default::default()),
-            solve::solve_in_place_scratch::<usize, f64>(n, 1, Par::Seq),
+            solve::solve_in_place_scratch::<usize, f64>(n, n, Par::Seq),
+            solve::solve_transpose_in_place_scratch::<usize, f64>(n, n, Par::Seq),
+            lu_inverse::inverse_scratch::<usize, f64>(n, Par::Seq),
         ]);
         Self {
             mat: Mat::zeros(n, n),
@@ -103,20 +107,59 @@ impl LuWorkspace {
         n == 0 || min_pivot > max_pivot * f64::EPSILON * n as f64
     }
 
+    /// Copy the row-major `n × n` matrix `a` into [`LuWorkspace::mat`] and
+    /// factor it ([`LuWorkspace::factor`]).
+    pub fn factor_row_major(&mut self, a: &[f64]) -> bool {
+        self.set_row_major(a);
+        self.factor()
+    }
+
     /// Solve `A x = rhs` in place with the last factorization.
     pub fn solve(&mut self, rhs: &mut [f64]) {
         let n = self.dim();
+        self.solve_mat(MatMut::from_column_major_slice_mut(rhs, n, 1), false);
+    }
+
+    /// Solve `Aᵀ x = rhs` in place with the last factorization (left null
+    /// vectors, bordered systems).
+    pub fn solve_transpose(&mut self, rhs: &mut [f64]) {
+        let n = self.dim();
+        self.solve_mat(MatMut::from_column_major_slice_mut(rhs, n, 1), true);
+    }
+
+    /// Solve `A X = B` (or `Aᵀ X = B` with `transpose`) in place for the
+    /// columns of `rhs` (`n × k`, `k ≤ n`).
+    ///
+    /// # Panics
+    /// If `rhs` has not `n` rows or has more than `n` columns.
+    pub fn solve_mat(&mut self, rhs: MatMut<'_, f64>, transpose: bool) {
+        let n = self.dim();
+        assert!(rhs.nrows() == n && rhs.ncols() <= n.max(1));
         let perm = PermRef::new_checked(&self.perm, &self.perm_inv, n);
         let lu = self.mat.as_ref();
-        solve::solve_in_place_with_conj(
+        let stack = MemStack::new(&mut self.mem);
+        if transpose {
+            solve::solve_transpose_in_place_with_conj(lu, lu, perm, Conj::No, rhs, Par::Seq, stack);
+        } else {
+            solve::solve_in_place_with_conj(lu, lu, perm, Conj::No, rhs, Par::Seq, stack);
+        }
+    }
+
+    /// The inverse of the last factored matrix into the row-major `n × n`
+    /// slice `out`. Returns `false` if an entry is not finite.
+    pub fn inverse_into(&mut self, out: &mut [f64]) -> bool {
+        let n = self.dim();
+        let perm = PermRef::new_checked(&self.perm, &self.perm_inv, n);
+        let lu = self.mat.as_ref();
+        lu_inverse::inverse(
+            MatMut::from_row_major_slice_mut(&mut out[..n * n], n, n),
             lu,
             lu,
             perm,
-            Conj::No,
-            MatMut::from_column_major_slice_mut(rhs, n, 1),
             Par::Seq,
             MemStack::new(&mut self.mem),
         );
+        out[..n * n].iter().all(|v| v.is_finite())
     }
 }
 
@@ -124,23 +167,46 @@ impl LuWorkspace {
 /// allocates its workspace). `None` if `a` is numerically singular.
 pub fn inverse(a: &[f64], n: usize) -> Option<Vec<f64>> {
     let mut lu = LuWorkspace::new(n);
-    lu.set_row_major(a);
-    if !lu.factor() {
-        return None;
+    let mut inv = vec![0.0; n * n];
+    (lu.factor_row_major(a) && lu.inverse_into(&mut inv)).then_some(inv)
+}
+
+/// Solves `A x = rhs` (or `Aᵀ x = rhs` with `transpose`) in place for the
+/// row-major `n × n` matrix `a` (a one-off solve: it allocates its workspace;
+/// for repeated solves keep a [`LuWorkspace`]). Near-singular pivots are
+/// accepted, so it serves inverse iteration at a bifurcation; returns `false`
+/// only if the solution is not finite (singular or poisoned matrix).
+pub fn solve_once(a: &[f64], n: usize, rhs: &mut [f64], transpose: bool) -> bool {
+    let mut lu = LuWorkspace::new(n);
+    lu.factor_row_major(a);
+    if transpose {
+        lu.solve_transpose(rhs);
+    } else {
+        lu.solve(rhs);
     }
-    // Solve for the columns of A⁻¹, then store them as rows of the transpose.
-    let mut cols = vec![0.0; n * n];
-    for (j, col) in cols.chunks_exact_mut(n.max(1)).enumerate() {
-        col[j] = 1.0;
-        lu.solve(col);
-    }
-    let inv: Vec<f64> = (0..n * n).map(|k| cols[(k % n) * n + k / n]).collect();
-    inv.iter().all(|v| v.is_finite()).then_some(inv)
+    rhs.iter().all(|v| v.is_finite())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `solve_once` and its transpose on a 3×3 with a known solution
+    /// x = (1, −1, 2): A x = (1, −1, 9), Aᵀ x = (4, −2, 7); an exactly
+    /// singular matrix gives `false`.
+    #[test]
+    fn one_off_solves() {
+        let a = [2.0, 1.0, 0.0, 0.0, 3.0, 1.0, 1.0, 0.0, 4.0];
+        let mut b = [1.0, -1.0, 9.0];
+        assert!(solve_once(&a, 3, &mut b, false));
+        let mut bt = [4.0, -2.0, 7.0];
+        assert!(solve_once(&a, 3, &mut bt, true));
+        for (x, w) in b.iter().chain(&bt).zip([1.0, -1.0, 2.0, 1.0, -1.0, 2.0]) {
+            assert!((x - w).abs() < 1e-14, "{b:?} {bt:?}");
+        }
+        let mut s = [1.0, 1.0];
+        assert!(!solve_once(&[1.0, 2.0, 2.0, 4.0], 2, &mut s, false));
+    }
 
     /// A 3×3 matrix that needs pivoting (zero leading entry): A·A⁻¹ = I to
     /// 1e-15, the determinant sign matches det = −5, and a singular matrix
@@ -162,5 +228,35 @@ mod tests {
         assert_eq!(lu.det_sign, -1.0);
         let singular = [1.0, 2.0, 3.0, 2.0, 4.0, 6.0, 0.0, 1.0, 1.0];
         assert!(inverse(&singular, 3).is_none());
+    }
+
+    /// `A = [[2, 1, 0], [0, 3, 1], [1, 0, 4]]`, `x = (1, −1, 2)`: `A x = (1, −1, 9)`
+    /// and `Aᵀ x = (4, −2, 7)` (integer arithmetic), recovered to 1e-15 by
+    /// `solve`, `solve_transpose` and a two-column `solve_mat`; the factor
+    /// is reused for all of them.
+    #[test]
+    fn plain_transposed_and_multi_rhs_solves() {
+        let a = [2.0, 1.0, 0.0, 0.0, 3.0, 1.0, 1.0, 0.0, 4.0];
+        let mut lu = LuWorkspace::new(3);
+        assert!(lu.factor_row_major(&a));
+        let mut b = [1.0, -1.0, 9.0];
+        lu.solve(&mut b);
+        let mut bt = [4.0, -2.0, 7.0];
+        lu.solve_transpose(&mut bt);
+        let mut two = [1.0, -1.0, 9.0, 4.0, -2.0, 7.0];
+        lu.solve_mat(MatMut::from_column_major_slice_mut(&mut two, 3, 2), true);
+        let x = [1.0, -1.0, 2.0];
+        for (got, want) in b.iter().chain(&bt).zip(x.iter().chain(&x)) {
+            assert!((got - want).abs() < 1e-15, "{b:?} {bt:?}");
+        }
+        // Column 2 of `two` solved Aᵀ: x again; column 1 (A x as rhs of Aᵀ)
+        // is checked by applying Aᵀ back.
+        for (got, want) in two[3..].iter().zip(x) {
+            assert!((got - want).abs() < 1e-15, "{two:?}");
+        }
+        for i in 0..3 {
+            let back: f64 = (0..3).map(|k| a[k * 3 + i] * two[k]).sum();
+            assert!((back - [1.0, -1.0, 9.0][i]).abs() < 1e-14, "{two:?}");
+        }
     }
 }

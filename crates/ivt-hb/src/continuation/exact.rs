@@ -14,7 +14,7 @@
 use faer::Mat;
 use ivt_num::LuWorkspace;
 
-use super::{parabola_extremum, ContinuationError, ContinuationOptions, Fold, Path, PathPoint};
+use super::{turn, ContinuationError, ContinuationOptions, Fold, Path, PathPoint};
 use super::{SolveError, Termination};
 
 /// `R(u, λ) = 0`, `R: R^m × R → R^m`, with its exact Jacobian.
@@ -97,14 +97,11 @@ where
         };
         let k = points.len();
         if k >= 2 && points[k - 1].dlambda * point.dlambda < 0.0 {
-            let near = if points[k - 1].dlambda.abs() <= point.dlambda.abs() {
-                k - 1
-            } else {
-                k
-            };
+            let (turned, nearest) = turn(&points[k - 2], &points[k - 1], &point);
             folds.push(Fold {
-                index: near,
-                lambda: parabola_extremum(&points[k - 2], &points[k - 1], &point),
+                index: k - 2 + nearest,
+                lambda: turned[m],
+                bracket: k - 2,
             });
         }
         points.push(point);
