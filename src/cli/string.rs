@@ -115,7 +115,7 @@ pub fn run(args: StringArgs) -> Result<Output, CliError> {
         .map(|(p, method)| {
             let _ = writeln!(human, "{:.6} {:.6e} {}", p.omega_f, p.amplitude, p.stable());
             json!({"omega": p.omega_f, "norm": p.amplitude, "stable": p.stable(),
-                   "kind": format!("{:?}", p.kind), "max_multiplier": p.multipliers[0].norm(),
+                   "kind": format!("{:?}", p.kind), "max_multiplier": p.multipliers.first().map(|m| m.norm()),
                    "method": format!("{method:?}")})
         })
         .collect();

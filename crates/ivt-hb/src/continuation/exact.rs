@@ -67,7 +67,7 @@ where
     if start.len() != m + 1 {
         return Err(ContinuationError::Input("start must hold m unknowns and λ"));
     }
-    if !start.iter().all(|v| v.is_finite()) || !(opts.ds > 0.0 && opts.ds_min > 0.0) {
+    if !(start.iter().all(|v| v.is_finite()) && opts.ds > 0.0 && opts.ds_min > 0.0) {
         return Err(ContinuationError::Input("non-finite start or step"));
     }
     let mut corrector = Corrector::new(m, opts);
