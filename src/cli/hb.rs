@@ -47,7 +47,7 @@ pub struct DuffingParams {
     /// Forcing amplitude F.
     #[arg(long, default_value_t = 0.1)]
     force: f64,
-    /// Residual tolerance on ‖r‖.
+    /// Absolute residual tolerance on ‖r‖₂.
     #[arg(long, default_value_t = 1e-10)]
     tol: f64,
 }
@@ -60,8 +60,16 @@ impl DuffingParams {
         }
         Ok(d)
     }
-    fn options(&self) -> HbOptions {
-        HbOptions::new(self.n, self.samples).with_tol(self.tol)
+    /// `--tol` is an absolute bound on ‖r‖₂ (no relative part), so it must be
+    /// positive itself.
+    fn options(&self) -> Result<HbOptions, CliError> {
+        if !(self.tol.is_finite() && self.tol > 0.0) {
+            return Err(CliError::Input(format!(
+                "--tol must be finite and > 0, got {}",
+                self.tol
+            )));
+        }
+        Ok(HbOptions::new(self.n, self.samples).with_tol(self.tol))
     }
 }
 
@@ -155,7 +163,7 @@ fn hb_err(e: ivt_hb::HbError) -> CliError {
 
 fn duffing(a: DuffingArgs) -> Result<Output, CliError> {
     let problem = a.params.problem()?;
-    let opts = a.params.options();
+    let opts = a.params.options()?;
     let t0 = std::time::Instant::now();
     let sol = match a.method {
         Method::Modified => {
@@ -231,7 +239,7 @@ fn duffing_frc(a: FrcArgs) -> Result<Output, CliError> {
         ..FrcOptions::default()
     };
     let t0 = std::time::Instant::now();
-    let frc = frequency_response(&problem, &a.params.options(), &opts).map_err(hb_err)?;
+    let frc = frequency_response(&problem, &a.params.options()?, &opts).map_err(hb_err)?;
     let time = t0.elapsed().as_secs_f64();
     let points: Vec<_> = frc
         .points
