@@ -18,6 +18,20 @@ fn kin_err(e: KinError) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
+/// The pair `f(a, b)` broadcast over two array-likes: a tuple of two arrays
+/// (of two floats for scalars), as the speed relations of Eq. 1–4 return.
+fn map_pair<'py>(
+    py: Python<'py>,
+    args: [(&'static str, &Bound<'py, PyAny>); 2],
+    f: impl Fn(f64, f64) -> (f64, f64),
+) -> PyResult<Bound<'py, PyTuple>> {
+    let [a, b] = map(py, args, |[x, y]| {
+        let (a, b) = f(x, y);
+        Ok::<_, std::convert::Infallible>([a, b])
+    })?;
+    PyTuple::new(py, [a, b])
+}
+
 /// The `#[pymethods]` block of a geometry class (`self.geometry`): the
 /// `items` as written, then one method per `fn name(a[, b]);` entry that
 /// broadcasts `self.geometry.name(a[, b])` over numpy array-likes like a ufunc
@@ -46,17 +60,8 @@ macro_rules! geometry_methods {
     };
 }
 
-const GIVT_FIELDS: &[Field<GivtGeometry>] = &[
-    ("l1", |g| g.l1, |g, v| g.l1 = v),
-    ("r_output", |g| g.r_output, |g, v| g.r_output = v),
-    ("r_sun", |g| g.r_sun, |g, v| g.r_sun = v),
-    ("r_planet", |g| g.r_planet, |g, v| g.r_planet = v),
-    ("r_crk", |g| g.r_crk, |g, v| g.r_crk = v),
-    (
-        "control_to_ring",
-        |g| g.control_to_ring,
-        |g, v| g.control_to_ring = v,
-    ),
+const GIVT_FIELDS: &[Field<GivtGeometry>] = fields::field_table![
+    GivtGeometry; l1, r_output, r_sun, r_planet, r_crk, control_to_ring
 ];
 
 /// The crank-slider GIVT of §2.1 (Eq. 1–10), SI units.
@@ -109,15 +114,9 @@ Givt {
         omega_c1: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyTuple>> {
         let g = self.geometry;
-        let [a, b] = map(
-            py,
-            [("omega_in", omega_in), ("omega_c1", omega_c1)],
-            |[w, c]| {
-                let (a, b) = g.sun_speeds(w, c);
-                Ok::<_, KinError>([a, b])
-            },
-        )?;
-        PyTuple::new(py, [a, b])
+        map_pair(py, [("omega_in", omega_in), ("omega_c1", omega_c1)], |w, c| {
+            g.sun_speeds(w, c)
+        })
     }
 
     /// Crank rotation and translation (ω_crk, v_crk) from the sun speeds, Eq. 3–4.
@@ -128,15 +127,9 @@ Givt {
         omega_sb: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyTuple>> {
         let g = self.geometry;
-        let [a, b] = map(
-            py,
-            [("omega_sa", omega_sa), ("omega_sb", omega_sb)],
-            |[x, y]| {
-                let (a, b) = g.crank_motion(x, y);
-                Ok::<_, KinError>([a, b])
-            },
-        )?;
-        PyTuple::new(py, [a, b])
+        map_pair(py, [("omega_sa", omega_sa), ("omega_sb", omega_sb)], |a, b| {
+            g.crank_motion(a, b)
+        })
     }
 
     fn __repr__(&self) -> String {
@@ -160,30 +153,9 @@ Givt {
     fn average_final_ratio(r);
 }
 
-const SGIVT_FIELDS: &[Field<SgivtGeometry>] = &[
-    ("d_sg", |g| g.d_sg, |g, v| g.d_sg = v),
-    ("d_pg", |g| g.d_pg, |g, v| g.d_pg = v),
-    ("d_acg", |g| g.d_acg, |g, v| g.d_acg = v),
-    ("d_esg", |g| g.d_esg, |g, v| g.d_esg = v),
-    ("d_erg", |g| g.d_erg, |g, v| g.d_erg = v),
-    ("d_ecg", |g| g.d_ecg, |g, v| g.d_ecg = v),
-    ("r_cg", |g| g.r_cg, |g, v| g.r_cg = v),
-    ("r_og", |g| g.r_og, |g, v| g.r_og = v),
-    (
-        "stepper_to_acg",
-        |g| g.stepper_to_acg,
-        |g, v| g.stepper_to_acg = v,
-    ),
-    (
-        "ncg_centre_distance",
-        |g| g.ncg_centre_distance,
-        |g, v| g.ncg_centre_distance = v,
-    ),
-    (
-        "theta_ct_max",
-        |g| g.theta_ct_max,
-        |g, v| g.theta_ct_max = v,
-    ),
+const SGIVT_FIELDS: &[Field<SgivtGeometry>] = fields::field_table![
+    SgivtGeometry; d_sg, d_pg, d_acg, d_esg, d_erg, d_ecg, r_cg, r_og, stepper_to_acg,
+    ncg_centre_distance, theta_ct_max
 ];
 
 /// The scotch-yoke SGIVT prototype of §2.2 and §4.4.2, SI units.

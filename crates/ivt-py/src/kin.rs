@@ -125,28 +125,9 @@ fn output_to_motor_ratio<'py>(
 }
 
 /// The numeric Table 1 parameters by their Rust (and Python) names.
-const FIELDS: &[Field<PlantParams>] = &[
-    ("r_a", |p| p.r_a, |p, v| p.r_a = v),
-    ("k_e", |p| p.k_e, |p, v| p.k_e = v),
-    ("k_t", |p| p.k_t, |p, v| p.k_t = v),
-    ("l_a", |p| p.l_a, |p, v| p.l_a = v),
-    ("j_n1", |p| p.j_n1, |p, v| p.j_n1 = v),
-    ("j_n2", |p| p.j_n2, |p, v| p.j_n2 = v),
-    ("j_inshaft", |p| p.j_inshaft, |p, v| p.j_inshaft = v),
-    ("j_carrier", |p| p.j_carrier, |p, v| p.j_carrier = v),
-    ("j_ring", |p| p.j_ring, |p, v| p.j_ring = v),
-    ("j_crk", |p| p.j_crk, |p, v| p.j_crk = v),
-    ("m_r", |p| p.m_r, |p, v| p.m_r = v),
-    ("m_dr", |p| p.m_dr, |p, v| p.m_dr = v),
-    ("j_u", |p| p.j_u, |p, v| p.j_u = v),
-    ("r_u", |p| p.r_u, |p, v| p.r_u = v),
-    ("g", |p| p.g, |p, v| p.g = v),
-    (
-        "sun_to_planet",
-        |p| p.sun_to_planet,
-        |p, v| p.sun_to_planet = v,
-    ),
-    ("r_max", |p| p.r_max, |p, v| p.r_max = v),
+const FIELDS: &[Field<PlantParams>] = fields::field_table![
+    PlantParams; r_a, k_e, k_t, l_a, j_n1, j_n2, j_inshaft, j_carrier, j_ring, j_crk, m_r, m_dr,
+    j_u, r_u, g, sun_to_planet, r_max
 ];
 
 fn gravity_name(g: GravityModel) -> &'static str {
