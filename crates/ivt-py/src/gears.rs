@@ -32,15 +32,46 @@ fn map_pair<'py>(
     PyTuple::new(py, [a, b])
 }
 
-/// The `#[pymethods]` block of a geometry class (`self.geometry`): the
-/// `items` as written, then one method per `fn name(a[, b]);` entry that
-/// broadcasts `self.geometry.name(a[, b])` over numpy array-likes like a ufunc
-/// (scalar in → float out), raising the Rust error with the flat index.
+/// The `#[pymethods]` block of a geometry class (`self.geometry`, its fields
+/// in `fields`): `params()` (the fields as a dict), `__repr__` (the fields
+/// that differ from `reference()`), the `items` as written; for each `fn name(a, b);` under `pairs`, a method
+/// broadcasting the pair `self.geometry.name(a, b)` (see [`map_pair`]); then
+/// one method per `fn name(a[, b]);` entry that broadcasts the fallible
+/// `self.geometry.name(a[, b])` over numpy array-likes like a ufunc (scalar in
+/// → float out), raising the Rust error with the flat index.
 macro_rules! geometry_methods {
-    ($ty:ident { $($items:tt)* } $( $(#[$doc:meta])* fn $name:ident($a:ident $(, $b:ident)?); )*) => {
+    (
+        $ty:ident($fields:expr, $reference:path) { $($items:tt)* }
+        $(pairs { $( $(#[$pdoc:meta])* fn $pair:ident($pa:ident, $pb:ident); )* })?
+        $( $(#[$doc:meta])* fn $name:ident($a:ident $(, $b:ident)?); )*
+    ) => {
         #[pymethods]
         impl $ty {
+            /// The dimensions as a dict (constructor keywords).
+            fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+                fields::to_dict(py, $fields, &self.geometry)
+            }
+
+            fn __repr__(&self) -> String {
+                let changed = fields::changed($fields, &self.geometry, &$reference());
+                format!("{}({})", stringify!($ty), changed.join(", "))
+            }
+
             $($items)*
+            $($(
+                $(#[$pdoc])*
+                fn $pair<'py>(
+                    &self,
+                    py: Python<'py>,
+                    $pa: &Bound<'py, PyAny>,
+                    $pb: &Bound<'py, PyAny>,
+                ) -> PyResult<Bound<'py, PyTuple>> {
+                    let g = self.geometry;
+                    map_pair(py, [(stringify!($pa), $pa), (stringify!($pb), $pb)], |$pa, $pb| {
+                        g.$pair($pa, $pb)
+                    })
+                }
+            )*)?
             $(
                 $(#[$doc])*
                 fn $name<'py>(
@@ -76,7 +107,7 @@ pub struct Givt {
 }
 
 geometry_methods! {
-Givt {
+Givt(GIVT_FIELDS, GivtGeometry::illustrative) {
     #[new]
     #[pyo3(signature = (**overrides))]
     fn new(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
@@ -86,11 +117,6 @@ Givt {
         })?;
         geometry.validate().map_err(kin_err)?;
         Ok(Self { geometry })
-    }
-
-    /// The dimensions as a dict (constructor keywords).
-    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        fields::to_dict(py, GIVT_FIELDS, &self.geometry)
     }
 
     /// Corners (kinks) of R(θ, r) in one period [rad].
@@ -105,37 +131,12 @@ Givt {
     fn crank_to_input(&self) -> f64 {
         self.geometry.crank_to_input()
     }
-
+}
+pairs {
     /// Sun-gear speeds (ω_sA, ω_sB) for input ω_in and control ω_c1, Eq. 1–2.
-    fn sun_speeds<'py>(
-        &self,
-        py: Python<'py>,
-        omega_in: &Bound<'py, PyAny>,
-        omega_c1: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyTuple>> {
-        let g = self.geometry;
-        map_pair(py, [("omega_in", omega_in), ("omega_c1", omega_c1)], |w, c| {
-            g.sun_speeds(w, c)
-        })
-    }
-
+    fn sun_speeds(omega_in, omega_c1);
     /// Crank rotation and translation (ω_crk, v_crk) from the sun speeds, Eq. 3–4.
-    fn crank_motion<'py>(
-        &self,
-        py: Python<'py>,
-        omega_sa: &Bound<'py, PyAny>,
-        omega_sb: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyTuple>> {
-        let g = self.geometry;
-        map_pair(py, [("omega_sa", omega_sa), ("omega_sb", omega_sb)], |a, b| {
-            g.crank_motion(a, b)
-        })
-    }
-
-    fn __repr__(&self) -> String {
-        let changed = fields::changed(GIVT_FIELDS, &self.geometry, &GivtGeometry::illustrative());
-        format!("Givt({})", changed.join(", "))
-    }
+    fn crank_motion(omega_sa, omega_sb);
 }
     /// Single crank-slider ratio R1(θ, r), Eq. 8.
     fn single_ratio(theta, r);
@@ -169,7 +170,7 @@ pub struct Sgivt {
 }
 
 geometry_methods! {
-Sgivt {
+Sgivt(SGIVT_FIELDS, SgivtGeometry::prototype) {
     #[new]
     #[pyo3(signature = (**overrides))]
     fn new(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
@@ -192,20 +193,10 @@ Sgivt {
         Ok(Self { geometry })
     }
 
-    /// The dimensions as a dict (constructor keywords).
-    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        fields::to_dict(py, SGIVT_FIELDS, &self.geometry)
-    }
-
     /// v_CRK/ω_CT = 7 r_CG/288 [m/rad] through the gear chain, Eq. 184.
     #[getter]
     fn crank_length_per_stepper_rad(&self) -> f64 {
         self.geometry.crank_length_per_stepper_rad()
-    }
-
-    fn __repr__(&self) -> String {
-        let changed = fields::changed(SGIVT_FIELDS, &self.geometry, &SgivtGeometry::prototype());
-        format!("Sgivt({})", changed.join(", "))
     }
 }
     /// Crank length e [m] for a stepper angle θ_CT [rad] ∈ [0, theta_ct_max], Eq. 182–185.
