@@ -32,21 +32,41 @@ fn map_pair<'py>(
     PyTuple::new(py, [a, b])
 }
 
-/// The `#[pymethods]` block of a geometry class (`self.geometry`, its fields
-/// in `fields`): `params()` (the fields as a dict), `__repr__` (the fields
-/// that differ from `reference()`), the `items` as written; for each `fn name(a, b);` under `pairs`, a method
-/// broadcasting the pair `self.geometry.name(a, b)` (see [`map_pair`]); then
-/// one method per `fn name(a[, b]);` entry that broadcasts the fallible
+/// A frozen geometry class `$ty` wrapping `geometry: $geom` (its fields in
+/// `fields`) with its `#[pymethods]`: the constructor (`reference()` with
+/// keyword overrides, then `check`), `params()` (the fields as a dict),
+/// `__repr__` (the fields that differ from `reference()`), the `items` as
+/// written; for each `fn name(a, b);` under `pairs`, a method broadcasting the
+/// pair `self.geometry.name(a, b)` (see [`map_pair`]); then one method per
+/// `fn name(a[, b]);` entry that broadcasts the fallible
 /// `self.geometry.name(a[, b])` over numpy array-likes like a ufunc (scalar in
 /// → float out), raising the Rust error with the flat index.
-macro_rules! geometry_methods {
+macro_rules! geometry_class {
     (
-        $ty:ident($fields:expr, $reference:path) { $($items:tt)* }
+        $(#[$cdoc:meta])*
+        $ty:ident($geom:ty, $what:literal, $fields:expr, $reference:path, $check:expr) {
+            $($items:tt)*
+        }
         $(pairs { $( $(#[$pdoc:meta])* fn $pair:ident($pa:ident, $pb:ident); )* })?
         $( $(#[$doc:meta])* fn $name:ident($a:ident $(, $b:ident)?); )*
     ) => {
+        $(#[$cdoc])*
+        #[pyclass(module = "ivt.kin", frozen)]
+        pub struct $ty {
+            geometry: $geom,
+        }
+
         #[pymethods]
         impl $ty {
+            #[new]
+            #[pyo3(signature = (**overrides))]
+            fn new(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+                let mut geometry = $reference();
+                fields::apply($what, $fields, &mut geometry, overrides, |_, _, _| Ok(false))?;
+                ($check)(&geometry)?;
+                Ok(Self { geometry })
+            }
+
             /// The dimensions as a dict (constructor keywords).
             fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
                 fields::to_dict(py, $fields, &self.geometry)
@@ -95,30 +115,16 @@ const GIVT_FIELDS: &[Field<GivtGeometry>] = fields::field_table![
     GivtGeometry; l1, r_output, r_sun, r_planet, r_crk, control_to_ring
 ];
 
-/// The crank-slider GIVT of §2.1 (Eq. 1–10), SI units.
-///
-/// `Givt()` uses ivt-kin's illustrative dimensions (l1 = 50 mm, r_output =
-/// 15 mm: **not printed in the thesis**); keywords override them. Ratio
-/// methods broadcast over numpy arrays; θ must be finite and 0 ≤ r < l1,
-/// else `ValueError` with the Rust message.
-#[pyclass(name = "Givt", module = "ivt.kin", frozen)]
-pub struct Givt {
-    geometry: GivtGeometry,
-}
-
-geometry_methods! {
-Givt(GIVT_FIELDS, GivtGeometry::illustrative) {
-    #[new]
-    #[pyo3(signature = (**overrides))]
-    fn new(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        let mut geometry = GivtGeometry::illustrative();
-        fields::apply("GIVT", GIVT_FIELDS, &mut geometry, overrides, |_, _, _| {
-            Ok(false)
-        })?;
-        geometry.validate().map_err(kin_err)?;
-        Ok(Self { geometry })
-    }
-
+geometry_class! {
+    /// The crank-slider GIVT of §2.1 (Eq. 1–10), SI units.
+    ///
+    /// `Givt()` uses ivt-kin's illustrative dimensions (l1 = 50 mm, r_output =
+    /// 15 mm: **not printed in the thesis**); keywords override them. Ratio
+    /// methods broadcast over numpy arrays; θ must be finite and 0 ≤ r < l1,
+    /// else `ValueError` with the Rust message.
+    Givt(GivtGeometry, "GIVT", GIVT_FIELDS, GivtGeometry::illustrative, |g: &GivtGeometry| {
+        g.validate().map_err(kin_err)
+    }) {
     /// Corners (kinks) of R(θ, r) in one period [rad].
     fn module_corners(&self, r: f64) -> PyResult<Vec<f64>> {
         let mut buf = [0.0; ivt_kin::givt::MAX_CORNERS];
@@ -159,40 +165,26 @@ const SGIVT_FIELDS: &[Field<SgivtGeometry>] = fields::field_table![
     ncg_centre_distance, theta_ct_max
 ];
 
-/// The scotch-yoke SGIVT prototype of §2.2 and §4.4.2, SI units.
-///
-/// `Sgivt()` is the printed prototype (gear diameters in inches converted to
-/// metres); keywords override dimensions (each finite and > 0). Methods
-/// broadcast over numpy arrays; out-of-domain inputs raise `ValueError`.
-#[pyclass(name = "Sgivt", module = "ivt.kin", frozen)]
-pub struct Sgivt {
-    geometry: SgivtGeometry,
+/// Every SGIVT dimension must be finite and > 0.
+fn sgivt_positive(geometry: &SgivtGeometry) -> PyResult<()> {
+    for (name, get, _) in SGIVT_FIELDS {
+        let v = get(geometry);
+        if !(v.is_finite() && v > 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "SGIVT parameter `{name}` = {v} must be finite and > 0"
+            )));
+        }
+    }
+    Ok(())
 }
 
-geometry_methods! {
-Sgivt(SGIVT_FIELDS, SgivtGeometry::prototype) {
-    #[new]
-    #[pyo3(signature = (**overrides))]
-    fn new(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        let mut geometry = SgivtGeometry::prototype();
-        fields::apply(
-            "SGIVT",
-            SGIVT_FIELDS,
-            &mut geometry,
-            overrides,
-            |_, _, _| Ok(false),
-        )?;
-        for (name, get, _) in SGIVT_FIELDS {
-            let v = get(&geometry);
-            if !(v.is_finite() && v > 0.0) {
-                return Err(PyValueError::new_err(format!(
-                    "SGIVT parameter `{name}` = {v} must be finite and > 0"
-                )));
-            }
-        }
-        Ok(Self { geometry })
-    }
-
+geometry_class! {
+    /// The scotch-yoke SGIVT prototype of §2.2 and §4.4.2, SI units.
+    ///
+    /// `Sgivt()` is the printed prototype (gear diameters in inches converted to
+    /// metres); keywords override dimensions (each finite and > 0). Methods
+    /// broadcast over numpy arrays; out-of-domain inputs raise `ValueError`.
+    Sgivt(SgivtGeometry, "SGIVT", SGIVT_FIELDS, SgivtGeometry::prototype, sgivt_positive) {
     /// v_CRK/ω_CT = 7 r_CG/288 [m/rad] through the gear chain, Eq. 184.
     #[getter]
     fn crank_length_per_stepper_rad(&self) -> f64 {
