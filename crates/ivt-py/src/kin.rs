@@ -177,8 +177,26 @@ pub struct Plant {
     pub params: PlantParams,
 }
 
-#[pymethods]
-impl Plant {
+/// `#[pymethods] impl Plant`: the `items` as written, then one read-only
+/// property per `name;` entry returning `self.params.name()`.
+macro_rules! plant_methods {
+    ({ $($items:tt)* } $( $(#[$doc:meta])* $name:ident; )*) => {
+        #[pymethods]
+        impl Plant {
+            $($items)*
+            $(
+                $(#[$doc])*
+                #[getter]
+                fn $name(&self) -> f64 {
+                    self.params.$name()
+                }
+            )*
+        }
+    };
+}
+
+plant_methods! {
+{
     #[new]
     #[pyo3(signature = (**overrides))]
     fn new(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
@@ -217,46 +235,6 @@ impl Plant {
         Ok(d)
     }
 
-    /// J_a [kg·m²] (§4.1; thesis 0.0237).
-    #[getter]
-    fn j_a(&self) -> f64 {
-        self.params.j_a()
-    }
-    /// J_b = m_r + m_dr [kg] (§4.1; thesis 2.1264).
-    #[getter]
-    fn j_b(&self) -> f64 {
-        self.params.j_b()
-    }
-    /// J_c = J_U·8/(π² r_u²) [kg] (§4.1; thesis 0.3388).
-    #[getter]
-    fn j_c(&self) -> f64 {
-        self.params.j_c()
-    }
-    /// J_d = J_N1 [kg·m²] (§4.1).
-    #[getter]
-    fn j_d(&self) -> f64 {
-        self.params.j_d()
-    }
-    /// k_t k_e/R_a: F_m = this·f² (thesis 2.375).
-    #[getter]
-    fn motor_damping(&self) -> f64 {
-        self.params.motor_damping()
-    }
-    /// k_t/R_a: f1 = this·f·V_m (thesis 3.1667).
-    #[getter]
-    fn motor_gain(&self) -> f64 {
-        self.params.motor_gain()
-    }
-    /// 2√2/(π r_u): f2 = this·f·T_U (thesis 40.5548).
-    #[getter]
-    fn load_gain(&self) -> f64 {
-        self.params.load_gain()
-    }
-    /// Coefficient of (sin θ + cos θ) in G: g, or m_r·g with gravity="roller_mass".
-    #[getter]
-    fn gravity_gain(&self) -> f64 {
-        self.params.gravity_gain()
-    }
     /// Largest eccentricity r_max [m] (§4.2.1: 0.012).
     #[getter]
     fn r_max(&self) -> f64 {
@@ -363,6 +341,23 @@ impl Plant {
         let args = PyTuple::new(py, [self.params(py)?])?;
         PyTuple::new(py, [rebuild, args.into_any()])
     }
+}
+    /// J_a [kg·m²] (§4.1; thesis 0.0237).
+    j_a;
+    /// J_b = m_r + m_dr [kg] (§4.1; thesis 2.1264).
+    j_b;
+    /// J_c = J_U·8/(π² r_u²) [kg] (§4.1; thesis 0.3388).
+    j_c;
+    /// J_d = J_N1 [kg·m²] (§4.1).
+    j_d;
+    /// k_t k_e/R_a: F_m = this·f² (thesis 2.375).
+    motor_damping;
+    /// k_t/R_a: f1 = this·f·V_m (thesis 3.1667).
+    motor_gain;
+    /// 2√2/(π r_u): f2 = this·f·T_U (thesis 40.5548).
+    load_gain;
+    /// Coefficient of (sin θ + cos θ) in G: g, or m_r·g with gravity="roller_mass".
+    gravity_gain;
 }
 
 /// Register `ivt._ivt.kin`.
