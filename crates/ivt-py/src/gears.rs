@@ -3,7 +3,7 @@
 
 use crate::args::int64;
 use crate::fields::{self, Field};
-use crate::vectorize::{map, map1};
+use crate::vectorize::{map, map1, map2};
 use ivt_kin::givt::{DirectionMode, DirectionModule, GivtGeometry};
 use ivt_kin::ncg::{self, GearRatio, GivtNcg, PitchPoint, SgivtNcg, SmoothNcg};
 use ivt_kin::sgivt::{self, SgivtGeometry};
@@ -12,24 +12,10 @@ use numpy::ndarray::Array1;
 use numpy::IntoPyArray;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyTuple};
+use pyo3::types::PyDict;
 
 fn kin_err(e: KinError) -> PyErr {
     PyValueError::new_err(e.to_string())
-}
-
-/// The pair `f(a, b)` broadcast over two array-likes: a tuple of two arrays
-/// (of two floats for scalars), as the speed relations of Eq. 1–4 return.
-fn map_pair<'py>(
-    py: Python<'py>,
-    args: [(&'static str, &Bound<'py, PyAny>); 2],
-    f: impl Fn(f64, f64) -> (f64, f64),
-) -> PyResult<Bound<'py, PyTuple>> {
-    let [a, b] = map(py, args, |[x, y]| {
-        let (a, b) = f(x, y);
-        Ok::<_, std::convert::Infallible>([a, b])
-    })?;
-    PyTuple::new(py, [a, b])
 }
 
 /// A frozen geometry class `$ty` wrapping `geometry: $geom` (its fields in
@@ -37,7 +23,7 @@ fn map_pair<'py>(
 /// keyword overrides, then `check`), `params()` (the fields as a dict),
 /// `__repr__` (the fields that differ from `reference()`), the `items` as
 /// written; for each `fn name(a, b);` under `pairs`, a method broadcasting the
-/// pair `self.geometry.name(a, b)` (see [`map_pair`]); then one method per
+/// pair `self.geometry.name(a, b)` (see [`map2`]); then one method per
 /// `fn name(a[, b]);` entry that broadcasts the fallible
 /// `self.geometry.name(a[, b])` over numpy array-likes like a ufunc (scalar in
 /// → float out), raising the Rust error with the flat index.
@@ -85,9 +71,9 @@ macro_rules! geometry_class {
                     py: Python<'py>,
                     $pa: &Bound<'py, PyAny>,
                     $pb: &Bound<'py, PyAny>,
-                ) -> PyResult<Bound<'py, PyTuple>> {
+                ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
                     let g = self.geometry;
-                    map_pair(py, [(stringify!($pa), $pa), (stringify!($pb), $pb)], |$pa, $pb| {
+                    map2(py, [(stringify!($pa), $pa), (stringify!($pb), $pb)], |[$pa, $pb]| {
                         g.$pair($pa, $pb)
                     })
                 }

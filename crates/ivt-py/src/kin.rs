@@ -2,7 +2,7 @@
 //! coefficients of Eq. 151, vectorized over numpy arrays.
 
 use crate::fields::{self, Field};
-use crate::vectorize::{map, map1};
+use crate::vectorize::{map, map1, map2};
 use ivt_kin::plant::{GravityModel, PlantParams};
 use ivt_kin::variant;
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -56,11 +56,9 @@ fn ring_speeds<'py>(
             "arguments `d_s` = {d_s}, `d_p` = {d_p} must be finite with d_s + 2 d_p != 0"
         )));
     }
-    let [a, b] = map(py, [("omega", omega), ("omega_c", omega_c)], |[w, wc]| {
-        let (r1, r2) = variant::ring_speeds(w, wc, d_s, d_p);
-        Ok::<_, std::convert::Infallible>([r1, r2])
-    })?;
-    Ok((a, b))
+    map2(py, [("omega", omega), ("omega_c", omega_c)], |[w, wc]| {
+        variant::ring_speeds(w, wc, d_s, d_p)
+    })
 }
 
 /// Driver speeds (v_d1, v_d2) = (ω r sin θ, ω r cos θ) [m/s], Eq. 45–46.
@@ -71,15 +69,11 @@ fn driver_speeds<'py>(
     omega: &Bound<'py, PyAny>,
     r: &Bound<'py, PyAny>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-    let [a, b] = map(
+    map2(
         py,
         [("theta", theta), ("omega", omega), ("r", r)],
-        |[t, w, r]| {
-            let (v1, v2) = variant::driver_speeds(t, w, r);
-            Ok::<_, std::convert::Infallible>([v1, v2])
-        },
-    )?;
-    Ok((a, b))
+        |[t, w, r]| variant::driver_speeds(t, w, r),
+    )
 }
 
 fn check_r_u(r_u: f64) -> PyResult<()> {
