@@ -17,7 +17,7 @@ use pyo3::types::{PyDict, PyList};
 use std::time::Instant;
 
 use crate::args::{count, int64};
-use crate::user_problem::{callback_error, user_problem, with_tolerances};
+use crate::user_problem::{callback_error, user_problem, with_tolerances, PyProblem};
 
 create_exception!(
     ivt,
@@ -47,6 +47,21 @@ fn hb_err(py: Python<'_>, e: HbError) -> PyErr {
         HbError::Continuation(_) => ConvergenceError::new_err(e.to_string()),
         _ => PyValueError::new_err(e.to_string()),
     }
+}
+
+/// Run `solve` on a user system with the GIL released (its callbacks take it
+/// back), then re-raise the first exception a callback raised (it aborted the
+/// run) or map the ivt-hb error with [`hb_err`].
+fn run_user<T: Send>(
+    py: Python<'_>,
+    problem: &PyProblem,
+    solve: impl FnOnce(&PyProblem) -> Result<T, HbError> + Send,
+) -> PyResult<T> {
+    let result = py.detach(|| solve(problem));
+    if let Some(e) = callback_error(problem) {
+        return Err(e);
+    }
+    result.map_err(|e| hb_err(py, e))
 }
 
 /// Options from the Python keywords: n harmonics, `samples` = N (2N AFT samples).
@@ -459,12 +474,9 @@ fn solve<'py>(
     let opts = with_tolerances(options(n, samples, subharmonic, 1.0)?, tol, rtol, max_iter)?;
     let meth = self::method(method)?;
     let guess = guess_vec(guess)?;
-    let result =
-        py.detach(|| solve_problem(&problem, &opts, meth, omega_f, guess.as_deref(), stability));
-    if let Some(e) = callback_error(&problem) {
-        return Err(e);
-    }
-    let solved = result.map_err(|e| hb_err(py, e))?;
+    let solved = run_user(py, &problem, |p| {
+        solve_problem(p, &opts, meth, omega_f, guess.as_deref(), stability)
+    })?;
     solved_dict(py, &solved)
 }
 
@@ -510,11 +522,7 @@ fn frc<'py>(
     frc_opts.from = finite("omega_from", omega_from)?;
     frc_opts.to = finite("omega_to", omega_to)?;
     frc_opts.stability_steps = stability_steps(opts.harmonics);
-    let result = py.detach(|| frequency_response(&problem, &opts, &frc_opts));
-    if let Some(e) = callback_error(&problem) {
-        return Err(e);
-    }
-    let frc = result.map_err(|e| hb_err(py, e))?;
+    let frc = run_user(py, &problem, |p| frequency_response(p, &opts, &frc_opts))?;
     let d = frc_dict(py, &frc)?;
     let folds = PyList::empty(py);
     let bifurcations = PyList::empty(py);
@@ -579,19 +587,15 @@ fn limit_cycle<'py>(
             q
         }
     };
-    let result = py.detach(|| {
+    let lc = run_user(py, &problem, |p| {
         ivt_hb::limit_cycle(
-            &problem,
+            p,
             &opts,
             omega_guess,
             &start,
             stability_steps(opts.harmonics),
         )
-    });
-    if let Some(e) = callback_error(&problem) {
-        return Err(e);
-    }
-    let lc = result.map_err(|e| hb_err(py, e))?;
+    })?;
     let d = PyDict::new(py);
     d.set_item("omega", lc.omega())?;
     d.set_item("period", lc.period())?;
