@@ -49,6 +49,11 @@ fn hb_err(py: Python<'_>, e: HbError) -> PyErr {
     }
 }
 
+/// Run `solve` with the GIL released; its error mapped by [`hb_err`].
+fn run<T: Send>(py: Python<'_>, solve: impl FnOnce() -> Result<T, HbError> + Send) -> PyResult<T> {
+    py.detach(solve).map_err(|e| hb_err(py, e))
+}
+
 /// Run `solve` on a user system with the GIL released (its callbacks take it
 /// back), then re-raise the first exception a callback raised (it aborted the
 /// run) or map the ivt-hb error with [`hb_err`].
@@ -58,6 +63,7 @@ fn run_user<T: Send>(
     solve: impl FnOnce(&PyProblem) -> Result<T, HbError> + Send,
 ) -> PyResult<T> {
     let result = py.detach(|| solve(problem));
+    // The callback's exception, not the failure it caused, is the error.
     if let Some(e) = callback_error(problem) {
         return Err(e);
     }
@@ -200,6 +206,16 @@ fn guess_vec(guess: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<f64>>> {
         .transpose()
 }
 
+/// Duffing's equation Eq. 49 from the keywords (each must be finite).
+fn duffing_problem(xi: f64, alpha: f64, eps: f64, force: f64) -> PyResult<Duffing> {
+    Ok(Duffing::new(
+        finite("xi", xi)?,
+        finite("alpha", alpha)?,
+        finite("eps", eps)?,
+        finite("force", force)?,
+    ))
+}
+
 /// Periodic solution of Duffing's equation Eq. 49,
 /// `u'' + 2ξu' + αu + εu³ = F cos(ω_f t)`, by harmonic balance.
 ///
@@ -233,17 +249,12 @@ fn duffing<'py>(
     stability: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let opts = options(n, samples, 1, tol)?;
-    let problem = Duffing::new(
-        finite("xi", xi)?,
-        finite("alpha", alpha)?,
-        finite("eps", eps)?,
-        finite("force", force)?,
-    );
+    let problem = duffing_problem(xi, alpha, eps, force)?;
     let m = self::method(method)?;
     let guess = guess_vec(guess)?;
-    let solved = py
-        .detach(|| solve_problem(&problem, &opts, m, omega_f, guess.as_deref(), stability))
-        .map_err(|e| hb_err(py, e))?;
+    let solved = run(py, || {
+        solve_problem(&problem, &opts, m, omega_f, guess.as_deref(), stability)
+    })?;
     solved_dict(py, &solved)
 }
 
@@ -280,18 +291,16 @@ fn mathieu_duffing<'py>(
         finite("gamma", gamma)?,
     );
     let guess = guess_vec(guess)?;
-    let solved = py
-        .detach(|| {
-            solve_problem(
-                &problem,
-                &opts,
-                Method::Modified,
-                omega,
-                guess.as_deref(),
-                stability,
-            )
-        })
-        .map_err(|e| hb_err(py, e))?;
+    let solved = run(py, || {
+        solve_problem(
+            &problem,
+            &opts,
+            Method::Modified,
+            omega,
+            guess.as_deref(),
+            stability,
+        )
+    })?;
     solved_dict(py, &solved)
 }
 
@@ -400,20 +409,13 @@ fn duffing_frc<'py>(
     force: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let opts = options(n, samples, 1, 1e-10)?;
-    let problem = Duffing::new(
-        finite("xi", xi)?,
-        finite("alpha", alpha)?,
-        finite("eps", eps)?,
-        finite("force", force)?,
-    );
+    let problem = duffing_problem(xi, alpha, eps, force)?;
     // FrcOptions is #[non_exhaustive]: no struct expression from outside ivt-hb
     // (hence the clippy allow on this function).
     let mut frc_opts = FrcOptions::default();
     frc_opts.from = finite("from_", from_)?;
     frc_opts.to = finite("to", to)?;
-    let frc = py
-        .detach(|| frequency_response(&problem, &opts, &frc_opts))
-        .map_err(|e| hb_err(py, e))?;
+    let frc = run(py, || frequency_response(&problem, &opts, &frc_opts))?;
     let d = frc_dict(py, &frc)?;
     let folds: Vec<f64> = frc.folds.iter().map(|f| f.omega_f).collect();
     d.set_item("folds", folds)?;
