@@ -206,6 +206,38 @@ fn guess_vec(guess: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<f64>>> {
         .transpose()
 }
 
+/// A `#[pyfunction]` on a user system `M x'' + C x' + K x + g(x, v, θ) =
+/// f(θ)` returning a dict: the Python parameters are `m, c, k, g`, the
+/// function's own (`name: type [= default]`, in order), then the keywords every
+/// user-system function shares, `velocity_dependent=True, vectorized=False,
+/// rtol=1e-9, max_iter=100` (consumed by [`user_problem`] and
+/// [`with_tolerances`]). The caller names every binding its body uses.
+macro_rules! user_system_fn {
+    (
+        $(#[$doc:meta])*
+        fn $name:ident<$lt:lifetime>(
+            $py:ident, [$m:ident, $c:ident, $k:ident, $g:ident],
+            $( $(#[$pa:ident($($pa_args:tt)*)])* $arg:ident: $ty:ty $(= $default:tt)? ),+;
+            [$vd:ident, $vec:ident, $rtol:ident, $max_iter:ident]
+        ) $body:block
+    ) => {
+        $(#[$doc])*
+        #[pyfunction]
+        #[pyo3(signature = (
+            $m, $c, $k, $g, $($arg $(= $default)?,)+
+            $vd = true, $vec = false, $rtol = 1e-9, $max_iter = 100
+        ))]
+        #[allow(clippy::too_many_arguments, clippy::field_reassign_with_default)]
+        fn $name<$lt>(
+            $py: Python<$lt>,
+            $m: &Bound<$lt, PyAny>, $c: &Bound<$lt, PyAny>, $k: &Bound<$lt, PyAny>,
+            $g: &Bound<$lt, PyAny>,
+            $( $(#[$pa($($pa_args)*)])* $arg: $ty, )+
+            $vd: bool, $vec: bool, $rtol: f64, $max_iter: usize,
+        ) -> PyResult<Bound<$lt, PyDict>> $body
+    };
+}
+
 /// Duffing's equation Eq. 49 from the keywords (each must be finite).
 fn duffing_problem(xi: f64, alpha: f64, eps: f64, force: f64) -> PyResult<Duffing> {
     Ok(Duffing::new(
@@ -422,6 +454,7 @@ fn duffing_frc<'py>(
     Ok(d)
 }
 
+user_system_fn! {
 /// Periodic solution of a user system `M x'' + C x' + K x + g(x, v, θ) = f(θ)`
 /// (θ = ω_f t, v = dx/dt) by the modified IHB (or classic), with Floquet
 /// multipliers.
@@ -445,33 +478,19 @@ fn duffing_frc<'py>(
 /// The GIL is released between callbacks, so other Python threads run. An
 /// exception in a callback aborts the solve and is re-raised. Same dict as
 /// `duffing`.
-#[pyfunction]
-#[pyo3(signature = (
-    m, c, k, g, omega_f, f = None, n = 20, samples = 64, subharmonic = 1,
-    method = "modified", guess = None, tol = 0.0, stability = true,
-    velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
-))]
-#[allow(clippy::too_many_arguments)]
 fn solve<'py>(
-    py: Python<'py>,
-    m: &Bound<'py, PyAny>,
-    c: &Bound<'py, PyAny>,
-    k: &Bound<'py, PyAny>,
-    g: &Bound<'py, PyAny>,
+    py, [m, c, k, g],
     omega_f: f64,
-    f: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = int64)] n: i64,
-    #[pyo3(from_py_with = int64)] samples: i64,
-    #[pyo3(from_py_with = int64)] subharmonic: i64,
-    method: &str,
-    guess: Option<&Bound<'py, PyAny>>,
-    tol: f64,
-    stability: bool,
-    velocity_dependent: bool,
-    vectorized: bool,
-    rtol: f64,
-    max_iter: usize,
-) -> PyResult<Bound<'py, PyDict>> {
+    f: Option<&Bound<'py, PyAny>> = None,
+    #[pyo3(from_py_with = int64)] n: i64 = 20,
+    #[pyo3(from_py_with = int64)] samples: i64 = 64,
+    #[pyo3(from_py_with = int64)] subharmonic: i64 = 1,
+    method: &str = "modified",
+    guess: Option<&Bound<'py, PyAny>> = None,
+    tol: f64 = 0.0,
+    stability: bool = true;
+    [velocity_dependent, vectorized, rtol, max_iter]
+) {
     let problem = user_problem(m, c, k, g, f, velocity_dependent, vectorized)?;
     let opts = with_tolerances(options(n, samples, subharmonic, 1.0)?, tol, rtol, max_iter)?;
     let meth = self::method(method)?;
@@ -481,7 +500,9 @@ fn solve<'py>(
     })?;
     solved_dict(py, &solved)
 }
+}
 
+user_system_fn! {
 /// Frequency-response curve of a user system `M x'' + C x' + K x + g(x, v, θ)
 /// = f(θ)` (θ = ω_f t) by pseudo-arclength continuation in ω_f from
 /// `omega_from` to `omega_to`, Floquet multipliers (Hsu) at every point, and
@@ -495,29 +516,16 @@ fn solve<'py>(
 /// "located", "index" (path point nearest the turn)}...], "bifurcations": [{"kind": "fold", "omega"}...],
 /// "termination"} and the arrays omega, amplitude, stable. amplitude is
 /// max |x_0| over the AFT samples (DOF 0). GIL released between callbacks.
-#[pyfunction]
-#[pyo3(signature = (
-    m, c, k, g, f, omega_from, omega_to, n = 20, samples = 64, tol = 0.0,
-    velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
-))]
-#[allow(clippy::too_many_arguments, clippy::field_reassign_with_default)]
 fn frc<'py>(
-    py: Python<'py>,
-    m: &Bound<'py, PyAny>,
-    c: &Bound<'py, PyAny>,
-    k: &Bound<'py, PyAny>,
-    g: &Bound<'py, PyAny>,
+    py, [m, c, k, g],
     f: Option<&Bound<'py, PyAny>>,
     omega_from: f64,
     omega_to: f64,
-    #[pyo3(from_py_with = int64)] n: i64,
-    #[pyo3(from_py_with = int64)] samples: i64,
-    tol: f64,
-    velocity_dependent: bool,
-    vectorized: bool,
-    rtol: f64,
-    max_iter: usize,
-) -> PyResult<Bound<'py, PyDict>> {
+    #[pyo3(from_py_with = int64)] n: i64 = 20,
+    #[pyo3(from_py_with = int64)] samples: i64 = 64,
+    tol: f64 = 0.0;
+    [velocity_dependent, vectorized, rtol, max_iter]
+) {
     let problem = user_problem(m, c, k, g, f, velocity_dependent, vectorized)?;
     let opts = with_tolerances(options(n, samples, 1, 1.0)?, tol, rtol, max_iter)?;
     let mut frc_opts = FrcOptions::default();
@@ -545,7 +553,9 @@ fn frc<'py>(
     d.set_item("bifurcations", bifurcations)?;
     Ok(d)
 }
+}
 
+user_system_fn! {
 /// Limit cycle of an autonomous user system `M x'' + C x' + K x + g(x, v) = 0`
 /// by harmonic balance with the response frequency ω as an unknown and the
 /// phase condition b1 = 0 on DOF 0 (Newton with the Galerkin Jacobian).
@@ -556,29 +566,16 @@ fn frc<'py>(
 /// Returns {"omega", "period", "coeffs", "multipliers" ([[re, im], ...],
 /// the trivial +1 included), "stable" (all others inside the unit circle),
 /// "stability", "iterations", "residual_norm"}.
-#[pyfunction]
-#[pyo3(signature = (
-    m, c, k, g, omega_guess, amplitude = 1.0, guess = None, n = 20, samples = 64,
-    tol = 0.0, velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
-))]
-#[allow(clippy::too_many_arguments)]
 fn limit_cycle<'py>(
-    py: Python<'py>,
-    m: &Bound<'py, PyAny>,
-    c: &Bound<'py, PyAny>,
-    k: &Bound<'py, PyAny>,
-    g: &Bound<'py, PyAny>,
+    py, [m, c, k, g],
     omega_guess: f64,
-    amplitude: f64,
-    guess: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = int64)] n: i64,
-    #[pyo3(from_py_with = int64)] samples: i64,
-    tol: f64,
-    velocity_dependent: bool,
-    vectorized: bool,
-    rtol: f64,
-    max_iter: usize,
-) -> PyResult<Bound<'py, PyDict>> {
+    amplitude: f64 = 1.0,
+    guess: Option<&Bound<'py, PyAny>> = None,
+    #[pyo3(from_py_with = int64)] n: i64 = 20,
+    #[pyo3(from_py_with = int64)] samples: i64 = 64,
+    tol: f64 = 0.0;
+    [velocity_dependent, vectorized, rtol, max_iter]
+) {
     let problem = user_problem(m, c, k, g, None, velocity_dependent, vectorized)?;
     let opts = with_tolerances(options(n, samples, 1, 1.0)?, tol, rtol, max_iter)?;
     let start = match guess_vec(guess)? {
@@ -608,6 +605,7 @@ fn limit_cycle<'py>(
     d.set_item("iterations", lc.solution.stats.iterations)?;
     d.set_item("residual_norm", lc.solution.stats.residual_norm)?;
     Ok(d)
+}
 }
 
 /// Evaluate the Fourier series u(τ) = a0/2 + Σ a_k cos kτ + b_k sin kτ of
