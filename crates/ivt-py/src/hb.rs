@@ -207,35 +207,70 @@ fn guess_vec(guess: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<f64>>> {
 }
 
 /// A `#[pyfunction]` on a user system `M x'' + C x' + K x + g(x, v, θ) =
-/// f(θ)` returning a dict: the Python parameters are `m, c, k, g`, the
-/// function's own (`name: type [= default]`, in order), then the keywords every
-/// user-system function shares, `velocity_dependent=True, vectorized=False,
-/// rtol=1e-9, max_iter=100` (consumed by [`user_problem`] and
-/// [`with_tolerances`]). The caller names every binding its body uses.
+/// f(θ)` returning a dict. Python parameters: `m, c, k, g`, the function's
+/// own (`name: type [= default]`), `n=20, samples=64`, its own again, then
+/// `velocity_dependent=True, vectorized=False, rtol=1e-9, max_iter=100`. The
+/// shared ones reach the body as the [`UserArgs`] named by the caller.
 macro_rules! user_system_fn {
     (
         $(#[$doc:meta])*
-        fn $name:ident<$lt:lifetime>(
-            $py:ident, [$m:ident, $c:ident, $k:ident, $g:ident],
+        fn $name:ident<$lt:lifetime>($py:ident, $user:ident;
             $( $(#[$pa:ident($($pa_args:tt)*)])* $arg:ident: $ty:ty $(= $default:tt)? ),+;
-            [$vd:ident, $vec:ident, $rtol:ident, $max_iter:ident]
+            $( $(#[$pb:ident($($pb_args:tt)*)])* $brg:ident: $bty:ty $(= $bdefault:tt)? ),+ $(,)?
         ) $body:block
     ) => {
         $(#[$doc])*
         #[pyfunction]
         #[pyo3(signature = (
-            $m, $c, $k, $g, $($arg $(= $default)?,)+
-            $vd = true, $vec = false, $rtol = 1e-9, $max_iter = 100
+            m, c, k, g, $($arg $(= $default)?,)+ n = 20, samples = 64, $($brg $(= $bdefault)?,)+
+            velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
         ))]
         #[allow(clippy::too_many_arguments, clippy::field_reassign_with_default)]
         fn $name<$lt>(
             $py: Python<$lt>,
-            $m: &Bound<$lt, PyAny>, $c: &Bound<$lt, PyAny>, $k: &Bound<$lt, PyAny>,
-            $g: &Bound<$lt, PyAny>,
+            m: &Bound<$lt, PyAny>, c: &Bound<$lt, PyAny>, k: &Bound<$lt, PyAny>, g: &Bound<$lt, PyAny>,
             $( $(#[$pa($($pa_args)*)])* $arg: $ty, )+
-            $vd: bool, $vec: bool, $rtol: f64, $max_iter: usize,
-        ) -> PyResult<Bound<$lt, PyDict>> $body
+            #[pyo3(from_py_with = int64)] n: i64, #[pyo3(from_py_with = int64)] samples: i64,
+            $( $(#[$pb($($pb_args)*)])* $brg: $bty, )+
+            velocity_dependent: bool, vectorized: bool, rtol: f64, max_iter: usize,
+        ) -> PyResult<Bound<$lt, PyDict>> {
+            let $user = UserArgs {
+                system: [m, c, k, g], n, samples, velocity_dependent, vectorized, rtol, max_iter,
+            };
+            $body
+        }
     };
+}
+
+/// The arguments every user-system function shares: the system `[m, c, k, g]`
+/// and the harmonic-balance settings.
+struct UserArgs<'a, 'py> {
+    system: [&'a Bound<'py, PyAny>; 4],
+    n: i64,
+    samples: i64,
+    velocity_dependent: bool,
+    vectorized: bool,
+    rtol: f64,
+    max_iter: usize,
+}
+
+impl UserArgs<'_, '_> {
+    /// The user problem forced by `f` and its options (`subharmonic`, absolute
+    /// tolerance `tol`, see [`with_tolerances`]).
+    fn setup(
+        &self,
+        f: Option<&Bound<'_, PyAny>>,
+        subharmonic: i64,
+        tol: f64,
+    ) -> PyResult<(PyProblem, HbOptions)> {
+        let [m, c, k, g] = self.system;
+        let problem = user_problem(m, c, k, g, f, self.velocity_dependent, self.vectorized)?;
+        let opts = options(self.n, self.samples, subharmonic, 1.0)?;
+        Ok((
+            problem,
+            with_tolerances(opts, tol, self.rtol, self.max_iter)?,
+        ))
+    }
 }
 
 /// Duffing's equation Eq. 49 from the keywords (each must be finite).
@@ -478,21 +513,16 @@ user_system_fn! {
 /// The GIL is released between callbacks, so other Python threads run. An
 /// exception in a callback aborts the solve and is re-raised. Same dict as
 /// `duffing`.
-fn solve<'py>(
-    py, [m, c, k, g],
+fn solve<'py>(py, user;
     omega_f: f64,
-    f: Option<&Bound<'py, PyAny>> = None,
-    #[pyo3(from_py_with = int64)] n: i64 = 20,
-    #[pyo3(from_py_with = int64)] samples: i64 = 64,
+    f: Option<&Bound<'py, PyAny>> = None;
     #[pyo3(from_py_with = int64)] subharmonic: i64 = 1,
     method: &str = "modified",
     guess: Option<&Bound<'py, PyAny>> = None,
     tol: f64 = 0.0,
-    stability: bool = true;
-    [velocity_dependent, vectorized, rtol, max_iter]
+    stability: bool = true,
 ) {
-    let problem = user_problem(m, c, k, g, f, velocity_dependent, vectorized)?;
-    let opts = with_tolerances(options(n, samples, subharmonic, 1.0)?, tol, rtol, max_iter)?;
+    let (problem, opts) = user.setup(f, subharmonic, tol)?;
     let meth = self::method(method)?;
     let guess = guess_vec(guess)?;
     let solved = run_user(py, &problem, |p| {
@@ -516,18 +546,13 @@ user_system_fn! {
 /// "located", "index" (path point nearest the turn)}...], "bifurcations": [{"kind": "fold", "omega"}...],
 /// "termination"} and the arrays omega, amplitude, stable. amplitude is
 /// max |x_0| over the AFT samples (DOF 0). GIL released between callbacks.
-fn frc<'py>(
-    py, [m, c, k, g],
+fn frc<'py>(py, user;
     f: Option<&Bound<'py, PyAny>>,
     omega_from: f64,
-    omega_to: f64,
-    #[pyo3(from_py_with = int64)] n: i64 = 20,
-    #[pyo3(from_py_with = int64)] samples: i64 = 64,
-    tol: f64 = 0.0;
-    [velocity_dependent, vectorized, rtol, max_iter]
+    omega_to: f64;
+    tol: f64 = 0.0,
 ) {
-    let problem = user_problem(m, c, k, g, f, velocity_dependent, vectorized)?;
-    let opts = with_tolerances(options(n, samples, 1, 1.0)?, tol, rtol, max_iter)?;
+    let (problem, opts) = user.setup(f, 1, tol)?;
     let mut frc_opts = FrcOptions::default();
     frc_opts.from = finite("omega_from", omega_from)?;
     frc_opts.to = finite("omega_to", omega_to)?;
@@ -566,18 +591,13 @@ user_system_fn! {
 /// Returns {"omega", "period", "coeffs", "multipliers" ([[re, im], ...],
 /// the trivial +1 included), "stable" (all others inside the unit circle),
 /// "stability", "iterations", "residual_norm"}.
-fn limit_cycle<'py>(
-    py, [m, c, k, g],
+fn limit_cycle<'py>(py, user;
     omega_guess: f64,
     amplitude: f64 = 1.0,
-    guess: Option<&Bound<'py, PyAny>> = None,
-    #[pyo3(from_py_with = int64)] n: i64 = 20,
-    #[pyo3(from_py_with = int64)] samples: i64 = 64,
-    tol: f64 = 0.0;
-    [velocity_dependent, vectorized, rtol, max_iter]
+    guess: Option<&Bound<'py, PyAny>> = None;
+    tol: f64 = 0.0,
 ) {
-    let problem = user_problem(m, c, k, g, None, velocity_dependent, vectorized)?;
-    let opts = with_tolerances(options(n, samples, 1, 1.0)?, tol, rtol, max_iter)?;
+    let (problem, opts) = user.setup(None, 1, tol)?;
     let start = match guess_vec(guess)? {
         Some(q) => q,
         None => {
