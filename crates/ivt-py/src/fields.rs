@@ -9,6 +9,21 @@ use pyo3::types::PyDict;
 /// Getter and setter of one `f64` field of `T`, by its Python name.
 pub type Field<T> = (&'static str, fn(&T) -> f64, fn(&mut T, f64));
 
+/// The `&[Field<T>]` table of the named `f64` fields of `T` (Python name =
+/// Rust field name): `field_table!(T; a, b)`.
+macro_rules! field_table {
+    ($ty:ty; $($name:ident),* $(,)?) => {
+        &[$(
+            (
+                stringify!($name),
+                |p: &$ty| p.$name,
+                |p: &mut $ty, v: f64| p.$name = v,
+            )
+        ),*]
+    };
+}
+pub(crate) use field_table;
+
 /// Set the fields named in `kw` (all must be floats in `fields`); keys that
 /// `extra` accepts (returns `Ok(true)`) are handled by it instead.
 ///

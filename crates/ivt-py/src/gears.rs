@@ -3,7 +3,7 @@
 
 use crate::args::int64;
 use crate::fields::{self, Field};
-use crate::vectorize::{map, map1};
+use crate::vectorize::{map, map1, map2};
 use ivt_kin::givt::{DirectionMode, DirectionModule, GivtGeometry};
 use ivt_kin::ncg::{self, GearRatio, GivtNcg, PitchPoint, SgivtNcg, SmoothNcg};
 use ivt_kin::sgivt::{self, SgivtGeometry};
@@ -12,21 +12,72 @@ use numpy::ndarray::Array1;
 use numpy::IntoPyArray;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyTuple};
+use pyo3::types::PyDict;
 
 fn kin_err(e: KinError) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
-/// The `#[pymethods]` block of a geometry class (`self.geometry`): the
-/// `items` as written, then one method per `fn name(a[, b]);` entry that
-/// broadcasts `self.geometry.name(a[, b])` over numpy array-likes like a ufunc
-/// (scalar in → float out), raising the Rust error with the flat index.
-macro_rules! geometry_methods {
-    ($ty:ident { $($items:tt)* } $( $(#[$doc:meta])* fn $name:ident($a:ident $(, $b:ident)?); )*) => {
+/// A frozen geometry class `$ty` wrapping `geometry: $geom` (its fields in
+/// `fields`) with its `#[pymethods]`: the constructor (`reference()` with
+/// keyword overrides, then `check`), `params()` (the fields as a dict),
+/// `__repr__` (the fields that differ from `reference()`), the `items` as
+/// written; for each `fn name(a, b);` under `pairs`, a method broadcasting the
+/// pair `self.geometry.name(a, b)` (see [`map2`]); then one method per
+/// `fn name(a[, b]);` entry that broadcasts the fallible
+/// `self.geometry.name(a[, b])` over numpy array-likes like a ufunc (scalar in
+/// → float out), raising the Rust error with the flat index.
+macro_rules! geometry_class {
+    (
+        $(#[$cdoc:meta])*
+        $ty:ident($geom:ty, $what:literal, $fields:expr, $reference:path, $check:expr) {
+            $($items:tt)*
+        }
+        $(pairs { $( $(#[$pdoc:meta])* fn $pair:ident($pa:ident, $pb:ident); )* })?
+        $( $(#[$doc:meta])* fn $name:ident($a:ident $(, $b:ident)?); )*
+    ) => {
+        $(#[$cdoc])*
+        #[pyclass(module = "ivt.kin", frozen)]
+        pub struct $ty {
+            geometry: $geom,
+        }
+
         #[pymethods]
         impl $ty {
+            #[new]
+            #[pyo3(signature = (**overrides))]
+            fn new(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+                let mut geometry = $reference();
+                fields::apply($what, $fields, &mut geometry, overrides, |_, _, _| Ok(false))?;
+                ($check)(&geometry)?;
+                Ok(Self { geometry })
+            }
+
+            /// The dimensions as a dict (constructor keywords).
+            fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+                fields::to_dict(py, $fields, &self.geometry)
+            }
+
+            fn __repr__(&self) -> String {
+                let changed = fields::changed($fields, &self.geometry, &$reference());
+                format!("{}({})", stringify!($ty), changed.join(", "))
+            }
+
             $($items)*
+            $($(
+                $(#[$pdoc])*
+                fn $pair<'py>(
+                    &self,
+                    py: Python<'py>,
+                    $pa: &Bound<'py, PyAny>,
+                    $pb: &Bound<'py, PyAny>,
+                ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+                    let g = self.geometry;
+                    map2(py, [(stringify!($pa), $pa), (stringify!($pb), $pb)], |[$pa, $pb]| {
+                        g.$pair($pa, $pb)
+                    })
+                }
+            )*)?
             $(
                 $(#[$doc])*
                 fn $name<'py>(
@@ -46,48 +97,20 @@ macro_rules! geometry_methods {
     };
 }
 
-const GIVT_FIELDS: &[Field<GivtGeometry>] = &[
-    ("l1", |g| g.l1, |g, v| g.l1 = v),
-    ("r_output", |g| g.r_output, |g, v| g.r_output = v),
-    ("r_sun", |g| g.r_sun, |g, v| g.r_sun = v),
-    ("r_planet", |g| g.r_planet, |g, v| g.r_planet = v),
-    ("r_crk", |g| g.r_crk, |g, v| g.r_crk = v),
-    (
-        "control_to_ring",
-        |g| g.control_to_ring,
-        |g, v| g.control_to_ring = v,
-    ),
+const GIVT_FIELDS: &[Field<GivtGeometry>] = fields::field_table![
+    GivtGeometry; l1, r_output, r_sun, r_planet, r_crk, control_to_ring
 ];
 
-/// The crank-slider GIVT of §2.1 (Eq. 1–10), SI units.
-///
-/// `Givt()` uses ivt-kin's illustrative dimensions (l1 = 50 mm, r_output =
-/// 15 mm: **not printed in the thesis**); keywords override them. Ratio
-/// methods broadcast over numpy arrays; θ must be finite and 0 ≤ r < l1,
-/// else `ValueError` with the Rust message.
-#[pyclass(name = "Givt", module = "ivt.kin", frozen)]
-pub struct Givt {
-    geometry: GivtGeometry,
-}
-
-geometry_methods! {
-Givt {
-    #[new]
-    #[pyo3(signature = (**overrides))]
-    fn new(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        let mut geometry = GivtGeometry::illustrative();
-        fields::apply("GIVT", GIVT_FIELDS, &mut geometry, overrides, |_, _, _| {
-            Ok(false)
-        })?;
-        geometry.validate().map_err(kin_err)?;
-        Ok(Self { geometry })
-    }
-
-    /// The dimensions as a dict (constructor keywords).
-    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        fields::to_dict(py, GIVT_FIELDS, &self.geometry)
-    }
-
+geometry_class! {
+    /// The crank-slider GIVT of §2.1 (Eq. 1–10), SI units.
+    ///
+    /// `Givt()` uses ivt-kin's illustrative dimensions (l1 = 50 mm, r_output =
+    /// 15 mm: **not printed in the thesis**); keywords override them. Ratio
+    /// methods broadcast over numpy arrays; θ must be finite and 0 ≤ r < l1,
+    /// else `ValueError` with the Rust message.
+    Givt(GivtGeometry, "GIVT", GIVT_FIELDS, GivtGeometry::illustrative, |g: &GivtGeometry| {
+        g.validate().map_err(kin_err)
+    }) {
     /// Corners (kinks) of R(θ, r) in one period [rad].
     fn module_corners(&self, r: f64) -> PyResult<Vec<f64>> {
         let mut buf = [0.0; ivt_kin::givt::MAX_CORNERS];
@@ -100,49 +123,12 @@ Givt {
     fn crank_to_input(&self) -> f64 {
         self.geometry.crank_to_input()
     }
-
+}
+pairs {
     /// Sun-gear speeds (ω_sA, ω_sB) for input ω_in and control ω_c1, Eq. 1–2.
-    fn sun_speeds<'py>(
-        &self,
-        py: Python<'py>,
-        omega_in: &Bound<'py, PyAny>,
-        omega_c1: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyTuple>> {
-        let g = self.geometry;
-        let [a, b] = map(
-            py,
-            [("omega_in", omega_in), ("omega_c1", omega_c1)],
-            |[w, c]| {
-                let (a, b) = g.sun_speeds(w, c);
-                Ok::<_, KinError>([a, b])
-            },
-        )?;
-        PyTuple::new(py, [a, b])
-    }
-
+    fn sun_speeds(omega_in, omega_c1);
     /// Crank rotation and translation (ω_crk, v_crk) from the sun speeds, Eq. 3–4.
-    fn crank_motion<'py>(
-        &self,
-        py: Python<'py>,
-        omega_sa: &Bound<'py, PyAny>,
-        omega_sb: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyTuple>> {
-        let g = self.geometry;
-        let [a, b] = map(
-            py,
-            [("omega_sa", omega_sa), ("omega_sb", omega_sb)],
-            |[x, y]| {
-                let (a, b) = g.crank_motion(x, y);
-                Ok::<_, KinError>([a, b])
-            },
-        )?;
-        PyTuple::new(py, [a, b])
-    }
-
-    fn __repr__(&self) -> String {
-        let changed = fields::changed(GIVT_FIELDS, &self.geometry, &GivtGeometry::illustrative());
-        format!("Givt({})", changed.join(", "))
-    }
+    fn crank_motion(omega_sa, omega_sb);
 }
     /// Single crank-slider ratio R1(θ, r), Eq. 8.
     fn single_ratio(theta, r);
@@ -160,80 +146,35 @@ Givt {
     fn average_final_ratio(r);
 }
 
-const SGIVT_FIELDS: &[Field<SgivtGeometry>] = &[
-    ("d_sg", |g| g.d_sg, |g, v| g.d_sg = v),
-    ("d_pg", |g| g.d_pg, |g, v| g.d_pg = v),
-    ("d_acg", |g| g.d_acg, |g, v| g.d_acg = v),
-    ("d_esg", |g| g.d_esg, |g, v| g.d_esg = v),
-    ("d_erg", |g| g.d_erg, |g, v| g.d_erg = v),
-    ("d_ecg", |g| g.d_ecg, |g, v| g.d_ecg = v),
-    ("r_cg", |g| g.r_cg, |g, v| g.r_cg = v),
-    ("r_og", |g| g.r_og, |g, v| g.r_og = v),
-    (
-        "stepper_to_acg",
-        |g| g.stepper_to_acg,
-        |g, v| g.stepper_to_acg = v,
-    ),
-    (
-        "ncg_centre_distance",
-        |g| g.ncg_centre_distance,
-        |g, v| g.ncg_centre_distance = v,
-    ),
-    (
-        "theta_ct_max",
-        |g| g.theta_ct_max,
-        |g, v| g.theta_ct_max = v,
-    ),
+const SGIVT_FIELDS: &[Field<SgivtGeometry>] = fields::field_table![
+    SgivtGeometry; d_sg, d_pg, d_acg, d_esg, d_erg, d_ecg, r_cg, r_og, stepper_to_acg,
+    ncg_centre_distance, theta_ct_max
 ];
 
-/// The scotch-yoke SGIVT prototype of §2.2 and §4.4.2, SI units.
-///
-/// `Sgivt()` is the printed prototype (gear diameters in inches converted to
-/// metres); keywords override dimensions (each finite and > 0). Methods
-/// broadcast over numpy arrays; out-of-domain inputs raise `ValueError`.
-#[pyclass(name = "Sgivt", module = "ivt.kin", frozen)]
-pub struct Sgivt {
-    geometry: SgivtGeometry,
+/// Every SGIVT dimension must be finite and > 0.
+fn sgivt_positive(geometry: &SgivtGeometry) -> PyResult<()> {
+    for (name, get, _) in SGIVT_FIELDS {
+        let v = get(geometry);
+        if !(v.is_finite() && v > 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "SGIVT parameter `{name}` = {v} must be finite and > 0"
+            )));
+        }
+    }
+    Ok(())
 }
 
-geometry_methods! {
-Sgivt {
-    #[new]
-    #[pyo3(signature = (**overrides))]
-    fn new(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        let mut geometry = SgivtGeometry::prototype();
-        fields::apply(
-            "SGIVT",
-            SGIVT_FIELDS,
-            &mut geometry,
-            overrides,
-            |_, _, _| Ok(false),
-        )?;
-        for (name, get, _) in SGIVT_FIELDS {
-            let v = get(&geometry);
-            if !(v.is_finite() && v > 0.0) {
-                return Err(PyValueError::new_err(format!(
-                    "SGIVT parameter `{name}` = {v} must be finite and > 0"
-                )));
-            }
-        }
-        Ok(Self { geometry })
-    }
-
-    /// The dimensions as a dict (constructor keywords).
-    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        fields::to_dict(py, SGIVT_FIELDS, &self.geometry)
-    }
-
+geometry_class! {
+    /// The scotch-yoke SGIVT prototype of §2.2 and §4.4.2, SI units.
+    ///
+    /// `Sgivt()` is the printed prototype (gear diameters in inches converted to
+    /// metres); keywords override dimensions (each finite and > 0). Methods
+    /// broadcast over numpy arrays; out-of-domain inputs raise `ValueError`.
+    Sgivt(SgivtGeometry, "SGIVT", SGIVT_FIELDS, SgivtGeometry::prototype, sgivt_positive) {
     /// v_CRK/ω_CT = 7 r_CG/288 [m/rad] through the gear chain, Eq. 184.
     #[getter]
     fn crank_length_per_stepper_rad(&self) -> f64 {
         self.geometry.crank_length_per_stepper_rad()
-    }
-
-    fn __repr__(&self) -> String {
-        let changed = fields::changed(SGIVT_FIELDS, &self.geometry, &SgivtGeometry::prototype());
-        format!("Sgivt({})", changed.join(", "))
     }
 }
     /// Crank length e [m] for a stepper angle θ_CT [rad] ∈ [0, theta_ct_max], Eq. 182–185.

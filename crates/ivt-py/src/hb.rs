@@ -17,7 +17,7 @@ use pyo3::types::{PyDict, PyList};
 use std::time::Instant;
 
 use crate::args::{count, int64};
-use crate::user_problem::{callback_error, user_problem, with_tolerances};
+use crate::user_problem::{callback_error, user_problem, with_tolerances, PyProblem};
 
 create_exception!(
     ivt,
@@ -47,6 +47,27 @@ fn hb_err(py: Python<'_>, e: HbError) -> PyErr {
         HbError::Continuation(_) => ConvergenceError::new_err(e.to_string()),
         _ => PyValueError::new_err(e.to_string()),
     }
+}
+
+/// Run `solve` with the GIL released; its error mapped by [`hb_err`].
+fn run<T: Send>(py: Python<'_>, solve: impl FnOnce() -> Result<T, HbError> + Send) -> PyResult<T> {
+    py.detach(solve).map_err(|e| hb_err(py, e))
+}
+
+/// Run `solve` on a user system with the GIL released (its callbacks take it
+/// back), then re-raise the first exception a callback raised (it aborted the
+/// run) or map the ivt-hb error with [`hb_err`].
+fn run_user<T: Send>(
+    py: Python<'_>,
+    problem: &PyProblem,
+    solve: impl FnOnce(&PyProblem) -> Result<T, HbError> + Send,
+) -> PyResult<T> {
+    let result = py.detach(|| solve(problem));
+    // The callback's exception, not the failure it caused, is the error.
+    if let Some(e) = callback_error(problem) {
+        return Err(e);
+    }
+    result.map_err(|e| hb_err(py, e))
 }
 
 /// Options from the Python keywords: n harmonics, `samples` = N (2N AFT samples).
@@ -185,6 +206,83 @@ fn guess_vec(guess: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<f64>>> {
         .transpose()
 }
 
+/// A `#[pyfunction]` on a user system `M x'' + C x' + K x + g(x, v, θ) =
+/// f(θ)` returning a dict. Python parameters: `m, c, k, g`, the function's
+/// own (`name: type [= default]`), `n=20, samples=64`, its own again, then
+/// `velocity_dependent=True, vectorized=False, rtol=1e-9, max_iter=100`. The
+/// shared ones reach the body as the [`UserArgs`] named by the caller.
+macro_rules! user_system_fn {
+    (
+        $(#[$doc:meta])*
+        fn $name:ident<$lt:lifetime>($py:ident, $user:ident;
+            $( $(#[$pa:ident($($pa_args:tt)*)])* $arg:ident: $ty:ty $(= $default:tt)? ),+;
+            $( $(#[$pb:ident($($pb_args:tt)*)])* $brg:ident: $bty:ty $(= $bdefault:tt)? ),+ $(,)?
+        ) $body:block
+    ) => {
+        $(#[$doc])*
+        #[pyfunction]
+        #[pyo3(signature = (
+            m, c, k, g, $($arg $(= $default)?,)+ n = 20, samples = 64, $($brg $(= $bdefault)?,)+
+            velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
+        ))]
+        #[allow(clippy::too_many_arguments, clippy::field_reassign_with_default)]
+        fn $name<$lt>(
+            $py: Python<$lt>,
+            m: &Bound<$lt, PyAny>, c: &Bound<$lt, PyAny>, k: &Bound<$lt, PyAny>, g: &Bound<$lt, PyAny>,
+            $( $(#[$pa($($pa_args)*)])* $arg: $ty, )+
+            #[pyo3(from_py_with = int64)] n: i64, #[pyo3(from_py_with = int64)] samples: i64,
+            $( $(#[$pb($($pb_args)*)])* $brg: $bty, )+
+            velocity_dependent: bool, vectorized: bool, rtol: f64, max_iter: usize,
+        ) -> PyResult<Bound<$lt, PyDict>> {
+            let $user = UserArgs {
+                system: [m, c, k, g], n, samples, velocity_dependent, vectorized, rtol, max_iter,
+            };
+            $body
+        }
+    };
+}
+
+/// The arguments every user-system function shares: the system `[m, c, k, g]`
+/// and the harmonic-balance settings.
+struct UserArgs<'a, 'py> {
+    system: [&'a Bound<'py, PyAny>; 4],
+    n: i64,
+    samples: i64,
+    velocity_dependent: bool,
+    vectorized: bool,
+    rtol: f64,
+    max_iter: usize,
+}
+
+impl UserArgs<'_, '_> {
+    /// The user problem forced by `f` and its options (`subharmonic`, absolute
+    /// tolerance `tol`, see [`with_tolerances`]).
+    fn setup(
+        &self,
+        f: Option<&Bound<'_, PyAny>>,
+        subharmonic: i64,
+        tol: f64,
+    ) -> PyResult<(PyProblem, HbOptions)> {
+        let [m, c, k, g] = self.system;
+        let problem = user_problem(m, c, k, g, f, self.velocity_dependent, self.vectorized)?;
+        let opts = options(self.n, self.samples, subharmonic, 1.0)?;
+        Ok((
+            problem,
+            with_tolerances(opts, tol, self.rtol, self.max_iter)?,
+        ))
+    }
+}
+
+/// Duffing's equation Eq. 49 from the keywords (each must be finite).
+fn duffing_problem(xi: f64, alpha: f64, eps: f64, force: f64) -> PyResult<Duffing> {
+    Ok(Duffing::new(
+        finite("xi", xi)?,
+        finite("alpha", alpha)?,
+        finite("eps", eps)?,
+        finite("force", force)?,
+    ))
+}
+
 /// Periodic solution of Duffing's equation Eq. 49,
 /// `u'' + 2ξu' + αu + εu³ = F cos(ω_f t)`, by harmonic balance.
 ///
@@ -218,17 +316,12 @@ fn duffing<'py>(
     stability: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let opts = options(n, samples, 1, tol)?;
-    let problem = Duffing::new(
-        finite("xi", xi)?,
-        finite("alpha", alpha)?,
-        finite("eps", eps)?,
-        finite("force", force)?,
-    );
+    let problem = duffing_problem(xi, alpha, eps, force)?;
     let m = self::method(method)?;
     let guess = guess_vec(guess)?;
-    let solved = py
-        .detach(|| solve_problem(&problem, &opts, m, omega_f, guess.as_deref(), stability))
-        .map_err(|e| hb_err(py, e))?;
+    let solved = run(py, || {
+        solve_problem(&problem, &opts, m, omega_f, guess.as_deref(), stability)
+    })?;
     solved_dict(py, &solved)
 }
 
@@ -265,18 +358,16 @@ fn mathieu_duffing<'py>(
         finite("gamma", gamma)?,
     );
     let guess = guess_vec(guess)?;
-    let solved = py
-        .detach(|| {
-            solve_problem(
-                &problem,
-                &opts,
-                Method::Modified,
-                omega,
-                guess.as_deref(),
-                stability,
-            )
-        })
-        .map_err(|e| hb_err(py, e))?;
+    let solved = run(py, || {
+        solve_problem(
+            &problem,
+            &opts,
+            Method::Modified,
+            omega,
+            guess.as_deref(),
+            stability,
+        )
+    })?;
     solved_dict(py, &solved)
 }
 
@@ -385,26 +476,20 @@ fn duffing_frc<'py>(
     force: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let opts = options(n, samples, 1, 1e-10)?;
-    let problem = Duffing::new(
-        finite("xi", xi)?,
-        finite("alpha", alpha)?,
-        finite("eps", eps)?,
-        finite("force", force)?,
-    );
+    let problem = duffing_problem(xi, alpha, eps, force)?;
     // FrcOptions is #[non_exhaustive]: no struct expression from outside ivt-hb
     // (hence the clippy allow on this function).
     let mut frc_opts = FrcOptions::default();
     frc_opts.from = finite("from_", from_)?;
     frc_opts.to = finite("to", to)?;
-    let frc = py
-        .detach(|| frequency_response(&problem, &opts, &frc_opts))
-        .map_err(|e| hb_err(py, e))?;
+    let frc = run(py, || frequency_response(&problem, &opts, &frc_opts))?;
     let d = frc_dict(py, &frc)?;
     let folds: Vec<f64> = frc.folds.iter().map(|f| f.omega_f).collect();
     d.set_item("folds", folds)?;
     Ok(d)
 }
 
+user_system_fn! {
 /// Periodic solution of a user system `M x'' + C x' + K x + g(x, v, θ) = f(θ)`
 /// (θ = ω_f t, v = dx/dt) by the modified IHB (or classic), with Floquet
 /// multipliers.
@@ -428,46 +513,26 @@ fn duffing_frc<'py>(
 /// The GIL is released between callbacks, so other Python threads run. An
 /// exception in a callback aborts the solve and is re-raised. Same dict as
 /// `duffing`.
-#[pyfunction]
-#[pyo3(signature = (
-    m, c, k, g, omega_f, f = None, n = 20, samples = 64, subharmonic = 1,
-    method = "modified", guess = None, tol = 0.0, stability = true,
-    velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
-))]
-#[allow(clippy::too_many_arguments)]
-fn solve<'py>(
-    py: Python<'py>,
-    m: &Bound<'py, PyAny>,
-    c: &Bound<'py, PyAny>,
-    k: &Bound<'py, PyAny>,
-    g: &Bound<'py, PyAny>,
+fn solve<'py>(py, user;
     omega_f: f64,
-    f: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = int64)] n: i64,
-    #[pyo3(from_py_with = int64)] samples: i64,
-    #[pyo3(from_py_with = int64)] subharmonic: i64,
-    method: &str,
-    guess: Option<&Bound<'py, PyAny>>,
-    tol: f64,
-    stability: bool,
-    velocity_dependent: bool,
-    vectorized: bool,
-    rtol: f64,
-    max_iter: usize,
-) -> PyResult<Bound<'py, PyDict>> {
-    let problem = user_problem(m, c, k, g, f, velocity_dependent, vectorized)?;
-    let opts = with_tolerances(options(n, samples, subharmonic, 1.0)?, tol, rtol, max_iter)?;
+    f: Option<&Bound<'py, PyAny>> = None;
+    #[pyo3(from_py_with = int64)] subharmonic: i64 = 1,
+    method: &str = "modified",
+    guess: Option<&Bound<'py, PyAny>> = None,
+    tol: f64 = 0.0,
+    stability: bool = true,
+) {
+    let (problem, opts) = user.setup(f, subharmonic, tol)?;
     let meth = self::method(method)?;
     let guess = guess_vec(guess)?;
-    let result =
-        py.detach(|| solve_problem(&problem, &opts, meth, omega_f, guess.as_deref(), stability));
-    if let Some(e) = callback_error(&problem) {
-        return Err(e);
-    }
-    let solved = result.map_err(|e| hb_err(py, e))?;
+    let solved = run_user(py, &problem, |p| {
+        solve_problem(p, &opts, meth, omega_f, guess.as_deref(), stability)
+    })?;
     solved_dict(py, &solved)
 }
+}
 
+user_system_fn! {
 /// Frequency-response curve of a user system `M x'' + C x' + K x + g(x, v, θ)
 /// = f(θ)` (θ = ω_f t) by pseudo-arclength continuation in ω_f from
 /// `omega_from` to `omega_to`, Floquet multipliers (Hsu) at every point, and
@@ -481,40 +546,18 @@ fn solve<'py>(
 /// "located", "index" (path point nearest the turn)}...], "bifurcations": [{"kind": "fold", "omega"}...],
 /// "termination"} and the arrays omega, amplitude, stable. amplitude is
 /// max |x_0| over the AFT samples (DOF 0). GIL released between callbacks.
-#[pyfunction]
-#[pyo3(signature = (
-    m, c, k, g, f, omega_from, omega_to, n = 20, samples = 64, tol = 0.0,
-    velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
-))]
-#[allow(clippy::too_many_arguments, clippy::field_reassign_with_default)]
-fn frc<'py>(
-    py: Python<'py>,
-    m: &Bound<'py, PyAny>,
-    c: &Bound<'py, PyAny>,
-    k: &Bound<'py, PyAny>,
-    g: &Bound<'py, PyAny>,
+fn frc<'py>(py, user;
     f: Option<&Bound<'py, PyAny>>,
     omega_from: f64,
-    omega_to: f64,
-    #[pyo3(from_py_with = int64)] n: i64,
-    #[pyo3(from_py_with = int64)] samples: i64,
-    tol: f64,
-    velocity_dependent: bool,
-    vectorized: bool,
-    rtol: f64,
-    max_iter: usize,
-) -> PyResult<Bound<'py, PyDict>> {
-    let problem = user_problem(m, c, k, g, f, velocity_dependent, vectorized)?;
-    let opts = with_tolerances(options(n, samples, 1, 1.0)?, tol, rtol, max_iter)?;
+    omega_to: f64;
+    tol: f64 = 0.0,
+) {
+    let (problem, opts) = user.setup(f, 1, tol)?;
     let mut frc_opts = FrcOptions::default();
     frc_opts.from = finite("omega_from", omega_from)?;
     frc_opts.to = finite("omega_to", omega_to)?;
     frc_opts.stability_steps = stability_steps(opts.harmonics);
-    let result = py.detach(|| frequency_response(&problem, &opts, &frc_opts));
-    if let Some(e) = callback_error(&problem) {
-        return Err(e);
-    }
-    let frc = result.map_err(|e| hb_err(py, e))?;
+    let frc = run_user(py, &problem, |p| frequency_response(p, &opts, &frc_opts))?;
     let d = frc_dict(py, &frc)?;
     let folds = PyList::empty(py);
     let bifurcations = PyList::empty(py);
@@ -535,7 +578,9 @@ fn frc<'py>(
     d.set_item("bifurcations", bifurcations)?;
     Ok(d)
 }
+}
 
+user_system_fn! {
 /// Limit cycle of an autonomous user system `M x'' + C x' + K x + g(x, v) = 0`
 /// by harmonic balance with the response frequency ω as an unknown and the
 /// phase condition b1 = 0 on DOF 0 (Newton with the Galerkin Jacobian).
@@ -546,31 +591,13 @@ fn frc<'py>(
 /// Returns {"omega", "period", "coeffs", "multipliers" ([[re, im], ...],
 /// the trivial +1 included), "stable" (all others inside the unit circle),
 /// "stability", "iterations", "residual_norm"}.
-#[pyfunction]
-#[pyo3(signature = (
-    m, c, k, g, omega_guess, amplitude = 1.0, guess = None, n = 20, samples = 64,
-    tol = 0.0, velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
-))]
-#[allow(clippy::too_many_arguments)]
-fn limit_cycle<'py>(
-    py: Python<'py>,
-    m: &Bound<'py, PyAny>,
-    c: &Bound<'py, PyAny>,
-    k: &Bound<'py, PyAny>,
-    g: &Bound<'py, PyAny>,
+fn limit_cycle<'py>(py, user;
     omega_guess: f64,
-    amplitude: f64,
-    guess: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = int64)] n: i64,
-    #[pyo3(from_py_with = int64)] samples: i64,
-    tol: f64,
-    velocity_dependent: bool,
-    vectorized: bool,
-    rtol: f64,
-    max_iter: usize,
-) -> PyResult<Bound<'py, PyDict>> {
-    let problem = user_problem(m, c, k, g, None, velocity_dependent, vectorized)?;
-    let opts = with_tolerances(options(n, samples, 1, 1.0)?, tol, rtol, max_iter)?;
+    amplitude: f64 = 1.0,
+    guess: Option<&Bound<'py, PyAny>> = None;
+    tol: f64 = 0.0,
+) {
+    let (problem, opts) = user.setup(None, 1, tol)?;
     let start = match guess_vec(guess)? {
         Some(q) => q,
         None => {
@@ -579,19 +606,15 @@ fn limit_cycle<'py>(
             q
         }
     };
-    let result = py.detach(|| {
+    let lc = run_user(py, &problem, |p| {
         ivt_hb::limit_cycle(
-            &problem,
+            p,
             &opts,
             omega_guess,
             &start,
             stability_steps(opts.harmonics),
         )
-    });
-    if let Some(e) = callback_error(&problem) {
-        return Err(e);
-    }
-    let lc = result.map_err(|e| hb_err(py, e))?;
+    })?;
     let d = PyDict::new(py);
     d.set_item("omega", lc.omega())?;
     d.set_item("period", lc.period())?;
@@ -602,6 +625,7 @@ fn limit_cycle<'py>(
     d.set_item("iterations", lc.solution.stats.iterations)?;
     d.set_item("residual_norm", lc.solution.stats.residual_norm)?;
     Ok(d)
+}
 }
 
 /// Evaluate the Fourier series u(τ) = a0/2 + Σ a_k cos kτ + b_k sin kτ of

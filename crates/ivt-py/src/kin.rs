@@ -2,7 +2,7 @@
 //! coefficients of Eq. 151, vectorized over numpy arrays.
 
 use crate::fields::{self, Field};
-use crate::vectorize::{map, map1};
+use crate::vectorize::{map, map1, map2};
 use ivt_kin::plant::{GravityModel, PlantParams};
 use ivt_kin::variant;
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -56,11 +56,9 @@ fn ring_speeds<'py>(
             "arguments `d_s` = {d_s}, `d_p` = {d_p} must be finite with d_s + 2 d_p != 0"
         )));
     }
-    let [a, b] = map(py, [("omega", omega), ("omega_c", omega_c)], |[w, wc]| {
-        let (r1, r2) = variant::ring_speeds(w, wc, d_s, d_p);
-        Ok::<_, std::convert::Infallible>([r1, r2])
-    })?;
-    Ok((a, b))
+    map2(py, [("omega", omega), ("omega_c", omega_c)], |[w, wc]| {
+        variant::ring_speeds(w, wc, d_s, d_p)
+    })
 }
 
 /// Driver speeds (v_d1, v_d2) = (ω r sin θ, ω r cos θ) [m/s], Eq. 45–46.
@@ -71,15 +69,11 @@ fn driver_speeds<'py>(
     omega: &Bound<'py, PyAny>,
     r: &Bound<'py, PyAny>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-    let [a, b] = map(
+    map2(
         py,
         [("theta", theta), ("omega", omega), ("r", r)],
-        |[t, w, r]| {
-            let (v1, v2) = variant::driver_speeds(t, w, r);
-            Ok::<_, std::convert::Infallible>([v1, v2])
-        },
-    )?;
-    Ok((a, b))
+        |[t, w, r]| variant::driver_speeds(t, w, r),
+    )
 }
 
 fn check_r_u(r_u: f64) -> PyResult<()> {
@@ -125,28 +119,9 @@ fn output_to_motor_ratio<'py>(
 }
 
 /// The numeric Table 1 parameters by their Rust (and Python) names.
-const FIELDS: &[Field<PlantParams>] = &[
-    ("r_a", |p| p.r_a, |p, v| p.r_a = v),
-    ("k_e", |p| p.k_e, |p, v| p.k_e = v),
-    ("k_t", |p| p.k_t, |p, v| p.k_t = v),
-    ("l_a", |p| p.l_a, |p, v| p.l_a = v),
-    ("j_n1", |p| p.j_n1, |p, v| p.j_n1 = v),
-    ("j_n2", |p| p.j_n2, |p, v| p.j_n2 = v),
-    ("j_inshaft", |p| p.j_inshaft, |p, v| p.j_inshaft = v),
-    ("j_carrier", |p| p.j_carrier, |p, v| p.j_carrier = v),
-    ("j_ring", |p| p.j_ring, |p, v| p.j_ring = v),
-    ("j_crk", |p| p.j_crk, |p, v| p.j_crk = v),
-    ("m_r", |p| p.m_r, |p, v| p.m_r = v),
-    ("m_dr", |p| p.m_dr, |p, v| p.m_dr = v),
-    ("j_u", |p| p.j_u, |p, v| p.j_u = v),
-    ("r_u", |p| p.r_u, |p, v| p.r_u = v),
-    ("g", |p| p.g, |p, v| p.g = v),
-    (
-        "sun_to_planet",
-        |p| p.sun_to_planet,
-        |p, v| p.sun_to_planet = v,
-    ),
-    ("r_max", |p| p.r_max, |p, v| p.r_max = v),
+const FIELDS: &[Field<PlantParams>] = fields::field_table![
+    PlantParams; r_a, k_e, k_t, l_a, j_n1, j_n2, j_inshaft, j_carrier, j_ring, j_crk, m_r, m_dr,
+    j_u, r_u, g, sun_to_planet, r_max
 ];
 
 fn gravity_name(g: GravityModel) -> &'static str {
@@ -196,8 +171,26 @@ pub struct Plant {
     pub params: PlantParams,
 }
 
-#[pymethods]
-impl Plant {
+/// `#[pymethods] impl Plant`: the `items` as written, then one read-only
+/// property per `name;` entry returning `self.params.name()`.
+macro_rules! plant_methods {
+    ({ $($items:tt)* } $( $(#[$doc:meta])* $name:ident; )*) => {
+        #[pymethods]
+        impl Plant {
+            $($items)*
+            $(
+                $(#[$doc])*
+                #[getter]
+                fn $name(&self) -> f64 {
+                    self.params.$name()
+                }
+            )*
+        }
+    };
+}
+
+plant_methods! {
+{
     #[new]
     #[pyo3(signature = (**overrides))]
     fn new(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
@@ -236,46 +229,6 @@ impl Plant {
         Ok(d)
     }
 
-    /// J_a [kg·m²] (§4.1; thesis 0.0237).
-    #[getter]
-    fn j_a(&self) -> f64 {
-        self.params.j_a()
-    }
-    /// J_b = m_r + m_dr [kg] (§4.1; thesis 2.1264).
-    #[getter]
-    fn j_b(&self) -> f64 {
-        self.params.j_b()
-    }
-    /// J_c = J_U·8/(π² r_u²) [kg] (§4.1; thesis 0.3388).
-    #[getter]
-    fn j_c(&self) -> f64 {
-        self.params.j_c()
-    }
-    /// J_d = J_N1 [kg·m²] (§4.1).
-    #[getter]
-    fn j_d(&self) -> f64 {
-        self.params.j_d()
-    }
-    /// k_t k_e/R_a: F_m = this·f² (thesis 2.375).
-    #[getter]
-    fn motor_damping(&self) -> f64 {
-        self.params.motor_damping()
-    }
-    /// k_t/R_a: f1 = this·f·V_m (thesis 3.1667).
-    #[getter]
-    fn motor_gain(&self) -> f64 {
-        self.params.motor_gain()
-    }
-    /// 2√2/(π r_u): f2 = this·f·T_U (thesis 40.5548).
-    #[getter]
-    fn load_gain(&self) -> f64 {
-        self.params.load_gain()
-    }
-    /// Coefficient of (sin θ + cos θ) in G: g, or m_r·g with gravity="roller_mass".
-    #[getter]
-    fn gravity_gain(&self) -> f64 {
-        self.params.gravity_gain()
-    }
     /// Largest eccentricity r_max [m] (§4.2.1: 0.012).
     #[getter]
     fn r_max(&self) -> f64 {
@@ -382,6 +335,23 @@ impl Plant {
         let args = PyTuple::new(py, [self.params(py)?])?;
         PyTuple::new(py, [rebuild, args.into_any()])
     }
+}
+    /// J_a [kg·m²] (§4.1; thesis 0.0237).
+    j_a;
+    /// J_b = m_r + m_dr [kg] (§4.1; thesis 2.1264).
+    j_b;
+    /// J_c = J_U·8/(π² r_u²) [kg] (§4.1; thesis 0.3388).
+    j_c;
+    /// J_d = J_N1 [kg·m²] (§4.1).
+    j_d;
+    /// k_t k_e/R_a: F_m = this·f² (thesis 2.375).
+    motor_damping;
+    /// k_t/R_a: f1 = this·f·V_m (thesis 3.1667).
+    motor_gain;
+    /// 2√2/(π r_u): f2 = this·f·T_U (thesis 40.5548).
+    load_gain;
+    /// Coefficient of (sin θ + cos θ) in G: g, or m_r·g with gravity="roller_mass".
+    gravity_gain;
 }
 
 /// Register `ivt._ivt.kin`.

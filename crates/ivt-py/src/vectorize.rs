@@ -157,3 +157,20 @@ pub fn map1<'py, const N: usize>(
     let [y] = map(py, args, |x| Ok::<_, std::convert::Infallible>([f(x)]))?;
     Ok(y)
 }
+
+/// [`map`] for a function that cannot fail and returns a pair (the speed
+/// pairs of Eq. 1–4 and 44–46): a tuple of two arrays, two floats for scalars.
+///
+/// # Errors
+/// As [`map`] for the arguments.
+pub fn map2<'py, const N: usize>(
+    py: Python<'py>,
+    args: [(&'static str, &Bound<'py, PyAny>); N],
+    f: impl Fn([f64; N]) -> (f64, f64),
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let [a, b] = map(py, args, |x| {
+        let (a, b) = f(x);
+        Ok::<_, std::convert::Infallible>([a, b])
+    })?;
+    Ok((a, b))
+}
