@@ -5,9 +5,10 @@
 //! r = 6 mm, from θ = 0, ω = 8 rad/s. The measured quantity is
 //! `ω_a = 2π / (t(Θ) − t(Θ − 2π))` at Θ = 100 rad (≈ 10 s): the mean speed
 //! over the last revolution, what the controller regulates. The reference is
-//! RK4 with 4000 steps per gear segment (its difference to 8000 steps is
-//! reported as `reference_check`, ≈ 1e-13 rad/s; below ≈ 1e-12 every method
-//! meets the round-off floor of accumulating t over 10⁴–10⁶ steps).
+//! DP5 at rtol = atol = 1e-14 (its difference to RK4 with 16 000 steps per
+//! gear segment is reported as `reference_check` and asserted below 1e-11
+//! rad/s; below ≈ 1e-12 every method meets the round-off floor of
+//! accumulating t over 10⁴–10⁶ steps).
 //! `bench/work_precision.py` runs the same problem through scipy's
 //! `solve_ivp` (RK45, DOP853, LSODA) in the same angle-domain form.
 
@@ -107,7 +108,7 @@ pub struct Study {
     pub plant: serde_json::Value,
     /// Reference ω_a \[rad/s\].
     pub reference: f64,
-    /// |reference − RK4 with 8000 steps per gear segment| \[rad/s\].
+    /// |reference − RK4 with 16 000 steps per gear segment| \[rad/s\].
     pub reference_check: f64,
     /// Rows, DP5 then RK4.
     pub rows: Vec<Row>,
