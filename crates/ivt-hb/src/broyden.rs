@@ -298,11 +298,8 @@ impl BroydenWorkspace {
     /// [`SolveError::SingularJacobian`] if the new `B` is singular.
     pub fn replace_row(&mut self, i: usize, row: &[f64]) -> Result<(), SolveError> {
         let m = self.m;
-        self.materialize_b();
         // B' = B + e_i dᵀ, d = row − B_i;  H' = H − (H e_i)(dᵀ H)/(1 + dᵀ H e_i).
-        for j in 0..m {
-            self.u[j] = row[j] - self.b[i * m + j];
-        }
+        self.overwrite_b(row, |j| i * m + j);
         for j in 0..m {
             self.hu[j] = self.h[j * m + i];
         }
@@ -310,9 +307,7 @@ impl BroydenWorkspace {
         for (uk, hrow) in self.u.iter().zip(self.h.chunks_exact(m)) {
             axpy(*uk, hrow, &mut self.sth);
         }
-        let denom = 1.0 + self.sth[i];
-        self.b[i * m..(i + 1) * m].copy_from_slice(&row[..m]);
-        self.sherman_morrison(denom)
+        self.sherman_morrison(1.0 + self.sth[i])
     }
 
     /// Replaces column `j` of `B` by `col` and updates `H` by Sherman–Morrison.
@@ -321,20 +316,24 @@ impl BroydenWorkspace {
     /// [`SolveError::SingularJacobian`] if the new `B` is singular.
     pub fn replace_col(&mut self, j: usize, col: &[f64]) -> Result<(), SolveError> {
         let m = self.m;
-        self.materialize_b();
         // B' = B + c e_jᵀ, c = col − B_:j;  H' = H − (H c)(e_jᵀ H)/(1 + e_jᵀ H c).
-        for i in 0..m {
-            self.u[i] = col[i] - self.b[i * m + j];
-        }
+        self.overwrite_b(col, |i| i * m + j);
         for i in 0..m {
             self.hu[i] = dot(&self.h[i * m..(i + 1) * m], &self.u);
         }
         self.sth.copy_from_slice(&self.h[j * m..(j + 1) * m]);
-        let denom = 1.0 + self.hu[j];
-        for i in 0..m {
-            self.b[i * m + j] = col[i];
+        self.sherman_morrison(1.0 + self.hu[j])
+    }
+
+    /// Writes `new` over the entries `at(k)` of `B` (one row or column, made
+    /// current first) and leaves the change `new − old` in `u`.
+    fn overwrite_b(&mut self, new: &[f64], at: impl Fn(usize) -> usize) {
+        self.materialize_b();
+        for (k, (u, &v)) in self.u.iter_mut().zip(new).enumerate() {
+            let e = at(k);
+            *u = v - self.b[e];
+            self.b[e] = v;
         }
-        self.sherman_morrison(denom)
     }
 
     /// `H ← H − hu sthᵀ / denom`, or a full inversion when `denom` is tiny.
