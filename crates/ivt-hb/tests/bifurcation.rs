@@ -7,9 +7,30 @@ use ivt_hb::mathieu::THESIS_A0;
 use ivt_hb::ode::{first_order, rk4};
 use ivt_hb::{
     period_doubled_start, switch_branch, trace, BifurcationKind, BifurcationOptions,
-    ContinuationOptions, FamilyBranch, GeneralProblem, HbOptions, MathieuDuffing, ModifiedIhb,
-    TraceOptions,
+    ContinuationOptions, Family, FamilyBranch, GeneralProblem, HbOptions, MathieuDuffing,
+    ModifiedIhb, PeriodicProblem, Trace, TraceOptions,
 };
+
+/// The forcing-frequency family `ω_f ↦ (problem, ω_f)` and its trace with the
+/// default options from the modified-IHB orbit at `omega_from` to `omega_to`.
+fn trace_in_omega<'a, P: PeriodicProblem>(
+    problem: &'a P,
+    hb: &HbOptions,
+    omega_from: f64,
+    omega_to: f64,
+) -> (FamilyBranch<impl Family<Problem = &'a P>>, Trace) {
+    let start = ModifiedIhb::new(problem, hb.clone())
+        .unwrap()
+        .solve(omega_from, None)
+        .unwrap();
+    let mut branch = FamilyBranch::new(move |w: f64| (problem, w), hb, omega_from).unwrap();
+    let opts = TraceOptions {
+        lambda_to: omega_to,
+        ..TraceOptions::default()
+    };
+    let tr = trace(&mut branch, &start.coeffs, omega_from, &opts).unwrap();
+    (branch, tr)
+}
 
 /// Flow and monodromy of `ẍ = a(t, x, ẋ)` (1 DOF) over `[0, period]` from `y0 =
 /// (x, ẋ)`, with `∂a/∂x`, `∂a/∂ẋ` for the variational equations: RK4, `steps`.
@@ -218,16 +239,7 @@ fn forced_van_der_pol_neimark_sacker_matches_shooting_and_time_integration() {
         move |t: f64, out: &mut [f64]| out[0] = f * t.cos(),
     );
     let hb = HbOptions::new(9, 32);
-    let start = ModifiedIhb::new(&vdp, hb.clone())
-        .unwrap()
-        .solve(0.5, None)
-        .unwrap();
-    let mut branch = FamilyBranch::new(|w: f64| (&vdp, w), &hb, 0.5).unwrap();
-    let opts = TraceOptions {
-        lambda_to: 1.6,
-        ..TraceOptions::default()
-    };
-    let tr = trace(&mut branch, &start.coeffs, 0.5, &opts).unwrap();
+    let (_, tr) = trace_in_omega(&vdp, &hb, 0.5, 1.6);
     let ns: Vec<_> = tr
         .events
         .iter()
@@ -315,16 +327,7 @@ fn symmetric_chain_branch_point_matches_shooting_and_switches_to_the_asymmetric_
         },
     );
     let hb = HbOptions::new(9, 32);
-    let start = ModifiedIhb::new(&chain, hb.clone())
-        .unwrap()
-        .solve(0.8, None)
-        .unwrap();
-    let mut branch = FamilyBranch::new(|w: f64| (&chain, w), &hb, 0.8).unwrap();
-    let opts = TraceOptions {
-        lambda_to: 2.5,
-        ..TraceOptions::default()
-    };
-    let tr = trace(&mut branch, &start.coeffs, 0.8, &opts).unwrap();
+    let (mut branch, tr) = trace_in_omega(&chain, &hb, 0.8, 2.5);
     let event = tr
         .events
         .iter()

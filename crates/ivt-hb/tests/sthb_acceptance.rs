@@ -153,14 +153,19 @@ fn kd10_curve_all_stable_and_n5_n10_overlap() {
     assert!(d < 1e-2, "N = 5 and N = 10 curves {d:e} apart (axis units)");
 }
 
+/// The default string (thesis §4 parameters) with Duffing coefficient `kd`.
+fn string_hb(kd: f64) -> StringHb {
+    StringHb::new(StringParams {
+        kd,
+        ..Default::default()
+    })
+    .unwrap()
+}
+
 #[test]
 fn kd30_has_unstable_middle_branch_without_period_doubling() {
     // Fig. 35: unstable solutions between two folds, no period doubling or NS.
-    let p = StringParams {
-        kd: 30.0,
-        ..Default::default()
-    };
-    let mut hb = StringHb::new(p).unwrap();
+    let mut hb = string_hb(30.0);
     let frc = frequency_response(&mut hb, 1.0, 6.0, &StringFrcOptions::default()).unwrap();
     assert_unstable_exactly_between_folds(&frc.frc);
 }
@@ -400,11 +405,7 @@ fn spring_linear_stability_converges_to_the_exact_string() {
 fn hill_agrees_with_monodromy() {
     // Two independent routes to the multipliers of Eq. 126: Hill (Eq. 130–131)
     // and RK4 of A(t). Compare the largest modulus on both sides of the folds.
-    let p = StringParams {
-        kd: 30.0,
-        ..Default::default()
-    };
-    let mut hb = StringHb::new(p).unwrap();
+    let mut hb = string_hb(30.0);
     let path = trace(&mut hb, 3.0, 5.0, &StringFrcOptions::default().continuation).unwrap();
     let n = hb.dim();
     let mut checked_unstable = 0;
