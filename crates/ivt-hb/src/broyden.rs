@@ -411,6 +411,25 @@ impl BroydenWorkspace {
         }
     }
 
+    /// [`Self::refresh`] at `x`, then `H = B⁻¹`, counting the work in `stats`.
+    ///
+    /// # Errors
+    /// [`SolveError::SingularJacobian`] with the history so far if `B` is singular.
+    fn refresh_inverse<S: System + ?Sized>(
+        &mut self,
+        sys: &mut S,
+        x: &[f64],
+        fd_step: f64,
+        stats: &mut BroydenStats,
+    ) -> Result<(), SolveError> {
+        stats.residual_evals += self.refresh(sys, x, fd_step);
+        stats.jacobian_refreshes += 1;
+        self.invert_b().map_err(|_| SolveError::SingularJacobian {
+            iteration: stats.iterations,
+            history: self.history.clone(),
+        })
+    }
+
     /// Refreshes `B` at `x` (whose residual is in `self.r`) from the system's
     /// Jacobian or by forward differences; returns residual evaluations used.
     fn refresh<S: System + ?Sized>(&mut self, sys: &mut S, x: &[f64], fd_step: f64) -> usize {
@@ -550,12 +569,7 @@ pub fn broyden_solve<S: System + ?Sized>(
         });
     }
     if !ws.has_jacobian {
-        stats.residual_evals += ws.refresh(sys, x, opts.fd_step);
-        stats.jacobian_refreshes += 1;
-        ws.invert_b().map_err(|_| SolveError::SingularJacobian {
-            iteration: 0,
-            history: ws.history.clone(),
-        })?;
+        ws.refresh_inverse(sys, x, opts.fd_step, &mut stats)?;
     }
     let mut stalled = 0usize;
     while norm > opts.tol {
@@ -601,15 +615,8 @@ pub fn broyden_solve<S: System + ?Sized>(
                     history: ws.history.clone(),
                 });
             }
-            stats.residual_evals += ws.refresh(sys, x, opts.fd_step);
-            stats.jacobian_refreshes += 1;
             stalled = 0;
-            if ws.invert_b().is_err() {
-                return Err(SolveError::SingularJacobian {
-                    iteration: stats.iterations,
-                    history: ws.history.clone(),
-                });
-            }
+            ws.refresh_inverse(sys, x, opts.fd_step, &mut stats)?;
             continue;
         }
         // Accept the step; s = t·dx.
@@ -637,15 +644,8 @@ pub fn broyden_solve<S: System + ?Sized>(
                 }
                 continue;
             }
-            stats.residual_evals += ws.refresh(sys, x, opts.fd_step);
-            stats.jacobian_refreshes += 1;
             stalled = 0;
-            if ws.invert_b().is_err() {
-                return Err(SolveError::SingularJacobian {
-                    iteration: stats.iterations,
-                    history: ws.history.clone(),
-                });
-            }
+            ws.refresh_inverse(sys, x, opts.fd_step, &mut stats)?;
         }
     }
     stats.residual_norm = norm;

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{orbit_defect, solve_classic, solve_modified};
+use common::{max_abs_diff, orbit_defect, solve_classic, solve_modified};
 use ivt_hb::aft::{eval_series, resize_harmonics};
 use ivt_hb::ode::{first_order, rk4};
 use ivt_hb::{ClassicIhb, Duffing, HbOptions, HsuRule, ModifiedIhb, StabilityAnalyzer};
@@ -45,13 +45,6 @@ fn hb_at_rk_points(coeffs: &[f64]) -> Vec<f64> {
     (0..64)
         .map(|j| eval_series(coeffs, 2.0 * PI * j as f64 / 64.0, 0))
         .collect()
-}
-
-fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max)
 }
 
 #[test]

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{orbit_defect, solve_classic, solve_modified};
+use common::{max_abs_diff, orbit_defect, solve_classic, solve_modified};
 use ivt_hb::{
     frequency_response, BroydenOptions, ClassicIhb, Duffing, FrcOptions, HbError, HbOptions,
     ModifiedIhb,
@@ -52,12 +52,7 @@ fn many_harmonics_and_classic_agree() {
     // The classic Newton starts on its own from the linear guess, not from
     // the modified solution.
     let b = solve_classic(d.clone(), opts, 1.3);
-    let diff = a
-        .coeffs
-        .iter()
-        .zip(&b.coeffs)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max);
+    let diff = max_abs_diff(&a.coeffs, &b.coeffs);
     assert!(diff < 1e-9, "{diff:e}");
     assert!(orbit_defect(&d, &a, 1 << 14) < 1e-8);
 }
@@ -73,12 +68,7 @@ fn near_the_folds() {
         let mut solver = ModifiedIhb::new(d.clone(), hb.clone()).unwrap();
         let sol = solver.solve(p.omega_f, Some(&p.coeffs)).unwrap();
         assert!(orbit_defect(&d, &sol, 1 << 14) < 1e-8);
-        let gap = sol
-            .coeffs
-            .iter()
-            .zip(&p.coeffs)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let gap = max_abs_diff(&sol.coeffs, &p.coeffs);
         assert!(gap < 1e-7, "fold at {}: {gap:e}", f.omega_f);
     }
 }

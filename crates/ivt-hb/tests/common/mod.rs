@@ -52,3 +52,11 @@ pub fn solve_classic<P: PeriodicProblem>(problem: P, opts: HbOptions, omega_f: f
         .solve(omega_f, None)
         .unwrap()
 }
+
+/// `max_i |a_i − b_i|`.
+pub fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
