@@ -87,8 +87,15 @@ where
     panic!("shooting did not converge from {y0:?}");
 }
 
-/// Secant iteration on `f(λ) = 0` from two guesses.
-fn secant(mut f: impl FnMut(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
+/// det(Φ − μI) of a row-major 2×2 monodromy `p`: zero iff μ is a multiplier.
+fn det_shifted(p: [f64; 4], mu: f64) -> f64 {
+    (p[0] - mu) * (p[3] - mu) - p[1] * p[2]
+}
+
+/// Secant iteration on `f(λ) = 0` from the guesses `λ0 ∓ 1e-3` around an HB
+/// location `λ0`.
+fn secant_near(mut f: impl FnMut(f64) -> f64, lambda0: f64) -> f64 {
+    let (mut a, mut b) = (lambda0 - 1e-3, lambda0 + 1e-3);
     let (mut fa, mut fb) = (f(a), f(b));
     for _ in 0..40 {
         let c = b - fb * (b - a) / (fb - fa);
@@ -148,7 +155,7 @@ fn mathieu_duffing_period_doubling_matches_shooting_and_switches_to_period_two()
     let c = &pd.q;
     let y_hb = [eval_series(c, 0.0, 0), 2.0 * eval_series(c, 0.0, 1)];
     let mut y0 = y_hb;
-    let beta_shoot = secant(
+    let beta_shoot = secant_near(
         |beta| {
             let acc = |t: f64, x: f64, v: f64| {
                 -2.0 * xi * v + (alpha + beta * (2.0 * t).sin()) * x - gamma * x * x * x
@@ -161,10 +168,9 @@ fn mathieu_duffing_period_doubling_matches_shooting_and_switches_to_period_two()
             };
             let (y, p) = shoot_1dof(&acc, &dacc, y0, period, steps);
             y0 = y;
-            (p[0] + 1.0) * (p[3] + 1.0) - p[1] * p[2]
+            det_shifted(p, -1.0)
         },
-        pd.lambda - 1e-3,
-        pd.lambda + 1e-3,
+        pd.lambda,
     );
     // Both sides solve the same β to their own accuracy: HB n = 20 (last
     // coefficients ~1e-12), Hsu 2048 Magnus4 steps, RK4 4000 steps per period.
@@ -262,15 +268,14 @@ fn forced_van_der_pol_neimark_sacker_matches_shooting_and_time_integration() {
         let acc =
             |w: f64| move |t: f64, x: f64, v: f64| eps * (1.0 - x * x) * v - x + f * (w * t).cos();
         let dacc = |_t: f64, x: f64, v: f64| (-2.0 * eps * x * v - 1.0, eps * (1.0 - x * x));
-        let w_shoot = secant(
+        let w_shoot = secant_near(
             |w| {
                 let period = 2.0 * std::f64::consts::PI / w;
                 let (y, p) = shoot_1dof(&acc(w), &dacc, y0, period, 4000);
                 y0 = y;
                 p[0] * p[3] - p[1] * p[2] - 1.0
             },
-            bif.lambda - 1e-3,
-            bif.lambda + 1e-3,
+            bif.lambda,
         );
         println!(
             "NS ω_f {} shooting {w_shoot} ({:e})",
@@ -346,16 +351,15 @@ fn symmetric_chain_branch_point_matches_shooting_and_switches_to_the_asymmetric_
     };
     let d_sym = |_t: f64, x: f64, _v: f64| (-1.2 - 3.0 * x * x, -0.02);
     let d_anti = |_t: f64, x: f64, _v: f64| (-1.0 - 3.0 * x * x, -0.02);
-    let w_shoot = secant(
+    let w_shoot = secant_near(
         |w| {
             let period = 2.0 * std::f64::consts::PI / w;
             let (y, _) = shoot_1dof(&acc(w), &d_sym, y0, period, 4000);
             y0 = y;
             let p = flow_1dof(acc(w), d_anti, y, period, 4000).1;
-            (p[0] - 1.0) * (p[3] - 1.0) - p[1] * p[2]
+            det_shifted(p, 1.0)
         },
-        bp.lambda - 1e-3,
-        bp.lambda + 1e-3,
+        bp.lambda,
     );
     // Measured 1e-12.
     assert!(
