@@ -19,12 +19,53 @@ use std::sync::Arc;
 pub struct Aft {
     n: usize,
     n_half: usize,
+    fft: RealFftPair,
+}
+
+/// Forward and inverse real FFT plans of one length with one scratch, the
+/// spectrum (`len/2 + 1` bins) and a sample buffer: the transforms of [`Aft`] and of
+/// the string's time axis ([`crate::sthb::StringHb`]). They allocate nothing.
+pub(crate) struct RealFftPair {
     fwd: Arc<dyn RealToComplex<f64>>,
     inv: Arc<dyn ComplexToReal<f64>>,
-    spectrum: Vec<Complex<f64>>,
-    scratch_fwd: Vec<Complex<f64>>,
-    scratch_inv: Vec<Complex<f64>>,
-    buf: Vec<f64>,
+    scratch: Vec<Complex<f64>>,
+    samples: Vec<f64>,
+    /// The spectrum: input of [`Self::inverse_into`] (overwritten), output of
+    /// [`Self::forward_from`].
+    pub(crate) spectrum: Vec<Complex<f64>>,
+}
+
+impl RealFftPair {
+    /// Plans for `len` real samples.
+    pub(crate) fn new(len: usize) -> Self {
+        let mut planner = RealFftPlanner::<f64>::new();
+        let fwd = planner.plan_fft_forward(len);
+        let inv = planner.plan_fft_inverse(len);
+        let scratch_len = fwd.get_scratch_len().max(inv.get_scratch_len());
+        Self {
+            scratch: vec![Complex::new(0.0, 0.0); scratch_len],
+            samples: vec![0.0; len],
+            spectrum: fwd.make_output_vec(),
+            fwd,
+            inv,
+        }
+    }
+
+    /// Unnormalised DFT of `samples` (`len`) into [`Self::spectrum`].
+    pub(crate) fn forward_from(&mut self, samples: &[f64]) {
+        self.samples.copy_from_slice(samples);
+        self.fwd
+            .process_with_scratch(&mut self.samples, &mut self.spectrum, &mut self.scratch)
+            .expect("sizes fixed at planning");
+    }
+
+    /// `x_i = Σ_K X_K e^{+jKτ_i}` over the Hermitian extension of
+    /// [`Self::spectrum`] into `samples` (`len`).
+    pub(crate) fn inverse_into(&mut self, samples: &mut [f64]) {
+        self.inv
+            .process_with_scratch(&mut self.spectrum, samples, &mut self.scratch)
+            .expect("sizes fixed at planning; DC and Nyquist imaginary parts are zero");
+    }
 }
 
 impl std::fmt::Debug for Aft {
@@ -55,22 +96,10 @@ impl Aft {
         if crate::limits::samples_error(n_half).is_some() {
             return Err(HbError::AftTooManySamples { n_half });
         }
-        let len = 2 * n_half;
-        let mut planner = RealFftPlanner::<f64>::new();
-        let fwd = planner.plan_fft_forward(len);
-        let inv = planner.plan_fft_inverse(len);
-        let scratch_fwd = fwd.make_scratch_vec();
-        let scratch_inv = inv.make_scratch_vec();
-        let spectrum = fwd.make_output_vec();
         Ok(Self {
             n: harmonics,
             n_half,
-            fwd,
-            inv,
-            spectrum,
-            scratch_fwd,
-            scratch_inv,
-            buf: vec![0.0; len],
+            fft: RealFftPair::new(2 * n_half),
         })
     }
 
@@ -104,17 +133,15 @@ impl Aft {
         let n = self.n;
         debug_assert_eq!(coeffs.len(), 2 * n + 1);
         debug_assert_eq!(samples.len(), 2 * self.n_half);
-        self.spectrum.fill(Complex::new(0.0, 0.0));
+        self.fft.spectrum.fill(Complex::new(0.0, 0.0));
         // realfft's inverse gives x_i = Σ_K X_K e^{+jKτ_i} over the full Hermitian
         // spectrum, so a_k cos + b_k sin needs X_k = (a_k − j b_k)/2, X_0 = a0/2.
-        self.spectrum[0] = Complex::new(if order == 0 { 0.5 * coeffs[0] } else { 0.0 }, 0.0);
+        self.fft.spectrum[0] = Complex::new(if order == 0 { 0.5 * coeffs[0] } else { 0.0 }, 0.0);
         for k in 1..=n {
             let (a, b) = derivative_pair(coeffs[k], coeffs[n + k], k, order);
-            self.spectrum[k] = Complex::new(0.5 * a, -0.5 * b);
+            self.fft.spectrum[k] = Complex::new(0.5 * a, -0.5 * b);
         }
-        self.inv
-            .process_with_scratch(&mut self.spectrum, samples, &mut self.scratch_inv)
-            .expect("sizes fixed at planning; DC and Nyquist imaginary parts are zero");
+        self.fft.inverse_into(samples);
     }
 
     /// Samples of the `order`-th τ-derivative of `n_dof` series (`q`: `n_dof` blocks
@@ -170,15 +197,12 @@ impl Aft {
     pub fn analyze(&mut self, samples: &[f64], coeffs: &mut [f64]) {
         let n = self.n;
         debug_assert_eq!(coeffs.len(), 2 * n + 1);
-        self.buf.copy_from_slice(samples);
-        self.fwd
-            .process_with_scratch(&mut self.buf, &mut self.spectrum, &mut self.scratch_fwd)
-            .expect("sizes fixed at planning");
+        self.fft.forward_from(samples);
         let scale = 1.0 / self.n_half as f64;
-        coeffs[0] = self.spectrum[0].re * scale;
+        coeffs[0] = self.fft.spectrum[0].re * scale;
         for k in 1..=n {
-            coeffs[k] = self.spectrum[k].re * scale;
-            coeffs[n + k] = -self.spectrum[k].im * scale;
+            coeffs[k] = self.fft.spectrum[k].re * scale;
+            coeffs[n + k] = -self.fft.spectrum[k].im * scale;
         }
     }
 

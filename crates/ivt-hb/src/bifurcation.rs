@@ -280,6 +280,40 @@ pub(crate) fn lambda_step(opts: &BifurcationOptions, lambda: f64) -> f64 {
     opts.fd_step * lambda.abs().max(1e-3)
 }
 
+/// The blocks `R_q` (row-major `m×m`) and `R_λ` of `[R_q, R_λ]` at `(q, λ)`,
+/// `R_λ` by a central difference with [`lambda_step`].
+pub(crate) fn jacobian_blocks<B: Branch>(
+    branch: &mut B,
+    q: &[f64],
+    lambda: f64,
+    opts: &BifurcationOptions,
+) -> (Vec<f64>, Vec<f64>) {
+    let m = q.len();
+    let mut jac = vec![0.0; m * m];
+    let mut r_lambda = vec![0.0; m];
+    branch.jacobian(q, lambda, &mut jac);
+    residual_lambda(branch, q, lambda, lambda_step(opts, lambda), &mut r_lambda);
+    (jac, r_lambda)
+}
+
+/// Right and left near-null vectors of the near-singular square row-major `a`,
+/// refined in place from their seeds; only a non-finite factor is refused.
+fn border_null_vectors(
+    a: &[f64],
+    right: &mut [f64],
+    left: &mut [f64],
+) -> Result<(), BifurcationError> {
+    let mut lu = LuWorkspace::new(right.len());
+    lu.factor_row_major(a);
+    if !null_vector(&mut lu, right, false) || !null_vector(&mut lu, left, true) {
+        return Err(solve_error(SolveError::SingularJacobian {
+            iteration: 0,
+            history: Vec::new(),
+        }));
+    }
+    Ok(())
+}
+
 /// Result of [`extended_newton`]: `(q, λ, iterations)`.
 type Converged = (Vec<f64>, f64, usize);
 
@@ -417,15 +451,7 @@ pub fn locate_multiplier_crossing<F: Family>(
         vec![1.0 / (s as f64).sqrt(); s],
         vec![1.0 / (s as f64).sqrt(); s],
     );
-    // `a` is near-singular here: only a non-finite factor is refused.
-    let mut lu = LuWorkspace::new(s);
-    lu.factor_row_major(&a);
-    if !null_vector(&mut lu, &mut c, false) || !null_vector(&mut lu, &mut b, true) {
-        return Err(solve_error(SolveError::SingularJacobian {
-            iteration: 0,
-            history: Vec::new(),
-        }));
-    }
+    border_null_vectors(&a, &mut c, &mut b)?;
     let (q, lambda, iterations) = extended_newton(
         branch,
         q0,
@@ -558,31 +584,14 @@ pub fn locate_branch_point<F: Family>(
     // near-null vectors are the second branch direction (right) and the
     // unfolding direction (left).
     let n1 = m + 1;
-    let mut jac = vec![0.0; m * m];
-    let mut r_lambda = vec![0.0; m];
-    branch.jacobian(q0, lambda0, &mut jac);
-    residual_lambda(
-        branch,
-        q0,
-        lambda0,
-        lambda_step(opts, lambda0),
-        &mut r_lambda,
-    );
+    let (jac, r_lambda) = jacobian_blocks(branch, q0, lambda0, opts);
     let t1: Vec<f64> = tangent.iter().map(|x| x / norm2(tangent)).collect();
     let mut aug = vec![0.0; n1 * n1];
     put_jacobian(&mut aug, n1, &jac, &r_lambda);
     aug[m * n1..].copy_from_slice(&t1);
     let seed: Vec<f64> = (0..n1).map(|i| 1.0 + 0.1 * (i as f64).sin()).collect();
     let (mut right, mut left) = (seed.clone(), seed);
-    // `aug` is near-singular here: only a non-finite factor is refused.
-    let mut lu = LuWorkspace::new(n1);
-    lu.factor_row_major(&aug);
-    if !null_vector(&mut lu, &mut right, false) || !null_vector(&mut lu, &mut left, true) {
-        return Err(solve_error(SolveError::SingularJacobian {
-            iteration: 0,
-            history: Vec::new(),
-        }));
-    }
+    border_null_vectors(&aug, &mut right, &mut left)?;
     let along = dot(&right, &t1);
     right.iter_mut().zip(&t1).for_each(|(r, t)| *r -= along * t);
     let nr = norm2(&right);

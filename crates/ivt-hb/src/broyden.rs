@@ -298,11 +298,8 @@ impl BroydenWorkspace {
     /// [`SolveError::SingularJacobian`] if the new `B` is singular.
     pub fn replace_row(&mut self, i: usize, row: &[f64]) -> Result<(), SolveError> {
         let m = self.m;
-        self.materialize_b();
         // B' = B + e_i dᵀ, d = row − B_i;  H' = H − (H e_i)(dᵀ H)/(1 + dᵀ H e_i).
-        for j in 0..m {
-            self.u[j] = row[j] - self.b[i * m + j];
-        }
+        self.overwrite_b(row, |j| i * m + j);
         for j in 0..m {
             self.hu[j] = self.h[j * m + i];
         }
@@ -310,9 +307,7 @@ impl BroydenWorkspace {
         for (uk, hrow) in self.u.iter().zip(self.h.chunks_exact(m)) {
             axpy(*uk, hrow, &mut self.sth);
         }
-        let denom = 1.0 + self.sth[i];
-        self.b[i * m..(i + 1) * m].copy_from_slice(&row[..m]);
-        self.sherman_morrison(denom)
+        self.sherman_morrison(1.0 + self.sth[i])
     }
 
     /// Replaces column `j` of `B` by `col` and updates `H` by Sherman–Morrison.
@@ -321,20 +316,24 @@ impl BroydenWorkspace {
     /// [`SolveError::SingularJacobian`] if the new `B` is singular.
     pub fn replace_col(&mut self, j: usize, col: &[f64]) -> Result<(), SolveError> {
         let m = self.m;
-        self.materialize_b();
         // B' = B + c e_jᵀ, c = col − B_:j;  H' = H − (H c)(e_jᵀ H)/(1 + e_jᵀ H c).
-        for i in 0..m {
-            self.u[i] = col[i] - self.b[i * m + j];
-        }
+        self.overwrite_b(col, |i| i * m + j);
         for i in 0..m {
             self.hu[i] = dot(&self.h[i * m..(i + 1) * m], &self.u);
         }
         self.sth.copy_from_slice(&self.h[j * m..(j + 1) * m]);
-        let denom = 1.0 + self.hu[j];
-        for i in 0..m {
-            self.b[i * m + j] = col[i];
+        self.sherman_morrison(1.0 + self.hu[j])
+    }
+
+    /// Writes `new` over the entries `at(k)` of `B` (one row or column, made
+    /// current first) and leaves the change `new − old` in `u`.
+    fn overwrite_b(&mut self, new: &[f64], at: impl Fn(usize) -> usize) {
+        self.materialize_b();
+        for (k, (u, &v)) in self.u.iter_mut().zip(new).enumerate() {
+            let e = at(k);
+            *u = v - self.b[e];
+            self.b[e] = v;
         }
-        self.sherman_morrison(denom)
     }
 
     /// `H ← H − hu sthᵀ / denom`, or a full inversion when `denom` is tiny.
@@ -410,6 +409,25 @@ impl BroydenWorkspace {
                 history: self.history.clone(),
             })
         }
+    }
+
+    /// [`Self::refresh`] at `x`, then `H = B⁻¹`, counting the work in `stats`.
+    ///
+    /// # Errors
+    /// [`SolveError::SingularJacobian`] with the history so far if `B` is singular.
+    fn refresh_inverse<S: System + ?Sized>(
+        &mut self,
+        sys: &mut S,
+        x: &[f64],
+        fd_step: f64,
+        stats: &mut BroydenStats,
+    ) -> Result<(), SolveError> {
+        stats.residual_evals += self.refresh(sys, x, fd_step);
+        stats.jacobian_refreshes += 1;
+        self.invert_b().map_err(|_| SolveError::SingularJacobian {
+            iteration: stats.iterations,
+            history: self.history.clone(),
+        })
     }
 
     /// Refreshes `B` at `x` (whose residual is in `self.r`) from the system's
@@ -551,12 +569,7 @@ pub fn broyden_solve<S: System + ?Sized>(
         });
     }
     if !ws.has_jacobian {
-        stats.residual_evals += ws.refresh(sys, x, opts.fd_step);
-        stats.jacobian_refreshes += 1;
-        ws.invert_b().map_err(|_| SolveError::SingularJacobian {
-            iteration: 0,
-            history: ws.history.clone(),
-        })?;
+        ws.refresh_inverse(sys, x, opts.fd_step, &mut stats)?;
     }
     let mut stalled = 0usize;
     while norm > opts.tol {
@@ -602,15 +615,8 @@ pub fn broyden_solve<S: System + ?Sized>(
                     history: ws.history.clone(),
                 });
             }
-            stats.residual_evals += ws.refresh(sys, x, opts.fd_step);
-            stats.jacobian_refreshes += 1;
             stalled = 0;
-            if ws.invert_b().is_err() {
-                return Err(SolveError::SingularJacobian {
-                    iteration: stats.iterations,
-                    history: ws.history.clone(),
-                });
-            }
+            ws.refresh_inverse(sys, x, opts.fd_step, &mut stats)?;
             continue;
         }
         // Accept the step; s = t·dx.
@@ -638,15 +644,8 @@ pub fn broyden_solve<S: System + ?Sized>(
                 }
                 continue;
             }
-            stats.residual_evals += ws.refresh(sys, x, opts.fd_step);
-            stats.jacobian_refreshes += 1;
             stalled = 0;
-            if ws.invert_b().is_err() {
-                return Err(SolveError::SingularJacobian {
-                    iteration: stats.iterations,
-                    history: ws.history.clone(),
-                });
-            }
+            ws.refresh_inverse(sys, x, opts.fd_step, &mut stats)?;
         }
     }
     stats.residual_norm = norm;

@@ -10,7 +10,7 @@
 //!   through a fold, where only `det R_q` does).
 
 use crate::bifurcation::{
-    finish, locate_branch_point, locate_multiplier_crossing, residual_lambda, Bifurcation,
+    finish, jacobian_blocks, locate_branch_point, locate_multiplier_crossing, Bifurcation,
     BifurcationError, BifurcationKind, BifurcationOptions, Monodromy,
 };
 use crate::continuation::{pseudo_arclength, ContinuationOptions, Termination};
@@ -243,16 +243,7 @@ fn augmented_sign<F: Family>(
 ) -> f64 {
     let m = q.len();
     let n1 = m + 1;
-    let mut jac = vec![0.0; m * m];
-    let mut r_lambda = vec![0.0; m];
-    branch.jacobian(q, lambda, &mut jac);
-    residual_lambda(
-        branch,
-        q,
-        lambda,
-        opts.fd_step * lambda.abs().max(1e-3),
-        &mut r_lambda,
-    );
+    let (jac, r_lambda) = jacobian_blocks(branch, q, lambda, opts);
     let mut aug = faer::Mat::<f64>::zeros(n1, n1);
     for i in 0..n1 {
         let row: Vec<f64> = if i < m {

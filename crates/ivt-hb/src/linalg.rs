@@ -171,11 +171,7 @@ mod tests {
     #[test]
     fn inverse_of_a_known_matrix() {
         // [[4, 3], [6, 3]]^{-1} = [[-0.5, 0.5], [1, -2/3]] (det = -6).
-        let a = [4.0, 3.0, 6.0, 3.0];
-        let mut inv = [0.0; 4];
-        let mut lu = [0.0; 4];
-        let mut piv = [0; 2];
-        invert(&a, 2, &mut inv, &mut lu, &mut piv).unwrap();
+        let inv = invert_2x2(&[4.0, 3.0, 6.0, 3.0]).unwrap();
         let want = [-0.5, 0.5, 1.0, -2.0 / 3.0];
         for (g, w) in inv.iter().zip(want) {
             assert!((g - w).abs() < 1e-15);
@@ -184,10 +180,12 @@ mod tests {
 
     #[test]
     fn singular_is_reported() {
-        let a = [1.0, 2.0, 2.0, 4.0];
-        let mut inv = [0.0; 4];
-        let mut lu = [0.0; 4];
-        let mut piv = [0; 2];
-        assert_eq!(invert(&a, 2, &mut inv, &mut lu, &mut piv), Err(Singular));
+        assert_eq!(invert_2x2(&[1.0, 2.0, 2.0, 4.0]), Err(Singular));
+    }
+
+    /// [`invert`] of a row-major 2×2 matrix with its own scratch.
+    fn invert_2x2(a: &[f64; 4]) -> Result<[f64; 4], Singular> {
+        let (mut inv, mut lu, mut piv) = ([0.0; 4], [0.0; 4], [0; 2]);
+        invert(a, 2, &mut inv, &mut lu, &mut piv).map(|()| inv)
     }
 }

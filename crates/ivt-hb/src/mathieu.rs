@@ -68,6 +68,30 @@ impl Default for CascadeOptions {
 /// A path point with its period-doubling indicator (μ_min + 1).
 type Sample = (Vec<f64>, f64);
 
+/// The first sign change of the period-doubling indicator from `> 0` to `≤ 0`
+/// along a path: the bracketing pair of points, once found.
+#[derive(Default)]
+struct PdBracket {
+    prev: Option<Sample>,
+    found: Option<(Sample, Sample)>,
+}
+
+impl PdBracket {
+    /// Records the path point `x` with indicator `g`; `false` (stop the path) once
+    /// the change is bracketed.
+    fn push(&mut self, x: &[f64], g: f64) -> bool {
+        let cur = (x.to_vec(), g);
+        if let Some(pr) = self.prev.take() {
+            if pr.1 > 0.0 && g <= 0.0 {
+                self.found = Some((pr, cur));
+                return false;
+            }
+        }
+        self.prev = Some(cur);
+        true
+    }
+}
+
 /// One period-doubling point.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PeriodDoubling {
@@ -163,8 +187,7 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
         max_points: 4000,
         ..ContinuationOptions::default()
     };
-    let mut prev: Option<(Vec<f64>, f64)> = None;
-    let mut bracket: Option<(Sample, Sample)> = None;
+    let mut bracket = PdBracket::default();
     let mut p = problem.clone();
     let stab = |an: &mut StabilityAnalyzer,
                 p: &MathieuDuffing,
@@ -199,19 +222,12 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
         |pt| {
             p.beta = pt.lambda();
             let (g, _) = stab(&mut an, &p, &pt.x[..m], n1, 1);
-            let cur = (pt.x.clone(), g);
-            if let Some(pr) = prev.take() {
-                if pr.1 > 0.0 && g <= 0.0 {
-                    bracket = Some((pr, cur));
-                    return false;
-                }
-            }
-            prev = Some(cur);
-            true
+            bracket.push(&pt.x, g)
         },
     )
     .map_err(|e| HbError::InvalidInput(format!("period-1 continuation: {e}")))?;
     let ((xa, ga), (xb, gb)) = bracket
+        .found
         .ok_or_else(|| HbError::InvalidInput("period-1 branch never reached μ = −1".into()))?;
     // Secant refinement in β with fixed-β solves.
     let mut solver = ModifiedIhb::new(problem.clone(), hb1.clone())?;
@@ -291,8 +307,7 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
             max_points: 4000,
             ..ContinuationOptions::default()
         };
-        let mut prev: Option<(Vec<f64>, f64)> = None;
-        let mut bracket: Option<(Sample, Sample)> = None;
+        let mut bracket = PdBracket::default();
         // Skip the start region where the new branch's multiplier is still ≈ +1.
         pseudo_arclength(
             |x: &[f64], r: &mut [f64]| ctl.eval(&x[..l], x[l], r),
@@ -305,19 +320,11 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
                 let mut q = pt.x[..l].to_vec();
                 q[c] = pt.lambda();
                 let (g, _) = stab(&mut an2, &pp, &q, new_n, new_period);
-                let cur = (pt.x.clone(), g);
-                if let Some(pr) = prev.take() {
-                    if pr.1 > 0.0 && g <= 0.0 {
-                        bracket = Some((pr, cur));
-                        return false;
-                    }
-                }
-                prev = Some(cur);
-                true
+                bracket.push(&pt.x, g)
             },
         )
         .map_err(|e| HbError::InvalidInput(format!("period-{new_period} continuation: {e}")))?;
-        let ((xa, ga), (xb, gb)) = bracket.ok_or_else(|| {
+        let ((xa, ga), (xb, gb)) = bracket.found.ok_or_else(|| {
             HbError::InvalidInput(format!("period-{new_period} branch never reached μ = −1"))
         })?;
         // Secant on the controlled amplitude.

@@ -16,25 +16,49 @@ macro_rules! matrix_getters {
         }
         matrix_getters!(@mck);
     };
-    ($n:literal) => {
+    ($n:literal $(, $field:ident)?) => {
         fn n_dof(&self) -> usize {
             $n
         }
-        matrix_getters!(@mck);
+        matrix_getters!(@mck $($field)?);
     };
-    (@mck) => {
+    (@mck $($field:ident)?) => {
         fn mass(&self) -> &[f64] {
-            &self.m
+            &self$(.$field)?.m
         }
         fn damping(&self) -> &[f64] {
-            &self.c
+            &self$(.$field)?.c
         }
         fn stiffness(&self) -> &[f64] {
-            &self.k
+            &self$(.$field)?.k
         }
     };
 }
 pub(crate) use matrix_getters;
+
+/// `velocity_dependent() = false` and a `nonlinear_jacobian` that writes `∂g/∂x`
+/// by `$body` (`$s` stands for `self`) and zeroes `∂g/∂v`: the trait items of a
+/// force that depends on displacement and phase only.
+macro_rules! displacement_jacobian {
+    (|$s:ident, $x:ident, $theta:ident, $dg_dx:ident| $body:expr) => {
+        fn velocity_dependent(&self) -> bool {
+            false
+        }
+        fn nonlinear_jacobian(
+            &self,
+            $x: &[f64],
+            _v: &[f64],
+            $theta: f64,
+            $dg_dx: &mut [f64],
+            dg_dv: &mut [f64],
+        ) {
+            let $s = self;
+            $body;
+            dg_dv.fill(0.0);
+        }
+    };
+}
+pub(crate) use displacement_jacobian;
 
 /// A periodically forced second-order system (see the module docs).
 pub trait PeriodicProblem {
@@ -220,12 +244,29 @@ fn orbit_scale(u: &[f64], n: usize, j: usize) -> f64 {
     .unwrap_or(1.0)
 }
 
-/// Duffing's equation Eq. 49: `ü + 2ξ u̇ + α u + ε u³ = F cos(ω_f t)`.
+/// The linear part `ü + 2ξ u̇ + k u` of a one-DOF oscillator with unit mass.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Duffing {
+struct UnitMass {
     m: [f64; 1],
     c: [f64; 1],
     k: [f64; 1],
+}
+
+impl UnitMass {
+    /// Damping ratio ξ and stiffness `k`.
+    fn new(xi: f64, k: f64) -> Self {
+        Self {
+            m: [1.0],
+            c: [2.0 * xi],
+            k: [k],
+        }
+    }
+}
+
+/// Duffing's equation Eq. 49: `ü + 2ξ u̇ + α u + ε u³ = F cos(ω_f t)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Duffing {
+    linear: UnitMass,
     /// Nonlinear stiffness ε.
     pub eps: f64,
     /// Forcing amplitude F.
@@ -236,9 +277,7 @@ impl Duffing {
     /// Duffing oscillator with damping ratio ξ, stiffness α, nonlinearity ε, force F.
     pub fn new(xi: f64, alpha: f64, eps: f64, force: f64) -> Self {
         Self {
-            m: [1.0],
-            c: [2.0 * xi],
-            k: [alpha],
+            linear: UnitMass::new(xi, alpha),
             eps,
             force,
         }
@@ -249,51 +288,36 @@ impl Duffing {
     }
     /// Damping ratio ξ.
     pub fn xi(&self) -> f64 {
-        0.5 * self.c[0]
+        0.5 * self.linear.c[0]
     }
     /// Linear stiffness α.
     pub fn alpha(&self) -> f64 {
-        self.k[0]
+        self.linear.k[0]
     }
     /// Whether all parameters are finite.
     pub fn is_finite(&self) -> bool {
-        [self.c[0], self.k[0], self.eps, self.force]
+        [self.linear.c[0], self.linear.k[0], self.eps, self.force]
             .iter()
             .all(|v| v.is_finite())
     }
 }
 
 impl PeriodicProblem for Duffing {
-    matrix_getters!(1);
+    matrix_getters!(1, linear);
     fn nonlinear(&self, x: &[f64], _v: &[f64], _theta: f64, out: &mut [f64]) {
         out[0] = self.eps * x[0] * x[0] * x[0];
     }
     fn excitation(&self, theta: f64, out: &mut [f64]) {
         out[0] = self.force * theta.cos();
     }
-    fn velocity_dependent(&self) -> bool {
-        false
-    }
-    fn nonlinear_jacobian(
-        &self,
-        x: &[f64],
-        _v: &[f64],
-        _theta: f64,
-        dg_dx: &mut [f64],
-        dg_dv: &mut [f64],
-    ) {
-        dg_dx[0] = 3.0 * self.eps * x[0] * x[0];
-        dg_dv[0] = 0.0;
-    }
+    displacement_jacobian!(|s, x, _theta, dg_dx| dg_dx[0] = 3.0 * s.eps * x[0] * x[0]);
 }
 
 /// Mathieu–Duffing equation Eq. 81: `ü + 2ξ̂ u̇ − (α̂ + β sin Ωt) u + γ u³ = 0`
 /// (θ = Ωt is the excitation phase, so ω_f = Ω).
 #[derive(Debug, Clone, PartialEq)]
 pub struct MathieuDuffing {
-    m: [f64; 1],
-    c: [f64; 1],
-    k: [f64; 1],
+    linear: UnitMass,
     /// Parametric amplitude β.
     pub beta: f64,
     /// Cubic stiffness γ.
@@ -304,9 +328,7 @@ impl MathieuDuffing {
     /// With damping ratio ξ̂, stiffness α̂ (enters as −α̂), β and γ.
     pub fn new(xi: f64, alpha: f64, beta: f64, gamma: f64) -> Self {
         Self {
-            m: [1.0],
-            c: [2.0 * xi],
-            k: [-alpha],
+            linear: UnitMass::new(xi, -alpha),
             beta,
             gamma,
         }
@@ -318,24 +340,13 @@ impl MathieuDuffing {
 }
 
 impl PeriodicProblem for MathieuDuffing {
-    matrix_getters!(1);
+    matrix_getters!(1, linear);
     fn nonlinear(&self, x: &[f64], _v: &[f64], theta: f64, out: &mut [f64]) {
         out[0] = -self.beta * theta.sin() * x[0] + self.gamma * x[0] * x[0] * x[0];
     }
-    fn velocity_dependent(&self) -> bool {
-        false
-    }
-    fn nonlinear_jacobian(
-        &self,
-        x: &[f64],
-        _v: &[f64],
-        theta: f64,
-        dg_dx: &mut [f64],
-        dg_dv: &mut [f64],
-    ) {
-        dg_dx[0] = -self.beta * theta.sin() + 3.0 * self.gamma * x[0] * x[0];
-        dg_dv[0] = 0.0;
-    }
+    displacement_jacobian!(|s, x, theta, dg_dx| {
+        dg_dx[0] = -s.beta * theta.sin() + 3.0 * s.gamma * x[0] * x[0]
+    });
 }
 
 /// The force `g(x, v, θ)` of a [`GeneralProblem`]: any closure

@@ -7,9 +7,30 @@ use ivt_hb::mathieu::THESIS_A0;
 use ivt_hb::ode::{first_order, rk4};
 use ivt_hb::{
     period_doubled_start, switch_branch, trace, BifurcationKind, BifurcationOptions,
-    ContinuationOptions, FamilyBranch, GeneralProblem, HbOptions, MathieuDuffing, ModifiedIhb,
-    TraceOptions,
+    ContinuationOptions, Family, FamilyBranch, GeneralProblem, HbOptions, MathieuDuffing,
+    ModifiedIhb, PeriodicProblem, Trace, TraceOptions,
 };
+
+/// The forcing-frequency family `ω_f ↦ (problem, ω_f)` and its trace with the
+/// default options from the modified-IHB orbit at `omega_from` to `omega_to`.
+fn trace_in_omega<'a, P: PeriodicProblem>(
+    problem: &'a P,
+    hb: &HbOptions,
+    omega_from: f64,
+    omega_to: f64,
+) -> (FamilyBranch<impl Family<Problem = &'a P>>, Trace) {
+    let start = ModifiedIhb::new(problem, hb.clone())
+        .unwrap()
+        .solve(omega_from, None)
+        .unwrap();
+    let mut branch = FamilyBranch::new(move |w: f64| (problem, w), hb, omega_from).unwrap();
+    let opts = TraceOptions {
+        lambda_to: omega_to,
+        ..TraceOptions::default()
+    };
+    let tr = trace(&mut branch, &start.coeffs, omega_from, &opts).unwrap();
+    (branch, tr)
+}
 
 /// Flow and monodromy of `ẍ = a(t, x, ẋ)` (1 DOF) over `[0, period]` from `y0 =
 /// (x, ẋ)`, with `∂a/∂x`, `∂a/∂ẋ` for the variational equations: RK4, `steps`.
@@ -66,8 +87,15 @@ where
     panic!("shooting did not converge from {y0:?}");
 }
 
-/// Secant iteration on `f(λ) = 0` from two guesses.
-fn secant(mut f: impl FnMut(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
+/// det(Φ − μI) of a row-major 2×2 monodromy `p`: zero iff μ is a multiplier.
+fn det_shifted(p: [f64; 4], mu: f64) -> f64 {
+    (p[0] - mu) * (p[3] - mu) - p[1] * p[2]
+}
+
+/// Secant iteration on `f(λ) = 0` from the guesses `λ0 ∓ 1e-3` around an HB
+/// location `λ0`.
+fn secant_near(mut f: impl FnMut(f64) -> f64, lambda0: f64) -> f64 {
+    let (mut a, mut b) = (lambda0 - 1e-3, lambda0 + 1e-3);
     let (mut fa, mut fb) = (f(a), f(b));
     for _ in 0..40 {
         let c = b - fb * (b - a) / (fb - fa);
@@ -127,7 +155,7 @@ fn mathieu_duffing_period_doubling_matches_shooting_and_switches_to_period_two()
     let c = &pd.q;
     let y_hb = [eval_series(c, 0.0, 0), 2.0 * eval_series(c, 0.0, 1)];
     let mut y0 = y_hb;
-    let beta_shoot = secant(
+    let beta_shoot = secant_near(
         |beta| {
             let acc = |t: f64, x: f64, v: f64| {
                 -2.0 * xi * v + (alpha + beta * (2.0 * t).sin()) * x - gamma * x * x * x
@@ -140,10 +168,9 @@ fn mathieu_duffing_period_doubling_matches_shooting_and_switches_to_period_two()
             };
             let (y, p) = shoot_1dof(&acc, &dacc, y0, period, steps);
             y0 = y;
-            (p[0] + 1.0) * (p[3] + 1.0) - p[1] * p[2]
+            det_shifted(p, -1.0)
         },
-        pd.lambda - 1e-3,
-        pd.lambda + 1e-3,
+        pd.lambda,
     );
     // Both sides solve the same β to their own accuracy: HB n = 20 (last
     // coefficients ~1e-12), Hsu 2048 Magnus4 steps, RK4 4000 steps per period.
@@ -218,16 +245,7 @@ fn forced_van_der_pol_neimark_sacker_matches_shooting_and_time_integration() {
         move |t: f64, out: &mut [f64]| out[0] = f * t.cos(),
     );
     let hb = HbOptions::new(9, 32);
-    let start = ModifiedIhb::new(&vdp, hb.clone())
-        .unwrap()
-        .solve(0.5, None)
-        .unwrap();
-    let mut branch = FamilyBranch::new(|w: f64| (&vdp, w), &hb, 0.5).unwrap();
-    let opts = TraceOptions {
-        lambda_to: 1.6,
-        ..TraceOptions::default()
-    };
-    let tr = trace(&mut branch, &start.coeffs, 0.5, &opts).unwrap();
+    let (_, tr) = trace_in_omega(&vdp, &hb, 0.5, 1.6);
     let ns: Vec<_> = tr
         .events
         .iter()
@@ -250,15 +268,14 @@ fn forced_van_der_pol_neimark_sacker_matches_shooting_and_time_integration() {
         let acc =
             |w: f64| move |t: f64, x: f64, v: f64| eps * (1.0 - x * x) * v - x + f * (w * t).cos();
         let dacc = |_t: f64, x: f64, v: f64| (-2.0 * eps * x * v - 1.0, eps * (1.0 - x * x));
-        let w_shoot = secant(
+        let w_shoot = secant_near(
             |w| {
                 let period = 2.0 * std::f64::consts::PI / w;
                 let (y, p) = shoot_1dof(&acc(w), &dacc, y0, period, 4000);
                 y0 = y;
                 p[0] * p[3] - p[1] * p[2] - 1.0
             },
-            bif.lambda - 1e-3,
-            bif.lambda + 1e-3,
+            bif.lambda,
         );
         println!(
             "NS ω_f {} shooting {w_shoot} ({:e})",
@@ -315,16 +332,7 @@ fn symmetric_chain_branch_point_matches_shooting_and_switches_to_the_asymmetric_
         },
     );
     let hb = HbOptions::new(9, 32);
-    let start = ModifiedIhb::new(&chain, hb.clone())
-        .unwrap()
-        .solve(0.8, None)
-        .unwrap();
-    let mut branch = FamilyBranch::new(|w: f64| (&chain, w), &hb, 0.8).unwrap();
-    let opts = TraceOptions {
-        lambda_to: 2.5,
-        ..TraceOptions::default()
-    };
-    let tr = trace(&mut branch, &start.coeffs, 0.8, &opts).unwrap();
+    let (mut branch, tr) = trace_in_omega(&chain, &hb, 0.8, 2.5);
     let event = tr
         .events
         .iter()
@@ -343,16 +351,15 @@ fn symmetric_chain_branch_point_matches_shooting_and_switches_to_the_asymmetric_
     };
     let d_sym = |_t: f64, x: f64, _v: f64| (-1.2 - 3.0 * x * x, -0.02);
     let d_anti = |_t: f64, x: f64, _v: f64| (-1.0 - 3.0 * x * x, -0.02);
-    let w_shoot = secant(
+    let w_shoot = secant_near(
         |w| {
             let period = 2.0 * std::f64::consts::PI / w;
             let (y, _) = shoot_1dof(&acc(w), &d_sym, y0, period, 4000);
             y0 = y;
             let p = flow_1dof(acc(w), d_anti, y, period, 4000).1;
-            (p[0] - 1.0) * (p[3] - 1.0) - p[1] * p[2]
+            det_shifted(p, 1.0)
         },
-        bp.lambda - 1e-3,
-        bp.lambda + 1e-3,
+        bp.lambda,
     );
     // Measured 1e-12.
     assert!(

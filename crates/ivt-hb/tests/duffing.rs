@@ -1,6 +1,9 @@
 //! Duffing's equation (Eq. 49) at the Fig. 28 parameters against independent
 //! references: a long RK4 integration, the classic Newton IHB, and Hill vs Hsu.
 
+mod common;
+
+use common::{max_abs_diff, orbit_defect, solve_classic, solve_modified};
 use ivt_hb::aft::{eval_series, resize_harmonics};
 use ivt_hb::ode::{first_order, rk4};
 use ivt_hb::{ClassicIhb, Duffing, HbOptions, HsuRule, ModifiedIhb, StabilityAnalyzer};
@@ -44,13 +47,6 @@ fn hb_at_rk_points(coeffs: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max)
-}
-
 #[test]
 fn fig28_matches_long_rk_integration() {
     let duffing = Duffing::fig28();
@@ -75,14 +71,8 @@ fn fig28_matches_long_rk_integration() {
 fn modified_and_classic_ihb_agree() {
     let duffing = Duffing::fig28();
     let opts = HbOptions::new(20, 64);
-    let a = ModifiedIhb::new(duffing.clone(), opts.clone())
-        .unwrap()
-        .solve(OMEGA_F, None)
-        .unwrap();
-    let b = ClassicIhb::new(duffing, opts)
-        .unwrap()
-        .solve(OMEGA_F, None)
-        .unwrap();
+    let a = solve_modified(duffing.clone(), opts.clone(), OMEGA_F);
+    let b = solve_classic(duffing, opts, OMEGA_F);
     let d = max_abs_diff(&a.coeffs, &b.coeffs);
     eprintln!(
         "modified vs classic: max coefficient difference {d:.3e} (iterations {} vs {})",
@@ -142,10 +132,7 @@ fn modified_and_classic_agree_on_the_resonant_branch() {
 fn hsu_and_hill_multipliers_agree() {
     let duffing = Duffing::fig28();
     for omega_f in [0.4, 1.0, 1.6] {
-        let sol = ModifiedIhb::new(duffing.clone(), HbOptions::new(20, 64))
-            .unwrap()
-            .solve(omega_f, None)
-            .unwrap();
+        let sol = solve_modified(duffing.clone(), HbOptions::new(20, 64), omega_f);
         let mut an = StabilityAnalyzer::new(&duffing, 20, 4096).unwrap();
         let hsu = an.hsu(&duffing, &sol, HsuRule::Magnus4);
         let hill = an.hill(&duffing, &sol, 20).unwrap();
@@ -174,10 +161,7 @@ fn hsu_and_hill_multipliers_agree() {
 fn eq80_literal_rule_converges_to_magnus() {
     // Eq. 80 (Θ frozen per sub-interval) is first order: its error halves with N_Q.
     let duffing = Duffing::fig28();
-    let sol = ModifiedIhb::new(duffing.clone(), HbOptions::new(20, 64))
-        .unwrap()
-        .solve(0.4, None)
-        .unwrap();
+    let sol = solve_modified(duffing.clone(), HbOptions::new(20, 64), 0.4);
     let reference =
         StabilityAnalyzer::new(&duffing, 20, 4096)
             .unwrap()
@@ -206,10 +190,7 @@ fn eq80_literal_rule_converges_to_magnus() {
 fn convergence_in_harmonics() {
     let duffing = Duffing::new(0.02, 1.0, 100.0, 1.0);
     let omega_f = 1.0;
-    let reference = ModifiedIhb::new(duffing.clone(), HbOptions::new(64, 160))
-        .unwrap()
-        .solve(omega_f, None)
-        .unwrap();
+    let reference = solve_modified(duffing.clone(), HbOptions::new(64, 160), omega_f);
     let mut table = Vec::new();
     for n in [4usize, 6, 8, 10, 12, 14, 16, 20, 24, 30] {
         let guess = resize_harmonics(&reference.coeffs, n);
@@ -238,25 +219,7 @@ fn convergence_in_harmonics() {
     // The n = 64 orbit is a solution of the ODE: one RK4 period started from the
     // HB state (x(0), ẋ(0)) stays on it (coexisting attractors rule out a start
     // from rest here).
-    let w = omega_f;
-    let x0 = eval_series(reference.dof(0), 0.0, 0);
-    let v0 = w * eval_series(reference.dof(0), 0.0, 1);
-    let period = 2.0 * PI / w;
-    let per = 65536;
-    let dt = period / per as f64;
-    let mut y = [x0, v0];
-    let mut err = 0.0f64;
-    for j in 0..64 {
-        let hb = eval_series(reference.dof(0), 2.0 * PI * j as f64 / 64.0, 0);
-        err = err.max((y[0] - hb).abs());
-        rk4(
-            first_order(&duffing, w),
-            j as f64 * period / 64.0,
-            &mut y,
-            dt,
-            per / 64,
-        );
-    }
+    let err = orbit_defect(&duffing, &reference, 65536);
     eprintln!("ε = 100: n = 64 orbit vs one RK period {err:.2e}");
     assert!(err < 1e-7, "{err:e}");
 }

@@ -1,11 +1,10 @@
 //! Two coupled DOFs through the general interface: M, C, K matrices plus a cubic
 //! spring on DOF 0 and a force on DOF 1. Checked against one RK4 period started on
 //! the HB orbit, and Hsu vs Hill for the 4×4 state-space Θ.
-#![allow(clippy::needless_range_loop)] // DOF-indexed state vectors
-use ivt_hb::aft::eval_series;
-use ivt_hb::ode::{first_order, rk4};
-use ivt_hb::{GeneralProblem, HbOptions, HsuRule, ModifiedIhb, StabilityAnalyzer};
-use std::f64::consts::PI;
+mod common;
+
+use common::{orbit_defect, solve_modified};
+use ivt_hb::{GeneralProblem, HbOptions, HsuRule, StabilityAnalyzer};
 
 #[test]
 fn coupled_two_dof_orbit_and_stability() {
@@ -24,31 +23,8 @@ fn coupled_two_dof_orbit_and_stability() {
         },
     );
     let omega_f = 0.9;
-    let sol = ModifiedIhb::new(&problem, HbOptions::new(24, 64))
-        .unwrap()
-        .solve(omega_f, None)
-        .unwrap();
-    let period = 2.0 * PI / omega_f;
-    let per = 1 << 14;
-    let dt = period / per as f64;
-    let mut y = [0.0; 4];
-    for d in 0..2 {
-        y[d] = eval_series(sol.dof(d), 0.0, 0);
-        y[2 + d] = omega_f * eval_series(sol.dof(d), 0.0, 1);
-    }
-    let mut err = 0.0f64;
-    for j in 0..64 {
-        for d in 0..2 {
-            err = err.max((y[d] - eval_series(sol.dof(d), 2.0 * PI * j as f64 / 64.0, 0)).abs());
-        }
-        rk4(
-            first_order(&problem, omega_f),
-            j as f64 * period / 64.0,
-            &mut y,
-            dt,
-            per / 64,
-        );
-    }
+    let sol = solve_modified(&problem, HbOptions::new(24, 64), omega_f);
+    let err = orbit_defect(&problem, &sol, 1 << 14);
     eprintln!(
         "2-DOF orbit defect {err:.2e}, amplitudes {:.4} {:.4}",
         sol.amplitude(0),

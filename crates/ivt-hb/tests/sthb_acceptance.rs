@@ -129,38 +129,32 @@ fn kd10_curve_all_stable_and_n5_n10_overlap() {
     .frc;
     assert!(frc.points.iter().all(|p| p.stable()));
     assert!((frc.points.last().unwrap().omega_f - 6.0).abs() < 1e-12);
-    let (_, c5) = curve(
-        &StringParams {
-            modes: 5,
+    let [c5, c10] = [5, 10].map(|modes| {
+        let p = StringParams {
+            modes,
             ..Default::default()
-        },
-        1.0,
-        6.0,
-        0.02,
-    );
-    let (_, c10) = curve(
-        &StringParams {
-            modes: 10,
-            ..Default::default()
-        },
-        1.0,
-        6.0,
-        0.02,
-    );
+        };
+        curve(&p, 1.0, 6.0, 0.02).1
+    });
     // "Plotting accuracy": within 1 % of the axes (2 px on a 200-px plot).
     // Measured 6.1e-3, on the steep side of the peak (ω ≈ 3.9).
     let d = plot_distance(&c5, &c10).max(plot_distance(&c10, &c5));
     assert!(d < 1e-2, "N = 5 and N = 10 curves {d:e} apart (axis units)");
 }
 
+/// The default string (thesis §4 parameters) with Duffing coefficient `kd`.
+fn string_hb(kd: f64) -> StringHb {
+    StringHb::new(StringParams {
+        kd,
+        ..Default::default()
+    })
+    .unwrap()
+}
+
 #[test]
 fn kd30_has_unstable_middle_branch_without_period_doubling() {
     // Fig. 35: unstable solutions between two folds, no period doubling or NS.
-    let p = StringParams {
-        kd: 30.0,
-        ..Default::default()
-    };
-    let mut hb = StringHb::new(p).unwrap();
+    let mut hb = string_hb(30.0);
     let frc = frequency_response(&mut hb, 1.0, 6.0, &StringFrcOptions::default()).unwrap();
     assert_unstable_exactly_between_folds(&frc.frc);
 }
@@ -400,11 +394,7 @@ fn spring_linear_stability_converges_to_the_exact_string() {
 fn hill_agrees_with_monodromy() {
     // Two independent routes to the multipliers of Eq. 126: Hill (Eq. 130–131)
     // and RK4 of A(t). Compare the largest modulus on both sides of the folds.
-    let p = StringParams {
-        kd: 30.0,
-        ..Default::default()
-    };
-    let mut hb = StringHb::new(p).unwrap();
+    let mut hb = string_hb(30.0);
     let path = trace(&mut hb, 3.0, 5.0, &StringFrcOptions::default().continuation).unwrap();
     let n = hb.dim();
     let mut checked_unstable = 0;

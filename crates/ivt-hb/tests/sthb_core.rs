@@ -52,6 +52,19 @@ fn linear_limit_equals_closed_form() {
     }
 }
 
+/// The string with Duffing coefficient `kd`, `modes` modes, `harmonics` harmonics,
+/// `ns` spatial and `ms` time samples; other parameters default.
+fn sized(kd: f64, modes: usize, harmonics: usize, ns: usize, ms: usize) -> StringParams {
+    StringParams {
+        kd,
+        modes,
+        harmonics,
+        ns,
+        ms,
+        ..Default::default()
+    }
+}
+
 fn check_fd(p: StringParams, amp: f64, omega: f64) {
     let mut hb = StringHb::new(p).unwrap();
     let n = hb.dim();
@@ -98,41 +111,20 @@ fn check_fd(p: StringParams, amp: f64, omega: f64) {
 
 #[test]
 fn jacobian_matches_finite_differences_fixed() {
-    let p = StringParams {
-        kd: 30.0,
-        modes: 4,
-        harmonics: 5,
-        ns: 32,
-        ms: 32,
-        ..Default::default()
-    };
-    check_fd(p, 0.3, 2.7);
+    check_fd(sized(30.0, 4, 5, 32, 32), 0.3, 2.7);
 }
 
 #[test]
 fn jacobian_matches_finite_differences_aliased() {
     // M_s = 24 < 4M + 1: products alias in time; the Jacobian stays exact for the sampled residual.
-    let p = StringParams {
-        kd: 10.0,
-        modes: 3,
-        harmonics: 7,
-        ns: 16,
-        ms: 24,
-        ..Default::default()
-    };
-    check_fd(p, 0.3, 3.3);
+    check_fd(sized(10.0, 3, 7, 16, 24), 0.3, 3.3);
 }
 
 #[test]
 fn jacobian_matches_finite_differences_spring() {
     let p = StringParams {
-        kd: 10.0,
-        modes: 4,
-        harmonics: 4,
-        ns: 32,
-        ms: 32,
         boundary: Boundary::Spring { k0: 10.0 },
-        ..Default::default()
+        ..sized(10.0, 4, 4, 32, 32)
     };
     check_fd(p, 0.3, 2.1);
 }

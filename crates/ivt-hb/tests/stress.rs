@@ -3,44 +3,20 @@
 //! on the HB orbit (an independent test that it solves the ODE); every failure
 //! must be an error, never a panic or a silent wrong answer.
 
-use ivt_hb::aft::eval_series;
-use ivt_hb::ode::{first_order, rk4};
+mod common;
+
+use common::{max_abs_diff, orbit_defect, solve_classic, solve_modified};
 use ivt_hb::{
     frequency_response, BroydenOptions, ClassicIhb, Duffing, FrcOptions, HbError, HbOptions,
-    HbSolution, ModifiedIhb,
+    ModifiedIhb,
 };
-use std::f64::consts::PI;
-
-/// Max |x_RK − x_HB| over one period, RK4 with `per` steps started at the HB state.
-fn orbit_defect(problem: &Duffing, sol: &HbSolution, per: usize) -> f64 {
-    let w = sol.omega_f;
-    let c = sol.dof(0);
-    let mut y = [eval_series(c, 0.0, 0), w * eval_series(c, 0.0, 1)];
-    let period = 2.0 * PI / w;
-    let dt = period / per as f64;
-    let mut err = 0.0f64;
-    for j in 0..64 {
-        err = err.max((y[0] - eval_series(c, 2.0 * PI * j as f64 / 64.0, 0)).abs());
-        rk4(
-            first_order(problem, w),
-            j as f64 * period / 64.0,
-            &mut y,
-            dt,
-            per / 64,
-        );
-    }
-    err
-}
 
 #[test]
 fn strong_nonlinearity_up_to_eps_100() {
     for eps in [1.0, 10.0, 100.0] {
         for omega_f in [0.5, 1.5, 3.0] {
             let d = Duffing::new(0.02, 1.0, eps, 1.0);
-            let sol = ModifiedIhb::new(d.clone(), HbOptions::new(40, 100))
-                .unwrap()
-                .solve(omega_f, None)
-                .unwrap();
+            let sol = solve_modified(d.clone(), HbOptions::new(40, 100), omega_f);
             let err = orbit_defect(&d, &sol, 1 << 15);
             eprintln!(
                 "ε = {eps}, ω_f = {omega_f}: amp {:.4}, {} it, orbit defect {err:.1e}",
@@ -58,10 +34,7 @@ fn strong_nonlinearity_up_to_eps_100() {
 fn tiny_damping() {
     for omega_f in [0.4, 0.9, 2.0] {
         let d = Duffing::new(1e-4, 1.0, 1.0, 0.1);
-        let sol = ModifiedIhb::new(d.clone(), HbOptions::new(30, 80))
-            .unwrap()
-            .solve(omega_f, None)
-            .unwrap();
+        let sol = solve_modified(d.clone(), HbOptions::new(30, 80), omega_f);
         let err = orbit_defect(&d, &sol, 1 << 14);
         eprintln!(
             "ξ = 1e-4, ω_f = {omega_f}: amp {:.4}, orbit defect {err:.1e}",
@@ -75,22 +48,11 @@ fn tiny_damping() {
 fn many_harmonics_and_classic_agree() {
     let d = Duffing::fig28();
     let opts = HbOptions::new(64, 160);
-    let a = ModifiedIhb::new(d.clone(), opts.clone())
-        .unwrap()
-        .solve(1.3, None)
-        .unwrap();
+    let a = solve_modified(d.clone(), opts.clone(), 1.3);
     // The classic Newton starts on its own from the linear guess, not from
     // the modified solution.
-    let b = ClassicIhb::new(d.clone(), opts)
-        .unwrap()
-        .solve(1.3, None)
-        .unwrap();
-    let diff = a
-        .coeffs
-        .iter()
-        .zip(&b.coeffs)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max);
+    let b = solve_classic(d.clone(), opts, 1.3);
+    let diff = max_abs_diff(&a.coeffs, &b.coeffs);
     assert!(diff < 1e-9, "{diff:e}");
     assert!(orbit_defect(&d, &a, 1 << 14) < 1e-8);
 }
@@ -106,12 +68,7 @@ fn near_the_folds() {
         let mut solver = ModifiedIhb::new(d.clone(), hb.clone()).unwrap();
         let sol = solver.solve(p.omega_f, Some(&p.coeffs)).unwrap();
         assert!(orbit_defect(&d, &sol, 1 << 14) < 1e-8);
-        let gap = sol
-            .coeffs
-            .iter()
-            .zip(&p.coeffs)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let gap = max_abs_diff(&sol.coeffs, &p.coeffs);
         assert!(gap < 1e-7, "fold at {}: {gap:e}", f.omega_f);
     }
 }

@@ -5,12 +5,12 @@ use std::sync::Arc;
 
 use faer::Mat;
 use realfft::num_complex::Complex;
-use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use rustdct::{Dct1, DctPlanner, Dst1};
 
 use super::lu::LuWorkspace;
 use super::toeplitz::{add_real_toeplitz, BlockLayout, PeriodicSpectrum};
 use super::{Boundary, StringParams};
+use crate::aft::RealFftPair;
 use crate::error::HbError;
 
 /// Up to this many modes the spatial balance sums the few needed DST-I/DCT-I
@@ -128,11 +128,7 @@ pub struct StringHb {
     p: StringParams,
     nq: usize,
     spatial: Spatial,
-    fwd: Arc<dyn RealToComplex<f64>>,
-    inv: Arc<dyn ComplexToReal<f64>>,
-    fft_scratch: Vec<Complex<f64>>,
-    spec: Vec<Complex<f64>>,
-    time: Vec<f64>,
+    fft: RealFftPair,
     q_t: Vec<f64>,
     wx: Vec<f64>,
     wxx: Vec<f64>,
@@ -175,10 +171,6 @@ impl StringHb {
         let mut dp = DctPlanner::new();
         let dst = dp.plan_dst1(ns - 1);
         let dct = dp.plan_dct1(ns + 1);
-        let mut fp = RealFftPlanner::<f64>::new();
-        let fwd = fp.plan_fft_forward(ms);
-        let inv = fp.plan_fft_inverse(ms);
-        let fft_scratch_len = fwd.get_scratch_len().max(inv.get_scratch_len());
         let p_max = (2 * m).min(ms / 2);
         // Discrete projection of e(x) = x on sin nπx (spring, Eq. 135).
         let mut e = (1..ns).map(|k| k as f64 / ns as f64).collect::<Vec<_>>();
@@ -189,11 +181,7 @@ impl StringHb {
         Ok(Self {
             nq,
             spatial: Spatial::new(dst, dct, ns, n, direct.unwrap_or(n <= DIRECT_MAX_MODES)),
-            fft_scratch: vec![Complex::new(0.0, 0.0); fft_scratch_len],
-            fwd,
-            inv,
-            spec: vec![Complex::new(0.0, 0.0); ms / 2 + 1],
-            time: vec![0.0; ms],
+            fft: RealFftPair::new(ms),
             q_t: vec![0.0; nq * ms],
             wx: vec![0.0; ns + 1],
             wxx: vec![0.0; ns - 1],
@@ -367,23 +355,15 @@ impl StringHb {
             self.p.kd,
         );
         let nq = self.nq;
-        let to_err = |r: Result<(), realfft::FftError>| {
-            r.expect("realfft buffer sizes are fixed at construction")
-        };
         // 1. q_j(t_i) by inverse real FFT (t_i = 2πi/M_s).
         for j in 0..nq {
-            self.spec.fill(Complex::new(0.0, 0.0));
-            self.spec[0] = Complex::new(a[j], 0.0);
+            self.fft.spectrum.fill(Complex::new(0.0, 0.0));
+            self.fft.spectrum[0] = Complex::new(a[j], 0.0);
             for k in 1..=m {
-                self.spec[k] =
+                self.fft.spectrum[k] =
                     Complex::new(0.5 * a[(2 * k - 1) * nq + j], -0.5 * a[2 * k * nq + j]);
             }
-            to_err(self.inv.process_with_scratch(
-                &mut self.spec,
-                &mut self.time,
-                &mut self.fft_scratch,
-            ));
-            self.q_t[j * ms..(j + 1) * ms].copy_from_slice(&self.time);
+            self.fft.inverse_into(&mut self.q_t[j * ms..(j + 1) * ms]);
         }
         // 2. Grid values per time sample, spatial balance by DST-I / DCT-I.
         let scale = 2.0 / ns as f64;
@@ -430,17 +410,11 @@ impl StringHb {
         // 3. Temporal balance of Γ: L(a) in the real basis.
         let inv_ms = 1.0 / ms as f64;
         for j in 0..n {
-            self.time
-                .copy_from_slice(&self.gamma_t[j * ms..(j + 1) * ms]);
-            to_err(self.fwd.process_with_scratch(
-                &mut self.time,
-                &mut self.spec,
-                &mut self.fft_scratch,
-            ));
-            self.nl[j] = self.spec[0].re * inv_ms;
+            self.fft.forward_from(&self.gamma_t[j * ms..(j + 1) * ms]);
+            self.nl[j] = self.fft.spectrum[0].re * inv_ms;
             for k in 1..=m {
-                self.nl[(2 * k - 1) * nq + j] = 2.0 * self.spec[k].re * inv_ms;
-                self.nl[2 * k * nq + j] = -2.0 * self.spec[k].im * inv_ms;
+                self.nl[(2 * k - 1) * nq + j] = 2.0 * self.fft.spectrum[k].re * inv_ms;
+                self.nl[2 * k * nq + j] = -2.0 * self.fft.spectrum[k].im * inv_ms;
             }
         }
         for j in 0..nq - n {
@@ -454,14 +428,9 @@ impl StringHb {
         let pm = self.s_hat.p_max;
         for (rows, hat) in [(&self.b_t, &mut self.b_hat), (&self.c_t, &mut self.c_hat)] {
             for (r, row) in rows.chunks_exact(ms).enumerate() {
-                self.time.copy_from_slice(row);
-                to_err(self.fwd.process_with_scratch(
-                    &mut self.time,
-                    &mut self.spec,
-                    &mut self.fft_scratch,
-                ));
+                self.fft.forward_from(row);
                 for p in 0..=pm {
-                    hat[r * (pm + 1) + p] = self.spec[p] * inv_ms;
+                    hat[r * (pm + 1) + p] = self.fft.spectrum[p] * inv_ms;
                 }
             }
         }

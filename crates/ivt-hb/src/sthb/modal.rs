@@ -13,7 +13,7 @@ use ivt_num::{ExplicitRk, RK4};
 use std::f64::consts::PI;
 
 use super::StringParams;
-use crate::problem::PeriodicProblem;
+use crate::problem::{displacement_jacobian, PeriodicProblem};
 
 /// The cubic Galerkin model of the fixed–fixed string with `N` sine modes.
 #[derive(Clone, Debug)]
@@ -185,19 +185,8 @@ impl PeriodicProblem for ModalString {
         out.fill(0.0);
         out[0] = self.params.y0 * theta.cos();
     }
-    fn velocity_dependent(&self) -> bool {
-        false
-    }
-    fn nonlinear_jacobian(
-        &self,
-        x: &[f64],
-        _v: &[f64],
-        _theta: f64,
-        dg_dx: &mut [f64],
-        dg_dv: &mut [f64],
-    ) {
-        ModalString::nonlinear_jacobian(self, x, dg_dx);
-        dg_dx.iter_mut().for_each(|g| *g = -*g);
-        dg_dv.fill(0.0);
-    }
+    displacement_jacobian!(|s, x, _theta, dg_dx| {
+        ModalString::nonlinear_jacobian(s, x, dg_dx);
+        dg_dx.iter_mut().for_each(|g| *g = -*g)
+    });
 }

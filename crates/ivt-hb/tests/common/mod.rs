@@ -1,0 +1,62 @@
+//! Helpers shared by the integration tests: the independent RK4 check of an HB
+//! orbit and the one-line modified-IHB solve.
+#![allow(dead_code)] // each test binary uses its own subset
+
+use ivt_hb::aft::eval_series;
+use ivt_hb::ode::{first_order, rk4};
+use ivt_hb::{ClassicIhb, HbOptions, HbSolution, ModifiedIhb, PeriodicProblem};
+use std::f64::consts::PI;
+
+/// Max over all DOFs and 64 points of one period of |x_RK − x_HB|, RK4 with `per`
+/// steps per period started at the HB state `(x(0), ẋ(0))`: an orbit that solves
+/// the ODE stays on itself up to the truncation of `sol` and RK4's O(h⁴).
+pub fn orbit_defect<P: PeriodicProblem>(problem: &P, sol: &HbSolution, per: usize) -> f64 {
+    let w = sol.omega_f;
+    let nd = problem.n_dof();
+    let x0 = (0..nd).map(|d| eval_series(sol.dof(d), 0.0, 0));
+    let v0 = (0..nd).map(|d| w * eval_series(sol.dof(d), 0.0, 1));
+    let mut y: Vec<f64> = x0.chain(v0).collect();
+    let period = 2.0 * PI / w;
+    let dt = period / per as f64;
+    let mut err = 0.0f64;
+    for j in 0..64 {
+        for (d, x) in y[..nd].iter().enumerate() {
+            let hb = eval_series(sol.dof(d), 2.0 * PI * j as f64 / 64.0, 0);
+            err = err.max((x - hb).abs());
+        }
+        rk4(
+            first_order(problem, w),
+            j as f64 * period / 64.0,
+            &mut y,
+            dt,
+            per / 64,
+        );
+    }
+    err
+}
+
+/// The modified IHB solution of `problem` at `omega_f` from the linear guess
+/// (panics if the solver cannot be built or does not converge).
+pub fn solve_modified<P: PeriodicProblem>(problem: P, opts: HbOptions, omega_f: f64) -> HbSolution {
+    ModifiedIhb::new(problem, opts)
+        .unwrap()
+        .solve(omega_f, None)
+        .unwrap()
+}
+
+/// The classic (full Newton) IHB solution of `problem` at `omega_f` from the
+/// linear guess (panics as [`solve_modified`]).
+pub fn solve_classic<P: PeriodicProblem>(problem: P, opts: HbOptions, omega_f: f64) -> HbSolution {
+    ClassicIhb::new(problem, opts)
+        .unwrap()
+        .solve(omega_f, None)
+        .unwrap()
+}
+
+/// `max_i |a_i − b_i|`.
+pub fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
