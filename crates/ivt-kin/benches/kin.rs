@@ -12,7 +12,7 @@ fn main() {
 }
 
 /// Benches `ratio` along a sample stream: θ advances 1 mrad per call.
-fn along_theta(b: divan::Bencher, ratio: impl Fn(f64) -> f64) {
+fn along_theta<R>(b: divan::Bencher, ratio: impl Fn(f64) -> R) {
     let mut t = 0.0;
     b.bench_local(|| {
         t += 0.001;
