@@ -2,7 +2,13 @@
 
 use std::process::Command;
 
-fn run(args: &[&str]) -> (i32, serde_json::Value) {
+/// Runs `ivt` with the whitespace-separated arguments of `cmd_line`.
+fn run(cmd_line: &str) -> (i32, serde_json::Value) {
+    run_args(&cmd_line.split_whitespace().collect::<Vec<_>>())
+}
+
+/// Runs `ivt` with `args` (one may be a path holding spaces).
+fn run_args(args: &[&str]) -> (i32, serde_json::Value) {
     let out = Command::new(env!("CARGO_BIN_EXE_ivt"))
         .args(args)
         .output()
@@ -15,7 +21,7 @@ fn run(args: &[&str]) -> (i32, serde_json::Value) {
 
 #[test]
 fn duffing_json_keys() {
-    let (code, v) = run(&["--json", "hb", "duffing"]);
+    let (code, v) = run("--json hb duffing");
     assert_eq!(code, 0);
     for key in [
         "coeffs",
@@ -30,28 +36,20 @@ fn duffing_json_keys() {
     assert_eq!(v["coeffs"].as_array().unwrap().len(), 41); // a0, a1..a20, b1..b20
     assert!(v["residual_norm"].as_f64().unwrap() <= 1e-10);
     assert_eq!(v["stable"], true);
-    let (code, v) = run(&["--json", "hb", "duffing", "--method", "classic"]);
+    let (code, v) = run("--json hb duffing --method classic");
     assert_eq!(code, 0, "{v}");
 }
 
 #[test]
 fn bad_input_is_a_json_error() {
-    let (code, v) = run(&["--json", "hb", "duffing", "--samples", "10"]);
+    let (code, v) = run("--json hb duffing --samples 10");
     assert_eq!(code, 2);
     assert!(v["error"].as_str().unwrap().contains("N > n"));
 }
 
 #[test]
 fn frc_and_mathieu_json_keys() {
-    let (code, v) = run(&[
-        "--json",
-        "hb",
-        "duffing-frc",
-        "--from",
-        "0.2",
-        "--to",
-        "3.0",
-    ]);
+    let (code, v) = run("--json hb duffing-frc --from 0.2 --to 3.0");
     assert_eq!(code, 0);
     let p = &v["points"][0];
     assert!(p.get("omega").is_some() && p.get("amplitude").is_some() && p.get("stable").is_some());
@@ -62,7 +60,7 @@ fn frc_and_mathieu_json_keys() {
     for (f, want) in folds.iter().zip([1.6548121, 1.1687244]) {
         assert!((f.as_f64().unwrap() - want).abs() < 1e-7, "{f} vs {want}");
     }
-    let (code, v) = run(&["--json", "hb", "mathieu-duffing"]);
+    let (code, v) = run("--json hb mathieu-duffing");
     assert_eq!(code, 0);
     let betas = v["period_doubling_beta"].as_array().unwrap();
     assert_eq!(betas.len(), 3);
@@ -83,19 +81,11 @@ fn string_json_keys_and_png_plot() {
     // SPEC §6: points [{omega, norm, stable}]; --plot writes a PNG.
     let png = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_hb_string.png");
     let _ = std::fs::remove_file(&png);
-    let (code, v) = run(&[
-        "--json",
-        "hb",
-        "string",
-        "--kd",
-        "30",
-        "--from",
-        "3",
-        "--to",
-        "5",
-        "--plot",
-        png.to_str().unwrap(),
-    ]);
+    let mut args: Vec<&str> = "--json hb string --kd 30 --from 3 --to 5 --plot"
+        .split_whitespace()
+        .collect();
+    args.push(png.to_str().unwrap());
+    let (code, v) = run_args(&args);
     assert_eq!(code, 0, "{v}");
     let pts = v["points"].as_array().unwrap();
     assert!(pts.len() > 10);
@@ -116,21 +106,7 @@ fn string_json_keys_and_png_plot() {
 fn string_spring_boundary_reports_stability() {
     // The spring boundary is no longer `"stable": null`; k0 = 1e4 behaves like
     // fixed–fixed (unstable points between the folds of the k_d = 30 curve).
-    let (code, v) = run(&[
-        "--json",
-        "hb",
-        "string",
-        "--boundary",
-        "spring",
-        "--k0",
-        "10000",
-        "--kd",
-        "30",
-        "--from",
-        "3",
-        "--to",
-        "5",
-    ]);
+    let (code, v) = run("--json hb string --boundary spring --k0 10000 --kd 30 --from 3 --to 5");
     assert_eq!(code, 0, "{v}");
     let pts = v["points"].as_array().unwrap();
     assert!(pts.iter().all(|p| p["stable"].is_boolean()));
@@ -148,21 +124,7 @@ fn string_cold_start_on_the_peak_flank_says_how_to_start() {
     // k_d = 30: ω = 4 is on the flank of the hardening peak (folds near 4.29
     // and 4.44), where Newton from a = 0 does not reach the large-amplitude
     // solution; the error carries the residual history and the remedy.
-    let (code, v) = run(&[
-        "--json",
-        "hb",
-        "string",
-        "--kd",
-        "30",
-        "--modes",
-        "5",
-        "--harmonics",
-        "19",
-        "--from",
-        "4",
-        "--to",
-        "4.6",
-    ]);
+    let (code, v) = run("--json hb string --kd 30 --modes 5 --harmonics 19 --from 4 --to 4.6");
     assert_eq!(code, 2, "{v}");
     let msg = v["error"].as_str().unwrap();
     assert!(

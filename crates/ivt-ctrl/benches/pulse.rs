@@ -24,6 +24,15 @@ fn warmed<const P: usize>(law: LawKind, interval: u32) -> (Controller<P>, u32) {
     (c, t)
 }
 
+/// Benches `f` on a 1 MHz timer reading that advances `dt` ticks per call
+/// from `t` (wrapping like the hardware counter).
+fn on_timer<R>(bencher: Bencher, mut t: u32, dt: u32, mut f: impl FnMut(u32) -> R) {
+    bencher.bench_local(move || {
+        t = t.wrapping_add(dt);
+        black_box(f(black_box(t)))
+    });
+}
+
 #[divan::bench(args = [LawKind::Delay, LawKind::NoDelay, LawKind::Prop, LawKind::Open])]
 fn on_pulse_ppr1200(bencher: Bencher, law: LawKind) {
     let (mut c, mut t) = warmed::<1200>(law, 500);
@@ -38,21 +47,14 @@ fn on_pulse_ppr1200(bencher: Bencher, law: LawKind) {
 
 #[divan::bench]
 fn on_pulse_ppr80(bencher: Bencher) {
-    let (mut c, mut t) = warmed::<80>(LawKind::Delay, 7500);
-    bencher.bench_local(move || {
-        t = t.wrapping_add(7500);
-        black_box(c.on_pulse(black_box(t)))
-    });
+    let (mut c, t) = warmed::<80>(LawKind::Delay, 7500);
+    on_timer(bencher, t, 7500, move |t| c.on_pulse(t));
 }
 
 #[divan::bench]
 fn averager_push_ppr1200(bencher: Bencher) {
     let mut a = AngleAverager::<1200>::new(1.0e6);
-    let mut t = 0u32;
-    bencher.bench_local(move || {
-        t = t.wrapping_add(500);
-        black_box(a.push(black_box(t)))
-    });
+    on_timer(bencher, 0, 500, move |t| a.push(t));
 }
 
 #[divan::bench]
@@ -67,9 +69,6 @@ fn update_inputs(bencher: Bencher) {
 
 #[divan::bench]
 fn step_tick(bencher: Bencher) {
-    let (mut c, mut t) = warmed::<1200>(LawKind::Delay, 500);
-    bencher.bench_local(move || {
-        t = t.wrapping_add(10);
-        black_box(c.step_tick(black_box(t)))
-    });
+    let (mut c, t) = warmed::<1200>(LawKind::Delay, 500);
+    on_timer(bencher, t, 10, move |t| c.step_tick(t));
 }

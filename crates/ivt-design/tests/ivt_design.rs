@@ -101,6 +101,18 @@ fn verdicts_follow_the_band() {
     assert_eq!(v(8.9, 6.0), Verdict::OverDrive);
 }
 
+/// Max |Floquet multiplier| of the delayed loop with gains `g` at `op`, by a
+/// Chebyshev collocation of order `n`.
+fn max_multiplier(plant: &PlantParams, op: &OperatingPoint, g: FeedbackGains, n: usize) -> f64 {
+    let o = DelayOptions {
+        chebyshev_order: n,
+        ..Default::default()
+    };
+    delay_stability(plant, op, g, &o)
+        .unwrap()
+        .max_abs_multiplier
+}
+
 /// Max |multiplier| converges in the Chebyshev order: N = 16 and 32 agree to
 /// 1e-3 (and N = 8 is already within 1e-2) at two points.
 #[test]
@@ -111,15 +123,7 @@ fn stability_converges_in_chebyshev_order() {
         let op = OperatingPoint::at_100_rpm(v, t);
         let m: Vec<f64> = [8, 16, 32]
             .iter()
-            .map(|&n| {
-                let o = DelayOptions {
-                    chebyshev_order: n,
-                    ..Default::default()
-                };
-                delay_stability(&plant, &op, g, &o)
-                    .unwrap()
-                    .max_abs_multiplier
-            })
+            .map(|&n| max_multiplier(&plant, &op, g, n))
             .collect();
         assert!((m[1] - m[2]).abs() < 1e-3, "({v},{t}): {m:?}");
         assert!((m[0] - m[2]).abs() < 1e-2, "({v},{t}): {m:?}");
@@ -284,15 +288,7 @@ fn readme_fig42_multipliers() {
     assert!(shoot(7.0, 2.0) < 0.0);
     let plant = PlantParams::printed();
     let op = OperatingPoint::at_100_rpm(7.0, 2.0);
-    let m = |g: FeedbackGains, n: usize| {
-        let o = DelayOptions {
-            chebyshev_order: n,
-            ..Default::default()
-        };
-        delay_stability(&plant, &op, g, &o)
-            .unwrap()
-            .max_abs_multiplier
-    };
+    let m = |g: FeedbackGains, n: usize| max_multiplier(&plant, &op, g, n);
     let mm = FeedbackGains::from_thesis_mm_per_rad;
     let si = |k, k2| FeedbackGains { k, k2 };
     for (g, stated, thesis) in [

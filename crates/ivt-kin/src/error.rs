@@ -122,3 +122,19 @@ pub(crate) fn positive(name: &'static str, x: f64) -> Result<f64, KinError> {
         })
     }
 }
+
+/// Test helper: a ratio function of (θ, r) rejects a NaN angle as
+/// [`KinError::NotFinite`], a negative eccentricity as
+/// [`KinError::OutOfDomain`] and an infinite one as an error.
+#[cfg(test)]
+pub(crate) fn assert_rejects_bad_theta_and_r(ratio: impl Fn(f64, f64) -> Result<f64, KinError>) {
+    assert!(matches!(
+        ratio(f64::NAN, 0.01),
+        Err(KinError::NotFinite { .. })
+    ));
+    assert!(matches!(
+        ratio(0.1, -0.01),
+        Err(KinError::OutOfDomain { .. })
+    ));
+    assert!(ratio(0.1, f64::INFINITY).is_err());
+}

@@ -220,27 +220,12 @@ impl PlantParams {
     /// # Errors
     /// Names the first offending parameter.
     pub fn validate(&self) -> Result<(), ParamError> {
-        let positive = [
-            ("r_a", self.r_a),
-            ("k_e", self.k_e),
-            ("k_t", self.k_t),
-            ("j_n1", self.j_n1),
-            ("j_n2", self.j_n2),
-            ("j_crk", self.j_crk),
-            ("r_u", self.r_u),
-            ("r_max", self.r_max),
-            ("sun_to_planet", self.sun_to_planet),
-        ];
-        let non_negative = [
-            ("l_a", self.l_a),
-            ("j_inshaft", self.j_inshaft),
-            ("j_carrier", self.j_carrier),
-            ("j_ring", self.j_ring),
-            ("m_r", self.m_r),
-            ("m_dr", self.m_dr),
-            ("j_u", self.j_u),
-            ("g", self.g),
-        ];
+        /// `[("field", self.field), ...]`: each parameter with its own name.
+        macro_rules! named {
+            ($($field:ident),*) => { [$((stringify!($field), self.$field)),*] };
+        }
+        let positive = named!(r_a, k_e, k_t, j_n1, j_n2, j_crk, r_u, r_max, sun_to_planet);
+        let non_negative = named!(l_a, j_inshaft, j_carrier, j_ring, m_r, m_dr, j_u, g);
         check_all(&positive, "finite and > 0", |v| v > 0.0)?;
         check_all(&non_negative, "finite and >= 0", |v| v >= 0.0)
     }
