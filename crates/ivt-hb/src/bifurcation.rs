@@ -340,6 +340,7 @@ where
     let mut jac = vec![0.0; m * m];
     let mut r_lambda = vec![0.0; m];
     let mut newton = vec![0.0; n * n];
+    let mut newton_lu = LuWorkspace::new(n);
     let mut step = vec![0.0; n];
     let mut history: Vec<f64> = Vec::with_capacity(opts.max_iter + 1);
     for it in 0..=opts.max_iter {
@@ -394,7 +395,9 @@ where
         for t in 0..k {
             step[m + t] = -psi[t];
         }
-        if !solve_once(&newton, n, &mut step, false) {
+        newton_lu.factor_row_major(&newton);
+        newton_lu.solve(&mut step);
+        if !step.iter().all(|x| x.is_finite()) {
             return Err(solve_error(SolveError::SingularJacobian {
                 iteration: it,
                 history,
@@ -525,6 +528,9 @@ struct BranchPointTest {
     jac: Vec<f64>,
     r_lambda: Vec<f64>,
     big: Vec<f64>,
+    /// LU of `big` and a right-hand side (reused across evaluations).
+    lu: LuWorkspace,
+    rhs: Vec<f64>,
     /// The last null-space columns `V` (2 × (m+1)).
     v: [Vec<f64>; 2],
 }
@@ -544,15 +550,19 @@ impl BranchPointTest {
         for t in 0..2 {
             self.big[(m + t) * n..(m + t) * n + m + 1].copy_from_slice(&self.c[t]);
         }
+        // One factorisation serves both right-hand sides; near-singular
+        // pivots are accepted, a non-finite solution is refused.
+        self.lu.factor_row_major(&self.big);
         for t in 0..2 {
-            let mut rhs = vec![0.0; n];
-            rhs[m + t] = 1.0;
-            if !solve_once(&self.big, n, &mut rhs, false) {
+            self.rhs.fill(0.0);
+            self.rhs[m + t] = 1.0;
+            self.lu.solve(&mut self.rhs);
+            if !self.rhs.iter().all(|x| x.is_finite()) {
                 out.fill(f64::NAN);
                 return;
             }
-            out[t] = rhs[m + 1];
-            self.v[t].copy_from_slice(&rhs[..m + 1]);
+            out[t] = self.rhs[m + 1];
+            self.v[t].copy_from_slice(&self.rhs[..m + 1]);
         }
     }
 }
@@ -606,6 +616,8 @@ pub fn locate_branch_point<F: Family>(
         jac,
         r_lambda,
         big: vec![0.0; (m + 2) * (m + 2)],
+        lu: LuWorkspace::new(m + 2),
+        rhs: vec![0.0; m + 2],
         v: [vec![0.0; n1], vec![0.0; n1]],
     };
     let h = lambda_step(opts, lambda0);
