@@ -110,7 +110,7 @@ fn r_avg_row(ctx: &mut Context) {
             return;
         }
     };
-    // 27492 is an integer rounding of 77760/(2√2) = 27492.4: half a unit in
+    // 27492 is an integer rounding of 77760/(2√2) = 27492.3: half a unit in
     // the denominator is the printed precision.
     let half = 7.0 / 27491.5 - R_AVG_SLOPE_PRINTED_PER_DEG;
     ctx.compare(
@@ -120,7 +120,7 @@ fn r_avg_row(ctx: &mut Context) {
         slope,
         half,
         6,
-        "(2√2/π)(7π/51840)/r_OG through the gear chain Eq. 182–185; 27492 is 77760/(2√2) = 27492.4 rounded",
+        "(2√2/π)(7π/51840)/r_OG through the gear chain Eq. 182–185; 27492 is 77760/(2√2) = 27492.3 rounded",
         None,
     );
 }

@@ -322,17 +322,23 @@ mod tests {
     }
 
     /// §4.4.2: R_avg(θ_CT) = (2√2/π)(7π/51840) θ_CT/r_OG is linear with slope
-    /// 14√2/77760 = 2.54607e-4 per degree; the printed 7/27492 = 2.54620e-4
-    /// rounds 77760/(2√2) = 27492.4 to an integer, a relative difference of
-    /// 1.5e-5.
+    /// 14√2/77760 = 2.54617e-4 per degree; the printed 7/27492 = 2.54620e-4
+    /// rounds 77760/(2√2) = 27492.3 to an integer, a relative difference of
+    /// 1.1e-5. Each figure is asserted to half a unit of its last digit.
     #[test]
     fn r_avg_slope_7_over_27492() {
         let g = SgivtGeometry::prototype();
         let exact_slope = 14.0 * SQRT_2 / 77760.0;
+        assert!((exact_slope - 2.54617e-4).abs() < 5e-10, "{exact_slope}");
+        assert!((R_AVG_SLOPE_PRINTED_PER_DEG - 2.54620e-4).abs() < 5e-10);
+        let denominator = 77760.0 / (2.0 * SQRT_2);
+        assert!((denominator - 27492.3).abs() < 0.05, "{denominator}");
+        assert_eq!(denominator.round(), 27492.0);
         for deg in [100.0, 1000.0, 3600.0] {
             let r = g.average_ratio_from_stepper(deg_to_rad(deg)).unwrap();
             assert!((r / deg - exact_slope).abs() < 1e-15);
-            assert!((r / deg / R_AVG_SLOPE_PRINTED_PER_DEG - 1.0).abs() < 2e-5);
+            let rel = R_AVG_SLOPE_PRINTED_PER_DEG / (r / deg) - 1.0;
+            assert!((rel - 1.1e-5).abs() < 5e-7, "{rel:e}");
         }
     }
 
