@@ -25,6 +25,55 @@ fn minimal_scene_parses_with_defaults() {
     assert!(!s.outputs.mcap && s.outputs.channels.is_empty());
 }
 
+/// Every default the README's scene-key table states, read back from a scene
+/// that sets none of them.
+#[test]
+fn readme_scene_table_defaults() {
+    let s = Scene::parse(OK, "s.toml").unwrap();
+    assert_eq!((s.name.as_str(), s.seed), ("scene", 0));
+    assert_eq!(s.plant.gravity, Gravity::Printed);
+    assert_eq!(
+        (s.initial.theta, s.initial.omega, s.initial.r),
+        (0.0, 0.0, 0.0)
+    );
+    let i = &s.integrator;
+    assert_eq!(
+        (i.rtol, i.atol, i.dtheta, i.omega_handover),
+        (1e-8, 1e-8, 0.02, 0.5)
+    );
+    assert_eq!((s.encoder.f_timer_hz, s.encoder.jitter_s), (1e6, 0.0));
+    let n = &s.sensors;
+    assert_eq!(n.period_s, 0.01);
+    assert_eq!(
+        (n.v_m_noise, n.v_m_quantum, n.t_u_noise, n.t_u_quantum),
+        (0.0, 0.0, 0.0, 0.0)
+    );
+    let st = &s.stepper;
+    assert_eq!(
+        (st.steps_per_rev, st.max_speed, st.accel, st.miss_prob),
+        (3200.0, 4000.0, 40_000.0, 0.0)
+    );
+    let c = &s.controller;
+    assert_eq!(
+        (c.omega0_rpm, c.k_mm_per_rad, c.k2_mm_per_rad),
+        (100.0, 1.0, 2.0)
+    );
+    assert_eq!(
+        (c.k_prop_deg_per_rpm, c.prop_period_s, c.feedforward),
+        (50.0, 0.1, true)
+    );
+    assert_eq!(
+        (s.metrics.from_s, s.metrics.band, s.metrics.static_window_s),
+        (0.0, 0.02, 2.0)
+    );
+    let o = &s.outputs;
+    assert!(!o.csv && !o.summary && !o.steady_state && o.plots.is_empty());
+    assert_eq!(o.max_bytes, 1e9);
+    let with_channel = format!("{OK}\n[[outputs.channels]]\nname = \"plant\"\n");
+    let s = Scene::parse(&with_channel, "s.toml").unwrap();
+    assert_eq!(s.outputs.channels.first().map(|c| c.every), Some(1));
+}
+
 #[test]
 fn errors_are_one_line_and_name_the_problem() {
     let e = err(&format!("{OK}\n[encoder]\nbogus = 3\n"));
