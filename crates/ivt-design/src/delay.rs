@@ -200,7 +200,7 @@ pub fn system_matrix(
     let (f, ft) = ivt_kin::variant::f_and_f_theta(theta);
     let p = plant.terms_with_f(theta, f, ft, r, op.v_m, op.t_u);
     let (_, a, b, c) = appendix_b(&p, r, omega);
-    let t0 = |i: usize| if i % 2 == 0 { 1.0 } else { -1.0 };
+    let t0 = |i: usize| if i.is_multiple_of(2) { 1.0 } else { -1.0 };
     let mut m = DMatrix::zeros(nn + 3, nn + 3);
     for n in 0..=nn {
         // Eq. 175: q_i' = −Σ_n D[n][i] q_n for i < N.
