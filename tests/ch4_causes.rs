@@ -48,11 +48,17 @@ fn printed_pair(
     })
 }
 
-/// Both printed pairs on the thesis-ch4 orbit at (7 V, 2 N·m), gains scaled.
-fn ch4_pair(scale: (f64, f64)) -> [f64; 2] {
+/// Thesis-ch4, the example point (7 V, 2 N·m) and its exact 100-rpm orbit.
+fn fig42_orbit() -> (PlantParams, OperatingPoint, PeriodicOrbit) {
     let plant = PlantPreset::ThesisCh4.params();
     let op = fig42_point();
     let orbit = steady_orbit(&plant, &op, None, &DelayOptions::default()).expect("orbit");
+    (plant, op, orbit)
+}
+
+/// Both printed pairs on the thesis-ch4 orbit at (7 V, 2 N·m), gains scaled.
+fn ch4_pair(scale: (f64, f64)) -> [f64; 2] {
+    let (plant, op, orbit) = fig42_orbit();
     printed_pair(&plant, &op, &orbit, scale)
 }
 
@@ -82,10 +88,8 @@ fn max_without_structural(m: &[f64], dim: usize) -> f64 {
 /// second-order midpoint rule and N_Q = 1000 it gives our RK6 values to 1e-4.
 #[test]
 fn hsu_transformation_matrix_is_not_the_cause() {
-    let plant = PlantPreset::ThesisCh4.params();
-    let op = fig42_point();
+    let (plant, op, orbit) = fig42_orbit();
     let opts = DelayOptions::default();
-    let orbit = steady_orbit(&plant, &op, None, &opts).expect("orbit");
     let dim = opts.chebyshev_order + 3;
     let hsu = |k: f64, k2: f64, n_q: usize, rule: HsuRule| {
         let gains = FeedbackGains::from_thesis_mm_per_rad(k, k2);
@@ -316,10 +320,8 @@ fn nearby_plants_keeping_r_bar_are_not_the_cause() {
 /// one multiplier 0.05 off the print.
 #[test]
 fn printed_gain_ratio_floors_the_multiplier_at_exp_minus_half() {
-    let plant = PlantPreset::ThesisCh4.params();
-    let op = fig42_point();
+    let (plant, op, orbit) = fig42_orbit();
     let opts = DelayOptions::default();
-    let orbit = steady_orbit(&plant, &op, None, &opts).expect("orbit");
     let mu = |k: f64, k2: f64| {
         let g = FeedbackGains::from_thesis_mm_per_rad(k, k2);
         delay_stability_about(&plant, &op, g, &orbit, &opts)
