@@ -168,9 +168,11 @@ fn fig42_multipliers_on_thesis_ch4_confirmed_by_simulation() {
 /// (7 V, 2 N·m) (ours 0.787 / 0.604, gains in mm·rad⁻¹):
 /// - the Chebyshev order: N = 4…16 stays within 5e-3 of 0.7866 and 0.6044;
 /// - a scale slip of the gains: over ×0.05…×20 the (0.06, 0.12) pair never
-///   gets max |μ| below 0.60 — the plant's own open-loop Floquet multiplier on
-///   this orbit, 0.593, found here independently as the return-map derivative
-///   dω(2π)/dω(0) at r = r̄ by finite differences, bounds it;
+///   gets max |μ| below 0.60 (what floors it is the feedback law's zero at
+///   e^{−k/k2}, `tests/ch4_causes.rs`); the plant's own open-loop Floquet
+///   multiplier on this orbit, 0.593, found here independently as the
+///   return-map derivative dω(2π)/dω(0) at r = r̄ by finite differences, is
+///   near that floor (0.607), which depends on k/k2 only, not on the plant;
 /// - the (7 V, 7 N·m) reading of §4.3's garbled "T_U = 7 V 2 Nm": 0.63 / 1.02.
 #[test]
 fn fig42_gap_is_not_gain_scale_order_or_point() {

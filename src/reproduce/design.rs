@@ -31,10 +31,15 @@ const DIGITS_TEST: &str = "src/reproduce/design.rs::printed_digits_limit_eq158";
 pub(super) const FIG42_TEST: &str =
     "tests/ch4_plant.rs::fig42_multipliers_on_thesis_ch4_confirmed_by_simulation";
 
-/// The test ruling out gain scale, Chebyshev order and operating point as
-/// the cause of the thesis-ch4 Fig. 42 gap.
-pub(super) const FIG42_FLOOR_TEST: &str =
-    "tests/ch4_plant.rs::fig42_gap_is_not_gain_scale_order_or_point";
+/// The test ruling out Hsu's transformation matrix (Eq. 80) as the cause of
+/// the thesis-ch4 gap to Fig. 42's 0.7776.
+pub(super) const FIG42_MU1_TEST: &str =
+    "tests/ch4_causes.rs::hsu_transformation_matrix_is_not_the_cause";
+
+/// The test showing that the printed gain ratio k2 = 2k keeps max |μ| above
+/// e^{−1/2} ≈ 0.607 on thesis-ch4, above Fig. 42's 0.4871.
+pub(super) const FIG42_MU2_TEST: &str =
+    "tests/ch4_causes.rs::printed_gain_ratio_floors_the_multiplier_at_exp_minus_half";
 
 /// Figure id of a thesis figure on a preset (`printed` keeps the bare id).
 pub(super) fn fig_id(base: &str, preset: PlantPreset) -> String {

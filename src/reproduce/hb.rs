@@ -19,6 +19,9 @@ const A0_TEST: &str = "src/reproduce/hb.rs::a0_differs_in_a8_sign_and_b3";
 /// The test ruling out β, n and truncation as the cause of A0's b3.
 const A0_RULED_OUT: &str = "src/reproduce/hb.rs::a0_b3_is_not_beta_n_or_truncation";
 
+/// The test ruling out one-parameter slips, the classic IHB and sign flips.
+const A0_SLIPS: &str = "tests/ch4_causes.rs::a0_b3_is_not_a_parameter_slip_or_the_classic_ihb";
+
 /// Fig. 28 forcing frequency (n = 20, N = 64, ξ = 0.02, α = 1, ε = 1, F = 0.1).
 const OMEGA_F: f64 = 0.4;
 
@@ -264,8 +267,10 @@ fn mathieu(ctx: &mut Context) -> Result<(), ReproError> {
                          and read as +0.0001 it agrees; b3: ours is 0.04718 also when stopped at the thesis's residual \
                          tolerance 1e-6, for AFT sizes N = 10…64 and with n = 20 harmonics; a β off 3.6 that gives \
                          0.0471 moves a1 off its printed digits (db3/dβ ≈ −0.28, da1/dβ ≈ 1.7), and truncating instead \
-                         of rounding would print a0 = 0.7880, not 0.7881: all ruled out (`{A0_RULED_OUT}`); what remains, a \
-                         slip in the last printed digit, no computation can show (demonstrated by `{A0_TEST}`)",
+                         of rounding would print a0 = 0.7880, not 0.7881: all ruled out (`{A0_RULED_OUT}`); so are a slip \
+                         in ξ̂, α̂, γ or Ω (no value that prints b3 = 0.0471 keeps the other 18 printed digits), the classic \
+                         IHB's Galerkin integrals (the same b3) and a flipped damping or forcing sign (`{A0_SLIPS}`); what \
+                         remains, a slip in the last printed digit, no computation can show (demonstrated by `{A0_TEST}`)",
                         sol.stats.residual_norm,
                         off.join("; ")
                     )

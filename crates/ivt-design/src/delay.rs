@@ -24,7 +24,7 @@ use super::pieces::{pieces, rk6, steps_for};
 use super::shooting::{shoot_steady_state, PeriodicOrbit, ShootingOptions};
 use super::{check_plant, IvtError, OperatingPoint};
 use core::f64::consts::PI;
-use ivt_kin::plant::PlantParams;
+use ivt_kin::plant::{PlantParams, PlantTerms};
 use ivt_kin::variant::f_on_segment;
 use nalgebra::DMatrix;
 
@@ -147,6 +147,78 @@ fn tau_rows(n_order: usize) -> DMatrix<f64> {
     dt
 }
 
+/// ω̄' of Eq. 162 and the coefficients A, B, C of Appendix B (Eq. 174) at one
+/// angle of the orbit, from the plant terms there and ω̄(θ) = `w`.
+fn appendix_b(p: &PlantTerms, r: f64, w: f64) -> (f64, f64, f64, f64) {
+    let drive = p.drive(r);
+    let wp = (drive / w - 0.5 * p.j_theta * w - p.f_m) / p.j;
+    let a = (-p.j_r * wp - 0.5 * p.j_theta_r * w + (p.g - p.f2) / w) / p.j;
+    let b = -(drive / (w * w) + 0.5 * p.j_theta) / p.j;
+    (wp, a, b, -1.0 / (w * w))
+}
+
+/// The periodic system matrix 𝒜(θ) of Eq. 179 (Appendix C), row-major
+/// (N + 3)², for η = {q_0 … q_N, Δr, Δz}, at the angle θ with ω̄(θ) = `omega`
+/// on the orbit at r = `r`; N = `opts.chebyshev_order`. The monodromy of
+/// [`monodromy`] applies the same matrix without forming it; this dense form
+/// is for other transformation-matrix rules, e.g. Hsu's product of matrix
+/// exponentials (Eq. 80, `ivt_hb::floquet::monodromy_hsu`) that §4.3 cites.
+///
+/// # Errors
+/// Bad inputs, an odd or zero N, non-finite gains or ω̄ ≤ 0.
+#[allow(clippy::too_many_arguments)]
+pub fn system_matrix(
+    plant: &PlantParams,
+    op: &OperatingPoint,
+    gains: FeedbackGains,
+    r: f64,
+    theta: f64,
+    omega: f64,
+    opts: &DelayOptions,
+) -> Result<DMatrix<f64>, IvtError> {
+    check_plant(plant)?;
+    op.validate()?;
+    opts.validate()?;
+    for (name, v) in [("k", gains.k), ("k2", gains.k2), ("r", r), ("theta", theta)] {
+        if !v.is_finite() {
+            return Err(IvtError::Input {
+                name,
+                value: v,
+                requirement: "finite",
+            });
+        }
+    }
+    if !(omega.is_finite() && omega > 0.0) {
+        return Err(IvtError::Input {
+            name: "omega",
+            value: omega,
+            requirement: "finite and > 0",
+        });
+    }
+    let nn = opts.chebyshev_order;
+    let dt = tau_rows(nn);
+    let (f, ft) = ivt_kin::variant::f_and_f_theta(theta);
+    let p = plant.terms_with_f(theta, f, ft, r, op.v_m, op.t_u);
+    let (_, a, b, c) = appendix_b(&p, r, omega);
+    let t0 = |i: usize| if i.is_multiple_of(2) { 1.0 } else { -1.0 };
+    let mut m = DMatrix::zeros(nn + 3, nn + 3);
+    for n in 0..=nn {
+        // Eq. 175: q_i' = −Σ_n D[n][i] q_n for i < N.
+        for i in 0..nn {
+            m[(i, n)] = -dt[(i, n)];
+        }
+        // Eq. 176 solved for q_N' (T0_N = 1 for even N).
+        let bound: f64 = (0..nn).map(|i| t0(i) * dt[(i, n)]).sum();
+        m[(nn, n)] = b * t0(n) + bound;
+        // Eq. 177–178: (T_0 − T_I)_n = (−1)^n − 1.
+        m[(nn + 1, n)] = gains.k2 * (t0(n) - 1.0);
+        m[(nn + 2, n)] = c * (t0(n) - 1.0);
+    }
+    m[(nn, nn + 1)] = a;
+    m[(nn + 1, nn + 2)] = -gains.k * op.omega0 * op.omega0 / (2.0 * PI);
+    Ok(m)
+}
+
 /// Steady state to linearize about: shooting to the time-mean ω0 (exact to
 /// ~1e-12; the IHB value may seed it).
 ///
@@ -240,13 +312,8 @@ fn monodromy_with_steps(
             let (f, ft) = f_on_segment(theta, seg);
             let p = plant.terms_with_f(theta, f, ft, r, op.v_m, op.t_u);
             let w = y[0];
-            let drive = p.drive(r);
-            let wp = (drive / w - 0.5 * p.j_theta * w - p.f_m) / p.j; // Eq. 162
+            let (wp, a_coef, b_coef, c_coef) = appendix_b(&p, r, w);
             dy[0] = wp;
-            // Appendix B.
-            let a_coef = (-p.j_r * wp - 0.5 * p.j_theta_r * w + (p.g - p.f2) / w) / p.j;
-            let b_coef = -(drive / (w * w) + 0.5 * p.j_theta) / p.j;
-            let c_coef = -1.0 / (w * w);
             for col in 0..d {
                 let phi = &y[1 + col * d..1 + (col + 1) * d];
                 let out = &mut dy[1 + col * d..1 + (col + 1) * d];
