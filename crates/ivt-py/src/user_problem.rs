@@ -1,10 +1,13 @@
 //! User systems for `ivt.hb`: `M x'' + C x' + K x + g(x, v, θ) = f(θ)` with `g`
 //! and `f` Python callables (per sample, or vectorized over all AFT samples).
-//! The system is an ivt-hb [`GeneralProblem`]; this module adds only the Python
-//! calls and the capture of the first exception a callback raises.
+//! `g` may instead be a composition of ivt-hb's Rust elements
+//! ([`crate::hb_elements::Elements`]): then no Python runs in the loop and the
+//! Jacobians ∂g/∂x, ∂g/∂v are exact. This module adds the Python calls and the
+//! capture of the first exception a callback raised.
 
+use crate::hb_elements::Elements;
 use ivt_hb::problem::{per_sample, Nonlinearity};
-use ivt_hb::{GeneralProblem, HbOptions};
+use ivt_hb::{central_difference_samples, ElementProblem, HbOptions, PeriodicProblem};
 use numpy::{IntoPyArray, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -16,8 +19,86 @@ type ErrorSlot = Arc<Mutex<Option<PyErr>>>;
 /// The excitation `f(θ)` of a user system (a Python callable or none).
 type PyExcitation = Box<dyn Fn(f64, &mut [f64]) + Send + Sync>;
 
-/// A user system: the ivt-hb general problem with Python `g` and `f`.
-pub(crate) type PyProblem = GeneralProblem<PyNonlinearity, PyExcitation>;
+/// The nonlinearity of a user system: a Python callable, or Rust elements
+/// (an [`ElementProblem`] without forcing; its `M`, `C`, `K` are the system's).
+enum UserG {
+    Python(PyNonlinearity),
+    Elements(ElementProblem),
+}
+
+/// A user system `M x'' + C x' + K x + g(x, v, θ) = f(θ)` with a Python `f`.
+pub(crate) struct PyProblem {
+    n: usize,
+    m: Vec<f64>,
+    c: Vec<f64>,
+    k: Vec<f64>,
+    g: UserG,
+    f: PyExcitation,
+    velocity_dependent: bool,
+    error: ErrorSlot,
+}
+
+impl PeriodicProblem for PyProblem {
+    fn n_dof(&self) -> usize {
+        self.n
+    }
+    fn mass(&self) -> &[f64] {
+        &self.m
+    }
+    fn damping(&self) -> &[f64] {
+        &self.c
+    }
+    fn stiffness(&self) -> &[f64] {
+        &self.k
+    }
+    fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
+        match &self.g {
+            UserG::Python(g) => g.eval(x, v, theta, out),
+            UserG::Elements(e) => e.nonlinear(x, v, theta, out),
+        }
+    }
+    fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+        match &self.g {
+            UserG::Python(g) => g.eval_samples(x, v, theta, out),
+            UserG::Elements(e) => e.nonlinear_samples(x, v, theta, out),
+        }
+    }
+    fn excitation(&self, theta: f64, out: &mut [f64]) {
+        (self.f)(theta, out)
+    }
+    fn velocity_dependent(&self) -> bool {
+        self.velocity_dependent
+    }
+    /// Elements: exact. Python: central differences on this one sample.
+    fn nonlinear_jacobian(
+        &self,
+        x: &[f64],
+        v: &[f64],
+        theta: f64,
+        dg_dx: &mut [f64],
+        dg_dv: &mut [f64],
+    ) {
+        match &self.g {
+            UserG::Elements(e) => e.nonlinear_jacobian(x, v, theta, dg_dx, dg_dv),
+            UserG::Python(_) => {
+                let mut dg = vec![0.0; dg_dx.len() + dg_dv.len()];
+                central_difference_samples(self, x, v, &[theta], &mut dg);
+                let (gx, gv) = dg.split_at(dg_dx.len());
+                dg_dx.copy_from_slice(gx);
+                dg_dv.copy_from_slice(gv);
+            }
+        }
+    }
+    /// Elements: exact per sample. Python: central differences over all
+    /// samples at once (4·n_dof calls of a vectorized `g`, steps relative to
+    /// the orbit's scale).
+    fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
+        match &self.g {
+            UserG::Elements(e) => e.nonlinear_jacobian_samples(x, v, theta, dg),
+            UserG::Python(_) => central_difference_samples(self, x, v, theta, dg),
+        }
+    }
+}
 
 /// The Python `g(x, v, theta)`: per sample, or (`vectorized`) once for all
 /// samples with (N, n_dof) arrays and a (N,) phase array, returning (N, n_dof).
@@ -150,12 +231,16 @@ fn matrix(name: &str, ob: &Bound<'_, PyAny>) -> PyResult<(usize, Vec<f64>)> {
                 ))
             })?;
         let shape = a.shape().to_vec();
-        if shape[0] != shape[1] || shape[0] == 0 {
-            return Err(PyValueError::new_err(format!(
-                "argument `{name}` must be square and non-empty, got shape {shape:?}"
-            )));
+        match shape.as_slice() {
+            &[rows, cols] if rows == cols && rows > 0 => {
+                (rows, a.as_array().iter().copied().collect())
+            }
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "argument `{name}` must be square and non-empty, got shape {shape:?}"
+                )))
+            }
         }
-        (shape[0], a.as_array().iter().copied().collect())
     };
     if let Some(bad) = data.iter().find(|v| !v.is_finite()) {
         return Err(PyValueError::new_err(format!(
@@ -165,8 +250,9 @@ fn matrix(name: &str, ob: &Bound<'_, PyAny>) -> PyResult<(usize, Vec<f64>)> {
     Ok((n, data))
 }
 
-/// The user system of `solve`, `frc` and `limit_cycle` from its Python arguments.
-#[allow(clippy::too_many_arguments)]
+/// The user system of `solve`, `frc`, `limit_cycle` and `backbone` from its
+/// Python arguments. `g` is a callable or an [`Elements`] composition (then
+/// `velocity_dependent` and `vectorized` are the elements' own).
 pub(crate) fn user_problem(
     m: &Bound<'_, PyAny>,
     c: &Bound<'_, PyAny>,
@@ -184,9 +270,13 @@ pub(crate) fn user_problem(
             "`m`, `c`, `k` must have the same size, got {nm}, {nc}, {nk}"
         )));
     }
-    if !g.is_callable() {
+    let elements = g
+        .cast::<Elements>()
+        .ok()
+        .map(|e| e.borrow().list().to_vec());
+    if elements.is_none() && !g.is_callable() {
         return Err(PyTypeError::new_err(
-            "argument `g` must be callable g(x, v, theta)",
+            "argument `g` must be callable g(x, v, theta) or ivt.hb.elements",
         ));
     }
     if let Some(f) = f {
@@ -206,23 +296,38 @@ pub(crate) fn user_problem(
         }
         None => Box::new(|_, out| out.fill(0.0)),
     };
-    let g = PyNonlinearity {
-        g: g.clone().unbind(),
-        n: nm,
-        vectorized,
-        error,
+    let (g, velocity_dependent) = match elements {
+        Some(list) => {
+            let problem = ElementProblem::new(nm, [m.clone(), c.clone(), k.clone()], list, vec![])
+                .map_err(|e| PyValueError::new_err(format!("argument `g`: {e}")))?;
+            let dependent = problem.velocity_dependent();
+            (UserG::Elements(problem), dependent)
+        }
+        None => (
+            UserG::Python(PyNonlinearity {
+                g: g.clone().unbind(),
+                n: nm,
+                vectorized,
+                error: Arc::clone(&error),
+            }),
+            velocity_dependent,
+        ),
     };
-    Ok(GeneralProblem::new(nm, m, c, k, g, excitation).with_velocity_dependent(velocity_dependent))
+    Ok(PyProblem {
+        n: nm,
+        m,
+        c,
+        k,
+        g,
+        f: excitation,
+        velocity_dependent,
+        error,
+    })
 }
 
 /// The first exception a callback raised during a run, if any.
 pub(crate) fn callback_error(problem: &PyProblem) -> Option<PyErr> {
-    problem
-        .nonlinearity()
-        .error
-        .lock()
-        .ok()
-        .and_then(|mut s| s.take())
+    problem.error.lock().ok().and_then(|mut s| s.take())
 }
 
 /// The tolerance keywords of `solve`, `frc` and `limit_cycle` applied to `opts`:
