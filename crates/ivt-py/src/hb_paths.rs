@@ -5,8 +5,9 @@
 //! points and branch points each located on its extended system.
 
 use ivt_hb::{
-    trace, Aft, Backbone, BackboneOptions, BifurcationKind, Event, FamilyBranch, Frc, FrcFold,
-    FrcOptions, FrcPoint, HbError, HbOptions, ModifiedIhb, PeriodicProblem, Trace, TraceOptions,
+    frequency_response, trace, Aft, Backbone, BackboneOptions, BifurcationKind, Event,
+    FamilyBranch, Frc, FrcFold, FrcOptions, FrcPoint, HbError, HbOptions, ModifiedIhb,
+    PeriodicProblem, Trace, TraceOptions,
 };
 use numpy::ndarray::Array1;
 use numpy::IntoPyArray;
@@ -24,14 +25,27 @@ fn amplitude(aft: &mut Aft, q: &[f64], samples: &mut [f64]) -> f64 {
     samples.iter().fold(0.0f64, |a, v| a.max(v.abs()))
 }
 
-/// The FRC of `problem` from `from` to `to`: the start solved by the modified
-/// IHB, then traced in ω_f with its events located.
+/// The FRC of `problem` from `from` to `to`. With `events`, the start is
+/// solved by the modified IHB and the branch traced in ω_f by
+/// [`ivt_hb::trace`], every event located (the trace's events are returned);
+/// without, [`ivt_hb::frequency_response`] traces it and locates the folds
+/// only (no branch-point test per point).
 fn traced_frc<P: PeriodicProblem>(
     problem: &P,
     opts: &HbOptions,
     from: f64,
     to: f64,
-) -> Result<(Trace, Frc), HbError> {
+    events: bool,
+) -> Result<(Option<Trace>, Frc), HbError> {
+    if !events {
+        let frc_opts = FrcOptions {
+            from,
+            to,
+            stability_steps: stability_steps(opts.harmonics),
+            ..FrcOptions::default()
+        };
+        return Ok((None, frequency_response(problem, opts, &frc_opts)?));
+    }
     let start = ModifiedIhb::new(problem, opts.clone())?.solve(from, None)?;
     let frc_opts = FrcOptions::default();
     let trace_opts = TraceOptions {
@@ -87,7 +101,7 @@ fn traced_frc<P: PeriodicProblem>(
         folds,
         termination: traced.termination.clone(),
     };
-    Ok((traced, frc))
+    Ok((Some(traced), frc))
 }
 
 /// The Python name of an event kind.
@@ -127,6 +141,21 @@ fn event_dict<'py>(py: Python<'py>, e: &Event, frc: &Frc) -> PyResult<Bound<'py,
     Ok(d)
 }
 
+/// A fold of the fast path (`events=False`) as an event dict (multipliers:
+/// those of the path point nearest the turn).
+fn fold_event<'py>(py: Python<'py>, fold: &FrcFold, frc: &Frc) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("kind", "fold")?;
+    d.set_item("index", fold.index)?;
+    d.set_item("omega", fold.omega_f)?;
+    d.set_item("located", fold.located)?;
+    let near = frc.points.get(fold.index);
+    d.set_item("multipliers", near.map(|p| pairs(&p.multipliers)))?;
+    d.set_item("coeffs", fold.coeffs.clone().into_pyarray(py))?;
+    d.set_item("error", py.None())?;
+    Ok(d)
+}
+
 user_system_fn! {
 /// Frequency-response curve of a user system `M x'' + C x' + K x + g(x, v, θ)
 /// = f(θ)` (θ = ω_f t) by pseudo-arclength continuation in ω_f from
@@ -143,12 +172,16 @@ user_system_fn! {
 /// [{"kind" ("fold", "period_doubling", "neimark_sacker", "branch_point"),
 /// "omega", "located", "multipliers", "coeffs", "index", "error"}...] in path
 /// order, "termination"} and the arrays omega, amplitude, stable. amplitude
-/// is max |x_0| over the AFT samples (DOF 0). GIL released between callbacks.
+/// is max |x_0| over the AFT samples (DOF 0). `events=False` locates the
+/// folds only (no period-doubling, Neimark–Sacker or branch-point test; the
+/// branch-point test costs an assembled Jacobian and a determinant per point,
+/// several times the cost of the point itself). GIL released between callbacks.
 fn frc<'py>(py, user;
     f: Option<&Bound<'py, PyAny>>,
     omega_from: f64,
     omega_to: f64;
     tol: f64 = 0.0,
+    events: bool = true,
 ) {
     let (problem, opts) = user.setup(f, 1, tol)?;
     let (from, to) = (finite("omega_from", omega_from)?, finite("omega_to", omega_to)?);
@@ -157,7 +190,7 @@ fn frc<'py>(py, user;
             "arguments `omega_from` = {from}, `omega_to` = {to} must be > 0 and distinct"
         )));
     }
-    let (traced, frc) = run_user(py, &problem, |p| traced_frc(p, &opts, from, to))?;
+    let (traced, frc) = run_user(py, &problem, |p| traced_frc(p, &opts, from, to, events))?;
     let d = frc_dict(py, &frc)?;
     let folds = PyList::empty(py);
     for fold in &frc.folds {
@@ -170,8 +203,17 @@ fn frc<'py>(py, user;
         folds.append(e)?;
     }
     let bifurcations = PyList::empty(py);
-    for e in &traced.events {
-        bifurcations.append(event_dict(py, e, &frc)?)?;
+    match &traced {
+        Some(t) => {
+            for e in &t.events {
+                bifurcations.append(event_dict(py, e, &frc)?)?;
+            }
+        }
+        None => {
+            for fold in &frc.folds {
+                bifurcations.append(fold_event(py, fold, &frc)?)?;
+            }
+        }
     }
     d.set_item("folds", folds)?;
     d.set_item("bifurcations", bifurcations)?;
