@@ -173,9 +173,9 @@ user_system_fn! {
 /// "omega", "located", "multipliers", "coeffs", "index", "error"}...] in path
 /// order, "termination"} and the arrays omega, amplitude, stable. amplitude
 /// is max |x_0| over the AFT samples (DOF 0). `events=False` locates the
-/// folds only (no period-doubling, Neimark–Sacker or branch-point test; the
-/// branch-point test costs an assembled Jacobian and a determinant per point,
-/// several times the cost of the point itself). GIL released between callbacks.
+/// folds only by `ivt_hb::frequency_response` (no period-doubling,
+/// Neimark–Sacker or branch-point test per point: several times cheaper per
+/// point, see the ivt-py README). GIL released between callbacks.
 fn frc<'py>(py, user;
     f: Option<&Bound<'py, PyAny>>,
     omega_from: f64,
