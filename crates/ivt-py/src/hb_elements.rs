@@ -1,8 +1,8 @@
 //! `ivt.hb.elements`: ivt-hb's library of nonlinear elements ([`Law`]) from
 //! Python. Each constructor returns an [`Elements`] holding one element; `+`
 //! composes them, and the sum is passed as `g` to `solve`, `frc`,
-//! `limit_cycle` or `backbone`: the forces and their exact Jacobians are then
-//! evaluated in Rust, with no Python call in the loop.
+//! `limit_cycle` or `backbone`: the forces are evaluated in Rust, with no
+//! Python call in the loop.
 
 use ivt_hb::{Element, Law};
 use pyo3::prelude::*;
@@ -60,75 +60,44 @@ fn element(law: Law, dof: i64, to: Option<i64>) -> PyResult<Elements> {
     })
 }
 
-/// Cubic spring F = k3·δ³.
-#[pyfunction]
-#[pyo3(signature = (k3, dof = 0, to = None))]
-fn cubic_spring(
-    k3: f64,
-    #[pyo3(from_py_with = int64)] dof: i64,
-    to: Option<i64>,
-) -> PyResult<Elements> {
-    element(Law::CubicSpring { k3 }, dof, to)
+/// A `#[pyfunction]` `name(params..., dof=0, to=None)` returning the one
+/// element of law `Law::$law { params }`.
+macro_rules! element_fn {
+    ($(#[$doc:meta])* fn $name:ident($($p:ident),+) => $law:ident) => {
+        $(#[$doc])*
+        #[pyfunction]
+        #[pyo3(signature = ($($p,)+ dof = 0, to = None))]
+        fn $name($($p: f64,)+ #[pyo3(from_py_with = int64)] dof: i64, to: Option<i64>) -> PyResult<Elements> {
+            element(Law::$law { $($p),+ }, dof, to)
+        }
+    };
 }
 
-/// Quadratic damper F = c2·δ̇|δ̇|.
-#[pyfunction]
-#[pyo3(signature = (c2, dof = 0, to = None))]
-fn quadratic_damper(
-    c2: f64,
-    #[pyo3(from_py_with = int64)] dof: i64,
-    to: Option<i64>,
-) -> PyResult<Elements> {
-    element(Law::QuadraticDamper { c2 }, dof, to)
+element_fn! {
+    /// Cubic spring F = k3·δ³.
+    fn cubic_spring(k3) => CubicSpring
 }
-
-/// Cubic damper F = c3·δ̇³.
-#[pyfunction]
-#[pyo3(signature = (c3, dof = 0, to = None))]
-fn cubic_damper(
-    c3: f64,
-    #[pyo3(from_py_with = int64)] dof: i64,
-    to: Option<i64>,
-) -> PyResult<Elements> {
-    element(Law::CubicDamper { c3 }, dof, to)
+element_fn! {
+    /// Quadratic damper F = c2·δ̇|δ̇|.
+    fn quadratic_damper(c2) => QuadraticDamper
 }
-
-/// Coulomb friction regularised by tanh: F = force·tanh(δ̇/v_reg) (v_reg > 0;
-/// the sign function as v_reg → 0).
-#[pyfunction]
-#[pyo3(signature = (force, v_reg, dof = 0, to = None))]
-fn coulomb(
-    force: f64,
-    v_reg: f64,
-    #[pyo3(from_py_with = int64)] dof: i64,
-    to: Option<i64>,
-) -> PyResult<Elements> {
-    element(Law::Coulomb { force, v_reg }, dof, to)
+element_fn! {
+    /// Cubic damper F = c3·δ̇³.
+    fn cubic_damper(c3) => CubicDamper
 }
-
-/// Clearance with penalty contact on both sides: F = k(δ − gap) for δ > gap,
-/// k(δ + gap) for δ < −gap, 0 in between (gap = half the free play).
-#[pyfunction]
-#[pyo3(signature = (gap, k, dof = 0, to = None))]
-fn clearance(
-    gap: f64,
-    k: f64,
-    #[pyo3(from_py_with = int64)] dof: i64,
-    to: Option<i64>,
-) -> PyResult<Elements> {
-    element(Law::Clearance { gap, k }, dof, to)
+element_fn! {
+    /// Coulomb friction regularised by tanh: F = force·tanh(δ̇/v_reg) (v_reg > 0;
+    /// the sign function as v_reg → 0).
+    fn coulomb(force, v_reg) => Coulomb
 }
-
-/// One-sided penalty contact: F = k(δ − gap) for δ > gap, else 0.
-#[pyfunction]
-#[pyo3(signature = (gap, k, dof = 0, to = None))]
-fn unilateral(
-    gap: f64,
-    k: f64,
-    #[pyo3(from_py_with = int64)] dof: i64,
-    to: Option<i64>,
-) -> PyResult<Elements> {
-    element(Law::Unilateral { gap, k }, dof, to)
+element_fn! {
+    /// Clearance with penalty contact on both sides: F = k(δ − gap) for δ > gap,
+    /// k(δ + gap) for δ < −gap, 0 in between (gap = half the free play).
+    fn clearance(gap, k) => Clearance
+}
+element_fn! {
+    /// One-sided penalty contact: F = k(δ − gap) for δ > gap, else 0.
+    fn unilateral(gap, k) => Unilateral
 }
 
 /// Register `ivt._ivt.hb.elements` under the `hb` module.

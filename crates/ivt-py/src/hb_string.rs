@@ -21,7 +21,11 @@ use crate::hb::hb_err;
 /// "spring" (k0 w(1) = w_x(1), Eq. 132, Tau method).
 /// Returns the dict of `ivt hb string --json`: points [{"omega", "norm" (‖a‖,
 /// Eq. 114), "stable", "kind", "max_multiplier", "method"}...], jacobians,
-/// hill_calls, stop, solve_time_s. GIL released.
+/// hill_calls, stop, solve_time_s. |kd| is limited to 1e9 (larger values
+/// only make the trace slow before it fails). GIL released.
+/// Largest |k_d| accepted (see [`string`]).
+const MAX_KD: f64 = 1e9;
+
 #[pyfunction]
 #[pyo3(signature = (
     kd = 10.0, modes = 5, harmonics = 19, from_ = 1.0, to = 6.0, cd = 0.8, y0 = 0.5, ns = 64,
@@ -52,6 +56,13 @@ fn string<'py>(
             )))
         }
     };
+    // Measured with `ivt hb string`: from k_d ≈ 1e9 on the trace ends in an
+    // error after seconds, growing to ~12 s at 1e17 (the thesis uses 10 and 30).
+    if !(kd.is_finite() && kd.abs() <= MAX_KD) {
+        return Err(PyValueError::new_err(format!(
+            "argument `kd` = {kd} must be finite with |kd| <= {MAX_KD:e}"
+        )));
+    }
     let params = StringParams {
         kd,
         cd,

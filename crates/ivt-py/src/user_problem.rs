@@ -1,13 +1,13 @@
 //! User systems for `ivt.hb`: `M x'' + C x' + K x + g(x, v, θ) = f(θ)` with `g`
 //! and `f` Python callables (per sample, or vectorized over all AFT samples).
 //! `g` may instead be a composition of ivt-hb's Rust elements
-//! ([`crate::hb_elements::Elements`]): then no Python runs in the loop and the
-//! Jacobians ∂g/∂x, ∂g/∂v are exact. This module adds the Python calls and the
-//! capture of the first exception a callback raised.
+//! ([`crate::hb_elements::Elements`]): then no Python runs in the loop. The
+//! system is an ivt-hb [`GeneralProblem`]; this module adds the Python calls
+//! and the capture of the first exception a callback raised.
 
 use crate::hb_elements::Elements;
 use ivt_hb::problem::{per_sample, Nonlinearity};
-use ivt_hb::{central_difference_samples, ElementProblem, HbOptions, PeriodicProblem};
+use ivt_hb::{ElementProblem, GeneralProblem, HbOptions, PeriodicProblem};
 use numpy::{IntoPyArray, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -20,85 +20,37 @@ type ErrorSlot = Arc<Mutex<Option<PyErr>>>;
 type PyExcitation = Box<dyn Fn(f64, &mut [f64]) + Send + Sync>;
 
 /// The nonlinearity of a user system: a Python callable, or Rust elements
-/// (an [`ElementProblem`] without forcing; its `M`, `C`, `K` are the system's).
-enum UserG {
+/// (an [`ElementProblem`] without forcing, evaluated with no Python call), and
+/// the slot of the first exception raised by `g` or `f`.
+pub(crate) struct UserG {
+    law: UserLaw,
+    error: ErrorSlot,
+}
+
+enum UserLaw {
     Python(PyNonlinearity),
     Elements(ElementProblem),
 }
 
-/// A user system `M x'' + C x' + K x + g(x, v, θ) = f(θ)` with a Python `f`.
-pub(crate) struct PyProblem {
-    n: usize,
-    m: Vec<f64>,
-    c: Vec<f64>,
-    k: Vec<f64>,
-    g: UserG,
-    f: PyExcitation,
-    velocity_dependent: bool,
-    error: ErrorSlot,
+impl Nonlinearity for UserG {
+    fn eval(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
+        match &self.law {
+            UserLaw::Python(g) => g.eval(x, v, theta, out),
+            UserLaw::Elements(e) => e.nonlinear(x, v, theta, out),
+        }
+    }
+    fn eval_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+        match &self.law {
+            UserLaw::Python(g) => g.eval_samples(x, v, theta, out),
+            UserLaw::Elements(e) => e.nonlinear_samples(x, v, theta, out),
+        }
+    }
 }
 
-impl PeriodicProblem for PyProblem {
-    fn n_dof(&self) -> usize {
-        self.n
-    }
-    fn mass(&self) -> &[f64] {
-        &self.m
-    }
-    fn damping(&self) -> &[f64] {
-        &self.c
-    }
-    fn stiffness(&self) -> &[f64] {
-        &self.k
-    }
-    fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
-        match &self.g {
-            UserG::Python(g) => g.eval(x, v, theta, out),
-            UserG::Elements(e) => e.nonlinear(x, v, theta, out),
-        }
-    }
-    fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
-        match &self.g {
-            UserG::Python(g) => g.eval_samples(x, v, theta, out),
-            UserG::Elements(e) => e.nonlinear_samples(x, v, theta, out),
-        }
-    }
-    fn excitation(&self, theta: f64, out: &mut [f64]) {
-        (self.f)(theta, out)
-    }
-    fn velocity_dependent(&self) -> bool {
-        self.velocity_dependent
-    }
-    /// Elements: exact. Python: central differences on this one sample.
-    fn nonlinear_jacobian(
-        &self,
-        x: &[f64],
-        v: &[f64],
-        theta: f64,
-        dg_dx: &mut [f64],
-        dg_dv: &mut [f64],
-    ) {
-        match &self.g {
-            UserG::Elements(e) => e.nonlinear_jacobian(x, v, theta, dg_dx, dg_dv),
-            UserG::Python(_) => {
-                let mut dg = vec![0.0; dg_dx.len() + dg_dv.len()];
-                central_difference_samples(self, x, v, &[theta], &mut dg);
-                let (gx, gv) = dg.split_at(dg_dx.len());
-                dg_dx.copy_from_slice(gx);
-                dg_dv.copy_from_slice(gv);
-            }
-        }
-    }
-    /// Elements: exact per sample. Python: central differences over all
-    /// samples at once (4·n_dof calls of a vectorized `g`, steps relative to
-    /// the orbit's scale).
-    fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
-        match &self.g {
-            UserG::Elements(e) => e.nonlinear_jacobian_samples(x, v, theta, dg),
-            UserG::Python(_) => central_difference_samples(self, x, v, theta, dg),
-        }
-    }
-}
+/// A user system: the ivt-hb general problem (∂g by central differences over
+/// all samples at once, steps relative to the orbit) with `g` a Python
+/// callable or Rust elements and `f` a Python callable.
+pub(crate) type PyProblem = GeneralProblem<UserG, PyExcitation>;
 
 /// The Python `g(x, v, theta)`: per sample, or (`vectorized`) once for all
 /// samples with (N, n_dof) arrays and a (N,) phase array, returning (N, n_dof).
@@ -301,10 +253,10 @@ pub(crate) fn user_problem(
             let problem = ElementProblem::new(nm, [m.clone(), c.clone(), k.clone()], list, vec![])
                 .map_err(|e| PyValueError::new_err(format!("argument `g`: {e}")))?;
             let dependent = problem.velocity_dependent();
-            (UserG::Elements(problem), dependent)
+            (UserLaw::Elements(problem), dependent)
         }
         None => (
-            UserG::Python(PyNonlinearity {
+            UserLaw::Python(PyNonlinearity {
                 g: g.clone().unbind(),
                 n: nm,
                 vectorized,
@@ -313,21 +265,18 @@ pub(crate) fn user_problem(
             velocity_dependent,
         ),
     };
-    Ok(PyProblem {
-        n: nm,
-        m,
-        c,
-        k,
-        g,
-        f: excitation,
-        velocity_dependent,
-        error,
-    })
+    let g = UserG { law: g, error };
+    Ok(GeneralProblem::new(nm, m, c, k, g, excitation).with_velocity_dependent(velocity_dependent))
 }
 
 /// The first exception a callback raised during a run, if any.
 pub(crate) fn callback_error(problem: &PyProblem) -> Option<PyErr> {
-    problem.error.lock().ok().and_then(|mut s| s.take())
+    problem
+        .nonlinearity()
+        .error
+        .lock()
+        .ok()
+        .and_then(|mut s| s.take())
 }
 
 /// The tolerance keywords of `solve`, `frc` and `limit_cycle` applied to `opts`:

@@ -48,8 +48,8 @@ def test_elements_equal_the_same_system_as_a_python_g() -> None:
 def test_elements_chain_frc_folds_equal_the_python_g_folds() -> None:
     """The 2-DOF cubic chain FRC with g = cubic_spring(0.5) and with the
     vectorized Python g: the same two located folds (each converged on the
-    extended system to a step of 1e-11; 1e-9 allows the Jacobians' difference,
-    exact against central differences)."""
+    extended system to a relative step of 1e-11; 1e-9 allows the rounding
+    difference of the two evaluations of g)."""
 
     def g(x: np.ndarray, v: np.ndarray, th: np.ndarray) -> np.ndarray:
         out = np.zeros_like(x)
@@ -150,6 +150,8 @@ def test_string_equals_cli(cli) -> None:  # type: ignore[no-untyped-def]
         hb.string(boundary="free")
     with pytest.raises(ValueError, match="`from_`"):
         hb.string(from_=3.0, to=1.0)
+    with pytest.raises(ValueError, match="`kd`"):
+        hb.string(kd=float(2**63))
 
 
 def test_bad_elements_are_named() -> None:

@@ -5,7 +5,7 @@ Mathieu–Duffing, the STHB string (:func:`string`) and user systems; backbone
 curves (:func:`backbone`) of conservative ones. ``g`` may be a Python callable
 or a sum of Rust elements from :mod:`ivt.hb.elements` (e.g.
 ``elements.cubic_spring(0.5, dof=0) + elements.coulomb(0.1, 1e-3, dof=1)``),
-evaluated with exact Jacobians and no Python in the loop.
+evaluated with no Python in the loop.
 
 Coefficient convention (as ``ivt hb ... --json``): ``[a0, a1..an, b1..bn]``
 per DOF with ``u(τ) = a0/2 + Σ a_k cos kτ + b_k sin kτ``, τ = ω t; a
