@@ -4,13 +4,14 @@
 
 use ivt_hb::sthb::frc::{frequency_response, StringFrcOptions};
 use ivt_hb::sthb::{Boundary, StringHb, StringParams};
+use ivt_hb::HbError;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::time::Instant;
 
 use crate::args::{count, int64};
-use crate::hb::hb_err;
+use crate::hb::{hb_err, ConvergenceError};
 
 /// Frequency-response curve of the string with geometric nonlinearity,
 /// `ω² w_tt + ω c_d w_t − w_xx − k_d w_x² w_xx − y0 sin(πx) cos t = 0`
@@ -21,7 +22,8 @@ use crate::hb::hb_err;
 /// "spring" (k0 w(1) = w_x(1), Eq. 132, Tau method).
 /// Returns the dict of `ivt hb string --json`: points [{"omega", "norm" (‖a‖,
 /// Eq. 114), "stable", "kind", "max_multiplier", "method"}...], jacobians,
-/// hill_calls, stop, solve_time_s. |kd| is limited to 1e9 (larger values
+/// hill_calls, stop, solve_time_s. A trace that fails numerically raises
+/// `ConvergenceError`. |kd| is limited to 1e9 (larger values
 /// only make the trace slow before it fails). GIL released.
 /// Largest |k_d| accepted (see [`string`]).
 const MAX_KD: f64 = 1e9;
@@ -82,12 +84,15 @@ fn string<'py>(
     let mut opts = StringFrcOptions::default();
     opts.continuation.ds_max = step_max;
     let t0 = Instant::now();
+    let mut hb = StringHb::new(params).map_err(|e| hb_err(py, e))?;
+    // The inputs are valid here: a failure of the trace (cold start, stalled
+    // step, Hill's method) is numerical, a ConvergenceError.
     let curve = py
-        .detach(|| {
-            let mut hb = StringHb::new(params)?;
-            frequency_response(&mut hb, from_, to, &opts)
-        })
-        .map_err(|e| hb_err(py, e))?;
+        .detach(|| frequency_response(&mut hb, from_, to, &opts))
+        .map_err(|e| match e {
+            HbError::InvalidInput(_) => hb_err(py, e),
+            other => ConvergenceError::new_err(other.to_string()),
+        })?;
     let solve_time_s = t0.elapsed().as_secs_f64();
     let points = PyList::empty(py);
     for (p, method) in curve.frc.points.iter().zip(&curve.methods) {

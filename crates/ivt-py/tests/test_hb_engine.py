@@ -152,6 +152,8 @@ def test_string_equals_cli(cli) -> None:  # type: ignore[no-untyped-def]
         hb.string(from_=3.0, to=1.0)
     with pytest.raises(ValueError, match="`kd`"):
         hb.string(kd=float(2**63))
+    with pytest.raises(hb.ConvergenceError):  # accepted, but Hill's method fails on the way
+        hb.string(kd=1e8)
 
 
 def test_bad_elements_are_named() -> None:
