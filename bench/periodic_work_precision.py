@@ -394,12 +394,16 @@ def chain_rows(n, ds_max, omega_from, omega_to):
     why = "no ivt.hb.frc on this build"
     if hasattr(ivt.hb, "frc"):
         try:
-            out, t = timed(lambda: ivt.hb.frc(CHAIN_M, CHAIN_C, CHAIN_K, chain_g_vec, chain_f, omega_from, omega_to,
-                                              n=n, samples=hb_samples(n), velocity_dependent=False, vectorized=True),
-                           budget=1.0)
-            row["ivt"] = dict(mode="ivt.hb.frc, vectorized g", time=t, points=len(out["points"]),
-                              folds=fold_omegas(out["folds"]),
-                              peak=max(p["amplitude"] for p in out["points"]), stability=True)
+            # events=False: folds only, the work of duffing_frc; events=True adds the
+            # period-doubling, Neimark–Sacker and branch-point tests at every point.
+            for key, events in (("ivt", False), ("ivt_events", True)):
+                out, t = timed(lambda: ivt.hb.frc(CHAIN_M, CHAIN_C, CHAIN_K, chain_g_vec, chain_f, omega_from,
+                                                  omega_to, n=n, samples=hb_samples(n), velocity_dependent=False,
+                                                  vectorized=True, events=events),
+                               budget=1.0)
+                row[key] = dict(mode=f"ivt.hb.frc, vectorized g, events={events}", time=t,
+                                points=len(out["points"]), folds=fold_omegas(out["folds"]),
+                                peak=max(p["amplitude"] for p in out["points"]), stability=True)
             return row
         except Exception as e:  # an API this script does not know: say so, measure per-ω solves
             why = f"ivt.hb.frc failed: {type(e).__name__}: {e}"
@@ -481,6 +485,10 @@ def print_report(refs, rows, frcs, pyharm_error):
         print(f"\npyHarm not measured: {pyharm_error}")
     per_point = {row["problem"]: row["ivt"]["time"] / max(row["ivt"]["points"], 1) for row in frcs if "ivt" in row}
     duffing = [t for name, t in per_point.items() if name.startswith("Duffing")]
+    for row in frcs:
+        if "ivt_events" in row:
+            ev = row["ivt_events"]["time"] / max(row["ivt_events"]["points"], 1)
+            print(f"per point, ivt {row['problem']} with events=True: {1e3 * ev:.2f} ms")
     for name, t in per_point.items():
         if duffing and not name.startswith("Duffing"):
             print(f"\nper point, ivt {name} / ivt Duffing FRC: {t / duffing[0]:.2f}×")
@@ -488,11 +496,11 @@ def print_report(refs, rows, frcs, pyharm_error):
         print(f"\n### {row['problem']} (n = {row['n']}, {2 * row['samples']} time samples)\n")
         print("| code | run time [s] | points | per point [ms] | folds (ω turns) | peak amplitude | stability |")
         print("|---|---|---|---|---|---|---|")
-        for name in ("ivt", "pyharm"):
+        for name in ("ivt", "ivt_events", "pyharm"):
             d = row.get(name)
             if d is None:
                 continue
-            label = d.get("mode", "ivt.hb.duffing_frc") if name == "ivt" else f"pyHarm, ds_max = {d['ds_max']}"
+            label = d.get("mode", "ivt.hb.duffing_frc") if name != "pyharm" else f"pyHarm, ds_max = {d['ds_max']}"
             folds = ", ".join(f"{f:.5f}" for f in d["folds"]) or "—"
             peak = f"{d['peak']:.5f}" if d["peak"] is not None else "—"
             per = d["time"] / d["points"] * 1e3 if d["points"] else float("nan")

@@ -28,13 +28,13 @@ create_exception!(
 
 /// Hsu sub-intervals per period for n harmonics: max(8n, 256), the rule of
 /// `ivt hb duffing` (ivt-hb: 256 is enough for the flags).
-fn stability_steps(harmonics: usize) -> usize {
+pub(crate) fn stability_steps(harmonics: usize) -> usize {
     (8 * harmonics).max(256)
 }
 
 /// Map an ivt-hb error to Python: bad inputs → ValueError, non-convergence →
 /// ConvergenceError carrying the residual history.
-fn hb_err(py: Python<'_>, e: HbError) -> PyErr {
+pub(crate) fn hb_err(py: Python<'_>, e: HbError) -> PyErr {
     match &e {
         HbError::Solve(s) => {
             let err = ConvergenceError::new_err(e.to_string());
@@ -57,7 +57,7 @@ fn run<T: Send>(py: Python<'_>, solve: impl FnOnce() -> Result<T, HbError> + Sen
 /// Run `solve` on a user system with the GIL released (its callbacks take it
 /// back), then re-raise the first exception a callback raised (it aborted the
 /// run) or map the ivt-hb error with [`hb_err`].
-fn run_user<T: Send>(
+pub(crate) fn run_user<T: Send>(
     py: Python<'_>,
     problem: &PyProblem,
     solve: impl FnOnce(&PyProblem) -> Result<T, HbError> + Send,
@@ -102,7 +102,7 @@ fn options(n: i64, samples: i64, subharmonic: i64, tol: f64) -> PyResult<HbOptio
         .with_tol(tol))
 }
 
-fn finite(name: &str, v: f64) -> PyResult<f64> {
+pub(crate) fn finite(name: &str, v: f64) -> PyResult<f64> {
     if v.is_finite() {
         Ok(v)
     } else {
@@ -230,7 +230,8 @@ macro_rules! user_system_fn {
             $py: Python<$lt>,
             m: &Bound<$lt, PyAny>, c: &Bound<$lt, PyAny>, k: &Bound<$lt, PyAny>, g: &Bound<$lt, PyAny>,
             $( $(#[$pa($($pa_args)*)])* $arg: $ty, )+
-            #[pyo3(from_py_with = int64)] n: i64, #[pyo3(from_py_with = int64)] samples: i64,
+            #[pyo3(from_py_with = crate::args::int64)] n: i64,
+            #[pyo3(from_py_with = crate::args::int64)] samples: i64,
             $( $(#[$pb($($pb_args)*)])* $brg: $bty, )+
             velocity_dependent: bool, vectorized: bool, rtol: f64, max_iter: usize,
         ) -> PyResult<Bound<$lt, PyDict>> {
@@ -241,23 +242,24 @@ macro_rules! user_system_fn {
         }
     };
 }
+pub(crate) use user_system_fn;
 
 /// The arguments every user-system function shares: the system `[m, c, k, g]`
 /// and the harmonic-balance settings.
-struct UserArgs<'a, 'py> {
-    system: [&'a Bound<'py, PyAny>; 4],
-    n: i64,
-    samples: i64,
-    velocity_dependent: bool,
-    vectorized: bool,
-    rtol: f64,
-    max_iter: usize,
+pub(crate) struct UserArgs<'a, 'py> {
+    pub(crate) system: [&'a Bound<'py, PyAny>; 4],
+    pub(crate) n: i64,
+    pub(crate) samples: i64,
+    pub(crate) velocity_dependent: bool,
+    pub(crate) vectorized: bool,
+    pub(crate) rtol: f64,
+    pub(crate) max_iter: usize,
 }
 
 impl UserArgs<'_, '_> {
     /// The user problem forced by `f` and its options (`subharmonic`, absolute
     /// tolerance `tol`, see [`with_tolerances`]).
-    fn setup(
+    pub(crate) fn setup(
         &self,
         f: Option<&Bound<'_, PyAny>>,
         subharmonic: i64,
@@ -418,14 +420,14 @@ fn mathieu_cascade<'py>(
 }
 
 /// Multipliers as `[[re, im], ...]`.
-fn pairs(mu: &[ivt_hb::c64]) -> Vec<[f64; 2]> {
+pub(crate) fn pairs(mu: &[ivt_hb::c64]) -> Vec<[f64; 2]> {
     mu.iter().map(|m| [m.re, m.im]).collect()
 }
 
 /// The dict of a traced curve: "points" [{"omega", "amplitude", "stable",
 /// "stability", "kind", "coeffs", "multipliers"}...], "termination", and the
 /// arrays omega, amplitude, stable for plotting ("folds" is set by the caller).
-fn frc_dict<'py>(py: Python<'py>, frc: &ivt_hb::Frc) -> PyResult<Bound<'py, PyDict>> {
+pub(crate) fn frc_dict<'py>(py: Python<'py>, frc: &ivt_hb::Frc) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let points = PyList::empty(py);
     for p in &frc.points {
@@ -533,54 +535,6 @@ fn solve<'py>(py, user;
 }
 
 user_system_fn! {
-/// Frequency-response curve of a user system `M x'' + C x' + K x + g(x, v, θ)
-/// = f(θ)` (θ = ω_f t) by pseudo-arclength continuation in ω_f from
-/// `omega_from` to `omega_to`, Floquet multipliers (Hsu) at every point, and
-/// each fold located by Newton on the extended system (not bracketed).
-///
-/// m, c, k, g, f, velocity_dependent as in `solve` (f may be None);
-/// `vectorized=True`: g(x, v, theta) gets x, v of shape (N, n_dof) and theta
-/// of shape (N,) (all 2·samples AFT samples at once) and returns (N, n_dof).
-/// Returns {"points": [{"omega", "coeffs", "amplitude", "multipliers",
-/// "stable", "stability"}...], "folds": [{"omega", "amplitude", "coeffs",
-/// "located", "index" (path point nearest the turn)}...], "bifurcations": [{"kind": "fold", "omega"}...],
-/// "termination"} and the arrays omega, amplitude, stable. amplitude is
-/// max |x_0| over the AFT samples (DOF 0). GIL released between callbacks.
-fn frc<'py>(py, user;
-    f: Option<&Bound<'py, PyAny>>,
-    omega_from: f64,
-    omega_to: f64;
-    tol: f64 = 0.0,
-) {
-    let (problem, opts) = user.setup(f, 1, tol)?;
-    let mut frc_opts = FrcOptions::default();
-    frc_opts.from = finite("omega_from", omega_from)?;
-    frc_opts.to = finite("omega_to", omega_to)?;
-    frc_opts.stability_steps = stability_steps(opts.harmonics);
-    let frc = run_user(py, &problem, |p| frequency_response(p, &opts, &frc_opts))?;
-    let d = frc_dict(py, &frc)?;
-    let folds = PyList::empty(py);
-    let bifurcations = PyList::empty(py);
-    for fold in &frc.folds {
-        let e = PyDict::new(py);
-        e.set_item("omega", fold.omega_f)?;
-        e.set_item("amplitude", fold.amplitude)?;
-        e.set_item("coeffs", fold.coeffs.clone().into_pyarray(py))?;
-        e.set_item("located", fold.located)?;
-        e.set_item("index", fold.index)?;
-        folds.append(e)?;
-        let b = PyDict::new(py);
-        b.set_item("kind", "fold")?;
-        b.set_item("omega", fold.omega_f)?;
-        bifurcations.append(b)?;
-    }
-    d.set_item("folds", folds)?;
-    d.set_item("bifurcations", bifurcations)?;
-    Ok(d)
-}
-}
-
-user_system_fn! {
 /// Limit cycle of an autonomous user system `M x'' + C x' + K x + g(x, v) = 0`
 /// by harmonic balance with the response frequency ω as an unknown and the
 /// phase condition b1 = 0 on DOF 0 (Newton with the Galerkin Jacobian).
@@ -601,8 +555,11 @@ fn limit_cycle<'py>(py, user;
     let start = match guess_vec(guess)? {
         Some(q) => q,
         None => {
+            // x_0 = amplitude·cos τ: a1 of DOF 0 (index 1), all else zero.
             let mut q = vec![0.0; problem.n_dof() * (2 * opts.harmonics + 1)];
-            q[1] = finite("amplitude", amplitude)?;
+            if let Some(a1) = q.get_mut(1) {
+                *a1 = finite("amplitude", amplitude)?;
+            }
             q
         }
     };
@@ -656,10 +613,9 @@ fn eval_series<'py>(
             ivt_hb::aft::eval_series(&q, t, order)
         });
     }
-    let l = q.len() / n_dof;
-    let per_dof = (0..n_dof)
-        .map(|d| {
-            let block = &q[d * l..(d + 1) * l];
+    let per_dof = q
+        .chunks_exact(q.len() / n_dof)
+        .map(|block| {
             crate::vectorize::map1(py, [("tau", tau)], |[t]| {
                 ivt_hb::aft::eval_series(block, t, order)
             })
@@ -681,11 +637,13 @@ pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
             mathieu_duffing,
             mathieu_cascade,
             solve,
-            frc,
             limit_cycle,
             eval_series
         ]
     );
+    crate::hb_paths::register(&m)?;
+    crate::hb_string::register(&m)?;
+    crate::hb_elements::register(&m)?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     parent.add_submodule(&m)
 }

@@ -1,10 +1,13 @@
 //! User systems for `ivt.hb`: `M x'' + C x' + K x + g(x, v, θ) = f(θ)` with `g`
 //! and `f` Python callables (per sample, or vectorized over all AFT samples).
-//! The system is an ivt-hb [`GeneralProblem`]; this module adds only the Python
-//! calls and the capture of the first exception a callback raises.
+//! `g` may instead be a composition of ivt-hb's Rust elements
+//! ([`crate::hb_elements::Elements`]): then no Python runs in the loop. The
+//! system is an ivt-hb [`GeneralProblem`]; this module adds the Python calls
+//! and the capture of the first exception a callback raised.
 
+use crate::hb_elements::Elements;
 use ivt_hb::problem::{per_sample, Nonlinearity};
-use ivt_hb::{GeneralProblem, HbOptions};
+use ivt_hb::{ElementProblem, GeneralProblem, HbOptions, PeriodicProblem};
 use numpy::{IntoPyArray, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -16,8 +19,38 @@ type ErrorSlot = Arc<Mutex<Option<PyErr>>>;
 /// The excitation `f(θ)` of a user system (a Python callable or none).
 type PyExcitation = Box<dyn Fn(f64, &mut [f64]) + Send + Sync>;
 
-/// A user system: the ivt-hb general problem with Python `g` and `f`.
-pub(crate) type PyProblem = GeneralProblem<PyNonlinearity, PyExcitation>;
+/// The nonlinearity of a user system: a Python callable, or Rust elements
+/// (an [`ElementProblem`] without forcing, evaluated with no Python call), and
+/// the slot of the first exception raised by `g` or `f`.
+pub(crate) struct UserG {
+    law: UserLaw,
+    error: ErrorSlot,
+}
+
+enum UserLaw {
+    Python(PyNonlinearity),
+    Elements(ElementProblem),
+}
+
+impl Nonlinearity for UserG {
+    fn eval(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
+        match &self.law {
+            UserLaw::Python(g) => g.eval(x, v, theta, out),
+            UserLaw::Elements(e) => e.nonlinear(x, v, theta, out),
+        }
+    }
+    fn eval_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+        match &self.law {
+            UserLaw::Python(g) => g.eval_samples(x, v, theta, out),
+            UserLaw::Elements(e) => e.nonlinear_samples(x, v, theta, out),
+        }
+    }
+}
+
+/// A user system: the ivt-hb general problem (∂g by central differences over
+/// all samples at once, steps relative to the orbit) with `g` a Python
+/// callable or Rust elements and `f` a Python callable.
+pub(crate) type PyProblem = GeneralProblem<UserG, PyExcitation>;
 
 /// The Python `g(x, v, theta)`: per sample, or (`vectorized`) once for all
 /// samples with (N, n_dof) arrays and a (N,) phase array, returning (N, n_dof).
@@ -150,12 +183,16 @@ fn matrix(name: &str, ob: &Bound<'_, PyAny>) -> PyResult<(usize, Vec<f64>)> {
                 ))
             })?;
         let shape = a.shape().to_vec();
-        if shape[0] != shape[1] || shape[0] == 0 {
-            return Err(PyValueError::new_err(format!(
-                "argument `{name}` must be square and non-empty, got shape {shape:?}"
-            )));
+        match shape.as_slice() {
+            &[rows, cols] if rows == cols && rows > 0 => {
+                (rows, a.as_array().iter().copied().collect())
+            }
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "argument `{name}` must be square and non-empty, got shape {shape:?}"
+                )))
+            }
         }
-        (shape[0], a.as_array().iter().copied().collect())
     };
     if let Some(bad) = data.iter().find(|v| !v.is_finite()) {
         return Err(PyValueError::new_err(format!(
@@ -165,8 +202,9 @@ fn matrix(name: &str, ob: &Bound<'_, PyAny>) -> PyResult<(usize, Vec<f64>)> {
     Ok((n, data))
 }
 
-/// The user system of `solve`, `frc` and `limit_cycle` from its Python arguments.
-#[allow(clippy::too_many_arguments)]
+/// The user system of `solve`, `frc`, `limit_cycle` and `backbone` from its
+/// Python arguments. `g` is a callable or an [`Elements`] composition (then
+/// `velocity_dependent` and `vectorized` are the elements' own).
 pub(crate) fn user_problem(
     m: &Bound<'_, PyAny>,
     c: &Bound<'_, PyAny>,
@@ -184,9 +222,13 @@ pub(crate) fn user_problem(
             "`m`, `c`, `k` must have the same size, got {nm}, {nc}, {nk}"
         )));
     }
-    if !g.is_callable() {
+    let elements = g
+        .cast::<Elements>()
+        .ok()
+        .map(|e| e.borrow().list().to_vec());
+    if elements.is_none() && !g.is_callable() {
         return Err(PyTypeError::new_err(
-            "argument `g` must be callable g(x, v, theta)",
+            "argument `g` must be callable g(x, v, theta) or ivt.hb.elements",
         ));
     }
     if let Some(f) = f {
@@ -206,12 +248,24 @@ pub(crate) fn user_problem(
         }
         None => Box::new(|_, out| out.fill(0.0)),
     };
-    let g = PyNonlinearity {
-        g: g.clone().unbind(),
-        n: nm,
-        vectorized,
-        error,
+    let (g, velocity_dependent) = match elements {
+        Some(list) => {
+            let problem = ElementProblem::new(nm, [m.clone(), c.clone(), k.clone()], list, vec![])
+                .map_err(|e| PyValueError::new_err(format!("argument `g`: {e}")))?;
+            let dependent = problem.velocity_dependent();
+            (UserLaw::Elements(problem), dependent)
+        }
+        None => (
+            UserLaw::Python(PyNonlinearity {
+                g: g.clone().unbind(),
+                n: nm,
+                vectorized,
+                error: Arc::clone(&error),
+            }),
+            velocity_dependent,
+        ),
     };
+    let g = UserG { law: g, error };
     Ok(GeneralProblem::new(nm, m, c, k, g, excitation).with_velocity_dependent(velocity_dependent))
 }
 

@@ -273,9 +273,10 @@ def test_2dof_chain_frc_folds_match_shooting_with_vectorized_g() -> None:
 
     def g_counted(x: np.ndarray, v: np.ndarray, th: np.ndarray) -> np.ndarray:
         calls["n"] += 1
-        # 128 residual samples, 512 on the stability grid (256 Hsu steps), 1 per
-        # call of the fold locator's one-sample ∂g.
-        assert x.shape in ((128, 2), (512, 2), (1, 2)), x.shape
+        # 128 residual samples, 512 on the stability grid (256 Hsu steps), 4096
+        # for the multipliers at a located event (2048 Hsu steps), 1 per call
+        # of a one-sample ∂g.
+        assert x.shape in ((128, 2), (512, 2), (4096, 2), (1, 2)), x.shape
         assert th.shape == (x.shape[0],)
         return g(x, v, th)  # type: ignore[no-any-return]
 

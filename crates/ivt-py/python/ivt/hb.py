@@ -1,6 +1,11 @@
 """Harmonic balance (``ivt-hb``): periodic solutions, Floquet stability,
-frequency-response curves with located folds, and limit cycles, for Duffing,
-Mathieu–Duffing and user systems.
+frequency-response curves with located folds, period doublings,
+Neimark–Sacker and branch points (:func:`frc`), and limit cycles, for Duffing,
+Mathieu–Duffing, the STHB string (:func:`string`) and user systems; backbone
+curves (:func:`backbone`) of conservative ones. ``g`` may be a Python callable
+or a sum of Rust elements from :mod:`ivt.hb.elements` (e.g.
+``elements.cubic_spring(0.5, dof=0) + elements.coulomb(0.1, 1e-3, dof=1)``),
+evaluated with no Python in the loop.
 
 Coefficient convention (as ``ivt hb ... --json``): ``[a0, a1..an, b1..bn]``
 per DOF with ``u(τ) = a0/2 + Σ a_k cos kτ + b_k sin kτ``, τ = ω t; a
@@ -19,6 +24,7 @@ from ._reexport import reexport
 
 __all__ = [
     "ConvergenceError",
+    "backbone",
     "duffing",
     "duffing_frc",
     "eval_series",
@@ -27,6 +33,9 @@ __all__ = [
     "mathieu_cascade",
     "mathieu_duffing",
     "solve",
+    "string",
 ]
 
 reexport(globals(), _ivt.hb, __all__)
+elements = _ivt.hb.elements
+Elements = _ivt.hb.elements.Elements

@@ -1,5 +1,6 @@
-"""Harmonic balance (``ivt-hb``): periodic solutions, Floquet stability and
-frequency-response curves, for Duffing, Mathieu–Duffing and user systems."""
+"""Harmonic balance (``ivt-hb``): periodic solutions, Floquet stability,
+frequency-response curves with located bifurcations, limit cycles and backbone
+curves, for Duffing, Mathieu–Duffing, the STHB string and user systems."""
 
 from typing import Any, Callable, Dict, List, Literal, Optional, Sequence, Union, overload
 
@@ -13,6 +14,29 @@ Matrix = Union[float, npt.ArrayLike]
 Callback = Callable[[FloatArray, FloatArray, float], Union[float, Sequence[float], FloatArray]]
 VectorizedCallback = Callable[[FloatArray, FloatArray, FloatArray], npt.ArrayLike]
 Forcing = Callable[[float], Union[float, Sequence[float], FloatArray]]
+
+class Elements:
+    """A sum of Rust nonlinear elements, passed as ``g`` (no Python in the loop)."""
+
+    def __add__(self, other: Elements) -> Elements: ...
+    def __len__(self) -> int: ...
+
+class elements:
+    """``ivt.hb.elements``: element constructors; ``+`` composes them. Each acts on
+    δ = x[dof] − x[to] (x[to] = 0 for ``to=None``, the ground)."""
+
+    @staticmethod
+    def cubic_spring(k3: float, dof: int = 0, to: Optional[int] = None) -> Elements: ...
+    @staticmethod
+    def quadratic_damper(c2: float, dof: int = 0, to: Optional[int] = None) -> Elements: ...
+    @staticmethod
+    def cubic_damper(c3: float, dof: int = 0, to: Optional[int] = None) -> Elements: ...
+    @staticmethod
+    def coulomb(force: float, v_reg: float, dof: int = 0, to: Optional[int] = None) -> Elements: ...
+    @staticmethod
+    def clearance(gap: float, k: float, dof: int = 0, to: Optional[int] = None) -> Elements: ...
+    @staticmethod
+    def unilateral(gap: float, k: float, dof: int = 0, to: Optional[int] = None) -> Elements: ...
 
 class ConvergenceError(RuntimeError):
     """A solve that did not converge."""
@@ -62,7 +86,7 @@ def solve(
     m: Matrix,
     c: Matrix,
     k: Matrix,
-    g: Callback,
+    g: Union[Callback, VectorizedCallback, Elements],
     omega_f: float,
     f: Optional[Forcing] = None,
     n: int = 20,
@@ -81,13 +105,14 @@ def frc(
     m: Matrix,
     c: Matrix,
     k: Matrix,
-    g: Union[Callback, VectorizedCallback],
+    g: Union[Callback, VectorizedCallback, Elements],
     f: Optional[Forcing],
     omega_from: float,
     omega_to: float,
     n: int = 20,
     samples: int = 64,
     tol: float = 0.0,
+    events: bool = True,
     velocity_dependent: bool = True,
     vectorized: bool = False,
     rtol: float = 1e-9,
@@ -97,7 +122,7 @@ def limit_cycle(
     m: Matrix,
     c: Matrix,
     k: Matrix,
-    g: Union[Callback, VectorizedCallback],
+    g: Union[Callback, VectorizedCallback, Elements],
     omega_guess: float,
     amplitude: float = 1.0,
     guess: Optional[ArrayLike] = None,
@@ -108,6 +133,38 @@ def limit_cycle(
     vectorized: bool = False,
     rtol: float = 1e-9,
     max_iter: int = 100,
+) -> Dict[str, Any]: ...
+def backbone(
+    m: Matrix,
+    c: Matrix,
+    k: Matrix,
+    g: Union[Callback, VectorizedCallback, Elements],
+    omega0: float,
+    mode: Sequence[float],
+    amplitude_from: float = 0.01,
+    amplitude_to: float = 1.0,
+    n: int = 20,
+    samples: int = 64,
+    dof: int = 0,
+    tol: float = 0.0,
+    velocity_dependent: bool = True,
+    vectorized: bool = False,
+    rtol: float = 1e-9,
+    max_iter: int = 100,
+) -> Dict[str, Any]: ...
+def string(
+    kd: float = 10.0,
+    modes: int = 5,
+    harmonics: int = 19,
+    from_: float = 1.0,
+    to: float = 6.0,
+    cd: float = 0.8,
+    y0: float = 0.5,
+    ns: int = 64,
+    ms: int = 128,
+    boundary: Literal["fixed", "spring"] = "fixed",
+    k0: float = 10.0,
+    step_max: float = 0.05,
 ) -> Dict[str, Any]: ...
 @overload
 def eval_series(coeffs: ArrayLike, tau: float, order: int = 0, n_dof: Literal[1] = 1) -> float: ...

@@ -1,0 +1,119 @@
+//! `ivt.hb.elements`: ivt-hb's library of nonlinear elements ([`Law`]) from
+//! Python. Each constructor returns an [`Elements`] holding one element; `+`
+//! composes them, and the sum is passed as `g` to `solve`, `frc`,
+//! `limit_cycle` or `backbone`: the forces are evaluated in Rust, with no
+//! Python call in the loop.
+
+use ivt_hb::{Element, Law};
+use pyo3::prelude::*;
+
+use crate::args::{count, int64};
+
+/// A sum of nonlinear elements, usable as `g`: each acts on the relative
+/// displacement δ = x[dof] − x[to] and velocity δ̇ (x[to] = 0 for the ground,
+/// `to=None`), adding its force F(δ, δ̇) to g[dof] and −F to g[to].
+#[pyclass(module = "ivt.hb.elements", frozen)]
+pub(crate) struct Elements {
+    list: Vec<Element>,
+}
+
+impl Elements {
+    /// The elements in the order they were added.
+    pub(crate) fn list(&self) -> &[Element] {
+        &self.list
+    }
+}
+
+#[pymethods]
+impl Elements {
+    /// The composition of both element lists.
+    fn __add__(&self, other: &Bound<'_, Elements>) -> Elements {
+        let mut list = self.list.clone();
+        list.extend_from_slice(other.get().list());
+        Elements { list }
+    }
+
+    fn __len__(&self) -> usize {
+        self.list.len()
+    }
+
+    fn __repr__(&self) -> String {
+        let parts: Vec<String> = self
+            .list
+            .iter()
+            .map(|e| format!("{:?} on ({}, {:?})", e.law, e.a, e.b))
+            .collect();
+        format!("Elements([{}])", parts.join(", "))
+    }
+}
+
+/// One element of law `law` between DOF `dof` and DOF `to` (None: ground).
+/// The DOFs (< n_dof, `dof != to`) and the law's parameters (finite,
+/// v_reg > 0, gap >= 0, k >= 0) are checked by ivt-hb when the system is built.
+fn element(law: Law, dof: i64, to: Option<i64>) -> PyResult<Elements> {
+    Ok(Elements {
+        list: vec![Element {
+            a: count("dof", dof)?,
+            b: to.map(|b| count("to", b)).transpose()?,
+            law,
+        }],
+    })
+}
+
+/// A `#[pyfunction]` `name(params..., dof=0, to=None)` returning the one
+/// element of law `Law::$law { params }`.
+macro_rules! element_fn {
+    ($(#[$doc:meta])* fn $name:ident($($p:ident),+) => $law:ident) => {
+        $(#[$doc])*
+        #[pyfunction]
+        #[pyo3(signature = ($($p,)+ dof = 0, to = None))]
+        fn $name($($p: f64,)+ #[pyo3(from_py_with = int64)] dof: i64, to: Option<i64>) -> PyResult<Elements> {
+            element(Law::$law { $($p),+ }, dof, to)
+        }
+    };
+}
+
+element_fn! {
+    /// Cubic spring F = k3·δ³.
+    fn cubic_spring(k3) => CubicSpring
+}
+element_fn! {
+    /// Quadratic damper F = c2·δ̇|δ̇|.
+    fn quadratic_damper(c2) => QuadraticDamper
+}
+element_fn! {
+    /// Cubic damper F = c3·δ̇³.
+    fn cubic_damper(c3) => CubicDamper
+}
+element_fn! {
+    /// Coulomb friction regularised by tanh: F = force·tanh(δ̇/v_reg) (v_reg > 0;
+    /// the sign function as v_reg → 0).
+    fn coulomb(force, v_reg) => Coulomb
+}
+element_fn! {
+    /// Clearance with penalty contact on both sides: F = k(δ − gap) for δ > gap,
+    /// k(δ + gap) for δ < −gap, 0 in between (gap = half the free play).
+    fn clearance(gap, k) => Clearance
+}
+element_fn! {
+    /// One-sided penalty contact: F = k(δ − gap) for δ > gap, else 0.
+    fn unilateral(gap, k) => Unilateral
+}
+
+/// Register `ivt._ivt.hb.elements` under the `hb` module.
+pub fn register(hb: &Bound<'_, PyModule>) -> PyResult<()> {
+    let m = PyModule::new(hb.py(), "elements")?;
+    add_functions!(
+        &m,
+        [
+            cubic_spring,
+            quadratic_damper,
+            cubic_damper,
+            coulomb,
+            clearance,
+            unilateral
+        ]
+    );
+    m.add_class::<Elements>()?;
+    hb.add_submodule(&m)
+}
