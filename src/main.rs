@@ -13,6 +13,18 @@
     clippy::unimplemented
 )]
 mod cli;
+#[cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::indexing_slicing,
+        clippy::unreachable,
+        clippy::todo,
+        clippy::unimplemented
+    )
+)]
 mod reproduce;
 
 fn main() -> std::process::ExitCode {

@@ -503,17 +503,17 @@ impl Controller {
         }
         let inputs = v_m.zip(t_u);
         let inner = &mut self.inner;
-        let outs: Vec<ControlOutput> = py.detach(|| {
-            ticks
+        // `inputs_from_py` checked that both input columns have one entry per tick.
+        let outs: Vec<ControlOutput> = py.detach(|| match &inputs {
+            Some((v, tu)) => ticks
                 .iter()
-                .enumerate()
-                .map(|(i, &t)| {
-                    if let Some((v, tu)) = &inputs {
-                        inner.update_inputs(v[i], tu[i]);
-                    }
+                .zip(v.iter().zip(tu))
+                .map(|(&t, (&v, &tu))| {
+                    inner.update_inputs(v, tu);
                     inner.on_pulse(t)
                 })
-                .collect()
+                .collect(),
+            None => ticks.iter().map(|&t| inner.on_pulse(t)).collect(),
         });
         let d = PyDict::new(py);
         let col_f32 = |f: fn(&ControlOutput) -> f32| -> Bound<'py, PyArray1<f32>> {

@@ -115,7 +115,7 @@ geometry_class! {
     fn module_corners(&self, r: f64) -> PyResult<Vec<f64>> {
         let mut buf = [0.0; ivt_kin::givt::MAX_CORNERS];
         let n = self.geometry.module_corners(r, &mut buf).map_err(kin_err)?;
-        Ok(buf[..n].to_vec())
+        Ok(buf.iter().take(n).copied().collect())
     }
 
     /// ω_crk/ω_in at zero control speed: 2(r_sun + r_planet)/r_sun (3 in the design).

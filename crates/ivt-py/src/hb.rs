@@ -601,9 +601,11 @@ fn limit_cycle<'py>(py, user;
     let start = match guess_vec(guess)? {
         Some(q) => q,
         None => {
-            let mut q = vec![0.0; problem.n_dof() * (2 * opts.harmonics + 1)];
-            q[1] = finite("amplitude", amplitude)?;
-            q
+            // Zero except the first cosine coefficient of the first dof.
+            let amplitude = finite("amplitude", amplitude)?;
+            (0..problem.n_dof() * (2 * opts.harmonics + 1))
+                .map(|i| if i == 1 { amplitude } else { 0.0 })
+                .collect()
         }
     };
     let lc = run_user(py, &problem, |p| {
@@ -656,10 +658,10 @@ fn eval_series<'py>(
             ivt_hb::aft::eval_series(&q, t, order)
         });
     }
-    let l = q.len() / n_dof;
-    let per_dof = (0..n_dof)
-        .map(|d| {
-            let block = &q[d * l..(d + 1) * l];
+    // `q.len() / n_dof` is odd, hence >= 1 (checked above).
+    let per_dof = q
+        .chunks_exact(q.len() / n_dof)
+        .map(|block| {
             crate::vectorize::map1(py, [("tau", tau)], |[t]| {
                 ivt_hb::aft::eval_series(block, t, order)
             })

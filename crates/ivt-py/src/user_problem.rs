@@ -149,13 +149,15 @@ fn matrix(name: &str, ob: &Bound<'_, PyAny>) -> PyResult<(usize, Vec<f64>)> {
                     "argument `{name}` must be a square matrix of floats"
                 ))
             })?;
-        let shape = a.shape().to_vec();
-        if shape[0] != shape[1] || shape[0] == 0 {
-            return Err(PyValueError::new_err(format!(
-                "argument `{name}` must be square and non-empty, got shape {shape:?}"
-            )));
-        }
-        (shape[0], a.as_array().iter().copied().collect())
+        let n = match a.shape() {
+            &[rows, cols] if rows == cols && rows > 0 => rows,
+            shape => {
+                return Err(PyValueError::new_err(format!(
+                    "argument `{name}` must be square and non-empty, got shape {shape:?}"
+                )))
+            }
+        };
+        (n, a.as_array().iter().copied().collect())
     };
     if let Some(bad) = data.iter().find(|v| !v.is_finite()) {
         return Err(PyValueError::new_err(format!(

@@ -49,8 +49,7 @@ fn broadcast_shape(inputs: &[Input<'_>]) -> PyResult<Vec<usize>> {
     for input in inputs {
         let s = input.array.shape();
         let offset = ndim - s.len();
-        for (k, &d) in s.iter().enumerate() {
-            let cur = &mut shape[offset + k];
+        for (cur, &d) in shape.iter_mut().skip(offset).zip(s) {
             if *cur == 1 {
                 *cur = d;
             } else if d != 1 && d != *cur {
@@ -99,18 +98,18 @@ pub fn map<'py, const N: usize, const M: usize, E: Display>(
     let mut outputs: [Vec<f64>; M] = std::array::from_fn(|_| Vec::with_capacity(len));
     for index in 0..len {
         let mut x = [0.0; N];
-        for (j, it) in iters.iter_mut().enumerate() {
+        for ((it, input), xj) in iters.iter_mut().zip(&inputs).zip(&mut x) {
             let Some(&v) = it.next() else {
                 return Err(PyValueError::new_err("internal: short broadcast iterator"));
             };
             if !v.is_finite() {
                 return Err(PyValueError::new_err(format!(
                     "argument `{}` is not finite ({v}){}",
-                    inputs[j].name,
+                    input.name,
                     at_index(&shape, index)
                 )));
             }
-            x[j] = v;
+            *xj = v;
         }
         let y =
             f(x).map_err(|e| PyValueError::new_err(format!("{e}{}", at_index(&shape, index))))?;
