@@ -153,5 +153,10 @@ fn default_chebyshev_order_error() {
             "Chebyshev ({v_m} V, {t_u} N·m): max |μ| = {reference:.8}, |N16 − N64| = {err:.2e}, |N48 − N64| = {converged:.2e}"
         );
         assert!(err <= 2e-5, "({v_m}, {t_u}): N = 16 off by {err:e}");
+        // The reference is converging: N = 48 lies closer to it than N = 16.
+        assert!(
+            converged < err,
+            "({v_m}, {t_u}): N = 48 off by {converged:e}"
+        );
     }
 }

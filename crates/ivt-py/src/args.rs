@@ -31,13 +31,12 @@ int_range!(u8, u16, u32, u64, usize, i32, i64);
 /// by name when it lies outside `T`'s range.
 ///
 /// # Errors
-/// `ValueError`: "argument `name` = v is out of range: must be an integer in
-/// [MIN, MAX]".
+/// `ValueError`: "argument `name` = v must be >= MIN and <= MAX".
 pub fn count<T: IntRange>(name: &str, v: impl Into<i128>) -> PyResult<T> {
     let v = v.into();
     T::try_from(v).map_err(|_| {
         PyValueError::new_err(format!(
-            "argument `{name}` = {v} is out of range: must be an integer in [{}, {}]",
+            "argument `{name}` = {v} must be >= {} and <= {}",
             T::MIN,
             T::MAX
         ))
