@@ -6,11 +6,16 @@
 //!   max(8n, 256) sub-intervals (256 at the default n = 20) against 8192;
 //! - `hb string` STHB truncation: N = 5 sine modes and M = 19 harmonics
 //!   against M = 39 (harmonic truncation) and N = 15 (modal truncation),
-//!   compared on the mid-span displacement w(½, t) over one period.
+//!   compared on the mid-span displacement w(½, t) over one period;
+//! - `stability` Chebyshev Tau order N = 16 of the delay loop against N = 64,
+//!   on the max |multiplier| at the default gains.
 
+use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
+use ivt_design::OperatingPoint;
 use ivt_hb::problem::Duffing;
 use ivt_hb::sthb::{StringHb, StringParams};
 use ivt_hb::{c64, HbOptions, HsuRule, ModifiedIhb, StabilityAnalyzer};
+use ivt_kin::plant::PlantParams;
 use std::f64::consts::PI;
 
 /// Floquet multipliers of the default Duffing orbit (Fig. 28 parameters,
@@ -111,9 +116,47 @@ fn default_sthb_truncation_errors() {
             "STHB ω = {omega}: |w(½)| = {amplitude:.4}, M = 19 vs 39: {harmonic:.2e}, N = 5 vs 15: {modal:.2e} (relative)"
         );
         assert!(
-            harmonic <= 1e-9,
+            harmonic <= 1e-10,
             "ω = {omega}: harmonic truncation {harmonic:e}"
         );
-        assert!(modal <= 1e-2, "ω = {omega}: modal truncation {modal:e}");
+        assert!(modal <= 1e-3, "ω = {omega}: modal truncation {modal:e}");
+    }
+}
+
+/// max |multiplier| of the delay loop (Eq. 174–179) at the CLI's default
+/// gains (k = 0.01, k2 = 0.02 mm·rad⁻¹) and 100 rpm with Chebyshev order `n`.
+fn delay_max_multiplier(v_m: f64, t_u: f64, n: usize) -> f64 {
+    let opts = DelayOptions {
+        chebyshev_order: n,
+        ..Default::default()
+    };
+    delay_stability(
+        &PlantParams::printed(),
+        &OperatingPoint::at_100_rpm(v_m, t_u),
+        FeedbackGains::from_thesis_mm_per_rad(0.01, 0.02),
+        &opts,
+    )
+    .unwrap()
+    .max_abs_multiplier
+}
+
+#[test]
+fn default_chebyshev_order_error() {
+    assert_eq!(DelayOptions::default().chebyshev_order, 16);
+    for (v_m, t_u) in [(8.0, 1.5), (11.0, 9.0)] {
+        let default = delay_max_multiplier(v_m, t_u, 16);
+        let fine = delay_max_multiplier(v_m, t_u, 48);
+        let reference = delay_max_multiplier(v_m, t_u, 64);
+        let err = (default - reference).abs();
+        let converged = (fine - reference).abs();
+        eprintln!(
+            "Chebyshev ({v_m} V, {t_u} N·m): max |μ| = {reference:.8}, |N16 − N64| = {err:.2e}, |N48 − N64| = {converged:.2e}"
+        );
+        assert!(err <= 2e-5, "({v_m}, {t_u}): N = 16 off by {err:e}");
+        // The reference is converging: N = 48 lies closer to it than N = 16.
+        assert!(
+            converged < err,
+            "({v_m}, {t_u}): N = 48 off by {converged:e}"
+        );
     }
 }

@@ -66,7 +66,9 @@ impl From<ivt_design::IvtError> for CliError {
         use ivt_design::IvtError as E;
         match e {
             E::Input { .. } | E::Plant(_) | E::EmptyGrid(_) => CliError::Input(e.to_string()),
-            E::Stall { .. } | E::NoConvergence { .. } => CliError::Failed(e.to_string()),
+            E::Stall { .. } | E::NoConvergence { .. } | E::AllFailed { .. } => {
+                CliError::Failed(e.to_string())
+            }
         }
     }
 }

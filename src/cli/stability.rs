@@ -7,7 +7,7 @@ use super::ol::PlantArg;
 use super::{CliError, Output};
 use clap::Args;
 use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
-use ivt_design::gains::stability_map;
+use ivt_design::gains::grid_stability_map;
 use ivt_design::sweep::{axis, Grid};
 use ivt_design::{rpm_to_rad_s, OperatingPoint};
 use serde_json::json;
@@ -164,72 +164,34 @@ pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
     Ok(Output { json, human })
 }
 
-/// `ivt stability-map`.
+/// `ivt stability-map`: [`grid_stability_map`] over the `--vm`/`--tu` grid.
 ///
 /// # Errors
-/// Bad input or an empty grid.
+/// Bad input, an empty grid, or every point failed.
 pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
     let grid = Grid {
         v_m: grid_axis("--vm", &a.vm)?,
         t_u: grid_axis("--tu", &a.tu)?,
         omega0: a.common.omega0()?,
     };
-    grid.validate()?;
     let plant = a.common.plant.preset.params();
-    let mut ops: Vec<OperatingPoint> = grid.operating_points();
-    if a.feasible_only {
-        let pts = ivt_design::sweep::sweep(&plant, &grid, Default::default(), || ())?;
-        ops = pts
-            .iter()
-            .filter(|p| {
-                p.result
-                    .as_ref()
-                    .is_ok_and(|s| (0.0..=plant.r_max).contains(&s.r))
-            })
-            .map(|p| p.op)
-            .collect();
-    }
+    let g = a.common.gains();
     let t0 = std::time::Instant::now();
-    let map = stability_map(&plant, &ops, a.common.gains(), &a.common.opts()?)?;
+    let map = grid_stability_map(&plant, &grid, a.feasible_only, g, &a.common.opts()?)?;
     let dt = t0.elapsed().as_secs_f64();
-    let solved: Vec<f64> = map
-        .iter()
-        .filter_map(|(_, r)| r.as_ref().ok().copied())
-        .collect();
-    if solved.is_empty() {
-        let first = map.iter().find_map(|(_, r)| r.as_ref().err());
-        return Err(CliError::Failed(format!(
-            "every one of the {} points failed (first: {})",
-            map.len(),
-            first.map_or("no reason given", String::as_str)
-        )));
-    }
-    let worst = solved.iter().fold(0.0f64, |m, v| m.max(*v));
-    let failed = map.len() - solved.len();
     let pts: Vec<_> = map
+        .entries
         .iter()
         .map(|(op, r)| match r {
             Ok(m) => json!({"vm": op.v_m, "tu": op.t_u, "max_abs_multiplier": m}),
             Err(e) => json!({"vm": op.v_m, "tu": op.t_u, "error": e}),
         })
         .collect();
-    let json = json!({"points": pts, "worst": worst, "failed": failed, "k_si": a.common.gains().k,
-                      "k2_si": a.common.gains().k2, "solve_time_s": dt,
+    let json = json!({"points": pts, "worst": map.worst, "failed": map.failed, "k_si": g.k,
+                      "k2_si": g.k2, "solve_time_s": dt,
                       "plant": a.common.plant.preset.name()});
     if let Some(path) = &a.plot {
-        let value = |v: f64, t: f64| {
-            map.iter()
-                .find(|(op, _)| (op.v_m - v).abs() < 1e-9 && (op.t_u - t).abs() < 1e-9)
-                .and_then(|(_, r)| r.as_ref().ok().copied())
-        };
-        // Row-major over (T_U, V_m); failed or skipped points are NaN (grey).
-        let values: Vec<f64> = grid
-            .t_u
-            .iter()
-            .flat_map(|&t| grid.v_m.iter().map(move |&v| (v, t)))
-            .map(|(v, t)| value(v, t).unwrap_or(f64::NAN))
-            .collect();
-        let g = a.common.gains();
+        let values = map.values(&grid);
         let title = format!(
             "max |multiplier|, k = {:.3e}, k2 = {:.3e} m·s/rad² (N = {})",
             g.k, g.k2, a.common.n
@@ -247,9 +209,9 @@ pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
     }
     let human = format!(
         "{} points ({} failed), worst max |multiplier| = {:.6}, {:.2} s\n",
-        map.len(),
-        failed,
-        worst,
+        map.entries.len(),
+        map.failed,
+        map.worst,
         dt
     );
     Ok(Output { json, human })

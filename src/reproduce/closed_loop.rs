@@ -37,9 +37,33 @@ macro_rules! shipped_scene {
 }
 pub(super) use shipped_scene;
 
-/// Column `j` of the samples against t, scaled.
-pub(super) fn column(samples: &[[f64; 6]], j: usize, scale: f64) -> Vec<(f64, f64)> {
-    samples.iter().map(|s| (s[0], s[j] * scale)).collect()
+/// A channel of the (t, ω, ω_a, r, V_m, T_U) samples of [`simulate`].
+#[derive(Clone, Copy)]
+pub(super) enum Channel {
+    /// ω_a \[rad/s\].
+    OmegaA,
+    /// r \[m\].
+    R,
+    /// V_m \[V\].
+    VM,
+    /// T_U \[N·m\].
+    TU,
+}
+
+/// One channel of the samples against t, scaled.
+pub(super) fn column(samples: &[[f64; 6]], channel: Channel, scale: f64) -> Vec<(f64, f64)> {
+    samples
+        .iter()
+        .map(|&[t, _omega, omega_a, r, v_m, t_u]| {
+            let y = match channel {
+                Channel::OmegaA => omega_a,
+                Channel::R => r,
+                Channel::VM => v_m,
+                Channel::TU => t_u,
+            };
+            (t, y * scale)
+        })
+        .collect()
 }
 
 /// A Fig. 43 panel: ω_a \[rpm\] of an open-loop and a feedback run after a
@@ -53,10 +77,10 @@ pub(super) fn fig43_panel(
     note: &str,
 ) -> Result<(), ReproError> {
     let (wo, wf) = (
-        column(open.1, 2, RAD_S_TO_RPM),
-        column(feedback.1, 2, RAD_S_TO_RPM),
+        column(open.1, Channel::OmegaA, RAD_S_TO_RPM),
+        column(feedback.1, Channel::OmegaA, RAD_S_TO_RPM),
     );
-    let v = column(feedback.1, 4, 10.0);
+    let v = column(feedback.1, Channel::VM, 10.0);
     ctx.line_figure(
         id,
         &Figure {
@@ -93,7 +117,10 @@ pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
     let nodelay = shipped_scene!("load_step_nodelay").map(|(_, s)| s);
     match (&delay, &nodelay) {
         (Ok(a), Ok(b)) => {
-            let (wa, wb) = (column(a, 2, RAD_S_TO_RPM), column(b, 2, RAD_S_TO_RPM));
+            let (wa, wb) = (
+                column(a, Channel::OmegaA, RAD_S_TO_RPM),
+                column(b, Channel::OmegaA, RAD_S_TO_RPM),
+            );
             ctx.line_figure(
                 "Fig. 44",
                 &Figure {
@@ -105,7 +132,7 @@ pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
                 "scenes load_step_delay/load_step_nodelay, same gain k; the no-delay law keeps a static error in ω_a \
                  (it regulates the θ-mean of ω, not the time mean; crates/ivt-sim/README.md)",
             )?;
-            let (ra, rb) = (column(a, 3, 1e3), column(b, 3, 1e3));
+            let (ra, rb) = (column(a, Channel::R, 1e3), column(b, Channel::R, 1e3));
             ctx.line_figure(
                 "Fig. 45",
                 &Figure {
@@ -127,10 +154,10 @@ pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
     match shipped_scene!("drive").map(|(_, s)| s) {
         Ok(s) => {
             let (w, r, t, v) = (
-                column(&s, 2, RAD_S_TO_RPM),
-                column(&s, 3, 5e3),
-                column(&s, 5, 10.0),
-                column(&s, 4, 10.0),
+                column(&s, Channel::OmegaA, RAD_S_TO_RPM),
+                column(&s, Channel::R, 5e3),
+                column(&s, Channel::TU, 10.0),
+                column(&s, Channel::VM, 10.0),
             );
             ctx.line_figure(
                 "Fig. 51",

@@ -3,7 +3,7 @@
 //! shipped scenes `scenes/ch4_fig43_*.toml` and `scenes/ch4_fig44_*.toml`
 //! (Figs. 43–45 and the claims made about them in §4.3).
 
-use super::closed_loop::{column, fig43_panel, shipped_scene, RAD_S_TO_RPM};
+use super::closed_loop::{column, fig43_panel, shipped_scene, Channel, RAD_S_TO_RPM};
 use super::{fmt_sig, series, Cause, Context, ReproError, Verdict};
 use ivt_plot::{Figure, Style};
 use ivt_sim::run::Summary;
@@ -145,7 +145,10 @@ fn figs_44_45(
         s.settling_time_s
             .map_or("never".into(), |t| format!("{t:.2} s"))
     };
-    let (wd, wn) = (column(d, 2, RAD_S_TO_RPM), column(n, 2, RAD_S_TO_RPM));
+    let (wd, wn) = (
+        column(d, Channel::OmegaA, RAD_S_TO_RPM),
+        column(n, Channel::OmegaA, RAD_S_TO_RPM),
+    );
     ctx.line_figure(
         "Fig. 44 (thesis-ch4)",
         &Figure {
@@ -165,7 +168,7 @@ fn figs_44_45(
             fmt_sig(sn.static_error_rad_s, 2)
         ),
     )?;
-    let (rd, rn) = (column(d, 3, 1e3), column(n, 3, 1e3));
+    let (rd, rn) = (column(d, Channel::R, 1e3), column(n, Channel::R, 1e3));
     ctx.line_figure(
         "Fig. 45 (thesis-ch4)",
         &Figure {

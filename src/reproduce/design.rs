@@ -125,10 +125,11 @@ fn rk4_orbit(
         let seg = segment_of(th + 0.5 * h);
         let mut rhs = |th: f64, w: &[f64], dw: &mut [f64]| {
             let (f, f_theta) = f_on_segment(th, seg);
-            dw[0] = plant
-                .terms_with_f(th, f, f_theta, r, v, t)
-                .acceleration(w[0], r)
-                / w[0];
+            let terms = plant.terms_with_f(th, f, f_theta, r, v, t);
+            // The state is the single ω.
+            for (dw, &w) in dw.iter_mut().zip(w) {
+                *dw = terms.acceleration(w, r) / w;
+            }
         };
         rk.step(&mut rhs, th, h, &mut w);
         out.push((th + h, w[0]));

@@ -64,18 +64,22 @@ impl ArcProfile {
     }
 
     /// Polar radius of the arc chain at ψ \[m\] (linear between samples,
-    /// periodic in 2π).
+    /// periodic in 2π). NaN for a chain without samples.
     pub(crate) fn radius(&self, psi: f64) -> f64 {
-        let (psi, n) = (psi.rem_euclid(2.0 * PI), self.psi.len());
+        let psi = psi.rem_euclid(2.0 * PI);
         let i = self.psi.partition_point(|&p| p <= psi);
-        // Neighbours (index, angle) on either side, wrapping across 0 = 2π.
-        let (lo, hi) = match i {
-            0 => ((n - 1, self.psi[n - 1] - 2.0 * PI), (0, self.psi[0])),
-            _ if i == n => ((n - 1, self.psi[n - 1]), (0, self.psi[0] + 2.0 * PI)),
-            _ => ((i - 1, self.psi[i - 1]), (i, self.psi[i])),
+        let sample = |j: usize| self.psi.get(j).copied().zip(self.rho.get(j).copied());
+        let last = self.psi.len().checked_sub(1).and_then(sample);
+        // Neighbours (angle, radius) on either side, wrapping across 0 = 2π.
+        let lo = match i.checked_sub(1) {
+            Some(j) => sample(j),
+            None => last.map(|(p, r)| (p - 2.0 * PI, r)),
         };
-        let w = (psi - lo.1) / (hi.1 - lo.1);
-        self.rho[lo.0] + w * (self.rho[hi.0] - self.rho[lo.0])
+        let hi = sample(i).or_else(|| sample(0).map(|(p, r)| (p + 2.0 * PI, r)));
+        match lo.zip(hi) {
+            Some(((p0, r0), (p1, r1))) => r0 + (psi - p0) / (p1 - p0) * (r1 - r0),
+            None => f64::NAN,
+        }
     }
 
     /// R_n = ω_NG1/ω_NG2 of a pair whose NG2 (this profile) is the arc chain

@@ -43,7 +43,7 @@ fn median_time(mut f: impl FnMut() -> bool, reps: usize) -> Option<f64> {
         t.push(s.elapsed().as_secs_f64());
     }
     t.sort_by(f64::total_cmp);
-    Some(t[t.len() / 2])
+    t.get(t.len() / 2).copied()
 }
 
 fn duffing(ctx: &mut Context) -> Result<(), ReproError> {
@@ -337,7 +337,10 @@ fn mathieu(ctx: &mut Context) -> Result<(), ReproError> {
         ("Fig. 32", 5.2508, 4),
     ] {
         let (strobe, phase, _) = mathieu_rk(beta, y0, transient, 16, 4);
-        let distinct = distinct_count(&strobe[..8], 1e-3);
+        let first8 = strobe
+            .get(..8)
+            .ok_or_else(|| ReproError::Numeric(format!("{id}: fewer than 8 strobe points")))?;
+        let distinct = distinct_count(first8, 1e-3);
         let title = format!(
             "{id}: Mathieu–Duffing attractor at β = {beta} (RK4, ξ̂ = 0.125, α̂ = 1, Ω = 2, γ = 1)"
         );

@@ -69,12 +69,11 @@ fn plant_rows(ctx: &mut Context) {
 }
 
 fn eq42_rows(ctx: &mut Context) {
-    for k in 1..=4u32 {
-        let printed = EQ42_PRINTED[k as usize - 1];
+    // Half a unit of the last printed digit (0.12 → 0.005, −0.0286 → 5e-5, ...).
+    let halves = [0.005, 5e-5, 5e-5, 5e-4];
+    for ((k, printed), half) in (1..=4u32).zip(EQ42_PRINTED).zip(halves) {
         let exact = fourier_coefficient_eq38(k);
         let quad = fourier_coefficient(&SgivtNcg, k).unwrap_or(f64::NAN);
-        // Half a unit of the last printed digit (0.12 → 0.005, −0.0286 → 5e-5, ...).
-        let half = [0.005, 5e-5, 5e-5, 5e-4][k as usize - 1];
         let why = format!(
             "the printed value is 0.9× the Fourier coefficient of Eq. 38: closed form \
              2(−1)^(k+1)/(16k²−1) = {}, quadrature of Eq. 38 = {} (agree to {:.0e}); \
@@ -203,7 +202,9 @@ fn givt_figures(ctx: &mut Context) -> Result<(), ReproError> {
                 deg,
                 1.0,
             );
-            let m = raw[..n - 1].iter().map(|p| p.1).sum::<f64>() / (n - 1) as f64;
+            // The last sample repeats the first period's start: leave it out.
+            let whole = raw.split_last().map_or(&[][..], |(_, w)| w);
+            let m = whole.iter().map(|p| p.1).sum::<f64>() / whole.len() as f64;
             let with: Vec<(f64, f64)> = raw.iter().map(|&(x, y)| (x, y / m)).collect();
             series_data.push((
                 format!("with gears (r_o = 10 mm), r = {r_mm} mm"),

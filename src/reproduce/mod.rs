@@ -441,9 +441,21 @@ impl Context {
             map.y_label.replace('"', "'"),
             map.value_label.replace('"', "'")
         );
-        for (j, &y) in map.ys.iter().enumerate() {
-            for (i, &x) in map.xs.iter().enumerate() {
-                let v = map.values[j * map.xs.len() + i];
+        if map.values.len() != map.xs.len() * map.ys.len() {
+            return Err(ReproError::Numeric(format!(
+                "{id}: {} map values for a {}×{} grid",
+                map.values.len(),
+                map.xs.len(),
+                map.ys.len()
+            )));
+        }
+        // Row-major: one row of `xs.len()` values per y.
+        for (&y, row) in map
+            .ys
+            .iter()
+            .zip(map.values.chunks_exact(map.xs.len().max(1)))
+        {
+            for (&x, &v) in map.xs.iter().zip(row) {
                 let _ = writeln!(csv, "{x:e},{y:e},{v:e}");
             }
         }

@@ -37,16 +37,14 @@ fn ripple_rms<G: GearRatio>(gear: &G, n: usize) -> f64 {
 }
 
 /// Eq. 188–189 iterated as the rig runs them: ω_{m,k} = K₁V − K₂T θ_k and
-/// θ_{k+1} = θ_k + K(ω_{m,k} − ω_r), with K₂T = `k2t`. Returns ω_{m,0..=steps}.
-fn iterate_loop(k1v: f64, k2t: f64, k: f64, omega_r: f64, theta0: f64, steps: usize) -> Vec<f64> {
+/// θ_{k+1} = θ_k + K(ω_{m,k} − ω_r), with K₂T = `k2t`. Returns ω_{m,0..N}.
+fn iterate_loop<const N: usize>(k1v: f64, k2t: f64, k: f64, omega_r: f64, theta0: f64) -> [f64; N] {
     let mut theta = theta0;
-    let mut out = Vec::with_capacity(steps + 1);
-    for _ in 0..=steps {
+    std::array::from_fn(|_| {
         let w = k1v - k2t * theta;
-        out.push(w);
         theta += k * (w - omega_r);
-    }
-    out
+        w
+    })
 }
 
 /// Eq. 192 with the exponent of the ω_r term as printed (`k`) or `k + 1`.
@@ -60,7 +58,7 @@ fn eq192(omega_0: f64, omega_r: f64, a: f64, k: i32, printed: bool) -> f64 {
 /// from the loop itself, not from the formula |1 − K₂T K| < 1.
 fn stability_bound_by_iteration(k2t: f64) -> f64 {
     let contracts = |k: f64| {
-        let w = iterate_loop(100.0, k2t, k, 60.0, 0.0, 400);
+        let w: [f64; 401] = iterate_loop(100.0, k2t, k, 60.0, 0.0);
         (w[400] - 60.0).abs() < (w[0] - 60.0).abs()
     };
     let (mut lo, mut hi) = (1.0, 1000.0);
@@ -156,7 +154,7 @@ fn gain_rows(ctx: &mut Context) {
         "largest K for which Eq. 188–189 iterated 400 samples contracts (bisection; closed form 2/0.0128 = 156.25)",
         None,
     );
-    let w = iterate_loop(100.0, K2T_FIG50, K_USED, OMEGA_R_RPM, 0.0, 10);
+    let w: [f64; 11] = iterate_loop(100.0, K2T_FIG50, K_USED, OMEGA_R_RPM, 0.0);
     let rate = (w[10] - OMEGA_R_RPM) / (w[9] - OMEGA_R_RPM);
     ctx.compare(
         "error contraction per sample at K = 50",
@@ -170,7 +168,8 @@ fn gain_rows(ctx: &mut Context) {
     );
     // Eq. 192 against the iteration of Eq. 190, at K = 50.
     let a = K2T_FIG50 * K_USED;
-    let (omega_0, k) = (w[0], 5usize);
+    const STEP: usize = 5;
+    let (omega_0, k) = (w[0], STEP);
     let printed = eq192(omega_0, OMEGA_R_RPM, a, k as i32, true);
     let corrected = eq192(omega_0, OMEGA_R_RPM, a, k as i32, false);
     ctx.differs(
@@ -180,7 +179,7 @@ fn gain_rows(ctx: &mut Context) {
         format!(
             "at k = {k}: printed {}, iteration {}",
             fmt_sig(printed, 6),
-            fmt_sig(w[k + 1], 6)
+            fmt_sig(w[STEP + 1], 6)
         ),
         Cause {
             why: &format!(
@@ -188,7 +187,7 @@ fn gain_rows(ctx: &mut Context) {
                  to rounding), as printed it does not, and it fails the k = 0 check ω_m,1 = (1 − a)ω_m,0 + aω_r",
                 fmt_sig(omega_0, 4),
                 k + 1,
-                fmt_sig(w[k + 1], 8),
+                fmt_sig(w[STEP + 1], 8),
                 fmt_sig(corrected, 8)
             ),
             test: "src/reproduce/rig.rs::eq192_needs_exponent_k_plus_1",
@@ -225,13 +224,17 @@ fn drive_test() -> Vec<[f64; 4]> {
 
 fn fig51(ctx: &mut Context) -> Result<(), ReproError> {
     let d = drive_test();
-    let col = |j: usize| -> Vec<(f64, f64)> { d.iter().map(|s| (s[0], s[j])).collect() };
-    let (w, th, load) = (col(1), col(2), col(3));
-    let settled: Vec<String> = (1..STAGES.len() - 1)
-        .map(|s| {
-            let end = d[(s + 1) * STAGE - 1][1];
-            format!("{:.2}", end)
-        })
+    let col = |pick: fn(&[f64; 4]) -> f64| -> Vec<(f64, f64)> {
+        d.iter().map(|s| (s[0], pick(s))).collect()
+    };
+    let (w, th, load) = (col(|s| s[1]), col(|s| s[2]), col(|s| s[3]));
+    // ω_m at the end of each stage but the first and the last.
+    let settled: Vec<String> = d
+        .chunks_exact(STAGE)
+        .skip(1)
+        .take(STAGES.len() - 2)
+        .filter_map(<[_]>::last)
+        .map(|end| format!("{:.2}", end[1]))
         .collect();
     let t_max_table1 = K2T_FIG50 / k2_rpm_per_nm_deg(&PlantParams::printed());
     let t_max_ch4 = K2T_FIG50 / k2_rpm_per_nm_deg(&PlantParams::thesis_ch4());
@@ -285,7 +288,7 @@ mod tests {
     /// Eq. 192 as printed disagrees with iterating Eq. 190; with exponent k+1 it agrees.
     #[test]
     fn eq192_needs_exponent_k_plus_1() {
-        let w = iterate_loop(100.0, K2T_FIG50, K_USED, 60.0, 0.0, 12);
+        let w: [f64; 13] = iterate_loop(100.0, K2T_FIG50, K_USED, 60.0, 0.0);
         let a = K2T_FIG50 * K_USED;
         for k in 0..12 {
             let fixed = eq192(w[0], 60.0, a, k as i32, false);
@@ -299,7 +302,7 @@ mod tests {
     #[test]
     fn bound_and_contraction_of_the_stepper_loop() {
         assert!((stability_bound_by_iteration(K2T_FIG50) - 156.25).abs() < 0.01);
-        let w = iterate_loop(100.0, K2T_FIG50, K_USED, 60.0, 0.0, 10);
+        let w: [f64; 11] = iterate_loop(100.0, K2T_FIG50, K_USED, 60.0, 0.0);
         assert!(((w[10] - 60.0) / (w[9] - 60.0) - 0.36).abs() < 1e-9);
     }
 

@@ -27,11 +27,15 @@ fn curve_points(params: StringParams) -> Result<Points, String> {
     let opts = StringFrcOptions::default();
     let path = trace(&mut hb, FROM, TO, &opts.continuation).map_err(|e| e.to_string())?;
     let n = hb.dim();
-    Ok(path
-        .points
+    path.points
         .iter()
-        .map(|p| (p.lambda(), hb.complex_norm(&p.x[..n])))
-        .collect())
+        .map(|p| {
+            let a =
+                p.x.get(..n)
+                    .ok_or("a continuation point shorter than the STHB unknowns")?;
+            Ok((p.lambda(), hb.complex_norm(a)))
+        })
+        .collect()
 }
 
 /// (all points, unstable points with NaN gaps elsewhere).
@@ -187,7 +191,12 @@ fn fig36(ctx: &mut Context) -> Result<(), ReproError> {
             stability.join("; ")
         ),
     )?;
-    let (fixed, stiff, soft) = (peaks[0], peaks[1], peaks[2]);
+    let &[fixed, stiff, soft, restoring] = peaks.as_slice() else {
+        return Err(ReproError::Numeric(format!(
+            "Fig. 36: {} boundary cases, expected 4",
+            peaks.len()
+        )));
+    };
     let how = "peak of the continuation curve (ω and ‖a‖ at the largest ‖a‖), STHB N = 5, M = 19";
     let stiff_gap = ((stiff.0 - fixed.0) / fixed.0)
         .abs()
@@ -214,7 +223,7 @@ fn fig36(ctx: &mut Context) -> Result<(), ReproError> {
         format!("{:+.3}", shift),
         format!(
             "peak ω {:.4} vs {:.4} (restoring k0 = −10: {:.4})",
-            soft.0, fixed.0, peaks[3].0
+            soft.0, fixed.0, restoring.0
         ),
         if shift.abs() > 1e-2 {
             Verdict::Reproduced

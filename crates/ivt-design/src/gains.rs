@@ -1,9 +1,10 @@
 //! Gain design for the integral time-delay feedback (§4.3): the (k, k2) in a
 //! box that minimise the max |multiplier| at one operating point, and the
-//! worst case over a set of points for given gains.
+//! worst case over a set of points (or a grid) for given gains.
 
 use super::delay::{delay_stability_about, steady_orbit, DelayOptions, FeedbackGains};
-use super::{IvtError, OperatingPoint};
+use super::sweep::{sweep, Grid};
+use super::{check_plant, IvtError, OperatingPoint};
 use ivt_kin::plant::PlantParams;
 use rayon::prelude::*;
 
@@ -106,4 +107,84 @@ pub fn stability_map(
             (*op, r)
         })
         .collect())
+}
+
+/// A stability map over a (V_m, T_U) grid for fixed gains (thesis Fig. 42):
+/// what `ivt stability-map` and `ivt.design.stability_map` report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridMap {
+    /// The points mapped, row by row in T_U (V_m fastest), each with its max
+    /// |multiplier| or why it failed; with `feasible_only`, only the points
+    /// whose r̄ lies in [0, r_max].
+    pub entries: Vec<MapEntry>,
+    /// Largest max |multiplier| over the solved points.
+    pub worst: f64,
+    /// Number of points that failed.
+    pub failed: usize,
+}
+
+impl GridMap {
+    /// The map over `grid` (the grid it was computed on), row-major over
+    /// (T_U, V_m), NaN where a point failed or was skipped: a heat map's values.
+    pub fn values(&self, grid: &Grid) -> Vec<f64> {
+        let mut entries = self.entries.iter().peekable();
+        grid.operating_points()
+            .iter()
+            .map(|op| match entries.next_if(|(e, _)| e == op) {
+                Some((_, Ok(m))) => *m,
+                _ => f64::NAN,
+            })
+            .collect()
+    }
+}
+
+/// Stability (Eq. 174–179) of every point of `grid` for the gains (rayon
+/// across points), or with `feasible_only` of the points whose IHB r̄
+/// (default options) lies in [0, r_max].
+///
+/// # Errors
+/// Bad grid, plant or options; [`IvtError::EmptyGrid`] when no point is
+/// feasible; [`IvtError::AllFailed`] when every point failed (a map of
+/// failures has no worst case to report).
+pub fn grid_stability_map(
+    plant: &PlantParams,
+    grid: &Grid,
+    feasible_only: bool,
+    gains: FeedbackGains,
+    opts: &DelayOptions,
+) -> Result<GridMap, IvtError> {
+    check_plant(plant)?;
+    grid.validate()?;
+    opts.validate()?;
+    let ops: Vec<OperatingPoint> = if feasible_only {
+        sweep(plant, grid, Default::default(), || ())?
+            .into_iter()
+            .filter(|p| {
+                p.result
+                    .as_ref()
+                    .is_ok_and(|s| (0.0..=plant.r_max).contains(&s.r))
+            })
+            .map(|p| p.op)
+            .collect()
+    } else {
+        grid.operating_points()
+    };
+    let entries = stability_map(plant, &ops, gains, opts)?;
+    let solved = entries.iter().filter_map(|(_, r)| r.as_ref().ok());
+    let worst = solved.clone().copied().reduce(f64::max);
+    let failed = entries.len() - solved.count();
+    match worst {
+        Some(worst) => Ok(GridMap {
+            entries,
+            worst,
+            failed,
+        }),
+        None => Err(IvtError::AllFailed {
+            points: entries.len(),
+            first: entries
+                .iter()
+                .find_map(|(_, r)| r.as_ref().err().cloned())
+                .unwrap_or_default(),
+        }),
+    }
 }

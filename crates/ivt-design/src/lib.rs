@@ -165,6 +165,14 @@ pub enum IvtError {
         /// Residual norm after each iteration.
         history: Vec<f64>,
     },
+    /// Every point of a map failed: there is no answer to report.
+    #[error("every one of the {points} points failed (first: {first})")]
+    AllFailed {
+        /// Points attempted.
+        points: usize,
+        /// Why the first one failed.
+        first: String,
+    },
 }
 
 /// Validate the plant once at every public entry point.

@@ -2,6 +2,7 @@
 //! convergence in n and in N, bad inputs.
 
 use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
+use ivt_design::gains::grid_stability_map;
 use ivt_design::shooting::{shoot_steady_state, ShootingOptions};
 use ivt_design::steady::{solve_steady_state, IhbOptions};
 use ivt_design::sweep::{sweep_serial, Grid};
@@ -305,5 +306,61 @@ fn readme_fig42_multipliers() {
             (stated - thesis).abs() > 0.04,
             "{stated} vs thesis {thesis}"
         );
+    }
+}
+
+/// The grid stability map (`ivt stability-map`): every point equals
+/// `delay_stability` there, `values` lays them out row by row in T_U, the
+/// worst case is their maximum; `feasible_only` skips exactly the points the
+/// verdict calls under- or over-drive (NaN in `values`); a map where every
+/// point fails is `AllFailed`, not a worst case of 0.
+#[test]
+fn grid_stability_map_layout_skips_and_failures() {
+    let plant = PlantParams::printed();
+    let g = FeedbackGains::from_thesis_mm_per_rad(2.0, 1.0);
+    let opts = DelayOptions::default();
+    let grid = Grid {
+        v_m: vec![7.0, 8.0, 8.4],
+        t_u: vec![4.0, 6.0],
+        omega0: ivt_design::thesis_omega0(),
+    };
+    let all = grid_stability_map(&plant, &grid, false, g, &opts).unwrap();
+    assert_eq!((all.entries.len(), all.failed), (6, 0));
+    let values = all.values(&grid);
+    for ((op, r), v) in all.entries.iter().zip(&values) {
+        let direct = delay_stability(&plant, op, g, &opts).unwrap();
+        assert_eq!(*r.as_ref().unwrap(), direct.max_abs_multiplier);
+        assert_eq!(*v, direct.max_abs_multiplier);
+    }
+    assert_eq!((all.entries[4].0.v_m, all.entries[4].0.t_u), (8.0, 6.0));
+    assert_eq!(all.worst, values.iter().copied().fold(f64::MIN, f64::max));
+
+    let feasible = grid_stability_map(&plant, &grid, true, g, &opts).unwrap();
+    let keep = |v: f64, t: f64| ihb(v, t, 7) >= 0.0 && ihb(v, t, 7) <= plant.r_max;
+    let expect: Vec<(f64, f64)> = grid
+        .operating_points()
+        .iter()
+        .filter(|op| keep(op.v_m, op.t_u))
+        .map(|op| (op.v_m, op.t_u))
+        .collect();
+    let got: Vec<(f64, f64)> = feasible
+        .entries
+        .iter()
+        .map(|(op, _)| (op.v_m, op.t_u))
+        .collect();
+    assert_eq!(got, expect);
+    assert!(!expect.is_empty() && expect.len() < 6, "{expect:?}");
+    let nan = feasible.values(&grid).iter().filter(|v| v.is_nan()).count();
+    assert_eq!(nan, 6 - expect.len());
+
+    let hopeless = FeedbackGains::from_thesis_mm_per_rad(1e6, 0.02);
+    let one_row = Grid {
+        v_m: vec![8.0, 9.0],
+        t_u: vec![1.5],
+        ..grid
+    };
+    match grid_stability_map(&plant, &one_row, false, hopeless, &opts) {
+        Err(IvtError::AllFailed { points: 2, first }) => assert!(!first.is_empty()),
+        other => panic!("expected AllFailed over 2 points, got {other:?}"),
     }
 }

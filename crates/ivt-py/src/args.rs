@@ -1,37 +1,63 @@
-//! Count arguments (harmonics, samples, grid points, orders, timer ticks):
-//! the bindings take them as `i64` and convert here, so that a negative or
-//! too large value raises a `ValueError` naming the argument (pyo3's unsigned
-//! extraction raises an `OverflowError` that does not name it). Upper limits
-//! of the numerics are checked by the Rust crates, before they allocate.
+//! Integer arguments (harmonics, samples, grid points, orders, timer ticks,
+//! step offsets): the bindings take them through [`int`] (or [`int64`]) and
+//! convert them with [`count`], so that a value outside the Rust type's range
+//! raises a `ValueError` that names the argument and the range, where pyo3's
+//! own conversion raises an `OverflowError` naming neither. Upper limits of
+//! the numerics are checked by the Rust crates, before they allocate.
 
-use pyo3::exceptions::{PyOverflowError, PyValueError};
+use pyo3::exceptions::{PyOverflowError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyBool;
 
-/// `v` as the unsigned type `T` (`usize`, `u32`, `u16`), refused by name
-/// when it is negative or does not fit.
+/// An integer type an argument converts to, with its range.
+pub trait IntRange: TryFrom<i128> {
+    /// Smallest value.
+    const MIN: i128;
+    /// Largest value.
+    const MAX: i128;
+}
+
+macro_rules! int_range {
+    ($($t:ty),*) => {
+        $(impl IntRange for $t {
+            const MIN: i128 = <$t>::MIN as i128;
+            const MAX: i128 = <$t>::MAX as i128;
+        })*
+    };
+}
+int_range!(u8, u16, u32, u64, usize, i32, i64);
+
+/// `v` as the integer type `T` (`usize`, `u32`, `u16`, `i32`, ...), refused
+/// by name when it lies outside `T`'s range.
 ///
 /// # Errors
-/// `ValueError`: "argument `name` = v must be >= 0 and fit in T".
-pub fn count<T: TryFrom<i64>>(name: &str, v: i64) -> PyResult<T> {
+/// `ValueError`: "argument `name` = v must be >= MIN and <= MAX".
+pub fn count<T: IntRange>(name: &str, v: impl Into<i128>) -> PyResult<T> {
+    let v = v.into();
     T::try_from(v).map_err(|_| {
         PyValueError::new_err(format!(
-            "argument `{name}` = {v} must be >= 0 and fit in {}",
-            std::any::type_name::<T>()
+            "argument `{name}` = {v} must be >= {} and <= {}",
+            T::MIN,
+            T::MAX
         ))
     })
 }
 
-/// `from_py_with` of every count argument: a Python int as `i64`. An int
-/// beyond the 64-bit range is a `ValueError` (pyo3 adds the note "while
-/// processing '<argument>'"), not an `OverflowError`.
+/// `from_py_with` of integer arguments: a Python int (not a bool, not a
+/// float) as `i128`, so that [`count`] sees 2⁶³, 2⁶⁴ and negative values and
+/// refuses them by name. pyo3 prefixes a `TypeError` with the argument's name.
 ///
 /// # Errors
-/// `TypeError` for a non-integer, `ValueError` beyond the 64-bit range.
-pub fn int64(ob: &Bound<'_, PyAny>) -> PyResult<i64> {
-    ob.extract::<i64>().map_err(|e| {
+/// `TypeError` for a non-integer or a bool, `ValueError` beyond ±2¹²⁷ (pyo3
+/// adds the note "while processing '<argument>'").
+pub fn int(ob: &Bound<'_, PyAny>) -> PyResult<i128> {
+    if ob.is_instance_of::<PyBool>() {
+        return Err(PyTypeError::new_err("must be an integer, not bool"));
+    }
+    ob.extract::<i128>().map_err(|e| {
         if e.is_instance_of::<PyOverflowError>(ob.py()) {
             PyValueError::new_err(format!(
-                "integer argument {} is outside the 64-bit range",
+                "integer argument {} is out of range",
                 ob.repr().map_or_else(|_| "?".into(), |r| r.to_string())
             ))
         } else {
@@ -40,14 +66,30 @@ pub fn int64(ob: &Bound<'_, PyAny>) -> PyResult<i64> {
     })
 }
 
-/// [`int64`] for an optional argument (None stays None).
+/// [`int`] for an optional argument (None stays None).
 ///
 /// # Errors
-/// As [`int64`].
-pub fn opt_int64(ob: &Bound<'_, PyAny>) -> PyResult<Option<i64>> {
+/// As [`int`].
+pub fn opt_int(ob: &Bound<'_, PyAny>) -> PyResult<Option<i128>> {
     if ob.is_none() {
         Ok(None)
     } else {
-        int64(ob).map(Some)
+        int(ob).map(Some)
     }
+}
+
+/// [`int`] limited to the 64-bit range, for arguments converted later with
+/// [`count`].
+///
+/// # Errors
+/// As [`int`]; `ValueError` beyond the 64-bit range.
+pub fn int64(ob: &Bound<'_, PyAny>) -> PyResult<i64> {
+    let v = int(ob)?;
+    i64::try_from(v).map_err(|_| {
+        PyValueError::new_err(format!(
+            "integer argument {v} is out of range: must be in [{}, {}]",
+            i64::MIN,
+            i64::MAX
+        ))
+    })
 }

@@ -15,7 +15,7 @@ use numpy::{
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
-use crate::args::{count, int64, opt_int64};
+use crate::args::{count, int, opt_int};
 use pyo3::types::PyDict;
 
 fn law_kind(name: &str) -> PyResult<LawKind> {
@@ -176,7 +176,7 @@ fn ticks_from_py(ob: &Bound<'_, PyAny>) -> PyResult<Vec<u32>> {
     if let Ok(a) = ob.cast::<PyArray1<u32>>() {
         return Ok(a.readonly().as_array().to_vec());
     }
-    let as_i64: Vec<i64> = if let Ok(arr) = ob.cast::<PyUntypedArray>() {
+    let ints: Vec<i128> = if let Ok(arr) = ob.cast::<PyUntypedArray>() {
         let kind = arr.dtype().kind();
         if kind == b'f' {
             return whole_ticks(ob);
@@ -191,14 +191,31 @@ fn ticks_from_py(ob: &Bound<'_, PyAny>) -> PyResult<Vec<u32>> {
         let a = cast
             .cast::<PyArray1<i64>>()
             .map_err(|_| PyValueError::new_err("argument `ticks` must be one-dimensional"))?;
-        a.readonly().as_array().to_vec()
+        a.readonly()
+            .as_array()
+            .iter()
+            .map(|&t| i128::from(t))
+            .collect()
     } else {
-        ob.extract().map_err(|_| {
+        let items: Vec<Bound<'_, PyAny>> = ob.extract().map_err(|_| {
             PyTypeError::new_err("argument `ticks` must be an integer array or sequence of ints")
-        })?
+        })?;
+        items
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                int(t).map_err(|e| {
+                    let msg = format!("argument `ticks`[{i}]: {e}");
+                    if e.is_instance_of::<PyTypeError>(ob.py()) {
+                        PyTypeError::new_err(msg)
+                    } else {
+                        PyValueError::new_err(msg)
+                    }
+                })
+            })
+            .collect::<PyResult<_>>()?
     };
-    as_i64
-        .iter()
+    ints.iter()
         .enumerate()
         .map(|(i, &t)| {
             u32::try_from(t).map_err(|_| {
@@ -271,11 +288,11 @@ impl Controller {
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
-        #[pyo3(from_py_with = int64)] ppr: i64,
+        #[pyo3(from_py_with = int)] ppr: i128,
         f_timer_hz: Option<f32>,
         omega0: Option<f32>,
         omega0_rpm: Option<f32>,
-        #[pyo3(from_py_with = opt_int64)] decimation: Option<i64>,
+        #[pyo3(from_py_with = opt_int)] decimation: Option<i128>,
         law: Option<&str>,
         k: Option<f32>,
         k2: Option<f32>,
@@ -284,7 +301,7 @@ impl Controller {
         open_loop: Option<&Bound<'_, PyAny>>,
         feedforward: Option<bool>,
         steps_per_metre: Option<f32>,
-        offset_steps: Option<i32>,
+        #[pyo3(from_py_with = opt_int)] offset_steps: Option<i128>,
         stepper_max_speed: Option<f32>,
         stepper_accel: Option<f32>,
         stall_timeout_s: Option<f32>,
@@ -296,6 +313,8 @@ impl Controller {
     ) -> PyResult<Self> {
         let ppr: usize = count("ppr", ppr)?;
         let decimation: Option<u16> = decimation.map(|d| count("decimation", d)).transpose()?;
+        let offset_steps: Option<i32> =
+            offset_steps.map(|o| count("offset_steps", o)).transpose()?;
         if !SUPPORTED_PPR.contains(&ppr) {
             return Err(PyValueError::new_err(format!(
                 "argument `ppr` = {ppr} has no compiled controller (supported: {SUPPORTED_PPR:?})"
@@ -441,7 +460,11 @@ impl Controller {
     /// is the timer's). Returns the output dict: omega, omega_a, omega_T,
     /// r_ol, r_d, r, stepper_target, saturated, fault (code), fault_name,
     /// ready, inputs_clamped, ol_region.
-    fn on_pulse<'py>(&mut self, py: Python<'py>, ticks: i64) -> PyResult<Bound<'py, PyDict>> {
+    fn on_pulse<'py>(
+        &mut self,
+        py: Python<'py>,
+        #[pyo3(from_py_with = int)] ticks: i128,
+    ) -> PyResult<Bound<'py, PyDict>> {
         let o = self.inner.on_pulse(count("ticks", ticks)?);
         output_dict(py, &o)
     }
@@ -461,7 +484,11 @@ impl Controller {
 
     /// Step-generator tick at timer count `now`: dict with step, forward,
     /// position, next_step_at, moving, fault, fault_name.
-    fn step_tick<'py>(&mut self, py: Python<'py>, now: i64) -> PyResult<Bound<'py, PyDict>> {
+    fn step_tick<'py>(
+        &mut self,
+        py: Python<'py>,
+        #[pyo3(from_py_with = int)] now: i128,
+    ) -> PyResult<Bound<'py, PyDict>> {
         let s = self.inner.step_tick(count("now", now)?);
         let d = PyDict::new(py);
         d.set_item("step", s.step)?;
@@ -503,17 +530,17 @@ impl Controller {
         }
         let inputs = v_m.zip(t_u);
         let inner = &mut self.inner;
-        let outs: Vec<ControlOutput> = py.detach(|| {
-            ticks
+        // `inputs_from_py` checked that both input columns have one entry per tick.
+        let outs: Vec<ControlOutput> = py.detach(|| match &inputs {
+            Some((v, tu)) => ticks
                 .iter()
-                .enumerate()
-                .map(|(i, &t)| {
-                    if let Some((v, tu)) = &inputs {
-                        inner.update_inputs(v[i], tu[i]);
-                    }
+                .zip(v.iter().zip(tu))
+                .map(|(&t, (&v, &tu))| {
+                    inner.update_inputs(v, tu);
                     inner.on_pulse(t)
                 })
-                .collect()
+                .collect(),
+            None => ticks.iter().map(|&t| inner.on_pulse(t)).collect(),
         });
         let d = PyDict::new(py);
         let col_f32 = |f: fn(&ControlOutput) -> f32| -> Bound<'py, PyArray1<f32>> {

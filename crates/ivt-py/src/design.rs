@@ -1,10 +1,12 @@
 //! `ivt.design`: the controller-design tools of ivt-hb (§4.2–4.3): IHB steady
-//! state and open-loop table, delay-loop stability. Keys follow
-//! `ivt ol solve`, `ivt ol table` and `ivt stability` (`--json`).
+//! state and open-loop table, delay-loop stability at a point and over a grid.
+//! Keys follow `ivt ol solve`, `ivt ol table`, `ivt stability` and
+//! `ivt stability-map` (`--json`).
 
-use crate::args::{count, int64};
+use crate::args::{count, int};
 use crate::kin::Plant;
 use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
+use ivt_design::gains::grid_stability_map;
 use ivt_design::polish::{accurate_r, SolveMethod};
 use ivt_design::steady::IhbOptions;
 use ivt_design::sweep::{self, Grid};
@@ -57,7 +59,57 @@ fn operating_point(v_m: f64, t_u: f64, omega0_rpm: f64) -> PyResult<OperatingPoi
     Ok(op)
 }
 
-fn ihb_options(harmonics: i64) -> PyResult<IhbOptions> {
+/// The (V_m, T_U) grid of `(from, step, to)` axes at ω0, validated (each
+/// axis at most `MAX_AXIS_POINTS` values, checked before allocation).
+fn grid_of(v_m: (f64, f64, f64), t_u: (f64, f64, f64), omega0_rpm: f64) -> PyResult<Grid> {
+    if !(omega0_rpm.is_finite() && omega0_rpm > 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "argument `omega0_rpm` = {omega0_rpm} must be finite and > 0"
+        )));
+    }
+    let grid = Grid {
+        v_m: sweep::axis("v_m", v_m.0, v_m.1, v_m.2).map_err(design_err)?,
+        t_u: sweep::axis("t_u", t_u.0, t_u.1, t_u.2).map_err(design_err)?,
+        omega0: rpm_to_rad_s(omega0_rpm),
+    };
+    grid.validate().map_err(design_err)?;
+    Ok(grid)
+}
+
+/// The delay loop of `stability` and `stability_map`: the plant (and the
+/// name the result echoes), the feedback gains (thesis mm·rad⁻¹, or SI with
+/// `si`; refused by name unless finite) and the Chebyshev Tau discretization
+/// of order `n` (validated; the message names `n` and `chebyshev_order`).
+fn delay_loop<'py>(
+    plant: Option<&Bound<'py, PyAny>>,
+    k: f64,
+    k2: f64,
+    si: bool,
+    n: i128,
+) -> PyResult<(PlantParams, &'static str, FeedbackGains, DelayOptions)> {
+    let (params, plant_name) = plant_of(plant)?;
+    for (name, v) in [("k", k), ("k2", k2)] {
+        if !v.is_finite() {
+            return Err(PyValueError::new_err(format!(
+                "argument `{name}` = {v} must be finite"
+            )));
+        }
+    }
+    let gains = if si {
+        FeedbackGains { k, k2 }
+    } else {
+        FeedbackGains::from_thesis_mm_per_rad(k, k2)
+    };
+    let opts = DelayOptions {
+        chebyshev_order: count("n", n)?,
+        ..Default::default()
+    };
+    opts.validate()
+        .map_err(|e| PyValueError::new_err(format!("argument `n`: {e}")))?;
+    Ok((params, plant_name, gains, opts))
+}
+
+fn ihb_options(harmonics: i128) -> PyResult<IhbOptions> {
     Ok(IhbOptions {
         harmonics: count("harmonics", harmonics)?,
         ..Default::default()
@@ -71,7 +123,7 @@ fn design_err(e: IvtError) -> PyErr {
         IvtError::Input { .. } | IvtError::Plant(_) | IvtError::EmptyGrid(_) => {
             PyValueError::new_err(e.to_string())
         }
-        IvtError::Stall { .. } | IvtError::NoConvergence { .. } => {
+        IvtError::Stall { .. } | IvtError::NoConvergence { .. } | IvtError::AllFailed { .. } => {
             PyRuntimeError::new_err(e.to_string())
         }
     }
@@ -96,7 +148,7 @@ fn ol_solve<'py>(
     v_m: f64,
     t_u: f64,
     omega0_rpm: f64,
-    #[pyo3(from_py_with = int64)] harmonics: i64,
+    #[pyo3(from_py_with = int)] harmonics: i128,
     plant: Option<&Bound<'py, PyAny>>,
     method: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -165,22 +217,12 @@ fn ol_table<'py>(
     v_m: (f64, f64, f64),
     t_u: (f64, f64, f64),
     omega0_rpm: f64,
-    #[pyo3(from_py_with = int64)] harmonics: i64,
+    #[pyo3(from_py_with = int)] harmonics: i128,
     plant: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (params, plant_name) = plant_of(plant)?;
     let opts = ihb_options(harmonics)?;
-    if !(omega0_rpm.is_finite() && omega0_rpm > 0.0) {
-        return Err(PyValueError::new_err(format!(
-            "argument `omega0_rpm` = {omega0_rpm} must be finite and > 0"
-        )));
-    }
-    let grid = Grid {
-        v_m: sweep::range(v_m.0, v_m.1, v_m.2),
-        t_u: sweep::range(t_u.0, t_u.1, t_u.2),
-        omega0: rpm_to_rad_s(omega0_rpm),
-    };
-    grid.validate().map_err(design_err)?;
+    let grid = grid_of(v_m, t_u, omega0_rpm)?;
     let pts = py
         .detach(|| sweep::sweep(&params, &grid, opts, || ()))
         .map_err(design_err)?;
@@ -234,29 +276,12 @@ fn stability<'py>(
     k: f64,
     k2: f64,
     si: bool,
-    #[pyo3(from_py_with = int64)] n: i64,
+    #[pyo3(from_py_with = int)] n: i128,
     omega0_rpm: f64,
     plant: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (params, plant_name) = plant_of(plant)?;
     let op = operating_point(v_m, t_u, omega0_rpm)?;
-    for (name, v) in [("k", k), ("k2", k2)] {
-        if !v.is_finite() {
-            return Err(PyValueError::new_err(format!(
-                "argument `{name}` = {v} must be finite"
-            )));
-        }
-    }
-    let gains = if si {
-        FeedbackGains { k, k2 }
-    } else {
-        FeedbackGains::from_thesis_mm_per_rad(k, k2)
-    };
-    let opts = DelayOptions {
-        chebyshev_order: count("n", n)?,
-        ..Default::default()
-    };
-    opts.validate().map_err(design_err)?;
+    let (params, plant_name, gains, opts) = delay_loop(plant, k, k2, si, n)?;
     let t0 = Instant::now();
     let s = py
         .detach(|| delay_stability(&params, &op, gains, &opts))
@@ -270,16 +295,78 @@ fn stability<'py>(
     d.set_item("r_bar", s.orbit.r)?;
     d.set_item("k_si", gains.k)?;
     d.set_item("k2_si", gains.k2)?;
-    d.set_item("chebyshev_order", n)?;
+    d.set_item("chebyshev_order", opts.chebyshev_order)?;
     d.set_item("stable", s.max_abs_multiplier < 1.0)?;
     d.set_item("solve_time_s", dt)?;
     d.set_item("plant", plant_name)?;
     Ok(d)
 }
 
+/// Stability of the time-delay loop over a (V_m, T_U) grid for fixed gains
+/// (thesis Fig. 42; `ivt stability-map`, same defaults). Axes are
+/// `(from, step, to)` at `omega0_rpm`, as in `ol_table`; k, k2, si, n, plant
+/// as in `stability`; `feasible_only` maps only the points whose IHB r̄ lies
+/// in [0, r_max]. Returns the dict of `ivt stability-map --json`: "points"
+/// [{"vm", "tu", "max_abs_multiplier"} or {"vm", "tu", "error"}], "worst",
+/// "failed", "k_si", "k2_si", "solve_time_s", "plant"; plus "v_m", "t_u" (the
+/// axes) and "max_abs_multiplier": an array of shape (len(t_u), len(v_m)),
+/// NaN where a point failed or was skipped. `RuntimeError` when every point
+/// fails. GIL released.
+#[pyfunction]
+#[pyo3(signature = (
+    v_m = (2.0, 0.4, 12.0), t_u = (1.5, 0.5, 9.0), omega0_rpm = 100.0, k = 0.01, k2 = 0.02,
+    si = false, n = 16, plant = None, feasible_only = false
+))]
+#[allow(clippy::too_many_arguments)]
+fn stability_map<'py>(
+    py: Python<'py>,
+    v_m: (f64, f64, f64),
+    t_u: (f64, f64, f64),
+    omega0_rpm: f64,
+    k: f64,
+    k2: f64,
+    si: bool,
+    #[pyo3(from_py_with = int)] n: i128,
+    plant: Option<&Bound<'py, PyAny>>,
+    feasible_only: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let grid = grid_of(v_m, t_u, omega0_rpm)?;
+    let (params, plant_name, gains, opts) = delay_loop(plant, k, k2, si, n)?;
+    let t0 = Instant::now();
+    let map = py
+        .detach(|| grid_stability_map(&params, &grid, feasible_only, gains, &opts))
+        .map_err(design_err)?;
+    let dt = t0.elapsed().as_secs_f64();
+    let points = PyList::empty(py);
+    for (op, r) in &map.entries {
+        let e = PyDict::new(py);
+        e.set_item("vm", op.v_m)?;
+        e.set_item("tu", op.t_u)?;
+        match r {
+            Ok(m) => e.set_item("max_abs_multiplier", m)?,
+            Err(msg) => e.set_item("error", msg)?,
+        }
+        points.append(e)?;
+    }
+    let values = Array2::from_shape_vec((grid.t_u.len(), grid.v_m.len()), map.values(&grid))
+        .map_err(|e| PyRuntimeError::new_err(format!("stability map layout: {e}")))?;
+    let d = PyDict::new(py);
+    d.set_item("points", points)?;
+    d.set_item("worst", map.worst)?;
+    d.set_item("failed", map.failed)?;
+    d.set_item("k_si", gains.k)?;
+    d.set_item("k2_si", gains.k2)?;
+    d.set_item("solve_time_s", dt)?;
+    d.set_item("plant", plant_name)?;
+    d.set_item("v_m", grid.v_m.clone())?;
+    d.set_item("t_u", grid.t_u.clone())?;
+    d.set_item("max_abs_multiplier", values.into_pyarray(py))?;
+    Ok(d)
+}
+
 /// Register `ivt._ivt.design`.
 pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     let m = PyModule::new(parent.py(), "design")?;
-    add_functions!(&m, [ol_solve, ol_table, stability]);
+    add_functions!(&m, [ol_solve, ol_table, stability, stability_map]);
     parent.add_submodule(&m)
 }

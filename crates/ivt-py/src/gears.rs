@@ -1,7 +1,7 @@
 //! `ivt.kin` continued: the GIVT (§2.1) and SGIVT (§2.2) mechanisms, the
 //! noncircular-gear pitch profiles (Eq. 13–17, 38–42) and unit helpers.
 
-use crate::args::int64;
+use crate::args::{count, int};
 use crate::fields::{self, Field};
 use crate::vectorize::{map, map1, map2};
 use ivt_kin::givt::{DirectionMode, DirectionModule, GivtGeometry};
@@ -115,7 +115,7 @@ geometry_class! {
     fn module_corners(&self, r: f64) -> PyResult<Vec<f64>> {
         let mut buf = [0.0; ivt_kin::givt::MAX_CORNERS];
         let n = self.geometry.module_corners(r, &mut buf).map_err(kin_err)?;
-        Ok(buf[..n].to_vec())
+        Ok(buf.iter().take(n).copied().collect())
     }
 
     /// ω_crk/ω_in at zero control speed: 2(r_sun + r_planet)/r_sun (3 in the design).
@@ -203,9 +203,9 @@ geometry_class! {
 fn pitch_profile<'py>(
     py: Python<'py>,
     design: &str,
-    #[pyo3(from_py_with = int64)] points: i64,
+    #[pyo3(from_py_with = int)] points: i128,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let points: usize = crate::args::count("points", points)?;
+    let points: usize = count("points", points)?;
     if !(2..=1_000_000).contains(&points) {
         return Err(PyValueError::new_err(format!(
             "argument `points` = {points} must be in 2..=1000000"
@@ -254,8 +254,8 @@ fn pitch_profile<'py>(
 /// Exact Fourier coefficient a_k of Eq. 38 in R_n = 1 + Σ a_k cos(4kθ):
 /// 2(−1)^(k+1)/(16k² − 1) (k ≥ 1; a_0 = 1).
 #[pyfunction]
-fn fourier_coefficient_eq38(#[pyo3(from_py_with = int64)] k: i64) -> PyResult<f64> {
-    Ok(ncg::fourier_coefficient_eq38(crate::args::count("k", k)?))
+fn fourier_coefficient_eq38(#[pyo3(from_py_with = int)] k: i128) -> PyResult<f64> {
+    Ok(ncg::fourier_coefficient_eq38(count("k", k)?))
 }
 
 /// Ratio of the SGIVT noncircular pair, Eq. 38 (= f(θ) of Eq. 43), or the

@@ -1,5 +1,5 @@
-"""ivt.design against `ivt ol solve`, `ivt ol table` and `ivt stability`
-(same Rust code: equal numbers), and against SPEC §5's averaged power
+"""ivt.design against `ivt ol solve`, `ivt ol table`, `ivt stability` and
+`ivt stability-map` (same Rust code: equal numbers), and against SPEC §5's averaged power
 balance for the feasible band."""
 
 import math
@@ -72,6 +72,51 @@ def test_stability_equals_cli(cli) -> None:  # type: ignore[no-untyped-def]
     for key in ["max_abs_multiplier", "r_bar", "k_si", "k2_si", "stable", "chebyshev_order"]:
         assert got[key] == ref[key], key
     assert got["k_si"] == pytest.approx(2e-3)  # mm·rad⁻¹ → m·s/rad² (ivt-ctrl units)
+
+
+def test_stability_map_equals_cli(cli) -> None:  # type: ignore[no-untyped-def]
+    """Same points, values, worst case and keys as `ivt stability-map --json`
+    (one Rust function behind both, so equal to the last bit); each point
+    equals `design.stability` there, and the array holds the points row by
+    row in T_U."""
+    args = ["--vm", "8", "0.4", "8.8", "--tu", "4", "2", "6", "--k", "2", "--k2", "1"]
+    ref = cli("stability-map", *args)
+    got = design.stability_map(v_m=(8.0, 0.4, 8.8), t_u=(4.0, 2.0, 6.0), k=2.0, k2=1.0)
+    for key in ["worst", "failed", "k_si", "k2_si", "plant"]:
+        assert got[key] == ref[key], key
+    assert set(ref) <= set(got)
+    assert got["points"] == ref["points"]
+    assert got["failed"] == 0 and len(got["points"]) == 3 * 2
+    values = got["max_abs_multiplier"]
+    assert values.shape == (len(got["t_u"]), len(got["v_m"])) == (2, 3)
+    np.testing.assert_array_equal(values.ravel(), [p["max_abs_multiplier"] for p in got["points"]])
+    assert got["worst"] == values.max()
+    p = got["points"][4]  # second row (T_U = 6), second column (V_m = 8.4)
+    assert (p["vm"], p["tu"]) == (8.4, 6.0)
+    assert p["max_abs_multiplier"] == design.stability(8.4, 6.0, k=2.0, k2=1.0)["max_abs_multiplier"]
+
+
+def test_stability_map_feasible_only_and_failures(cli) -> None:  # type: ignore[no-untyped-def]
+    """feasible_only skips the under-drive points (NaN in the array) like
+    `--feasible-only`; a map where every point fails is a RuntimeError (the
+    CLI's `failed`), never a worst case of 0; a step that would allocate
+    without bound is refused by name before allocation."""
+    args = ["--vm", "6", "1", "9", "--tu", "6", "1", "6", "--feasible-only"]
+    ref = cli("stability-map", *args)
+    got = design.stability_map(v_m=(6.0, 1.0, 9.0), t_u=(6.0, 1.0, 6.0), feasible_only=True)
+    assert got["points"] == ref["points"] and got["worst"] == ref["worst"]
+    skipped = np.isnan(got["max_abs_multiplier"]).sum()
+    assert skipped == 4 - len(got["points"]) and skipped >= 1  # 6 V is under-drive (SPEC §5)
+    with pytest.raises(RuntimeError, match="every one of the 2 points failed"):
+        design.stability_map(v_m=(8.0, 1.0, 9.0), t_u=(1.5, 1.0, 1.5), k=1e6)
+    with pytest.raises(ValueError, match="`v_m`"):
+        design.stability_map(v_m=(2.0, 1e-300, 12.0))
+    with pytest.raises(ValueError, match="`t_u`"):
+        design.stability_map(t_u=(9.0, 0.5, 1.5))
+    with pytest.raises(ValueError, match="`k2`"):
+        design.stability_map(k2=float("nan"))
+    with pytest.raises(ValueError, match="`v_m`"):
+        design.ol_table(v_m=(2.0, 1e-300, 12.0))
 
 
 def test_design_errors() -> None:

@@ -1,7 +1,8 @@
 """Controller design from the model (``ivt-hb``'s IVT tools, thesis §4.2–4.3):
 the IHB steady state r̄(V_m, T_U), the open-loop table over a grid, and the
-local stability of the integral time-delay loop. Dict keys follow
-``ivt ol solve``, ``ivt ol table`` and ``ivt stability`` (``--json``).
+stability of the integral time-delay loop at a point and over a grid. Dict
+keys follow ``ivt ol solve``, ``ivt ol table``, ``ivt stability`` and
+``ivt stability-map`` (``--json``).
 
 Every function takes ``plant="printed"`` (Table 1, the default),
 ``plant="thesis-ch4"`` (Table 1 with k_t and k_e divided by 10, the
@@ -12,6 +13,6 @@ from . import _ivt
 from ._reexport import reexport
 
 
-__all__ = ["ol_solve", "ol_table", "stability"]
+__all__ = ["ol_solve", "ol_table", "stability", "stability_map"]
 
 reexport(globals(), _ivt.design, __all__)

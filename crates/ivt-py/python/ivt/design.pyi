@@ -32,3 +32,14 @@ def stability(
     omega0_rpm: float = 100.0,
     plant: Optional[PlantArg] = None,
 ) -> Dict[str, Any]: ...
+def stability_map(
+    v_m: Tuple[float, float, float] = (2.0, 0.4, 12.0),
+    t_u: Tuple[float, float, float] = (1.5, 0.5, 9.0),
+    omega0_rpm: float = 100.0,
+    k: float = 0.01,
+    k2: float = 0.02,
+    si: bool = False,
+    n: int = 16,
+    plant: Optional[PlantArg] = None,
+    feasible_only: bool = False,
+) -> Dict[str, Any]: ...
