@@ -185,26 +185,6 @@ impl Get<'_> {
     }
 }
 
-fn fault_from(code: u8) -> Result<Fault, WireError> {
-    Ok(match code {
-        0 => Fault::None,
-        1 => Fault::Stall,
-        2 => Fault::IntervalTooShort,
-        3 => Fault::InputInvalid,
-        4 => Fault::Config,
-        _ => return Err(WireError::BadValue),
-    })
-}
-
-fn region_from(code: u8) -> Result<OlRegion, WireError> {
-    Ok(match code {
-        0 => OlRegion::Normal,
-        1 => OlRegion::OverDrive,
-        2 => OlRegion::UnderDrive,
-        _ => return Err(WireError::BadValue),
-    })
-}
-
 fn law_code(law: LawKind) -> u8 {
     match law {
         LawKind::Delay => 0,
@@ -439,7 +419,7 @@ impl Reply {
                 p.f32s(&[omega, omega_a, omega_t, r_ol, r_d, r]);
                 p.bytes(&stepper_target.to_le_bytes());
                 let flags = saturated as u8 | (ready as u8) << 1 | (inputs_clamped as u8) << 2;
-                p.bytes(&[flags, fault as u8, ol_region as u8]);
+                p.bytes(&[flags, fault.code(), ol_region.code()]);
                 K_R_OUTPUT
             }
             Reply::Ack => K_R_ACK,
@@ -480,8 +460,8 @@ impl Reply {
                     saturated: flags & 1 != 0,
                     ready: flags & 2 != 0,
                     inputs_clamped: flags & 4 != 0,
-                    fault: fault_from(g.u8())?,
-                    ol_region: region_from(g.u8())?,
+                    fault: Fault::from_code(g.u8()).ok_or(WireError::BadValue)?,
+                    ol_region: OlRegion::from_code(g.u8()).ok_or(WireError::BadValue)?,
                 })
             }
             K_R_ACK => {
