@@ -402,24 +402,13 @@ impl Reply {
                 K_R_HELLO
             }
             Reply::Output(o) => {
-                let ControlOutput {
-                    omega,
-                    omega_a,
-                    omega_t,
-                    r_ol,
-                    r_d,
-                    r,
-                    stepper_target,
-                    saturated,
-                    fault,
-                    ready,
-                    inputs_clamped,
-                    ol_region,
-                } = o;
-                p.f32s(&[omega, omega_a, omega_t, r_ol, r_d, r]);
-                p.bytes(&stepper_target.to_le_bytes());
-                let flags = saturated as u8 | (ready as u8) << 1 | (inputs_clamped as u8) << 2;
-                p.bytes(&[flags, fault.code(), ol_region.code()]);
+                // Every field is written: `decode` builds the struct with all
+                // of them named, so a new field fails to compile there.
+                p.f32s(&[o.omega, o.omega_a, o.omega_t, o.r_ol, o.r_d, o.r]);
+                p.bytes(&o.stepper_target.to_le_bytes());
+                let flags =
+                    o.saturated as u8 | (o.ready as u8) << 1 | (o.inputs_clamped as u8) << 2;
+                p.bytes(&[flags, o.fault.code(), o.ol_region.code()]);
                 K_R_OUTPUT
             }
             Reply::Ack => K_R_ACK,
