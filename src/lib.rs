@@ -5,6 +5,7 @@
 //! |---|---|---|
 //! | [`kin`] | `ivt-kin` | kinematics and plant coefficients (Ch. 2, §4.1; no_std) |
 //! | [`ctrl`] | `ivt-ctrl` | the rig controller (§4.2–4.4; no_std, f32, no heap) |
+//! | [`num`] | `ivt-num` | Runge–Kutta tableaux and stepper, damped Newton, faer LU workspace |
 //! | [`hb`] | `ivt-hb` | periodic orbits: harmonic balance, continuation, Floquet/Hill, STHB (Ch. 3) |
 //! | [`design`] | `ivt-design` | IVT steady state, open-loop law, delay-loop stability (§4.2–4.3) |
 //! | [`sim`] | `ivt-sim` | plant integration, closed loop, scenes, MCAP logs |
@@ -19,6 +20,7 @@ pub use ivt_ctrl as ctrl;
 pub use ivt_design as design;
 pub use ivt_hb as hb;
 pub use ivt_kin as kin;
+pub use ivt_num as num;
 pub use ivt_plot as plot;
 pub use ivt_sim as sim;
 pub use ivt_wire as wire;

@@ -9,6 +9,7 @@
 //! vectors, default 48, and half as many scenes and logs; well under two
 //! minutes together).
 
+use ivt_sim::testing::{listing, scratch_dir};
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use serde_json::Value;
@@ -92,20 +93,9 @@ fn contract(args: &[&str], limit: Duration) -> Result<(i32, Value), String> {
     Ok((code, v))
 }
 
+/// A fresh scratch directory for one test of this file.
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ivt-hardening-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn listing(d: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(d)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
+    scratch_dir(&format!("hardening-{name}"))
 }
 
 /// 200 pulses of a steady 100 rpm at PPR 1200 and 1 MHz.
@@ -461,8 +451,7 @@ proptest! {
         picks in prop::collection::vec((any::<prop::sample::Index>(), value()), 0..4),
     ) {
         let _serial = serial();
-        let dir = std::env::temp_dir().join(format!("ivt-hardening-{}-fuzz", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = tmp("fuzz");
         let log = replay_log(&dir);
         let mut argv: Vec<String> = vec!["--json".into()];
         argv.extend(base.iter().map(|a| if *a == "LOG" { log.clone() } else { (*a).to_string() }));
@@ -653,8 +642,7 @@ proptest! {
         rows in prop::collection::vec(prop::collection::vec(csv_cell(), 1..4), 0..40),
     ) {
         let _serial = serial();
-        let dir = std::env::temp_dir().join(format!("ivt-hardening-{}-csv", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = tmp("csv");
         let log = dir.join("log.csv");
         let body: Vec<String> = rows.iter().map(|r| r.join(",")).collect();
         std::fs::write(&log, format!("{header}\n{}\n", body.join("\n"))).unwrap();

@@ -16,9 +16,7 @@ fn ivt(args: &[&str]) -> (i32, String, String) {
 }
 
 fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("ivt-sim-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    ivt_sim::testing::scratch_dir(&format!("sim-cli-{name}"))
 }
 
 #[test]

@@ -168,7 +168,7 @@ impl<L: ByteSink> TelemetryTx<L> {
             omega_a: out.omega_a,
             r: out.r,
             stepper_position,
-            fault: out.fault as u8,
+            fault: out.fault.code(),
         };
         if let Ok(n) = t.encode(&mut self.buf) {
             self.link.write_all(self.buf.get(..n).unwrap_or(&[]));

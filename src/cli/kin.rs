@@ -3,7 +3,7 @@
 
 use super::{CliError, Output};
 use clap::{Subcommand, ValueEnum};
-use ivt_kin::arcs::{fit_arcs, Arc, ArcFit, ArcOptions, GearProfile, Member};
+use ivt_kin::arcs::{fit_arcs, Arc, ArcOptions, GearProfile, Member};
 use ivt_kin::givt::{DirectionMode, DirectionModule, GivtGeometry, MAX_CORNERS};
 use ivt_kin::ncg::{
     fourier_coefficient, fourier_coefficient_eq38, output_ripple, pitch_profile, GearRatio,
@@ -291,7 +291,7 @@ fn givt_ratio(r_mm: f64, l1_mm: f64, r_output_mm: f64, points: usize) -> Result<
 /// Run `f` with the gear ratio and centre distance of a design.
 fn with_design(
     design: Design,
-    f: impl FnOnce(&dyn DynGear, f64) -> Result<Output, CliError>,
+    f: impl FnOnce(&dyn GearRatio, f64) -> Result<Output, CliError>,
 ) -> Result<Output, CliError> {
     let d_sgivt = SgivtGeometry::prototype().ncg_centre_distance;
     match design {
@@ -304,50 +304,10 @@ fn with_design(
     }
 }
 
-/// Object-safe view of the generic kinematics calls the CLI needs.
-trait DynGear {
-    fn profile(
-        &self,
-        d: f64,
-        out: &mut [PitchPoint],
-    ) -> Result<ivt_kin::ncg::ProfileCheck, KinError>;
-    fn arcs(
-        &self,
-        d: f64,
-        member: Member,
-        o: &ArcOptions,
-        out: &mut [Arc],
-    ) -> Result<ArcFit, KinError>;
-}
-
-impl<G: GearRatio> DynGear for G {
-    fn profile(
-        &self,
-        d: f64,
-        out: &mut [PitchPoint],
-    ) -> Result<ivt_kin::ncg::ProfileCheck, KinError> {
-        pitch_profile(self, d, out)
-    }
-    fn arcs(
-        &self,
-        d: f64,
-        member: Member,
-        o: &ArcOptions,
-        out: &mut [Arc],
-    ) -> Result<ArcFit, KinError> {
-        let prof = GearProfile {
-            gear: self,
-            centre_distance: d,
-            member,
-        };
-        fit_arcs(&prof, o, out)
-    }
-}
-
-fn profile(design: Design, g: &dyn DynGear, d: f64, points: usize) -> Result<Output, CliError> {
+fn profile(design: Design, g: &dyn GearRatio, d: f64, points: usize) -> Result<Output, CliError> {
     check_points(points, 2)?;
     let mut pts = vec![PitchPoint::default(); points];
-    let c = g.profile(d, &mut pts).map_err(kin_err)?;
+    let c = pitch_profile(g, d, &mut pts).map_err(kin_err)?;
     let json = json!({
         "design": design.name(),
         "centre_distance": d,
@@ -379,7 +339,7 @@ fn profile(design: Design, g: &dyn DynGear, d: f64, points: usize) -> Result<Out
 
 fn arcs(
     design: Design,
-    g: &dyn DynGear,
+    g: &dyn GearRatio,
     d: f64,
     tolerance: f64,
     corner_deg: f64,
@@ -402,7 +362,12 @@ fn arcs(
     );
     for (key, member) in [("driven", Member::Driven), ("driving", Member::Driving)] {
         let mut buf = vec![Arc::default(); 1 << 16];
-        let fit = g.arcs(d, member, &opts, &mut buf).map_err(kin_err)?;
+        let prof = GearProfile {
+            gear: g,
+            centre_distance: d,
+            member,
+        };
+        let fit = fit_arcs(&prof, &opts, &mut buf).map_err(kin_err)?;
         let list: Vec<Value> = buf
             .iter()
             .take(fit.count)

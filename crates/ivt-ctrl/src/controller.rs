@@ -34,28 +34,20 @@ use crate::law::{DelayLaw, FeedbackLaw, LawState, NoDelayLaw, NoFeedback, PropLa
 use crate::open_loop::{clamp_f32, OlRegion, OpenLoopCoeffs, REFIT};
 use crate::units;
 
-/// Fault codes (see the module doc for the safe state of each).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-#[repr(u8)]
-pub enum Fault {
-    /// No fault.
-    #[default]
-    None = 0,
-    /// Encoder stalled (no pulse within the timeout).
-    Stall = 1,
-    /// Zero or implausibly short pulse interval; the pulse was ignored.
-    IntervalTooShort = 2,
-    /// NaN/∞ or implausible V_m/T_U reading; it was ignored.
-    InputInvalid = 3,
-    /// Invalid configuration; permanent safe state.
-    Config = 4,
-}
-
-impl Fault {
-    /// The numeric code (`repr(u8)`).
-    #[must_use]
-    pub fn code(self) -> u8 {
-        self as u8
+coded_enum! {
+    /// Fault codes (see the module doc for the safe state of each).
+    pub enum Fault {
+        /// No fault.
+        #[default]
+        None = 0,
+        /// Encoder stalled (no pulse within the timeout).
+        Stall = 1,
+        /// Zero or implausibly short pulse interval; the pulse was ignored.
+        IntervalTooShort = 2,
+        /// NaN/∞ or implausible V_m/T_U reading; it was ignored.
+        InputInvalid = 3,
+        /// Invalid configuration; permanent safe state.
+        Config = 4,
     }
 }
 
@@ -465,19 +457,28 @@ impl<const PPR: usize> Controller<PPR> {
         self.out.r = r;
         self.out.saturated = saturated;
         self.set_target(r);
-        self.out.fault = self.reported_fault(fault);
+        self.out.fault = self.reported_fault(fault, self.held_input_fault());
     }
 
     /// Fault precedence, the one rule every call reports by: the call's own
     /// event (a stall seen by this pulse, a too-short interval, an invalid
-    /// reading just given, a bad config) first; else a held stall; else a
-    /// held invalid reading; else none.
-    fn reported_fault(&self, event: Fault) -> Fault {
+    /// reading just given, a bad config) first; else a held stall; else
+    /// `held`, what the call carries over (a pulse or an input update: a held
+    /// invalid reading, [`Self::held_input_fault`]; a step tick: the last
+    /// call's fault).
+    fn reported_fault(&self, event: Fault, held: Fault) -> Fault {
         if event != Fault::None {
             event
         } else if self.stalled {
             Fault::Stall
-        } else if self.input_fault {
+        } else {
+            held
+        }
+    }
+
+    /// `Fault::InputInvalid` while the last V_m/T_U reading was invalid.
+    fn held_input_fault(&self) -> Fault {
+        if self.input_fault {
             Fault::InputInvalid
         } else {
             Fault::None
@@ -534,7 +535,7 @@ impl<const PPR: usize> Controller<PPR> {
         self.last_raw = ticks;
         if self.skip > 0 {
             self.skip -= 1;
-            self.out.fault = self.reported_fault(event);
+            self.out.fault = self.reported_fault(event, self.held_input_fault());
             return self.out;
         }
         self.skip = self.decimation - 1;
@@ -592,7 +593,7 @@ impl<const PPR: usize> Controller<PPR> {
             Fault::InputInvalid
         };
         if self.stalled {
-            self.out.fault = self.reported_fault(event);
+            self.out.fault = self.reported_fault(event, self.held_input_fault());
         } else {
             self.command(event);
         }
@@ -617,11 +618,7 @@ impl<const PPR: usize> Controller<PPR> {
             next_step_at: d.next_step_at,
             moving: d.moving,
             // A stall detected here or held outranks the last call's fault.
-            fault: if self.stalled {
-                Fault::Stall
-            } else {
-                self.out.fault
-            },
+            fault: self.reported_fault(Fault::None, self.out.fault),
         }
     }
 }

@@ -14,6 +14,9 @@
     )
 )]
 
+#[macro_use]
+mod coded;
+
 pub mod actuator;
 pub mod averager;
 pub mod controller;

@@ -14,7 +14,7 @@
 //! stage points); the mid-step value is the cubic Hermite interpolant of the
 //! step's end values and slopes (error O(h⁴), like the method).
 
-use super::delay::FeedbackGains;
+use super::delay::{DelayStability, FeedbackGains};
 use super::shooting::PeriodicOrbit;
 use super::{check_plant, IvtError, OperatingPoint};
 use core::f64::consts::{FRAC_PI_2, PI};
@@ -199,4 +199,23 @@ pub fn simulate_contraction(
         measured: (late / earlier).powf(1.0 / q as f64),
         error,
     })
+}
+
+/// The independent check of a Floquet prediction (§4.3): simulates the loop
+/// from the steady state `s.orbit` and returns the measured contraction with
+/// its relative gap |measured − max|μ|| / max|μ| to `s.max_abs_multiplier`.
+///
+/// # Errors
+/// As [`simulate_contraction`].
+pub fn check_prediction(
+    plant: &PlantParams,
+    op: &OperatingPoint,
+    gains: FeedbackGains,
+    s: &DelayStability,
+    opts: &DelaySimOptions,
+) -> Result<(Contraction, f64), IvtError> {
+    let c = simulate_contraction(plant, op, gains, &s.orbit, opts)?;
+    let predicted = s.max_abs_multiplier;
+    let gap = (c.measured - predicted).abs() / predicted;
+    Ok((c, gap))
 }

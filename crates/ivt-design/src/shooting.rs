@@ -442,24 +442,4 @@ mod tests {
         assert!(d2 < 1e-11 * c.abs() || d1 / d2 > 30.0, "{d1:e} {d2:e}");
         assert!(d2 < 1e-9 * c.abs(), "{d2:e}");
     }
-
-    #[test]
-    fn nan_and_negative_speed_rejected() {
-        let plant = PlantParams::printed();
-        let opts = ShootingOptions::default();
-        let bad = OperatingPoint::at_100_rpm(f64::NAN, 4.0);
-        assert!(matches!(
-            shoot_steady_state(&plant, &bad, None, &opts),
-            Err(IvtError::Input { name: "v_m", .. })
-        ));
-        let bad = OperatingPoint {
-            v_m: 9.0,
-            t_u: 4.0,
-            omega0: -1.0,
-        };
-        assert!(matches!(
-            shoot_steady_state(&plant, &bad, None, &opts),
-            Err(IvtError::Input { name: "omega0", .. })
-        ));
-    }
 }

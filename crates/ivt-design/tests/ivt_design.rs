@@ -131,23 +131,39 @@ fn stability_converges_in_chebyshev_order() {
     }
 }
 
+/// A steady-state route reduced to the error it reports, if any.
+type Solve<'a> = dyn Fn(&OperatingPoint) -> Option<IvtError> + 'a;
+
+/// Both steady-state routes (IHB and shooting) name the bad input: a NaN
+/// V_m or T_U, a negative speed; so do the grid sweep and the stability.
 #[test]
 fn bad_inputs_give_clear_errors() {
     let plant = PlantParams::printed();
-    let nan_t = OperatingPoint::at_100_rpm(8.0, f64::NAN);
-    assert!(matches!(
-        solve_steady_state(&plant, &nan_t, IhbOptions::default()),
-        Err(IvtError::Input { name: "t_u", .. })
-    ));
-    let neg = OperatingPoint {
-        v_m: 8.0,
-        t_u: 4.0,
-        omega0: -1.0,
+    let ihb = |op: &OperatingPoint| solve_steady_state(&plant, op, IhbOptions::default()).err();
+    let shooting = |op: &OperatingPoint| {
+        shoot_steady_state(&plant, op, None, &ShootingOptions::default()).err()
     };
-    assert!(matches!(
-        solve_steady_state(&plant, &neg, IhbOptions::default()),
-        Err(IvtError::Input { name: "omega0", .. })
-    ));
+    let routes: [&Solve; 2] = [&ihb, &shooting];
+    let bad = [
+        ("v_m", OperatingPoint::at_100_rpm(f64::NAN, 4.0)),
+        ("t_u", OperatingPoint::at_100_rpm(8.0, f64::NAN)),
+        (
+            "omega0",
+            OperatingPoint {
+                omega0: -1.0,
+                ..OperatingPoint::at_100_rpm(8.0, 4.0)
+            },
+        ),
+    ];
+    for (k, solve) in routes.iter().enumerate() {
+        for (name, op) in &bad {
+            let e = solve(op);
+            assert!(
+                matches!(e, Some(IvtError::Input { name: n, .. }) if n == *name),
+                "route {k}, {name}: {e:?}"
+            );
+        }
+    }
     let empty = Grid {
         v_m: vec![],
         ..Grid::thesis()
@@ -194,7 +210,7 @@ fn thesis_grid_solves_everywhere() {
 /// fourth case uses the thesis's 0.01/0.02 (λ ≈ 0.996).
 #[test]
 fn predicted_multiplier_matches_simulated_contraction() {
-    use ivt_design::delay_sim::{simulate_contraction, DelaySimOptions};
+    use ivt_design::delay_sim::{check_prediction, DelaySimOptions};
     let plant = PlantParams::printed();
     let cases = [
         (8.4, 4.0, 1.0, 2.0),
@@ -206,9 +222,7 @@ fn predicted_multiplier_matches_simulated_contraction() {
         let op = OperatingPoint::at_100_rpm(v, t);
         let g = FeedbackGains::from_thesis_mm_per_rad(k, k2);
         let s = delay_stability(&plant, &op, g, &DelayOptions::default()).unwrap();
-        let c =
-            simulate_contraction(&plant, &op, g, &s.orbit, &DelaySimOptions::default()).unwrap();
-        let rel = (c.measured - s.max_abs_multiplier).abs() / s.max_abs_multiplier;
+        let (c, rel) = check_prediction(&plant, &op, g, &s, &DelaySimOptions::default()).unwrap();
         assert!(
             rel < 2e-4,
             "({v},{t}) k={k}: predicted {} simulated {} (relative {rel:.1e})",

@@ -34,7 +34,7 @@ pub enum Member {
 
 /// The pitch curve of one gear as a polar curve r(ψ) in its own angle ψ.
 #[derive(Clone, Copy, Debug)]
-pub struct GearProfile<'a, G> {
+pub struct GearProfile<'a, G: ?Sized> {
     /// The ratio the pair is designed for.
     pub gear: &'a G,
     /// Centre distance D \[m\].
@@ -43,7 +43,7 @@ pub struct GearProfile<'a, G> {
     pub member: Member,
 }
 
-impl<G: GearRatio> GearProfile<'_, G> {
+impl<G: GearRatio + ?Sized> GearProfile<'_, G> {
     /// Driven-gear angle θ₂ that puts the point of polar angle ψ on the line of centres.
     fn theta2(&self, psi: f64) -> Result<f64, KinError> {
         let psi = wrap_2pi(psi);
@@ -295,7 +295,7 @@ pub struct ArcFit {
     pub max_corner_deviation: f64,
 }
 
-struct Fitter<'p, 'o, G> {
+struct Fitter<'p, 'o, G: ?Sized> {
     profile: &'p GearProfile<'p, G>,
     opts: ArcOptions,
     out: &'o mut [Arc],
@@ -304,7 +304,7 @@ struct Fitter<'p, 'o, G> {
     max_corner_dev: f64,
 }
 
-impl<G: GearRatio> Fitter<'_, '_, G> {
+impl<G: GearRatio + ?Sized> Fitter<'_, '_, G> {
     /// Largest relative radial deviation of an arc from the curve (sampled).
     fn deviation(&self, arc: &Arc) -> Result<f64, KinError> {
         let n = self.opts.samples_per_arc.max(2);
@@ -369,7 +369,7 @@ impl<G: GearRatio> Fitter<'_, '_, G> {
 /// Bad options (tolerance or δ not positive, δ larger than a quarter of the
 /// smallest corner spacing), `BufferTooSmall`, or `NotConverged` when a smooth
 /// piece needs more than `max_depth` bisections.
-pub fn fit_arcs<G: GearRatio>(
+pub fn fit_arcs<G: GearRatio + ?Sized>(
     profile: &GearProfile<'_, G>,
     opts: &ArcOptions,
     out: &mut [Arc],

@@ -125,7 +125,7 @@ pub fn fourier_coefficient_eq38(k: u32) -> f64 {
 ///
 /// # Errors
 /// `NotConverged` if the quadrature fails.
-pub fn fourier_coefficient<G: GearRatio>(gear: &G, k: u32) -> Result<f64, KinError> {
+pub fn fourier_coefficient<G: GearRatio + ?Sized>(gear: &G, k: u32) -> Result<f64, KinError> {
     let p = gear.period();
     let w = 2.0 * PI * k as f64 / p;
     let g = |t: f64| gear.ratio(t) * libm::cos(w * t);
@@ -146,7 +146,7 @@ pub fn fourier_coefficient<G: GearRatio>(gear: &G, k: u32) -> Result<f64, KinErr
 ///
 /// # Errors
 /// `n` must be ≥ 2.
-pub fn output_ripple<G: GearRatio>(gear: &G, n: usize) -> Result<(f64, f64), KinError> {
+pub fn output_ripple<G: GearRatio + ?Sized>(gear: &G, n: usize) -> Result<(f64, f64), KinError> {
     if n < 2 {
         return Err(KinError::BufferTooSmall {
             needed: 2,
@@ -166,7 +166,7 @@ pub fn output_ripple<G: GearRatio>(gear: &G, n: usize) -> Result<(f64, f64), Kin
 }
 
 /// ∫_a^b g over [a, b] ⊂ one or more periods, split at the gear's corners.
-fn integrate_pieces<G: GearRatio, F: Fn(f64) -> f64>(
+fn integrate_pieces<G: GearRatio + ?Sized, F: Fn(f64) -> f64>(
     gear: &G,
     g: &F,
     a: f64,
@@ -210,7 +210,7 @@ fn integrate_pieces<G: GearRatio, F: Fn(f64) -> f64>(
 ///
 /// # Errors
 /// θ₂ must be finite and ≥ 0; `NotConverged` if the quadrature fails.
-pub fn driving_angle<G: GearRatio>(gear: &G, theta2: f64) -> Result<f64, KinError> {
+pub fn driving_angle<G: GearRatio + ?Sized>(gear: &G, theta2: f64) -> Result<f64, KinError> {
     let th = in_range("theta2", theta2, 0.0, f64::INFINITY, "theta2 >= 0")?;
     let p = gear.period();
     let whole = libm::floor(th / p);
@@ -232,7 +232,7 @@ pub fn driving_angle<G: GearRatio>(gear: &G, theta2: f64) -> Result<f64, KinErro
 ///
 /// # Errors
 /// φ must be finite and ≥ 0; `NotConverged` if Newton stalls.
-pub fn driven_angle<G: GearRatio>(gear: &G, phi: f64) -> Result<f64, KinError> {
+pub fn driven_angle<G: GearRatio + ?Sized>(gear: &G, phi: f64) -> Result<f64, KinError> {
     let ph = in_range("phi", phi, 0.0, f64::INFINITY, "phi >= 0")?;
     let p = gear.period();
     let per = gear.turns_ratio() * p; // φ advance per period of R_n
@@ -313,7 +313,7 @@ pub struct ProfileCheck {
 ///
 /// # Errors
 /// D finite and > 0; `out.len() >= 2`; `NotConverged` if a quadrature fails.
-pub fn pitch_profile<G: GearRatio>(
+pub fn pitch_profile<G: GearRatio + ?Sized>(
     gear: &G,
     centre_distance: f64,
     out: &mut [PitchPoint],
@@ -420,23 +420,28 @@ impl GivtNcg {
         let th = finite("theta_prime", theta_prime)?;
         Ok(3.0 * self.geometry.module_ratio(3.0 * th, r)? / self.ratio(th))
     }
+
+    /// `scale · module(3θ₂, r_o) / mean R`: R_n (Eq. 13) with `module_ratio`
+    /// and scale 3, dR_n/dθ₂ with `module_ratio_derivative` and scale 9
+    /// (chain rule through θ = 3θ₂).
+    fn of_module(
+        &self,
+        module: fn(&GivtGeometry, f64, f64) -> Result<f64, KinError>,
+        scale: f64,
+        theta2: f64,
+    ) -> f64 {
+        // r_o was validated in `new`; θ finite is the caller's contract.
+        let value = module(&self.geometry, 3.0 * theta2, self.r_o).unwrap_or(f64::NAN);
+        scale * value / self.mean_r
+    }
 }
 
 impl GearRatio for GivtNcg {
     fn ratio(&self, theta2: f64) -> f64 {
-        // r_o was validated in `new`; θ finite is the caller's contract.
-        let r = self
-            .geometry
-            .module_ratio(3.0 * theta2, self.r_o)
-            .unwrap_or(f64::NAN);
-        3.0 * r / self.mean_r
+        self.of_module(GivtGeometry::module_ratio, 3.0, theta2)
     }
     fn ratio_derivative(&self, theta2: f64) -> f64 {
-        let d = self
-            .geometry
-            .module_ratio_derivative(3.0 * theta2, self.r_o)
-            .unwrap_or(f64::NAN);
-        9.0 * d / self.mean_r
+        self.of_module(GivtGeometry::module_ratio_derivative, 9.0, theta2)
     }
     fn period(&self) -> f64 {
         MODULE_PERIOD / 3.0

@@ -10,6 +10,8 @@
 //!   is how stable and unstable branches are drawn as separate pieces.
 //! - [`heat_map`]: a value on a rectangular grid (e.g. a stability map).
 
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::{register_font, FontStyle};
 use std::path::{Path, PathBuf};
@@ -100,6 +102,51 @@ fn finite_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// A chart on a bitmap with f64 axes.
+type Chart<'r, 'p> =
+    ChartContext<'r, BitMapBackend<'p>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// The frame every figure kind shares: caption, margins, axis ranges and
+/// labelled axes.
+struct Frame<'a> {
+    title: &'a str,
+    caption_px: u32,
+    y_label_area: u32,
+    x: (f64, f64),
+    y: (f64, f64),
+    x_label: &'a str,
+    y_label: &'a str,
+    /// Draw the mesh (grid) lines.
+    grid: bool,
+}
+
+impl Frame<'_> {
+    /// Builds the chart on `root` and draws its axes.
+    fn draw<'r, 'p>(
+        &self,
+        root: &'r DrawingArea<BitMapBackend<'p>, Shift>,
+        err: impl Fn(&dyn std::fmt::Display) -> PlotError,
+    ) -> Result<Chart<'r, 'p>, PlotError> {
+        let mut chart = ChartBuilder::on(root)
+            .caption(self.title, ("sans-serif", self.caption_px))
+            .margin(12)
+            .x_label_area_size(48)
+            .y_label_area_size(self.y_label_area)
+            .build_cartesian_2d(self.x.0..self.x.1, self.y.0..self.y.1)
+            .map_err(|e| err(&e))?;
+        let mut mesh = chart.configure_mesh();
+        if !self.grid {
+            mesh.disable_mesh();
+        }
+        mesh.x_desc(self.x_label)
+            .y_desc(self.y_label)
+            .label_style(("sans-serif", 15))
+            .draw()
+            .map_err(|e| err(&e))?;
+        Ok(chart)
+    }
+}
+
 /// Split a point list at non-finite points into drawable pieces.
 fn pieces(points: &[(f64, f64)]) -> impl Iterator<Item = &[(f64, f64)]> {
     points
@@ -118,24 +165,19 @@ pub fn line_plot(path: &Path, figure: &Figure<'_>) -> Result<(), PlotError> {
         msg: e.to_string(),
     };
     let all = || figure.series.iter().flat_map(|s| s.points.iter());
-    let (x0, x1) = finite_range(all().map(|p| p.0));
-    let (y0, y1) = finite_range(all().map(|p| p.1));
     let root = BitMapBackend::new(path, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(figure.title, ("sans-serif", 24))
-        .margin(12)
-        .x_label_area_size(48)
-        .y_label_area_size(80)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(|e| err(&e))?;
-    chart
-        .configure_mesh()
-        .x_desc(figure.x_label)
-        .y_desc(figure.y_label)
-        .label_style(("sans-serif", 15))
-        .draw()
-        .map_err(|e| err(&e))?;
+    let mut chart = Frame {
+        title: figure.title,
+        caption_px: 24,
+        y_label_area: 80,
+        x: finite_range(all().map(|p| p.0)),
+        y: finite_range(all().map(|p| p.1)),
+        x_label: figure.x_label,
+        y_label: figure.y_label,
+        grid: true,
+    }
+    .draw(&root, err)?;
     let mut legend = false;
     for (i, series) in figure.series.iter().enumerate() {
         let color = PALETTE[i % PALETTE.len()];
@@ -231,29 +273,23 @@ pub fn heat_map(path: &Path, map: &HeatMap<'_>) -> Result<(), PlotError> {
     );
     let root = BitMapBackend::new(path, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
-    let (x0, x1) = (
-        map.xs[0] - half(map.xs, 0),
-        map.xs[nx - 1] + half(map.xs, nx - 1),
-    );
-    let (y0, y1) = (
-        map.ys[0] - half(map.ys, 0),
-        map.ys[ny - 1] + half(map.ys, ny - 1),
-    );
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 20))
-        .margin(12)
-        .x_label_area_size(48)
-        .y_label_area_size(70)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(|e| err(&e))?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc(map.x_label)
-        .y_desc(map.y_label)
-        .label_style(("sans-serif", 15))
-        .draw()
-        .map_err(|e| err(&e))?;
+    let mut chart = Frame {
+        title: &title,
+        caption_px: 20,
+        y_label_area: 70,
+        x: (
+            map.xs[0] - half(map.xs, 0),
+            map.xs[nx - 1] + half(map.xs, nx - 1),
+        ),
+        y: (
+            map.ys[0] - half(map.ys, 0),
+            map.ys[ny - 1] + half(map.ys, ny - 1),
+        ),
+        x_label: map.x_label,
+        y_label: map.y_label,
+        grid: false,
+    }
+    .draw(&root, err)?;
     let cells = (0..ny).flat_map(|j| (0..nx).map(move |i| (i, j)));
     chart
         .draw_series(cells.map(|(i, j)| {

@@ -133,26 +133,11 @@ pub fn on_interrupt() -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn dir(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("ivt-atomic-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        d
-    }
-
-    fn listing(d: &Path) -> Vec<String> {
-        let mut v: Vec<String> = std::fs::read_dir(d)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .collect();
-        v.sort();
-        v
-    }
+    use crate::testing::{listing, scratch_dir};
 
     #[test]
     fn commit_renames_and_drop_leaves_the_directory_as_it_was() {
-        let d = dir("commit");
+        let d = scratch_dir("atomic-commit");
         std::fs::write(d.join("keep.csv"), "old").unwrap();
         {
             let mut s = Staged::new();

@@ -16,6 +16,8 @@ pub mod scene;
 pub mod sensors;
 pub mod steady;
 pub mod telemetry;
+#[doc(hidden)]
+pub mod testing;
 pub mod work_precision;
 
 pub use error::SimError;

@@ -185,26 +185,6 @@ impl Get<'_> {
     }
 }
 
-fn fault_from(code: u8) -> Result<Fault, WireError> {
-    Ok(match code {
-        0 => Fault::None,
-        1 => Fault::Stall,
-        2 => Fault::IntervalTooShort,
-        3 => Fault::InputInvalid,
-        4 => Fault::Config,
-        _ => return Err(WireError::BadValue),
-    })
-}
-
-fn region_from(code: u8) -> Result<OlRegion, WireError> {
-    Ok(match code {
-        0 => OlRegion::Normal,
-        1 => OlRegion::OverDrive,
-        2 => OlRegion::UnderDrive,
-        _ => return Err(WireError::BadValue),
-    })
-}
-
 fn law_code(law: LawKind) -> u8 {
     match law {
         LawKind::Delay => 0,
@@ -422,24 +402,13 @@ impl Reply {
                 K_R_HELLO
             }
             Reply::Output(o) => {
-                let ControlOutput {
-                    omega,
-                    omega_a,
-                    omega_t,
-                    r_ol,
-                    r_d,
-                    r,
-                    stepper_target,
-                    saturated,
-                    fault,
-                    ready,
-                    inputs_clamped,
-                    ol_region,
-                } = o;
-                p.f32s(&[omega, omega_a, omega_t, r_ol, r_d, r]);
-                p.bytes(&stepper_target.to_le_bytes());
-                let flags = saturated as u8 | (ready as u8) << 1 | (inputs_clamped as u8) << 2;
-                p.bytes(&[flags, fault as u8, ol_region as u8]);
+                // Every field is written: `decode` builds the struct with all
+                // of them named, so a new field fails to compile there.
+                p.f32s(&[o.omega, o.omega_a, o.omega_t, o.r_ol, o.r_d, o.r]);
+                p.bytes(&o.stepper_target.to_le_bytes());
+                let flags =
+                    o.saturated as u8 | (o.ready as u8) << 1 | (o.inputs_clamped as u8) << 2;
+                p.bytes(&[flags, o.fault.code(), o.ol_region.code()]);
                 K_R_OUTPUT
             }
             Reply::Ack => K_R_ACK,
@@ -480,8 +449,8 @@ impl Reply {
                     saturated: flags & 1 != 0,
                     ready: flags & 2 != 0,
                     inputs_clamped: flags & 4 != 0,
-                    fault: fault_from(g.u8())?,
-                    ol_region: region_from(g.u8())?,
+                    fault: Fault::from_code(g.u8()).ok_or(WireError::BadValue)?,
+                    ol_region: OlRegion::from_code(g.u8()).ok_or(WireError::BadValue)?,
                 })
             }
             K_R_ACK => {

@@ -8,8 +8,7 @@
 #![no_main]
 
 use cortex_m_rt::entry;
-use ivt_ctrl::Config;
-use ivt_firmware::app::{ivt_fw_pulse, take_controller, PPR};
+use ivt_firmware::app::{ivt_fw_pulse, PPR};
 use ivt_firmware::board::qemu;
 use ivt_firmware::stack;
 
@@ -26,11 +25,7 @@ pub fn ivt_fw_canary(table: &[u32; 4], i: usize) -> u32 {
 
 #[entry]
 fn main() -> ! {
-    stack::paint();
-    let ctrl = match take_controller(Config::default()) {
-        Some(c) => c,
-        None => qemu::exit(false),
-    };
+    let ctrl = qemu::boot();
     let table = [1, 2, 3, 4];
     let i = core::hint::black_box(2usize);
     let canary = ivt_fw_canary(&table, i);

@@ -6,18 +6,13 @@
 #![no_main]
 
 use cortex_m_rt::entry;
-use ivt_ctrl::Config;
-use ivt_firmware::app::{take_controller, PilServer, Session, TelemetryTx};
+use ivt_firmware::app::{PilServer, Session, TelemetryTx};
 use ivt_firmware::board::qemu::{self, CmsdkUart};
 use ivt_firmware::stack;
 
 #[entry]
 fn main() -> ! {
-    stack::paint();
-    let ctrl = match take_controller(Config::default()) {
-        Some(c) => c,
-        None => qemu::exit(false),
-    };
+    let ctrl = qemu::boot();
     let mut pil = CmsdkUart::new(CmsdkUart::UART0);
     pil.enable_rx_wakeup();
     let mut telemetry = TelemetryTx::new(CmsdkUart::new(CmsdkUart::UART1));

@@ -1,6 +1,9 @@
 //! QEMU `mps2-an386` board layer: CMSDK APB UART0 and semihosting.
 
+use crate::app::{take_controller, Ctrl};
+use crate::stack;
 use cortex_m_semihosting::{debug, hprintln};
+use ivt_ctrl::Config;
 
 /// CMSDK APB UART (ARM DDI 0479, §4.3): DATA, STATE, CTRL, INTSTATUS, BAUDDIV.
 pub struct CmsdkUart {
@@ -94,6 +97,17 @@ pub fn exit(ok: bool) -> ! {
     });
     loop {
         cortex_m::asm::wfi();
+    }
+}
+
+/// Start of a QEMU image: paints the stack (for [`stack::high_water`]) and
+/// takes the controller with the default configuration; exits QEMU with a
+/// failure if it was taken already.
+pub fn boot() -> &'static mut Ctrl {
+    stack::paint();
+    match take_controller(Config::default()) {
+        Some(c) => c,
+        None => exit(false),
     }
 }
 

@@ -85,17 +85,17 @@ pub struct OpenLoopCoeffs {
     pub t_u_range: [f32; 2],
 }
 
-/// Which branch of Eq. 160 produced `u_ol`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-#[repr(u8)]
-pub enum OlRegion {
-    /// `0 ≤ r_f ≤ r_max`, `f_B ≤ 0`: the polynomial value.
-    #[default]
-    Normal = 0,
-    /// `f_B > 0` or `r_f > r_max`: u_ol = r_max, the speed will exceed ω0.
-    OverDrive = 1,
-    /// `r_f < 0`: the target speed is not reachable even at r = 0.
-    UnderDrive = 2,
+coded_enum! {
+    /// Which branch of Eq. 160 produced `u_ol`.
+    pub enum OlRegion {
+        /// `0 ≤ r_f ≤ r_max`, `f_B ≤ 0`: the polynomial value.
+        #[default]
+        Normal = 0,
+        /// `f_B > 0` or `r_f > r_max`: u_ol = r_max, the speed will exceed ω0.
+        OverDrive = 1,
+        /// `r_f < 0`: the target speed is not reachable even at r = 0.
+        UnderDrive = 2,
+    }
 }
 
 /// Result of evaluating the open-loop law.

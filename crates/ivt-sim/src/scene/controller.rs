@@ -71,66 +71,38 @@ impl From<OpenLoopLaw> for OpenLoopPreset {
 
 /// `[controller]`.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct ControllerSection {
     /// `"delay"` (Eq. 180), `"nodelay"` (Eq. 181), `"prop"` (Eq. 189),
     /// `"open"` (u_ol only, Eq. 160) or `"none"` (r from `r_schedule`, no controller).
-    #[serde(default)]
     pub law: Law,
     /// Target ω0 \[rpm\].
-    #[serde(default = "default_omega0")]
     pub omega0_rpm: f64,
     /// k of Eq. 180/181 in the thesis's "mm·rad⁻¹" (ivt-ctrl `units`: ×1e-3 → m·s/rad²).
-    #[serde(default = "default_k")]
     pub k_mm_per_rad: f64,
     /// k2 of Eq. 180/181 in "mm·rad⁻¹".
-    #[serde(default = "default_k2")]
     pub k2_mm_per_rad: f64,
     /// K of Eq. 189 \[deg of stepper per rpm\].
-    #[serde(default = "default_k_prop")]
     pub k_prop_deg_per_rpm: f64,
     /// Sample period of Eq. 189 \[s\].
-    #[serde(default = "default_prop_period")]
     pub prop_period_s: f64,
     /// Add u_ol (Eq. 160) to r.
-    #[serde(default = "default_true")]
     pub feedforward: bool,
     /// Open-loop coefficients: `"refit"` (default) or `"thesis"`.
-    #[serde(default)]
     pub open_loop: OpenLoopLaw,
     /// r(t) for `law = "none"`: `[[t, r], ...]` \[s, m\].
-    #[serde(default)]
     pub r_schedule: Vec<[f64; 2]>,
-}
-
-fn default_omega0() -> f64 {
-    100.0
-}
-fn default_k() -> f64 {
-    1.0
-}
-fn default_k2() -> f64 {
-    2.0
-}
-fn default_k_prop() -> f64 {
-    50.0
-}
-fn default_prop_period() -> f64 {
-    0.1
-}
-fn default_true() -> bool {
-    true
 }
 
 impl Default for ControllerSection {
     fn default() -> Self {
         Self {
             law: Law::default(),
-            omega0_rpm: default_omega0(),
-            k_mm_per_rad: default_k(),
-            k2_mm_per_rad: default_k2(),
-            k_prop_deg_per_rpm: default_k_prop(),
-            prop_period_s: default_prop_period(),
+            omega0_rpm: 100.0,
+            k_mm_per_rad: 1.0,
+            k2_mm_per_rad: 2.0,
+            k_prop_deg_per_rpm: 50.0,
+            prop_period_s: 0.1,
             feedforward: true,
             open_loop: OpenLoopLaw::default(),
             r_schedule: vec![],
@@ -152,11 +124,7 @@ impl ControllerSection {
         ] {
             Invalid::check(v.is_finite(), key, || format!("must be finite, got {v}"))?;
         }
-        Invalid::check(
-            self.prop_period_s.is_finite() && self.prop_period_s > 0.0,
-            "controller.prop_period_s",
-            || format!("must be > 0 s, got {}", self.prop_period_s),
-        )?;
+        Invalid::positive(self.prop_period_s, "controller.prop_period_s", " s")?;
         if self.law == Law::None {
             Invalid::check(!self.r_schedule.is_empty(), "controller.r_schedule", || {
                 "is required when law = \"none\"".into()
@@ -172,53 +140,35 @@ impl ControllerSection {
 /// `[metrics]`: how the summary is measured on ω_a (exact, from the
 /// simulated pulse times).
 #[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct MetricsSection {
     /// Metrics use t ≥ from_s only \[s\] (at or past `duration_s` the
     /// window is empty and the summary's metrics are null with a reason).
-    #[serde(default)]
     pub from_s: f64,
     /// Settling band, relative to ω0.
-    #[serde(default = "default_band")]
     pub band: f64,
     /// Static error = mean(ω_a − ω0) over the last `static_window_s` \[s\].
-    #[serde(default = "default_static_window")]
     pub static_window_s: f64,
-}
-
-fn default_band() -> f64 {
-    0.02
-}
-fn default_static_window() -> f64 {
-    2.0
 }
 
 impl Default for MetricsSection {
     fn default() -> Self {
         Self {
             from_s: 0.0,
-            band: default_band(),
-            static_window_s: default_static_window(),
+            band: 0.02,
+            static_window_s: 2.0,
         }
     }
 }
 
 impl MetricsSection {
     pub(super) fn validate(&self) -> Result<(), Invalid> {
-        Invalid::check(
-            self.from_s.is_finite() && self.from_s >= 0.0,
-            "metrics.from_s",
-            || format!("must be ≥ 0 s, got {}", self.from_s),
-        )?;
+        Invalid::non_negative(self.from_s, "metrics.from_s", " s")?;
         Invalid::check(
             self.band.is_finite() && self.band > 0.0 && self.band < 1.0,
             "metrics.band",
             || format!("must be in (0, 1), got {}", self.band),
         )?;
-        Invalid::check(
-            self.static_window_s.is_finite() && self.static_window_s > 0.0,
-            "metrics.static_window_s",
-            || format!("must be > 0 s, got {}", self.static_window_s),
-        )
+        Invalid::positive(self.static_window_s, "metrics.static_window_s", " s")
     }
 }

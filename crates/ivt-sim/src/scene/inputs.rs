@@ -37,14 +37,11 @@ pub struct InitialSection {
 
 impl InitialSection {
     pub(super) fn validate(&self, r_max: f64) -> Result<(), Invalid> {
-        let nonneg = |x: f64| x.is_finite() && x >= 0.0;
         Invalid::check(self.theta.is_finite(), "initial.theta", || {
             format!("must be finite, got {}", self.theta)
         })?;
-        Invalid::check(nonneg(self.omega), "initial.omega", || {
-            format!("must be finite and ≥ 0, got {}", self.omega)
-        })?;
-        Invalid::check(nonneg(self.r) && self.r <= r_max, "initial.r", || {
+        Invalid::non_negative(self.omega, "initial.omega", "")?;
+        Invalid::check((0.0..=r_max).contains(&self.r), "initial.r", || {
             format!("must be in [0, r_max = {r_max}] m, got {}", self.r)
         })
     }

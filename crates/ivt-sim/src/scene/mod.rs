@@ -70,6 +70,29 @@ impl Invalid {
             Err(Self::new(key, message()))
         }
     }
+
+    /// `value` must be finite and > 0 (`unit` follows the bound in the message).
+    fn positive(value: f64, key: &str, unit: &str) -> Result<(), Self> {
+        Self::check(value.is_finite() && value > 0.0, key, || {
+            format!("must be finite and > 0{unit}, got {value}")
+        })
+    }
+
+    /// `value` must be finite, > 0 and ≤ `max`.
+    fn positive_at_most(value: f64, max: f64, key: &str, unit: &str) -> Result<(), Self> {
+        Self::check(
+            value.is_finite() && value > 0.0 && value <= max,
+            key,
+            || format!("must be in (0, {max}]{unit}, got {value}"),
+        )
+    }
+
+    /// `value` must be finite and ≥ 0 (`unit` follows the bound in the message).
+    fn non_negative(value: f64, key: &str, unit: &str) -> Result<(), Self> {
+        Self::check(value.is_finite() && value >= 0.0, key, || {
+            format!("must be finite and ≥ 0{unit}, got {value}")
+        })
+    }
 }
 
 /// The whole scene file.

@@ -86,41 +86,29 @@ pub const DEFAULT_MAX_BYTES: f64 = 1e9;
 
 /// `[outputs]`: only what is named here is computed and written.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct OutputsSection {
     /// Write `<name>.mcap` with the channels.
-    #[serde(default)]
     pub mcap: bool,
     /// Write one `<name>_<channel>.csv` per channel.
-    #[serde(default)]
     pub csv: bool,
     /// Write `<name>_summary.json`.
-    #[serde(default)]
     pub summary: bool,
     /// Plots to draw into `<name>.png`, one panel each: any of [`PLOTS`].
-    #[serde(default)]
     pub plots: Vec<String>,
     /// Logged channel groups.
-    #[serde(default)]
     pub channels: Vec<ChannelSpec>,
     /// Ask for the steady-state metrics at the scene's (constant) inputs:
     /// mean speed ω_a, min/max ω over a revolution, the r held, r̄ and the
     /// feasibility verdict (see [`crate::steady`]).
-    #[serde(default)]
     pub steady_state: bool,
     /// How the scene is answered: `"auto"` (default), `"ihb_steady_state"`
     /// or `"time_integration"` (forced).
-    #[serde(default)]
     pub route: RouteRequest,
     /// Largest estimated size of the recorded channels \[bytes\]
     /// ([`super::Scene::estimated_output_bytes`]); a scene above it is
     /// refused before it runs.
-    #[serde(default = "default_max_bytes")]
     pub max_bytes: f64,
-}
-
-fn default_max_bytes() -> f64 {
-    DEFAULT_MAX_BYTES
 }
 
 impl Default for OutputsSection {
@@ -168,10 +156,6 @@ impl OutputsSection {
                 || format!("\"{}\" is listed twice", ch.name),
             )?;
         }
-        Invalid::check(
-            self.max_bytes.is_finite() && self.max_bytes > 0.0,
-            "outputs.max_bytes",
-            || format!("must be finite and > 0, got {}", self.max_bytes),
-        )
+        Invalid::positive(self.max_bytes, "outputs.max_bytes", "")
     }
 }

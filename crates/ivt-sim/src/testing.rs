@@ -1,0 +1,38 @@
+//! Test support shared by this crate's tests and the workspace's CLI tests:
+//! fresh scratch directories and sorted directory listings (used to prove
+//! that an atomic write left nothing behind).
+//!
+//! Not part of the simulator's API; these helpers panic on I/O errors,
+//! which is what a test wants.
+
+use std::path::{Path, PathBuf};
+
+/// A fresh, empty directory `ivt-{name}-{pid}` under the system temporary
+/// directory (removed first if a previous run left it).
+///
+/// # Panics
+/// If the directory cannot be created.
+pub fn scratch_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("ivt-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("create scratch directory");
+    d
+}
+
+/// The file names in `dir`, sorted.
+///
+/// # Panics
+/// If `dir` cannot be read.
+pub fn listing(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .expect("read directory")
+        .map(|e| {
+            e.expect("read directory entry")
+                .file_name()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .collect();
+    v.sort();
+    v
+}
