@@ -16,8 +16,8 @@
 
 use crate::broyden::SolveError;
 use crate::ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual};
-use crate::linalg::norm2;
 use crate::problem::PeriodicProblem;
+use ivt_num::vector::norm2;
 use ivt_num::LuWorkspace;
 
 /// A one-parameter family of square systems `R(q, λ) = 0` with `∂R/∂q`.
