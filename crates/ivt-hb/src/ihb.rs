@@ -13,7 +13,6 @@ use crate::aft::Aft;
 use crate::broyden::{BroydenOptions, BroydenStats};
 pub(crate) use crate::error::HbError;
 use crate::problem::PeriodicProblem;
-use ivt_num::LuWorkspace;
 
 /// Options of the IHB solvers.
 ///
@@ -440,8 +439,6 @@ impl HbResidual {
         let bs = 2 * nd;
         let mut blk = vec![0.0; bs * bs];
         let mut inv = vec![0.0; bs * bs];
-        // The mean block (h = 0) is n_dof × n_dof, every harmonic's 2·n_dof.
-        let (mut lu_mean, mut lu_harmonic) = (LuWorkspace::new(nd), LuWorkspace::new(bs));
         let mut idx = vec![0usize; bs];
         let mut ok = true;
         for h in 0..=n {
@@ -458,13 +455,7 @@ impl HbResidual {
                     blk[i * size + j] = b0[idx[i] * len + idx[j]];
                 }
             }
-            let lu = if h == 0 {
-                &mut lu_mean
-            } else {
-                &mut lu_harmonic
-            };
-            if lu.factor_row_major(&blk[..size * size]) && lu.inverse_into(&mut inv[..size * size])
-            {
+            if ivt_num::small::inverse(&blk[..size * size], size, &mut inv[..size * size]) {
                 for i in 0..size {
                     for j in 0..size {
                         h0[idx[i] * len + idx[j]] = inv[i * size + j];
