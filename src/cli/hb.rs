@@ -156,7 +156,9 @@ fn hb_err(e: ivt_hb::HbError) -> CliError {
         ivt_hb::HbError::Solve(s) => {
             CliError::Failed(format!("{s}; ‖r‖ history {:?}", s.history()))
         }
-        e @ ivt_hb::HbError::Continuation(_) => CliError::Failed(e.to_string()),
+        e @ (ivt_hb::HbError::ContinuationStart { .. } | ivt_hb::HbError::SingularStart { .. }) => {
+            CliError::Failed(e.to_string())
+        }
         other => CliError::Input(other.to_string()),
     }
 }

@@ -18,10 +18,10 @@ use crate::broyden::{BroydenStats, SolveError};
 use crate::continuation::{pseudo_arclength, ContinuationOptions, Termination};
 use crate::floquet::HsuRule;
 use crate::ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution};
-use crate::linalg::norm2;
 use crate::problem::PeriodicProblem;
 use crate::stability::{classify, StabilityAnalyzer, StabilityKind};
 use faer::c64;
+use ivt_num::vector::norm2;
 use ivt_num::LuWorkspace;
 
 /// A converged limit cycle.
@@ -65,7 +65,7 @@ pub struct LimitCycleBranch {
 /// `family(μ)` must build an autonomous problem of the same size for every μ.
 ///
 /// # Errors
-/// [`HbError::InvalidInput`] for sizes or bounds, [`HbError::Continuation`]
+/// [`HbError::InvalidInput`] for sizes or bounds, [`HbError::ContinuationStart`]
 /// when the start does not converge; trouble later on ends the branch with a
 /// [`Termination`].
 pub fn limit_cycle_branch<P, F>(

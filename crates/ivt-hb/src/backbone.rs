@@ -87,7 +87,7 @@ fn add_unfolding(mass: &[f64], nd: usize, n: usize, q: &[f64], kappa_omega: f64,
 ///
 /// # Errors
 /// [`HbError::InvalidInput`] for sizes, a zero reference entry of `mode`, bad
-/// amplitudes, or a problem with damping or excitation; [`HbError::Continuation`] when the start does not converge.
+/// amplitudes, or a problem with damping or excitation; [`HbError::ContinuationStart`] when the start does not converge.
 pub fn backbone<P: PeriodicProblem>(
     problem: &P,
     hb: &HbOptions,

@@ -27,10 +27,10 @@ use crate::family::{Family, FamilyBranch};
 use crate::floquet::{eigenvalues, monodromy_uniform, HsuRule};
 use crate::fold::{null_vector, Branch};
 use crate::ihb::HbError;
-use crate::linalg::norm2;
 use crate::stability::StabilityAnalyzer;
 use faer::c64;
 use ivt_num::lu::solve_once;
+use ivt_num::vector::norm2;
 use ivt_num::LuWorkspace;
 use thiserror::Error;
 

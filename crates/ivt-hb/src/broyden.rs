@@ -17,7 +17,8 @@
 //! the line search fails, a refresh of `B` by the system's Jacobian (or by forward
 //! finite differences when the system has none).
 
-use crate::linalg::{axpy, dot, invert, norm2};
+use ivt_num::vector::{axpy, dot, norm2};
+use ivt_num::LuWorkspace;
 use thiserror::Error;
 
 /// A nonlinear system `F(x) = 0` with as many equations as unknowns.
@@ -104,6 +105,12 @@ pub struct BroydenStats {
 }
 
 /// Why a solve failed; every variant carries the residual-norm history.
+///
+/// Kept apart from [`crate::HbError`] (which nests it as `HbError::Solve` by
+/// `#[from]`) because it is also a record, not only an error: a path that ends
+/// because its step fell below the minimum keeps the last corrector failure in
+/// [`crate::Termination::StepTooSmall`], and the Broyden and fold iterations
+/// report it without a frequency or problem to attach.
 #[derive(Debug, Clone, Error, PartialEq)]
 pub enum SolveError {
     /// The tolerance was not reached within `max_iter` steps or after the
@@ -209,8 +216,8 @@ pub struct BroydenWorkspace {
     u: Vec<f64>,
     hu: Vec<f64>,
     sth: Vec<f64>,
-    lu: Vec<f64>,
-    piv: Vec<usize>,
+    /// Factor of `B` or `H` when one is inverted from the other.
+    lu: LuWorkspace,
     history: Vec<f64>,
 }
 
@@ -235,8 +242,7 @@ impl BroydenWorkspace {
             u: vec![0.0; m],
             hu: vec![0.0; m],
             sth: vec![0.0; m],
-            lu: vec![0.0; m * m],
-            piv: vec![0; m],
+            lu: LuWorkspace::new(m),
             history: Vec::with_capacity(256),
         }
     }
@@ -364,8 +370,7 @@ impl BroydenWorkspace {
         if self.b_current {
             return;
         }
-        let m = self.m;
-        if invert(&self.h, m, &mut self.b, &mut self.lu, &mut self.piv).is_err() {
+        if !invert(&mut self.lu, &self.h, &mut self.b) {
             self.b.fill(f64::NAN);
         }
         self.b_current = true;
@@ -399,8 +404,7 @@ impl BroydenWorkspace {
     fn invert_b(&mut self) -> Result<(), SolveError> {
         self.b_current = true;
         self.dx_next_ready = false;
-        self.has_jacobian =
-            invert(&self.b, self.m, &mut self.h, &mut self.lu, &mut self.piv).is_ok();
+        self.has_jacobian = invert(&mut self.lu, &self.b, &mut self.h);
         if self.has_jacobian {
             Ok(())
         } else {
@@ -509,6 +513,18 @@ impl BroydenWorkspace {
 /// Copies the `m×m` matrix `from` into `to` (`m²` entries).
 ///
 /// # Errors
+/// `out = a⁻¹` (row-major) through `lu`; `false` only if the inverse is not
+/// finite (an exactly zero pivot or a poisoned matrix). A badly conditioned
+/// `B` is inverted all the same: Broyden's approximations are often poorly
+/// conditioned in strongly nonlinear solves, and their quasi-Newton steps stay
+/// useful there (the line search and the refresh policy judge them).
+fn invert(lu: &mut LuWorkspace, a: &[f64], out: &mut [f64]) -> bool {
+    // The factor's own verdict (pivots above n·ε of the largest) is stricter
+    // than this solver needs; only a non-finite inverse is refused.
+    let _well_conditioned = lu.factor_row_major(a);
+    lu.inverse_into(out)
+}
+
 /// [`SolveError::Dimension`] if the lengths differ.
 fn copy_square(from: &[f64], to: &mut [f64]) -> Result<(), SolveError> {
     if from.len() != to.len() {

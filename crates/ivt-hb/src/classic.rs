@@ -5,8 +5,8 @@
 
 use crate::broyden::{BroydenStats, SolveError};
 use crate::ihb::{validate_omega, GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution};
-use crate::linalg::matvec;
 use crate::problem::PeriodicProblem;
+use ivt_num::vector::matvec;
 use ivt_num::{newton, NewtonOptions, NewtonSystem, NewtonWorkspace};
 use std::convert::Infallible;
 

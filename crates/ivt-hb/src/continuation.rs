@@ -11,8 +11,9 @@
 //! component marks a fold (turning point).
 
 use crate::broyden::{broyden_solve, BroydenOptions, BroydenWorkspace, SolveError};
-use crate::linalg::{dot, lu_factor, lu_solve, norm2};
-use thiserror::Error;
+use crate::error::HbError;
+use ivt_num::vector::{dot, norm2};
+use ivt_num::LuWorkspace;
 
 mod exact;
 pub use exact::{pseudo_arclength_exact, PathSystem};
@@ -113,18 +114,9 @@ pub struct Path {
     pub termination: Termination,
 }
 
-/// The start point could not be used.
-#[derive(Debug, Clone, Error, PartialEq)]
-pub enum ContinuationError {
-    /// The start point did not converge at fixed λ.
-    #[error("start point does not converge: {0}")]
-    Start(SolveError),
-    /// The tangent at the start is undefined (singular `∂R/∂q`).
-    #[error("singular Jacobian at the start point")]
-    SingularStart,
-    /// Bad sizes or non-finite inputs.
-    #[error("invalid input: {0}")]
-    Input(&'static str),
+/// The error of a start point or step that is not finite.
+fn non_finite_start() -> HbError {
+    HbError::InvalidInput("continuation: non-finite start or step".into())
 }
 
 /// Traces the solution path of `residual` from `start` (`m+1` entries, λ last; it is
@@ -134,7 +126,9 @@ pub enum ContinuationError {
 /// returns `false` to stop.
 ///
 /// # Errors
-/// [`ContinuationError`] if the start cannot be converged or has no tangent;
+/// [`HbError::ContinuationStart`] if the start cannot be converged,
+/// [`HbError::SingularStart`] if it has no tangent, [`HbError::InvalidInput`]
+/// for bad sizes or non-finite inputs;
 /// trouble later on ends the path with a [`Termination`] instead.
 pub fn pseudo_arclength<R, C>(
     mut residual: R,
@@ -143,21 +137,21 @@ pub fn pseudo_arclength<R, C>(
     direction: f64,
     opts: &ContinuationOptions,
     mut on_point: C,
-) -> Result<Path, ContinuationError>
+) -> Result<Path, HbError>
 where
     R: FnMut(&[f64], &mut [f64]),
     C: FnMut(&PathPoint) -> bool,
 {
     let n1 = start.len();
     if n1 < 2 {
-        return Err(ContinuationError::Input(
-            "need at least one unknown and the parameter",
+        return Err(HbError::InvalidInput(
+            "continuation needs at least one unknown and the parameter".into(),
         ));
     }
     if !start.iter().all(|v| v.is_finite())
         || opts.ds.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
     {
-        return Err(ContinuationError::Input("non-finite start or step"));
+        return Err(non_finite_start());
     }
     let m = n1 - 1;
     // Jacobian estimate J (m × (m+1)).
@@ -183,7 +177,11 @@ where
     };
     match jac0 {
         Some(j) if j.len() == m * n1 => jac.copy_from_slice(j),
-        Some(_) => return Err(ContinuationError::Input("jac0 must be m×(m+1)")),
+        Some(_) => {
+            return Err(HbError::InvalidInput(
+                "continuation: jac0 must be m×(m+1)".into(),
+            ))
+        }
         None => fd_jac(&mut residual, &xp, &mut jac),
     }
     // Correct the start at fixed λ.
@@ -203,22 +201,32 @@ where
             xfull[m] = lam0;
             residual(&xfull, r);
         };
-        broyden_solve(&mut fixed, &mut q, &mut wsq, &opts.broyden)
-            .map_err(ContinuationError::Start)?;
+        broyden_solve(&mut fixed, &mut q, &mut wsq, &opts.broyden).map_err(|cause| {
+            HbError::ContinuationStart {
+                lambda: lam0,
+                cause,
+            }
+        })?;
     }
     xp[..m].copy_from_slice(&q);
     for i in 0..m {
         jac[i * n1..i * n1 + m].copy_from_slice(&wsq.jacobian()[i * m..(i + 1) * m]);
     }
     // Tangent at the start: B_q z = B_λ, t = [−z; 1].
-    let mut lu = bq;
+    let mut lu = LuWorkspace::new(m);
     for i in 0..m {
-        lu[i * m..(i + 1) * m].copy_from_slice(&jac[i * n1..i * n1 + m]);
+        for j in 0..m {
+            lu.mat[(i, j)] = jac[i * n1 + j];
+        }
     }
-    let mut piv = vec![0; m];
-    lu_factor(&mut lu, m, &mut piv).map_err(|_| ContinuationError::SingularStart)?;
+    // A start near a fold has an ill-conditioned B_q and still a tangent: only
+    // a non-finite solution (an exactly singular B_q) is refused.
+    lu.factor();
     let mut z: Vec<f64> = (0..m).map(|i| jac[i * n1 + m]).collect();
-    lu_solve(&lu, m, &piv, &mut z);
+    lu.solve(&mut z);
+    if !z.iter().all(|v| v.is_finite()) {
+        return Err(HbError::SingularStart { lambda: lam0 });
+    }
     let mut xd: Vec<f64> = z.iter().map(|v| -v).chain(std::iter::once(1.0)).collect();
     let nt = norm2(&xd);
     let sign = if direction >= 0.0 { 1.0 } else { -1.0 };

@@ -203,17 +203,10 @@ impl PeriodicProblem for ElementProblem {
     fn velocity_dependent(&self) -> bool {
         self.elements.iter().any(|e| e.law.velocity_dependent())
     }
-    fn nonlinear_jacobian(
-        &self,
-        x: &[f64],
-        v: &[f64],
-        _theta: f64,
-        dg_dx: &mut [f64],
-        dg_dv: &mut [f64],
-    ) {
+    fn nonlinear_jacobian(&self, x: &[f64], v: &[f64], _theta: f64, dg: &mut [f64]) {
         let n = self.n;
-        dg_dx.fill(0.0);
-        dg_dv.fill(0.0);
+        dg.fill(0.0);
+        let (dg_dx, dg_dv) = dg.split_at_mut(n * n);
         for e in &self.elements {
             let (_, fx, fv) = e.law.eval(Self::relative(e, x), Self::relative(e, v));
             // δ = x_a − x_b: ∂g_a/∂x_a = F', ∂g_a/∂x_b = −F', ∂g_b = −∂g_a.
@@ -268,8 +261,9 @@ mod tests {
         let eye = vec![1.0, 0.0, 0.0, 1.0];
         let p = ElementProblem::new(2, [eye.clone(), eye.clone(), eye], elements, vec![]).unwrap();
         let (x, v) = ([0.9, -0.35], [0.3, -0.4]);
-        let (mut jx, mut jv) = ([0.0; 4], [0.0; 4]);
-        p.nonlinear_jacobian(&x, &v, 0.0, &mut jx, &mut jv);
+        let mut dg = [0.0; 8];
+        p.nonlinear_jacobian(&x, &v, 0.0, &mut dg);
+        let (jx, jv) = dg.split_at(4);
         let h = 1e-6;
         let (mut gp, mut gm) = ([0.0; 2], [0.0; 2]);
         for j in 0..2 {

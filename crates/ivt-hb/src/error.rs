@@ -1,9 +1,8 @@
-//! The crate's error type. The solver-level outcomes of Broyden
-//! ([`SolveError`]) and of the path followers ([`ContinuationError`]) nest in it
-//! by `#[from]`, so a failed path or solve keeps its residual history.
+//! The crate's error type. The outcome of a failed Broyden solve
+//! ([`SolveError`]) nests in it by `#[from]`, so a failed path or solve keeps its
+//! residual history.
 
 use crate::broyden::SolveError;
-use crate::continuation::ContinuationError;
 use thiserror::Error;
 
 /// Errors of the harmonic-balance engine, its AFT, Hill's method and STHB.
@@ -34,9 +33,20 @@ pub enum HbError {
     /// A limit-cycle iteration collapsed onto the equilibrium `x = 0`.
     #[error("the iteration collapsed onto the equilibrium x = 0 (no limit cycle near the guess)")]
     Equilibrium,
-    /// A continuation could not start (its first point or tangent failed).
-    #[error("continuation: {0}")]
-    Continuation(#[from] ContinuationError),
+    /// A path's first point did not converge at its fixed parameter.
+    #[error("continuation start at λ = {lambda} does not converge: {cause}")]
+    ContinuationStart {
+        /// Path parameter of the start.
+        lambda: f64,
+        /// The corrector's failure (with its residual history).
+        cause: SolveError,
+    },
+    /// A path has no tangent at its start (singular `∂R/∂q` there).
+    #[error("continuation start at λ = {lambda}: singular Jacobian, no tangent")]
+    SingularStart {
+        /// Path parameter of the start.
+        lambda: f64,
+    },
     /// A Newton iteration at a fixed frequency did not reach the tolerance.
     #[error("{method} did not converge at omega = {omega}: residual norms {history:?}")]
     NoConvergence {

@@ -111,8 +111,7 @@ pub fn trace<F: Family>(
         opts.lambda_to - lambda0,
         &copts,
         |_| true,
-    )
-    .map_err(HbError::from)?;
+    )?;
     let mut mono = Monodromy::new(branch, lambda0, opts.stability_steps)?;
     let mut points = Vec::with_capacity(path.points.len());
     let mut bp_signs = Vec::with_capacity(path.points.len());

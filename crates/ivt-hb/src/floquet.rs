@@ -207,21 +207,31 @@ pub fn eigenvalues(a: &[f64], dim: usize) -> Vec<c64> {
     ev
 }
 
-/// Sorts complex numbers by decreasing modulus, then by imaginary part (stable
-/// order for comparisons between methods). The modulus is compared to 10
-/// significant digits: the two members of a conjugate pair have equal moduli,
-/// and rounding must not decide which comes first.
+/// Relative difference below which two moduli count as equal in
+/// [`sort_by_modulus`]. The two members of a conjugate pair have equal moduli up
+/// to the eigensolver's rounding (a few ε), and no multiplier of this crate is
+/// more accurate than 1e-10 (Hsu, Hill and the monodromy integrations are
+/// 1e-12…1e-6 accurate), so moduli within 1e-10 are equal to every method's
+/// accuracy: ordering them by imaginary part gives the same order for the same
+/// multipliers computed by different methods.
+pub const MODULUS_TIE: f64 = 1e-10;
+
+/// Sorts complex numbers by decreasing modulus; each run of neighbours whose
+/// moduli agree within [`MODULUS_TIE`] (relative) is then ordered by increasing
+/// imaginary part, so a conjugate pair comes out as (a − ib, a + ib) whatever
+/// its rounding.
 pub fn sort_by_modulus(v: &mut [c64]) {
-    let key = |z: &c64| {
-        let r = z.norm();
-        if r > 0.0 && r.is_finite() {
-            let scale = 10f64.powi(9 - r.log10().floor() as i32);
-            (r * scale).round() / scale
-        } else {
-            r
+    v.sort_by(|a, b| b.norm().total_cmp(&a.norm()));
+    let mut start = 0;
+    while start < v.len() {
+        let mut end = start + 1;
+        while end < v.len() && v[end - 1].norm() - v[end].norm() <= MODULUS_TIE * v[end - 1].norm()
+        {
+            end += 1;
         }
-    };
-    v.sort_by(|a, b| key(b).total_cmp(&key(a)).then(a.im.total_cmp(&b.im)));
+        v[start..end].sort_by(|a, b| a.im.total_cmp(&b.im));
+        start = end;
+    }
 }
 
 #[cfg(test)]
@@ -239,6 +249,28 @@ mod tests {
         for (o, w) in out.iter().zip(want) {
             assert!((o - w).abs() < 1e-14, "{o} vs {w}");
         }
+    }
+
+    #[test]
+    fn modulus_ties_are_ordered_by_imaginary_part() {
+        // A conjugate pair whose moduli differ in the last bits, a real
+        // multiplier between two runs, and a second pair 2e-6 apart in angle.
+        let pair = c64::new(0.3, 0.4);
+        let nudged = c64::new(0.3 * (1.0 + 4.0 * f64::EPSILON), -0.4);
+        let mut v = [
+            c64::new(0.1, 0.0),
+            pair,
+            c64::new(0.2, 1e-6),
+            nudged,
+            c64::new(0.9, 0.0),
+            c64::new(0.2, -1e-6 * (1.0 + 1e-6)),
+        ];
+        sort_by_modulus(&mut v);
+        assert_eq!(v[0], c64::new(0.9, 0.0));
+        assert_eq!((v[1], v[2]), (nudged, pair), "{v:?}");
+        assert_eq!(v[5], c64::new(0.1, 0.0));
+        // 0.2 ± 1e-6 i: moduli equal within 1e-10, so −i first.
+        assert!(v[3].im < 0.0 && v[4].im > 0.0, "{v:?}");
     }
 
     #[test]

@@ -16,8 +16,8 @@
 
 use crate::broyden::SolveError;
 use crate::ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual};
-use crate::linalg::norm2;
 use crate::problem::PeriodicProblem;
+use ivt_num::vector::norm2;
 use ivt_num::LuWorkspace;
 
 /// A one-parameter family of square systems `R(q, λ) = 0` with `∂R/∂q`.
@@ -315,20 +315,22 @@ struct Bordered {
 }
 
 impl Bordered {
-    /// Assembles `J` at `(q, λ)` and solves `[[J, b], [cᵀ, 0]] [v; g] = e` and
-    /// `[[Jᵀ, c], [bᵀ, 0]] [w; g] = e`; returns `g` (NaN if singular), `J` stays
-    /// in `self.jac`.
+    /// Assembles `J` at `(q, λ)` (unless `self.jac` already holds it) and solves
+    /// `[[J, b], [cᵀ, 0]] [v; g] = e` and `[[Jᵀ, c], [bᵀ, 0]] [w; g] = e`;
+    /// returns `g` (NaN if singular), `J` stays in `self.jac`.
     fn solve_pair<B: Branch>(
         &mut self,
         branch: &mut B,
-        q: &[f64],
-        lambda: f64,
+        (q, lambda): (&[f64], f64),
+        jac_current: bool,
         v: &mut [f64],
         w: &mut [f64],
     ) -> f64 {
         let m = self.m;
         let n1 = m + 1;
-        branch.jacobian(q, lambda, &mut self.jac);
+        if !jac_current {
+            branch.jacobian(q, lambda, &mut self.jac);
+        }
         for i in 0..m {
             self.big[i * n1..i * n1 + m].copy_from_slice(&self.jac[i * m..(i + 1) * m]);
             self.big[i * n1 + m] = self.b[i];
@@ -435,7 +437,8 @@ pub fn locate_fold<B: Branch>(
     let mut history = Vec::with_capacity(opts.max_iter + 1);
     for it in 0..=opts.max_iter {
         branch.residual(&q, lambda, &mut r);
-        let g = bd.solve_pair(branch, &q, lambda, &mut v, &mut w);
+        // The first step's J is the one the borders came from.
+        let g = bd.solve_pair(branch, (&q, lambda), it == 0, &mut v, &mut w);
         let norm = (norm2(&r).powi(2) + g * g).sqrt();
         history.push(norm);
         if !norm.is_finite() {
@@ -544,14 +547,8 @@ mod tests {
             f[0] = th.cos();
             f[1] = 0.0;
         }
-        fn nonlinear_jacobian(
-            &self,
-            x: &[f64],
-            v: &[f64],
-            th: f64,
-            dg_dx: &mut [f64],
-            dg_dv: &mut [f64],
-        ) {
+        fn nonlinear_jacobian(&self, x: &[f64], v: &[f64], th: f64, dg: &mut [f64]) {
+            let (dg_dx, dg_dv) = dg.split_at_mut(4);
             dg_dx.copy_from_slice(&[
                 1.5 * x[0] * x[0] + 0.2 * x[0] * v[1],
                 0.2 * th.sin(),

@@ -12,7 +12,6 @@
 use crate::aft::Aft;
 use crate::broyden::{BroydenOptions, BroydenStats};
 pub(crate) use crate::error::HbError;
-use crate::linalg::invert;
 use crate::problem::PeriodicProblem;
 
 /// Options of the IHB solvers.
@@ -292,12 +291,12 @@ impl HbResidual {
         omega: f64,
         scratch: &mut [f64],
     ) -> f64 {
-        let forcing = crate::linalg::norm2(&self.exc);
+        let forcing = ivt_num::vector::norm2(&self.exc);
         if forcing > 0.0 {
             return forcing;
         }
         self.apply_linear(problem, q0, omega, scratch);
-        crate::linalg::norm2(scratch)
+        ivt_num::vector::norm2(scratch)
     }
 
     /// Number of unknowns `n_dof·(2n+1)`.
@@ -440,8 +439,6 @@ impl HbResidual {
         let bs = 2 * nd;
         let mut blk = vec![0.0; bs * bs];
         let mut inv = vec![0.0; bs * bs];
-        let mut lu = vec![0.0; bs * bs];
-        let mut piv = vec![0; bs];
         let mut idx = vec![0usize; bs];
         let mut ok = true;
         for h in 0..=n {
@@ -458,15 +455,7 @@ impl HbResidual {
                     blk[i * size + j] = b0[idx[i] * len + idx[j]];
                 }
             }
-            if invert(
-                &blk[..size * size],
-                size,
-                &mut inv[..size * size],
-                &mut lu[..size * size],
-                &mut piv[..size],
-            )
-            .is_ok()
-            {
+            if ivt_num::small::inverse(&blk[..size * size], size, &mut inv[..size * size]) {
                 for i in 0..size {
                     for j in 0..size {
                         h0[idx[i] * len + idx[j]] = inv[i * size + j];

@@ -20,7 +20,6 @@ pub mod frc;
 pub mod hill;
 pub mod ihb;
 pub mod limits;
-pub mod linalg;
 pub mod mathieu;
 pub mod modified;
 pub mod ode;
@@ -40,8 +39,8 @@ pub use broyden::{
 };
 pub use classic::ClassicIhb;
 pub use continuation::{
-    pseudo_arclength, pseudo_arclength_exact, ContinuationError, ContinuationOptions, Fold, Path,
-    PathPoint, PathSystem, Termination,
+    pseudo_arclength, pseudo_arclength_exact, ContinuationOptions, Fold, Path, PathPoint,
+    PathSystem, Termination,
 };
 pub use elements::{Element, ElementProblem, Harmonic, Law};
 pub use error::HbError;

@@ -322,8 +322,7 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
                 let (g, _) = stab(&mut an2, &pp, &q, new_n, new_period);
                 bracket.push(&pt.x, g)
             },
-        )
-        .map_err(|e| HbError::InvalidInput(format!("period-{new_period} continuation: {e}")))?;
+        )?;
         let ((xa, ga), (xb, gb)) = bracket.found.ok_or_else(|| {
             HbError::InvalidInput(format!("period-{new_period} branch never reached μ = −1"))
         })?;

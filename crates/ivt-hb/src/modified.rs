@@ -9,8 +9,8 @@ use crate::continuation::{pseudo_arclength, ContinuationOptions};
 use crate::ihb::{
     validate_omega, GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution, HbSolver,
 };
-use crate::linalg::matvec;
 use crate::problem::PeriodicProblem;
+use ivt_num::vector::matvec;
 
 /// The modified IHB solver for one problem and one size (plans and buffers reused
 /// across solves; nothing is allocated inside the iteration, except the Galerkin

@@ -44,15 +44,9 @@ macro_rules! displacement_jacobian {
         fn velocity_dependent(&self) -> bool {
             false
         }
-        fn nonlinear_jacobian(
-            &self,
-            $x: &[f64],
-            _v: &[f64],
-            $theta: f64,
-            $dg_dx: &mut [f64],
-            dg_dv: &mut [f64],
-        ) {
+        fn nonlinear_jacobian(&self, $x: &[f64], _v: &[f64], $theta: f64, dg: &mut [f64]) {
             let $s = self;
+            let ($dg_dx, dg_dv) = dg.split_at_mut(dg.len() / 2);
             $body;
             dg_dv.fill(0.0);
         }
@@ -90,18 +84,14 @@ pub trait PeriodicProblem {
     fn velocity_dependent(&self) -> bool {
         true
     }
-    /// `∂g/∂x` and `∂g/∂v` at one sample (row-major `n_dof×n_dof`). Default: central
-    /// differences with the step `1e-6·max(|x_j|, 1)` (one sample carries no orbit
-    /// scale; the engine's assemblies call [`Self::nonlinear_jacobian_samples`]).
-    fn nonlinear_jacobian(
-        &self,
-        x: &[f64],
-        v: &[f64],
-        theta: f64,
-        dg_dx: &mut [f64],
-        dg_dv: &mut [f64],
-    ) {
+    /// `∂g/∂x` and `∂g/∂v` at one sample into `dg` as the row-major blocks
+    /// `[∂g/∂x | ∂g/∂v]` (`2·n_dof²`, one sample of
+    /// [`Self::nonlinear_jacobian_samples`]). Default: central differences with
+    /// the step `1e-6·max(|x_j|, 1)` (one sample carries no orbit scale; the
+    /// engine's assemblies call [`Self::nonlinear_jacobian_samples`]).
+    fn nonlinear_jacobian(&self, x: &[f64], v: &[f64], theta: f64, dg: &mut [f64]) {
         let n = self.n_dof();
+        let (dg_dx, dg_dv) = dg.split_at_mut(n * n);
         let mut xp = x.to_vec();
         let mut vp = v.to_vec();
         let mut gp = vec![0.0; n];
@@ -139,8 +129,12 @@ pub trait PeriodicProblem {
         let n2 = n * n;
         for (i, &th) in theta.iter().enumerate() {
             let s = i * n..(i + 1) * n;
-            let (gx, gv) = dg[2 * i * n2..2 * (i + 1) * n2].split_at_mut(n2);
-            self.nonlinear_jacobian(&x[s.clone()], &v[s], th, gx, gv);
+            self.nonlinear_jacobian(
+                &x[s.clone()],
+                &v[s],
+                th,
+                &mut dg[2 * i * n2..2 * (i + 1) * n2],
+            );
         }
     }
 }
@@ -473,15 +467,8 @@ impl<P: PeriodicProblem + ?Sized> PeriodicProblem for &P {
     fn velocity_dependent(&self) -> bool {
         (**self).velocity_dependent()
     }
-    fn nonlinear_jacobian(
-        &self,
-        x: &[f64],
-        v: &[f64],
-        theta: f64,
-        dg_dx: &mut [f64],
-        dg_dv: &mut [f64],
-    ) {
-        (**self).nonlinear_jacobian(x, v, theta, dg_dx, dg_dv)
+    fn nonlinear_jacobian(&self, x: &[f64], v: &[f64], theta: f64, dg: &mut [f64]) {
+        (**self).nonlinear_jacobian(x, v, theta, dg)
     }
     fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
         (**self).nonlinear_jacobian_samples(x, v, theta, dg)

@@ -13,8 +13,8 @@ use crate::broyden::SolveError;
 use crate::family::{Family, FamilyBranch};
 use crate::fold::{null_vector, Branch};
 use crate::ihb::{HbError, HbOptions};
-use crate::linalg::norm2;
 use ivt_num::lu::solve_once;
+use ivt_num::vector::norm2;
 use ivt_num::LuWorkspace;
 
 /// A first point on a new branch: Newton on `[R(q, λ); dᵀ(x − x*) − h] = 0`

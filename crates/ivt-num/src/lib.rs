@@ -21,6 +21,8 @@
 //! - [`lu`]: dense LU on faer with caller-owned scratch, factor once per
 //!   Jacobian refresh and solve many without allocating;
 //! - [`small`]: products of small row-major matrices on nalgebra;
+//! - [`vector`]: dot, norm, axpy and the row-major matrix–vector product
+//!   on slices for the quasi-Newton loops;
 //! - [`newton`]: the one damped Newton method (dense Jacobian through
 //!   [`lu::LuWorkspace`], backtracking, residual and step tests).
 //!
@@ -33,6 +35,7 @@ pub mod newton;
 pub mod rk;
 pub mod small;
 pub mod tableau;
+pub mod vector;
 
 pub use lu::LuWorkspace;
 pub use newton::{newton, NewtonError, NewtonOptions, NewtonStats, NewtonSystem, NewtonWorkspace};

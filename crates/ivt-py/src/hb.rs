@@ -44,7 +44,9 @@ pub(crate) fn hb_err(py: Python<'_>, e: HbError) -> PyErr {
             }
             err
         }
-        HbError::Continuation(_) => ConvergenceError::new_err(e.to_string()),
+        HbError::ContinuationStart { .. } | HbError::SingularStart { .. } => {
+            ConvergenceError::new_err(e.to_string())
+        }
         _ => PyValueError::new_err(e.to_string()),
     }
 }

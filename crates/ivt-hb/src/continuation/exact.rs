@@ -14,8 +14,9 @@
 use faer::Mat;
 use ivt_num::LuWorkspace;
 
-use super::{turn, ContinuationError, ContinuationOptions, Fold, Path, PathPoint};
+use super::{non_finite_start, turn, ContinuationOptions, Fold, Path, PathPoint};
 use super::{SolveError, Termination};
+use crate::error::HbError;
 
 /// `R(u, λ) = 0`, `R: R^m × R → R^m`, with its exact Jacobian.
 pub trait PathSystem {
@@ -49,8 +50,8 @@ const NEWTON_WEIGHT: usize = 2;
 /// to stop.
 ///
 /// # Errors
-/// [`ContinuationError::Input`] for bad sizes or non-finite inputs,
-/// [`ContinuationError::SingularStart`] when the start has no tangent.
+/// [`HbError::InvalidInput`] for bad sizes or non-finite inputs,
+/// [`HbError::SingularStart`] when the start has no tangent.
 pub fn pseudo_arclength_exact<S, C>(
     system: &mut S,
     start: &[f64],
@@ -58,17 +59,19 @@ pub fn pseudo_arclength_exact<S, C>(
     direction: f64,
     opts: &ContinuationOptions,
     mut on_point: C,
-) -> Result<Path, ContinuationError>
+) -> Result<Path, HbError>
 where
     S: PathSystem,
     C: FnMut(&mut S, &PathPoint) -> bool,
 {
     let m = system.dim();
     if start.len() != m + 1 {
-        return Err(ContinuationError::Input("start must hold m unknowns and λ"));
+        return Err(HbError::InvalidInput(
+            "continuation: start must hold m unknowns and λ".into(),
+        ));
     }
     if !(start.iter().all(|v| v.is_finite()) && opts.ds > 0.0 && opts.ds_min > 0.0) {
-        return Err(ContinuationError::Input("non-finite start or step"));
+        return Err(non_finite_start());
     }
     let mut corrector = Corrector::new(m, opts);
     let mut x = start.to_vec();
@@ -83,7 +86,7 @@ where
     let termination = loop {
         if !corrector.tangent(system, &x, &mut tangent) {
             if points.is_empty() {
-                return Err(ContinuationError::SingularStart);
+                return Err(HbError::SingularStart { lambda: start[m] });
             }
             break Termination::StepTooSmall(SolveError::SingularJacobian {
                 iteration: 0,

@@ -1,0 +1,87 @@
+//! Level-1/2 kernels on slices (dot, norm, axpy, row-major matrix–vector
+//! product) for the quasi-Newton and continuation loops, where vectors of a
+//! few dozen entries are updated many times per solve and a call into a
+//! dense-matrix library costs more than the arithmetic.
+
+/// Independent partial sums in [`dot`]: enough to hide the add latency and let the
+/// compiler use SIMD lanes (a single running sum serialises every addition).
+const LANES: usize = 8;
+
+/// Dot product over the common length, summed in [`LANES`] interleaved partial sums
+/// (a different, not less accurate, rounding order than a left-to-right sum).
+pub fn dot(x: &[f64], y: &[f64]) -> f64 {
+    let n = x.len().min(y.len());
+    let (x, y) = (&x[..n], &y[..n]);
+    let mut acc = [0.0; LANES];
+    let (xc, yc) = (x.chunks_exact(LANES), y.chunks_exact(LANES));
+    let tail: f64 = xc
+        .remainder()
+        .iter()
+        .zip(yc.remainder())
+        .map(|(a, b)| a * b)
+        .sum();
+    for (a, b) in xc.zip(yc) {
+        for k in 0..LANES {
+            acc[k] += a[k] * b[k];
+        }
+    }
+    acc.iter().sum::<f64>() + tail
+}
+
+/// Euclidean norm.
+pub fn norm2(x: &[f64]) -> f64 {
+    dot(x, x).sqrt()
+}
+
+/// `y ← y + alpha·x` over the common length.
+pub fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi += alpha * xi;
+    }
+}
+
+/// `y = A x` for row-major `A` (`rows×cols`).
+pub fn matvec(a: &[f64], rows: usize, cols: usize, x: &[f64], y: &mut [f64]) {
+    for (yi, row) in y[..rows].iter_mut().zip(a.chunks_exact(cols)) {
+        *yi = dot(row, x);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lane_split_dot_matches_the_plain_sum_at_every_length() {
+        // Lengths 0…20 cover empty, tail-only, whole chunks and chunk + tail; the
+        // integer-valued data make every partial sum exact, so equality is exact.
+        for n in 0usize..=20 {
+            let x: Vec<f64> = (0..n).map(|i| (i % 5) as f64 - 2.0).collect();
+            let y: Vec<f64> = (0..n).map(|i| (i * 3 % 7) as f64).collect();
+            let plain: f64 = x.iter().zip(&y).map(|(a, b)| a * b).sum();
+            assert_eq!(dot(&x, &y), plain, "n = {n}");
+            assert_eq!(
+                dot(&x, &y[..n.saturating_sub(1)]),
+                dot(&x[..n.saturating_sub(1)], &y)
+            );
+        }
+        let mut y = vec![1.0; 9];
+        axpy(2.0, &[1.0; 9], &mut y);
+        assert!(y.iter().all(|&v| v == 3.0));
+    }
+
+    #[test]
+    fn row_major_product_and_norm() {
+        // [[1, 2, 3], [4, 5, 6]] (1, 0, −1) = (−2, −2); ‖(3, 4)‖ = 5 (exact).
+        let mut y = [0.0; 2];
+        matvec(
+            &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0],
+            2,
+            3,
+            &[1.0, 0.0, -1.0],
+            &mut y,
+        );
+        assert_eq!(y, [-2.0, -2.0]);
+        assert_eq!(norm2(&[3.0, 4.0]), 5.0);
+    }
+}
