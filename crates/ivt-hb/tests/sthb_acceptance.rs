@@ -451,7 +451,7 @@ fn spring_boundary_fig36() {
         );
     }
     // k0 = 10 shifts the peak: with Eq. 132 as printed (k0 w = +w_x) the first
-    // linear mode sin βx has tan β = β/k0, β ≈ 3.475 > π, so the peak moves up.
+    // linear mode sin βx has tan β = β/k0, β ≈ 3.4761 > π, so the peak moves up.
     let peak = |params: StringParams| {
         let (_, pts) = curve(&params, 2.0, 5.0, 0.05);
         assert!((pts.last().unwrap().0 - 5.0).abs() < 1e-9);
