@@ -3,7 +3,8 @@
 
 use super::{CliError, Output};
 use clap::{Args, Subcommand};
-use ivt_design::fit::{self, OpenLoopLaw, PolyForm};
+use ivt_design::fit::{self, PolyForm};
+use ivt_design::open_loop::fit_law;
 use ivt_design::polish::{self, accurate_r};
 use ivt_design::steady::IhbOptions;
 use ivt_design::sweep::{self, Grid, SweepPoint};
@@ -183,7 +184,8 @@ fn solve(a: SolveArgs) -> Result<Output, CliError> {
     Ok(Output { json, human })
 }
 
-fn run_sweep(a: &GridArgs) -> Result<(Grid, Vec<SweepPoint>), CliError> {
+/// The grid of `table`/`fit` from its arguments, validated.
+fn grid_of(a: &GridArgs) -> Result<Grid, CliError> {
     if !(a.omega0_rpm.is_finite() && a.omega0_rpm > 0.0) {
         return Err(CliError::Input(format!(
             "--omega0-rpm must be finite and > 0, got {}",
@@ -196,26 +198,23 @@ fn run_sweep(a: &GridArgs) -> Result<(Grid, Vec<SweepPoint>), CliError> {
         omega0: rpm_to_rad_s(a.omega0_rpm),
     };
     grid.validate()?;
-    let opts = IhbOptions {
+    Ok(grid)
+}
+
+fn ihb_options(a: &GridArgs) -> IhbOptions {
+    IhbOptions {
         harmonics: a.harmonics,
         ..Default::default()
-    };
-    let bar = if a.quiet {
+    }
+}
+
+/// One tick per grid point on stderr, hidden under `--quiet`.
+fn progress_bar(a: &GridArgs, grid: &Grid) -> indicatif::ProgressBar {
+    if a.quiet {
         indicatif::ProgressBar::hidden()
     } else {
         indicatif::ProgressBar::new(grid.len() as u64)
-    };
-    let pts = sweep::sweep(&a.plant.preset.params(), &grid, opts, || bar.inc(1))?;
-    bar.finish_and_clear();
-    if let Some(Err(first)) = pts.first().map(|p| &p.result) {
-        if pts.iter().all(|p| p.result.is_err()) {
-            return Err(CliError::Failed(format!(
-                "every one of the {} grid points failed (first: {first})",
-                pts.len()
-            )));
-        }
     }
-    Ok((grid, pts))
 }
 
 fn point_json(p: &SweepPoint) -> serde_json::Value {
@@ -227,7 +226,13 @@ fn point_json(p: &SweepPoint) -> serde_json::Value {
 }
 
 fn table(a: GridArgs) -> Result<Output, CliError> {
-    let (grid, pts) = run_sweep(&a)?;
+    let grid = grid_of(&a)?;
+    let bar = progress_bar(&a, &grid);
+    let pts = sweep::sweep(&a.plant.preset.params(), &grid, ihb_options(&a), || {
+        bar.inc(1)
+    })?;
+    bar.finish_and_clear();
+    sweep::require_some_solved(&pts)?;
     let mut human = format!("r̄ [mm] (rows T_U, columns V_m = {:?})\n", grid.v_m);
     for row in pts.chunks(grid.v_m.len()) {
         let t_u = row.first().map_or(f64::NAN, |p| p.op.t_u);
@@ -248,27 +253,22 @@ fn table(a: GridArgs) -> Result<Output, CliError> {
 
 fn fit_cmd(a: FitArgs) -> Result<Output, CliError> {
     let plant = a.grid.plant.preset.params();
-    let (grid, pts) = run_sweep(&a.grid)?;
+    let grid = grid_of(&a.grid)?;
     let form = if a.full {
         PolyForm::Full
     } else {
         PolyForm::Eq158
     };
-    let pf = fit::fit_polynomial(&pts, plant.r_max, form)?;
-    let opts = IhbOptions {
-        harmonics: a.grid.harmonics,
-        ..Default::default()
-    };
-    let (alpha, beta, b_err) =
-        fit::fit_boundary(&plant, &grid.t_u, grid.omega0, plant.r_max, opts)?;
-    let (alpha0, beta0, _) = fit::fit_boundary(&plant, &grid.t_u, grid.omega0, 0.0, opts)?;
-    let law = OpenLoopLaw {
-        poly: pf.poly,
-        boundary: [1.0, -alpha, -beta],
-        r_max: plant.r_max,
-    };
-    let err = fit::law_error(&plant, &law, &pts)?;
-    let thesis_err = fit::law_error(&plant, &OpenLoopLaw::thesis(), &pts)?;
+    let bar = progress_bar(&a.grid, &grid);
+    let rep = fit_law(&plant, &grid, form, ihb_options(&a.grid), || bar.inc(1))?;
+    bar.finish_and_clear();
+    let (pf, law, err, thesis_err) = (&rep.fit, &rep.law, &rep.law_error, &rep.thesis_error);
+    let (alpha, beta, b_err) = (
+        rep.overdrive.alpha,
+        rep.overdrive.beta,
+        rep.overdrive.max_dev_v,
+    );
+    let (alpha0, beta0) = (rep.underdrive.alpha, rep.underdrive.beta);
     if let Some(path) = &a.emit_rust {
         let header = format!(
             "Open-loop law refitted on the {} plant (Eq. 151) by `ivt ol fit{}`:\n\
@@ -279,7 +279,7 @@ fn fit_cmd(a: FitArgs) -> Result<Output, CliError> {
             a.grid.vm_from, a.grid.vm_step, a.grid.vm_to, a.grid.tu_from, a.grid.tu_step, a.grid.tu_to,
             a.grid.omega0_rpm, pf.points, pf.rms_r, pf.max_r, err.max_abs_rpm, err.rms_rpm, alpha, beta, b_err
         );
-        super::write_atomic(path, fit::emit_rust(&law, "REFIT", &header).as_bytes())?;
+        super::write_atomic(path, fit::emit_rust(law, "REFIT", &header).as_bytes())?;
     }
     let json = json!({
         "poly": pf.poly, "boundary": law.boundary, "r_max": law.r_max,

@@ -16,6 +16,7 @@
 //!   error estimate;
 //! - [`sweep`]: r̄ over a (V_m, T_U) grid, warm starts along rows, rayon across rows;
 //! - [`fit`]: least-squares refit of the Eq. 158 form and of the Eq. 159 boundary;
+//! - [`open_loop`]: the whole refit in one call (sweep, fit, boundaries, ω_a errors);
 //! - [`delay`]: Eq. 174 (Appendix B) discretized by the Chebyshev spectral Tau
 //!   method (Eq. 175–179, Appendix C) and its monodromy matrix;
 //! - [`gains`]: the gain-design helper.
@@ -26,6 +27,7 @@ pub mod delay;
 pub mod delay_sim;
 pub mod fit;
 pub mod gains;
+pub mod open_loop;
 pub mod pieces;
 pub mod polish;
 pub mod shooting;

@@ -188,6 +188,23 @@ pub fn sweep_serial(
         .collect())
 }
 
+/// A sweep with no solved point has no answer to report.
+///
+/// # Errors
+/// [`IvtError::AllFailed`] (with the first point's failure) when every point failed.
+pub fn require_some_solved(points: &[SweepPoint]) -> Result<(), IvtError> {
+    if points.iter().any(|p| p.result.is_ok()) {
+        return Ok(());
+    }
+    Err(IvtError::AllFailed {
+        points: points.len(),
+        first: points
+            .iter()
+            .find_map(|p| p.result.as_ref().err().cloned())
+            .unwrap_or_default(),
+    })
+}
+
 fn sweep_row(
     plant: &PlantParams,
     grid: &Grid,
