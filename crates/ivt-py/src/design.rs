@@ -1,12 +1,14 @@
 //! `ivt.design`: the controller-design tools of ivt-hb (§4.2–4.3): IHB steady
-//! state and open-loop table, delay-loop stability at a point and over a grid.
-//! Keys follow `ivt ol solve`, `ivt ol table`, `ivt stability` and
+//! state, open-loop table and refit, delay-loop stability at a point and over a grid.
+//! Keys follow `ivt ol solve`, `ivt ol table`, `ivt ol fit`, `ivt stability` and
 //! `ivt stability-map` (`--json`).
 
 use crate::args::{count, int};
 use crate::kin::Plant;
 use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
+use ivt_design::fit::{LawError, PolyForm};
 use ivt_design::gains::grid_stability_map;
+use ivt_design::open_loop::fit_law;
 use ivt_design::polish::{accurate_r, SolveMethod};
 use ivt_design::steady::IhbOptions;
 use ivt_design::sweep::{self, Grid};
@@ -256,6 +258,69 @@ fn ol_table<'py>(
     Ok(d)
 }
 
+/// Open-loop refit (thesis §4.2.1, `ivt ol fit`, same defaults): the IHB r̄
+/// over the grid, the Eq. 158 polynomial (all 15 terms V^0..2 T^0..4 with
+/// `full=True`) through the feasible points, the Eq. 159 over-drive boundary
+/// (r̄ = r_max) and the under-drive one (r̄ = 0), and the ω_a error of the
+/// refitted law and of the thesis's printed law. Axes `(from, step, to)` at
+/// `omega0_rpm`, as in `ol_table`. Returns the dict of `ivt ol fit --json`:
+/// poly [[V^i T^j]], boundary, r_max, form ("eq158" or "full"), points,
+/// plant, rms_r, max_r, omega_a_error_rpm {max_abs, rms},
+/// thesis_omega_a_error_rpm {max_abs, rms}, boundary_max_dev_v,
+/// underdrive_boundary {alpha, beta}, emitted (None: no Rust file is
+/// written). `RuntimeError` when every point or a boundary solve fails. GIL
+/// released.
+#[pyfunction]
+#[pyo3(signature = (
+    v_m = (2.0, 0.4, 12.0), t_u = (1.5, 0.5, 9.0), omega0_rpm = 100.0, harmonics = 7,
+    plant = None, full = false
+))]
+fn ol_fit<'py>(
+    py: Python<'py>,
+    v_m: (f64, f64, f64),
+    t_u: (f64, f64, f64),
+    omega0_rpm: f64,
+    #[pyo3(from_py_with = int)] harmonics: i128,
+    plant: Option<&Bound<'py, PyAny>>,
+    full: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (params, plant_name) = plant_of(plant)?;
+    let opts = ihb_options(harmonics)?;
+    let grid = grid_of(v_m, t_u, omega0_rpm)?;
+    let form = if full {
+        PolyForm::Full
+    } else {
+        PolyForm::Eq158
+    };
+    let rep = py
+        .detach(|| fit_law(&params, &grid, form, opts, || ()))
+        .map_err(design_err)?;
+    let error_dict = |e: &LawError| -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("max_abs", e.max_abs_rpm)?;
+        d.set_item("rms", e.rms_rpm)?;
+        Ok(d)
+    };
+    let d = PyDict::new(py);
+    d.set_item("poly", rep.law.poly)?;
+    d.set_item("boundary", rep.law.boundary)?;
+    d.set_item("r_max", rep.law.r_max)?;
+    d.set_item("form", if full { "full" } else { "eq158" })?;
+    d.set_item("points", rep.fit.points)?;
+    d.set_item("plant", plant_name)?;
+    d.set_item("rms_r", rep.fit.rms_r)?;
+    d.set_item("max_r", rep.fit.max_r)?;
+    d.set_item("omega_a_error_rpm", error_dict(&rep.law_error)?)?;
+    d.set_item("thesis_omega_a_error_rpm", error_dict(&rep.thesis_error)?)?;
+    d.set_item("boundary_max_dev_v", rep.overdrive.max_dev_v)?;
+    let under = PyDict::new(py);
+    under.set_item("alpha", rep.underdrive.alpha)?;
+    under.set_item("beta", rep.underdrive.beta)?;
+    d.set_item("underdrive_boundary", under)?;
+    d.set_item("emitted", py.None())?;
+    Ok(d)
+}
+
 /// Local stability of the integral time-delay loop (Eq. 174–179, Chebyshev
 /// spectral Tau of order `n`, monodromy over θ ∈ [0, 2π]) at (V_m, T_U).
 ///
@@ -367,6 +432,6 @@ fn stability_map<'py>(
 /// Register `ivt._ivt.design`.
 pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     let m = PyModule::new(parent.py(), "design")?;
-    add_functions!(&m, [ol_solve, ol_table, stability, stability_map]);
+    add_functions!(&m, [ol_solve, ol_fit, ol_table, stability, stability_map]);
     parent.add_submodule(&m)
 }

@@ -119,6 +119,52 @@ def test_stability_map_feasible_only_and_failures(cli) -> None:  # type: ignore[
         design.ol_table(v_m=(2.0, 1e-300, 12.0))
 
 
+# 7 × 9 points around the feasible band at 100 rpm (≥ the 15 terms of `full`).
+_FIT_GRID = dict(v_m=(7.6, 0.2, 8.8), t_u=(2.0, 0.5, 6.0))
+_FIT_ARGS = ["--vm-from", "7.6", "--vm-step", "0.2", "--vm-to", "8.8",
+             "--tu-from", "2", "--tu-step", "0.5", "--tu-to", "6", "--quiet"]
+
+
+def test_ol_fit_equals_cli(cli) -> None:  # type: ignore[no-untyped-def]
+    """`ol_fit` is `ivt ol fit --json` as a dict (one Rust function behind
+    both, so equal to the last bit), with and without `full`."""
+    assert design.ol_fit(**_FIT_GRID) == cli("ol", "fit", *_FIT_ARGS)
+    got = design.ol_fit(**_FIT_GRID, full=True, plant="printed")
+    assert got == cli("ol", "fit", "--full", *_FIT_ARGS)
+    assert got["form"] == "full" and got["emitted"] is None
+
+
+def test_ol_fit_boundaries() -> None:
+    """Checks from outside the fit: at r̄ = 0 the brake torque does not reach
+    the motor (Eq. 151: the load term is b T_U r), so the under-drive boundary
+    has slope 0; on the over-drive line V_m = α T_U + β an independent IHB
+    solve (n = 7, as the fit) gives r̄ = r_max."""
+    got = design.ol_fit(**_FIT_GRID)
+    assert abs(got["underdrive_boundary"]["alpha"]) < 1e-9  # V/(N·m); Newton tol ~1e-12
+    _, alpha_neg, beta_neg = got["boundary"]
+    assert got["boundary_max_dev_v"] < 1e-9
+    for t_u in [2.5, 5.5]:  # between the grid's T_U values
+        r = design.ol_solve(-alpha_neg * t_u - beta_neg, t_u, method="ihb")["r"]
+        # the line is exact to 1e-9 V here, ∂r̄/∂V_m ~ 0.03 m/V: 1e-9 m is ample
+        assert r == pytest.approx(got["r_max"], abs=1e-9), t_u
+    # The law refitted on this plant holds ω0 better than the printed one.
+    assert got["omega_a_error_rpm"]["max_abs"] < got["thesis_omega_a_error_rpm"]["max_abs"]
+
+
+def test_ol_fit_errors() -> None:
+    with pytest.raises(ValueError, match="`v_m`"):
+        design.ol_fit(v_m=(2.0, 0.0, 12.0))
+    with pytest.raises(ValueError, match="omega0_rpm"):
+        design.ol_fit(omega0_rpm=float("nan"))
+    with pytest.raises(ValueError, match="`harmonics` = -1"):
+        design.ol_fit(harmonics=-1)
+    with pytest.raises(ValueError, match="`plant`"):
+        design.ol_fit(plant="nope")
+    # 2 × 2 points cannot determine the ten Eq. 158 terms (CLI: kind "input").
+    with pytest.raises(ValueError, match="fewer feasible points than polynomial terms"):
+        design.ol_fit(v_m=(7.6, 0.4, 8.0), t_u=(2.0, 2.0, 4.0))
+
+
 def test_design_errors() -> None:
     with pytest.raises(ValueError, match="omega0_rpm"):
         design.ol_solve(8.0, 6.0, omega0_rpm=-1.0)

@@ -22,6 +22,14 @@ def ol_table(
     harmonics: int = 7,
     plant: Optional[PlantArg] = None,
 ) -> Dict[str, Any]: ...
+def ol_fit(
+    v_m: Tuple[float, float, float] = (2.0, 0.4, 12.0),
+    t_u: Tuple[float, float, float] = (1.5, 0.5, 9.0),
+    omega0_rpm: float = 100.0,
+    harmonics: int = 7,
+    plant: Optional[PlantArg] = None,
+    full: bool = False,
+) -> Dict[str, Any]: ...
 def stability(
     v_m: float,
     t_u: float,
