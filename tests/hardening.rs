@@ -125,6 +125,8 @@ fn regression_corpus_is_refused_by_name() {
         (vec!["stability-map", "--vm", "2", "1e-6", "12"], "input", "--vm"),
         (vec!["ol", "table", "--vm-step", "1e-300"], "input", "--vm-step"),
         (vec!["ol", "table", "--tu-step", "0"], "input", "--tu-step"),
+        (vec!["ol", "fit", "--quiet", "--tu-step", "0"], "input", "--tu-step"),
+        (vec!["ol", "fit", "--quiet", "--vm-from", "7.6", "--vm-to", "8", "--tu-from", "2", "--tu-to", "2.5"], "input", "fewer feasible points"),
         (vec!["hb", "mathieu-duffing", "--n", "4294967296"], "input", "unknowns"),
         (vec!["stability", "--vm", "8", "--tu", "1.5", "--n", "4294967296"], "input", "chebyshev_order"),
         (vec!["rig", "record", "--port", "/nonexistent", "--out", &mcap, "--idle-timeout-s", "1e308"], "input", "--idle-timeout-s"),
