@@ -6,7 +6,10 @@
 //! started from the quadratic through the three path points around the turn
 //! ([`crate::continuation::turn_estimate`]).
 
+use crate::aft::Aft;
+use crate::bifurcation::BifurcationKind;
 use crate::continuation::{pseudo_arclength, turn_estimate, ContinuationOptions, Termination};
+use crate::events::Trace;
 use crate::floquet::HsuRule;
 use crate::fold::{locate_fold, FoldOptions, HbBranch};
 use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
@@ -139,11 +142,8 @@ pub fn frequency_response<P: PeriodicProblem>(
         hb.harmonics,
         opts.stability_steps.max(hb.harmonics + 1),
     )?;
-    let mut res = HbResidual::new(problem, hb)?;
-    let ns = res.aft_mut().n_samples();
-    let mut samples = vec![0.0; ns];
+    let mut probe = AmplitudeProbe::new(hb)?;
     let mut points = Vec::with_capacity(path.points.len());
-    let l = 2 * hb.harmonics + 1;
     for p in &path.points {
         let sol = HbSolution {
             coeffs: p.x[..m].to_vec(),
@@ -157,8 +157,7 @@ pub fn frequency_response<P: PeriodicProblem>(
                 residual_norm: 0.0,
             },
         };
-        res.aft_mut().synthesize(&sol.coeffs[..l], &mut samples);
-        let amplitude = samples.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let amplitude = probe.of(&sol.coeffs);
         let fl = analyzer.hsu(problem, &sol, HsuRule::Magnus4);
         points.push(FrcPoint {
             omega_f: sol.omega_f,
@@ -175,31 +174,102 @@ pub fn frequency_response<P: PeriodicProblem>(
         // Start from the quadratic through the three points around the turn.
         let around = &path.points[turn.bracket..turn.bracket + 3];
         let start = turn_estimate(&around[0], &around[1], &around[2]);
-        let fold = match locate_fold(&mut branch, &start[..m], start[m], &FoldOptions::default()) {
-            Ok(f) => {
-                let (coeffs, omega_f) = (f.q, f.lambda);
-                res.aft_mut().synthesize(&coeffs[..l], &mut samples);
-                FrcFold {
-                    index: turn.index,
-                    omega_f,
-                    amplitude: samples.iter().fold(0.0f64, |a, v| a.max(v.abs())),
-                    coeffs,
-                    located: true,
-                }
-            }
-            Err(_) => FrcFold {
-                index: turn.index,
-                omega_f: turn.lambda,
-                amplitude: near.amplitude,
-                coeffs: near.coeffs.clone(),
-                located: false,
-            },
-        };
-        folds.push(fold);
+        let located = locate_fold(&mut branch, &start[..m], start[m], &FoldOptions::default())
+            .ok()
+            .map(|f| (f.q, f.lambda));
+        folds.push(probe.fold(turn.index, located, near, turn.lambda));
     }
     Ok(Frc {
         points,
         folds,
         termination: path.termination,
     })
+}
+
+impl Frc {
+    /// The curve of an event trace in ω_f ([`crate::trace`] on a frequency
+    /// family): its points with their amplitudes, and its fold events as
+    /// [`FrcFold`]s (located, or the point before the turn when location failed).
+    ///
+    /// # Errors
+    /// [`HbError`] if `hb`'s AFT sizes are invalid.
+    pub fn from_trace(trace: &Trace, hb: &HbOptions) -> Result<Self, HbError> {
+        let mut probe = AmplitudeProbe::new(hb)?;
+        let points: Vec<FrcPoint> = trace
+            .points
+            .iter()
+            .map(|p| FrcPoint {
+                omega_f: p.lambda,
+                amplitude: probe.of(&p.q),
+                kind: p.kind,
+                multipliers: p.multipliers.clone(),
+                coeffs: p.q.clone(),
+            })
+            .collect();
+        let folds = trace
+            .events
+            .iter()
+            .filter(|e| e.kind == BifurcationKind::Fold)
+            .filter_map(|e| {
+                let near = points.get(e.index)?;
+                let located = e.location.as_ref().ok().map(|b| (b.q.clone(), b.lambda));
+                Some(probe.fold(e.index, located, near, near.omega_f))
+            })
+            .collect();
+        Ok(Self {
+            points,
+            folds,
+            termination: trace.termination.clone(),
+        })
+    }
+}
+
+/// `max_τ |x_0(τ)|` over the 2N AFT samples of a coefficient vector (DOF 0):
+/// the `amplitude` of [`FrcPoint`] and [`FrcFold`].
+struct AmplitudeProbe {
+    aft: Aft,
+    samples: Vec<f64>,
+}
+
+impl AmplitudeProbe {
+    fn new(hb: &HbOptions) -> Result<Self, HbError> {
+        let aft = Aft::new(hb.harmonics, hb.n_half)?;
+        Ok(Self {
+            samples: vec![0.0; aft.n_samples()],
+            aft,
+        })
+    }
+
+    fn of(&mut self, q: &[f64]) -> f64 {
+        let l = self.aft.coeff_len();
+        self.aft.synthesize(&q[..l], &mut self.samples);
+        self.samples.iter().fold(0.0f64, |a, v| a.max(v.abs()))
+    }
+
+    /// The fold next to path point `near` (index `index`): the located orbit
+    /// `(q, ω_f)`, or, when location failed, `near`'s orbit at `omega_estimate`.
+    fn fold(
+        &mut self,
+        index: usize,
+        located: Option<(Vec<f64>, f64)>,
+        near: &FrcPoint,
+        omega_estimate: f64,
+    ) -> FrcFold {
+        match located {
+            Some((coeffs, omega_f)) => FrcFold {
+                index,
+                omega_f,
+                amplitude: self.of(&coeffs),
+                coeffs,
+                located: true,
+            },
+            None => FrcFold {
+                index,
+                omega_f: omega_estimate,
+                amplitude: near.amplitude,
+                coeffs: near.coeffs.clone(),
+                located: false,
+            },
+        }
+    }
 }

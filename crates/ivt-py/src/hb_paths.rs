@@ -5,9 +5,9 @@
 //! points and branch points each located on its extended system.
 
 use ivt_hb::{
-    frequency_response, trace, Aft, Backbone, BackboneOptions, BifurcationKind, Event,
-    FamilyBranch, Frc, FrcFold, FrcOptions, FrcPoint, HbError, HbOptions, ModifiedIhb,
-    PeriodicProblem, Trace, TraceOptions,
+    frequency_response, trace, Backbone, BackboneOptions, BifurcationKind, Event, FamilyBranch,
+    Frc, FrcFold, FrcOptions, HbError, HbOptions, ModifiedIhb, PeriodicProblem, Trace,
+    TraceOptions,
 };
 use numpy::ndarray::Array1;
 use numpy::IntoPyArray;
@@ -16,14 +16,6 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::hb::{finite, frc_dict, pairs, run_user, stability_steps, user_system_fn, UserArgs};
-
-/// max |x_0| over the 2N AFT samples of the coefficients `q` (DOF 0), the
-/// `amplitude` of an FRC point.
-fn amplitude(aft: &mut Aft, q: &[f64], samples: &mut [f64]) -> f64 {
-    let l = aft.coeff_len();
-    aft.synthesize(q.get(..l).unwrap_or(q), samples);
-    samples.iter().fold(0.0f64, |a, v| a.max(v.abs()))
-}
 
 /// The FRC of `problem` from `from` to `to`. With `events`, the start is
 /// solved by the modified IHB and the branch traced in ω_f by
@@ -59,48 +51,7 @@ fn traced_frc<P: PeriodicProblem>(
         ivt_hb::BifurcationError::Hb(h) => h,
         other => HbError::InvalidInput(other.to_string()),
     })?;
-    let mut aft = Aft::new(opts.harmonics, opts.n_half)?;
-    let mut samples = vec![0.0; aft.n_samples()];
-    let points: Vec<FrcPoint> = traced
-        .points
-        .iter()
-        .map(|p| FrcPoint {
-            omega_f: p.lambda,
-            amplitude: amplitude(&mut aft, &p.q, &mut samples),
-            kind: p.kind,
-            multipliers: p.multipliers.clone(),
-            coeffs: p.q.clone(),
-        })
-        .collect();
-    let folds = traced
-        .events
-        .iter()
-        .filter(|e| e.kind == BifurcationKind::Fold)
-        .filter_map(|e| {
-            let near = points.get(e.index)?;
-            Some(match &e.location {
-                Ok(b) => FrcFold {
-                    index: e.index,
-                    omega_f: b.lambda,
-                    amplitude: amplitude(&mut aft, &b.q, &mut samples),
-                    coeffs: b.q.clone(),
-                    located: true,
-                },
-                Err(_) => FrcFold {
-                    index: e.index,
-                    omega_f: near.omega_f,
-                    amplitude: near.amplitude,
-                    coeffs: near.coeffs.clone(),
-                    located: false,
-                },
-            })
-        })
-        .collect();
-    let frc = Frc {
-        points,
-        folds,
-        termination: traced.termination.clone(),
-    };
+    let frc = Frc::from_trace(&traced, opts)?;
     Ok((Some(traced), frc))
 }
 
