@@ -170,21 +170,13 @@ pub fn grid_stability_map(
         grid.operating_points()
     };
     let entries = stability_map(plant, &ops, gains, opts)?;
+    IvtError::unless_some_solved(entries.iter().map(|(_, r)| r))?;
     let solved = entries.iter().filter_map(|(_, r)| r.as_ref().ok());
-    let worst = solved.clone().copied().reduce(f64::max);
+    let worst = solved.clone().copied().fold(f64::NEG_INFINITY, f64::max);
     let failed = entries.len() - solved.count();
-    match worst {
-        Some(worst) => Ok(GridMap {
-            entries,
-            worst,
-            failed,
-        }),
-        None => Err(IvtError::AllFailed {
-            points: entries.len(),
-            first: entries
-                .iter()
-                .find_map(|(_, r)| r.as_ref().err().cloned())
-                .unwrap_or_default(),
-        }),
-    }
+    Ok(GridMap {
+        entries,
+        worst,
+        failed,
+    })
 }

@@ -177,6 +177,31 @@ pub enum IvtError {
     },
 }
 
+impl IvtError {
+    /// `Ok` when at least one of these per-point results is solved, else
+    /// [`IvtError::AllFailed`] with the first failure: a sweep or map of
+    /// failures has no answer to report.
+    ///
+    /// # Errors
+    /// [`IvtError::AllFailed`] when every result is an error (or there are none).
+    pub fn unless_some_solved<'a, T: 'a>(
+        results: impl Iterator<Item = &'a Result<T, String>> + Clone,
+    ) -> Result<(), IvtError> {
+        if results.clone().any(|r| r.is_ok()) {
+            return Ok(());
+        }
+        let points = results.clone().count();
+        Err(IvtError::AllFailed {
+            points,
+            first: results
+                .filter_map(|r| r.as_ref().err())
+                .next()
+                .cloned()
+                .unwrap_or_default(),
+        })
+    }
+}
+
 /// Validate the plant once at every public entry point.
 pub(crate) fn check_plant(plant: &PlantParams) -> Result<(), IvtError> {
     plant.validate().map_err(IvtError::from)

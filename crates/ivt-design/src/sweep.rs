@@ -193,16 +193,7 @@ pub fn sweep_serial(
 /// # Errors
 /// [`IvtError::AllFailed`] (with the first point's failure) when every point failed.
 pub fn require_some_solved(points: &[SweepPoint]) -> Result<(), IvtError> {
-    if points.iter().any(|p| p.result.is_ok()) {
-        return Ok(());
-    }
-    Err(IvtError::AllFailed {
-        points: points.len(),
-        first: points
-            .iter()
-            .find_map(|p| p.result.as_ref().err().cloned())
-            .unwrap_or_default(),
-    })
+    IvtError::unless_some_solved(points.iter().map(|p| &p.result))
 }
 
 fn sweep_row(
