@@ -3,8 +3,8 @@
 //! frequency-response curve 0.2–3.0 with a stability flag at every point.
 
 use ivt_hb::{
-    frequency_response, ClassicIhb, Duffing, FrcOptions, HbOptions, HsuRule, ModifiedIhb,
-    StabilityAnalyzer,
+    frequency_response, ClassicIhb, Corrector, Duffing, Element, ElementProblem, FrcOptions,
+    Harmonic, HbOptions, HsuRule, Law, ModifiedIhb, StabilityAnalyzer,
 };
 
 fn main() {
@@ -59,5 +59,62 @@ fn duffing_frc_0p2_to_3(bencher: divan::Bencher) {
     let d = Duffing::fig28();
     let hb = HbOptions::new(20, 64);
     let opts = FrcOptions::default();
+    bencher.bench_local(|| frequency_response(&d, &hb, &opts).unwrap());
+}
+
+/// The 2-DOF cubic chain of issue 17 (M = I, K = [[2, −1], [−1, 2]], C = 0.02 I,
+/// g = [0.5 x₁³, 0], f = [0.1 cos ωt, 0]) with a Rust element: the whole curve
+/// 0.2 → 3.0 with stability at every point, to compare per point with the Duffing.
+fn chain() -> ElementProblem {
+    ElementProblem::new(
+        2,
+        [
+            vec![1.0, 0.0, 0.0, 1.0],
+            vec![0.02, 0.0, 0.0, 0.02],
+            vec![2.0, -1.0, -1.0, 2.0],
+        ],
+        vec![Element {
+            a: 0,
+            b: None,
+            law: Law::CubicSpring { k3: 0.5 },
+        }],
+        vec![Harmonic {
+            dof: 0,
+            amplitude: 0.1,
+            phase: 0.0,
+        }],
+    )
+    .unwrap()
+}
+
+#[divan::bench(sample_count = 10)]
+fn chain_frc_0p2_to_3(bencher: divan::Bencher) {
+    let p = chain();
+    let hb = HbOptions::new(20, 84);
+    let opts = FrcOptions::default();
+    bencher.bench_local(|| frequency_response(&p, &hb, &opts).unwrap());
+}
+
+/// The same curve with the Newton–chord corrector (exact Galerkin Jacobian).
+#[divan::bench(sample_count = 10)]
+fn chain_frc_newton_0p2_to_3(bencher: divan::Bencher) {
+    let p = chain();
+    let hb = HbOptions::new(20, 84);
+    let opts = FrcOptions {
+        corrector: Corrector::Newton,
+        ..FrcOptions::default()
+    };
+    bencher.bench_local(|| frequency_response(&p, &hb, &opts).unwrap());
+}
+
+/// The Duffing curve with the Newton–chord corrector.
+#[divan::bench(sample_count = 10)]
+fn duffing_frc_newton_0p2_to_3(bencher: divan::Bencher) {
+    let d = Duffing::fig28();
+    let hb = HbOptions::new(20, 64);
+    let opts = FrcOptions {
+        corrector: Corrector::Newton,
+        ..FrcOptions::default()
+    };
     bencher.bench_local(|| frequency_response(&d, &hb, &opts).unwrap());
 }

@@ -60,6 +60,21 @@ impl Default for ContinuationOptions {
     }
 }
 
+/// The corrector of a path follower.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Corrector {
+    /// Broyden on the secant model with the exact constraint row (Eq. 68–77,
+    /// [`pseudo_arclength`]): many cheap iterations per point, no Jacobian
+    /// assembly; the thesis's method and the cheapest when the residual is.
+    #[default]
+    Broyden,
+    /// Chord iterations on the exact bordered Jacobian, Newton as fallback
+    /// ([`pseudo_arclength_exact`]): one Jacobian assembly and a few residuals
+    /// per point; the cheapest when residual evaluations are costly (a user's
+    /// callback).
+    Newton,
+}
+
 /// One converged point on the path.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PathPoint {

@@ -13,7 +13,7 @@ use crate::bifurcation::{
     finish, jacobian_blocks, locate_branch_point, locate_multiplier_crossing, Bifurcation,
     BifurcationError, BifurcationKind, BifurcationOptions, Monodromy,
 };
-use crate::continuation::{pseudo_arclength, ContinuationOptions, Termination};
+use crate::continuation::{ContinuationOptions, Corrector, Termination};
 use crate::family::{Family, FamilyBranch};
 use crate::fold::{locate_fold, Branch, FoldOptions};
 use crate::ihb::HbError;
@@ -32,6 +32,8 @@ pub struct TraceOptions {
     pub stability_steps: usize,
     /// Options of the located events.
     pub locate: BifurcationOptions,
+    /// The path's corrector ([`Corrector::Broyden`] by default).
+    pub corrector: Corrector,
 }
 
 impl Default for TraceOptions {
@@ -41,6 +43,7 @@ impl Default for TraceOptions {
             continuation: ContinuationOptions::default(),
             stability_steps: 256,
             locate: BifurcationOptions::default(),
+            corrector: Corrector::Broyden,
         }
     }
 }
@@ -104,14 +107,7 @@ pub fn trace<F: Family>(
     let mut copts = opts.continuation.clone();
     copts.lambda_min = lambda0.min(opts.lambda_to);
     copts.lambda_max = lambda0.max(opts.lambda_to);
-    let path = pseudo_arclength(
-        |x: &[f64], r: &mut [f64]| branch.residual(&x[..m], x[m], r),
-        &x0,
-        None,
-        opts.lambda_to - lambda0,
-        &copts,
-        |_| true,
-    )?;
+    let path = branch.follow(&x0, 0, opts.lambda_to - lambda0, &copts, opts.corrector)?;
     let mut mono = Monodromy::new(branch, lambda0, opts.stability_steps)?;
     let mut points = Vec::with_capacity(path.points.len());
     let mut bp_signs = Vec::with_capacity(path.points.len());

@@ -6,10 +6,16 @@
 //! `f(θ)` is projected once (it is part of the planned residual), so it must not
 //! depend on λ; [`FamilyBranch::new`] checks this.
 
+use crate::broyden::SolveError;
+use crate::continuation::{
+    pseudo_arclength, pseudo_arclength_exact, ContinuationOptions, Corrector, Path, PathSystem,
+};
 use crate::fold::Branch;
 use crate::ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
 use crate::BroydenStats;
+use faer::Mat;
+use ivt_num::LuWorkspace;
 
 /// A one-parameter family of periodic problems.
 pub trait Family {
@@ -34,6 +40,12 @@ pub struct FamilyBranch<F: Family> {
     hb: HbOptions,
     res: HbResidual,
     galerkin: GalerkinJacobian,
+    /// Row-major `∂R/∂q` scratch of the [`PathSystem`] assembly.
+    rows: Vec<f64>,
+    /// `(q, λ)` of the last [`PathSystem::residual_jacobian`] and its residual,
+    /// reused by the forward difference in λ at the same point.
+    last_at: Vec<f64>,
+    last_r: Vec<f64>,
 }
 
 impl<F: Family> FamilyBranch<F> {
@@ -60,11 +72,15 @@ impl<F: Family> FamilyBranch<F> {
             ));
         }
         let galerkin = GalerkinJacobian::new(&res);
+        let m = res.len();
         Ok(Self {
             family,
             hb: hb.clone(),
             res,
             galerkin,
+            rows: vec![0.0; m * m],
+            last_at: Vec::with_capacity(m + 1),
+            last_r: vec![0.0; m],
         })
     }
 
@@ -76,6 +92,86 @@ impl<F: Family> FamilyBranch<F> {
     /// The family.
     pub fn family(&self) -> &F {
         &self.family
+    }
+
+    /// Follows the branch from the converged point `start` (`q` then λ) in the
+    /// direction of increasing λ if `direction > 0`, with `corrector`:
+    /// Broyden on the secant model (Eq. 68–77; `start` is corrected first) or
+    /// Newton–chord on the exact Galerkin Jacobian
+    /// ([`pseudo_arclength_exact`]; `start_iterations` is the start's count).
+    ///
+    /// # Errors
+    /// As [`pseudo_arclength`] / [`pseudo_arclength_exact`].
+    pub fn follow(
+        &mut self,
+        start: &[f64],
+        start_iterations: usize,
+        direction: f64,
+        opts: &ContinuationOptions,
+        corrector: Corrector,
+    ) -> Result<Path, HbError> {
+        let m = self.res.len();
+        match corrector {
+            Corrector::Broyden => pseudo_arclength(
+                |x: &[f64], r: &mut [f64]| Branch::residual(self, &x[..m], x[m], r),
+                start,
+                None,
+                direction,
+                opts,
+                |_| true,
+            ),
+            Corrector::Newton => {
+                let mut x = start.to_vec();
+                let its = self.correct_at_fixed_lambda(&mut x, opts)?;
+                pseudo_arclength_exact(self, &x, start_iterations + its, direction, opts, |_, _| {
+                    true
+                })
+            }
+        }
+    }
+
+    /// Newton on `R(q, λ) = 0` at the λ of `x` (`q` then λ, corrected in
+    /// place) to `opts.broyden.tol` within `opts.broyden.max_iter` steps.
+    /// Returns the steps taken.
+    fn correct_at_fixed_lambda(
+        &mut self,
+        x: &mut [f64],
+        opts: &ContinuationOptions,
+    ) -> Result<usize, HbError> {
+        let m = self.res.len();
+        let lambda = x[m];
+        let mut r = vec![0.0; m];
+        let mut lu = LuWorkspace::new(m);
+        let mut history = Vec::new();
+        loop {
+            let it = history.len();
+            Branch::residual(self, &x[..m], lambda, &mut r);
+            let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+            history.push(norm);
+            if norm <= opts.broyden.tol {
+                return Ok(it);
+            }
+            if !norm.is_finite() || it == opts.broyden.max_iter {
+                return Err(HbError::ContinuationStart {
+                    lambda,
+                    cause: SolveError::NonConvergence {
+                        iterations: it,
+                        history,
+                    },
+                });
+            }
+            let mut rows = std::mem::take(&mut self.rows);
+            Branch::jacobian(self, &x[..m], lambda, &mut rows);
+            let factored = lu.factor_row_major(&rows);
+            self.rows = rows;
+            if !factored {
+                return Err(HbError::SingularStart { lambda });
+            }
+            lu.solve(&mut r);
+            for (q, d) in x.iter_mut().zip(&r) {
+                *q -= d;
+            }
+        }
     }
 
     /// The problem at λ and the orbit `q` as an [`HbSolution`] of it.
@@ -109,5 +205,53 @@ impl<F: Family> Branch for FamilyBranch<F> {
         let (problem, omega_f) = self.family.at(lambda);
         self.galerkin
             .assemble(&mut self.res, &problem, q, omega_f, 1.0, jac);
+    }
+}
+
+/// The branch as a [`PathSystem`]: the exact Galerkin Jacobian (Eq. 56) and
+/// `∂R/∂λ` by a forward difference of relative step 1e-7 (it enters only the
+/// tangent and the chord corrector's matrix, not the converged points; it
+/// reuses the residual of the last assembly at the same point, so it costs one
+/// residual evaluation).
+impl<F: Family> PathSystem for FamilyBranch<F> {
+    fn dim(&self) -> usize {
+        self.res.len()
+    }
+    fn residual(&mut self, u: &[f64], lambda: f64, r: &mut [f64]) {
+        Branch::residual(self, u, lambda, r);
+    }
+    fn residual_jacobian(&mut self, u: &[f64], lambda: f64, r: &mut [f64], jac: &mut Mat<f64>) {
+        let m = u.len();
+        Branch::residual(self, u, lambda, r);
+        let mut rows = std::mem::take(&mut self.rows);
+        Branch::jacobian(self, u, lambda, &mut rows);
+        for (i, row) in rows.chunks_exact(m).enumerate() {
+            for (k, v) in row.iter().enumerate() {
+                jac[(i, k)] = *v;
+            }
+        }
+        self.rows = rows;
+        self.last_at.clear();
+        self.last_at.extend_from_slice(u);
+        self.last_at.push(lambda);
+        self.last_r.copy_from_slice(r);
+    }
+    fn d_residual_d_lambda(&mut self, u: &[f64], lambda: f64, r_lambda: &mut [f64]) {
+        let m = u.len();
+        let same =
+            self.last_at.len() == m + 1 && self.last_at[..m] == *u && self.last_at[m] == lambda;
+        if !same {
+            let mut r0 = std::mem::take(&mut self.last_r);
+            Branch::residual(self, u, lambda, &mut r0);
+            self.last_r = r0;
+            self.last_at.clear();
+            self.last_at.extend_from_slice(u);
+            self.last_at.push(lambda);
+        }
+        let h = 1e-7 * lambda.abs().max(1.0);
+        Branch::residual(self, u, lambda + h, r_lambda);
+        for (a, b) in r_lambda.iter_mut().zip(&self.last_r) {
+            *a = (*a - b) / h;
+        }
     }
 }

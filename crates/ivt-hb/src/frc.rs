@@ -8,11 +8,12 @@
 
 use crate::aft::Aft;
 use crate::bifurcation::BifurcationKind;
-use crate::continuation::{pseudo_arclength, turn_estimate, ContinuationOptions, Termination};
+use crate::continuation::{turn_estimate, ContinuationOptions, Corrector, Termination};
 use crate::events::Trace;
+use crate::family::FamilyBranch;
 use crate::floquet::HsuRule;
 use crate::fold::{locate_fold, FoldOptions, HbBranch};
-use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
+use crate::ihb::{HbError, HbOptions, HbSolution};
 use crate::modified::ModifiedIhb;
 use crate::problem::PeriodicProblem;
 use crate::stability::{StabilityAnalyzer, StabilityKind};
@@ -30,6 +31,10 @@ pub struct FrcOptions {
     pub continuation: ContinuationOptions,
     /// Hsu sub-intervals per period for the stability flags.
     pub stability_steps: usize,
+    /// The path's corrector: [`Corrector::Broyden`] (the thesis's Eq. 68–77,
+    /// the default) or [`Corrector::Newton`] (exact Galerkin Jacobian; fewer
+    /// residual evaluations per point, for costly `g`).
+    pub corrector: Corrector,
 }
 
 impl Default for FrcOptions {
@@ -47,6 +52,7 @@ impl Default for FrcOptions {
                 ..ContinuationOptions::default()
             },
             stability_steps: 256,
+            corrector: Corrector::Broyden,
         }
     }
 }
@@ -121,21 +127,20 @@ pub fn frequency_response<P: PeriodicProblem>(
         ));
     }
     let start: HbSolution = ModifiedIhb::new(problem, hb.clone())?.solve(opts.from, None)?;
-    let mut res = HbResidual::new(problem, hb)?;
-    let m = res.len();
+    let mut family = FamilyBranch::new(|w: f64| (problem, w), hb, opts.from)?;
+    let m = start.coeffs.len();
     let mut x0 = start.coeffs.clone();
     x0.push(opts.from);
     let mut copts = opts.continuation.clone();
     copts.lambda_min = opts.from.min(opts.to);
     copts.lambda_max = opts.from.max(opts.to);
     let direction = if opts.to > opts.from { 1.0 } else { -1.0 };
-    let path = pseudo_arclength(
-        |x: &[f64], r: &mut [f64]| res.eval(problem, &x[..m], x[m], 1.0, r),
+    let path = family.follow(
         &x0,
-        None,
+        start.stats.iterations,
         direction,
         &copts,
-        |_| true,
+        opts.corrector,
     )?;
     let mut analyzer = StabilityAnalyzer::new(
         problem,

@@ -39,8 +39,8 @@ pub use broyden::{
 };
 pub use classic::ClassicIhb;
 pub use continuation::{
-    pseudo_arclength, pseudo_arclength_exact, ContinuationOptions, Fold, Path, PathPoint,
-    PathSystem, Termination,
+    pseudo_arclength, pseudo_arclength_exact, ContinuationOptions, Corrector, Fold, Path,
+    PathPoint, PathSystem, Termination,
 };
 pub use elements::{Element, ElementProblem, Harmonic, Law};
 pub use error::HbError;

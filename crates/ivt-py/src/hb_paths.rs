@@ -5,9 +5,9 @@
 //! points and branch points each located on its extended system.
 
 use ivt_hb::{
-    frequency_response, trace, Backbone, BackboneOptions, BifurcationKind, Event, FamilyBranch,
-    Frc, FrcFold, FrcOptions, HbError, HbOptions, ModifiedIhb, PeriodicProblem, Trace,
-    TraceOptions,
+    frequency_response, trace, Backbone, BackboneOptions, BifurcationKind, Corrector, Event,
+    FamilyBranch, Frc, FrcFold, FrcOptions, HbError, HbOptions, ModifiedIhb, PeriodicProblem,
+    Trace, TraceOptions,
 };
 use numpy::ndarray::Array1;
 use numpy::IntoPyArray;
@@ -17,7 +17,10 @@ use pyo3::types::{PyDict, PyList};
 
 use crate::hb::{finite, frc_dict, pairs, run_user, stability_steps, user_system_fn, UserArgs};
 
-/// The FRC of `problem` from `from` to `to`. With `events`, the start is
+/// The FRC of `problem` from `from` to `to`, followed with the Newton–chord
+/// corrector (one Galerkin Jacobian and a few residuals per point: the user's
+/// `g` is called about half as often as by Broyden's many iterations). With
+/// `events`, the start is
 /// solved by the modified IHB and the branch traced in ω_f by
 /// [`ivt_hb::trace`], every event located (the trace's events are returned);
 /// without, [`ivt_hb::frequency_response`] traces it and locates the folds
@@ -34,6 +37,7 @@ fn traced_frc<P: PeriodicProblem>(
             from,
             to,
             stability_steps: stability_steps(opts.harmonics),
+            corrector: Corrector::Newton,
             ..FrcOptions::default()
         };
         return Ok((None, frequency_response(problem, opts, &frc_opts)?));
@@ -44,6 +48,7 @@ fn traced_frc<P: PeriodicProblem>(
         lambda_to: to,
         continuation: frc_opts.continuation,
         stability_steps: stability_steps(opts.harmonics),
+        corrector: Corrector::Newton,
         ..TraceOptions::default()
     };
     let mut branch = FamilyBranch::new(|w: f64| (problem, w), opts, from)?;
