@@ -87,6 +87,7 @@ fn chain() -> ElementProblem {
     .unwrap()
 }
 
+/// The chain's curve with the default (Broyden) corrector.
 #[divan::bench(sample_count = 10)]
 fn chain_frc_0p2_to_3(bencher: divan::Bencher) {
     let p = chain();
