@@ -3,8 +3,8 @@
 //! frequency-response curve 0.2–3.0 with a stability flag at every point.
 
 use ivt_hb::{
-    frequency_response, ClassicIhb, Duffing, FrcOptions, HbOptions, HsuRule, ModifiedIhb,
-    StabilityAnalyzer,
+    frequency_response, ClassicIhb, Duffing, Element, ElementProblem, FrcOptions, GalerkinJacobian,
+    Harmonic, HbOptions, HbResidual, HsuRule, Law, ModifiedIhb, StabilityAnalyzer,
 };
 
 fn main() {
@@ -60,4 +60,50 @@ fn duffing_frc_0p2_to_3(bencher: divan::Bencher) {
     let hb = HbOptions::new(20, 64);
     let opts = FrcOptions::default();
     bencher.bench_local(|| frequency_response(&d, &hb, &opts).unwrap());
+}
+
+/// One exact Galerkin Jacobian (Eq. 56) of the 2-DOF cubic chain (README example:
+/// M = I, K = [[2, −1], [−1, 2]], C = 0.02 I, 0.5 x₀³ to ground, 0.1 cos θ on DOF 0),
+/// n = 20, 2N = 168, at the orbit of ω_f = 1.2: what every Newton step of the classic
+/// IHB, the fold locator and exact continuation pays.
+#[divan::bench]
+fn chain_galerkin_assemble(bencher: divan::Bencher) {
+    let chain = ElementProblem::new(
+        2,
+        [
+            vec![1.0, 0.0, 0.0, 1.0],
+            vec![0.02, 0.0, 0.0, 0.02],
+            vec![2.0, -1.0, -1.0, 2.0],
+        ],
+        vec![Element {
+            a: 0,
+            b: None,
+            law: Law::CubicSpring { k3: 0.5 },
+        }],
+        vec![Harmonic {
+            dof: 0,
+            amplitude: 0.1,
+            phase: 0.0,
+        }],
+    )
+    .unwrap();
+    let opts = HbOptions::new(20, 84);
+    let sol = ModifiedIhb::new(chain.clone(), opts.clone())
+        .unwrap()
+        .solve(1.2, None)
+        .unwrap();
+    let mut res = HbResidual::new(&chain, &opts).unwrap();
+    let mut galerkin = GalerkinJacobian::new(&res);
+    let m = res.len();
+    let mut jac = vec![0.0; m * m];
+    bencher.bench_local(|| {
+        galerkin.assemble(
+            &mut res,
+            &chain,
+            divan::black_box(&sol.coeffs),
+            1.2,
+            1.0,
+            &mut jac,
+        )
+    });
 }
