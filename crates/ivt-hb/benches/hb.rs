@@ -5,7 +5,8 @@
 
 use ivt_hb::{
     frequency_response, ClassicIhb, Corrector, Duffing, Element, ElementProblem, FrcOptions,
-    Harmonic, HbOptions, HsuRule, Law, ModifiedIhb, StabilityAnalyzer,
+    GalerkinJacobian, Harmonic, HbOptions, HbResidual, HsuRule, Law, ModifiedIhb,
+    StabilityAnalyzer,
 };
 
 fn main() {
@@ -119,4 +120,31 @@ fn duffing_frc_newton_0p2_to_3(bencher: divan::Bencher) {
         ..FrcOptions::default()
     };
     bencher.bench_local(|| frequency_response(&d, &hb, &opts).unwrap());
+}
+
+/// One exact Galerkin Jacobian (Eq. 56) of the chain, n = 20, 2N = 168, at the
+/// orbit of ω_f = 1.2: what every Newton step of the classic IHB, the fold
+/// locator and exact continuation pays.
+#[divan::bench]
+fn chain_galerkin_assemble(bencher: divan::Bencher) {
+    let chain = chain();
+    let opts = HbOptions::new(20, 84);
+    let sol = ModifiedIhb::new(chain.clone(), opts.clone())
+        .unwrap()
+        .solve(1.2, None)
+        .unwrap();
+    let mut res = HbResidual::new(&chain, &opts).unwrap();
+    let mut galerkin = GalerkinJacobian::new(&res);
+    let m = res.len();
+    let mut jac = vec![0.0; m * m];
+    bencher.bench_local(|| {
+        galerkin.assemble(
+            &mut res,
+            &chain,
+            divan::black_box(&sol.coeffs),
+            1.2,
+            1.0,
+            &mut jac,
+        )
+    });
 }

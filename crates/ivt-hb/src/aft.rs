@@ -206,6 +206,13 @@ impl Aft {
         }
     }
 
+    /// The unnormalised DFT `X_l = Σ_i u_i e^{−ilτ_i}`, `l = 0..=N`, of the 2N
+    /// samples: `Re X_l = Σ u cos lτ_i`, `Im X_l = −Σ u sin lτ_i`.
+    pub(crate) fn spectrum(&mut self, samples: &[f64]) -> &[Complex<f64>] {
+        self.fft.forward_from(samples);
+        &self.fft.spectrum
+    }
+
     /// Galerkin projection `(1/π)∫ C_s f dτ` of the samples (Eq. 61): like
     /// [`Self::analyze`] but the first entry is the mean `a0/2`.
     pub fn galerkin(&mut self, samples: &[f64], out: &mut [f64]) {

@@ -15,7 +15,8 @@
 //! Galerkin Jacobian (Eq. 56), the branch of a frequency-response curve.
 
 use crate::broyden::SolveError;
-use crate::ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual};
+use crate::galerkin::{GalerkinForm, GalerkinJacobian};
+use crate::ihb::{HbError, HbOptions, HbResidual};
 use crate::problem::PeriodicProblem;
 use ivt_num::vector::norm2;
 use ivt_num::LuWorkspace;
@@ -93,20 +94,24 @@ pub struct HbBranch<'a, P> {
     problem: &'a P,
     res: HbResidual,
     galerkin: GalerkinJacobian,
+    form: GalerkinForm,
+    /// `L(ω)v` of [`Branch::bilinear`].
+    lv: Vec<f64>,
 }
 
 impl<'a, P: PeriodicProblem> HbBranch<'a, P> {
-    /// Plans the residual and the Galerkin quadrature.
+    /// Plans the residual, the Galerkin Jacobian and the bilinear form's scratch.
     ///
     /// # Errors
     /// As [`HbResidual::new`].
     pub fn new(problem: &'a P, opts: &HbOptions) -> Result<Self, HbError> {
         let res = HbResidual::new(problem, opts)?;
-        let galerkin = GalerkinJacobian::new(&res);
         Ok(Self {
             problem,
+            galerkin: GalerkinJacobian::new(&res),
+            form: GalerkinForm::new(&res, problem),
+            lv: vec![0.0; res.len()],
             res,
-            galerkin,
         })
     }
 }
@@ -122,144 +127,18 @@ impl<P: PeriodicProblem> Branch for HbBranch<'_, P> {
         self.galerkin
             .assemble(&mut self.res, self.problem, q, lambda, 1.0, jac);
     }
-    /// `wᵀL(ω)v` exactly plus the quadrature of the nonlinear part (see
-    /// [`HbBranch::quadrature`]): no `J` is assembled.
+    /// `wᵀL(ω)v` exactly plus the sum of the nonlinear part over the AFT grid
+    /// (`GalerkinForm`): no `J` is assembled.
     fn bilinear(&mut self, q: &[f64], lambda: f64, w: &[f64], v: &[f64]) -> f64 {
         let omega = lambda / self.res.subharmonic() as f64;
-        let mut lv = vec![0.0; v.len()];
-        self.res.apply_linear(self.problem, v, omega, &mut lv);
-        let linear: f64 = w.iter().zip(&lv).map(|(a, b)| a * b).sum();
-        linear + self.quadrature(q, lambda, w, v, None)
+        self.res.apply_linear(self.problem, v, omega, &mut self.lv);
+        let linear: f64 = w.iter().zip(&self.lv).map(|(a, b)| a * b).sum();
+        linear + self.form.value(self.problem, q, lambda, w, v, None)
     }
-    /// `L` does not depend on `q`: the gradient is that of the quadrature.
+    /// `L` does not depend on `q`: the gradient is that of the nonlinear part.
     fn jacobian_gradient(&mut self, q: &[f64], lambda: f64, w: &[f64], v: &[f64], out: &mut [f64]) {
-        self.quadrature(q, lambda, w, v, Some(out));
+        self.form.value(self.problem, q, lambda, w, v, Some(out));
     }
-}
-
-impl<P: PeriodicProblem> HbBranch<'_, P> {
-    /// The nonlinear part of `wᵀJv` without assembling `J`: `(2/2N) Σᵢ ψᵢ` with
-    /// `ψᵢ = w̃ᵀ(G_x ṽ + ω G_v ṽ')` at sample τᵢ (`w̃`, `ṽ`, `ṽ'` the syntheses of
-    /// `w`, `v` and `v'`, Eq. 56's quadrature). With `grad`, also its gradient in
-    /// `q`: `∂ψᵢ/∂x`, `∂ψᵢ/∂ẋ` by central differences of `∂g` (steps relative to
-    /// the orbit's scale) projected back on the basis — O(2N·m), where
-    /// differencing assembled Jacobians would cost 2m assemblies. `∂g` is taken
-    /// at all samples per call (`nonlinear_jacobian_samples`): 1 + 2·n_dof calls
-    /// (twice that with velocity dependence) whatever the number of samples.
-    fn quadrature(
-        &mut self,
-        q: &[f64],
-        lambda: f64,
-        w: &[f64],
-        v: &[f64],
-        grad: Option<&mut [f64]>,
-    ) -> f64 {
-        let nd = self.problem.n_dof();
-        let l = q.len() / nd;
-        let basis = self.galerkin.basis();
-        let ns = basis.len() / (2 * l);
-        let p = self.res.subharmonic() as f64;
-        let omega = lambda / p;
-        let velocity = self.problem.velocity_dependent();
-        let synth = |c: &[f64], row: &[f64]| c.iter().zip(row).map(|(a, b)| a * b).sum::<f64>();
-        // Sample-major x(τᵢ), ẋ(τᵢ) of the orbit and the syntheses of w, v, v'.
-        let mut xs = vec![0.0; ns * nd];
-        let mut vs = vec![0.0; ns * nd];
-        let (mut wt, mut vt, mut vdt) =
-            (vec![0.0; ns * nd], vec![0.0; ns * nd], vec![0.0; ns * nd]);
-        for i in 0..ns {
-            let (cs, ds) = basis_rows(basis, l, ns, i);
-            for d in 0..nd {
-                let (k, dof) = (i * nd + d, d * l..(d + 1) * l);
-                xs[k] = synth(&q[dof.clone()], cs);
-                vs[k] = omega * synth(&q[dof.clone()], ds);
-                wt[k] = synth(&w[dof.clone()], cs);
-                vt[k] = synth(&v[dof.clone()], cs);
-                vdt[k] = synth(&v[dof], ds);
-            }
-        }
-        let thetas: Vec<f64> = (0..ns)
-            .map(|i| p * 2.0 * std::f64::consts::PI * i as f64 / ns as f64)
-            .collect();
-        let n2 = nd * nd;
-        let mut dg = vec![0.0; 2 * ns * n2];
-        let problem = &self.problem;
-        // ψᵢ of every sample at the states (x, ẋ) from one batched ∂g.
-        let mut psi = |x: &[f64], xv: &[f64], out: &mut [f64]| {
-            problem.nonlinear_jacobian_samples(x, xv, &thetas, &mut dg);
-            for (i, o) in out.iter_mut().enumerate() {
-                let mut acc = 0.0;
-                for d in 0..nd {
-                    for e in 0..nd {
-                        let (gx, gv) = (
-                            dg[2 * i * n2 + d * nd + e],
-                            dg[2 * i * n2 + n2 + d * nd + e],
-                        );
-                        acc +=
-                            wt[i * nd + d] * (gx * vt[i * nd + e] + omega * gv * vdt[i * nd + e]);
-                    }
-                }
-                *o = acc;
-            }
-        };
-        let weight = 2.0 / ns as f64;
-        let mut at = vec![0.0; ns];
-        psi(&xs, &vs, &mut at);
-        let total = weight * at.iter().sum::<f64>();
-        let Some(out) = grad else {
-            return total;
-        };
-        out.fill(0.0);
-        let scale = |u: &[f64]| u.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        let (x_scale, v_scale) = (scale(&xs), scale(&vs));
-        let (mut plus, mut minus) = (vec![0.0; ns], vec![0.0; ns]);
-        for f in 0..nd {
-            for wrt_v in [false, true] {
-                if wrt_v && !velocity {
-                    continue;
-                }
-                let (base, u_scale) = if wrt_v {
-                    (&vs, v_scale)
-                } else {
-                    (&xs, x_scale)
-                };
-                let h: Vec<f64> = (0..ns)
-                    .map(|i| 1e-6 * base[i * nd + f].abs().max(u_scale).max(f64::MIN_POSITIVE))
-                    .collect();
-                let mut moved = base.clone();
-                for (sign, dst) in [(1.0, &mut plus), (-1.0, &mut minus)] {
-                    for i in 0..ns {
-                        moved[i * nd + f] = base[i * nd + f] + sign * h[i];
-                    }
-                    if wrt_v {
-                        psi(&xs, &moved, dst)
-                    } else {
-                        psi(&moved, &vs, dst)
-                    }
-                }
-                let factor = if wrt_v { weight * omega } else { weight };
-                let target = &mut out[f * l..(f + 1) * l];
-                for i in 0..ns {
-                    let d_psi = factor * (plus[i] - minus[i]) / (2.0 * h[i]);
-                    let (cs, ds) = basis_rows(basis, l, ns, i);
-                    let row = if wrt_v { ds } else { cs };
-                    target
-                        .iter_mut()
-                        .zip(row)
-                        .for_each(|(o, c)| *o += d_psi * c);
-                }
-            }
-        }
-        total
-    }
-}
-
-/// `C_s(τ_i)` and `C_s'(τ_i)` from the quadrature table of `ns` samples.
-fn basis_rows(basis: &[f64], l: usize, ns: usize, i: usize) -> (&[f64], &[f64]) {
-    (
-        &basis[i * l..(i + 1) * l],
-        &basis[(ns + i) * l..(ns + i + 1) * l],
-    )
 }
 
 /// Options of the fold Newton iteration.

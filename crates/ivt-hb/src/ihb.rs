@@ -12,6 +12,8 @@
 use crate::aft::Aft;
 use crate::broyden::{BroydenOptions, BroydenStats};
 pub(crate) use crate::error::HbError;
+/// The Galerkin Jacobian of [`HbResidual`] lives in [`crate::galerkin`].
+pub use crate::galerkin::GalerkinJacobian;
 use crate::problem::PeriodicProblem;
 
 /// Options of the IHB solvers.
@@ -468,119 +470,32 @@ impl HbResidual {
         ok
     }
 
-    /// Galerkin Jacobian of the nonlinear part by quadrature on the 2N grid (the
-    /// classic IHB's Φ_q minus `L(ω)`, §3.2.1), times `s`, added into `jac`. `∂g`
-    /// at all samples come from one [`PeriodicProblem::nonlinear_jacobian_samples`]
-    /// call into `dg` (`2N·2n_dof²`); `basis` (`2·2N·(2n+1)`) is
-    /// filled by [`Self::fill_basis`]. Allocation-free if the problem's
-    /// `nonlinear_jacobian_samples` is.
-    #[allow(clippy::too_many_arguments)]
-    pub fn add_nonlinear_jacobian<P: PeriodicProblem>(
+    /// `∂g/∂x`, `∂g/∂v` of the orbit `q` at all samples, from one
+    /// [`PeriodicProblem::nonlinear_jacobian_samples`] call into `dg` (`2N·2n_dof²`,
+    /// per sample the blocks `[∂g/∂x | ∂g/∂v]`); `omega` = ω_f/p.
+    pub(crate) fn jacobian_samples<P: PeriodicProblem>(
         &mut self,
         problem: &P,
         q: &[f64],
-        omega_f: f64,
-        s: f64,
-        basis: &[f64],
+        omega: f64,
         dg: &mut [f64],
-        jac: &mut [f64],
     ) {
-        let (nd, n) = (self.n_dof, self.n);
-        let l = 2 * n + 1;
-        let len = nd * l;
-        let ns = self.aft.n_samples();
-        let omega = omega_f / self.p as f64;
         self.synthesize_states(q, omega, true);
         problem.nonlinear_jacobian_samples(&self.xs, &self.vs, &self.thetas, dg);
-        let w = s / ns as f64 * 2.0; // (1/π)·(2π/2N)
-        let n2 = nd * nd;
-        for i in 0..ns {
-            let cs = &basis[i * l..(i + 1) * l];
-            let ds = &basis[(ns + i) * l..(ns + i + 1) * l];
-            for d in 0..nd {
-                for e in 0..nd {
-                    let gx = w * dg[2 * i * n2 + d * nd + e];
-                    let gv = w * omega * dg[2 * i * n2 + n2 + d * nd + e];
-                    if gx == 0.0 && gv == 0.0 {
-                        continue;
-                    }
-                    for a in 0..l {
-                        let row =
-                            &mut jac[(d * l + a) * len + e * l..(d * l + a) * len + (e + 1) * l];
-                        let ca = cs[a];
-                        for (bcol, j) in row.iter_mut().zip(0..l) {
-                            *bcol += ca * (gx * cs[j] + gv * ds[j]);
-                        }
-                    }
-                }
-            }
-        }
     }
 
-    /// Basis table for [`Self::add_nonlinear_jacobian`]: rows `i < 2N` hold
-    /// `C_s(τ_i) = {1/2, cos kτ_i, sin kτ_i}`, rows `2N + i` its τ-derivative.
-    pub fn fill_basis(&self, basis: &mut [f64]) {
-        let n = self.n;
-        let l = 2 * n + 1;
-        let ns = self.aft.n_samples();
-        // k·τ_i = 2π·(k·i mod 2N)/2N: one sin/cos table of the 2N grid angles
-        // serves every harmonic (and reduces the angle exactly).
-        let table: Vec<(f64, f64)> = (0..ns).map(|j| self.aft.tau(j).sin_cos()).collect();
-        for i in 0..ns {
-            basis[i * l] = 0.5;
-            basis[(ns + i) * l] = 0.0;
-            for k in 1..=n {
-                let (sn, cs) = table[(k * i) % ns];
-                basis[i * l + k] = cs;
-                basis[i * l + n + k] = sn;
-                basis[(ns + i) * l + k] = -(k as f64) * sn;
-                basis[(ns + i) * l + n + k] = k as f64 * cs;
-            }
-        }
-    }
-}
-
-/// The exact Galerkin Jacobian `Φ_q = L(ω) + s·(1/π)∫ C_s (G_x C_sᵀ + ω G_v C_s'ᵀ) dτ`
-/// (Eq. 56) of the residual at nonlinearity scale `s`, with its quadrature scratch:
-/// the classic IHB's Newton matrix, and the modified IHB's refresh when Broyden stalls.
-#[derive(Debug, Clone)]
-pub struct GalerkinJacobian {
-    basis: Vec<f64>,
-    /// `[∂g/∂x | ∂g/∂v]` at every sample.
-    dg: Vec<f64>,
-}
-
-impl GalerkinJacobian {
-    /// Scratch for `res`'s size and `n_dof` of the problem it evaluates.
-    pub fn new(res: &HbResidual) -> Self {
-        let (nd, l, ns) = (res.n_dof, 2 * res.n + 1, res.aft.n_samples());
-        let mut basis = vec![0.0; 2 * ns * l];
-        res.fill_basis(&mut basis);
-        Self {
-            basis,
-            dg: vec![0.0; 2 * ns * nd * nd],
-        }
+    /// Number of DOFs.
+    pub(crate) fn n_dof(&self) -> usize {
+        self.n_dof
     }
 
-    /// The quadrature basis table ([`HbResidual::fill_basis`]).
-    pub(crate) fn basis(&self) -> &[f64] {
-        &self.basis
+    /// Number of AFT samples 2N.
+    pub(crate) fn n_samples(&self) -> usize {
+        self.aft.n_samples()
     }
 
-    /// Writes `Φ_q(q)` (row-major `m×m`) into `jac`; allocation-free when the problem
-    /// supplies an analytic Jacobian (central differences allocate their scratch).
-    pub fn assemble<P: PeriodicProblem>(
-        &mut self,
-        res: &mut HbResidual,
-        problem: &P,
-        q: &[f64],
-        omega_f: f64,
-        s: f64,
-        jac: &mut [f64],
-    ) {
-        res.linear_matrix(problem, omega_f / res.p as f64, jac);
-        if s != 0.0 {
-            res.add_nonlinear_jacobian(problem, q, omega_f, s, &self.basis, &mut self.dg, jac);
-        }
+    /// Whether `g` depends on the velocity (the problem's flag at construction).
+    pub(crate) fn velocity_dependent(&self) -> bool {
+        self.velocity
     }
 }

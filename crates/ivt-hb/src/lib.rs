@@ -17,6 +17,7 @@ pub mod family;
 pub mod floquet;
 pub mod fold;
 pub mod frc;
+pub mod galerkin;
 pub mod hill;
 pub mod ihb;
 pub mod limits;

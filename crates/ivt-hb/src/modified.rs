@@ -14,7 +14,7 @@ use ivt_num::vector::matvec;
 
 /// The modified IHB solver for one problem and one size (plans and buffers reused
 /// across solves; nothing is allocated inside the iteration, except the Galerkin
-/// quadrature table, built once on the solver's first stalled-Broyden refresh).
+/// Jacobian's scratch, built once on the solver's first stalled-Broyden refresh).
 #[derive(Debug)]
 pub struct ModifiedIhb<P> {
     problem: P,
