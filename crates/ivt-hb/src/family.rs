@@ -11,7 +11,8 @@ use crate::continuation::{
     pseudo_arclength, pseudo_arclength_exact, ContinuationOptions, Corrector, Path, PathSystem,
 };
 use crate::fold::Branch;
-use crate::ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution};
+use crate::galerkin::{GalerkinForm, GalerkinJacobian};
+use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
 use crate::BroydenStats;
 use faer::Mat;
@@ -40,6 +41,10 @@ pub struct FamilyBranch<F: Family> {
     hb: HbOptions,
     res: HbResidual,
     galerkin: GalerkinJacobian,
+    /// The nonlinear part of `wᵀJv` and its gradient (fold location).
+    form: GalerkinForm,
+    /// `L v` of [`Branch::bilinear`].
+    lv: Vec<f64>,
     /// Row-major `∂R/∂q` scratch of the [`PathSystem`] assembly.
     rows: Vec<f64>,
     /// `(q, λ)` of the last [`PathSystem::residual_jacobian`] and its residual,
@@ -72,12 +77,15 @@ impl<F: Family> FamilyBranch<F> {
             ));
         }
         let galerkin = GalerkinJacobian::new(&res);
+        let form = GalerkinForm::new(&res, &family.at(lambda0).0);
         let m = res.len();
         Ok(Self {
             family,
             hb: hb.clone(),
             res,
             galerkin,
+            form,
+            lv: vec![0.0; m],
             rows: vec![0.0; m * m],
             last_at: Vec::with_capacity(m + 1),
             last_r: vec![0.0; m],
@@ -205,6 +213,21 @@ impl<F: Family> Branch for FamilyBranch<F> {
         let (problem, omega_f) = self.family.at(lambda);
         self.galerkin
             .assemble(&mut self.res, &problem, q, omega_f, 1.0, jac);
+    }
+    /// `wᵀL v` exactly plus the sum of the nonlinear part over the AFT grid
+    /// ([`GalerkinForm`]): no `J` is assembled.
+    fn bilinear(&mut self, q: &[f64], lambda: f64, w: &[f64], v: &[f64]) -> f64 {
+        let (problem, omega_f) = self.family.at(lambda);
+        let omega = omega_f / self.res.subharmonic() as f64;
+        self.res.apply_linear(&problem, v, omega, &mut self.lv);
+        let linear: f64 = w.iter().zip(&self.lv).map(|(a, b)| a * b).sum();
+        linear + self.form.value(&problem, q, omega_f, w, v, None)
+    }
+    /// `L` does not depend on `q`: the gradient is that of the nonlinear part
+    /// (O(2N·m), where differencing assembled Jacobians costs 2m assemblies).
+    fn jacobian_gradient(&mut self, q: &[f64], lambda: f64, w: &[f64], v: &[f64], out: &mut [f64]) {
+        let (problem, omega_f) = self.family.at(lambda);
+        self.form.value(&problem, q, omega_f, w, v, Some(out));
     }
 }
 

@@ -11,13 +11,12 @@
 //! difference of [`Branch::bilinear`] in λ); `∂R/∂λ` by central differences. One
 //! Jacobian per Newton step.
 //!
-//! [`HbBranch`] is the harmonic-balance residual (Eq. 61) in λ = ω_f with the exact
-//! Galerkin Jacobian (Eq. 56), the branch of a frequency-response curve.
+//! [`crate::FamilyBranch`] is the harmonic-balance residual (Eq. 61) in any
+//! parameter λ (e.g. `|w| (&problem, w)` for λ = ω_f, the branch of a
+//! frequency-response curve) with the exact Galerkin Jacobian (Eq. 56).
 
 use crate::broyden::SolveError;
-use crate::galerkin::{GalerkinForm, GalerkinJacobian};
-use crate::ihb::{HbError, HbOptions, HbResidual};
-use crate::problem::PeriodicProblem;
+use crate::ihb::HbError;
 use ivt_num::vector::norm2;
 use ivt_num::LuWorkspace;
 
@@ -86,58 +85,6 @@ pub fn fd_jacobian_gradient<B: Branch>(
         let minus = wjv(branch, &qt);
         qt[k] = q[k];
         out[k] = (plus - minus) / (2.0 * h);
-    }
-}
-
-/// The HB residual Eq. 61 of `problem` as a branch in the excitation frequency ω_f.
-pub struct HbBranch<'a, P> {
-    problem: &'a P,
-    res: HbResidual,
-    galerkin: GalerkinJacobian,
-    form: GalerkinForm,
-    /// `L(ω)v` of [`Branch::bilinear`].
-    lv: Vec<f64>,
-}
-
-impl<'a, P: PeriodicProblem> HbBranch<'a, P> {
-    /// Plans the residual, the Galerkin Jacobian and the bilinear form's scratch.
-    ///
-    /// # Errors
-    /// As [`HbResidual::new`].
-    pub fn new(problem: &'a P, opts: &HbOptions) -> Result<Self, HbError> {
-        let res = HbResidual::new(problem, opts)?;
-        Ok(Self {
-            problem,
-            galerkin: GalerkinJacobian::new(&res),
-            form: GalerkinForm::new(&res, problem),
-            lv: vec![0.0; res.len()],
-            res,
-        })
-    }
-}
-
-impl<P: PeriodicProblem> Branch for HbBranch<'_, P> {
-    fn len(&self) -> usize {
-        self.res.len()
-    }
-    fn residual(&mut self, q: &[f64], lambda: f64, r: &mut [f64]) {
-        self.res.eval(self.problem, q, lambda, 1.0, r);
-    }
-    fn jacobian(&mut self, q: &[f64], lambda: f64, jac: &mut [f64]) {
-        self.galerkin
-            .assemble(&mut self.res, self.problem, q, lambda, 1.0, jac);
-    }
-    /// `wᵀL(ω)v` exactly plus the sum of the nonlinear part over the AFT grid
-    /// (`GalerkinForm`): no `J` is assembled.
-    fn bilinear(&mut self, q: &[f64], lambda: f64, w: &[f64], v: &[f64]) -> f64 {
-        let omega = lambda / self.res.subharmonic() as f64;
-        self.res.apply_linear(self.problem, v, omega, &mut self.lv);
-        let linear: f64 = w.iter().zip(&self.lv).map(|(a, b)| a * b).sum();
-        linear + self.form.value(self.problem, q, lambda, w, v, None)
-    }
-    /// `L` does not depend on `q`: the gradient is that of the nonlinear part.
-    fn jacobian_gradient(&mut self, q: &[f64], lambda: f64, w: &[f64], v: &[f64], out: &mut [f64]) {
-        self.form.value(self.problem, q, lambda, w, v, Some(out));
     }
 }
 
@@ -384,6 +331,8 @@ pub fn locate_fold<B: Branch>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ihb::HbOptions;
+    use crate::problem::PeriodicProblem;
 
     /// `R = (q₀² − 2q₀ + 2 − λ, q₁ − q₀³)`: along the branch `λ = (q₀ − 1)² + 1`,
     /// a fold at `q = (1, 1)`, `λ = 1`.
@@ -445,7 +394,7 @@ mod tests {
         // Jacobians (central differences, error ~1e-10 relative).
         let problem = Coupled;
         let opts = HbOptions::new(4, 16);
-        let mut branch = HbBranch::new(&problem, &opts).unwrap();
+        let mut branch = crate::FamilyBranch::new(|w: f64| (&problem, w), &opts, 1.2).unwrap();
         let m = branch.len();
         let pattern = |k: usize, a: f64| (a * (k as f64 + 1.0)).sin() / (1.0 + k as f64);
         let q: Vec<f64> = (0..m).map(|k| pattern(k, 1.3)).collect();

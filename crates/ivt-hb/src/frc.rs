@@ -12,7 +12,7 @@ use crate::continuation::{turn_estimate, ContinuationOptions, Corrector, Termina
 use crate::events::Trace;
 use crate::family::FamilyBranch;
 use crate::floquet::HsuRule;
-use crate::fold::{locate_fold, FoldOptions, HbBranch};
+use crate::fold::{locate_fold, FoldOptions};
 use crate::ihb::{HbError, HbOptions, HbSolution};
 use crate::modified::ModifiedIhb;
 use crate::problem::PeriodicProblem;
@@ -172,14 +172,13 @@ pub fn frequency_response<P: PeriodicProblem>(
             coeffs: sol.coeffs,
         });
     }
-    let mut branch = HbBranch::new(problem, hb)?;
     let mut folds = Vec::with_capacity(path.folds.len());
     for turn in &path.folds {
         let near = &points[turn.index];
         // Start from the quadratic through the three points around the turn.
         let around = &path.points[turn.bracket..turn.bracket + 3];
         let start = turn_estimate(&around[0], &around[1], &around[2]);
-        let located = locate_fold(&mut branch, &start[..m], start[m], &FoldOptions::default())
+        let located = locate_fold(&mut family, &start[..m], start[m], &FoldOptions::default())
             .ok()
             .map(|f| (f.q, f.lambda));
         folds.push(probe.fold(turn.index, located, near, turn.lambda));

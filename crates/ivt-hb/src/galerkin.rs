@@ -217,7 +217,7 @@ pub(crate) fn quadrature_basis(n: usize, ns: usize) -> Vec<f64> {
 }
 
 /// The nonlinear part of `wᵀΦ_q v` without assembling `Φ_q` (the fold test of
-/// [`crate::fold::HbBranch`]), and its gradient in `q`, with all scratch.
+/// [`crate::FamilyBranch`]), and its gradient in `q`, with all scratch.
 #[derive(Debug, Clone)]
 pub(crate) struct GalerkinForm {
     n_dof: usize,

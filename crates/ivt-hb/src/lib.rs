@@ -49,7 +49,7 @@ pub use events::{trace, Event, Trace, TraceOptions, TracedPoint};
 pub use faer::c64;
 pub use family::{Family, FamilyBranch};
 pub use floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
-pub use fold::{locate_fold, Branch, FoldLocation, FoldOptions, HbBranch};
+pub use fold::{locate_fold, Branch, FoldLocation, FoldOptions};
 pub use frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
 pub use hill::{fourier_blocks, hill_multipliers, HillResult};
 pub use ihb::{GalerkinJacobian, HbOptions, HbResidual, HbSolution, HbSolver};
