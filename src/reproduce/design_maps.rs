@@ -204,7 +204,10 @@ const FIG42_MU1_CAUSE: &str = "not found by computation. Ours is confirmed by si
      or about the orbit at Eq. 158's r_f = 0.024195 m (0.792, or 0.785 with its own mean speed in K) \
      (`tests/ch4_causes.rs::sampled_law_averaged_orbit_or_eq158_r_is_not_the_cause`); Table 1 gives no armature \
      inductance to add; and Hsu's transformation matrix (Eq. 80, the method §4.3 cites), which for N_Q = 8…1000 \
-     never comes below ours";
+     never comes below ours. Both printed numbers hold only with the gains scaled separately, k × 0.786 and \
+     k2 × 0.523 (ratio k2/k = 1.33, not 2), which no unit reading gives \
+     (`tests/ch4_causes.rs::both_printed_multipliers_need_another_gain_ratio`): they belong to other gains or \
+     another plant";
 
 /// Why thesis-ch4 misses Fig. 42's 0.4871 (k = 0.06, k2 = 0.12 mm·rad⁻¹).
 const FIG42_MU2_CAUSE: &str = "0.4871 is below what the printed gain ratio k2 = 2k allows here: the feedback law of \
@@ -213,7 +216,8 @@ const FIG42_MU2_CAUSE: &str = "0.4871 is below what the printed gain ratio k2 = 
      nearby points (V_m 5…9 V, T_U 1.5…9 N·m), nor below 0.54 with k_t, k_e scaled separately and r̄ kept; other \
      ratios get there ((0.075, 0.10): 0.38), as does a plant with 1.6× the inertia (0.449, but 0.795 for the \
      first case). A delay over half a revolution would lower the floor to e^{−1} but gives 0.550 (a quarter: \
-     0.672), and the sampled law, the averaged orbit and Eq. 158's r_f give 0.600…0.613. Ours is confirmed by \
+     0.672), and the sampled law, the averaged orbit and Eq. 158's r_f give 0.600…0.613; both printed numbers hold \
+     with k × 0.786 and k2 × 0.523 (ratio 1.33). Ours is confirmed by \
      simulating the delay loop (to 1e-3), and the hypotheses ruled out for the 0.7776 row fail here too";
 
 pub(super) fn stability(
