@@ -198,7 +198,16 @@ const FIG42_MU1_CAUSE: &str = "not found by computation. Ours is confirmed by si
      that give 0.7776 give 0.599 or 0.515 for the second case \
      (`tests/ch4_causes.rs::nearby_plants_keeping_r_bar_are_not_the_cause`); a unit factor on one gain and the \
      nearby operating points (`tests/ch4_causes.rs::printed_gain_ratio_floors_the_multiplier_at_exp_minus_half`); \
-     and Hsu's transformation matrix (Eq. 80, the method §4.3 cites), which for N_Q = 8…1000 never comes below ours";
+     a delay over a half or a quarter revolution (0.734 / 0.550, 0.753 / 0.672; \
+     `tests/ch4_causes.rs::quarter_or_half_revolution_delay_is_not_the_cause`); the law sampled 4…80 times per \
+     revolution (0.785…0.787), linearizing about the averaged orbit (ω̄ ≡ ω0: 0.794; 𝒜 averaged over θ: 0.792) \
+     or about the orbit at Eq. 158's r_f = 0.024195 m (0.792, or 0.785 with its own mean speed in K) \
+     (`tests/ch4_causes.rs::sampled_law_averaged_orbit_or_eq158_r_is_not_the_cause`); Table 1 gives no armature \
+     inductance to add; and Hsu's transformation matrix (Eq. 80, the method §4.3 cites), which for N_Q = 8…1000 \
+     never comes below ours. Both printed numbers hold only with the gains scaled separately, k × 0.786 and \
+     k2 × 0.523 (ratio k2/k = 1.33, not 2), which no unit reading gives \
+     (`tests/ch4_causes.rs::both_printed_multipliers_need_another_gain_ratio`): they belong to other gains or \
+     another plant";
 
 /// Why thesis-ch4 misses Fig. 42's 0.4871 (k = 0.06, k2 = 0.12 mm·rad⁻¹).
 const FIG42_MU2_CAUSE: &str = "0.4871 is below what the printed gain ratio k2 = 2k allows here: the feedback law of \
@@ -206,8 +215,10 @@ const FIG42_MU2_CAUSE: &str = "0.4871 is below what the printed gain ratio k2 = 
      that ratio max |μ| never goes below 0.60 (k = 1e-3…1e2 mm·rad⁻¹; floor e^{−1/2} to 5e-3), nor below 0.59 at the \
      nearby points (V_m 5…9 V, T_U 1.5…9 N·m), nor below 0.54 with k_t, k_e scaled separately and r̄ kept; other \
      ratios get there ((0.075, 0.10): 0.38), as does a plant with 1.6× the inertia (0.449, but 0.795 for the \
-     first case). Ours is confirmed by simulating the delay loop (to 1e-3), and the hypotheses ruled out for the \
-     0.7776 row fail here too";
+     first case). A delay over half a revolution would lower the floor to e^{−1} but gives 0.550 (a quarter: \
+     0.672), and the sampled law, the averaged orbit and Eq. 158's r_f give 0.600…0.613; both printed numbers hold \
+     with k × 0.786 and k2 × 0.523 (ratio 1.33). Ours is confirmed by \
+     simulating the delay loop (to 1e-3), and the hypotheses ruled out for the 0.7776 row fail here too";
 
 pub(super) fn stability(
     ctx: &mut Context,

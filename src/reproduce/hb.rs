@@ -20,7 +20,10 @@ const A0_TEST: &str = "src/reproduce/hb.rs::a0_differs_in_a8_sign_and_b3";
 const A0_RULED_OUT: &str = "src/reproduce/hb.rs::a0_b3_is_not_beta_n_or_truncation";
 
 /// The test ruling out one-parameter slips, the classic IHB and sign flips.
-const A0_SLIPS: &str = "tests/ch4_causes.rs::a0_b3_is_not_a_parameter_slip_or_the_classic_ihb";
+const A0_SLIPS: &str = "tests/a0_causes.rs::a0_b3_is_not_a_parameter_slip_or_the_classic_ihb";
+
+/// The test ruling out collocation and the literal Eq. 83 residual.
+const A0_COLLOCATION: &str = "tests/a0_causes.rs::a0_b3_is_not_collocation_or_the_literal_eq83";
 
 /// Fig. 28 forcing frequency (n = 20, N = 64, ξ = 0.02, α = 1, ε = 1, F = 0.1).
 const OMEGA_F: f64 = 0.4;
@@ -269,7 +272,9 @@ fn mathieu(ctx: &mut Context) -> Result<(), ReproError> {
                          0.0471 moves a1 off its printed digits (db3/dβ ≈ −0.28, da1/dβ ≈ 1.7), and truncating instead \
                          of rounding would print a0 = 0.7880, not 0.7881: all ruled out (`{A0_RULED_OUT}`); so are a slip \
                          in ξ̂, α̂, γ or Ω (no value that prints b3 = 0.0471 keeps the other 18 printed digits), the classic \
-                         IHB's Galerkin integrals (the same b3) and a flipped damping or forcing sign (`{A0_SLIPS}`); what \
+                         IHB's Galerkin integrals (the same b3) and a flipped damping or forcing sign (`{A0_SLIPS}`), and \
+                         collocation at the 2n + 1 = 19 points (b3 = 0.04718 again) or Eq. 83 taken literally (damping on \
+                         u: another solution) (`{A0_COLLOCATION}`); what \
                          remains, a slip in the last printed digit, no computation can show (demonstrated by `{A0_TEST}`)",
                         sol.stats.residual_norm,
                         off.join("; ")
