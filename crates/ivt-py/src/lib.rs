@@ -28,6 +28,7 @@ mod hb_paths;
 mod hb_string;
 mod kin;
 mod sim;
+mod user_jacobian;
 mod user_problem;
 mod vectorize;
 
