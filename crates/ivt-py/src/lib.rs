@@ -18,6 +18,7 @@ macro_rules! add_functions {
 }
 
 mod args;
+mod callback_arrays;
 mod ctrl;
 mod design;
 mod fields;

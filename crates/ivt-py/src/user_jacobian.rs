@@ -4,9 +4,10 @@
 //! central differences of `g` in every Jacobian assembly (ivt-hb's
 //! [`Nonlinearity::jacobian_samples`](ivt_hb::Nonlinearity::jacobian_samples)).
 
-use crate::user_problem::{failed, record, sample_arrays, ErrorSlot};
+use crate::callback_arrays::{float_array, SampleArrays};
+use crate::user_problem::{failed, record, ErrorSlot};
 use ivt_hb::problem::per_sample_jacobian;
-use numpy::{AllowTypeChange, IntoPyArray, PyArrayLikeDyn, PyUntypedArrayMethods};
+use numpy::IntoPyArray;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
@@ -15,6 +16,7 @@ pub(crate) struct PyJacobian {
     jac: Py<PyAny>,
     n: usize,
     vectorized: bool,
+    arrays: SampleArrays,
     error: ErrorSlot,
 }
 
@@ -25,6 +27,7 @@ impl PyJacobian {
             jac,
             n,
             vectorized,
+            arrays: SampleArrays::default(),
             error,
         }
     }
@@ -51,7 +54,7 @@ impl PyJacobian {
         let (n, ns) = (self.n, theta.len());
         let r = Python::attach(|py| -> PyResult<()> {
             let res = if batch {
-                let [xs, vs, ths] = sample_arrays(py, n, x, v, theta)?;
+                let [xs, vs, ths] = self.arrays.args(py, n, x, v, theta)?;
                 self.jac.bind(py).call1((xs, vs, ths))?
             } else {
                 let th = theta.first().copied().unwrap_or(f64::NAN);
@@ -105,19 +108,15 @@ fn pair<'py>(res: &Bound<'py, PyAny>) -> PyResult<(Bound<'py, PyAny>, Bound<'py,
 /// `shape` (axes of length 1 aside, so a 1-DOF `jac` may return (N, 1) or a
 /// float) and its entries finite.
 fn block(name: &str, ob: &Bound<'_, PyAny>, shape: &[usize]) -> PyResult<Vec<f64>> {
-    let a = ob
-        .extract::<PyArrayLikeDyn<'_, f64, AllowTypeChange>>()
-        .map_err(|_| {
-            PyTypeError::new_err(format!("`jac` must return {name} as an array of floats"))
-        })?;
+    let (got, values) = float_array(ob).ok_or_else(|| {
+        PyTypeError::new_err(format!("`jac` must return {name} as an array of floats"))
+    })?;
     let squeeze = |s: &[usize]| s.iter().copied().filter(|&d| d != 1).collect::<Vec<_>>();
-    if squeeze(a.shape()) != squeeze(shape) {
+    if squeeze(&got) != squeeze(shape) {
         return Err(PyValueError::new_err(format!(
-            "`jac` returned {name} of shape {:?}, expected {shape:?}",
-            a.shape()
+            "`jac` returned {name} of shape {got:?}, expected {shape:?}"
         )));
     }
-    let values: Vec<f64> = a.as_array().iter().copied().collect();
     if let Some((k, bad)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
         return Err(PyValueError::new_err(format!(
             "`jac` returned a non-finite {name} entry ({bad}) at flat index {k}"

@@ -7,6 +7,7 @@
 //! Python `jac` ([`PyJacobian`]) replaces the differences of a Python `g`;
 //! elements bring their own analytic Jacobian.
 
+use crate::callback_arrays::{float_array, SampleArrays};
 use crate::hb_elements::Elements;
 use crate::user_jacobian::PyJacobian;
 use ivt_hb::problem::{per_sample, Nonlinearity};
@@ -70,6 +71,7 @@ pub(crate) struct PyNonlinearity {
     g: Py<PyAny>,
     n: usize,
     vectorized: bool,
+    arrays: SampleArrays,
     error: ErrorSlot,
 }
 
@@ -86,27 +88,6 @@ pub(crate) fn record(slot: &ErrorSlot, e: PyErr) {
 /// called (their outputs are NaN), so a failed run ends without more Python.
 pub(crate) fn failed(slot: &ErrorSlot) -> bool {
     slot.lock().is_ok_and(|s| s.is_some())
-}
-
-/// The arguments of a vectorized callback: `x`, `v` as new (N, n) arrays and
-/// `theta` as a new (N,) array (copies: the solver's buffers never reach Python).
-pub(crate) fn sample_arrays<'py>(
-    py: Python<'py>,
-    n: usize,
-    x: &[f64],
-    v: &[f64],
-    theta: &[f64],
-) -> PyResult<[Bound<'py, PyAny>; 3]> {
-    let shape = |a: &[f64]| {
-        numpy::ndarray::Array2::from_shape_vec((theta.len(), n), a.to_vec())
-            .map(|a| a.into_pyarray(py).into_any())
-            .map_err(|e| PyValueError::new_err(e.to_string()))
-    };
-    Ok([
-        shape(x)?,
-        shape(v)?,
-        theta.to_vec().into_pyarray(py).into_any(),
-    ])
 }
 
 /// Calls `func(*args)` and writes its `out.len()` floats into `out` (NaN and the
@@ -153,23 +134,17 @@ impl PyNonlinearity {
         }
         let (n, ns) = (self.n, theta.len());
         let r = Python::attach(|py| -> PyResult<()> {
-            let [xs, vs, ths] = sample_arrays(py, n, x, v, theta)?;
+            let [xs, vs, ths] = self.arrays.args(py, n, x, v, theta)?;
             let res = self.g.bind(py).call1((xs, vs, ths))?;
-            let arr = res
-                .extract::<numpy::PyArrayLikeDyn<'_, f64, numpy::AllowTypeChange>>()
-                .map_err(|_| {
-                    PyTypeError::new_err("vectorized `g` must return an array of floats")
-                })?;
-            let a = arr.as_array();
-            if a.len() != ns * n || (a.ndim() == 2 && a.shape() != [ns, n]) {
+            let (shape, values) = float_array(&res).ok_or_else(|| {
+                PyTypeError::new_err("vectorized `g` must return an array of floats")
+            })?;
+            if values.len() != ns * n || (shape.len() == 2 && shape != [ns, n]) {
                 return Err(PyValueError::new_err(format!(
-                    "vectorized `g` returned shape {:?}, expected ({ns}, {n})",
-                    a.shape()
+                    "vectorized `g` returned shape {shape:?}, expected ({ns}, {n})"
                 )));
             }
-            for (o, val) in out.iter_mut().zip(a.iter()) {
-                *o = *val;
-            }
+            out.copy_from_slice(&values);
             Ok(())
         });
         if let Err(e) = r {
@@ -320,6 +295,7 @@ pub(crate) fn user_problem(
                     g: g.clone().unbind(),
                     n: nm,
                     vectorized,
+                    arrays: SampleArrays::default(),
                     error: Arc::clone(&error),
                 },
                 jac.map(|j| {

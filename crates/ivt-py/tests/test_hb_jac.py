@@ -131,3 +131,27 @@ def test_jac_errors() -> None:
         hb.limit_cycle(1.0, -1.0, 1.0, lambda x, v, th: x**2 * v, 1.0, jac=lambda x, v, th: 1.0)
     with pytest.raises(ZeroDivisionError):  # the first exception, re-raised after the run
         hb.frc(m, c, k, g, f, 0.5, 0.6, n=8, samples=32, vectorized=True, jac=lambda x, v, th: 1 / 0)
+
+
+def test_callback_arrays_are_never_changed_by_the_solver() -> None:
+    """The arrays a vectorized `g` or `jac` receives are its own: `x` and `v`
+    keep the values they had at the call after the run goes on, and the phase
+    array (shared by the calls on one sample grid) is read-only."""
+    m, c, k, g, f = chain_2dof()
+    kept = []
+
+    def g_keeping(x: np.ndarray, v: np.ndarray, th: np.ndarray) -> np.ndarray:
+        kept.append((x, x.copy(), v, v.copy(), th, th.copy()))
+        with pytest.raises(ValueError, match="read-only"):
+            th[0] = 1.0
+        return g(x, v, th)  # type: ignore[no-any-return]
+
+    def jac_keeping(x: np.ndarray, v: np.ndarray, th: np.ndarray) -> Pair:
+        kept.append((x, x.copy(), v, v.copy(), th, th.copy()))
+        return chain_jac(x, v, th)
+
+    hb.frc(m, c, k, g_keeping, f, 0.9, 1.0, n=8, samples=32, vectorized=True, jac=jac_keeping)
+    assert len(kept) > 20 and len({id(t[4]) for t in kept}) < len(kept)
+    for arrays in kept:
+        for seen, copy in zip(arrays[::2], arrays[1::2]):
+            np.testing.assert_array_equal(seen, copy)
