@@ -125,48 +125,34 @@ pub trait PeriodicProblem {
     /// analytic Jacobian; a problem without one should use
     /// [`central_difference_samples`], as [`GeneralProblem`] does).
     fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
-        per_sample_jacobian(self.n_dof(), x, v, theta, dg, |x, v, th, dg| {
+        per_sample(self.n_dof(), x, v, theta, dg, |x, v, th, dg| {
             self.nonlinear_jacobian(x, v, th, dg)
         });
     }
 }
 
-/// Calls a one-sample `g` on each of `theta.len()` sample-major samples (`x`, `v`,
-/// `out`: `samples×n`), the default way to evaluate all AFT samples.
+/// Calls a one-sample function `f(x_i, v_i, θ_i, out_i)` on each of
+/// `theta.len()` sample-major samples: `x`, `v` hold `n` entries per sample and
+/// `out` an equal share per sample (`n` for `g`; `2n²` for the Jacobian blocks
+/// `[∂g/∂x | ∂g/∂v]`, the layout of
+/// [`PeriodicProblem::nonlinear_jacobian_samples`]). The default way to
+/// evaluate all AFT samples.
 pub fn per_sample(
     n: usize,
     x: &[f64],
     v: &[f64],
     theta: &[f64],
     out: &mut [f64],
-    mut g: impl FnMut(&[f64], &[f64], f64, &mut [f64]),
+    mut f: impl FnMut(&[f64], &[f64], f64, &mut [f64]),
 ) {
+    let width = out.len() / theta.len().max(1);
     for (i, &th) in theta.iter().enumerate() {
         let s = i * n..(i + 1) * n;
-        g(&x[s.clone()], &v[s.clone()], th, &mut out[s]);
-    }
-}
-
-/// Calls a one-sample Jacobian on each of `theta.len()` sample-major samples
-/// (`x`, `v`: `samples×n`), writing its `[∂g/∂x | ∂g/∂v]` blocks (`2n²` per
-/// sample) into `dg`: the layout of
-/// [`PeriodicProblem::nonlinear_jacobian_samples`].
-pub fn per_sample_jacobian(
-    n: usize,
-    x: &[f64],
-    v: &[f64],
-    theta: &[f64],
-    dg: &mut [f64],
-    mut jacobian: impl FnMut(&[f64], &[f64], f64, &mut [f64]),
-) {
-    let n2 = n * n;
-    for (i, &th) in theta.iter().enumerate() {
-        let s = i * n..(i + 1) * n;
-        jacobian(
+        f(
             &x[s.clone()],
             &v[s],
             th,
-            &mut dg[2 * i * n2..2 * (i + 1) * n2],
+            &mut out[i * width..(i + 1) * width],
         );
     }
 }
@@ -414,7 +400,7 @@ where
     }
     fn jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) -> bool {
         let n = x.len() / theta.len().max(1);
-        per_sample_jacobian(n, x, v, theta, dg, &self.jacobian);
+        per_sample(n, x, v, theta, dg, &self.jacobian);
         true
     }
 }

@@ -6,7 +6,7 @@
 
 use crate::callback_arrays::{float_array, SampleArrays};
 use crate::user_problem::{failed, record, ErrorSlot};
-use ivt_hb::problem::per_sample_jacobian;
+use ivt_hb::problem::per_sample;
 use numpy::IntoPyArray;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -38,7 +38,7 @@ impl PyJacobian {
         if self.vectorized {
             self.call(x, v, theta, true, dg);
         } else {
-            per_sample_jacobian(self.n, x, v, theta, dg, |x, v, th, dg| {
+            per_sample(self.n, x, v, theta, dg, |x, v, th, dg| {
                 self.call(x, v, &[th], false, dg)
             });
         }
