@@ -57,7 +57,7 @@ pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;
 pub use problem::{
     central_difference_samples, Duffing, GeneralProblem, MathieuDuffing, Nonlinearity,
-    PeriodicProblem,
+    PeriodicProblem, WithJacobian,
 };
 pub use stability::{classify, Floquet, StabilityAnalyzer, StabilityKind};
 pub use switching::{period_doubled_start, switch_branch};

@@ -211,12 +211,14 @@ fn guess_vec(guess: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<f64>>> {
 /// A `#[pyfunction]` on a user system `M x'' + C x' + K x + g(x, v, θ) =
 /// f(θ)` returning a dict. Python parameters: `m, c, k, g`, the function's
 /// own (`name: type [= default]`), `n=20, samples=64`, its own again, then
-/// `velocity_dependent=True, vectorized=False, rtol=1e-9, max_iter=100`. The
+/// `velocity_dependent=True, vectorized=False, rtol=1e-9, max_iter=100`, and
+/// `jac=None` when the caller names it after the `UserArgs` binding (a
+/// function whose solver assembles the Galerkin Jacobian). The
 /// shared ones reach the body as the [`UserArgs`] named by the caller.
 macro_rules! user_system_fn {
     (
         $(#[$doc:meta])*
-        fn $name:ident<$lt:lifetime>($py:ident, $user:ident;
+        fn $name:ident<$lt:lifetime>($py:ident, $user:ident $(, $jac:ident)?;
             $( $(#[$pa:ident($($pa_args:tt)*)])* $arg:ident: $ty:ty $(= $default:tt)? ),+;
             $( $(#[$pb:ident($($pb_args:tt)*)])* $brg:ident: $bty:ty $(= $bdefault:tt)? ),+ $(,)?
         ) $body:block
@@ -226,6 +228,7 @@ macro_rules! user_system_fn {
         #[pyo3(signature = (
             m, c, k, g, $($arg $(= $default)?,)+ n = 20, samples = 64, $($brg $(= $bdefault)?,)+
             velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
+            $(, $jac = None)?
         ))]
         #[allow(clippy::too_many_arguments, clippy::field_reassign_with_default)]
         fn $name<$lt>(
@@ -236,9 +239,11 @@ macro_rules! user_system_fn {
             #[pyo3(from_py_with = crate::args::int64)] samples: i64,
             $( $(#[$pb($($pb_args)*)])* $brg: $bty, )+
             velocity_dependent: bool, vectorized: bool, rtol: f64, max_iter: usize,
+            $( $jac: Option<&Bound<$lt, PyAny>>, )?
         ) -> PyResult<Bound<$lt, PyDict>> {
             let $user = UserArgs {
                 system: [m, c, k, g], n, samples, velocity_dependent, vectorized, rtol, max_iter,
+                jac: None $( .or($jac) )?,
             };
             $body
         }
@@ -246,7 +251,8 @@ macro_rules! user_system_fn {
 }
 pub(crate) use user_system_fn;
 
-/// The arguments every user-system function shares: the system `[m, c, k, g]`
+/// The arguments every user-system function shares: the system `[m, c, k, g]`,
+/// `g`'s optional Jacobian `jac` (always None where the keyword is not offered)
 /// and the harmonic-balance settings.
 pub(crate) struct UserArgs<'a, 'py> {
     pub(crate) system: [&'a Bound<'py, PyAny>; 4],
@@ -256,6 +262,7 @@ pub(crate) struct UserArgs<'a, 'py> {
     pub(crate) vectorized: bool,
     pub(crate) rtol: f64,
     pub(crate) max_iter: usize,
+    pub(crate) jac: Option<&'a Bound<'py, PyAny>>,
 }
 
 impl UserArgs<'_, '_> {
@@ -268,7 +275,16 @@ impl UserArgs<'_, '_> {
         tol: f64,
     ) -> PyResult<(PyProblem, HbOptions)> {
         let [m, c, k, g] = self.system;
-        let problem = user_problem(m, c, k, g, f, self.velocity_dependent, self.vectorized)?;
+        let problem = user_problem(
+            m,
+            c,
+            k,
+            g,
+            f,
+            self.jac,
+            self.velocity_dependent,
+            self.vectorized,
+        )?;
         let opts = options(self.n, self.samples, subharmonic, 1.0)?;
         Ok((
             problem,
@@ -509,15 +525,22 @@ user_system_fn! {
 /// force): `tol` is absolute (default 0), `rtol` relative (default 1e-9), so
 /// by default a change of length unit changes nothing. `max_iter` caps the
 /// iterations. ∂g (stability, Jacobian refreshes) is differenced over all
-/// samples at once with steps relative to the orbit's amplitude.
+/// samples at once with steps relative to the orbit's amplitude, unless
+/// `jac` is given: jac(x, v, theta) → (dg_dx, dg_dv), per sample two
+/// (n_dof, n_dof) arrays (row i, column j: ∂g_i/∂x_j); with `vectorized=True`
+/// for (N, n_dof) inputs two (N, n_dof, n_dof) arrays. dg_dv may be None
+/// (zero; it is taken as zero anyway when velocity_dependent=False). A wrong
+/// shape or a non-finite entry raises ValueError naming `jac`; `jac` with
+/// ivt.hb.elements as g is a TypeError (elements have their own Jacobian).
 /// Speed cost: a per-sample g is called once per AFT sample and residual
 /// evaluation (2·samples calls per iteration), each costing ~1–3 µs of
 /// interpreter time against ~10 ns for a Rust g; with `vectorized=True` it is
-/// one call per residual and 2 (4 with velocity dependence) per DOF for ∂g.
+/// one call per residual and 2 (4 with velocity dependence) per DOF for ∂g
+/// (none with `jac`: one `jac` call per Jacobian assembly instead).
 /// The GIL is released between callbacks, so other Python threads run. An
 /// exception in a callback aborts the solve and is re-raised. Same dict as
 /// `duffing`.
-fn solve<'py>(py, user;
+fn solve<'py>(py, user, jac;
     omega_f: f64,
     f: Option<&Bound<'py, PyAny>> = None;
     #[pyo3(from_py_with = int64)] subharmonic: i64 = 1,
@@ -543,11 +566,12 @@ user_system_fn! {
 ///
 /// The start is `guess` (coefficients, n_dof blocks of [a0, a1..an, b1..bn])
 /// or, by default, x_0 = `amplitude`·cos τ. g(x, v, theta): theta is the
-/// phase ω t (an autonomous g ignores it); `vectorized` as in `frc`.
+/// phase ω t (an autonomous g ignores it); `vectorized` and `jac` as in
+/// `solve`.
 /// Returns {"omega", "period", "coeffs", "multipliers" ([[re, im], ...],
 /// the trivial +1 included), "stable" (all others inside the unit circle),
 /// "stability", "iterations", "residual_norm"}.
-fn limit_cycle<'py>(py, user;
+fn limit_cycle<'py>(py, user, jac;
     omega_guess: f64,
     amplitude: f64 = 1.0,
     guess: Option<&Bound<'py, PyAny>> = None;

@@ -118,8 +118,8 @@ user_system_fn! {
 /// `omega_from` to `omega_to`, Floquet multipliers (Hsu) at every point, and
 /// its events each located by Newton on its extended system (not bracketed).
 ///
-/// m, c, k, g, f, velocity_dependent as in `solve` (f may be None; g may be
-/// an `ivt.hb.elements` composition); `vectorized=True`: g(x, v, theta) gets
+/// m, c, k, g, f, velocity_dependent, jac as in `solve` (f may be None; g may
+/// be an `ivt.hb.elements` composition); `vectorized=True`: g(x, v, theta) gets
 /// x, v of shape (N, n_dof) and theta of shape (N,) (all 2·samples AFT
 /// samples at once) and returns (N, n_dof).
 /// Returns {"points": [{"omega", "coeffs", "amplitude", "multipliers",
@@ -132,7 +132,7 @@ user_system_fn! {
 /// folds only by `ivt_hb::frequency_response` (no period-doubling,
 /// Neimark–Sacker or branch-point test per point: several times cheaper per
 /// point, see the ivt-py README). GIL released between callbacks.
-fn frc<'py>(py, user;
+fn frc<'py>(py, user, jac;
     f: Option<&Bound<'py, PyAny>>,
     omega_from: f64,
     omega_to: f64;
@@ -207,6 +207,8 @@ user_system_fn! {
 /// and its first cosine coefficient a1 prescribed: `amplitude` is a1 of DOF
 /// `dof`, traced from `amplitude_from` to `amplitude_to` (ivt_hb::backbone, a
 /// fictitious damping κ unfolds the family and is ~0 on the result).
+/// g, velocity_dependent and vectorized as in `solve`; no `jac`: the
+/// backbone's path follower differences its whole residual, ∂g included.
 /// Returns {"amplitude", "omega", "kappa" (arrays), "points": [{"amplitude",
 /// "omega", "kappa", "coeffs"}...], "termination"}. GIL released between
 /// callbacks.

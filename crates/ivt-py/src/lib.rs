@@ -18,6 +18,7 @@ macro_rules! add_functions {
 }
 
 mod args;
+mod callback_arrays;
 mod ctrl;
 mod design;
 mod fields;
@@ -28,6 +29,7 @@ mod hb_paths;
 mod hb_string;
 mod kin;
 mod sim;
+mod user_jacobian;
 mod user_problem;
 mod vectorize;
 

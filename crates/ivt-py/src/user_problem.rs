@@ -3,9 +3,13 @@
 //! `g` may instead be a composition of ivt-hb's Rust elements
 //! ([`crate::hb_elements::Elements`]): then no Python runs in the loop. The
 //! system is an ivt-hb [`GeneralProblem`]; this module adds the Python calls
-//! and the capture of the first exception a callback raised.
+//! and the capture of the first exception a callback raised. An optional
+//! Python `jac` ([`PyJacobian`]) replaces the differences of a Python `g`;
+//! elements bring their own analytic Jacobian.
 
+use crate::callback_arrays::{float_array, SampleArrays};
 use crate::hb_elements::Elements;
+use crate::user_jacobian::PyJacobian;
 use ivt_hb::problem::{per_sample, Nonlinearity};
 use ivt_hb::{ElementProblem, GeneralProblem, HbOptions, PeriodicProblem};
 use numpy::{IntoPyArray, PyUntypedArrayMethods};
@@ -14,42 +18,51 @@ use pyo3::prelude::*;
 use std::sync::{Arc, Mutex};
 
 /// The first exception raised by a callback (the solver then sees NaN).
-type ErrorSlot = Arc<Mutex<Option<PyErr>>>;
+pub(crate) type ErrorSlot = Arc<Mutex<Option<PyErr>>>;
 
 /// The excitation `f(θ)` of a user system (a Python callable or none).
 type PyExcitation = Box<dyn Fn(f64, &mut [f64]) + Send + Sync>;
 
-/// The nonlinearity of a user system: a Python callable, or Rust elements
-/// (an [`ElementProblem`] without forcing, evaluated with no Python call), and
-/// the slot of the first exception raised by `g` or `f`.
+/// The nonlinearity of a user system: a Python callable (with its Python
+/// Jacobian, if given), or Rust elements (an [`ElementProblem`] without
+/// forcing, evaluated with no Python call, with its analytic Jacobian), and the
+/// slot of the first exception raised by `g`, `jac` or `f`.
 pub(crate) struct UserG {
     law: UserLaw,
     error: ErrorSlot,
 }
 
 enum UserLaw {
-    Python(PyNonlinearity),
+    Python(PyNonlinearity, Option<PyJacobian>),
     Elements(ElementProblem),
 }
 
 impl Nonlinearity for UserG {
     fn eval(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
         match &self.law {
-            UserLaw::Python(g) => g.eval(x, v, theta, out),
+            UserLaw::Python(g, _) => g.eval(x, v, theta, out),
             UserLaw::Elements(e) => e.nonlinear(x, v, theta, out),
         }
     }
     fn eval_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
         match &self.law {
-            UserLaw::Python(g) => g.eval_samples(x, v, theta, out),
+            UserLaw::Python(g, _) => g.eval_samples(x, v, theta, out),
             UserLaw::Elements(e) => e.nonlinear_samples(x, v, theta, out),
         }
     }
+    fn jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) -> bool {
+        match &self.law {
+            UserLaw::Python(_, Some(jac)) => jac.eval_samples(x, v, theta, dg),
+            UserLaw::Python(_, None) => return false,
+            UserLaw::Elements(e) => e.nonlinear_jacobian_samples(x, v, theta, dg),
+        }
+        true
+    }
 }
 
-/// A user system: the ivt-hb general problem (∂g by central differences over
-/// all samples at once, steps relative to the orbit) with `g` a Python
-/// callable or Rust elements and `f` a Python callable.
+/// A user system: the ivt-hb general problem (∂g from `jac` or the elements,
+/// else by central differences over all samples at once, steps relative to the
+/// orbit) with `g` a Python callable or Rust elements and `f` a Python callable.
 pub(crate) type PyProblem = GeneralProblem<UserG, PyExcitation>;
 
 /// The Python `g(x, v, theta)`: per sample, or (`vectorized`) once for all
@@ -58,15 +71,23 @@ pub(crate) struct PyNonlinearity {
     g: Py<PyAny>,
     n: usize,
     vectorized: bool,
+    arrays: SampleArrays,
     error: ErrorSlot,
 }
 
-fn record(slot: &ErrorSlot, e: PyErr) {
+/// Keeps `e` in `slot` unless an earlier exception is there.
+pub(crate) fn record(slot: &ErrorSlot, e: PyErr) {
     if let Ok(mut slot) = slot.lock() {
         if slot.is_none() {
             *slot = Some(e);
         }
     }
+}
+
+/// Whether a callback of the run already raised: later callbacks are not
+/// called (their outputs are NaN), so a failed run ends without more Python.
+pub(crate) fn failed(slot: &ErrorSlot) -> bool {
+    slot.lock().is_ok_and(|s| s.is_some())
 }
 
 /// Calls `func(*args)` and writes its `out.len()` floats into `out` (NaN and the
@@ -77,6 +98,10 @@ fn call_into(
     args: impl FnOnce(Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyTuple>>,
     out: &mut [f64],
 ) {
+    if failed(slot) {
+        out.fill(f64::NAN);
+        return;
+    }
     let n = out.len();
     let r = Python::attach(|py| -> PyResult<()> {
         let res = func.bind(py).call1(args(py)?)?;
@@ -103,30 +128,23 @@ fn call_into(
 impl PyNonlinearity {
     /// One call of a vectorized `g` on `theta.len()` samples (sample-major).
     fn call_vectorized(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+        if failed(&self.error) {
+            out.fill(f64::NAN);
+            return;
+        }
         let (n, ns) = (self.n, theta.len());
         let r = Python::attach(|py| -> PyResult<()> {
-            let shape = |a: &[f64]| {
-                numpy::ndarray::Array2::from_shape_vec((ns, n), a.to_vec())
-                    .map(|a| a.into_pyarray(py))
-                    .map_err(|e| PyValueError::new_err(e.to_string()))
-            };
-            let args = (shape(x)?, shape(v)?, theta.to_vec().into_pyarray(py));
-            let res = self.g.bind(py).call1(args)?;
-            let arr = res
-                .extract::<numpy::PyArrayLikeDyn<'_, f64, numpy::AllowTypeChange>>()
-                .map_err(|_| {
-                    PyTypeError::new_err("vectorized `g` must return an array of floats")
-                })?;
-            let a = arr.as_array();
-            if a.len() != ns * n || (a.ndim() == 2 && a.shape() != [ns, n]) {
+            let [xs, vs, ths] = self.arrays.args(py, n, x, v, theta)?;
+            let res = self.g.bind(py).call1((xs, vs, ths))?;
+            let (shape, values) = float_array(&res).ok_or_else(|| {
+                PyTypeError::new_err("vectorized `g` must return an array of floats")
+            })?;
+            if values.len() != ns * n || (shape.len() == 2 && shape != [ns, n]) {
                 return Err(PyValueError::new_err(format!(
-                    "vectorized `g` returned shape {:?}, expected ({ns}, {n})",
-                    a.shape()
+                    "vectorized `g` returned shape {shape:?}, expected ({ns}, {n})"
                 )));
             }
-            for (o, val) in out.iter_mut().zip(a.iter()) {
-                *o = *val;
-            }
+            out.copy_from_slice(&values);
             Ok(())
         });
         if let Err(e) = r {
@@ -204,13 +222,16 @@ fn matrix(name: &str, ob: &Bound<'_, PyAny>) -> PyResult<(usize, Vec<f64>)> {
 
 /// The user system of `solve`, `frc`, `limit_cycle` and `backbone` from its
 /// Python arguments. `g` is a callable or an [`Elements`] composition (then
-/// `velocity_dependent` and `vectorized` are the elements' own).
+/// `velocity_dependent` and `vectorized` are the elements' own, and `jac`
+/// must be None); `jac` is `g`'s Jacobian ([`PyJacobian`]) or None.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn user_problem(
     m: &Bound<'_, PyAny>,
     c: &Bound<'_, PyAny>,
     k: &Bound<'_, PyAny>,
     g: &Bound<'_, PyAny>,
     f: Option<&Bound<'_, PyAny>>,
+    jac: Option<&Bound<'_, PyAny>>,
     velocity_dependent: bool,
     vectorized: bool,
 ) -> PyResult<PyProblem> {
@@ -230,6 +251,19 @@ pub(crate) fn user_problem(
         return Err(PyTypeError::new_err(
             "argument `g` must be callable g(x, v, theta) or ivt.hb.elements",
         ));
+    }
+    match (jac, &elements) {
+        (Some(_), Some(_)) => {
+            return Err(PyTypeError::new_err(
+                "argument `jac` must be None when `g` is ivt.hb.elements (they have their own Jacobian)",
+            ))
+        }
+        (Some(j), None) if !j.is_callable() => {
+            return Err(PyTypeError::new_err(
+                "argument `jac` must be callable jac(x, v, theta) -> (dg_dx, dg_dv) or None",
+            ))
+        }
+        _ => {}
     }
     if let Some(f) = f {
         if !f.is_callable() {
@@ -256,12 +290,18 @@ pub(crate) fn user_problem(
             (UserLaw::Elements(problem), dependent)
         }
         None => (
-            UserLaw::Python(PyNonlinearity {
-                g: g.clone().unbind(),
-                n: nm,
-                vectorized,
-                error: Arc::clone(&error),
-            }),
+            UserLaw::Python(
+                PyNonlinearity {
+                    g: g.clone().unbind(),
+                    n: nm,
+                    vectorized,
+                    arrays: SampleArrays::default(),
+                    error: Arc::clone(&error),
+                },
+                jac.map(|j| {
+                    PyJacobian::new(j.clone().unbind(), nm, vectorized, Arc::clone(&error))
+                }),
+            ),
             velocity_dependent,
         ),
     };

@@ -14,6 +14,9 @@ Matrix = Union[float, npt.ArrayLike]
 Callback = Callable[[FloatArray, FloatArray, float], Union[float, Sequence[float], FloatArray]]
 VectorizedCallback = Callable[[FloatArray, FloatArray, FloatArray], npt.ArrayLike]
 Forcing = Callable[[float], Union[float, Sequence[float], FloatArray]]
+# ``jac(x, v, theta) -> (dg_dx, dg_dv)``: per sample two (n, n) arrays, with
+# ``vectorized=True`` two (N, n, n) arrays; ``dg_dv`` may be None (zero).
+Jacobian = Callable[[FloatArray, FloatArray, Any], Sequence[Optional[npt.ArrayLike]]]
 
 class Elements:
     """A sum of Rust nonlinear elements, passed as ``g`` (no Python in the loop)."""
@@ -100,6 +103,7 @@ def solve(
     vectorized: bool = False,
     rtol: float = 1e-9,
     max_iter: int = 100,
+    jac: Optional[Jacobian] = None,
 ) -> Dict[str, Any]: ...
 def frc(
     m: Matrix,
@@ -117,6 +121,7 @@ def frc(
     vectorized: bool = False,
     rtol: float = 1e-9,
     max_iter: int = 100,
+    jac: Optional[Jacobian] = None,
 ) -> Dict[str, Any]: ...
 def limit_cycle(
     m: Matrix,
@@ -133,6 +138,7 @@ def limit_cycle(
     vectorized: bool = False,
     rtol: float = 1e-9,
     max_iter: int = 100,
+    jac: Optional[Jacobian] = None,
 ) -> Dict[str, Any]: ...
 def backbone(
     m: Matrix,
