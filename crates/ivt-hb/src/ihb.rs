@@ -20,8 +20,9 @@ use crate::problem::PeriodicProblem;
 ///
 /// Convergence: `‖r‖₂ ≤ atol + rtol·S` with `atol = broyden.tol`, the residual
 /// `r` of Eq. 61 (a force) and the force scale `S` = ‖f̂‖₂, the norm of the
-/// excitation's Galerkin projection, or for an unforced problem ‖L(ω)q₀‖₂, the
-/// linear force of the start ([`HbResidual::force_scale`]). The defaults
+/// excitation's Galerkin projection, or for an unforced problem the larger of
+/// ‖L(ω)q₀‖₂ and ‖K q₀‖₂, the linear and elastic forces of the start
+/// ([`HbResidual::force_scale`]). The defaults
 /// (`atol = 0`, `rtol = 1e-9`; ‖r‖₂ ≤ 1e-10 for Fig. 28's F = 0.1) make the test
 /// invariant under a change of length unit: `x = L·u` scales r and S alike.
 #[derive(Debug, Clone, PartialEq)]
@@ -285,7 +286,10 @@ impl HbResidual {
 
     /// The force scale `S` of the tolerance ([`HbOptions`]): ‖f̂‖₂, the Galerkin
     /// projection of the excitation, or if that is zero (an unforced problem)
-    /// ‖L(ω)q₀‖₂ at the start `q0`, written through `scratch` (`len()`).
+    /// the larger of ‖L(ω)q₀‖₂ and ‖K q₀‖₂ at the start `q0` (‖L(0)q₀‖₂, the
+    /// elastic force alone: at resonance, e.g. a limit cycle's guess at its
+    /// linear frequency, the inertia cancels it in L(ω)q₀), written through
+    /// `scratch` (`len()`).
     pub fn force_scale<P: PeriodicProblem>(
         &self,
         problem: &P,
@@ -298,7 +302,9 @@ impl HbResidual {
             return forcing;
         }
         self.apply_linear(problem, q0, omega, scratch);
-        ivt_num::vector::norm2(scratch)
+        let dynamic = ivt_num::vector::norm2(scratch);
+        self.apply_linear(problem, q0, 0.0, scratch);
+        dynamic.max(ivt_num::vector::norm2(scratch))
     }
 
     /// Number of unknowns `n_dof·(2n+1)`.

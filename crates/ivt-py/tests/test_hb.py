@@ -370,6 +370,19 @@ def test_van_der_pol_limit_cycle_period_against_time_integration() -> None:
     assert abs(mu0 - 1) < 1e-6
 
 
+def test_van_der_pol_written_with_the_damping_in_g_converges() -> None:
+    """The same cycle with C = 0 and g = −μ(1 − x²)v: the guess at ω = 1
+    makes the linear force L(ω)q₀ vanish (K = ω²M), so the tolerance's force
+    scale falls back on the elastic force ‖K q₀‖; with S = 0 the default
+    tolerance was 0 and the solve could not stop (‖r‖ reached 2.5e-17)."""
+    for mu in (0.2, 1.0):
+        a = hb.limit_cycle(1.0, 0.0, 1.0, lambda x, v, th: -mu * (1 - x**2) * v, 1.0, amplitude=2.0,
+                           vectorized=True)
+        b = hb.limit_cycle(1.0, -mu, 1.0, lambda x, v, th: mu * x**2 * v, 1.0, amplitude=2.0,
+                           vectorized=True)
+        assert a["period"] == pytest.approx(b["period"], rel=1e-10)
+
+
 def test_eval_series_multi_dof_layout() -> None:
     # Two DOFs, n = 1: x0 = 1/2 + cos τ, x1 = −sin τ.
     q = np.array([1.0, 1.0, 0.0, 0.0, 0.0, -1.0])
