@@ -103,7 +103,10 @@ impl GalerkinJacobian {
         }
     }
 
-    /// Writes `Φ_q(q)` (row-major `m×m`, DOF-major unknowns) into `jac`.
+    /// Writes `Φ_q(q)` (row-major `m×m`, DOF-major unknowns) into `jac`: `L(ω)`,
+    /// then `s·(1/π)∫ C_s (G_x C_sᵀ + ω G_v C_s'ᵀ) dτ` added per DOF block `(d, e)`
+    /// from one FFT of `∂g_d/∂x_e` and, for a velocity-dependent problem, one of
+    /// `ω ∂g_d/∂v_e`; identically zero samples are skipped.
     pub fn assemble<P: PeriodicProblem>(
         &mut self,
         res: &mut HbResidual,
@@ -114,23 +117,9 @@ impl GalerkinJacobian {
         jac: &mut [f64],
     ) {
         res.linear_matrix(problem, omega_f / res.subharmonic() as f64, jac);
-        if s != 0.0 {
-            self.add_nonlinear(res, problem, q, omega_f, s, jac);
+        if s == 0.0 {
+            return;
         }
-    }
-
-    /// Adds `s·(1/π)∫ C_s (G_x C_sᵀ + ω G_v C_s'ᵀ) dτ` into `jac`: per DOF block
-    /// `(d, e)` one FFT of `∂g_d/∂x_e` and, for a velocity-dependent problem, one of
-    /// `ω ∂g_d/∂v_e`; identically zero samples are skipped.
-    fn add_nonlinear<P: PeriodicProblem>(
-        &mut self,
-        res: &mut HbResidual,
-        problem: &P,
-        q: &[f64],
-        omega_f: f64,
-        s: f64,
-        jac: &mut [f64],
-    ) {
         let (nd, n) = (res.n_dof(), res.harmonics());
         let l = 2 * n + 1;
         let len = nd * l;
@@ -419,8 +408,9 @@ fn basis_rows(basis: &[f64], l: usize, ns: usize, i: usize) -> (&[f64], &[f64]) 
 mod tests {
     use super::*;
     use crate::elements::{Element, ElementProblem, Harmonic, Law};
+    use crate::fold::{Branch, HbBranch};
     use crate::ihb::HbOptions;
-    use crate::problem::{Duffing, GeneralProblem, MathieuDuffing};
+    use crate::problem::{matrix_getters, Duffing, GeneralProblem, MathieuDuffing};
     use crate::ModifiedIhb;
 
     /// The direct O(2N·n_dof²·(2n+1)²) sum `(2s/2N) Σᵢ C_s(τᵢ)(G_x C_sᵀ + ω G_v C_s'ᵀ)`
@@ -458,9 +448,10 @@ mod tests {
         jac
     }
 
-    /// Coefficients with a spread of harmonics (amplitude ~ 1/(k+1)), deterministic.
-    fn coefficients(nd: usize, n: usize, amplitude: f64) -> Vec<f64> {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
+    /// Coefficients with a spread of harmonics (amplitude ~ 1/(k+1)), deterministic
+    /// per `seed`.
+    fn coefficients(nd: usize, n: usize, amplitude: f64, seed: u64) -> Vec<f64> {
+        let mut state = 0x2545_f491_4f6c_dd1du64 ^ seed;
         (0..nd * (2 * n + 1))
             .map(|i| {
                 state = state.wrapping_mul(6364136223846793005).wrapping_add(1);
@@ -472,6 +463,29 @@ mod tests {
             .collect()
     }
 
+    /// `problem` with `M = C = K = 0`: its Galerkin Jacobian is the nonlinear part
+    /// alone, exactly (`L(ω) = 0`).
+    struct NonlinearPart<'a, P> {
+        inner: &'a P,
+        n: usize,
+        m: Vec<f64>,
+        c: Vec<f64>,
+        k: Vec<f64>,
+    }
+
+    impl<P: PeriodicProblem> PeriodicProblem for NonlinearPart<'_, P> {
+        matrix_getters!();
+        fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
+            self.inner.nonlinear(x, v, theta, out);
+        }
+        fn velocity_dependent(&self) -> bool {
+            self.inner.velocity_dependent()
+        }
+        fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], th: &[f64], dg: &mut [f64]) {
+            self.inner.nonlinear_jacobian_samples(x, v, th, dg);
+        }
+    }
+
     /// max |FFT assembly − quadrature| / max |quadrature| of the nonlinear part.
     fn relative_gap(
         problem: &impl PeriodicProblem,
@@ -480,11 +494,19 @@ mod tests {
         omega_f: f64,
         s: f64,
     ) -> f64 {
+        let n = problem.n_dof();
+        let problem = &NonlinearPart {
+            inner: problem,
+            n,
+            m: vec![0.0; n * n],
+            c: vec![0.0; n * n],
+            k: vec![0.0; n * n],
+        };
         let mut res = HbResidual::new(problem, opts).unwrap();
         let mut galerkin = GalerkinJacobian::new(&res);
         let m = res.len();
         let mut fast = vec![0.0; m * m];
-        galerkin.add_nonlinear(&mut res, problem, q, omega_f, s, &mut fast);
+        galerkin.assemble(&mut res, problem, q, omega_f, s, &mut fast);
         let slow = quadrature(&mut res, problem, q, omega_f, s);
         let max = |it: &mut dyn Iterator<Item = f64>| it.fold(0.0f64, |a, x| a.max(x.abs()));
         let scale = max(&mut slow.iter().copied());
@@ -544,7 +566,7 @@ mod tests {
         // Eq. 81: g = −β sin θ·u + γu³ depends on the phase; period-2 orbit (p = 2).
         let md = MathieuDuffing::thesis(1.6);
         let opts = HbOptions::new(20, 84).with_subharmonic(2);
-        let q = coefficients(1, 20, 1.2);
+        let q = coefficients(1, 20, 1.2, 0);
         let gap = relative_gap(&md, &opts, &q, 2.0, 0.7);
         assert!(gap <= 1e-12, "{gap:e}");
     }
@@ -554,7 +576,7 @@ mod tests {
         // N = 84 and N = 64 (even), N = 21 (odd, 2N = 42 < 2n: the sums j + k > N
         // alias onto bin 2N − (j + k), as in the quadrature).
         let chain = damped_chain();
-        let q = coefficients(2, 20, 0.8);
+        let q = coefficients(2, 20, 0.8, 0);
         for n_half in [84, 64, 21] {
             let gap = relative_gap(&chain, &HbOptions::new(20, n_half), &q, 1.1, 1.0);
             assert!(gap <= 1e-12, "N = {n_half}: {gap:e}");
@@ -564,7 +586,7 @@ mod tests {
     #[test]
     fn fft_assembly_equals_quadrature_for_subharmonic_p3() {
         let duffing = Duffing::fig28();
-        let q = coefficients(1, 20, 1.5);
+        let q = coefficients(1, 20, 1.5, 0);
         for n_half in [64, 21] {
             let opts = HbOptions::new(20, n_half).with_subharmonic(3);
             let gap = relative_gap(&duffing, &opts, &q, 3.3, 0.6);
@@ -587,7 +609,7 @@ mod tests {
             },
             |_theta: f64, f: &mut [f64]| f.fill(0.0),
         );
-        let q = coefficients(2, 20, 0.7);
+        let q = coefficients(2, 20, 0.7, 0);
         for n_half in [64, 21] {
             let gap = relative_gap(&problem, &HbOptions::new(20, n_half), &q, 0.9, 1.0);
             assert!(gap <= 1e-12, "N = {n_half}: {gap:e}");
@@ -596,21 +618,18 @@ mod tests {
 
     #[test]
     fn bilinear_form_equals_the_assembled_jacobian() {
-        // wᵀ J_nl v from the form (direct synthesis on the grid) and from the FFT
-        // assembly: two routes through the same sum.
+        // wᵀJv of the fold test (grid synthesis, no J) and from the FFT assembly:
+        // two routes through the same sum.
         let chain = damped_chain();
-        let opts = HbOptions::new(20, 84);
-        let mut res = HbResidual::new(&chain, &opts).unwrap();
-        let mut galerkin = GalerkinJacobian::new(&res);
-        let mut form = GalerkinForm::new(&res, &chain);
-        let m = res.len();
+        let mut branch = HbBranch::new(&chain, &HbOptions::new(20, 84)).unwrap();
+        let m = branch.len();
         let (q, w, v) = (
-            coefficients(2, 20, 0.8),
-            coefficients(2, 20, 1.0),
-            coefficients(2, 20, -0.6),
+            coefficients(2, 20, 0.8, 1),
+            coefficients(2, 20, 1.0, 2),
+            coefficients(2, 20, -0.6, 3),
         );
         let mut jac = vec![0.0; m * m];
-        galerkin.add_nonlinear(&mut res, &chain, &q, 1.1, 1.0, &mut jac);
+        branch.jacobian(&q, 1.1, &mut jac);
         let (mut assembled, mut scale) = (0.0, 0.0);
         for (row, wi) in jac.chunks_exact(m).zip(&w) {
             for (a, vj) in row.iter().zip(&v) {
@@ -618,7 +637,7 @@ mod tests {
                 scale += (wi * a * vj).abs();
             }
         }
-        let value = form.value(&chain, &q, 1.1, &w, &v, None);
+        let value = branch.bilinear(&q, 1.1, &w, &v);
         assert!(
             (value - assembled).abs() <= 1e-12 * scale,
             "{value} vs {assembled}"
