@@ -35,9 +35,11 @@ pub struct GalerkinJacobian {
     v_sums: CosSinSums,
 }
 
-/// `C_l = Σ_i g(τ_i) cos lτ_i` and `S_l = Σ_i g(τ_i) sin lτ_i` for `l = 0..2n`.
+/// `C_l = Σ_i g(τ_i) cos lτ_i` and `S_l = Σ_i g(τ_i) sin lτ_i` for `l = −n..2n`
+/// (`C_{−l} = C_l`, `S_{−l} = −S_l`), stored at `n + l`.
 #[derive(Debug, Clone)]
 struct CosSinSums {
+    n: usize,
     cos: Vec<f64>,
     sin: Vec<f64>,
 }
@@ -45,8 +47,9 @@ struct CosSinSums {
 impl CosSinSums {
     fn new(n: usize) -> Self {
         Self {
-            cos: vec![0.0; 2 * n + 1],
-            sin: vec![0.0; 2 * n + 1],
+            n,
+            cos: vec![0.0; 3 * n + 1],
+            sin: vec![0.0; 3 * n + 1],
         }
     }
 
@@ -54,40 +57,77 @@ impl CosSinSums {
     /// for `l ≤ N`, and `X_l = conj(X_{2N−l})` beyond the Nyquist bin.
     fn fill(&mut self, aft: &mut Aft, samples: &[f64], scale: f64) {
         let spectrum = aft.spectrum(samples);
-        let ns = samples.len();
-        for (l, (c, s)) in self.cos.iter_mut().zip(&mut self.sin).enumerate() {
+        let (n, ns) = (self.n, samples.len());
+        for l in 0..=2 * n {
             let (x, sign) = if 2 * l <= ns {
                 (spectrum[l], -1.0)
             } else {
                 (spectrum[ns - l], 1.0)
             };
-            *c = scale * x.re;
-            *s = sign * scale * x.im;
+            self.cos[n + l] = scale * x.re;
+            self.sin[n + l] = sign * scale * x.im;
+        }
+        for l in 1..=n {
+            self.cos[n - l] = self.cos[n + l];
+            self.sin[n - l] = -self.sin[n + l];
         }
     }
 
-    /// `(C_{j−k}, C_{j+k}, S_{j−k}, S_{j+k})`, with `C_{−l} = C_l`, `S_{−l} = −S_l`.
+    /// `(C_{j−k}, C_{j+k}, S_{j−k}, S_{j+k})`.
     fn pair(&self, j: usize, k: usize) -> (f64, f64, f64, f64) {
-        let diff_sin = if j >= k {
-            self.sin[j - k]
-        } else {
-            -self.sin[k - j]
-        };
+        let (minus, plus) = (self.n + j - k, self.n + j + k);
         (
-            self.cos[j.abs_diff(k)],
-            self.cos[j + k],
-            diff_sin,
-            self.sin[j + k],
+            self.cos[minus],
+            self.cos[plus],
+            self.sin[minus],
+            self.sin[plus],
         )
     }
-}
 
-/// Weight of basis function `cos kτ` in `C_s`: ½ for the constant.
-fn weight(k: usize) -> f64 {
-    if k == 0 {
-        0.5
-    } else {
-        1.0
+    /// Adds to the row `row` (`a_0, a_k.., b_k..` columns) of basis function
+    /// `cos jτ` (weight `c_j`, ½ for j = 0) the sums `Σ g c_j cos jτ · C_s` (`x`)
+    /// or `Σ g c_j cos jτ · C_s'` (`!x`, the derivative columns `−k sin, k cos`).
+    fn add_cos_row(&self, row: &mut [f64], j: usize, x: bool) {
+        let n = self.n;
+        let cj = if j == 0 { 0.5 } else { 1.0 };
+        let (head, tail) = row.split_at_mut(n + 1);
+        if x {
+            // Column a_0 (weight ½): ½·½(C_j + C_j).
+            head[0] += cj * self.cos[n + j];
+        }
+        for (i, (a, b)) in head[1..].iter_mut().zip(tail.iter_mut()).enumerate() {
+            let k = i + 1;
+            let (cm, cp, sm, sp) = self.pair(j, k);
+            if x {
+                *a += cj * (cm + cp);
+                *b += cj * (sp - sm);
+            } else {
+                let kf = k as f64;
+                *a -= cj * kf * (sp - sm);
+                *b += cj * kf * (cm + cp);
+            }
+        }
+    }
+
+    /// As [`Self::add_cos_row`] for the row of `sin jτ`, `j ≥ 1`.
+    fn add_sin_row(&self, row: &mut [f64], j: usize, x: bool) {
+        let n = self.n;
+        let (head, tail) = row.split_at_mut(n + 1);
+        if x {
+            head[0] += self.sin[n + j];
+        }
+        for (i, (a, b)) in head[1..].iter_mut().zip(tail.iter_mut()).enumerate() {
+            let k = i + 1;
+            let (cm, cp, sm, sp) = self.pair(j, k);
+            if x {
+                *a += sp + sm;
+                *b += cm - cp;
+            } else {
+                let kf = k as f64;
+                *a -= kf * (cm - cp);
+                *b += kf * (sp + sm);
+            }
+        }
     }
 }
 
@@ -146,34 +186,15 @@ impl GalerkinJacobian {
                 if has_v {
                     self.v_sums.fill(res.aft_mut(), &self.column, w * omega);
                 }
-                let block = |a: usize| (d * l + a) * len + e * l;
-                for j in 0..=n {
-                    for k in 0..=n {
-                        let (cj, ck, kf) = (weight(j), weight(k), k as f64);
-                        let (cos_jk, sin_jk) = (block(j) + k, block(j) + n + k);
-                        let (cos_sin, sin_sin) = (block(n + j) + k, block(n + j) + n + k);
-                        if has_x {
-                            let (cm, cp, sm, sp) = self.x_sums.pair(j, k);
-                            jac[cos_jk] += cj * ck * (cm + cp);
-                            if k > 0 {
-                                jac[sin_jk] += cj * (sp - sm);
-                            }
-                            if j > 0 {
-                                jac[cos_sin] += ck * (sp + sm);
-                                if k > 0 {
-                                    jac[sin_sin] += cm - cp;
-                                }
-                            }
-                        }
-                        // C_s' = {0, −k sin kτ, k cos kτ}: the derivative columns.
-                        if has_v && k > 0 {
-                            let (cm, cp, sm, sp) = self.v_sums.pair(j, k);
-                            jac[cos_jk] -= cj * kf * (sp - sm);
-                            jac[sin_jk] += cj * kf * (cm + cp);
-                            if j > 0 {
-                                jac[cos_sin] -= kf * (cm - cp);
-                                jac[sin_sin] += kf * (sp + sm);
-                            }
+                for a in 0..l {
+                    let start = (d * l + a) * len + e * l;
+                    let row = &mut jac[start..start + l];
+                    let parts = [(has_x, &self.x_sums, true), (has_v, &self.v_sums, false)];
+                    for (_, sums, x) in parts.into_iter().filter(|part| part.0) {
+                        if a <= n {
+                            sums.add_cos_row(row, a, x);
+                        } else {
+                            sums.add_sin_row(row, a - n, x);
                         }
                     }
                 }
