@@ -30,7 +30,7 @@ pub struct GalerkinJacobian {
     dg: Vec<f64>,
     /// One block's 2N samples.
     column: Vec<f64>,
-    /// `C_l`, `S_l` (`l = 0..2n`) of `∂g_d/∂x_e` and of `ω ∂g_d/∂v_e`, times `s/2N`.
+    /// `C_l`, `S_l` (`l = −n..2n`) of `∂g_d/∂x_e` and of `ω ∂g_d/∂v_e`, times `s/2N`.
     x_sums: CosSinSums,
     v_sums: CosSinSums,
 }
@@ -84,48 +84,35 @@ impl CosSinSums {
         )
     }
 
-    /// Adds to the row `row` (`a_0, a_k.., b_k..` columns) of basis function
-    /// `cos jτ` (weight `c_j`, ½ for j = 0) the sums `Σ g c_j cos jτ · C_s` (`x`)
-    /// or `Σ g c_j cos jτ · C_s'` (`!x`, the derivative columns `−k sin, k cos`).
-    fn add_cos_row(&self, row: &mut [f64], j: usize, x: bool) {
-        let n = self.n;
+    /// Adds to `row` (columns `a_0, a_1..a_n, b_1..b_n` of one DOF) the sums of the
+    /// basis row `cos jτ` (weight ½ for j = 0), or `sin jτ` if `sin_row`, against
+    /// `C_s` (`x`) or against the derivative columns `C_s' = {0, −k sin, k cos}`.
+    /// With `(P_k, Q_k)` = the sums against `(cos kτ, sin kτ)`, the derivative
+    /// columns get `(−k Q_k, k P_k)`, and `a_0` (weight ½) gets `½ P_0`.
+    fn add_row(&self, row: &mut [f64], j: usize, sin_row: bool, x: bool) {
         let cj = if j == 0 { 0.5 } else { 1.0 };
-        let (head, tail) = row.split_at_mut(n + 1);
-        if x {
-            // Column a_0 (weight ½): ½·½(C_j + C_j).
-            head[0] += cj * self.cos[n + j];
-        }
-        for (i, (a, b)) in head[1..].iter_mut().zip(tail.iter_mut()).enumerate() {
-            let k = i + 1;
+        let sums = |k: usize| {
             let (cm, cp, sm, sp) = self.pair(j, k);
-            if x {
-                *a += cj * (cm + cp);
-                *b += cj * (sp - sm);
+            if sin_row {
+                (sp + sm, cm - cp)
             } else {
-                let kf = k as f64;
-                *a -= cj * kf * (sp - sm);
-                *b += cj * kf * (cm + cp);
+                (cj * (cm + cp), cj * (sp - sm))
             }
-        }
-    }
-
-    /// As [`Self::add_cos_row`] for the row of `sin jτ`, `j ≥ 1`.
-    fn add_sin_row(&self, row: &mut [f64], j: usize, x: bool) {
-        let n = self.n;
-        let (head, tail) = row.split_at_mut(n + 1);
+        };
+        let (head, tail) = row.split_at_mut(self.n + 1);
         if x {
-            head[0] += self.sin[n + j];
+            head[0] += 0.5 * sums(0).0;
         }
         for (i, (a, b)) in head[1..].iter_mut().zip(tail.iter_mut()).enumerate() {
             let k = i + 1;
-            let (cm, cp, sm, sp) = self.pair(j, k);
+            let (p, q) = sums(k);
             if x {
-                *a += sp + sm;
-                *b += cm - cp;
+                *a += p;
+                *b += q;
             } else {
                 let kf = k as f64;
-                *a -= kf * (cm - cp);
-                *b += kf * (sp + sm);
+                *a -= kf * q;
+                *b += kf * p;
             }
         }
     }
@@ -191,11 +178,8 @@ impl GalerkinJacobian {
                     let row = &mut jac[start..start + l];
                     let parts = [(has_x, &self.x_sums, true), (has_v, &self.v_sums, false)];
                     for (_, sums, x) in parts.into_iter().filter(|part| part.0) {
-                        if a <= n {
-                            sums.add_cos_row(row, a, x);
-                        } else {
-                            sums.add_sin_row(row, a - n, x);
-                        }
+                        let (j, sin_row) = if a <= n { (a, false) } else { (a - n, true) };
+                        sums.add_row(row, j, sin_row, x);
                     }
                 }
             }
