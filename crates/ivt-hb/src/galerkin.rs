@@ -30,14 +30,16 @@ pub struct GalerkinJacobian {
     dg: Vec<f64>,
     /// One block's 2N samples.
     column: Vec<f64>,
-    /// `C_l`, `S_l` (`l = 0..2n`) of `∂g_d/∂x_e` and of `ω ∂g_d/∂v_e`, times `s/2N`.
+    /// `C_l`, `S_l` (`l = −n..2n`) of `∂g_d/∂x_e` and of `ω ∂g_d/∂v_e`, times `s/2N`.
     x_sums: CosSinSums,
     v_sums: CosSinSums,
 }
 
-/// `C_l = Σ_i g(τ_i) cos lτ_i` and `S_l = Σ_i g(τ_i) sin lτ_i` for `l = 0..2n`.
+/// `C_l = Σ_i g(τ_i) cos lτ_i` and `S_l = Σ_i g(τ_i) sin lτ_i` for `l = −n..2n`
+/// (`C_{−l} = C_l`, `S_{−l} = −S_l`), stored at `n + l`.
 #[derive(Debug, Clone)]
 struct CosSinSums {
+    n: usize,
     cos: Vec<f64>,
     sin: Vec<f64>,
 }
@@ -45,8 +47,9 @@ struct CosSinSums {
 impl CosSinSums {
     fn new(n: usize) -> Self {
         Self {
-            cos: vec![0.0; 2 * n + 1],
-            sin: vec![0.0; 2 * n + 1],
+            n,
+            cos: vec![0.0; 3 * n + 1],
+            sin: vec![0.0; 3 * n + 1],
         }
     }
 
@@ -54,40 +57,64 @@ impl CosSinSums {
     /// for `l ≤ N`, and `X_l = conj(X_{2N−l})` beyond the Nyquist bin.
     fn fill(&mut self, aft: &mut Aft, samples: &[f64], scale: f64) {
         let spectrum = aft.spectrum(samples);
-        let ns = samples.len();
-        for (l, (c, s)) in self.cos.iter_mut().zip(&mut self.sin).enumerate() {
+        let (n, ns) = (self.n, samples.len());
+        for l in 0..=2 * n {
             let (x, sign) = if 2 * l <= ns {
                 (spectrum[l], -1.0)
             } else {
                 (spectrum[ns - l], 1.0)
             };
-            *c = scale * x.re;
-            *s = sign * scale * x.im;
+            self.cos[n + l] = scale * x.re;
+            self.sin[n + l] = sign * scale * x.im;
+        }
+        for l in 1..=n {
+            self.cos[n - l] = self.cos[n + l];
+            self.sin[n - l] = -self.sin[n + l];
         }
     }
 
-    /// `(C_{j−k}, C_{j+k}, S_{j−k}, S_{j+k})`, with `C_{−l} = C_l`, `S_{−l} = −S_l`.
+    /// `(C_{j−k}, C_{j+k}, S_{j−k}, S_{j+k})`.
     fn pair(&self, j: usize, k: usize) -> (f64, f64, f64, f64) {
-        let diff_sin = if j >= k {
-            self.sin[j - k]
-        } else {
-            -self.sin[k - j]
-        };
+        let (minus, plus) = (self.n + j - k, self.n + j + k);
         (
-            self.cos[j.abs_diff(k)],
-            self.cos[j + k],
-            diff_sin,
-            self.sin[j + k],
+            self.cos[minus],
+            self.cos[plus],
+            self.sin[minus],
+            self.sin[plus],
         )
     }
-}
 
-/// Weight of basis function `cos kτ` in `C_s`: ½ for the constant.
-fn weight(k: usize) -> f64 {
-    if k == 0 {
-        0.5
-    } else {
-        1.0
+    /// Adds to `row` (columns `a_0, a_1..a_n, b_1..b_n` of one DOF) the sums of the
+    /// basis row `cos jτ` (weight ½ for j = 0), or `sin jτ` if `sin_row`, against
+    /// `C_s` (`x`) or against the derivative columns `C_s' = {0, −k sin, k cos}`.
+    /// With `(P_k, Q_k)` = the sums against `(cos kτ, sin kτ)`, the derivative
+    /// columns get `(−k Q_k, k P_k)`, and `a_0` (weight ½) gets `½ P_0`.
+    fn add_row(&self, row: &mut [f64], j: usize, sin_row: bool, x: bool) {
+        let cj = if j == 0 { 0.5 } else { 1.0 };
+        let sums = |k: usize| {
+            let (cm, cp, sm, sp) = self.pair(j, k);
+            if sin_row {
+                (sp + sm, cm - cp)
+            } else {
+                (cj * (cm + cp), cj * (sp - sm))
+            }
+        };
+        let (head, tail) = row.split_at_mut(self.n + 1);
+        if x {
+            head[0] += 0.5 * sums(0).0;
+        }
+        for (i, (a, b)) in head[1..].iter_mut().zip(tail.iter_mut()).enumerate() {
+            let k = i + 1;
+            let (p, q) = sums(k);
+            if x {
+                *a += p;
+                *b += q;
+            } else {
+                let kf = k as f64;
+                *a -= kf * q;
+                *b += kf * p;
+            }
+        }
     }
 }
 
@@ -103,7 +130,10 @@ impl GalerkinJacobian {
         }
     }
 
-    /// Writes `Φ_q(q)` (row-major `m×m`, DOF-major unknowns) into `jac`.
+    /// Writes `Φ_q(q)` (row-major `m×m`, DOF-major unknowns) into `jac`: `L(ω)`,
+    /// then `s·(1/π)∫ C_s (G_x C_sᵀ + ω G_v C_s'ᵀ) dτ` added per DOF block `(d, e)`
+    /// from one FFT of `∂g_d/∂x_e` and, for a velocity-dependent problem, one of
+    /// `ω ∂g_d/∂v_e`; identically zero samples are skipped.
     pub fn assemble<P: PeriodicProblem>(
         &mut self,
         res: &mut HbResidual,
@@ -114,23 +144,9 @@ impl GalerkinJacobian {
         jac: &mut [f64],
     ) {
         res.linear_matrix(problem, omega_f / res.subharmonic() as f64, jac);
-        if s != 0.0 {
-            self.add_nonlinear(res, problem, q, omega_f, s, jac);
+        if s == 0.0 {
+            return;
         }
-    }
-
-    /// Adds `s·(1/π)∫ C_s (G_x C_sᵀ + ω G_v C_s'ᵀ) dτ` into `jac`: per DOF block
-    /// `(d, e)` one FFT of `∂g_d/∂x_e` and, for a velocity-dependent problem, one of
-    /// `ω ∂g_d/∂v_e`; identically zero samples are skipped.
-    fn add_nonlinear<P: PeriodicProblem>(
-        &mut self,
-        res: &mut HbResidual,
-        problem: &P,
-        q: &[f64],
-        omega_f: f64,
-        s: f64,
-        jac: &mut [f64],
-    ) {
         let (nd, n) = (res.n_dof(), res.harmonics());
         let l = 2 * n + 1;
         let len = nd * l;
@@ -157,35 +173,13 @@ impl GalerkinJacobian {
                 if has_v {
                     self.v_sums.fill(res.aft_mut(), &self.column, w * omega);
                 }
-                let block = |a: usize| (d * l + a) * len + e * l;
-                for j in 0..=n {
-                    for k in 0..=n {
-                        let (cj, ck, kf) = (weight(j), weight(k), k as f64);
-                        let (cos_jk, sin_jk) = (block(j) + k, block(j) + n + k);
-                        let (cos_sin, sin_sin) = (block(n + j) + k, block(n + j) + n + k);
-                        if has_x {
-                            let (cm, cp, sm, sp) = self.x_sums.pair(j, k);
-                            jac[cos_jk] += cj * ck * (cm + cp);
-                            if k > 0 {
-                                jac[sin_jk] += cj * (sp - sm);
-                            }
-                            if j > 0 {
-                                jac[cos_sin] += ck * (sp + sm);
-                                if k > 0 {
-                                    jac[sin_sin] += cm - cp;
-                                }
-                            }
-                        }
-                        // C_s' = {0, −k sin kτ, k cos kτ}: the derivative columns.
-                        if has_v && k > 0 {
-                            let (cm, cp, sm, sp) = self.v_sums.pair(j, k);
-                            jac[cos_jk] -= cj * kf * (sp - sm);
-                            jac[sin_jk] += cj * kf * (cm + cp);
-                            if j > 0 {
-                                jac[cos_sin] -= kf * (cm - cp);
-                                jac[sin_sin] += kf * (sp + sm);
-                            }
-                        }
+                for a in 0..l {
+                    let start = (d * l + a) * len + e * l;
+                    let row = &mut jac[start..start + l];
+                    let parts = [(has_x, &self.x_sums, true), (has_v, &self.v_sums, false)];
+                    for (_, sums, x) in parts.into_iter().filter(|part| part.0) {
+                        let (j, sin_row) = if a <= n { (a, false) } else { (a - n, true) };
+                        sums.add_row(row, j, sin_row, x);
                     }
                 }
             }
@@ -419,8 +413,9 @@ fn basis_rows(basis: &[f64], l: usize, ns: usize, i: usize) -> (&[f64], &[f64]) 
 mod tests {
     use super::*;
     use crate::elements::{Element, ElementProblem, Harmonic, Law};
+    use crate::fold::{Branch, HbBranch};
     use crate::ihb::HbOptions;
-    use crate::problem::{Duffing, GeneralProblem, MathieuDuffing};
+    use crate::problem::{matrix_getters, Duffing, GeneralProblem, MathieuDuffing};
     use crate::ModifiedIhb;
 
     /// The direct O(2N·n_dof²·(2n+1)²) sum `(2s/2N) Σᵢ C_s(τᵢ)(G_x C_sᵀ + ω G_v C_s'ᵀ)`
@@ -458,9 +453,10 @@ mod tests {
         jac
     }
 
-    /// Coefficients with a spread of harmonics (amplitude ~ 1/(k+1)), deterministic.
-    fn coefficients(nd: usize, n: usize, amplitude: f64) -> Vec<f64> {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
+    /// Coefficients with a spread of harmonics (amplitude ~ 1/(k+1)), deterministic
+    /// per `seed`.
+    fn coefficients(nd: usize, n: usize, amplitude: f64, seed: u64) -> Vec<f64> {
+        let mut state = 0x2545_f491_4f6c_dd1du64 ^ seed;
         (0..nd * (2 * n + 1))
             .map(|i| {
                 state = state.wrapping_mul(6364136223846793005).wrapping_add(1);
@@ -472,6 +468,29 @@ mod tests {
             .collect()
     }
 
+    /// `problem` with `M = C = K = 0`: its Galerkin Jacobian is the nonlinear part
+    /// alone, exactly (`L(ω) = 0`).
+    struct NonlinearPart<'a, P> {
+        inner: &'a P,
+        n: usize,
+        m: Vec<f64>,
+        c: Vec<f64>,
+        k: Vec<f64>,
+    }
+
+    impl<P: PeriodicProblem> PeriodicProblem for NonlinearPart<'_, P> {
+        matrix_getters!();
+        fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
+            self.inner.nonlinear(x, v, theta, out);
+        }
+        fn velocity_dependent(&self) -> bool {
+            self.inner.velocity_dependent()
+        }
+        fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], th: &[f64], dg: &mut [f64]) {
+            self.inner.nonlinear_jacobian_samples(x, v, th, dg);
+        }
+    }
+
     /// max |FFT assembly − quadrature| / max |quadrature| of the nonlinear part.
     fn relative_gap(
         problem: &impl PeriodicProblem,
@@ -480,11 +499,19 @@ mod tests {
         omega_f: f64,
         s: f64,
     ) -> f64 {
+        let n = problem.n_dof();
+        let problem = &NonlinearPart {
+            inner: problem,
+            n,
+            m: vec![0.0; n * n],
+            c: vec![0.0; n * n],
+            k: vec![0.0; n * n],
+        };
         let mut res = HbResidual::new(problem, opts).unwrap();
         let mut galerkin = GalerkinJacobian::new(&res);
         let m = res.len();
         let mut fast = vec![0.0; m * m];
-        galerkin.add_nonlinear(&mut res, problem, q, omega_f, s, &mut fast);
+        galerkin.assemble(&mut res, problem, q, omega_f, s, &mut fast);
         let slow = quadrature(&mut res, problem, q, omega_f, s);
         let max = |it: &mut dyn Iterator<Item = f64>| it.fold(0.0f64, |a, x| a.max(x.abs()));
         let scale = max(&mut slow.iter().copied());
@@ -544,7 +571,7 @@ mod tests {
         // Eq. 81: g = −β sin θ·u + γu³ depends on the phase; period-2 orbit (p = 2).
         let md = MathieuDuffing::thesis(1.6);
         let opts = HbOptions::new(20, 84).with_subharmonic(2);
-        let q = coefficients(1, 20, 1.2);
+        let q = coefficients(1, 20, 1.2, 0);
         let gap = relative_gap(&md, &opts, &q, 2.0, 0.7);
         assert!(gap <= 1e-12, "{gap:e}");
     }
@@ -554,7 +581,7 @@ mod tests {
         // N = 84 and N = 64 (even), N = 21 (odd, 2N = 42 < 2n: the sums j + k > N
         // alias onto bin 2N − (j + k), as in the quadrature).
         let chain = damped_chain();
-        let q = coefficients(2, 20, 0.8);
+        let q = coefficients(2, 20, 0.8, 0);
         for n_half in [84, 64, 21] {
             let gap = relative_gap(&chain, &HbOptions::new(20, n_half), &q, 1.1, 1.0);
             assert!(gap <= 1e-12, "N = {n_half}: {gap:e}");
@@ -564,7 +591,7 @@ mod tests {
     #[test]
     fn fft_assembly_equals_quadrature_for_subharmonic_p3() {
         let duffing = Duffing::fig28();
-        let q = coefficients(1, 20, 1.5);
+        let q = coefficients(1, 20, 1.5, 0);
         for n_half in [64, 21] {
             let opts = HbOptions::new(20, n_half).with_subharmonic(3);
             let gap = relative_gap(&duffing, &opts, &q, 3.3, 0.6);
@@ -587,7 +614,7 @@ mod tests {
             },
             |_theta: f64, f: &mut [f64]| f.fill(0.0),
         );
-        let q = coefficients(2, 20, 0.7);
+        let q = coefficients(2, 20, 0.7, 0);
         for n_half in [64, 21] {
             let gap = relative_gap(&problem, &HbOptions::new(20, n_half), &q, 0.9, 1.0);
             assert!(gap <= 1e-12, "N = {n_half}: {gap:e}");
@@ -596,21 +623,18 @@ mod tests {
 
     #[test]
     fn bilinear_form_equals_the_assembled_jacobian() {
-        // wᵀ J_nl v from the form (direct synthesis on the grid) and from the FFT
-        // assembly: two routes through the same sum.
+        // wᵀJv of the fold test (grid synthesis, no J) and from the FFT assembly:
+        // two routes through the same sum.
         let chain = damped_chain();
-        let opts = HbOptions::new(20, 84);
-        let mut res = HbResidual::new(&chain, &opts).unwrap();
-        let mut galerkin = GalerkinJacobian::new(&res);
-        let mut form = GalerkinForm::new(&res, &chain);
-        let m = res.len();
+        let mut branch = HbBranch::new(&chain, &HbOptions::new(20, 84)).unwrap();
+        let m = branch.len();
         let (q, w, v) = (
-            coefficients(2, 20, 0.8),
-            coefficients(2, 20, 1.0),
-            coefficients(2, 20, -0.6),
+            coefficients(2, 20, 0.8, 1),
+            coefficients(2, 20, 1.0, 2),
+            coefficients(2, 20, -0.6, 3),
         );
         let mut jac = vec![0.0; m * m];
-        galerkin.add_nonlinear(&mut res, &chain, &q, 1.1, 1.0, &mut jac);
+        branch.jacobian(&q, 1.1, &mut jac);
         let (mut assembled, mut scale) = (0.0, 0.0);
         for (row, wi) in jac.chunks_exact(m).zip(&w) {
             for (a, vj) in row.iter().zip(&v) {
@@ -618,7 +642,7 @@ mod tests {
                 scale += (wi * a * vj).abs();
             }
         }
-        let value = form.value(&chain, &q, 1.1, &w, &v, None);
+        let value = branch.bilinear(&q, 1.1, &w, &v);
         assert!(
             (value - assembled).abs() <= 1e-12 * scale,
             "{value} vs {assembled}"
