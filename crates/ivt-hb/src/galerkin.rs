@@ -413,9 +413,10 @@ fn basis_rows(basis: &[f64], l: usize, ns: usize, i: usize) -> (&[f64], &[f64]) 
 mod tests {
     use super::*;
     use crate::elements::{Element, ElementProblem, Harmonic, Law};
-    use crate::fold::{Branch, HbBranch};
+    use crate::fold::Branch;
     use crate::ihb::HbOptions;
     use crate::problem::{matrix_getters, Duffing, GeneralProblem, MathieuDuffing};
+    use crate::FamilyBranch;
     use crate::ModifiedIhb;
 
     /// The direct O(2N·n_dof²·(2n+1)²) sum `(2s/2N) Σᵢ C_s(τᵢ)(G_x C_sᵀ + ω G_v C_s'ᵀ)`
@@ -626,7 +627,8 @@ mod tests {
         // wᵀJv of the fold test (grid synthesis, no J) and from the FFT assembly:
         // two routes through the same sum.
         let chain = damped_chain();
-        let mut branch = HbBranch::new(&chain, &HbOptions::new(20, 84)).unwrap();
+        let mut branch =
+            FamilyBranch::new(|w: f64| (&chain, w), &HbOptions::new(20, 84), 1.2).unwrap();
         let m = branch.len();
         let (q, w, v) = (
             coefficients(2, 20, 0.8, 1),
