@@ -372,6 +372,13 @@ def chain_g_vec(x, v, t):
     return out
 
 
+def chain_jac_vec(x, v, t):
+    """(∂g/∂x, ∂g/∂v) of chain_g_vec at the N samples: (N, 2, 2) and None."""
+    dg_dx = np.zeros((x.shape[0], 2, 2))
+    dg_dx[:, 0, 0] = 1.5 * x[:, 0] ** 2
+    return dg_dx, None
+
+
 def chain_f(theta):
     return [FORCE * math.cos(theta), 0.0]
 
@@ -396,12 +403,16 @@ def chain_rows(n, ds_max, omega_from, omega_to):
         try:
             # events=False: folds only, the work of duffing_frc; events=True adds the
             # period-doubling, Neimark–Sacker and branch-point tests at every point.
-            for key, events in (("ivt", False), ("ivt_events", True)):
+            # jac: the user's ∂g/∂x (vectorized), used by every Jacobian assembly
+            # in place of differencing g.
+            for key, events, jac in (("ivt", False, None), ("ivt_events", True, None),
+                                     ("ivt_jac", False, chain_jac_vec), ("ivt_jac_events", True, chain_jac_vec)):
                 out, t = timed(lambda: ivt.hb.frc(CHAIN_M, CHAIN_C, CHAIN_K, chain_g_vec, chain_f, omega_from,
                                                   omega_to, n=n, samples=hb_samples(n), velocity_dependent=False,
-                                                  vectorized=True, events=events),
+                                                  vectorized=True, events=events, jac=jac),
                                budget=1.0)
-                row[key] = dict(mode=f"ivt.hb.frc, vectorized g, events={events}", time=t,
+                with_jac = ", vectorized jac" if jac is not None else ""
+                row[key] = dict(mode=f"ivt.hb.frc, vectorized g{with_jac}, events={events}", time=t,
                                 points=len(out["points"]), folds=fold_omegas(out["folds"]),
                                 peak=max(p["amplitude"] for p in out["points"]), stability=True)
             return row
@@ -486,17 +497,16 @@ def print_report(refs, rows, frcs, pyharm_error):
     per_point = {row["problem"]: row["ivt"]["time"] / max(row["ivt"]["points"], 1) for row in frcs if "ivt" in row}
     duffing = [t for name, t in per_point.items() if name.startswith("Duffing")]
     for row in frcs:
-        if "ivt_events" in row:
-            ev = row["ivt_events"]["time"] / max(row["ivt_events"]["points"], 1)
-            print(f"per point, ivt {row['problem']} with events=True: {1e3 * ev:.2f} ms")
-    for name, t in per_point.items():
-        if duffing and not name.startswith("Duffing"):
-            print(f"\nper point, ivt {name} / ivt Duffing FRC: {t / duffing[0]:.2f}×")
+        for key in ("ivt", "ivt_events", "ivt_jac", "ivt_jac_events"):
+            if key in row and duffing and not row["problem"].startswith("Duffing"):
+                pp = row[key]["time"] / max(row[key]["points"], 1)
+                print(f"per point, {row[key]['mode']} ({row['problem']}): {1e3 * pp:.3f} ms, "
+                      f"{pp / duffing[0]:.2f}× the ivt Duffing FRC")
     for row in frcs:
         print(f"\n### {row['problem']} (n = {row['n']}, {2 * row['samples']} time samples)\n")
         print("| code | run time [s] | points | per point [ms] | folds (ω turns) | peak amplitude | stability |")
         print("|---|---|---|---|---|---|---|")
-        for name in ("ivt", "ivt_events", "pyharm"):
+        for name in ("ivt", "ivt_events", "ivt_jac", "ivt_jac_events", "pyharm"):
             d = row.get(name)
             if d is None:
                 continue
