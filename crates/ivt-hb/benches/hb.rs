@@ -4,9 +4,8 @@
 //! either corrector, for the Duffing and for the 2-DOF chain of issue 17.
 
 use ivt_hb::{
-    frequency_response, ClassicIhb, Corrector, Duffing, Element, ElementProblem, FrcOptions,
-    GalerkinJacobian, Harmonic, HbOptions, HbResidual, HsuRule, Law, ModifiedIhb,
-    StabilityAnalyzer,
+    frequency_response, ClassicIhb, Corrector, Duffing, FrcOptions, GalerkinJacobian, HbOptions,
+    HbResidual, HsuRule, ModifiedIhb, StabilityAnalyzer,
 };
 
 fn main() {
@@ -64,30 +63,9 @@ fn duffing_frc_0p2_to_3(bencher: divan::Bencher) {
     bencher.bench_local(|| frequency_response(&d, &hb, &opts).unwrap());
 }
 
-/// The 2-DOF cubic chain of issue 17 (M = I, K = [[2, −1], [−1, 2]], C = 0.02 I,
-/// g = [0.5 x₁³, 0], f = [0.1 cos ωt, 0]) with a Rust element: the whole curve
-/// 0.2 → 3.0 with stability at every point, to compare per point with the Duffing.
-fn chain() -> ElementProblem {
-    ElementProblem::new(
-        2,
-        [
-            vec![1.0, 0.0, 0.0, 1.0],
-            vec![0.02, 0.0, 0.0, 0.02],
-            vec![2.0, -1.0, -1.0, 2.0],
-        ],
-        vec![Element {
-            a: 0,
-            b: None,
-            law: Law::CubicSpring { k3: 0.5 },
-        }],
-        vec![Harmonic {
-            dof: 0,
-            amplitude: 0.1,
-            phase: 0.0,
-        }],
-    )
-    .unwrap()
-}
+#[path = "../tests/common/chain.rs"]
+mod chain;
+use chain::cubic_chain as chain;
 
 /// The chain's curve with the default (Broyden) corrector.
 #[divan::bench(sample_count = 10)]

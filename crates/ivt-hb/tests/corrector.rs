@@ -2,9 +2,10 @@
 //! issue 17: the same located folds, and the Newton–chord corrector calls `g`
 //! about half as often per point as Broyden's (the reason user systems use it).
 
+mod common;
+
 use ivt_hb::{
-    frequency_response, Corrector, Element, ElementProblem, FrcOptions, Harmonic, HbOptions, Law,
-    PeriodicProblem,
+    frequency_response, Corrector, ElementProblem, FrcOptions, HbOptions, PeriodicProblem,
 };
 use std::cell::Cell;
 
@@ -48,27 +49,8 @@ impl PeriodicProblem for Counted {
 }
 
 fn chain() -> Counted {
-    let chain = ElementProblem::new(
-        2,
-        [
-            vec![1.0, 0.0, 0.0, 1.0],
-            vec![0.02, 0.0, 0.0, 0.02],
-            vec![2.0, -1.0, -1.0, 2.0],
-        ],
-        vec![Element {
-            a: 0,
-            b: None,
-            law: Law::CubicSpring { k3: 0.5 },
-        }],
-        vec![Harmonic {
-            dof: 0,
-            amplitude: 0.1,
-            phase: 0.0,
-        }],
-    )
-    .unwrap();
     Counted {
-        chain,
+        chain: common::chain::cubic_chain(),
         g_calls: Cell::new(0),
         jacobian_calls: Cell::new(0),
     }

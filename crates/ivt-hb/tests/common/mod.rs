@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests: the independent RK4 check of an HB
-//! orbit and the one-line modified-IHB solve.
+//! orbit, the one-line modified-IHB solve and the 2-DOF cubic chain.
 #![allow(dead_code)] // each test binary uses its own subset
+
+pub mod chain;
 
 use ivt_hb::aft::eval_series;
 use ivt_hb::ode::{first_order, rk4};
