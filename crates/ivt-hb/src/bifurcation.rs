@@ -29,7 +29,6 @@ use crate::fold::{null_vector, Branch};
 use crate::ihb::HbError;
 use crate::stability::StabilityAnalyzer;
 use faer::c64;
-use ivt_num::lu::solve_once;
 use ivt_num::vector::norm2;
 use ivt_num::LuWorkspace;
 use thiserror::Error;
@@ -218,21 +217,48 @@ fn test_matrix(kind: BifurcationKind, phi: &[f64], dim: usize, a: &mut Vec<f64>)
     s
 }
 
-/// `g` of `[[A, b], [cᵀ, 0]] [v; g] = [0; 1]` (NaN if singular).
-fn bordered_scalar(a: &[f64], s: usize, b: &[f64], c: &[f64]) -> f64 {
-    let n1 = s + 1;
-    let mut big = vec![0.0; n1 * n1];
-    for i in 0..s {
-        big[i * n1..i * n1 + s].copy_from_slice(&a[i * s..(i + 1) * s]);
-        big[i * n1 + s] = b[i];
+/// `g` of `[[A, b], [cᵀ, 0]] [v; g] = [0; 1]` for fixed borders `b`, `c`: the
+/// bordered matrix, its LU and the right-hand side are kept across the calls of
+/// the finite-difference loop of [`extended_newton`].
+struct BorderedScalar {
+    b: Vec<f64>,
+    c: Vec<f64>,
+    big: Vec<f64>,
+    lu: LuWorkspace,
+    rhs: Vec<f64>,
+}
+
+impl BorderedScalar {
+    fn new(b: Vec<f64>, c: Vec<f64>) -> Self {
+        let n1 = b.len() + 1;
+        Self {
+            b,
+            c,
+            big: vec![0.0; n1 * n1],
+            lu: LuWorkspace::new(n1),
+            rhs: vec![0.0; n1],
+        }
     }
-    big[s * n1..s * n1 + s].copy_from_slice(c);
-    let mut rhs = vec![0.0; n1];
-    rhs[s] = 1.0;
-    if solve_once(&big, n1, &mut rhs, false) {
-        rhs[s]
-    } else {
-        f64::NAN
+
+    /// `g` for the `s×s` row-major `a` (NaN if singular).
+    fn eval(&mut self, a: &[f64]) -> f64 {
+        let s = self.b.len();
+        let n1 = s + 1;
+        for i in 0..s {
+            self.big[i * n1..i * n1 + s].copy_from_slice(&a[i * s..(i + 1) * s]);
+            self.big[i * n1 + s] = self.b[i];
+        }
+        self.big[s * n1..s * n1 + s].copy_from_slice(&self.c);
+        self.big[s * n1 + s] = 0.0;
+        self.lu.factor_row_major(&self.big);
+        self.rhs.fill(0.0);
+        self.rhs[s] = 1.0;
+        self.lu.solve(&mut self.rhs);
+        if self.rhs.iter().all(|v| v.is_finite()) {
+            self.rhs[s]
+        } else {
+            f64::NAN
+        }
     }
 }
 
@@ -455,14 +481,15 @@ pub fn locate_multiplier_crossing<F: Family>(
         vec![1.0 / (s as f64).sqrt(); s],
     );
     border_null_vectors(&a, &mut c, &mut b)?;
+    let mut bordered = BorderedScalar::new(b, c);
     let (q, lambda, iterations) = extended_newton(
         branch,
         q0,
         lambda0,
         &[],
         |br: &mut FamilyBranch<F>, q: &[f64], l: f64, out: &mut [f64]| {
-            let size = test_matrix(kind, mono.eval(br, q, l), dim, &mut a);
-            out[0] = bordered_scalar(&a, size, &b, &c);
+            test_matrix(kind, mono.eval(br, q, l), dim, &mut a);
+            out[0] = bordered.eval(&a);
         },
         opts,
     )?;

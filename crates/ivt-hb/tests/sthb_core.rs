@@ -177,3 +177,58 @@ fn direct_spatial_sums_equal_rustdct() {
         }
     }
 }
+
+/// `σ_min / σ_max` of the exact Jacobian at `(a, ω)`.
+fn jacobian_conditioning(hb: &mut StringHb, a: &[f64], omega: f64) -> f64 {
+    let n = hb.dim();
+    let mut r = vec![0.0; n];
+    let mut jac = Mat::zeros(n, n);
+    hb.residual_jacobian(a, omega, &mut r, &mut jac);
+    let s = jac.singular_values().unwrap();
+    s.iter().copied().fold(f64::INFINITY, f64::min) / s.iter().copied().fold(0.0, f64::max)
+}
+
+#[test]
+fn kd30_folds_are_located_by_the_bordered_system() {
+    // Fig. 35 (k_d = 30): both turns of the curve are located by Newton on the
+    // bordered fold system. At a fold (simple turning point) `J = ∂R/∂a` is
+    // singular and the path tangent has ∂ω/∂s = 0; near it σ_min(J) ∝ |s − s*| and
+    // ω − ω* ∝ (s − s*)², so σ_min/σ_max ≤ 1e-12 (measured ~4e-18) puts the
+    // located ω far within 1e-8 of the turn (relative to the conditioning at the nearest path point,
+    // ~0.02 of arclength away: measured 3e-6–1e-5).
+    use ivt_hb::sthb::frc::{frequency_response, trace, StringFrcOptions};
+    let p = StringParams {
+        kd: 30.0,
+        ..Default::default()
+    };
+    let opts = StringFrcOptions::default();
+    let mut hb = StringHb::new(p.clone()).unwrap();
+    let frc = frequency_response(&mut hb, 1.0, 6.0, &opts).unwrap();
+    let path = trace(&mut hb, 1.0, 6.0, &opts.continuation).unwrap();
+    assert_eq!(frc.frc.folds.len(), 2, "Fig. 35 has two folds");
+    assert_eq!(path.folds.len(), 2);
+    for (f, turn) in frc.frc.folds.iter().zip(&path.folds) {
+        assert!(f.located, "fold near ω = {} not located", turn.lambda);
+        // The parabola through the points around the turn is accurate to the step.
+        let moved = (f.omega_f - turn.lambda).abs();
+        assert!(
+            moved < opts.continuation.ds_max,
+            "located ω = {} is {moved:e} from the parabola {}",
+            f.omega_f,
+            turn.lambda
+        );
+        let mut r = vec![0.0; hb.dim()];
+        hb.residual(&f.coeffs, f.omega_f, &mut r);
+        let res = r.iter().map(|x| x * x).sum::<f64>().sqrt();
+        assert!(res < 1e-9, "‖R‖ = {res:e} at the fold");
+        let at_fold = jacobian_conditioning(&mut hb, &f.coeffs, f.omega_f);
+        let near = &frc.frc.points[f.index];
+        let at_point = jacobian_conditioning(&mut hb, &near.coeffs, near.omega_f);
+        println!(
+            "fold ω = {:.12} (parabola {:.12}), ‖R‖ = {res:.1e}, σ_min/σ_max = {at_fold:.1e} (path point {at_point:.1e})",
+            f.omega_f, turn.lambda
+        );
+        assert!(at_fold < 1e-12, "J not singular at the fold: {at_fold:e}");
+        assert!(at_point > 1e4 * at_fold, "path point {at_point:e}");
+    }
+}

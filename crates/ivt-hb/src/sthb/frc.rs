@@ -17,6 +17,7 @@ use crate::continuation::{
     pseudo_arclength_exact, ContinuationOptions, Path, PathPoint, PathSystem, Termination,
 };
 use crate::error::HbError;
+use crate::fold::{locate_fold, Branch, FoldOptions};
 use crate::frc::{Frc, FrcFold, FrcPoint};
 
 /// Settings of a string curve.
@@ -57,8 +58,9 @@ impl Default for StringFrcOptions {
 ///
 /// `FrcPoint::amplitude` is `‖a‖`, the Euclidean norm of the complex
 /// coefficients (Eq. 114, the ordinate of Figs. 34–36); `multipliers` are those
-/// of the method in `methods`, decreasing modulus; folds are the parabola
-/// through the points around each turn (`located = false`).
+/// of the method in `methods`, decreasing modulus; each turn of the path is
+/// located by Newton on the bordered fold system ([`locate_fold`], exact `J`),
+/// `located = false` leaving the parabola through the points around the turn.
 #[derive(Clone, Debug)]
 pub struct StringFrc {
     /// The curve.
@@ -75,6 +77,33 @@ pub struct StringFrc {
 struct StringPath<'a> {
     hb: &'a mut StringHb,
     jacobians: usize,
+}
+
+/// [`StringHb`] as a [`Branch`] in ω for the bordered fold system
+/// ([`locate_fold`]), with the exact Jacobian of Eq. 115–125.
+struct StringBranch<'a> {
+    hb: &'a mut StringHb,
+    jac: Mat<f64>,
+    r: Vec<f64>,
+}
+
+impl Branch for StringBranch<'_> {
+    fn len(&self) -> usize {
+        self.hb.dim()
+    }
+    fn residual(&mut self, q: &[f64], lambda: f64, r: &mut [f64]) {
+        self.hb.residual(q, lambda, r);
+    }
+    fn jacobian(&mut self, q: &[f64], lambda: f64, jac: &mut [f64]) {
+        self.hb
+            .residual_jacobian(q, lambda, &mut self.r, &mut self.jac);
+        let m = self.r.len();
+        for (i, row) in jac.chunks_exact_mut(m).enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = self.jac[(i, j)];
+            }
+        }
+    }
 }
 
 impl PathSystem for StringPath<'_> {
@@ -220,15 +249,37 @@ pub fn frequency_response(
             coeffs: p.x[..n].to_vec(),
         })
         .collect::<Vec<_>>();
+    let mut branch = StringBranch {
+        hb,
+        jac: Mat::zeros(n, n),
+        r: vec![0.0; n],
+    };
     let folds = path
         .folds
         .iter()
-        .map(|f| FrcFold {
-            index: f.index,
-            omega_f: f.lambda,
-            amplitude: points[f.index].amplitude,
-            coeffs: points[f.index].coeffs.clone(),
-            located: false,
+        .map(|f| {
+            let near = &points[f.index];
+            match locate_fold(
+                &mut branch,
+                &near.coeffs,
+                near.omega_f,
+                &FoldOptions::default(),
+            ) {
+                Ok(loc) => FrcFold {
+                    index: f.index,
+                    omega_f: loc.lambda,
+                    amplitude: branch.hb.complex_norm(&loc.q),
+                    coeffs: loc.q,
+                    located: true,
+                },
+                Err(_) => FrcFold {
+                    index: f.index,
+                    omega_f: f.lambda,
+                    amplitude: near.amplitude,
+                    coeffs: near.coeffs.clone(),
+                    located: false,
+                },
+            }
         })
         .collect();
     Ok(StringFrc {
