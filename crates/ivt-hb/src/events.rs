@@ -17,7 +17,7 @@ use crate::continuation::{ContinuationOptions, Corrector, Termination};
 use crate::family::{Family, FamilyBranch};
 use crate::fold::{locate_fold, Branch, FoldOptions};
 use crate::ihb::HbError;
-use crate::stability::{classify, StabilityKind};
+use crate::stability::{AdaptiveHsu, HsuSteps, StabilityKind};
 use faer::c64;
 
 /// Options of [`trace`].
@@ -28,8 +28,9 @@ pub struct TraceOptions {
     pub lambda_to: f64,
     /// Path following (its λ bounds are set from λ₀ and `lambda_to`).
     pub continuation: ContinuationOptions,
-    /// Hsu sub-intervals for the multipliers of the path points.
-    pub stability_steps: usize,
+    /// Hsu sub-intervals of the path points' multipliers (by default chosen
+    /// per point for multipliers to 1e-6).
+    pub stability: HsuSteps,
     /// Options of the located events.
     pub locate: BifurcationOptions,
     /// The path's corrector ([`Corrector::Broyden`] by default).
@@ -41,7 +42,7 @@ impl Default for TraceOptions {
         Self {
             lambda_to: 1.0,
             continuation: ContinuationOptions::default(),
-            stability_steps: 256,
+            stability: HsuSteps::default(),
             locate: BifurcationOptions::default(),
             corrector: Corrector::Broyden,
         }
@@ -57,6 +58,9 @@ pub struct TracedPoint {
     pub lambda: f64,
     /// Floquet multipliers (Hsu), decreasing modulus.
     pub multipliers: Vec<c64>,
+    /// Error estimate of their monodromy ([`crate::HsuEstimate::error`]):
+    /// `None` for fixed Hsu steps.
+    pub multiplier_error: Option<f64>,
     /// Stability class.
     pub kind: StabilityKind,
 }
@@ -108,19 +112,24 @@ pub fn trace<F: Family>(
     copts.lambda_min = lambda0.min(opts.lambda_to);
     copts.lambda_max = lambda0.max(opts.lambda_to);
     let path = branch.follow(&x0, 0, opts.lambda_to - lambda0, &copts, opts.corrector)?;
-    let mut mono = Monodromy::new(branch, lambda0, opts.stability_steps)?;
+    let mut hsu = AdaptiveHsu::new(
+        &branch.family().at(lambda0).0,
+        branch.options().harmonics,
+        opts.stability,
+    )?;
     let mut points = Vec::with_capacity(path.points.len());
     let mut bp_signs = Vec::with_capacity(path.points.len());
     let xs: Vec<&[f64]> = path.points.iter().map(|p| p.x.as_slice()).collect();
     for (k, x) in xs.iter().enumerate() {
         let (q, lambda) = (&x[..m], x[m]);
-        let multipliers = mono.multipliers(branch, q, lambda);
-        let kind = classify(&multipliers);
+        let (problem, sol) = branch.solution(q, lambda);
+        let fl = hsu.floquet(&problem, &sol)?;
         points.push(TracedPoint {
             q: q.to_vec(),
             lambda,
-            multipliers,
-            kind,
+            multipliers: fl.floquet.multipliers,
+            multiplier_error: fl.error,
+            kind: fl.floquet.kind,
         });
         bp_signs.push(match secant(&xs, k) {
             Some(t) => augmented_sign(branch, q, lambda, &t, &opts.locate),

@@ -11,12 +11,11 @@ use crate::bifurcation::BifurcationKind;
 use crate::continuation::{turn_estimate, ContinuationOptions, Corrector, Termination};
 use crate::events::Trace;
 use crate::family::FamilyBranch;
-use crate::floquet::HsuRule;
 use crate::fold::{locate_fold, FoldOptions};
 use crate::ihb::{HbError, HbOptions, HbSolution};
 use crate::modified::ModifiedIhb;
 use crate::problem::PeriodicProblem;
-use crate::stability::{StabilityAnalyzer, StabilityKind};
+use crate::stability::{AdaptiveHsu, HsuSteps, StabilityKind};
 use crate::BroydenStats;
 use faer::c64;
 
@@ -29,8 +28,9 @@ pub struct FrcOptions {
     pub to: f64,
     /// Path-following options (λ bounds are set from `from`/`to`).
     pub continuation: ContinuationOptions,
-    /// Hsu sub-intervals per period for the stability flags.
-    pub stability_steps: usize,
+    /// Hsu sub-intervals of each point's multipliers (by default chosen per
+    /// point for multipliers to 1e-6, [`HsuSteps::Tolerance`]).
+    pub stability: HsuSteps,
     /// The path's corrector: [`Corrector::Broyden`] (the thesis's Eq. 68–77,
     /// the default) or [`Corrector::Newton`] (exact Galerkin Jacobian; fewer
     /// residual evaluations per point, for costly `g`).
@@ -51,7 +51,7 @@ impl Default for FrcOptions {
                 target_iter: 16,
                 ..ContinuationOptions::default()
             },
-            stability_steps: 256,
+            stability: HsuSteps::default(),
             corrector: Corrector::Broyden,
         }
     }
@@ -68,6 +68,9 @@ pub struct FrcPoint {
     pub kind: StabilityKind,
     /// Floquet multipliers (Hsu), decreasing modulus.
     pub multipliers: Vec<c64>,
+    /// Error estimate of the monodromy behind `multipliers` ([`crate::HsuEstimate::error`]):
+    /// `None` for fixed Hsu steps.
+    pub multiplier_error: Option<f64>,
     /// Fourier coefficients.
     pub coeffs: Vec<f64>,
 }
@@ -142,11 +145,7 @@ pub fn frequency_response<P: PeriodicProblem>(
         &copts,
         opts.corrector,
     )?;
-    let mut analyzer = StabilityAnalyzer::new(
-        problem,
-        hb.harmonics,
-        opts.stability_steps.max(hb.harmonics + 1),
-    )?;
+    let mut hsu = AdaptiveHsu::new(problem, hb.harmonics, opts.stability)?;
     let mut probe = AmplitudeProbe::new(hb)?;
     let mut points = Vec::with_capacity(path.points.len());
     for p in &path.points {
@@ -163,12 +162,13 @@ pub fn frequency_response<P: PeriodicProblem>(
             },
         };
         let amplitude = probe.of(&sol.coeffs);
-        let fl = analyzer.hsu(problem, &sol, HsuRule::Magnus4);
+        let fl = hsu.floquet(problem, &sol)?;
         points.push(FrcPoint {
             omega_f: sol.omega_f,
             amplitude,
-            kind: fl.kind,
-            multipliers: fl.multipliers,
+            kind: fl.floquet.kind,
+            multipliers: fl.floquet.multipliers,
+            multiplier_error: fl.error,
             coeffs: sol.coeffs,
         });
     }
@@ -207,6 +207,7 @@ impl Frc {
                 amplitude: probe.of(&p.q),
                 kind: p.kind,
                 multipliers: p.multipliers.clone(),
+                multiplier_error: p.multiplier_error,
                 coeffs: p.q.clone(),
             })
             .collect();

@@ -59,7 +59,9 @@ pub use problem::{
     central_difference_samples, Duffing, GeneralProblem, MathieuDuffing, Nonlinearity,
     PeriodicProblem, WithJacobian,
 };
-pub use stability::{classify, Floquet, StabilityAnalyzer, StabilityKind};
+pub use stability::{
+    classify, AdaptiveHsu, Floquet, HsuEstimate, HsuSteps, StabilityAnalyzer, StabilityKind,
+};
 pub use switching::{period_doubled_start, switch_branch};
 
 pub mod sthb;

@@ -9,7 +9,7 @@
 
 use crate::aft::Aft;
 use crate::error::HbError;
-use crate::floquet::{eigenvalues, monodromy_uniform, HsuRule};
+use crate::floquet::{eigenvalues, monodromy_strided, monodromy_uniform, HsuRule};
 use crate::hill::{fourier_blocks, hill_multipliers};
 use crate::ihb::HbSolution;
 use crate::problem::PeriodicProblem;
@@ -219,4 +219,190 @@ impl StabilityAnalyzer {
         let res = hill_multipliers(dim, &blocks, h)?;
         Ok(Floquet::new(res.multipliers))
     }
+}
+
+/// How many Hsu sub-intervals the multipliers of each point of a path get.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum HsuSteps {
+    /// This many at every point (Magnus-4, no error estimate).
+    Fixed(usize),
+    /// Chosen per point ([`AdaptiveHsu`]): doubled from `max(2(n + 1), 32)`
+    /// until the Richardson estimate of the multipliers' error is at most
+    /// `tol` (relative to max(1, |μ|)), at most `max` sub-intervals.
+    Tolerance {
+        /// Target error of the multipliers.
+        tol: f64,
+        /// Cap on the sub-intervals (a point that reaches it keeps its larger
+        /// error estimate).
+        max: usize,
+    },
+}
+
+impl Default for HsuSteps {
+    /// Multipliers to 1e-6 (the accuracy 256 fixed steps had on the Duffing
+    /// and chain curves, 5.6e-7 at worst, now held at every point), at most
+    /// 4096 sub-intervals.
+    fn default() -> Self {
+        Self::Tolerance {
+            tol: 1e-6,
+            max: 4096,
+        }
+    }
+}
+
+/// The multipliers of one orbit by [`AdaptiveHsu`], with the sub-intervals used
+/// and the error estimate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HsuEstimate {
+    /// Multipliers and verdict.
+    pub floquet: Floquet,
+    /// Hsu sub-intervals used.
+    pub steps: usize,
+    /// Richardson estimate of the multipliers' error from those of `S/2`
+    /// sub-intervals (relative to max(1, |μ|); Magnus-4 is fourth order);
+    /// `None` for [`HsuSteps::Fixed`].
+    pub error: Option<f64>,
+}
+
+/// Hsu's method (Magnus-4) along a path of orbits with the step count chosen
+/// per orbit: the multipliers of the monodromy Φ_S of `S` sub-intervals and
+/// of Φ_{S/2} from every other Θ sample of the same grid give the Richardson
+/// error estimate ([`richardson_error`]); `S` doubles until it meets the
+/// tolerance, and the next orbit starts at the `S` that met it (or half of it
+/// when the estimate was 32× below). Estimating on the multipliers, not on
+/// Φ's entries, takes their conditioning into account: next to a fold the
+/// multiplier at +1 moves 20× more than Φ's entries. One
+/// [`StabilityAnalyzer`] per step count is kept.
+#[derive(Debug, Clone)]
+pub struct AdaptiveHsu {
+    control: HsuSteps,
+    harmonics: usize,
+    /// Step count of level 0; level `k` has `base·2^k`.
+    base: usize,
+    /// Highest level (`base·2^top ≤ max`).
+    top: usize,
+    /// Level the next orbit starts at.
+    level: usize,
+    levels: Vec<StabilityAnalyzer>,
+    coarse: Vec<f64>,
+}
+
+impl AdaptiveHsu {
+    /// For orbits of `problem` with `harmonics` harmonics.
+    ///
+    /// # Errors
+    /// [`HbError::InvalidInput`] for a tolerance that is not positive and finite
+    /// or a cap below the first step count; [`HbError::AftTooFewSamples`] for a
+    /// fixed count `≤ harmonics`.
+    pub fn new<P: PeriodicProblem>(
+        problem: &P,
+        harmonics: usize,
+        control: HsuSteps,
+    ) -> Result<Self, HbError> {
+        let (base, top) = match control {
+            HsuSteps::Fixed(steps) => (steps, 0),
+            HsuSteps::Tolerance { tol, max } => {
+                let base = (2 * (harmonics + 1)).max(32);
+                if !(tol > 0.0 && tol.is_finite()) || max < base {
+                    return Err(HbError::InvalidInput(format!(
+                        "Hsu tolerance {tol} must be positive and finite and the cap {max} at \
+                         least {base} sub-intervals (2(n + 1), at least 32)"
+                    )));
+                }
+                (base, (max / base).ilog2() as usize)
+            }
+        };
+        let first = StabilityAnalyzer::new(problem, harmonics, base)?;
+        let dim = 2 * problem.n_dof();
+        Ok(Self {
+            control,
+            harmonics,
+            base,
+            top,
+            level: 0,
+            levels: vec![first],
+            coarse: vec![0.0; dim * dim],
+        })
+    }
+
+    /// The multipliers of `sol` with the error estimate and the steps used.
+    ///
+    /// # Errors
+    /// [`HbError`] if the analyzer of a finer level cannot be set up.
+    pub fn floquet<P: PeriodicProblem>(
+        &mut self,
+        problem: &P,
+        sol: &HbSolution,
+    ) -> Result<HsuEstimate, HbError> {
+        let HsuSteps::Tolerance { tol, .. } = self.control else {
+            let an = &mut self.levels[0];
+            return Ok(HsuEstimate {
+                floquet: an.hsu(problem, sol, HsuRule::Magnus4),
+                steps: self.base,
+                error: None,
+            });
+        };
+        let dim = 2 * self.levels[0].nd;
+        let period = 2.0 * std::f64::consts::PI;
+        let mut level = self.level;
+        // Multipliers of the level below, when it was just computed.
+        let mut coarse: Option<Vec<c64>> = None;
+        loop {
+            while self.levels.len() <= level {
+                let steps = self.base << self.levels.len();
+                self.levels
+                    .push(StabilityAnalyzer::new(problem, self.harmonics, steps)?);
+            }
+            let an = &mut self.levels[level];
+            an.theta_samples(problem, sol);
+            monodromy_uniform(
+                dim,
+                &an.theta,
+                an.steps,
+                period,
+                HsuRule::Magnus4,
+                &mut an.q,
+            );
+            let fine = eigenvalues(&an.q, dim);
+            let coarse_mu = match coarse.take() {
+                Some(mu) => mu,
+                None => {
+                    let samples = 2 * an.steps;
+                    let phi = &mut self.coarse;
+                    monodromy_strided(dim, &an.theta, samples, 2, period, HsuRule::Magnus4, phi);
+                    eigenvalues(phi, dim)
+                }
+            };
+            let error = richardson_error(&fine, &coarse_mu);
+            // NaN (singular mass, non-finite Θ) stops here and classifies as unstable.
+            if error <= tol || level == self.top || !error.is_finite() {
+                self.level = if error * 32.0 <= tol && level > 0 {
+                    level - 1
+                } else {
+                    level
+                };
+                return Ok(HsuEstimate {
+                    floquet: Floquet::new(fine),
+                    steps: an.steps,
+                    error: Some(error),
+                });
+            }
+            coarse = Some(fine);
+            level += 1;
+        }
+    }
+}
+
+/// Richardson estimate of the error of the multipliers `fine` of `S` Magnus-4
+/// steps from those of `S/2`, `coarse`: the Hausdorff distance between the two
+/// sets, relative to max(1, |μ|), over 2⁴ − 1 = 15 (fourth order; the pairing
+/// by nearest neighbour needs no common order of the two lists).
+fn richardson_error(fine: &[c64], coarse: &[c64]) -> f64 {
+    let nearest = |z: &c64, set: &[c64]| {
+        set.iter()
+            .map(|w| (z - w).norm() / z.norm().max(1.0))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let one_way = |a: &[c64], b: &[c64]| a.iter().map(|z| nearest(z, b)).fold(0.0, f64::max);
+    one_way(fine, coarse).max(one_way(coarse, fine)) / 15.0
 }

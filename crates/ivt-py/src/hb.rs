@@ -457,6 +457,7 @@ pub(crate) fn frc_dict<'py>(py: Python<'py>, frc: &ivt_hb::Frc) -> PyResult<Boun
         e.set_item("kind", p.kind.name())?;
         e.set_item("coeffs", p.coeffs.clone().into_pyarray(py))?;
         e.set_item("multipliers", pairs(&p.multipliers))?;
+        e.set_item("multiplier_error", p.multiplier_error)?;
         points.append(e)?;
     }
     d.set_item("points", points)?;

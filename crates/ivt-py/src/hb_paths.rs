@@ -15,7 +15,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use crate::hb::{finite, frc_dict, pairs, run_user, stability_steps, user_system_fn, UserArgs};
+use crate::hb::{finite, frc_dict, pairs, run_user, user_system_fn, UserArgs};
 
 /// The FRC of `problem` from `from` to `to`, followed with the Newton–chord
 /// corrector (one Galerkin Jacobian and a few residuals per point: the user's
@@ -36,7 +36,6 @@ fn traced_frc<P: PeriodicProblem>(
         let frc_opts = FrcOptions {
             from,
             to,
-            stability_steps: stability_steps(opts.harmonics),
             corrector: Corrector::Newton,
             ..FrcOptions::default()
         };
@@ -47,7 +46,6 @@ fn traced_frc<P: PeriodicProblem>(
     let trace_opts = TraceOptions {
         lambda_to: to,
         continuation: frc_opts.continuation,
-        stability_steps: stability_steps(opts.harmonics),
         corrector: Corrector::Newton,
         ..TraceOptions::default()
     };
@@ -123,13 +121,17 @@ user_system_fn! {
 /// x, v of shape (N, n_dof) and theta of shape (N,) (all 2·samples AFT
 /// samples at once) and returns (N, n_dof).
 /// Returns {"points": [{"omega", "coeffs", "amplitude", "multipliers",
-/// "stable", "stability"}...], "folds": [{"omega", "amplitude", "coeffs",
-/// "located", "index" (path point before the turn)}...], "bifurcations":
+/// "multiplier_error", "stable", "stability"}...], "folds": [{"omega",
+/// "amplitude", "coeffs", "located", "index" (path point before the
+/// turn)}...], "bifurcations":
 /// [{"kind" ("fold", "period_doubling", "neimark_sacker", "branch_point"),
 /// "omega", "located", "multipliers", "coeffs", "index", "error"}...] in path
 /// order, "termination"} and the arrays omega, amplitude, stable. amplitude
-/// is max |x_0| over the AFT samples (DOF 0). `events=False` locates the
-/// folds only by `ivt_hb::frequency_response` (no period-doubling,
+/// is max |x_0| over the AFT samples (DOF 0). Each point's Hsu sub-intervals
+/// are doubled until the Richardson estimate of its multipliers' error
+/// ("multiplier_error", relative to max(1, |μ|)) is ≤ 1e-6; the events'
+/// multipliers come from 2048 fixed steps. `events=False` locates the folds
+/// only by `ivt_hb::frequency_response` (no period-doubling,
 /// Neimark–Sacker or branch-point test per point: several times cheaper per
 /// point, see the ivt-py README). GIL released between callbacks.
 fn frc<'py>(py, user, jac;

@@ -246,6 +246,7 @@ pub fn frequency_response(
             amplitude: hb.complex_norm(&p.x[..n]),
             kind: s.kind,
             multipliers: s.multipliers,
+            multiplier_error: None,
             coeffs: p.x[..n].to_vec(),
         })
         .collect::<Vec<_>>();
