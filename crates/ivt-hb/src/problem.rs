@@ -172,11 +172,14 @@ const FD_STEP: f64 = 1e-6;
 
 /// `∂g/∂x`, `∂g/∂v` at all samples (layout of
 /// [`PeriodicProblem::nonlinear_jacobian_samples`]) by central differences of
-/// [`PeriodicProblem::nonlinear_samples`]: one call per perturbed DOF and sign, so
-/// 4·n_dof calls (2·n_dof without velocity dependence) whatever the number of
-/// samples. DOF j is stepped by `1e-6·max_i |x_ij|` (`v` likewise), relative to the
-/// orbit's own scale: an orbit of micrometres is differenced like one of metres,
-/// where a floor of 1 would step by its whole amplitude. Allocates its scratch.
+/// [`PeriodicProblem::nonlinear_samples`]: the `2·n_dof` perturbed copies of the
+/// samples (`4·n_dof` with velocity dependence; each DOF stepped up and down)
+/// are stacked into one call, so a vectorized `g` is called once per Jacobian
+/// whatever the number of DOFs and samples (`g` acts sample by sample, so
+/// stacking changes nothing else). DOF j is stepped by `1e-6·max_i |x_ij|`
+/// (`v` likewise), relative to the orbit's own scale: an orbit of micrometres
+/// is differenced like one of metres, where a floor of 1 would step by its
+/// whole amplitude. Allocates its scratch.
 pub fn central_difference_samples<P: PeriodicProblem + ?Sized>(
     problem: &P,
     x: &[f64],
@@ -184,51 +187,50 @@ pub fn central_difference_samples<P: PeriodicProblem + ?Sized>(
     theta: &[f64],
     dg: &mut [f64],
 ) {
-    difference_columns(problem, x, v, theta, false, dg);
-    if problem.velocity_dependent() {
-        difference_columns(problem, x, v, theta, true, dg);
-    } else {
-        zero_velocity_blocks(problem.n_dof(), dg);
-    }
-}
-
-/// The columns `∂g/∂x_j` (or `∂g/∂v_j` with `wrt_v`) of every sample's blocks.
-fn difference_columns<P: PeriodicProblem + ?Sized>(
-    problem: &P,
-    x: &[f64],
-    v: &[f64],
-    theta: &[f64],
-    wrt_v: bool,
-    dg: &mut [f64],
-) {
     let n = problem.n_dof();
-    let base = if wrt_v { v } else { x };
-    let mut moved = base.to_vec();
-    let (mut gp, mut gm) = (vec![0.0; base.len()], vec![0.0; base.len()]);
-    let eval = |moved: &[f64], out: &mut [f64]| {
-        if wrt_v {
-            problem.nonlinear_samples(x, moved, theta, out)
-        } else {
-            problem.nonlinear_samples(moved, v, theta, out)
-        }
-    };
-    for j in 0..n {
-        let h = FD_STEP * orbit_scale(base, n, j);
-        for (dst, sign) in [(&mut gp, 1.0), (&mut gm, -1.0)] {
-            for (m, b) in moved.iter_mut().zip(base).skip(j).step_by(n) {
-                *m = b + sign * h;
+    let ns = theta.len();
+    let with_v = problem.velocity_dependent();
+    // Perturbation k = (wrt_v, j, sign): x₀⁺, x₀⁻, x₁⁺, …, then v₀⁺, … .
+    let wrt: &[bool] = if with_v { &[false, true] } else { &[false] };
+    let copies = 2 * n * wrt.len();
+    let (mut xs, mut vs) = (
+        Vec::with_capacity(copies * n * ns),
+        Vec::with_capacity(copies * n * ns),
+    );
+    let mut thetas = Vec::with_capacity(copies * ns);
+    let mut steps = Vec::with_capacity(copies / 2);
+    for &wrt_v in wrt {
+        let base = if wrt_v { v } else { x };
+        for j in 0..n {
+            let h = FD_STEP * orbit_scale(base, n, j);
+            steps.push(h);
+            for sign in [1.0, -1.0] {
+                let start = if wrt_v { vs.len() } else { xs.len() };
+                xs.extend_from_slice(&x[..n * ns]);
+                vs.extend_from_slice(&v[..n * ns]);
+                let moved = if wrt_v { &mut vs } else { &mut xs };
+                for m in moved[start..].iter_mut().skip(j).step_by(n) {
+                    *m += sign * h;
+                }
+                thetas.extend_from_slice(theta);
             }
-            eval(&moved, dst);
         }
-        for (m, b) in moved.iter_mut().zip(base).skip(j).step_by(n) {
-            *m = *b;
-        }
+    }
+    let mut g = vec![0.0; copies * n * ns];
+    problem.nonlinear_samples(&xs, &vs, &thetas, &mut g);
+    let copy = n * ns;
+    for (pair, &h) in steps.iter().enumerate() {
+        let (wrt_v, j) = (pair >= n, pair % n);
+        let (gp, gm) = (&g[2 * pair * copy..], &g[(2 * pair + 1) * copy..]);
         let block = if wrt_v { n * n } else { 0 };
-        for i in 0..theta.len() {
+        for i in 0..ns {
             for r in 0..n {
                 dg[2 * i * n * n + block + r * n + j] = (gp[i * n + r] - gm[i * n + r]) / (2.0 * h);
             }
         }
+    }
+    if !with_v {
+        zero_velocity_blocks(n, dg);
     }
 }
 
@@ -371,8 +373,9 @@ pub trait Nonlinearity {
     /// [`PeriodicProblem::nonlinear_jacobian_samples`]: per sample the row-major
     /// blocks `[∂g/∂x | ∂g/∂v]`, `2·n_dof²`); returns whether it wrote them.
     /// Default: `false`, and [`GeneralProblem`] differences [`Self::eval_samples`]
-    /// ([`central_difference_samples`], 2·n_dof calls per Jacobian, 4·n_dof with
-    /// velocity dependence) instead.
+    /// ([`central_difference_samples`]: one call per Jacobian on the 2·n_dof
+    /// perturbed copies of the samples, 4·n_dof with velocity dependence)
+    /// instead.
     fn jacobian_samples(&self, _x: &[f64], _v: &[f64], _theta: &[f64], _dg: &mut [f64]) -> bool {
         false
     }

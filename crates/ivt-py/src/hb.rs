@@ -520,7 +520,9 @@ user_system_fn! {
 /// unforced). `velocity_dependent=False` when g ignores v (saves work).
 /// `vectorized=True`: g(x, v, theta) is called once per residual with x, v of
 /// shape (N, n_dof) and theta of shape (N,) for all N = 2·samples AFT
-/// samples, and returns (N, n_dof).
+/// samples, and returns (N, n_dof); g must act row by row (other grids
+/// come: Hsu's stability grid, and differencing ∂g stacks its 2·n_dof
+/// perturbed copies of a grid into one call).
 /// Convergence: ‖r‖₂ ≤ tol + rtol·S, r the Galerkin residual (a force), S
 /// the norm of the forcing's projection (for f = None: of the guess's linear
 /// force): `tol` is absolute (default 0), `rtol` relative (default 1e-9), so
@@ -536,8 +538,8 @@ user_system_fn! {
 /// Speed cost: a per-sample g is called once per AFT sample and residual
 /// evaluation (2·samples calls per iteration), each costing ~1–3 µs of
 /// interpreter time against ~10 ns for a Rust g; with `vectorized=True` it is
-/// one call per residual and 2 (4 with velocity dependence) per DOF for ∂g
-/// (none with `jac`: one `jac` call per Jacobian assembly instead).
+/// one call per residual and one per ∂g (none with `jac`: one `jac` call per
+/// Jacobian assembly instead).
 /// The GIL is released between callbacks, so other Python threads run. An
 /// exception in a callback aborts the solve and is re-raised. Same dict as
 /// `duffing`.

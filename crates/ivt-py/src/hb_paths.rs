@@ -119,7 +119,7 @@ user_system_fn! {
 /// m, c, k, g, f, velocity_dependent, jac as in `solve` (f may be None; g may
 /// be an `ivt.hb.elements` composition); `vectorized=True`: g(x, v, theta) gets
 /// x, v of shape (N, n_dof) and theta of shape (N,) (all 2·samples AFT
-/// samples at once) and returns (N, n_dof).
+/// samples at once, or another grid, see `solve`) and returns (N, n_dof).
 /// Returns {"points": [{"omega", "coeffs", "amplitude", "multipliers",
 /// "multiplier_error", "stable", "stability"}...], "folds": [{"omega",
 /// "amplitude", "coeffs", "located", "index" (path point before the

@@ -12,7 +12,9 @@ per DOF with ``u(τ) = a0/2 + Σ a_k cos kτ + b_k sin kτ``, τ = ω t; a
 multi-DOF vector is the DOF blocks one after the other (``eval_series(...,
 n_dof=)`` evaluates it). User callbacks: ``g(x, v, theta)`` with v = dx/dt and
 theta = ω_f t; with ``vectorized=True`` x, v have shape (N, n_dof) and theta
-shape (N,) for all N AFT samples, and g returns (N, n_dof).
+shape (N,) for all N samples of a grid (the AFT's, Hsu's, or the 2·n_dof
+perturbed copies of one stacked to difference ∂g), and g returns (N, n_dof)
+acting row by row.
 All solvers release the GIL; :func:`solve` re-acquires it only to call the
 user's Python callbacks. Non-convergence raises :class:`ConvergenceError`
 whose ``history`` attribute is the residual norm per iteration.
