@@ -10,7 +10,7 @@ use crate::aft::Aft;
 use crate::bifurcation::BifurcationKind;
 use crate::continuation::{turn_estimate, ContinuationOptions, Corrector, Termination};
 use crate::events::Trace;
-use crate::family::FamilyBranch;
+use crate::family::{FamilyBranch, Frequency};
 use crate::fold::{locate_fold, FoldOptions};
 use crate::ihb::{HbError, HbOptions, HbSolution};
 use crate::modified::ModifiedIhb;
@@ -130,7 +130,7 @@ pub fn frequency_response<P: PeriodicProblem>(
         ));
     }
     let start: HbSolution = ModifiedIhb::new(problem, hb.clone())?.solve(opts.from, None)?;
-    let mut family = FamilyBranch::new(|w: f64| (problem, w), hb, opts.from)?;
+    let mut family = FamilyBranch::new(Frequency(problem), hb, opts.from)?;
     let m = start.coeffs.len();
     let mut x0 = start.coeffs.clone();
     x0.push(opts.from);

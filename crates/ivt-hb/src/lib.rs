@@ -47,7 +47,7 @@ pub use elements::{Element, ElementProblem, Harmonic, Law};
 pub use error::HbError;
 pub use events::{trace, Event, Trace, TraceOptions, TracedPoint};
 pub use faer::c64;
-pub use family::{Family, FamilyBranch};
+pub use family::{Family, FamilyBranch, Frequency};
 pub use floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
 pub use fold::{locate_fold, Branch, FoldLocation, FoldOptions};
 pub use frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};

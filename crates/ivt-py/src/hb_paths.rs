@@ -6,8 +6,8 @@
 
 use ivt_hb::{
     frequency_response, trace, Backbone, BackboneOptions, BifurcationKind, Corrector, Event,
-    FamilyBranch, Frc, FrcFold, FrcOptions, HbError, HbOptions, ModifiedIhb, PeriodicProblem,
-    Trace, TraceOptions,
+    FamilyBranch, Frc, FrcFold, FrcOptions, Frequency, HbError, HbOptions, ModifiedIhb,
+    PeriodicProblem, Trace, TraceOptions,
 };
 use numpy::ndarray::Array1;
 use numpy::IntoPyArray;
@@ -49,7 +49,7 @@ fn traced_frc<P: PeriodicProblem>(
         corrector: Corrector::Newton,
         ..TraceOptions::default()
     };
-    let mut branch = FamilyBranch::new(|w: f64| (problem, w), opts, from)?;
+    let mut branch = FamilyBranch::new(Frequency(problem), opts, from)?;
     let traced = trace(&mut branch, &start.coeffs, from, &trace_opts).map_err(|e| match e {
         ivt_hb::BifurcationError::Hb(h) => h,
         other => HbError::InvalidInput(other.to_string()),
