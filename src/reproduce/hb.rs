@@ -305,7 +305,7 @@ fn mathieu(ctx: &mut Context) -> Result<(), ReproError> {
                     5e-4,
                     6,
                     &format!(
-                        "continuation in β with Hsu multipliers, secant on μ = −1 (μ = {:.8}), n = 12·period",
+                        "continuation in β with Hsu multipliers, μ = −1 located on its extended system (μ = {:.8}), n = 12·period",
                         pd.multiplier.re
                     ),
                     Some(Cause {

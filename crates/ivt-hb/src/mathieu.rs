@@ -5,7 +5,9 @@
 //! 1. The period-1 solution at β₀ = 3.6 is solved from the thesis's printed
 //!    coefficients (n = 9) and followed in β by pseudo-arclength continuation
 //!    with Hsu multipliers at every point.
-//! 2. The crossing μ = −1 is located by a secant iteration on the path parameter.
+//! 2. The crossing μ = −1, bracketed by two path points, is located by Newton
+//!    on the extended system of [`crate::bifurcation`] (the branch in β with
+//!    the bordered test function of Φ + I), as every event of [`crate::trace`].
 //! 3. The period-2p branch is entered with the controlled-amplitude scheme of
 //!    Eq. 84–85: the solution is embedded with harmonic k → 2k
 //!    (`a_{2j}^{(2)} = a_j^{(1)}`), the amplitude `a_1` of the new lowest harmonic is
@@ -13,8 +15,12 @@
 //!    unknowns; `a_1` is then the continuation parameter.
 
 use crate::aft::{embed_subharmonic, resize_harmonics};
+use crate::bifurcation::{
+    locate_multiplier_crossing, BifurcationError, BifurcationKind, BifurcationOptions,
+};
 use crate::broyden::{broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace};
 use crate::continuation::{pseudo_arclength, ContinuationOptions};
+use crate::family::FamilyBranch;
 use crate::floquet::HsuRule;
 use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
 use crate::modified::ModifiedIhb;
@@ -159,6 +165,75 @@ impl Controlled {
     }
 }
 
+/// Of two bracketing path points with period-doubling indicators `ga`, `gb`,
+/// the orbit `(q, β)` (by `orbit`) of the one nearer the crossing.
+fn nearer(
+    xa: &[f64],
+    ga: f64,
+    xb: &[f64],
+    gb: f64,
+    orbit: impl Fn(&[f64]) -> (Vec<f64>, f64),
+) -> (Vec<f64>, f64) {
+    orbit(if ga.abs() <= gb.abs() { xa } else { xb })
+}
+
+/// The period doubling of the period-`period` branch in β next to its orbit
+/// `(q, β)`: Newton on the extended system `[R(q, β); ψ(q, β)] = 0`, ψ the
+/// bordered test function of `Φ + I` (Hsu with the cascade's sub-intervals),
+/// [`locate_multiplier_crossing`].
+fn locate_period_doubling(
+    opts: &CascadeOptions,
+    hb: &HbOptions,
+    period: usize,
+    q: &[f64],
+    beta: f64,
+) -> Result<PeriodDoubling, HbError> {
+    let family = |b: f64| {
+        (
+            MathieuDuffing::new(opts.xi, opts.alpha, b, opts.gamma),
+            opts.omega,
+        )
+    };
+    let mut branch = FamilyBranch::new(family, hb, beta)?;
+    let located = locate_multiplier_crossing(
+        &mut branch,
+        BifurcationKind::PeriodDoubling,
+        q,
+        beta,
+        &BifurcationOptions {
+            stability_steps: opts.hsu_steps_per_harmonic * hb.harmonics,
+            ..BifurcationOptions::default()
+        },
+    )
+    .map_err(|e| match e {
+        BifurcationError::Hb(h) => h,
+        other => HbError::InvalidInput(other.to_string()),
+    })?;
+    let multiplier = located
+        .multipliers
+        .iter()
+        .copied()
+        .min_by(|a, b| (a + 1.0).norm().total_cmp(&(b + 1.0).norm()))
+        .unwrap_or(c64::new(f64::NAN, 0.0));
+    Ok(PeriodDoubling {
+        period,
+        beta: located.lambda,
+        multiplier,
+        solution: HbSolution {
+            coeffs: located.q,
+            omega_f: opts.omega,
+            harmonics: hb.harmonics,
+            subharmonic: period,
+            stats: BroydenStats {
+                iterations: located.iterations,
+                residual_evals: 0,
+                jacobian_refreshes: 0,
+                residual_norm: located.residual_norm,
+            },
+        },
+    })
+}
+
 /// Runs the cascade and returns the critical points β1, β2, β4, … in order.
 ///
 /// # Errors
@@ -229,35 +304,8 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
     let ((xa, ga), (xb, gb)) = bracket
         .found
         .ok_or_else(|| HbError::InvalidInput("period-1 branch never reached μ = −1".into()))?;
-    // Secant refinement in β with fixed-β solves.
-    let mut solver = ModifiedIhb::new(problem.clone(), hb1.clone())?;
-    let (mut ba, mut bb, mut fa, mut fb) = (xa[m], xb[m], ga, gb);
-    let mut best = (xb[..m].to_vec(), bb, fb, c64::new(f64::NAN, 0.0));
-    for _ in 0..40 {
-        let beta = bb - fb * (bb - ba) / (fb - fa);
-        solver.problem_mut().beta = beta;
-        let sol = solver.solve(opts.omega, Some(&best.0))?;
-        let (g, mu) = stab(&mut an, solver.problem(), &sol.coeffs, n1, 1);
-        (ba, fa) = (bb, fb);
-        bb = beta;
-        fb = g;
-        best = (sol.coeffs, beta, g, mu);
-        if g.abs() < 1e-10 || (bb - ba).abs() < 1e-12 {
-            break;
-        }
-    }
-    let mut crit = PeriodDoubling {
-        period: 1,
-        beta: best.1,
-        multiplier: best.3,
-        solution: HbSolution {
-            coeffs: best.0,
-            omega_f: opts.omega,
-            harmonics: n1,
-            subharmonic: 1,
-            stats: start.stats,
-        },
-    };
+    let (q, beta) = nearer(&xa, ga, &xb, gb, |x| (x[..m].to_vec(), x[m]));
+    let mut crit = locate_period_doubling(opts, &hb1, 1, &q, beta)?;
     out.push(crit.clone());
     // --- period 2, 4, …: controlled amplitude a_1.
     let mut period = 1;
@@ -326,35 +374,12 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
         let ((xa, ga), (xb, gb)) = bracket.found.ok_or_else(|| {
             HbError::InvalidInput(format!("period-{new_period} branch never reached μ = −1"))
         })?;
-        // Secant on the controlled amplitude.
-        let (mut aa, mut ab, mut fa, mut fb) = (xa[l], xb[l], ga, gb);
-        let mut yb = xb[..l].to_vec();
-        let mut mu_b = c64::new(f64::NAN, 0.0);
-        for _ in 0..40 {
-            let a = ab - fb * (ab - aa) / (fb - fa);
-            let mut yv = yb.clone();
-            broyden_solve(
-                &mut |v: &[f64], r: &mut [f64]| ctl.eval(v, a, r),
-                &mut yv,
-                &mut ws,
-                &bopts,
-            )?;
-            let (sol, beta) = ctl.solution(&yv, a, new_n, new_period);
-            pp.beta = beta;
-            let (g, mu) = stab(&mut an2, &pp, &sol.coeffs, new_n, new_period);
-            (aa, fa) = (ab, fb);
-            (ab, fb, yb, mu_b) = (a, g, yv, mu);
-            if g.abs() < 1e-10 || (ab - aa).abs() < 1e-14 {
-                break;
-            }
-        }
-        let (sol, beta) = ctl.solution(&yb, ab, new_n, new_period);
-        crit = PeriodDoubling {
-            period: new_period,
-            beta,
-            multiplier: mu_b,
-            solution: sol,
-        };
+        // The bracketing points as orbits of the period-2p branch in β.
+        let (q, beta) = nearer(&xa, ga, &xb, gb, |x| {
+            let (sol, beta) = ctl.solution(&x[..l], x[l], new_n, new_period);
+            (sol.coeffs, beta)
+        });
+        crit = locate_period_doubling(opts, &hb, new_period, &q, beta)?;
         out.push(crit.clone());
         period = new_period;
         n = new_n;
