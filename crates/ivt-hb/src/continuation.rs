@@ -84,6 +84,11 @@ pub struct PathPoint {
     pub iterations: usize,
     /// λ component of the unit secant that led here (sign = direction in λ).
     pub dlambda: f64,
+    /// Sign of `det [[R_q, R_λ], [tᵀ]]` at the point (`t` the oriented unit
+    /// tangent), the branch-point test function, when the corrector factored
+    /// that matrix ([`pseudo_arclength_exact`]: the tangent's LU, bordered by
+    /// the previous tangent, has the same sign); `None` from Broyden.
+    pub bordered_sign: Option<f64>,
 }
 
 impl PathPoint {
@@ -251,6 +256,7 @@ where
         x: xp.clone(),
         iterations: 0,
         dlambda: xd[m],
+        bordered_sign: None,
     }];
     let mut folds = Vec::new();
     if !on_point(&points[0]) {
@@ -359,6 +365,7 @@ where
             x: x.clone(),
             iterations: iters,
             dlambda: new_xd[m],
+            bordered_sign: None,
         };
         if prev_dl * new_xd[m] < 0.0 && points.len() >= 2 {
             let k = points.len() - 1;

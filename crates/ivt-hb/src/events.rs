@@ -131,9 +131,13 @@ pub fn trace<F: Family>(
             multiplier_error: fl.error,
             kind: fl.floquet.kind,
         });
-        bp_signs.push(match secant(&xs, k) {
-            Some(t) => augmented_sign(branch, q, lambda, &t, &opts.locate),
-            None => 0.0,
+        // The exact corrector's tangent LU carries the sign; Broyden's path
+        // has no factored bordered matrix, so it is assembled here.
+        bp_signs.push(match path.points[k].bordered_sign {
+            Some(sign) => sign,
+            None => {
+                secant(&xs, k).map_or(0.0, |t| augmented_sign(branch, q, lambda, &t, &opts.locate))
+            }
         });
     }
     let mut events = Vec::new();

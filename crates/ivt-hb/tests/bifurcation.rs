@@ -7,8 +7,8 @@ use ivt_hb::mathieu::THESIS_A0;
 use ivt_hb::ode::{first_order, rk4};
 use ivt_hb::{
     period_doubled_start, switch_branch, trace, BifurcationKind, BifurcationOptions,
-    ContinuationOptions, Family, FamilyBranch, GeneralProblem, HbOptions, MathieuDuffing,
-    ModifiedIhb, PeriodicProblem, Trace, TraceOptions,
+    ContinuationOptions, Corrector, Family, FamilyBranch, GeneralProblem, HbOptions,
+    MathieuDuffing, ModifiedIhb, PeriodicProblem, Trace, TraceOptions,
 };
 
 /// The forcing-frequency family `ω_f ↦ (problem, ω_f)` and its trace with the
@@ -18,6 +18,7 @@ fn trace_in_omega<'a, P: PeriodicProblem>(
     hb: &HbOptions,
     omega_from: f64,
     omega_to: f64,
+    corrector: Corrector,
 ) -> (FamilyBranch<impl Family<Problem = &'a P>>, Trace) {
     let start = ModifiedIhb::new(problem, hb.clone())
         .unwrap()
@@ -26,6 +27,7 @@ fn trace_in_omega<'a, P: PeriodicProblem>(
     let mut branch = FamilyBranch::new(move |w: f64| (problem, w), hb, omega_from).unwrap();
     let opts = TraceOptions {
         lambda_to: omega_to,
+        corrector,
         ..TraceOptions::default()
     };
     let tr = trace(&mut branch, &start.coeffs, omega_from, &opts).unwrap();
@@ -245,7 +247,7 @@ fn forced_van_der_pol_neimark_sacker_matches_shooting_and_time_integration() {
         move |t: f64, out: &mut [f64]| out[0] = f * t.cos(),
     );
     let hb = HbOptions::new(9, 32);
-    let (_, tr) = trace_in_omega(&vdp, &hb, 0.5, 1.6);
+    let (_, tr) = trace_in_omega(&vdp, &hb, 0.5, 1.6, Corrector::Broyden);
     let ns: Vec<_> = tr
         .events
         .iter()
@@ -332,7 +334,7 @@ fn symmetric_chain_branch_point_matches_shooting_and_switches_to_the_asymmetric_
         },
     );
     let hb = HbOptions::new(9, 32);
-    let (mut branch, tr) = trace_in_omega(&chain, &hb, 0.8, 2.5);
+    let (mut branch, tr) = trace_in_omega(&chain, &hb, 0.8, 2.5, Corrector::Broyden);
     let event = tr
         .events
         .iter()
@@ -340,6 +342,17 @@ fn symmetric_chain_branch_point_matches_shooting_and_switches_to_the_asymmetric_
         .unwrap();
     let bp = event.location.as_ref().unwrap();
     assert!(bp.residual_norm < 1e-12 && bp.iterations <= 8, "{bp:?}");
+    // The Newton path detects it from the sign of its tangent's LU (no own
+    // assembly): the same branch point, located to the same λ.
+    let (_, by_newton) = trace_in_omega(&chain, &hb, 0.8, 2.5, Corrector::Newton);
+    let first = by_newton
+        .events
+        .iter()
+        .find(|e| e.kind == BifurcationKind::BranchPoint)
+        .unwrap();
+    let same = first.location.as_ref().unwrap().lambda;
+    // Measured 1e-13.
+    assert!((same - bp.lambda).abs() < 1e-10, "{same} vs {}", bp.lambda);
     // Shooting on the symmetric orbit (x₁ = x₂ = x: ẍ + 0.02ẋ + 1.2x + x³ =
     // 0.05 cos ωt) and Floquet of the anti-phase variation
     // ÿ + 0.02ẏ + (1 + 3x²) y = 0: a multiplier +1 there.

@@ -97,6 +97,7 @@ where
             x: x.clone(),
             iterations,
             dlambda: tangent[m],
+            bordered_sign: Some(corrector.aug.det_sign),
         };
         let k = points.len();
         if k >= 2 && points[k - 1].dlambda * point.dlambda < 0.0 {
