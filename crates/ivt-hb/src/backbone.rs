@@ -12,9 +12,14 @@
 //! is the continuation parameter ([`pseudo_arclength`], Eq. 68–77). The problem
 //! must be undamped and unforced (`C = 0`, `f = 0`; checked).
 
-use crate::continuation::{pseudo_arclength, ContinuationOptions, Termination};
+use crate::continuation::{
+    correct_at_fixed_lambda, pseudo_arclength, pseudo_arclength_exact, ContinuationOptions,
+    Corrector, PathSystem, Termination,
+};
+use crate::family::{FamilyBranch, Frequency};
 use crate::ihb::{HbError, HbOptions, HbResidual};
 use crate::problem::PeriodicProblem;
+use faer::Mat;
 
 /// Options of [`backbone`].
 #[derive(Debug, Clone, PartialEq)]
@@ -28,6 +33,10 @@ pub struct BackboneOptions {
     pub amplitude_to: f64,
     /// Path following (λ bounds are set from the amplitudes).
     pub continuation: ContinuationOptions,
+    /// The path's corrector: [`Corrector::Broyden`] on the secant model (the
+    /// default) or [`Corrector::Newton`] on the exact Jacobian of `{q, ω, κ}`
+    /// (the Galerkin Jacobian, so the problem's analytic `∂g` is used).
+    pub corrector: Corrector,
 }
 
 impl Default for BackboneOptions {
@@ -37,6 +46,7 @@ impl Default for BackboneOptions {
             amplitude_from: 0.01,
             amplitude_to: 1.0,
             continuation: ContinuationOptions::default(),
+            corrector: Corrector::Broyden,
         }
     }
 }
@@ -77,6 +87,83 @@ fn add_unfolding(mass: &[f64], nd: usize, n: usize, q: &[f64], kappa_omega: f64,
                 r[d * l + n + h] -= s * q[e * l + h];
             }
         }
+    }
+}
+
+/// The backbone equations `[R(q, ω) + κω D q; b₁; a₁ − λ] = 0` in the unknowns
+/// `{q, ω, κ}` at `λ` = the prescribed `a₁`, with their exact Jacobian for
+/// [`pseudo_arclength_exact`]: `∂R/∂q` is the Galerkin Jacobian (Eq. 56) of
+/// the frequency family at ω, `∂R/∂ω` its exact ω-derivative
+/// ([`Frequency`]), and the unfolding `κω D q` is linear in each unknown.
+struct BackboneSystem<'a, P: PeriodicProblem> {
+    branch: FamilyBranch<Frequency<'a, P>>,
+    mass: &'a [f64],
+    nd: usize,
+    n: usize,
+    /// Indices of `a₁` and `b₁` of the reference DOF in `q`.
+    a1: usize,
+    b1: usize,
+    /// `∂R/∂q` of the branch, `∂R/∂ω`, and `D q` scratch (`m` each).
+    jq: Mat<f64>,
+    column: Vec<f64>,
+    dq: Vec<f64>,
+}
+
+impl<P: PeriodicProblem> BackboneSystem<'_, P> {
+    /// `D q` (the unfolding per unit κω) into `self.dq`.
+    fn unfolding_of(&mut self, q: &[f64]) {
+        self.dq.fill(0.0);
+        add_unfolding(self.mass, self.nd, self.n, q, 1.0, &mut self.dq);
+    }
+}
+
+impl<P: PeriodicProblem> PathSystem for BackboneSystem<'_, P> {
+    fn dim(&self) -> usize {
+        self.dq.len() + 2
+    }
+    fn residual(&mut self, u: &[f64], lambda: f64, r: &mut [f64]) {
+        let m = self.dq.len();
+        let (q, omega, kappa) = (&u[..m], u[m], u[m + 1]);
+        PathSystem::residual(&mut self.branch, q, omega, &mut r[..m]);
+        add_unfolding(self.mass, self.nd, self.n, q, kappa * omega, r);
+        r[m] = u[self.b1];
+        r[m + 1] = u[self.a1] - lambda;
+    }
+    fn residual_jacobian(&mut self, u: &[f64], lambda: f64, r: &mut [f64], jac: &mut Mat<f64>) {
+        let m = self.dq.len();
+        let (q, omega, kappa) = (&u[..m], u[m], u[m + 1]);
+        self.branch
+            .residual_jacobian(q, omega, &mut r[..m], &mut self.jq);
+        add_unfolding(self.mass, self.nd, self.n, q, kappa * omega, r);
+        r[m] = u[self.b1];
+        r[m + 1] = u[self.a1] - lambda;
+        jac.fill(0.0);
+        jac.as_mut().submatrix_mut(0, 0, m, m).copy_from(&self.jq);
+        // ∂(κω D q)/∂q = κω D, column k the image of the unit vector e_k.
+        let mut unit = vec![0.0; m];
+        for k in 0..m {
+            unit[k] = 1.0;
+            self.unfolding_of(&unit);
+            unit[k] = 0.0;
+            for (i, d) in self.dq.iter().enumerate() {
+                jac[(i, k)] += kappa * omega * d;
+            }
+        }
+        let mut column = std::mem::take(&mut self.column);
+        self.branch.d_residual_d_lambda(q, omega, &mut column);
+        self.unfolding_of(q);
+        for i in 0..m {
+            jac[(i, m)] = column[i] + kappa * self.dq[i];
+            jac[(i, m + 1)] = omega * self.dq[i];
+        }
+        self.column = column;
+        jac[(m, self.b1)] = 1.0;
+        jac[(m + 1, self.a1)] = 1.0;
+    }
+    fn d_residual_d_lambda(&mut self, _u: &[f64], _lambda: f64, r_lambda: &mut [f64]) {
+        r_lambda.fill(0.0);
+        let m = self.dq.len();
+        r_lambda[m + 1] = -1.0;
     }
 }
 
@@ -136,26 +223,43 @@ pub fn backbone<P: PeriodicProblem>(
     let mut copts = opts.continuation.clone();
     copts.lambda_min = a_from.min(a_to);
     copts.lambda_max = a_from.max(a_to);
-    let path = pseudo_arclength(
-        |x: &[f64], r: &mut [f64]| {
-            res.eval(problem, &x[..m], x[m], 1.0, &mut r[..m]);
-            add_unfolding(
-                problem.mass(),
+    let path = match opts.corrector {
+        Corrector::Broyden => pseudo_arclength(
+            |x: &[f64], r: &mut [f64]| {
+                res.eval(problem, &x[..m], x[m], 1.0, &mut r[..m]);
+                add_unfolding(
+                    problem.mass(),
+                    nd,
+                    hb.harmonics,
+                    &x[..m],
+                    x[m + 1] * x[m],
+                    r,
+                );
+                r[m] = x[b1];
+                r[m + 1] = x[a1] - x[m + 2];
+            },
+            &x0,
+            None,
+            a_to - a_from,
+            &copts,
+            |_| true,
+        )?,
+        Corrector::Newton => {
+            let mut system = BackboneSystem {
+                branch: FamilyBranch::new(Frequency(problem), hb, omega0)?,
+                mass: problem.mass(),
                 nd,
-                hb.harmonics,
-                &x[..m],
-                x[m + 1] * x[m],
-                r,
-            );
-            r[m] = x[b1];
-            r[m + 1] = x[a1] - x[m + 2];
-        },
-        &x0,
-        None,
-        a_to - a_from,
-        &copts,
-        |_| true,
-    )?;
+                n: hb.harmonics,
+                a1,
+                b1,
+                jq: Mat::zeros(m, m),
+                column: vec![0.0; m],
+                dq: vec![0.0; m],
+            };
+            let its = correct_at_fixed_lambda(&mut system, &mut x0, &copts)?;
+            pseudo_arclength_exact(&mut system, &x0, its, a_to - a_from, &copts, |_, _| true)?
+        }
+    };
     let points = path
         .points
         .iter()

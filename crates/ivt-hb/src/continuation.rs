@@ -16,7 +16,9 @@ use ivt_num::vector::{dot, norm2};
 use ivt_num::LuWorkspace;
 
 mod exact;
+mod start;
 pub use exact::{pseudo_arclength_exact, PathSystem};
+pub use start::correct_at_fixed_lambda;
 
 /// Options of the path follower.
 #[derive(Debug, Clone, PartialEq)]

@@ -6,9 +6,9 @@
 //! `f(θ)` is projected once (it is part of the planned residual), so it must not
 //! depend on λ; [`FamilyBranch::new`] checks this.
 
-use crate::broyden::SolveError;
 use crate::continuation::{
-    pseudo_arclength, pseudo_arclength_exact, ContinuationOptions, Corrector, Path, PathSystem,
+    correct_at_fixed_lambda, pseudo_arclength, pseudo_arclength_exact, ContinuationOptions,
+    Corrector, Path, PathSystem,
 };
 use crate::fold::Branch;
 use crate::galerkin::{GalerkinForm, GalerkinJacobian};
@@ -16,7 +16,6 @@ use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
 use crate::BroydenStats;
 use faer::{Mat, MatRef};
-use ivt_num::LuWorkspace;
 
 /// A one-parameter family of periodic problems.
 pub trait Family {
@@ -150,54 +149,10 @@ impl<F: Family> FamilyBranch<F> {
             ),
             Corrector::Newton => {
                 let mut x = start.to_vec();
-                let its = self.correct_at_fixed_lambda(&mut x, opts)?;
+                let its = correct_at_fixed_lambda(self, &mut x, opts)?;
                 pseudo_arclength_exact(self, &x, start_iterations + its, direction, opts, |_, _| {
                     true
                 })
-            }
-        }
-    }
-
-    /// Newton on `R(q, λ) = 0` at the λ of `x` (`q` then λ, corrected in
-    /// place) to `opts.broyden.tol` within `opts.broyden.max_iter` steps.
-    /// Returns the steps taken.
-    fn correct_at_fixed_lambda(
-        &mut self,
-        x: &mut [f64],
-        opts: &ContinuationOptions,
-    ) -> Result<usize, HbError> {
-        let m = self.res.len();
-        let lambda = x[m];
-        let mut r = vec![0.0; m];
-        let mut lu = LuWorkspace::new(m);
-        let mut history = Vec::new();
-        loop {
-            let it = history.len();
-            Branch::residual(self, &x[..m], lambda, &mut r);
-            let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
-            history.push(norm);
-            if norm <= opts.broyden.tol {
-                return Ok(it);
-            }
-            if !norm.is_finite() || it == opts.broyden.max_iter {
-                return Err(HbError::ContinuationStart {
-                    lambda,
-                    cause: SolveError::NonConvergence {
-                        iterations: it,
-                        history,
-                    },
-                });
-            }
-            let mut rows = std::mem::take(&mut self.rows);
-            Branch::jacobian(self, &x[..m], lambda, &mut rows);
-            let factored = lu.factor_row_major(&rows);
-            self.rows = rows;
-            if !factored {
-                return Err(HbError::SingularStart { lambda });
-            }
-            lu.solve(&mut r);
-            for (q, d) in x.iter_mut().zip(&r) {
-                *q -= d;
             }
         }
     }

@@ -209,12 +209,14 @@ user_system_fn! {
 /// and its first cosine coefficient a1 prescribed: `amplitude` is a1 of DOF
 /// `dof`, traced from `amplitude_from` to `amplitude_to` (ivt_hb::backbone, a
 /// fictitious damping κ unfolds the family and is ~0 on the result).
-/// g, velocity_dependent and vectorized as in `solve`; no `jac`: the
-/// backbone's path follower differences its whole residual, ∂g included.
+/// g, velocity_dependent, vectorized and jac as in `solve`: the curve is
+/// followed with the Newton–chord corrector on the exact Jacobian of
+/// {q, ω, κ} (the Galerkin Jacobian, with ∂g from `jac`, the elements, or
+/// differences of `g`).
 /// Returns {"amplitude", "omega", "kappa" (arrays), "points": [{"amplitude",
 /// "omega", "kappa", "coeffs"}...], "termination"}. GIL released between
 /// callbacks.
-fn backbone<'py>(py, user;
+fn backbone<'py>(py, user, jac;
     omega0: f64,
     mode: Vec<f64>,
     amplitude_from: f64 = 0.01,
@@ -227,6 +229,7 @@ fn backbone<'py>(py, user;
         dof: crate::args::count("dof", dof)?,
         amplitude_from: finite("amplitude_from", amplitude_from)?,
         amplitude_to: finite("amplitude_to", amplitude_to)?,
+        corrector: Corrector::Newton,
         ..BackboneOptions::default()
     };
     let omega0 = finite("omega0", omega0)?;

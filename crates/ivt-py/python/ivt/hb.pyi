@@ -157,6 +157,7 @@ def backbone(
     vectorized: bool = False,
     rtol: float = 1e-9,
     max_iter: int = 100,
+    jac: Optional[Jacobian] = None,
 ) -> Dict[str, Any]: ...
 def string(
     kd: float = 10.0,
