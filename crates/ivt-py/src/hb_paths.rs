@@ -132,7 +132,7 @@ user_system_fn! {
 /// ("multiplier_error", relative to max(1, |μ|)) is ≤ 1e-6; the events'
 /// multipliers come from 2048 fixed steps. `events=False` locates the folds
 /// only by `ivt_hb::frequency_response` (no period-doubling,
-/// Neimark–Sacker or branch-point test per point: several times cheaper per
+/// Neimark–Sacker or branch-point test per point: cheaper per
 /// point, see the ivt-py README). GIL released between callbacks.
 fn frc<'py>(py, user, jac;
     f: Option<&Bound<'py, PyAny>>,
