@@ -200,6 +200,9 @@ struct Corrector {
     rhs: Vec<f64>,
     /// The corrected point.
     u: Vec<f64>,
+    /// `jac` was assembled at `u` as Newton converged there: the tangent at
+    /// that point reuses it instead of assembling it again.
+    jac_at_u: bool,
     tol: f64,
     max_newton: usize,
 }
@@ -213,6 +216,7 @@ impl Corrector {
             r_lambda: vec![0.0; m],
             rhs: vec![0.0; m + 1],
             u: vec![0.0; m + 1],
+            jac_at_u: false,
             tol: opts.broyden.tol,
             max_newton: opts.broyden.max_iter,
         }
@@ -222,6 +226,7 @@ impl Corrector {
     fn assemble<S: PathSystem>(&mut self, system: &mut S, x: &[f64]) {
         let m = self.jac.nrows();
         system.residual_jacobian(&x[..m], x[m], &mut self.r, &mut self.jac);
+        self.jac_at_u = false;
     }
 
     /// Factors `[J R_λ; rowᵀ]` with the `J` of the last [`Self::assemble`] at `x`;
@@ -230,10 +235,8 @@ impl Corrector {
         let m = self.jac.nrows();
         system.d_residual_d_lambda(&x[..m], x[m], &mut self.r_lambda);
         let a = &mut self.aug.mat;
+        a.as_mut().submatrix_mut(0, 0, m, m).copy_from(&self.jac);
         for j in 0..m {
-            for i in 0..m {
-                a[(i, j)] = self.jac[(i, j)];
-            }
             a[(j, m)] = self.r_lambda[j];
             a[(m, j)] = row[j];
         }
@@ -245,7 +248,12 @@ impl Corrector {
     /// also borders the matrix); leaves its LU in `aug` for the chord corrector.
     fn tangent<S: PathSystem>(&mut self, system: &mut S, x: &[f64], tangent: &mut [f64]) -> bool {
         let m = self.jac.nrows();
-        self.assemble(system, x);
+        // After Newton converged, `jac` is already the Jacobian at `x`.
+        let reuse = self.jac_at_u && self.u == x;
+        if !reuse {
+            self.assemble(system, x);
+        }
+        self.jac_at_u = false;
         if !self.factor(system, x, tangent) {
             return false;
         }
@@ -320,6 +328,7 @@ impl Corrector {
             self.u = u;
             let constraint = pred.constraint(&self.u);
             if let Some(done) = settle(&mut history, norm2(&self.r).hypot(constraint), self.tol) {
+                self.jac_at_u = done.is_ok();
                 return done;
             }
             if it == self.max_newton || (it >= 2 && history[it] > history[it - 1]) {
