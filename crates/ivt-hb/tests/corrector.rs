@@ -1,6 +1,6 @@
 //! The two path correctors of `frequency_response` on the 2-DOF cubic chain of
 //! issue 17: the same located folds, and the Newton–chord corrector calls `g`
-//! about half as often per point as Broyden's (the reason user systems use it).
+//! about a third as often per point as Broyden's (the reason user systems use it).
 
 mod common;
 
@@ -74,7 +74,7 @@ fn curve(corrector: Corrector) -> (Vec<f64>, f64, f64) {
 }
 
 #[test]
-fn newton_corrector_finds_the_same_folds_with_half_the_g_calls() {
+fn newton_corrector_finds_the_same_folds_with_a_third_of_the_g_calls() {
     let (broyden, g_b, j_b) = curve(Corrector::Broyden);
     let (newton, g_n, j_n) = curve(Corrector::Newton);
     eprintln!("per point: Broyden g {g_b:.1}, ∂g {j_b:.2}; Newton g {g_n:.1}, ∂g {j_n:.2}");
@@ -85,6 +85,8 @@ fn newton_corrector_finds_the_same_folds_with_half_the_g_calls() {
     for (a, b) in broyden.iter().zip(&newton) {
         assert!((a - b).abs() < 1e-9, "{broyden:?} vs {newton:?}");
     }
-    // Measured 22.5 and 11.9 g calls per point (1.5 and 3.8 ∂g calls).
-    assert!(g_n < 0.6 * g_b, "g per point: Newton {g_n}, Broyden {g_b}");
+    // Measured 22.5 and 8.0 g calls per point (1.5 and 3.0 ∂g calls): the
+    // Newton path's chord is Broyden-accelerated, and its tangent reuses the
+    // Jacobian Newton converged with.
+    assert!(g_n < 0.4 * g_b, "g per point: Newton {g_n}, Broyden {g_b}");
 }
