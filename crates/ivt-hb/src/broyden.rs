@@ -91,8 +91,9 @@ impl BroydenOptions {
     }
 }
 
-/// Statistics of a converged solve.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Statistics of a converged solve (`Default`: no work done, for orbits built
+/// from given coefficients).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct BroydenStats {
     /// Quasi-Newton steps taken.
     pub iterations: usize,

@@ -165,12 +165,7 @@ impl<F: Family> FamilyBranch<F> {
             omega_f,
             harmonics: self.hb.harmonics,
             subharmonic: self.hb.subharmonic,
-            stats: BroydenStats {
-                iterations: 0,
-                residual_evals: 0,
-                jacobian_refreshes: 0,
-                residual_norm: 0.0,
-            },
+            stats: BroydenStats::default(),
         };
         (problem, sol)
     }

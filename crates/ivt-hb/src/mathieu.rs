@@ -146,12 +146,7 @@ impl Controlled {
     fn solution(&self, y: &[f64], a_c: f64, harmonics: usize, period: usize) -> (HbSolution, f64) {
         let mut q = y.to_vec();
         q[self.c] = a_c;
-        let stats = BroydenStats {
-            iterations: 0,
-            residual_evals: 0,
-            jacobian_refreshes: 0,
-            residual_norm: 0.0,
-        };
+        let stats = BroydenStats::default();
         (
             HbSolution {
                 coeffs: q,
@@ -269,12 +264,7 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
                 coeffs: &[f64],
                 harmonics: usize,
                 period: usize| {
-        let stats = BroydenStats {
-            iterations: 0,
-            residual_evals: 0,
-            jacobian_refreshes: 0,
-            residual_norm: 0.0,
-        };
+        let stats = BroydenStats::default();
         let sol = HbSolution {
             coeffs: coeffs.to_vec(),
             omega_f: opts.omega,

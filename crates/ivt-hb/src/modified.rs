@@ -193,12 +193,7 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         q.copy_from_slice(&start);
         seed(ws, &self.h0);
         let mut q_ok = start;
-        let mut total = BroydenStats {
-            iterations: 0,
-            residual_evals: 0,
-            jacobian_refreshes: 0,
-            residual_norm: 0.0,
-        };
+        let mut total = BroydenStats::default();
         while s_done < 1.0 {
             let s = (s_done + ds).min(1.0);
             sys.s = s;

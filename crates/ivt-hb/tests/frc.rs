@@ -175,12 +175,7 @@ fn duffing_folds_located_to_shooting_accuracy_in_both_directions() {
             omega_f: fold.omega_f,
             harmonics: 20,
             subharmonic: 1,
-            stats: BroydenStats {
-                iterations: 0,
-                residual_evals: 0,
-                jacobian_refreshes: 0,
-                residual_norm: 0.0,
-            },
+            stats: BroydenStats::default(),
         };
         let mu = analyzer.hsu(&d, &sol, HsuRule::Magnus4).multipliers[0];
         assert!((mu.re - 1.0).abs() < 1e-6 && mu.im.abs() < 1e-9, "μ = {mu}");

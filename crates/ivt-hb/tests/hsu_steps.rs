@@ -25,12 +25,7 @@ fn errors<P: PeriodicProblem>(problem: &P, frc: &Frc, harmonics: usize) -> (f64,
             omega_f: p.omega_f,
             harmonics,
             subharmonic: 1,
-            stats: BroydenStats {
-                iterations: 0,
-                residual_evals: 0,
-                jacobian_refreshes: 0,
-                residual_norm: 0.0,
-            },
+            stats: BroydenStats::default(),
         };
         let want = reference.hsu(problem, &sol, HsuRule::Magnus4).multipliers;
         let err = p
