@@ -14,7 +14,9 @@ use ivt_design::shooting::{
 };
 use ivt_design::steady::{solve_steady_state, IhbOptions, Quadrature};
 use ivt_design::OperatingPoint;
-use ivt_hb::floquet::{eigenvalues, expm, monodromy_hsu, monodromy_uniform, HsuRule};
+use ivt_hb::floquet::{
+    eigenvalues, expm, expm_scratch_len, monodromy_hsu, monodromy_uniform, HsuRule,
+};
 use ivt_kin::plant::{GravityModel, PlantParams, PlantPreset};
 
 /// Fig. 42's two printed cases at (7 V, 2 N·m): gains in mm·rad⁻¹ and the
@@ -477,7 +479,7 @@ fn sampled_mu(samples: &[f64], per_rev: usize) -> f64 {
         m[i * dim + i] = 1.0;
     }
     let (mut step, mut e, mut prod) = (vec![0.0; d2], vec![0.0; d2], vec![0.0; d2]);
-    let mut scratch = vec![0.0; 2 * d2];
+    let mut scratch = vec![0.0; expm_scratch_len(dim)];
     for (s, mid) in samples.chunks_exact(d2).skip(1).step_by(2).enumerate() {
         for (i, (o, a)) in step.iter_mut().zip(mid).enumerate() {
             *o = if i / dim == dr { 0.0 } else { h * a };
@@ -536,7 +538,7 @@ fn sampled_law_averaged_orbit_or_eq158_r_is_not_the_cause() {
                 *m += v * PI / N_Q as f64;
             }
         }
-        let (mut e, mut scratch) = (vec![0.0; dim * dim], vec![0.0; 2 * dim * dim]);
+        let (mut e, mut scratch) = (vec![0.0; dim * dim], vec![0.0; expm_scratch_len(dim)]);
         expm(&mean, dim, &mut e, &mut scratch);
         max_without_structural(&e, dim)
     };

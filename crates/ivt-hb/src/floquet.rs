@@ -48,6 +48,10 @@ const EXPM_TAYLOR: [f64; 13] = {
 /// (five products of `dim×dim` matrices instead of twelve; the one-step
 /// exponential of every Hsu sub-interval). `scratch` needs
 /// [`expm_scratch_len`] entries; nothing is allocated.
+///
+/// # Panics
+/// If `scratch` is shorter than [`expm_scratch_len`]`(dim)` (for `dim > 2`)
+/// or `a`, `out` shorter than `dim²`.
 pub fn expm(a: &[f64], dim: usize, out: &mut [f64], scratch: &mut [f64]) {
     let d2 = dim * dim;
     if dim == 2 {
