@@ -42,6 +42,26 @@ const EXPM_TAYLOR: [f64; 13] = {
     c
 };
 
+/// Calls `$f::<N>(args)` with the compile-time size `N = $dim` for sizes
+/// 1–8 (the state sizes `2·n_dof` of systems up to 4 DOF: every loop over
+/// the size is then unrolled and free of bounds checks), `N = 0` (the size
+/// read at run time) beyond.
+macro_rules! by_size {
+    ($dim:expr, $f:ident($($arg:expr),* $(,)?)) => {
+        match $dim {
+            1 => $f::<1>($($arg),*),
+            2 => $f::<2>($($arg),*),
+            3 => $f::<3>($($arg),*),
+            4 => $f::<4>($($arg),*),
+            5 => $f::<5>($($arg),*),
+            6 => $f::<6>($($arg),*),
+            7 => $f::<7>($($arg),*),
+            8 => $f::<8>($($arg),*),
+            _ => $f::<0>($($arg),*),
+        }
+    };
+}
+
 /// `out = exp(a)` for a small dense row-major `dim×dim` matrix: scaling and
 /// squaring to `‖a/2^s‖₁ ≤ 1/4` and the degree-12 Taylor polynomial evaluated
 /// by Paterson–Stockmeyer, `p = B₀ + A⁴(B₁ + A⁴B₂)` with `Bᵢ` in `I, A, A², A³`
@@ -53,11 +73,19 @@ const EXPM_TAYLOR: [f64; 13] = {
 /// If `scratch` is shorter than [`expm_scratch_len`]`(dim)` (for `dim > 2`)
 /// or `a`, `out` shorter than `dim²`.
 pub fn expm(a: &[f64], dim: usize, out: &mut [f64], scratch: &mut [f64]) {
-    let d2 = dim * dim;
     if dim == 2 {
         expm2(a, out);
         return;
     }
+    by_size!(dim, expm_sized(a, dim, out, scratch));
+}
+
+/// [`expm`] (Taylor) with the size `N` known at compile time, or read from
+/// `dim` for `N = 0`.
+fn expm_sized<const N: usize>(a: &[f64], dim: usize, out: &mut [f64], scratch: &mut [f64]) {
+    let dim = if N == 0 { dim } else { N };
+    let d2 = dim * dim;
+    let (a, out) = (&a[..d2], &mut out[..d2]);
     let norm1 = (0..dim)
         .map(|j| (0..dim).map(|i| a[i * dim + j].abs()).sum::<f64>())
         .fold(0.0, f64::max);
@@ -71,9 +99,7 @@ pub fn expm(a: &[f64], dim: usize, out: &mut [f64], scratch: &mut [f64]) {
     let (a2, rest) = rest.split_at_mut(d2);
     let (a3, rest) = rest.split_at_mut(d2);
     let (a4, tmp) = rest.split_at_mut(d2);
-    a1.iter_mut()
-        .zip(&a[..d2])
-        .for_each(|(x, y)| *x = y * scale);
+    a1.iter_mut().zip(a).for_each(|(x, y)| *x = y * scale);
     matmul(a1, a1, dim, a2);
     matmul(a2, a1, dim, a3);
     matmul(a2, a2, dim, a4);
@@ -91,19 +117,16 @@ pub fn expm(a: &[f64], dim: usize, out: &mut [f64], scratch: &mut [f64]) {
         }
     };
     // out = B₂; tmp = A⁴ B₂ + B₁; out = A⁴ tmp + B₀.
-    block(2, &mut out[..d2]);
+    block(2, out);
     matmul(a4, out, dim, tmp);
-    block(1, &mut out[..d2]);
-    tmp.iter_mut().zip(&out[..d2]).for_each(|(t, b)| *t += b);
+    block(1, out);
+    tmp.iter_mut().zip(out.iter()).for_each(|(t, b)| *t += b);
     matmul(a4, tmp, dim, out);
     block(0, tmp);
-    out[..d2]
-        .iter_mut()
-        .zip(tmp.iter())
-        .for_each(|(o, b)| *o += b);
+    out.iter_mut().zip(tmp.iter()).for_each(|(o, b)| *o += b);
     for _ in 0..s {
         matmul(out, out, dim, tmp);
-        out[..d2].copy_from_slice(tmp);
+        out.copy_from_slice(tmp);
     }
 }
 
@@ -161,6 +184,24 @@ pub(crate) fn monodromy_strided(
     rule: HsuRule,
     q: &mut [f64],
 ) {
+    by_size!(
+        dim,
+        monodromy_sized(dim, theta, samples, stride, period, rule, q)
+    );
+}
+
+/// [`monodromy_strided`] with the size `N` known at compile time, or read
+/// from `dim` for `N = 0`.
+fn monodromy_sized<const N: usize>(
+    dim: usize,
+    theta: &[f64],
+    samples: usize,
+    stride: usize,
+    period: f64,
+    rule: HsuRule,
+    q: &mut [f64],
+) {
+    let dim = if N == 0 { dim } else { N };
     let d2 = dim * dim;
     let steps = samples / (2 * stride);
     debug_assert!(theta.len() >= samples * d2 && steps * 2 * stride == samples);
@@ -169,7 +210,8 @@ pub(crate) fn monodromy_strided(
     let mut step = vec![0.0; d2];
     let mut prod = vec![0.0; d2];
     let mut scratch = vec![0.0; expm_scratch_len(dim)];
-    q[..d2].fill(0.0);
+    let q = &mut q[..d2];
+    q.fill(0.0);
     for i in 0..dim {
         q[i * dim + i] = 1.0;
     }
@@ -200,10 +242,14 @@ pub(crate) fn monodromy_strided(
                 }
             }
         }
-        expm(&omega, dim, &mut step, &mut scratch);
+        if dim == 2 {
+            expm2(&omega, &mut step);
+        } else {
+            expm_sized::<N>(&omega, dim, &mut step, &mut scratch);
+        }
         // Later sub-intervals multiply from the left.
         matmul(&step, q, dim, &mut prod);
-        q[..d2].copy_from_slice(&prod);
+        q.copy_from_slice(&prod);
     }
 }
 
@@ -329,10 +375,11 @@ mod tests {
     }
 
     #[test]
-    fn expm_matches_nalgebra_pade_for_sizes_3_to_8() {
+    fn expm_matches_nalgebra_pade_for_sizes_3_to_8_and_10() {
         // nalgebra's exp (Padé with its own scaling) is an independent method.
         // Entries from a fixed LCG; norms 1e-4…20 cover no scaling (a Hsu step at
-        // high ω_f) to seven squarings (ω_f = 0.2 with few steps).
+        // high ω_f) to seven squarings (ω_f = 0.2 with few steps). Sizes 3–8 run
+        // the compile-time sizes of `by_size!`, 10 the size read at run time.
         let mut seed = 0x2545_f491_4f6c_dd1du64;
         let mut next = || {
             seed = seed
@@ -341,7 +388,7 @@ mod tests {
             (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
         };
         let mut worst = 0.0f64;
-        for dim in 3..=8 {
+        for dim in (3..=8).chain([10]) {
             for norm in [1e-4, 0.03, 0.2, 0.9, 4.0, 20.0] {
                 let mut a: Vec<f64> = (0..dim * dim).map(|_| next()).collect();
                 let n1 = (0..dim)
@@ -366,6 +413,33 @@ mod tests {
             }
         }
         eprintln!("expm vs nalgebra: worst relative error {worst:.1e}");
+    }
+
+    /// A constant Θ makes every Magnus-4 step exact: the monodromy over 2π is
+    /// `exp(2πΘ)` (nalgebra's Padé, independent), for the compile-time size 4
+    /// and the run-time size 10 of `by_size!`, by both step counts of a
+    /// Richardson pair.
+    #[test]
+    fn constant_theta_monodromy_is_the_exponential_for_every_size_path() {
+        for dim in [4, 10] {
+            let d2 = dim * dim;
+            let theta: Vec<f64> = (0..d2)
+                .map(|k| 0.3 * ((k * 37 % 11) as f64 / 11.0 - 0.5))
+                .collect();
+            let period = 2.0 * std::f64::consts::PI;
+            let want = (nalgebra::DMatrix::from_row_slice(dim, dim, &theta) * period).exp();
+            let samples: Vec<f64> = (0..64).flat_map(|_| theta.iter().copied()).collect();
+            for stride in [1, 2] {
+                let mut q = vec![0.0; d2];
+                monodromy_strided(dim, &samples, 64, stride, period, HsuRule::Magnus4, &mut q);
+                let scale = want.norm();
+                let err = (0..d2)
+                    .map(|k| (q[k] - want[(k / dim, k % dim)]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                assert!(err <= 1e-12 * scale, "dim {dim}, stride {stride}: {err:e}");
+            }
+        }
     }
 
     #[test]
