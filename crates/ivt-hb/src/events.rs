@@ -111,26 +111,47 @@ pub fn trace<F: Family>(
     let mut copts = opts.continuation.clone();
     copts.lambda_min = lambda0.min(opts.lambda_to);
     copts.lambda_max = lambda0.max(opts.lambda_to);
-    let path = branch.follow(&x0, 0, opts.lambda_to - lambda0, &copts, opts.corrector)?;
     let mut hsu = AdaptiveHsu::new(
         &branch.family().at(lambda0).0,
         branch.options().harmonics,
         opts.stability,
     )?;
-    let mut points = Vec::with_capacity(path.points.len());
+    let mut points = Vec::new();
+    let mut failed = None;
+    // Multipliers as each point is reached (see `frequency_response`: the
+    // Newton corrector's last assembly there gives Hsu its ∂g samples).
+    let path = branch.follow(
+        &x0,
+        0,
+        opts.lambda_to - lambda0,
+        &copts,
+        opts.corrector,
+        |branch, p| {
+            if failed.is_some() {
+                return;
+            }
+            let (q, lambda) = (&p.x[..m], p.lambda());
+            let (problem, sol) = branch.solution(q, lambda);
+            let known = branch.jacobian_samples_at(&p.x);
+            match hsu.floquet_with_samples(&problem, &sol, known) {
+                Ok(fl) => points.push(TracedPoint {
+                    q: q.to_vec(),
+                    lambda,
+                    multipliers: fl.floquet.multipliers,
+                    multiplier_error: fl.error,
+                    kind: fl.floquet.kind,
+                }),
+                Err(e) => failed = Some(e),
+            }
+        },
+    )?;
+    if let Some(e) = failed {
+        return Err(e.into());
+    }
     let mut bp_signs = Vec::with_capacity(path.points.len());
     let xs: Vec<&[f64]> = path.points.iter().map(|p| p.x.as_slice()).collect();
     for (k, x) in xs.iter().enumerate() {
         let (q, lambda) = (&x[..m], x[m]);
-        let (problem, sol) = branch.solution(q, lambda);
-        let fl = hsu.floquet(&problem, &sol)?;
-        points.push(TracedPoint {
-            q: q.to_vec(),
-            lambda,
-            multipliers: fl.floquet.multipliers,
-            multiplier_error: fl.error,
-            kind: fl.floquet.kind,
-        });
         // The exact corrector's tangent LU carries the sign; Broyden's path
         // has no factored bordered matrix, so it is assembled here.
         bp_signs.push(match path.points[k].bordered_sign {

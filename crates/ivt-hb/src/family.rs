@@ -8,9 +8,9 @@
 
 use crate::continuation::{
     correct_at_fixed_lambda, pseudo_arclength, pseudo_arclength_exact, ContinuationOptions,
-    Corrector, Path, PathSystem,
+    Corrector, Path, PathPoint, PathSystem,
 };
-use crate::fold::Branch;
+use crate::fold::{bilinear_lambda_difference, residual_lambda_difference, Branch};
 use crate::galerkin::{GalerkinForm, GalerkinJacobian};
 use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
@@ -70,6 +70,9 @@ pub struct FamilyBranch<F: Family> {
     /// reused by the forward difference in λ at the same point.
     last_at: Vec<f64>,
     last_r: Vec<f64>,
+    /// `(q, λ)` of the last Galerkin assembly, whose `∂g` samples
+    /// [`FamilyBranch::jacobian_samples_at`] hands out.
+    galerkin_at: Vec<f64>,
 }
 
 impl<F: Family> FamilyBranch<F> {
@@ -108,6 +111,7 @@ impl<F: Family> FamilyBranch<F> {
             rows: vec![0.0; m * m],
             last_at: Vec::with_capacity(m + 1),
             last_r: vec![0.0; m],
+            galerkin_at: Vec::with_capacity(m + 1),
         })
     }
 
@@ -127,6 +131,13 @@ impl<F: Family> FamilyBranch<F> {
     /// Newton–chord on the exact Galerkin Jacobian
     /// ([`pseudo_arclength_exact`]; `start_iterations` is the start's count).
     ///
+    /// `on_point(branch, point)` is called once for every point, in path
+    /// order. With Newton it is called as the point is reached, after its
+    /// tangent: the branch's last Galerkin assembly is then that point's, so
+    /// [`Self::jacobian_samples_at`] gives its `∂g` samples without another
+    /// evaluation of `g` (the path points' stability uses them). With Broyden
+    /// it is called after the path is traced.
+    ///
     /// # Errors
     /// As [`pseudo_arclength`] / [`pseudo_arclength_exact`].
     pub fn follow(
@@ -136,24 +147,59 @@ impl<F: Family> FamilyBranch<F> {
         direction: f64,
         opts: &ContinuationOptions,
         corrector: Corrector,
+        mut on_point: impl FnMut(&mut Self, &PathPoint),
     ) -> Result<Path, HbError> {
         let m = self.res.len();
         match corrector {
-            Corrector::Broyden => pseudo_arclength(
-                |x: &[f64], r: &mut [f64]| Branch::residual(self, &x[..m], x[m], r),
-                start,
-                None,
-                direction,
-                opts,
-                |_| true,
-            ),
+            Corrector::Broyden => {
+                let path = pseudo_arclength(
+                    |x: &[f64], r: &mut [f64]| Branch::residual(self, &x[..m], x[m], r),
+                    start,
+                    None,
+                    direction,
+                    opts,
+                    |_| true,
+                )?;
+                path.points.iter().for_each(|p| on_point(self, p));
+                Ok(path)
+            }
             Corrector::Newton => {
                 let mut x = start.to_vec();
                 let its = correct_at_fixed_lambda(self, &mut x, opts)?;
-                pseudo_arclength_exact(self, &x, start_iterations + its, direction, opts, |_, _| {
+                pseudo_arclength_exact(self, &x, start_iterations + its, direction, opts, |b, p| {
+                    on_point(b, p);
                     true
                 })
             }
+        }
+    }
+
+    /// `[∂g/∂x | ∂g/∂v]` at the 2N AFT samples of the orbit `x` (`q` then λ)
+    /// when the branch's last Galerkin assembly was at exactly `x` (layout of
+    /// [`PeriodicProblem::nonlinear_jacobian_samples`]); `None` otherwise.
+    pub fn jacobian_samples_at(&self, x: &[f64]) -> Option<&[f64]> {
+        (self.galerkin_at == x).then(|| self.galerkin.samples())
+    }
+
+    /// Whether λ moves only the linear part `L(ω)` of the residual: λ is ω_f
+    /// ([`Family::is_frequency`]) and `g` does not depend on the velocity.
+    fn only_linear_part_moves(&self) -> bool {
+        self.family.is_frequency() && !self.res.velocity_dependent()
+    }
+
+    /// `∂(L(λ/p) u)/∂λ` into `out`: for R = L(ω_f/p) q + G(q) − F with G
+    /// independent of ω_f, `∂R/∂λ` at `u = q` and `(∂J/∂λ) v` at `u = v`. L(ω)u
+    /// is quadratic in ω, so its central difference is exact (step ω_f/2: no
+    /// cancellation), and `g` is not evaluated.
+    fn linear_lambda_derivative(&mut self, u: &[f64], lambda: f64, out: &mut [f64]) {
+        let (problem, _) = self.family.at(lambda);
+        let p = self.res.subharmonic() as f64;
+        let h = 0.5 * lambda.abs().max(f64::MIN_POSITIVE.sqrt());
+        let minus = &mut self.lv;
+        self.res.apply_linear(&problem, u, (lambda - h) / p, minus);
+        self.res.apply_linear(&problem, u, (lambda + h) / p, out);
+        for (a, b) in out.iter_mut().zip(minus.iter()) {
+            *a = (*a - b) / (2.0 * h);
         }
     }
 
@@ -183,6 +229,9 @@ impl<F: Family> Branch for FamilyBranch<F> {
         let (problem, omega_f) = self.family.at(lambda);
         self.galerkin
             .assemble(&mut self.res, &problem, q, omega_f, 1.0, jac);
+        self.galerkin_at.clear();
+        self.galerkin_at.extend_from_slice(q);
+        self.galerkin_at.push(lambda);
     }
     /// `wᵀL v` exactly plus the sum of the nonlinear part over the AFT grid
     /// ([`GalerkinForm`]): no `J` is assembled.
@@ -199,6 +248,25 @@ impl<F: Family> Branch for FamilyBranch<F> {
         let (problem, omega_f) = self.family.at(lambda);
         self.form.value(&problem, q, omega_f, w, v, Some(out));
     }
+    /// Exact and without evaluating `g` where only `L` depends on λ
+    /// ([`Self::linear_lambda_derivative`]), else the central difference.
+    fn residual_lambda(&mut self, q: &[f64], lambda: f64, h: f64, out: &mut [f64]) {
+        if self.only_linear_part_moves() {
+            self.linear_lambda_derivative(q, lambda, out);
+        } else {
+            residual_lambda_difference(self, q, lambda, h, out);
+        }
+    }
+    /// `wᵀ (∂L/∂λ) v` where only `L` depends on λ, else the central difference.
+    fn bilinear_lambda(&mut self, q: &[f64], lambda: f64, h: f64, w: &[f64], v: &[f64]) -> f64 {
+        if self.only_linear_part_moves() {
+            let mut lv = vec![0.0; v.len()];
+            self.linear_lambda_derivative(v, lambda, &mut lv);
+            w.iter().zip(&lv).map(|(a, b)| a * b).sum()
+        } else {
+            bilinear_lambda_difference(self, q, lambda, h, w, v)
+        }
+    }
 }
 
 /// The branch as a [`PathSystem`]: the exact Galerkin Jacobian (Eq. 56) and
@@ -214,34 +282,26 @@ impl<F: Family> PathSystem for FamilyBranch<F> {
         Branch::residual(self, u, lambda, r);
     }
     fn residual_jacobian(&mut self, u: &[f64], lambda: f64, r: &mut [f64], jac: &mut Mat<f64>) {
-        let m = u.len();
         Branch::residual(self, u, lambda, r);
-        let mut rows = std::mem::take(&mut self.rows);
-        Branch::jacobian(self, u, lambda, &mut rows);
-        jac.as_mut()
-            .copy_from(MatRef::from_row_major_slice(&rows[..m * m], m, m));
-        self.rows = rows;
+        PathSystem::jacobian(self, u, lambda, jac);
         self.last_at.clear();
         self.last_at.extend_from_slice(u);
         self.last_at.push(lambda);
         self.last_r.copy_from_slice(r);
     }
+    /// The Galerkin Jacobian alone: it needs `∂g` at the samples, not `R`.
+    fn jacobian(&mut self, u: &[f64], lambda: f64, jac: &mut Mat<f64>) {
+        let m = u.len();
+        let mut rows = std::mem::take(&mut self.rows);
+        Branch::jacobian(self, u, lambda, &mut rows);
+        jac.as_mut()
+            .copy_from(MatRef::from_row_major_slice(&rows[..m * m], m, m));
+        self.rows = rows;
+    }
     fn d_residual_d_lambda(&mut self, u: &[f64], lambda: f64, r_lambda: &mut [f64]) {
         let m = u.len();
-        if self.family.is_frequency() && !self.res.velocity_dependent() {
-            // R = L(ω_f/p) q + G(q) − F with G independent of ω_f: only the
-            // linear part moves, and L(ω)q is quadratic in ω, so the central
-            // difference of it is exact (step ω_f/2: no cancellation).
-            let (problem, _) = self.family.at(lambda);
-            let p = self.res.subharmonic() as f64;
-            let h = 0.5 * lambda.abs().max(f64::MIN_POSITIVE.sqrt());
-            let minus = &mut self.lv;
-            self.res.apply_linear(&problem, u, (lambda - h) / p, minus);
-            self.res
-                .apply_linear(&problem, u, (lambda + h) / p, r_lambda);
-            for (a, b) in r_lambda.iter_mut().zip(minus.iter()) {
-                *a = (*a - b) / (2.0 * h);
-            }
+        if self.only_linear_part_moves() {
+            self.linear_lambda_derivative(u, lambda, r_lambda);
             return;
         }
         let same =
@@ -305,6 +365,19 @@ mod tests {
                 .zip(&fd)
                 .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
             assert!(err <= 1e-8 * scale, "p = {p}: {err:e} of {scale:e}");
+            // The fold system's λ entries take the same path: the residual's
+            // column, and ∂(wᵀJv)/∂λ against the difference of the whole form.
+            let mut column = vec![0.0; m];
+            Branch::residual_lambda(&mut branch, &q, 1.3, 1e-4, &mut column);
+            assert_eq!(column, exact);
+            let w: Vec<f64> = (0..m).map(|i| (0.7 * i as f64).sin()).collect();
+            let v: Vec<f64> = (0..m).map(|i| (0.3 * i as f64).cos()).collect();
+            let form = Branch::bilinear_lambda(&mut branch, &q, 1.3, 1e-4, &w, &v);
+            let fd = bilinear_lambda_difference(&mut branch, &q, 1.3, 1e-4, &w, &v);
+            assert!(
+                (form - fd).abs() <= 1e-8 * fd.abs(),
+                "p = {p}: {form} vs {fd}"
+            );
         }
     }
 

@@ -48,6 +48,46 @@ pub trait Branch {
     {
         fd_jacobian_gradient(self, q, lambda, w, v, 1e-6, out);
     }
+    /// `∂R/∂λ` at `(q, λ)` into `out` (`m`): the λ column of the fold system.
+    /// Default: [`residual_lambda_difference`] with step `h`.
+    fn residual_lambda(&mut self, q: &[f64], lambda: f64, h: f64, out: &mut [f64]) {
+        residual_lambda_difference(self, q, lambda, h, out);
+    }
+    /// `∂(wᵀ J v)/∂λ` at `(q, λ)`. Default: [`bilinear_lambda_difference`]
+    /// with step `h`.
+    fn bilinear_lambda(&mut self, q: &[f64], lambda: f64, h: f64, w: &[f64], v: &[f64]) -> f64 {
+        bilinear_lambda_difference(self, q, lambda, h, w, v)
+    }
+}
+
+/// `∂R/∂λ` by the central difference of [`Branch::residual`] with step `h`
+/// (O(h²)).
+pub fn residual_lambda_difference<B: Branch + ?Sized>(
+    branch: &mut B,
+    q: &[f64],
+    lambda: f64,
+    h: f64,
+    out: &mut [f64],
+) {
+    let mut minus = vec![0.0; out.len()];
+    branch.residual(q, lambda + h, out);
+    branch.residual(q, lambda - h, &mut minus);
+    for (o, b) in out.iter_mut().zip(&minus) {
+        *o = (*o - b) / (2.0 * h);
+    }
+}
+
+/// `∂(wᵀ J v)/∂λ` by the central difference of [`Branch::bilinear`] with
+/// step `h` (O(h²)).
+pub fn bilinear_lambda_difference<B: Branch + ?Sized>(
+    branch: &mut B,
+    q: &[f64],
+    lambda: f64,
+    h: f64,
+    w: &[f64],
+    v: &[f64],
+) -> f64 {
+    (branch.bilinear(q, lambda + h, w, v) - branch.bilinear(q, lambda - h, w, v)) / (2.0 * h)
 }
 
 /// `wᵀ A v` for a row-major square `A`.
@@ -254,8 +294,7 @@ pub fn locate_fold<B: Branch>(
     let mut q = q0.to_vec();
     let mut lambda = lambda0;
     let mut r = vec![0.0; m];
-    let mut rp = vec![0.0; m];
-    let mut rm = vec![0.0; m];
+    let mut r_lambda = vec![0.0; m];
     let (mut v, mut w, mut grad) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
     let mut newton = vec![0.0; n1 * n1];
     let mut newton_lu = LuWorkspace::new(n1);
@@ -283,14 +322,11 @@ pub fn locate_fold<B: Branch>(
         }
         let q_scale = q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let h_lambda = opts.fd_step * lambda.abs().max(f64::MIN_POSITIVE);
-        branch.residual(&q, lambda + h_lambda, &mut rp);
-        branch.residual(&q, lambda - h_lambda, &mut rm);
+        branch.residual_lambda(&q, lambda, h_lambda, &mut r_lambda);
         for i in 0..m {
-            newton[i * n1 + m] = (rp[i] - rm[i]) / (2.0 * h_lambda);
+            newton[i * n1 + m] = r_lambda[i];
         }
-        let bp = branch.bilinear(&q, lambda + h_lambda, &w, &v);
-        let bm = branch.bilinear(&q, lambda - h_lambda, &w, &v);
-        newton[m * n1 + m] = -(bp - bm) / (2.0 * h_lambda);
+        newton[m * n1 + m] = -branch.bilinear_lambda(&q, lambda, h_lambda, &w, &v);
         branch.jacobian_gradient(&q, lambda, &w, &v, &mut grad);
         for k in 0..m {
             newton[m * n1 + k] = -grad[k];

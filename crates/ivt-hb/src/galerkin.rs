@@ -119,6 +119,13 @@ impl CosSinSums {
 }
 
 impl GalerkinJacobian {
+    /// `[∂g/∂x | ∂g/∂v]` at the 2N samples of the last [`Self::assemble`]
+    /// (`2N·2n_dof²`, the layout of
+    /// [`PeriodicProblem::nonlinear_jacobian_samples`]).
+    pub(crate) fn samples(&self) -> &[f64] {
+        &self.dg
+    }
+
     /// Scratch for `res`'s size and `n_dof` of the problem it evaluates.
     pub fn new(res: &HbResidual) -> Self {
         let (nd, n, ns) = (res.n_dof(), res.harmonics(), res.n_samples());

@@ -142,21 +142,40 @@ impl StabilityAnalyzer {
 
     /// Θ(τ_j) on the grid τ_j = 2πj/(2·steps), row-major `2n_dof×2n_dof` each.
     pub fn theta_samples<P: PeriodicProblem>(&mut self, problem: &P, sol: &HbSolution) -> &[f64] {
+        self.theta_samples_with(problem, sol, None)
+    }
+
+    /// [`Self::theta_samples`] from `∂g` samples the caller already has:
+    /// `known` holds `[∂g/∂x | ∂g/∂v]` of `sol` at the same `2·steps` grid
+    /// points (layout of [`PeriodicProblem::nonlinear_jacobian_samples`]), as
+    /// the Galerkin Jacobian of an orbit with `N = steps` has them; `None` (or
+    /// a slice of another length) evaluates them.
+    fn theta_samples_with<P: PeriodicProblem>(
+        &mut self,
+        problem: &P,
+        sol: &HbSolution,
+        known: Option<&[f64]>,
+    ) -> &[f64] {
         let nd = self.nd;
         let dim = 2 * nd;
         let d2 = dim * dim;
         let ns = 2 * self.steps;
         let omega = sol.omega();
-        let p = sol.subharmonic as f64;
-        let q = &sol.coeffs;
-        self.aft
-            .synthesize_states(q, nd, 0, 1.0, &mut self.xs, &mut self.column);
-        self.aft
-            .synthesize_states(q, nd, 1, omega, &mut self.vs, &mut self.column);
-        for (j, phase) in self.phases.iter_mut().enumerate() {
-            *phase = p * self.aft.tau(j);
+        match known {
+            Some(dg) if dg.len() == self.dg.len() => self.dg.copy_from_slice(dg),
+            _ => {
+                let p = sol.subharmonic as f64;
+                let q = &sol.coeffs;
+                self.aft
+                    .synthesize_states(q, nd, 0, 1.0, &mut self.xs, &mut self.column);
+                self.aft
+                    .synthesize_states(q, nd, 1, omega, &mut self.vs, &mut self.column);
+                for (j, phase) in self.phases.iter_mut().enumerate() {
+                    *phase = p * self.aft.tau(j);
+                }
+                problem.nonlinear_jacobian_samples(&self.xs, &self.vs, &self.phases, &mut self.dg);
+            }
         }
-        problem.nonlinear_jacobian_samples(&self.xs, &self.vs, &self.phases, &mut self.dg);
         let (c, k) = (problem.damping(), problem.stiffness());
         let n2 = nd * nd;
         for j in 0..ns {
@@ -186,7 +205,19 @@ impl StabilityAnalyzer {
         sol: &HbSolution,
         rule: HsuRule,
     ) -> Floquet {
-        self.theta_samples(problem, sol);
+        self.hsu_with(problem, sol, rule, None)
+    }
+
+    /// [`Self::hsu`] with `∂g` samples the caller has (see
+    /// [`Self::theta_samples_with`]).
+    fn hsu_with<P: PeriodicProblem>(
+        &mut self,
+        problem: &P,
+        sol: &HbSolution,
+        rule: HsuRule,
+        known: Option<&[f64]>,
+    ) -> Floquet {
+        self.theta_samples_with(problem, sol, known);
         let dim = 2 * self.nd;
         monodromy_uniform(
             dim,
@@ -334,10 +365,31 @@ impl AdaptiveHsu {
         problem: &P,
         sol: &HbSolution,
     ) -> Result<HsuEstimate, HbError> {
+        self.floquet_with_samples(problem, sol, None)
+    }
+
+    /// [`Self::floquet`] with `∂g` samples of `sol` the caller already has:
+    /// `known` holds `[∂g/∂x | ∂g/∂v]` on the uniform grid of `M` points
+    /// (`M = known.len()/(2n_dof²)`, layout of
+    /// [`PeriodicProblem::nonlinear_jacobian_samples`]), e.g. the AFT samples
+    /// of a Galerkin assembly at `sol` ([`crate::FamilyBranch::jacobian_samples_at`]).
+    /// The level with `2·steps = M` uses them instead of calling `g`; the
+    /// other levels evaluate their own. An AFT of `N = max(2(n + 1), 32)` (2N
+    /// samples) matches the first level of [`HsuSteps::Tolerance`], so an
+    /// orbit that needs no finer level costs no `g` evaluation.
+    ///
+    /// # Errors
+    /// As [`Self::floquet`].
+    pub fn floquet_with_samples<P: PeriodicProblem>(
+        &mut self,
+        problem: &P,
+        sol: &HbSolution,
+        known: Option<&[f64]>,
+    ) -> Result<HsuEstimate, HbError> {
         let HsuSteps::Tolerance { tol, .. } = self.control else {
             let an = &mut self.levels[0];
             return Ok(HsuEstimate {
-                floquet: an.hsu(problem, sol, HsuRule::Magnus4),
+                floquet: an.hsu_with(problem, sol, HsuRule::Magnus4, known),
                 steps: self.base,
                 error: None,
             });
@@ -354,7 +406,7 @@ impl AdaptiveHsu {
                     .push(StabilityAnalyzer::new(problem, self.harmonics, steps)?);
             }
             let an = &mut self.levels[level];
-            an.theta_samples(problem, sol);
+            an.theta_samples_with(problem, sol, known);
             monodromy_uniform(
                 dim,
                 &an.theta,

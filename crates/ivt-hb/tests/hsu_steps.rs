@@ -7,9 +7,12 @@
 mod common;
 
 use common::chain::cubic_chain;
+use common::counted::Counted;
+use faer::Mat;
 use ivt_hb::{
-    frequency_response, AdaptiveHsu, BroydenStats, Corrector, Duffing, Frc, FrcOptions, HbError,
-    HbOptions, HbSolution, HsuRule, HsuSteps, PeriodicProblem, StabilityAnalyzer,
+    frequency_response, AdaptiveHsu, BroydenStats, Corrector, Duffing, FamilyBranch, Frc,
+    FrcOptions, Frequency, HbError, HbOptions, HbSolution, HsuRule, HsuSteps, ModifiedIhb,
+    PathSystem, PeriodicProblem, StabilityAnalyzer,
 };
 
 /// Worst multiplier error over the curve against 8192 steps, and the steps
@@ -103,4 +106,49 @@ fn tolerance_and_cap_are_checked() {
     }
     // A fixed count must exceed the harmonics, as for StabilityAnalyzer.
     assert!(AdaptiveHsu::new(&duffing, 20, HsuSteps::Fixed(20)).is_err());
+}
+
+/// The `∂g` samples of a Galerkin assembly at an orbit serve Hsu's level of
+/// the same grid (2N = 84 AFT samples, the first level's 2·42 = 2·2(n + 1)):
+/// the multipliers equal those evaluated afresh (to 1e-12) with one `∂g`
+/// evaluation fewer, and samples of another grid are not used.
+#[test]
+fn galerkin_jacobian_samples_serve_hsu_on_the_same_grid() {
+    let omega = 0.8; // off resonance: the first level meets 1e-6
+    for (n_half, reused) in [(42, true), (64, false)] {
+        let chain = Counted::chain();
+        let hb = HbOptions::new(20, n_half);
+        let sol = ModifiedIhb::new(&chain, hb.clone())
+            .unwrap()
+            .solve(omega, None)
+            .unwrap();
+        let mut branch = FamilyBranch::new(Frequency(&chain), &hb, omega).unwrap();
+        let m = sol.coeffs.len();
+        let mut x = sol.coeffs.clone();
+        x.push(omega);
+        let mut jac = Mat::zeros(m, m);
+        PathSystem::jacobian(&mut branch, &x[..m], omega, &mut jac);
+        let mut elsewhere = x.clone();
+        elsewhere[0] += 1e-9;
+        assert!(branch.jacobian_samples_at(&elsewhere).is_none());
+        let known = branch.jacobian_samples_at(&x).expect("assembled at x");
+
+        let mut hsu = AdaptiveHsu::new(&chain, 20, HsuSteps::default()).unwrap();
+        let calls = chain.jacobian_calls.get();
+        let with = hsu.floquet_with_samples(&chain, &sol, Some(known)).unwrap();
+        let spent = chain.jacobian_calls.get() - calls;
+        assert_eq!(with.steps, 42, "N = {n_half}");
+        assert_eq!(spent, usize::from(!reused), "N = {n_half}: ∂g evaluations");
+
+        let mut fresh = AdaptiveHsu::new(&chain, 20, HsuSteps::default()).unwrap();
+        let without = fresh.floquet(&chain, &sol).unwrap();
+        for (a, b) in with
+            .floquet
+            .multipliers
+            .iter()
+            .zip(&without.floquet.multipliers)
+        {
+            assert!((a - b).norm() <= 1e-12, "N = {n_half}: {a} vs {b}");
+        }
+    }
 }

@@ -18,10 +18,10 @@ use pyo3::types::{PyDict, PyList};
 use crate::hb::{finite, frc_dict, pairs, run_user, user_system_fn, UserArgs};
 
 /// The FRC of `problem` from `from` to `to`, followed with the Newton–chord
-/// corrector (one Galerkin Jacobian and a few residuals per point: the user's
-/// `g` is called about half as often as by Broyden's many iterations). With
-/// `events`, the start is
-/// solved by the modified IHB and the branch traced in ω_f by
+/// corrector and `FrcOptions::default()`'s second-order predictor (one
+/// Galerkin Jacobian and ~3 residuals per point: the user's `g` is called
+/// about a sixth as often as by Broyden's many iterations). With `events`,
+/// the start is solved by the modified IHB and the branch traced in ω_f by
 /// [`ivt_hb::trace`], every event located (the trace's events are returned);
 /// without, [`ivt_hb::frequency_response`] traces it and locates the folds
 /// only (no branch-point test per point).

@@ -58,7 +58,7 @@ def test_chain_frc_folds_equal_and_g_is_called_less(events: bool) -> None:
     extended systems are solved to ~1e-10; ∂g differs by ~1e-10 relative). With
     `jac` no Jacobian assembly differences `g` (one call on the 2·n_dof = 4
     stacked perturbed copies of a grid each), so `g` runs on the residual's
-    2N = 128 samples only. Measured calls of `g` per point: 11.2 → 8.4 with
+    2N = 128 samples only. Measured calls of `g` per point: 5.9 → 3.4 with
     events=True and with events=False; the rest are the continuation's residual
     evaluations, which `jac` does not replace (asserted: fewer, and none off
     the residual grid)."""

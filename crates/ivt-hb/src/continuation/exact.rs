@@ -6,7 +6,11 @@
 //! Each point's tangent solves `[J R_λ; t_prevᵀ] t = e_{m+1}` (oriented along the
 //! previous one); the predictor is `u + s t`; the corrector solves
 //! `[R(u); tᵀ(u − u_pred)] = 0`, first as a chord iteration on the tangent's LU
-//! (no new factorization), falling back to full Newton. A step about to leave
+//! (no new factorization), falling back to full Newton. With
+//! [`ContinuationOptions::second_order_predictor`] the predictor adds the
+//! curvature of the last two tangents, the chord's matrix is assembled and
+//! factored at the prediction, and that LU (bordered by the tangent) gives the
+//! next point's tangent. A step about to leave
 //! `[lambda_min, lambda_max]` is corrected on `λ = bound` instead, so the path
 //! ends exactly on the bound. A sign change of the tangent's λ component marks
 //! a fold.
@@ -27,6 +31,14 @@ pub trait PathSystem {
     fn residual(&mut self, u: &[f64], lambda: f64, r: &mut [f64]);
     /// `R(u, λ)` into `r` and `∂R/∂u` into `jac` (`m × m`, overwritten).
     fn residual_jacobian(&mut self, u: &[f64], lambda: f64, r: &mut [f64], jac: &mut Mat<f64>);
+    /// `∂R/∂u` alone into `jac`: all the tangent needs. The default calls
+    /// [`Self::residual_jacobian`] into scratch; a system whose Jacobian does
+    /// not need `R` (the Galerkin Jacobian needs only `∂g`) saves a residual
+    /// evaluation per path point by overriding it.
+    fn jacobian(&mut self, u: &[f64], lambda: f64, jac: &mut Mat<f64>) {
+        let mut r = vec![0.0; self.dim()];
+        self.residual_jacobian(u, lambda, &mut r, jac);
+    }
     /// `∂R/∂λ` at `(u, λ)` into `r_lambda`.
     fn d_residual_d_lambda(&mut self, u: &[f64], lambda: f64, r_lambda: &mut [f64]);
 }
@@ -47,8 +59,9 @@ const NEWTON_WEIGHT: usize = 2;
 /// halves it. `PathPoint::dlambda` is the λ component of the unit tangent.
 ///
 /// `on_point` is called once the point's tangent is computed, so the last
-/// Jacobian `system` assembled is the one at that point; it returns `false`
-/// to stop.
+/// Jacobian `system` assembled is the one the tangent used: the point's own,
+/// or, with [`ContinuationOptions::second_order_predictor`] after a chord
+/// correction, the predictor's. It returns `false` to stop.
 ///
 /// # Errors
 /// [`HbError::InvalidInput`] for bad sizes or non-finite inputs,
@@ -84,8 +97,20 @@ where
     let mut iterations = start_iterations;
     let mut landed = false;
     let mut u_pred = vec![0.0; m + 1];
+    // `aug` holds the predictor's LU of the chord that reached `x`, bordered
+    // by the tangent: the next tangent comes from it.
+    let mut factored_near_x = false;
+    // The previous point's tangent, and the curvature vector of the second-order predictor.
+    let mut prev_tangent = vec![0.0; m + 1];
+    let mut curvature = vec![0.0; m + 1];
     let termination = loop {
-        if !corrector.tangent(system, &x, &mut tangent) {
+        prev_tangent.copy_from_slice(&tangent);
+        let tangent_found = if factored_near_x {
+            corrector.solve_tangent(&mut tangent)
+        } else {
+            corrector.tangent(system, &x, &mut tangent)
+        };
+        if !tangent_found {
             if points.is_empty() {
                 return Err(HbError::SingularStart { lambda: start[m] });
             }
@@ -121,9 +146,25 @@ where
         }
         // Predictor–corrector with step halving.
         let mut chord_ok = true;
+        // The curvature term is dropped where it would move the prediction by
+        // more than a quarter of the step (a turn sharper than the step).
+        let curved = opts.second_order_predictor
+            && k >= 1
+            && curvature_between(
+                &points[k - 1].x,
+                &x,
+                &prev_tangent,
+                &tangent,
+                &mut curvature,
+            );
         let err = loop {
             for (p, (xi, ti)) in u_pred.iter_mut().zip(x.iter().zip(&tangent)) {
                 *p = xi + step * ti;
+            }
+            if curved && 0.5 * step * norm2(&curvature) <= 0.25 {
+                for (p, c) in u_pred.iter_mut().zip(&curvature) {
+                    *p += 0.5 * step * step * c;
+                }
             }
             let clip = if tangent[m] > 0.0 && u_pred[m] > opts.lambda_max {
                 Some(opts.lambda_max)
@@ -138,8 +179,13 @@ where
                 fix: clip,
             };
             corrector.start(&pred);
+            // A fresh LU at the predictor (its residual is the chord's first).
+            let fresh = chord_ok && opts.second_order_predictor;
+            if fresh && !corrector.factor_at_start(system, &pred) {
+                chord_ok = false;
+            }
             let chord = if chord_ok {
-                corrector.chord(system, &pred)
+                corrector.chord(system, &pred, fresh)
             } else {
                 Err(SolveError::NonConvergence {
                     iterations: 0,
@@ -159,6 +205,9 @@ where
             match attempt {
                 Ok(weighted) => {
                     landed = clip.is_some();
+                    // Not after landing: bordered by e_{m+1}, the LU's
+                    // determinant is det J, not the branch-point test's.
+                    factored_near_x = fresh && chord_ok && !landed;
                     x.copy_from_slice(&corrector.u);
                     iterations = if chord_ok {
                         weighted
@@ -189,6 +238,25 @@ where
         folds,
         termination,
     })
+}
+
+/// The curvature vector `(t₁ − t₀)/‖x₁ − x₀‖` of the path between two
+/// consecutive points and their unit tangents into `out`; `false` for
+/// coincident points.
+fn curvature_between(x0: &[f64], x1: &[f64], t0: &[f64], t1: &[f64], out: &mut [f64]) -> bool {
+    let ds = x0
+        .iter()
+        .zip(x1)
+        .map(|(a, b)| (b - a) * (b - a))
+        .sum::<f64>()
+        .sqrt();
+    if !(ds > 0.0 && ds.is_finite()) {
+        return false;
+    }
+    for ((o, a), b) in out.iter_mut().zip(t0).zip(t1) {
+        *o = (b - a) / ds;
+    }
+    true
 }
 
 /// Buffers of the tangent and the correctors; `aug` holds the LU of the last
@@ -252,12 +320,27 @@ impl Corrector {
         // After Newton converged, `jac` is already the Jacobian at `x`.
         let reuse = self.jac_at_u && self.u == x;
         if !reuse {
-            self.assemble(system, x);
+            system.jacobian(&x[..m], x[m], &mut self.jac);
         }
         self.jac_at_u = false;
-        if !self.factor(system, x, tangent) {
-            return false;
-        }
+        self.factor(system, x, tangent) && self.solve_tangent(tangent)
+    }
+
+    /// `[R(u); ·]` and the LU of `[J R_λ; rowᵀ]` at the corrector's start
+    /// (the predictor), `row` the constraint's gradient: the chord's matrix
+    /// of [`ContinuationOptions::second_order_predictor`]. `false` if singular.
+    fn factor_at_start<S: PathSystem>(&mut self, system: &mut S, pred: &Prediction) -> bool {
+        let u = std::mem::take(&mut self.u);
+        self.assemble(system, &u);
+        let factored = self.factor(system, &u, &pred.row());
+        self.u = u;
+        factored
+    }
+
+    /// The unit solution of `aug · z = e_{m+1}` (the tangent of the factored
+    /// bordered matrix), oriented along the previous `tangent`, into it.
+    fn solve_tangent(&mut self, tangent: &mut [f64]) -> bool {
+        let m = self.jac.nrows();
         let z = &mut self.rhs;
         z.fill(0.0);
         z[m] = 1.0;
@@ -291,12 +374,17 @@ impl Corrector {
         &mut self,
         sys: &mut S,
         pred: &Prediction,
+        start_residual_known: bool,
     ) -> Result<usize, SolveError> {
         let (m, mut history) = (self.jac.nrows(), Vec::new());
         let mut steps: Vec<Vec<f64>> = Vec::new();
         let mut best = (f64::INFINITY, self.u.clone());
         for it in 0..=3 * self.max_newton {
-            sys.residual(&self.u[..m], self.u[m], &mut self.rhs[..m]);
+            if it == 0 && start_residual_known {
+                self.rhs[..m].copy_from_slice(&self.r);
+            } else {
+                sys.residual(&self.u[..m], self.u[m], &mut self.rhs[..m]);
+            }
             self.rhs[m] = pred.constraint(&self.u);
             if let Some(done) = settle(&mut history, norm2(&self.rhs), self.tol) {
                 return done;
@@ -342,11 +430,7 @@ impl Corrector {
         pred: &Prediction,
     ) -> Result<usize, SolveError> {
         let m = self.jac.nrows();
-        let mut row = pred.tangent.to_vec();
-        if pred.fix.is_some() {
-            row.fill(0.0);
-            row[m] = 1.0;
-        }
+        let row = pred.row();
         let mut history = Vec::new();
         for it in 0..=self.max_newton {
             let u = std::mem::take(&mut self.u);
@@ -392,6 +476,18 @@ struct Prediction<'a> {
 }
 
 impl Prediction<'_> {
+    /// The constraint's gradient: the tangent, or `e_{m+1}` on `λ = fix`.
+    fn row(&self) -> Vec<f64> {
+        match self.fix {
+            Some(_) => {
+                let mut row = vec![0.0; self.tangent.len()];
+                row[self.tangent.len() - 1] = 1.0;
+                row
+            }
+            None => self.tangent.to_vec(),
+        }
+    }
+
     /// The constraint `tᵀ(u − u_pred)`, or `λ − λ_fix`.
     fn constraint(&self, u: &[f64]) -> f64 {
         match self.fix {

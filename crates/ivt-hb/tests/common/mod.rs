@@ -1,8 +1,10 @@
 //! Helpers shared by the integration tests: the independent RK4 check of an HB
-//! orbit, the one-line modified-IHB solve and the 2-DOF cubic chain.
+//! orbit, the one-line modified-IHB solve and the 2-DOF cubic chain (also with
+//! call counters).
 #![allow(dead_code)] // each test binary uses its own subset
 
 pub mod chain;
+pub mod counted;
 
 use ivt_hb::aft::eval_series;
 use ivt_hb::ode::{first_order, rk4};
