@@ -46,8 +46,8 @@ pub struct ContinuationOptions {
     /// `κ = (t − t_prev)/‖x − x_prev‖`, and assemble and factor the chord
     /// corrector's Jacobian at that prediction instead of at the previous
     /// point. From a distance of O(Δη³) the chord then converges in about two
-    /// iterations (on the 2-DOF chain of `tests/corrector.rs`: one assembly
-    /// and ~3 residuals per point instead of ~7), and its LU, bordered by the
+    /// iterations (on the 2-DOF chain of `tests/corrector.rs`: 3.5 calls of
+    /// `g` per point instead of 7.2, measured; < 0.6× asserted), and its LU, bordered by the
     /// tangent, gives the next tangent. The price: the last Jacobian assembled
     /// when `on_point` runs is the prediction's, not the point's.
     pub second_order_predictor: bool,

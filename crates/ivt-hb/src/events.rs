@@ -118,8 +118,8 @@ pub fn trace<F: Family>(
     )?;
     let mut points = Vec::new();
     let mut failed = None;
-    // Multipliers as each point is reached (see `frequency_response`: the
-    // Newton corrector's last assembly there gives Hsu its ∂g samples).
+    // Multipliers as each point is reached (see `frequency_response`: where
+    // the last Galerkin assembly is the point's, Hsu takes its ∂g samples).
     let path = branch.follow(
         &x0,
         0,

@@ -133,10 +133,12 @@ impl<F: Family> FamilyBranch<F> {
     ///
     /// `on_point(branch, point)` is called once for every point, in path
     /// order. With Newton it is called as the point is reached, after its
-    /// tangent: the branch's last Galerkin assembly is then that point's, so
-    /// [`Self::jacobian_samples_at`] gives its `∂g` samples without another
-    /// evaluation of `g` (the path points' stability uses them). With Broyden
-    /// it is called after the path is traced.
+    /// tangent: where the branch's last Galerkin assembly is that point's (a
+    /// point Newton corrected, or every point without
+    /// [`ContinuationOptions::second_order_predictor`], whose chord assembles
+    /// at the prediction), [`Self::jacobian_samples_at`] gives its `∂g`
+    /// samples without another evaluation of `g` (the path points' stability
+    /// uses them). With Broyden it is called after the path is traced.
     ///
     /// # Errors
     /// As [`pseudo_arclength`] / [`pseudo_arclength_exact`].

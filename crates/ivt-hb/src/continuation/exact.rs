@@ -18,6 +18,7 @@
 use faer::Mat;
 use ivt_num::vector::{dot, norm2};
 use ivt_num::LuWorkspace;
+use std::borrow::Cow;
 
 use super::{non_finite_start, turn, ContinuationOptions, Fold, Path, PathPoint};
 use super::{SolveError, Termination};
@@ -157,11 +158,12 @@ where
                 &tangent,
                 &mut curvature,
             );
+        let kappa = norm2(&curvature);
         let err = loop {
             for (p, (xi, ti)) in u_pred.iter_mut().zip(x.iter().zip(&tangent)) {
                 *p = xi + step * ti;
             }
-            if curved && 0.5 * step * norm2(&curvature) <= 0.25 {
+            if curved && 0.5 * step * kappa <= 0.25 {
                 for (p, c) in u_pred.iter_mut().zip(&curvature) {
                     *p += 0.5 * step * step * c;
                 }
@@ -476,15 +478,16 @@ struct Prediction<'a> {
 }
 
 impl Prediction<'_> {
-    /// The constraint's gradient: the tangent, or `e_{m+1}` on `λ = fix`.
-    fn row(&self) -> Vec<f64> {
+    /// The constraint's gradient: the tangent (borrowed, no copy per point),
+    /// or `e_{m+1}` on `λ = fix`.
+    fn row(&self) -> Cow<'_, [f64]> {
         match self.fix {
             Some(_) => {
                 let mut row = vec![0.0; self.tangent.len()];
                 row[self.tangent.len() - 1] = 1.0;
-                row
+                Cow::Owned(row)
             }
-            None => self.tangent.to_vec(),
+            None => Cow::Borrowed(self.tangent),
         }
     }
 
