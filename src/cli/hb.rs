@@ -376,5 +376,5 @@ fn draw(
         y_label,
         series,
     };
-    ivt_plot::line_plot(path, &figure).map_err(|e| CliError::Failed(e.to_string()))
+    super::write_figure(path, |tmp| ivt_plot::line_plot(tmp, &figure))
 }

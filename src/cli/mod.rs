@@ -7,6 +7,8 @@
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
 
 pub mod bench;
 pub mod ctrl;
@@ -117,14 +119,33 @@ enum Command {
     Reproduce(reproduce::ReproduceArgs),
 }
 
-/// Write `bytes` to `path` atomically: into a temporary file in the same
-/// directory, renamed over `path` once complete, so that a failure (full disk,
-/// interruption) never leaves a partial file behind.
+/// Write `bytes` to `path` through the one output writer
+/// ([`ivt_sim::atomic`]): into a fresh temporary file beside it, renamed over
+/// `path` once complete, so that a failure (full disk, interruption) never
+/// leaves a partial file behind; a `path` that is a symlink, a directory or a
+/// device is refused.
 ///
 /// # Errors
 /// [`CliError::Io`] naming the path.
 pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<(), CliError> {
     ivt_sim::atomic::write_atomic(path, bytes).map_err(|e| CliError::io(path, e))
+}
+
+/// Draw a figure into `path` through the one output writer: `draw` renders
+/// into the staged temporary PNG, which replaces `path` only when complete.
+///
+/// # Errors
+/// [`CliError::Io`] for the file, [`CliError::Failed`] for the drawing, both
+/// naming `path`.
+pub fn write_figure(
+    path: &std::path::Path,
+    draw: impl FnOnce(&std::path::Path) -> Result<(), ivt_plot::PlotError>,
+) -> Result<(), CliError> {
+    let mut staged = ivt_sim::atomic::Staged::new();
+    let tmp = staged.path(path).map_err(|e| CliError::io(path, e))?;
+    draw(&tmp).map_err(|e| CliError::Failed(e.for_path(path).to_string()))?;
+    staged.commit().map_err(|e| CliError::io(path, e))?;
+    Ok(())
 }
 
 /// Exit status of every failure (argument, input, numerical, I/O).
@@ -136,12 +157,19 @@ const EXIT_FAILURE: u8 = 2;
 /// argument-parse errors included. A closed stdout (EPIPE) ends quietly with
 /// status 2; any other write error (ENOSPC, ...) is reported on stderr.
 pub fn main() -> ExitCode {
+    // Looked up in the raw arguments: the interrupt handler and a parse
+    // failure need it before (or without) a parsed command line.
+    let json = std::env::args_os()
+        .take_while(|a| a != "--")
+        .any(|a| a == "--json");
+    JSON.store(json, Ordering::SeqCst);
     install_interrupt_handler();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
-        Err(e) => return parse_failure(&e),
+        Err(e) => return parse_failure(&e, json),
     };
     let json = cli.json;
+    JSON.store(json, Ordering::SeqCst);
     let result = match cli.command {
         Some(Command::Kin(cmd)) => kin::run(cmd),
         Some(Command::Sim(args)) => sim::run_file(&args, json),
@@ -165,31 +193,62 @@ pub fn main() -> ExitCode {
 /// Exit status after SIGINT/SIGTERM (128 + SIGINT, the shell's convention).
 const EXIT_INTERRUPTED: i32 = 130;
 
-/// On SIGINT/SIGTERM, delete every staged (incomplete) output file and exit
-/// 130, or — while the rig recorder is running — let it stop reading and
-/// close its MCAP with a valid footer ([`ivt_sim::atomic::on_interrupt`]).
+/// `--json` is on the command line.
+static JSON: AtomicBool = AtomicBool::new(false);
+/// Stdout, and whether the command's one object (or error) was printed on
+/// it: the interrupt handler and the command never both print.
+static STDOUT_DONE: Mutex<bool> = Mutex::new(false);
+
+/// On SIGINT/SIGTERM, delete every staged (incomplete) output file and every
+/// directory the run created, print the one `{"error", "kind":
+/// "interrupted"}` object under `--json`, and exit 130 — or, while the rig
+/// recorder is running, let it stop reading and close its MCAP with a valid
+/// footer ([`ivt_sim::atomic::on_interrupt`]).
 fn install_interrupt_handler() {
     let installed = ctrlc::set_handler(|| {
-        if !ivt_sim::atomic::on_interrupt() {
-            std::process::exit(EXIT_INTERRUPTED);
+        if ivt_sim::atomic::on_interrupt() {
+            return;
         }
+        let message = "interrupted (SIGINT/SIGTERM); the outputs of this run were removed";
+        let mut done = STDOUT_DONE
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if !*done && JSON.load(Ordering::SeqCst) {
+            let object = serde_json::json!({ "error": message, "kind": "interrupted" });
+            let _ = write_stdout(&format!("{object}\n"));
+        }
+        *done = true;
+        note(&format!("error: {message}"));
+        // exits with the lock held: nothing else reaches stdout
+        std::process::exit(EXIT_INTERRUPTED);
     });
     if let Err(e) = installed {
         note(&format!("warning: no interrupt handler: {e}"));
     }
 }
 
-/// `--help`/`--version` print and succeed; every other parse error is a
-/// `usage` error (JSON object under `--json`, which is looked up in the raw
-/// arguments because parsing failed).
-fn parse_failure(e: &clap::Error) -> ExitCode {
+/// `--help`/`--version` (and `help`) print and succeed — under `--json` as
+/// one object, `{"help": text}` or `{"name", "version"}`; every other parse
+/// error is a `usage` error (a JSON object under `--json`).
+fn parse_failure(e: &clap::Error, json: bool) -> ExitCode {
     use clap::error::ErrorKind;
-    if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
-        return finish(print_stdout(&e.render().to_string()));
+    match (e.kind(), json) {
+        (ErrorKind::DisplayVersion, true) => {
+            let object = serde_json::json!({
+                "name": env!("CARGO_PKG_NAME"),
+                "version": env!("CARGO_PKG_VERSION"),
+            });
+            return finish(print_stdout(&format!("{object}\n")));
+        }
+        (ErrorKind::DisplayHelp, true) => {
+            let object = serde_json::json!({ "help": e.render().to_string() });
+            return finish(print_stdout(&format!("{object}\n")));
+        }
+        (ErrorKind::DisplayHelp | ErrorKind::DisplayVersion, false) => {
+            return finish(print_stdout(&e.render().to_string()));
+        }
+        _ => {}
     }
-    let json = std::env::args_os()
-        .take_while(|a| a != "--")
-        .any(|a| a == "--json");
     let rendered = e.render().to_string();
     let message = if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
         "a subcommand is required (see --help)".to_string()
@@ -241,9 +300,21 @@ fn finish(printed: std::io::Result<()>) -> ExitCode {
     }
 }
 
-/// Write `text` to stdout and flush, returning the error instead of
-/// panicking as `print!` does on a closed pipe or a full disk.
+/// Write the command's one answer to stdout and flush, returning the error
+/// instead of panicking as `print!` does on a closed pipe or a full disk;
+/// nothing is printed after an interruption was reported.
 fn print_stdout(text: &str) -> std::io::Result<()> {
+    let mut done = STDOUT_DONE
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    if *done {
+        return Ok(());
+    }
+    *done = true;
+    write_stdout(text)
+}
+
+fn write_stdout(text: &str) -> std::io::Result<()> {
     use std::io::Write as _;
     let mut out = std::io::stdout().lock();
     out.write_all(text.as_bytes())?;

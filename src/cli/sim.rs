@@ -2,11 +2,11 @@
 
 use super::{CliError, Output};
 use clap::{Args, ValueEnum};
-use ivt_sim::output::run_and_write;
+use ivt_sim::output::{run_and_write, write_outputs};
 use ivt_sim::progress::Progress;
 use ivt_sim::run::Simulation;
 use ivt_sim::scene::Scene;
-use ivt_sim::steady::{write_outputs, write_summary, Route, SceneRun};
+use ivt_sim::steady::{Route, SceneRun};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -88,43 +88,27 @@ fn run_scene(
 ) -> Result<Output, CliError> {
     let mut bar = Progress::new(!json && scene.duration_s >= 5.0, &scene.name);
     let failed = |e: &dyn std::fmt::Display| CliError::Failed(e.to_string());
-    let t0 = std::time::Instant::now();
-    let time_run = |run, route_reason: String| SceneRun {
-        route: Route::TimeIntegration,
-        route_reason,
-        steady: None,
-        run: Some(run),
-        wall_time_s: t0.elapsed().as_secs_f64(),
-    };
     let (answered, paths) = if pil {
         let r = ivt_sim::pil::run_pil(scene, &mut |f| bar.update(f)).map_err(|e| failed(&e))?;
         bar.finish();
-        let answered = time_run(r, "processor in the loop".into());
+        let mut answered = SceneRun::time_integration(scene, r);
+        answered.route_reason = "processor in the loop".into();
         let paths = write_outputs(out, scene, &answered).map_err(|e| failed(&e))?;
         (answered, paths)
     } else if !scene.outputs.steady_state && route != Some(Route::IhbSteadyState) {
         // A transient is asked for: the MCAP log is written by a thread while
-        // the loop runs; the summary is rewritten with the route afterwards.
-        let (r, mut paths) = run_and_write(out, scene, |sink| {
+        // the loop runs, the other files and the summary after it, all
+        // renamed into place together.
+        run_and_write(out, scene, |sink| {
             let r = Simulation::new(scene)
+                .route(route)
                 .progress(&mut |f| bar.update(f))
                 .sink(sink)
-                .run();
+                .answer_by_time_integration();
             bar.finish();
             r
         })
-        .map_err(|e| failed(&e))?;
-        let reason = match route {
-            Some(_) => "forced".to_string(),
-            None => scene.ihb_route_blocker().unwrap_or_default(),
-        };
-        let answered = time_run(r, reason);
-        if let Some(p) = write_summary(out, scene, &answered).map_err(|e| failed(&e))? {
-            if !paths.contains(&p) {
-                paths.push(p);
-            }
-        }
-        (answered, paths)
+        .map_err(|e| failed(&e))?
     } else {
         let answered = Simulation::new(scene)
             .route(route)

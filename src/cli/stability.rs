@@ -205,7 +205,7 @@ pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
             ys: &grid.t_u,
             values: &values,
         };
-        ivt_plot::heat_map(path, &heat).map_err(|e| CliError::Failed(e.to_string()))?;
+        super::write_figure(path, |tmp| ivt_plot::heat_map(tmp, &heat))?;
     }
     let human = format!(
         "{} points ({} failed), worst max |multiplier| = {:.6}, {:.2} s\n",

@@ -198,5 +198,5 @@ fn plot(path: &Path, title: &str, points: &[FrcPoint]) -> Result<(), CliError> {
         y_label: "||a|| (Eq. 114)",
         series,
     };
-    ivt_plot::line_plot(path, &figure).map_err(|e| CliError::Failed(e.to_string()))
+    super::write_figure(path, |tmp| ivt_plot::line_plot(tmp, &figure))
 }

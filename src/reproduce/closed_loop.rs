@@ -9,13 +9,14 @@
 
 use super::{series, Context, ReproError};
 use ivt_plot::{Figure, Style};
+use ivt_sim::record::{Panel, PlantSample};
 use ivt_sim::run::{Simulation, Summary};
 use ivt_sim::scene::Scene;
 
 pub(super) const RAD_S_TO_RPM: f64 = 60.0 / (2.0 * std::f64::consts::PI);
 
-/// Run a scene: its summary and its (t, ω, ω_a, r, V_m, T_U) samples, or why not.
-pub(super) fn simulate(name: &str, src: &str) -> Result<(Summary, Vec<[f64; 6]>), String> {
+/// Run a scene: its summary and its plot samples of the plant, or why not.
+pub(super) fn simulate(name: &str, src: &str) -> Result<(Summary, Vec<PlantSample>), String> {
     let scene = Scene::parse(src, name).map_err(|e| e.to_string())?;
     let res = Simulation::new(&scene).run().map_err(|e| e.to_string())?;
     let plot = res
@@ -37,33 +38,9 @@ macro_rules! shipped_scene {
 }
 pub(super) use shipped_scene;
 
-/// A channel of the (t, ω, ω_a, r, V_m, T_U) samples of [`simulate`].
-#[derive(Clone, Copy)]
-pub(super) enum Channel {
-    /// ω_a \[rad/s\].
-    OmegaA,
-    /// r \[m\].
-    R,
-    /// V_m \[V\].
-    VM,
-    /// T_U \[N·m\].
-    TU,
-}
-
-/// One channel of the samples against t, scaled.
-pub(super) fn column(samples: &[[f64; 6]], channel: Channel, scale: f64) -> Vec<(f64, f64)> {
-    samples
-        .iter()
-        .map(|&[t, _omega, omega_a, r, v_m, t_u]| {
-            let y = match channel {
-                Channel::OmegaA => omega_a,
-                Channel::R => r,
-                Channel::VM => v_m,
-                Channel::TU => t_u,
-            };
-            (t, y * scale)
-        })
-        .collect()
+/// One plot panel of the plant samples against t, scaled.
+pub(super) fn column(samples: &[PlantSample], panel: Panel, scale: f64) -> Vec<(f64, f64)> {
+    samples.iter().map(|s| (s.t, panel.of(s) * scale)).collect()
 }
 
 /// A Fig. 43 panel: ω_a \[rpm\] of an open-loop and a feedback run after a
@@ -72,15 +49,15 @@ pub(super) fn fig43_panel(
     ctx: &mut Context,
     id: &str,
     title: &str,
-    open: (&str, &[[f64; 6]]),
-    feedback: (&str, &[[f64; 6]]),
+    open: (&str, &[PlantSample]),
+    feedback: (&str, &[PlantSample]),
     note: &str,
 ) -> Result<(), ReproError> {
     let (wo, wf) = (
-        column(open.1, Channel::OmegaA, RAD_S_TO_RPM),
-        column(feedback.1, Channel::OmegaA, RAD_S_TO_RPM),
+        column(open.1, Panel::OmegaA, RAD_S_TO_RPM),
+        column(feedback.1, Panel::OmegaA, RAD_S_TO_RPM),
     );
-    let v = column(feedback.1, Channel::VM, 10.0);
+    let v = column(feedback.1, Panel::VM, 10.0);
     ctx.line_figure(
         id,
         &Figure {
@@ -118,8 +95,8 @@ pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
     match (&delay, &nodelay) {
         (Ok(a), Ok(b)) => {
             let (wa, wb) = (
-                column(a, Channel::OmegaA, RAD_S_TO_RPM),
-                column(b, Channel::OmegaA, RAD_S_TO_RPM),
+                column(a, Panel::OmegaA, RAD_S_TO_RPM),
+                column(b, Panel::OmegaA, RAD_S_TO_RPM),
             );
             ctx.line_figure(
                 "Fig. 44",
@@ -132,7 +109,7 @@ pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
                 "scenes load_step_delay/load_step_nodelay, same gain k; the no-delay law keeps a static error in ω_a \
                  (it regulates the θ-mean of ω, not the time mean; crates/ivt-sim/README.md)",
             )?;
-            let (ra, rb) = (column(a, Channel::R, 1e3), column(b, Channel::R, 1e3));
+            let (ra, rb) = (column(a, Panel::R, 1e3), column(b, Panel::R, 1e3));
             ctx.line_figure(
                 "Fig. 45",
                 &Figure {
@@ -154,10 +131,10 @@ pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
     match shipped_scene!("drive").map(|(_, s)| s) {
         Ok(s) => {
             let (w, r, t, v) = (
-                column(&s, Channel::OmegaA, RAD_S_TO_RPM),
-                column(&s, Channel::R, 5e3),
-                column(&s, Channel::TU, 10.0),
-                column(&s, Channel::VM, 10.0),
+                column(&s, Panel::OmegaA, RAD_S_TO_RPM),
+                column(&s, Panel::R, 5e3),
+                column(&s, Panel::TU, 10.0),
+                column(&s, Panel::VM, 10.0),
             );
             ctx.line_figure(
                 "Fig. 51",

@@ -3,17 +3,18 @@
 //! shipped scenes `scenes/ch4_fig43_*.toml` and `scenes/ch4_fig44_*.toml`
 //! (Figs. 43–45 and the claims made about them in §4.3).
 
-use super::closed_loop::{column, fig43_panel, shipped_scene, Channel, RAD_S_TO_RPM};
+use super::closed_loop::{column, fig43_panel, shipped_scene, RAD_S_TO_RPM};
 use super::{fmt_sig, series, Cause, Context, ReproError, Verdict};
 use ivt_plot::{Figure, Style};
+use ivt_sim::record::{Panel, PlantSample};
 use ivt_sim::run::Summary;
 
 /// Mean of ω_a − ω0 over t ∈ [from, to) \[rad/s\].
-fn mean_error(samples: &[[f64; 6]], omega0: f64, from: f64, to: f64) -> f64 {
+fn mean_error(samples: &[PlantSample], omega0: f64, from: f64, to: f64) -> f64 {
     let w: Vec<f64> = samples
         .iter()
-        .filter(|s| (from..to).contains(&s[0]))
-        .map(|s| s[2] - omega0)
+        .filter(|s| (from..to).contains(&s.t))
+        .map(|s| s.omega_a - omega0)
         .collect();
     w.iter().sum::<f64>() / w.len().max(1) as f64
 }
@@ -42,8 +43,8 @@ pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
 
 fn fig43(
     ctx: &mut Context,
-    (sd, d): (&Summary, &[[f64; 6]]),
-    (so, o): (&Summary, &[[f64; 6]]),
+    (sd, d): (&Summary, &[PlantSample]),
+    (so, o): (&Summary, &[PlantSample]),
 ) -> Result<(), ReproError> {
     let settle = sd
         .settling_time_s
@@ -115,8 +116,8 @@ fn fig43(
 
 fn figs_44_45(
     ctx: &mut Context,
-    (sd, d): (&Summary, &[[f64; 6]]),
-    (sn, n): (&Summary, &[[f64; 6]]),
+    (sd, d): (&Summary, &[PlantSample]),
+    (sn, n): (&Summary, &[PlantSample]),
 ) -> Result<(), ReproError> {
     let ratio = sn.rms_dr_dt_m_per_s / sd.rms_dr_dt_m_per_s;
     let q = "RMS dr/dt, no-delay law (0.04/0.15) ÷ delay law (0.01/0.02), at (8 V, 8 N·m)";
@@ -146,8 +147,8 @@ fn figs_44_45(
             .map_or("never".into(), |t| format!("{t:.2} s"))
     };
     let (wd, wn) = (
-        column(d, Channel::OmegaA, RAD_S_TO_RPM),
-        column(n, Channel::OmegaA, RAD_S_TO_RPM),
+        column(d, Panel::OmegaA, RAD_S_TO_RPM),
+        column(n, Panel::OmegaA, RAD_S_TO_RPM),
     );
     ctx.line_figure(
         "Fig. 44 (thesis-ch4)",
@@ -168,7 +169,7 @@ fn figs_44_45(
             fmt_sig(sn.static_error_rad_s, 2)
         ),
     )?;
-    let (rd, rn) = (column(d, Channel::R, 1e3), column(n, Channel::R, 1e3));
+    let (rd, rn) = (column(d, Panel::R, 1e3), column(n, Panel::R, 1e3));
     ctx.line_figure(
         "Fig. 45 (thesis-ch4)",
         &Figure {

@@ -200,7 +200,7 @@ pub(crate) fn fmt_sig(x: f64, sig: usize) -> String {
 }
 
 impl Context {
-    fn new(out: &Path, opts: Options, steps: u64) -> Self {
+    fn new(out: &Path, staged: Staged, opts: Options, steps: u64) -> Self {
         let bar = if opts.progress {
             let b = ProgressBar::new(steps);
             if let Ok(style) =
@@ -214,7 +214,7 @@ impl Context {
         };
         Self {
             out: out.to_path_buf(),
-            staged: Staged::new(),
+            staged,
             opts,
             rows: Vec::new(),
             figures: Vec::new(),
@@ -346,17 +346,19 @@ impl Context {
 
     /// Write `text` as `name` in the output directory (staged).
     fn write(&mut self, name: &str, text: &str) -> Result<(), ReproError> {
-        let path = self.staging(name);
-        std::fs::write(&path, text).map_err(|source| ReproError::Io {
-            path: self.out.join(name),
-            source,
-        })
+        let path = self.out.join(name);
+        self.staged
+            .write(&path, text.as_bytes())
+            .map_err(|source| ReproError::Io { path, source })
     }
 
     /// The temporary path that becomes `name` in the output directory when
     /// the run completes.
-    fn staging(&mut self, name: &str) -> PathBuf {
-        self.staged.path(&self.out.join(name))
+    fn staging(&mut self, name: &str) -> Result<PathBuf, ReproError> {
+        let path = self.out.join(name);
+        self.staged
+            .path(&path)
+            .map_err(|source| ReproError::Io { path, source })
     }
 
     /// Draw a line figure and save its data as CSV (`series,x,y`, NaN rows
@@ -387,7 +389,8 @@ impl Context {
                 .map(|(s, l)| ivt_plot::Series { label: l, ..*s })
                 .collect(),
         };
-        ivt_plot::line_plot(&self.staging(&png), &drawable)?;
+        ivt_plot::line_plot(&self.staging(&png)?, &drawable)
+            .map_err(|e| e.for_path(&self.out.join(&png)))?;
         let mut csv = format!(
             "series,\"{}\",\"{}\"\n",
             figure.x_label.replace('"', "'"),
@@ -426,7 +429,7 @@ impl Context {
             glyphs(map.value_label),
         );
         ivt_plot::heat_map(
-            &self.staging(&png),
+            &self.staging(&png)?,
             &HeatMap {
                 title: &title,
                 x_label: &x_label,
@@ -434,7 +437,8 @@ impl Context {
                 value_label: &value_label,
                 ..*map
             },
-        )?;
+        )
+        .map_err(|e| e.for_path(&self.out.join(&png)))?;
         let mut csv = format!(
             "\"{}\",\"{}\",\"{}\"\n",
             map.x_label.replace('"', "'"),
@@ -498,24 +502,20 @@ fn glyphs(s: &str) -> String {
 /// # Errors
 /// I/O or drawing failures; numerical failures become rows instead.
 pub fn run(out: &Path, opts: Options) -> Result<Report, ReproError> {
-    let existed = out.is_dir();
-    std::fs::create_dir_all(out).map_err(|source| ReproError::Io {
+    // `out` is created if needed, and removed again if the run fails or is
+    // interrupted (the staged set of the one output writer).
+    let staged = Staged::in_dir(out).map_err(|source| ReproError::Io {
         path: out.to_path_buf(),
         source,
     })?;
-    let result = run_in(out, opts);
-    if result.is_err() && !existed {
-        // Only succeeds while empty: the staged files are already removed.
-        let _ = std::fs::remove_dir(out);
-    }
-    result
+    run_in(out, staged, opts)
 }
 
 /// Every chapter into the staged set of `out`, renamed into place once the
 /// report is written.
-fn run_in(out: &Path, opts: Options) -> Result<Report, ReproError> {
+fn run_in(out: &Path, staged: Staged, opts: Options) -> Result<Report, ReproError> {
     let start = std::time::Instant::now();
-    let mut ctx = Context::new(out, opts, 17);
+    let mut ctx = Context::new(out, staged, opts, 17);
     ctx.section = "kinematics";
     kinematics::run(&mut ctx)?;
     ctx.section = "hb";

@@ -41,6 +41,18 @@ pub struct PlotError {
     pub msg: String,
 }
 
+impl PlotError {
+    /// The same failure, naming `path` (the target of a figure that was drawn
+    /// into a staged temporary file).
+    #[must_use]
+    pub fn for_path(self, path: &Path) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            msg: self.msg,
+        }
+    }
+}
+
 /// How a series is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Style {

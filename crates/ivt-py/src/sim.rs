@@ -1,9 +1,11 @@
 //! `ivt.sim`: run ivt-sim scenes (TOML path, TOML text or a dict) and get
 //! the recorded channels as numpy arrays plus the summary of `ivt sim --json`.
 
+use ivt_sim::output::write_outputs;
+use ivt_sim::record::Channel;
 use ivt_sim::run::Simulation;
 use ivt_sim::scene::Scene;
-use ivt_sim::steady::{write_outputs, Route};
+use ivt_sim::steady::Route;
 use numpy::ndarray::{Array1, Array2};
 use numpy::IntoPyArray;
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
@@ -59,14 +61,13 @@ pub fn scene_from_py(ob: &Bound<'_, PyAny>) -> PyResult<Scene> {
     ))
 }
 
-/// One channel (a list of serde-serializable samples) as a dict of column
-/// arrays: numbers → float64, integers → int64, booleans → bool.
-fn columns<'py, T: Serialize>(py: Python<'py>, samples: &[T]) -> PyResult<Bound<'py, PyDict>> {
-    let rows: Vec<Value> = samples
-        .iter()
-        .map(serde_json::to_value)
-        .collect::<Result<_, _>>()
-        .map_err(|e| PyRuntimeError::new_err(format!("serializing channel: {e}")))?;
+/// One channel (its samples as JSON objects) as a dict of column arrays:
+/// numbers → float64, integers → int64, booleans → bool.
+fn columns<'py>(
+    py: Python<'py>,
+    rows: Result<Vec<Value>, serde_json::Error>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let rows = rows.map_err(|e| PyRuntimeError::new_err(format!("serializing channel: {e}")))?;
     let out = PyDict::new(py);
     let Some(Value::Object(first)) = rows.first() else {
         return Ok(out);
@@ -146,20 +147,17 @@ fn run<'py>(
     let ch = PyDict::new(py);
     let empty = ivt_sim::run::Channels::default();
     let c = answer.run.as_ref().map_or(&empty, |r| &r.channels);
-    if let Some(v) = &c.plant {
-        ch.set_item("plant", columns(py, v)?)?;
-    }
-    if let Some(v) = &c.control {
-        ch.set_item("control", columns(py, v)?)?;
-    }
-    if let Some(v) = &c.stepper {
-        ch.set_item("stepper", columns(py, v)?)?;
-    }
-    if let Some(v) = &c.sensors {
-        ch.set_item("sensors", columns(py, v)?)?;
+    for &channel in Channel::ALL {
+        if let Some(rows) = c.json_rows(channel) {
+            ch.set_item(channel.name(), columns(py, rows)?)?;
+        }
     }
     if let Some(v) = &c.plot {
-        let flat: Vec<f64> = v.iter().flatten().copied().collect();
+        // (t, ω, ω_a, r, V_m, T_U) per row
+        let flat: Vec<f64> = v
+            .iter()
+            .flat_map(|s| [s.t, s.omega, s.omega_a, s.r, s.v_m, s.t_u])
+            .collect();
         let a = Array2::from_shape_vec((v.len(), 6), flat)
             .map_err(|e| PyRuntimeError::new_err(format!("plot channel: {e}")))?;
         ch.set_item("plot", a.into_pyarray(py))?;

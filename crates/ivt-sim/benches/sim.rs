@@ -55,7 +55,9 @@ fn bench_write(b: divan::Bencher, s: &Scene, dir_name: &str) {
     let dir = std::env::temp_dir().join(dir_name);
     b.bench(|| {
         ivt_sim::output::run_and_write(&dir, s, |sink| {
-            ivt_sim::run::Simulation::new(s).sink(sink).run()
+            ivt_sim::run::Simulation::new(s)
+                .sink(sink)
+                .answer_by_time_integration()
         })
         .expect("runs and writes")
         .1

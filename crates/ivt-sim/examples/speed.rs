@@ -83,7 +83,9 @@ fn one(mode: &str, scene: &Scene, dir: &Path) {
         }
         _ => {
             ivt_sim::output::run_and_write(dir, scene, |sink| {
-                Simulation::new(scene).sink(sink).run()
+                Simulation::new(scene)
+                    .sink(sink)
+                    .answer_by_time_integration()
             })
             .expect("runs and writes");
         }

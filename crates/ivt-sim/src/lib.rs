@@ -3,6 +3,7 @@
 pub mod atomic;
 pub mod backend;
 pub mod error;
+pub mod field;
 pub mod integrate;
 pub mod output;
 pub mod pil;

@@ -2,34 +2,42 @@
 //! signal group, zstd chunks, Foxglove-readable), CSV files, the summary JSON
 //! and a PNG with one panel per requested plot.
 //!
-//! [`write_all`] writes them from a finished run; [`run_and_write`] (what
+//! [`write_outputs`] writes them from a scene's answer (either route),
+//! [`write_all`] from a finished time integration; [`run_and_write`] (what
 //! `ivt sim` uses) writes the MCAP log on a second thread while the loop
 //! runs — on two cores it costs little more than the loop alone.
 //!
-//! Every file is written under a temporary name and the set is renamed into
-//! place only when all of it is complete ([`crate::atomic::Staged`]): a failed
-//! run, a failed plot or an interrupted run leaves the directory as it was.
+//! Every file, the summary included, is staged in one
+//! [`crate::atomic::Staged`] set and the set is renamed into place once,
+//! when all of it is complete: a failed run, a failed plot or an interrupted
+//! run leaves the directory as it was (and removes it if the run created it).
 
 use crate::atomic::Staged;
 use crate::error::{io_at as io, mcap_at as mcap_error, SimError};
-use crate::record::{Record, Sample, CHANNELS};
+use crate::record::{Channel, Sample};
 use crate::run::{Channels, RunResult};
 use crate::scene::Scene;
+use crate::steady::SceneRun;
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
-pub use crate::record::channel_fields;
-
 /// The JSON schema of a channel (`ivt.<name>`), as written into MCAP logs.
-pub fn json_schema(name: &str) -> String {
-    let props: serde_json::Map<String, serde_json::Value> = channel_fields(name)
+#[must_use]
+pub fn json_schema(channel: Channel) -> String {
+    let props: serde_json::Map<String, serde_json::Value> = channel
+        .fields()
         .iter()
-        .map(|(f, ty)| ((*f).to_string(), serde_json::json!({ "type": ty })))
+        .map(|f| {
+            (
+                f.name.to_string(),
+                serde_json::json!({ "type": f.json_type }),
+            )
+        })
         .collect();
     serde_json::json!({
-        "title": format!("ivt.{name}"),
+        "title": format!("ivt.{}", channel.name()),
         "type": "object",
         "properties": props,
     })
@@ -39,13 +47,14 @@ pub fn json_schema(name: &str) -> String {
 /// Adds the channel `/name` with the JSON schema `ivt.name` to an MCAP log.
 pub(crate) fn add_json_channel<W: std::io::Write + std::io::Seek>(
     w: &mut mcap::Writer<W>,
-    name: &str,
+    channel: Channel,
     meta: &BTreeMap<String, String>,
 ) -> Result<u16, mcap::McapError> {
+    let name = channel.name();
     let schema = w.add_schema(
         &format!("ivt.{name}"),
         "jsonschema",
-        json_schema(name).as_bytes(),
+        json_schema(channel).as_bytes(),
     )?;
     w.add_channel(schema, &format!("/{name}"), "json", meta)
 }
@@ -55,18 +64,24 @@ pub(crate) fn add_json_channel<W: std::io::Write + std::io::Seek>(
 struct McapLog {
     path: PathBuf,
     w: mcap::Writer<BufWriter<File>>,
-    /// MCAP channel id and next sequence number per entry of [`CHANNELS`].
-    channels: [Option<(u16, u32)>; 4],
+    /// MCAP channel id and next sequence number per [`Channel`] (in
+    /// [`Channel::ALL`] order; None: not logged).
+    channels: Vec<Option<(u16, u32)>>,
     /// The JSON text of the message being written (reused).
     buf: Vec<u8>,
 }
 
 impl McapLog {
-    /// Creates the log of `path` at the staged name `tmp`, with the channels
-    /// of [`CHANNELS`] marked in `wanted`.
-    fn create(tmp: &Path, path: &Path, scene: &Scene, wanted: [bool; 4]) -> Result<Self, SimError> {
+    /// Creates the log of `path` in the staged set, with the channels
+    /// `wanted`.
+    fn create(
+        staged: &mut Staged,
+        path: &Path,
+        scene: &Scene,
+        wanted: impl Fn(Channel) -> bool,
+    ) -> Result<Self, SimError> {
         let err = mcap_error(path);
-        let file = File::create(tmp).map_err(io(path))?;
+        let (_, file) = staged.file(path).map_err(io(path))?;
         let mut w = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
             // level 1: ~3× faster than the default 3 on these JSON logs, files ~10 % larger
@@ -80,13 +95,12 @@ impl McapLog {
         let mut meta = BTreeMap::new();
         meta.insert("scene".to_string(), scene.name.clone());
         meta.insert("description".to_string(), scene.description.clone());
-        let mut channels = [None; 4];
-        for (k, name) in CHANNELS.iter().enumerate() {
-            if !wanted[k] {
-                continue;
+        let mut channels = vec![None; Channel::ALL.len()];
+        for (slot, &channel) in channels.iter_mut().zip(Channel::ALL) {
+            if wanted(channel) {
+                let id = add_json_channel(&mut w, channel, &meta).map_err(&err)?;
+                *slot = Some((id, 0));
             }
-            let id = add_json_channel(&mut w, name, &meta).map_err(&err)?;
-            channels[k] = Some((id, 0));
         }
         Ok(Self {
             path: path.to_path_buf(),
@@ -98,7 +112,11 @@ impl McapLog {
 
     /// Appends one message (ignored if its channel was not created).
     fn write(&mut self, s: &Sample) -> Result<(), SimError> {
-        let Some((id, seq)) = self.channels[s.channel()].as_mut() else {
+        let Some((id, seq)) = self
+            .channels
+            .get_mut(s.channel() as usize)
+            .and_then(Option::as_mut)
+        else {
             return Ok(());
         };
         let ns = (s.time().max(0.0) * 1e9).round() as u64;
@@ -123,19 +141,6 @@ impl McapLog {
     }
 }
 
-/// The recorded channels in [`CHANNELS`] order, as samples.
-fn recorded(ch: &Channels) -> [Option<Vec<Sample>>; 4] {
-    fn wrap<T: Copy>(v: &Option<Vec<T>>, f: fn(T) -> Sample) -> Option<Vec<Sample>> {
-        v.as_ref().map(|v| v.iter().map(|&s| f(s)).collect())
-    }
-    [
-        wrap(&ch.plant, Sample::Plant),
-        wrap(&ch.control, Sample::Control),
-        wrap(&ch.stepper, Sample::Stepper),
-        wrap(&ch.sensors, Sample::Sensors),
-    ]
-}
-
 /// Write the MCAP log of the recorded channels to `path` (channel after
 /// channel; [`run_and_write`] streams them in time order instead).
 ///
@@ -154,11 +159,12 @@ fn stage_mcap(
     result: &RunResult,
     scene: &Scene,
 ) -> Result<(), SimError> {
-    let channels = recorded(&result.channels);
-    let tmp = staged.path(path);
-    let mut log = McapLog::create(&tmp, path, scene, channels.each_ref().map(Option::is_some))?;
-    for s in channels.iter().flatten().flatten() {
-        log.write(s)?;
+    let ch = &result.channels;
+    let mut log = McapLog::create(staged, path, scene, |c| ch.recorded(c))?;
+    for &channel in Channel::ALL {
+        for s in ch.samples(channel).iter().flatten() {
+            log.write(s)?;
+        }
     }
     log.finish()
 }
@@ -174,100 +180,95 @@ pub fn write_csv(dir: &Path, stem: &str, ch: &Channels) -> Result<Vec<PathBuf>, 
 }
 
 fn stage_csv(staged: &mut Staged, dir: &Path, stem: &str, ch: &Channels) -> Result<(), SimError> {
-    fn one<T: Record>(
-        staged: &mut Staged,
-        dir: &Path,
-        stem: &str,
-        samples: &Option<Vec<T>>,
-    ) -> Result<(), SimError> {
-        let Some(samples) = samples else {
-            return Ok(());
-        };
-        let path = dir.join(format!("{stem}_{}.csv", T::CHANNEL));
-        let header: Vec<&str> = T::FIELDS.iter().map(|(n, _)| *n).collect();
-        let mut text = header.join(",").into_bytes();
-        text.push(b'\n');
-        for s in samples {
-            s.write_csv(&mut text);
+    for &channel in Channel::ALL {
+        if let Some(text) = ch.csv(channel) {
+            let path = dir.join(format!("{stem}_{}.csv", channel.name()));
+            staged.write(&path, &text).map_err(io(&path))?;
         }
-        std::fs::write(staged.path(&path), text).map_err(io(&path))
     }
-    one(staged, dir, stem, &ch.plant)?;
-    one(staged, dir, stem, &ch.control)?;
-    one(staged, dir, stem, &ch.stepper)?;
-    one(staged, dir, stem, &ch.sensors)
+    Ok(())
 }
 
-/// Everything the scene asked for, under `dir`, from a finished run;
-/// returns the written paths.
+/// Everything the scene asked for, under `dir`, from a finished time
+/// integration (the summary file as [`SceneRun::time_integration`] gives
+/// it); returns the written paths.
 ///
 /// # Errors
 /// I/O, MCAP or plot errors.
 pub fn write_all(dir: &Path, scene: &Scene, result: &RunResult) -> Result<Vec<PathBuf>, SimError> {
-    let o = &scene.outputs;
-    if !(o.mcap || o.csv || o.summary || !o.plots.is_empty()) {
-        return Ok(vec![]);
-    }
-    let ((), paths) = in_dir(dir, |staged| -> Result<(), SimError> {
-        if o.mcap {
-            stage_mcap(staged, &mcap_path(dir, scene), result, scene)?;
-        }
-        stage_rest(staged, dir, scene, result)
-    })?;
-    Ok(paths)
+    write_outputs(
+        dir,
+        scene,
+        &SceneRun::time_integration(scene, result.clone()),
+    )
 }
 
-/// Create `dir` if needed, stage files into it with `write`, and commit them
-/// all; on any failure the staged files are removed, and so is `dir` when
-/// this call created it (if it is still empty).
-fn in_dir<T, E, F>(dir: &Path, write: F) -> Result<(T, Vec<PathBuf>), E>
-where
-    E: From<SimError>,
-    F: FnOnce(&mut Staged) -> Result<T, E>,
-{
-    let created = !dir.exists();
-    std::fs::create_dir_all(dir).map_err(io(dir))?;
-    let mut staged = Staged::new();
-    let done = write(&mut staged).and_then(|value| {
-        let paths = staged.commit().map_err(io(dir))?;
-        Ok((value, paths))
-    });
-    if done.is_err() && created {
-        let _ = std::fs::remove_dir(dir);
+/// Everything the scene asked for under `dir`, from its answer on either
+/// route: the time route's MCAP, CSV and plots, and the summary file
+/// ([`SceneRun::summary_json`], which names the route), staged as one set
+/// and renamed together. Returns the written paths.
+///
+/// # Errors
+/// I/O, MCAP or plot errors; no file of the set is then written.
+pub fn write_outputs(
+    dir: &Path,
+    scene: &Scene,
+    answer: &SceneRun,
+) -> Result<Vec<PathBuf>, SimError> {
+    let o = &scene.outputs;
+    let has_run = answer.run.is_some();
+    if !(o.summary || has_run && (o.mcap || o.csv || !o.plots.is_empty())) {
+        return Ok(vec![]);
     }
-    done
+    let mut staged = Staged::in_dir(dir).map_err(io(dir))?;
+    if let (Some(result), true) = (&answer.run, o.mcap) {
+        stage_mcap(&mut staged, &mcap_path(dir, scene), result, scene)?;
+    }
+    stage_rest(&mut staged, dir, scene, answer)?;
+    staged.commit().map_err(io(dir))
 }
 
 fn mcap_path(dir: &Path, scene: &Scene) -> PathBuf {
     dir.join(format!("{}.mcap", scene.name))
 }
 
-/// Stage the outputs other than the MCAP log: CSV, summary, plots.
+/// Stage the outputs other than the MCAP log: CSV of the time route, the
+/// summary, plots of the time route (in this order).
 fn stage_rest(
     staged: &mut Staged,
     dir: &Path,
     scene: &Scene,
-    result: &RunResult,
+    answer: &SceneRun,
 ) -> Result<(), SimError> {
     let o = &scene.outputs;
-    if o.csv {
-        stage_csv(staged, dir, &scene.name, &result.channels)?;
+    if let Some(result) = &answer.run {
+        if o.csv {
+            stage_csv(staged, dir, &scene.name, &result.channels)?;
+        }
     }
     if o.summary {
         let p = dir.join(format!("{}_summary.json", scene.name));
-        let text = serde_json::to_string_pretty(&result.summary).unwrap_or_default();
-        std::fs::write(staged.path(&p), text + "\n").map_err(io(&p))?;
+        let text = serde_json::to_string_pretty(&answer.summary_json(scene)).unwrap_or_default();
+        staged.write(&p, (text + "\n").as_bytes()).map_err(io(&p))?;
     }
-    if !o.plots.is_empty() {
-        if let Some(series) = &result.channels.plot {
+    if let Some(result) = &answer.run {
+        if let (Some(series), false) = (&result.channels.plot, o.plots.is_empty()) {
             let p = dir.join(format!("{}.png", scene.name));
+            let tmp = staged.path(&p).map_err(io(&p))?;
             crate::plot::draw(
-                &staged.path(&p),
+                &tmp,
                 &scene.name,
                 &o.plots,
                 series,
                 result.summary.omega0_rad_s,
-            )?;
+            )
+            .map_err(|e| match e {
+                SimError::Plot { msg, .. } => SimError::Plot {
+                    path: p.clone(),
+                    msg,
+                },
+                e => e,
+            })?;
         }
     }
     Ok(())
@@ -280,12 +281,13 @@ const BATCH: usize = 256;
 /// instead of buffering the whole log twice.
 const IN_FLIGHT: usize = 32;
 
-/// Runs a scene and writes everything it asks for under `dir`, as
-/// `ivt sim` does: the MCAP log is written *while* the loop runs, by a
-/// writer thread fed through a bounded channel (JSON + zstd of a 60 s run
-/// take about as long as the simulation, so on two cores they overlap);
-/// CSV, summary and plots follow the run. `run` is the closed loop with a
-/// sample sink, e.g. `|sink| Simulation::new(scene).sink(sink).run()`.
+/// Runs a scene's time integration and writes everything it asks for under
+/// `dir`, as `ivt sim` does: the MCAP log is written *while* the loop runs,
+/// by a writer thread fed through a bounded channel (JSON + zstd of a 60 s
+/// run take about as long as the simulation, so on two cores they overlap);
+/// CSV, plots and the summary follow the run, and the whole set is renamed
+/// into place at the end. `run` is the closed loop with a sample sink, e.g.
+/// `|sink| Simulation::new(scene).sink(sink).answer_by_time_integration()`.
 ///
 /// Messages are in time order across channels (each channel's sequence
 /// counts from 0), the same channels and counts as [`write_all`].
@@ -296,20 +298,20 @@ pub fn run_and_write<F>(
     dir: &Path,
     scene: &Scene,
     run: F,
-) -> Result<(RunResult, Vec<PathBuf>), SimError>
+) -> Result<(SceneRun, Vec<PathBuf>), SimError>
 where
-    F: FnOnce(&mut dyn FnMut(Sample)) -> Result<RunResult, SimError>,
+    F: FnOnce(&mut dyn FnMut(Sample)) -> Result<SceneRun, SimError>,
 {
     if !scene.outputs.mcap {
-        let result = run(&mut |_| {})?;
-        let paths = write_all(dir, scene, &result)?;
-        return Ok((result, paths));
+        let answer = run(&mut |_| {})?;
+        let paths = write_outputs(dir, scene, &answer)?;
+        return Ok((answer, paths));
     }
-    in_dir(dir, |staged| -> Result<RunResult, SimError> {
-        let result = stream_mcap(staged, &mcap_path(dir, scene), scene, run)?;
-        stage_rest(staged, dir, scene, &result)?;
-        Ok(result)
-    })
+    let mut staged = Staged::in_dir(dir).map_err(io(dir))?;
+    let answer = stream_mcap(&mut staged, &mcap_path(dir, scene), scene, run)?;
+    stage_rest(&mut staged, dir, scene, &answer)?;
+    let paths = staged.commit().map_err(io(dir))?;
+    Ok((answer, paths))
 }
 
 /// Run the loop while a writer thread streams its samples into the staged
@@ -319,12 +321,11 @@ fn stream_mcap<F>(
     path: &Path,
     scene: &Scene,
     run: F,
-) -> Result<RunResult, SimError>
+) -> Result<SceneRun, SimError>
 where
-    F: FnOnce(&mut dyn FnMut(Sample)) -> Result<RunResult, SimError>,
+    F: FnOnce(&mut dyn FnMut(Sample)) -> Result<SceneRun, SimError>,
 {
-    let wanted = CHANNELS.map(|name| scene.outputs.every(name).is_some());
-    let log = McapLog::create(&staged.path(path), path, scene, wanted)?;
+    let log = McapLog::create(staged, path, scene, |c| scene.outputs.every(c).is_some())?;
     let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<Sample>>(IN_FLIGHT);
     let writer = std::thread::Builder::new()
         .name("mcap-writer".into())

@@ -3,29 +3,19 @@
 //! registers at run time (one font setup for the whole toolkit).
 
 use crate::error::SimError;
+use crate::record::{Panel, PlantSample};
 use plotters::prelude::*;
 use std::path::Path;
 
-/// Panel title, unit and column of the plot series `(t, ω, ω_a, r, V_m, T_U)`.
-fn panel(name: &str) -> (&'static str, usize, f64) {
-    match name {
-        "omega" => ("ω [rpm]", 1, 60.0 / std::f64::consts::TAU),
-        "omega_a" => ("ω_a [rpm]", 2, 60.0 / std::f64::consts::TAU),
-        "r" => ("r [mm]", 3, 1e3),
-        "v_m" => ("V_m [V]", 4, 1.0),
-        _ => ("T_U [N·m]", 5, 1.0),
-    }
-}
-
-/// Draw `plots` (names from [`crate::scene::PLOTS`]) from `series` into `path`.
+/// Draw the panels `plots` of the plant samples `series` into `path`.
 ///
 /// # Errors
 /// Drawing or encoding failures.
 pub fn draw(
     path: &Path,
     title: &str,
-    plots: &[String],
-    series: &[[f64; 6]],
+    plots: &[Panel],
+    series: &[PlantSample],
     omega0: f64,
 ) -> Result<(), SimError> {
     ivt_plot::ensure_font();
@@ -40,13 +30,13 @@ pub fn draw(
         .titled(title, ("sans-serif", 22))
         .map_err(|e| err(e.to_string()))?;
     let areas = root.split_evenly((n, 1));
-    let t_end = series.last().map_or(1.0, |s| s[0]).max(1e-9);
-    for (area, name) in areas.iter().zip(plots) {
-        let (label, col, scale) = panel(name);
+    let t_end = series.last().map_or(1.0, |s| s.t).max(1e-9);
+    for (area, &panel) in areas.iter().zip(plots) {
+        let (label, scale) = panel.label();
         let pts: Vec<(f64, f64)> = series
             .iter()
-            .filter(|s| s[col].is_finite())
-            .map(|s| (s[0], s[col] * scale))
+            .filter(|s| panel.of(s).is_finite())
+            .map(|s| (s.t, panel.of(s) * scale))
             .collect();
         let (mut lo, mut hi) = pts
             .iter()
@@ -70,7 +60,7 @@ pub fn draw(
             .label_style(("sans-serif", 12))
             .draw()
             .map_err(|e| err(e.to_string()))?;
-        if name == "omega_a" || name == "omega" {
+        if panel.is_speed() {
             let w0 = omega0 * scale;
             chart
                 .draw_series(LineSeries::new([(0.0, w0), (t_end, w0)], RED.mix(0.6)))

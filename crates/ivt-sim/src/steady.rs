@@ -36,8 +36,8 @@
 //!   last revolution of θ (per-pulse plant and control samples are recorded
 //!   for that and decimated back to what the scene asked for).
 
-use crate::error::{io_at, SimError};
-use crate::output::write_all;
+use crate::error::SimError;
+use crate::record::Channel;
 use crate::run::{RunResult, Simulation};
 use crate::scene::{ChannelSpec, Law, Scene};
 use ivt_ctrl::{ActuatorMap, OpenLoopPreset};
@@ -46,7 +46,6 @@ use ivt_design::shooting::{omega_at_angles, periodic_at_r, ShootingOptions};
 use ivt_design::steady::{IhbOptions, IhbSolver};
 use ivt_design::{OperatingPoint, Verdict};
 use serde::Serialize;
-use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 pub use crate::scene::Route;
@@ -111,6 +110,22 @@ impl Simulation<'_> {
     pub fn answer(self) -> Result<SceneRun, SimError> {
         answer(self.scene, self.route, self.progress)
     }
+
+    /// The time integration ([`Simulation::run`]) as the scene's answer,
+    /// without steady-state metrics: the route reason is `"forced"` when
+    /// [`Simulation::route`] forced it, else as
+    /// [`SceneRun::time_integration`] gives it.
+    ///
+    /// # Errors
+    /// As [`Simulation::run`].
+    pub fn answer_by_time_integration(self) -> Result<SceneRun, SimError> {
+        let (scene, forced) = (self.scene, self.route.is_some());
+        let mut answer = SceneRun::time_integration(scene, self.run()?);
+        if forced {
+            answer.route_reason = "forced".into();
+        }
+        Ok(answer)
+    }
 }
 
 fn answer(
@@ -166,6 +181,20 @@ fn answer(
 }
 
 impl SceneRun {
+    /// The answer of a time integration `run` of `scene` without
+    /// steady-state metrics: why it was not the IHB route is the scene's
+    /// [`Scene::ihb_route_blocker`], or `"forced"` when nothing blocks it.
+    #[must_use]
+    pub fn time_integration(scene: &Scene, run: RunResult) -> Self {
+        Self {
+            route: Route::TimeIntegration,
+            route_reason: scene.ihb_route_blocker().unwrap_or_else(|| "forced".into()),
+            steady: None,
+            wall_time_s: run.summary.wall_time_s,
+            run: Some(run),
+        }
+    }
+
     /// The summary JSON: the time integration's [`crate::run::Summary`]
     /// fields (time route), plus `route`, `route_reason`, `steady_state` and
     /// `wall_time_s` (the whole answer).
@@ -191,50 +220,6 @@ impl SceneRun {
         }
         v
     }
-}
-
-/// Everything the scene asked for under `dir` ([`write_all`] for the time
-/// route's files); the summary file is [`SceneRun::summary_json`], so it
-/// names the route on both routes. Returns the written paths.
-///
-/// # Errors
-/// I/O, MCAP or plot errors.
-pub fn write_outputs(
-    dir: &Path,
-    scene: &Scene,
-    answer: &SceneRun,
-) -> Result<Vec<PathBuf>, SimError> {
-    let mut paths = match &answer.run {
-        Some(result) => write_all(dir, scene, result)?,
-        None => vec![],
-    };
-    if let Some(p) = write_summary(dir, scene, answer)? {
-        if !paths.contains(&p) {
-            paths.push(p);
-        }
-    }
-    Ok(paths)
-}
-
-/// Writes (or overwrites) `<name>_summary.json` with
-/// [`SceneRun::summary_json`], route included, if the scene asks for a
-/// summary; returns its path.
-///
-/// # Errors
-/// [`SimError::Io`] when the file cannot be written.
-pub fn write_summary(
-    dir: &Path,
-    scene: &Scene,
-    answer: &SceneRun,
-) -> Result<Option<PathBuf>, SimError> {
-    if !scene.outputs.summary {
-        return Ok(None);
-    }
-    let p = dir.join(format!("{}_summary.json", scene.name));
-    std::fs::create_dir_all(dir).map_err(io_at(&p))?;
-    let text = serde_json::to_string_pretty(&answer.summary_json(scene)).unwrap_or_default();
-    std::fs::write(&p, text + "\n").map_err(io_at(&p))?;
-    Ok(Some(p))
 }
 
 /// The IHB route (module doc). The scene must pass
@@ -359,17 +344,16 @@ fn time_route(
     if !scene.outputs.steady_state {
         return Ok((run(scene, progress)?, None));
     }
-    let (every_plant, every_control) =
-        (scene.outputs.every("plant"), scene.outputs.every("control"));
+    let (every_plant, every_control) = (
+        scene.outputs.every(Channel::Plant),
+        scene.outputs.every(Channel::Control),
+    );
     let mut s = scene.clone();
     s.outputs
         .channels
-        .retain(|c| c.name != "plant" && c.name != "control");
-    for name in ["plant", "control"] {
-        s.outputs.channels.push(ChannelSpec {
-            name: name.into(),
-            every: 1,
-        });
+        .retain(|c| !matches!(c.name, Channel::Plant | Channel::Control));
+    for name in [Channel::Plant, Channel::Control] {
+        s.outputs.channels.push(ChannelSpec { name, every: 1 });
     }
     let mut result = run(&s, progress)?;
     let steady = last_revolution(scene, &result);

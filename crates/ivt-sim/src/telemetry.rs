@@ -12,7 +12,6 @@
 //! and divided by the timer rate, relative to the first frame.
 
 use std::collections::BTreeMap;
-use std::fs::File;
 use std::io::{BufWriter, ErrorKind, Read};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -22,6 +21,7 @@ use ivt_wire::msg::Telemetry;
 
 use crate::error::{io_at, mcap_at, SimError};
 use crate::output::add_json_channel;
+use crate::record::Channel;
 
 /// When to stop and how to read time.
 #[derive(Clone, Debug)]
@@ -70,7 +70,7 @@ pub fn record<R: Read>(
     // SIGINT/SIGTERM stops the reading like the end of the stream does.
     let _listener = crate::atomic::listen();
     let mut staged = crate::atomic::Staged::new();
-    let file = File::create(staged.path(out)).map_err(io_at(out))?;
+    let (_, file) = staged.file(out).map_err(io_at(out))?;
     let mut w = mcap::WriteOptions::new()
         .compression(Some(mcap::Compression::Zstd))
         .profile("")
@@ -78,8 +78,8 @@ pub fn record<R: Read>(
         .map_err(&mcap_err)?;
     let mut meta = BTreeMap::new();
     meta.insert("source".to_string(), "rig telemetry".to_string());
-    let control = add_json_channel(&mut w, "control", &meta).map_err(&mcap_err)?;
-    let stepper = add_json_channel(&mut w, "stepper", &meta).map_err(&mcap_err)?;
+    let control = add_json_channel(&mut w, Channel::Control, &meta).map_err(&mcap_err)?;
+    let stepper = add_json_channel(&mut w, Channel::Stepper, &meta).map_err(&mcap_err)?;
 
     let mut dec = Decoder::new();
     let mut buf = [0u8; 512];

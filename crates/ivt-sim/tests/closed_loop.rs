@@ -1,6 +1,7 @@
 //! Closed loop through the SIL backend (the `ivt-ctrl` controller), scenes
 //! and outputs. Scenes come from `scenes/` so that what is tested is what ships.
 
+use ivt_sim::record::Channel;
 use ivt_sim::run::{RunResult, Simulation};
 use ivt_sim::scene::{ChannelSpec, Law, Scene};
 use std::path::PathBuf;
@@ -19,11 +20,11 @@ fn go(s: &Scene) -> RunResult {
 fn keep_all(s: &mut Scene) {
     s.outputs.channels = vec![
         ChannelSpec {
-            name: "plant".into(),
+            name: Channel::Plant,
             every: 1,
         },
         ChannelSpec {
-            name: "control".into(),
+            name: Channel::Control,
             every: 1,
         },
     ];
@@ -169,11 +170,11 @@ fn mcap_has_exactly_the_requested_channels() {
     s.outputs.summary = false;
     s.outputs.channels = vec![
         ChannelSpec {
-            name: "plant".into(),
+            name: Channel::Plant,
             every: 5,
         },
         ChannelSpec {
-            name: "sensors".into(),
+            name: Channel::Sensors,
             every: 3,
         },
     ];
@@ -228,10 +229,10 @@ fn mcap_has_exactly_the_requested_channels() {
     // byte for byte and in each channel's order, only interleaved in time.
     let streamed_dir = dir.join("streamed");
     let (res2, paths2) = ivt_sim::output::run_and_write(&streamed_dir, &s, |sink| {
-        Simulation::new(&s).sink(sink).run()
+        Simulation::new(&s).sink(sink).answer_by_time_integration()
     })
     .unwrap();
-    assert_eq!(res2.summary.pulses, res.summary.pulses);
+    assert_eq!(res2.run.unwrap().summary.pulses, res.summary.pulses);
     assert_eq!(paths2.len(), 1);
     let by_topic = |bytes: &[u8]| {
         let mut m: std::collections::BTreeMap<String, Vec<(u32, u64, Vec<u8>)>> =

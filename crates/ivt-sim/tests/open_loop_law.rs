@@ -10,6 +10,7 @@
 //! must travel the whole Δr̄ at the loop's rate — the transient of the
 //! no-feed-forward loop. Same gains (k = 2, k2 = 1 mm·rad⁻¹), same stepper.
 
+use ivt_sim::record::Channel;
 use ivt_sim::run::{RunResult, Simulation};
 use ivt_sim::scene::{ChannelSpec, OpenLoopLaw, Scene};
 use std::path::PathBuf;
@@ -27,7 +28,7 @@ fn load_step(v_m: f64, t_from: f64, t_to: f64, open_loop: OpenLoopLaw, gains: (f
     s.metrics.static_window_s = 2.0;
     s.outputs = Default::default();
     s.outputs.channels = vec![ChannelSpec {
-        name: "plant".into(),
+        name: Channel::Plant,
         every: 1,
     }];
     s

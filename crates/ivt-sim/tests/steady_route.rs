@@ -5,6 +5,7 @@
 //! rest through the real controller, measured on its last revolution).
 //! Timing belongs to `benches/steady_route.rs`.
 
+use ivt_sim::record::Channel;
 use ivt_sim::run::Simulation;
 use ivt_sim::scene::Law;
 use ivt_sim::scene::{ChannelSpec, Scene};
@@ -118,7 +119,7 @@ fn scenes_that_need_a_transient_take_the_time_route() {
     let mut s = scene("steady_state");
     s.duration_s = 2.0;
     s.outputs.channels.push(ChannelSpec {
-        name: "plant".into(),
+        name: Channel::Plant,
         every: 100,
     });
     let r = answer(&s, None);

@@ -23,7 +23,7 @@ use crate::error::SimError;
 use crate::integrate::{Method, PlantIntegrator, Reached, Tolerance};
 use crate::plant::Plant;
 use crate::profile::{Drive, Pwl};
-use crate::record::Sample;
+use crate::record::{Channel, Sample};
 use crate::scene::{IntegratorMethod, Scene};
 use crate::sensors::{Encoder, Reading, Rng, Stepper};
 use ivt_ctrl::ActuatorMap;
@@ -137,19 +137,13 @@ impl<'s> ClosedLoop<'s> {
         let omega0 = scene.omega0_rad_s();
         let est_pulses = scene.duration_s * omega0 / dtheta;
         let every = Every {
-            plant: o.every("plant"),
-            control: o.every("control"),
-            stepper: o.every("stepper"),
-            sensors: o.every("sensors"),
+            plant: o.every(Channel::Plant),
+            control: o.every(Channel::Control),
+            stepper: o.every(Channel::Stepper),
+            sensors: o.every(Channel::Sensors),
             plot: ((est_pulses / 4000.0).ceil() as u64).max(1),
         };
-        let ch = Channels {
-            plant: every.plant.map(|_| Vec::new()),
-            control: every.control.map(|_| Vec::new()),
-            stepper: every.stepper.map(|_| Vec::new()),
-            sensors: every.sensors.map(|_| Vec::new()),
-            plot: (!o.plots.is_empty()).then(Vec::new),
-        };
+        let ch = Channels::recording(|c| o.every(c).is_some(), !o.plots.is_empty());
         let met = Metrics::new(scene, omega0, dtheta);
         let r = match &r_schedule {
             Some(s) if backend.is_none() => s.at(0.0),
@@ -302,23 +296,12 @@ impl<'s> ClosedLoop<'s> {
         self.r_cmd_prev = r_cmd;
         self.last_pulse_t = t;
         let n = self.n_pulse;
-        if let (Some(buf), Some(e)) = (self.ch.plant.as_mut(), self.every.plant) {
-            if n.is_multiple_of(e as u64) {
-                let (v, tu) = self.drive.at_time(t);
-                let (theta, omega) = (self.integ.theta(), self.integ.omega());
-                let s = PlantSample {
-                    t,
-                    theta,
-                    omega,
-                    omega_a: p.omega_a,
-                    r: self.r,
-                    v_m: v,
-                    t_u: tu,
-                    i_a: armature_current(&self.integ, v),
-                };
+        if self.every.plant.is_some_and(|e| n.is_multiple_of(e as u64)) {
+            let s = self.plant_sample(p);
+            if let Some(buf) = self.ch.plant.as_mut() {
                 buf.push(s);
-                sink(Sample::Plant(s));
             }
+            sink(Sample::Plant(s));
         }
         if let (Some(buf), Some(e)) = (self.ch.stepper.as_mut(), self.every.stepper) {
             if n.is_multiple_of(e as u64) {
@@ -333,11 +316,26 @@ impl<'s> ClosedLoop<'s> {
                 sink(Sample::Stepper(s));
             }
         }
-        if let Some(buf) = self.ch.plot.as_mut() {
-            if n.is_multiple_of(self.every.plot) {
-                let (v, tu) = self.drive.at_time(t);
-                buf.push([t, self.integ.omega(), p.omega_a, self.r, v, tu]);
+        if self.ch.plot.is_some() && n.is_multiple_of(self.every.plot) {
+            let s = self.plant_sample(p);
+            if let Some(buf) = self.ch.plot.as_mut() {
+                buf.push(s);
             }
+        }
+    }
+
+    /// The plant's state at the pulse `p`, as the `plant` channel logs it.
+    fn plant_sample(&self, p: &Pulse) -> PlantSample {
+        let (v, tu) = self.drive.at_time(p.t);
+        PlantSample {
+            t: p.t,
+            theta: self.integ.theta(),
+            omega: self.integ.omega(),
+            omega_a: p.omega_a,
+            r: self.r,
+            v_m: v,
+            t_u: tu,
+            i_a: armature_current(&self.integ, v),
         }
     }
 

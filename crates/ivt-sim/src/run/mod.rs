@@ -15,88 +15,14 @@ mod metrics;
 use crate::backend::{self, ControllerBackend};
 use crate::error::SimError;
 use crate::integrate::Reached;
-use crate::record::Sample;
+pub use crate::record::{
+    Channels, ControlSample, PlantSample, Sample, SensorSample, StepperSample,
+};
 use crate::scene::{Law, Route, Scene};
 use closed_loop::ClosedLoop;
-use ivt_ctrl::{units, ActuatorMap, Config, ControlOutput, Gains, OpenLoopPreset, StepperLimits};
+use ivt_ctrl::{units, ActuatorMap, Config, Gains, OpenLoopPreset, StepperLimits};
 use serde::Serialize;
 use std::time::Instant;
-
-/// One `plant` channel sample (at a pulse).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PlantSample {
-    /// Time \[s\].
-    pub t: f64,
-    /// θ \[rad\].
-    pub theta: f64,
-    /// ω \[rad/s\].
-    pub omega: f64,
-    /// ω_a from the exact pulse times (NaN for the first revolution) \[rad/s\].
-    pub omega_a: f64,
-    /// Real eccentricity r \[m\].
-    pub r: f64,
-    /// True V_m \[V\].
-    pub v_m: f64,
-    /// True T_U \[N·m\].
-    pub t_u: f64,
-    /// Armature current: the state with L_a > 0 (Eq. 137), the algebraic
-    /// (V_m − k_e f ω)/R_a with L_a = 0 (Eq. 138) \[A\].
-    pub i_a: f64,
-}
-
-/// One `control` channel sample: the backend's [`ControlOutput`] for the
-/// pulse at `t` with timer capture `ticks`, as the controller returned it
-/// (the `control` channel logs its fields listed in [`crate::record`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ControlSample {
-    /// Time \[s\].
-    pub t: f64,
-    /// Timer capture \[ticks\].
-    pub ticks: u32,
-    /// The controller's answer to the pulse.
-    pub out: ControlOutput,
-}
-
-/// One `stepper` channel sample.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StepperSample {
-    /// Time \[s\].
-    pub t: f64,
-    /// Target from the controller \[steps\].
-    pub target: i64,
-    /// Steps issued \[steps\].
-    pub commanded: i64,
-    /// Real position \[steps\].
-    pub position: i64,
-    /// Steps lost so far.
-    pub missed: u64,
-}
-
-/// One `sensors` channel sample (what the controller was given).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SensorSample {
-    /// Time \[s\].
-    pub t: f64,
-    /// V_m reading \[V\].
-    pub v_m: f64,
-    /// T_U reading \[N·m\].
-    pub t_u: f64,
-}
-
-/// The channels that were asked for (None = not recorded at all).
-#[derive(Clone, Debug, Default)]
-pub struct Channels {
-    /// `plant` samples.
-    pub plant: Option<Vec<PlantSample>>,
-    /// `control` samples.
-    pub control: Option<Vec<ControlSample>>,
-    /// `stepper` samples.
-    pub stepper: Option<Vec<StepperSample>>,
-    /// `sensors` samples.
-    pub sensors: Option<Vec<SensorSample>>,
-    /// Series for the plots (only when plots are asked for): (t, ω, ω_a, r, V_m, T_U).
-    pub plot: Option<Vec<[f64; 6]>>,
-}
 
 /// The summary of a run (SPEC §3: settling time, overshoot, static error,
 /// control effort).

@@ -19,9 +19,7 @@ pub use hardware::{
     EncoderSection, IntegratorMethod, IntegratorSection, SensorsSection, StepperSection,
 };
 pub use inputs::{InitialSection, InputsSection};
-pub use outputs::{
-    ChannelSpec, OutputsSection, Route, RouteRequest, CHANNELS, DEFAULT_MAX_BYTES, PLOTS,
-};
+pub use outputs::{ChannelSpec, OutputsSection, Route, RouteRequest, DEFAULT_MAX_BYTES};
 pub use plant::{Gravity, PlantSection, PresetName};
 
 use ivt_kin::plant::PlantParams;
@@ -215,12 +213,12 @@ impl Scene {
         o.channels
             .iter()
             .map(|c| {
-                let n = if c.name == "sensors" {
+                let n = if c.name == crate::record::Channel::Sensors {
                     sensor_samples
                 } else {
                     pulses
                 };
-                let fields = crate::record::channel_fields(&c.name).len() as f64;
+                let fields = c.name.fields().len() as f64;
                 (n / c.every.max(1) as f64).ceil() * fields * BYTES_PER_FIELD
             })
             .sum::<f64>()

@@ -2,12 +2,8 @@
 //! the output-size cap.
 
 use super::Invalid;
+use crate::record::{Channel, Panel};
 use serde::{Deserialize, Serialize};
-
-/// Channel groups a scene may log.
-pub const CHANNELS: [&str; 4] = ["plant", "control", "stepper", "sensors"];
-/// Plot panels a scene may ask for.
-pub const PLOTS: [&str; 5] = ["omega", "omega_a", "r", "v_m", "t_u"];
 
 /// How a scene is answered (see [`crate::steady`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -70,8 +66,8 @@ impl RouteRequest {
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ChannelSpec {
-    /// `"plant"`, `"control"`, `"stepper"` or `"sensors"`.
-    pub name: String,
+    /// The channel, by name ([`Channel::name`]).
+    pub name: Channel,
     /// Keep every n-th sample (pulses; sensor samples for `"sensors"`).
     #[serde(default = "default_every")]
     pub every: usize,
@@ -94,8 +90,9 @@ pub struct OutputsSection {
     pub csv: bool,
     /// Write `<name>_summary.json`.
     pub summary: bool,
-    /// Plots to draw into `<name>.png`, one panel each: any of [`PLOTS`].
-    pub plots: Vec<String>,
+    /// Plots to draw into `<name>.png`, one panel each, by name
+    /// ([`Panel::name`]).
+    pub plots: Vec<Panel>,
     /// Logged channel groups.
     pub channels: Vec<ChannelSpec>,
     /// Ask for the steady-state metrics at the scene's (constant) inputs:
@@ -127,33 +124,23 @@ impl Default for OutputsSection {
 }
 
 impl OutputsSection {
-    /// Decimation of channel `name` (`every` n-th sample), `None` if not logged.
+    /// Decimation of `channel` (`every` n-th sample), `None` if not logged.
     #[must_use]
-    pub fn every(&self, name: &str) -> Option<usize> {
+    pub fn every(&self, channel: Channel) -> Option<usize> {
         self.channels
             .iter()
-            .find(|c| c.name == name)
+            .find(|c| c.name == channel)
             .map(|c| c.every)
     }
 
     pub(super) fn validate(&self) -> Result<(), Invalid> {
-        for (k, p) in self.plots.iter().enumerate() {
-            Invalid::check(
-                PLOTS.contains(&p.as_str()),
-                format!("outputs.plots[{k}]"),
-                || format!("entry \"{p}\" is not one of {PLOTS:?}"),
-            )?;
-        }
         for (k, ch) in self.channels.iter().enumerate() {
             let at = |field: &str| format!("outputs.channels[{k}].{field}");
-            Invalid::check(CHANNELS.contains(&ch.name.as_str()), at("name"), || {
-                format!("\"{}\" is not one of {CHANNELS:?}", ch.name)
-            })?;
             Invalid::check(ch.every >= 1, at("every"), || "must be ≥ 1".into())?;
             Invalid::check(
-                !self.channels[..k].iter().any(|c| c.name == ch.name),
+                !self.channels.iter().take(k).any(|c| c.name == ch.name),
                 at("name"),
-                || format!("\"{}\" is listed twice", ch.name),
+                || format!("\"{}\" is listed twice", ch.name.name()),
             )?;
         }
         Invalid::positive(self.max_bytes, "outputs.max_bytes", "")

@@ -186,7 +186,7 @@ fn duration_and_output_size_are_capped() {
     let logged = format!("{OK}\n[outputs]\ncsv = true\n[[outputs.channels]]\nname = \"plant\"\n");
     let s = Scene::parse(&logged, "s").unwrap();
     let pulses = 2.0 * s.omega0_rad_s() * 1200.0 / std::f64::consts::TAU;
-    let fields = crate::record::channel_fields("plant").len() as f64;
+    let fields = crate::record::Channel::Plant.fields().len() as f64;
     let want = pulses.ceil() * fields * 24.0 * 2.0;
     assert!((s.estimated_output_bytes() - want).abs() < 1e-9 * want);
     let capped = logged.replace("csv = true", "csv = true\nmax_bytes = 1e5");
