@@ -19,8 +19,7 @@ const FIG42_TEST: &str =
 
 /// The test ruling out Hsu's transformation matrix (Eq. 80) as the cause of
 /// the thesis-ch4 gap to Fig. 42's 0.7776.
-const FIG42_MU1_TEST: &str =
-    "tests/ch4_causes.rs::hsu_transformation_matrix_is_not_the_cause";
+const FIG42_MU1_TEST: &str = "tests/ch4_causes.rs::hsu_transformation_matrix_is_not_the_cause";
 
 /// The test showing that the printed gain ratio k2 = 2k keeps max |μ| above
 /// e^{−1/2} ≈ 0.607 on thesis-ch4, above Fig. 42's 0.4871.

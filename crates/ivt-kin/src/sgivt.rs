@@ -221,7 +221,10 @@ pub fn rectified_shape(theta: f64) -> f64 {
 ///
 /// # Errors
 /// `n` must be ≥ 2.
-pub fn output_ripple<G: crate::ncg::GearRatio + ?Sized>(gear: &G, n: usize) -> Result<(f64, f64), KinError> {
+pub fn output_ripple<G: crate::ncg::GearRatio + ?Sized>(
+    gear: &G,
+    n: usize,
+) -> Result<(f64, f64), KinError> {
     if n < 2 {
         return Err(KinError::BufferTooSmall {
             needed: 2,
@@ -456,9 +459,7 @@ mod tests {
         let expected = g.average_ratio(e).unwrap();
         for k in 0..5000 {
             let th = -4.0 + k as f64 * 0.0017;
-            let v = g
-                .output_to_engine_ratio(&SgivtNcg, th, e)
-                .unwrap();
+            let v = g.output_to_engine_ratio(&SgivtNcg, th, e).unwrap();
             assert!((v - expected).abs() <= 1e-12 * expected, "θ={th}");
         }
     }

@@ -23,4 +23,3 @@ pub(crate) fn record(slot: &ErrorSlot, e: PyErr) {
 pub(crate) fn failed(slot: &ErrorSlot) -> bool {
     slot.lock().is_ok_and(|s| s.is_some())
 }
-

@@ -38,11 +38,7 @@ impl Elements {
     }
 
     fn __repr__(&self) -> String {
-        let parts: Vec<String> = self
-            .list
-            .iter()
-            .map(call_text)
-            .collect();
+        let parts: Vec<String> = self.list.iter().map(call_text).collect();
         format!("Elements([{}])", parts.join(", "))
     }
 }

@@ -16,7 +16,7 @@ use ivt_hb::{ElementProblem, GeneralProblem, HbOptions, PeriodicProblem};
 use numpy::{IntoPyArray, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 /// The excitation `f(θ)` of a user system (a Python callable or none).
 type PyExcitation = Box<dyn Fn(f64, &mut [f64]) + Send + Sync>;
