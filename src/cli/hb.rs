@@ -1,15 +1,14 @@
 //! `ivt hb ...`: harmonic balance (thesis §3.2) — Duffing by modified/classic IHB
 //! with Floquet stability, the Duffing frequency-response curve, and the
 //! Mathieu–Duffing period-doubling cascade. `--plot FILE.png` draws the curves.
+//! Each command parses its arguments, runs an `ivt_hb::jobs` job and prints
+//! its serialized result (the keys of `ivt.hb`'s dicts).
 
 use super::{CliError, Output};
-use clap::{Args, Subcommand, ValueEnum};
+use clap::{Args, Subcommand};
 use ivt_hb::aft::eval_series;
-use ivt_hb::{
-    frequency_response, period_doubling_cascade, CascadeOptions, ClassicIhb, Duffing, FrcOptions,
-    HbOptions, HsuRule, ModifiedIhb, StabilityAnalyzer,
-};
-use serde_json::json;
+use ivt_hb::jobs::{self, CascadeRequest, FrcRequest, Method, OrbitRequest};
+use ivt_hb::{Duffing, HbOptions};
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
@@ -73,15 +72,6 @@ impl DuffingParams {
     }
 }
 
-/// Which IHB variant.
-#[derive(ValueEnum, Clone, Copy, PartialEq, Eq)]
-pub enum Method {
-    /// §3.2.2: AFT + Broyden seeded with the linear Jacobian.
-    Modified,
-    /// §3.2.1: Newton with the Galerkin Jacobian.
-    Classic,
-}
-
 /// `ivt hb duffing`.
 #[derive(Args)]
 pub struct DuffingArgs {
@@ -90,8 +80,9 @@ pub struct DuffingArgs {
     /// Excitation frequency ω_f.
     #[arg(long, default_value_t = 0.4)]
     omega_f: f64,
-    /// IHB variant.
-    #[arg(long, value_enum, default_value_t = Method::Modified)]
+    /// IHB variant: `modified` (§3.2.2, AFT + Broyden seeded with the linear
+    /// Jacobian) or `classic` (§3.2.1, Newton with the Galerkin Jacobian).
+    #[arg(long, default_value = "modified")]
     method: Method,
     /// Write a PNG of x(t) over one period.
     #[arg(long)]
@@ -109,6 +100,10 @@ pub struct FrcArgs {
     /// End frequency.
     #[arg(long, default_value_t = 3.0)]
     to: f64,
+    /// Also locate period doublings, Neimark–Sacker and branch points (the
+    /// start by the modified IHB, every event on its extended system).
+    #[arg(long)]
+    events: bool,
     /// Write a PNG of amplitude vs ω_f (stable solid, unstable red).
     #[arg(long)]
     plot: Option<PathBuf>,
@@ -151,60 +146,21 @@ pub fn run(cmd: HbCommand) -> Result<Output, CliError> {
     }
 }
 
-fn hb_err(e: ivt_hb::HbError) -> CliError {
-    match e {
-        ivt_hb::HbError::Solve(s) => {
-            CliError::Failed(format!("{s}; ‖r‖ history {:?}", s.history()))
-        }
-        e @ (ivt_hb::HbError::ContinuationStart { .. } | ivt_hb::HbError::SingularStart { .. }) => {
-            CliError::Failed(e.to_string())
-        }
-        other => CliError::Input(other.to_string()),
-    }
+/// The JSON object of a job's result.
+fn to_json<T: serde::Serialize>(result: &T) -> Result<serde_json::Value, CliError> {
+    serde_json::to_value(result).map_err(|e| CliError::Failed(e.to_string()))
 }
 
 fn duffing(a: DuffingArgs) -> Result<Output, CliError> {
     let problem = a.params.problem()?;
-    let opts = a.params.options()?;
-    let t0 = std::time::Instant::now();
-    let sol = match a.method {
-        Method::Modified => {
-            ModifiedIhb::new(problem.clone(), opts).and_then(|mut s| s.solve(a.omega_f, None))
-        }
-        Method::Classic => {
-            ClassicIhb::new(problem.clone(), opts).and_then(|mut s| s.solve(a.omega_f, None))
-        }
-    }
-    .map_err(hb_err)?;
-    let solve_time_s = t0.elapsed().as_secs_f64();
-    let steps = (8 * a.params.n).max(256);
-    let floquet = StabilityAnalyzer::new(&problem, a.params.n, steps)
-        .map_err(|e| CliError::Input(e.to_string()))?
-        .hsu(&problem, &sol, HsuRule::Magnus4);
-    if !floquet
-        .multipliers
-        .iter()
-        .all(|m| m.re.is_finite() && m.im.is_finite())
-    {
-        return Err(CliError::Failed(format!(
-            "the Floquet multipliers at ω_f = {} are not finite (Hsu's method over {steps} steps \
-             of one period 2π/ω_f); the stability of this solution is unknown",
-            a.omega_f
-        )));
-    }
-    let mults: Vec<[f64; 2]> = floquet.multipliers.iter().map(|m| [m.re, m.im]).collect();
-    let json = json!({
-        "coeffs": sol.coeffs,
-        "iterations": sol.stats.iterations,
-        "residual_norm": sol.stats.residual_norm,
-        "solve_time_s": solve_time_s,
-        "floquet": mults,
-        "stable": floquet.stable(),
-        "stability": floquet.kind.name(),
-        "amplitude": sol.amplitude(0),
-        "omega_f": a.omega_f,
-    });
+    let req = OrbitRequest {
+        omega_f: a.omega_f,
+        method: a.method,
+        ..OrbitRequest::default()
+    };
+    let orbit = jobs::orbit(&problem, &a.params.options()?, &req)?;
     if let Some(path) = &a.plot {
+        let sol = &orbit.solution;
         let period = 2.0 * PI / sol.omega();
         let pts: Vec<(f64, f64)> = (0..=400)
             .map(|i| {
@@ -223,33 +179,28 @@ fn duffing(a: DuffingArgs) -> Result<Output, CliError> {
     let human = format!(
         "Duffing ω_f = {}: {} iterations, ‖r‖ = {:.2e}, {:.1} µs, amplitude {:.6}, {} (|μ|max = {:.6})\n",
         a.omega_f,
-        sol.stats.iterations,
-        sol.stats.residual_norm,
-        solve_time_s * 1e6,
-        sol.amplitude(0),
-        floquet.kind.name(),
-        floquet.max_modulus()
+        orbit.iterations,
+        orbit.residual_norm,
+        orbit.solve_time_s * 1e6,
+        orbit.amplitude,
+        orbit.stability.map_or("unknown", |k| k.name()),
+        orbit.max_modulus()
     );
-    Ok(Output { json, human })
+    Ok(Output {
+        json: to_json(&orbit)?,
+        human,
+    })
 }
 
 fn duffing_frc(a: FrcArgs) -> Result<Output, CliError> {
     let problem = a.params.problem()?;
-    let opts = FrcOptions {
+    let req = FrcRequest {
         from: a.from,
         to: a.to,
-        ..FrcOptions::default()
+        events: a.events,
+        ..FrcRequest::default()
     };
-    let t0 = std::time::Instant::now();
-    let frc = frequency_response(&problem, &a.params.options()?, &opts).map_err(hb_err)?;
-    let time = t0.elapsed().as_secs_f64();
-    let points: Vec<_> = frc
-        .points
-        .iter()
-        .map(|p| json!({"omega": p.omega_f, "amplitude": p.amplitude, "stable": p.stable(), "kind": p.kind.name()}))
-        .collect();
-    let folds: Vec<f64> = frc.folds.iter().map(|f| f.omega_f).collect();
-    let json = json!({ "points": points, "folds": folds, "time_s": time, "termination": format!("{:?}", frc.termination) });
+    let frc = jobs::frc(&problem, &a.params.options()?, &req)?.with_fold_omegas();
     if let Some(path) = &a.plot {
         // One curve per stability; a NaN point breaks a curve where the other
         // takes over, and each run shares its end point with the next.
@@ -257,7 +208,7 @@ fn duffing_frc(a: FrcArgs) -> Result<Output, CliError> {
         let (mut stable, mut unstable) = (Vec::new(), Vec::new());
         let mut prev: Option<((f64, f64), bool)> = None;
         for p in &frc.points {
-            let (pt, s) = ((p.omega_f, p.amplitude), p.stable());
+            let (pt, s) = ((p.omega, p.amplitude), p.stable);
             if let Some((last, _)) = prev.filter(|&(_, was)| was != s) {
                 let (into, other) = if s {
                     (&mut stable, &mut unstable)
@@ -283,46 +234,33 @@ fn duffing_frc(a: FrcArgs) -> Result<Output, CliError> {
         )?;
     }
     let human = format!(
-        "{} points from ω_f = {} to {}, folds at {:?}, {:.1} ms\n",
+        "{} points from ω_f = {} to {}, folds at {:?}, {} events, {:.1} ms\n",
         frc.points.len(),
         a.from,
         a.to,
-        folds,
-        time * 1e3
+        frc.folds,
+        frc.bifurcations.len(),
+        frc.time_s * 1e3
     );
-    Ok(Output { json, human })
+    Ok(Output {
+        json: to_json(&frc)?,
+        human,
+    })
 }
 
 fn mathieu(a: MathieuArgs) -> Result<Output, CliError> {
-    if ![a.xi, a.alpha, a.omega, a.gamma]
-        .iter()
-        .all(|v| v.is_finite())
-        || a.omega <= 0.0
-    {
-        return Err(CliError::Input("parameters must be finite, Ω > 0".into()));
-    }
-    let opts = CascadeOptions {
+    let req = CascadeRequest {
         xi: a.xi,
         alpha: a.alpha,
         omega: a.omega,
         gamma: a.gamma,
         harmonics: a.n,
-        ..CascadeOptions::default()
     };
-    let t0 = std::time::Instant::now();
-    let pds = period_doubling_cascade(&opts).map_err(hb_err)?;
-    let time = t0.elapsed().as_secs_f64();
-    let betas: Vec<f64> = pds.iter().map(|p| p.beta).collect();
-    let json = json!({
-        "period_doubling_beta": betas,
-        "periods": pds.iter().map(|p| p.period).collect::<Vec<_>>(),
-        "multipliers": pds.iter().map(|p| [p.multiplier.re, p.multiplier.im]).collect::<Vec<_>>(),
-        "thesis": [4.825, 5.194, 5.253],
-        "time_s": time,
-    });
+    let cascade = jobs::cascade(&req)?;
     if let Some(path) = &a.plot {
         let names = ["period 1 at β1", "period 2 at β2", "period 4 at β4"];
-        let series: Vec<_> = pds
+        let series: Vec<_> = cascade
+            .doublings
             .iter()
             .zip(names)
             .map(|(p, name)| {
@@ -348,10 +286,13 @@ fn mathieu(a: MathieuArgs) -> Result<Output, CliError> {
     }
     let human = format!(
         "period doubling at β = {:?} (thesis 4.825, 5.194, 5.253), {:.1} ms\n",
-        betas,
-        time * 1e3
+        cascade.period_doubling_beta,
+        cascade.time_s * 1e3
     );
-    Ok(Output { json, human })
+    Ok(Output {
+        json: to_json(&cascade)?,
+        human,
+    })
 }
 
 /// Draw curves with the shared figure crate (embedded font, NaN breaks).

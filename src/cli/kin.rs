@@ -6,11 +6,11 @@ use clap::{Subcommand, ValueEnum};
 use ivt_kin::arcs::{fit_arcs, Arc, ArcOptions, GearProfile, Member};
 use ivt_kin::givt::{DirectionMode, DirectionModule, GivtGeometry, MAX_CORNERS};
 use ivt_kin::ncg::{
-    fourier_coefficient, fourier_coefficient_eq38, output_ripple, pitch_profile, GearRatio,
-    GivtNcg, PitchPoint, SgivtNcg, SmoothNcg, EQ42_PRINTED,
+    fourier_coefficient, fourier_coefficient_eq38, pitch_profile, GearRatio, GivtNcg, PitchPoint,
+    SgivtNcg, SmoothNcg, EQ42_PRINTED,
 };
 use ivt_kin::plant::PlantParams;
-use ivt_kin::sgivt::{SgivtGeometry, R_AVG_SLOPE_PRINTED_PER_DEG};
+use ivt_kin::sgivt::{output_ripple, SgivtGeometry, R_AVG_SLOPE_PRINTED_PER_DEG};
 use ivt_kin::units::{deg_to_rad, m_to_inch, rad_to_deg};
 use ivt_kin::KinError;
 use serde_json::{json, Value};

@@ -61,6 +61,18 @@ impl CliError {
     }
 }
 
+/// A harmonic-balance error: `input` or `failed` as
+/// [`ivt_hb::HbError::kind`] says.
+impl From<ivt_hb::HbError> for CliError {
+    fn from(e: ivt_hb::HbError) -> Self {
+        if e.kind() == "input" {
+            CliError::Input(e.to_string())
+        } else {
+            CliError::Failed(e.to_string())
+        }
+    }
+}
+
 /// A design-crate error: bad inputs (out-of-range or non-finite arguments,
 /// plant parameters, empty grids) are `input`, solver failures `failed`.
 impl From<ivt_design::IvtError> for CliError {

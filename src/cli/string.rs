@@ -3,10 +3,9 @@
 
 use super::{CliError, Output};
 use clap::{Args, ValueEnum};
-use ivt_hb::sthb::frc::{frequency_response, StringFrcOptions};
-use ivt_hb::sthb::{Boundary, StringHb, StringParams};
+use ivt_hb::jobs::{self, StringRequest};
+use ivt_hb::sthb::{Boundary, StringParams};
 use ivt_hb::FrcPoint;
-use serde_json::json;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -64,7 +63,10 @@ pub struct StringArgs {
     plot: Option<PathBuf>,
 }
 
-/// Trace the curve and report `{"points": [{"omega", "norm", "stable"}...]}`.
+/// Trace the curve (the job [`ivt_hb::jobs::string`]) and report
+/// `{"points": [{"omega", "norm", "stable", "kind", "max_multiplier",
+/// "method"}...], "jacobians", "hill_calls", "stop", "solve_time_s"}` (and
+/// `boundary_note` for a spring of k0 > 1).
 ///
 /// # Errors
 /// [`CliError::Input`] for invalid parameters, [`CliError::Failed`] when the
@@ -74,67 +76,34 @@ pub fn run(args: StringArgs) -> Result<Output, CliError> {
         BoundaryArg::Fixed => Boundary::Fixed,
         BoundaryArg::Spring => Boundary::Spring { k0: args.k0 },
     };
-    let params = StringParams {
-        kd: args.kd,
-        cd: args.cd,
-        y0: args.y0,
-        modes: args.modes,
-        harmonics: args.harmonics,
-        ns: args.ns,
-        ms: args.ms,
-        boundary,
+    let req = StringRequest {
+        params: StringParams {
+            kd: args.kd,
+            cd: args.cd,
+            y0: args.y0,
+            modes: args.modes,
+            harmonics: args.harmonics,
+            ns: args.ns,
+            ms: args.ms,
+            boundary,
+        },
+        from: args.from,
+        to: args.to,
+        step_max: args.step_max,
     };
-    params
-        .validate()
-        .map_err(|e| CliError::Input(e.to_string()))?;
-    if !(args.from > 0.0 && args.to > args.from && args.to.is_finite() && args.step_max > 0.0) {
-        return Err(CliError::Input(format!(
-            "need 0 < --from < --to and --step-max > 0, got {} .. {}",
-            args.from, args.to
-        )));
-    }
-    let t0 = std::time::Instant::now();
+    let curve = jobs::string(&req)?;
     let mut human = format!(
-        "# STHB string, k_d = {}, N = {}, M = {}, {:?}\n# omega norm stable\n",
-        args.kd, args.modes, args.harmonics, args.boundary
+        "# STHB string, k_d = {}, N = {}, M = {}, {}\n# omega norm stable\n",
+        args.kd,
+        args.modes,
+        args.harmonics,
+        boundary_name(boundary)
     );
-    // Both boundaries: Newton arclength with the exact (Tau) Jacobian. The
-    // engine's Broyden continuation (`spring_frequency_response`, §3.3.5) gives
-    // the same spring curve but ~50× slower (crates/ivt-hb/README.md, STHB).
-    let mut hb = StringHb::new(params).map_err(|e| CliError::Input(e.to_string()))?;
-    let mut opts = StringFrcOptions::default();
-    opts.continuation.ds_max = args.step_max;
-    let curve = frequency_response(&mut hb, args.from, args.to, &opts)
-        .map_err(|e| CliError::Failed(e.to_string()))?;
-    let solve_time_s = t0.elapsed().as_secs_f64();
-    let frc = &curve.frc;
-    let points: Vec<_> = frc
-        .points
-        .iter()
-        .zip(&curve.methods)
-        .map(|(p, method)| {
-            let _ = writeln!(human, "{:.6} {:.6e} {}", p.omega_f, p.amplitude, p.stable());
-            json!({"omega": p.omega_f, "norm": p.amplitude, "stable": p.stable(),
-                   "kind": format!("{:?}", p.kind), "max_multiplier": p.multipliers.first().map(|m| m.norm()),
-                   "method": format!("{method:?}")})
-        })
-        .collect();
-    let mut extra = json!({"jacobians": curve.jacobians, "hill_calls": curve.hill_calls,
-                       "stop": format!("{:?}", frc.termination)});
-    if let Boundary::Spring { k0 } = boundary {
-        if k0 > 1.0 {
-            let note = format!(
-                "Eq. 132 as printed (k0 w = +w_x) is a negative spring: for k0 > 1 the continuous \
-                 string has a growing mode (tanh γ = γ/k0). `stable` is the verdict of the \
-                 {}-mode Tau model, which resolves that mode only when N > (k0 − 1)/2; \
-                 a restoring spring of stiffness k is --k0=-k",
-                args.modes
-            );
-            let _ = writeln!(human, "# note: {note}");
-            if let Some(o) = extra.as_object_mut() {
-                o.insert("boundary_note".into(), json!(note));
-            }
-        }
+    for p in &curve.points {
+        let _ = writeln!(human, "{:.6} {:.6e} {}", p.omega, p.norm, p.stable);
+    }
+    if let Some(note) = &curve.boundary_note {
+        let _ = writeln!(human, "# note: {note}");
     }
     if let Some(path) = &args.plot {
         let title = format!(
@@ -142,19 +111,21 @@ pub fn run(args: StringArgs) -> Result<Output, CliError> {
             args.kd,
             args.modes,
             args.harmonics,
-            match boundary {
-                Boundary::Fixed => "fixed–fixed".to_string(),
-                Boundary::Spring { k0 } => format!("spring k0 = {k0}"),
-            }
+            boundary_name(boundary)
         );
-        plot(path, &title, &frc.points)?;
+        plot(path, &title, &curve.frc.points)?;
         let _ = writeln!(human, "# plot: {}", path.display());
     }
-    let mut obj = json!({"points": points, "solve_time_s": solve_time_s});
-    if let (Some(o), Some(e)) = (obj.as_object_mut(), extra.as_object()) {
-        o.extend(e.clone());
+    let json = serde_json::to_value(&curve).map_err(|e| CliError::Failed(e.to_string()))?;
+    Ok(Output { json, human })
+}
+
+/// The boundary at x = 1 in words.
+fn boundary_name(boundary: Boundary) -> String {
+    match boundary {
+        Boundary::Fixed => "fixed–fixed".to_string(),
+        Boundary::Spring { k0 } => format!("spring k0 = {k0}"),
     }
-    Ok(Output { json: obj, human })
 }
 
 /// ‖a‖(ω) with the stable stretches solid and the unstable ones dashed; each

@@ -5,6 +5,7 @@
 //! does not reproduce on it); `thesis-ch4` divides k_t and k_e by 10.
 
 use super::design_maps::{figs_38_40, stability};
+use super::design_refs::{fig_id, BAND_TEST, SPEC5};
 use super::{borrow_series, fmt_sig, Cause, Context, OwnedSeries, ReproError};
 use ivt_design::fit::{self, OpenLoopLaw, PolyForm};
 use ivt_design::shooting::{periodic_at_r, shoot_steady_state, ShootingOptions};
@@ -17,37 +18,8 @@ use ivt_num::{ExplicitRk, RK4};
 use ivt_plot::{Figure, Style};
 use std::f64::consts::PI;
 
-pub(super) const SPEC5: &str =
-    "SPEC §5: the printed u_ol (Eq. 158) does not hold 100 rpm on the printed \
-plant (Eq. 151 + Table 1); 100 rpm needs V_m in the band [7.87, 7.87 + 0.154 T_U] V";
-
-/// The test showing that the printed plant's 100-rpm band excludes the thesis's points.
-pub(super) const BAND_TEST: &str =
-    "crates/ivt-design/tests/ivt_design.rs::verdicts_follow_the_band";
 /// The test showing how far Eq. 158's printed digits can represent a fit.
 const DIGITS_TEST: &str = "src/reproduce/design.rs::printed_digits_limit_eq158";
-
-/// The test confirming the thesis-ch4 multipliers of Fig. 42 by simulation.
-pub(super) const FIG42_TEST: &str =
-    "tests/ch4_plant.rs::fig42_multipliers_on_thesis_ch4_confirmed_by_simulation";
-
-/// The test ruling out Hsu's transformation matrix (Eq. 80) as the cause of
-/// the thesis-ch4 gap to Fig. 42's 0.7776.
-pub(super) const FIG42_MU1_TEST: &str =
-    "tests/ch4_causes.rs::hsu_transformation_matrix_is_not_the_cause";
-
-/// The test showing that the printed gain ratio k2 = 2k keeps max |μ| above
-/// e^{−1/2} ≈ 0.607 on thesis-ch4, above Fig. 42's 0.4871.
-pub(super) const FIG42_MU2_TEST: &str =
-    "tests/ch4_causes.rs::printed_gain_ratio_floors_the_multiplier_at_exp_minus_half";
-
-/// Figure id of a thesis figure on a preset (`printed` keeps the bare id).
-pub(super) fn fig_id(base: &str, preset: PlantPreset) -> String {
-    match preset {
-        PlantPreset::Printed => base.to_string(),
-        _ => format!("{base} ({})", preset.name()),
-    }
-}
 
 /// Report section of a preset.
 fn section(preset: PlantPreset) -> &'static str {

@@ -2,7 +2,7 @@
 //! open-loop law and Γ̂ of §4.2.2 over the working grid, with the Γ̂ = 0
 //! boundary) and Fig. 42 (max |multiplier| of the time-delay loop, with the
 //! thesis's two example multipliers).
-use super::design::{fig_id, BAND_TEST, FIG42_MU1_TEST, FIG42_MU2_TEST, FIG42_TEST, SPEC5};
+use super::design_refs::{fig_id, BAND_TEST, SPEC5};
 use super::{borrow_series, fmt_sig, Cause, Context, OwnedSeries, ReproError, Verdict};
 use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
 use ivt_design::fit::OpenLoopLaw;
@@ -12,6 +12,19 @@ use ivt_design::OperatingPoint;
 use ivt_kin::plant::{PlantParams, PlantPreset};
 use ivt_plot::{Figure, HeatMap, Style};
 use std::f64::consts::SQRT_2;
+
+/// The test confirming the thesis-ch4 multipliers of Fig. 42 by simulation.
+const FIG42_TEST: &str =
+    "tests/ch4_plant.rs::fig42_multipliers_on_thesis_ch4_confirmed_by_simulation";
+
+/// The test ruling out Hsu's transformation matrix (Eq. 80) as the cause of
+/// the thesis-ch4 gap to Fig. 42's 0.7776.
+const FIG42_MU1_TEST: &str = "tests/ch4_causes.rs::hsu_transformation_matrix_is_not_the_cause";
+
+/// The test showing that the printed gain ratio k2 = 2k keeps max |μ| above
+/// e^{−1/2} ≈ 0.607 on thesis-ch4, above Fig. 42's 0.4871.
+const FIG42_MU2_TEST: &str =
+    "tests/ch4_causes.rs::printed_gain_ratio_floors_the_multiplier_at_exp_minus_half";
 
 pub(super) fn gamma_hat(plant: &PlantParams, law: &OpenLoopLaw, v: f64, t: f64) -> f64 {
     // §4.2.2, the equation after Eq. 170: Γ̂ = −9.8√2 r_f + (k_t/R_a V_m − 2√2 T_U r_f/(π r_u))/√2.

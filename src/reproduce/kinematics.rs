@@ -8,11 +8,11 @@ use super::{
 use ivt_kin::arcs::Member;
 use ivt_kin::givt::GivtGeometry;
 use ivt_kin::ncg::{
-    fourier_coefficient, fourier_coefficient_eq38, output_ripple, pitch_profile, GearRatio,
-    GivtNcg, PitchPoint, SgivtNcg, SmoothNcg, EQ42_PRINTED,
+    fourier_coefficient, fourier_coefficient_eq38, pitch_profile, GearRatio, GivtNcg, PitchPoint,
+    SgivtNcg, SmoothNcg, EQ42_PRINTED,
 };
 use ivt_kin::plant::PlantParams;
-use ivt_kin::sgivt::{SgivtGeometry, R_AVG_SLOPE_PRINTED_PER_DEG};
+use ivt_kin::sgivt::{output_ripple, SgivtGeometry, R_AVG_SLOPE_PRINTED_PER_DEG};
 use ivt_kin::units::{deg_to_rad, inch_to_m};
 use ivt_kin::variant;
 use ivt_plot::{Figure, Style};

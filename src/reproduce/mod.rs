@@ -13,6 +13,7 @@ mod closed_loop;
 mod closed_loop_ch4;
 mod design;
 mod design_maps;
+mod design_refs;
 mod gear_arcs;
 mod hb;
 mod kinematics;

@@ -34,7 +34,8 @@ use ivt_num::LuWorkspace;
 use thiserror::Error;
 
 /// The kind of a located bifurcation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum BifurcationKind {
     /// A turning point in λ (a real multiplier through +1), located by
     /// [`crate::fold::locate_fold`].

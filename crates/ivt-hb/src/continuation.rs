@@ -136,6 +136,25 @@ pub enum Termination {
     StepTooSmall(SolveError),
 }
 
+impl Termination {
+    /// The snake_case word of JSON and Python (SPEC §6), never Debug text.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Self::LeftInterval => "left_interval",
+            Self::MaxPoints => "max_points",
+            Self::Stopped => "stopped",
+            Self::StepTooSmall(_) => "step_too_small",
+        }
+    }
+}
+
+/// Serialized as [`Termination::as_str`] (the corrector error is not part of it).
+impl serde::Serialize for Termination {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.as_str())
+    }
+}
+
 /// A traced path.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Path {

@@ -28,7 +28,7 @@ pub enum HbError {
         n_half: usize,
     },
     /// The iteration did not converge (carries the residual history).
-    #[error("harmonic balance did not converge: {0}")]
+    #[error("harmonic balance did not converge: {0}; ‖r‖ history {history:?}", history = .0.history())]
     Solve(#[from] SolveError),
     /// A limit-cycle iteration collapsed onto the equilibrium `x = 0`.
     #[error("the iteration collapsed onto the equilibrium x = 0 (no limit cycle near the guess)")]
@@ -91,4 +91,78 @@ pub enum HbError {
     /// An eigenvalue computation (Hill matrix, monodromy matrix) failed.
     #[error("eigenvalue computation failed: {0}")]
     Eigen(String),
+    /// Hsu's monodromy matrix of a converged orbit has non-finite multipliers,
+    /// so its stability is unknown (e.g. ω_f so small that one period spans
+    /// far more time than the steps resolve).
+    #[error(
+        "the Floquet multipliers at ω_f = {omega} are not finite (Hsu's method over {steps} \
+         steps of one period 2π/ω_f); the stability of this solution is unknown"
+    )]
+    NonFiniteMultipliers {
+        /// Excitation frequency.
+        omega: f64,
+        /// Hsu sub-intervals of the period.
+        steps: usize,
+    },
+}
+
+impl HbError {
+    /// A stable snake_case word for the class of the error, the `kind` of the
+    /// CLI's `{"error", "kind"}` object (SPEC §6) and the Python exception
+    /// (`ValueError` for `"input"`, `ivt.hb.ConvergenceError` for
+    /// `"failed"`): `"input"` when the arguments are invalid (sizes,
+    /// parameters, the AFT's sample count), `"failed"` when a solve, a path,
+    /// a stability or eigenvalue computation failed on valid arguments.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::InvalidInput(_)
+            | Self::AftTooFewSamples { .. }
+            | Self::AftTooManySamples { .. } => "input",
+            Self::Solve(_)
+            | Self::Equilibrium
+            | Self::ContinuationStart { .. }
+            | Self::SingularStart { .. }
+            | Self::NoConvergence { .. }
+            | Self::Singular { .. }
+            | Self::NonFinite { .. }
+            | Self::Stalled { .. }
+            | Self::ColdStart { .. }
+            | Self::Eigen(_)
+            | Self::NonFiniteMultipliers { .. } => "failed",
+        }
+    }
+
+    /// The residual norm per iteration of a failed Broyden or Newton solve
+    /// (empty for the other errors).
+    pub fn history(&self) -> &[f64] {
+        match self {
+            Self::Solve(s) | Self::ContinuationStart { cause: s, .. } => s.history(),
+            Self::NoConvergence { history, .. } => history,
+            _ => &[],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kinds_split_bad_arguments_from_failed_computations() {
+        let input = HbError::AftTooFewSamples {
+            harmonics: 20,
+            n_half: 10,
+        };
+        assert_eq!(input.kind(), "input");
+        assert_eq!(HbError::InvalidInput("n".into()).kind(), "input");
+        let failed = HbError::NoConvergence {
+            method: "classic IHB",
+            omega: 1.0,
+            history: vec![1.0, 0.5],
+        };
+        assert_eq!(failed.kind(), "failed");
+        assert_eq!(failed.history(), [1.0, 0.5]);
+        assert_eq!(HbError::Equilibrium.kind(), "failed");
+        assert!(HbError::Equilibrium.history().is_empty());
+    }
 }

@@ -20,6 +20,7 @@ pub mod frc;
 pub mod galerkin;
 pub mod hill;
 pub mod ihb;
+pub mod jobs;
 pub mod limits;
 pub mod mathieu;
 pub mod modified;

@@ -16,7 +16,8 @@ use crate::problem::PeriodicProblem;
 use faer::c64;
 
 /// What the leading multiplier says.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum StabilityKind {
     /// All multipliers inside the unit circle.
     Stable,

@@ -139,32 +139,6 @@ pub fn fourier_coefficient<G: GearRatio + ?Sized>(gear: &G, k: u32) -> Result<f6
     Ok(if k == 0 { value / p } else { 2.0 * value / p })
 }
 
-/// Range of the SGIVT output/engine ratio R/R_n (Eq. 37 with Eq. 35) over a
-/// period, relative to its mean: `(min/mean, max/mean)`, sampled at `n`
-/// points. (1, 1) for the exact pair Eq. 38; the smooth Eq. 42 leaves a ripple
-/// (Fig. 24).
-///
-/// # Errors
-/// `n` must be ≥ 2.
-pub fn output_ripple<G: GearRatio + ?Sized>(gear: &G, n: usize) -> Result<(f64, f64), KinError> {
-    if n < 2 {
-        return Err(KinError::BufferTooSmall {
-            needed: 2,
-            capacity: n,
-        });
-    }
-    let (mut lo, mut hi, mut sum) = (f64::INFINITY, f64::NEG_INFINITY, 0.0);
-    for j in 0..n {
-        let t = FRAC_PI_2 * (j as f64 + 0.5) / n as f64;
-        let v = crate::sgivt::rectified_shape(t) / gear.ratio(t);
-        lo = libm::fmin(lo, v);
-        hi = libm::fmax(hi, v);
-        sum += v;
-    }
-    let mean = sum / n as f64;
-    Ok((lo / mean, hi / mean))
-}
-
 /// ∫_a^b g over [a, b] ⊂ one or more periods, split at the gear's corners.
 fn integrate_pieces<G: GearRatio + ?Sized, F: Fn(f64) -> f64>(
     gear: &G,
@@ -457,7 +431,6 @@ impl GearRatio for GivtNcg {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sgivt::SgivtGeometry;
     use crate::NCG_AMPLITUDE;
 
     /// Closed-form angle map of Eq. 38: on the segment θ = kπ/2 + φ, |φ| ≤ π/4,
@@ -481,7 +454,8 @@ mod tests {
     /// form) plus NG2's radius is D at every point.
     #[test]
     fn sgivt_profiles_close_and_keep_centre_distance() {
-        let d = SgivtGeometry::prototype().ncg_centre_distance;
+        // The prototype's D (`SgivtGeometry::prototype().ncg_centre_distance`).
+        let d = crate::units::inch_to_m(5.25);
         let mut pts = [PitchPoint::default(); 721];
         let check = pitch_profile(&SgivtNcg, d, &mut pts).unwrap();
         assert!(check.closure_error.abs() < 1e-12, "{}", check.closure_error);
@@ -544,26 +518,6 @@ mod tests {
             let half_ulp = if k == 3 { 5e-4 } else { 5e-5 };
             assert!((printed - 0.9 * exact).abs() <= half_ulp, "k={}", k + 1);
         }
-    }
-
-    /// Fig. 24: the exact pair Eq. 38 leaves no ripple (Eq. 37: the output
-    /// ratio is constant), to rounding.
-    #[test]
-    fn output_ripple_of_exact_pair_is_zero() {
-        let (lo, hi) = output_ripple(&SgivtNcg, 10_000).unwrap();
-        assert!((lo - 1.0).abs() < 1e-12 && (hi - 1.0).abs() < 1e-12);
-    }
-
-    /// Regression pin, not a correctness check (no independent value: the
-    /// thesis shows Fig. 24 without numbers): the Fourier truncation of
-    /// Eq. 38 leaves 4.55 % peak-to-peak, the printed (softened) Eq. 42
-    /// series 6.84 %, as measured when this was written.
-    #[test]
-    fn regression_pin_output_ripple_of_smooth_series() {
-        let (lo, hi) = output_ripple(&SmoothNcg::fourier(), 100_000).unwrap();
-        assert!((hi - lo - 0.0455).abs() < 5e-4, "{lo} {hi}");
-        let (lo, hi) = output_ripple(&SmoothNcg::PRINTED, 100_000).unwrap();
-        assert!((hi - lo - 0.0684).abs() < 5e-4, "{lo} {hi}");
     }
 
     /// The smooth ratio Eq. 42 keeps the 1:1 design (mean 1): its profiles close.

@@ -214,6 +214,35 @@ pub fn rectified_shape(theta: f64) -> f64 {
     libm::fmax(libm::fabs(libm::sin(theta)), libm::fabs(libm::cos(theta)))
 }
 
+/// Range of the SGIVT output/engine ratio R/R_n (Eq. 37 with Eq. 35) over a
+/// period, relative to its mean: `(min/mean, max/mean)`, sampled at `n`
+/// points. (1, 1) for the exact pair Eq. 38; the smooth Eq. 42 leaves a ripple
+/// (Fig. 24).
+///
+/// # Errors
+/// `n` must be ≥ 2.
+pub fn output_ripple<G: crate::ncg::GearRatio + ?Sized>(
+    gear: &G,
+    n: usize,
+) -> Result<(f64, f64), KinError> {
+    if n < 2 {
+        return Err(KinError::BufferTooSmall {
+            needed: 2,
+            capacity: n,
+        });
+    }
+    let (mut lo, mut hi, mut sum) = (f64::INFINITY, f64::NEG_INFINITY, 0.0);
+    for j in 0..n {
+        let t = FRAC_PI_2 * (j as f64 + 0.5) / n as f64;
+        let v = rectified_shape(t) / gear.ratio(t);
+        lo = libm::fmin(lo, v);
+        hi = libm::fmax(hi, v);
+        sum += v;
+    }
+    let mean = sum / n as f64;
+    Ok((lo / mean, hi / mean))
+}
+
 /// Yoke displacements and speeds, Eq. 24–27: `x1 = e cos θ`,
 /// `x2 = e cos(θ − 90°)`, and their time derivatives with ė ≠ 0.
 /// θ = θ_CRK and ω = ω_CRK in the clockwise sense of Fig. 21.
@@ -264,7 +293,28 @@ pub fn rectified_output(omega_og: &[f64; 4]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ncg::{SgivtNcg, SmoothNcg};
     use crate::units::{m_to_inch, rad_to_deg};
+
+    /// Fig. 24: the exact pair Eq. 38 leaves no ripple (Eq. 37: the output
+    /// ratio is constant), to rounding.
+    #[test]
+    fn output_ripple_of_exact_pair_is_zero() {
+        let (lo, hi) = output_ripple(&SgivtNcg, 10_000).unwrap();
+        assert!((lo - 1.0).abs() < 1e-12 && (hi - 1.0).abs() < 1e-12);
+    }
+
+    /// Regression pin, not a correctness check (no independent value: the
+    /// thesis shows Fig. 24 without numbers): the Fourier truncation of
+    /// Eq. 38 leaves 4.55 % peak-to-peak, the printed (softened) Eq. 42
+    /// series 6.84 %, as measured when this was written.
+    #[test]
+    fn regression_pin_output_ripple_of_smooth_series() {
+        let (lo, hi) = output_ripple(&SmoothNcg::fourier(), 100_000).unwrap();
+        assert!((hi - lo - 0.0455).abs() < 5e-4, "{lo} {hi}");
+        let (lo, hi) = output_ripple(&SmoothNcg::PRINTED, 100_000).unwrap();
+        assert!((hi - lo - 0.0684).abs() < 5e-4, "{lo} {hi}");
+    }
 
     /// Eq. 31–32: with d_SG = d_PG and ω_SG2 = −ω_SG1 the ring speeds are
     /// 4ω_in/3 ∓ ω_SG1/3; Eq. 33: the crank turns at ω_in whatever the control
@@ -409,9 +459,7 @@ mod tests {
         let expected = g.average_ratio(e).unwrap();
         for k in 0..5000 {
             let th = -4.0 + k as f64 * 0.0017;
-            let v = g
-                .output_to_engine_ratio(&crate::ncg::SgivtNcg, th, e)
-                .unwrap();
+            let v = g.output_to_engine_ratio(&SgivtNcg, th, e).unwrap();
             assert!((v - expected).abs() <= 1e-12 * expected, "θ={th}");
         }
     }

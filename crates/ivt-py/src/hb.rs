@@ -1,296 +1,37 @@
 //! `ivt.hb`: the harmonic-balance engine of ivt-hb (modified/classic IHB, limit
 //! cycles, Floquet stability by Hsu's method, frequency-response curves with
 //! located folds) for Duffing, Mathieu–Duffing and user systems
-//! `M x'' + C x' + K x + g(x, x', θ) = f(θ)`.
+//! `M x'' + C x' + K x + g(x, x', θ) = f(θ)`. Each function parses its
+//! arguments, runs an `ivt_hb::jobs` job and returns its result as a dict
+//! (the keys of the CLI's JSON, [`crate::to_python`]).
 
-use ivt_hb::{
-    frequency_response, period_doubling_cascade, CascadeOptions, ClassicIhb, Duffing, Floquet,
-    FrcOptions, HbError, HbOptions, HbSolution, HbSolver, HsuRule, MathieuDuffing, ModifiedIhb,
-    PeriodicProblem, StabilityAnalyzer,
-};
-use numpy::ndarray::Array1;
-use numpy::{IntoPyArray, PyArray1};
-use pyo3::create_exception;
-use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
+use ivt_hb::jobs::{self, CascadeRequest, FrcRequest, LimitCycleRequest, OrbitRequest};
+use ivt_hb::{Duffing, MathieuDuffing};
+use numpy::PyArrayLike1;
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
-use std::time::Instant;
+use pyo3::types::PyDict;
 
 use crate::args::{count, int64};
-use crate::user_problem::{callback_error, user_problem, with_tolerances, PyProblem};
+use crate::hb_shared::{
+    finite, guess_vec, hb_err, options, run, run_user, user_system_fn, ConvergenceError, UserArgs,
+};
+use crate::to_python::to_dict;
 
-create_exception!(
-    ivt,
-    ConvergenceError,
-    PyRuntimeError,
-    "A harmonic-balance solve that did not converge; `.history` holds ‖r‖ per iteration."
-);
-
-/// Hsu sub-intervals per period for n harmonics: max(8n, 256), the rule of
-/// `ivt hb duffing` (ivt-hb: 256 is enough for the flags).
-pub(crate) fn stability_steps(harmonics: usize) -> usize {
-    (8 * harmonics).max(256)
-}
-
-/// Map an ivt-hb error to Python: bad inputs → ValueError, non-convergence →
-/// ConvergenceError carrying the residual history.
-pub(crate) fn hb_err(py: Python<'_>, e: HbError) -> PyErr {
-    match &e {
-        HbError::Solve(s) => {
-            let err = ConvergenceError::new_err(e.to_string());
-            let history = s.history().to_vec();
-            if let Ok(list) = PyList::new(py, history) {
-                let _ = err.value(py).setattr("history", list);
-            }
-            err
-        }
-        HbError::ContinuationStart { .. } | HbError::SingularStart { .. } => {
-            ConvergenceError::new_err(e.to_string())
-        }
-        _ => PyValueError::new_err(e.to_string()),
-    }
-}
-
-/// Run `solve` with the GIL released; its error mapped by [`hb_err`].
-fn run<T: Send>(py: Python<'_>, solve: impl FnOnce() -> Result<T, HbError> + Send) -> PyResult<T> {
-    py.detach(solve).map_err(|e| hb_err(py, e))
-}
-
-/// Run `solve` on a user system with the GIL released (its callbacks take it
-/// back), then re-raise the first exception a callback raised (it aborted the
-/// run) or map the ivt-hb error with [`hb_err`].
-pub(crate) fn run_user<T: Send>(
+/// The orbit job's request from the keywords (`method` by name).
+fn orbit_request(
     py: Python<'_>,
-    problem: &PyProblem,
-    solve: impl FnOnce(&PyProblem) -> Result<T, HbError> + Send,
-) -> PyResult<T> {
-    let result = py.detach(|| solve(problem));
-    // The callback's exception, not the failure it caused, is the error.
-    if let Some(e) = callback_error(problem) {
-        return Err(e);
-    }
-    result.map_err(|e| hb_err(py, e))
-}
-
-/// Options from the Python keywords: n harmonics, `samples` = N (2N AFT samples).
-fn options(n: i64, samples: i64, subharmonic: i64, tol: f64) -> PyResult<HbOptions> {
-    let (n, samples): (usize, usize) = (count("n", n)?, count("samples", samples)?);
-    let subharmonic: usize = count("subharmonic", subharmonic)?;
-    if n == 0 {
-        return Err(PyValueError::new_err(
-            "argument `n` (harmonics) must be >= 1",
-        ));
-    }
-    if let Some(why) = ivt_hb::limits::unknowns_error(1, n) {
-        return Err(PyValueError::new_err(format!("argument `n` = {n}: {why}")));
-    }
-    if let Some(why) = ivt_hb::limits::samples_error(samples) {
-        return Err(PyValueError::new_err(format!(
-            "argument `samples` = {samples}: {why}"
-        )));
-    }
-    if samples <= n {
-        return Err(PyValueError::new_err(format!(
-            "argument `samples` = {samples} must exceed `n` = {n} (2N > 2n AFT samples)"
-        )));
-    }
-    if !(tol.is_finite() && tol > 0.0) {
-        return Err(PyValueError::new_err(format!(
-            "argument `tol` = {tol} must be finite and > 0"
-        )));
-    }
-    Ok(HbOptions::new(n, samples)
-        .with_subharmonic(subharmonic)
-        .with_tol(tol))
-}
-
-pub(crate) fn finite(name: &str, v: f64) -> PyResult<f64> {
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(PyValueError::new_err(format!(
-            "argument `{name}` = {v} must be finite"
-        )))
-    }
-}
-
-/// Which IHB variant.
-#[derive(Clone, Copy)]
-enum Method {
-    Modified,
-    Classic,
-}
-
-fn method(name: &str) -> PyResult<Method> {
-    match name {
-        "modified" => Ok(Method::Modified),
-        "classic" => Ok(Method::Classic),
-        other => Err(PyValueError::new_err(format!(
-            "argument `method` = {other:?} must be 'modified' or 'classic'"
-        ))),
-    }
-}
-
-/// What one solve returns before conversion to Python.
-struct Solved {
-    sol: HbSolution,
-    solve_time_s: f64,
-    floquet: Option<Floquet>,
-}
-
-/// Solve `problem` at `omega_f` and (optionally) its Floquet multipliers.
-fn solve_problem<P: PeriodicProblem>(
-    problem: &P,
-    opts: &HbOptions,
-    method: Method,
     omega_f: f64,
-    guess: Option<&[f64]>,
+    method: &str,
+    guess: Option<&Bound<'_, PyAny>>,
     stability: bool,
-) -> Result<Solved, HbError> {
-    let t0 = Instant::now();
-    let mut solver: Box<dyn HbSolver + '_> = match method {
-        Method::Modified => Box::new(ModifiedIhb::new(problem, opts.clone())?),
-        Method::Classic => Box::new(ClassicIhb::new(problem, opts.clone())?),
-    };
-    let sol = solver.solve(omega_f, guess)?;
-    let solve_time_s = t0.elapsed().as_secs_f64();
-    let floquet = if stability {
-        let mut an =
-            StabilityAnalyzer::new(problem, opts.harmonics, stability_steps(opts.harmonics))?;
-        Some(an.hsu(problem, &sol, HsuRule::Magnus4))
-    } else {
-        None
-    };
-    Ok(Solved {
-        sol,
-        solve_time_s,
-        floquet,
+) -> PyResult<OrbitRequest> {
+    Ok(OrbitRequest {
+        omega_f,
+        method: method.parse().map_err(|e| hb_err(py, e))?,
+        guess: guess_vec(guess)?,
+        stability,
     })
-}
-
-/// The result dict with the keys of `ivt hb duffing --json`: coeffs (numpy),
-/// iterations, residual_norm, solve_time_s, floquet ([[re, im], ...]) and
-/// stable (None when stability was not asked for), plus stability (the
-/// class name), omega_f, harmonics, subharmonic, residual_evals.
-fn solved_dict<'py>(py: Python<'py>, s: &Solved) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("coeffs", s.sol.coeffs.clone().into_pyarray(py))?;
-    d.set_item("iterations", s.sol.stats.iterations)?;
-    d.set_item("residual_norm", s.sol.stats.residual_norm)?;
-    d.set_item("residual_evals", s.sol.stats.residual_evals)?;
-    d.set_item("solve_time_s", s.solve_time_s)?;
-    d.set_item("omega_f", s.sol.omega_f)?;
-    d.set_item("harmonics", s.sol.harmonics)?;
-    d.set_item("subharmonic", s.sol.subharmonic)?;
-    match &s.floquet {
-        Some(f) => {
-            let pairs: Vec<[f64; 2]> = f.multipliers.iter().map(|m| [m.re, m.im]).collect();
-            d.set_item("floquet", pairs)?;
-            d.set_item("stable", f.stable())?;
-            d.set_item("stability", f.kind.name())?;
-        }
-        None => {
-            d.set_item("floquet", PyList::empty(py))?;
-            d.set_item("stable", py.None())?;
-            d.set_item("stability", py.None())?;
-        }
-    }
-    Ok(d)
-}
-
-fn guess_vec(guess: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<f64>>> {
-    guess
-        .map(|g| {
-            g.extract::<numpy::PyArrayLike1<'_, f64, numpy::AllowTypeChange>>()
-                .map(|a| a.as_array().to_vec())
-                .map_err(|_| PyTypeError::new_err("argument `guess` must be a 1-D array of floats"))
-        })
-        .transpose()
-}
-
-/// A `#[pyfunction]` on a user system `M x'' + C x' + K x + g(x, v, θ) =
-/// f(θ)` returning a dict. Python parameters: `m, c, k, g`, the function's
-/// own (`name: type [= default]`), `n=20, samples=64`, its own again, then
-/// `velocity_dependent=True, vectorized=False, rtol=1e-9, max_iter=100`, and
-/// `jac=None` when the caller names it after the `UserArgs` binding (a
-/// function whose solver assembles the Galerkin Jacobian). The
-/// shared ones reach the body as the [`UserArgs`] named by the caller.
-macro_rules! user_system_fn {
-    (
-        $(#[$doc:meta])*
-        fn $name:ident<$lt:lifetime>($py:ident, $user:ident $(, $jac:ident)?;
-            $( $(#[$pa:ident($($pa_args:tt)*)])* $arg:ident: $ty:ty $(= $default:tt)? ),+;
-            $( $(#[$pb:ident($($pb_args:tt)*)])* $brg:ident: $bty:ty $(= $bdefault:tt)? ),+ $(,)?
-        ) $body:block
-    ) => {
-        $(#[$doc])*
-        #[pyfunction]
-        #[pyo3(signature = (
-            m, c, k, g, $($arg $(= $default)?,)+ n = 20, samples = 64, $($brg $(= $bdefault)?,)+
-            velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
-            $(, $jac = None)?
-        ))]
-        #[allow(clippy::too_many_arguments, clippy::field_reassign_with_default)]
-        fn $name<$lt>(
-            $py: Python<$lt>,
-            m: &Bound<$lt, PyAny>, c: &Bound<$lt, PyAny>, k: &Bound<$lt, PyAny>, g: &Bound<$lt, PyAny>,
-            $( $(#[$pa($($pa_args)*)])* $arg: $ty, )+
-            #[pyo3(from_py_with = crate::args::int64)] n: i64,
-            #[pyo3(from_py_with = crate::args::int64)] samples: i64,
-            $( $(#[$pb($($pb_args)*)])* $brg: $bty, )+
-            velocity_dependent: bool, vectorized: bool, rtol: f64, max_iter: usize,
-            $( $jac: Option<&Bound<$lt, PyAny>>, )?
-        ) -> PyResult<Bound<$lt, PyDict>> {
-            let $user = UserArgs {
-                system: [m, c, k, g], n, samples, velocity_dependent, vectorized, rtol, max_iter,
-                jac: None $( .or($jac) )?,
-            };
-            $body
-        }
-    };
-}
-pub(crate) use user_system_fn;
-
-/// The arguments every user-system function shares: the system `[m, c, k, g]`,
-/// `g`'s optional Jacobian `jac` (always None where the keyword is not offered)
-/// and the harmonic-balance settings.
-pub(crate) struct UserArgs<'a, 'py> {
-    pub(crate) system: [&'a Bound<'py, PyAny>; 4],
-    pub(crate) n: i64,
-    pub(crate) samples: i64,
-    pub(crate) velocity_dependent: bool,
-    pub(crate) vectorized: bool,
-    pub(crate) rtol: f64,
-    pub(crate) max_iter: usize,
-    pub(crate) jac: Option<&'a Bound<'py, PyAny>>,
-}
-
-impl UserArgs<'_, '_> {
-    /// The user problem forced by `f` and its options (`subharmonic`, absolute
-    /// tolerance `tol`, see [`with_tolerances`]).
-    pub(crate) fn setup(
-        &self,
-        f: Option<&Bound<'_, PyAny>>,
-        subharmonic: i64,
-        tol: f64,
-    ) -> PyResult<(PyProblem, HbOptions)> {
-        let [m, c, k, g] = self.system;
-        let problem = user_problem(
-            m,
-            c,
-            k,
-            g,
-            f,
-            self.jac,
-            self.velocity_dependent,
-            self.vectorized,
-        )?;
-        let opts = options(self.n, self.samples, subharmonic, 1.0)?;
-        Ok((
-            problem,
-            with_tolerances(opts, tol, self.rtol, self.max_iter)?,
-        ))
-    }
 }
 
 /// Duffing's equation Eq. 49 from the keywords (each must be finite).
@@ -337,12 +78,9 @@ fn duffing<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let opts = options(n, samples, 1, tol)?;
     let problem = duffing_problem(xi, alpha, eps, force)?;
-    let m = self::method(method)?;
-    let guess = guess_vec(guess)?;
-    let solved = run(py, || {
-        solve_problem(&problem, &opts, m, omega_f, guess.as_deref(), stability)
-    })?;
-    solved_dict(py, &solved)
+    let req = orbit_request(py, omega_f, method, guess, stability)?;
+    let orbit = run(py, || jobs::orbit(&problem, &opts, &req))?;
+    to_dict(py, &orbit)
 }
 
 /// Periodic solution of the Mathieu–Duffing equation Eq. 81,
@@ -377,18 +115,9 @@ fn mathieu_duffing<'py>(
         finite("beta", beta)?,
         finite("gamma", gamma)?,
     );
-    let guess = guess_vec(guess)?;
-    let solved = run(py, || {
-        solve_problem(
-            &problem,
-            &opts,
-            Method::Modified,
-            omega,
-            guess.as_deref(),
-            stability,
-        )
-    })?;
-    solved_dict(py, &solved)
+    let req = orbit_request(py, omega, "modified", guess, stability)?;
+    let orbit = run(py, || jobs::orbit(&problem, &opts, &req))?;
+    to_dict(py, &orbit)
 }
 
 /// The period-doubling cascade of the Mathieu–Duffing equation Eq. 81
@@ -407,84 +136,32 @@ fn mathieu_cascade<'py>(
     gamma: f64,
     #[pyo3(from_py_with = int64)] n: i64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    if !(omega.is_finite() && omega > 0.0) {
-        return Err(PyValueError::new_err(format!(
-            "argument `omega` = {omega} must be finite and > 0"
-        )));
-    }
-    let opts = CascadeOptions {
+    let req = CascadeRequest {
         xi: finite("xi", xi)?,
         alpha: finite("alpha", alpha)?,
-        omega,
+        omega: finite("omega", omega)?,
         gamma: finite("gamma", gamma)?,
         harmonics: count("n", n)?,
-        ..CascadeOptions::default()
     };
-    let t0 = Instant::now();
-    let pds = py
-        .detach(|| period_doubling_cascade(&opts))
-        .map_err(|e| hb_err(py, e))?;
-    let d = PyDict::new(py);
-    d.set_item("time_s", t0.elapsed().as_secs_f64())?;
-    d.set_item(
-        "period_doubling_beta",
-        pds.iter().map(|p| p.beta).collect::<Vec<_>>(),
-    )?;
-    d.set_item("periods", pds.iter().map(|p| p.period).collect::<Vec<_>>())?;
-    let mu: Vec<_> = pds.iter().map(|p| p.multiplier).collect();
-    d.set_item("multipliers", pairs(&mu))?;
-    d.set_item("thesis", [4.825, 5.194, 5.253])?;
-    Ok(d)
-}
-
-/// Multipliers as `[[re, im], ...]`.
-pub(crate) fn pairs(mu: &[ivt_hb::c64]) -> Vec<[f64; 2]> {
-    mu.iter().map(|m| [m.re, m.im]).collect()
-}
-
-/// The dict of a traced curve: "points" [{"omega", "amplitude", "stable",
-/// "stability", "kind", "coeffs", "multipliers"}...], "termination", and the
-/// arrays omega, amplitude, stable for plotting ("folds" is set by the caller).
-pub(crate) fn frc_dict<'py>(py: Python<'py>, frc: &ivt_hb::Frc) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    let points = PyList::empty(py);
-    for p in &frc.points {
-        let e = PyDict::new(py);
-        e.set_item("omega", p.omega_f)?;
-        e.set_item("amplitude", p.amplitude)?;
-        e.set_item("stable", p.stable())?;
-        e.set_item("stability", p.kind.name())?;
-        e.set_item("kind", p.kind.name())?;
-        e.set_item("coeffs", p.coeffs.clone().into_pyarray(py))?;
-        e.set_item("multipliers", pairs(&p.multipliers))?;
-        e.set_item("multiplier_error", p.multiplier_error)?;
-        points.append(e)?;
-    }
-    d.set_item("points", points)?;
-    d.set_item("termination", format!("{:?}", frc.termination))?;
-    let col = |f: fn(&ivt_hb::FrcPoint) -> f64| -> Bound<'py, PyArray1<f64>> {
-        Array1::from_iter(frc.points.iter().map(f)).into_pyarray(py)
-    };
-    d.set_item("omega", col(|p| p.omega_f))?;
-    d.set_item("amplitude", col(|p| p.amplitude))?;
-    d.set_item(
-        "stable",
-        Array1::from_iter(frc.points.iter().map(|p| p.stable())).into_pyarray(py),
-    )?;
-    Ok(d)
+    let cascade = run(py, || jobs::cascade(&req))?;
+    to_dict(py, &cascade)
 }
 
 /// Frequency-response curve of Duffing's equation by pseudo-arclength
 /// continuation in ω_f from `from_` to `to` (Fig. 29), with the Floquet
-/// verdict at every point. Returns {"points": [{"omega", "amplitude",
-/// "stable", "stability"}...], "folds": [ω_f at each turning point],
-/// "termination"} — the keys of `ivt hb duffing-frc --json` — and the arrays
-/// omega, amplitude, stable for plotting. GIL released.
+/// verdict at every point: the dict of `ivt hb duffing-frc --json`
+/// ([`ivt_hb::jobs::FrcCurve`]): {"points": [{"omega", "amplitude",
+/// "stable", "stability", "kind", "coeffs", "multipliers",
+/// "multiplier_error"}...], "folds": [ω_f at each turning point],
+/// "bifurcations", "termination", "time_s"} and the arrays omega,
+/// amplitude, stable for plotting. `events=True` (`--events`) also locates
+/// period doublings, Neimark–Sacker and branch points. GIL released.
 #[pyfunction]
 #[pyo3(signature = (
-    from_ = 0.2, to = 3.0, n = 20, samples = 64, xi = 0.02, alpha = 1.0, eps = 1.0, force = 0.1
+    from_ = 0.2, to = 3.0, n = 20, samples = 64, xi = 0.02, alpha = 1.0, eps = 1.0, force = 0.1,
+    events = false
 ))]
-#[allow(clippy::too_many_arguments, clippy::field_reassign_with_default)]
+#[allow(clippy::too_many_arguments)]
 fn duffing_frc<'py>(
     py: Python<'py>,
     from_: f64,
@@ -495,19 +172,18 @@ fn duffing_frc<'py>(
     alpha: f64,
     eps: f64,
     force: f64,
+    events: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let opts = options(n, samples, 1, 1e-10)?;
     let problem = duffing_problem(xi, alpha, eps, force)?;
-    // FrcOptions is #[non_exhaustive]: no struct expression from outside ivt-hb
-    // (hence the clippy allow on this function).
-    let mut frc_opts = FrcOptions::default();
-    frc_opts.from = finite("from_", from_)?;
-    frc_opts.to = finite("to", to)?;
-    let frc = run(py, || frequency_response(&problem, &opts, &frc_opts))?;
-    let d = frc_dict(py, &frc)?;
-    let folds: Vec<f64> = frc.folds.iter().map(|f| f.omega_f).collect();
-    d.set_item("folds", folds)?;
-    Ok(d)
+    let req = FrcRequest {
+        from: finite("from_", from_)?,
+        to: finite("to", to)?,
+        events,
+        ..FrcRequest::default()
+    };
+    let curve = run(py, || jobs::frc(&problem, &opts, &req))?;
+    to_dict(py, &curve.with_fold_omegas())
 }
 
 user_system_fn! {
@@ -553,12 +229,9 @@ fn solve<'py>(py, user, jac;
     stability: bool = true,
 ) {
     let (problem, opts) = user.setup(f, subharmonic, tol)?;
-    let meth = self::method(method)?;
-    let guess = guess_vec(guess)?;
-    let solved = run_user(py, &problem, |p| {
-        solve_problem(p, &opts, meth, omega_f, guess.as_deref(), stability)
-    })?;
-    solved_dict(py, &solved)
+    let req = orbit_request(py, omega_f, method, guess, stability)?;
+    let orbit = run_user(py, &problem, |p| jobs::orbit(p, &opts, &req))?;
+    to_dict(py, &orbit)
 }
 }
 
@@ -581,36 +254,13 @@ fn limit_cycle<'py>(py, user, jac;
     tol: f64 = 0.0,
 ) {
     let (problem, opts) = user.setup(None, 1, tol)?;
-    let start = match guess_vec(guess)? {
-        Some(q) => q,
-        None => {
-            // x_0 = amplitude·cos τ: a1 of DOF 0 (index 1), all else zero.
-            let mut q = vec![0.0; problem.n_dof() * (2 * opts.harmonics + 1)];
-            if let Some(a1) = q.get_mut(1) {
-                *a1 = finite("amplitude", amplitude)?;
-            }
-            q
-        }
+    let req = LimitCycleRequest {
+        omega_guess,
+        guess: guess_vec(guess)?,
+        amplitude: finite("amplitude", amplitude)?,
     };
-    let lc = run_user(py, &problem, |p| {
-        ivt_hb::limit_cycle(
-            p,
-            &opts,
-            omega_guess,
-            &start,
-            stability_steps(opts.harmonics),
-        )
-    })?;
-    let d = PyDict::new(py);
-    d.set_item("omega", lc.omega())?;
-    d.set_item("period", lc.period())?;
-    d.set_item("coeffs", lc.solution.coeffs.clone().into_pyarray(py))?;
-    d.set_item("multipliers", pairs(&lc.multipliers))?;
-    d.set_item("stable", lc.stable())?;
-    d.set_item("stability", lc.kind.name())?;
-    d.set_item("iterations", lc.solution.stats.iterations)?;
-    d.set_item("residual_norm", lc.solution.stats.residual_norm)?;
-    Ok(d)
+    let cycle = run_user(py, &problem, |p| jobs::limit_cycle(p, &opts, &req))?;
+    to_dict(py, &cycle)
 }
 }
 
@@ -623,7 +273,7 @@ fn limit_cycle<'py>(py, user, jac;
 #[pyo3(signature = (coeffs, tau, order = 0, n_dof = 1))]
 fn eval_series<'py>(
     py: Python<'py>,
-    coeffs: numpy::PyArrayLike1<'py, f64, numpy::AllowTypeChange>,
+    coeffs: PyArrayLike1<'py, f64, numpy::AllowTypeChange>,
     tau: &Bound<'py, PyAny>,
     #[pyo3(from_py_with = int64)] order: i64,
     #[pyo3(from_py_with = int64)] n_dof: i64,

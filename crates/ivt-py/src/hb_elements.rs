@@ -38,13 +38,24 @@ impl Elements {
     }
 
     fn __repr__(&self) -> String {
-        let parts: Vec<String> = self
-            .list
-            .iter()
-            .map(|e| format!("{:?} on ({}, {:?})", e.law, e.a, e.b))
-            .collect();
+        let parts: Vec<String> = self.list.iter().map(call_text).collect();
         format!("Elements([{}])", parts.join(", "))
     }
+}
+
+/// The element as the Python call that builds it, e.g.
+/// `cubic_spring(k3=0.5, dof=0, to=None)` (not the Debug text of [`Law`]).
+fn call_text(e: &Element) -> String {
+    let law = match e.law {
+        Law::CubicSpring { k3 } => format!("cubic_spring(k3={k3}"),
+        Law::QuadraticDamper { c2 } => format!("quadratic_damper(c2={c2}"),
+        Law::CubicDamper { c3 } => format!("cubic_damper(c3={c3}"),
+        Law::Coulomb { force, v_reg } => format!("coulomb(force={force}, v_reg={v_reg}"),
+        Law::Clearance { gap, k } => format!("clearance(gap={gap}, k={k}"),
+        Law::Unilateral { gap, k } => format!("unilateral(gap={gap}, k={k}"),
+    };
+    let to = e.b.map_or_else(|| "None".to_string(), |b| b.to_string());
+    format!("{law}, dof={}, to={to})", e.a)
 }
 
 /// One element of law `law` between DOF `dof` and DOF `to` (None: ground).

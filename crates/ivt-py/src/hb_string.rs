@@ -1,17 +1,16 @@
 //! `ivt.hb.string`: the frequency-response curve of the nonlinear string by
 //! space–time harmonic balance (STHB, thesis §3.3, Eq. 103; Figs. 34–36), the
-//! computation of `ivt hb string --json` with its defaults and keys.
+//! job [`ivt_hb::jobs::string`] of `ivt hb string --json`.
 
-use ivt_hb::sthb::frc::{frequency_response, StringFrcOptions};
-use ivt_hb::sthb::{Boundary, StringHb, StringParams};
-use ivt_hb::HbError;
+use ivt_hb::jobs::{self, StringRequest};
+use ivt_hb::sthb::{Boundary, StringParams};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
-use std::time::Instant;
+use pyo3::types::PyDict;
 
 use crate::args::{count, int64};
-use crate::hb::{hb_err, ConvergenceError};
+use crate::hb_shared::run;
+use crate::to_python::to_dict;
 
 /// Frequency-response curve of the string with geometric nonlinearity,
 /// `ω² w_tt + ω c_d w_t − w_xx − k_d w_x² w_xx − y0 sin(πx) cos t = 0`
@@ -22,12 +21,11 @@ use crate::hb::{hb_err, ConvergenceError};
 /// "spring" (k0 w(1) = w_x(1), Eq. 132, Tau method).
 /// Returns the dict of `ivt hb string --json`: points [{"omega", "norm" (‖a‖,
 /// Eq. 114), "stable", "kind", "max_multiplier", "method"}...], jacobians,
-/// hill_calls, stop, solve_time_s. A trace that fails numerically raises
-/// `ConvergenceError`. |kd| is limited to 1e9 (larger values
-/// only make the trace slow before it fails). GIL released.
-/// Largest |k_d| accepted (see [`string`]).
-const MAX_KD: f64 = 1e9;
-
+/// hill_calls, stop, solve_time_s ([`ivt_hb::jobs::StringCurve`]; a spring
+/// of k0 > 1 adds boundary_note). A trace that fails numerically raises
+/// `ConvergenceError`. |kd| is limited to 1e9
+/// ([`ivt_hb::jobs::string::MAX_KD`]: larger values only make the trace slow
+/// before it fails). GIL released.
 #[pyfunction]
 #[pyo3(signature = (
     kd = 10.0, modes = 5, harmonics = 19, from_ = 1.0, to = 6.0, cd = 0.8, y0 = 0.5, ns = 64,
@@ -58,13 +56,6 @@ fn string<'py>(
             )))
         }
     };
-    // Measured with `ivt hb string`: from k_d ≈ 1e9 on the trace ends in an
-    // error after seconds, growing to ~12 s at 1e17 (the thesis uses 10 and 30).
-    if !(kd.is_finite() && kd.abs() <= MAX_KD) {
-        return Err(PyValueError::new_err(format!(
-            "argument `kd` = {kd} must be finite with |kd| <= {MAX_KD:e}"
-        )));
-    }
     let params = StringParams {
         kd,
         cd,
@@ -75,43 +66,19 @@ fn string<'py>(
         ms: count("ms", ms)?,
         boundary,
     };
-    params.validate().map_err(|e| hb_err(py, e))?;
     if !(from_ > 0.0 && to > from_ && to.is_finite() && step_max > 0.0 && step_max.is_finite()) {
         return Err(PyValueError::new_err(format!(
             "need 0 < `from_` < `to` (finite) and `step_max` > 0, got {from_} .. {to}, {step_max}"
         )));
     }
-    let mut opts = StringFrcOptions::default();
-    opts.continuation.ds_max = step_max;
-    let t0 = Instant::now();
-    let mut hb = StringHb::new(params).map_err(|e| hb_err(py, e))?;
-    // The inputs are valid here: a failure of the trace (cold start, stalled
-    // step, Hill's method) is numerical, a ConvergenceError.
-    let curve = py
-        .detach(|| frequency_response(&mut hb, from_, to, &opts))
-        .map_err(|e| match e {
-            HbError::InvalidInput(_) => hb_err(py, e),
-            other => ConvergenceError::new_err(other.to_string()),
-        })?;
-    let solve_time_s = t0.elapsed().as_secs_f64();
-    let points = PyList::empty(py);
-    for (p, method) in curve.frc.points.iter().zip(&curve.methods) {
-        let e = PyDict::new(py);
-        e.set_item("omega", p.omega_f)?;
-        e.set_item("norm", p.amplitude)?;
-        e.set_item("stable", p.stable())?;
-        e.set_item("kind", format!("{:?}", p.kind))?;
-        e.set_item("max_multiplier", p.multipliers.first().map(|m| m.norm()))?;
-        e.set_item("method", format!("{method:?}"))?;
-        points.append(e)?;
-    }
-    let d = PyDict::new(py);
-    d.set_item("points", points)?;
-    d.set_item("solve_time_s", solve_time_s)?;
-    d.set_item("jacobians", curve.jacobians)?;
-    d.set_item("hill_calls", curve.hill_calls)?;
-    d.set_item("stop", format!("{:?}", curve.frc.termination))?;
-    Ok(d)
+    let req = StringRequest {
+        params,
+        from: from_,
+        to,
+        step_max,
+    };
+    let curve = run(py, || jobs::string(&req))?;
+    to_dict(py, &curve)
 }
 
 /// Add `string` to the `hb` module.

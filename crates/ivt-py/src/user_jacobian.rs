@@ -5,7 +5,7 @@
 //! [`Nonlinearity::jacobian_samples`](ivt_hb::Nonlinearity::jacobian_samples)).
 
 use crate::callback_arrays::{float_array, SampleArrays};
-use crate::user_problem::{failed, record, ErrorSlot};
+use crate::error_slot::{failed, record, ErrorSlot};
 use ivt_hb::problem::per_sample;
 use numpy::IntoPyArray;
 use pyo3::exceptions::{PyTypeError, PyValueError};

@@ -8,6 +8,7 @@
 //! elements bring their own analytic Jacobian.
 
 use crate::callback_arrays::{float_array, SampleArrays};
+use crate::error_slot::{failed, record, ErrorSlot};
 use crate::hb_elements::Elements;
 use crate::user_jacobian::PyJacobian;
 use ivt_hb::problem::{per_sample, Nonlinearity};
@@ -15,10 +16,7 @@ use ivt_hb::{ElementProblem, GeneralProblem, HbOptions, PeriodicProblem};
 use numpy::{IntoPyArray, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use std::sync::{Arc, Mutex};
-
-/// The first exception raised by a callback (the solver then sees NaN).
-pub(crate) type ErrorSlot = Arc<Mutex<Option<PyErr>>>;
+use std::sync::Arc;
 
 /// The excitation `f(θ)` of a user system (a Python callable or none).
 type PyExcitation = Box<dyn Fn(f64, &mut [f64]) + Send + Sync>;
@@ -73,21 +71,6 @@ pub(crate) struct PyNonlinearity {
     vectorized: bool,
     arrays: SampleArrays,
     error: ErrorSlot,
-}
-
-/// Keeps `e` in `slot` unless an earlier exception is there.
-pub(crate) fn record(slot: &ErrorSlot, e: PyErr) {
-    if let Ok(mut slot) = slot.lock() {
-        if slot.is_none() {
-            *slot = Some(e);
-        }
-    }
-}
-
-/// Whether a callback of the run already raised: later callbacks are not
-/// called (their outputs are NaN), so a failed run ends without more Python.
-pub(crate) fn failed(slot: &ErrorSlot) -> bool {
-    slot.lock().is_ok_and(|s| s.is_some())
 }
 
 /// Calls `func(*args)` and writes its `out.len()` floats into `out` (NaN and the

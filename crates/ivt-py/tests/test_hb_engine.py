@@ -77,7 +77,7 @@ def test_duffing_backbone_against_the_elliptic_closed_form() -> None:
     # The cubic spring as a Rust element, then as a Python g.
     for g in (hb.elements.cubic_spring(eps), lambda x, v, th: eps * x**3):
         bb = hb.backbone(1.0, 0.0, 1.0, g, 1.0, [1.0], 0.01, 2.0, velocity_dependent=False)
-        assert bb["termination"] == "LeftInterval"
+        assert bb["termination"] == "left_interval"
         assert bb["amplitude"][0] == pytest.approx(0.01, abs=1e-12) and bb["amplitude"][-1] >= 2.0
         assert len(bb["points"]) > 10
         for p in bb["points"]:

@@ -172,7 +172,7 @@ def test_backbone_with_jac_is_the_elliptic_closed_form_with_fewer_calls() -> Non
 
         bb = hb.backbone(1.0, 0.0, 1.0, g, 1.0, [1.0], 0.01, 2.0, velocity_dependent=False,
                          vectorized=True, jac=jac)
-        assert bb["termination"] == "LeftInterval" and bb["amplitude"][-1] >= 2.0
+        assert bb["termination"] == "left_interval" and bb["amplitude"][-1] >= 2.0
         for p in bb["points"]:
             a = float(hb.eval_series(p["coeffs"], 0.0))
             mm = a * a / (2 * (1 + a * a))

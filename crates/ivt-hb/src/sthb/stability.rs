@@ -29,7 +29,8 @@ use crate::error::HbError;
 pub use crate::stability::StabilityKind;
 
 /// Which method produced a verdict.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum StabilityMethod {
     /// Eigenvalues of the Hill matrix (Eq. 130–131).
     Hill,

@@ -84,6 +84,7 @@ def duffing_frc(
     alpha: float = 1.0,
     eps: float = 1.0,
     force: float = 0.1,
+    events: bool = False,
 ) -> Dict[str, Any]: ...
 def solve(
     m: Matrix,

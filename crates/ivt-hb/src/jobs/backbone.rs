@@ -1,0 +1,145 @@
+//! Backbone curve (nonlinear normal mode) of an undamped, unforced system,
+//! followed in amplitude from a linear mode with ω unknown (phase condition
+//! b1 = 0, a fictitious damping κ unfolding the family: [`crate::backbone`]).
+
+use super::{finite, Array};
+use crate::backbone::{BackboneOptions, BackbonePoint};
+use crate::continuation::{Corrector, Termination};
+use crate::error::HbError;
+use crate::ihb::HbOptions;
+use crate::problem::PeriodicProblem;
+use serde::Serialize;
+
+/// The linear mode to start from and the amplitude interval.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BackboneRequest {
+    /// Linear frequency ω₀ of the mode (K·mode = ω₀² M·mode).
+    pub omega0: f64,
+    /// Mode shape (n_dof entries).
+    pub mode: Vec<f64>,
+    /// DOF whose first cosine coefficient a1 is the amplitude.
+    pub dof: usize,
+    /// First amplitude.
+    pub amplitude_from: f64,
+    /// Last amplitude.
+    pub amplitude_to: f64,
+    /// Corrector of the path.
+    pub corrector: Corrector,
+}
+
+impl Default for BackboneRequest {
+    /// One DOF of unit frequency, a1 from 0.01 to 1, Newton–chord corrector.
+    fn default() -> Self {
+        let o = BackboneOptions::default();
+        Self {
+            omega0: 1.0,
+            mode: vec![1.0],
+            dof: o.dof,
+            amplitude_from: o.amplitude_from,
+            amplitude_to: o.amplitude_to,
+            corrector: Corrector::Newton,
+        }
+    }
+}
+
+impl BackboneRequest {
+    /// # Errors
+    /// [`HbError::InvalidInput`] for a non-finite frequency or amplitude (the
+    /// mode and the system are checked by [`crate::backbone`]).
+    pub fn validate(&self) -> Result<(), HbError> {
+        finite("omega0", self.omega0)?;
+        finite("amplitude_from", self.amplitude_from)?;
+        finite("amplitude_to", self.amplitude_to)?;
+        Ok(())
+    }
+}
+
+/// One point of the backbone.
+#[derive(Debug, Clone, Serialize)]
+pub struct BackboneSample {
+    /// a1 of the amplitude DOF.
+    pub amplitude: f64,
+    /// Frequency ω.
+    pub omega: f64,
+    /// Fictitious damping κ (~0 on the result).
+    pub kappa: f64,
+    /// Coefficients.
+    pub coeffs: Array<f64>,
+}
+
+/// A backbone: the keys of `ivt.hb.backbone`.
+#[derive(Debug, Clone, Serialize)]
+pub struct BackboneCurve {
+    /// a1 of every point (a column).
+    pub amplitude: Array<f64>,
+    /// ω of every point.
+    pub omega: Array<f64>,
+    /// κ of every point.
+    pub kappa: Array<f64>,
+    /// The points.
+    pub points: Vec<BackboneSample>,
+    /// Why the path stopped.
+    pub termination: Termination,
+}
+
+/// The backbone of `problem` from `req`'s mode.
+///
+/// # Errors
+/// [`BackboneRequest::validate`]'s and [`crate::backbone`]'s.
+pub fn backbone<P: PeriodicProblem>(
+    problem: &P,
+    hb: &HbOptions,
+    req: &BackboneRequest,
+) -> Result<BackboneCurve, HbError> {
+    req.validate()?;
+    let opts = BackboneOptions {
+        dof: req.dof,
+        amplitude_from: req.amplitude_from,
+        amplitude_to: req.amplitude_to,
+        corrector: req.corrector,
+        ..BackboneOptions::default()
+    };
+    let bb = crate::backbone(problem, hb, req.omega0, &req.mode, &opts)?;
+    let col = |f: fn(&BackbonePoint) -> f64| bb.points.iter().map(f).collect();
+    Ok(BackboneCurve {
+        amplitude: col(|p| p.amplitude),
+        omega: col(|p| p.omega),
+        kappa: col(|p| p.kappa),
+        points: bb
+            .points
+            .iter()
+            .map(|p| BackboneSample {
+                amplitude: p.amplitude,
+                omega: p.omega,
+                kappa: p.kappa,
+                coeffs: Array(p.coeffs.clone()),
+            })
+            .collect(),
+        termination: bb.termination,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Duffing;
+
+    #[test]
+    fn duffing_backbone_follows_the_first_order_frequency_law() {
+        // u'' + u + u³ = 0: ω² ≈ 1 + 3a²/4 for small a (Lindstedt); at
+        // a1 = 0.1 the O(a⁴) rest is below 1e-5.
+        let d = Duffing::new(0.0, 1.0, 1.0, 0.0);
+        let hb = HbOptions::new(10, 32);
+        let req = BackboneRequest {
+            amplitude_to: 0.1,
+            ..BackboneRequest::default()
+        };
+        let bb = backbone(&d, &hb, &req).unwrap();
+        assert_eq!(bb.termination, Termination::LeftInterval);
+        let last = bb.points.last().unwrap();
+        let a = last.amplitude;
+        let law = (1.0 + 0.75 * a * a).sqrt();
+        assert!((last.omega - law).abs() < 1e-5, "{} vs {law}", last.omega);
+        assert!(bb.kappa.0.iter().all(|k| k.abs() < 1e-8));
+    }
+}

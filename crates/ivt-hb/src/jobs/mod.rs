@@ -1,0 +1,64 @@
+//! The harmonic-balance jobs run by the command line (`ivt hb ...`) and by
+//! Python (`ivt.hb.*`): each takes a typed request (with `Default` and
+//! `validate`) and returns a [`serde::Serialize`] result whose field names
+//! are the JSON keys of SPEC §6 and the keys of the Python dicts. Neither
+//! front end assembles a job or classifies its errors
+//! ([`crate::HbError::kind`]); they parse arguments and serialize results.
+//!
+//! | job | request | result | CLI | Python |
+//! |---|---|---|---|---|
+//! | orbit + stability (Eq. 56–67, 78) | [`OrbitRequest`] | [`Orbit`] | `hb duffing` | `duffing`, `mathieu_duffing`, `solve` |
+//! | FRC, with or without events (Eq. 68–77) | [`FrcRequest`] | [`FrcCurve`] | `hb duffing-frc [--events]` | `duffing_frc`, `frc` |
+//! | limit cycle (ω unknown) | [`LimitCycleRequest`] | [`Cycle`] | — | `limit_cycle` |
+//! | backbone | [`BackboneRequest`] | [`BackboneCurve`] | — | `backbone` |
+//! | Mathieu–Duffing cascade (Eq. 81–85) | [`CascadeRequest`] | [`Cascade`] | `hb mathieu-duffing` | `mathieu_cascade` |
+//! | STHB string curve (Eq. 103–136) | [`StringRequest`] | [`StringCurve`] | `hb string` | `string` |
+
+mod array;
+pub mod backbone;
+pub mod cascade;
+pub mod frc;
+pub mod limit_cycle;
+pub mod orbit;
+pub mod string;
+
+pub use array::{pairs, Array, ARRAY_NAME};
+pub use backbone::{backbone, BackboneCurve, BackboneRequest, BackboneSample};
+pub use cascade::{cascade, Cascade, CascadeRequest, THESIS_BETAS};
+pub use frc::{frc, CurvePoint, EventRecord, FoldPoint, FrcCurve, FrcRequest};
+pub use limit_cycle::{limit_cycle, Cycle, LimitCycleRequest};
+pub use orbit::{orbit, Method, Orbit, OrbitRequest};
+pub use string::{string, StringCurve, StringPoint, StringRequest};
+
+use crate::error::HbError;
+
+/// Hsu sub-intervals per period for `harmonics` harmonics: max(8n, 256)
+/// (Eq. 78; 256 resolve the stability flags of the thesis's examples, 8n
+/// the fastest harmonic's period with 8 Magnus-4 steps).
+pub fn stability_steps(harmonics: usize) -> usize {
+    harmonics.saturating_mul(8).max(256)
+}
+
+/// `Err(InvalidInput)` unless `v` is finite, naming the argument.
+pub(crate) fn finite(name: &str, v: f64) -> Result<f64, HbError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(HbError::InvalidInput(format!(
+            "`{name}` = {v} must be finite"
+        )))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hsu_steps_are_eight_per_harmonic_and_at_least_256() {
+        assert_eq!(stability_steps(20), 256);
+        assert_eq!(stability_steps(32), 256);
+        assert_eq!(stability_steps(40), 320);
+        assert_eq!(stability_steps(usize::MAX), usize::MAX);
+    }
+}

@@ -1,0 +1,232 @@
+//! Orbit + stability: one periodic solution at a fixed ω_f by the modified
+//! IHB (§3.2.2, AFT residual Eq. 62 + Broyden Eq. 63–67) or the classic IHB
+//! (§3.2.1, Newton with the Galerkin Jacobian Eq. 56–61), then its Floquet
+//! multipliers by Hsu's method (Eq. 78) over [`super::stability_steps`]
+//! Magnus-4 steps.
+
+use super::{pairs, stability_steps, Array};
+use crate::error::HbError;
+use crate::floquet::HsuRule;
+use crate::ihb::{HbOptions, HbSolution, HbSolver};
+use crate::problem::PeriodicProblem;
+use crate::stability::{StabilityAnalyzer, StabilityKind};
+use crate::{ClassicIhb, ModifiedIhb};
+use serde::Serialize;
+use std::str::FromStr;
+use std::time::Instant;
+
+/// Which IHB variant solves the orbit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// §3.2.2: AFT residual + Broyden seeded with the linear Jacobian.
+    #[default]
+    Modified,
+    /// §3.2.1: Newton with the Galerkin Jacobian.
+    Classic,
+}
+
+impl FromStr for Method {
+    type Err = HbError;
+
+    /// `"modified"` or `"classic"`.
+    fn from_str(s: &str) -> Result<Self, HbError> {
+        match s {
+            "modified" => Ok(Self::Modified),
+            "classic" => Ok(Self::Classic),
+            other => Err(HbError::InvalidInput(format!(
+                "`method` = {other:?} must be 'modified' or 'classic'"
+            ))),
+        }
+    }
+}
+
+/// What to solve at which frequency.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OrbitRequest {
+    /// Excitation frequency ω_f (finite, > 0).
+    pub omega_f: f64,
+    /// IHB variant.
+    pub method: Method,
+    /// Start coefficients (default: the solver's own start).
+    pub guess: Option<Vec<f64>>,
+    /// Compute the Floquet multipliers.
+    pub stability: bool,
+}
+
+impl Default for OrbitRequest {
+    /// Fig. 28's ω_f = 0.4, modified IHB, with stability.
+    fn default() -> Self {
+        Self {
+            omega_f: 0.4,
+            method: Method::Modified,
+            guess: None,
+            stability: true,
+        }
+    }
+}
+
+impl OrbitRequest {
+    /// # Errors
+    /// [`HbError::InvalidInput`] for a non-finite or non-positive ω_f.
+    pub fn validate(&self) -> Result<(), HbError> {
+        if !(self.omega_f.is_finite() && self.omega_f > 0.0) {
+            return Err(HbError::InvalidInput(format!(
+                "`omega_f` = {} must be finite and > 0",
+                self.omega_f
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// One orbit: the keys of `ivt hb duffing --json` and `ivt.hb.duffing`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Orbit {
+    /// `[a0, a1..an, b1..bn]` per DOF (u = a0/2 + Σ a_k cos kτ + b_k sin kτ).
+    pub coeffs: Array<f64>,
+    /// Solver iterations.
+    pub iterations: usize,
+    /// ‖r‖₂ at the result.
+    pub residual_norm: f64,
+    /// Residual evaluations.
+    pub residual_evals: usize,
+    /// Wall time of the solve alone (not the stability).
+    pub solve_time_s: f64,
+    /// Excitation frequency.
+    pub omega_f: f64,
+    /// Harmonics n.
+    pub harmonics: usize,
+    /// Period multiple p (period p·2π/ω_f).
+    pub subharmonic: usize,
+    /// max |x_0| over the period (DOF 0).
+    pub amplitude: f64,
+    /// Floquet multipliers `[[re, im], ...]`, decreasing modulus (empty
+    /// without stability).
+    pub floquet: Vec<[f64; 2]>,
+    /// All multipliers inside the unit circle (None without stability).
+    pub stable: Option<bool>,
+    /// The leading multiplier's class (None without stability).
+    pub stability: Option<StabilityKind>,
+    /// The solution itself (for plots; not serialized).
+    #[serde(skip)]
+    pub solution: HbSolution,
+}
+
+impl Orbit {
+    /// Largest |μ| (0 without stability).
+    pub fn max_modulus(&self) -> f64 {
+        self.floquet
+            .iter()
+            .map(|[re, im]| re.hypot(*im))
+            .fold(0.0, f64::max)
+    }
+}
+
+/// Solve `problem` at `req.omega_f` and, if asked, its Floquet multipliers.
+///
+/// # Errors
+/// [`OrbitRequest::validate`]'s, the solver's (non-convergence carries the
+/// residual history), and [`HbError::NonFiniteMultipliers`] when Hsu's
+/// monodromy is not finite (the stability would be unknown).
+pub fn orbit<P: PeriodicProblem>(
+    problem: &P,
+    hb: &HbOptions,
+    req: &OrbitRequest,
+) -> Result<Orbit, HbError> {
+    req.validate()?;
+    let t0 = Instant::now();
+    let mut solver: Box<dyn HbSolver + '_> = match req.method {
+        Method::Modified => Box::new(ModifiedIhb::new(problem, hb.clone())?),
+        Method::Classic => Box::new(ClassicIhb::new(problem, hb.clone())?),
+    };
+    let sol = solver.solve(req.omega_f, req.guess.as_deref())?;
+    let solve_time_s = t0.elapsed().as_secs_f64();
+    let (floquet, stable, stability) = if req.stability {
+        let steps = stability_steps(hb.harmonics);
+        let f = StabilityAnalyzer::new(problem, hb.harmonics, steps)?.hsu(
+            problem,
+            &sol,
+            HsuRule::Magnus4,
+        );
+        if !f
+            .multipliers
+            .iter()
+            .all(|m| m.re.is_finite() && m.im.is_finite())
+        {
+            return Err(HbError::NonFiniteMultipliers {
+                omega: req.omega_f,
+                steps,
+            });
+        }
+        (pairs(&f.multipliers), Some(f.stable()), Some(f.kind))
+    } else {
+        (Vec::new(), None, None)
+    };
+    Ok(Orbit {
+        coeffs: Array(sol.coeffs.clone()),
+        iterations: sol.stats.iterations,
+        residual_norm: sol.stats.residual_norm,
+        residual_evals: sol.stats.residual_evals,
+        solve_time_s,
+        omega_f: sol.omega_f,
+        harmonics: sol.harmonics,
+        subharmonic: sol.subharmonic,
+        amplitude: sol.amplitude(0),
+        floquet,
+        stable,
+        stability,
+        solution: sol,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Duffing;
+
+    #[test]
+    fn methods_parse_by_name_and_refuse_others() {
+        assert_eq!("classic".parse::<Method>(), Ok(Method::Classic));
+        assert_eq!("modified".parse::<Method>(), Ok(Method::Modified));
+        let e = "newton".parse::<Method>().unwrap_err();
+        assert_eq!(e.kind(), "input");
+    }
+
+    #[test]
+    fn both_methods_give_the_same_fig28_orbit() {
+        // Fig. 28 (ξ = 0.02, α = ε = 1, F = 0.1, ω_f = 0.4): the classic and
+        // the modified IHB converge to one orbit, a stable one.
+        let d = Duffing::new(0.02, 1.0, 1.0, 0.1);
+        let hb = HbOptions::new(20, 64).with_tol(1e-10);
+        let m = orbit(&d, &hb, &OrbitRequest::default()).unwrap();
+        let req = OrbitRequest {
+            method: Method::Classic,
+            ..OrbitRequest::default()
+        };
+        let c = orbit(&d, &hb, &req).unwrap();
+        assert_eq!(m.coeffs.0.len(), 41);
+        for (a, b) in m.coeffs.0.iter().zip(&c.coeffs.0) {
+            assert!((a - b).abs() < 1e-9, "{a} vs {b}");
+        }
+        assert_eq!(m.stable, Some(true));
+        assert!(m.max_modulus() < 1.0);
+    }
+
+    #[test]
+    fn tiny_frequency_gives_a_failed_error_not_nan_multipliers() {
+        let d = Duffing::new(0.02, 1.0, 1.0, 0.1);
+        let req = OrbitRequest {
+            omega_f: 1e-6,
+            ..OrbitRequest::default()
+        };
+        let e = orbit(&d, &HbOptions::new(20, 64), &req).unwrap_err();
+        assert_eq!(e.kind(), "failed", "{e}");
+        assert!(e.to_string().contains("not finite"), "{e}");
+        let bad = OrbitRequest {
+            omega_f: f64::NAN,
+            ..OrbitRequest::default()
+        };
+        assert_eq!(bad.validate().unwrap_err().kind(), "input");
+    }
+}

@@ -1,0 +1,200 @@
+//! Helpers shared by the `ivt.hb` bindings (hb.rs, hb_paths.rs,
+//! hb_string.rs), kept here so that none of those modules imports another:
+//! the `ConvergenceError` exception and the mapping of ivt-hb errors onto
+//! Python exceptions by [`ivt_hb::HbError::kind`], the GIL-released runs that
+//! re-raise a callback's exception (the error slot of the user problem), the
+//! argument checks that name the Python argument, and the `user_system_fn!`
+//! signature of every user-system function.
+
+use ivt_hb::{HbError, HbOptions};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyList;
+
+use crate::args::count;
+use crate::user_problem::{callback_error, user_problem, with_tolerances, PyProblem};
+
+create_exception!(
+    ivt,
+    ConvergenceError,
+    PyRuntimeError,
+    "A harmonic-balance solve that did not converge; `.history` holds ‖r‖ per iteration."
+);
+
+/// Map an ivt-hb error to Python by its [`HbError::kind`]: `"input"` →
+/// ValueError, `"failed"` → ConvergenceError carrying the residual history
+/// (`.history`, empty when the failure had none).
+pub(crate) fn hb_err(py: Python<'_>, e: HbError) -> PyErr {
+    if e.kind() == "input" {
+        return PyValueError::new_err(e.to_string());
+    }
+    let err = ConvergenceError::new_err(e.to_string());
+    if let Ok(list) = PyList::new(py, e.history()) {
+        let _ = err.value(py).setattr("history", list);
+    }
+    err
+}
+
+/// Run `solve` with the GIL released; its error mapped by [`hb_err`].
+pub(crate) fn run<T: Send>(
+    py: Python<'_>,
+    solve: impl FnOnce() -> Result<T, HbError> + Send,
+) -> PyResult<T> {
+    py.detach(solve).map_err(|e| hb_err(py, e))
+}
+
+/// Run `solve` on a user system with the GIL released (its callbacks take it
+/// back), then re-raise the first exception a callback raised (it aborted the
+/// run) or map the ivt-hb error with [`hb_err`].
+pub(crate) fn run_user<T: Send>(
+    py: Python<'_>,
+    problem: &PyProblem,
+    solve: impl FnOnce(&PyProblem) -> Result<T, HbError> + Send,
+) -> PyResult<T> {
+    let result = py.detach(|| solve(problem));
+    // The callback's exception, not the failure it caused, is the error.
+    if let Some(e) = callback_error(problem) {
+        return Err(e);
+    }
+    result.map_err(|e| hb_err(py, e))
+}
+
+/// Options from the Python keywords: n harmonics, `samples` = N (2N AFT samples).
+pub(crate) fn options(n: i64, samples: i64, subharmonic: i64, tol: f64) -> PyResult<HbOptions> {
+    let (n, samples): (usize, usize) = (count("n", n)?, count("samples", samples)?);
+    let subharmonic: usize = count("subharmonic", subharmonic)?;
+    if n == 0 {
+        return Err(PyValueError::new_err(
+            "argument `n` (harmonics) must be >= 1",
+        ));
+    }
+    if let Some(why) = ivt_hb::limits::unknowns_error(1, n) {
+        return Err(PyValueError::new_err(format!("argument `n` = {n}: {why}")));
+    }
+    if let Some(why) = ivt_hb::limits::samples_error(samples) {
+        return Err(PyValueError::new_err(format!(
+            "argument `samples` = {samples}: {why}"
+        )));
+    }
+    if samples <= n {
+        return Err(PyValueError::new_err(format!(
+            "argument `samples` = {samples} must exceed `n` = {n} (2N > 2n AFT samples)"
+        )));
+    }
+    if !(tol.is_finite() && tol > 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "argument `tol` = {tol} must be finite and > 0"
+        )));
+    }
+    Ok(HbOptions::new(n, samples)
+        .with_subharmonic(subharmonic)
+        .with_tol(tol))
+}
+
+/// `v` unless it is NaN or infinite (ValueError naming the argument).
+pub(crate) fn finite(name: &str, v: f64) -> PyResult<f64> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(PyValueError::new_err(format!(
+            "argument `{name}` = {v} must be finite"
+        )))
+    }
+}
+
+/// The `guess` keyword: a 1-D array-like of floats, or None.
+pub(crate) fn guess_vec(guess: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<f64>>> {
+    guess
+        .map(|g| {
+            g.extract::<numpy::PyArrayLike1<'_, f64, numpy::AllowTypeChange>>()
+                .map(|a| a.as_array().to_vec())
+                .map_err(|_| PyTypeError::new_err("argument `guess` must be a 1-D array of floats"))
+        })
+        .transpose()
+}
+
+/// A `#[pyfunction]` on a user system `M x'' + C x' + K x + g(x, v, θ) =
+/// f(θ)` returning a dict. Python parameters: `m, c, k, g`, the function's
+/// own (`name: type [= default]`), `n=20, samples=64`, its own again, then
+/// `velocity_dependent=True, vectorized=False, rtol=1e-9, max_iter=100`, and
+/// `jac=None` when the caller names it after the `UserArgs` binding (a
+/// function whose solver assembles the Galerkin Jacobian). The
+/// shared ones reach the body as the [`UserArgs`] named by the caller.
+macro_rules! user_system_fn {
+    (
+        $(#[$doc:meta])*
+        fn $name:ident<$lt:lifetime>($py:ident, $user:ident $(, $jac:ident)?;
+            $( $(#[$pa:ident($($pa_args:tt)*)])* $arg:ident: $ty:ty $(= $default:tt)? ),+;
+            $( $(#[$pb:ident($($pb_args:tt)*)])* $brg:ident: $bty:ty $(= $bdefault:tt)? ),+ $(,)?
+        ) $body:block
+    ) => {
+        $(#[$doc])*
+        #[pyfunction]
+        #[pyo3(signature = (
+            m, c, k, g, $($arg $(= $default)?,)+ n = 20, samples = 64, $($brg $(= $bdefault)?,)+
+            velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
+            $(, $jac = None)?
+        ))]
+        #[allow(clippy::too_many_arguments, clippy::field_reassign_with_default)]
+        fn $name<$lt>(
+            $py: Python<$lt>,
+            m: &Bound<$lt, PyAny>, c: &Bound<$lt, PyAny>, k: &Bound<$lt, PyAny>, g: &Bound<$lt, PyAny>,
+            $( $(#[$pa($($pa_args)*)])* $arg: $ty, )+
+            #[pyo3(from_py_with = crate::args::int64)] n: i64,
+            #[pyo3(from_py_with = crate::args::int64)] samples: i64,
+            $( $(#[$pb($($pb_args)*)])* $brg: $bty, )+
+            velocity_dependent: bool, vectorized: bool, rtol: f64, max_iter: usize,
+            $( $jac: Option<&Bound<$lt, PyAny>>, )?
+        ) -> PyResult<Bound<$lt, PyDict>> {
+            let $user = UserArgs {
+                system: [m, c, k, g], n, samples, velocity_dependent, vectorized, rtol, max_iter,
+                jac: None $( .or($jac) )?,
+            };
+            $body
+        }
+    };
+}
+pub(crate) use user_system_fn;
+
+/// The arguments every user-system function shares: the system `[m, c, k, g]`,
+/// `g`'s optional Jacobian `jac` (always None where the keyword is not offered)
+/// and the harmonic-balance settings.
+pub(crate) struct UserArgs<'a, 'py> {
+    pub(crate) system: [&'a Bound<'py, PyAny>; 4],
+    pub(crate) n: i64,
+    pub(crate) samples: i64,
+    pub(crate) velocity_dependent: bool,
+    pub(crate) vectorized: bool,
+    pub(crate) rtol: f64,
+    pub(crate) max_iter: usize,
+    pub(crate) jac: Option<&'a Bound<'py, PyAny>>,
+}
+
+impl UserArgs<'_, '_> {
+    /// The user problem forced by `f` and its options (`subharmonic`, absolute
+    /// tolerance `tol`, see [`with_tolerances`]).
+    pub(crate) fn setup(
+        &self,
+        f: Option<&Bound<'_, PyAny>>,
+        subharmonic: i64,
+        tol: f64,
+    ) -> PyResult<(PyProblem, HbOptions)> {
+        let [m, c, k, g] = self.system;
+        let problem = user_problem(
+            m,
+            c,
+            k,
+            g,
+            f,
+            self.jac,
+            self.velocity_dependent,
+            self.vectorized,
+        )?;
+        let opts = options(self.n, self.samples, subharmonic, 1.0)?;
+        Ok((
+            problem,
+            with_tolerances(opts, tol, self.rtol, self.max_iter)?,
+        ))
+    }
+}
