@@ -7,6 +7,7 @@ pub mod aft;
 pub mod autonomous;
 pub mod backbone;
 pub mod bifurcation;
+pub mod branch_point;
 pub mod broyden;
 pub mod classic;
 pub mod continuation;
@@ -32,9 +33,9 @@ pub use aft::Aft;
 pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
 pub use backbone::{backbone, Backbone, BackboneOptions, BackbonePoint};
 pub use bifurcation::{
-    locate_branch_point, locate_multiplier_crossing, Bifurcation, BifurcationError,
-    BifurcationKind, BifurcationOptions,
+    locate_multiplier_crossing, Bifurcation, BifurcationError, BifurcationKind, BifurcationOptions,
 };
+pub use branch_point::locate_branch_point;
 pub use broyden::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
 };
