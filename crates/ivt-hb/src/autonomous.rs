@@ -17,7 +17,8 @@
 use crate::broyden::{BroydenStats, SolveError};
 use crate::continuation::{pseudo_arclength, ContinuationOptions, Termination};
 use crate::floquet::HsuRule;
-use crate::ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution};
+use crate::galerkin::GalerkinJacobian;
+use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
 use crate::stability::{classify, StabilityAnalyzer, StabilityKind};
 use faer::c64;
