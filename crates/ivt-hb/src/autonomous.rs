@@ -17,12 +17,13 @@
 use crate::broyden::{BroydenStats, SolveError};
 use crate::continuation::{pseudo_arclength, ContinuationOptions, Termination};
 use crate::floquet::HsuRule;
-use crate::ihb::{GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution};
+use crate::galerkin::GalerkinJacobian;
+use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
 use crate::stability::{classify, StabilityAnalyzer, StabilityKind};
 use faer::c64;
 use ivt_num::vector::norm2;
-use ivt_num::LuWorkspace;
+use ivt_num::BorderedLu;
 
 /// A converged limit cycle.
 #[derive(Debug, Clone, PartialEq)]
@@ -203,8 +204,11 @@ pub fn limit_cycle<P: PeriodicProblem>(
     let mut omega = omega_guess;
     let (mut r, mut rp, mut rm) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
     let mut jac = vec![0.0; m * m];
-    let mut big = vec![0.0; n1 * n1];
-    let mut lu = LuWorkspace::new(n1);
+    let mut r_omega = vec![0.0; m];
+    // The phase condition b₁ = 0 (DOF 0) as the border row, ω as the border column.
+    let mut phase_row = vec![0.0; m];
+    phase_row[phase] = 1.0;
+    let mut lu = BorderedLu::new(m, 1);
     let mut step = vec![0.0; n1];
     let (mut q_trial, mut r_trial) = (vec![0.0; m], vec![0.0; m]);
     let norm_f = |r: &[f64], q: &[f64]| (norm2(r).powi(2) + q[phase] * q[phase]).sqrt();
@@ -243,20 +247,20 @@ pub fn limit_cycle<P: PeriodicProblem>(
         res.eval(problem, &q, omega - h, 1.0, &mut rm);
         stats.residual_evals += 2;
         for i in 0..m {
-            big[i * n1..i * n1 + m].copy_from_slice(&jac[i * m..(i + 1) * m]);
-            big[i * n1 + m] = (rp[i] - rm[i]) / (2.0 * h);
+            r_omega[i] = (rp[i] - rm[i]) / (2.0 * h);
         }
-        big[m * n1..].fill(0.0);
-        big[m * n1 + phase] = 1.0;
         step[..m].iter_mut().zip(&r).for_each(|(s, r)| *s = -r);
         step[m] = -q[phase];
-        if !lu.factor_row_major(&big) {
+        if lu
+            .factor(&jac, &r_omega, &phase_row, &[0.0])
+            .and_then(|()| lu.solve(&mut step))
+            .is_err()
+        {
             return Err(HbError::Solve(SolveError::SingularJacobian {
                 iteration: stats.iterations,
                 history,
             }));
         }
-        lu.solve(&mut step);
         // Damped step: halve while ‖F‖ does not decrease (or ω would turn ≤ 0).
         let mut t = 1.0;
         let mut accepted = false;

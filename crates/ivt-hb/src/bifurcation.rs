@@ -14,7 +14,7 @@
 //!   product) of `Φ`, whose eigenvalues are the products `μᵢμⱼ`, `i < j`: a complex
 //!   pair on the unit circle (`μμ̄ = 1`). A real pair `μ, 1/μ` (neutral saddle)
 //!   is also a zero and is reported as an error.
-//! - **Branch point** (simple): `[∂R/∂q, ∂R/∂λ]` (m × (m+1)) loses rank; two
+//! - **Branch point** (simple, located in [`crate::branch_point`]): `[∂R/∂q, ∂R/∂λ]` (m × (m+1)) loses rank; two
 //!   test functions from the two-column bordering `[[R_x, b], [Cᵀ, 0]]`, and an
 //!   unfolding `R + μ b = 0` with μ unknown make the system square and regular.
 //!
@@ -25,12 +25,12 @@
 use crate::broyden::SolveError;
 use crate::family::{Family, FamilyBranch};
 use crate::floquet::{eigenvalues, monodromy_uniform, HsuRule};
-use crate::fold::{null_vector, Branch};
+use crate::fold::{null_vector, residual_lambda_difference as residual_lambda, Branch};
 use crate::ihb::HbError;
 use crate::stability::StabilityAnalyzer;
 use faer::c64;
 use ivt_num::vector::norm2;
-use ivt_num::LuWorkspace;
+use ivt_num::{BorderedError, BorderedLu, LuWorkspace};
 use thiserror::Error;
 
 /// The kind of a located bifurcation.
@@ -219,48 +219,48 @@ fn test_matrix(kind: BifurcationKind, phi: &[f64], dim: usize, a: &mut Vec<f64>)
 }
 
 /// `g` of `[[A, b], [cᵀ, 0]] [v; g] = [0; 1]` for fixed borders `b`, `c`: the
-/// bordered matrix, its LU and the right-hand side are kept across the calls of
-/// the finite-difference loop of [`extended_newton`].
+/// bordered LU and the right-hand side are kept across the calls of the
+/// finite-difference loop of [`extended_newton`].
 struct BorderedScalar {
     b: Vec<f64>,
     c: Vec<f64>,
-    big: Vec<f64>,
-    lu: LuWorkspace,
+    lu: BorderedLu,
     rhs: Vec<f64>,
 }
 
 impl BorderedScalar {
     fn new(b: Vec<f64>, c: Vec<f64>) -> Self {
-        let n1 = b.len() + 1;
+        let s = b.len();
         Self {
             b,
             c,
-            big: vec![0.0; n1 * n1],
-            lu: LuWorkspace::new(n1),
-            rhs: vec![0.0; n1],
+            lu: BorderedLu::new(s, 1),
+            rhs: vec![0.0; s + 1],
         }
     }
 
     /// `g` for the `s×s` row-major `a` (NaN if singular).
     fn eval(&mut self, a: &[f64]) -> f64 {
         let s = self.b.len();
-        let n1 = s + 1;
-        for i in 0..s {
-            self.big[i * n1..i * n1 + s].copy_from_slice(&a[i * s..(i + 1) * s]);
-            self.big[i * n1 + s] = self.b[i];
+        // Near-singular pivots are accepted (the solve is checked instead).
+        if !factored(self.lu.factor(a, &self.b, &self.c, &[0.0])) {
+            return f64::NAN;
         }
-        self.big[s * n1..s * n1 + s].copy_from_slice(&self.c);
-        self.big[s * n1 + s] = 0.0;
-        self.lu.factor_row_major(&self.big);
         self.rhs.fill(0.0);
         self.rhs[s] = 1.0;
-        self.lu.solve(&mut self.rhs);
-        if self.rhs.iter().all(|v| v.is_finite()) {
+        if self.lu.solve(&mut self.rhs).is_ok() && self.rhs.iter().all(|v| v.is_finite()) {
             self.rhs[s]
         } else {
             f64::NAN
         }
     }
+}
+
+/// A factorization usable for solves: regular, or singular to rounding
+/// (inverse iteration and test functions at a bifurcation accept it and
+/// check the solution); not one refused for its sizes.
+pub(crate) fn factored(result: Result<(), BorderedError>) -> bool {
+    matches!(result, Ok(()) | Err(BorderedError::Singular))
 }
 
 /// Writes `[J | R_λ]` (`m` rows) into the first `m + 1` columns of the row-major
@@ -286,23 +286,6 @@ pub(crate) fn record(history: &mut Vec<f64>, norm: f64) -> Result<(), Bifurcatio
     }))
 }
 
-/// Central difference of the residual in λ.
-pub(crate) fn residual_lambda<B: Branch>(
-    branch: &mut B,
-    q: &[f64],
-    lambda: f64,
-    h: f64,
-    out: &mut [f64],
-) {
-    let m = q.len();
-    let (mut rp, mut rm) = (vec![0.0; m], vec![0.0; m]);
-    branch.residual(q, lambda + h, &mut rp);
-    branch.residual(q, lambda - h, &mut rm);
-    for i in 0..m {
-        out[i] = (rp[i] - rm[i]) / (2.0 * h);
-    }
-}
-
 pub(crate) fn lambda_step(opts: &BifurcationOptions, lambda: f64) -> f64 {
     opts.fd_step * lambda.abs().max(1e-3)
 }
@@ -325,7 +308,7 @@ pub(crate) fn jacobian_blocks<B: Branch>(
 
 /// Right and left near-null vectors of the near-singular square row-major `a`,
 /// refined in place from their seeds; only a non-finite factor is refused.
-fn border_null_vectors(
+pub(crate) fn border_null_vectors(
     a: &[f64],
     right: &mut [f64],
     left: &mut [f64],
@@ -342,11 +325,11 @@ fn border_null_vectors(
 }
 
 /// Result of [`extended_newton`]: `(q, λ, iterations)`.
-type Converged = (Vec<f64>, f64, usize);
+pub(crate) type Converged = (Vec<f64>, f64, usize);
 
 /// Newton on `[R(q, λ) + Σⱼ μⱼ bⱼ; ψ(q, λ)] = 0`, unknowns `{q, λ, μ}` with
 /// `k = unfold.len() + 1` test functions `ψ` (the unfoldings `μ` make it square).
-fn extended_newton<B, T>(
+pub(crate) fn extended_newton<B, T>(
     branch: &mut B,
     q0: &[f64],
     lambda0: f64,
@@ -367,7 +350,7 @@ where
     let mut jac = vec![0.0; m * m];
     let mut r_lambda = vec![0.0; m];
     let mut newton = vec![0.0; n * n];
-    let mut newton_lu = LuWorkspace::new(n);
+    let mut newton_lu = BorderedLu::new(m, k);
     let mut step = vec![0.0; n];
     let mut history: Vec<f64> = Vec::with_capacity(opts.max_iter + 1);
     for it in 0..=opts.max_iter {
@@ -422,9 +405,10 @@ where
         for t in 0..k {
             step[m + t] = -psi[t];
         }
-        newton_lu.factor_row_major(&newton);
-        newton_lu.solve(&mut step);
-        if !step.iter().all(|x| x.is_finite()) {
+        let (top, bottom) = newton.split_at(m * n);
+        let solved =
+            factored(newton_lu.factor_rows(top, bottom)) && newton_lu.solve(&mut step).is_ok();
+        if !solved || !step.iter().all(|x| x.is_finite()) {
             return Err(solve_error(SolveError::SingularJacobian {
                 iteration: it,
                 history,
@@ -544,143 +528,4 @@ pub(crate) fn finish<B: Branch>(
         iterations,
         residual_norm: norm2(&r),
     })
-}
-
-/// The two-column bordering of `[R_q, R_λ]` for branch points.
-struct BranchPointTest {
-    m: usize,
-    /// Border column (m).
-    b: Vec<f64>,
-    /// Border rows (2 × (m+1)).
-    c: [Vec<f64>; 2],
-    jac: Vec<f64>,
-    r_lambda: Vec<f64>,
-    big: Vec<f64>,
-    /// LU of `big` and a right-hand side (reused across evaluations).
-    lu: LuWorkspace,
-    rhs: Vec<f64>,
-    /// The last null-space columns `V` (2 × (m+1)).
-    v: [Vec<f64>; 2],
-}
-
-impl BranchPointTest {
-    /// `(g₁, g₂)` at `(q, λ)`; keeps `V` (NaN if singular).
-    fn eval<B: Branch>(&mut self, branch: &mut B, q: &[f64], lambda: f64, h: f64, out: &mut [f64]) {
-        let m = self.m;
-        let n = m + 2;
-        branch.jacobian(q, lambda, &mut self.jac);
-        residual_lambda(branch, q, lambda, h, &mut self.r_lambda);
-        self.big.fill(0.0);
-        put_jacobian(&mut self.big, n, &self.jac, &self.r_lambda);
-        for i in 0..m {
-            self.big[i * n + m + 1] = self.b[i];
-        }
-        for t in 0..2 {
-            self.big[(m + t) * n..(m + t) * n + m + 1].copy_from_slice(&self.c[t]);
-        }
-        // One factorisation serves both right-hand sides; near-singular
-        // pivots are accepted, a non-finite solution is refused.
-        self.lu.factor_row_major(&self.big);
-        for t in 0..2 {
-            self.rhs.fill(0.0);
-            self.rhs[m + t] = 1.0;
-            self.lu.solve(&mut self.rhs);
-            if !self.rhs.iter().all(|x| x.is_finite()) {
-                out.fill(f64::NAN);
-                return;
-            }
-            out[t] = self.rhs[m + 1];
-            self.v[t].copy_from_slice(&self.rhs[..m + 1]);
-        }
-    }
-}
-
-/// Locates the simple branch point nearest the converged orbit `(q0, λ0)` of
-/// `branch`, where the followed branch has unit tangent `tangent` (`m + 1`
-/// entries, λ last, e.g. the secant between two path points). The result
-/// carries the null space of `[R_q, R_λ]` there ([`Bifurcation::second_direction`]).
-///
-/// # Errors
-/// As [`locate_multiplier_crossing`] (no neutral-saddle case).
-pub fn locate_branch_point<F: Family>(
-    branch: &mut FamilyBranch<F>,
-    q0: &[f64],
-    lambda0: f64,
-    tangent: &[f64],
-    opts: &BifurcationOptions,
-) -> Result<Bifurcation, BifurcationError> {
-    check_start(branch, q0, lambda0)?;
-    let m = branch.len();
-    if tangent.len() != m + 1 || norm2(tangent) == 0.0 {
-        return Err(HbError::InvalidInput(format!(
-            "tangent must have {} entries, not all zero",
-            m + 1
-        ))
-        .into());
-    }
-    // Borders from the augmented matrix [[R_q, R_λ], [tᵀ]] at the start: its
-    // near-null vectors are the second branch direction (right) and the
-    // unfolding direction (left).
-    let n1 = m + 1;
-    let (jac, r_lambda) = jacobian_blocks(branch, q0, lambda0, opts);
-    let t1: Vec<f64> = tangent.iter().map(|x| x / norm2(tangent)).collect();
-    let mut aug = vec![0.0; n1 * n1];
-    put_jacobian(&mut aug, n1, &jac, &r_lambda);
-    aug[m * n1..].copy_from_slice(&t1);
-    let seed: Vec<f64> = (0..n1).map(|i| 1.0 + 0.1 * (i as f64).sin()).collect();
-    let (mut right, mut left) = (seed.clone(), seed);
-    border_null_vectors(&aug, &mut right, &mut left)?;
-    let along = dot(&right, &t1);
-    right.iter_mut().zip(&t1).for_each(|(r, t)| *r -= along * t);
-    let nr = norm2(&right);
-    right.iter_mut().for_each(|r| *r /= nr);
-    let mut b = left[..m].to_vec();
-    let nb = norm2(&b);
-    b.iter_mut().for_each(|x| *x /= nb);
-    let mut test = BranchPointTest {
-        m,
-        b: b.clone(),
-        c: [t1, right],
-        jac,
-        r_lambda,
-        big: vec![0.0; (m + 2) * (m + 2)],
-        lu: LuWorkspace::new(m + 2),
-        rhs: vec![0.0; m + 2],
-        v: [vec![0.0; n1], vec![0.0; n1]],
-    };
-    let h = lambda_step(opts, lambda0);
-    let (q, lambda, iterations) = extended_newton(
-        branch,
-        q0,
-        lambda0,
-        &[b],
-        |br: &mut FamilyBranch<F>, q: &[f64], l: f64, out: &mut [f64]| test.eval(br, q, l, h, out),
-        opts,
-    )?;
-    let mut g = [0.0; 2];
-    test.eval(branch, &q, lambda, h, &mut g);
-    let null_vectors = orthonormal_pair(&test.v);
-    let mut mono = Monodromy::new(branch, lambda, opts.stability_steps)?;
-    let multipliers = mono.multipliers(branch, &q, lambda);
-    finish(
-        branch,
-        BifurcationKind::BranchPoint,
-        q,
-        lambda,
-        multipliers,
-        null_vectors,
-        iterations,
-    )
-}
-
-/// Gram–Schmidt on two vectors.
-fn orthonormal_pair(v: &[Vec<f64>; 2]) -> Vec<Vec<f64>> {
-    let mut a = v[0].clone();
-    let na = norm2(&a);
-    a.iter_mut().for_each(|x| *x /= na);
-    let along = dot(&v[1], &a);
-    let mut b: Vec<f64> = v[1].iter().zip(&a).map(|(x, y)| x - along * y).collect();
-    let nb = norm2(&b);
-    b.iter_mut().for_each(|x| *x /= nb);
-    vec![a, b]
 }

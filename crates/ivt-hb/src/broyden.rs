@@ -182,6 +182,14 @@ impl From<ivt_num::NewtonError<std::convert::Infallible>> for SolveError {
                 Self::SingularJacobian { iteration, history }
             }
             N::NonFinite { iteration, history } => Self::NonFinite { iteration, history },
+            N::BorderSize {
+                rows,
+                values,
+                unknowns,
+            } => Self::Dimension {
+                expected: values * unknowns,
+                got: rows,
+            },
             N::Eval(never) => match never {},
         }
     }

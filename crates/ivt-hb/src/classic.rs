@@ -4,7 +4,8 @@
 //! against (thesis: 0.25 s vs 0.003 s).
 
 use crate::broyden::{BroydenStats, SolveError};
-use crate::ihb::{validate_omega, GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution};
+use crate::galerkin::GalerkinJacobian;
+use crate::ihb::{validate_omega, HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
 use ivt_num::vector::matvec;
 use ivt_num::{newton, NewtonOptions, NewtonSystem, NewtonWorkspace};

@@ -27,8 +27,17 @@ pub struct ContinuationOptions {
     pub ds: f64,
     /// Smallest step before giving up.
     pub ds_min: f64,
-    /// Largest step.
+    /// Largest step while the solution is of order `ds_relative_scale`;
+    /// beyond, the largest step grows with it ([`ContinuationOptions::step_cap`]).
     pub ds_max: f64,
+    /// The size of `‖x‖₂` above which `ds_max` turns relative:
+    /// `Δη ≤ ds_max·max(1, ‖x‖₂/ds_relative_scale)`. An absolute cap cannot
+    /// serve a curve that is both of order one (where the sweep starts) and
+    /// of order `1/(2ζ)` (the peak of a lightly damped resonance: 500 for
+    /// ζ = 0.001, a circle of that diameter in the plane of the first
+    /// harmonic, whose arclength would need 20 000 steps of 0.08). Default 10;
+    /// `f64::INFINITY` keeps the cap absolute.
+    pub ds_relative_scale: f64,
     /// Maximum number of points (including the start).
     pub max_points: usize,
     /// Stop once λ leaves `[lambda_min, lambda_max]` (that point is kept).
@@ -59,6 +68,7 @@ impl Default for ContinuationOptions {
             ds: 0.02,
             ds_min: 1e-7,
             ds_max: 0.2,
+            ds_relative_scale: 10.0,
             max_points: 5000,
             lambda_min: f64::NEG_INFINITY,
             lambda_max: f64::INFINITY,
@@ -164,6 +174,14 @@ pub struct Path {
     pub folds: Vec<Fold>,
     /// Why tracing stopped.
     pub termination: Termination,
+}
+
+impl ContinuationOptions {
+    /// The largest step at the point `x`: `ds_max`, relative to `‖x‖₂`
+    /// above `ds_relative_scale`.
+    pub fn step_cap(&self, x: &[f64]) -> f64 {
+        self.ds_max * (norm2(x) / self.ds_relative_scale).max(1.0)
+    }
 }
 
 /// The error of a start point or step that is not finite.
@@ -419,7 +437,7 @@ where
             break Termination::LeftInterval;
         }
         if iters * 2 <= opts.target_iter {
-            ds = (ds * opts.growth).min(opts.ds_max);
+            ds = (ds * opts.growth).min(opts.step_cap(&xp));
         } else if iters > opts.target_iter {
             ds = (ds * 0.7).max(opts.ds_min);
         }

@@ -10,9 +10,10 @@
 //!   through a fold, where only `det R_q` does).
 
 use crate::bifurcation::{
-    finish, jacobian_blocks, locate_branch_point, locate_multiplier_crossing, Bifurcation,
-    BifurcationError, BifurcationKind, BifurcationOptions, Monodromy,
+    finish, jacobian_blocks, locate_multiplier_crossing, Bifurcation, BifurcationError,
+    BifurcationKind, BifurcationOptions, Monodromy,
 };
+use crate::branch_point::locate_branch_point;
 use crate::continuation::{ContinuationOptions, Corrector, Termination};
 use crate::family::{Family, FamilyBranch};
 use crate::fold::{locate_fold, Branch, FoldOptions};

@@ -18,7 +18,7 @@
 use crate::broyden::SolveError;
 use crate::ihb::HbError;
 use ivt_num::vector::norm2;
-use ivt_num::LuWorkspace;
+use ivt_num::{BorderedLu, LuWorkspace};
 
 /// A one-parameter family of square systems `R(q, λ) = 0` with `∂R/∂q`.
 pub trait Branch {
@@ -173,8 +173,7 @@ pub struct FoldLocation {
 struct Bordered {
     m: usize,
     jac: Vec<f64>,
-    big: Vec<f64>,
-    lu: LuWorkspace,
+    lu: BorderedLu,
     rhs: Vec<f64>,
     b: Vec<f64>,
     c: Vec<f64>,
@@ -193,27 +192,24 @@ impl Bordered {
         w: &mut [f64],
     ) -> f64 {
         let m = self.m;
-        let n1 = m + 1;
         if !jac_current {
             branch.jacobian(q, lambda, &mut self.jac);
         }
-        for i in 0..m {
-            self.big[i * n1..i * n1 + m].copy_from_slice(&self.jac[i * m..(i + 1) * m]);
-            self.big[i * n1 + m] = self.b[i];
-        }
-        self.big[m * n1..m * n1 + m].copy_from_slice(&self.c);
-        self.big[m * n1 + m] = 0.0;
-        if !self.lu.factor_row_major(&self.big) {
+        if self.lu.factor(&self.jac, &self.b, &self.c, &[0.0]).is_err() {
             return f64::NAN;
         }
         self.rhs.fill(0.0);
         self.rhs[m] = 1.0;
-        self.lu.solve(&mut self.rhs);
+        if self.lu.solve(&mut self.rhs).is_err() {
+            return f64::NAN;
+        }
         v.copy_from_slice(&self.rhs[..m]);
         let g = self.rhs[m];
         self.rhs.fill(0.0);
         self.rhs[m] = 1.0;
-        self.lu.solve_transpose(&mut self.rhs);
+        if self.lu.solve_transpose(&mut self.rhs).is_err() {
+            return f64::NAN;
+        }
         w.copy_from_slice(&self.rhs[..m]);
         if v.iter().chain(w.iter()).all(|x| x.is_finite()) {
             g
@@ -271,8 +267,7 @@ pub fn locate_fold<B: Branch>(
     let mut bd = Bordered {
         m,
         jac: vec![0.0; m * m],
-        big: vec![0.0; n1 * n1],
-        lu: LuWorkspace::new(n1),
+        lu: BorderedLu::new(m, 1),
         rhs: vec![0.0; n1],
         b: vec![1.0 / (m as f64).sqrt(); m],
         c: vec![1.0 / (m as f64).sqrt(); m],
@@ -296,8 +291,7 @@ pub fn locate_fold<B: Branch>(
     let mut r = vec![0.0; m];
     let mut r_lambda = vec![0.0; m];
     let (mut v, mut w, mut grad) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
-    let mut newton = vec![0.0; n1 * n1];
-    let mut newton_lu = LuWorkspace::new(n1);
+    let mut newton_lu = BorderedLu::new(m, 1);
     let mut step = vec![0.0; n1];
     let mut history = Vec::with_capacity(opts.max_iter + 1);
     for it in 0..=opts.max_iter {
@@ -315,30 +309,26 @@ pub fn locate_fold<B: Branch>(
         if it == opts.max_iter {
             break;
         }
-        // Newton matrix [[J, R_λ], [g_q, g_λ]]: J from the bordered solve, and
-        // g_(q, λ) = −wᵀ J_(q, λ) v (Govaerts) with [v; g], [w; g] its solutions.
-        for i in 0..m {
-            newton[i * n1..i * n1 + m].copy_from_slice(&bd.jac[i * m..(i + 1) * m]);
-        }
+        // Newton matrix [[J, R_λ], [g_q, g_λ]], bordered: J from the bordered
+        // solve, and g_(q, λ) = −wᵀ J_(q, λ) v (Govaerts) with [v; g], [w; g]
+        // its solutions.
         let q_scale = q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let h_lambda = opts.fd_step * lambda.abs().max(f64::MIN_POSITIVE);
         branch.residual_lambda(&q, lambda, h_lambda, &mut r_lambda);
-        for i in 0..m {
-            newton[i * n1 + m] = r_lambda[i];
-        }
-        newton[m * n1 + m] = -branch.bilinear_lambda(&q, lambda, h_lambda, &w, &v);
+        let g_lambda = -branch.bilinear_lambda(&q, lambda, h_lambda, &w, &v);
         branch.jacobian_gradient(&q, lambda, &w, &v, &mut grad);
-        for k in 0..m {
-            newton[m * n1 + k] = -grad[k];
-        }
+        grad.iter_mut().for_each(|x| *x = -*x);
         for i in 0..m {
             step[i] = -r[i];
         }
         step[m] = -g;
-        if !newton_lu.factor_row_major(&newton) {
+        if newton_lu
+            .factor(&bd.jac, &r_lambda, &grad, &[g_lambda])
+            .and_then(|()| newton_lu.solve(&mut step))
+            .is_err()
+        {
             return Err(singular(it, &history));
         }
-        newton_lu.solve(&mut step);
         for i in 0..m {
             q[i] += step[i];
         }

@@ -12,8 +12,6 @@
 use crate::aft::Aft;
 use crate::broyden::{BroydenOptions, BroydenStats};
 pub(crate) use crate::error::HbError;
-/// The Galerkin Jacobian of [`HbResidual`] lives in [`crate::galerkin`].
-pub use crate::galerkin::GalerkinJacobian;
 use crate::problem::PeriodicProblem;
 
 /// Options of the IHB solvers.

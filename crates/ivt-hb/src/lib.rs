@@ -7,6 +7,7 @@ pub mod aft;
 pub mod autonomous;
 pub mod backbone;
 pub mod bifurcation;
+pub mod branch_point;
 pub mod broyden;
 pub mod classic;
 pub mod continuation;
@@ -33,9 +34,9 @@ pub use aft::Aft;
 pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
 pub use backbone::{backbone, Backbone, BackboneOptions, BackbonePoint};
 pub use bifurcation::{
-    locate_branch_point, locate_multiplier_crossing, Bifurcation, BifurcationError,
-    BifurcationKind, BifurcationOptions,
+    locate_multiplier_crossing, Bifurcation, BifurcationError, BifurcationKind, BifurcationOptions,
 };
+pub use branch_point::locate_branch_point;
 pub use broyden::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
 };
@@ -52,8 +53,9 @@ pub use family::{Family, FamilyBranch, Frequency};
 pub use floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
 pub use fold::{locate_fold, Branch, FoldLocation, FoldOptions};
 pub use frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
+pub use galerkin::GalerkinJacobian;
 pub use hill::{fourier_blocks, hill_multipliers, HillResult};
-pub use ihb::{GalerkinJacobian, HbOptions, HbResidual, HbSolution, HbSolver};
+pub use ihb::{HbOptions, HbResidual, HbSolution, HbSolver};
 pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;
 pub use problem::{

@@ -6,9 +6,8 @@
 
 use crate::broyden::{broyden_solve, BroydenStats, BroydenWorkspace, System};
 use crate::continuation::{pseudo_arclength, ContinuationOptions};
-use crate::ihb::{
-    validate_omega, GalerkinJacobian, HbError, HbOptions, HbResidual, HbSolution, HbSolver,
-};
+use crate::galerkin::GalerkinJacobian;
+use crate::ihb::{validate_omega, HbError, HbOptions, HbResidual, HbSolution, HbSolver};
 use crate::problem::PeriodicProblem;
 use ivt_num::vector::matvec;
 

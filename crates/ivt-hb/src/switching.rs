@@ -6,16 +6,16 @@
 //! [`period_doubled_start`]).
 
 use crate::bifurcation::{
-    check_start, dot, lambda_step, put_jacobian, record, residual_lambda, solve_error, Bifurcation,
-    BifurcationError, BifurcationKind, BifurcationOptions,
+    check_start, dot, lambda_step, put_jacobian, solve_error, Bifurcation, BifurcationError,
+    BifurcationKind, BifurcationOptions,
 };
 use crate::broyden::SolveError;
 use crate::family::{Family, FamilyBranch};
-use crate::fold::{null_vector, Branch};
+use crate::fold::{null_vector, residual_lambda_difference as residual_lambda, Branch};
 use crate::ihb::{HbError, HbOptions};
-use ivt_num::lu::solve_once;
 use ivt_num::vector::norm2;
-use ivt_num::LuWorkspace;
+use ivt_num::{newton_bordered, Border, LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace};
+use std::convert::Infallible;
 
 /// A first point on a new branch: Newton on `[R(q, λ); dᵀ(x − x*) − h] = 0`
 /// (`x = {q, λ}`) from the predictor `x* + h d`, where `x* = {q, λ}` is the
@@ -43,51 +43,67 @@ pub fn switch_branch<B: Branch>(
     }
     let star: Vec<f64> = q.iter().copied().chain([lambda]).collect();
     let mut x: Vec<f64> = star.iter().zip(direction).map(|(s, d)| s + h * d).collect();
-    let mut r = vec![0.0; m];
-    let mut jac = vec![0.0; m * m];
-    let mut r_lambda = vec![0.0; m];
-    let mut big = vec![0.0; n1 * n1];
-    let mut step = vec![0.0; n1];
-    let mut history = Vec::new();
-    for it in 0..=opts.max_iter {
-        branch.residual(&x[..m], x[m], &mut r);
-        let arc = dot(direction, &x) - dot(direction, &star) - h;
-        record(&mut history, (norm2(&r).powi(2) + arc * arc).sqrt())?;
-        if it == opts.max_iter {
-            break;
-        }
-        branch.jacobian(&x[..m], x[m], &mut jac);
-        residual_lambda(
-            branch,
-            &x[..m],
-            x[m],
-            lambda_step(opts, x[m]),
-            &mut r_lambda,
-        );
-        put_jacobian(&mut big, n1, &jac, &r_lambda);
-        for i in 0..m {
-            step[i] = -r[i];
-        }
-        big[m * n1..].copy_from_slice(direction);
-        step[m] = -arc;
-        if !solve_once(&big, n1, &mut step, false) {
-            return Err(solve_error(SolveError::SingularJacobian {
-                iteration: it,
-                history,
-            }));
-        }
-        x.iter_mut().zip(&step).for_each(|(a, d)| *a += d);
-        let scale = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        if step.iter().fold(0.0f64, |a, v| a.max(v.abs())) <= opts.step_tol * scale {
-            let lambda = x[m];
-            x.truncate(m);
-            return Ok((x, lambda));
-        }
+    let mut system = BranchWithLambda {
+        branch,
+        opts,
+        jac: vec![0.0; m * m],
+        r_lambda: vec![0.0; m],
+    };
+    // Full steps until the largest update is below `step_tol` of the
+    // largest entry of x (at the predictor).
+    let scale = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let nopts = NewtonOptions {
+        ftol: 0.0,
+        rtol: 0.0,
+        atol: opts.step_tol * scale,
+        max_iter: opts.max_iter,
+        max_halvings: 0,
+        accept_no_descent: true,
+    };
+    let border = Border {
+        rows: direction,
+        values: &[dot(direction, &star) + h],
+    };
+    newton_bordered(
+        &mut system,
+        border,
+        &mut x,
+        &mut NewtonWorkspace::bordered(n1, 1),
+        &nopts,
+    )
+    .map_err(|e| solve_error(SolveError::from(e)))?;
+    let lambda = x[m];
+    x.truncate(m);
+    Ok((x, lambda))
+}
+
+/// `R(q, λ)` of a [`Branch`] in the unknowns `{q, λ}`, with the Jacobian
+/// `[R_q, R_λ]` (`R_λ` by the central difference of [`lambda_step`]).
+struct BranchWithLambda<'a, B> {
+    branch: &'a mut B,
+    opts: &'a BifurcationOptions,
+    jac: Vec<f64>,
+    r_lambda: Vec<f64>,
+}
+
+impl<B: Branch> NewtonSystem for BranchWithLambda<'_, B> {
+    type Error = Infallible;
+
+    fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
+        let m = self.r_lambda.len();
+        self.branch.residual(&x[..m], x[m], r);
+        Ok(())
     }
-    Err(solve_error(SolveError::NonConvergence {
-        iterations: opts.max_iter,
-        history,
-    }))
+
+    fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> Result<(), Infallible> {
+        let m = self.r_lambda.len();
+        let (q, lambda) = (&x[..m], x[m]);
+        self.branch.jacobian(q, lambda, &mut self.jac);
+        let h = lambda_step(self.opts, lambda);
+        residual_lambda(self.branch, q, lambda, h, &mut self.r_lambda);
+        put_jacobian(jac, m + 1, &self.jac, &self.r_lambda);
+        Ok(())
+    }
 }
 
 /// The period-doubled branch at a located period doubling `pd` of the branch

@@ -23,13 +23,18 @@
 //! - [`small`]: products of small row-major matrices on nalgebra;
 //! - [`vector`]: dot, norm, axpy and the row-major matrix–vector product
 //!   on slices for the quasi-Newton loops;
-//! - [`newton`]: the one damped Newton method (dense Jacobian through
-//!   [`lu::LuWorkspace`], backtracking, residual and step tests).
+//! - [`bordered`]: the bordered matrix `[[J, B], [Cᵀ, D]]` factored once
+//!   (solve, transposed solve, determinant sign): every extended system of
+//!   the path engine;
+//! - [`newton`]: the one damped Newton method (dense Jacobian, optional
+//!   linear border rows, through [`bordered::BorderedLu`], backtracking,
+//!   residual and step tests).
 //!
 //! The rule for linear algebra: faer for dense LU and eigenvalues
 //! (workspace-based, no allocation in loops); nalgebra only for small
 //! fixed-size algebra and `expm`.
 
+pub mod bordered;
 pub mod lu;
 pub mod newton;
 pub mod rk;
@@ -37,7 +42,11 @@ pub mod small;
 pub mod tableau;
 pub mod vector;
 
+pub use bordered::{BorderedError, BorderedLu};
 pub use lu::LuWorkspace;
-pub use newton::{newton, NewtonError, NewtonOptions, NewtonStats, NewtonSystem, NewtonWorkspace};
+pub use newton::{
+    newton, newton_bordered, Border, NewtonError, NewtonOptions, NewtonStats, NewtonSystem,
+    NewtonWorkspace,
+};
 pub use rk::{ExplicitRk, Tolerance};
 pub use tableau::{Tableau, DP5, RK4, RK6};

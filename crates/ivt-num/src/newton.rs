@@ -1,7 +1,9 @@
-//! One damped Newton method for square systems `F(x) = 0` with a dense
-//! Jacobian: each step solves `J Δx = −F` through [`LuWorkspace`] (factor
-//! once per Jacobian, no allocation per step) and halves the step until
-//! `‖F‖₂` falls (backtracking line search).
+//! One damped Newton method for `F(x) = 0` with a dense Jacobian, optionally
+//! closed by linear border rows `C x = d` ([`newton_bordered`]: the
+//! pseudo-arclength constraint of thesis Eq. 70, a fixed parameter, a phase
+//! condition): each step solves `[[∂F/∂x], [C]] Δx = −[F; C x − d]` through
+//! [`BorderedLu`] (factor once per Jacobian, no allocation per step) and
+//! halves the step until `‖[F; C x − d]‖₂` falls (backtracking line search).
 //!
 //! Stopping: `‖F(x)‖₂ ≤ ftol` (residual test), or a full step with
 //! `|Δx_i| ≤ rtol·|x_i| + atol` for every `i` (step test; the step is taken
@@ -9,20 +11,21 @@
 //! Jacobian, a non-finite residual, no decrease along the step, or
 //! `max_iter` steps; every error carries the `‖F‖₂` history.
 
-use crate::lu::LuWorkspace;
+use crate::bordered::BorderedLu;
 use thiserror::Error;
 
-/// A square system with its Jacobian.
+/// A system `F: Rⁿ → Rᵐ` with its Jacobian: square (`m = n`) for
+/// [`newton`], `m = n − k` for [`newton_bordered`] with `k` border rows.
 pub trait NewtonSystem {
     /// Error of an evaluation (e.g. an integration that stalls).
     type Error;
-    /// `F(x)` into `r`. A non-finite `r` at a trial point rejects the trial
+    /// `F(x)` into `r` (`m` entries). A non-finite `r` at a trial point rejects the trial
     /// (the step is halved): a way to say "outside the domain".
     ///
     /// # Errors
     /// Any evaluation failure; it ends the iteration ([`NewtonError::Eval`]).
     fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), Self::Error>;
-    /// `∂F/∂x` at `x`, row-major `m × m`, into `jac`. Called only at the `x`
+    /// `∂F/∂x` at `x`, row-major `m × n`, into `jac`. Called only at the `x`
     /// of the last [`Self::residual`] call, so state computed there may be
     /// reused.
     ///
@@ -117,6 +120,17 @@ pub enum NewtonError<E> {
     /// The system's evaluation failed.
     #[error("evaluation failed")]
     Eval(E),
+    /// The border rows, their right-hand side and the unknowns disagree in
+    /// size (`rows` must be `k × n`, `values` `k`, `k ≤ n`).
+    #[error("border of {rows} entries and {values} values does not fit {unknowns} unknowns")]
+    BorderSize {
+        /// Entries of the border rows.
+        rows: usize,
+        /// Entries of the right-hand side.
+        values: usize,
+        /// Unknowns `n`.
+        unknowns: usize,
+    },
 }
 
 impl<E> NewtonError<E> {
@@ -127,18 +141,36 @@ impl<E> NewtonError<E> {
             | Self::NoDescent { history, .. }
             | Self::SingularJacobian { history, .. }
             | Self::NonFinite { history, .. } => history,
-            Self::Eval(_) => &[],
+            Self::Eval(_) | Self::BorderSize { .. } => &[],
         }
     }
 }
 
-/// Caller-owned buffers of [`newton`]: Jacobian, its LU, step, trial point
-/// and residuals. Reused across solves of the same size; resized (the only
-/// allocation) when the size changes.
+/// `k` linear rows `C x = d` closing an `n − k`-row system (`rows`
+/// row-major `k × n`, `values` `k`).
+#[derive(Debug, Clone, Copy)]
+pub struct Border<'a> {
+    /// `C`, row-major `k × n`.
+    pub rows: &'a [f64],
+    /// `d`.
+    pub values: &'a [f64],
+}
+
+impl Border<'_> {
+    /// No border rows: [`newton`]'s square system.
+    pub const NONE: Border<'static> = Border {
+        rows: &[],
+        values: &[],
+    };
+}
+
+/// Caller-owned buffers of [`newton`] and [`newton_bordered`]: Jacobian,
+/// its (bordered) LU, step, trial point and residuals. Reused across solves
+/// of the same sizes; resized (the only allocation) when they change.
 #[derive(Debug, Clone)]
 pub struct NewtonWorkspace {
     jac: Vec<f64>,
-    lu: LuWorkspace,
+    lu: BorderedLu,
     dx: Vec<f64>,
     x_trial: Vec<f64>,
     r: Vec<f64>,
@@ -147,15 +179,21 @@ pub struct NewtonWorkspace {
 }
 
 impl NewtonWorkspace {
-    /// Buffers for `m` unknowns.
+    /// Buffers for a square system of `m` unknowns.
     pub fn new(m: usize) -> Self {
+        Self::bordered(m, 0)
+    }
+
+    /// Buffers for `n` unknowns of which `k` are fixed by border rows.
+    pub fn bordered(n: usize, k: usize) -> Self {
+        let m = n.saturating_sub(k);
         Self {
-            jac: vec![0.0; m * m],
-            lu: LuWorkspace::new(m),
-            dx: vec![0.0; m],
-            x_trial: vec![0.0; m],
-            r: vec![0.0; m],
-            r_trial: vec![0.0; m],
+            jac: vec![0.0; m * n],
+            lu: BorderedLu::new(m, n - m),
+            dx: vec![0.0; n],
+            x_trial: vec![0.0; n],
+            r: vec![0.0; n],
+            r_trial: vec![0.0; n],
             history: Vec::with_capacity(64),
         }
     }
@@ -165,18 +203,43 @@ impl NewtonWorkspace {
         self.dx.len()
     }
 
-    /// `F` at the last accepted point of the last solve.
+    /// `[F; C x − d]` at the last accepted point of the last solve.
     pub fn residual(&self) -> &[f64] {
         &self.r
     }
+
+    /// Sign of the determinant of the last factored (bordered) Jacobian.
+    pub fn det_sign(&self) -> f64 {
+        self.lu.det_sign()
+    }
+}
+
+/// `[F(x); C x − d]` into `r`.
+fn bordered_residual<S: NewtonSystem + ?Sized>(
+    sys: &mut S,
+    border: &Border,
+    x: &[f64],
+    r: &mut [f64],
+) -> Result<(), S::Error> {
+    let m = x.len() - border.values.len();
+    let (rf, rc) = r.split_at_mut(m);
+    sys.residual(x, rf)?;
+    for ((out, row), d) in rc
+        .iter_mut()
+        .zip(border.rows.chunks_exact(x.len()))
+        .zip(border.values)
+    {
+        *out = crate::vector::dot(row, x) - d;
+    }
+    Ok(())
 }
 
 fn norm2(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
-/// Solves `F(x) = 0` by damped Newton from the guess `x` (overwritten by the
-/// solution).
+/// Solves the square system `F(x) = 0` by damped Newton from the guess `x`
+/// (overwritten by the solution).
 ///
 /// # Errors
 /// [`NewtonError`] as described there.
@@ -186,9 +249,35 @@ pub fn newton<S: NewtonSystem + ?Sized>(
     ws: &mut NewtonWorkspace,
     opts: &NewtonOptions,
 ) -> Result<NewtonStats, NewtonError<S::Error>> {
-    let m = x.len();
-    if ws.dim() != m {
-        *ws = NewtonWorkspace::new(m);
+    newton_bordered(sys, Border::NONE, x, ws, opts)
+}
+
+/// Solves `[F(x); C x − d] = 0` (`F` with `n − k` rows, `k` border rows)
+/// by damped Newton from the guess `x` (overwritten by the solution). The
+/// Jacobian `[[∂F/∂x], [C]]` is factored by [`BorderedLu`]; the residual
+/// and its history include the border rows.
+///
+/// # Errors
+/// [`NewtonError`] as described there; [`NewtonError::BorderSize`] when
+/// the border does not fit `x`.
+pub fn newton_bordered<S: NewtonSystem + ?Sized>(
+    sys: &mut S,
+    border: Border,
+    x: &mut [f64],
+    ws: &mut NewtonWorkspace,
+    opts: &NewtonOptions,
+) -> Result<NewtonStats, NewtonError<S::Error>> {
+    let n = x.len();
+    let k = border.values.len();
+    if k > n || border.rows.len() != k * n {
+        return Err(NewtonError::BorderSize {
+            rows: border.rows.len(),
+            values: k,
+            unknowns: n,
+        });
+    }
+    if ws.dim() != n || ws.lu.borders() != k {
+        *ws = NewtonWorkspace::bordered(n, k);
     }
     ws.history.clear();
     let mut stats = NewtonStats {
@@ -204,7 +293,7 @@ pub fn newton<S: NewtonSystem + ?Sized>(
     if !x.iter().all(|v| v.is_finite()) {
         return Err(non_finite(0, &ws.history));
     }
-    sys.residual(x, &mut ws.r).map_err(NewtonError::Eval)?;
+    bordered_residual(sys, &border, x, &mut ws.r).map_err(NewtonError::Eval)?;
     stats.residual_evals += 1;
     let mut norm = norm2(&ws.r);
     ws.history.push(norm);
@@ -226,11 +315,13 @@ pub fn newton<S: NewtonSystem + ?Sized>(
             iteration: it,
             history: history.to_vec(),
         };
-        if !ws.lu.factor_row_major(&ws.jac) {
+        if ws.lu.factor_rows(&ws.jac, border.rows).is_err() {
             return Err(singular(&ws.history));
         }
         ws.dx.iter_mut().zip(&ws.r).for_each(|(d, r)| *d = -r);
-        ws.lu.solve(&mut ws.dx);
+        if ws.lu.solve(&mut ws.dx).is_err() {
+            return Err(singular(&ws.history));
+        }
         if !ws.dx.iter().all(|v| v.is_finite()) {
             return Err(singular(&ws.history));
         }
@@ -241,7 +332,7 @@ pub fn newton<S: NewtonSystem + ?Sized>(
             .all(|(d, xi)| d.abs() <= opts.rtol * xi.abs() + opts.atol);
         if small {
             x.iter_mut().zip(&ws.dx).for_each(|(xi, d)| *xi += d);
-            sys.residual(x, &mut ws.r).map_err(NewtonError::Eval)?;
+            bordered_residual(sys, &border, x, &mut ws.r).map_err(NewtonError::Eval)?;
             stats.residual_evals += 1;
             norm = norm2(&ws.r);
             ws.history.push(norm);
@@ -257,7 +348,7 @@ pub fn newton<S: NewtonSystem + ?Sized>(
             for ((xt, xi), d) in ws.x_trial.iter_mut().zip(x.iter()).zip(&ws.dx) {
                 *xt = xi + t * d;
             }
-            sys.residual(&ws.x_trial, &mut ws.r_trial)
+            bordered_residual(sys, &border, &ws.x_trial, &mut ws.r_trial)
                 .map_err(NewtonError::Eval)?;
             stats.residual_evals += 1;
             let trial = norm2(&ws.r_trial);
@@ -335,6 +426,92 @@ mod tests {
         );
         assert!(sys.jacobians_at_last_residual);
         assert_eq!(stats.jacobian_evals, stats.iterations);
+    }
+
+    /// The circle `x₀² + x₁² = 4` closed by the border row `x₀ − x₁ = 0`
+    /// takes the same steps as the square system `Circle` that has that row
+    /// in its Jacobian (same history to rounding), and lands on the closed
+    /// form `(√2, √2)`. Two border rows on three unknowns (`x₂ = 0.5`,
+    /// `x₀ + x₁ = 1` with `F = x₀² − x₁ + x₂`): the root of `x₀² + x₀ − 0.5`,
+    /// `x₀ = (−1 + √3)/2`.
+    #[test]
+    fn border_rows_close_the_system() {
+        struct Arc;
+        impl NewtonSystem for Arc {
+            type Error = ();
+            fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), ()> {
+                r[0] = x[0] * x[0] + x[1] * x[1] - 4.0;
+                Ok(())
+            }
+            fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> Result<(), ()> {
+                jac.copy_from_slice(&[2.0 * x[0], 2.0 * x[1]]);
+                Ok(())
+            }
+        }
+        let opts = NewtonOptions {
+            ftol: 1e-14,
+            ..Default::default()
+        };
+        let mut square = Circle {
+            jacobians_at_last_residual: true,
+            last: Vec::new(),
+        };
+        let mut x_sq = [3.0, 1.0];
+        let mut ws_sq = NewtonWorkspace::new(2);
+        newton(&mut square, &mut x_sq, &mut ws_sq, &opts).unwrap();
+        let mut x = [3.0, 1.0];
+        let mut ws = NewtonWorkspace::new(2);
+        let border = Border {
+            rows: &[1.0, -1.0],
+            values: &[0.0],
+        };
+        let stats = newton_bordered(&mut Arc, border, &mut x, &mut ws, &opts).unwrap();
+        assert_eq!(ws.history.len(), ws_sq.history.len());
+        for (a, b) in ws.history.iter().zip(&ws_sq.history) {
+            assert!((a - b).abs() <= 1e-13 * b.max(1.0), "{:?}", ws.history);
+        }
+        let s2 = 2f64.sqrt();
+        assert!(
+            (x[0] - s2).abs() < 1e-15 && (x[1] - s2).abs() < 1e-15,
+            "{x:?} {stats:?}"
+        );
+
+        struct Parabola;
+        impl NewtonSystem for Parabola {
+            type Error = ();
+            fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), ()> {
+                r[0] = x[0] * x[0] - x[1] + x[2];
+                Ok(())
+            }
+            fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> Result<(), ()> {
+                jac.copy_from_slice(&[2.0 * x[0], -1.0, 1.0]);
+                Ok(())
+            }
+        }
+        let mut x = [1.0, 0.0, 0.0];
+        let border = Border {
+            rows: &[0.0, 0.0, 1.0, 1.0, 1.0, 0.0],
+            values: &[0.5, 1.0],
+        };
+        newton_bordered(&mut Parabola, border, &mut x, &mut ws, &opts).unwrap();
+        let root = (3f64.sqrt() - 1.0) / 2.0;
+        assert!(
+            (x[0] - root).abs() < 1e-15 && (x[1] - (1.0 - root)).abs() < 1e-15,
+            "{x:?}"
+        );
+        assert_eq!(x[2], 0.5);
+        let bad = Border {
+            rows: &[1.0],
+            values: &[0.0],
+        };
+        assert!(matches!(
+            newton_bordered(&mut Parabola, bad, &mut x, &mut ws, &opts),
+            Err(NewtonError::BorderSize {
+                rows: 1,
+                values: 1,
+                unknowns: 3
+            })
+        ));
     }
 
     /// `F = atan(x)` from x = 1.5: the full Newton step overshoots to

@@ -17,7 +17,7 @@
 
 use faer::Mat;
 use ivt_num::vector::{dot, norm2};
-use ivt_num::LuWorkspace;
+use ivt_num::BorderedLu;
 use std::borrow::Cow;
 
 use super::{non_finite_start, turn, ContinuationOptions, Fold, Path, PathPoint};
@@ -124,7 +124,7 @@ where
             x: x.clone(),
             iterations,
             dlambda: tangent[m],
-            bordered_sign: Some(corrector.aug.det_sign),
+            bordered_sign: Some(corrector.aug.det_sign()),
         };
         let k = points.len();
         if k >= 2 && points[k - 1].dlambda * point.dlambda < 0.0 {
@@ -217,7 +217,7 @@ where
                         weighted / NEWTON_WEIGHT
                     };
                     if weighted * 2 <= opts.target_iter {
-                        step = (step * opts.growth).min(opts.ds_max);
+                        step = (step * opts.growth).min(opts.step_cap(&x));
                     } else if weighted >= opts.target_iter {
                         step *= 0.7;
                     }
@@ -264,7 +264,7 @@ fn curvature_between(x0: &[f64], x1: &[f64], t0: &[f64], t1: &[f64], out: &mut [
 /// Buffers of the tangent and the correctors; `aug` holds the LU of the last
 /// bordered matrix `[J R_λ; rowᵀ]`.
 struct Corrector {
-    aug: LuWorkspace,
+    aug: BorderedLu,
     jac: Mat<f64>,
     r: Vec<f64>,
     r_lambda: Vec<f64>,
@@ -281,7 +281,7 @@ struct Corrector {
 impl Corrector {
     fn new(m: usize, opts: &ContinuationOptions) -> Self {
         Self {
-            aug: LuWorkspace::new(m + 1),
+            aug: BorderedLu::new(m, 1),
             jac: Mat::zeros(m, m),
             r: vec![0.0; m],
             r_lambda: vec![0.0; m],
@@ -305,14 +305,10 @@ impl Corrector {
     fn factor<S: PathSystem>(&mut self, system: &mut S, x: &[f64], row: &[f64]) -> bool {
         let m = self.jac.nrows();
         system.d_residual_d_lambda(&x[..m], x[m], &mut self.r_lambda);
-        let a = &mut self.aug.mat;
-        a.as_mut().submatrix_mut(0, 0, m, m).copy_from(&self.jac);
-        for j in 0..m {
-            a[(j, m)] = self.r_lambda[j];
-            a[(m, j)] = row[j];
-        }
-        a[(m, m)] = row[m];
-        self.aug.factor()
+        let (row, corner) = row.split_at(m);
+        self.aug
+            .factor_mat(self.jac.as_ref(), &self.r_lambda, row, corner)
+            .is_ok()
     }
 
     /// The unit tangent at `x`, oriented along the previous `tangent` (which
@@ -346,14 +342,14 @@ impl Corrector {
         let z = &mut self.rhs;
         z.fill(0.0);
         z[m] = 1.0;
-        self.aug.solve(z);
+        let solved = self.aug.solve(z).is_ok();
         let norm = norm2(z);
         let along: f64 = z.iter().zip(tangent.iter()).map(|(a, b)| a * b).sum();
         let sign = if along < 0.0 { -1.0 } else { 1.0 };
         for (t, v) in tangent.iter_mut().zip(z.iter()) {
             *t = sign * v / norm;
         }
-        norm.is_finite()
+        solved && norm.is_finite()
     }
 
     /// The start of a corrector: `u_pred`, on `λ = fix` if given.
@@ -401,7 +397,9 @@ impl Corrector {
             }
             // z = −A₀⁻¹F, then the updates s_{j+1} s_jᵀ z / ‖s_j‖² in order.
             let mut z = self.rhs.clone();
-            self.aug.solve(&mut z);
+            if self.aug.solve(&mut z).is_err() {
+                break;
+            }
             z.iter_mut().for_each(|v| *v = -*v);
             for pair in steps.windows(2) {
                 let c = dot(&pair[0], &z) / dot(&pair[0], &pair[0]);
@@ -457,7 +455,12 @@ impl Corrector {
             }
             self.rhs[..m].copy_from_slice(&self.r);
             self.rhs[m] = constraint;
-            self.aug.solve(&mut self.rhs);
+            if self.aug.solve(&mut self.rhs).is_err() {
+                return Err(SolveError::SingularJacobian {
+                    iteration: it,
+                    history,
+                });
+            }
             for (x, d) in self.u.iter_mut().zip(&self.rhs) {
                 *x -= d;
             }

@@ -1,56 +1,79 @@
-//! The start of an exact-Jacobian path: Newton at fixed λ.
+//! The start of an exact-Jacobian path: Newton at fixed λ ([`ivt_num::newton`]).
 
 use faer::Mat;
-use ivt_num::LuWorkspace;
+use ivt_num::{newton, NewtonError, NewtonOptions, NewtonSystem, NewtonWorkspace};
+use std::convert::Infallible;
 
 use super::{ContinuationOptions, PathSystem, SolveError};
 use crate::error::HbError;
+
+/// A [`PathSystem`] at fixed λ as a square [`NewtonSystem`] in `u`.
+struct FixedLambda<'a, S> {
+    system: &'a mut S,
+    lambda: f64,
+    jac: Mat<f64>,
+}
+
+impl<S: PathSystem> NewtonSystem for FixedLambda<'_, S> {
+    type Error = Infallible;
+
+    fn residual(&mut self, u: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
+        self.system.residual(u, self.lambda, r);
+        Ok(())
+    }
+
+    fn jacobian(&mut self, u: &[f64], jac: &mut [f64]) -> Result<(), Infallible> {
+        self.system.jacobian(u, self.lambda, &mut self.jac);
+        let m = self.jac.nrows();
+        for (i, row) in jac.chunks_exact_mut(m.max(1)).enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = self.jac[(i, j)];
+            }
+        }
+        Ok(())
+    }
+}
 
 /// Newton on `R(u, λ) = 0` at the λ of `x` (`u` then λ, corrected in place) to
 /// `opts.broyden.tol` within `opts.broyden.max_iter` steps, for any
 /// [`PathSystem`] (the first point of [`super::pseudo_arclength_exact`] must
 /// be converged). The Jacobian is assembled only when the residual misses the
-/// tolerance. Returns the steps taken.
+/// tolerance; every step is taken in full (no line search: the start is a
+/// converged orbit of another method, already close). Returns the steps taken.
 ///
 /// # Errors
 /// [`HbError::ContinuationStart`] with the residual history when Newton does
-/// not converge; [`HbError::SingularStart`] for a singular Jacobian.
+/// not converge; [`HbError::SingularStart`] for a singular Jacobian;
+/// [`HbError::InvalidInput`] when `x` has not `m + 1` entries.
 pub fn correct_at_fixed_lambda<S: PathSystem>(
     system: &mut S,
     x: &mut [f64],
     opts: &ContinuationOptions,
 ) -> Result<usize, HbError> {
     let m = system.dim();
-    let lambda = x[m];
-    let mut r = vec![0.0; m];
-    let mut jac = Mat::zeros(m, m);
-    let mut lu = LuWorkspace::new(m);
-    let mut history = Vec::new();
-    loop {
-        let it = history.len();
-        system.residual(&x[..m], lambda, &mut r);
-        let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
-        history.push(norm);
-        if norm <= opts.broyden.tol {
-            return Ok(it);
-        }
-        if !norm.is_finite() || it == opts.broyden.max_iter {
-            return Err(HbError::ContinuationStart {
-                lambda,
-                cause: SolveError::NonConvergence {
-                    iterations: it,
-                    history,
-                },
-            });
-        }
-        system.residual_jacobian(&x[..m], lambda, &mut r, &mut jac);
-        lu.mat.copy_from(&jac);
-        if !lu.factor() {
-            return Err(HbError::SingularStart { lambda });
-        }
-        lu.solve(&mut r);
-        for (u, d) in x.iter_mut().zip(&r) {
-            *u -= d;
-        }
+    let Some((&mut lambda, u)) = x.split_last_mut().filter(|(_, u)| u.len() == m) else {
+        return Err(HbError::InvalidInput(
+            "continuation start must hold m unknowns and λ".into(),
+        ));
+    };
+    let mut fixed = FixedLambda {
+        system,
+        lambda,
+        jac: Mat::zeros(m, m),
+    };
+    let nopts = NewtonOptions {
+        ftol: opts.broyden.tol,
+        max_iter: opts.broyden.max_iter,
+        max_halvings: 0,
+        accept_no_descent: true,
+        ..NewtonOptions::default()
+    };
+    match newton(&mut fixed, u, &mut NewtonWorkspace::new(m), &nopts) {
+        Ok(stats) => Ok(stats.iterations),
+        Err(NewtonError::SingularJacobian { .. }) => Err(HbError::SingularStart { lambda }),
+        Err(e) => Err(HbError::ContinuationStart {
+            lambda,
+            cause: SolveError::from(e),
+        }),
     }
 }
