@@ -11,20 +11,18 @@
 //! with half the step ([`monodromy_refined`]), whose Richardson error estimate
 //! is the point's `multiplier_error`.
 
-use faer::Mat;
-
+use super::reduced::ReducedString;
 use super::stability::{
     hill, hill_dim, monodromy, monodromy_refined, Stability, StabilityMethod, HILL_MAX_DIM,
 };
 use super::StringHb;
 use crate::broyden::BroydenOptions;
 use crate::continuation::{
-    pseudo_arclength_exact, ContinuationOptions, Path, PathPoint, PathSystem, Termination,
+    pseudo_arclength_exact, ContinuationOptions, Path, PathPoint, Termination,
 };
 use crate::error::HbError;
-use crate::fold::{locate_fold, Branch, FoldOptions};
+use crate::fold::{locate_fold, FoldOptions};
 use crate::frc::{Frc, FrcFold, FrcPoint};
-use ivt_num::vector::dot;
 
 /// Settings of a string curve.
 #[derive(Clone, Debug, PartialEq)]
@@ -79,110 +77,6 @@ pub struct StringFrc {
     pub hill_calls: usize,
 }
 
-/// [`StringHb`] as a path in ω, counting Jacobian assemblies.
-struct StringPath<'a> {
-    hb: &'a mut StringHb,
-    jacobians: usize,
-}
-
-/// [`StringHb`] as a [`Branch`] in ω for the bordered fold system
-/// ([`locate_fold`]), with the exact Jacobian of Eq. 115–125 and exact
-/// derivatives of the fold test function: `∂R/∂ω = ∂J_lin/∂ω a` (Eq. 115; the
-/// balanced term does not depend on ω), `∂(wᵀJv)/∂ω = wᵀ ∂J_lin/∂ω v`, and
-/// `∂(wᵀJv)/∂a` from two Jacobians (see [`Branch::jacobian_gradient`] below)
-/// instead of the default's `2·dim` finite-difference Jacobians, which took
-/// minutes per fold at `N = 20`, `M = 39`.
-struct StringBranch<'a> {
-    hb: &'a mut StringHb,
-    jac: Mat<f64>,
-    r: Vec<f64>,
-    shifted: Vec<f64>,
-}
-
-impl StringBranch<'_> {
-    /// `J(a)ᵀ w` into `out`.
-    fn jacobian_transpose_times(&mut self, a: &[f64], omega: f64, w: &[f64], out: &mut [f64]) {
-        self.hb
-            .residual_jacobian(a, omega, &mut self.r, &mut self.jac);
-        for (j, o) in out.iter_mut().enumerate() {
-            *o = w
-                .iter()
-                .enumerate()
-                .map(|(i, y)| self.jac[(i, j)] * y)
-                .sum();
-        }
-    }
-}
-
-impl Branch for StringBranch<'_> {
-    fn len(&self) -> usize {
-        self.hb.dim()
-    }
-    fn residual(&mut self, q: &[f64], lambda: f64, r: &mut [f64]) {
-        self.hb.residual(q, lambda, r);
-    }
-    fn jacobian(&mut self, q: &[f64], lambda: f64, jac: &mut [f64]) {
-        self.hb
-            .residual_jacobian(q, lambda, &mut self.r, &mut self.jac);
-        let m = self.r.len();
-        for (i, row) in jac.chunks_exact_mut(m).enumerate() {
-            for (j, v) in row.iter_mut().enumerate() {
-                *v = self.jac[(i, j)];
-            }
-        }
-    }
-    fn residual_lambda(&mut self, q: &[f64], lambda: f64, _h: f64, out: &mut [f64]) {
-        self.hb.d_residual_d_omega(q, lambda, out);
-    }
-    fn bilinear_lambda(&mut self, _q: &[f64], lambda: f64, _h: f64, w: &[f64], v: &[f64]) -> f64 {
-        // ∂J/∂ω = ∂J_lin/∂ω, and d_residual_d_omega(v) = ∂J_lin/∂ω v.
-        self.hb.d_residual_d_omega(v, lambda, &mut self.r);
-        dot(w, &self.r)
-    }
-    /// `∂/∂a (wᵀ J(a) v) = (J′(a)[v])ᵀ w` (the Hessians of `R` are symmetric).
-    /// `J = J_lin − S_𝒯(a)` with `S_𝒯` quadratic in `a` (Eq. 122–125: the
-    /// spectra of `w_x w_xx` and `w_x²`), so the central difference
-    /// `(J(a + h v) − J(a − h v)) / 2h` is `J′(a)[v]` exactly for every `h`; `h`
-    /// scales `v` to the size of `a`.
-    fn jacobian_gradient(&mut self, q: &[f64], lambda: f64, w: &[f64], v: &[f64], out: &mut [f64]) {
-        let size = |x: &[f64]| x.iter().fold(0.0f64, |m, y| m.max(y.abs()));
-        let v_size = size(v);
-        if v_size == 0.0 || !v_size.is_finite() {
-            out.fill(0.0);
-            return;
-        }
-        let h = size(q).max(1e-3) / v_size;
-        let mut minus = vec![0.0; q.len()];
-        let mut shifted = std::mem::take(&mut self.shifted);
-        shifted.clear();
-        shifted.extend(q.iter().zip(v).map(|(a, b)| a - h * b));
-        self.jacobian_transpose_times(&shifted, lambda, w, &mut minus);
-        shifted.clear();
-        shifted.extend(q.iter().zip(v).map(|(a, b)| a + h * b));
-        self.jacobian_transpose_times(&shifted, lambda, w, out);
-        self.shifted = shifted;
-        for (o, m) in out.iter_mut().zip(&minus) {
-            *o = (*o - m) / (2.0 * h);
-        }
-    }
-}
-
-impl PathSystem for StringPath<'_> {
-    fn dim(&self) -> usize {
-        self.hb.dim()
-    }
-    fn residual(&mut self, u: &[f64], lambda: f64, r: &mut [f64]) {
-        self.hb.residual(u, lambda, r);
-    }
-    fn residual_jacobian(&mut self, u: &[f64], lambda: f64, r: &mut [f64], jac: &mut Mat<f64>) {
-        self.jacobians += 1;
-        self.hb.residual_jacobian(u, lambda, r, jac);
-    }
-    fn d_residual_d_lambda(&mut self, u: &[f64], lambda: f64, r_lambda: &mut [f64]) {
-        self.hb.d_residual_d_omega(u, lambda, r_lambda);
-    }
-}
-
 /// Follows the branch of periodic responses from `omega_from` to `omega_to`
 /// (either direction), starting from rest at `omega_from`, calling `on_point`
 /// with the problem linearized at each point. Returns the path and the Jacobian
@@ -195,7 +89,7 @@ fn follow<C>(
     on_point: C,
 ) -> Result<(Path, usize), HbError>
 where
-    C: FnMut(&mut StringPath<'_>, &PathPoint) -> bool,
+    C: FnMut(&mut ReducedString<'_>, &PathPoint) -> bool,
 {
     if !(omega_from.is_finite() && omega_to.is_finite() && omega_from > 0.0 && omega_to > 0.0) {
         return Err(HbError::InvalidInput(format!(
@@ -213,16 +107,19 @@ where
             },
             e => e,
         })?;
-    start.push(omega_from);
+    // The branch lives in the invariant subspace (`reduced`): trace it there.
+    let mut system = ReducedString::new(hb);
+    let mut reduced = vec![0.0; system.sub.dim()];
+    system.sub.gather(&start, &mut reduced);
+    reduced.push(omega_from);
     let mut copts = opts.clone();
-    copts.broyden.tol = tol * (1.0 + hb.params().y0.abs());
+    copts.broyden.tol = tol * (1.0 + system.hb.params().y0.abs());
     copts.lambda_min = omega_from.min(omega_to);
     copts.lambda_max = omega_from.max(omega_to);
     let direction = if omega_to >= omega_from { 1.0 } else { -1.0 };
-    let mut system = StringPath { hb, jacobians: 0 };
-    let path = pseudo_arclength_exact(
+    let mut path = pseudo_arclength_exact(
         &mut system,
-        &start,
+        &reduced,
         first.iterations,
         direction,
         &copts,
@@ -234,6 +131,14 @@ where
             step: copts.ds_min,
             cause: Box::new(HbError::Solve(e.clone())),
         });
+    }
+    // Back to the full coefficients (zeros outside the subspace), then ω.
+    let n = system.hb.dim();
+    for p in &mut path.points {
+        let mut full = vec![0.0; n + 1];
+        system.sub.embed(&p.x[..p.x.len() - 1], &mut full[..n]);
+        full[n] = p.lambda();
+        p.x = full;
     }
     // `solve` assembles once more than it iterates (the converged check).
     Ok((path, first.iterations + 1 + system.jacobians))
@@ -314,30 +219,26 @@ pub fn frequency_response(
             coeffs: p.x[..n].to_vec(),
         })
         .collect::<Vec<_>>();
-    let mut branch = StringBranch {
-        hb,
-        jac: Mat::zeros(n, n),
-        r: vec![0.0; n],
-        shifted: Vec::with_capacity(n),
-    };
+    let mut branch = ReducedString::new(hb);
+    let mut q = vec![0.0; branch.sub.dim()];
     let folds = path
         .folds
         .iter()
         .map(|f| {
             let near = &points[f.index];
-            match locate_fold(
-                &mut branch,
-                &near.coeffs,
-                near.omega_f,
-                &FoldOptions::default(),
-            ) {
-                Ok(loc) => FrcFold {
-                    index: f.index,
-                    omega_f: loc.lambda,
-                    amplitude: branch.hb.complex_norm(&loc.q),
-                    coeffs: loc.q,
-                    located: true,
-                },
+            branch.sub.gather(&near.coeffs, &mut q);
+            match locate_fold(&mut branch, &q, near.omega_f, &FoldOptions::default()) {
+                Ok(loc) => {
+                    let mut coeffs = vec![0.0; n];
+                    branch.sub.embed(&loc.q, &mut coeffs);
+                    FrcFold {
+                        index: f.index,
+                        omega_f: loc.lambda,
+                        amplitude: branch.hb.complex_norm(&coeffs),
+                        coeffs,
+                        located: true,
+                    }
+                }
                 Err(_) => FrcFold {
                     index: f.index,
                     omega_f: f.lambda,

@@ -32,6 +32,8 @@ pub mod frc;
 mod hb;
 mod lu;
 pub mod modal;
+mod reduced;
+mod spatial;
 pub mod spring;
 pub mod stability;
 pub mod toeplitz;
