@@ -259,3 +259,108 @@ impl Branch for ReducedString<'_> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fold::fd_jacobian_gradient;
+    use crate::sthb::StringParams;
+
+    /// A response on the branch from rest at `omega` (in the subspace).
+    fn solved(params: StringParams, omega: f64) -> (StringHb, Vec<f64>) {
+        let mut hb = StringHb::new(params).unwrap();
+        let mut a = vec![0.0; hb.dim()];
+        hb.solve(omega, &mut a, 1e-12, 50).unwrap();
+        (hb, a)
+    }
+
+    fn cases() -> Vec<StringParams> {
+        let base = StringParams {
+            kd: 30.0,
+            modes: 6,
+            harmonics: 5,
+            ..Default::default()
+        };
+        vec![
+            base.clone(),
+            StringParams {
+                boundary: Boundary::Spring { k0: 7.0 },
+                ..base.clone()
+            },
+            // Odd M_s: the harmonics are not reduced.
+            StringParams { ms: 15, ..base },
+        ]
+    }
+
+    #[test]
+    fn full_jacobian_is_block_diagonal_and_the_block_is_the_reduced_one() {
+        for p in cases() {
+            let (mut hb, a) = solved(p.clone(), 3.8);
+            let n = hb.dim();
+            let (mut r, mut full) = (vec![0.0; n], Mat::zeros(n, n));
+            hb.residual_jacobian(&a, 3.8, &mut r, &mut full);
+            let scale = (0..n)
+                .flat_map(|i| (0..n).map(move |j| (i, j)))
+                .map(|(i, j)| full[(i, j)].abs())
+                .fold(0.0, f64::max);
+            let mut sys = ReducedString::new(&mut hb);
+            let m = sys.sub.dim();
+            let mut q = vec![0.0; m];
+            sys.sub.gather(&a, &mut q);
+            // The response lies in the subspace: nothing outside it.
+            let outside: f64 = (0..n)
+                .filter(|&i| sys.sub.position[i] == OUTSIDE)
+                .map(|i| a[i].abs())
+                .fold(0.0, f64::max);
+            assert!(outside < 1e-14, "{p:?}: {outside:e} outside");
+            let (mut rr, mut red) = (vec![0.0; m], Mat::zeros(m, m));
+            sys.residual_jacobian(&q, 3.8, &mut rr, &mut red);
+            let pos = &sys.sub.position;
+            for i in 0..n {
+                for j in 0..n {
+                    let v = full[(i, j)];
+                    let err = match (pos[i], pos[j]) {
+                        (OUTSIDE, OUTSIDE) => 0.0,
+                        (OUTSIDE, _) | (_, OUTSIDE) => v.abs(),
+                        (ri, rj) => (red[(ri, rj)] - v).abs(),
+                    };
+                    assert!(err <= 1e-13 * scale, "{p:?} ({i}, {j}): {err:e}");
+                }
+            }
+            for (ri, &fi) in sys.sub.full_index.iter().enumerate() {
+                assert!((rr[ri] - r[fi]).abs() <= 1e-13 * scale);
+            }
+            let expected = match (p.boundary, p.ms % 2) {
+                (Boundary::Fixed, 0) => 3 * 6,
+                (Boundary::Spring { .. }, 0) => 6 * 7,
+                _ => 11 * 3,
+            };
+            assert_eq!(m, expected, "{p:?}");
+        }
+    }
+
+    #[test]
+    fn exact_fold_derivatives_match_finite_differences() {
+        for p in cases() {
+            let (mut hb, a) = solved(p, 3.8);
+            let mut sys = ReducedString::new(&mut hb);
+            let m = sys.sub.dim();
+            let mut q = vec![0.0; m];
+            sys.sub.gather(&a, &mut q);
+            let w: Vec<f64> = (0..m).map(|i| ((i * 7 + 3) % 11) as f64 - 5.0).collect();
+            let v: Vec<f64> = (0..m).map(|i| ((i * 5 + 1) % 13) as f64 - 6.0).collect();
+            let (mut exact, mut fd) = (vec![0.0; m], vec![0.0; m]);
+            sys.jacobian_gradient(&q, 3.8, &w, &v, &mut exact);
+            fd_jacobian_gradient(&mut sys, &q, 3.8, &w, &v, 1e-5, &mut fd);
+            let scale = fd.iter().fold(0.0f64, |s, x| s.max(x.abs()));
+            for (e, f) in exact.iter().zip(&fd) {
+                assert!((e - f).abs() <= 1e-6 * scale, "{e} vs {f}");
+            }
+            // ∂(wᵀJv)/∂ω against the central difference of wᵀJv in ω.
+            let h = 1e-4;
+            let exact_w = sys.bilinear_lambda(&q, 3.8, h, &w, &v);
+            let fd_w = crate::fold::bilinear_lambda_difference(&mut sys, &q, 3.8, h, &w, &v);
+            assert!((exact_w - fd_w).abs() <= 1e-6 * exact_w.abs().max(1.0));
+        }
+    }
+}
