@@ -90,3 +90,25 @@ fn scaling() {
         );
     }
 }
+
+#[test]
+fn split_monodromy_has_the_full_matrix_multipliers() {
+    // The curve's multipliers come from the odd/even-mode blocks; the public
+    // monodromy_matrix integrates all modes together.
+    for (modes, omega) in [(6, 3.8), (7, 2.0)] {
+        let (hb, _) = solved(modes, 9, 30.0, omega);
+        let split = ivt_hb::sthb::stability::monodromy_multipliers(&hb, omega).unwrap();
+        let phi = monodromy_matrix(&hb, omega, default_steps(&hb, omega)).unwrap();
+        let mut full: Vec<f64> = phi
+            .eigenvalues()
+            .unwrap()
+            .iter()
+            .map(|z| z.norm())
+            .collect();
+        full.sort_by(|a, b| b.total_cmp(a));
+        assert_eq!(split.len(), full.len());
+        for (s, f) in split.iter().zip(&full) {
+            assert!((s.norm() - f).abs() <= 1e-12, "{} vs {f}", s.norm());
+        }
+    }
+}
