@@ -51,15 +51,19 @@ def main():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    for s, style, label in (("sthb", "o-", "this tree (invariant subspace)"), ("baseline", "s--", "before issue 28 (dense full system)")):
-        rs = sorted(done[s], key=lambda r: r["modes"] * r["harmonics"])
-        if not rs:
-            continue
-        nm = np.array([r["modes"] * r["harmonics"] for r in rs])
-        per = np.array([1e3 * r["cpu_s"] / r["points"] for r in rs])
-        ax.loglog(nm, per, style, label=label + (f", fit ∝ (N·M)^{fits[s][0]:.2f}" if s in fits else ""))
-        for r, x, y in zip(rs, nm, per):
-            ax.annotate(f"{r['modes']}×{r['harmonics']}", (x, y), fontsize=7, xytext=(3, 3), textcoords="offset points")
+    colors = {5: "tab:blue", 10: "tab:green", 20: "tab:red"}
+    for s, style, label in (("sthb", "o-", "this tree"), ("baseline", "s--", "before issue 28")):
+        for n in sorted({r["modes"] for r in done[s]}):
+            rs = sorted((r for r in done[s] if r["modes"] == n), key=lambda r: r["harmonics"])
+            nm = np.array([n * r["harmonics"] for r in rs])
+            per = np.array([1e3 * r["cpu_s"] / r["points"] for r in rs])
+            ax.loglog(nm, per, style, color=colors.get(n), label=f"{label}, N = {n} (M = "
+                      + ", ".join(str(r["harmonics"]) for r in rs) + ")")
+        if s in fits:
+            b, a = fits[s]
+            x = np.array([40.0, 800.0])
+            ax.loglog(x, 1e3 * a * x ** b, ":", color="gray" if s == "sthb" else "orange",
+                      label=f"{label}: fit over all sizes ∝ (N·M)^{b:.2f}")
     ax.set_xlabel("N·M (modes × harmonics)")
     ax.set_ylabel("CPU ms per curve point (with stability)")
     ax.set_title("STHB string, whole curve ω 1–6, k_d = 10")

@@ -6,7 +6,8 @@
 #   bench/sthb_scaling.sh                      this tree: bench/sthb_scaling.json,
 #                                              docs/figures/sthb_scaling.png, table on stdout
 #   bench/sthb_scaling.sh --baseline PATH      also the `ivt` CLI at PATH (the tree
-#                                              before issue 28), each size cut at 300 s
+#                                              before issue 28), each size cut at
+#                                              $BASELINE_TIMEOUT s (default 300)
 # The timings come from the ignored test `scaling` of crates/ivt-hb/tests/sthb_scale.rs
 # (CPU seconds from /proc, so a loaded machine inflates wall time, not the CPU column).
 # Needs python3 with numpy and matplotlib (the repository's .venv if present).
@@ -17,7 +18,7 @@ out=bench/sthb_scaling.json
 py=python3
 [ -x .venv/bin/python ] && py=.venv/bin/python
 tmp=$(mktemp)
-trap 'rm -f "$tmp"' EXIT
+cut_s=${BASELINE_TIMEOUT:-300}
 SIZES="$sizes" CARGO_BUILD_JOBS=${CARGO_BUILD_JOBS:-2} cargo test --release -q -p ivt-hb \
   --test sthb_scale -- --ignored --exact scaling --nocapture 2>/dev/null |
   grep '^{' | sed 's/^{/{"solver": "sthb", /' >"$tmp"
@@ -26,17 +27,18 @@ if [ "${1:-}" = "--baseline" ]; then
   for size in $sizes; do
     n=${size%x*}; m=${size#*x}
     t0=$(date +%s.%N)
-    if res=$( { /usr/bin/time -f '%U %S' timeout 300 "$cli" hb string --modes "$n" --harmonics "$m" --json >"$tmp.json"; } 2>&1 ); then
+    if res=$( { /usr/bin/time -f '%U %S' timeout "$cut_s" "$cli" hb string --modes "$n" --harmonics "$m" --json >"$tmp.json"; } 2>&1 ); then
       cpu=$(echo "$res" | tail -n 1 | awk '{print $1 + $2}')
       points=$("$py" -c "import json,sys; print(len(json.load(open('$tmp.json'))['points']))")
       jac=$("$py" -c "import json,sys; print(json.load(open('$tmp.json'))['jacobians'])")
-      wall=$(echo "$(date +%s.%N) - $t0" | bc)
+      wall=$(awk "BEGIN { print $(date +%s.%N) - $t0 }")
       echo "{\"solver\": \"baseline\", \"modes\": $n, \"harmonics\": $m, \"points\": $points, \"jacobians\": $jac, \"wall_s\": $wall, \"cpu_s\": $cpu}" >>"$tmp"
     else
-      echo "{\"solver\": \"baseline\", \"modes\": $n, \"harmonics\": $m, \"timeout_s\": 300}" >>"$tmp"
+      echo "{\"solver\": \"baseline\", \"modes\": $n, \"harmonics\": $m, \"timeout_s\": $cut_s}" >>"$tmp"
     fi
     rm -f "$tmp.json"
   done
 fi
 mkdir -p docs/figures
 "$py" bench/sthb_scaling.py "$tmp" --json "$out" --png docs/figures/sthb_scaling.png
+rm -f "$tmp"

@@ -62,7 +62,9 @@ impl Default for StringFrcOptions {
 ///
 /// `FrcPoint::amplitude` is `‖a‖`, the Euclidean norm of the complex
 /// coefficients (Eq. 114, the ordinate of Figs. 34–36); `multipliers` are those
-/// of the method in `methods`, decreasing modulus; each turn of the path is
+/// of the method in `methods`, decreasing modulus, and `multiplier_error` the
+/// Richardson estimate of a [`StabilityMethod::MonodromyRefined`] verdict
+/// (`None` otherwise); each turn of the path is
 /// located by Newton on the bordered fold system ([`locate_fold`], exact `J`),
 /// `located = false` leaving the parabola through the points around the turn.
 #[derive(Clone, Debug)]
@@ -71,7 +73,9 @@ pub struct StringFrc {
     pub frc: Frc,
     /// The method behind each point's verdict.
     pub methods: Vec<StabilityMethod>,
-    /// Jacobian assemblies (each `O(N² M²)`, most followed by one LU).
+    /// Jacobian assemblies: the full ones of the start's Newton, then those of
+    /// the branch's invariant-subspace block (`sthb::reduced`; most followed by
+    /// one LU).
     pub jacobians: usize,
     /// How many points Hill's method assessed.
     pub hill_calls: usize,
