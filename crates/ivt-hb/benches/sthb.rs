@@ -39,6 +39,30 @@ fn frc_kd10_n5(bencher: Bencher) {
     });
 }
 
+/// Whole curve ω ∈ [1, 6] with stability against N × M (issue 28): traced in
+/// the invariant subspace (odd harmonics × odd modes), monodromy split by mode
+/// parity. `bench/sthb_scaling.sh` gives the same with CPU time and points.
+#[divan::bench(args = [(5, 19), (10, 19), (10, 39), (20, 39)], sample_count = 3)]
+fn frc_whole_curve(bencher: Bencher, (n, m): (usize, usize)) {
+    let params = StringParams {
+        modes: n,
+        harmonics: m,
+        ..Default::default()
+    };
+    bencher.bench_local(|| {
+        let mut hb = StringHb::new(params.clone()).unwrap();
+        frequency_response(&mut hb, 1.0, 6.0, &StringFrcOptions::default()).unwrap()
+    });
+}
+
+/// The curve's per-point stability at N = 20, M = 39 (ω = 3): the RK4
+/// monodromy of the odd- and even-mode blocks.
+#[divan::bench]
+fn stability_monodromy_n20(bencher: Bencher) {
+    let (hb, _) = solved(20, 39, 3.0);
+    bencher.bench_local(|| monodromy(&hb, 3.0).unwrap());
+}
+
 /// Residual + exact Jacobian (one Newton step's assembly), unknowns N(2M+1).
 #[divan::bench(args = [(5, 19), (10, 19), (20, 19), (5, 40), (10, 40)])]
 fn residual_jacobian(bencher: Bencher, (n, m): (usize, usize)) {

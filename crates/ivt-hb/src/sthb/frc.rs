@@ -6,18 +6,22 @@
 //! Stability per point: the RK4 monodromy matrix (cheap, `O(N³)` per step);
 //! Hill's method (Eq. 126–131) confirms where a multiplier is within
 //! [`StringFrcOptions::hill_band`] of the unit circle, where the verdict
-//! changes, or where `dω/ds` changes sign (a fold).
+//! changes, or where `dω/ds` changes sign (a fold) — while its matrix has at
+//! most [`HILL_MAX_DIM`] rows; above that the confirmation is the monodromy
+//! with half the step ([`monodromy_refined`]), whose Richardson error estimate
+//! is the point's `multiplier_error`.
 
-use faer::Mat;
-
-use super::stability::{hill, monodromy, Stability, StabilityMethod};
+use super::reduced::ReducedString;
+use super::stability::{
+    hill, hill_dim, monodromy, monodromy_refined, Stability, StabilityMethod, HILL_MAX_DIM,
+};
 use super::StringHb;
 use crate::broyden::BroydenOptions;
 use crate::continuation::{
-    pseudo_arclength_exact, ContinuationOptions, Path, PathPoint, PathSystem, Termination,
+    pseudo_arclength_exact, ContinuationOptions, Path, PathPoint, Termination,
 };
 use crate::error::HbError;
-use crate::fold::{locate_fold, Branch, FoldOptions};
+use crate::fold::{locate_fold, FoldOptions};
 use crate::frc::{Frc, FrcFold, FrcPoint};
 
 /// Settings of a string curve.
@@ -58,7 +62,9 @@ impl Default for StringFrcOptions {
 ///
 /// `FrcPoint::amplitude` is `‖a‖`, the Euclidean norm of the complex
 /// coefficients (Eq. 114, the ordinate of Figs. 34–36); `multipliers` are those
-/// of the method in `methods`, decreasing modulus; each turn of the path is
+/// of the method in `methods`, decreasing modulus, and `multiplier_error` the
+/// Richardson estimate of a [`StabilityMethod::MonodromyRefined`] verdict
+/// (`None` otherwise); each turn of the path is
 /// located by Newton on the bordered fold system ([`locate_fold`], exact `J`),
 /// `located = false` leaving the parabola through the points around the turn.
 #[derive(Clone, Debug)]
@@ -67,59 +73,12 @@ pub struct StringFrc {
     pub frc: Frc,
     /// The method behind each point's verdict.
     pub methods: Vec<StabilityMethod>,
-    /// Jacobian assemblies (each `O(N² M²)`, most followed by one LU).
+    /// Jacobian assemblies: the full ones of the start's Newton, then those of
+    /// the branch's invariant-subspace block (`sthb::reduced`; most followed by
+    /// one LU).
     pub jacobians: usize,
     /// How many points Hill's method assessed.
     pub hill_calls: usize,
-}
-
-/// [`StringHb`] as a path in ω, counting Jacobian assemblies.
-struct StringPath<'a> {
-    hb: &'a mut StringHb,
-    jacobians: usize,
-}
-
-/// [`StringHb`] as a [`Branch`] in ω for the bordered fold system
-/// ([`locate_fold`]), with the exact Jacobian of Eq. 115–125.
-struct StringBranch<'a> {
-    hb: &'a mut StringHb,
-    jac: Mat<f64>,
-    r: Vec<f64>,
-}
-
-impl Branch for StringBranch<'_> {
-    fn len(&self) -> usize {
-        self.hb.dim()
-    }
-    fn residual(&mut self, q: &[f64], lambda: f64, r: &mut [f64]) {
-        self.hb.residual(q, lambda, r);
-    }
-    fn jacobian(&mut self, q: &[f64], lambda: f64, jac: &mut [f64]) {
-        self.hb
-            .residual_jacobian(q, lambda, &mut self.r, &mut self.jac);
-        let m = self.r.len();
-        for (i, row) in jac.chunks_exact_mut(m).enumerate() {
-            for (j, v) in row.iter_mut().enumerate() {
-                *v = self.jac[(i, j)];
-            }
-        }
-    }
-}
-
-impl PathSystem for StringPath<'_> {
-    fn dim(&self) -> usize {
-        self.hb.dim()
-    }
-    fn residual(&mut self, u: &[f64], lambda: f64, r: &mut [f64]) {
-        self.hb.residual(u, lambda, r);
-    }
-    fn residual_jacobian(&mut self, u: &[f64], lambda: f64, r: &mut [f64], jac: &mut Mat<f64>) {
-        self.jacobians += 1;
-        self.hb.residual_jacobian(u, lambda, r, jac);
-    }
-    fn d_residual_d_lambda(&mut self, u: &[f64], lambda: f64, r_lambda: &mut [f64]) {
-        self.hb.d_residual_d_omega(u, lambda, r_lambda);
-    }
 }
 
 /// Follows the branch of periodic responses from `omega_from` to `omega_to`
@@ -134,7 +93,7 @@ fn follow<C>(
     on_point: C,
 ) -> Result<(Path, usize), HbError>
 where
-    C: FnMut(&mut StringPath<'_>, &PathPoint) -> bool,
+    C: FnMut(&mut ReducedString<'_>, &PathPoint) -> bool,
 {
     if !(omega_from.is_finite() && omega_to.is_finite() && omega_from > 0.0 && omega_to > 0.0) {
         return Err(HbError::InvalidInput(format!(
@@ -152,16 +111,19 @@ where
             },
             e => e,
         })?;
-    start.push(omega_from);
+    // The branch lives in the invariant subspace (`reduced`): trace it there.
+    let mut system = ReducedString::new(hb);
+    let mut reduced = vec![0.0; system.sub.dim()];
+    system.sub.gather(&start, &mut reduced);
+    reduced.push(omega_from);
     let mut copts = opts.clone();
-    copts.broyden.tol = tol * (1.0 + hb.params().y0.abs());
+    copts.broyden.tol = tol * (1.0 + system.hb.params().y0.abs());
     copts.lambda_min = omega_from.min(omega_to);
     copts.lambda_max = omega_from.max(omega_to);
     let direction = if omega_to >= omega_from { 1.0 } else { -1.0 };
-    let mut system = StringPath { hb, jacobians: 0 };
-    let path = pseudo_arclength_exact(
+    let mut path = pseudo_arclength_exact(
         &mut system,
-        &start,
+        &reduced,
         first.iterations,
         direction,
         &copts,
@@ -173,6 +135,14 @@ where
             step: copts.ds_min,
             cause: Box::new(HbError::Solve(e.clone())),
         });
+    }
+    // Back to the full coefficients (zeros outside the subspace), then ω.
+    let n = system.hb.dim();
+    for p in &mut path.points {
+        let mut full = vec![0.0; n + 1];
+        system.sub.embed(&p.x[..p.x.len() - 1], &mut full[..n]);
+        full[n] = p.lambda();
+        p.x = full;
     }
     // `solve` assembles once more than it iterates (the converged check).
     Ok((path, first.iterations + 1 + system.jacobians))
@@ -203,7 +173,8 @@ pub fn frequency_response(
     omega_to: f64,
     opts: &StringFrcOptions,
 ) -> Result<StringFrc, HbError> {
-    let mut verdicts: Vec<Stability> = Vec::new();
+    // Each point's verdict with the error estimate of a refined monodromy.
+    let mut verdicts: Vec<(Stability, Option<f64>)> = Vec::new();
     let mut hill_calls = 0;
     let mut failure = None;
     let mut prev_dlambda = if omega_to >= omega_from { 1.0 } else { -1.0 };
@@ -213,12 +184,14 @@ pub fn frequency_response(
         prev_dlambda = p.dlambda;
         let verdict = monodromy(sys.hb, omega).and_then(|s| {
             let near = (s.critical().norm() - 1.0).abs() < opts.hill_band;
-            let changed = verdicts.last().is_some_and(|v| v.kind != s.kind);
-            if near || changed || fold {
+            let changed = verdicts.last().is_some_and(|v| v.0.kind != s.kind);
+            if !(near || changed || fold) {
+                Ok((s, None))
+            } else if hill_dim(sys.hb) <= HILL_MAX_DIM {
                 hill_calls += 1;
-                hill(sys.hb, omega)
+                hill(sys.hb, omega).map(|h| (h, None))
             } else {
-                Ok(s)
+                monodromy_refined(sys.hb, omega, &s).map(|(f, e)| (f, Some(e)))
             }
         });
         match verdict {
@@ -236,43 +209,40 @@ pub fn frequency_response(
         return Err(e);
     }
     let n = hb.dim();
-    let methods = verdicts.iter().map(|s| s.method).collect();
+    let methods = verdicts.iter().map(|s| s.0.method).collect();
     let points = path
         .points
         .iter()
         .zip(verdicts)
-        .map(|(p, s)| FrcPoint {
+        .map(|(p, (s, error))| FrcPoint {
             omega_f: p.lambda(),
             amplitude: hb.complex_norm(&p.x[..n]),
             kind: s.kind,
             multipliers: s.multipliers,
-            multiplier_error: None,
+            multiplier_error: error,
             coeffs: p.x[..n].to_vec(),
         })
         .collect::<Vec<_>>();
-    let mut branch = StringBranch {
-        hb,
-        jac: Mat::zeros(n, n),
-        r: vec![0.0; n],
-    };
+    let mut branch = ReducedString::new(hb);
+    let mut q = vec![0.0; branch.sub.dim()];
     let folds = path
         .folds
         .iter()
         .map(|f| {
             let near = &points[f.index];
-            match locate_fold(
-                &mut branch,
-                &near.coeffs,
-                near.omega_f,
-                &FoldOptions::default(),
-            ) {
-                Ok(loc) => FrcFold {
-                    index: f.index,
-                    omega_f: loc.lambda,
-                    amplitude: branch.hb.complex_norm(&loc.q),
-                    coeffs: loc.q,
-                    located: true,
-                },
+            branch.sub.gather(&near.coeffs, &mut q);
+            match locate_fold(&mut branch, &q, near.omega_f, &FoldOptions::default()) {
+                Ok(loc) => {
+                    let mut coeffs = vec![0.0; n];
+                    branch.sub.embed(&loc.q, &mut coeffs);
+                    FrcFold {
+                        index: f.index,
+                        omega_f: loc.lambda,
+                        amplitude: branch.hb.complex_norm(&coeffs),
+                        coeffs,
+                        located: true,
+                    }
+                }
                 Err(_) => FrcFold {
                     index: f.index,
                     omega_f: f.lambda,

@@ -15,7 +15,9 @@
 //!   same linearization, with the classification stable / fold / period
 //!   doubling / Neimark–Sacker.
 //! * [`frc`] — curves ‖a‖(ω) (Figs. 34–36) traced by the engine's
-//!   exact-Jacobian pseudo-arclength, as the engine's [`crate::Frc`].
+//!   exact-Jacobian pseudo-arclength, as the engine's [`crate::Frc`], in the
+//!   branch's invariant subspace (`reduced`: odd harmonics × odd modes, the
+//!   Jacobian's block structure in modes × harmonics).
 //! * [`modal`] — the "traditional route": the Galerkin modal ODEs derived in
 //!   closed form, used as an independent reference in tests and benches.
 //!
@@ -32,6 +34,8 @@ pub mod frc;
 mod hb;
 mod lu;
 pub mod modal;
+mod reduced;
+mod spatial;
 pub mod spring;
 pub mod stability;
 pub mod toeplitz;

@@ -148,3 +148,36 @@ pub fn add_real_toeplitz(
         }
     }
 }
+
+/// [`add_real_toeplitz`] restricted to the odd harmonics `k, l` and to the
+/// coordinates `coords` (rows and columns), into a target ordered as the full
+/// one without the even harmonics: `(cos kt, coords[c])` at index
+/// `(k − 1)·coords.len() + c`, `(sin kt, coords[c])` at `k·coords.len() + c`.
+/// Only `Ŝ_r` of even `r = k ∓ l` enter. Rows `coords[c] ≥ s.rows` (the
+/// spring's Tau row, not in `S`) get nothing.
+pub fn add_real_toeplitz_odd(
+    s: &PeriodicSpectrum,
+    harmonics: usize,
+    scale: f64,
+    coords: &[usize],
+    mut target: MatMut<'_, f64>,
+) {
+    let nc = coords.len();
+    for k in (1..=harmonics).step_by(2) {
+        for l in (1..=harmonics).step_by(2) {
+            let (dif, sum) = (k as isize - l as isize, (k + l) as isize);
+            for (ci, &i) in coords.iter().enumerate().filter(|c| *c.1 < s.rows) {
+                let (hc, hs) = ((k - 1) * nc + ci, k * nc + ci);
+                for (cj, &j) in coords.iter().enumerate() {
+                    let (d, su) = (s.get(dif, i, j), s.get(sum, i, j));
+                    let (gc, gs) = ((l - 1) * nc + cj, l * nc + cj);
+                    // The (false, false) row of the table in the module docs.
+                    target[(hc, gc)] += scale * (d.re + su.re);
+                    target[(hc, gs)] += scale * (d.im - su.im);
+                    target[(hs, gc)] -= scale * (d.im + su.im);
+                    target[(hs, gs)] += scale * (d.re - su.re);
+                }
+            }
+        }
+    }
+}
