@@ -43,32 +43,79 @@ pub(super) fn column(samples: &[PlantSample], panel: Panel, scale: f64) -> Vec<(
     samples.iter().map(|s| (s.t, panel.of(s) * scale)).collect()
 }
 
-/// A Fig. 43 panel: ω_a \[rpm\] of an open-loop and a feedback run after a
-/// V_m step, with V_m × 10 of the feedback run.
-pub(super) fn fig43_panel(
+/// What a panel of two runs plots (Figs. 43–45): a `plant` field, its scale
+/// to plot units, the axis label, the second run's line style, and whether
+/// V_m × 10 of the second run is drawn too (dashed).
+pub(super) struct RunPair {
+    panel: Panel,
+    scale: f64,
+    y_label: &'static str,
+    second_style: Style,
+    v_m_of_second: bool,
+}
+
+/// Fig. 43: ω_a \[rpm\] of an open-loop and a feedback run after a V_m
+/// step, with V_m × 10 of the feedback run.
+pub(super) const FIG43: RunPair = RunPair {
+    panel: Panel::OmegaA,
+    scale: RAD_S_TO_RPM,
+    y_label: "ω_a [rpm]; V_m [V]×10",
+    second_style: Style::Line,
+    v_m_of_second: true,
+};
+
+/// Fig. 44: ω_a \[rpm\] with the time-delay law (Eq. 180) and without it
+/// (Eq. 181, dashed).
+pub(super) const FIG44: RunPair = RunPair {
+    panel: Panel::OmegaA,
+    scale: RAD_S_TO_RPM,
+    y_label: "ω_a [rpm]",
+    second_style: Style::Dashed,
+    v_m_of_second: false,
+};
+
+/// Fig. 45: the control variable r \[mm\] with and without time delay.
+pub(super) const FIG45: RunPair = RunPair {
+    panel: Panel::R,
+    scale: 1e3,
+    y_label: "r [mm]",
+    second_style: Style::Line,
+    v_m_of_second: false,
+};
+
+/// A panel of two runs, each as (legend label, samples), against t \[s\].
+pub(super) fn run_pair_panel(
     ctx: &mut Context,
+    what: &RunPair,
     id: &str,
     title: &str,
-    open: (&str, &[PlantSample]),
-    feedback: (&str, &[PlantSample]),
+    first: (&str, &[PlantSample]),
+    second: (&str, &[PlantSample]),
     note: &str,
 ) -> Result<(), ReproError> {
-    let (wo, wf) = (
-        column(open.1, Panel::OmegaA, RAD_S_TO_RPM),
-        column(feedback.1, Panel::OmegaA, RAD_S_TO_RPM),
+    let (y1, y2) = (
+        column(first.1, what.panel, what.scale),
+        column(second.1, what.panel, what.scale),
     );
-    let v = column(feedback.1, Panel::VM, 10.0);
+    let v = if what.v_m_of_second {
+        column(second.1, Panel::VM, 10.0)
+    } else {
+        Vec::new()
+    };
+    let mut curves = vec![
+        (first.0, y1.as_slice(), Style::Line),
+        (second.0, y2.as_slice(), what.second_style),
+    ];
+    if what.v_m_of_second {
+        curves.push(("V_m × 10", v.as_slice(), Style::Dashed));
+    }
     ctx.line_figure(
         id,
         &Figure {
             title,
             x_label: "t [s]",
-            y_label: "ω_a [rpm]; V_m [V]×10",
-            series: series(&[
-                (open.0, &wo, Style::Line),
-                (feedback.0, &wf, Style::Line),
-                ("V_m × 10", &v, Style::Dashed),
-            ]),
+            y_label: what.y_label,
+            series: series(&curves),
         },
         note,
     )
@@ -79,8 +126,9 @@ pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
     let open = shipped_scene!("voltage_step_open").map(|(_, s)| s);
     let delay_v = shipped_scene!("voltage_step_delay").map(|(_, s)| s);
     match (&open, &delay_v) {
-        (Ok(a), Ok(b)) => fig43_panel(
+        (Ok(a), Ok(b)) => run_pair_panel(
             ctx,
+            &FIG43,
             "Fig. 43",
             "Fig. 43 analogue: ω_a with and without the time-delay feedback after a V_m step",
             ("open loop (u_ol only)", a),
@@ -94,30 +142,23 @@ pub(crate) fn run(ctx: &mut Context) -> Result<(), ReproError> {
     let nodelay = shipped_scene!("load_step_nodelay").map(|(_, s)| s);
     match (&delay, &nodelay) {
         (Ok(a), Ok(b)) => {
-            let (wa, wb) = (
-                column(a, Panel::OmegaA, RAD_S_TO_RPM),
-                column(b, Panel::OmegaA, RAD_S_TO_RPM),
-            );
-            ctx.line_figure(
+            run_pair_panel(
+                ctx,
+                &FIG44,
                 "Fig. 44",
-                &Figure {
-                    title: "Fig. 44 analogue: ω_a for the feedback with and without time delay (T_U 6 → 8 N·m, V_m = 8.6 V)",
-                    x_label: "t [s]",
-                    y_label: "ω_a [rpm]",
-                    series: series(&[("with time delay, Eq. 180", &wa, Style::Line), ("without time delay, Eq. 181", &wb, Style::Dashed)]),
-                },
+                "Fig. 44 analogue: ω_a for the feedback with and without time delay (T_U 6 → 8 N·m, V_m = 8.6 V)",
+                ("with time delay, Eq. 180", a),
+                ("without time delay, Eq. 181", b),
                 "scenes load_step_delay/load_step_nodelay, same gain k; the no-delay law keeps a static error in ω_a \
                  (it regulates the θ-mean of ω, not the time mean; crates/ivt-sim/README.md)",
             )?;
-            let (ra, rb) = (column(a, Panel::R, 1e3), column(b, Panel::R, 1e3));
-            ctx.line_figure(
+            run_pair_panel(
+                ctx,
+                &FIG45,
                 "Fig. 45",
-                &Figure {
-                    title: "Fig. 45 analogue: control variable r with and without time delay",
-                    x_label: "t [s]",
-                    y_label: "r [mm]",
-                    series: series(&[("with time delay, Eq. 180", &ra, Style::Line), ("without time delay, Eq. 181", &rb, Style::Line)]),
-                },
+                "Fig. 45 analogue: control variable r with and without time delay",
+                ("with time delay, Eq. 180", a),
+                ("without time delay, Eq. 181", b),
                 "both with the refitted feed-forward u_ol (REFIT), which steps r by the same amount at the load step; \
                  the delay law's feedback part is much smoother (ivt-sim test delay_law_is_smoother_than_no_delay_law)",
             )?;

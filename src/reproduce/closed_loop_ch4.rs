@@ -3,10 +3,9 @@
 //! shipped scenes `scenes/ch4_fig43_*.toml` and `scenes/ch4_fig44_*.toml`
 //! (Figs. 43–45 and the claims made about them in §4.3).
 
-use super::closed_loop::{column, fig43_panel, shipped_scene, RAD_S_TO_RPM};
-use super::{fmt_sig, series, Cause, Context, ReproError, Verdict};
-use ivt_plot::{Figure, Style};
-use ivt_sim::record::{Panel, PlantSample};
+use super::closed_loop::{run_pair_panel, shipped_scene, FIG43, FIG44, FIG45};
+use super::{fmt_sig, Cause, Context, ReproError, Verdict};
+use ivt_sim::record::PlantSample;
 use ivt_sim::run::Summary;
 
 /// Mean of ω_a − ω0 over t ∈ [from, to) \[rad/s\].
@@ -98,8 +97,9 @@ fn fig43(
             test: "tests/ch4_plant.rs::thesis_ch4_r_bar_matches_the_audit_values",
         },
     );
-    fig43_panel(
+    run_pair_panel(
         ctx,
+        &FIG43,
         "Fig. 43 (thesis-ch4)",
         "Fig. 43 on thesis-ch4: ω_a with and without the time-delay feedback, V_m 8 → 7 V at T_U = 8 N·m",
         ("printed u_ol alone", o),
@@ -146,21 +146,13 @@ fn figs_44_45(
         s.settling_time_s
             .map_or("never".into(), |t| format!("{t:.2} s"))
     };
-    let (wd, wn) = (
-        column(d, Panel::OmegaA, RAD_S_TO_RPM),
-        column(n, Panel::OmegaA, RAD_S_TO_RPM),
-    );
-    ctx.line_figure(
+    run_pair_panel(
+        ctx,
+        &FIG44,
         "Fig. 44 (thesis-ch4)",
-        &Figure {
-            title: "Fig. 44 on thesis-ch4: ω_a with and without time delay, V_m = 8 V, T_U = 8 N·m",
-            x_label: "t [s]",
-            y_label: "ω_a [rpm]",
-            series: series(&[
-                ("delay law, k = 0.01, k2 = 0.02", &wd, Style::Line),
-                ("no-delay law, k = 0.04, k2 = 0.15", &wn, Style::Dashed),
-            ]),
-        },
+        "Fig. 44 on thesis-ch4: ω_a with and without time delay, V_m = 8 V, T_U = 8 N·m",
+        ("delay law, k = 0.01, k2 = 0.02", d),
+        ("no-delay law, k = 0.04, k2 = 0.15", n),
         &format!(
             "settling into ±0.5 %: {} (delay) and {} (no delay); static errors {} and {} rad/s",
             settle(sd),
@@ -169,18 +161,13 @@ fn figs_44_45(
             fmt_sig(sn.static_error_rad_s, 2)
         ),
     )?;
-    let (rd, rn) = (column(d, Panel::R, 1e3), column(n, Panel::R, 1e3));
-    ctx.line_figure(
+    run_pair_panel(
+        ctx,
+        &FIG45,
         "Fig. 45 (thesis-ch4)",
-        &Figure {
-            title: "Fig. 45 on thesis-ch4: control variable r with and without time delay",
-            x_label: "t [s]",
-            y_label: "r [mm]",
-            series: series(&[
-                ("delay law", &rd, Style::Line),
-                ("no-delay law", &rn, Style::Line),
-            ]),
-        },
+        "Fig. 45 on thesis-ch4: control variable r with and without time delay",
+        ("delay law", d),
+        ("no-delay law", n),
         &format!("RMS dr/dt {ratio:.0}× smaller with the delay law (tests/ch4_scenes.rs)"),
     )
 }

@@ -370,9 +370,6 @@ impl Context {
         figure: &Figure<'_>,
         note: &str,
     ) -> Result<(), ReproError> {
-        let stem = Self::file_stem(id);
-        let png = format!("{stem}.png");
-        let csv_name = format!("{stem}.csv");
         let (title, x_label, y_label) = (
             glyphs(figure.title),
             glyphs(figure.x_label),
@@ -390,27 +387,20 @@ impl Context {
                 .map(|(s, l)| ivt_plot::Series { label: l, ..*s })
                 .collect(),
         };
-        ivt_plot::line_plot(&self.staging(&png)?, &drawable)
-            .map_err(|e| e.for_path(&self.out.join(&png)))?;
         let mut csv = format!(
-            "series,\"{}\",\"{}\"\n",
-            figure.x_label.replace('"', "'"),
-            figure.y_label.replace('"', "'")
+            "series,{},{}\n",
+            csv_quoted(figure.x_label),
+            csv_quoted(figure.y_label)
         );
         for s in &figure.series {
+            let label = csv_quoted(s.label);
             for &(x, y) in s.points {
-                let _ = writeln!(csv, "\"{}\",{x:e},{y:e}", s.label.replace('"', "'"));
+                let _ = writeln!(csv, "{label},{x:e},{y:e}");
             }
         }
-        self.write(&csv_name, &csv)?;
-        self.figures.push(FigureEntry {
-            id: id.to_string(),
-            title: figure.title.to_string(),
-            png: Some(png),
-            csv: Some(csv_name),
-            note: note.to_string(),
-        });
-        Ok(())
+        self.save_figure(id, figure.title, note, &csv, |png| {
+            ivt_plot::line_plot(png, &drawable)
+        })
     }
 
     /// Draw a heat map and save its grid as CSV (`x,y,value`).
@@ -420,32 +410,6 @@ impl Context {
         map: &HeatMap<'_>,
         note: &str,
     ) -> Result<(), ReproError> {
-        let stem = Self::file_stem(id);
-        let png = format!("{stem}.png");
-        let csv_name = format!("{stem}.csv");
-        let (title, x_label, y_label, value_label) = (
-            glyphs(map.title),
-            glyphs(map.x_label),
-            glyphs(map.y_label),
-            glyphs(map.value_label),
-        );
-        ivt_plot::heat_map(
-            &self.staging(&png)?,
-            &HeatMap {
-                title: &title,
-                x_label: &x_label,
-                y_label: &y_label,
-                value_label: &value_label,
-                ..*map
-            },
-        )
-        .map_err(|e| e.for_path(&self.out.join(&png)))?;
-        let mut csv = format!(
-            "\"{}\",\"{}\",\"{}\"\n",
-            map.x_label.replace('"', "'"),
-            map.y_label.replace('"', "'"),
-            map.value_label.replace('"', "'")
-        );
         if map.values.len() != map.xs.len() * map.ys.len() {
             return Err(ReproError::Numeric(format!(
                 "{id}: {} map values for a {}×{} grid",
@@ -454,6 +418,25 @@ impl Context {
                 map.ys.len()
             )));
         }
+        let (title, x_label, y_label, value_label) = (
+            glyphs(map.title),
+            glyphs(map.x_label),
+            glyphs(map.y_label),
+            glyphs(map.value_label),
+        );
+        let drawable = HeatMap {
+            title: &title,
+            x_label: &x_label,
+            y_label: &y_label,
+            value_label: &value_label,
+            ..*map
+        };
+        let mut csv = format!(
+            "{},{},{}\n",
+            csv_quoted(map.x_label),
+            csv_quoted(map.y_label),
+            csv_quoted(map.value_label)
+        );
         // Row-major: one row of `xs.len()` values per y.
         for (&y, row) in map
             .ys
@@ -464,10 +447,29 @@ impl Context {
                 let _ = writeln!(csv, "{x:e},{y:e},{v:e}");
             }
         }
-        self.write(&csv_name, &csv)?;
+        self.save_figure(id, map.title, note, &csv, |png| {
+            ivt_plot::heat_map(png, &drawable)
+        })
+    }
+
+    /// The one way a drawn figure reaches the output: `draw` renders
+    /// `<stem>.png` (staged), `csv` is written as `<stem>.csv`, and both are
+    /// listed under `id` with `title` and `note`.
+    fn save_figure(
+        &mut self,
+        id: &str,
+        title: &str,
+        note: &str,
+        csv: &str,
+        draw: impl FnOnce(&Path) -> Result<(), ivt_plot::PlotError>,
+    ) -> Result<(), ReproError> {
+        let stem = Self::file_stem(id);
+        let (png, csv_name) = (format!("{stem}.png"), format!("{stem}.csv"));
+        draw(&self.staging(&png)?).map_err(|e| e.for_path(&self.out.join(&png)))?;
+        self.write(&csv_name, csv)?;
         self.figures.push(FigureEntry {
             id: id.to_string(),
-            title: map.title.to_string(),
+            title: title.to_string(),
             png: Some(png),
             csv: Some(csv_name),
             note: note.to_string(),
@@ -485,6 +487,11 @@ impl Context {
             note: why.to_string(),
         });
     }
+}
+
+/// `s` as one quoted CSV field (a `"` inside becomes `'`).
+fn csv_quoted(s: &str) -> String {
+    format!("\"{}\"", s.replace('"', "'"))
 }
 
 /// Spell out the characters the embedded font subset lacks (combining
@@ -512,25 +519,29 @@ pub fn run(out: &Path, opts: Options) -> Result<Report, ReproError> {
     run_in(out, staged, opts)
 }
 
+/// A chapter's entry point: appends its rows and figures to the context.
+type Chapter = fn(&mut Context) -> Result<(), ReproError>;
+
+/// The chapters in report order, each with its section id.
+const CHAPTERS: &[(&str, Chapter)] = &[
+    ("kinematics", kinematics::run),
+    ("hb", hb::run),
+    ("sthb", sthb::run),
+    ("design", design::run),
+    ("closed_loop", closed_loop::run),
+    ("closed_loop/thesis-ch4", closed_loop_ch4::run),
+    ("rig", rig::run),
+];
+
 /// Every chapter into the staged set of `out`, renamed into place once the
 /// report is written.
 fn run_in(out: &Path, staged: Staged, opts: Options) -> Result<Report, ReproError> {
     let start = std::time::Instant::now();
     let mut ctx = Context::new(out, staged, opts, 17);
-    ctx.section = "kinematics";
-    kinematics::run(&mut ctx)?;
-    ctx.section = "hb";
-    hb::run(&mut ctx)?;
-    ctx.section = "sthb";
-    sthb::run(&mut ctx)?;
-    ctx.section = "design";
-    design::run(&mut ctx)?;
-    ctx.section = "closed_loop";
-    closed_loop::run(&mut ctx)?;
-    ctx.section = "closed_loop/thesis-ch4";
-    closed_loop_ch4::run(&mut ctx)?;
-    ctx.section = "rig";
-    rig::run(&mut ctx)?;
+    for &(section, chapter) in CHAPTERS {
+        ctx.section = section;
+        chapter(&mut ctx)?;
+    }
     ctx.bar.finish_and_clear();
     let elapsed_s = start.elapsed().as_secs_f64();
     let report_path = out.join("REPRODUCTION.md");
