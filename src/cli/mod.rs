@@ -9,12 +9,14 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 pub mod bench;
+pub mod commissioning;
 pub mod ctrl;
 pub mod hb;
 pub mod kin;
 pub mod ol;
 pub mod reproduce;
 pub mod rig;
+pub mod rig_identify;
 pub mod sim;
 pub mod stability;
 pub mod string;
