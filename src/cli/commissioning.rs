@@ -126,7 +126,31 @@ fn walk(bytes: &[u8], c: &mut Collected) -> Result<(), String> {
         let record = mcap::read::parse_record(op, body)
             .map_err(|e| format!("corrupt record 0x{op:02x} at byte offset {at}: {e}"))?;
         match record {
-            Record::Footer(_) => {
+            Record::DataEnd(d) => {
+                // The data section's CRC covers every byte before this record
+                // (messages, chunks and their indexes alike).
+                let crc = crc32fast::hash(bytes.get(..at).unwrap_or_default());
+                if d.data_section_crc != 0 && d.data_section_crc != crc {
+                    return Err(format!(
+                        "corrupt data section (bytes 0 to {at}): its CRC 0x{crc:08x} is not the recorded 0x{:08x} (data end record at byte offset {at})",
+                        d.data_section_crc
+                    ));
+                }
+            }
+            Record::Footer(f) => {
+                let start = usize::try_from(f.summary_start).unwrap_or(usize::MAX);
+                // The summary CRC covers the summary section up to the footer's summary_crc field.
+                let covered = bytes.get(start..at + 9 + 16);
+                if f.summary_start != 0 && f.summary_crc != 0 {
+                    match covered.map(crc32fast::hash) {
+                        Some(crc) if crc == f.summary_crc => {}
+                        _ => {
+                            return Err(format!(
+                                "corrupt summary section (from byte offset {start}): CRC mismatch (footer at byte offset {at})"
+                            ))
+                        }
+                    }
+                }
                 return if bytes.get(end..) == Some(MAGIC.as_slice()) {
                     Ok(())
                 } else {

@@ -179,6 +179,35 @@ impl Recording {
         out
     }
 
+    /// Every second encoder edge and sensor reading, from `parity` (0 or 1):
+    /// half of the data, its noise independent of the other half's (the
+    /// instruments of [`identify`]). None for an odd PPR.
+    pub fn half(&self, parity: usize) -> Option<Self> {
+        if self.ppr % 2 != 0 || parity > 1 {
+            return None;
+        }
+        Some(Self {
+            ppr: self.ppr / 2,
+            theta0: self.theta0 + self.dtheta() * parity as f64,
+            pulse_t: self
+                .pulse_t
+                .iter()
+                .skip(parity)
+                .step_by(2)
+                .copied()
+                .collect(),
+            sensors: self
+                .sensors
+                .iter()
+                .skip(parity)
+                .step_by(2)
+                .copied()
+                .collect(),
+            eccentricity: self.eccentricity.clone(),
+            stages: self.stages.clone(),
+        })
+    }
+
     /// Checks: PPR > 0, increasing finite pulse times, sorted finite samples.
     fn validate(&self) -> Result<(), IdentifyError> {
         let bad = |field, why: &str| IdentifyError::Recording {
@@ -333,24 +362,43 @@ pub fn identify(rec: &Recording, nominal: &PlantParams) -> Result<Identification
                 .into(),
         });
     }
-    let smoothed = rec.with_smoothed_inputs();
-    let rec = &smoothed;
-    let rows = windows::rows(rec);
+    // Regressors from one half of the edges and readings, instruments from
+    // the other (regression::instrumental_variables), window by window.
+    let halves = [rec.half(0), rec.half(1)];
+    let [Some(h0), Some(h1)] = halves else {
+        return Err(IdentifyError::Recording {
+            field: "ppr",
+            why: format!("= {} must be even (the two halves of the edges)", rec.ppr),
+        });
+    };
+    let (rx, rz) = (
+        windows::rows(&h0.with_smoothed_inputs()),
+        windows::rows(&h1.with_smoothed_inputs()),
+    );
+    let by_key: std::collections::BTreeMap<i64, windows::Row> =
+        rz.into_iter().map(|r| (r.key, r)).collect();
+    let pairs: Vec<(windows::Row, windows::Row)> = rx
+        .into_iter()
+        .filter_map(|r| by_key.get(&r.key).map(|z| (r, *z)))
+        .collect();
     let g = nominal.gravity_gain();
-    let x = DMatrix::from_fn(rows.len(), windows::UNKNOWNS, |i, j| {
-        rows.get(i)
-            .and_then(|r| r.x.get(j))
-            .copied()
+    let column = |i: usize, j: usize, second: bool| {
+        pairs
+            .get(i)
+            .and_then(|(x, z)| if second { z } else { x }.x.get(j).copied())
             .unwrap_or(f64::NAN)
-    });
-    let y = DVector::from_iterator(rows.len(), rows.iter().map(|r| g * r.gravity));
+    };
+    let x = DMatrix::from_fn(pairs.len(), windows::UNKNOWNS, |i, j| column(i, j, false));
+    let z = DMatrix::from_fn(pairs.len(), windows::UNKNOWNS, |i, j| column(i, j, true));
+    let y = DVector::from_iterator(pairs.len(), pairs.iter().map(|(r, _)| g * r.gravity));
     // Rows share smoothed readings over 2·SMOOTH_HALF_S: the HAC lag spans that.
-    let span = match (rows.first(), rows.last()) {
-        (Some(a), Some(b)) if rows.len() > 1 => (b.t - a.t) / (rows.len() - 1) as f64,
+    let span = match (pairs.first(), pairs.last()) {
+        (Some(a), Some(b)) if pairs.len() > 1 => (b.0.t - a.0.t) / (pairs.len() - 1) as f64,
         _ => f64::INFINITY,
     };
     let lag = (2.0 * SMOOTH_HALF_S / span).ceil().clamp(1.0, 1e4) as usize + 2;
-    let fit = regression::least_squares_hac(&x, &y, lag, "Eq. 151")?;
+    let fit = regression::instrumental_variables(&x, &z, &y, lag, "Eq. 151")?;
+    let rec = &rec.with_smoothed_inputs();
     let mut estimates = [Estimate {
         value: f64::NAN,
         ci95: [f64::NAN; 2],

@@ -16,34 +16,43 @@ pub struct LsFit {
     pub residual_rms: f64,
     /// Rows n.
     pub rows: usize,
-    /// 1/condition number of the column-scaled X (small: nearly collinear).
+    /// 1/condition number of the column-scaled ZᵀX (small: nearly collinear).
     pub inverse_condition: f64,
 }
 
-/// Least squares by the SVD of the column-scaled X (columns of very
-/// different sizes: inertias in kg·m², gains in N·m/V).
+/// Least squares `p = (XᵀX)⁻¹Xᵀy` with White's (heteroscedasticity-robust)
+/// covariance: [`instrumental_variables`] with Z = X and no lag.
 ///
 /// # Errors
-/// [`IdentifyError::NotIdentifiable`] when X has fewer rows than columns + 2,
-/// a zero column, or an inverse condition number below 1e-12 (the data do not
-/// excite every parameter), `what` naming the fit.
+/// As [`instrumental_variables`].
 pub fn least_squares(
     x: &DMatrix<f64>,
     y: &DVector<f64>,
     what: &str,
 ) -> Result<LsFit, IdentifyError> {
-    least_squares_hac(x, y, 0, what)
+    instrumental_variables(x, x, y, 0, what)
 }
 
-/// [`least_squares`] with the Newey–West (Bartlett-weighted) covariance over
-/// `lag` neighbouring rows: rows that share data (overlapping smoothing of
-/// the inputs, shared window ends) have correlated residuals, and the plain
-/// s²(XᵀX)⁻¹ would understate the intervals. `lag` = 0 is the plain form.
+/// Instrumental-variable estimate `p = (ZᵀX)⁻¹ Zᵀy` with the Newey–West
+/// covariance over `lag` rows (Bartlett weights).
+///
+/// Least squares on regressors with noise shrinks the estimate along its
+/// weakly determined directions (errors in variables); when Z is X computed
+/// from data whose noise is independent of X's (the other half of the
+/// encoder edges and readings), ZᵀX and Zᵀy carry no noise products and the
+/// estimate is consistent.
+///
+/// Columns are scaled by the norms of X's (inertias in kg·m², gains in
+/// N·m/V) before ZᵀX is inverted.
 ///
 /// # Errors
-/// As [`least_squares`].
-pub fn least_squares_hac(
+/// [`IdentifyError::NotIdentifiable`] when there are fewer rows than
+/// columns + 2, a zero column, or an inverse condition number of the scaled
+/// ZᵀX below 1e-12 (the data do not excite every parameter), `what` naming
+/// the fit.
+pub fn instrumental_variables(
     x: &DMatrix<f64>,
+    z: &DMatrix<f64>,
     y: &DVector<f64>,
     lag: usize,
     what: &str,
@@ -53,7 +62,7 @@ pub fn least_squares_hac(
         what: what.to_string(),
         why,
     };
-    if n < p + 2 {
+    if n < p + 2 || z.shape() != (n, p) {
         return Err(not(format!("{n} equations for {p} unknowns")));
     }
     let scale: Vec<f64> = x.column_iter().map(|c| c.norm()).collect();
@@ -62,62 +71,42 @@ pub fn least_squares_hac(
             "column {k} of the regression is zero or not finite"
         )));
     }
-    let mut xs = x.clone();
-    for (mut c, s) in xs.column_iter_mut().zip(&scale) {
-        c /= *s;
+    let (mut xs, mut zs) = (x.clone(), z.clone());
+    for ((mut cx, mut cz), s) in xs.column_iter_mut().zip(zs.column_iter_mut()).zip(&scale) {
+        cx /= *s;
+        cz /= *s;
     }
-    let svd = xs.clone().svd(true, true);
-    let (Some(u), Some(v_t)) = (&svd.u, &svd.v_t) else {
-        return Err(not("the SVD did not converge".into()));
-    };
-    let sv = &svd.singular_values;
-    let (smax, smin) = (sv.max(), sv.min());
-    let inverse_condition = smin / smax;
+    let zx = zs.transpose() * &xs;
+    let sv = zx.clone().svd(false, false).singular_values;
+    let inverse_condition = sv.min() / sv.max();
     if !(inverse_condition > 1e-12) {
         return Err(not(format!(
             "the regressors are collinear (inverse condition number {inverse_condition:.1e})"
         )));
     }
-    // p_s = V Σ⁻¹ Uᵀ y; cov_s = s² V Σ⁻² Vᵀ.
-    let uty = u.transpose() * y;
-    let mut ps = DVector::zeros(p);
-    for k in 0..p {
-        ps += v_t.row(k).transpose() * (uty[k] / sv[k]);
-    }
-    let resid = y - &xs * &ps;
-    let dof = (n - p) as f64;
-    let t = student_t_975(dof);
-    // Bread B = (XsᵀXs)⁻¹ = V Σ⁻² Vᵀ.
-    let mut bread = DMatrix::<f64>::zeros(p, p);
-    for k in 0..p {
-        let v = v_t.row(k).transpose();
-        bread += &v * v.transpose() / (sv[k] * sv[k]);
-    }
-    let cov = if lag == 0 {
-        bread * (resid.norm_squared() / dof)
-    } else {
-        // Meat Σ_l w_l Σ_i (a_i e_i)(a_{i−l} e_{i−l})ᵀ + transpose, w_l = 1 − l/(L+1).
-        let score: Vec<DVector<f64>> = (0..n).map(|i| xs.row(i).transpose() * resid[i]).collect();
-        let mut meat = DMatrix::<f64>::zeros(p, p);
-        for (i, si) in score.iter().enumerate() {
-            meat += si * si.transpose();
-            for l in 1..=lag.min(i) {
-                let w = 1.0 - l as f64 / (lag + 1) as f64;
-                let c = si * score[i - l].transpose() * w;
-                meat += &c + c.transpose();
-            }
-        }
-        &bread * meat * &bread * (n as f64 / dof)
+    let Some(bread) = zx.try_inverse() else {
+        return Err(not("ZᵀX is singular".into()));
     };
-    let mut params = Vec::with_capacity(p);
-    let mut half_width = Vec::with_capacity(p);
-    for j in 0..p {
-        params.push(ps[j] / scale[j]);
-        half_width.push(t * cov[(j, j)].max(0.0).sqrt() / scale[j]);
+    let ps = &bread * (zs.transpose() * y);
+    let resid = y - &xs * &ps;
+    let score: Vec<DVector<f64>> = (0..n).map(|i| zs.row(i).transpose() * resid[i]).collect();
+    let mut meat = DMatrix::<f64>::zeros(p, p);
+    for (i, si) in score.iter().enumerate() {
+        meat += si * si.transpose();
+        for l in 1..=lag.min(i) {
+            let w = 1.0 - l as f64 / (lag + 1) as f64;
+            let c = si * score[i - l].transpose() * w;
+            meat += &c + c.transpose();
+        }
     }
+    let dof = (n - p) as f64;
+    let cov = &bread * meat * bread.transpose() * (n as f64 / dof);
+    let t = student_t_975(dof);
     Ok(LsFit {
-        params,
-        half_width,
+        params: (0..p).map(|j| ps[j] / scale[j]).collect(),
+        half_width: (0..p)
+            .map(|j| t * cov[(j, j)].max(0.0).sqrt() / scale[j])
+            .collect(),
         residual_rms: (resid.norm_squared() / n as f64).sqrt(),
         rows: n,
         inverse_condition,

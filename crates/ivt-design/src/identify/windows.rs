@@ -35,6 +35,9 @@ pub struct Row {
     pub gravity: f64,
     /// Time of the window's start \[s\].
     pub t: f64,
+    /// Which window: the index of its start among the angles kπ/2,
+    /// kπ/2 ± π/8 (the same window in every view of a recording).
+    pub key: i64,
 }
 
 /// Pulses on each side of a window end in the local cubic fit of t(θ).
@@ -62,9 +65,9 @@ fn point_speed(t: &[f64], k: usize, m: usize, dtheta: f64) -> Option<f64> {
     (dt_dtheta > 0.0).then(|| 1.0 / dt_dtheta)
 }
 
-/// Pulse indices of the window ends: the first pulse at or after each
-/// angle kπ/2, kπ/2 ± π/8 (in order), inside the data.
-fn window_ends(rec: &Recording) -> Vec<usize> {
+/// The window ends: (angle index, first pulse at or after the angle) for the
+/// angles kπ/2, kπ/2 ± π/8 in order, inside the data.
+fn window_ends(rec: &Recording) -> Vec<(i64, usize)> {
     let dtheta = rec.dtheta();
     let n = rec.pulse_t.len();
     let theta_end = rec.theta0 + dtheta * n.saturating_sub(1) as f64;
@@ -77,10 +80,16 @@ fn window_ends(rec: &Recording) -> Vec<usize> {
         if base - FRAC_PI_8 > theta_end {
             break;
         }
-        for off in [-FRAC_PI_8, 0.0, FRAC_PI_8] {
+        for (o, off) in [-FRAC_PI_8, 0.0, FRAC_PI_8].into_iter().enumerate() {
             let k = ((base + off - rec.theta0) / dtheta).ceil();
-            if k >= 0.0 && (k as usize) < n && ends.last().is_none_or(|&e| (k as usize) > e) {
-                ends.push(k as usize);
+            let key = 3 * j + o as i64;
+            if k >= 0.0
+                && (k as usize) < n
+                && ends
+                    .last()
+                    .is_none_or(|e: &(i64, usize)| (k as usize) > e.1)
+            {
+                ends.push((key, k as usize));
             }
         }
         j += 1;
@@ -96,8 +105,13 @@ pub fn rows(rec: &Recording) -> Vec<Row> {
     let ends = window_ends(rec);
     let mut out = Vec::new();
     for pair in ends.windows(2) {
-        let &[a, b] = pair else { continue };
-        if let Some(row) = window_row(rec, a, b, m, dtheta) {
+        let &[(key, a), (next, b)] = pair else {
+            continue;
+        };
+        if next != key + 1 {
+            continue;
+        }
+        if let Some(row) = window_row(rec, a, b, m, dtheta, key) {
             if row.x.iter().chain([&row.gravity]).all(|v| v.is_finite()) {
                 out.push(row);
             }
@@ -108,7 +122,7 @@ pub fn rows(rec: &Recording) -> Vec<Row> {
 
 /// The row of the window from pulse `a` to pulse `b` (None: r changes in
 /// it, an input is missing, or a point speed cannot be fitted).
-fn window_row(rec: &Recording, a: usize, b: usize, m: usize, dtheta: f64) -> Option<Row> {
+fn window_row(rec: &Recording, a: usize, b: usize, m: usize, dtheta: f64, key: i64) -> Option<Row> {
     let t = &rec.pulse_t;
     let (ta, tb) = (*t.get(a)?, *t.get(b)?);
     if !rec.settled(ta) || rec.stage_start(ta) != rec.stage_start(tb) {
@@ -136,6 +150,7 @@ fn window_row(rec: &Recording, a: usize, b: usize, m: usize, dtheta: f64) -> Opt
         ],
         gravity: i.grav,
         t: ta,
+        key,
     })
 }
 
