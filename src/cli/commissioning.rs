@@ -109,10 +109,11 @@ fn walk(bytes: &[u8], c: &mut Collected) -> Result<(), String> {
                 "truncated at byte offset {at}: the file ends ({len} bytes) before the footer"
             ));
         };
-        let op = head[0];
-        let mut n = [0u8; 8];
-        n.copy_from_slice(&head[1..9]);
-        let body_len = u64::from_le_bytes(n);
+        let (op, body_len) = match head.split_first() {
+            Some((&op, len)) => (op, <[u8; 8]>::try_from(len).map(u64::from_le_bytes)),
+            None => (0, Ok(u64::MAX)),
+        };
+        let body_len = body_len.unwrap_or(u64::MAX);
         let end = usize::try_from(body_len)
             .ok()
             .and_then(|b| (at + 9).checked_add(b))
@@ -246,7 +247,7 @@ fn assemble(c: Collected) -> Result<Commissioning, String> {
             .transpose()
     };
     let ppr = number("ppr")?.ok_or("metadata `ppr` is missing")?;
-    if !(ppr >= 1.0 && ppr <= 1e6 && ppr.fract() == 0.0) {
+    if !((1.0..=1e6).contains(&ppr) && ppr.fract() == 0.0) {
         return Err(format!("metadata `ppr` = {ppr} is not a pulse count"));
     }
     let f_timer_hz = number("f_timer_hz")?.filter(|f| f.is_finite() && *f > 0.0);

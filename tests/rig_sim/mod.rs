@@ -90,9 +90,55 @@ fn position(theta_ct_deg: f64) -> i64 {
     (theta_ct_deg * STEPS_PER_REV / 360.0).round() as i64
 }
 
+/// A simulated commissioning run: what a rig would record.
+pub struct Run {
+    /// The stages with their start times.
+    pub stages: Vec<(StageSpec, f64)>,
+    /// Edge times as captured (ticks over the timer rate) \[s\].
+    pub times: Vec<f64>,
+    /// Timer captures of the edges.
+    pub ticks: Vec<u32>,
+    /// Sensor readings (t, V_m, T_U).
+    pub sensors: Vec<[f64; 3]>,
+    /// Stepper position changes (t, position).
+    pub stepper: Vec<(f64, i64)>,
+    /// The timer rate \[Hz\].
+    pub f_timer_hz: f64,
+}
+
+/// The run as `ivt_design::identify` arrays (what the MCAP reader returns).
+pub fn recording(run: &Run) -> ivt_design::identify::Recording {
+    ivt_design::identify::Recording {
+        ppr: PPR,
+        theta0: std::f64::consts::TAU / PPR as f64,
+        pulse_t: run.times.clone(),
+        sensors: run.sensors.clone(),
+        eccentricity: run
+            .stepper
+            .iter()
+            .map(|&(t, p)| (t, p as f64 * r_per_step()))
+            .collect(),
+        stages: run
+            .stages
+            .iter()
+            .map(|&((name, th, ..), t)| ivt_design::identify::Stage {
+                t,
+                name: name.to_string(),
+                theta_ct_deg: th,
+            })
+            .collect(),
+    }
+}
+
 /// Run the sequence on the plant given by `plant_toml` (the body of a
 /// `[plant]` table) and return the recording's MCAP bytes.
 pub fn commission(plant_toml: &str, sensors: Sensors, seed: u64) -> Vec<u8> {
+    mcap_bytes(&simulate(plant_toml, sensors, seed))
+}
+
+/// Run the sequence on the plant given by `plant_toml` (the body of a
+/// `[plant]` table).
+pub fn simulate(plant_toml: &str, sensors: Sensors, seed: u64) -> Run {
     let stages = sequence();
     let ramp = 0.1;
     let (mut v, mut tu, mut r) = (Vec::new(), Vec::new(), Vec::new());
@@ -149,7 +195,25 @@ pub fn commission(plant_toml: &str, sensors: Sensors, seed: u64) -> Vec<u8> {
         }
         times.push(now);
     }
+    let mut stepper = Vec::new();
+    for p in &plant {
+        let pos = (p.r / r_per_step()).round() as i64;
+        if stepper.last().is_none_or(|s: &(f64, i64)| s.1 != pos) {
+            stepper.push((p.t, pos));
+        }
+    }
+    Run {
+        stages: stages.into_iter().zip(starts).collect(),
+        times,
+        ticks,
+        sensors: sens.iter().map(|s| [s.t, s.v_m, s.t_u]).collect(),
+        stepper,
+        f_timer_hz: sensors.f_timer_hz,
+    }
+}
 
+/// The run as a commissioning recording (MCAP bytes on the reader's contract).
+pub fn mcap_bytes(run: &Run) -> Vec<u8> {
     let mut w = mcap::WriteOptions::new()
         .compression(Some(mcap::Compression::Zstd))
         .profile("")
@@ -183,8 +247,7 @@ pub fn commission(plant_toml: &str, sensors: Sensors, seed: u64) -> Vec<u8> {
         w.write_to_known_channel(&header, msg.to_string().as_bytes())
             .unwrap();
     };
-    for (k, &(name, th, _, _, dur)) in stages.iter().enumerate() {
-        let ts = starts[k];
+    for (k, &((name, th, _, _, dur), ts)) in run.stages.iter().enumerate() {
         put(
             &mut w,
             "/sequence",
@@ -192,28 +255,23 @@ pub fn commission(plant_toml: &str, sensors: Sensors, seed: u64) -> Vec<u8> {
             serde_json::json!({"t": ts, "name": name, "stage": k, "theta_ct_deg": th, "hold": dur}),
         );
     }
-    for s in &sens {
+    for s in &run.sensors {
         put(
             &mut w,
             "/sensors",
-            s.t,
-            serde_json::json!({"t": s.t, "v_m": s.v_m, "t_u": s.t_u}),
+            s[0],
+            serde_json::json!({"t": s[0], "v_m": s[1], "t_u": s[2]}),
         );
     }
-    let mut last_pos = None;
-    for p in &plant {
-        let pos = (p.r / r_per_step()).round() as i64;
-        if last_pos != Some(pos) {
-            put(
-                &mut w,
-                "/stepper",
-                p.t,
-                serde_json::json!({"t": p.t, "position": pos}),
-            );
-            last_pos = Some(pos);
-        }
+    for &(t, pos) in &run.stepper {
+        put(
+            &mut w,
+            "/stepper",
+            t,
+            serde_json::json!({"t": t, "position": pos}),
+        );
     }
-    for (tb, kb) in times.chunks(256).zip(ticks.chunks(256)) {
+    for (tb, kb) in run.times.chunks(256).zip(run.ticks.chunks(256)) {
         put(
             &mut w,
             "/pulses",
@@ -224,7 +282,7 @@ pub fn commission(plant_toml: &str, sensors: Sensors, seed: u64) -> Vec<u8> {
     let meta = [
         ("frame_version", "2".to_string()),
         ("ppr", PPR.to_string()),
-        ("f_timer_hz", sensors.f_timer_hz.to_string()),
+        ("f_timer_hz", run.f_timer_hz.to_string()),
         ("plant", "printed".to_string()),
         ("steps_per_rev", STEPS_PER_REV.to_string()),
     ];

@@ -20,8 +20,10 @@
 //! J_b and J_c multiply r², at most 1–2 % of J, and come with wide intervals.
 //!
 //! The estimator is in [`windows`] (Eq. 151 in its energy form over windows
-//! of θ, no θ̈), [`regression`] (least squares, Student-t intervals) and
-//! [`steady`] (Fig. 47/48/50).
+//! of θ, no θ̈), [`regression`] (instrumental variables: regressors from
+//! every other encoder edge and reading, instruments from the other half,
+//! so that measurement noise does not shrink the estimates; Newey–West 95 %
+//! intervals) and [`steady`] (Fig. 47/48/50).
 
 pub mod regression;
 pub mod steady;
@@ -183,7 +185,7 @@ impl Recording {
     /// half of the data, its noise independent of the other half's (the
     /// instruments of [`identify`]). None for an odd PPR.
     pub fn half(&self, parity: usize) -> Option<Self> {
-        if self.ppr % 2 != 0 || parity > 1 {
+        if !self.ppr.is_multiple_of(2) || parity > 1 {
             return None;
         }
         Some(Self {

@@ -79,7 +79,7 @@ pub fn instrumental_variables(
     let zx = zs.transpose() * &xs;
     let sv = zx.clone().svd(false, false).singular_values;
     let inverse_condition = sv.min() / sv.max();
-    if !(inverse_condition > 1e-12) {
+    if inverse_condition.is_nan() || inverse_condition <= 1e-12 {
         return Err(not(format!(
             "the regressors are collinear (inverse condition number {inverse_condition:.1e})"
         )));

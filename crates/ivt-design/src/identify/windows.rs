@@ -184,7 +184,7 @@ pub fn integrals(rec: &Recording, a: usize, b: usize, r: f64) -> Option<Integral
     for k in a..b {
         let (t0, t1) = (*t.get(k)?, *t.get(k + 1)?);
         let dt = t1 - t0;
-        if !(dt > 0.0) {
+        if dt.is_nan() || dt <= 0.0 {
             return None;
         }
         let (th0, th1) = (rec.theta_of(k), rec.theta_of(k + 1));
