@@ -67,10 +67,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     println!("plant file → {}", file.display());
 
-    // The open-loop law for the identified plant (a coarse grid: quick).
+    // The open-loop law for the identified plant, on a grid around its
+    // feasible band for 100 rpm (SPEC §5: V_m from c·ω0/a, a few tenths of a
+    // volt wide per N·m of load).
     let grid = Grid {
-        v_m: vec![9.0, 10.0, 11.0, 12.0],
-        t_u: vec![2.0, 4.0, 6.0, 8.0],
+        v_m: ivt_design::sweep::range(6.8, 0.2, 8.6),
+        t_u: ivt_design::sweep::range(2.0, 1.0, 8.0),
         omega0: ivt_design::rpm_to_rad_s(100.0),
     };
     let rep = fit_law(
