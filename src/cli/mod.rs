@@ -11,12 +11,14 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
 pub mod bench;
+pub mod commissioning;
 pub mod ctrl;
 pub mod hb;
 pub mod kin;
 pub mod ol;
 pub mod reproduce;
 pub mod rig;
+pub mod rig_identify;
 pub mod sim;
 pub mod stability;
 pub mod string;

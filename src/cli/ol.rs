@@ -9,15 +9,49 @@ use ivt_design::polish::{self, accurate_r};
 use ivt_design::steady::IhbOptions;
 use ivt_design::sweep::{self, Grid, SweepPoint};
 use ivt_design::{rad_s_to_rpm, rpm_to_rad_s, OperatingPoint};
-use ivt_kin::plant::PlantPreset;
+use ivt_kin::plant::{PlantParams, PlantPreset};
 use serde_json::json;
+use std::path::PathBuf;
 
-/// `--plant printed|thesis-ch4` (SPEC §6), shared by `ivt ol` and `ivt stability(-map)`.
-#[derive(Args, Clone, Copy)]
+/// `--plant printed|thesis-ch4` or `--plant-file P.toml` (SPEC §6), shared
+/// by `ivt ol` and `ivt stability(-map)`.
+#[derive(Args, Clone)]
 pub struct PlantArg {
     /// Plant parameter set: `printed` (Table 1) or `thesis-ch4` (k_t, k_e ÷ 10).
     #[arg(long = "plant", default_value = "printed", value_parser = parse_plant)]
     pub preset: PlantPreset,
+    /// A plant file: a `[plant]` table (preset + overrides) as in scenes,
+    /// e.g. written by `ivt rig identify --out`. Replaces `--plant`.
+    #[arg(long = "plant-file", conflicts_with = "preset")]
+    pub file: Option<PathBuf>,
+}
+
+impl PlantArg {
+    /// The plant's parameters: the preset, or the plant file's table.
+    ///
+    /// # Errors
+    /// An unreadable or invalid plant file ([`CliError::Input`], naming the
+    /// file, line and key).
+    pub fn params(&self) -> Result<PlantParams, CliError> {
+        match &self.file {
+            None => Ok(self.preset.params()),
+            Some(path) => ivt_sim::scene::PlantSection::from_file(path)
+                .and_then(|s| {
+                    s.params()
+                        .map_err(|e| ivt_sim::scene::SceneError(format!("{}: {e}", path.display())))
+                })
+                .map_err(|e| CliError::Input(e.0)),
+        }
+    }
+
+    /// What JSON and emitted headers call the plant: the preset's name or
+    /// the plant file's path.
+    pub fn name(&self) -> String {
+        match &self.file {
+            None => self.preset.name().to_string(),
+            Some(path) => path.display().to_string(),
+        }
+    }
 }
 
 fn parse_plant(name: &str) -> Result<PlantPreset, String> {
@@ -143,7 +177,7 @@ pub fn run(cmd: OlCommand) -> Result<Output, CliError> {
 }
 
 fn solve(a: SolveArgs) -> Result<Output, CliError> {
-    let plant = a.plant.preset.params();
+    let plant = a.plant.params()?;
     let op = OperatingPoint {
         v_m: a.vm,
         t_u: a.tu,
@@ -169,7 +203,7 @@ fn solve(a: SolveArgs) -> Result<Output, CliError> {
         "error_estimate": {"r_abs": acc.error_abs, "r_rel": acc.error_abs / acc.r.abs(),
                            "how": acc.how},
         "thesis_choice": thesis_choice,
-        "plant": a.plant.preset.name(),
+        "plant": a.plant.name(),
     });
     let label = if thesis_choice {
         " — n = 7, the thesis's choice"
@@ -228,9 +262,7 @@ fn point_json(p: &SweepPoint) -> serde_json::Value {
 fn table(a: GridArgs) -> Result<Output, CliError> {
     let grid = grid_of(&a)?;
     let bar = progress_bar(&a, &grid);
-    let pts = sweep::sweep(&a.plant.preset.params(), &grid, ihb_options(&a), || {
-        bar.inc(1)
-    })?;
+    let pts = sweep::sweep(&a.plant.params()?, &grid, ihb_options(&a), || bar.inc(1))?;
     bar.finish_and_clear();
     sweep::require_some_solved(&pts)?;
     let mut human = format!("r̄ [mm] (rows T_U, columns V_m = {:?})\n", grid.v_m);
@@ -246,13 +278,13 @@ fn table(a: GridArgs) -> Result<Output, CliError> {
         human.push('\n');
     }
     let json = json!({"v_m": grid.v_m, "t_u": grid.t_u, "omega0": grid.omega0,
-                      "plant": a.plant.preset.name(),
+                      "plant": a.plant.name(),
                       "points": pts.iter().map(point_json).collect::<Vec<_>>()});
     Ok(Output { json, human })
 }
 
 fn fit_cmd(a: FitArgs) -> Result<Output, CliError> {
-    let plant = a.grid.plant.preset.params();
+    let plant = a.grid.plant.params()?;
     let grid = grid_of(&a.grid)?;
     let form = if a.full {
         PolyForm::Full
@@ -275,7 +307,7 @@ fn fit_cmd(a: FitArgs) -> Result<Output, CliError> {
              IHB (n = {}) over V_m ∈ {}:{}:{} V, T_U ∈ {}:{}:{} N·m, ω0 = {} rpm; {} feasible points.\n\
              Fit error in r: RMS {:.3e} m, max {:.3e} m. ω_a error of the clamped law: max {:.3} rpm, RMS {:.3} rpm.\n\
              Boundary r̄ = r_max: V_m = {:.4} T_U + {:.4} (max deviation {:.3} V).",
-            a.grid.plant.preset.name(), if a.full { " --full" } else { "" }, a.grid.harmonics,
+            a.grid.plant.name(), if a.full { " --full" } else { "" }, a.grid.harmonics,
             a.grid.vm_from, a.grid.vm_step, a.grid.vm_to, a.grid.tu_from, a.grid.tu_step, a.grid.tu_to,
             a.grid.omega0_rpm, pf.points, pf.rms_r, pf.max_r, err.max_abs_rpm, err.rms_rpm, alpha, beta, b_err
         );
@@ -284,7 +316,7 @@ fn fit_cmd(a: FitArgs) -> Result<Output, CliError> {
     let json = json!({
         "poly": pf.poly, "boundary": law.boundary, "r_max": law.r_max,
         "form": if a.full { "full" } else { "eq158" }, "points": pf.points,
-        "plant": a.grid.plant.preset.name(),
+        "plant": a.grid.plant.name(),
         "rms_r": pf.rms_r, "max_r": pf.max_r,
         "omega_a_error_rpm": {"max_abs": err.max_abs_rpm, "rms": err.rms_rpm},
         "thesis_omega_a_error_rpm": {"max_abs": thesis_err.max_abs_rpm, "rms": thesis_err.rms_rpm},

@@ -13,6 +13,8 @@ use std::time::Duration;
 pub enum RigCommand {
     /// Record telemetry frames from a serial port into an MCAP file.
     Record(RecordArgs),
+    /// Identify the plant from a commissioning recording (`rig_identify.rs`).
+    Identify(super::rig_identify::IdentifyArgs),
 }
 
 /// Arguments of `ivt rig record`.
@@ -45,6 +47,7 @@ pub struct RecordArgs {
 pub fn run(cmd: RigCommand) -> Result<Output, CliError> {
     match cmd {
         RigCommand::Record(a) => record_cmd(&a),
+        RigCommand::Identify(a) => super::rig_identify::run(&a),
     }
 }
 

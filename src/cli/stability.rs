@@ -118,7 +118,7 @@ pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
     };
     op.validate()?;
     let g = a.common.gains();
-    let plant = a.common.plant.preset.params();
+    let plant = a.common.plant.params()?;
     let t0 = std::time::Instant::now();
     let s = delay_stability(&plant, &op, g, &a.common.opts()?)?;
     let dt = t0.elapsed().as_secs_f64();
@@ -155,7 +155,7 @@ pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
         "multipliers": s.multipliers.iter().map(|m| [m.0, m.1]).collect::<Vec<_>>(),
         "r_bar": s.orbit.r, "k_si": g.k, "k2_si": g.k2, "chebyshev_order": a.common.n,
         "stable": s.max_abs_multiplier < 1.0, "solve_time_s": dt,
-        "plant": a.common.plant.preset.name(),
+        "plant": a.common.plant.name(),
     });
     let human = format!(
         "V_m = {} V, T_U = {} N·m, k = {:e}, k2 = {:e} m·s/rad² (N = {})\nr̄ = {:.6} m\nmax |multiplier| = {:.6} (structural one: {:.6}{:+.1e}i)\n",
@@ -174,7 +174,7 @@ pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
         t_u: grid_axis("--tu", &a.tu)?,
         omega0: a.common.omega0()?,
     };
-    let plant = a.common.plant.preset.params();
+    let plant = a.common.plant.params()?;
     let g = a.common.gains();
     let t0 = std::time::Instant::now();
     let map = grid_stability_map(&plant, &grid, a.feasible_only, g, &a.common.opts()?)?;
@@ -189,7 +189,7 @@ pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
         .collect();
     let json = json!({"points": pts, "worst": map.worst, "failed": map.failed, "k_si": g.k,
                       "k2_si": g.k2, "solve_time_s": dt,
-                      "plant": a.common.plant.preset.name()});
+                      "plant": a.common.plant.name()});
     if let Some(path) = &a.plot {
         let values = map.values(&grid);
         let title = format!(

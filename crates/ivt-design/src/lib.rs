@@ -27,6 +27,7 @@ pub mod delay;
 pub mod delay_sim;
 pub mod fit;
 pub mod gains;
+pub mod identify;
 pub mod open_loop;
 pub mod pieces;
 pub mod polish;

@@ -22,28 +22,36 @@ use pyo3::types::{PyDict, PyList};
 use std::time::Instant;
 
 /// The plant of a `plant=` argument: a preset name (`"printed"`,
-/// `"thesis-ch4"`), an `ivt.kin.Plant`, or None (printed), with the name the
-/// result echoes (`"custom"` for a Plant matching no preset).
-fn plant_of(plant: Option<&Bound<'_, PyAny>>) -> PyResult<(PlantParams, &'static str)> {
+/// `"thesis-ch4"`), the path of a plant file (`*.toml` or an `os.PathLike`;
+/// [`crate::kin::plant_from_file`]), an `ivt.kin.Plant`, or None (printed),
+/// with the name the result echoes (the path for a file, `"custom"` for a
+/// Plant matching no preset).
+fn plant_of(plant: Option<&Bound<'_, PyAny>>) -> PyResult<(PlantParams, String)> {
     let Some(obj) = plant else {
-        return Ok((PlantParams::printed(), PlantPreset::Printed.name()));
+        return Ok((PlantParams::printed(), PlantPreset::Printed.name().into()));
     };
     if let Ok(name) = obj.extract::<String>() {
-        let preset = PlantPreset::from_name(&name).ok_or_else(|| {
+        if let Some(preset) = PlantPreset::from_name(&name) {
+            return Ok((preset.params(), preset.name().into()));
+        }
+        if !name.ends_with(".toml") {
             let names: Vec<_> = PlantPreset::ALL.iter().map(|p| p.name()).collect();
-            PyValueError::new_err(format!(
-                "argument `plant` = \"{name}\" must be one of {}",
+            return Err(PyValueError::new_err(format!(
+                "argument `plant` = \"{name}\" must be one of {} or a plant file (*.toml)",
                 names.join(", ")
-            ))
-        })?;
-        return Ok((preset.params(), preset.name()));
+            )));
+        }
+    }
+    if let Ok(path) = obj.extract::<std::path::PathBuf>() {
+        let params = crate::kin::plant_from_file(&path)?;
+        return Ok((params, path.display().to_string()));
     }
     let params = obj.extract::<PyRef<'_, Plant>>()?.params;
     let name = PlantPreset::ALL
         .into_iter()
         .find(|p| p.params() == params)
         .map_or("custom", PlantPreset::name);
-    Ok((params, name))
+    Ok((params, name.into()))
 }
 
 fn operating_point(v_m: f64, t_u: f64, omega0_rpm: f64) -> PyResult<OperatingPoint> {
@@ -88,7 +96,7 @@ fn delay_loop<'py>(
     k2: f64,
     si: bool,
     n: i128,
-) -> PyResult<(PlantParams, &'static str, FeedbackGains, DelayOptions)> {
+) -> PyResult<(PlantParams, String, FeedbackGains, DelayOptions)> {
     let (params, plant_name) = plant_of(plant)?;
     for (name, v) in [("k", k), ("k2", k2)] {
         if !v.is_finite() {

@@ -5,7 +5,7 @@ use crate::fields::{self, Field};
 use crate::vectorize::{map, map1, map2};
 use ivt_kin::plant::{GravityModel, PlantParams};
 use ivt_kin::variant;
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::{PyFileNotFoundError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
@@ -159,6 +159,27 @@ fn apply_overrides(
         .map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
+/// The parameters of a plant file (a `[plant]` table: preset + overrides,
+/// as in scenes; what `ivt rig identify --out` writes), read by ivt-sim's
+/// one parser.
+///
+/// # Errors
+/// `FileNotFoundError` for a missing file, `ValueError` (one line: file,
+/// line, column, key) for an invalid one.
+pub fn plant_from_file(path: &std::path::Path) -> PyResult<PlantParams> {
+    if !path.is_file() {
+        return Err(PyFileNotFoundError::new_err(format!(
+            "plant file {} does not exist",
+            path.display()
+        )));
+    }
+    let section =
+        ivt_sim::scene::PlantSection::from_file(path).map_err(|e| PyValueError::new_err(e.0))?;
+    section
+        .params()
+        .map_err(|e| PyValueError::new_err(format!("{}: {e}", path.display())))
+}
+
 /// The IVT plant of Eq. 151 with the Table 1 parameters.
 ///
 /// `Plant()` is the printed plant; keyword arguments override parameters by
@@ -197,6 +218,15 @@ plant_methods! {
         let mut params = PlantParams::printed();
         apply_overrides(&mut params, overrides)?;
         Ok(Self { params })
+    }
+
+    /// The plant of a plant file: its `[plant]` table (preset + overrides),
+    /// e.g. written by `ivt rig identify --out` (same file as `--plant-file`).
+    #[staticmethod]
+    fn from_file(path: std::path::PathBuf) -> PyResult<Self> {
+        Ok(Self {
+            params: plant_from_file(&path)?,
+        })
     }
 
     /// A copy with some parameters changed (same keywords as the constructor).

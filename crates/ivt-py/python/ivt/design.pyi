@@ -1,11 +1,13 @@
 """Controller design from the model (thesis §4.2–4.3)."""
 
+import os
 from typing import Any, Dict, Literal, Optional, Tuple, Union
 
 from .kin import Plant
 
-# A preset name (Table 1, or Table 1 with k_t and k_e divided by 10) or a Plant.
-PlantArg = Union[Literal["printed", "thesis-ch4"], Plant]
+# A preset name (Table 1, or Table 1 with k_t and k_e divided by 10), a plant
+# file (`[plant]` table, e.g. from `ivt rig identify --out`) or a Plant.
+PlantArg = Union[Literal["printed", "thesis-ch4"], str, "os.PathLike[str]", Plant]
 
 def ol_solve(
     v_m: float,

@@ -144,11 +144,23 @@ fn default_name() -> String {
 }
 
 impl Scene {
-    /// Parse and validate a scene. `origin` names the source in errors.
+    /// Parse and validate a scene. `origin` names the source in errors; a
+    /// relative `[plant] file` is taken from the working directory.
     ///
     /// # Errors
     /// One-line [`SceneError`] naming the position and the key.
     pub fn parse(src: &str, origin: &str) -> Result<Self, SceneError> {
+        Self::parse_in(src, origin, std::path::Path::new("."))
+    }
+
+    /// As [`Self::parse`], a relative `[plant] file` taken from `base` (the
+    /// scene file's directory). The plant file's `[plant]` table is merged
+    /// into the scene's ([`PlantSection::resolve`]) before validation.
+    ///
+    /// # Errors
+    /// One-line [`SceneError`] naming the position and the key (the plant
+    /// file's own position for an error inside it).
+    pub fn parse_in(src: &str, origin: &str, base: &std::path::Path) -> Result<Self, SceneError> {
         let doc = locate::Doc::new(src);
         let at = |span: Option<std::ops::Range<usize>>| match span {
             Some(s) => {
@@ -157,7 +169,7 @@ impl Scene {
             }
             None => origin.to_string(),
         };
-        let scene: Scene = toml::from_str(src).map_err(|e| {
+        let mut scene: Scene = toml::from_str(src).map_err(|e| {
             let msg = e.message().replace('\n', " ");
             let key = e
                 .span()
@@ -166,6 +178,23 @@ impl Scene {
                 .unwrap_or_default();
             SceneError(format!("{}: {key}{}", at(e.span()), msg.trim()))
         })?;
+        if scene.plant.file.is_some() {
+            for key in ["plant.preset", "plant.gravity"] {
+                if let Some(span) = doc.span_of(key) {
+                    return Err(SceneError(format!(
+                        "{}: `{key}` comes from `plant.file`; give it there, not beside it",
+                        at(Some(span))
+                    )));
+                }
+            }
+            scene.plant = scene.plant.resolve(base).map_err(|e| {
+                SceneError(format!(
+                    "{}: `plant.file`: {}",
+                    at(doc.span_of("plant.file")),
+                    e.0
+                ))
+            })?;
+        }
         scene
             .validate()
             .map_err(|e| SceneError(format!("{}: {e}", at(doc.span_of(&e.key)))))?;
@@ -179,7 +208,8 @@ impl Scene {
     pub fn load(path: &std::path::Path) -> Result<Self, SceneError> {
         let src = std::fs::read_to_string(path)
             .map_err(|e| SceneError(format!("{}: {e}", path.display())))?;
-        Self::parse(&src, &path.display().to_string())
+        let base = path.parent().unwrap_or(std::path::Path::new("."));
+        Self::parse_in(&src, &path.display().to_string(), base)
     }
 
     /// Plant parameters: preset plus overrides ([`PlantSection::params`]).

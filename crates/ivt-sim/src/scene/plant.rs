@@ -1,8 +1,12 @@
-//! `[plant]`: the preset (SPEC §6) and per-parameter overrides.
+//! `[plant]`: the preset (SPEC §6) and per-parameter overrides, in a scene
+//! or in a plant file of its own (`[plant] file = "P.toml"`, `--plant-file`,
+//! the output of `ivt rig identify`).
 
-use super::Invalid;
+use super::locate::Doc;
+use super::{Invalid, SceneError};
 use ivt_kin::plant::{GravityModel, PlantParams, PlantPreset};
 use serde::Deserialize;
+use std::path::{Path, PathBuf};
 
 /// `[plant] preset`: the parameter set the overrides start from.
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, Default)]
@@ -21,6 +25,15 @@ impl From<PresetName> for PlantPreset {
         match p {
             PresetName::Printed => Self::Printed,
             PresetName::ThesisCh4 => Self::ThesisCh4,
+        }
+    }
+}
+
+impl From<PlantPreset> for PresetName {
+    fn from(p: PlantPreset) -> Self {
+        match p {
+            PlantPreset::Printed => Self::Printed,
+            PlantPreset::ThesisCh4 => Self::ThesisCh4,
         }
     }
 }
@@ -51,6 +64,11 @@ impl From<Gravity> for GravityModel {
 #[serde(deny_unknown_fields)]
 #[allow(missing_docs)]
 pub struct PlantSection {
+    /// A plant file whose `[plant]` table is the base of this one (scenes
+    /// only; relative to the scene's directory). The keys given beside it
+    /// override the file's; `preset` and `gravity` come from the file.
+    #[serde(default)]
+    pub file: Option<PathBuf>,
     /// Parameter set (default `"printed"`, Table 1).
     #[serde(default)]
     pub preset: PresetName,
@@ -76,36 +94,205 @@ pub struct PlantSection {
     pub r_max: Option<f64>,
 }
 
+/// A plant file: its `[plant]` table; other top-level tables are ignored, so
+/// that a scene serves as a plant file too.
+#[derive(Deserialize)]
+struct PlantFile {
+    plant: PlantSection,
+}
+
+/// The names of the overridable parameters, in [`PlantSection::overrides`] order.
+const OVERRIDE_NAMES: [&str; 17] = [
+    "r_a",
+    "k_e",
+    "k_t",
+    "l_a",
+    "j_n1",
+    "j_n2",
+    "j_inshaft",
+    "j_carrier",
+    "j_ring",
+    "j_crk",
+    "m_r",
+    "m_dr",
+    "j_u",
+    "r_u",
+    "g",
+    "sun_to_planet",
+    "r_max",
+];
+
 impl PlantSection {
+    /// The `[plant]` table of a plant file (preset + overrides), validated.
+    ///
+    /// # Errors
+    /// One line `path:line:column: `plant.key` message` for I/O, TOML,
+    /// unknown keys, a missing `[plant]` table, a nested `file` or an
+    /// invalid parameter.
+    pub fn from_file(path: &Path) -> Result<Self, SceneError> {
+        let origin = path.display().to_string();
+        let src =
+            std::fs::read_to_string(path).map_err(|e| SceneError(format!("{origin}: {e}")))?;
+        Self::parse_file(&src, &origin)
+    }
+
+    /// As [`Self::from_file`] from the file's text; `origin` names it in errors.
+    ///
+    /// # Errors
+    /// As [`Self::from_file`].
+    pub fn parse_file(src: &str, origin: &str) -> Result<Self, SceneError> {
+        let doc = Doc::new(src);
+        let at = |span: Option<std::ops::Range<usize>>| match span {
+            Some(s) => {
+                let (line, col) = doc.line_col(s.start);
+                format!("{origin}:{line}:{col}")
+            }
+            None => origin.to_string(),
+        };
+        let file: PlantFile = toml::from_str(src).map_err(|e| {
+            let key = e
+                .span()
+                .and_then(|s| doc.path_at(s.start))
+                .map(|k| format!("`{k}`: "))
+                .unwrap_or_default();
+            let msg = e.message().replace('\n', " ");
+            SceneError(format!("{}: {key}{}", at(e.span()), msg.trim()))
+        })?;
+        let plant = file.plant;
+        let check = || {
+            Invalid::check(plant.file.is_none(), "plant.file", || {
+                "is not allowed in a plant file (no chains of plant files)".into()
+            })?;
+            plant.params().map(|_| ())
+        };
+        check().map_err(|e| SceneError(format!("{}: {e}", at(doc.span_of(&e.key)))))?;
+        Ok(plant)
+    }
+
+    /// This section with its `file` (if any) read and merged: the file's
+    /// preset, gravity and overrides, then the overrides given here. A
+    /// relative `file` is taken from `base`.
+    ///
+    /// # Errors
+    /// The plant file's own errors ([`Self::from_file`]).
+    pub fn resolve(&self, base: &Path) -> Result<Self, SceneError> {
+        let Some(file) = &self.file else {
+            return Ok(self.clone());
+        };
+        let path = if file.is_absolute() {
+            file.clone()
+        } else {
+            base.join(file)
+        };
+        let mut merged = Self::from_file(&path)?;
+        for (mine, theirs) in self.overrides().into_iter().zip(merged.overrides_mut()) {
+            if mine.is_some() {
+                *theirs = mine;
+            }
+        }
+        Ok(merged)
+    }
+
+    /// The section that describes `params` exactly: `preset` plus an
+    /// override for every parameter that differs from it (what `ivt rig
+    /// identify` writes).
+    #[must_use]
+    pub fn from_params(preset: PresetName, params: &PlantParams) -> Self {
+        let mut s = Self {
+            preset,
+            gravity: match params.gravity {
+                GravityModel::Printed => Gravity::Printed,
+                GravityModel::RollerMass => Gravity::RollerMass,
+            },
+            ..Self::default()
+        };
+        let (mut want, mut have) = (*params, PlantPreset::from(preset).params());
+        let pairs = param_slots(&mut want)
+            .into_iter()
+            .zip(param_slots(&mut have));
+        for ((w, h), slot) in pairs.zip(s.overrides_mut()) {
+            if w.to_bits() != h.to_bits() {
+                *slot = Some(*w);
+            }
+        }
+        s
+    }
+
+    /// The section as a plant file (`[plant]` table, preset first, then the
+    /// overrides in Table 1 order; floats in shortest round-trip form).
+    #[must_use]
+    pub fn to_toml(&self) -> String {
+        let preset = PlantPreset::from(self.preset).name();
+        let gravity = match self.gravity {
+            Gravity::Printed => "printed",
+            Gravity::RollerMass => "roller_mass",
+        };
+        let mut out = format!("[plant]\npreset = \"{preset}\"\ngravity = \"{gravity}\"\n");
+        for (name, v) in OVERRIDE_NAMES.iter().zip(self.overrides()) {
+            if let Some(v) = v {
+                out.push_str(&format!("{name} = {v:?}\n"));
+            }
+        }
+        out
+    }
+
+    /// The override values, in [`OVERRIDE_NAMES`] order.
+    fn overrides(&self) -> [Option<f64>; 17] {
+        let p = self;
+        [
+            p.r_a,
+            p.k_e,
+            p.k_t,
+            p.l_a,
+            p.j_n1,
+            p.j_n2,
+            p.j_inshaft,
+            p.j_carrier,
+            p.j_ring,
+            p.j_crk,
+            p.m_r,
+            p.m_dr,
+            p.j_u,
+            p.r_u,
+            p.g,
+            p.sun_to_planet,
+            p.r_max,
+        ]
+    }
+
+    /// The override slots, in [`OVERRIDE_NAMES`] order.
+    fn overrides_mut(&mut self) -> [&mut Option<f64>; 17] {
+        let p = self;
+        [
+            &mut p.r_a,
+            &mut p.k_e,
+            &mut p.k_t,
+            &mut p.l_a,
+            &mut p.j_n1,
+            &mut p.j_n2,
+            &mut p.j_inshaft,
+            &mut p.j_carrier,
+            &mut p.j_ring,
+            &mut p.j_crk,
+            &mut p.m_r,
+            &mut p.m_dr,
+            &mut p.j_u,
+            &mut p.r_u,
+            &mut p.g,
+            &mut p.sun_to_planet,
+            &mut p.r_max,
+        ]
+    }
+
     /// Plant parameters: preset plus overrides, validated.
     ///
     /// # Errors
     /// An invalid parameter (named `plant.<name>`), or an inductance too
     /// stiff for the explicit integrators.
     pub fn params(&self) -> Result<PlantParams, Invalid> {
-        let p = self;
-        let mut params = PlantPreset::from(p.preset).params();
-        params.gravity = p.gravity.into();
-        let overrides: [(Option<f64>, &mut f64); 17] = [
-            (p.r_a, &mut params.r_a),
-            (p.k_e, &mut params.k_e),
-            (p.k_t, &mut params.k_t),
-            (p.l_a, &mut params.l_a),
-            (p.j_n1, &mut params.j_n1),
-            (p.j_n2, &mut params.j_n2),
-            (p.j_inshaft, &mut params.j_inshaft),
-            (p.j_carrier, &mut params.j_carrier),
-            (p.j_ring, &mut params.j_ring),
-            (p.j_crk, &mut params.j_crk),
-            (p.m_r, &mut params.m_r),
-            (p.m_dr, &mut params.m_dr),
-            (p.j_u, &mut params.j_u),
-            (p.r_u, &mut params.r_u),
-            (p.g, &mut params.g),
-            (p.sun_to_planet, &mut params.sun_to_planet),
-            (p.r_max, &mut params.r_max),
-        ];
-        for (v, slot) in overrides {
+        let mut params = PlantPreset::from(self.preset).params();
+        params.gravity = self.gravity.into();
+        for (v, slot) in self.overrides().into_iter().zip(param_slots(&mut params)) {
             if let Some(v) = v {
                 *slot = v;
             }
@@ -125,3 +312,30 @@ impl PlantSection {
         Ok(params)
     }
 }
+
+/// The parameters of `p` that a section overrides, in [`OVERRIDE_NAMES`] order.
+fn param_slots(p: &mut PlantParams) -> [&mut f64; 17] {
+    [
+        &mut p.r_a,
+        &mut p.k_e,
+        &mut p.k_t,
+        &mut p.l_a,
+        &mut p.j_n1,
+        &mut p.j_n2,
+        &mut p.j_inshaft,
+        &mut p.j_carrier,
+        &mut p.j_ring,
+        &mut p.j_crk,
+        &mut p.m_r,
+        &mut p.m_dr,
+        &mut p.j_u,
+        &mut p.r_u,
+        &mut p.g,
+        &mut p.sun_to_planet,
+        &mut p.r_max,
+    ]
+}
+
+#[cfg(test)]
+#[path = "plant_file_tests.rs"]
+mod tests;

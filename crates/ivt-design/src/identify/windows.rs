@@ -1,0 +1,224 @@
+//! The equation-error rows: Eq. 151 integrated over windows of θ.
+//!
+//! With E(θ) = ½ J(θ, r) θ̇², dE/dθ = J θ̈ + ½ J_θ θ̇² at constant r, so
+//! Eq. 151 over a window [θ_a, θ_b] at constant r reads
+//!
+//! ```text
+//! J_a·½Δ(ω²) + J_b·½r²Δ(ω²) + J_c·½r²Δ(f²ω²) + J_d·½Δ(f²ω²)
+//!   + (k_t k_e/R_a)·∫f²ω dθ − (k_t/R_a)·∫f V_m dθ + (2√2/(π r_u))·∫f T_U r dθ
+//!   = g·∫(sin θ + cos θ) r dθ
+//! ```
+//!
+//! — linear in the seven coefficients, with no θ̈: the speeds enter only at
+//! the two ends (point speeds from a local cubic fit of t(θ) to the pulse
+//! times) and inside integrals (the mean speed of each pulse interval), so
+//! timer quantization and jitter are averaged instead of differentiated.
+//!
+//! The window ends sit at θ = kπ/2 and kπ/2 ± π/8: π/8 away from the kinks
+//! of f at π/4 + kπ/2 (Eq. 139), where ω is smooth enough for the cubic fit,
+//! and at two different values of f (A and A cos π/8) so that J_a and J_d are
+//! told apart (with ends at one value of f the two columns would be equal).
+
+use super::Recording;
+use core::f64::consts::FRAC_PI_8;
+use ivt_kin::variant;
+
+/// Number of unknowns of a row: J_a, J_b, J_c, J_d, motor damping, motor gain, load gain.
+pub const UNKNOWNS: usize = 7;
+
+/// One equation-error row: regressors x and the known gravity side y.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Row {
+    /// Coefficients of [J_a, J_b, J_c, J_d, k_t k_e/R_a, k_t/R_a, 2√2/(π r_u)].
+    pub x: [f64; UNKNOWNS],
+    /// ∫(sin θ + cos θ) r dθ (times the known gravity gain gives y).
+    pub gravity: f64,
+    /// Time of the window's start \[s\].
+    pub t: f64,
+    /// Which window: the index of its start among the angles kπ/2,
+    /// kπ/2 ± π/8 (the same window in every view of a recording).
+    pub key: i64,
+}
+
+/// Pulses on each side of a window end in the local cubic fit of t(θ).
+fn half_span(ppr: usize) -> usize {
+    (ppr / 150).clamp(3, 32)
+}
+
+/// Speed θ̇ at pulse `k` from a cubic least-squares fit of t(θ) over pulses
+/// k−m..k+m: θ̇ = 1/t′(θ_k). None if the span leaves the data.
+fn point_speed(t: &[f64], k: usize, m: usize, dtheta: f64) -> Option<f64> {
+    let lo = k.checked_sub(m)?;
+    let span = t.get(lo..=k + m)?;
+    let t0 = *t.get(k)?;
+    // Normal equations of t − t_k = c1 u + c2 u² + c3 u³ (u = pulse offset).
+    let mut a = nalgebra::Matrix3::<f64>::zeros();
+    let mut b = nalgebra::Vector3::<f64>::zeros();
+    for (i, ti) in span.iter().enumerate() {
+        let u = i as f64 - m as f64;
+        let phi = nalgebra::Vector3::new(u, u * u, u * u * u);
+        a += phi * phi.transpose();
+        b += phi * (ti - t0);
+    }
+    let c = a.lu().solve(&b)?;
+    let dt_dtheta = c[0] / dtheta;
+    (dt_dtheta > 0.0).then(|| 1.0 / dt_dtheta)
+}
+
+/// The window ends: (angle index, first pulse at or after the angle) for the
+/// angles kπ/2, kπ/2 ± π/8 in order, inside the data.
+fn window_ends(rec: &Recording) -> Vec<(i64, usize)> {
+    let dtheta = rec.dtheta();
+    let n = rec.pulse_t.len();
+    let theta_end = rec.theta0 + dtheta * n.saturating_sub(1) as f64;
+    // Ends repeat every π/2 at offsets −π/8, 0, +π/8.
+    let first = ((rec.theta0 + FRAC_PI_8) / (4.0 * FRAC_PI_8)).floor() as i64;
+    let mut ends = Vec::new();
+    let mut j = first;
+    loop {
+        let base = j as f64 * 4.0 * FRAC_PI_8;
+        if base - FRAC_PI_8 > theta_end {
+            break;
+        }
+        for (o, off) in [-FRAC_PI_8, 0.0, FRAC_PI_8].into_iter().enumerate() {
+            let k = ((base + off - rec.theta0) / dtheta).ceil();
+            let key = 3 * j + o as i64;
+            if k >= 0.0
+                && (k as usize) < n
+                && ends
+                    .last()
+                    .is_none_or(|e: &(i64, usize)| (k as usize) > e.1)
+            {
+                ends.push((key, k as usize));
+            }
+        }
+        j += 1;
+    }
+    ends
+}
+
+/// The equation-error rows of a recording: one per window between
+/// consecutive ends over which r is constant and every input is known.
+pub fn rows(rec: &Recording) -> Vec<Row> {
+    let dtheta = rec.dtheta();
+    let m = half_span(rec.ppr);
+    let ends = window_ends(rec);
+    let mut out = Vec::new();
+    for pair in ends.windows(2) {
+        let &[(key, a), (next, b)] = pair else {
+            continue;
+        };
+        if next != key + 1 {
+            continue;
+        }
+        if let Some(row) = window_row(rec, a, b, m, dtheta, key) {
+            if row.x.iter().chain([&row.gravity]).all(|v| v.is_finite()) {
+                out.push(row);
+            }
+        }
+    }
+    out
+}
+
+/// The row of the window from pulse `a` to pulse `b` (None: r changes in
+/// it, an input is missing, or a point speed cannot be fitted).
+fn window_row(rec: &Recording, a: usize, b: usize, m: usize, dtheta: f64, key: i64) -> Option<Row> {
+    let t = &rec.pulse_t;
+    let (ta, tb) = (*t.get(a)?, *t.get(b)?);
+    if !rec.settled(ta) || rec.stage_start(ta) != rec.stage_start(tb) {
+        return None;
+    }
+    let r = rec.eccentricity_at(ta)?;
+    if rec.eccentricity_at(tb)? != r || rec.eccentricity_changes_in(ta, tb) {
+        return None;
+    }
+    let (wa, wb) = (point_speed(t, a, m, dtheta)?, point_speed(t, b, m, dtheta)?);
+    let (tha, thb) = (rec.theta_of(a), rec.theta_of(b));
+    let (fa, fb) = (variant::f(tha), variant::f(thb));
+    let d_w2 = 0.5 * (wb * wb - wa * wa);
+    let d_fw2 = 0.5 * (fb * fb * wb * wb - fa * fa * wa * wa);
+    let i = integrals(rec, a, b, r)?;
+    Some(Row {
+        x: [
+            d_w2,
+            r * r * d_w2,
+            r * r * d_fw2,
+            d_fw2,
+            i.damp,
+            -i.volt,
+            i.load,
+        ],
+        gravity: i.grav,
+        t: ta,
+        key,
+    })
+}
+
+/// The θ-integrals of one stretch of pulses at constant r.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Integrals {
+    /// ∫ f² ω dθ (ω: the mean speed of each pulse interval).
+    pub damp: f64,
+    /// ∫ f V_m dθ.
+    pub volt: f64,
+    /// ∫ f T_U r dθ.
+    pub load: f64,
+    /// ∫ (sin θ + cos θ) r dθ.
+    pub grav: f64,
+    /// ∫ T_U dθ.
+    pub torque: f64,
+}
+
+/// [`Integrals`] from pulse `a` to pulse `b` at eccentricity `r` (None: a
+/// non-increasing pulse time or an input outside the sensor record).
+pub fn integrals(rec: &Recording, a: usize, b: usize, r: f64) -> Option<Integrals> {
+    let t = &rec.pulse_t;
+    let dtheta = rec.dtheta();
+    let mut s = Integrals {
+        damp: 0.0,
+        volt: 0.0,
+        load: 0.0,
+        grav: 0.0,
+        torque: 0.0,
+    };
+    for k in a..b {
+        let (t0, t1) = (*t.get(k)?, *t.get(k + 1)?);
+        let dt = t1 - t0;
+        if dt.is_nan() || dt <= 0.0 {
+            return None;
+        }
+        let (th0, th1) = (rec.theta_of(k), rec.theta_of(k + 1));
+        let f = variant::f(0.5 * (th0 + th1));
+        let (v_m, t_u) = rec.inputs_at(0.5 * (t0 + t1))?;
+        s.damp += f * f * (dtheta / dt) * dtheta;
+        s.volt += f * v_m * dtheta;
+        s.load += f * t_u * r * dtheta;
+        s.torque += t_u * dtheta;
+        // ∫(sin θ + cos θ) dθ exactly over the pulse interval.
+        s.grav += ((th0.cos() - th1.cos()) + (th1.sin() - th0.sin())) * r;
+    }
+    Some(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A cubic t(θ) is fitted exactly: the point speed is 1/t′ to rounding.
+    #[test]
+    fn point_speed_is_exact_for_a_cubic() {
+        let h = 0.005;
+        let t: Vec<f64> = (0..40)
+            .map(|k| {
+                let u = k as f64 * h;
+                0.1 * u + 0.02 * u * u - 0.003 * u * u * u
+            })
+            .collect();
+        let k = 20;
+        let u = k as f64 * h;
+        let want = 1.0 / (0.1 + 0.04 * u - 0.009 * u * u);
+        let got = point_speed(&t, k, 8, h).unwrap();
+        assert!((got / want - 1.0).abs() < 1e-9, "{got} vs {want}");
+        assert_eq!(point_speed(&t, 3, 8, h), None);
+    }
+}

@@ -1,0 +1,288 @@
+//! The rig loop (issue #29): a simulated rig commissioned, its recording
+//! identified by `ivt rig identify`, the plant file used by the design tools.
+
+mod rig_sim;
+
+use ivt_kin::plant::PlantParams;
+use ivt_sim::scene::{PlantSection, PresetName};
+use ivt_sim::sensors::Rng;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("ivt-rig-identify-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// `ivt --json ARGS` → (exit status, JSON).
+fn ivt(args: &[&str]) -> (i32, Value) {
+    let out = Command::new(env!("CARGO_BIN_EXE_ivt"))
+        .arg("--json")
+        .args(args)
+        .output()
+        .unwrap();
+    let v = serde_json::from_slice(&out.stdout).unwrap_or(Value::Null);
+    (out.status.code().unwrap_or(-1), v)
+}
+
+/// Table 1 with k_t, k_e, R_a, the inertias and the brake gain (through
+/// r_u) each scaled by a factor in [0.7, 1.3] drawn from `seed`: the values
+/// are not written in the test.
+fn perturbed(seed: u64) -> PlantParams {
+    let mut rng = Rng::new(seed);
+    let mut p = PlantParams::printed();
+    for x in [
+        &mut p.k_t,
+        &mut p.k_e,
+        &mut p.r_a,
+        &mut p.j_n1,
+        &mut p.j_n2,
+        &mut p.j_carrier,
+        &mut p.j_ring,
+        &mut p.j_crk,
+        &mut p.m_r,
+        &mut p.m_dr,
+        &mut p.j_u,
+        &mut p.r_u,
+    ] {
+        *x *= 0.7 + 0.6 * rng.uniform();
+    }
+    p
+}
+
+/// The `[plant]` table body of `p` (overrides of the printed preset).
+fn plant_body(p: &PlantParams) -> String {
+    let text = PlantSection::from_params(PresetName::Printed, p).to_toml();
+    text.lines().skip(1).collect::<Vec<_>>().join("\n")
+}
+
+fn identify(dir: &Path, mcap: &[u8]) -> Value {
+    let rec = dir.join("run.mcap");
+    std::fs::write(&rec, mcap).unwrap();
+    let out = dir.join("plant.toml");
+    let (code, v) = ivt(&[
+        "rig",
+        "identify",
+        rec.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{v}");
+    v
+}
+
+fn truth(p: &PlantParams) -> [(&'static str, f64); 4] {
+    [
+        ("motor_gain", p.motor_gain()),
+        ("motor_damping", p.motor_damping()),
+        ("j_a", p.j_a()),
+        ("load_gain", p.load_gain()),
+    ]
+}
+
+/// Ideal sensors: the four coefficients within 2 %.
+#[test]
+fn perturbed_plant_identified_within_2_percent_with_ideal_sensors() {
+    let p = perturbed(29);
+    let dir = scratch("ideal");
+    let v = identify(
+        &dir,
+        &rig_sim::commission(&plant_body(&p), rig_sim::Sensors::IDEAL, 1),
+    );
+    for (name, want) in truth(&p) {
+        let got = v["summary"][name].as_f64().unwrap();
+        assert!((got / want - 1.0).abs() < 0.02, "{name}: {got} vs {want}");
+    }
+}
+
+/// Noise, quantization and jitter on (1 MHz timer, 1 µs edge jitter, noisy
+/// quantized V_m and T_U): the truth inside each reported 95 % interval, for
+/// four plants drawn from four seeds (16 intervals).
+#[test]
+fn perturbed_plants_inside_the_95_percent_intervals_with_noisy_sensors() {
+    for seed in [5, 7, 13, 29] {
+        let p = perturbed(seed);
+        let dir = scratch(&format!("noisy{seed}"));
+        let rec = rig_sim::commission(&plant_body(&p), rig_sim::Sensors::NOISY, seed);
+        let v = identify(&dir, &rec);
+        for (name, want) in truth(&p) {
+            let ci = &v["ci95"][name];
+            let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
+            eprintln!(
+                "seed {seed} {name}: {:+.3} %, interval ±{:.3} %",
+                100.0 * (v["summary"][name].as_f64().unwrap() / want - 1.0),
+                50.0 * (hi - lo) / want
+            );
+            assert!(
+                lo <= want && want <= hi,
+                "seed {seed} {name}: {want} outside [{lo}, {hi}]"
+            );
+        }
+    }
+}
+
+/// Eq. 185's slope (2√2/π)(7π/51840 inch/deg)/r_OG with r_OG → r_u [1/deg].
+fn eq185(r_u_m: f64) -> f64 {
+    let crank_m_per_deg = 7.0 * std::f64::consts::PI / 51840.0 * 0.0254;
+    2.0 * std::f64::consts::SQRT_2 / std::f64::consts::PI * crank_m_per_deg / r_u_m
+}
+
+/// On the printed plant the sweep's average ratio T_in/T_out rises with
+/// θ_CT at Eq. 185's slope (r_OG in the place of Table 1's r_u: 7/27492 at
+/// r_u = 1.5″ = 0.0381 m; 7/27492·0.0381/0.0222 with Table 1's r_u =
+/// 0.0222 m), and the motor speed falls at K₂T_out = load_gain·⟨f⟩·T_U·
+/// (de/dθ_CT)/(motor_damping·⟨f²⟩) (Eq. 187 with ⟨f⟩ = 1, ⟨f²⟩ =
+/// π²/8·(1/2 + 1/π), SPEC §5), which at the sweep's T_U = 7.35 N·m is the
+/// thesis's 0.0128 rpm/deg and K = 1/(K₂T_out) ≈ 78 deg/rpm (§4.4.3).
+#[test]
+fn printed_plant_reproduces_eq_185_slope_and_the_k_chain() {
+    let dir = scratch("printed");
+    let v = identify(&dir, &rig_sim::commission("", rig_sim::Sensors::IDEAL, 3));
+    let s = &v["sweep"];
+    let slope = s["r_avg_slope_per_deg"].as_f64().unwrap();
+    let want = eq185(0.0222);
+    assert!((slope / want - 1.0).abs() < 0.01, "{slope} vs {want}");
+    assert!((want / (7.0 / 27492.0) - 0.0381 / 0.0222).abs() < 1e-3);
+    let p = PlantParams::printed();
+    let f2 = std::f64::consts::PI.powi(2) / 8.0 * (0.5 + 1.0 / std::f64::consts::PI);
+    let crank_m_per_deg = 7.0 * std::f64::consts::PI / 51840.0 * 0.0254;
+    let k2 = p.load_gain() * 7.35 * crank_m_per_deg / (p.motor_damping() * f2) * 60.0
+        / std::f64::consts::TAU;
+    let got = s["k2_t_out_rpm_per_deg"].as_f64().unwrap();
+    eprintln!("slope {slope} vs {want}; K2 T_out {got} vs {k2}");
+    assert!((got / k2 - 1.0).abs() < 0.02, "K2 T_out {got} vs {k2}");
+    assert!(
+        (got / 0.0128 - 1.0).abs() < 0.03,
+        "K2 T_out {got} vs Fig. 50's 0.0128"
+    );
+    let k = s["k_deg_per_rpm"].as_f64().unwrap();
+    assert!(
+        (k * got - 1.0).abs() < 1e-12 && (k - 78.0).abs() < 2.5,
+        "K = {k}"
+    );
+    for f in v["figures"].as_array().unwrap() {
+        assert!(Path::new(f.as_str().unwrap()).exists(), "{f}");
+    }
+    assert_eq!(v["figures"].as_array().unwrap().len(), 3);
+
+    // With r_u = r_OG = 1.5″ the slope is the printed 7/27492 per degree.
+    let dir = scratch("r_og");
+    let rec = rig_sim::commission("r_u = 0.0381", rig_sim::Sensors::IDEAL, 3);
+    let v = identify(&dir, &rec);
+    let slope = v["sweep"]["r_avg_slope_per_deg"].as_f64().unwrap();
+    assert!((slope / (7.0 / 27492.0) - 1.0).abs() < 0.01, "{slope}");
+}
+
+/// A truncated or corrupted recording: exit 2, an error naming the byte
+/// offset, and no estimate.
+#[test]
+fn truncated_or_corrupt_recording_names_the_byte_offset() {
+    let dir = scratch("corrupt");
+    let good = rig_sim::commission("", rig_sim::Sensors::IDEAL, 4);
+    let flip = |at: usize| {
+        let mut b = good.clone();
+        b[at] ^= 0x5a;
+        b
+    };
+    let n = good.len();
+    let cases = [
+        ("truncated", good[..n / 2].to_vec()),
+        ("no_footer", good[..n - 8].to_vec()),
+        ("flipped_early", flip(200)),
+        ("flipped_third", flip(n / 3)),
+        ("flipped_middle", flip(n / 2)),
+        ("flipped_late", flip(n - 100)),
+        ("not_mcap", b"hello".to_vec()),
+    ];
+    for (name, bytes) in cases {
+        let path = dir.join(format!("{name}.mcap"));
+        std::fs::write(&path, bytes).unwrap();
+        let (code, v) = ivt(&["rig", "identify", path.to_str().unwrap()]);
+        assert_eq!(code, 2, "{name}: {v}");
+        let e = v["error"].as_str().unwrap_or_default();
+        eprintln!("{name}: {e}");
+        assert!(e.contains("byte offset"), "{name}: {e}");
+        assert!(v.get("summary").is_none(), "{name}");
+    }
+}
+
+/// The plant file written by `ivt rig identify --out` is a `[plant]` table
+/// that round-trips: its parameters carry the identified coefficients, a
+/// scene takes it as `[plant] file`, and `ivt ol solve --plant-file` on it
+/// gives the true plant's r̄ to 2 % (against a plant file of the truth).
+#[test]
+fn identified_plant_file_round_trips_into_scenes_and_design_tools() {
+    let p = perturbed(41);
+    let dir = scratch("roundtrip");
+    let v = identify(
+        &dir,
+        &rig_sim::commission(&plant_body(&p), rig_sim::Sensors::IDEAL, 5),
+    );
+    let file = dir.join("plant.toml");
+    assert_eq!(v["plant_file"].as_str().unwrap(), file.to_str().unwrap());
+    let back = PlantSection::from_file(&file).unwrap().params().unwrap();
+    for (name, want) in truth(&p) {
+        let got = match name {
+            "motor_gain" => back.motor_gain(),
+            "motor_damping" => back.motor_damping(),
+            "j_a" => back.j_a(),
+            _ => back.load_gain(),
+        };
+        let summary = v["summary"][name].as_f64().unwrap();
+        assert!(
+            (got / summary - 1.0).abs() < 1e-12,
+            "{name}: file {got} vs summary {summary}"
+        );
+        assert!((got / want - 1.0).abs() < 0.02, "{name}: {got} vs {want}");
+    }
+    let scene = dir.join("s.toml");
+    std::fs::write(
+        &scene,
+        "duration_s = 1.0\n[inputs]\nv_m = [[0.0, 8.0]]\nt_u = [[0.0, 4.0]]\n\
+         [plant]\nfile = \"plant.toml\"\n",
+    )
+    .unwrap();
+    let s = ivt_sim::scene::Scene::load(&scene).unwrap();
+    assert_eq!(s.plant_params().unwrap(), back);
+
+    let truth_file = dir.join("truth.toml");
+    let truth_toml = PlantSection::from_params(PresetName::Printed, &p).to_toml();
+    std::fs::write(&truth_file, truth_toml).unwrap();
+    let solve = |f: &Path| {
+        let args = [
+            "ol",
+            "solve",
+            "--vm",
+            "10",
+            "--tu",
+            "4",
+            "--plant-file",
+            f.to_str().unwrap(),
+        ];
+        let (code, v) = ivt(&args);
+        assert_eq!(code, 0, "{v}");
+        assert_eq!(v["plant"].as_str().unwrap(), f.to_str().unwrap());
+        v["r"].as_f64().unwrap()
+    };
+    let (r_id, r_true) = (solve(&file), solve(&truth_file));
+    eprintln!("r̄ identified {r_id} vs true {r_true}");
+    assert!((r_id / r_true - 1.0).abs() < 0.02, "r̄ {r_id} vs {r_true}");
+    let missing = [
+        "ol",
+        "solve",
+        "--vm",
+        "10",
+        "--tu",
+        "4",
+        "--plant-file",
+        "/nonexistent.toml",
+    ];
+    let (code, v) = ivt(&missing);
+    assert_eq!(code, 2);
+    assert!(
+        v["error"].as_str().unwrap().contains("nonexistent.toml"),
+        "{v}"
+    );
+}
