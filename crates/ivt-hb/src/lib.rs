@@ -27,6 +27,7 @@ pub mod ode;
 pub mod problem;
 pub mod stability;
 pub mod switching;
+pub mod transient;
 
 pub use aft::Aft;
 pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
@@ -63,5 +64,6 @@ pub use stability::{
     classify, AdaptiveHsu, Floquet, HsuEstimate, HsuSteps, StabilityAnalyzer, StabilityKind,
 };
 pub use switching::{period_doubled_start, switch_branch};
+pub use transient::{limit_cycle_from_state, settle, Settled, TransientOptions};
 
 pub mod sthb;
