@@ -10,6 +10,7 @@ pub mod bifurcation;
 pub mod broyden;
 pub mod classic;
 pub mod continuation;
+pub mod damped;
 pub mod deflation;
 pub mod elements;
 mod error;
@@ -45,6 +46,7 @@ pub use continuation::{
     pseudo_arclength, pseudo_arclength_exact, ContinuationOptions, Corrector, Fold, Path,
     PathPoint, PathSystem, Termination,
 };
+pub use damped::{damped_modes, linear_mode, DampedModePoint, DampedModes};
 pub use deflation::{all_solutions, AllSolutions, FoundSolution, SearchOptions, SearchReport};
 pub use elements::{Element, ElementProblem, Harmonic, Law};
 pub use error::HbError;
