@@ -21,6 +21,7 @@ pub mod fold;
 pub mod frc;
 pub mod galerkin;
 pub mod hill;
+mod hysteresis;
 pub mod ihb;
 pub mod limits;
 pub mod mathieu;
