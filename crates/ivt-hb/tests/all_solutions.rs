@@ -172,3 +172,14 @@ fn bad_bounds_are_invalid_input() {
         Err(HbError::InvalidInput(_))
     ));
 }
+
+/// The README's bounds: 6 amplitudes (× 4 phases), 60 steps per run, the box
+/// 10, deflation power 2 and shift 1.
+#[test]
+fn defaults_are_the_readme_values() {
+    let o = SearchOptions::default();
+    assert_eq!(
+        (o.amplitudes, o.max_iter, o.max_amplitude, o.power, o.shift),
+        (6, 60, 10.0, 2.0, 1.0)
+    );
+}

@@ -168,3 +168,11 @@ fn bad_states_and_forced_problems_are_invalid_input() {
         Err(HbError::InvalidInput(_))
     ));
 }
+
+/// The README's defaults: tolerance 1e-10, settled at 1e-6, up to 8 crossings
+/// per period.
+#[test]
+fn defaults_are_the_readme_values() {
+    let o = TransientOptions::default();
+    assert_eq!((o.tol, o.settle, o.max_returns), (1e-10, 1e-6, 8));
+}

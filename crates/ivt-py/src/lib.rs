@@ -24,6 +24,7 @@ mod design;
 mod fields;
 mod gears;
 mod hb;
+mod hb_analyses;
 mod hb_elements;
 mod hb_paths;
 mod hb_string;

@@ -1,0 +1,194 @@
+//! `ivt.hb.all_solutions` and `ivt.hb.damped_modes` (issue 27): every periodic
+//! solution at one frequency by deflated Newton ([`ivt_hb::all_solutions`]),
+//! and damped nonlinear modes by the extended periodic motion concept
+//! ([`ivt_hb::damped_modes`]), on a user system. The limit cycle from a state
+//! is `limit_cycle(..., x0=)` ([`limit_cycle_start`]).
+
+use ivt_hb::{
+    AllSolutions, BackboneOptions, Corrector, DampedModes, HbOptions, LimitCycle, PeriodicProblem,
+    SearchOptions, TransientOptions,
+};
+use numpy::IntoPyArray;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyTuple};
+
+use crate::args::count;
+use crate::hb::{finite, pairs, run_user, stability_steps, user_system_fn, UserArgs};
+use crate::user_problem::PyProblem;
+
+/// The limit cycle of `limit_cycle(...)` without a coefficient guess: the
+/// transient from `x0` (`[x, v]`, 2·n_dof entries) or, by default, from
+/// x = (`amplitude`, 0, …), v = 0, settled and refined by HB
+/// ([`ivt_hb::limit_cycle_from_state`]). `limit_cycle` calls this when it is
+/// given no `guess`.
+pub(crate) fn limit_cycle_start(
+    py: Python<'_>,
+    problem: &PyProblem,
+    opts: &HbOptions,
+    x0: Option<Vec<f64>>,
+    amplitude: f64,
+) -> PyResult<LimitCycle> {
+    let state = match x0 {
+        Some(s) => s,
+        None => {
+            let mut s = vec![0.0; 2 * problem.n_dof()];
+            if let Some(x) = s.first_mut() {
+                *x = finite("amplitude", amplitude)?;
+            }
+            s
+        }
+    };
+    run_user(py, problem, |p| {
+        ivt_hb::limit_cycle_from_state(
+            p,
+            opts,
+            &state,
+            &TransientOptions::default(),
+            stability_steps(opts.harmonics),
+        )
+    })
+}
+
+/// One orbit of [`AllSolutions`] as `{"coeffs", "amplitude", "multipliers",
+/// "stable", "stability"}` (amplitude: max |x| of DOF 0).
+fn solutions_list<'py>(py: Python<'py>, all: &AllSolutions) -> PyResult<Bound<'py, PyList>> {
+    let list = PyList::empty(py);
+    for s in &all.solutions {
+        let d = PyDict::new(py);
+        d.set_item("coeffs", s.solution.coeffs.clone().into_pyarray(py))?;
+        d.set_item("amplitude", s.solution.amplitude(0))?;
+        d.set_item("multipliers", pairs(&s.multipliers))?;
+        d.set_item("stable", s.kind == ivt_hb::StabilityKind::Stable)?;
+        d.set_item("stability", s.kind.name())?;
+        list.append(d)?;
+    }
+    Ok(list)
+}
+
+user_system_fn! {
+/// Every period-one solution of `M x'' + C x' + K x + g(x, v, θ) = f(θ)` at
+/// the excitation frequency `omega` that deflated Newton finds (Farrell et
+/// al. 2015, as BifurcationKit): after each root the residual is deflated by
+/// it, and Newton on the Galerkin Jacobian is restarted. The search is
+/// bounded: starts are the linear solution and its shape scaled to
+/// `amplitudes` amplitudes from max_amplitude/100 to max_amplitude/2 at four
+/// phases; `newton_steps` steps per run; iterates leaving the box
+/// max|coefficient| ≤ `max_amplitude` are abandoned.
+/// Returns {"solutions", "search"}; `ivt.hb.all_solutions` returns
+/// `ivt.hb.AllSolutions`: a list of {"coeffs", "amplitude" (max |x|
+/// of DOF 0), "multipliers" ([[re, im], ...], Hsu), "stable", "stability"}
+/// by increasing size, whose `search` attribute is {"starts", "runs",
+/// "max_amplitude", "newton_steps", "exhausted"} ("exhausted": every start's
+/// last run found nothing new within the bounds). g, f, jac as in `solve`.
+fn _all_solutions<'py>(py, user, jac;
+    f: Option<&Bound<'py, PyAny>>,
+    omega: f64;
+    max_amplitude: f64 = 10.0,
+    #[pyo3(from_py_with = crate::args::int64)] amplitudes: i64 = 6,
+    #[pyo3(from_py_with = crate::args::int64)] newton_steps: i64 = 60,
+    tol: f64 = 0.0,
+) {
+    let (problem, opts) = user.setup(f, 1, tol)?;
+    let search = SearchOptions {
+        max_amplitude: finite("max_amplitude", max_amplitude)?,
+        amplitudes: count("amplitudes", amplitudes)?,
+        max_iter: count("newton_steps", newton_steps)?,
+        stability_steps: stability_steps(opts.harmonics),
+        ..SearchOptions::default()
+    };
+    let omega = finite("omega", omega)?;
+    let all = run_user(py, &problem, |p| ivt_hb::all_solutions(p, &opts, omega, &search))?;
+    let report = PyDict::new(py);
+    report.set_item("starts", all.report.starts)?;
+    report.set_item("runs", all.report.runs)?;
+    report.set_item("max_amplitude", all.report.max_amplitude)?;
+    report.set_item("newton_steps", all.report.max_iter)?;
+    report.set_item("exhausted", all.report.exhausted)?;
+    // `ivt.hb.all_solutions` makes this an `AllSolutions` (a list with a
+    // `search` attribute).
+    let out = PyDict::new(py);
+    out.set_item("solutions", solutions_list(py, &all)?)?;
+    out.set_item("search", report)?;
+    Ok(out)
+}
+}
+
+/// The damped modes as `{"points": [{"amplitude", "omega", "damping_ratio",
+/// "coeffs"}...], "linear_omega", "linear_mode", "termination"}`.
+fn damped_dict<'py>(py: Python<'py>, dm: &DampedModes) -> PyResult<Bound<'py, PyDict>> {
+    let points = PyList::empty(py);
+    for p in &dm.points {
+        let e = PyDict::new(py);
+        e.set_item("amplitude", p.amplitude)?;
+        e.set_item("omega", p.omega)?;
+        e.set_item("damping_ratio", p.damping_ratio)?;
+        e.set_item("coeffs", p.coeffs.clone().into_pyarray(py))?;
+        points.append(e)?;
+    }
+    let d = PyDict::new(py);
+    d.set_item("points", points)?;
+    d.set_item("linear_omega", dm.linear_omega)?;
+    d.set_item("linear_mode", PyTuple::new(py, &dm.linear_mode)?)?;
+    d.set_item("termination", termination_name(&dm.termination))?;
+    Ok(d)
+}
+
+user_system_fn! {
+/// Damped nonlinear mode `mode` (0: lowest linear frequency) of the free
+/// system `M x'' + C x' + K x + g(x, v) = 0` by the extended periodic motion
+/// concept (Krack 2015, NLvib's EPMC): a negative mass-proportional damping
+/// κ M x' makes the orbit periodic; the modal damping ratio is
+/// ζ = −κ/(2ω). `amplitude` is a1 (first cosine coefficient) of DOF `dof`,
+/// whose b1 is held at 0, traced from `amplitude_from` to `amplitude_to`
+/// (Newton–chord on the exact Jacobian). At vanishing amplitude the point is
+/// the linear mode (ω₀ and, for proportional damping, its ζ); for C = 0 the
+/// curve is `backbone`'s.
+/// Returns {"points": [{"amplitude", "omega", "damping_ratio", "coeffs"}...],
+/// "linear_omega", "linear_mode", "termination"}.
+fn damped_modes<'py>(py, user, jac;
+    amplitude_from: f64,
+    amplitude_to: f64;
+    #[pyo3(from_py_with = crate::args::int64)] mode: i64 = 0,
+    #[pyo3(from_py_with = crate::args::int64)] dof: i64 = 0,
+    tol: f64 = 0.0,
+) {
+    let (problem, opts) = user.setup(None, 1, tol)?;
+    let bopts = BackboneOptions {
+        dof: count("dof", dof)?,
+        amplitude_from: finite("amplitude_from", amplitude_from)?,
+        amplitude_to: finite("amplitude_to", amplitude_to)?,
+        corrector: Corrector::Newton,
+        ..BackboneOptions::default()
+    };
+    let mode = count("mode", mode)?;
+    let dm = run_user(py, &problem, |p| ivt_hb::damped_modes(p, &opts, mode, &bopts))?;
+    damped_dict(py, &dm)
+}
+}
+
+/// The snake_case word of a path's termination (SPEC §6).
+fn termination_name(t: &ivt_hb::Termination) -> &'static str {
+    match t {
+        ivt_hb::Termination::LeftInterval => "left_interval",
+        ivt_hb::Termination::MaxPoints => "max_points",
+        ivt_hb::Termination::Stopped => "stopped",
+        ivt_hb::Termination::StepTooSmall(_) => "step_too_small",
+    }
+}
+
+/// `x0` as a vector, if given.
+pub(crate) fn state_vec(x0: Option<Vec<f64>>) -> PyResult<Option<Vec<f64>>> {
+    match x0 {
+        Some(s) if s.iter().any(|v| !v.is_finite()) => Err(PyValueError::new_err(
+            "argument `x0` must be finite [x..., v...]",
+        )),
+        other => Ok(other),
+    }
+}
+
+/// Add `_all_solutions` and `damped_modes` to the `hb` module.
+pub fn register(hb: &Bound<'_, PyModule>) -> PyResult<()> {
+    add_functions!(hb, [_all_solutions, damped_modes]);
+    Ok(())
+}
