@@ -9,6 +9,7 @@ pub mod backbone;
 pub mod bifurcation;
 pub mod broyden;
 pub mod classic;
+pub mod codim2;
 pub mod continuation;
 pub mod damped;
 pub mod deflation;
@@ -43,6 +44,7 @@ pub use broyden::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
 };
 pub use classic::ClassicIhb;
+pub use codim2::{fold_curve, FoldCurve, FoldPoint};
 pub use continuation::{
     pseudo_arclength, pseudo_arclength_exact, ContinuationOptions, Corrector, Fold, Path,
     PathPoint, PathSystem, Termination,
