@@ -136,3 +136,40 @@ def test_jenkins_orbit_against_time_integration():
 def test_jenkins_parameters_are_checked():
     with pytest.raises(ValueError, match="element 0"):
         hb.solve(1.0, 0.1, 1.0, hb.elements.jenkins(-1.0, 0.3), 1.0, f=lambda th: np.cos(th))
+
+
+def test_continue_bifurcation_duffing_fold_curve_to_the_cusp():
+    # The thesis Duffing family in F: from the F = 0.1 fold at the higher ω,
+    # down to the cusp and up the other fold to F = 0.3. Fold frequencies by
+    # shooting (tests/fold_curve.rs, 5e-14 there): 1.6548121230 and
+    # 1.1687243884 at F = 0.1, 1.2589591460 at 0.2, 1.3297591465 at 0.3;
+    # the cusp at F = 0.0120510724 (the extremum of F along the shooting curve).
+    family = lambda F: (1.0, 0.04, 1.0, hb.elements.cubic_spring(1.0),
+                        lambda th: F * np.cos(th))
+    frc = hb.frc(*family(0.1), 0.5, 2.5, n=15, events=True)
+    folds = [b for b in frc["bifurcations"] if b["kind"] == "fold"]
+    start = max(folds, key=lambda b: b["omega"])
+    curve = hb.continue_bifurcation(family, start, 0.0, 0.3, at=[0.1, 0.2, 0.3],
+                                    p_start=0.1, n=15)
+    assert curve["kind"] == "fold" and curve["termination"] == "left_interval"
+    got = sorted((round(a["p"], 12), a["omega"]) for a in curve["at"])
+    want = [(0.1, 1.1687243884), (0.1, 1.6548121230), (0.2, 1.2589591460), (0.3, 1.3297591465)]
+    assert len(got) == 4
+    for (p, w), (pw, ww) in zip(got, want):
+        assert p == pw and abs(w - ww) < 1e-7
+    (cusp,) = curve["special"]
+    assert cusp["kind"] == "cusp" and abs(cusp["p"] / 0.0120510724 - 1) < 1e-6
+    assert set(curve["points"][0]) >= {"omega", "p", "amplitude", "coeffs"}
+
+
+def test_continue_bifurcation_reraises_the_family_error():
+    def family(F):
+        if F < 0.09:
+            raise RuntimeError("no model below 0.09")
+        return (1.0, 0.04, 1.0, hb.elements.cubic_spring(1.0), lambda th: F * np.cos(th))
+    frc = hb.frc(*family(0.1), 0.5, 2.5, n=15, events=True)
+    start = max((b for b in frc["bifurcations"] if b["kind"] == "fold"), key=lambda b: b["omega"])
+    with pytest.raises(RuntimeError, match="no model below"):
+        hb.continue_bifurcation(family, start, 0.0, 0.3, p_start=0.1, n=15)
+    with pytest.raises(ValueError, match="p_start"):
+        hb.continue_bifurcation(family, start, 0.0, 0.3, n=15)

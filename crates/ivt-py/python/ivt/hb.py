@@ -29,6 +29,7 @@ __all__ = [
     "ConvergenceError",
     "all_solutions",
     "backbone",
+    "continue_bifurcation",
     "damped_modes",
     "duffing",
     "duffing_frc",

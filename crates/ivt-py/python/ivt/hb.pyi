@@ -188,6 +188,23 @@ def all_solutions(
     max_iter: int = 100,
     jac: Optional[Jacobian] = None,
 ) -> AllSolutions: ...
+def continue_bifurcation(
+    family: Callable[[float], Sequence[Any]],
+    start: Dict[str, Any],
+    p_from: float,
+    p_to: float,
+    at: Sequence[float] = ...,
+    p_start: Optional[float] = None,
+    n: int = 20,
+    samples: int = 64,
+    velocity_dependent: bool = True,
+    vectorized: bool = False,
+    rtol: float = 1e-9,
+    max_iter: int = 100,
+    ds: float = 0.02,
+    ds_max: float = 0.05,
+    max_points: int = 2000,
+) -> Dict[str, Any]: ...
 def damped_modes(
     m: Matrix,
     c: Matrix,
