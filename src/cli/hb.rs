@@ -4,6 +4,8 @@
 //! Each command parses its arguments, runs an `ivt_hb::jobs` job and prints
 //! its serialized result (the keys of `ivt.hb`'s dicts).
 
+mod folds;
+
 use super::{CliError, Output};
 use clap::{Args, Subcommand};
 use ivt_hb::aft::eval_series;
@@ -19,6 +21,8 @@ pub enum HbCommand {
     Duffing(DuffingArgs),
     /// Frequency-response curve of Duffing's equation with stability (Fig. 29).
     DuffingFrc(FrcArgs),
+    /// The folds of Duffing's frequency response followed in the force F, through the cusp.
+    DuffingFolds(folds::FoldsArgs),
     /// Period-doubling cascade of the Mathieu–Duffing equation (§3.2.5).
     MathieuDuffing(MathieuArgs),
     /// Nonlinear string by STHB (§3.3): frequency–response curve with stability (Figs. 34–36).
@@ -141,6 +145,7 @@ pub fn run(cmd: HbCommand) -> Result<Output, CliError> {
     match cmd {
         HbCommand::Duffing(a) => duffing(a),
         HbCommand::DuffingFrc(a) => duffing_frc(a),
+        HbCommand::DuffingFolds(a) => folds::run(a),
         HbCommand::MathieuDuffing(a) => mathieu(a),
         HbCommand::String(a) => super::string::run(a),
     }

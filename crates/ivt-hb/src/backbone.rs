@@ -182,6 +182,25 @@ pub fn backbone<P: PeriodicProblem>(
     mode: &[f64],
     opts: &BackboneOptions,
 ) -> Result<Backbone, HbError> {
+    if problem.damping().iter().any(|v| *v != 0.0) {
+        return Err(HbError::InvalidInput(
+            "a backbone needs an undamped, unforced problem (C = 0, f = 0)".into(),
+        ));
+    }
+    modal_path(problem, hb, omega0, mode, opts)
+}
+
+/// The path of [`backbone`] without its check `C = 0`: with damping, the
+/// unfolding `κ M ẋ` is the extended periodic motion concept's negative modal
+/// damping (Krack 2015), and [`crate::damped`] reads `ζ = −κ/(2ω)` off it.
+/// Arguments and errors as [`backbone`] (all checked here except `C = 0`).
+pub(crate) fn modal_path<P: PeriodicProblem>(
+    problem: &P,
+    hb: &HbOptions,
+    omega0: f64,
+    mode: &[f64],
+    opts: &BackboneOptions,
+) -> Result<Backbone, HbError> {
     let nd = problem.n_dof();
     let (a_from, a_to) = (opts.amplitude_from, opts.amplitude_to);
     if hb.subharmonic != 1 || mode.len() != nd || opts.dof >= nd {
@@ -200,14 +219,9 @@ pub fn backbone<P: PeriodicProblem>(
         ));
     }
     let mut res = HbResidual::new(problem, hb)?;
-    if problem
-        .damping()
-        .iter()
-        .chain(res.excitation())
-        .any(|v| *v != 0.0)
-    {
+    if res.excitation().iter().any(|v| *v != 0.0) {
         return Err(HbError::InvalidInput(
-            "a backbone needs an undamped, unforced problem (C = 0, f = 0)".into(),
+            "a backbone needs an unforced problem (f = 0)".into(),
         ));
     }
     let m = res.len();
@@ -219,6 +233,22 @@ pub fn backbone<P: PeriodicProblem>(
         x0[d * l + 1] = a_from * phi / mode[opts.dof];
     }
     x0[m] = omega0;
+    // κ of the linear mode, −φᵀCφ/φᵀMφ (zero without damping; exact for
+    // proportional damping): the start is then nearly converged, and the
+    // path's first secant does not point along κ.
+    let quadratic = |a: &[f64]| -> f64 {
+        (0..nd)
+            .map(|i| {
+                (0..nd)
+                    .map(|j| mode[i] * a[i * nd + j] * mode[j])
+                    .sum::<f64>()
+            })
+            .sum()
+    };
+    let modal_mass = quadratic(problem.mass());
+    if modal_mass != 0.0 && modal_mass.is_finite() {
+        x0[m + 1] = -quadratic(problem.damping()) / modal_mass;
+    }
     x0[m + 2] = a_from;
     let mut copts = opts.continuation.clone();
     copts.lambda_min = a_from.min(a_to);

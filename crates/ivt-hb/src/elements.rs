@@ -4,8 +4,16 @@
 //! Each element acts between DOF `a` and DOF `b` (or the ground, `b = None`) on
 //! the relative displacement `δ = x_a − x_b` and velocity `δ̇ = v_a − v_b`; its
 //! force `F(δ, δ̇)` is added to `g_a` and subtracted from `g_b`.
+//!
+//! The hysteretic [`Law::Jenkins`] depends on the history of δ: its force is
+//! computed period by period over the AFT samples ([`crate::hysteresis`]) by
+//! [`PeriodicProblem::nonlinear_samples`] and
+//! [`PeriodicProblem::nonlinear_jacobian_samples`]; a one-sample call
+//! ([`PeriodicProblem::nonlinear`]) has no history and gives its virgin loading
+//! curve `clamp(kδ, −F_s, F_s)`, so a time integration of an [`ElementProblem`]
+//! with a Jenkins element does not model it.
 
-use crate::problem::{matrix_getters, PeriodicProblem};
+use crate::problem::{matrix_getters, per_sample, PeriodicProblem};
 
 /// The force law of one element.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -48,6 +56,15 @@ pub enum Law {
         /// Contact stiffness.
         k: f64,
     },
+    /// Jenkins element: a spring `k` in series with a Coulomb slider of slip
+    /// force `F_s`, `F = k(δ − z)` with the slider `z` moving only while
+    /// `|F| = F_s` (hysteretic, see the module docs).
+    Jenkins {
+        /// Spring stiffness (> 0).
+        k: f64,
+        /// Slip force (> 0).
+        slip_force: f64,
+    },
 }
 
 impl Law {
@@ -70,7 +87,21 @@ impl Law {
                 let (f, fx) = one_sided(d, gap, k);
                 (f, fx, 0.0)
             }
+            Law::Jenkins { k, slip_force } => {
+                // The virgin loading curve (no history at one sample).
+                let f = k * d;
+                if f.abs() < slip_force {
+                    (f, k, 0.0)
+                } else {
+                    (slip_force.copysign(f), 0.0, 0.0)
+                }
+            }
         }
+    }
+
+    /// Whether the force depends on the history of δ ([`Law::Jenkins`]).
+    fn hysteretic(self) -> bool {
+        matches!(self, Law::Jenkins { .. })
     }
 
     /// Whether the force depends on δ̇.
@@ -157,6 +188,9 @@ impl ElementProblem {
                 Law::Clearance { gap, k } | Law::Unilateral { gap, k } => {
                     gap >= 0.0 && gap.is_finite() && k >= 0.0 && k.is_finite()
                 }
+                Law::Jenkins { k, slip_force } => {
+                    k > 0.0 && k.is_finite() && slip_force > 0.0 && slip_force.is_finite()
+                }
             };
             if !ok {
                 return Err(format!("element {i}: invalid parameters {:?}", e.law));
@@ -182,17 +216,116 @@ impl ElementProblem {
     }
 }
 
-impl PeriodicProblem for ElementProblem {
-    matrix_getters!();
-    fn nonlinear(&self, x: &[f64], v: &[f64], _theta: f64, out: &mut [f64]) {
+impl ElementProblem {
+    /// Adds the forces of the elements for which `pick(law)` holds at one
+    /// sample into `out` (zeroed first).
+    fn forces(&self, x: &[f64], v: &[f64], out: &mut [f64], pick: impl Fn(Law) -> bool) {
         out.fill(0.0);
-        for e in &self.elements {
+        for e in self.elements.iter().filter(|e| pick(e.law)) {
             let (f, _, _) = e.law.eval(Self::relative(e, x), Self::relative(e, v));
             out[e.a] += f;
             if let Some(b) = e.b {
                 out[b] -= f;
             }
         }
+    }
+
+    /// Adds `∂F/∂δ = fx`, `∂F/∂δ̇ = fv` of element `e` to the blocks
+    /// `[∂g/∂x | ∂g/∂v]` of one sample (`dg`, `2n²`).
+    fn add_tangent(&self, e: &Element, fx: f64, fv: f64, dg: &mut [f64]) {
+        let n = self.n;
+        let (dg_dx, dg_dv) = dg.split_at_mut(n * n);
+        // δ = x_a − x_b: ∂g_a/∂x_a = F', ∂g_a/∂x_b = −F', ∂g_b = −∂g_a.
+        let mut add = |i: usize, j: usize, s: f64| {
+            dg_dx[i * n + j] += s * fx;
+            dg_dv[i * n + j] += s * fv;
+        };
+        add(e.a, e.a, 1.0);
+        if let Some(b) = e.b {
+            add(e.a, b, -1.0);
+            add(b, e.a, -1.0);
+            add(b, b, 1.0);
+        }
+    }
+
+    /// The Jacobian blocks of the elements for which `pick(law)` holds at one
+    /// sample into `dg` (zeroed first).
+    fn tangents(&self, x: &[f64], v: &[f64], dg: &mut [f64], pick: impl Fn(Law) -> bool) {
+        dg.fill(0.0);
+        for e in self.elements.iter().filter(|e| pick(e.law)) {
+            let (_, fx, fv) = e.law.eval(Self::relative(e, x), Self::relative(e, v));
+            self.add_tangent(e, fx, fv, dg);
+        }
+    }
+
+    /// Adds the hysteretic elements' forces (into `out`, `n` per sample) and
+    /// local tangents (into `dg`, `2n²` per sample) over the periods of the
+    /// sample-major `x` (periods split where θ restarts).
+    fn add_hysteretic(
+        &self,
+        x: &[f64],
+        theta: &[f64],
+        mut out: Option<&mut [f64]>,
+        mut dg: Option<&mut [f64]>,
+    ) {
+        let n = self.n;
+        let ranges = crate::hysteresis::period_ranges(theta);
+        let mut delta = vec![0.0; theta.len()];
+        let (mut force, mut tangent) = (vec![0.0; theta.len()], vec![0.0; theta.len()]);
+        for e in self.elements.iter().filter(|e| e.law.hysteretic()) {
+            let Law::Jenkins { k, slip_force } = e.law else {
+                continue;
+            };
+            for (i, d) in delta.iter_mut().enumerate() {
+                *d = Self::relative(e, &x[i * n..(i + 1) * n]);
+            }
+            for r in &ranges {
+                crate::hysteresis::jenkins_period(
+                    k,
+                    slip_force,
+                    &delta[r.clone()],
+                    &mut force[r.clone()],
+                    &mut tangent[r.clone()],
+                );
+            }
+            if let Some(out) = out.as_deref_mut() {
+                for (i, f) in force.iter().enumerate() {
+                    out[i * n + e.a] += f;
+                    if let Some(b) = e.b {
+                        out[i * n + b] -= f;
+                    }
+                }
+            }
+            if let Some(dg) = dg.as_deref_mut() {
+                let w = 2 * n * n;
+                for (i, t) in tangent.iter().enumerate() {
+                    self.add_tangent(e, *t, 0.0, &mut dg[i * w..(i + 1) * w]);
+                }
+            }
+        }
+    }
+
+    /// Whether any element is hysteretic.
+    fn has_hysteresis(&self) -> bool {
+        self.elements.iter().any(|e| e.law.hysteretic())
+    }
+}
+
+impl PeriodicProblem for ElementProblem {
+    matrix_getters!();
+    fn nonlinear(&self, x: &[f64], v: &[f64], _theta: f64, out: &mut [f64]) {
+        self.forces(x, v, out, |_| true);
+    }
+    fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+        if !self.has_hysteresis() {
+            return per_sample(self.n, x, v, theta, out, |x, v, _, o| {
+                self.forces(x, v, o, |_| true)
+            });
+        }
+        per_sample(self.n, x, v, theta, out, |x, v, _, o| {
+            self.forces(x, v, o, |law| !law.hysteretic())
+        });
+        self.add_hysteretic(x, theta, Some(out), None);
     }
     fn excitation(&self, theta: f64, out: &mut [f64]) {
         out.fill(0.0);
@@ -204,23 +337,18 @@ impl PeriodicProblem for ElementProblem {
         self.elements.iter().any(|e| e.law.velocity_dependent())
     }
     fn nonlinear_jacobian(&self, x: &[f64], v: &[f64], _theta: f64, dg: &mut [f64]) {
-        let n = self.n;
-        dg.fill(0.0);
-        let (dg_dx, dg_dv) = dg.split_at_mut(n * n);
-        for e in &self.elements {
-            let (_, fx, fv) = e.law.eval(Self::relative(e, x), Self::relative(e, v));
-            // δ = x_a − x_b: ∂g_a/∂x_a = F', ∂g_a/∂x_b = −F', ∂g_b = −∂g_a.
-            let mut add = |i: usize, j: usize, s: f64| {
-                dg_dx[i * n + j] += s * fx;
-                dg_dv[i * n + j] += s * fv;
-            };
-            add(e.a, e.a, 1.0);
-            if let Some(b) = e.b {
-                add(e.a, b, -1.0);
-                add(b, e.a, -1.0);
-                add(b, b, 1.0);
-            }
+        self.tangents(x, v, dg, |_| true);
+    }
+    fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
+        if !self.has_hysteresis() {
+            return per_sample(self.n, x, v, theta, dg, |x, v, _, d| {
+                self.tangents(x, v, d, |_| true)
+            });
         }
+        per_sample(self.n, x, v, theta, dg, |x, v, _, d| {
+            self.tangents(x, v, d, |law| !law.hysteretic())
+        });
+        self.add_hysteretic(x, theta, None, Some(dg));
     }
 }
 

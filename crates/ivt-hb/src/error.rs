@@ -88,6 +88,17 @@ pub enum HbError {
         /// The start solve's failure (with its residual history).
         cause: Box<HbError>,
     },
+    /// A transient integration (limit cycle from a state) ended without
+    /// settling onto a periodic attractor.
+    #[error(
+        "the transient from the given state did not reach a limit cycle (t = {time}): {reason}"
+    )]
+    Transient {
+        /// Time integrated.
+        time: f64,
+        /// What stopped it.
+        reason: &'static str,
+    },
     /// An eigenvalue computation (Hill matrix, monodromy matrix) failed.
     #[error("eigenvalue computation failed: {0}")]
     Eigen(String),
@@ -128,6 +139,7 @@ impl HbError {
             | Self::Stalled { .. }
             | Self::ColdStart { .. }
             | Self::Eigen(_)
+            | Self::Transient { .. }
             | Self::NonFiniteMultipliers { .. } => "failed",
         }
     }

@@ -10,7 +10,10 @@ pub mod bifurcation;
 pub mod branch_point;
 pub mod broyden;
 pub mod classic;
+pub mod codim2;
 pub mod continuation;
+pub mod damped;
+pub mod deflation;
 pub mod elements;
 mod error;
 pub mod events;
@@ -20,6 +23,7 @@ pub mod fold;
 pub mod frc;
 pub mod galerkin;
 pub mod hill;
+mod hysteresis;
 pub mod ihb;
 pub mod jobs;
 pub mod limits;
@@ -29,6 +33,7 @@ pub mod ode;
 pub mod problem;
 pub mod stability;
 pub mod switching;
+pub mod transient;
 
 pub use aft::Aft;
 pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
@@ -41,10 +46,13 @@ pub use broyden::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
 };
 pub use classic::ClassicIhb;
+pub use codim2::{fold_curve, FoldCurve, FoldPoint};
 pub use continuation::{
     pseudo_arclength, pseudo_arclength_exact, ContinuationOptions, Corrector, Fold, Path,
     PathPoint, PathSystem, Termination,
 };
+pub use damped::{damped_modes, linear_mode, DampedModePoint, DampedModes};
+pub use deflation::{all_solutions, AllSolutions, FoundSolution, SearchOptions, SearchReport};
 pub use elements::{Element, ElementProblem, Harmonic, Law};
 pub use error::HbError;
 pub use events::{trace, Event, Trace, TraceOptions, TracedPoint};
@@ -66,5 +74,6 @@ pub use stability::{
     classify, AdaptiveHsu, Floquet, HsuEstimate, HsuSteps, StabilityAnalyzer, StabilityKind,
 };
 pub use switching::{period_doubled_start, switch_branch};
+pub use transient::{limit_cycle_from_state, settle, Settled, TransientOptions};
 
 pub mod sthb;

@@ -241,9 +241,13 @@ user_system_fn! {
 /// phase condition b1 = 0 on DOF 0 (Newton with the Galerkin Jacobian).
 ///
 /// The start is `guess` (coefficients, n_dof blocks of [a0, a1..an, b1..bn])
-/// or, by default, x_0 = `amplitude`·cos τ. g(x, v, theta): theta is the
-/// phase ω t (an autonomous g ignores it); `vectorized` and `jac` as in
-/// `solve`.
+/// at `omega_guess`, or else the transient from the state `x0` = [x..., v...]
+/// (default: x = (`amplitude`, 0, ...), v = 0) integrated until it settles
+/// onto the attractor (Dormand–Prince 5(4); settled when a section crossing
+/// returns within 1e-6), then refined by HB (ivt_hb::limit_cycle_from_state;
+/// a transient that comes to rest raises ValueError naming the equilibrium).
+/// g(x, v, theta): theta is the phase ω t (an autonomous g ignores it);
+/// `vectorized` and `jac` as in `solve`.
 /// Returns {"omega", "period", "coeffs", "multipliers" ([[re, im], ...],
 /// the trivial +1 included), "stable" (all others inside the unit circle),
 /// "stability", "iterations", "residual_norm"}.
@@ -252,11 +256,13 @@ fn limit_cycle<'py>(py, user, jac;
     amplitude: f64 = 1.0,
     guess: Option<&Bound<'py, PyAny>> = None;
     tol: f64 = 0.0,
+    x0: Option<Vec<f64>> = None,
 ) {
     let (problem, opts) = user.setup(None, 1, tol)?;
     let req = LimitCycleRequest {
         omega_guess,
         guess: guess_vec(guess)?,
+        x0,
         amplitude: finite("amplitude", amplitude)?,
     };
     let cycle = run_user(py, &problem, |p| jobs::limit_cycle(p, &opts, &req))?;
@@ -321,6 +327,7 @@ pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
         ]
     );
     crate::hb_paths::register(&m)?;
+    crate::hb_analyses::register(&m)?;
     crate::hb_string::register(&m)?;
     crate::hb_elements::register(&m)?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;

@@ -53,6 +53,7 @@ fn call_text(e: &Element) -> String {
         Law::Coulomb { force, v_reg } => format!("coulomb(force={force}, v_reg={v_reg}"),
         Law::Clearance { gap, k } => format!("clearance(gap={gap}, k={k}"),
         Law::Unilateral { gap, k } => format!("unilateral(gap={gap}, k={k}"),
+        Law::Jenkins { k, slip_force } => format!("jenkins(k={k}, slip_force={slip_force}"),
     };
     let to = e.b.map_or_else(|| "None".to_string(), |b| b.to_string());
     format!("{law}, dof={}, to={to})", e.a)
@@ -110,6 +111,15 @@ element_fn! {
     /// One-sided penalty contact: F = k(δ − gap) for δ > gap, else 0.
     fn unilateral(gap, k) => Unilateral
 }
+element_fn! {
+    /// Jenkins element: a spring k in series with a Coulomb slider of slip
+    /// force `slip_force` (both > 0), F = k(δ − z) with the slider z moving
+    /// only while |F| = slip_force. Hysteretic: the force over a period is
+    /// computed from the period's history (the play operator, two passes to
+    /// the periodic state); Jacobians use the local tangent (k in stick, 0 in
+    /// slip), so folds and multipliers with it are approximate.
+    fn jenkins(k, slip_force) => Jenkins
+}
 
 /// Register `ivt._ivt.hb.elements` under the `hb` module.
 pub fn register(hb: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -122,7 +132,8 @@ pub fn register(hb: &Bound<'_, PyModule>) -> PyResult<()> {
             cubic_damper,
             coulomb,
             clearance,
-            unilateral
+            unilateral,
+            jenkins
         ]
     );
     m.add_class::<Elements>()?;

@@ -25,6 +25,7 @@ mod error_slot;
 mod fields;
 mod gears;
 mod hb;
+mod hb_analyses;
 mod hb_elements;
 mod hb_paths;
 mod hb_shared;

@@ -12,7 +12,7 @@ def test_readme_examples_run() -> None:
     text = README.read_text()
     section = text.split("### Examples", 1)[1].split("\n### ", 1)[0]
     blocks = re.findall(r"```python\n(.*?)```", section, flags=re.S)
-    assert len(blocks) == 5, len(blocks)
+    assert len(blocks) == 10, len(blocks)
     namespace: dict = {}  # type: ignore[type-arg]
     for block in blocks:
         exec(compile(block, str(README), "exec"), namespace)

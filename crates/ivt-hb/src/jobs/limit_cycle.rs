@@ -14,10 +14,15 @@ use serde::Serialize;
 pub struct LimitCycleRequest {
     /// Guess of ω (finite, > 0).
     pub omega_guess: f64,
-    /// Start coefficients (n_dof blocks of `[a0, a1..an, b1..bn]`); None:
-    /// `x_0 = amplitude·cos τ`.
+    /// Start coefficients (n_dof blocks of `[a0, a1..an, b1..bn]`) at
+    /// `omega_guess`; None: the transient from [`Self::x0`].
     pub guess: Option<Vec<f64>>,
-    /// Amplitude of the default start.
+    /// Start state `[x..., v...]` (2·n_dof entries) of the transient that
+    /// settles onto the attractor before HB refines it
+    /// ([`crate::limit_cycle_from_state`]); None: x = (`amplitude`, 0, …),
+    /// v = 0. Not used with a `guess`.
+    pub x0: Option<Vec<f64>>,
+    /// x of DOF 0 in the default start state.
     pub amplitude: f64,
 }
 
@@ -27,6 +32,7 @@ impl Default for LimitCycleRequest {
         Self {
             omega_guess: 1.0,
             guess: None,
+            x0: None,
             amplitude: 1.0,
         }
     }
@@ -34,10 +40,23 @@ impl Default for LimitCycleRequest {
 
 impl LimitCycleRequest {
     /// # Errors
-    /// [`HbError::InvalidInput`] for a non-finite ω guess or amplitude.
+    /// [`HbError::InvalidInput`] for a non-finite ω guess, amplitude or
+    /// start state, or for both a `guess` and an `x0`.
     pub fn validate(&self) -> Result<(), HbError> {
         finite("omega_guess", self.omega_guess)?;
         finite("amplitude", self.amplitude)?;
+        if let Some(x0) = &self.x0 {
+            if x0.iter().any(|v| !v.is_finite()) {
+                return Err(HbError::InvalidInput(
+                    "x0 must be finite [x..., v...]".into(),
+                ));
+            }
+            if self.guess.is_some() {
+                return Err(HbError::InvalidInput(
+                    "give either `guess` (coefficients) or `x0` (a state), not both".into(),
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -66,35 +85,38 @@ pub struct Cycle {
 /// The limit cycle of `problem` near `req`'s start.
 ///
 /// # Errors
-/// [`LimitCycleRequest::validate`]'s and those of [`crate::limit_cycle`]
-/// (non-convergence, collapse onto the equilibrium).
+/// [`LimitCycleRequest::validate`]'s, those of [`crate::limit_cycle`]
+/// (non-convergence, collapse onto the equilibrium) and, without a guess,
+/// those of [`crate::limit_cycle_from_state`] (a transient that comes to rest).
 pub fn limit_cycle<P: PeriodicProblem>(
     problem: &P,
     hb: &HbOptions,
     req: &LimitCycleRequest,
 ) -> Result<Cycle, HbError> {
     req.validate()?;
-    let start = match &req.guess {
-        Some(q) => q.clone(),
+    let steps = stability_steps(hb.harmonics);
+    let lc = match &req.guess {
+        Some(start) => crate::limit_cycle(problem, hb, req.omega_guess, start, steps)?,
         None => {
-            // x_0 = amplitude·cos τ: a1 of DOF 0 (index 1), all else zero.
-            let len = problem
-                .n_dof()
-                .saturating_mul(hb.harmonics.saturating_mul(2).saturating_add(1));
-            let mut q = vec![0.0; len];
-            if let Some(a1) = q.get_mut(1) {
-                *a1 = req.amplitude;
-            }
-            q
+            let state = match &req.x0 {
+                Some(x0) => x0.clone(),
+                None => {
+                    let mut s = vec![0.0; problem.n_dof().saturating_mul(2)];
+                    if let Some(x) = s.first_mut() {
+                        *x = req.amplitude;
+                    }
+                    s
+                }
+            };
+            crate::limit_cycle_from_state(
+                problem,
+                hb,
+                &state,
+                &crate::TransientOptions::default(),
+                steps,
+            )?
         }
     };
-    let lc = crate::limit_cycle(
-        problem,
-        hb,
-        req.omega_guess,
-        &start,
-        stability_steps(hb.harmonics),
-    )?;
     Ok(Cycle {
         omega: lc.omega(),
         period: lc.period(),

@@ -25,8 +25,12 @@ from ._reexport import reexport
 
 
 __all__ = [
+    "AllSolutions",
     "ConvergenceError",
+    "all_solutions",
     "backbone",
+    "continue_bifurcation",
+    "damped_modes",
     "duffing",
     "duffing_frc",
     "eval_series",
@@ -38,6 +42,36 @@ __all__ = [
     "string",
 ]
 
-reexport(globals(), _ivt.hb, __all__)
+_NATIVE = [name for name in __all__ if name not in ("AllSolutions", "all_solutions")]
+reexport(globals(), _ivt.hb, _NATIVE)
 elements = _ivt.hb.elements
 Elements = _ivt.hb.elements.Elements
+
+
+class AllSolutions(list):  # type: ignore[type-arg]
+    """The orbits found by :func:`all_solutions` (a list of dicts), with the
+    search's bounds and outcome in ``search``: {"starts", "runs",
+    "max_amplitude", "newton_steps", "exhausted"}."""
+
+    def __init__(self, solutions: list, search: dict) -> None:  # type: ignore[type-arg]
+        super().__init__(solutions)
+        self.search = search
+
+
+def all_solutions(
+    m, c, k, g, f, omega, n=20, samples=64, max_amplitude=10.0, amplitudes=6,
+    newton_steps=60, tol=0.0, velocity_dependent=True, vectorized=False,
+    rtol=1e-9, max_iter=100, jac=None,
+):  # type: ignore[no-untyped-def]
+    """Every period-one solution at ``omega`` that deflated Newton finds
+    within bounded starts (see ``ivt._ivt.hb._all_solutions``): a list of
+    {"coeffs", "amplitude", "multipliers", "stable", "stability"} by
+    increasing size, with ``.search`` = {"starts", "runs", "max_amplitude",
+    "newton_steps", "exhausted"}."""
+    found = _ivt.hb._all_solutions(
+        m, c, k, g, f, omega, n=n, samples=samples, max_amplitude=max_amplitude,
+        amplitudes=amplitudes, newton_steps=newton_steps, tol=tol,
+        velocity_dependent=velocity_dependent, vectorized=vectorized, rtol=rtol,
+        max_iter=max_iter, jac=jac,
+    )
+    return AllSolutions(found["solutions"], found["search"])

@@ -40,6 +40,8 @@ class elements:
     def clearance(gap: float, k: float, dof: int = 0, to: Optional[int] = None) -> Elements: ...
     @staticmethod
     def unilateral(gap: float, k: float, dof: int = 0, to: Optional[int] = None) -> Elements: ...
+    @staticmethod
+    def jenkins(k: float, slip_force: float, dof: int = 0, to: Optional[int] = None) -> Elements: ...
 
 class ConvergenceError(RuntimeError):
     """A solve that did not converge."""
@@ -135,6 +137,7 @@ def limit_cycle(
     n: int = 20,
     samples: int = 64,
     tol: float = 0.0,
+    x0: Optional[Sequence[float]] = None,
     velocity_dependent: bool = True,
     vectorized: bool = False,
     rtol: float = 1e-9,
@@ -152,6 +155,67 @@ def backbone(
     amplitude_to: float = 1.0,
     n: int = 20,
     samples: int = 64,
+    dof: int = 0,
+    tol: float = 0.0,
+    velocity_dependent: bool = True,
+    vectorized: bool = False,
+    rtol: float = 1e-9,
+    max_iter: int = 100,
+    jac: Optional[Jacobian] = None,
+) -> Dict[str, Any]: ...
+class AllSolutions(List[Dict[str, Any]]):
+    """The orbits of :func:`all_solutions`; ``search`` holds the search's bounds
+    and whether it was exhausted."""
+
+    search: Dict[str, Any]
+    def __init__(self, solutions: List[Dict[str, Any]], search: Dict[str, Any]) -> None: ...
+
+def all_solutions(
+    m: Matrix,
+    c: Matrix,
+    k: Matrix,
+    g: Union[Callback, VectorizedCallback, Elements],
+    f: Optional[Forcing],
+    omega: float,
+    n: int = 20,
+    samples: int = 64,
+    max_amplitude: float = 10.0,
+    amplitudes: int = 6,
+    newton_steps: int = 60,
+    tol: float = 0.0,
+    velocity_dependent: bool = True,
+    vectorized: bool = False,
+    rtol: float = 1e-9,
+    max_iter: int = 100,
+    jac: Optional[Jacobian] = None,
+) -> AllSolutions: ...
+def continue_bifurcation(
+    family: Callable[[float], Sequence[Any]],
+    start: Dict[str, Any],
+    p_from: float,
+    p_to: float,
+    at: Sequence[float] = ...,
+    p_start: Optional[float] = None,
+    n: int = 20,
+    samples: int = 64,
+    velocity_dependent: bool = True,
+    vectorized: bool = False,
+    rtol: float = 1e-9,
+    max_iter: int = 100,
+    ds: float = 0.02,
+    ds_max: float = 0.05,
+    max_points: int = 2000,
+) -> Dict[str, Any]: ...
+def damped_modes(
+    m: Matrix,
+    c: Matrix,
+    k: Matrix,
+    g: Union[Callback, VectorizedCallback, Elements],
+    amplitude_from: float,
+    amplitude_to: float,
+    n: int = 20,
+    samples: int = 64,
+    mode: int = 0,
     dof: int = 0,
     tol: float = 0.0,
     velocity_dependent: bool = True,

@@ -1,0 +1,382 @@
+//! Every periodic solution at one excitation frequency by deflated Newton
+//! (Farrell, Birkisson & Funke, SIAM J. Sci. Comput. 37 (2015); BifurcationKit's
+//! `DeflationOperator`): once solutions `q₁…q_k` of the HB residual `R(q) = 0`
+//! (Eq. 61) are known, Newton is run on
+//!
+//! `G(q) = M(q) R(q)`,  `M(q) = Π_i (‖q − q_i‖⁻ᵖ/s⁻ᵖ + σ)`,
+//!
+//! whose only roots are the other roots of `R` (M blows up at each `q_i`). The
+//! deflated Newton step is the plain one `δ₀ = −Φ_q⁻¹R` (Φ_q the Galerkin
+//! Jacobian, Eq. 56) rescaled by Sherman–Morrison,
+//! `δ = δ₀ / (1 − ∇ln M · δ₀)`, so no second factorisation is needed. Each root
+//! found is polished by undeflated Newton and its Floquet multipliers (Hsu,
+//! Eq. 80) are computed.
+//!
+//! The search is bounded, and the result says how: a fixed set of starts (the
+//! linear solution, Eq. 59, and its shape scaled to amplitudes spread
+//! geometrically up to `max_amplitude` at four phases), from each start deflated
+//! runs until one fails, at most `max_iter` Newton steps per run, and iterates
+//! leaving the box `‖q‖∞ ≤ max_amplitude` abandoned. "Exhausted" means every
+//! start's last run found nothing new within these bounds, not a proof.
+
+use crate::error::HbError;
+use crate::floquet::HsuRule;
+use crate::galerkin::GalerkinJacobian;
+use crate::ihb::{HbOptions, HbResidual, HbSolution};
+use crate::problem::PeriodicProblem;
+use crate::stability::{StabilityAnalyzer, StabilityKind};
+use crate::BroydenStats;
+use faer::c64;
+use ivt_num::vector::norm2;
+use ivt_num::LuWorkspace;
+
+/// Bounds of the search.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SearchOptions {
+    /// Largest `‖q‖∞` searched (the box; also the scale `s` of the distances).
+    pub max_amplitude: f64,
+    /// Start amplitudes per phase, spread geometrically from
+    /// `max_amplitude/100` to `max_amplitude/2` (default 6).
+    pub amplitudes: usize,
+    /// Newton steps per deflated run (default 60).
+    pub max_iter: usize,
+    /// Power `p` of the deflation (default 2).
+    pub power: f64,
+    /// Shift `σ` of the deflation (default 1).
+    pub shift: f64,
+    /// Hsu sub-intervals of the stability analysis (> harmonics; default 512).
+    pub stability_steps: usize,
+}
+
+impl Default for SearchOptions {
+    fn default() -> Self {
+        Self {
+            max_amplitude: 10.0,
+            amplitudes: 6,
+            max_iter: 60,
+            power: 2.0,
+            shift: 1.0,
+            stability_steps: 512,
+        }
+    }
+}
+
+/// One solution with its stability.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FoundSolution {
+    /// The orbit.
+    pub solution: HbSolution,
+    /// Floquet multipliers (Hsu), decreasing modulus.
+    pub multipliers: Vec<c64>,
+    /// Their verdict.
+    pub kind: StabilityKind,
+}
+
+/// How the search was bounded and how it ended.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SearchReport {
+    /// Starts tried.
+    pub starts: usize,
+    /// Deflated Newton runs (successful and failed).
+    pub runs: usize,
+    /// The box `‖q‖∞ ≤ max_amplitude`.
+    pub max_amplitude: f64,
+    /// Newton steps allowed per run.
+    pub max_iter: usize,
+    /// Whether every start's last run failed to find a new solution (the search
+    /// found nothing more within its bounds).
+    pub exhausted: bool,
+}
+
+/// Every solution found, by increasing `‖q‖₂`, and the search's bounds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AllSolutions {
+    /// The solutions.
+    pub solutions: Vec<FoundSolution>,
+    /// The search.
+    pub report: SearchReport,
+}
+
+/// Most solutions kept (a guard against a continuum of solutions, e.g. an
+/// unforced conservative problem).
+const MAX_SOLUTIONS: usize = 64;
+
+/// All periodic solutions of `problem` at `omega_f` that deflated Newton finds
+/// within `opts` (see the module docs).
+///
+/// # Errors
+/// [`HbError::InvalidInput`] for a bad frequency or bounds, the AFT's size
+/// errors.
+pub fn all_solutions<P: PeriodicProblem>(
+    problem: &P,
+    hb: &HbOptions,
+    omega_f: f64,
+    opts: &SearchOptions,
+) -> Result<AllSolutions, HbError> {
+    crate::ihb::validate_omega(omega_f)?;
+    if !(opts.max_amplitude.is_finite()
+        && opts.max_amplitude > 0.0
+        && opts.amplitudes > 0
+        && opts.max_iter > 0
+        && opts.power > 0.0
+        && opts.shift > 0.0)
+    {
+        return Err(HbError::InvalidInput(
+            "search bounds: max_amplitude > 0 finite, amplitudes ≥ 1, max_iter ≥ 1, power > 0, shift > 0".into(),
+        ));
+    }
+    let mut newton = Deflated::new(problem, hb, omega_f, opts)?;
+    let starts = newton.starts()?;
+    let mut known: Vec<Vec<f64>> = Vec::new();
+    let mut runs = 0;
+    let mut exhausted = true;
+    'starts: for start in &starts {
+        loop {
+            if known.len() >= MAX_SOLUTIONS {
+                exhausted = false;
+                break 'starts;
+            }
+            runs += 1;
+            match newton.run(start, &known) {
+                Some(q) => known.push(q),
+                None => break,
+            }
+        }
+    }
+    let mut analyzer = StabilityAnalyzer::new(problem, hb.harmonics, opts.stability_steps)?;
+    let mut solutions: Vec<FoundSolution> = known
+        .into_iter()
+        .map(|coeffs| {
+            let solution = HbSolution {
+                coeffs,
+                omega_f,
+                harmonics: hb.harmonics,
+                subharmonic: hb.subharmonic,
+                stats: BroydenStats::default(),
+            };
+            let floquet = analyzer.hsu(problem, &solution, HsuRule::Magnus4);
+            FoundSolution {
+                solution,
+                multipliers: floquet.multipliers,
+                kind: floquet.kind,
+            }
+        })
+        .collect();
+    solutions.sort_by(|a, b| norm2(&a.solution.coeffs).total_cmp(&norm2(&b.solution.coeffs)));
+    Ok(AllSolutions {
+        solutions,
+        report: SearchReport {
+            starts: starts.len(),
+            runs,
+            max_amplitude: opts.max_amplitude,
+            max_iter: opts.max_iter,
+            exhausted,
+        },
+    })
+}
+
+/// The deflated Newton iteration on one problem at one frequency.
+struct Deflated<'p, P> {
+    problem: &'p P,
+    res: HbResidual,
+    galerkin: GalerkinJacobian,
+    lu: LuWorkspace,
+    jac: Vec<f64>,
+    r: Vec<f64>,
+    omega_f: f64,
+    tol: f64,
+    opts: SearchOptions,
+}
+
+impl<'p, P: PeriodicProblem> Deflated<'p, P> {
+    fn new(
+        problem: &'p P,
+        hb: &HbOptions,
+        omega_f: f64,
+        opts: &SearchOptions,
+    ) -> Result<Self, HbError> {
+        let res = HbResidual::new(problem, hb)?;
+        let m = res.len();
+        let mut r = vec![0.0; m];
+        // Tolerance from the forcing (or, unforced, from a unit first harmonic).
+        let mut unit = vec![0.0; m];
+        if let Some(a1) = unit.get_mut(1) {
+            *a1 = 1.0;
+        }
+        let tol = hb.residual_tol(res.force_scale(problem, &unit, omega_f, &mut r));
+        Ok(Self {
+            galerkin: GalerkinJacobian::new(&res),
+            lu: LuWorkspace::new(m),
+            jac: vec![0.0; m * m],
+            r,
+            problem,
+            res,
+            omega_f,
+            tol,
+            opts: opts.clone(),
+        })
+    }
+
+    /// The linear solution (Eq. 59) and its shape at `amplitudes` amplitudes and
+    /// four phases (a unit cosine on DOF 0 if the linear solution vanishes).
+    fn starts(&mut self) -> Result<Vec<Vec<f64>>, HbError> {
+        let m = self.res.len();
+        let n = self.res.harmonics();
+        let l = 2 * n + 1;
+        self.res.linear_matrix(
+            self.problem,
+            self.omega_f / self.res.subharmonic() as f64,
+            &mut self.jac,
+        );
+        let mut linear = self.res.excitation().to_vec();
+        let solvable = self.lu.factor_row_major(&self.jac);
+        if solvable {
+            self.lu.solve(&mut linear);
+        }
+        let size = linear.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let mut starts = Vec::new();
+        if solvable && size > 0.0 && size.is_finite() && size <= self.opts.max_amplitude {
+            starts.push(linear.clone());
+        }
+        let shape: Vec<f64> = if solvable && size > 0.0 && size.is_finite() {
+            linear.iter().map(|v| v / size).collect()
+        } else {
+            let mut unit = vec![0.0; m];
+            if let Some(a1) = unit.get_mut(1) {
+                *a1 = 1.0;
+            }
+            unit
+        };
+        let k = self.opts.amplitudes;
+        let (lo, hi) = (
+            self.opts.max_amplitude / 100.0,
+            self.opts.max_amplitude / 2.0,
+        );
+        for i in 0..k {
+            let amp = if k == 1 {
+                hi
+            } else {
+                lo * (hi / lo).powf(i as f64 / (k - 1) as f64)
+            };
+            for quarter in 0..4 {
+                // Rotate every harmonic h by h·quarter·π/2 (a time shift of the
+                // shape; for a forced problem a different orbit).
+                let mut q = vec![0.0; m];
+                for (d, block) in shape.chunks_exact(l).enumerate() {
+                    q[d * l] = amp * block[0];
+                    for h in 1..=n {
+                        let phi = h as f64 * quarter as f64 * std::f64::consts::FRAC_PI_2;
+                        let (s, c) = phi.sin_cos();
+                        let (a, b) = (block[h], block[n + h]);
+                        q[d * l + h] = amp * (a * c + b * s);
+                        q[d * l + n + h] = amp * (b * c - a * s);
+                    }
+                }
+                starts.push(q);
+            }
+        }
+        Ok(starts)
+    }
+
+    /// ‖R(q)‖₂ into `self.r`.
+    fn residual(&mut self, q: &[f64]) -> f64 {
+        self.res
+            .eval(self.problem, q, self.omega_f, 1.0, &mut self.r);
+        norm2(&self.r)
+    }
+
+    /// The plain Newton step `−Φ_q⁻¹R(q)` (with `self.r = R(q)`), or `None` if
+    /// Φ_q is singular.
+    fn newton_step(&mut self, q: &[f64]) -> Option<Vec<f64>> {
+        self.galerkin.assemble(
+            &mut self.res,
+            self.problem,
+            q,
+            self.omega_f,
+            1.0,
+            &mut self.jac,
+        );
+        if !self.lu.factor_row_major(&self.jac) {
+            return None;
+        }
+        let mut step: Vec<f64> = self.r.iter().map(|r| -r).collect();
+        self.lu.solve(&mut step);
+        step.iter().all(|s| s.is_finite()).then_some(step)
+    }
+
+    /// `∇ln M(q)` of the deflation by the `known` roots (see the module docs).
+    fn log_gradient(&self, q: &[f64], known: &[Vec<f64>]) -> Vec<f64> {
+        let (p, sigma, s) = (self.opts.power, self.opts.shift, self.opts.max_amplitude);
+        let mut grad = vec![0.0; q.len()];
+        for root in known {
+            let d2: f64 = q.iter().zip(root).map(|(a, b)| ((a - b) / s).powi(2)).sum();
+            let dist = d2.sqrt().max(f64::MIN_POSITIVE);
+            let mp = dist.powf(-p);
+            // ∂/∂q ln(‖d‖⁻ᵖ + σ) = −p‖d‖⁻ᵖ⁻² d/s² / (‖d‖⁻ᵖ + σ).
+            let w = -p * mp / (dist * dist * (mp + sigma) * s * s);
+            for ((g, a), b) in grad.iter_mut().zip(q).zip(root) {
+                *g += w * (a - b);
+            }
+        }
+        grad
+    }
+
+    /// One deflated run from `start`: a new root polished by plain Newton, or
+    /// `None` if the run fails within its bounds or only finds a known root.
+    fn run(&mut self, start: &[f64], known: &[Vec<f64>]) -> Option<Vec<f64>> {
+        let mut q = start.to_vec();
+        let box_size = self.opts.max_amplitude;
+        let mut converged = false;
+        for _ in 0..self.opts.max_iter {
+            let norm = self.residual(&q);
+            if !norm.is_finite() {
+                return None;
+            }
+            if norm <= self.tol {
+                converged = true;
+                break;
+            }
+            let step = self.newton_step(&q)?;
+            let grad = self.log_gradient(&q, known);
+            let dot: f64 = grad.iter().zip(&step).map(|(g, s)| g * s).sum();
+            let factor = 1.0 / (1.0 - dot);
+            if !factor.is_finite() {
+                return None;
+            }
+            for (qi, si) in q.iter_mut().zip(&step) {
+                *qi += factor * si;
+            }
+            if q.iter().any(|v| v.abs() > box_size || v.is_nan()) {
+                return None;
+            }
+        }
+        if !converged {
+            return None;
+        }
+        // Polish undeflated: a few plain Newton steps to the root's accuracy.
+        for _ in 0..5 {
+            self.residual(&q);
+            let step = self.newton_step(&q)?;
+            let size = step.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            for (qi, si) in q.iter_mut().zip(&step) {
+                *qi += si;
+            }
+            if size <= 1e-13 * box_size {
+                break;
+            }
+        }
+        let norm = self.residual(&q);
+        if norm > self.tol || norm.is_nan() {
+            return None;
+        }
+        let scale = q.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-300);
+        let is_known = known.iter().any(|root| {
+            let d = q
+                .iter()
+                .zip(root)
+                .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+            d <= 1e-6 * scale
+        });
+        (!is_known).then_some(q)
+    }
+}

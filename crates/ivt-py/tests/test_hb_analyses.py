@@ -1,0 +1,175 @@
+"""Issue 27's analyses from Python: limit cycles from a state, every solution at
+one frequency, damped nonlinear modes and the Jenkins element. References are
+scipy time integrations (solve_ivp, rtol 1e-12) and closed forms, never HB."""
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.special import ellipk
+
+from ivt import hb
+
+
+def _period_by_integration(accel, y0=(2.0, 0.0), settle=200.0):
+    """Period of the attracting cycle of x'' = accel(x, v): integrate `settle`
+    time units, then the spacing of the last two maxima of x (events v = 0,
+    v decreasing, located by the dense output)."""
+    rhs = lambda t, y: [y[1], accel(y[0], y[1])]
+    first = solve_ivp(rhs, (0, settle), y0, method="DOP853", rtol=1e-12, atol=1e-12)
+    event = lambda t, y: y[1]
+    event.direction = -1
+    run = solve_ivp(rhs, (0, 60.0), first.y[:, -1], method="DOP853", rtol=1e-12,
+                    atol=1e-12, events=event)
+    t = run.t_events[0]
+    return t[-1] - t[-2]
+
+
+CYCLES = [  # (name, μ, harmonics)
+    ("van_der_pol", 0.2, 15),
+    ("van_der_pol", 1.0, 30),
+    ("van_der_pol", 5.0, 120),
+    ("rayleigh", 2.0, 60),
+    ("rayleigh", 5.0, 120),
+]
+
+
+@pytest.mark.parametrize("name,mu,n", CYCLES)
+def test_limit_cycle_from_the_default_start_and_from_x0(name, mu, n):
+    if name == "van_der_pol":
+        accel = lambda x, v: mu * (1 - x * x) * v - x
+        g = lambda x, v, th: mu * x * x * v
+    else:
+        accel = lambda x, v: mu * (v - v ** 3 / 3) - x
+        g = lambda x, v, th: mu * v ** 3 / 3
+    period = _period_by_integration(accel)
+    for kwargs in ({}, {"x0": [0.05, 0.0]}, {"x0": [3.0, -2.0]}):
+        lc = hb.limit_cycle(1.0, -mu, 1.0, g, 1.0, n=n, samples=4 * n,
+                            vectorized=True, **kwargs)
+        assert abs(lc["period"] - period) < 1e-8 * period, (kwargs, lc["period"], period)
+        assert lc["stable"]
+
+
+def test_limit_cycle_start_errors():
+    g = lambda x, v, th: x * x * v
+    with pytest.raises(ValueError, match="not both"):
+        hb.limit_cycle(1.0, -1.0, 1.0, g, 1.0, guess=np.zeros(41) + 0.1, x0=[1.0, 0.0], n=20)
+    with pytest.raises(ValueError, match="equilibrium"):  # μ < 0: the origin attracts
+        hb.limit_cycle(1.0, 0.5, 1.0, lambda x, v, th: -0.5 * x * x * v, 1.0, x0=[0.5, 0.0])
+    with pytest.raises(ValueError, match="x0"):
+        hb.limit_cycle(1.0, -1.0, 1.0, g, 1.0, x0=[np.nan, 0.0])
+
+
+def _duffing_period_map(omega, y):
+    """RK (DOP853, rtol 1e-12) over one period of u'' + 0.04u' + u + u³ = 0.1 cos ωt."""
+    rhs = lambda t, y: [y[1], 0.1 * np.cos(omega * t) - 0.04 * y[1] - y[0] - y[0] ** 3]
+    return solve_ivp(rhs, (0, 2 * np.pi / omega), y, method="DOP853", rtol=1e-12,
+                     atol=1e-12).y[:, -1]
+
+
+def test_all_solutions_of_the_thesis_duffing_at_1_4():
+    omega = 1.4
+    found = hb.all_solutions(1.0, 0.04, 1.0, hb.elements.cubic_spring(1.0),
+                             lambda th: 0.1 * np.cos(th), omega, n=15)
+    assert isinstance(found, hb.AllSolutions) and isinstance(found, list)
+    assert len(found) == 3 and found.search["exhausted"]
+    assert found.search["starts"] == 25 and found.search["max_amplitude"] == 10.0
+    assert [s["stable"] for s in found] == [True, False, True]
+    for s in found:
+        # Each orbit's state at t = 0 is a fixed point of the period map.
+        y = [hb.eval_series(s["coeffs"], 0.0), omega * hb.eval_series(s["coeffs"], 0.0, order=1)]
+        assert np.max(np.abs(_duffing_period_map(omega, y) - y)) < 1e-8
+        assert set(s) >= {"coeffs", "amplitude", "multipliers", "stable", "stability"}
+
+
+def test_damped_modes_duffing_and_the_linear_limit():
+    # One DOF: the EPMC damping cancels c exactly, so ω(A) is the free Duffing
+    # frequency π√(1 + A²)/(2K(m)) and ζ = c/(2ω).
+    c = 0.04
+    dm = hb.damped_modes(1.0, c, 1.0, hb.elements.cubic_spring(1.0), 0.01, 1.0, n=21,
+                         samples=84)
+    assert dm["termination"] == "left_interval"
+    for p in dm["points"]:
+        a = float(hb.eval_series(p["coeffs"], 0.0))
+        mk = a * a / (2 * (1 + a * a))
+        exact = np.pi * np.sqrt(1 + a * a) / (2 * ellipk(mk))
+        assert abs(p["omega"] - exact) < 1e-9 * exact
+        assert abs(p["damping_ratio"] - c / (2 * p["omega"])) < 1e-9 * c
+    # Two DOF, C = 0.05 M + 0.01 K: mode 1 (ω = √3) at a vanishing amplitude.
+    m, k = np.eye(2), np.array([[2.0, -1.0], [-1.0, 2.0]])
+    lin = hb.damped_modes(m, 0.05 * m + 0.01 * k, k, hb.elements.cubic_spring(0.5),
+                          1e-7, 1e-3, mode=1, n=7, samples=32)
+    w = np.sqrt(3.0)
+    first = lin["points"][0]
+    assert abs(first["omega"] - w) < 1e-10 * w
+    assert abs(first["damping_ratio"] - (0.05 + 0.01 * 3) / (2 * w)) < 1e-10
+
+
+def test_jenkins_orbit_against_time_integration():
+    # x'' + 0.1x' + x + F_J = 0.5 cos 1.2t, Jenkins k = 1, F_s = 0.3 (play
+    # operator of half-width 0.3): RK with the slider advanced per step.
+    k, fs, omega = 1.0, 0.3, 1.2
+    period = 2 * np.pi / omega
+    steps = 3200
+    dt = period / steps
+    x, v, z = 0.0, 0.0, 0.0
+    def acc(t, x, v, z):
+        zz = min(max(z, x - fs / k), x + fs / k)
+        return 0.5 * np.cos(omega * t) - 0.1 * v - x - k * (x - zz)
+    samples = []
+    for i in range(120 * steps + steps):
+        if i >= 120 * steps and (i - 120 * steps) % (steps // 32) == 0:
+            samples.append(x)
+        t = i * dt
+        k1 = (v, acc(t, x, v, z))
+        k2 = (v + 0.5 * dt * k1[1], acc(t + 0.5 * dt, x + 0.5 * dt * k1[0], v + 0.5 * dt * k1[1], z))
+        k3 = (v + 0.5 * dt * k2[1], acc(t + 0.5 * dt, x + 0.5 * dt * k2[0], v + 0.5 * dt * k2[1], z))
+        k4 = (v + dt * k3[1], acc(t + dt, x + dt * k3[0], v + dt * k3[1], z))
+        x += dt / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
+        v += dt / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+        z = min(max(z, x - fs / k), x + fs / k)
+    sol = hb.solve(1.0, 0.1, 1.0, hb.elements.jenkins(k, fs), omega,
+                   f=lambda th: 0.5 * np.cos(th), n=64, samples=2048, max_iter=400)
+    taus = 2 * np.pi * np.arange(32) / 32
+    assert np.max(np.abs(hb.eval_series(sol["coeffs"], taus) - samples)) < 1e-4
+
+
+def test_jenkins_parameters_are_checked():
+    with pytest.raises(ValueError, match="element 0"):
+        hb.solve(1.0, 0.1, 1.0, hb.elements.jenkins(-1.0, 0.3), 1.0, f=lambda th: np.cos(th))
+
+
+def test_continue_bifurcation_duffing_fold_curve_to_the_cusp():
+    # The thesis Duffing family in F: from the F = 0.1 fold at the higher ω,
+    # down to the cusp and up the other fold to F = 0.3. Fold frequencies by
+    # shooting (tests/fold_curve.rs, 5e-14 there): 1.6548121230 and
+    # 1.1687243884 at F = 0.1, 1.2589591460 at 0.2, 1.3297591465 at 0.3;
+    # the cusp at F = 0.0120510724 (the extremum of F along the shooting curve).
+    family = lambda F: (1.0, 0.04, 1.0, hb.elements.cubic_spring(1.0),
+                        lambda th: F * np.cos(th))
+    frc = hb.frc(*family(0.1), 0.5, 2.5, n=15, events=True)
+    folds = [b for b in frc["bifurcations"] if b["kind"] == "fold"]
+    start = max(folds, key=lambda b: b["omega"])
+    curve = hb.continue_bifurcation(family, start, 0.0, 0.3, at=[0.1, 0.2, 0.3],
+                                    p_start=0.1, n=15)
+    assert curve["kind"] == "fold" and curve["termination"] == "left_interval"
+    got = sorted((round(a["p"], 12), a["omega"]) for a in curve["at"])
+    want = [(0.1, 1.1687243884), (0.1, 1.6548121230), (0.2, 1.2589591460), (0.3, 1.3297591465)]
+    assert len(got) == 4
+    for (p, w), (pw, ww) in zip(got, want):
+        assert p == pw and abs(w - ww) < 1e-7
+    (cusp,) = curve["special"]
+    assert cusp["kind"] == "cusp" and abs(cusp["p"] / 0.0120510724 - 1) < 1e-6
+    assert set(curve["points"][0]) >= {"omega", "p", "amplitude", "coeffs"}
+
+
+def test_continue_bifurcation_reraises_the_family_error():
+    def family(F):
+        if F < 0.09:
+            raise RuntimeError("no model below 0.09")
+        return (1.0, 0.04, 1.0, hb.elements.cubic_spring(1.0), lambda th: F * np.cos(th))
+    frc = hb.frc(*family(0.1), 0.5, 2.5, n=15, events=True)
+    start = max((b for b in frc["bifurcations"] if b["kind"] == "fold"), key=lambda b: b["omega"])
+    with pytest.raises(RuntimeError, match="no model below"):
+        hb.continue_bifurcation(family, start, 0.0, 0.3, p_start=0.1, n=15)
+    with pytest.raises(ValueError, match="p_start"):
+        hb.continue_bifurcation(family, start, 0.0, 0.3, n=15)
