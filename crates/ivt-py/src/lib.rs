@@ -25,6 +25,7 @@ mod fields;
 mod gears;
 mod hb;
 mod hb_elements;
+mod hb_large;
 mod hb_paths;
 mod hb_string;
 mod kin;

@@ -111,6 +111,29 @@ impl Structure {
         })
     }
 
+    /// The structure of `n` DOFs from `(row, col, value)` triplets of `M`, `C`
+    /// and `K` (duplicates summed).
+    ///
+    /// # Errors
+    /// [`HbError::InvalidInput`] for an index out of range, as [`Self::new`]
+    /// otherwise.
+    pub fn from_triplets(
+        n: usize,
+        m: &[(usize, usize, f64)],
+        c: &[(usize, usize, f64)],
+        k: &[(usize, usize, f64)],
+    ) -> Result<Self, HbError> {
+        let [m, c, k] = [m, c, k].map(|t| {
+            if t.iter().any(|&(i, j, _)| i >= n || j >= n) {
+                return Err(HbError::InvalidInput(format!(
+                    "a matrix index is out of range for {n} DOFs"
+                )));
+            }
+            crate::models::from_triplets(n, t)
+        });
+        Self::new(m?.as_ref(), c?.as_ref(), k?.as_ref())
+    }
+
     /// Number of DOFs.
     pub fn n_dof(&self) -> usize {
         self.pattern.nrows()

@@ -52,8 +52,16 @@ pub fn truncation_error<P: PeriodicProblem>(
         wide.galerkin_state(&gs, s, d, &mut spectra[d * lw..(d + 1) * lw], &mut column);
     }
     let structure = branch.structure();
+    // Harmonics `g` does not excite (to rounding: the even ones of an odd `g`
+    // on an odd orbit) need no factorization.
+    let size = |h: usize| {
+        (0..s)
+            .map(|b| spectra[b * lw + h].hypot(spectra[b * lw + nw + h]))
+            .fold(0.0f64, f64::max)
+    };
+    let largest = (0..=nw).map(size).fold(0.0f64, f64::max);
     let mut worst = 0.0f64;
-    for h in n + 1..=top {
+    for h in (n + 1..=top).filter(|&h| size(h) > 1e-13 * largest) {
         let factored = structure.factor(h as f64 * omega)?;
         let mut u = Mat::<c64>::zeros(structure.n_dof(), s);
         for (b, &d) in branch.dofs().iter().enumerate() {

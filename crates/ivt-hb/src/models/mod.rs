@@ -31,6 +31,20 @@ impl SparseModel {
     pub fn n_dof(&self) -> usize {
         self.m.nrows()
     }
+
+    /// `(row, col, value)` triplets of `M`, `C` and `K` (column by column).
+    pub fn triplets(&self) -> [Vec<(usize, usize, f64)>; 3] {
+        [&self.m, &self.c, &self.k].map(|a| {
+            (0..a.ncols())
+                .flat_map(|j| {
+                    let rows = a.symbolic().row_idx_of_col_raw(j);
+                    rows.iter()
+                        .zip(a.val_of_col(j))
+                        .map(move |(&i, &v)| (i, j, v))
+                })
+                .collect()
+        })
+    }
 }
 
 /// A sparse matrix from `(row, col, value)` triplets (duplicates summed).
