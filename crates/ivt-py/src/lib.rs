@@ -27,6 +27,7 @@ mod gears;
 mod hb;
 mod hb_analyses;
 mod hb_elements;
+mod hb_large;
 mod hb_paths;
 mod hb_shared;
 mod hb_string;

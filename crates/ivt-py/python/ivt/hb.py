@@ -75,3 +75,179 @@ def all_solutions(
         max_iter=max_iter, jac=jac,
     )
     return AllSolutions(found["solutions"], found["search"])
+# --- large structures (issue 28): condensation onto the nonlinear DOFs -------
+
+import inspect as _inspect
+from types import SimpleNamespace as _Namespace
+
+import numpy as _np
+
+_LARGE_KEYS = ("nonlinear_dofs", "amplitude_dof", "record_dofs")
+
+
+def _coo(name, a):
+    """COO triplets (rows, cols, values) of a scipy.sparse or dense matrix."""
+    if hasattr(a, "tocoo"):
+        c = a.tocoo()
+        rows, cols, vals = c.row, c.col, c.data
+        n = c.shape[0]
+        if c.shape[0] != c.shape[1]:
+            raise ValueError(f"argument `{name}` must be square, got shape {c.shape}")
+    else:
+        arr = _np.atleast_2d(_np.asarray(a, dtype=float))
+        if arr.ndim != 2 or arr.shape[0] != arr.shape[1]:
+            raise ValueError(f"argument `{name}` must be square, got shape {arr.shape}")
+        rows, cols = _np.nonzero(arr)
+        vals = arr[rows, cols]
+        n = arr.shape[0]
+    return n, ([int(i) for i in rows], [int(j) for j in cols], [float(v) for v in vals])
+
+
+def _loads(f, n):
+    """(F_cos, F_sin) from an array F (F cos θ) or a pair (F_cos, F_sin)."""
+    if isinstance(f, (tuple, list)) and len(f) == 2 and _np.ndim(f[0]) == 1:
+        fc, fs = (_np.asarray(v, dtype=float).ravel() for v in f)
+    else:
+        fc = _np.asarray(f, dtype=float).ravel()
+        fs = _np.zeros(n)
+    if fc.shape != (n,) or fs.shape != (n,):
+        raise ValueError(f"load vectors of `f` must have n_dof = {n} entries")
+    return [float(v) for v in fc], [float(v) for v in fs]
+
+
+def _is_large(m, f, extra):
+    loads = f is not None and not callable(f)
+    return hasattr(m, "tocoo") or loads or extra.get("nonlinear_dofs") is not None
+
+
+def _series_max(coeffs):
+    """max_τ |x(τ)| of one series: a 4096-point grid refined by Newton."""
+    tau = _np.linspace(0.0, 2.0 * _np.pi, 4096, endpoint=False)
+    x = _np.abs(_ivt.hb.eval_series(coeffs, tau))
+    t = float(tau[int(_np.argmax(x))])
+    for _ in range(8):
+        d1 = float(_ivt.hb.eval_series(coeffs, t, 1))
+        d2 = float(_ivt.hb.eval_series(coeffs, t, 2))
+        if d2 == 0.0:
+            break
+        t -= d1 / d2
+    return max(float(x.max()), abs(float(_ivt.hb.eval_series(coeffs, t))))
+
+
+def _dense_dofs(entry, n_dof, amplitude_dof, record_dofs):
+    """dof_coeffs / amplitude of a dense solution's point (all DOFs known)."""
+    coeffs = _np.asarray(entry["coeffs"])
+    blocks = coeffs.reshape(n_dof, -1)
+    for j in list(record_dofs or ()) + ([] if amplitude_dof is None else [amplitude_dof]):
+        if not 0 <= j < n_dof:
+            raise ValueError(f"DOF {j} is out of range for {n_dof} DOFs")
+    entry["dof_coeffs"] = {int(j): blocks[j].copy() for j in (record_dofs or ())}
+    if amplitude_dof is not None:
+        entry["amplitude"] = _series_max(blocks[amplitude_dof])
+
+
+def _large_call(native_name, bound, extra):
+    a = _Namespace(**bound.arguments)
+    given = bound.arguments
+    dofs = extra.get("nonlinear_dofs")
+    if dofs is None:
+        raise ValueError(
+            "a large model (sparse m/c/k or load-vector f) needs nonlinear_dofs=[...]: "
+            "the DOFs g acts on (g then sees x, v of those DOFs only)"
+        )
+    n, m = _coo("m", a.m)
+    nc, c = _coo("c", a.c)
+    nk, k = _coo("k", a.k)
+    if not n == nc == nk:
+        raise ValueError(f"`m`, `c`, `k` must have one size, got {n}, {nc}, {nk}")
+    if given.get("stability", False):
+        raise ValueError("stability=True is not available for condensed models (yet): pass stability=False")
+    kw = dict(
+        amplitude_dof=extra.get("amplitude_dof"),
+        record_dofs=[int(j) for j in (extra.get("record_dofs") or ())],
+        n=int(given.get("n", 7)),
+        samples=int(given.get("samples", 32)),
+        velocity_dependent=bool(given.get("velocity_dependent", True)),
+        vectorized=bool(given.get("vectorized", False)),
+        jac=given.get("jac"),
+    )
+    if "rtol" in given:
+        kw["rtol"] = float(given["rtol"])
+    f = _loads(a.f, n) if a.f is not None else ([0.0] * n, [0.0] * n)
+    dofs = [int(j) for j in dofs]
+    if native_name == "frc":
+        for key in ("ds", "ds_min", "ds_max"):
+            if given.get(key) is not None:
+                kw[key] = float(given[key])
+        return _ivt.hb.frc_large(n, m, c, k, a.g, f, a.omega_from, a.omega_to, dofs, **kw)
+    return _ivt.hb.solve_large(n, m, c, k, a.g, f, a.omega_f, dofs, **kw)
+
+
+def _with_large(native):
+    """`native` (ivt.hb.frc or solve) extended by the keywords of issue 28:
+    `nonlinear_dofs`, `amplitude_dof`, `record_dofs`; sparse m, c, k and
+    load-vector `f` route to the condensed solver."""
+    sig = _inspect.signature(native)
+
+    def call(*args, nonlinear_dofs=None, amplitude_dof=None, record_dofs=None, **kwargs):
+        extra = dict(nonlinear_dofs=nonlinear_dofs, amplitude_dof=amplitude_dof, record_dofs=record_dofs)
+        bound = sig.bind_partial(*args, **{k: v for k, v in kwargs.items() if k in sig.parameters})
+        unknown = [k for k in kwargs if k not in sig.parameters]
+        m, f = bound.arguments.get("m"), bound.arguments.get("f")
+        if _is_large(m, f, extra):
+            for key in unknown:
+                bound.arguments[key] = kwargs[key]
+            return _large_call(native.__name__, bound, extra)
+        out = native(*args, **kwargs)
+        if amplitude_dof is not None or record_dofs is not None:
+            n_dof = _np.atleast_2d(_np.asarray(m, dtype=float)).shape[0]
+            entries = out["points"] if "points" in out else [out]
+            for e in entries:
+                _dense_dofs(e, n_dof, amplitude_dof, record_dofs)
+            if "points" in out and amplitude_dof is not None:
+                out["amplitude"] = _np.array([e["amplitude"] for e in entries])
+        return out
+
+    params = list(sig.parameters.values()) + [
+        _inspect.Parameter(name, _inspect.Parameter.KEYWORD_ONLY, default=None) for name in _LARGE_KEYS
+    ]
+    call.__signature__ = sig.replace(parameters=params)
+    call.__name__ = native.__name__
+    call.__qualname__ = native.__name__
+    call.__doc__ = (native.__doc__ or "") + _LARGE_DOC
+    return call
+
+
+_LARGE_DOC = """
+
+Large models (issue 28): `m`, `c`, `k` may be scipy.sparse matrices and `f`
+an array F (F cos θ) or a pair (F_cos, F_sin) of load vectors; with
+`nonlinear_dofs=[...]` the problem is condensed onto those DOFs (per harmonic
+the linear DOFs decouple exactly; sparse LU of the dynamic stiffness with
+refinement in double-double residuals) and `g(x, v, theta)` sees x, v of those
+DOFs only. Defaults there: n = 7, samples = 32, rtol = 1e-12 (on the
+receptance-form residual, relative to the linear response). Each point then
+carries "solve_error", "truncation_error" and "error_estimate" (their sum, a
+relative error). `amplitude_dof=j`: "amplitude" is max |x_j(τ)|;
+`record_dofs=[...]`: each point carries "dof_coeffs": {j: [a0, a1..an,
+b1..bn]} (any model). Stability of condensed models is not computed
+("multipliers"/"stable" are None).
+"""
+
+frc = _with_large(_ivt.hb.frc)
+solve = _with_large(_ivt.hb.solve)
+
+
+def _cantilever(n_elements, length=1.0, ei=1.0, rho_a=1.0, alpha=0.07, beta=2e-4):
+    """The Euler–Bernoulli cantilever of issue 28 (Hermite-cubic elements,
+    consistent mass, clamped at x = 0, DOFs [w1, θ1, …, wN, θN],
+    C = alpha·M + beta·K): returns (m, c, k, tip) with scipy.sparse CSR
+    matrices and the index of the tip displacement."""
+    import scipy.sparse as sp
+
+    n, mats, tip = _ivt.hb.cantilever_coo(n_elements, length, ei, rho_a, alpha, beta)
+    m, c, k = (sp.csr_matrix((v, (r, cc)), shape=(n, n)) for r, cc, v in mats)
+    return m, c, k, tip
+
+
+models = _Namespace(cantilever=_cantilever)

@@ -2,7 +2,7 @@
 frequency-response curves with located bifurcations, limit cycles and backbone
 curves, for Duffing, Mathieu–Duffing, the STHB string and user systems."""
 
-from typing import Any, Callable, Dict, List, Literal, Optional, Sequence, Union, overload
+from typing import Any, Callable, Dict, List, Literal, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -14,6 +14,10 @@ Matrix = Union[float, npt.ArrayLike]
 Callback = Callable[[FloatArray, FloatArray, float], Union[float, Sequence[float], FloatArray]]
 VectorizedCallback = Callable[[FloatArray, FloatArray, FloatArray], npt.ArrayLike]
 Forcing = Callable[[float], Union[float, Sequence[float], FloatArray]]
+# Large models (issue 28): scipy.sparse matrices (untyped here) and load
+# vectors F (F cos θ) or (F_cos, F_sin).
+SparseMatrix = Any
+Loads = Union[npt.ArrayLike, Tuple[npt.ArrayLike, npt.ArrayLike]]
 # ``jac(x, v, theta) -> (dg_dx, dg_dv)``: per sample two (n, n) arrays, with
 # ``vectorized=True`` two (N, n, n) arrays; ``dg_dv`` may be None (zero).
 Jacobian = Callable[[FloatArray, FloatArray, Any], Sequence[Optional[npt.ArrayLike]]]
@@ -89,12 +93,12 @@ def duffing_frc(
     events: bool = False,
 ) -> Dict[str, Any]: ...
 def solve(
-    m: Matrix,
-    c: Matrix,
-    k: Matrix,
+    m: Union[Matrix, SparseMatrix],
+    c: Union[Matrix, SparseMatrix],
+    k: Union[Matrix, SparseMatrix],
     g: Union[Callback, VectorizedCallback, Elements],
     omega_f: float,
-    f: Optional[Forcing] = None,
+    f: Optional[Union[Forcing, Loads]] = None,
     n: int = 20,
     samples: int = 64,
     subharmonic: int = 1,
@@ -107,13 +111,17 @@ def solve(
     rtol: float = 1e-9,
     max_iter: int = 100,
     jac: Optional[Jacobian] = None,
+    *,
+    nonlinear_dofs: Optional[Sequence[int]] = None,
+    amplitude_dof: Optional[int] = None,
+    record_dofs: Optional[Sequence[int]] = None,
 ) -> Dict[str, Any]: ...
 def frc(
-    m: Matrix,
-    c: Matrix,
-    k: Matrix,
+    m: Union[Matrix, SparseMatrix],
+    c: Union[Matrix, SparseMatrix],
+    k: Union[Matrix, SparseMatrix],
     g: Union[Callback, VectorizedCallback, Elements],
-    f: Optional[Forcing],
+    f: Optional[Union[Forcing, Loads]],
     omega_from: float,
     omega_to: float,
     n: int = 20,
@@ -125,6 +133,10 @@ def frc(
     rtol: float = 1e-9,
     max_iter: int = 100,
     jac: Optional[Jacobian] = None,
+    *,
+    nonlinear_dofs: Optional[Sequence[int]] = None,
+    amplitude_dof: Optional[int] = None,
+    record_dofs: Optional[Sequence[int]] = None,
 ) -> Dict[str, Any]: ...
 def limit_cycle(
     m: Matrix,
@@ -242,3 +254,16 @@ def string(
 def eval_series(coeffs: ArrayLike, tau: float, order: int = 0, n_dof: Literal[1] = 1) -> float: ...
 @overload
 def eval_series(coeffs: ArrayLike, tau: ArrayLike, order: int = 0, n_dof: int = 1) -> FloatArray: ...
+
+class models:
+    """``ivt.hb.models``: structural test models (issue 28)."""
+
+    @staticmethod
+    def cantilever(
+        n_elements: int,
+        length: float = 1.0,
+        ei: float = 1.0,
+        rho_a: float = 1.0,
+        alpha: float = 0.07,
+        beta: float = 2e-4,
+    ) -> Tuple[SparseMatrix, SparseMatrix, SparseMatrix, int]: ...

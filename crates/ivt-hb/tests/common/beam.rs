@@ -1,0 +1,58 @@
+//! The cantilever of issue 28 condensed onto its tip: k3 = 200 cubic spring
+//! from the tip to ground, the tip forced by `F cos ωt` (shared by the tests
+//! and the benches, `#[path]`-included there).
+
+use ivt_hb::condense::{CondensedBranch, Structure};
+use ivt_hb::models::cantilever;
+use ivt_hb::{GeneralProblem, HbOptions};
+
+/// Cubic spring constant at the tip (issue 28).
+pub const K3: f64 = 200.0;
+/// Tip force amplitude of the tests: the peak near 1.15 ω₁, two folds.
+pub const FORCE: f64 = 0.005;
+/// ω₁ of the continuous cantilever, (1.8751041)².
+pub const OMEGA1: f64 = 3.516_015_268_066_119;
+
+/// `g = k3 x³` on the local DOF.
+pub fn spring(x: &[f64], _v: &[f64], _theta: f64, g: &mut [f64]) {
+    g[0] = K3 * x[0] * x[0] * x[0];
+}
+
+/// `∂g/∂x = 3 k3 x²`.
+pub fn spring_jacobian(x: &[f64], _v: &[f64], _theta: f64, dg: &mut [f64]) {
+    dg[0] = 3.0 * K3 * x[0] * x[0];
+    dg[1] = 0.0;
+}
+
+fn unforced(_theta: f64, f: &mut [f64]) {
+    f[0] = 0.0;
+}
+
+/// The local problem on the tip: zero matrices, the spring, no excitation.
+pub fn tip_problem() -> impl ivt_hb::PeriodicProblem {
+    GeneralProblem::new(
+        1,
+        vec![0.0],
+        vec![0.0],
+        vec![0.0],
+        spring as fn(&[f64], &[f64], f64, &mut [f64]),
+        unforced as fn(f64, &mut [f64]),
+    )
+    .with_velocity_dependent(false)
+    .with_jacobian(spring_jacobian)
+}
+
+/// The condensed beam of `n_elements`, tip forced by `force`.
+pub fn beam(
+    n_elements: usize,
+    force: f64,
+    hb: &HbOptions,
+) -> CondensedBranch<impl ivt_hb::PeriodicProblem> {
+    let model = cantilever(n_elements, 1.0, 1.0, 1.0, 0.07, 2e-4).expect("valid beam");
+    let s = &model.model;
+    let structure = Structure::new(s.m.as_ref(), s.c.as_ref(), s.k.as_ref()).expect("structure");
+    let mut load = vec![0.0; s.n_dof()];
+    load[model.tip] = force;
+    CondensedBranch::new(structure, vec![model.tip], &load, &[], tip_problem(), hb)
+        .expect("valid branch")
+}

@@ -1,0 +1,341 @@
+//! Large structures for `ivt.hb` (issue 28): the frequency response and the
+//! single orbit of a sparse `M, C, K` with `g` on a few DOFs, condensed onto
+//! those DOFs ([`ivt_hb::condense`]), any DOF recovered per point, and the
+//! cantilever model. The public wrappers in `ivt/hb.py` convert
+//! `scipy.sparse`/dense matrices to COO triplets and `f` to load vectors.
+
+use crate::hb_shared::{finite, run_user};
+use crate::user_problem::{user_problem, PyProblem};
+use ivt_hb::condense::{
+    condensed_response, CondensedBranch, CondensedFrc, CondensedFrcOptions, CondensedPoint,
+    Structure,
+};
+use ivt_hb::{HbError, HbOptions, Termination};
+use numpy::{IntoPyArray, PyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyTuple};
+
+/// COO triplets `(rows, cols, values)` of one matrix.
+type Coo = (Vec<usize>, Vec<usize>, Vec<f64>);
+
+fn triplets(name: &str, coo: &Coo) -> PyResult<Vec<(usize, usize, f64)>> {
+    let (r, c, v) = coo;
+    if r.len() != c.len() || r.len() != v.len() {
+        return Err(PyValueError::new_err(format!(
+            "argument `{name}`: rows, cols and values must have one length"
+        )));
+    }
+    Ok(r.iter()
+        .zip(c)
+        .zip(v)
+        .map(|((&i, &j), &x)| (i, j, x))
+        .collect())
+}
+
+/// The settings shared by `frc` and `solve` on a large structure.
+struct Large<'py> {
+    n_dof: usize,
+    m: Coo,
+    c: Coo,
+    k: Coo,
+    g: Bound<'py, PyAny>,
+    jac: Option<Bound<'py, PyAny>>,
+    load: (Vec<f64>, Vec<f64>),
+    dofs: Vec<usize>,
+    hb: HbOptions,
+    velocity_dependent: bool,
+    vectorized: bool,
+}
+
+impl<'py> Large<'py> {
+    /// The local problem (zero matrices on the nonlinear DOFs, `g`, no `f`)
+    /// and the structure, or a Python error.
+    fn build(&self, py: Python<'py>) -> PyResult<(Structure, PyProblem)> {
+        let s = self.dofs.len();
+        let structure = Structure::from_triplets(
+            self.n_dof,
+            &triplets("m", &self.m)?,
+            &triplets("c", &self.c)?,
+            &triplets("k", &self.k)?,
+        )
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let zeros = PyArray2::<f64>::zeros(py, [s, s], false).into_any();
+        let local = user_problem(
+            &zeros,
+            &zeros,
+            &zeros,
+            &self.g,
+            None,
+            self.jac.as_ref(),
+            self.velocity_dependent,
+            self.vectorized,
+        )?;
+        Ok((structure, local))
+    }
+}
+
+/// `n` harmonics, `samples` = N, relative tolerance `rtol`.
+fn hb_options(n: usize, samples: usize) -> PyResult<HbOptions> {
+    if n == 0 || samples <= n {
+        return Err(PyValueError::new_err(format!(
+            "need n ≥ 1 harmonics and samples > n, got n = {n}, samples = {samples}"
+        )));
+    }
+    Ok(HbOptions::new(n, samples))
+}
+
+/// The snake_case word of a termination (SPEC §6).
+fn termination_name(t: &Termination) -> &'static str {
+    match t {
+        Termination::LeftInterval => "left_interval",
+        Termination::MaxPoints => "max_points",
+        Termination::Stopped => "stopped",
+        Termination::StepTooSmall(_) => "step_too_small",
+    }
+}
+
+fn point_dict<'py>(py: Python<'py>, p: &CondensedPoint) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("omega", p.omega_f)?;
+    d.set_item("amplitude", p.amplitude)?;
+    d.set_item("coeffs", p.coeffs.clone().into_pyarray(py))?;
+    let dofs = PyDict::new(py);
+    for (j, c) in &p.dof_coeffs {
+        dofs.set_item(j, c.clone().into_pyarray(py))?;
+    }
+    d.set_item("dof_coeffs", dofs)?;
+    d.set_item("solve_error", p.solve_error)?;
+    d.set_item("truncation_error", p.truncation_error)?;
+    d.set_item(
+        "error_estimate",
+        p.solve_error + p.truncation_error.unwrap_or(0.0),
+    )?;
+    d.set_item("multipliers", py.None())?;
+    d.set_item("stable", py.None())?;
+    Ok(d)
+}
+
+fn frc_dict<'py>(py: Python<'py>, frc: &CondensedFrc) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let points = PyList::empty(py);
+    for p in &frc.points {
+        points.append(point_dict(py, p)?)?;
+    }
+    let folds = PyList::empty(py);
+    for f in &frc.folds {
+        let e = PyDict::new(py);
+        e.set_item("omega", f.omega_f)?;
+        e.set_item("amplitude", f.amplitude)?;
+        e.set_item("coeffs", f.coeffs.clone().into_pyarray(py))?;
+        e.set_item("located", f.located)?;
+        e.set_item("index", f.index)?;
+        folds.append(e)?;
+    }
+    d.set_item("points", points)?;
+    d.set_item("folds", folds)?;
+    d.set_item("termination", termination_name(&frc.termination))?;
+    let omega: Vec<f64> = frc.points.iter().map(|p| p.omega_f).collect();
+    let amplitude: Vec<f64> = frc.points.iter().map(|p| p.amplitude).collect();
+    d.set_item("omega", omega.into_pyarray(py))?;
+    d.set_item("amplitude", amplitude.into_pyarray(py))?;
+    Ok(d)
+}
+
+/// The frequency response of a large structure condensed onto
+/// `nonlinear_dofs` (private: `ivt.hb.frc` calls it for sparse matrices,
+/// load-vector forcing, `nonlinear_dofs`, `amplitude_dof` or `record_dofs`).
+/// `m, c, k`: `(rows, cols, values)` triplets of `n_dof × n_dof`; `f`:
+/// `(F_cos, F_sin)`; `g(x, v, theta)` sees the nonlinear DOFs only.
+#[pyfunction]
+#[pyo3(signature = (
+    n_dof, m, c, k, g, f, omega_from, omega_to, nonlinear_dofs, amplitude_dof = None,
+    record_dofs = Vec::new(), n = 7, samples = 32, velocity_dependent = true,
+    vectorized = false, rtol = 1e-12, jac = None, ds = None, ds_min = None, ds_max = None,
+    truncation_estimate = true
+))]
+#[allow(clippy::too_many_arguments)]
+fn frc_large<'py>(
+    py: Python<'py>,
+    n_dof: usize,
+    m: Coo,
+    c: Coo,
+    k: Coo,
+    g: Bound<'py, PyAny>,
+    f: (Vec<f64>, Vec<f64>),
+    omega_from: f64,
+    omega_to: f64,
+    nonlinear_dofs: Vec<usize>,
+    amplitude_dof: Option<usize>,
+    record_dofs: Vec<usize>,
+    n: usize,
+    samples: usize,
+    velocity_dependent: bool,
+    vectorized: bool,
+    rtol: f64,
+    jac: Option<Bound<'py, PyAny>>,
+    ds: Option<f64>,
+    ds_min: Option<f64>,
+    ds_max: Option<f64>,
+    truncation_estimate: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let large = Large {
+        n_dof,
+        m,
+        c,
+        k,
+        g,
+        jac,
+        load: f,
+        dofs: nonlinear_dofs,
+        hb: hb_options(n, samples)?,
+        velocity_dependent,
+        vectorized,
+    };
+    let mut opts = CondensedFrcOptions {
+        from: finite("omega_from", omega_from)?,
+        to: finite("omega_to", omega_to)?,
+        rtol: finite("rtol", rtol)?,
+        amplitude_dof,
+        record_dofs,
+        truncation_estimate,
+        ..CondensedFrcOptions::default()
+    };
+    let steps = [
+        (ds, &mut opts.continuation.ds),
+        (ds_min, &mut opts.continuation.ds_min),
+    ];
+    for (given, slot) in steps {
+        if let Some(v) = given {
+            *slot = positive("ds", v)?;
+        }
+    }
+    if let Some(v) = ds_max {
+        opts.continuation.ds_max = positive("ds_max", v)?;
+    }
+    let (structure, local) = large.build(py)?;
+    let (dofs, load, hb) = (large.dofs.clone(), large.load.clone(), large.hb.clone());
+    let frc = run_user(py, &local, move |p| {
+        let mut branch = CondensedBranch::new(structure, dofs, &load.0, &load.1, p, &hb)?;
+        condensed_response(&mut branch, &opts)
+    })?;
+    frc_dict(py, &frc)
+}
+
+fn positive(name: &str, v: f64) -> PyResult<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(PyValueError::new_err(format!(
+            "argument `{name}` must be > 0, got {v}"
+        )))
+    }
+}
+
+/// One orbit of a large structure at `omega` (private: `ivt.hb.solve` calls
+/// it as [`frc_large`]): Newton on the condensed system from the linear
+/// response. Returns {"coeffs", "omega", "amplitude", "dof_coeffs",
+/// "solve_error", "iterations"}.
+#[pyfunction]
+#[pyo3(signature = (
+    n_dof, m, c, k, g, f, omega, nonlinear_dofs, amplitude_dof = None,
+    record_dofs = Vec::new(), n = 7, samples = 32, velocity_dependent = true,
+    vectorized = false, rtol = 1e-12, jac = None
+))]
+#[allow(clippy::too_many_arguments)]
+fn solve_large<'py>(
+    py: Python<'py>,
+    n_dof: usize,
+    m: Coo,
+    c: Coo,
+    k: Coo,
+    g: Bound<'py, PyAny>,
+    f: (Vec<f64>, Vec<f64>),
+    omega: f64,
+    nonlinear_dofs: Vec<usize>,
+    amplitude_dof: Option<usize>,
+    record_dofs: Vec<usize>,
+    n: usize,
+    samples: usize,
+    velocity_dependent: bool,
+    vectorized: bool,
+    rtol: f64,
+    jac: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let large = Large {
+        n_dof,
+        m,
+        c,
+        k,
+        g,
+        jac,
+        load: f,
+        dofs: nonlinear_dofs,
+        hb: hb_options(n, samples)?,
+        velocity_dependent,
+        vectorized,
+    };
+    let omega = positive("omega", finite("omega", omega)?)?;
+    let rtol = positive("rtol", rtol)?;
+    let (structure, local) = large.build(py)?;
+    let (dofs, load, hb) = (large.dofs.clone(), large.load.clone(), large.hb.clone());
+    let point = run_user(py, &local, move |p| {
+        let mut branch = CondensedBranch::new(structure, dofs, &load.0, &load.1, p, &hb)?;
+        // A curve of one point: the start at ω, corrected at fixed ω.
+        let opts = CondensedFrcOptions {
+            from: omega,
+            to: omega * (1.0 + 1e-9),
+            rtol,
+            amplitude_dof,
+            record_dofs,
+            truncation_estimate: true,
+            continuation: ivt_hb::ContinuationOptions {
+                max_points: 1,
+                ..CondensedFrcOptions::default().continuation
+            },
+        };
+        let frc = condensed_response(&mut branch, &opts)?;
+        frc.points
+            .into_iter()
+            .next()
+            .ok_or_else(|| HbError::InvalidInput("no orbit".into()))
+    })?;
+    point_dict(py, &point)
+}
+
+/// The cantilever of issue 28 as COO triplets: `(n_dof, (m, c, k), tip)`
+/// with each matrix `(rows, cols, values)` (private: `ivt.hb.models.cantilever`
+/// builds scipy.sparse matrices from it).
+#[pyfunction]
+#[pyo3(signature = (n_elements, length = 1.0, ei = 1.0, rho_a = 1.0, alpha = 0.07, beta = 2e-4))]
+fn cantilever_coo<'py>(
+    py: Python<'py>,
+    n_elements: usize,
+    length: f64,
+    ei: f64,
+    rho_a: f64,
+    alpha: f64,
+    beta: f64,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let beam = ivt_hb::models::cantilever(n_elements, length, ei, rho_a, alpha, beta)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let mats = beam.model.triplets().map(|t| {
+        let rows: Vec<usize> = t.iter().map(|e| e.0).collect();
+        let cols: Vec<usize> = t.iter().map(|e| e.1).collect();
+        let vals: Vec<f64> = t.iter().map(|e| e.2).collect();
+        (
+            rows.into_pyarray(py),
+            cols.into_pyarray(py),
+            vals.into_pyarray(py),
+        )
+    });
+    (beam.model.n_dof(), mats, beam.tip).into_pyobject(py)
+}
+
+/// Register the large-structure functions on `ivt._ivt.hb`.
+pub fn register(hb: &Bound<'_, PyModule>) -> PyResult<()> {
+    hb.add_function(wrap_pyfunction!(frc_large, hb)?)?;
+    hb.add_function(wrap_pyfunction!(solve_large, hb)?)?;
+    hb.add_function(wrap_pyfunction!(cantilever_coo, hb)?)?;
+    Ok(())
+}

@@ -1,0 +1,127 @@
+"""Large structures (issue 28): ivt.hb.frc/solve on scipy.sparse matrices
+condensed onto the nonlinear DOFs, load-vector forcing, amplitude_dof and
+record_dofs, and ivt.hb.models.cantilever."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+import ivt
+
+W1 = 3.516015268066119  # (1.8751041)², the clamped–free beam
+K3, F0 = 200.0, 0.005
+
+
+def spring(x, v, t):
+    return K3 * x**3
+
+
+def spring_jac(x, v, t):
+    return np.array([[3.0 * K3 * x[0] ** 2]]), np.zeros((1, 1))
+
+
+def test_cantilever_is_sparse_symmetric_with_the_static_tip_stiffness():
+    m, c, k, tip = ivt.hb.models.cantilever(20)
+    assert all(sp.issparse(a) for a in (m, c, k))
+    assert m.shape == (40, 40) and tip == 38
+    for a in (m, c, k):
+        assert abs(a - a.T).max() == 0.0
+    # K⁻¹ e_tip at the tip is 1/(3EI/L³) exactly for Hermite cubics (scipy's
+    # plain sparse LU already loses 1.3e-12 of it at N = 20: κ(K) ~ N⁴).
+    e = np.zeros(40)
+    e[tip] = 1.0
+    assert abs(spla.spsolve(k.tocsc(), e)[tip] - 1.0 / 3.0) < 1e-10
+    # C = 0.07 M + 2e-4 K.
+    assert abs(c - (0.07 * m + 2e-4 * k)).max() < 1e-12 * abs(k).max()
+
+
+def test_condensed_curve_with_located_folds_and_recovered_dofs():
+    m, c, k, tip = ivt.hb.models.cantilever(20)
+    f = np.zeros(m.shape[0])
+    f[tip] = F0
+    out = ivt.hb.frc(m, c, k, spring, f, 0.7 * W1, 1.3 * W1, jac=spring_jac,
+                     nonlinear_dofs=[tip], record_dofs=[0, tip])
+    assert out["termination"] == "left_interval"
+    assert [fold["located"] for fold in out["folds"]] == [True, True]
+    # The folds of the Rust tests (tests/condense.rs checks them on the full
+    # extended system to 1e-10).
+    assert abs(out["folds"][0]["omega"] - 3.906984060533) < 1e-9
+    assert abs(out["folds"][1]["omega"] - 3.672391045809) < 1e-9
+    n = 7
+    for p in out["points"]:
+        assert set(p["dof_coeffs"]) == {0, tip}
+        assert p["dof_coeffs"][0].shape == (2 * n + 1,)
+        # The recovered tip is the condensed unknown itself (to the corrector's
+        # tolerance, 1e-12 of the start's linear response ≈ 4e-15).
+        assert np.allclose(p["dof_coeffs"][tip], p["coeffs"], rtol=0, atol=1e-13)
+        assert p["multipliers"] is None and p["stable"] is None
+        assert 0 < p["error_estimate"] < 1e-7
+    assert np.array_equal(out["omega"], [p["omega"] for p in out["points"]])
+
+
+def test_condensed_solve_equals_the_dense_uncondensed_solve():
+    # N = 8: the dense solve (classic Newton on all 16 DOFs) from its own
+    # linear guess reaches the same orbit.
+    m, c, k, tip = ivt.hb.models.cantilever(8)
+    nd = m.shape[0]
+    f = np.zeros(nd)
+    f[tip] = F0
+    large = ivt.hb.solve(m, c, k, spring, 3.0, f, nonlinear_dofs=[tip], record_dofs=list(range(nd)))
+
+    def g_full(x, v, t):
+        out = np.zeros(nd)
+        out[tip] = K3 * x[tip] ** 3
+        return out
+
+    dense = ivt.hb.solve(m.toarray(), c.toarray(), k.toarray(), g_full, 3.0,
+                         lambda t: f * np.cos(t), n=7, samples=32, method="classic",
+                         velocity_dependent=False, rtol=1e-11)
+    full = np.concatenate([large["dof_coeffs"][j] for j in range(nd)])
+    assert np.max(np.abs(full - np.asarray(dense["coeffs"]))) < 1e-10 * np.max(np.abs(full))
+
+
+def test_sine_load_is_the_cosine_orbit_shifted():
+    m, c, k, tip = ivt.hb.models.cantilever(10)
+    f = np.zeros(m.shape[0])
+    f[tip] = F0
+    cos = ivt.hb.solve(m, c, k, spring, 3.0, f, nonlinear_dofs=[tip])
+    sin = ivt.hb.solve(m, c, k, spring, 3.0, (np.zeros_like(f), f), nonlinear_dofs=[tip])
+    assert abs(cos["amplitude"] - sin["amplitude"]) < 1e-13
+    n = 7
+    a, b = cos["coeffs"][1 : n + 1], cos["coeffs"][n + 1 :]
+    a2, b2 = sin["coeffs"][1 : n + 1], sin["coeffs"][n + 1 :]
+    # x(τ − π/2): harmonic 1 turns (a, b) → (−b, a).
+    assert abs(a2[0] + b[0]) < 1e-13 and abs(b2[0] - a[0]) < 1e-13
+
+
+def test_amplitude_dof_and_record_dofs_on_a_dense_model():
+    m = np.eye(2)
+    k = np.array([[2.0, -1.0], [-1.0, 2.0]])
+    c = 0.02 * np.eye(2)
+
+    def g(x, v, t):
+        return np.array([0.5 * x[0] ** 3, 0.0])
+
+    out = ivt.hb.solve(m, c, k, g, 0.8, lambda t: np.array([0.1 * np.cos(t), 0.0]),
+                       n=9, samples=32, amplitude_dof=1, record_dofs=[1])
+    block = np.asarray(out["coeffs"]).reshape(2, -1)[1]
+    assert np.array_equal(out["dof_coeffs"][1], block)
+    tau = np.linspace(0, 2 * np.pi, 20001)
+    assert abs(out["amplitude"] - np.abs(ivt.hb.eval_series(block, tau)).max()) < 1e-8
+
+
+def test_bad_large_inputs_raise_value_errors():
+    m, c, k, tip = ivt.hb.models.cantilever(4)
+    f = np.zeros(m.shape[0])
+    f[tip] = F0
+    with pytest.raises(ValueError, match="nonlinear_dofs"):
+        ivt.hb.frc(m, c, k, spring, f, 2.0, 3.0)
+    with pytest.raises(ValueError, match="stability"):
+        ivt.hb.frc(m, c, k, spring, f, 2.0, 3.0, nonlinear_dofs=[tip], stability=True)
+    with pytest.raises(ValueError):
+        ivt.hb.frc(m, c, k, spring, f, 2.0, 3.0, nonlinear_dofs=[99])
+    with pytest.raises(ValueError):
+        ivt.hb.solve(m, c, k, spring, 2.0, f[:3], nonlinear_dofs=[tip])
+    with pytest.raises(ValueError):
+        ivt.hb.models.cantilever(0)
