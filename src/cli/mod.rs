@@ -15,6 +15,7 @@ pub mod kin;
 pub mod ol;
 pub mod reproduce;
 pub mod rig;
+pub mod rig_commission;
 pub mod sim;
 pub mod stability;
 pub mod string;

@@ -2,6 +2,7 @@
 
 pub mod atomic;
 pub mod backend;
+pub mod commission;
 pub mod error;
 pub mod integrate;
 pub mod output;
@@ -11,6 +12,7 @@ pub mod plot;
 pub mod profile;
 pub mod progress;
 pub mod record;
+pub mod recording;
 pub mod run;
 pub mod scene;
 pub mod sensors;

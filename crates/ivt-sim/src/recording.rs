@@ -1,0 +1,198 @@
+//! A commissioning recording: the MCAP file that `ivt rig record`, `ivt rig
+//! commission` (rig, SIL, PIL) write and `ivt rig identify` reads. JSON
+//! channels, `t` always in seconds from the start:
+//!
+//! | channel | fields | one message per |
+//! |---|---|---|
+//! | `/control` | `t`, `ticks`, `omega`, `omega_a`, `r`, `fault` (rig); the simulator's whole control sample (SIL/PIL) | telemetry frame / pulse |
+//! | `/stepper` | `t`, `position` (+ `target`, `commanded`, `missed` in the simulator) | telemetry frame / pulse |
+//! | `/sensors` | `t`, `v_m`, `t_u`: the inputs the controller read | telemetry frame / sensor reading |
+//! | `/pulses` | `t: [s…]`, `ticks: [u32…]`: every encoder edge (pulse-log stages) | batch |
+//! | `/sequence` | `t`, `name` (sweep, hold, step, drive), `stage`, `theta_ct_deg` (null when the law runs), `hold` | stage start |
+//!
+//! and a metadata record `ivt`: `frame_version`, `ppr`, `f_timer_hz` and,
+//! for a simulated rig, `plant` (the plant's parameters as JSON). Metadata
+//! values are strings (MCAP), each a JSON value.
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+use crate::atomic::Staged;
+use crate::error::{io_at, mcap_at, SimError};
+use crate::output::add_json_channel;
+use crate::record::Record;
+use ivt_ctrl::commission::SequenceName;
+
+/// The channels of a recording, in MCAP channel order.
+pub const RECORDING_CHANNELS: [&str; 5] = ["control", "stepper", "sensors", "pulses", "sequence"];
+
+/// What the metadata record `ivt` says.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecordingMeta {
+    /// Telemetry frame version of the source (2 for the simulator and v2 firmware).
+    pub frame_version: u8,
+    /// Encoder samples per revolution.
+    pub ppr: u32,
+    /// Timer rate of the `ticks` \[Hz\].
+    pub f_timer_hz: f64,
+    /// The simulated plant (None for a rig).
+    pub plant: Option<serde_json::Value>,
+    /// Free text: where the recording comes from.
+    pub source: String,
+}
+
+/// An MCAP recording being written (under a temporary name until
+/// [`Recording::finish`]).
+pub struct Recording {
+    out: PathBuf,
+    staged: Staged,
+    w: mcap::Writer<BufWriter<File>>,
+    ids: [u16; 5],
+    counts: [u64; 5],
+    buf: Vec<u8>,
+}
+
+impl Recording {
+    /// Creates the recording `out` with its channels and metadata.
+    ///
+    /// # Errors
+    /// File creation or MCAP writing.
+    pub fn create(out: &Path, meta: &RecordingMeta) -> Result<Self, SimError> {
+        let mcap_err = mcap_at(out);
+        let mut staged = Staged::new();
+        let file = File::create(staged.path(out)).map_err(io_at(out))?;
+        let mut w = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .profile("")
+            .create(BufWriter::new(file))
+            .map_err(&mcap_err)?;
+        let mut channel_meta = BTreeMap::new();
+        channel_meta.insert("source".to_string(), meta.source.clone());
+        let mut ids = [0u16; 5];
+        for (id, name) in ids.iter_mut().zip(RECORDING_CHANNELS) {
+            *id = add_json_channel(&mut w, name, &channel_meta).map_err(&mcap_err)?;
+        }
+        let mut m = BTreeMap::new();
+        m.insert("frame_version".into(), meta.frame_version.to_string());
+        m.insert("ppr".into(), meta.ppr.to_string());
+        m.insert(
+            "f_timer_hz".into(),
+            serde_json::json!(meta.f_timer_hz).to_string(),
+        );
+        if let Some(p) = &meta.plant {
+            m.insert("plant".into(), p.to_string());
+        }
+        w.write_metadata(&mcap::records::Metadata {
+            name: "ivt".into(),
+            metadata: m,
+        })
+        .map_err(&mcap_err)?;
+        Ok(Self {
+            out: out.to_path_buf(),
+            staged,
+            w,
+            ids,
+            counts: [0; 5],
+            buf: Vec::with_capacity(512),
+        })
+    }
+
+    fn write(&mut self, channel: usize, t: f64) -> Result<(), SimError> {
+        let (Some(&id), Some(count)) = (self.ids.get(channel), self.counts.get_mut(channel)) else {
+            return Ok(());
+        };
+        let ns = (t.max(0.0) * 1e9).round() as u64;
+        let header = mcap::records::MessageHeader {
+            channel_id: id,
+            sequence: *count as u32,
+            log_time: ns,
+            publish_time: ns,
+        };
+        *count += 1;
+        self.w
+            .write_to_known_channel(&header, &self.buf)
+            .map_err(mcap_at(&self.out))
+    }
+
+    /// Writes a sample of one of the simulator's channels (`record::Record`):
+    /// `/control`, `/stepper` or `/sensors`.
+    ///
+    /// # Errors
+    /// MCAP writing.
+    pub fn sample<R: Record>(&mut self, s: &R) -> Result<(), SimError> {
+        let Some(channel) = RECORDING_CHANNELS.iter().position(|c| *c == R::CHANNEL) else {
+            return Ok(());
+        };
+        self.buf.clear();
+        s.write_json(&mut self.buf);
+        self.write(channel, s.time())
+    }
+
+    /// Writes a JSON message on `/control`, `/stepper` or `/sensors` (the rig's
+    /// fields) at time `t`.
+    ///
+    /// # Errors
+    /// MCAP writing.
+    pub fn json(&mut self, channel: &str, t: f64, msg: &serde_json::Value) -> Result<(), SimError> {
+        match RECORDING_CHANNELS.iter().position(|c| *c == channel) {
+            Some(k) => self.json_on(k, t, msg),
+            None => Ok(()),
+        }
+    }
+
+    /// A batch of encoder edges on `/pulses` (logged at the first edge's time).
+    ///
+    /// # Errors
+    /// MCAP writing.
+    pub fn pulses(&mut self, t: &[f64], ticks: &[u32]) -> Result<(), SimError> {
+        let Some(&t0) = t.first() else {
+            return Ok(());
+        };
+        let msg = serde_json::json!({ "t": t, "ticks": ticks });
+        self.json_on(3, t0, &msg)
+    }
+
+    /// A stage start on `/sequence`.
+    ///
+    /// # Errors
+    /// MCAP writing.
+    pub fn stage(
+        &mut self,
+        t: f64,
+        name: SequenceName,
+        stage: u16,
+        theta_ct_deg: f32,
+        hold: bool,
+    ) -> Result<(), SimError> {
+        let theta = theta_ct_deg.is_finite().then_some(theta_ct_deg);
+        let msg = serde_json::json!({
+            "t": t, "name": name.as_str(), "stage": stage, "theta_ct_deg": theta, "hold": hold,
+        });
+        self.json_on(4, t, &msg)
+    }
+
+    fn json_on(&mut self, k: usize, t: f64, msg: &serde_json::Value) -> Result<(), SimError> {
+        self.buf.clear();
+        self.buf.extend_from_slice(msg.to_string().as_bytes());
+        self.write(k, t)
+    }
+
+    /// Writes the summary, renames the file into place and returns the
+    /// message count of each channel that got any (`/name` → count).
+    ///
+    /// # Errors
+    /// MCAP writing or the rename.
+    pub fn finish(mut self) -> Result<BTreeMap<String, u64>, SimError> {
+        self.w.finish().map_err(mcap_at(&self.out))?;
+        drop(self.w);
+        self.staged.commit().map_err(io_at(&self.out))?;
+        Ok(RECORDING_CHANNELS
+            .iter()
+            .zip(self.counts)
+            .filter(|(_, n)| *n > 0)
+            .map(|(c, n)| (format!("/{c}"), n))
+            .collect())
+    }
+}
