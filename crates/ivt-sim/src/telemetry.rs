@@ -103,7 +103,9 @@ pub fn record<R: Read>(
         strict: opts.strict,
     };
     let mut dec = Decoder::new();
-    let mut buf = [0u8; 512];
+    // A pty holds ~4 KiB: drain all of it per read, so a recorder that gets
+    // little CPU (a loaded machine) still empties it before it overflows.
+    let mut buf = [0u8; 4096];
     let mut last_byte = Instant::now();
     'read: loop {
         if crate::atomic::interrupted() || opts.max_frames.is_some_and(|m| sink.frames >= m) {
