@@ -31,7 +31,8 @@ pub const RECORDING_CHANNELS: [&str; 5] = ["control", "stepper", "sensors", "pul
 /// What the metadata record `ivt` says.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RecordingMeta {
-    /// Telemetry frame version of the source (2 for the simulator and v2 firmware).
+    /// Telemetry frame version of the source (2 for the simulator and v2
+    /// firmware; a recorder sets what it read, [`Recording::set_frame_version`]).
     pub frame_version: u8,
     /// Encoder samples per revolution.
     pub ppr: u32,
@@ -52,6 +53,7 @@ pub struct Recording {
     ids: [u16; 5],
     counts: [u64; 5],
     buf: Vec<u8>,
+    meta: RecordingMeta,
 }
 
 impl Recording {
@@ -74,21 +76,6 @@ impl Recording {
         for (id, name) in ids.iter_mut().zip(RECORDING_CHANNELS) {
             *id = add_json_channel(&mut w, name, &channel_meta).map_err(&mcap_err)?;
         }
-        let mut m = BTreeMap::new();
-        m.insert("frame_version".into(), meta.frame_version.to_string());
-        m.insert("ppr".into(), meta.ppr.to_string());
-        m.insert(
-            "f_timer_hz".into(),
-            serde_json::json!(meta.f_timer_hz).to_string(),
-        );
-        if let Some(p) = &meta.plant {
-            m.insert("plant".into(), p.to_string());
-        }
-        w.write_metadata(&mcap::records::Metadata {
-            name: "ivt".into(),
-            metadata: m,
-        })
-        .map_err(&mcap_err)?;
         Ok(Self {
             out: out.to_path_buf(),
             staged,
@@ -96,6 +83,7 @@ impl Recording {
             ids,
             counts: [0; 5],
             buf: Vec::with_capacity(512),
+            meta: meta.clone(),
         })
     }
 
@@ -179,12 +167,35 @@ impl Recording {
         self.write(k, t)
     }
 
-    /// Writes the summary, renames the file into place and returns the
+    /// The telemetry frame version the source turned out to send (the
+    /// metadata is written at [`Recording::finish`]).
+    pub fn set_frame_version(&mut self, v: u8) {
+        self.meta.frame_version = v;
+    }
+
+    /// Writes the metadata and the summary, renames the file into place and returns the
     /// message count of each channel that got any (`/name` → count).
     ///
     /// # Errors
     /// MCAP writing or the rename.
     pub fn finish(mut self) -> Result<BTreeMap<String, u64>, SimError> {
+        let meta = &self.meta;
+        let mut m = BTreeMap::new();
+        m.insert("frame_version".into(), meta.frame_version.to_string());
+        m.insert("ppr".into(), meta.ppr.to_string());
+        m.insert(
+            "f_timer_hz".into(),
+            serde_json::json!(meta.f_timer_hz).to_string(),
+        );
+        if let Some(p) = &meta.plant {
+            m.insert("plant".into(), p.to_string());
+        }
+        self.w
+            .write_metadata(&mcap::records::Metadata {
+                name: "ivt".into(),
+                metadata: m,
+            })
+            .map_err(mcap_at(&self.out))?;
         self.w.finish().map_err(mcap_at(&self.out))?;
         drop(self.w);
         self.staged.commit().map_err(io_at(&self.out))?;

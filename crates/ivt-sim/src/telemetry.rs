@@ -163,6 +163,7 @@ pub fn record<R: Read>(
         sink.t_last,
         sink.version,
     );
+    rec.set_frame_version(version);
     let channels = rec.finish()?;
     Ok(RecordSummary {
         frames,
@@ -203,6 +204,9 @@ impl Sink<'_> {
     }
 
     fn frame(&mut self, f: TelemetryFrame) -> Result<(), SimError> {
+        if !matches!(f, TelemetryFrame::Sample(_)) {
+            self.version = self.version.max(ivt_wire::telemetry::TELEMETRY_VERSION);
+        }
         match f {
             TelemetryFrame::Sample(s) => self.sample(&s),
             TelemetryFrame::Pulses(b) => {
