@@ -2,7 +2,7 @@
 # Firmware builds and QEMU checks (scripts/test calls `test`).
 #
 #   firmware/run-qemu.sh build     build the qemu images (PIL server, bench) and the rig image
-#   firmware/run-qemu.sh pil       PIL-vs-SIL tests (ivt-sim) and `ivt rig record` end to end (needs `build`)
+#   firmware/run-qemu.sh pil       PIL-vs-SIL tests (ivt-sim: scenes, commissioning) and `ivt rig record` end to end (needs `build`)
 #   firmware/run-qemu.sh panic     prove from the release ELFs that the pulse path cannot reach the panic handler
 #   firmware/run-qemu.sh budgets   flash/RAM, instructions per pulse, stack; fails over the targets
 #   firmware/run-qemu.sh test      all of the above
@@ -23,6 +23,7 @@ build() {
 pil() {
   (cd .. && export IVT_FW_ELF="$here/$out/ivt-fw-qemu" &&
     cargo test -p ivt-sim --release --test pil -- --include-ignored &&
+    cargo test -p ivt-sim --release --test commission -- --include-ignored &&
     cargo test --release --test rig_record -- --include-ignored)
 }
 
@@ -30,8 +31,8 @@ pil() {
 # `||` list, where errexit is off inside the function.
 panic_check() {
   python3 panic_reach.py "$out/ivt-fw-bench" --root ivt_fw_pulse --must-reach ivt_fw_canary &&
-    python3 panic_reach.py "$out/ivt-fw-qemu" --root ivt_fw_pulse &&
-    python3 panic_reach.py "$out/ivt-fw-rig" --root ivt_fw_pulse --root TIM2 --root TIM3
+    python3 panic_reach.py "$out/ivt-fw-qemu" --root ivt_fw_pulse --root ivt_fw_sequenced_pulse &&
+    python3 panic_reach.py "$out/ivt-fw-rig" --root ivt_fw_pulse --root ivt_fw_sequenced_pulse --root TIM2 --root TIM3
 }
 
 budgets() {

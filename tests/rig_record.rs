@@ -45,6 +45,10 @@ fn rig_record_captures_every_frame_the_qemu_firmware_sends() {
     let mut line = String::new();
     err.read_line(&mut line).unwrap();
     assert!(line.starts_with("recording from"), "recorder said: {line}");
+    // QEMU notices that the pty's slave side is open on a 1 s poll; until
+    // then it writes without back-pressure and a full pty drops bytes (lost
+    // frames when the recorder is short of CPU). Give it that second.
+    std::thread::sleep(std::time::Duration::from_millis(1200));
 
     let config = Config::default(); // 1 MHz timer
     pil.configure(&config).unwrap();

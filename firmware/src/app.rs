@@ -3,7 +3,9 @@
 
 use core::sync::atomic::{AtomicBool, Ordering};
 
+use ivt_ctrl::commission::{SequenceStep, Sequencer, Stage};
 use ivt_ctrl::{Config, ControlOutput, Controller};
+use ivt_wire::telemetry::{PulseBatch, StageStart, TelemetryFrame, TelemetrySample};
 use ivt_wire::{frame::Decoder, msg, ErrorCode, Reply, Request, MAX_FRAME};
 
 /// Samples per revolution of θ the firmware is built for (the encoder of the
@@ -27,6 +29,15 @@ pub type Ctrl = Controller<PPR>;
 #[inline(never)]
 pub fn ivt_fw_pulse(ctrl: &mut Ctrl, ticks: u32) -> ControlOutput {
     ctrl.on_pulse(ticks)
+}
+
+/// The pulse path while a commissioning sequence runs
+/// (`ivt_ctrl::commission`): the stage logic, then [`Controller::on_pulse`].
+/// Out of line under a fixed symbol for the panic-reachability proof.
+#[no_mangle]
+#[inline(never)]
+pub fn ivt_fw_sequenced_pulse(seq: &mut Sequencer, ctrl: &mut Ctrl, ticks: u32) -> SequenceStep {
+    seq.on_pulse(ctrl, ticks)
 }
 
 /// Takes the firmware's one controller: a static initialised to
@@ -75,6 +86,27 @@ pub struct PilServer {
     tx: [u8; MAX_FRAME],
     /// Pulses served since the start (for telemetry and the exit report).
     pub pulses: u32,
+    /// The running commissioning sequence (after `Commission`, until `Configure`).
+    seq: Option<Sequencer>,
+    /// Timer rate of the last configuration (the sequencer's clock).
+    f_timer_hz: f32,
+    /// The last inputs received.
+    inputs: [f32; 2],
+}
+
+/// What one served pulse produced, for telemetry.
+#[derive(Clone, Copy, Debug)]
+pub struct PulseEvent {
+    /// The pulse's timestamp.
+    pub ticks: u32,
+    /// The controller's output.
+    pub out: ControlOutput,
+    /// The inputs the controller holds (V_m, T_U).
+    pub inputs: [f32; 2],
+    /// The commissioning stage that started at this pulse.
+    pub started: Option<Stage>,
+    /// The pulse falls in a pulse-log stage.
+    pub pulse_log: bool,
 }
 
 impl Default for PilServer {
@@ -84,12 +116,17 @@ impl Default for PilServer {
 }
 
 impl PilServer {
-    /// A server waiting for the first frame.
-    pub const fn new() -> Self {
+    /// A server waiting for the first frame (the controller as `boot` made
+    /// it: `Config::default()`).
+    pub fn new() -> Self {
+        let c = Config::default();
         Self {
             dec: Decoder::new(),
             tx: [0; MAX_FRAME],
             pulses: 0,
+            seq: None,
+            f_timer_hz: c.f_timer_hz,
+            inputs: c.initial_inputs,
         }
     }
 
@@ -100,7 +137,7 @@ impl PilServer {
         byte: u8,
         ctrl: &mut Ctrl,
         link: &mut impl Link,
-        mut on_output: impl FnMut(u32, &ControlOutput),
+        mut on_output: impl FnMut(&PulseEvent),
     ) -> Session {
         let Some(frame) = self.dec.push(byte) else {
             return Session::Continue;
@@ -112,20 +149,53 @@ impl PilServer {
                 ppr: PPR as u32,
             },
             Ok(Request::Pulse { ticks }) => {
-                let out = ivt_fw_pulse(ctrl, ticks);
                 self.pulses = self.pulses.wrapping_add(1);
-                on_output(ticks, &out);
-                Reply::Output(out)
+                let mut ev = PulseEvent {
+                    ticks,
+                    out: ControlOutput::IDLE,
+                    inputs: self.inputs,
+                    started: None,
+                    pulse_log: false,
+                };
+                let reply = match self.seq.as_mut() {
+                    Some(seq) => {
+                        let st = ivt_fw_sequenced_pulse(seq, ctrl, ticks);
+                        ev.out = st.out;
+                        ev.started = st.started;
+                        ev.pulse_log = st.pulse_log;
+                        Reply::Sequenced {
+                            out: st.out,
+                            stage: st.stage,
+                            started: st.started.is_some(),
+                            pulse_log: st.pulse_log,
+                            done: st.done,
+                        }
+                    }
+                    None => {
+                        ev.out = ivt_fw_pulse(ctrl, ticks);
+                        Reply::Output(ev.out)
+                    }
+                };
+                on_output(&ev);
+                reply
             }
             Ok(Request::Inputs { v_m, t_u }) => {
                 ctrl.update_inputs(v_m, t_u);
+                self.inputs = [v_m, t_u];
                 Reply::Ack
             }
             Ok(Request::Configure(config)) => {
                 // In place (no stack temporary); an invalid config gives the
-                // controller's own Fault::Config state.
+                // controller's own Fault::Config state. Ends a sequence.
                 ctrl.reset(config);
                 self.pulses = 0;
+                self.seq = None;
+                self.f_timer_hz = config.f_timer_hz;
+                self.inputs = config.initial_inputs;
+                Reply::Ack
+            }
+            Ok(Request::Commission { selection, plan }) => {
+                self.seq = Some(Sequencer::new(plan, selection, self.f_timer_hz));
                 Reply::Ack
             }
             Ok(Request::Exit) => {
@@ -141,38 +211,80 @@ impl PilServer {
     }
 }
 
-/// Streams telemetry frames (`ivt_wire::Telemetry`) over a link.
+/// Streams telemetry frames (`ivt_wire::telemetry`, v2) over a link:
+/// samples, stage starts and batches of logged encoder edges.
 pub struct TelemetryTx<L: ByteSink> {
     link: L,
-    buf: [u8; 32],
-    /// Frames sent so far.
+    buf: [u8; MAX_FRAME],
+    batch: PulseBatch,
+    /// Sample frames sent so far.
     pub frames: u32,
 }
 
 impl<L: ByteSink> TelemetryTx<L> {
     /// A sender over `link`.
-    pub fn new(link: L) -> Self {
+    pub const fn new(link: L) -> Self {
         Self {
             link,
-            buf: [0; 32],
+            buf: [0; MAX_FRAME],
+            batch: PulseBatch::new(0),
             frames: 0,
         }
     }
 
-    /// Sends one sample: the pulse's timestamp, ω, ω_a, r, the stepper
-    /// position and the fault code.
-    pub fn send(&mut self, time_ticks: u32, out: &ControlOutput, stepper_position: i32) {
-        let t = ivt_wire::Telemetry {
+    fn send(&mut self, f: &TelemetryFrame) -> bool {
+        match f.encode(&mut self.buf) {
+            Ok(n) => {
+                self.link.write_all(self.buf.get(..n).unwrap_or(&[]));
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// Sends one sample: the timestamp, ω, ω_a, r, the inputs read, the
+    /// stepper position and the fault code.
+    pub fn sample(
+        &mut self,
+        time_ticks: u32,
+        out: &ControlOutput,
+        inputs: [f32; 2],
+        position: i32,
+    ) {
+        let s = TelemetrySample {
             time_ticks,
             omega: out.omega,
             omega_a: out.omega_a,
             r: out.r,
-            stepper_position,
+            inputs: Some(inputs),
+            stepper_position: position,
             fault: out.fault.code(),
         };
-        if let Ok(n) = t.encode(&mut self.buf) {
-            self.link.write_all(self.buf.get(..n).unwrap_or(&[]));
+        if self.send(&TelemetryFrame::Sample(s)) {
             self.frames = self.frames.wrapping_add(1);
         }
+    }
+
+    /// Announces a stage start (flushing the edges of the stage before).
+    pub fn stage(&mut self, stage: &Stage, time_ticks: u32) {
+        self.flush_pulses();
+        self.send(&TelemetryFrame::Stage(StageStart::of(stage, time_ticks)));
+    }
+
+    /// Logs one encoder edge; a full batch is sent.
+    pub fn log_pulse(&mut self, ticks: u32) {
+        if !self.batch.push(ticks) {
+            self.flush_pulses();
+            self.batch.push(ticks);
+        }
+    }
+
+    /// Sends the logged edges not sent yet.
+    pub fn flush_pulses(&mut self) {
+        if self.batch.len > 0 {
+            self.send(&TelemetryFrame::Pulses(self.batch));
+        }
+        let next = self.batch.first.wrapping_add(u32::from(self.batch.len));
+        self.batch = PulseBatch::new(next);
     }
 }

@@ -18,6 +18,7 @@ pub mod kin;
 pub mod ol;
 pub mod reproduce;
 pub mod rig;
+pub mod rig_commission;
 pub mod rig_identify;
 pub mod sim;
 pub mod stability;

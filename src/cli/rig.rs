@@ -1,5 +1,6 @@
 //! `ivt rig record --port DEV --out run.mcap`: telemetry of the rig firmware
-//! (or the QEMU image's UART1 on a pty) into the simulator's MCAP channels.
+//! (or the QEMU image's UART1 on a pty) into the simulator's MCAP channels;
+//! `ivt rig commission` is in `rig_commission.rs`.
 
 use super::{CliError, Output};
 use clap::{Args, Subcommand};
@@ -8,6 +9,10 @@ use serde_json::json;
 use std::path::PathBuf;
 use std::time::Duration;
 
+/// Encoder samples per revolution the rig firmware is built for
+/// (`firmware/src/app.rs`, `PPR`), written into recordings.
+pub const FIRMWARE_PPR: u32 = 1200;
+
 /// `ivt rig ...`
 #[derive(Subcommand)]
 pub enum RigCommand {
@@ -15,6 +20,9 @@ pub enum RigCommand {
     Record(RecordArgs),
     /// Identify the plant from a commissioning recording (`rig_identify.rs`).
     Identify(super::rig_identify::IdentifyArgs),
+    /// Run the commissioning sequences (Fig. 47, 48, 50, 51) on a rig or
+    /// against the simulated one, into an MCAP recording.
+    Commission(super::rig_commission::CommissionArgs),
 }
 
 /// Arguments of `ivt rig record`.
@@ -48,6 +56,7 @@ pub fn run(cmd: RigCommand) -> Result<Output, CliError> {
     match cmd {
         RigCommand::Record(a) => record_cmd(&a),
         RigCommand::Identify(a) => super::rig_identify::run(&a),
+        RigCommand::Commission(a) => super::rig_commission::commission_cmd(&a),
     }
 }
 
@@ -76,6 +85,8 @@ fn record_cmd(a: &RecordArgs) -> Result<Output, CliError> {
         f_timer_hz: a.f_timer_hz,
         max_frames: a.frames,
         idle_timeout,
+        ppr: FIRMWARE_PPR,
+        strict: false,
     };
     let s = record(port, &a.out, &opts).map_err(|e| CliError::Failed(e.to_string()))?;
     let human = format!(
@@ -89,6 +100,8 @@ fn record_cmd(a: &RecordArgs) -> Result<Output, CliError> {
         json: json!({
             "frames": s.frames,
             "bad_frames": s.bad_frames,
+            "first_bad_offset": s.first_bad_offset,
+            "frame_version": s.frame_version,
             "duration_s": s.duration_s,
             "channels": s.channels,
             "out": s.out.display().to_string(),

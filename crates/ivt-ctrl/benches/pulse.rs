@@ -3,7 +3,7 @@
 #![allow(missing_docs)]
 
 use divan::{black_box, Bencher};
-use ivt_ctrl::{AngleAverager, Config, Controller, LawKind};
+use ivt_ctrl::{AngleAverager, Config, Controller, LawKind, Plan, Selection, Sequencer};
 
 fn main() {
     divan::main();
@@ -71,4 +71,14 @@ fn update_inputs(bencher: Bencher) {
 fn step_tick(bencher: Bencher) {
     let (mut c, t) = warmed::<1200>(LawKind::Delay, 500);
     on_timer(bencher, t, 10, move |t| c.step_tick(t));
+}
+
+/// A pulse through the commissioning sequencer (stage check, hold) and the
+/// controller: the firmware's `ivt_fw_sequenced_pulse`. The plan is all
+/// sequences (≈ 122 s), so the benchmark's pulses stay inside it.
+#[divan::bench]
+fn sequenced_pulse_ppr1200(bencher: Bencher) {
+    let (mut c, t) = warmed::<1200>(LawKind::Prop, 500);
+    let mut seq = Sequencer::new(Plan::default(), Selection::ALL, 1.0e6);
+    on_timer(bencher, t, 500, move |t| seq.on_pulse(&mut c, t));
 }

@@ -8,6 +8,7 @@
 //! the simulator, the CLI, the Python bindings and (by a compile-time check)
 //! the firmware.
 
+use crate::commission::{SequenceStep, Sequencer};
 use crate::controller::{Config, ControlOutput, Controller, StepTick};
 
 macro_rules! any_controller {
@@ -71,6 +72,11 @@ macro_rules! any_controller {
             #[must_use]
             pub fn output(&self) -> ControlOutput {
                 match self { $(Self::$var(c) => c.output()),* }
+            }
+
+            /// [`Sequencer::on_pulse`] on this controller.
+            pub fn sequence_pulse(&mut self, seq: &mut Sequencer, ticks: u32) -> SequenceStep {
+                match self { $(Self::$var(c) => seq.on_pulse(c, ticks)),* }
             }
 
             /// [`Controller::r_max`].

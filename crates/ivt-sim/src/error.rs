@@ -87,6 +87,9 @@ pub enum SimError {
     /// Reading the telemetry stream failed.
     #[error("reading telemetry: {0}")]
     TelemetryRead(std::io::Error),
+    /// A telemetry stream with a truncated or corrupt frame (strict reading).
+    #[error("telemetry: {0}")]
+    TelemetryStream(ivt_wire::telemetry::StreamError),
     /// The telemetry timer rate is not a positive finite number.
     #[error("f_timer_hz must be positive and finite, got {0}")]
     BadTimer(f64),

@@ -2,6 +2,7 @@
 
 pub mod atomic;
 pub mod backend;
+pub mod commission;
 pub mod error;
 pub mod field;
 pub mod integrate;
@@ -12,6 +13,7 @@ pub mod plot;
 pub mod profile;
 pub mod progress;
 pub mod record;
+pub mod recording;
 pub mod run;
 pub mod scene;
 pub mod sensors;

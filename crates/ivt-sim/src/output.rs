@@ -50,13 +50,21 @@ pub(crate) fn add_json_channel<W: std::io::Write + std::io::Seek>(
     channel: Channel,
     meta: &BTreeMap<String, String>,
 ) -> Result<u16, mcap::McapError> {
-    let name = channel.name();
-    let schema = w.add_schema(
-        &format!("ivt.{name}"),
-        "jsonschema",
-        json_schema(channel).as_bytes(),
-    )?;
-    w.add_channel(schema, &format!("/{name}"), "json", meta)
+    add_schema_channel(w, channel.name(), &json_schema(channel), meta)
+}
+
+/// Adds the channel `/name` with the JSON schema text `schema` (titled
+/// `ivt.name`) to an MCAP log: [`add_json_channel`] for the simulator's
+/// channels, and the rig-only channels of a recording
+/// ([`crate::recording`]).
+pub(crate) fn add_schema_channel<W: std::io::Write + std::io::Seek>(
+    w: &mut mcap::Writer<W>,
+    name: &str,
+    schema: &str,
+    meta: &BTreeMap<String, String>,
+) -> Result<u16, mcap::McapError> {
+    let id = w.add_schema(&format!("ivt.{name}"), "jsonschema", schema.as_bytes())?;
+    w.add_channel(id, &format!("/{name}"), "json", meta)
 }
 
 /// An MCAP log being written: one JSON-schema channel per recorded signal

@@ -75,6 +75,55 @@ impl ControllerBackend for Pil {
     }
 }
 
+impl crate::commission::SequencedBackend for Pil {
+    fn sequenced_pulse(&mut self, ticks: u32) -> Result<crate::commission::Sequenced, SimError> {
+        match self.link()?.sequenced_pulse(ticks).map_err(to_backend)? {
+            ivt_wire::Reply::Sequenced {
+                out,
+                stage,
+                started,
+                pulse_log,
+                ..
+            } => Ok(crate::commission::Sequenced {
+                out,
+                stage,
+                started,
+                pulse_log,
+            }),
+            got => Err(SimError::BackendProtocol(format!(
+                "expected Sequenced, got {got:?}"
+            ))),
+        }
+    }
+
+    fn update_inputs(&mut self, v_m: f32, t_u: f32) -> Result<(), SimError> {
+        self.link()?.update_inputs(v_m, t_u).map_err(to_backend)
+    }
+}
+
+/// Runs the commissioning plan of `opts` with the QEMU firmware driving the
+/// sequence (`ivt rig commission --sim --pil`): the SIL run of
+/// [`crate::commission::run_sil`] with the firmware's sequencer and
+/// controller; the recording is the same bit for bit. The QEMU session is
+/// ended cleanly afterwards.
+///
+/// # Errors
+/// As [`crate::commission::run_sil`], and the backend's start or end.
+pub fn run_pil_commission(
+    opts: &crate::commission::CommissionOptions,
+    out: &std::path::Path,
+) -> Result<crate::commission::CommissionSummary, SimError> {
+    let scene = crate::commission::scene(opts)?;
+    let config = crate::commission::rig_config(&scene)?;
+    let mut pil = Pil::start(scene.encoder.ppr, &config)?;
+    pil.link()?
+        .commission(opts.selection, &opts.plan)
+        .map_err(to_backend)?;
+    let (summary, mut pil) = crate::commission::run_with(opts, &scene, pil, out)?;
+    pil.finish()?;
+    Ok(summary)
+}
+
 /// Runs a scene with the QEMU firmware as the controller (`ivt sim SCENE
 /// --pil`): the same closed loop as [`crate::run::Simulation::run`] with the [`Pil`]
 /// backend in place of the in-process one. The QEMU session is ended cleanly

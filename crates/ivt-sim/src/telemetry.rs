@@ -1,48 +1,60 @@
-//! Rig telemetry → MCAP (`ivt rig record`): decodes the firmware's telemetry
-//! frames (`ivt_wire::Telemetry`, see firmware/README.md) from any byte
-//! source and writes them into the simulator's channels, so a rig run and a
-//! simulated run open side by side in Foxglove:
+//! Rig telemetry → MCAP (`ivt rig record`, `ivt rig commission --port`):
+//! decodes the firmware's telemetry frames (`ivt_wire::telemetry`: v2
+//! samples with V_m and T_U, pulse-log batches, stage starts; v1 samples of
+//! older firmware too) from any byte source and writes a commissioning
+//! recording ([`crate::recording`]), so a rig run and a simulated run open
+//! side by side in Foxglove and `ivt rig identify` reads both:
 //!
-//! - `/control` (schema `ivt.control`): `t`, `ticks`, `omega`, `omega_a`,
-//!   `r`, `fault` (the fields the rig sends; the others of the simulator's
-//!   control samples are absent);
-//! - `/stepper` (schema `ivt.stepper`): `t`, `position`.
+//! - `/control`: `t`, `ticks`, `omega`, `omega_a`, `r`, `fault`;
+//! - `/stepper`: `t`, `position`;
+//! - `/sensors`: `t`, `v_m`, `t_u` (v2 frames only);
+//! - `/pulses`, `/sequence`: from pulse-log and stage frames.
 //!
 //! Time `t` is the frame's timer timestamp unwrapped across u32 wrap-arounds
-//! and divided by the timer rate, relative to the first frame.
+//! (signed differences, so a pulse batch older than the last sample is
+//! placed right) and divided by the timer rate, relative to the first frame.
 
 use std::collections::BTreeMap;
-use std::io::{BufWriter, ErrorKind, Read};
+use std::io::{ErrorKind, Read};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use ivt_wire::frame::Decoder;
-use ivt_wire::msg::Telemetry;
+use ivt_wire::telemetry::{StreamError, StreamProblem, TelemetryFrame, TelemetrySample};
 
-use crate::error::{io_at, mcap_at, SimError};
-use crate::output::add_json_channel;
-use crate::record::Channel;
+use crate::error::SimError;
+use crate::recording::{Recording, RecordingMeta};
 
-/// When to stop and how to read time.
+/// When to stop, how to read time, and how to treat bad frames.
 #[derive(Clone, Debug)]
 pub struct RecordOptions {
     /// Rate of the firmware's timestamp timer \[Hz\] (rig: 10 MHz).
     pub f_timer_hz: f64,
-    /// Stop after this many frames (None: until the source ends or idles).
+    /// Stop after this many sample frames (None: until the source ends or idles).
     pub max_frames: Option<u64>,
     /// Stop when no byte arrived for this long.
     pub idle_timeout: Duration,
+    /// Encoder samples per revolution of the firmware (metadata).
+    pub ppr: u32,
+    /// Stop at the first truncated or corrupt frame with an error naming its
+    /// byte offset (a stored capture); false counts and skips them (a live port).
+    pub strict: bool,
 }
 
 /// What a recording produced.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RecordSummary {
-    /// Telemetry frames written.
+    /// Telemetry sample frames written.
     pub frames: u64,
-    /// Frames dropped for a bad CRC, length or kind.
+    /// Frames dropped for a bad CRC, length, kind or version, garbage runs
+    /// and a truncated last frame.
     pub bad_frames: u64,
+    /// Byte offset of the first bad frame, if any.
+    pub first_bad_offset: Option<usize>,
     /// Time span covered by the frames \[s\].
     pub duration_s: f64,
+    /// Highest telemetry frame version seen (1 or 2; 0 if none).
+    pub frame_version: u8,
     /// Messages per MCAP channel.
     pub channels: BTreeMap<String, u64>,
     /// The MCAP file.
@@ -55,8 +67,9 @@ pub struct RecordSummary {
 /// `out` as MCAP.
 ///
 /// # Errors
-/// Output creation/writing, or a read error other than a time-out or a
-/// closed peer.
+/// Output creation/writing, a read error other than a time-out or a
+/// closed peer, and under `strict` the first bad frame
+/// ([`SimError::TelemetryStream`], with its byte offset).
 pub fn record<R: Read>(
     mut src: R,
     out: &Path,
@@ -65,33 +78,37 @@ pub fn record<R: Read>(
     if !(opts.f_timer_hz.is_finite() && opts.f_timer_hz > 0.0) {
         return Err(SimError::BadTimer(opts.f_timer_hz));
     }
-    let mcap_err = mcap_at(out);
     // Written under a temporary name and renamed once the footer is on; a
     // SIGINT/SIGTERM stops the reading like the end of the stream does.
     let _listener = crate::atomic::listen();
-    let mut staged = crate::atomic::Staged::new();
-    let (_, file) = staged.file(out).map_err(io_at(out))?;
-    let mut w = mcap::WriteOptions::new()
-        .compression(Some(mcap::Compression::Zstd))
-        .profile("")
-        .create(BufWriter::new(file))
-        .map_err(&mcap_err)?;
-    let mut meta = BTreeMap::new();
-    meta.insert("source".to_string(), "rig telemetry".to_string());
-    let control = add_json_channel(&mut w, Channel::Control, &meta).map_err(&mcap_err)?;
-    let stepper = add_json_channel(&mut w, Channel::Stepper, &meta).map_err(&mcap_err)?;
-
+    let mut rec = Recording::create(
+        out,
+        &RecordingMeta {
+            frame_version: ivt_wire::telemetry::TELEMETRY_VERSION,
+            ppr: opts.ppr,
+            f_timer_hz: opts.f_timer_hz,
+            plant: None,
+            source: "rig telemetry".into(),
+        },
+    )?;
+    let mut sink = Sink {
+        rec: &mut rec,
+        clock: Unwrap::default(),
+        f_timer_hz: opts.f_timer_hz,
+        frames: 0,
+        bad: 0,
+        first_bad: None,
+        t_last: 0.0,
+        version: 0,
+        strict: opts.strict,
+    };
     let mut dec = Decoder::new();
-    let mut buf = [0u8; 512];
-    let (mut frames, mut bad) = (0u64, 0u64);
-    let mut clock = Unwrap::default();
+    // A pty holds ~4 KiB: drain all of it per read, so a recorder that gets
+    // little CPU (a loaded machine) still empties it before it overflows.
+    let mut buf = [0u8; 4096];
     let mut last_byte = Instant::now();
-    let mut t_last = 0.0;
     'read: loop {
-        if crate::atomic::interrupted() {
-            break;
-        }
-        if opts.max_frames.is_some_and(|m| frames >= m) {
+        if crate::atomic::interrupted() || opts.max_frames.is_some_and(|m| sink.frames >= m) {
             break;
         }
         let n = match src.read(&mut buf) {
@@ -116,49 +133,114 @@ pub fn record<R: Read>(
         };
         last_byte = Instant::now();
         for &b in &buf[..n] {
-            let Some(frame) = dec.push(b) else { continue };
-            let Ok(sample) = frame.and_then(|f| Telemetry::decode(f.kind, f.payload)) else {
-                bad += 1;
+            if dec.skips(b) {
+                // Bytes between frames: an error in a stored capture; on a
+                // live port the line noise before the first frame is normal.
+                if opts.strict {
+                    sink.bad(dec.position(), StreamProblem::Garbage)?;
+                }
+                dec.push(b);
                 continue;
-            };
-            let t = clock.ticks(sample.time_ticks) as f64 / opts.f_timer_hz;
-            t_last = t;
-            let ns = (t * 1e9).round() as u64;
-            let ctl = serde_json::json!({
-                "t": t, "ticks": sample.time_ticks, "omega": finite(sample.omega),
-                "omega_a": finite(sample.omega_a), "r": finite(sample.r), "fault": sample.fault,
-            });
-            let stp = serde_json::json!({ "t": t, "position": sample.stepper_position });
-            for (id, msg) in [(control, ctl), (stepper, stp)] {
-                let header = mcap::records::MessageHeader {
-                    channel_id: id,
-                    sequence: frames as u32,
-                    log_time: ns,
-                    publish_time: ns,
-                };
-                w.write_to_known_channel(&header, msg.to_string().as_bytes())
-                    .map_err(&mcap_err)?;
             }
-            frames += 1;
-            if opts.max_frames.is_some_and(|m| frames >= m) {
+            let offset = dec.frame_start();
+            let Some(frame) = dec.push(b) else { continue };
+            match frame.and_then(|f| TelemetryFrame::decode(f.kind, f.payload)) {
+                Ok(f) => sink.frame(f)?,
+                Err(e) => sink.bad(offset, StreamProblem::Frame(e))?,
+            }
+            if opts.max_frames.is_some_and(|m| sink.frames >= m) {
                 break 'read;
             }
         }
     }
-    w.finish().map_err(&mcap_err)?;
-    drop(w);
-    staged.commit().map_err(io_at(out))?;
+    if dec.in_frame() && opts.max_frames.is_none_or(|m| sink.frames < m) {
+        sink.bad(dec.frame_start(), StreamProblem::Truncated)?;
+    }
+    let (frames, bad, first_bad, t_last, version) = (
+        sink.frames,
+        sink.bad,
+        sink.first_bad,
+        sink.t_last,
+        sink.version,
+    );
+    rec.set_frame_version(version);
+    let channels = rec.finish()?;
     Ok(RecordSummary {
         frames,
         bad_frames: bad,
+        first_bad_offset: first_bad,
         duration_s: t_last,
-        channels: [
-            ("/control".to_string(), frames),
-            ("/stepper".to_string(), frames),
-        ]
-        .into(),
+        frame_version: version,
+        channels,
         out: out.to_path_buf(),
     })
+}
+
+/// Where decoded frames go.
+struct Sink<'a> {
+    rec: &'a mut Recording,
+    clock: Unwrap,
+    f_timer_hz: f64,
+    frames: u64,
+    bad: u64,
+    first_bad: Option<usize>,
+    t_last: f64,
+    version: u8,
+    strict: bool,
+}
+
+impl Sink<'_> {
+    fn t(&mut self, ticks: u32) -> f64 {
+        self.clock.ticks(ticks) as f64 / self.f_timer_hz
+    }
+
+    fn bad(&mut self, offset: usize, problem: StreamProblem) -> Result<(), SimError> {
+        if self.strict {
+            return Err(SimError::TelemetryStream(StreamError { offset, problem }));
+        }
+        self.bad += 1;
+        self.first_bad.get_or_insert(offset);
+        Ok(())
+    }
+
+    fn frame(&mut self, f: TelemetryFrame) -> Result<(), SimError> {
+        if !matches!(f, TelemetryFrame::Sample(_)) {
+            self.version = self.version.max(ivt_wire::telemetry::TELEMETRY_VERSION);
+        }
+        match f {
+            TelemetryFrame::Sample(s) => self.sample(&s),
+            TelemetryFrame::Pulses(b) => {
+                let ticks = b.edges();
+                let t: Vec<f64> = ticks.iter().map(|&k| self.t(k)).collect();
+                self.rec.pulses(&t, ticks)
+            }
+            TelemetryFrame::Stage(s) => {
+                let t = self.t(s.time_ticks);
+                self.rec
+                    .stage(t, s.sequence, s.index, s.theta_ct_deg, s.hold)
+            }
+        }
+    }
+
+    fn sample(&mut self, s: &TelemetrySample) -> Result<(), SimError> {
+        let t = self.t(s.time_ticks);
+        self.t_last = t;
+        let v = if s.inputs.is_some() { 2 } else { 1 };
+        self.version = self.version.max(v);
+        let ctl = serde_json::json!({
+            "t": t, "ticks": s.time_ticks, "omega": finite(s.omega),
+            "omega_a": finite(s.omega_a), "r": finite(s.r), "fault": s.fault,
+        });
+        self.rec.json("control", t, &ctl)?;
+        let stp = serde_json::json!({ "t": t, "position": s.stepper_position });
+        self.rec.json("stepper", t, &stp)?;
+        if let Some([v_m, t_u]) = s.inputs {
+            let sen = serde_json::json!({ "t": t, "v_m": finite(v_m), "t_u": finite(t_u) });
+            self.rec.json("sensors", t, &sen)?;
+        }
+        self.frames += 1;
+        Ok(())
+    }
 }
 
 /// NaN/∞ as JSON `null`, like the simulator's logs.
@@ -166,17 +248,18 @@ fn finite(x: f32) -> Option<f32> {
     x.is_finite().then_some(x)
 }
 
-/// Unwraps u32 timer ticks into a monotonic count from the first frame.
+/// Unwraps u32 timer ticks into a count from the first frame, by signed
+/// differences (steps of less than 2³¹ ticks either way).
 #[derive(Default)]
 struct Unwrap {
     last: Option<u32>,
-    total: u64,
+    total: i64,
 }
 
 impl Unwrap {
-    fn ticks(&mut self, now: u32) -> u64 {
+    fn ticks(&mut self, now: u32) -> i64 {
         if let Some(last) = self.last {
-            self.total += u64::from(now.wrapping_sub(last));
+            self.total += i64::from(now.wrapping_sub(last) as i32);
         }
         self.last = Some(now);
         self.total
@@ -187,9 +270,9 @@ impl Unwrap {
 mod tests {
     use super::*;
 
-    fn frame(t: &Telemetry) -> Vec<u8> {
+    fn frame(t: &TelemetrySample) -> Vec<u8> {
         let mut b = [0u8; 64];
-        let n = t.encode(&mut b).unwrap();
+        let n = TelemetryFrame::Sample(*t).encode(&mut b).unwrap();
         b[..n].to_vec()
     }
 
@@ -198,11 +281,12 @@ mod tests {
         let mut bytes = vec![0x00, 0x13];
         let mut sent = 0;
         for k in 0..50u32 {
-            let s = Telemetry {
+            let s = TelemetrySample {
                 time_ticks: 0xFFFF_FF00u32.wrapping_add(k * 100), // wraps at k = 3
                 omega: 10.0,
                 omega_a: if k < 5 { f32::NAN } else { 10.5 },
                 r: 0.001 * k as f32,
+                inputs: Some([8.0, 6.0]),
                 stepper_position: k as i32,
                 fault: 0,
             };
@@ -221,6 +305,8 @@ mod tests {
             f_timer_hz: 1.0e6,
             max_frames: None,
             idle_timeout: Duration::from_millis(100),
+            ppr: 1200,
+            strict: false,
         };
         let s = record(&bytes[..], &out, &opts).unwrap();
         assert_eq!((s.frames, s.bad_frames), (sent, 1));
@@ -246,11 +332,12 @@ mod tests {
     fn max_frames_stops_early() {
         let mut bytes = vec![];
         for k in 0..10 {
-            bytes.extend(frame(&Telemetry {
+            bytes.extend(frame(&TelemetrySample {
                 time_ticks: k,
                 omega: 1.0,
                 omega_a: 1.0,
                 r: 0.0,
+                inputs: None,
                 stepper_position: 0,
                 fault: 0,
             }));
@@ -261,8 +348,109 @@ mod tests {
             f_timer_hz: 1.0,
             max_frames: Some(4),
             idle_timeout: Duration::from_millis(100),
+            ppr: 1200,
+            strict: false,
         };
         assert_eq!(record(&bytes[..], &out, &opts).unwrap().frames, 4);
+        let _ = std::fs::remove_file(&out);
+    }
+
+    fn opts(strict: bool) -> RecordOptions {
+        RecordOptions {
+            f_timer_hz: 1.0e6,
+            max_frames: None,
+            idle_timeout: Duration::from_millis(100),
+            ppr: 1200,
+            strict,
+        }
+    }
+
+    /// The committed v1 capture of ivt-wire (20 frames, written by an
+    /// independent Python encoder) records into /control and /stepper; cut
+    /// inside its 4th frame, a strict read names byte offset 78 and writes
+    /// no file, a lenient one keeps the 3 whole frames and counts the rest.
+    #[test]
+    fn v1_capture_records_and_a_truncated_one_names_the_offset() {
+        let v1: &[u8] = include_bytes!("../../ivt-wire/tests/data/telemetry_v1.bin");
+        let dir = std::env::temp_dir().join(format!("ivt-telemetry-v1-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let out = dir.join("v1.mcap");
+        let s = record(v1, &out, &opts(true)).unwrap();
+        assert_eq!((s.frames, s.bad_frames, s.frame_version), (20, 0, 1));
+        assert_eq!(s.channels["/control"], 20);
+        assert!(
+            !s.channels.contains_key("/sensors"),
+            "v1 frames carry no inputs"
+        );
+
+        let cut = dir.join("cut.mcap");
+        let err = record(&v1[..3 * 26 + 10], &cut, &opts(true)).unwrap_err();
+        assert!(err.to_string().contains("byte offset 78"), "{err}");
+        assert!(!cut.exists(), "no recording from a bad capture");
+        let s = record(&v1[..3 * 26 + 10], &cut, &opts(false)).unwrap();
+        assert_eq!(
+            (s.frames, s.bad_frames, s.first_bad_offset),
+            (3, 1, Some(78))
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Pulse-log and stage frames become /pulses and /sequence messages, in
+    /// seconds from the first frame.
+    #[test]
+    fn pulse_log_and_stage_frames_are_recorded() {
+        use ivt_ctrl::commission::SequenceName;
+        use ivt_wire::{PulseBatch, StageStart};
+        let mut bytes = frame(&TelemetrySample {
+            time_ticks: 1_000,
+            omega: 1.0,
+            omega_a: 1.0,
+            r: 0.0,
+            inputs: Some([8.0, 6.0]),
+            stepper_position: 0,
+            fault: 0,
+        });
+        let mut b = [0u8; 300];
+        let n = TelemetryFrame::Stage(StageStart {
+            time_ticks: 1_500,
+            sequence: SequenceName::Hold,
+            index: 0,
+            theta_ct_deg: 1000.0,
+            hold: true,
+            pulse_log: true,
+        })
+        .encode(&mut b)
+        .unwrap();
+        bytes.extend_from_slice(&b[..n]);
+        let mut batch = PulseBatch::new(0);
+        for k in 0..5 {
+            batch.push(900 + 100 * k); // the first edge is older than the sample
+        }
+        let n = TelemetryFrame::Pulses(batch).encode(&mut b).unwrap();
+        bytes.extend_from_slice(&b[..n]);
+        let out =
+            std::env::temp_dir().join(format!("ivt-telemetry-log-{}.mcap", std::process::id()));
+        let s = record(&bytes[..], &out, &opts(true)).unwrap();
+        assert_eq!(s.channels["/pulses"], 1);
+        assert_eq!(s.channels["/sequence"], 1);
+        let data = std::fs::read(&out).unwrap();
+        for m in mcap::MessageStream::new(&data).unwrap() {
+            let m = m.unwrap();
+            let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
+            match m.channel.topic.as_str() {
+                "/pulses" => {
+                    assert_eq!(v["t"][0].as_f64().unwrap(), -100e-6);
+                    assert_eq!(v["t"][4].as_f64().unwrap(), 300e-6);
+                    assert_eq!(v["ticks"][4], 1300);
+                }
+                "/sequence" => {
+                    assert_eq!(v["name"], "hold");
+                    assert_eq!(v["t"].as_f64().unwrap(), 500e-6);
+                    assert_eq!(v["hold"], true);
+                }
+                _ => {}
+            }
+        }
         let _ = std::fs::remove_file(&out);
     }
 }

@@ -27,6 +27,13 @@ pub enum WireError {
     UnknownKind(u8),
     /// A field that is not a valid value (an enum code out of range).
     BadValue,
+    /// A known kind whose version byte this side does not read.
+    UnsupportedVersion {
+        /// The frame kind.
+        kind: u8,
+        /// Its version byte.
+        version: u8,
+    },
     /// A known kind with the wrong payload length.
     BadLength {
         /// The frame kind.
@@ -44,6 +51,12 @@ impl core::fmt::Display for WireError {
             WireError::PayloadTooLong => write!(f, "payload longer than {MAX_PAYLOAD} bytes"),
             WireError::BadValue => write!(f, "field value out of range"),
             WireError::UnknownKind(k) => write!(f, "unknown frame kind 0x{k:02x}"),
+            WireError::UnsupportedVersion { kind, version } => {
+                write!(
+                    f,
+                    "frame kind 0x{kind:02x} in unsupported version {version}"
+                )
+            }
             WireError::BadLength { kind, len } => {
                 write!(f, "frame kind 0x{kind:02x} with wrong payload length {len}")
             }
@@ -123,6 +136,9 @@ pub struct Decoder {
     len: u8,
     fill: usize,
     crc_lo: u8,
+    /// Bytes pushed so far, and the offset of the current frame's SYNC.
+    pos: usize,
+    start: usize,
     buf: [u8; MAX_PAYLOAD],
 }
 
@@ -141,15 +157,47 @@ impl Decoder {
             len: 0,
             fill: 0,
             crc_lo: 0,
+            pos: 0,
+            start: 0,
             buf: [0; MAX_PAYLOAD],
         }
     }
 
+    /// Byte offset (counted from the first byte pushed) of the SYNC of the
+    /// frame being read, or of the last one completed.
+    #[must_use]
+    pub fn frame_start(&self) -> usize {
+        self.start
+    }
+
+    /// Bytes pushed so far (the offset of the next byte).
+    #[must_use]
+    pub fn position(&self) -> usize {
+        self.pos
+    }
+
+    /// True while a frame has started but is not complete (a stream that
+    /// ends now is truncated at [`Decoder::frame_start`]).
+    #[must_use]
+    pub fn in_frame(&self) -> bool {
+        self.state != State::Hunt
+    }
+
+    /// True if the decoder is between frames and `byte` cannot start one
+    /// (a byte that a strict reader calls garbage).
+    #[must_use]
+    pub fn skips(&self, byte: u8) -> bool {
+        self.state == State::Hunt && byte != SYNC
+    }
+
     /// Feeds one byte; returns a frame (or a CRC error) when one is complete.
     pub fn push(&mut self, byte: u8) -> Option<Result<RawFrame<'_>, WireError>> {
+        let at = self.pos;
+        self.pos = self.pos.wrapping_add(1);
         match self.state {
             State::Hunt => {
                 if byte == SYNC {
+                    self.start = at;
                     self.state = State::Kind;
                 }
             }

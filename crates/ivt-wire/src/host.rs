@@ -16,7 +16,7 @@ use std::process::{Child, ChildStdout, Command, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
-use ivt_ctrl::{Config, ControlOutput};
+use ivt_ctrl::{Config, ControlOutput, Plan, Selection};
 
 use crate::frame::{Decoder, WireError, MAX_FRAME};
 use crate::msg::{Reply, Request, VERSION};
@@ -334,6 +334,33 @@ impl QemuPil {
             Reply::Output(o) => Ok(o),
             got => Err(PilError::Protocol {
                 expected: "Output",
+                got,
+            }),
+        }
+    }
+
+    /// Starts the commissioning sequences `selection` of `plan` on the next
+    /// pulse; pulses are then answered by [`QemuPil::sequenced_pulse`].
+    ///
+    /// # Errors
+    /// As [`QemuPil::call`], or a reply other than `Ack`.
+    pub fn commission(&mut self, selection: Selection, plan: &Plan) -> Result<(), PilError> {
+        let req = Request::Commission {
+            selection,
+            plan: *plan,
+        };
+        self.expect_ack(&req, "Ack to Commission")
+    }
+
+    /// One encoder pulse while a sequence runs: the `Sequenced` reply.
+    ///
+    /// # Errors
+    /// As [`QemuPil::call`], or a reply other than `Sequenced`.
+    pub fn sequenced_pulse(&mut self, ticks: u32) -> Result<Reply, PilError> {
+        match self.call(&Request::Pulse { ticks })? {
+            r @ Reply::Sequenced { .. } => Ok(r),
+            got => Err(PilError::Protocol {
+                expected: "Sequenced",
                 got,
             }),
         }

@@ -4,7 +4,11 @@
 //! 0x29B1 is asserted in `frame::tests`).
 
 use ivt_ctrl::{Config, ControlOutput};
-use ivt_wire::{crc16, ErrorCode, Reply, Request, Telemetry, MAX_FRAME};
+use ivt_ctrl::{Plan, Selection, SequenceName};
+use ivt_wire::{
+    crc16, ErrorCode, PulseBatch, Reply, Request, StageStart, TelemetryFrame, TelemetrySample,
+    MAX_FRAME,
+};
 
 /// (kind, payload length) of an encoded frame, after checking the layout.
 fn kind_and_len(encode: impl FnOnce(&mut [u8]) -> usize) -> (u8, usize) {
@@ -30,7 +34,7 @@ fn frame_table_kinds_and_payload_lengths() {
     assert_eq!(req(Request::Configure(Config::default())), (0x05, 172));
     assert_eq!(
         rep(Reply::Hello {
-            version: 1,
+            version: 2,
             ppr: 1200
         }),
         (0x81, 6)
@@ -38,15 +42,58 @@ fn frame_table_kinds_and_payload_lengths() {
     assert_eq!(rep(Reply::Output(ControlOutput::IDLE)), (0x82, 31));
     assert_eq!(rep(Reply::Ack), (0x83, 0));
     assert_eq!(rep(Reply::Error(1)), (0x8F, 1));
-    let t = Telemetry {
+    assert_eq!(
+        req(Request::Commission {
+            selection: Selection::ALL,
+            plan: Plan::default()
+        }),
+        (0x06, 138)
+    );
+    assert_eq!(
+        rep(Reply::Sequenced {
+            out: ControlOutput::IDLE,
+            stage: 0,
+            started: true,
+            pulse_log: false,
+            done: false
+        }),
+        (0x84, 36)
+    );
+    let tel = |f: TelemetryFrame| kind_and_len(|b| f.encode(b).unwrap());
+    let sample = TelemetrySample {
         time_ticks: 1,
         omega: 10.0,
         omega_a: 10.0,
         r: 0.005,
+        inputs: Some([8.0, 6.0]),
         stepper_position: -3,
         fault: 0,
     };
-    assert_eq!(kind_and_len(|b| t.encode(b).unwrap()), (0x90, 21));
+    assert_eq!(tel(TelemetryFrame::Sample(sample)), (0x91, 30));
+    let mut batch = PulseBatch::new(0);
+    for k in 0..60 {
+        batch.push(k);
+    }
+    assert_eq!(tel(TelemetryFrame::Pulses(batch)), (0x92, 6 + 4 * 60));
+    let stage = StageStart {
+        time_ticks: 0,
+        sequence: SequenceName::Sweep,
+        index: 0,
+        theta_ct_deg: 0.0,
+        hold: true,
+        pulse_log: false,
+    };
+    assert_eq!(tel(TelemetryFrame::Stage(stage)), (0x93, 13));
+    // Every v2 telemetry frame starts its payload with the version byte 2.
+    let mut buf = [0u8; MAX_FRAME];
+    for f in [
+        TelemetryFrame::Sample(sample),
+        TelemetryFrame::Pulses(batch),
+        TelemetryFrame::Stage(stage),
+    ] {
+        f.encode(&mut buf).unwrap();
+        assert_eq!(buf[3], 2);
+    }
 }
 
 /// The Error frame's codes: 1 CRC, 2 unknown kind, 3 length, 4 bad value.

@@ -1,7 +1,10 @@
 //! STM32F411 rig image. Interrupts (lower number = more urgent):
 //! - TIM2 (priority 0): encoder edge captured on CH1 → `ivt_fw_pulse`.
 //! - TIM3 (priority 1): step generator tick → step/dir pins.
-//! - thread mode: ADC → `update_inputs` every ms, telemetry on USART1, fault LED.
+//! - thread mode: ADC → `update_inputs` every ms, telemetry on USART1, fault LED,
+//!   and requests from the host on USART1 RX: `Commission` starts the
+//!   commissioning sequences (`ivt_ctrl::commission`), run from here on by
+//!   the TIM2 ISR; stage starts and the logged edges go out as telemetry.
 //!
 //! The controller is shared in a `Mutex<RefCell<..>>`; TIM3 and the thread
 //! mode take it inside `interrupt::free`, which delays (never loses) the
@@ -14,9 +17,15 @@ use core::cell::RefCell;
 use cortex_m::interrupt::{free, Mutex};
 use cortex_m_rt::entry;
 use defmt_rtt as _;
+use ivt_ctrl::commission::{Sequencer, Stage};
 use ivt_ctrl::{ControlOutput, Fault};
-use ivt_firmware::app::{ivt_fw_pulse, take_controller, ByteSink, Ctrl, TelemetryTx};
+use ivt_firmware::app::{
+    ivt_fw_pulse, ivt_fw_sequenced_pulse, take_controller, ByteSink, Ctrl, TelemetryTx,
+};
 use ivt_firmware::board::rig::{self, F_TIMER_HZ, STEP_TICK_HZ, T_U_SCALE, V_M_SCALE};
+use ivt_wire::frame::Decoder;
+use ivt_wire::telemetry::PulseBatch;
+use ivt_wire::Request;
 use stm32f4xx_hal::{
     adc::{config::AdcConfig, config::SampleTime, Adc},
     gpio::{Output, PushPull, PB0, PB1},
@@ -34,12 +43,33 @@ struct Shared {
     step: PB0<Output<PushPull>>,
     dir: PB1<Output<PushPull>>,
     step_high: bool,
+    /// The running commissioning sequence.
+    seq: Option<Sequencer>,
+    /// A stage that started (with its pulse's timestamp), not announced yet.
+    started: Option<(Stage, u32)>,
+    /// Edges logged by the TIM2 ISR in a pulse-log stage, not sent yet.
+    log: PulseBatch,
+    /// Edges that did not fit in `log` before thread mode sent it.
+    log_lost: u32,
 }
 
 static SHARED: Mutex<RefCell<Option<Shared>>> = Mutex::new(RefCell::new(None));
 
 /// USART1 transmit through the PAC (the HAL configured pins and baud rate).
 struct Usart1;
+
+/// The byte USART1 received, if one is waiting (PAC; RE enabled at start).
+fn usart1_read() -> Option<u8> {
+    // SAFETY: USART1 is owned by this image; this reads its RX side only.
+    let u = unsafe { &*pac::USART1::ptr() };
+    let sr = u.sr().read();
+    if sr.ore().bit_is_set() || sr.rxne().bit_is_set() {
+        // Reading DR clears RXNE (and, after SR, an overrun).
+        Some(u.dr().read().bits() as u8)
+    } else {
+        None
+    }
+}
 
 impl ByteSink for Usart1 {
     fn write_all(&mut self, bytes: &[u8]) {
@@ -87,6 +117,10 @@ fn main() -> ! {
     else {
         halt()
     };
+    let _rx_pin = gpioa.pa10.into_alternate::<7>();
+    // SAFETY: turns on the receiver of the USART1 the HAL just configured.
+    unsafe { (*pac::USART1::ptr()).cr1().modify(|_, w| w.re().set_bit()) };
+    let mut requests = Decoder::new();
     let mut telemetry = TelemetryTx::new(Usart1);
     let mut led = gpioc.pc13.into_push_pull_output(); // active low on the Black Pill
     led.set_high();
@@ -104,6 +138,10 @@ fn main() -> ! {
             step: gpiob.pb0.into_push_pull_output(),
             dir: gpiob.pb1.into_push_pull_output(),
             step_high: false,
+            seq: None,
+            started: None,
+            log: PulseBatch::new(0),
+            log_lost: 0,
         }));
     });
     // SAFETY: priorities are set before the interrupts are unmasked.
@@ -121,15 +159,41 @@ fn main() -> ! {
 
     let mut n: u32 = 0;
     loop {
+        let mut commission = None;
+        while let Some(b) = usart1_read() {
+            if let Some(Ok(f)) = requests.push(b) {
+                if let Ok(Request::Commission { selection, plan }) =
+                    Request::decode(f.kind, f.payload)
+                {
+                    commission = Some(Sequencer::new(plan, selection, F_TIMER_HZ as f32));
+                }
+            }
+        }
         let v_m = V_M_SCALE.apply(adc.convert(&v_m_pin, SampleTime::Cycles_480));
         let t_u = T_U_SCALE.apply(adc.convert(&t_u_pin, SampleTime::Cycles_480));
         let snapshot = free(|cs| {
             let mut guard = SHARED.borrow(cs).try_borrow_mut().ok()?;
             let s = guard.as_mut()?;
             s.ctrl.update_inputs(v_m, t_u);
-            Some((s.last, s.position, s.overcaptures))
+            if commission.is_some() {
+                s.seq = commission;
+            }
+            let log = s.log;
+            let next = log
+                .first
+                .wrapping_add(u32::from(log.len))
+                .wrapping_add(s.log_lost);
+            s.log = PulseBatch::new(next);
+            s.log_lost = 0;
+            Some((s.last, s.position, s.overcaptures, s.started.take(), log))
         });
-        if let Some((last, position, overcaptures)) = snapshot {
+        if let Some((last, position, overcaptures, started, log)) = snapshot {
+            for &edge in log.edges() {
+                telemetry.log_pulse(edge);
+            }
+            if let Some((stage, at)) = started {
+                telemetry.stage(&stage, at);
+            }
             let out = last.unwrap_or(ControlOutput::IDLE);
             if out.fault == Fault::None && overcaptures == 0 {
                 led.set_high();
@@ -140,7 +204,8 @@ fn main() -> ! {
             if n % rig::TELEMETRY_EVERY == 0 {
                 // SAFETY: read-only access to the free-running TIM2 counter.
                 let now = unsafe { (*pac::TIM2::ptr()).cnt().read().bits() };
-                telemetry.send(now, &out, position);
+                telemetry.flush_pulses();
+                telemetry.sample(now, &out, [v_m, t_u], position);
                 if out.fault != Fault::None {
                     defmt::warn!("fault {}", out.fault as u8);
                 }
@@ -168,7 +233,20 @@ fn TIM2() {
     free(|cs| {
         if let Ok(mut guard) = SHARED.borrow(cs).try_borrow_mut() {
             if let Some(s) = guard.as_mut() {
-                s.last = Some(ivt_fw_pulse(s.ctrl, ticks));
+                let out = match s.seq.as_mut() {
+                    Some(seq) => {
+                        let st = ivt_fw_sequenced_pulse(seq, s.ctrl, ticks);
+                        if let Some(stage) = st.started {
+                            s.started = Some((stage, ticks));
+                        }
+                        if st.pulse_log && !s.log.push(ticks) {
+                            s.log_lost = s.log_lost.wrapping_add(1);
+                        }
+                        st.out
+                    }
+                    None => ivt_fw_pulse(s.ctrl, ticks),
+                };
+                s.last = Some(out);
                 s.overcaptures = s.overcaptures.wrapping_add(overcapture as u32);
             }
         }
