@@ -245,7 +245,7 @@ user_system_fn! {
 /// (default: x = (`amplitude`, 0, ...), v = 0) integrated until it settles
 /// onto the attractor (Dormand–Prince 5(4); settled when a section crossing
 /// returns within 1e-6), then refined by HB (ivt_hb::limit_cycle_from_state;
-/// a transient that comes to rest raises ValueError naming the equilibrium).
+/// a transient that comes to rest raises ivt.hb.ConvergenceError naming the equilibrium).
 /// g(x, v, theta): theta is the phase ω t (an autonomous g ignores it);
 /// `vectorized` and `jac` as in `solve`.
 /// Returns {"omega", "period", "coeffs", "multipliers" ([[re, im], ...],

@@ -53,7 +53,8 @@ def test_limit_cycle_start_errors():
     g = lambda x, v, th: x * x * v
     with pytest.raises(ValueError, match="not both"):
         hb.limit_cycle(1.0, -1.0, 1.0, g, 1.0, guess=np.zeros(41) + 0.1, x0=[1.0, 0.0], n=20)
-    with pytest.raises(ValueError, match="equilibrium"):  # μ < 0: the origin attracts
+    # μ < 0: the origin attracts; no cycle on valid input is "failed" (SPEC §6)
+    with pytest.raises(hb.ConvergenceError, match="equilibrium"):
         hb.limit_cycle(1.0, 0.5, 1.0, lambda x, v, th: -0.5 * x * x * v, 1.0, x0=[0.5, 0.0])
     with pytest.raises(ValueError, match="x0"):
         hb.limit_cycle(1.0, -1.0, 1.0, g, 1.0, x0=[np.nan, 0.0])

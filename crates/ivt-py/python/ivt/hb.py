@@ -146,9 +146,17 @@ def _dense_dofs(entry, n_dof, amplitude_dof, record_dofs):
         entry["amplitude"] = _series_max(blocks[amplitude_dof])
 
 
-def _large_call(native_name, bound, extra):
+def _large_call(native_name, sig, args, kwargs, extra):
+    known = {k: v for k, v in kwargs.items() if k in sig.parameters}
+    try:
+        bound = sig.bind(*args, **known)
+    except TypeError as e:
+        raise TypeError(f"{native_name}: {e}") from None
+    # What the caller gave (the condensed path's own defaults apply to the
+    # rest), including the path keywords the native signature lacks.
+    given = {**bound.arguments, **{k: v for k, v in kwargs.items() if k not in known}}
+    bound.apply_defaults()
     a = _Namespace(**bound.arguments)
-    given = bound.arguments
     dofs = extra.get("nonlinear_dofs")
     if dofs is None:
         raise ValueError(
@@ -192,12 +200,9 @@ def _with_large(native):
     def call(*args, nonlinear_dofs=None, amplitude_dof=None, record_dofs=None, **kwargs):
         extra = dict(nonlinear_dofs=nonlinear_dofs, amplitude_dof=amplitude_dof, record_dofs=record_dofs)
         bound = sig.bind_partial(*args, **{k: v for k, v in kwargs.items() if k in sig.parameters})
-        unknown = [k for k in kwargs if k not in sig.parameters]
         m, f = bound.arguments.get("m"), bound.arguments.get("f")
         if _is_large(m, f, extra):
-            for key in unknown:
-                bound.arguments[key] = kwargs[key]
-            return _large_call(native.__name__, bound, extra)
+            return _large_call(native.__name__, sig, args, kwargs, extra)
         out = native(*args, **kwargs)
         if amplitude_dof is not None or record_dofs is not None:
             n_dof = _np.atleast_2d(_np.asarray(m, dtype=float)).shape[0]
