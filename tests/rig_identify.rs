@@ -1,7 +1,8 @@
-//! The rig loop (issue #29): a simulated rig commissioned, its recording
-//! identified by `ivt rig identify`, the plant file used by the design tools.
-
-mod rig_sim;
+//! The rig loop (issue #29): a simulated rig commissioned by `ivt rig
+//! commission --sim --plant-file P.toml` (SIL: the sequences of
+//! `ivt_ctrl::commission` run by the controller in the simulator's loop), its
+//! recording identified by `ivt rig identify`, the plant file used by the
+//! design tools.
 
 use ivt_kin::plant::PlantParams;
 use ivt_sim::scene::{PlantSection, PresetName};
@@ -58,6 +59,31 @@ fn plant_body(p: &PlantParams) -> String {
     text.lines().skip(1).collect::<Vec<_>>().join("\n")
 }
 
+/// `ivt rig commission --sim` (every sequence) on the plant whose `[plant]`
+/// table body is `plant_body`, with `sensors` (`ideal` or `realistic`):
+/// the recording's bytes.
+fn commission(dir: &Path, plant_body: &str, sensors: &str, seed: u64) -> Vec<u8> {
+    let plant = dir.join("rig_plant.toml");
+    std::fs::write(&plant, format!("[plant]\n{plant_body}\n")).unwrap();
+    let out = dir.join("commission.mcap");
+    let seed = seed.to_string();
+    let (code, v) = ivt(&[
+        "rig",
+        "commission",
+        "--sim",
+        "--plant-file",
+        plant.to_str().unwrap(),
+        "--sensors",
+        sensors,
+        "--seed",
+        &seed,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{v}");
+    std::fs::read(&out).unwrap()
+}
+
 fn identify(dir: &Path, mcap: &[u8]) -> Value {
     let rec = dir.join("run.mcap");
     std::fs::write(&rec, mcap).unwrap();
@@ -87,12 +113,10 @@ fn truth(p: &PlantParams) -> [(&'static str, f64); 4] {
 fn perturbed_plant_identified_within_2_percent_with_ideal_sensors() {
     let p = perturbed(29);
     let dir = scratch("ideal");
-    let v = identify(
-        &dir,
-        &rig_sim::commission(&plant_body(&p), rig_sim::Sensors::IDEAL, 1),
-    );
+    let v = identify(&dir, &commission(&dir, &plant_body(&p), "ideal", 1));
     for (name, want) in truth(&p) {
         let got = v["summary"][name].as_f64().unwrap();
+        eprintln!("{name}: {:+.3} %", 100.0 * (got / want - 1.0));
         assert!((got / want - 1.0).abs() < 0.02, "{name}: {got} vs {want}");
     }
 }
@@ -105,7 +129,7 @@ fn perturbed_plants_inside_the_95_percent_intervals_with_noisy_sensors() {
     for seed in [5, 7, 13, 29] {
         let p = perturbed(seed);
         let dir = scratch(&format!("noisy{seed}"));
-        let rec = rig_sim::commission(&plant_body(&p), rig_sim::Sensors::NOISY, seed);
+        let rec = commission(&dir, &plant_body(&p), "realistic", seed);
         let v = identify(&dir, &rec);
         for (name, want) in truth(&p) {
             let ci = &v["ci95"][name];
@@ -139,7 +163,7 @@ fn eq185(r_u_m: f64) -> f64 {
 #[test]
 fn printed_plant_reproduces_eq_185_slope_and_the_k_chain() {
     let dir = scratch("printed");
-    let v = identify(&dir, &rig_sim::commission("", rig_sim::Sensors::IDEAL, 3));
+    let v = identify(&dir, &commission(&dir, "", "ideal", 3));
     let s = &v["sweep"];
     let slope = s["r_avg_slope_per_deg"].as_f64().unwrap();
     let want = eq185(0.0222);
@@ -169,7 +193,7 @@ fn printed_plant_reproduces_eq_185_slope_and_the_k_chain() {
 
     // With r_u = r_OG = 1.5″ the slope is the printed 7/27492 per degree.
     let dir = scratch("r_og");
-    let rec = rig_sim::commission("r_u = 0.0381", rig_sim::Sensors::IDEAL, 3);
+    let rec = commission(&dir, "r_u = 0.0381", "ideal", 3);
     let v = identify(&dir, &rec);
     let slope = v["sweep"]["r_avg_slope_per_deg"].as_f64().unwrap();
     assert!((slope / (7.0 / 27492.0) - 1.0).abs() < 0.01, "{slope}");
@@ -180,7 +204,7 @@ fn printed_plant_reproduces_eq_185_slope_and_the_k_chain() {
 #[test]
 fn truncated_or_corrupt_recording_names_the_byte_offset() {
     let dir = scratch("corrupt");
-    let good = rig_sim::commission("", rig_sim::Sensors::IDEAL, 4);
+    let good = commission(&dir, "", "ideal", 4);
     let flip = |at: usize| {
         let mut b = good.clone();
         b[at] ^= 0x5a;
@@ -216,10 +240,7 @@ fn truncated_or_corrupt_recording_names_the_byte_offset() {
 fn identified_plant_file_round_trips_into_scenes_and_design_tools() {
     let p = perturbed(41);
     let dir = scratch("roundtrip");
-    let v = identify(
-        &dir,
-        &rig_sim::commission(&plant_body(&p), rig_sim::Sensors::IDEAL, 5),
-    );
+    let v = identify(&dir, &commission(&dir, &plant_body(&p), "ideal", 5));
     let file = dir.join("plant.toml");
     assert_eq!(v["plant_file"].as_str().unwrap(), file.to_str().unwrap());
     let back = PlantSection::from_file(&file).unwrap().params().unwrap();
