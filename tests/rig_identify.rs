@@ -307,3 +307,147 @@ fn identified_plant_file_round_trips_into_scenes_and_design_tools() {
         "{v}"
     );
 }
+
+/// The drive cycle's T_U per stage (scenes/drive.toml, Fig. 51: idle,
+/// start-up load, flat, uphill, downhill, stop) and where V_m sits in the
+/// band of each, as the fraction of r_max the law asks for (the scene's).
+const DRIVE: [(f64, f64); 6] = [
+    (1.5, 0.3),
+    (7.0, 0.7),
+    (4.0, 0.5),
+    (8.5, 0.8),
+    (2.0, 0.25),
+    (1.5, 0.4),
+];
+
+/// V_m of each drive stage for the rig whose law is `law`: r_f(V_m, T_U) =
+/// fraction·r_max (bisection on [6, 11] V; r_f rises with V_m at fixed
+/// ω0) — the set-points an engineer picks from the identified plant's band.
+fn drive_v_m(law: &ivt_design::fit::OpenLoopLaw) -> [f64; 6] {
+    DRIVE.map(|(t_u, frac)| {
+        let target = frac * law.r_max;
+        let (mut lo, mut hi) = (6.0, 11.0);
+        assert!(law.r_f(lo, t_u) < target && law.r_f(hi, t_u) > target);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if law.r_f(mid, t_u) < target {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    })
+}
+
+/// The drive cycle (scenes/drive.toml's six stages at the set-points
+/// `v_m`) on the TRUE plant `p`, run by the scene's law `kind` (`open`:
+/// Eq. 160 alone; `delay`: Eq. 180 with u_ol fed forward) with the
+/// coefficient set `law` (None: the scene's, fitted on the printed plant):
+/// per stage, ω_a's mean over the stage's last 2 s minus ω0 \[rpm\].
+fn drive_static_errors_rpm(
+    p: &PlantParams,
+    v_m: &[f64; 6],
+    kind: &str,
+    law: Option<&ivt_design::fit::OpenLoopLaw>,
+    ranges: ([f64; 2], [f64; 2]),
+) -> Vec<f64> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/drive.toml");
+    let src = std::fs::read_to_string(&path).unwrap();
+    let printed = "[plant]\npreset = \"printed\"\n";
+    assert!(src.contains(printed) && src.contains("law = \"delay\""));
+    let v_m_line = src.lines().find(|l| l.starts_with("v_m = ")).unwrap();
+    // The scene's knots: each stage's value from its start (a 1–2 s ramp
+    // after a stage change) to its end.
+    let [a, b, c, d, e, f] = *v_m;
+    let knots = format!(
+        "v_m = [[0.0, {a}], [5.0, {a}], [6.0, {b}], [12.0, {b}], [13.0, {c}], [24.0, {c}], \
+         [26.0, {d}], [38.0, {d}], [40.0, {e}], [50.0, {e}], [52.0, {f}]]"
+    );
+    let src = src
+        .replace(printed, &format!("[plant]\n{}\n", plant_body(p)))
+        .replace(v_m_line, &knots)
+        .replace("law = \"delay\"", &format!("law = \"{kind}\""));
+    let scene = ivt_sim::scene::Scene::parse(&src, "drive on the true plant").unwrap();
+    let mut config = ivt_sim::run::controller_config(&scene, p.r_max).unwrap();
+    if let Some(l) = law {
+        let ol = &mut config.open_loop;
+        ol.poly = l.poly.map(|row| row.map(|x| x as f32));
+        ol.boundary = l.boundary.map(|x| x as f32);
+        ol.r_max = l.r_max as f32;
+        ol.v_m_range = ranges.0.map(|x| x as f32);
+        ol.t_u_range = ranges.1.map(|x| x as f32);
+    }
+    let backend = ivt_sim::backend::sil(scene.encoder.ppr, config).unwrap();
+    let run = ivt_sim::run::Simulation::new(&scene)
+        .backend(backend)
+        .run()
+        .unwrap();
+    let control = run.channels.control.unwrap();
+    [5.0, 12.0, 24.0, 38.0, 50.0, 60.0]
+        .iter()
+        .map(|&end| {
+            let w: Vec<f64> = control
+                .iter()
+                .filter(|c| (end - 2.0..end).contains(&c.t))
+                .map(|c| f64::from(c.out.omega_a))
+                .collect();
+            assert!(w.len() > 100, "{} samples before {end} s", w.len());
+            (w.iter().sum::<f64>() / w.len() as f64) * 30.0 / std::f64::consts::PI - 100.0
+        })
+        .collect()
+}
+
+/// The last item of #29's acceptance: the open-loop law refitted on the
+/// identified plant (Eq. 158 form, `ivt_design::open_loop::fit_law`), run on
+/// the true perturbed plant through the drive cycle, holds ω_a within
+/// ±0.5 rpm of ω0 = 100 rpm after each stage's transient; the printed-plant
+/// design (the scene's law, fitted on Table 1) does not. The comparison is
+/// the open-loop law alone: with the integral law Eq. 180 both designs reach
+/// zero static error (the integrator removes any feed-forward error), so the
+/// plant knowledge shows in u_ol, the part of r that is designed from it.
+#[test]
+fn law_refitted_on_the_identified_plant_holds_omega0_where_the_printed_design_does_not() {
+    let p = perturbed(29);
+    let dir = scratch("redesign");
+    let v = identify(&dir, &commission(&dir, &plant_body(&p), "ideal", 1));
+    let file = dir.join("plant.toml");
+    assert_eq!(v["plant_file"].as_str().unwrap(), file.to_str().unwrap());
+    let identified = PlantSection::from_file(&file).unwrap().params().unwrap();
+    let grid = ivt_design::sweep::Grid {
+        v_m: ivt_design::sweep::range(6.0, 0.25, 11.0),
+        t_u: ivt_design::sweep::range(1.0, 1.0, 9.0),
+        omega0: ivt_design::rpm_to_rad_s(100.0),
+    };
+    let rep = ivt_design::open_loop::fit_law(
+        &identified,
+        &grid,
+        ivt_design::fit::PolyForm::Eq158,
+        ivt_design::steady::IhbOptions::default(),
+        || {},
+    )
+    .unwrap();
+    let ranges = ([6.0, 11.0], [1.0, 9.0]);
+    let v_m = drive_v_m(&rep.law);
+    let refit = drive_static_errors_rpm(&p, &v_m, "open", Some(&rep.law), ranges);
+    let printed = drive_static_errors_rpm(&p, &v_m, "open", None, ranges);
+    // Why the open-loop law is the comparison: Eq. 180's integrator takes
+    // the printed-plant design to ω0 as well (stages 2–6; stage 1, the
+    // start-up from rest, is still settling at 5 s).
+    let integral = drive_static_errors_rpm(&p, &v_m, "delay", None, ranges);
+    eprintln!("printed design with Eq. 180: {integral:+.3?}");
+    for (k, e) in integral.iter().enumerate().skip(1) {
+        assert!(
+            e.abs() < 0.05,
+            "stage {}: Eq. 180, printed u_ol: {e:+.3} rpm",
+            k + 1
+        );
+    }
+    eprintln!("drive V_m for the identified rig: {v_m:.3?}");
+    eprintln!("static error per stage [rpm]: refitted {refit:+.3?}; printed design {printed:+.3?}");
+    for (k, e) in refit.iter().enumerate() {
+        assert!(e.abs() < 0.5, "stage {}: refitted law {e:+.3} rpm", k + 1);
+    }
+    let worst = printed.iter().fold(0.0_f64, |m, e| m.max(e.abs()));
+    assert!(worst > 0.5, "printed design: {printed:?}");
+}
