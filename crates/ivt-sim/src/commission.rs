@@ -336,6 +336,7 @@ pub(crate) fn run_with<B: SequencedBackend + 'static>(
             ppr: scene.encoder.ppr as u32,
             f_timer_hz: scene.encoder.f_timer_hz,
             plant: Some(plant_json(&params)),
+            steps_per_rev: Some(scene.stepper.steps_per_rev),
             source: "simulated rig".into(),
         },
     )?;

@@ -53,6 +53,7 @@ fn sil_recording_follows_the_plan() {
     let (ch, meta) = read(&out);
     assert_eq!(meta["ppr"], "1200");
     assert_eq!(meta["frame_version"], "2");
+    assert_eq!(meta["steps_per_rev"].parse::<f64>().unwrap(), 3200.0);
     let plant: Value = serde_json::from_str(&meta["plant"]).unwrap();
     assert_eq!(plant["r_max"], 0.012);
 
