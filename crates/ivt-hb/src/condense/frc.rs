@@ -9,11 +9,10 @@ use super::branch::CondensedBranch;
 use super::estimate::truncation_error;
 use crate::aft::{eval_series, Aft};
 use crate::continuation::{
-    correct_at_fixed_lambda, pseudo_arclength_exact, turn_estimate, ContinuationOptions, PathPoint,
-    Termination,
+    correct_at_fixed_lambda, pseudo_arclength_exact, ContinuationOptions, PathPoint, Termination,
 };
 use crate::error::HbError;
-use crate::fold::{locate_fold, FoldOptions};
+use crate::frc::locate_turns;
 use crate::problem::PeriodicProblem;
 
 /// Options of a condensed frequency sweep.
@@ -165,28 +164,25 @@ pub fn condensed_response<P: PeriodicProblem>(
         return Err(e);
     }
     let mut folds = Vec::with_capacity(path.folds.len());
-    for turn in &path.folds {
-        let around = &path.points[turn.bracket..turn.bracket + 3];
-        let start = turn_estimate(&around[0], &around[1], &around[2]);
-        let located = locate_fold(branch, &start[..m], start[m], &FoldOptions::default()).ok();
+    for (turn, located) in path.folds.iter().zip(locate_turns(branch, &path)) {
         let fold = match located {
-            Some(f) => CondensedFold {
+            Some((coeffs, omega_f)) => CondensedFold {
                 index: turn.index,
-                omega_f: f.lambda,
-                amplitude: probe.amplitude(branch, &f.q, f.lambda)?,
-                coeffs: f.q,
+                omega_f,
+                amplitude: probe.amplitude(branch, &coeffs, omega_f)?,
+                coeffs,
                 located: true,
             },
-            None => {
-                let near = &points[turn.index];
-                CondensedFold {
+            None => match points.get(turn.index) {
+                Some(near) => CondensedFold {
                     index: turn.index,
                     omega_f: turn.lambda,
                     amplitude: near.amplitude,
                     coeffs: near.coeffs.clone(),
                     located: false,
-                }
-            }
+                },
+                None => continue,
+            },
         };
         folds.push(fold);
     }
