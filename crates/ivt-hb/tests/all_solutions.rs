@@ -7,17 +7,14 @@ use ivt_hb::aft::eval_series;
 use ivt_hb::{all_solutions, Duffing, HbError, HbOptions, SearchOptions, StabilityKind};
 
 mod common;
-use common::shooting::{period_map, period_map_jacobian};
+use common::shooting::{newton_step, period_map, period_map_jacobian};
 
 /// A fixed point of the period map by Newton from `y`, if it converges.
 fn shoot(duffing: &Duffing, omega: f64, mut y: [f64; 2]) -> Option<[f64; 2]> {
     for _ in 0..30 {
         let p = period_map(duffing, omega, y);
         let r = [p[0] - y[0], p[1] - y[1]];
-        let j = period_map_jacobian(duffing, omega, y);
-        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-        let dx = -(j[1][1] * r[0] - j[0][1] * r[1]) / det;
-        let dv = -(j[0][0] * r[1] - j[1][0] * r[0]) / det;
+        let [dx, dv] = newton_step(period_map_jacobian(duffing, omega, y), r);
         y = [y[0] + dx, y[1] + dv];
         if !(y[0].abs() < 10.0 && y[1].abs() < 10.0) {
             return None;
