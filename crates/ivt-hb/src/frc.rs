@@ -91,7 +91,8 @@ pub struct FrcFold {
     pub index: usize,
     /// ω_f at the fold.
     pub omega_f: f64,
-    /// max |x_0(τ)| of the fold orbit over the 2N AFT samples.
+    /// Amplitude of the fold orbit, as the curve's points measure it
+    /// ([`FrcPoint::amplitude`]: max |x_0(τ)| over the 2N AFT samples).
     pub amplitude: f64,
     /// Fourier coefficients of the fold orbit.
     pub coeffs: Vec<f64>,

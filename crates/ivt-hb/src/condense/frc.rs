@@ -12,7 +12,7 @@ use crate::continuation::{
     correct_at_fixed_lambda, pseudo_arclength_exact, ContinuationOptions, PathPoint, Termination,
 };
 use crate::error::HbError;
-use crate::frc::locate_turns;
+use crate::frc::{locate_turns, FrcFold};
 use crate::problem::PeriodicProblem;
 
 /// Options of a condensed frequency sweep.
@@ -76,21 +76,10 @@ pub struct CondensedPoint {
     pub truncation_error: Option<f64>,
 }
 
-/// A fold of a condensed curve.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CondensedFold {
-    /// Index of the path point nearest the turn.
-    pub index: usize,
-    /// ω_f of the fold.
-    pub omega_f: f64,
-    /// Amplitude of the fold orbit.
-    pub amplitude: f64,
-    /// The condensed unknowns at the fold.
-    pub coeffs: Vec<f64>,
-    /// `true` when Newton on the extended system converged (else the parabola's
-    /// estimate and the nearest point's orbit).
-    pub located: bool,
-}
+/// A fold of a condensed curve: a [`FrcFold`] whose `amplitude` is that of
+/// the amplitude DOF ([`CondensedPoint::amplitude`]) and whose `coeffs` are
+/// the condensed unknowns (harmonics of the nonlinear DOFs).
+pub type CondensedFold = FrcFold;
 
 /// A traced condensed curve.
 #[derive(Debug, Clone, PartialEq)]
