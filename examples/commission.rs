@@ -1,16 +1,23 @@
 //! The rig loop end to end against a simulated rig (issue #29, README
 //! "Commission your rig"): a rig whose motor, gears and output radius differ
-//! from Table 1 runs the commissioning sequence (θ_CT sweep, hold, steps)
-//! with noisy sensors; the recording is identified (Eq. 151 by equation
-//! error, 95 % intervals); the identified plant is written as a plant file;
-//! the open-loop law is refitted for it and emitted as Rust for the firmware.
+//! from Table 1 runs every commissioning sequence (θ_CT sweep, hold, step
+//! test, drive cycle; `ivt_sim::commission`, SIL) with realistic sensors; the
+//! recording is read back as `ivt rig identify` reads it and identified
+//! (Eq. 151 by equation error, 95 % intervals); the identified plant is
+//! written as a plant file; the open-loop law is refitted for it and emitted
+//! as Rust for the firmware.
 //!
 //! `cargo run --release --example commission` → `out/commission/`.
-//! The command-line form of the same loop is `ivt rig identify run.mcap --out
-//! plant.toml`, then `ivt ol fit --plant-file plant.toml --emit-rust FILE`.
+//! The command-line form of the same loop is `ivt rig commission --sim
+//! --plant-file rig.toml --sensors realistic --out run.mcap`, `ivt rig
+//! identify run.mcap --out plant.toml`, then `ivt ol fit --plant-file
+//! plant.toml --emit-rust FILE`.
 
-#[path = "../tests/rig_sim/mod.rs"]
-mod rig_sim;
+/// The reader of `ivt rig identify` (the binary's module, not a copy; the
+/// example uses its arrays only, hence the allowance).
+#[allow(dead_code)]
+#[path = "../src/cli/commissioning.rs"]
+mod commissioning;
 
 use ivt_design::identify::{identify, NAMES};
 use ivt_design::open_loop::fit_law;
@@ -31,9 +38,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let body = PlantSection::from_params(PresetName::Printed, &rig).to_toml();
     let body: String = body.lines().skip(1).map(|l| format!("{l}\n")).collect();
 
-    let run = rig_sim::simulate(&body, rig_sim::Sensors::NOISY, 1);
-    std::fs::write(out.join("run.mcap"), rig_sim::mcap_bytes(&run))?;
-    let id = identify(&rig_sim::recording(&run), &PlantParams::printed())?;
+    let rig_file = out.join("rig.toml");
+    std::fs::write(&rig_file, format!("[plant]\n{body}"))?;
+    let run = out.join("run.mcap");
+    let opts = ivt_sim::commission::CommissionOptions {
+        plant: ivt_sim::commission::load_plant_file(&rig_file)?,
+        sensors: ivt_sim::commission::SensorModel::Realistic,
+        ..Default::default()
+    };
+    ivt_sim::commission::run_sil(&opts, &run)?;
+    let id = identify(
+        &commissioning::read(&run)?.recording,
+        &PlantParams::printed(),
+    )?;
     let truth = [
         rig.j_a(),
         rig.j_b(),

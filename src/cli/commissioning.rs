@@ -226,7 +226,11 @@ fn message(topic: &str, v: &Value, c: &mut Collected) -> Option<()> {
         _ => c.stages.push(Stage {
             t: num("t")?,
             name: v.get("name")?.as_str()?.to_string(),
-            theta_ct_deg: num("theta_ct_deg")?,
+            // null while the law runs (the drive cycle, the step test's law stages).
+            theta_ct_deg: match v.get("theta_ct_deg")? {
+                Value::Null => f64::NAN,
+                x => x.as_f64()?,
+            },
         }),
     }
     Some(())
@@ -253,6 +257,7 @@ fn assemble(c: Collected) -> Result<Commissioning, String> {
     let f_timer_hz = number("f_timer_hz")?.filter(|f| f.is_finite() && *f > 0.0);
     let nominal = match field("plant") {
         None => PlantSection::default(),
+        Some(p) if p.starts_with('{') => plant_from_json(&p)?,
         Some(p) if p.contains('[') => {
             PlantSection::parse_file(&p, "metadata `plant`").map_err(|e| e.0)?
         }
@@ -305,6 +310,23 @@ fn assemble(c: Collected) -> Result<Commissioning, String> {
         f_timer_hz,
         steps_per_rev,
     })
+}
+
+/// A simulated rig's metadata `plant`: a flat JSON object of `[plant]` keys
+/// (`ivt_sim::commission`), read by the scene's `[plant]` parser.
+fn plant_from_json(text: &str) -> Result<PlantSection, String> {
+    let bad = |why: String| format!("metadata `plant` = {text}: {why}");
+    let obj: serde_json::Map<String, Value> =
+        serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
+    let mut toml = String::from("[plant]\n");
+    for (k, v) in &obj {
+        match v {
+            Value::Number(n) => toml.push_str(&format!("{k} = {n}\n")),
+            Value::String(s) => toml.push_str(&format!("{k} = {s:?}\n")),
+            _ => return Err(bad(format!("`{k}` is neither a number nor a string"))),
+        }
+    }
+    PlantSection::parse_file(&toml, "metadata `plant`").map_err(|e| bad(e.0))
 }
 
 /// Eq. 185 in SI: e \[m\] per degree of θ_CT, 7π/51840 inch.

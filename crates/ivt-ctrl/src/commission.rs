@@ -11,6 +11,12 @@
 //! | [`SequenceName::Step`] | `points` θ_CT holds at constant V_m, T_U (the ω_m–θ_CT line of Eq. 187, slope K₂T_out), then the proportional law Eq. 189 from the last angle, then a T_U step under the law | Fig. 50, Eq. 186–190 |
 //! | [`SequenceName::Drive`] | six stages of V_m, T_U set-points; law off (θ_CT = 0) in the first and the last | Fig. 51 |
 //!
+//! Every edge is logged (the pulse log) in the holds of the sweep, the hold
+//! and the step test: the encoder edge times at constant θ_CT are what
+//! identification fits Eq. 151 to (`ivt rig identify`); a recording whose
+//! edges come from the one hold at constant inputs and r leaves Eq. 151's
+//! regressors collinear. The law stages and the drive cycle log none.
+//!
 //! A held stage commands `r = θ_CT · SGIVT_M_PER_DEG` (Eq. 185) through
 //! [`Controller::set_hold`]; a law stage releases the hold, and the law
 //! continues from the held r (bumpless: r_d starts at r − u_ol). V_m and T_U
@@ -161,7 +167,9 @@ impl Default for Plan {
                 to_deg: 3600.0,
                 step_deg: 100.0,
                 hold_s: 2.0,
-                inputs: [8.6, 6.0],
+                // T_U = 7.35 N·m: the load at which Fig. 50's slope K₂T_out
+                // is 0.0128 rpm/deg (§4.4.3) on the printed plant.
+                inputs: [8.6, 7.35],
             },
             hold: HoldPlan {
                 theta_ct_deg: 3600.0,
@@ -205,7 +213,8 @@ pub struct Stage {
     pub duration_s: f32,
     /// Bench set-points V_m \[V\], T_U \[N·m\].
     pub inputs: [f32; 2],
-    /// True if every encoder edge is logged (Fig. 48).
+    /// True if every encoder edge is logged (Fig. 48; the holds that
+    /// identification fits Eq. 151 to).
     pub pulse_log: bool,
 }
 
@@ -282,7 +291,7 @@ impl Plan {
         match sequence {
             SequenceName::Sweep => {
                 let s = &self.sweep;
-                held(f32::from(index) * s.step_deg, s.hold_s, s.inputs, false)
+                held(f32::from(index) * s.step_deg, s.hold_s, s.inputs, true)
             }
             SequenceName::Hold => {
                 let h = &self.hold;
@@ -298,7 +307,7 @@ impl Plan {
                     } else {
                         0.0
                     };
-                    held(a + (b - a) * frac, s.hold_s, s.inputs, false)
+                    held(a + (b - a) * frac, s.hold_s, s.inputs, true)
                 } else if index == n {
                     law(s.law_s, s.inputs)
                 } else {

@@ -8,7 +8,7 @@
 
 use crate::aft::Aft;
 use crate::bifurcation::BifurcationKind;
-use crate::continuation::{turn_estimate, ContinuationOptions, Corrector, Termination};
+use crate::continuation::{turn_estimate, ContinuationOptions, Corrector, Path, Termination};
 use crate::events::Trace;
 use crate::family::{FamilyBranch, Frequency};
 use crate::fold::{locate_fold, FoldOptions};
@@ -91,7 +91,8 @@ pub struct FrcFold {
     pub index: usize,
     /// ω_f at the fold.
     pub omega_f: f64,
-    /// max |x_0(τ)| of the fold orbit over the 2N AFT samples.
+    /// Amplitude of the fold orbit, as the curve's points measure it
+    /// ([`FrcPoint::amplitude`]: max |x_0(τ)| over the 2N AFT samples).
     pub amplitude: f64,
     /// Fourier coefficients of the fold orbit.
     pub coeffs: Vec<f64>,
@@ -177,21 +178,40 @@ pub fn frequency_response<P: PeriodicProblem>(
         return Err(e);
     }
     let mut folds = Vec::with_capacity(path.folds.len());
-    for turn in &path.folds {
-        let near = &points[turn.index];
-        // Start from the quadratic through the three points around the turn.
-        let around = &path.points[turn.bracket..turn.bracket + 3];
-        let start = turn_estimate(&around[0], &around[1], &around[2]);
-        let located = locate_fold(&mut family, &start[..m], start[m], &FoldOptions::default())
-            .ok()
-            .map(|f| (f.q, f.lambda));
-        folds.push(probe.fold(turn.index, located, near, turn.lambda));
+    for (turn, located) in path.folds.iter().zip(locate_turns(&mut family, &path)) {
+        if let Some(near) = points.get(turn.index) {
+            folds.push(probe.fold(turn.index, located, near, turn.lambda));
+        }
     }
     Ok(Frc {
         points,
         folds,
         termination: path.termination,
     })
+}
+
+/// Each fold of `path` located by [`locate_fold`] (Newton on the extended
+/// system) from the quadratic through the three path points around the turn
+/// ([`turn_estimate`]): the fold orbit and its λ, or `None` where Newton did
+/// not converge (or the turn has no three points around it). One entry per
+/// `path.folds`, in order; shared by [`frequency_response`] and
+/// [`crate::condense::condensed_response`].
+pub(crate) fn locate_turns<B: crate::fold::Branch>(
+    branch: &mut B,
+    path: &Path,
+) -> Vec<Option<(Vec<f64>, f64)>> {
+    let m = branch.len();
+    path.folds
+        .iter()
+        .map(|turn| {
+            let around = path.points.get(turn.bracket..turn.bracket + 3)?;
+            let start = turn_estimate(&around[0], &around[1], &around[2]);
+            let (q0, lambda0) = (start.get(..m)?, *start.get(m)?);
+            locate_fold(branch, q0, lambda0, &FoldOptions::default())
+                .ok()
+                .map(|f| (f.q, f.lambda))
+        })
+        .collect()
 }
 
 impl Frc {

@@ -4,53 +4,17 @@
 //! states (no HB): its distinct fixed points and their stability.
 
 use ivt_hb::aft::eval_series;
-use ivt_hb::ode::{first_order, rk4};
 use ivt_hb::{all_solutions, Duffing, HbError, HbOptions, SearchOptions, StabilityKind};
-use std::f64::consts::PI;
 
-const STEPS: usize = 4000;
-
-/// The period map of Duffing at ω over 2π/ω (RK4, `STEPS` steps).
-fn period_map(duffing: &Duffing, omega: f64, y: [f64; 2]) -> [f64; 2] {
-    let mut y = y;
-    rk4(
-        first_order(duffing, omega),
-        0.0,
-        &mut y,
-        2.0 * PI / omega / STEPS as f64,
-        STEPS,
-    );
-    y
-}
-
-/// Jacobian of P(y) − y by central differences.
-fn jacobian(duffing: &Duffing, omega: f64, y: [f64; 2]) -> [[f64; 2]; 2] {
-    let mut j = [[0.0; 2]; 2];
-    for k in 0..2 {
-        let h = 1e-6;
-        let (mut yp, mut ym) = (y, y);
-        yp[k] += h;
-        ym[k] -= h;
-        let (rp, rm) = (
-            period_map(duffing, omega, yp),
-            period_map(duffing, omega, ym),
-        );
-        for i in 0..2 {
-            j[i][k] = (rp[i] - rm[i]) / (2.0 * h) - if i == k { 1.0 } else { 0.0 };
-        }
-    }
-    j
-}
+mod common;
+use common::shooting::{newton_step, period_map, period_map_jacobian};
 
 /// A fixed point of the period map by Newton from `y`, if it converges.
 fn shoot(duffing: &Duffing, omega: f64, mut y: [f64; 2]) -> Option<[f64; 2]> {
     for _ in 0..30 {
         let p = period_map(duffing, omega, y);
         let r = [p[0] - y[0], p[1] - y[1]];
-        let j = jacobian(duffing, omega, y);
-        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-        let dx = -(j[1][1] * r[0] - j[0][1] * r[1]) / det;
-        let dv = -(j[0][0] * r[1] - j[1][0] * r[0]) / det;
+        let [dx, dv] = newton_step(period_map_jacobian(duffing, omega, y), r);
         y = [y[0] + dx, y[1] + dv];
         if !(y[0].abs() < 10.0 && y[1].abs() < 10.0) {
             return None;
@@ -64,7 +28,7 @@ fn shoot(duffing: &Duffing, omega: f64, mut y: [f64; 2]) -> Option<[f64; 2]> {
 
 /// The largest |multiplier| of the fixed point (eigenvalues of ∂P/∂y).
 fn max_multiplier(duffing: &Duffing, omega: f64, y: [f64; 2]) -> f64 {
-    let j = jacobian(duffing, omega, y);
+    let j = period_map_jacobian(duffing, omega, y);
     let (a, b, c, d) = (j[0][0] + 1.0, j[0][1], j[1][0], j[1][1] + 1.0);
     let (tr, det) = (a + d, a * d - b * c);
     let disc = tr * tr / 4.0 - det;

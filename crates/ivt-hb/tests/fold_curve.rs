@@ -5,42 +5,19 @@
 //! the cusp is the extremum of F along the curve of such points.
 
 use ivt_hb::aft::eval_series;
-use ivt_hb::ode::{first_order, rk4};
 use ivt_hb::{
     fold_curve, frequency_response, ContinuationOptions, Duffing, FrcOptions, HbError, HbOptions,
     Termination,
 };
-use std::f64::consts::PI;
 
-const STEPS: usize = 4000;
-
-fn period_map(force: f64, omega: f64, y: [f64; 2]) -> [f64; 2] {
-    let d = Duffing::new(0.02, 1.0, 1.0, force);
-    let mut y = y;
-    rk4(
-        first_order(&d, omega),
-        0.0,
-        &mut y,
-        2.0 * PI / omega / STEPS as f64,
-        STEPS,
-    );
-    y
-}
+mod common;
+use common::shooting::{period_map, period_map_jacobian};
 
 /// `[P(y) − y, det(∂P/∂y − I)]` (∂P/∂y by central differences).
 fn fold_residual(force: f64, omega: f64, y: [f64; 2]) -> [f64; 3] {
-    let p = period_map(force, omega, y);
-    let mut j = [[0.0; 2]; 2];
-    for k in 0..2 {
-        let h = 1e-6;
-        let (mut yp, mut ym) = (y, y);
-        yp[k] += h;
-        ym[k] -= h;
-        let (a, b) = (period_map(force, omega, yp), period_map(force, omega, ym));
-        for i in 0..2 {
-            j[i][k] = (a[i] - b[i]) / (2.0 * h) - f64::from(u8::from(i == k));
-        }
-    }
+    let d = Duffing::new(0.02, 1.0, 1.0, force);
+    let p = period_map(&d, omega, y);
+    let j = period_map_jacobian(&d, omega, y);
     [
         p[0] - y[0],
         p[1] - y[1],

@@ -10,6 +10,9 @@ use ivt_hb::{
 };
 use std::f64::consts::PI;
 
+mod common;
+use common::shooting::{central_jacobian, newton_step};
+
 fn van_der_pol(mu: f64) -> impl PeriodicProblem {
     GeneralProblem::new(
         1,
@@ -42,20 +45,8 @@ fn shooting_period(mu: f64, steps: usize) -> f64 {
     let mut y = [2.0, 2.0 * PI * (1.0 + mu * mu / 16.0)];
     for _ in 0..40 {
         let r = flow(y);
-        let mut j = [[0.0; 2]; 2];
-        for k in 0..2 {
-            let h = 1e-6 * y[k];
-            let (mut yp, mut ym) = (y, y);
-            yp[k] += h;
-            ym[k] -= h;
-            let (rp, rm) = (flow(yp), flow(ym));
-            for i in 0..2 {
-                j[i][k] = (rp[i] - rm[i]) / (2.0 * h);
-            }
-        }
-        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-        let dx = -(j[1][1] * r[0] - j[0][1] * r[1]) / det;
-        let dt = -(j[0][0] * r[1] - j[1][0] * r[0]) / det;
+        let j = central_jacobian(flow, y, [1e-6 * y[0], 1e-6 * y[1]]);
+        let [dx, dt] = newton_step(j, r);
         y[0] += dx;
         y[1] += dt;
         if dx.abs() < 1e-14 && dt.abs() < 1e-13 {

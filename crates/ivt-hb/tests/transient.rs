@@ -9,6 +9,9 @@ use ivt_hb::{
     TransientOptions,
 };
 
+mod common;
+use common::shooting::{central_jacobian, newton_step};
+
 /// `ẍ = accel(x, ẋ)` of each oscillator.
 fn accel(rayleigh: bool, mu: f64) -> impl Fn(f64, f64) -> f64 + Copy {
     move |x: f64, v: f64| {
@@ -77,20 +80,8 @@ fn shooting_period(a: impl Fn(f64, f64) -> f64 + Copy, steps: usize) -> f64 {
     };
     for _ in 0..40 {
         let r = residual(u);
-        let mut j = [[0.0; 2]; 2];
-        for k in 0..2 {
-            let h = 1e-6 * u[k].abs().max(1.0);
-            let (mut up, mut um) = (u, u);
-            up[k] += h;
-            um[k] -= h;
-            let (rp, rm) = (residual(up), residual(um));
-            for i in 0..2 {
-                j[i][k] = (rp[i] - rm[i]) / (2.0 * h);
-            }
-        }
-        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-        let dx = -(j[1][1] * r[0] - j[0][1] * r[1]) / det;
-        let dt = -(j[0][0] * r[1] - j[1][0] * r[0]) / det;
+        let h = u.map(|v| 1e-6 * v.abs().max(1.0));
+        let [dx, dt] = newton_step(central_jacobian(residual, u, h), r);
         u[0] += dx;
         u[1] += dt;
         if dx.abs() < 1e-13 && dt.abs() < 1e-12 {

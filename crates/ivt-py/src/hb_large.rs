@@ -10,7 +10,7 @@ use ivt_hb::condense::{
     condensed_response, CondensedBranch, CondensedFrc, CondensedFrcOptions, CondensedPoint,
     Structure,
 };
-use ivt_hb::{HbError, HbOptions, Termination};
+use ivt_hb::{HbError, HbOptions};
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -73,6 +73,21 @@ impl<'py> Large<'py> {
         )?;
         Ok((structure, local))
     }
+
+    /// Runs `solve` on the condensed branch of this structure with the GIL
+    /// released ([`run_user`]: a callback's exception is the error).
+    fn run<T: Send>(
+        &self,
+        py: Python<'py>,
+        solve: impl FnOnce(&mut CondensedBranch<&PyProblem>) -> Result<T, HbError> + Send,
+    ) -> PyResult<T> {
+        let (structure, local) = self.build(py)?;
+        let (dofs, load, hb) = (self.dofs.clone(), self.load.clone(), self.hb.clone());
+        run_user(py, &local, move |p| {
+            let mut branch = CondensedBranch::new(structure, dofs, &load.0, &load.1, p, &hb)?;
+            solve(&mut branch)
+        })
+    }
 }
 
 /// `n` harmonics, `samples` = N, relative tolerance `rtol`.
@@ -83,16 +98,6 @@ fn hb_options(n: usize, samples: usize) -> PyResult<HbOptions> {
         )));
     }
     Ok(HbOptions::new(n, samples))
-}
-
-/// The snake_case word of a termination (SPEC §6).
-fn termination_name(t: &Termination) -> &'static str {
-    match t {
-        Termination::LeftInterval => "left_interval",
-        Termination::MaxPoints => "max_points",
-        Termination::Stopped => "stopped",
-        Termination::StepTooSmall(_) => "step_too_small",
-    }
 }
 
 fn point_dict<'py>(py: Python<'py>, p: &CondensedPoint) -> PyResult<Bound<'py, PyDict>> {
@@ -134,7 +139,7 @@ fn frc_dict<'py>(py: Python<'py>, frc: &CondensedFrc) -> PyResult<Bound<'py, PyD
     }
     d.set_item("points", points)?;
     d.set_item("folds", folds)?;
-    d.set_item("termination", termination_name(&frc.termination))?;
+    d.set_item("termination", frc.termination.as_str())?;
     let omega: Vec<f64> = frc.points.iter().map(|p| p.omega_f).collect();
     let amplitude: Vec<f64> = frc.points.iter().map(|p| p.amplitude).collect();
     d.set_item("omega", omega.into_pyarray(py))?;
@@ -202,23 +207,16 @@ fn frc_large<'py>(
         ..CondensedFrcOptions::default()
     };
     let steps = [
-        (ds, &mut opts.continuation.ds),
-        (ds_min, &mut opts.continuation.ds_min),
+        ("ds", ds, &mut opts.continuation.ds),
+        ("ds_min", ds_min, &mut opts.continuation.ds_min),
+        ("ds_max", ds_max, &mut opts.continuation.ds_max),
     ];
-    for (given, slot) in steps {
+    for (name, given, slot) in steps {
         if let Some(v) = given {
-            *slot = positive("ds", v)?;
+            *slot = positive(name, v)?;
         }
     }
-    if let Some(v) = ds_max {
-        opts.continuation.ds_max = positive("ds_max", v)?;
-    }
-    let (structure, local) = large.build(py)?;
-    let (dofs, load, hb) = (large.dofs.clone(), large.load.clone(), large.hb.clone());
-    let frc = run_user(py, &local, move |p| {
-        let mut branch = CondensedBranch::new(structure, dofs, &load.0, &load.1, p, &hb)?;
-        condensed_response(&mut branch, &opts)
-    })?;
+    let frc = large.run(py, move |branch| condensed_response(branch, &opts))?;
     frc_dict(py, &frc)
 }
 
@@ -277,10 +275,7 @@ fn solve_large<'py>(
     };
     let omega = positive("omega", finite("omega", omega)?)?;
     let rtol = positive("rtol", rtol)?;
-    let (structure, local) = large.build(py)?;
-    let (dofs, load, hb) = (large.dofs.clone(), large.load.clone(), large.hb.clone());
-    let point = run_user(py, &local, move |p| {
-        let mut branch = CondensedBranch::new(structure, dofs, &load.0, &load.1, p, &hb)?;
+    let point = large.run(py, move |branch| {
         // A curve of one point: the start at ω, corrected at fixed ω.
         let opts = CondensedFrcOptions {
             from: omega,
@@ -294,7 +289,7 @@ fn solve_large<'py>(
                 ..CondensedFrcOptions::default().continuation
             },
         };
-        let frc = condensed_response(&mut branch, &opts)?;
+        let frc = condensed_response(branch, &opts)?;
         frc.points
             .into_iter()
             .next()

@@ -257,49 +257,30 @@ impl<'py> ser::Serializer for Ser<'py> {
     }
 }
 
-impl<'py> ser::SerializeSeq for SeqSer<'py> {
-    type Ok = Bound<'py, PyAny>;
-    type Error = Error;
-    fn serialize_element<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Error> {
-        self.push(v)
-    }
-    fn end(self) -> Res<'py> {
-        self.finish()
-    }
+/// The four sequence traits of serde (`Seq`, `Tuple`, `TupleStruct`,
+/// `TupleVariant`) all push an element onto the one list and end with it;
+/// `$push` is the trait's name for "add an element".
+macro_rules! seq_impl {
+    ($($trait:ident :: $push:ident),+ $(,)?) => {$(
+        impl<'py> ser::$trait for SeqSer<'py> {
+            type Ok = Bound<'py, PyAny>;
+            type Error = Error;
+            fn $push<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Error> {
+                self.push(v)
+            }
+            fn end(self) -> Res<'py> {
+                self.finish()
+            }
+        }
+    )+};
 }
 
-impl<'py> ser::SerializeTuple for SeqSer<'py> {
-    type Ok = Bound<'py, PyAny>;
-    type Error = Error;
-    fn serialize_element<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Error> {
-        self.push(v)
-    }
-    fn end(self) -> Res<'py> {
-        self.finish()
-    }
-}
-
-impl<'py> ser::SerializeTupleStruct for SeqSer<'py> {
-    type Ok = Bound<'py, PyAny>;
-    type Error = Error;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Error> {
-        self.push(v)
-    }
-    fn end(self) -> Res<'py> {
-        self.finish()
-    }
-}
-
-impl<'py> ser::SerializeTupleVariant for SeqSer<'py> {
-    type Ok = Bound<'py, PyAny>;
-    type Error = Error;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Error> {
-        self.push(v)
-    }
-    fn end(self) -> Res<'py> {
-        self.finish()
-    }
-}
+seq_impl!(
+    SerializeSeq::serialize_element,
+    SerializeTuple::serialize_element,
+    SerializeTupleStruct::serialize_field,
+    SerializeTupleVariant::serialize_field,
+);
 
 impl<'py> ser::SerializeMap for MapSer<'py> {
     type Ok = Bound<'py, PyAny>;
@@ -322,32 +303,24 @@ impl<'py> ser::SerializeMap for MapSer<'py> {
     }
 }
 
-impl<'py> ser::SerializeStruct for MapSer<'py> {
-    type Ok = Bound<'py, PyAny>;
-    type Error = Error;
-    fn serialize_field<T: Serialize + ?Sized>(
-        &mut self,
-        key: &'static str,
-        v: &T,
-    ) -> Result<(), Error> {
-        self.field(key, v)
-    }
-    fn end(self) -> Res<'py> {
-        self.finish()
-    }
+/// A struct and a struct variant both set a named field of the one dict.
+macro_rules! struct_impl {
+    ($($trait:ident),+ $(,)?) => {$(
+        impl<'py> ser::$trait for MapSer<'py> {
+            type Ok = Bound<'py, PyAny>;
+            type Error = Error;
+            fn serialize_field<T: Serialize + ?Sized>(
+                &mut self,
+                key: &'static str,
+                v: &T,
+            ) -> Result<(), Error> {
+                self.field(key, v)
+            }
+            fn end(self) -> Res<'py> {
+                self.finish()
+            }
+        }
+    )+};
 }
 
-impl<'py> ser::SerializeStructVariant for MapSer<'py> {
-    type Ok = Bound<'py, PyAny>;
-    type Error = Error;
-    fn serialize_field<T: Serialize + ?Sized>(
-        &mut self,
-        key: &'static str,
-        v: &T,
-    ) -> Result<(), Error> {
-        self.field(key, v)
-    }
-    fn end(self) -> Res<'py> {
-        self.finish()
-    }
-}
+struct_impl!(SerializeStruct, SerializeStructVariant);

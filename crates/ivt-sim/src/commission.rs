@@ -336,6 +336,7 @@ pub(crate) fn run_with<B: SequencedBackend + 'static>(
             ppr: scene.encoder.ppr as u32,
             f_timer_hz: scene.encoder.f_timer_hz,
             plant: Some(plant_json(&params)),
+            steps_per_rev: Some(scene.stepper.steps_per_rev),
             source: "simulated rig".into(),
         },
     )?;
@@ -395,14 +396,19 @@ fn flush(rec: &mut Recording, batch: &mut (Vec<f64>, Vec<u32>)) -> Result<(), Si
     Ok(())
 }
 
-/// The plant's parameters as JSON (the recording's metadata).
+/// The plant's parameters as JSON (the recording's metadata): the keys and
+/// values of a `[plant]` table, so that a reader rebuilds it with the scene's parser.
 fn plant_json(p: &ivt_kin::plant::PlantParams) -> serde_json::Value {
+    let gravity = match p.gravity {
+        ivt_kin::plant::GravityModel::Printed => "printed",
+        ivt_kin::plant::GravityModel::RollerMass => "roller_mass",
+    };
     serde_json::json!({
         "r_a": p.r_a, "k_e": p.k_e, "k_t": p.k_t, "l_a": p.l_a,
         "j_n1": p.j_n1, "j_n2": p.j_n2, "j_inshaft": p.j_inshaft, "j_carrier": p.j_carrier,
         "j_ring": p.j_ring, "j_crk": p.j_crk, "m_r": p.m_r, "m_dr": p.m_dr, "j_u": p.j_u,
         "r_u": p.r_u, "g": p.g, "sun_to_planet": p.sun_to_planet,
-        "gravity": format!("{:?}", p.gravity), "r_max": p.r_max,
+        "gravity": gravity, "r_max": p.r_max,
     })
 }
 

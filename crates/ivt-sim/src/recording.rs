@@ -11,7 +11,8 @@
 //! | `/sequence` | `t`, `name` (sweep, hold, step, drive), `stage`, `theta_ct_deg` (null when the law runs), `hold` | stage start |
 //!
 //! and a metadata record `ivt`: `frame_version`, `ppr`, `f_timer_hz` and,
-//! for a simulated rig, `plant` (the plant's parameters as JSON). Metadata
+//! for a simulated rig, `plant` (the plant's parameters as JSON, the keys of
+//! a `[plant]` table) and `steps_per_rev`. Metadata
 //! values are strings (MCAP), each a JSON value.
 
 use std::collections::BTreeMap;
@@ -82,6 +83,9 @@ pub struct RecordingMeta {
     pub f_timer_hz: f64,
     /// The simulated plant (None for a rig).
     pub plant: Option<serde_json::Value>,
+    /// Stepper (micro)steps per revolution of θ_CT, when known (the
+    /// simulator's; a rig's reader infers it from the held stages).
+    pub steps_per_rev: Option<f64>,
     /// Free text: where the recording comes from.
     pub source: String,
 }
@@ -238,6 +242,9 @@ impl Recording {
         );
         if let Some(p) = &meta.plant {
             m.insert("plant".into(), p.to_string());
+        }
+        if let Some(s) = meta.steps_per_rev {
+            m.insert("steps_per_rev".into(), serde_json::json!(s).to_string());
         }
         self.w
             .write_metadata(&mcap::records::Metadata {

@@ -88,6 +88,7 @@ pub fn record<R: Read>(
             ppr: opts.ppr,
             f_timer_hz: opts.f_timer_hz,
             plant: None,
+            steps_per_rev: None,
             source: "rig telemetry".into(),
         },
     )?;

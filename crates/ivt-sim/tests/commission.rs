@@ -53,6 +53,7 @@ fn sil_recording_follows_the_plan() {
     let (ch, meta) = read(&out);
     assert_eq!(meta["ppr"], "1200");
     assert_eq!(meta["frame_version"], "2");
+    assert_eq!(meta["steps_per_rev"].parse::<f64>().unwrap(), 3200.0);
     let plant: Value = serde_json::from_str(&meta["plant"]).unwrap();
     assert_eq!(plant["r_max"], 0.012);
 
@@ -116,23 +117,53 @@ fn sil_recording_follows_the_plan() {
     assert!(held > 100_000, "{held}");
 
     // The hold logs every edge: as many edge times as pulses in the stage,
-    // the same ticks as /control, in batches of at most 60.
-    let (a, b, _) = bounds.iter().find(|(_, _, m)| m["name"] == "hold").unwrap();
-    let in_hold: Vec<u64> = ctl
-        .iter()
-        .filter(|c| (*a..*b).contains(&f(c, "t")))
-        .map(|c| c["ticks"].as_u64().unwrap())
-        .collect();
-    let logged: Vec<u64> = ch["/pulses"]
+    // the same ticks as /control, in batches of at most 60. So do the holds
+    // of the sweep and the step test (what identification fits), and no
+    // other stage.
+    let logged: Vec<(f64, u64)> = ch["/pulses"]
         .iter()
         .flat_map(|m| {
             assert!(m["ticks"].as_array().unwrap().len() <= 60);
-            m["ticks"].as_array().unwrap().clone()
+            let t = m["t"].as_array().unwrap().clone();
+            let k = m["ticks"].as_array().unwrap().clone();
+            assert_eq!(t.len(), k.len());
+            t.into_iter().zip(k)
         })
-        .map(|t| t.as_u64().unwrap())
+        .map(|(t, k)| (t.as_f64().unwrap(), k.as_u64().unwrap()))
         .collect();
-    assert_eq!(logged, in_hold);
-    assert!(logged.len() > 15_000, "10 s at ~10 rad/s: {}", logged.len());
+    let edges_in = |a: f64, b: f64| -> (Vec<u64>, Vec<u64>) {
+        let want = ctl
+            .iter()
+            .filter(|c| (a..b).contains(&f(c, "t")))
+            .map(|c| c["ticks"].as_u64().unwrap())
+            .collect();
+        let got = logged
+            .iter()
+            .filter(|(t, _)| (a..b).contains(t))
+            .map(|&(_, k)| k)
+            .collect();
+        (got, want)
+    };
+    let (a, b, _) = bounds.iter().find(|(_, _, m)| m["name"] == "hold").unwrap();
+    let (in_hold, want) = edges_in(*a, *b);
+    assert_eq!(in_hold, want);
+    assert!(
+        in_hold.len() > 15_000,
+        "10 s at ~10 rad/s: {}",
+        in_hold.len()
+    );
+    let mut logged_in_stages = 0;
+    for (a, b, m) in &bounds {
+        let (got, want) = edges_in(*a, *b);
+        if m["hold"] == true && m["name"] != "drive" {
+            assert_eq!(got, want, "{m}");
+            assert!(!got.is_empty(), "{m}");
+        } else {
+            assert!(got.is_empty(), "{m}: {} edges logged", got.len());
+        }
+        logged_in_stages += got.len();
+    }
+    assert_eq!(logged_in_stages, logged.len());
 
     // The law stages (step test 6, 7; drive 1–4) end with ω_a within
     // 0.5 rpm of ω_r = 100 rpm: Eq. 190's recursion converges for

@@ -9,11 +9,10 @@ use super::branch::CondensedBranch;
 use super::estimate::truncation_error;
 use crate::aft::{eval_series, Aft};
 use crate::continuation::{
-    correct_at_fixed_lambda, pseudo_arclength_exact, turn_estimate, ContinuationOptions, PathPoint,
-    Termination,
+    correct_at_fixed_lambda, pseudo_arclength_exact, ContinuationOptions, PathPoint, Termination,
 };
 use crate::error::HbError;
-use crate::fold::{locate_fold, FoldOptions};
+use crate::frc::{locate_turns, FrcFold};
 use crate::problem::PeriodicProblem;
 
 /// Options of a condensed frequency sweep.
@@ -77,21 +76,10 @@ pub struct CondensedPoint {
     pub truncation_error: Option<f64>,
 }
 
-/// A fold of a condensed curve.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CondensedFold {
-    /// Index of the path point nearest the turn.
-    pub index: usize,
-    /// ω_f of the fold.
-    pub omega_f: f64,
-    /// Amplitude of the fold orbit.
-    pub amplitude: f64,
-    /// The condensed unknowns at the fold.
-    pub coeffs: Vec<f64>,
-    /// `true` when Newton on the extended system converged (else the parabola's
-    /// estimate and the nearest point's orbit).
-    pub located: bool,
-}
+/// A fold of a condensed curve: a [`FrcFold`] whose `amplitude` is that of
+/// the amplitude DOF ([`CondensedPoint::amplitude`]) and whose `coeffs` are
+/// the condensed unknowns (harmonics of the nonlinear DOFs).
+pub type CondensedFold = FrcFold;
 
 /// A traced condensed curve.
 #[derive(Debug, Clone, PartialEq)]
@@ -165,28 +153,25 @@ pub fn condensed_response<P: PeriodicProblem>(
         return Err(e);
     }
     let mut folds = Vec::with_capacity(path.folds.len());
-    for turn in &path.folds {
-        let around = &path.points[turn.bracket..turn.bracket + 3];
-        let start = turn_estimate(&around[0], &around[1], &around[2]);
-        let located = locate_fold(branch, &start[..m], start[m], &FoldOptions::default()).ok();
+    for (turn, located) in path.folds.iter().zip(locate_turns(branch, &path)) {
         let fold = match located {
-            Some(f) => CondensedFold {
+            Some((coeffs, omega_f)) => CondensedFold {
                 index: turn.index,
-                omega_f: f.lambda,
-                amplitude: probe.amplitude(branch, &f.q, f.lambda)?,
-                coeffs: f.q,
+                omega_f,
+                amplitude: probe.amplitude(branch, &coeffs, omega_f)?,
+                coeffs,
                 located: true,
             },
-            None => {
-                let near = &points[turn.index];
-                CondensedFold {
+            None => match points.get(turn.index) {
+                Some(near) => CondensedFold {
                     index: turn.index,
                     omega_f: turn.lambda,
                     amplitude: near.amplitude,
                     coeffs: near.coeffs.clone(),
                     located: false,
-                }
-            }
+                },
+                None => continue,
+            },
         };
         folds.push(fold);
     }

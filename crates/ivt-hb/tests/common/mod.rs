@@ -5,6 +5,7 @@
 
 pub mod chain;
 pub mod counted;
+pub mod shooting;
 
 use ivt_hb::aft::eval_series;
 use ivt_hb::ode::{first_order, rk4};

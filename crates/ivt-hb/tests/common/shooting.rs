@@ -1,0 +1,60 @@
+//! Shooting, the references without HB: Newton in the plane with a
+//! central-difference Jacobian, and the RK4 period map of the thesis Duffing
+//! (Eq. 49) for the fold-curve and all-solutions tests.
+
+use ivt_hb::ode::{first_order, rk4};
+use ivt_hb::Duffing;
+use std::f64::consts::PI;
+
+/// RK4 steps per period of the period map.
+pub const STEPS: usize = 4000;
+
+/// The period map of `duffing` at ω: the state `y = (x, ẋ)` at t = 0 carried
+/// over 2π/ω (RK4, [`STEPS`] steps).
+pub fn period_map(duffing: &Duffing, omega: f64, y: [f64; 2]) -> [f64; 2] {
+    let mut y = y;
+    rk4(
+        first_order(duffing, omega),
+        0.0,
+        &mut y,
+        2.0 * PI / omega / STEPS as f64,
+        STEPS,
+    );
+    y
+}
+
+/// ∂P/∂y − I of [`period_map`] at `y` by central differences (step 1e-6).
+pub fn period_map_jacobian(duffing: &Duffing, omega: f64, y: [f64; 2]) -> [[f64; 2]; 2] {
+    let mut j = central_jacobian(|y| period_map(duffing, omega, y), y, [1e-6; 2]);
+    j[0][0] -= 1.0;
+    j[1][1] -= 1.0;
+    j
+}
+
+/// `J[i][k] = ∂f_i/∂u_k` at `u` by central differences with steps `h[k]`.
+pub fn central_jacobian(
+    f: impl Fn([f64; 2]) -> [f64; 2],
+    u: [f64; 2],
+    h: [f64; 2],
+) -> [[f64; 2]; 2] {
+    let mut j = [[0.0; 2]; 2];
+    for k in 0..2 {
+        let (mut up, mut um) = (u, u);
+        up[k] += h[k];
+        um[k] -= h[k];
+        let (a, b) = (f(up), f(um));
+        for i in 0..2 {
+            j[i][k] = (a[i] - b[i]) / (2.0 * h[k]);
+        }
+    }
+    j
+}
+
+/// The Newton step `−J⁻¹ r` in the plane (Cramer's rule).
+pub fn newton_step(j: [[f64; 2]; 2], r: [f64; 2]) -> [f64; 2] {
+    let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+    [
+        -(j[1][1] * r[0] - j[0][1] * r[1]) / det,
+        -(j[0][0] * r[1] - j[1][0] * r[0]) / det,
+    ]
+}
