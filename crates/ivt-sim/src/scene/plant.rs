@@ -101,26 +101,52 @@ struct PlantFile {
     plant: PlantSection,
 }
 
-/// The names of the overridable parameters, in [`PlantSection::overrides`] order.
-const OVERRIDE_NAMES: [&str; 17] = [
-    "r_a",
-    "k_e",
-    "k_t",
-    "l_a",
-    "j_n1",
-    "j_n2",
-    "j_inshaft",
-    "j_carrier",
-    "j_ring",
-    "j_crk",
-    "m_r",
-    "m_dr",
-    "j_u",
-    "r_u",
-    "g",
-    "sun_to_planet",
-    "r_max",
-];
+/// The overridable parameters, listed once: their names
+/// (`OVERRIDE_NAMES`), the section's values and slots
+/// (`PlantSection::overrides`, `overrides_mut`) and the matching
+/// [`PlantParams`] fields (`param_slots`), all in this order.
+macro_rules! overridable {
+    ($($f:ident),+ $(,)?) => {
+        const OVERRIDE_NAMES: [&str; 17] = [$(stringify!($f)),+];
+
+        impl PlantSection {
+            /// The override values, in `OVERRIDE_NAMES` order.
+            fn overrides(&self) -> [Option<f64>; 17] {
+                [$(self.$f),+]
+            }
+
+            /// The override slots, in `OVERRIDE_NAMES` order.
+            fn overrides_mut(&mut self) -> [&mut Option<f64>; 17] {
+                [$(&mut self.$f),+]
+            }
+        }
+
+        /// The parameters of `p` that a section overrides, in `OVERRIDE_NAMES` order.
+        fn param_slots(p: &mut PlantParams) -> [&mut f64; 17] {
+            [$(&mut p.$f),+]
+        }
+    };
+}
+
+overridable!(
+    r_a,
+    k_e,
+    k_t,
+    l_a,
+    j_n1,
+    j_n2,
+    j_inshaft,
+    j_carrier,
+    j_ring,
+    j_crk,
+    m_r,
+    m_dr,
+    j_u,
+    r_u,
+    g,
+    sun_to_planet,
+    r_max
+);
 
 impl PlantSection {
     /// The `[plant]` table of a plant file (preset + overrides), validated.
@@ -236,54 +262,6 @@ impl PlantSection {
         out
     }
 
-    /// The override values, in [`OVERRIDE_NAMES`] order.
-    fn overrides(&self) -> [Option<f64>; 17] {
-        let p = self;
-        [
-            p.r_a,
-            p.k_e,
-            p.k_t,
-            p.l_a,
-            p.j_n1,
-            p.j_n2,
-            p.j_inshaft,
-            p.j_carrier,
-            p.j_ring,
-            p.j_crk,
-            p.m_r,
-            p.m_dr,
-            p.j_u,
-            p.r_u,
-            p.g,
-            p.sun_to_planet,
-            p.r_max,
-        ]
-    }
-
-    /// The override slots, in [`OVERRIDE_NAMES`] order.
-    fn overrides_mut(&mut self) -> [&mut Option<f64>; 17] {
-        let p = self;
-        [
-            &mut p.r_a,
-            &mut p.k_e,
-            &mut p.k_t,
-            &mut p.l_a,
-            &mut p.j_n1,
-            &mut p.j_n2,
-            &mut p.j_inshaft,
-            &mut p.j_carrier,
-            &mut p.j_ring,
-            &mut p.j_crk,
-            &mut p.m_r,
-            &mut p.m_dr,
-            &mut p.j_u,
-            &mut p.r_u,
-            &mut p.g,
-            &mut p.sun_to_planet,
-            &mut p.r_max,
-        ]
-    }
-
     /// Plant parameters: preset plus overrides, validated.
     ///
     /// # Errors
@@ -311,29 +289,6 @@ impl PlantSection {
         })?;
         Ok(params)
     }
-}
-
-/// The parameters of `p` that a section overrides, in [`OVERRIDE_NAMES`] order.
-fn param_slots(p: &mut PlantParams) -> [&mut f64; 17] {
-    [
-        &mut p.r_a,
-        &mut p.k_e,
-        &mut p.k_t,
-        &mut p.l_a,
-        &mut p.j_n1,
-        &mut p.j_n2,
-        &mut p.j_inshaft,
-        &mut p.j_carrier,
-        &mut p.j_ring,
-        &mut p.j_crk,
-        &mut p.m_r,
-        &mut p.m_dr,
-        &mut p.j_u,
-        &mut p.r_u,
-        &mut p.g,
-        &mut p.sun_to_planet,
-        &mut p.r_max,
-    ]
 }
 
 #[cfg(test)]
