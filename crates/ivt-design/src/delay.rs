@@ -64,7 +64,7 @@ pub const MAX_CHEBYSHEV_ORDER: usize = 64;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DelayOptions {
     /// Chebyshev order N (even; thesis uses an even N). 16 is converged to
-    /// ~1e-6 in the max |multiplier| (README).
+    /// ~1e-6 in the max |multiplier| (docs/guide/src/reproducing.md).
     pub chebyshev_order: usize,
     /// RK6 steps per gear segment for the monodromy; 0 = automatic (grows
     /// with N² because the Tau transport operator is stiff like N²). If the

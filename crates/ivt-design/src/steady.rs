@@ -23,7 +23,7 @@
 //! Accuracy: f_θ (Eq. 139) jumps at the gear corners, so ω̄(θ) has kinks and
 //! θ₁ has Fourier coefficients decaying like k⁻³. The truncation at n
 //! harmonics, not the solver, limits how well r̄ matches the exact (shooting)
-//! value; `tests::converges_in_n` and the README show r̄(n).
+//! value; `tests::converges_in_n` and docs/guide/src/reproducing.md show r̄(n).
 
 use super::{averaged_r, check_plant, IvtError, OperatingPoint, Verdict};
 use core::f64::consts::PI;
@@ -71,7 +71,7 @@ pub enum IhbMethod {
 pub enum Quadrature {
     /// Equally spaced samples (the thesis's FFT/AFT route). The residual jumps
     /// where θ(τ) crosses a gear corner, so this sum converges only like
-    /// 1/samples (≈1e-4 relative in r̄ at 1024 samples, see README).
+    /// 1/samples (≈1e-4 relative in r̄ at 1024 samples, see docs/guide/src/reproducing.md).
     Uniform,
     /// Gauss–Legendre on each smooth piece between the τ where θ(τ) crosses a
     /// corner (found by Newton on Eq. 152), with the moving-end terms in the
@@ -117,7 +117,7 @@ impl IhbOptions {
 }
 
 /// Most harmonics of the IVT IHB: r̄(n) converges like n⁻³ (8.7e-9 relative
-/// at n = 383, crates/ivt-design/README.md), and the tables grow like n²
+/// at n = 383, docs/guide/src/reproducing.md), and the tables grow like n²
 /// (~50 MB and seconds per solve at 511), so more buys nothing.
 pub const MAX_HARMONICS: usize = 511;
 

@@ -39,7 +39,7 @@ fn ihb(v: f64, t: f64, n: usize) -> f64 {
 /// truncation error falls like n⁻³ (see `converges_in_n`); n = 383 is where
 /// it is below 1e-8 at all ten. The shooting reference is converged to
 /// ~1e-11 (RK6 step study in `shooting::tests`) and checked against a plain
-/// time integration in the README.
+/// time integration in docs/guide/src/reproducing.md.
 #[test]
 fn ihb_matches_shooting_at_ten_points() {
     let pts = [

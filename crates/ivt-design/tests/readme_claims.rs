@@ -1,4 +1,5 @@
-//! The README's numbers for the open-loop law on the printed plant
+//! The numbers the guide (docs/guide/src/reproducing.md, "On the printed
+//! plant") states for the open-loop law on the printed plant
 //! ("Refit" and "ω_a error of the printed THESIS law"): how many thesis grid
 //! points are feasible, the refit's residuals and boundary line, and the ω_a
 //! error of each law, measured by θ-shooting of the open-loop periodic orbit at

@@ -137,7 +137,7 @@ fn bad_bounds_are_invalid_input() {
     ));
 }
 
-/// The README's bounds: 6 amplitudes (× 4 phases), 60 steps per run, the box
+/// The bounds docs/guide/src/model/all-solutions.md states: 6 amplitudes (× 4 phases), 60 steps per run, the box
 /// 10, deflation power 2 and shift 1.
 #[test]
 fn defaults_are_the_readme_values() {

@@ -1,5 +1,6 @@
-//! The defaults the README's API tables state (Broyden, HB options, Hsu
-//! rule, the STHB string of §3.3.4).
+//! The defaults the guide quotes (docs/guide/src/model/orbit.md and
+//! string.md; crates/ivt-hb/README.md points there): Broyden, HB options, Hsu
+//! rule, the STHB string of §3.3.4.
 
 use ivt_hb::sthb::{Boundary, StringParams};
 use ivt_hb::{BroydenOptions, HbOptions, HsuRule};

@@ -66,7 +66,7 @@ fn cpu_seconds() -> f64 {
 #[test]
 #[ignore = "scaling driver of bench/sthb_scaling.sh (minutes)"]
 fn scaling() {
-    // SIZES="5x19 10x39 ..." (default: the grid of the README table).
+    // SIZES="5x19 10x39 ..." (default: the grid of the table in docs/guide/src/accuracy-speed.md).
     let sizes = std::env::var("SIZES")
         .unwrap_or_else(|_| "5x9 5x19 5x39 10x9 10x19 10x39 20x9 20x19 20x39".to_string());
     for size in sizes.split_whitespace() {
@@ -118,7 +118,7 @@ fn twenty_modes_thirty_nine_harmonics_whole_curve_with_stability() {
     // Issue 28's case that did not finish in 15 minutes (1580 unknowns): the
     // whole curve, every point a solution of the full system, every turn
     // located, every point with a verdict (no time is asserted here; see the
-    // README's "At scale" and bench/sthb_scaling.sh).
+    // guide's docs/guide/src/accuracy-speed.md and bench/sthb_scaling.sh).
     let mut hb = StringHb::new(StringParams {
         modes: 20,
         harmonics: 39,

@@ -160,7 +160,7 @@ fn bad_states_and_forced_problems_are_invalid_input() {
     ));
 }
 
-/// The README's defaults: tolerance 1e-10, settled at 1e-6, up to 8 crossings
+/// The defaults docs/guide/src/model/limit-cycles.md states: tolerance 1e-10, settled at 1e-6, up to 8 crossings
 /// per period.
 #[test]
 fn defaults_are_the_readme_values() {

@@ -37,7 +37,7 @@ user_system_fn! {
 /// multipliers come from 2048 fixed steps. `events=False` locates the folds
 /// only by `ivt_hb::frequency_response` (no period-doubling,
 /// Neimark–Sacker or branch-point test per point: cheaper per
-/// point, see the ivt-py README). GIL released between callbacks.
+/// point, see docs/guide/src/accuracy-speed.md). GIL released between callbacks.
 fn frc<'py>(py, user, jac;
     f: Option<&Bound<'py, PyAny>>,
     omega_from: f64,

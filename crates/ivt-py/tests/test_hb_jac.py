@@ -86,9 +86,9 @@ def test_chain_frc_folds_equal_and_g_is_called_less(events: bool) -> None:
 
 def test_van_der_pol_period_with_jac_equals_without() -> None:
     """x'' − μ(1 − x²)x' + x = 0 (μ = 1) as C = −μ, g = μx²v with ∂g/∂x = 2μxv,
-    ∂g/∂v = μx² (the README's form: with C = 0 and g = μ(x² − 1)v the
-    unforced system's force scale, that of the start's linear force, is 0 at
-    ω = 1). Newton converges quadratically either way (‖r‖ ≈ 2e-15 after 5
+    ∂g/∂v = μx² (the form of docs/guide/src/model/limit-cycles.md: with C = 0
+    and g = μ(x² − 1)v the unforced system's force scale, that of the
+    start's linear force, is 0 at ω = 1). Newton converges quadratically either way (‖r‖ ≈ 2e-15 after 5
     iterations, measured), so the periods agree to rounding; 1e-12 relative
     is asserted."""
     mu = 1.0

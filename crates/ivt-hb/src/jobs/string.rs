@@ -116,7 +116,7 @@ pub fn string(req: &StringRequest) -> Result<StringCurve, HbError> {
     let t0 = Instant::now();
     // Newton arclength with the exact (Tau) Jacobian for both boundaries: the
     // engine's Broyden continuation (`spring_frequency_response`, §3.3.5)
-    // gives the same spring curve ~50× slower (crates/ivt-hb/README.md, STHB).
+    // gives the same spring curve ~50× slower (docs/guide/src/model/string.md).
     let mut hb = StringHb::new(req.params.clone())?;
     let curve = frequency_response(&mut hb, req.from, req.to, &opts)?;
     let solve_time_s = t0.elapsed().as_secs_f64();
