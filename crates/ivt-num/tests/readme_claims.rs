@@ -2,8 +2,8 @@
 
 use ivt_num::NewtonOptions;
 
-/// "residual test `ftol` [1e-10], step test [off], `max_iter` [50],
-/// `max_halvings` [8], `accept_no_descent` [false]".
+/// "residual test `ftol`: 1e-10, step test …: off, `max_iter`: 50,
+/// `max_halvings`: 8, `accept_no_descent`: false".
 #[test]
 fn newton_defaults_are_the_readme_values() {
     let o = NewtonOptions::default();
