@@ -231,7 +231,7 @@ impl Scene {
     /// Upper estimate of the bytes the recorded channels take (in memory,
     /// and once more per file format asked for): the pulses at ω0 (or the
     /// initial speed, if larger) over `duration_s`, decimated per channel,
-    /// times [`BYTES_PER_FIELD`] per field (uncompressed; the MCAP log is
+    /// times `BYTES_PER_FIELD` per field (uncompressed; the MCAP log is
     /// zstd-compressed and smaller).
     #[must_use]
     pub fn estimated_output_bytes(&self) -> f64 {
