@@ -40,17 +40,25 @@ mod guide {
     mod getting_started {}
     #[doc = include_str!("../docs/guide/src/limits.md")]
     mod limits {}
+    #[doc = include_str!("../docs/guide/src/kinematics.md")]
+    mod kinematics {}
     #[doc = include_str!("../docs/guide/src/reproducing.md")]
     mod reproducing {}
+    #[doc = include_str!("../docs/guide/src/thesis-findings.md")]
+    mod thesis_findings {}
     mod controller {
         #[doc = include_str!("../docs/guide/src/controller/gains.md")]
         mod gains {}
+        #[doc = include_str!("../docs/guide/src/controller/inside.md")]
+        mod inside {}
         #[doc = include_str!("../docs/guide/src/controller/open-loop.md")]
         mod open_loop {}
         #[doc = include_str!("../docs/guide/src/controller/reading-a-run.md")]
         mod reading_a_run {}
         #[doc = include_str!("../docs/guide/src/controller/scenes.md")]
         mod scenes {}
+        #[doc = include_str!("../docs/guide/src/controller/simulator.md")]
+        mod simulator {}
     }
     mod model {
         #[doc = include_str!("../docs/guide/src/model/all-solutions.md")]

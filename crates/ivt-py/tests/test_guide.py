@@ -42,7 +42,11 @@ NOT_RUN: Dict[str, str] = {
     "cd ": "moves into a checkout; the runner's cwd is the chapter's directory",
     "git clone": "needs the network",
     "probe-rs": "needs the STM32F411 rig board",
+    "RUSTC=/usr/bin/rustc": "the firmware with Debian's toolchain: scripts/test builds and tests it "
+    "(firmware/run-qemu.sh test); `--features rig` flashes the rig board",
     "ivt rig record --port": "needs the rig's serial port",
+    "cargo doc": "scripts/guide builds the Rust reference",
+    "pdoc ": "scripts/py-test builds the Python reference",
     "ivt rig commission --port": "needs the rig's serial port",
 }
 
