@@ -4,7 +4,7 @@
 //! are enums); every error is one line `origin:line:column: `key` message`,
 //! the position taken from toml's own spans. Each section validates itself
 //! next to its definition. See `scenes/*.toml` for examples and the crate
-//! README for the full key list and the limits ([`MAX_DURATION_S`],
+//! guide's Scenes chapter (docs/guide/src/controller/scenes.md) for the full key list and the limits ([`MAX_DURATION_S`],
 //! `[outputs] max_bytes`).
 
 mod controller;
