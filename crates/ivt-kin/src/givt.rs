@@ -390,7 +390,7 @@ impl DirectionModule {
 
     /// ω_carrier1/ω_rg2 in forward mode from Eq. 18–19:
     /// −(r_s + 2r_p)/(2(r_s + r_p)). The thesis prints 4 in the denominator,
-    /// which Eq. 18–19 do not give (see the guide, docs/guide/src/kinematics.md).
+    /// which Eq. 18–19 do not give (see the crate README).
     pub fn forward_ratio(&self) -> f64 {
         let (s, p) = (self.r_sun, self.r_planet);
         -(s + 2.0 * p) / (2.0 * (s + p))
