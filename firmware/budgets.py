@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Measure the firmware budgets and fail over the targets (README.md).
+"""Measure the firmware budgets and fail over the targets (the guide, docs/guide/src/rig/firmware.md).
 
 - flash / static RAM of each image: `arm-none-eabi-size` (flash = text + data,
   RAM = data + bss);

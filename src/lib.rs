@@ -24,3 +24,70 @@ pub use ivt_num as num;
 pub use ivt_plot as plot;
 pub use ivt_sim as sim;
 pub use ivt_wire as wire;
+
+/// The guide's chapters (docs/guide/src) as doctests: every ```rust block of
+/// the book compiles and runs under `cargo test --doc` (tests/guide.rs checks
+/// that each chapter is listed here).
+#[cfg(doctest)]
+mod guide {
+    #[doc = include_str!("../docs/guide/src/accuracy-speed.md")]
+    mod accuracy_speed {}
+    #[doc = include_str!("../docs/guide/src/api.md")]
+    mod api {}
+    #[doc = include_str!("../docs/guide/src/architecture.md")]
+    mod architecture {}
+    #[doc = include_str!("../docs/guide/src/getting-started.md")]
+    mod getting_started {}
+    #[doc = include_str!("../docs/guide/src/limits.md")]
+    mod limits {}
+    #[doc = include_str!("../docs/guide/src/kinematics.md")]
+    mod kinematics {}
+    #[doc = include_str!("../docs/guide/src/reproducing.md")]
+    mod reproducing {}
+    #[doc = include_str!("../docs/guide/src/thesis-findings.md")]
+    mod thesis_findings {}
+    mod controller {
+        #[doc = include_str!("../docs/guide/src/controller/gains.md")]
+        mod gains {}
+        #[doc = include_str!("../docs/guide/src/controller/inside.md")]
+        mod inside {}
+        #[doc = include_str!("../docs/guide/src/controller/open-loop.md")]
+        mod open_loop {}
+        #[doc = include_str!("../docs/guide/src/controller/reading-a-run.md")]
+        mod reading_a_run {}
+        #[doc = include_str!("../docs/guide/src/controller/scenes.md")]
+        mod scenes {}
+        #[doc = include_str!("../docs/guide/src/controller/simulator.md")]
+        mod simulator {}
+    }
+    mod model {
+        #[doc = include_str!("../docs/guide/src/model/all-solutions.md")]
+        mod all_solutions {}
+        #[doc = include_str!("../docs/guide/src/model/backbones.md")]
+        mod backbones {}
+        #[doc = include_str!("../docs/guide/src/model/elements.md")]
+        mod elements {}
+        #[doc = include_str!("../docs/guide/src/model/frc.md")]
+        mod frc {}
+        #[doc = include_str!("../docs/guide/src/model/large-models.md")]
+        mod large_models {}
+        #[doc = include_str!("../docs/guide/src/model/limit-cycles.md")]
+        mod limit_cycles {}
+        #[doc = include_str!("../docs/guide/src/model/orbit.md")]
+        mod orbit {}
+        #[doc = include_str!("../docs/guide/src/model/string.md")]
+        mod string {}
+        #[doc = include_str!("../docs/guide/src/model/two-parameter.md")]
+        mod two_parameter {}
+    }
+    mod rig {
+        #[doc = include_str!("../docs/guide/src/rig/commissioning.md")]
+        mod commissioning {}
+        #[doc = include_str!("../docs/guide/src/rig/firmware.md")]
+        mod firmware {}
+        #[doc = include_str!("../docs/guide/src/rig/identification.md")]
+        mod identification {}
+        #[doc = include_str!("../docs/guide/src/rig/recording.md")]
+        mod recording {}
+    }
+}

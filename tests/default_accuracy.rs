@@ -1,6 +1,7 @@
 //! The accuracy of two defaults of the command line, each against a
 //! converged reference computed the same way with a much finer setting
-//! (README, "Accuracy of the defaults"):
+//! (the guide's Limits and errors, docs/guide/src/limits.md, "Accuracy of the
+//! defaults"):
 //!
 //! - `hb duffing` Floquet multipliers: Hsu's method with Magnus-4 over
 //!   max(8n, 256) sub-intervals (256 at the default n = 20) against 8192;

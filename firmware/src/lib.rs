@@ -1,5 +1,6 @@
 //! IVT rig firmware: the `ivt-ctrl` controller behind a board layer. See
-//! README.md for boards, wiring, the PIL protocol and the measured budgets.
+//! docs/guide/src/rig/firmware.md (the guide) for boards, wiring, the PIL
+//! protocol and the measured budgets.
 #![no_std]
 
 pub mod app;

@@ -16,7 +16,7 @@ pub const DEFAULT_SCENE: &str = include_str!("../../scenes/drive.toml");
 /// Arguments of `ivt sim`.
 #[derive(Args)]
 pub struct SimArgs {
-    /// Scene file (TOML); see scenes/ and crates/ivt-sim/README.md.
+    /// Scene file (TOML); see scenes/ and the guide's Scenes chapter (docs/guide/src/controller/scenes.md).
     pub scene: PathBuf,
     /// Directory for the outputs the scene asks for.
     #[arg(long, default_value = "out")]

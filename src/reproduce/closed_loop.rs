@@ -5,7 +5,7 @@
 //! Analogues, not reproductions: the thesis's scene of §4.3 (T_U = 8 N·m,
 //! V_m 8 → 7 V) leaves the feasible band of the printed plant (SPEC §5), so
 //! the scenes keep the same shape inside the band; their gains come from the
-//! simulator's gain study (crates/ivt-sim/README.md).
+//! simulator's gain study (docs/guide/src/controller/gains.md).
 
 use super::{series, Context, ReproError};
 use ivt_plot::{Figure, Style};

@@ -1,13 +1,13 @@
-//! README numbers of ivt-ctrl that no behavioural test covers, each checked
-//! against its closed form (the README's "Gain units" and "Per pulse"
-//! sections).
+//! Numbers of ivt-ctrl that no behavioural test covers, each checked against
+//! its closed form: the guide's "Gain units" and "Per pulse" sections
+//! (docs/guide/src/controller/inside.md; the crate README's units paragraph).
 
 use ivt_ctrl::units;
 
 /// Eq. 189's K = 50 deg of stepper per rpm, through the SGIVT map Eq. 185
 /// (7π/51840 in per deg), is 50 · (60/2π) · 7π/51840 · 0.0254 =
 /// 50·60·7·0.0254/(2·51840) = 5.1447e-3 m per rad/s. The f32 conversion
-/// rounds three constants and two products (≤ 4 ε relative); the README
+/// rounds three constants and two products (≤ 4 ε relative); the guide
 /// prints 5.14e-3, so half a printed unit is 5e-6.
 #[test]
 fn prop_gain_k50_is_5_14e_3_m_per_rad_s() {

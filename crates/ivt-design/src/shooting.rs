@@ -9,7 +9,7 @@
 //! map ω(0) ↦ ω(2π) (unique and attracting by Theorem 2); its period in time is
 //! T = ∫₀^{2π} dθ/ω, so the time mean of ω is ω_a = 2π/T (the quantity the
 //! controller measures, §4.3). The design point r̄ solves `ω_a(r̄) = ω0`.
-//! Both conditions are solved together by Newton ([`ivt_num::newton`]) on
+//! Both conditions are solved together by Newton ([`ivt_num::newton()`]) on
 //! (ω(0), r), with the exact Jacobian from the variational equations
 //! integrated alongside.
 
@@ -344,7 +344,7 @@ impl NewtonSystem for ReturnMap<'_> {
     }
 }
 
-/// Newton on the return map ([`ivt_num::newton`]): stops when every update
+/// Newton on the return map ([`ivt_num::newton()`]): stops when every update
 /// is below `tol` relative (r: relative to max(|r|, 1e-6 m)); a step
 /// without descent is taken (the map contracts, Theorem 2).
 fn solve(

@@ -96,7 +96,7 @@ impl BranchPointTest {
 /// carries the null space of `[R_q, R_λ]` there ([`Bifurcation::second_direction`]).
 ///
 /// # Errors
-/// As [`locate_multiplier_crossing`] (no neutral-saddle case).
+/// As [`crate::bifurcation::locate_multiplier_crossing`] (no neutral-saddle case).
 pub fn locate_branch_point<F: Family>(
     branch: &mut FamilyBranch<F>,
     q0: &[f64],

@@ -74,7 +74,7 @@ impl<P: PeriodicProblem> ClassicIhb<P> {
         &self.problem
     }
 
-    /// Solves by damped Newton (Eq. 57, [`ivt_num::newton`]: step halving while
+    /// Solves by damped Newton (Eq. 57, [`ivt_num::newton()`]: step halving while
     /// ‖R‖ does not fall) from the linear solution or from `guess`.
     ///
     /// # Errors

@@ -17,7 +17,7 @@
 //! the path's fold detection brackets it and a second, short path with a
 //! hundredth of the step through the bracket locates it (parabola through the
 //! three points around the turn). The fold at each requested `p` is solved at
-//! fixed `p` by Newton ([`ivt_num::newton`]) from the bracketing points.
+//! fixed `p` by Newton ([`ivt_num::newton()`]) from the bracketing points.
 //!
 //! Here the excitation may depend on `p` (a force amplitude): the residual is
 //! planned anew when `p` changes. `family(p)` returns a `Result`, so a family

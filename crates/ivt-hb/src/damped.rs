@@ -5,7 +5,7 @@
 //! system dissipates; `ζ = −κ/(2ω)` is then the modal damping ratio at that
 //! amplitude, ω the modal frequency. The unknowns `{q, ω, κ}`, the phase
 //! condition `b₁ = 0` and the prescribed amplitude `a₁` of the reference DOF are
-//! those of the backbone ([`crate::backbone`], whose path this traces): for
+//! those of the backbone ([`crate::backbone()`], whose path this traces): for
 //! `C = 0` the curve is the backbone (κ = 0), and at vanishing amplitude it
 //! is the linear mode: for proportional damping `C = αM + βK`, mode i has
 //! `ω = ω_i` and `ζ = (α + βω_i²)/(2ω_i)` exactly.
@@ -101,7 +101,7 @@ pub fn linear_mode<P: PeriodicProblem>(
 /// `opts.amplitude_to` (see the module docs). `hb.subharmonic` must be 1.
 ///
 /// # Errors
-/// As [`linear_mode`] and [`crate::backbone`] (without its `C = 0`); a
+/// As [`linear_mode`] and [`crate::backbone()`] (without its `C = 0`); a
 /// reference DOF at a node of the mode is [`HbError::InvalidInput`].
 pub fn damped_modes<P: PeriodicProblem>(
     problem: &P,

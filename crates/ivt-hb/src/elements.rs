@@ -6,7 +6,7 @@
 //! force `F(δ, δ̇)` is added to `g_a` and subtracted from `g_b`.
 //!
 //! The hysteretic [`Law::Jenkins`] depends on the history of δ: its force is
-//! computed period by period over the AFT samples ([`crate::hysteresis`]) by
+//! computed period by period over the AFT samples (`crate::hysteresis`) by
 //! [`PeriodicProblem::nonlinear_samples`] and
 //! [`PeriodicProblem::nonlinear_jacobian_samples`]; a one-sample call
 //! ([`PeriodicProblem::nonlinear`]) has no history and gives its virgin loading

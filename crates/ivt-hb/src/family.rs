@@ -236,7 +236,7 @@ impl<F: Family> Branch for FamilyBranch<F> {
         self.galerkin_at.push(lambda);
     }
     /// `wᵀL v` exactly plus the sum of the nonlinear part over the AFT grid
-    /// ([`GalerkinForm`]): no `J` is assembled.
+    /// (`GalerkinForm`): no `J` is assembled.
     fn bilinear(&mut self, q: &[f64], lambda: f64, w: &[f64], v: &[f64]) -> f64 {
         let (problem, omega_f) = self.family.at(lambda);
         let omega = omega_f / self.res.subharmonic() as f64;
@@ -251,7 +251,7 @@ impl<F: Family> Branch for FamilyBranch<F> {
         self.form.value(&problem, q, omega_f, w, v, Some(out));
     }
     /// Exact and without evaluating `g` where only `L` depends on λ
-    /// ([`Self::linear_lambda_derivative`]), else the central difference.
+    /// (`linear_lambda_derivative`), else the central difference.
     fn residual_lambda(&mut self, q: &[f64], lambda: f64, h: f64, out: &mut [f64]) {
         if self.only_linear_part_moves() {
             self.linear_lambda_derivative(q, lambda, out);

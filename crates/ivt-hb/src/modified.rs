@@ -31,7 +31,7 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
     /// Prepares the solver.
     ///
     /// # Errors
-    /// [`HbError::InvalidInput`]/[`HbError::Aft`] for bad sizes (N ≤ n, p = 0,
+    /// [`HbError::InvalidInput`]/[`HbError::AftTooFewSamples`] for bad sizes (N ≤ n, p = 0,
     /// non-finite matrices or excitation).
     pub fn new(problem: P, opts: HbOptions) -> Result<Self, HbError> {
         let res = HbResidual::new(&problem, &opts)?;

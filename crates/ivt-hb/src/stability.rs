@@ -299,7 +299,7 @@ pub struct HsuEstimate {
 /// Hsu's method (Magnus-4) along a path of orbits with the step count chosen
 /// per orbit: the multipliers of the monodromy Φ_S of `S` sub-intervals and
 /// of Φ_{S/2} from every other Θ sample of the same grid give the Richardson
-/// error estimate ([`richardson_error`]); `S` doubles until it meets the
+/// error estimate (`richardson_error`); `S` doubles until it meets the
 /// tolerance, and the next orbit starts at the `S` that met it (or half of it
 /// when the estimate was 32× below). Estimating on the multipliers, not on
 /// Φ's entries, takes their conditioning into account: next to a fold the

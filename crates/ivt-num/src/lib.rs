@@ -26,7 +26,7 @@
 //! - [`bordered`]: the bordered matrix `[[J, B], [Cᵀ, D]]` factored once
 //!   (solve, transposed solve, determinant sign): every extended system of
 //!   the path engine;
-//! - [`newton`]: the one damped Newton method (dense Jacobian, optional
+//! - [`newton`](mod@newton): the one damped Newton method (dense Jacobian, optional
 //!   linear border rows, through [`bordered::BorderedLu`], backtracking,
 //!   residual and step tests).
 //!

@@ -7,7 +7,7 @@
 /// compiler use SIMD lanes (a single running sum serialises every addition).
 const LANES: usize = 8;
 
-/// Dot product over the common length, summed in [`LANES`] interleaved partial sums
+/// Dot product over the common length, summed in `LANES` interleaved partial sums
 /// (a different, not less accurate, rounding order than a left-to-right sum).
 pub fn dot(x: &[f64], y: &[f64]) -> f64 {
     let n = x.len().min(y.len());

@@ -30,7 +30,7 @@
 //!   system (Eq. 174–179, `ivt_design::delay`) for the scene's gains. If it
 //!   is ≥ 1, `"auto"` falls back to time integration. The check assumes an
 //!   ideal actuator: a stepper rate limit can still turn a linearly stable
-//!   loop into a limit cycle (README: k2 = 4 at the shipped point).
+//!   loop into a limit cycle (the guide's gains chapter: k2 = 4 at the shipped point).
 //! - [`Route::TimeIntegration`]: the closed-loop simulation ([`Simulation::run`]).
 //!   If the scene asks for steady-state metrics, they are measured on the
 //!   last revolution of θ (per-pulse plant and control samples are recorded

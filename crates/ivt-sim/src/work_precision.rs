@@ -34,7 +34,7 @@ pub struct Problem {
     pub theta_end: f64,
 }
 
-/// The problem of the README table.
+/// The problem of the work–precision table (docs/guide/src/controller/simulator.md).
 pub const PROBLEM: Problem = Problem {
     v_m: 8.6,
     t_u: 6.0,

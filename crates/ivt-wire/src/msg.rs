@@ -52,9 +52,9 @@ pub enum Request {
         /// Timer ticks of the pulse edge.
         ticks: u32,
     },
-    /// Slow readings: motor voltage [V] and load torque [N·m].
+    /// Slow readings: motor voltage \[V\] and load torque \[N·m\].
     Inputs {
-        /// Motor voltage V_m [V].
+        /// Motor voltage V_m \[V\].
         v_m: f32,
         /// Load torque T_U [N·m].
         t_u: f32,

@@ -1,4 +1,4 @@
-//! The frame table of `firmware/README.md`: `0xA5 kind len payload crc_lo
+//! The frame table of the guide's firmware chapter (`docs/guide/src/rig/firmware.md`): `0xA5 kind len payload crc_lo
 //! crc_hi`, each message's kind byte and payload length, and the CRC over
 //! `kind len payload`, read back from encoded frames (the CRC's check value
 //! 0x29B1 is asserted in `frame::tests`).

@@ -1,6 +1,6 @@
 //! STM32F411CE rig board (e.g. WeAct "Black Pill", 25 MHz HSE, SYSCLK 100 MHz).
-//! Pins, timers and scaling are constants here; the wiring table is in
-//! README.md.
+//! Pins, timers and scaling are constants here; the wiring table is in the
+//! guide, docs/guide/src/rig/firmware.md.
 
 use ivt_ctrl::{Config, REFIT};
 

@@ -266,7 +266,7 @@ mod tests {
         // + 0.101520 + 0.165600 − 0.116280 − 0.000756 − 0.070200 + 0.053100
         // + 0.006430 = 0.007438 m. Fig. 39 quotes the IHB value r̄ = 0.0067 m
         // there: the printed fit is 0.74 mm off its own data point (noted in
-        // the README, like the other inconsistencies of SPEC §5).
+        // the guide's controller/inside.md, like the other inconsistencies of SPEC §5).
         let v = THESIS.evaluate(6.0, 6.0);
         assert_eq!(v.region, OlRegion::Normal);
         assert!((v.r_ol - 0.007438).abs() < 2e-7, "{}", v.r_ol);

@@ -58,7 +58,7 @@ impl SolveError {
     }
 }
 
-/// A failed [`ivt_num::newton`] on an infallible system, in this crate's
+/// A failed [`ivt_num::newton()`] on an infallible system, in this crate's
 /// terms: a line search without descent is a non-convergence.
 impl From<ivt_num::NewtonError<std::convert::Infallible>> for SolveError {
     fn from(e: ivt_num::NewtonError<std::convert::Infallible>) -> Self {

@@ -1,6 +1,6 @@
 //! Backbone curve (nonlinear normal mode) of an undamped, unforced system,
 //! followed in amplitude from a linear mode with ω unknown (phase condition
-//! b1 = 0, a fictitious damping κ unfolding the family: [`crate::backbone`]).
+//! b1 = 0, a fictitious damping κ unfolding the family: [`crate::backbone()`]).
 
 use super::{finite, Array};
 use crate::backbone::{BackboneOptions, BackbonePoint};
@@ -45,7 +45,7 @@ impl Default for BackboneRequest {
 impl BackboneRequest {
     /// # Errors
     /// [`HbError::InvalidInput`] for a non-finite frequency or amplitude (the
-    /// mode and the system are checked by [`crate::backbone`]).
+    /// mode and the system are checked by [`crate::backbone()`]).
     pub fn validate(&self) -> Result<(), HbError> {
         finite("omega0", self.omega0)?;
         finite("amplitude_from", self.amplitude_from)?;
@@ -85,7 +85,7 @@ pub struct BackboneCurve {
 /// The backbone of `problem` from `req`'s mode.
 ///
 /// # Errors
-/// [`BackboneRequest::validate`]'s and [`crate::backbone`]'s.
+/// [`BackboneRequest::validate`]'s and [`crate::backbone()`]'s.
 pub fn backbone<P: PeriodicProblem>(
     problem: &P,
     hb: &HbOptions,

@@ -11,12 +11,25 @@ same names and dict keys as its ``--json`` output, SPEC §6):
 - :mod:`ivt.sim`   scenes of the simulator → numpy arrays and the summary
 - :mod:`ivt.scenes` the shipped scenes: ``names()``, ``path(name)``
 - :mod:`ivt.sweep` grid / Monte-Carlo sweeps of scenes on threads or dask
+- :func:`ivt.foxglove_layout` the Foxglove layout for a run's or a rig's MCAP
 
 The numerics are the Rust crates of the workspace, reached through the private
 native module ``ivt._ivt``; long calls release the GIL.
 """
 
+import pathlib
+
 from . import ctrl, design, hb, kin, scenes, sim, sweep
 from ._ivt import __version__
 
-__all__ = ["ctrl", "design", "hb", "kin", "scenes", "sim", "sweep", "__version__"]
+__all__ = ["ctrl", "design", "hb", "kin", "scenes", "sim", "sweep", "foxglove_layout", "__version__"]
+
+
+def foxglove_layout() -> pathlib.Path:
+    """Path of the Foxglove layout shipped with the package (``ivt-layout.json``).
+
+    Import it in Foxglove (Layouts → Import from file) and open a simulator
+    run's ``out/*.mcap`` or a rig recording: plots of ω and ω_a, r, V_m, T_U and
+    the stepper position, and the controller's fault state over time.
+    """
+    return pathlib.Path(__file__).resolve().with_name("foxglove") / "ivt-layout.json"

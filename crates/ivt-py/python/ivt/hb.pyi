@@ -2,6 +2,9 @@
 frequency-response curves with located bifurcations, limit cycles and backbone
 curves, for Duffing, Mathieu–Duffing, the STHB string and user systems."""
 
+# Forward references in class bodies: pdoc executes the stubs as Python.
+from __future__ import annotations
+
 from typing import Any, Callable, Dict, List, Literal, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np

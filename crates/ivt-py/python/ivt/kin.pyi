@@ -1,7 +1,7 @@
 """Kinematics of the SGIVT variant (thesis §2.3) and the plant of Eq. 151."""
 
 import os
-from typing import Any, Dict, List, Literal, Tuple, Union, overload
+from typing import Any, ClassVar, Dict, List, Literal, Tuple, Union, overload
 
 from ._types import ArrayLike, FloatArray
 
@@ -50,6 +50,8 @@ Gravity = Literal["printed", "roller_mass"]
 class Plant:
     """The IVT plant of Eq. 151 with the Table 1 parameters (SI units)."""
 
+    # Compared by value and not hashable, as at runtime (Plant.__hash__ is None).
+    __hash__: ClassVar[None] = None  # type: ignore[assignment]
     def __init__(self, **overrides: Union[float, Gravity]) -> None: ...
     @staticmethod
     def from_file(path: Union[str, "os.PathLike[str]"]) -> "Plant": ...

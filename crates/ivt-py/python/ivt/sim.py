@@ -2,7 +2,7 @@
 
 A scene is a dict (the TOML structure), a path to a ``.toml`` file, or TOML
 text (a ``str`` containing a newline or ``=``); see ``scenes/*.toml`` and
-``crates/ivt-sim/README.md`` for the keys. :func:`run` releases the GIL, so
+``docs/guide/src/controller/scenes.md`` for the keys. :func:`run` releases the GIL, so
 several scenes run in parallel on threads (see :mod:`ivt.sweep`).
 """
 

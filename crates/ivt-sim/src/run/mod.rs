@@ -1,5 +1,5 @@
 //! Running a scene: the [`Simulation`] builder, the closed loop
-//! ([`closed_loop`], in named stages) and what a run produces (channels and
+//! (`closed_loop`, in named stages) and what a run produces (channels and
 //! the [`Summary`]).
 //!
 //! ```no_run

@@ -4,7 +4,7 @@
 //! are enums); every error is one line `origin:line:column: `key` message`,
 //! the position taken from toml's own spans. Each section validates itself
 //! next to its definition. See `scenes/*.toml` for examples and the crate
-//! README for the full key list and the limits ([`MAX_DURATION_S`],
+//! guide's Scenes chapter (docs/guide/src/controller/scenes.md) for the full key list and the limits ([`MAX_DURATION_S`],
 //! `[outputs] max_bytes`).
 
 mod controller;
@@ -231,7 +231,7 @@ impl Scene {
     /// Upper estimate of the bytes the recorded channels take (in memory,
     /// and once more per file format asked for): the pulses at ω0 (or the
     /// initial speed, if larger) over `duration_s`, decimated per channel,
-    /// times [`BYTES_PER_FIELD`] per field (uncompressed; the MCAP log is
+    /// times `BYTES_PER_FIELD` per field (uncompressed; the MCAP log is
     /// zstd-compressed and smaller).
     #[must_use]
     pub fn estimated_output_bytes(&self) -> f64 {

@@ -25,7 +25,7 @@ fn minimal_scene_parses_with_defaults() {
     assert!(!s.outputs.mcap && s.outputs.channels.is_empty());
 }
 
-/// Every default the README's scene-key table states, read back from a scene
+/// Every default the scene-key table of the guide (docs/guide/src/controller/scenes.md) states, read back from a scene
 /// that sets none of them.
 #[test]
 fn readme_scene_table_defaults() {

@@ -1,0 +1,165 @@
+"""The guide's (docs/guide) Python and command-line blocks run as a reader would
+run them, chapter by chapter:
+
+- each chapter runs in a fresh temporary directory (its cwd) that holds
+  ``scenes/``, the repository's shipped scenes, as a checkout does;
+- its ```python blocks run top to bottom in ONE fresh namespace, so a later
+  block uses what an earlier one defined; their assertions are the checks;
+- its ```console blocks run in the same directory, in document order with the
+  Python blocks: every line ``$ ivt ...`` runs with the built CLI ($IVT_BIN,
+  else target/release/ivt) first on PATH and must exit 0 (a line ending in
+  ``\\`` continues on the next). ``$ cargo run --release [-- ARGS]`` is the same
+  program and runs as ``ivt [ARGS]``. The only ``$`` lines not run are those in
+  ``NOT_RUN`` (the check itself, or a machine this is not), each named there;
+  any other ``$`` line fails the test;
+- lines without ``$`` in a console block, and ```text blocks, are output shown.
+
+```rust blocks are doctests (src/lib.rs includes every chapter); tests/guide.rs
+refuses any other fence language.
+"""
+
+import os
+import pathlib
+import re
+import shlex
+import subprocess
+from typing import Dict, List, Tuple
+
+import pytest
+
+REPO = pathlib.Path(__file__).resolve().parents[3]
+GUIDE = REPO / "docs" / "guide" / "src"
+
+# `$` commands shown but not run, each with its reason.
+NOT_RUN: Dict[str, str] = {
+    "./scripts/test": "the check that runs this test",
+    "./scripts/py-test": "the check that runs this test",
+    "cargo install": "installs a tool into the user's ~/.cargo",
+    "pip install": "installs into the user's environment (tests/test_wheel.py installs the wheel)",
+    "python -m venv": "creates the user's environment",
+    "source ": "activates the user's environment",
+    "firmware/run-qemu.sh": "scripts/test runs the firmware step itself",
+    "cd ": "moves into a checkout; the runner's cwd is the chapter's directory",
+    "git clone": "needs the network",
+    "probe-rs": "needs the STM32F411 rig board",
+    "RUSTC=/usr/bin/rustc": "the firmware with Debian's toolchain: scripts/test builds and tests it "
+    "(firmware/run-qemu.sh test); `--features rig` flashes the rig board",
+    "ivt rig record --port": "needs the rig's serial port",
+    "cargo doc": "scripts/guide builds the Rust reference",
+    "pdoc ": "scripts/py-test builds the Python reference",
+    "ivt rig commission --port": "needs the rig's serial port",
+}
+
+FENCE = re.compile(r"^(\s*)(`{3,}|~{3,})\s*([^\s`]*)")
+
+
+def ivt_bin() -> pathlib.Path:
+    env = os.environ.get("IVT_BIN")
+    path = pathlib.Path(env) if env else REPO / "target" / "release" / "ivt"
+    if not path.is_file():
+        pytest.fail(f"ivt CLI not found at {path}: cargo build --release --bin ivt, or set IVT_BIN")
+    return path
+
+
+def blocks(text: str) -> List[Tuple[str, int, str]]:
+    """(language, first line number, body) of every fenced block, in order;
+    the opening fence's indentation is removed from the body."""
+    out: List[Tuple[str, int, str]] = []
+    lines = text.splitlines()
+    i = 0
+    while i < len(lines):
+        m = FENCE.match(lines[i])
+        if not m:
+            i += 1
+            continue
+        indent, fence, lang = len(m.group(1)), m.group(2), m.group(3).split(",")[0]
+        body: List[str] = []
+        start = i + 1
+        i += 1
+        while i < len(lines) and not (
+            lines[i].strip().startswith(fence) and set(lines[i].strip()) == {fence[0]}
+        ):
+            line = lines[i]
+            body.append(line[indent:] if line[:indent].strip() == "" else line.lstrip())
+            i += 1
+        out.append((lang, start + 1, "\n".join(body) + "\n"))
+        i += 1
+    return out
+
+
+def commands(body: str) -> List[str]:
+    """The ``$`` lines of a console block, continuation lines joined."""
+    out: List[str] = []
+    pending = None
+    for line in body.splitlines():
+        if pending is not None:
+            pending += " " + line.strip()
+        elif line.startswith("$ "):
+            pending = line[2:].strip()
+        else:
+            continue
+        if pending.endswith("\\"):
+            pending = pending[:-1].rstrip()
+        else:
+            out.append(pending)
+            pending = None
+    assert pending is None, "a console line ends in \\ with nothing after it"
+    return out
+
+
+def as_ivt(cmd: str) -> str:
+    """``cargo run --release [-- ARGS]`` is ``ivt [ARGS]``; others unchanged."""
+    m = re.match(r"cargo run --release(?: --bin ivt)?(?:\s+--\s*(.*))?$", cmd)
+    if m:
+        return ("ivt " + (m.group(1) or "")).strip()
+    return cmd
+
+
+def chapters() -> List[str]:
+    return sorted(
+        p.relative_to(GUIDE).as_posix() for p in GUIDE.rglob("*.md") if p.name != "SUMMARY.md"
+    )
+
+
+def test_block_reader() -> None:
+    text = "x\n```python\na = 1\n```\n- item\n  ```console\n  $ ivt kin \\\n  plant\n  out\n  ```\n"
+    got = blocks(text)
+    assert got == [("python", 3, "a = 1\n"), ("console", 7, "$ ivt kin \\\nplant\nout\n")]
+    assert commands(got[1][2]) == ["ivt kin plant"]
+    assert as_ivt("cargo run --release") == "ivt"
+    assert as_ivt("cargo run --release -- sim scenes/drive.toml") == "ivt sim scenes/drive.toml"
+
+
+@pytest.mark.parametrize("chapter", chapters())
+def test_chapter_runs(chapter: str, tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    path = GUIDE / chapter
+    (tmp_path / "scenes").symlink_to(REPO / "scenes", target_is_directory=True)
+    monkeypatch.chdir(tmp_path)
+    exe = ivt_bin()
+    monkeypatch.setenv("PATH", f"{exe.parent}{os.pathsep}{os.environ.get('PATH', '')}")
+    namespace: Dict[str, object] = {"__name__": "__main__"}
+    for lang, line, body in blocks(path.read_text()):
+        where = f"{path.relative_to(REPO)}:{line}"
+        if lang == "python":
+            # Line numbers in a traceback point into the chapter.
+            code = compile("\n" * (line - 1) + body, str(path), "exec")
+            exec(code, namespace)
+        elif lang == "console":
+            for cmd in commands(body):
+                cmd = as_ivt(cmd)
+                if any(cmd.startswith(p) for p in NOT_RUN):
+                    continue
+                assert cmd.split()[0] == "ivt", (
+                    f"{where}: `$ {cmd}` is neither an ivt command nor in NOT_RUN"
+                )
+                argv = [str(exe), *shlex.split(cmd)[1:]]
+                if any(c in cmd for c in "|><;&"):
+                    run = subprocess.run(
+                        ["bash", "-o", "pipefail", "-c", cmd], capture_output=True, text=True
+                    )
+                else:
+                    run = subprocess.run(argv, capture_output=True, text=True)
+                assert run.returncode == 0, (
+                    f"{where}: `$ {cmd}` exited {run.returncode}\n"
+                    f"stdout: {run.stdout[-2000:]}\nstderr: {run.stderr[-2000:]}"
+                )
