@@ -130,7 +130,7 @@ pub fn simulate_contraction(
         let mid = hermite_mid(
             w,
             w1,
-            rk_open.stage(0)[0],
+            first_slope(&rk_open),
             sys.omega_dot(seg, th + h, w1, r_bar),
         );
         hist[2 * i] = w;
@@ -160,7 +160,7 @@ pub fn simulate_contraction(
                 });
             }
             let d1 = sys.omega_dot(seg, th + h, y1[0], y1[1]);
-            let mid = hermite_mid(y[0], y1[0], rk.stage(0)[0], d1);
+            let mid = hermite_mid(y[0], y1[0], first_slope(&rk), d1);
             // z by Simpson on exactly the values that enter and leave the
             // history, so z ≡ Simpson ∫_{θ−2π}^{θ} dσ/ω to round-off. (RK4 on
             // z' = 1/ω − 1/ω_T would drift by O(h⁴) per revolution along the
@@ -218,4 +218,12 @@ pub fn check_prediction(
     let predicted = s.max_abs_multiplier;
     let gap = (c.measured - predicted).abs() / predicted;
     Ok((c, gap))
+}
+/// dω/dθ at the start of the last RK4 step (its stage 0, ω the state's
+/// first entry): the Hermite midpoint's left slope.
+fn first_slope<const N: usize>(rk: &ExplicitRk<4, [f64; N]>) -> f64 {
+    rk.stage(0)
+        .and_then(|k| k.first())
+        .copied()
+        .unwrap_or(f64::NAN)
 }
