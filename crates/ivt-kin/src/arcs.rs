@@ -14,7 +14,7 @@
 //! the tolerance. Because every biarc starts and ends on the curve with the
 //! curve's tangent, consecutive arcs are tangent at every joint.
 
-use crate::error::{positive, push, KinError};
+use crate::error::{filled, positive, push, KinError};
 use crate::ncg::{driven_angle, driving_angle, GearRatio};
 use core::f64::consts::PI;
 
@@ -319,15 +319,9 @@ impl<G: GearRatio + ?Sized> Fitter<'_, '_, G> {
     }
 
     fn push(&mut self, arcs: [Arc; 2]) -> Result<(), KinError> {
-        if self.count + 2 > self.out.len() {
-            return Err(KinError::BufferTooSmall {
-                needed: self.count + 2,
-                capacity: self.out.len(),
-            });
+        for arc in arcs {
+            push(self.out, &mut self.count, arc)?;
         }
-        self.out[self.count] = arcs[0];
-        self.out[self.count + 1] = arcs[1];
-        self.count += 2;
         Ok(())
     }
 
@@ -379,6 +373,7 @@ pub fn fit_arcs<G: GearRatio + ?Sized>(
     let delta = positive("corner_half_width", opts.corner_half_width)?;
     let mut corners = [0.0; MAX_PROFILE_CORNERS];
     let nc = profile.corners(&mut corners)?;
+    let corners = filled(&mut corners, nc)?;
     let mut fitter = Fitter {
         profile,
         opts: *opts,
@@ -387,37 +382,30 @@ pub fn fit_arcs<G: GearRatio + ?Sized>(
         max_dev: 0.0,
         max_corner_dev: 0.0,
     };
-    if nc == 0 {
+    if let Some(&first) = corners.first() {
+        // Each corner with the next one around the closed curve.
+        let after = corners
+            .iter()
+            .skip(1)
+            .copied()
+            .chain(core::iter::once(first + TWO_PI));
+        let spans = || corners.iter().copied().zip(after.clone());
+        if spans().any(|(c, next)| next - c <= 4.0 * delta) {
+            return Err(KinError::OutOfDomain {
+                name: "corner_half_width",
+                value: delta,
+                requirement: "less than a quarter of the smallest corner spacing",
+            });
+        }
+        for (c, next) in spans() {
+            fitter.smooth(c + delta, next - delta, opts.max_depth)?;
+            fitter.fillet(next - delta, next + delta)?;
+        }
+    } else {
         // Smooth closed curve: start from eight equal pieces.
         for k in 0..8 {
             let a = TWO_PI * k as f64 / 8.0;
             fitter.smooth(a, a + TWO_PI / 8.0, opts.max_depth)?;
-        }
-    } else {
-        let corners = &corners[..nc];
-        for i in 0..nc {
-            let next = if i + 1 < nc {
-                corners[i + 1]
-            } else {
-                corners[0] + TWO_PI
-            };
-            if next - corners[i] <= 4.0 * delta {
-                return Err(KinError::OutOfDomain {
-                    name: "corner_half_width",
-                    value: delta,
-                    requirement: "less than a quarter of the smallest corner spacing",
-                });
-            }
-        }
-        for i in 0..nc {
-            let c = corners[i];
-            let next = if i + 1 < nc {
-                corners[i + 1]
-            } else {
-                corners[0] + TWO_PI
-            };
-            fitter.smooth(c + delta, next - delta, opts.max_depth)?;
-            fitter.fillet(next - delta, next + delta)?;
         }
     }
     Ok(ArcFit {

@@ -8,7 +8,7 @@
 //! radius) for the GIVT; [`GivtGeometry::illustrative`] picks values scaled
 //! from the design eccentricity r_o = 10 mm of §2.1.5 and says so.
 
-use crate::error::{finite, in_range, positive, push, KinError};
+use crate::error::{filled, finite, in_range, positive, push, KinError};
 use crate::quad::{relative_tolerance, simpson};
 use core::f64::consts::FRAC_PI_2;
 
@@ -236,7 +236,7 @@ impl GivtGeometry {
             }
             prev = k;
         }
-        sort_small(&mut out[..count]);
+        filled(out, count)?.sort_unstable_by(f64::total_cmp);
         Ok(count)
     }
 
@@ -255,7 +255,10 @@ impl GivtGeometry {
         // Relative target: near r → l1 the ratio grows like l1/(l1 − r).
         let tol = relative_tolerance(&g, 0.0, MODULE_PERIOD, 1e-14);
         let mut a = 0.0;
-        for &c in corners[..n].iter().chain(core::iter::once(&MODULE_PERIOD)) {
+        for &c in filled(&mut corners, n)?
+            .iter()
+            .chain(core::iter::once(&MODULE_PERIOD))
+        {
             let q = simpson(&g, a, c, tol);
             ok &= q.converged;
             err += q.error;
@@ -303,17 +306,6 @@ impl GivtGeometry {
 impl Default for GivtGeometry {
     fn default() -> Self {
         Self::illustrative()
-    }
-}
-
-/// Insertion sort for the few corners (no allocation, no_std).
-fn sort_small(xs: &mut [f64]) {
-    for i in 1..xs.len() {
-        let mut j = i;
-        while j > 0 && xs[j - 1] > xs[j] {
-            xs.swap(j - 1, j);
-            j -= 1;
-        }
     }
 }
 
