@@ -1,18 +1,3 @@
-// Issue #30 item 1: the panic lints the binary, ivt-py and ivt-ctrl deny,
-// denied in this library's shipped code (every failure is a typed error).
-// Unit tests (`cfg(test)`) and the tests/ and benches/ targets may unwrap.
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::indexing_slicing,
-        clippy::unreachable,
-        clippy::todo,
-        clippy::unimplemented
-    )
-)]
 #![doc = include_str!("../README.md")]
 // Dense kernels index several arrays with the same row/column counters; iterator
 // chains would hide the matrix structure the equations are written in.
