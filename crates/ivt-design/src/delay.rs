@@ -133,18 +133,22 @@ pub struct DelayStability {
 
 /// The constant part of the Tau rows: dq_i/dθ = −Σ_n D[n][i] q_n (Eq. 175),
 /// with d T_n/dx = Σ_i D[n][i] T_i and T_i(x) = cos(i·arccos(x/π − 1)).
-fn tau_rows(n_order: usize) -> DMatrix<f64> {
-    // dt[(i, n)] = coefficient of T_i in dT_n/dx.
-    let mut dt = DMatrix::zeros(n_order, n_order + 1);
-    for n in 1..=n_order {
-        for i in 0..n {
-            if (n - i) % 2 == 1 {
-                let ci = if i == 0 { 2.0 } else { 1.0 };
-                dt[(i, n)] = 2.0 * n as f64 / ci / PI;
-            }
-        }
-    }
-    dt
+/// Row i (of N) holds the coefficient of T_i in dT_n/dx for n = 0..=N.
+fn tau_rows(n_order: usize) -> Vec<Vec<f64>> {
+    (0..n_order)
+        .map(|i| {
+            let ci = if i == 0 { 2.0 } else { 1.0 };
+            (0..=n_order)
+                .map(|n| {
+                    if n > i && (n - i) % 2 == 1 {
+                        2.0 * n as f64 / ci / PI
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// ω̄' of Eq. 162 and the coefficients A, B, C of Appendix B (Eq. 174) at one
@@ -201,22 +205,23 @@ pub fn system_matrix(
     let p = plant.terms_with_f(theta, f, ft, r, op.v_m, op.t_u);
     let (_, a, b, c) = appendix_b(&p, r, omega);
     let t0 = |i: usize| if i.is_multiple_of(2) { 1.0 } else { -1.0 };
-    let mut m = DMatrix::zeros(nn + 3, nn + 3);
-    for n in 0..=nn {
+    // Outside the table (never asked for below) a coefficient is zero.
+    let coef = |i: usize, n: usize| dt.get(i).and_then(|row| row.get(n)).copied().unwrap_or(0.0);
+    let big_k = -gains.k * op.omega0 * op.omega0 / (2.0 * PI);
+    Ok(DMatrix::from_fn(nn + 3, nn + 3, |i, n| match (i, n) {
         // Eq. 175: q_i' = −Σ_n D[n][i] q_n for i < N.
-        for i in 0..nn {
-            m[(i, n)] = -dt[(i, n)];
-        }
+        (i, n) if n <= nn && i < nn => -coef(i, n),
         // Eq. 176 solved for q_N' (T0_N = 1 for even N).
-        let bound: f64 = (0..nn).map(|i| t0(i) * dt[(i, n)]).sum();
-        m[(nn, n)] = b * t0(n) + bound;
+        (i, n) if n <= nn && i == nn => {
+            b * t0(n) + (0..nn).map(|k| t0(k) * coef(k, n)).sum::<f64>()
+        }
         // Eq. 177–178: (T_0 − T_I)_n = (−1)^n − 1.
-        m[(nn + 1, n)] = gains.k2 * (t0(n) - 1.0);
-        m[(nn + 2, n)] = c * (t0(n) - 1.0);
-    }
-    m[(nn, nn + 1)] = a;
-    m[(nn + 1, nn + 2)] = -gains.k * op.omega0 * op.omega0 / (2.0 * PI);
-    Ok(m)
+        (i, n) if n <= nn && i == nn + 1 => gains.k2 * (t0(n) - 1.0),
+        (_, n) if n <= nn => c * (t0(n) - 1.0),
+        (i, n) if i == nn && n == nn + 1 => a,
+        (i, n) if i == nn + 1 && n == nn + 2 => big_k,
+        _ => 0.0,
+    }))
 }
 
 /// Steady state to linearize about: shooting to the time-mean ω0 (exact to
@@ -300,56 +305,63 @@ fn monodromy_with_steps(
     let diff: Vec<f64> = t0.iter().map(|t| t - 1.0).collect();
     let big_k = -gains.k * op.omega0 * op.omega0 / (2.0 * PI);
     let r = orbit.r;
-    // State: [ω̄, Φ column-major (d × d)].
+    // State: [ω̄, Φ column-major (d × d)], Φ = I.
     let mut y = vec![0.0; 1 + d * d];
-    y[0] = orbit.omega_start;
-    for i in 0..d {
-        y[1 + i * d + i] = 1.0;
+    if let Some((w, phi)) = y.split_first_mut() {
+        *w = orbit.omega_start;
+        phi.iter_mut().step_by(d + 1).for_each(|v| *v = 1.0);
     }
     let mut rk = rk6(y.len());
     for (a, b, seg) in pieces(0.0, 2.0 * PI) {
         let mut rhs = |theta: f64, y: &[f64], dy: &mut [f64]| {
             let (f, ft) = f_on_segment(theta, seg);
             let p = plant.terms_with_f(theta, f, ft, r, op.v_m, op.t_u);
-            let w = y[0];
+            let (Some((&w, phis)), Some((dw, outs))) = (y.split_first(), dy.split_first_mut())
+            else {
+                return;
+            };
             let (wp, a_coef, b_coef, c_coef) = appendix_b(&p, r, w);
-            dy[0] = wp;
-            for col in 0..d {
-                let phi = &y[1 + col * d..1 + (col + 1) * d];
-                let out = &mut dy[1 + col * d..1 + (col + 1) * d];
-                let q = &phi[..=nn];
-                let (dr, dz) = (phi[nn + 1], phi[nn + 2]);
+            *dw = wp;
+            // Column by column of Φ: {q_0 … q_N, Δr, Δz}.
+            for (phi, out) in phis.chunks_exact(d).zip(outs.chunks_exact_mut(d)) {
+                let (q, [dr, dz]) = phi.split_at(nn + 1) else {
+                    continue;
+                };
+                let (out_q, [out_n, out_r, out_z]) = out.split_at_mut(nn) else {
+                    continue;
+                };
                 let mut bound = 0.0; // Σ_{i<N} T0_i q'_i
-                for i in 0..nn {
+                for (i, ((o, row), t)) in out_q.iter_mut().zip(&dt).zip(&t0).enumerate() {
                     let mut s = 0.0;
-                    for (nidx, qn) in q.iter().enumerate().skip(i + 1) {
-                        s += dt[(i, nidx)] * qn;
+                    for (coef, qn) in row.iter().zip(q).skip(i + 1) {
+                        s += coef * qn;
                     }
-                    out[i] = -s;
-                    bound += t0[i] * out[i];
+                    *o = -s;
+                    bound += t * *o;
                 }
                 let u0: f64 = q.iter().zip(&t0).map(|(a, b)| a * b).sum();
                 let jump: f64 = q.iter().zip(&diff).map(|(a, b)| a * b).sum();
                 // Eq. 176 solved for q'_N (T0_N = 1 for even N).
-                out[nn] = a_coef * dr + b_coef * u0 - bound;
-                out[nn + 1] = big_k * dz + gains.k2 * jump; // Eq. 177
-                out[nn + 2] = c_coef * jump; // Eq. 178
+                *out_n = a_coef * dr + b_coef * u0 - bound;
+                *out_r = big_k * dz + gains.k2 * jump; // Eq. 177
+                *out_z = c_coef * jump; // Eq. 178
             }
         };
         let n = steps_for(b - a, steps);
         let h = (b - a) / n as f64;
         for i in 0..n {
             rk.step(&mut rhs, a + i as f64 * h, h, &mut y);
-            if !(y[0].is_finite() && y[0] > 0.0) {
+            let w = y.first().copied().unwrap_or(f64::NAN);
+            if !(w.is_finite() && w > 0.0) {
                 return Err(IvtError::Stall {
                     theta: a + (i + 1) as f64 * h,
-                    omega: y[0],
+                    omega: w,
                     r,
                 });
             }
         }
     }
-    Ok(DMatrix::from_column_slice(d, d, &y[1..]))
+    Ok(DMatrix::from_iterator(d, d, y.into_iter().skip(1)))
 }
 
 /// Max |Floquet multiplier| of Eq. 179 at `op` for `gains`, linearized about
@@ -390,17 +402,18 @@ pub fn delay_stability_about(
             history: vec![f64::NAN],
         });
     }
-    let unit = mult
-        .iter()
-        .enumerate()
-        .min_by(|a, b| {
-            let da = (a.1 .0 - 1.0).hypot(a.1 .1);
-            let db = (b.1 .0 - 1.0).hypot(b.1 .1);
-            da.total_cmp(&db)
-        })
-        .map(|(i, _)| i)
-        .unwrap_or(0);
-    let structural = mult[unit];
+    let nearest_one = mult.iter().copied().enumerate().min_by(|a, b| {
+        let da = (a.1 .0 - 1.0).hypot(a.1 .1);
+        let db = (b.1 .0 - 1.0).hypot(b.1 .1);
+        da.total_cmp(&db)
+    });
+    let Some((unit, structural)) = nearest_one else {
+        return Err(IvtError::NoConvergence {
+            method: "monodromy eigenvalues (none)",
+            iterations: 0,
+            history: vec![f64::NAN],
+        });
+    };
     let max_abs = mult
         .iter()
         .enumerate()

@@ -73,7 +73,9 @@ impl Loop<'_> {
 
     /// dy/dθ for y = [ω, r, z] with ω_T given.
     fn rhs(&self, seg: i64, theta: f64, y: &[f64], w_t: f64) -> [f64; 3] {
-        let (w, r, z) = (y[0], y[1], y[2]);
+        let &[w, r, z] = y else {
+            return [f64::NAN; 3];
+        };
         [
             self.omega_dot(seg, theta, w, r),
             self.gains.k * (2.0 * PI / z - self.op.omega0) + self.gains.k2 * (w - w_t),
@@ -110,8 +112,8 @@ pub fn simulate_contraction(
     };
     let h = FRAC_PI_2 / m as f64;
     let per_rev = 4 * m; // steps per revolution
-                         // hist[2i] = ω at step i, hist[2i+1] = ω at step i + ½ (one revolution, circular).
-    let mut hist = vec![0.0; 2 * per_rev];
+                         // hist[i] = [ω at step i, ω at step i + ½] (one revolution, circular).
+    let mut hist = vec![[0.0; 2]; per_rev];
     // Segment of step i: the corner-aligned grid puts each step inside one segment.
     let seg_of = |i: usize| segment_of((i as f64 + 0.5) * h);
     let hermite_mid = |w0: f64, w1: f64, d0: f64, d1: f64| 0.5 * (w0 + w1) + h * (d0 - d1) / 8.0;
@@ -121,20 +123,23 @@ pub fn simulate_contraction(
     let mut rk_open = ExplicitRk::<4, [f64; 1]>::new(&RK4);
     let mut rk = ExplicitRk::<4, [f64; 3]>::new(&RK4);
     let mut z = 0.0;
-    for i in 0..per_rev {
+    for (i, slot) in hist.iter_mut().enumerate() {
         let (seg, th) = (seg_of(i), i as f64 * h);
-        let mut f = |t: f64, w: &[f64], dw: &mut [f64]| dw[0] = sys.omega_dot(seg, t, w[0], r_bar);
+        let mut f = |t: f64, w: &[f64], dw: &mut [f64]| {
+            if let (Some(dw), Some(&w)) = (dw.first_mut(), w.first()) {
+                *dw = sys.omega_dot(seg, t, w, r_bar);
+            }
+        };
         let mut w1 = [w];
         rk_open.step(&mut f, th, h, &mut w1);
         let w1 = w1[0];
         let mid = hermite_mid(
             w,
             w1,
-            rk_open.stage(0)[0],
+            first_slope(&rk_open),
             sys.omega_dot(seg, th + h, w1, r_bar),
         );
-        hist[2 * i] = w;
-        hist[2 * i + 1] = mid;
+        *slot = [w, mid];
         z += h / 6.0 * (1.0 / w + 4.0 / mid + 1.0 / w1); // Simpson on the same nodes
         w = w1;
     }
@@ -143,12 +148,17 @@ pub fn simulate_contraction(
     for _rev in 0..opts.revolutions {
         for i in 0..per_rev {
             let (seg, th) = (seg_of(i), i as f64 * h);
-            let (wt0, wth) = (hist[2 * i], hist[2 * i + 1]);
-            let wt1 = hist[(2 * i + 2) % (2 * per_rev)];
+            // NaN only off the ring (cannot happen): the stall check below reports it.
+            let [wt0, wth] = hist.get(i).copied().unwrap_or([f64::NAN; 2]);
+            let [wt1, _] = hist
+                .get((i + 1) % per_rev)
+                .copied()
+                .unwrap_or([f64::NAN; 2]);
             // The RK4 stages sit at θ, θ + h/2 and θ + h: the history nodes 0, 1, 2.
             let mut f = |t: f64, y: &[f64], dy: &mut [f64]| {
                 let node = (2.0 * (t - th) / h).round() as usize;
-                dy.copy_from_slice(&sys.rhs(seg, t, y, [wt0, wth, wt1][node]));
+                let w_t = [wt0, wth, wt1].get(node).copied().unwrap_or(f64::NAN);
+                dy.copy_from_slice(&sys.rhs(seg, t, y, w_t));
             };
             let mut y1 = y;
             rk.step(&mut f, th, h, &mut y1);
@@ -160,7 +170,7 @@ pub fn simulate_contraction(
                 });
             }
             let d1 = sys.omega_dot(seg, th + h, y1[0], y1[1]);
-            let mid = hermite_mid(y[0], y1[0], rk.stage(0)[0], d1);
+            let mid = hermite_mid(y[0], y1[0], first_slope(&rk), d1);
             // z by Simpson on exactly the values that enter and leave the
             // history, so z ≡ Simpson ∫_{θ−2π}^{θ} dσ/ω to round-off. (RK4 on
             // z' = 1/ω − 1/ω_T would drift by O(h⁴) per revolution along the
@@ -168,8 +178,9 @@ pub fn simulate_contraction(
             y1[2] = y[2] + h / 6.0 * (1.0 / y[0] + 4.0 / mid + 1.0 / y1[0])
                 - h / 6.0 * (1.0 / wt0 + 4.0 / wth + 1.0 / wt1);
             // Overwrite the history slot of this step: it becomes ω_T one revolution later.
-            hist[2 * i] = y[0];
-            hist[2 * i + 1] = mid;
+            if let Some(slot) = hist.get_mut(i) {
+                *slot = [y[0], mid];
+            }
             y = y1;
         }
         error.push(2.0 * PI / y[2] - op.omega0);
@@ -178,7 +189,11 @@ pub fn simulate_contraction(
     // values of ω and the Hermite history values of ω_T differ at that order),
     // so the contraction is measured on successive differences, which decay
     // like λ^k whatever the offset.
-    let diff: Vec<f64> = error.windows(2).map(|w| w[1] - w[0]).collect();
+    let diff: Vec<f64> = error
+        .iter()
+        .zip(error.iter().skip(1))
+        .map(|(a, b)| b - a)
+        .collect();
     let peak = diff.iter().fold(0.0f64, |a, e| a.max(e.abs()));
     let n = diff
         .iter()
@@ -193,8 +208,14 @@ pub fn simulate_contraction(
     }
     let q = n / 4;
     let rms = |s: &[f64]| (s.iter().map(|e| e * e).sum::<f64>() / s.len() as f64).sqrt();
-    let late = rms(&diff[n - q..n]);
-    let earlier = rms(&diff[n - 2 * q..n - q]);
+    let (Some(late), Some(earlier)) = (diff.get(n - q..n), diff.get(n - 2 * q..n - q)) else {
+        return Err(IvtError::Input {
+            name: "revolutions",
+            value: n as f64,
+            requirement: "enough revolutions above the round-off floor (>= 8)",
+        });
+    };
+    let (late, earlier) = (rms(late), rms(earlier));
     Ok(Contraction {
         measured: (late / earlier).powf(1.0 / q as f64),
         error,
@@ -218,4 +239,12 @@ pub fn check_prediction(
     let predicted = s.max_abs_multiplier;
     let gap = (c.measured - predicted).abs() / predicted;
     Ok((c, gap))
+}
+/// dω/dθ at the start of the last RK4 step (its stage 0, ω the state's
+/// first entry): the Hermite midpoint's left slope.
+fn first_slope<const N: usize>(rk: &ExplicitRk<4, [f64; N]>) -> f64 {
+    rk.stage(0)
+        .and_then(|k| k.first())
+        .copied()
+        .unwrap_or(f64::NAN)
 }

@@ -67,11 +67,9 @@ impl OpenLoopLaw {
     /// (≤ 7 significant digits, e.g. 6.43e-3) becomes exactly the f64 of
     /// that decimal, not the f64 of its f32 rounding.
     pub fn from_coeffs(c: &ivt_ctrl::open_loop::OpenLoopCoeffs) -> Self {
-        let widen = |x: f32| -> f64 {
-            x.to_string()
-                .parse()
-                .expect("an f32's Display output parses as f64")
-        };
+        // An f32's Display output always parses as f64; were it not to, the
+        // exact widening of the f32 is the same number to f32 precision.
+        let widen = |x: f32| -> f64 { x.to_string().parse().unwrap_or(f64::from(x)) };
         Self {
             poly: c.poly.map(|row| row.map(widen)),
             boundary: c.boundary.map(widen),
@@ -135,10 +133,15 @@ pub fn fit_polynomial(
             "fewer feasible points than polynomial terms",
         ));
     }
-    let a = DMatrix::from_fn(data.len(), terms.len(), |row, col| {
-        let (v, t, _) = data[row];
-        v.powi(terms[col].0 as i32) * t.powi(terms[col].1 as i32)
-    });
+    let a = DMatrix::from_row_iterator(
+        data.len(),
+        terms.len(),
+        data.iter().flat_map(|&(v, t, _)| {
+            terms
+                .iter()
+                .map(move |&(i, j)| v.powi(i as i32) * t.powi(j as i32))
+        }),
+    );
     let b = DVector::from_iterator(data.len(), data.iter().map(|d| d.2));
     let x = a
         .clone()
@@ -146,8 +149,11 @@ pub fn fit_polynomial(
         .solve(&b, 1e-14)
         .map_err(|_| IvtError::EmptyGrid("least-squares solve failed"))?;
     let mut poly = [[0.0; 5]; 3];
-    for (c, (i, j)) in terms.iter().enumerate() {
-        poly[*i][*j] = x[c];
+    for (&(i, j), &xc) in terms.iter().zip(x.iter()) {
+        // V_m^i T_U^j with i < 3, j < 5 (PolyForm::terms)
+        if let Some(slot) = poly.get_mut(i).and_then(|row| row.get_mut(j)) {
+            *slot = xc;
+        }
     }
     let res = &a * &x - &b;
     Ok(PolyFit {

@@ -80,7 +80,13 @@ impl Variational<'_> {
         let p = self
             .plant
             .terms_with_f(theta, f, ft, self.r, self.v_m, self.t_u);
-        let w = y[0];
+        // y = [ω, t, ∂ω/∂ω0, ∂ω/∂r, ∂t/∂ω0, ∂t/∂r]
+        let (Some(&[w, _, s_w, s_r, _, _]), Some(out)) =
+            (y.first_chunk::<6>(), dy.first_chunk_mut::<6>())
+        else {
+            dy.fill(f64::NAN);
+            return;
+        };
         let inv_w = 1.0 / w;
         let drive = p.drive(self.r);
         let num = drive * inv_w - 0.5 * p.j_theta * w - p.f_m;
@@ -88,12 +94,14 @@ impl Variational<'_> {
         // ∂(ω')/∂ω and ∂(ω')/∂r (J depends on r through J_r).
         let f_w = (-drive * inv_w * inv_w - 0.5 * p.j_theta) / p.j;
         let f_r = ((p.g - p.f2) * inv_w - 0.5 * p.j_theta_r * w - dw * p.j_r) / p.j;
-        dy[0] = dw;
-        dy[1] = inv_w;
-        dy[2] = f_w * y[2];
-        dy[3] = f_w * y[3] + f_r;
-        dy[4] = -y[2] * inv_w * inv_w;
-        dy[5] = -y[3] * inv_w * inv_w;
+        *out = [
+            dw,
+            inv_w,
+            f_w * s_w,
+            f_w * s_r + f_r,
+            -s_w * inv_w * inv_w,
+            -s_r * inv_w * inv_w,
+        ];
     }
 }
 
@@ -211,8 +219,9 @@ pub fn omega_at_angles(
             let mut rhs = |theta: f64, y: &[f64], dy: &mut [f64]| {
                 let (f, ft) = f_on_segment(theta, seg);
                 let p = plant.terms_with_f(theta, f, ft, r, v_m, t_u);
-                let w = y[0];
-                dy[0] = (p.drive(r) / w - 0.5 * p.j_theta * w - p.f_m) / p.j;
+                if let (Some(dw), Some(&w)) = (dy.first_mut(), y.first()) {
+                    *dw = (p.drive(r) / w - 0.5 * p.j_theta * w - p.f_m) / p.j;
+                }
             };
             rk.integrate(&mut rhs, a, b, steps_for(b - a, steps_per_segment), &mut y);
             if !(y[0].is_finite() && y[0] > 0.0) {
@@ -306,21 +315,25 @@ impl NewtonSystem for ReturnMap<'_> {
     /// A trial with ω(0) ≤ 0 is outside the domain (NaN residual: the step
     /// is halved); a revolution that stalls is an error.
     fn residual(&mut self, x: &[f64], res: &mut [f64]) -> Result<(), IvtError> {
-        if x[0].is_nan() || x[0] <= 0.0 {
+        // x = [ω(0)] or [ω(0), r]; too short a trial is outside the domain too.
+        let (omega_start, r) = match (self.unknowns, x) {
+            (Unknowns::OmegaStart { r }, &[w, ..]) => (w, r),
+            (Unknowns::OmegaStartAndR { .. }, &[w, r, ..]) => (w, r),
+            _ => (f64::NAN, f64::NAN),
+        };
+        if omega_start.is_nan() || omega_start <= 0.0 {
             res.fill(f64::NAN);
             return Ok(());
         }
-        let r = match self.unknowns {
-            Unknowns::OmegaStart { r } => r,
-            Unknowns::OmegaStartAndR { .. } => x[1],
-        };
         let (v_m, t_u, steps) = (self.v_m, self.t_u, self.steps_per_segment);
-        self.last = revolution(self.plant, v_m, t_u, r, x[0], steps, &mut self.rk)?;
+        self.last = revolution(self.plant, v_m, t_u, r, omega_start, steps, &mut self.rk)?;
         let y = &self.last.0;
-        res[0] = y[0] - x[0];
-        if let Unknowns::OmegaStartAndR { omega0, t_target } = self.unknowns {
-            res[0] /= omega0;
-            res[1] = (y[1] - t_target) / t_target;
+        match (self.unknowns, res) {
+            (Unknowns::OmegaStartAndR { omega0, t_target }, [r0, r1, ..]) => {
+                *r0 = (y[0] - omega_start) / omega0;
+                *r1 = (y[1] - t_target) / t_target;
+            }
+            (_, res) => res.fill(y[0] - omega_start),
         }
         Ok(())
     }
@@ -330,14 +343,15 @@ impl NewtonSystem for ReturnMap<'_> {
     fn jacobian(&mut self, _x: &[f64], jac: &mut [f64]) -> Result<(), IvtError> {
         let y = &self.last.0;
         match self.unknowns {
-            Unknowns::OmegaStart { .. } => jac[0] = y[2] - 1.0,
+            Unknowns::OmegaStart { .. } => jac.fill(y[2] - 1.0),
             Unknowns::OmegaStartAndR { omega0, t_target } => {
-                jac.copy_from_slice(&[
+                let entries = [
                     (y[2] - 1.0) / omega0,
                     y[3] / omega0,
                     y[4] / t_target,
                     y[5] / t_target,
-                ]);
+                ];
+                jac.iter_mut().zip(entries).for_each(|(j, e)| *j = e);
             }
         }
         Ok(())

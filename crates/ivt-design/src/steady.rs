@@ -25,14 +25,17 @@
 //! harmonics, not the solver, limits how well r̄ matches the exact (shooting)
 //! value; `tests::converges_in_n` and docs/guide/src/reproducing.md show r̄(n).
 
+mod gauss;
+mod residual;
+
 use super::{averaged_r, check_plant, IvtError, OperatingPoint, Verdict};
 use core::f64::consts::PI;
-use ivt_hb::broyden::{broyden_solve, BroydenOptions, BroydenWorkspace, System};
+use gauss::gauss_legendre;
+use ivt_hb::broyden::{broyden_solve, BroydenOptions, BroydenWorkspace};
 use ivt_kin::plant::PlantParams;
-use ivt_kin::variant::{f_on_segment, f_on_segment_from_trig, segment_of};
-use ivt_num::{newton, NewtonError, NewtonOptions, NewtonSystem, NewtonWorkspace};
+use ivt_num::{newton, NewtonError, NewtonOptions, NewtonWorkspace};
 use nalgebra::{DMatrix, DVector};
-use std::convert::Infallible;
+use residual::{theta1_of, BalancedResidual};
 
 /// Harmonics, sampling and stopping rule of the IHB solve.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -182,7 +185,6 @@ impl SteadyState {
 #[derive(Clone, Debug)]
 pub struct IhbSolver {
     opts: IhbOptions,
-    samples: usize,
     /// Quadrature nodes τ_j and weights (Σ w = 2π).
     tau: Vec<f64>,
     weight: Vec<f64>,
@@ -198,8 +200,10 @@ pub struct IhbSolver {
     res: DVector<f64>,
     /// Moving-end (corner-crossing) contributions to the Jacobian.
     jump_jac: DMatrix<f64>,
-    /// (sin kτ_c, cos kτ_c) at one corner crossing, k = 0..=n.
+    /// (sin kτ_c, cos kτ_c) at one corner crossing, k = 1..=n.
     trig_c: Vec<(f64, f64)>,
+    /// The projection row weights at one corner crossing (2n+1).
+    jump_row: Vec<f64>,
     /// Broyden matrices, kept between solves (warm start along a sweep).
     broyden: BroydenWorkspace,
 }
@@ -236,7 +240,6 @@ impl IhbSolver {
         }
         let mut s = Self {
             opts,
-            samples: m,
             tau: vec![0.0; m],
             weight: vec![2.0 * PI / m as f64; m],
             gauss: gauss_legendre(opts.gauss_nodes()),
@@ -246,11 +249,12 @@ impl IhbSolver {
             dres: DMatrix::zeros(m, 2 * n + 1),
             res: DVector::zeros(m),
             jump_jac: DMatrix::zeros(2 * n + 1, 2 * n + 1),
-            trig_c: vec![(0.0, 1.0); n + 1],
+            trig_c: vec![(0.0, 1.0); n],
+            jump_row: vec![0.0; 2 * n + 1],
             broyden: BroydenWorkspace::new(2 * n + 1),
         };
-        for j in 0..m {
-            s.tau[j] = 2.0 * PI * j as f64 / m as f64;
+        for (j, tau) in s.tau.iter_mut().enumerate() {
+            *tau = 2.0 * PI * j as f64 / m as f64;
         }
         s.fill_tables();
         Ok(s)
@@ -259,160 +263,6 @@ impl IhbSolver {
     /// The options this plan was made for.
     pub fn options(&self) -> &IhbOptions {
         &self.opts
-    }
-
-    /// Trig tables and projection matrix for the current nodes and weights.
-    fn fill_tables(&mut self) {
-        let n = self.opts.harmonics;
-        for j in 0..self.samples {
-            let (w, tau) = (self.weight[j], self.tau[j]);
-            self.project[(0, j)] = w / (2.0 * PI);
-            let (s1, c1) = tau.sin_cos();
-            let (mut s, mut c) = (s1, c1);
-            for k in 1..=n {
-                if k > 1 && k % 8 == 1 {
-                    // Refresh the recurrence now and then against drift.
-                    (s, c) = (k as f64 * tau).sin_cos();
-                }
-                self.cos[j * n + k - 1] = c;
-                self.sin[j * n + k - 1] = s;
-                self.project[(k, j)] = w * c / PI;
-                self.project[(n + k, j)] = w * s / PI;
-                (s, c) = (s * c1 + c * s1, c * c1 - s * s1);
-            }
-        }
-    }
-
-    /// τ where θ(τ) = τ + θ₁(τ) equals `theta` (Newton; θ(τ) is monotone).
-    fn tau_of_theta(q: &[f64], theta: f64) -> f64 {
-        let mut tau = theta;
-        for _ in 0..60 {
-            let (v, d) = theta1_of(q, tau);
-            let step = (tau + v - theta) / (1.0 + d).max(1e-3);
-            tau -= step;
-            // Quadratic convergence: one more step after 1e-9 reaches round-off.
-            if step.abs() < 1e-9 {
-                let (v, d) = theta1_of(q, tau);
-                tau -= (tau + v - theta) / (1.0 + d).max(1e-3);
-                break;
-            }
-        }
-        tau
-    }
-
-    /// Place Gauss nodes on the four smooth pieces between corner crossings.
-    /// Returns the crossing τ's (for the moving-end Jacobian terms).
-    fn place_piecewise_nodes(&mut self, q: &[f64]) -> [f64; 5] {
-        use core::f64::consts::{FRAC_PI_2, FRAC_PI_4};
-        let mut ends = [0.0; 5];
-        for (k, e) in ends.iter_mut().enumerate() {
-            *e = Self::tau_of_theta(q, FRAC_PI_4 + k as f64 * FRAC_PI_2);
-        }
-        let g = self.gauss.0.len();
-        for p in 0..4 {
-            let (a, b) = (ends[p], ends[p + 1]);
-            let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
-            for i in 0..g {
-                self.tau[p * g + i] = mid + half * self.gauss.0[i];
-                self.weight[p * g + i] = half * self.gauss.1[i];
-            }
-        }
-        self.fill_tables();
-        ends
-    }
-
-    /// Sampled residual (and, if `jac`, its derivatives) at x = {r, q_p}.
-    fn sample(&mut self, plant: &PlantParams, op: &OperatingPoint, x: &[f64], jac: bool) {
-        let n = self.opts.harmonics;
-        let (w0, r) = (op.omega0, x[0]);
-        let q = &x[1..];
-        let corners = match self.opts.quadrature {
-            Quadrature::PiecewiseGauss => Some(self.place_piecewise_nodes(q)),
-            Quadrature::Uniform => None,
-        };
-        let (jc, jd) = (plant.j_c(), plant.j_d());
-        let (gg, a, b, c) = (
-            plant.gravity_gain(),
-            plant.motor_gain(),
-            plant.load_gain(),
-            plant.motor_damping(),
-        );
-        for j in 0..self.samples {
-            let tau = self.tau[j];
-            let (cs, sn) = (&self.cos[j * n..(j + 1) * n], &self.sin[j * n..(j + 1) * n]);
-            let (mut t1, mut t1d, mut t1dd) = (0.0, 0.0, 0.0);
-            for k in 0..n {
-                let kk = (k + 1) as f64;
-                let (qc, qs) = (q[k], q[n + k]);
-                t1 += qc * cs[k] + qs * sn[k];
-                t1d += kk * (qs * cs[k] - qc * sn[k]);
-                t1dd -= kk * kk * (qc * cs[k] + qs * sn[k]);
-            }
-            let theta = tau + t1;
-            let seg = segment_of(theta);
-            let (st, ct) = theta.sin_cos();
-            let (f, ft) = f_on_segment_from_trig(st, ct, seg);
-            let p = plant.terms_with_trig(st, ct, f, ft, r, op.v_m, op.t_u);
-            let s = 1.0 + t1d;
-            self.res[j] =
-                w0 * w0 * (p.j * t1dd + 0.5 * p.j_theta * s * s) + w0 * p.f_m * s - p.drive(r);
-            if jac {
-                // ∂/∂θ of the coefficients on one smooth segment (f_θθ = −f there).
-                let j_tt = 2.0 * (jc * r * r + jd) * (ft * ft - f * f);
-                let fm_t = 2.0 * c * f * ft;
-                let drive_t = gg * (ct - st) * r + a * ft * op.v_m - b * ft * op.t_u * r;
-                let r_theta =
-                    w0 * w0 * (p.j_theta * t1dd + 0.5 * j_tt * s * s) + w0 * fm_t * s - drive_t;
-                let r_s = w0 * w0 * p.j_theta * s + w0 * p.f_m;
-                let r_ss = w0 * w0 * p.j;
-                self.dres[(j, 0)] =
-                    w0 * w0 * (p.j_r * t1dd + 0.5 * p.j_theta_r * s * s) - (p.g - p.f2);
-                for k in 0..n {
-                    let kk = (k + 1) as f64;
-                    let base = r_theta - kk * kk * r_ss;
-                    self.dres[(j, 1 + k)] = base * cs[k] - kk * r_s * sn[k];
-                    self.dres[(j, 1 + n + k)] = base * sn[k] + kk * r_s * cs[k];
-                }
-            }
-        }
-        self.jump_jac.fill(0.0);
-        if let (true, Some(ends)) = (jac, corners) {
-            // d/dx Σ_pieces ∫ w R dτ gains w(τ_c) (R⁻ − R⁺) dτ_c/dx at each corner
-            // crossing τ_c; only J_θ jumps there, so R⁻ − R⁺ = ½ ω0² ΔJ_θ (1+θ₁')².
-            for &tc in &ends[1..] {
-                let (t1, t1d) = theta1_of(q, tc);
-                let (theta_c, s) = (tc + t1, 1.0 + t1d);
-                let left = segment_of(theta_c - 1e-9);
-                let right = segment_of(theta_c + 1e-9);
-                let jt = |seg: i64| {
-                    let (f, ft) = f_on_segment(theta_c, seg);
-                    plant
-                        .terms_with_f(theta_c, f, ft, r, op.v_m, op.t_u)
-                        .j_theta
-                };
-                let jump = 0.5 * w0 * w0 * (jt(left) - jt(right)) * s * s;
-                // dτ_c/dq = −∂θ₁/∂q (τ_c) / (1 + θ₁'(τ_c)); dτ_c/dr = 0.
-                let (s1, c1) = tc.sin_cos();
-                let (mut sr, mut cr) = (s1, c1);
-                for k in 1..=n {
-                    self.trig_c[k] = (sr, cr);
-                    (sr, cr) = (sr * c1 + cr * s1, cr * c1 - sr * s1);
-                }
-                for row in 0..=2 * n {
-                    let wrow = match row {
-                        0 => 1.0 / (2.0 * PI),
-                        k if k <= n => self.trig_c[k].1 / PI,
-                        k => self.trig_c[k - n].0 / PI,
-                    } * jump
-                        / s;
-                    for k in 1..=n {
-                        let (sk, ck) = self.trig_c[k];
-                        self.jump_jac[(row, k)] -= wrow * ck;
-                        self.jump_jac[(row, n + k)] -= wrow * sk;
-                    }
-                }
-            }
-        }
     }
 
     /// Solve Eq. 152–157 at `op`. `warm` = a previous solution {r, q_p} of the
@@ -431,14 +281,15 @@ impl IhbSolver {
         op.validate()?;
         let n = self.opts.harmonics;
         let dim = 2 * n + 1;
-        let mut x = vec![0.0; dim];
-        match warm {
+        // x = {r, q_p}
+        let x: Vec<f64> = match warm {
             Some((r, q)) if q.len() == 2 * n => {
-                x[0] = r;
-                x[1..].copy_from_slice(q);
+                core::iter::once(r).chain(q.iter().copied()).collect()
             }
-            _ => x[0] = averaged_r(plant, op),
-        }
+            _ => core::iter::once(averaged_r(plant, op))
+                .chain(core::iter::repeat_n(0.0, 2 * n))
+                .collect(),
+        };
         if self.opts.method == IhbMethod::Broyden {
             return self.solve_broyden(plant, op, x, warm.is_some());
         }
@@ -474,14 +325,20 @@ impl IhbSolver {
         iterations: usize,
         norm: f64,
     ) -> Result<SteadyState, IvtError> {
-        let q = x[1..].to_vec();
+        let Some((&r, q)) = x.split_first() else {
+            return Err(IvtError::Input {
+                name: "unknowns {r, q_p}",
+                value: 0.0,
+                requirement: "2n + 1 values",
+            });
+        };
         let mut st = SteadyState {
             op: *op,
-            r: x[0],
-            q,
+            r,
+            q: q.to_vec(),
             omega_min: f64::INFINITY,
             omega_max: f64::NEG_INFINITY,
-            verdict: Verdict::classify(x[0], plant.r_max),
+            verdict: Verdict::classify(r, plant.r_max),
             iterations,
             residual_norm: norm,
         };
@@ -563,46 +420,6 @@ impl IhbSolver {
     }
 }
 
-/// The harmonic-balanced residual R_p with its exact Jacobian: a [`System`]
-/// for the Broyden solver (the Jacobian (re)seeds it) and a [`NewtonSystem`].
-struct BalancedResidual<'a> {
-    solver: &'a mut IhbSolver,
-    plant: &'a PlantParams,
-    op: &'a OperatingPoint,
-}
-
-impl System for BalancedResidual<'_> {
-    fn residual(&mut self, x: &[f64], r: &mut [f64]) {
-        self.solver.sample(self.plant, self.op, x, false);
-        let rb = &self.solver.project * &self.solver.res;
-        r.copy_from_slice(rb.as_slice());
-    }
-
-    fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> bool {
-        self.solver.sample(self.plant, self.op, x, true);
-        let j = &self.solver.project * &self.solver.dres + &self.solver.jump_jac;
-        let m = x.len();
-        for i in 0..m {
-            for k in 0..m {
-                jac[i * m + k] = j[(i, k)];
-            }
-        }
-        true
-    }
-}
-
-impl NewtonSystem for BalancedResidual<'_> {
-    type Error = Infallible;
-    fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
-        System::residual(self, x, r);
-        Ok(())
-    }
-    fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> Result<(), Infallible> {
-        System::jacobian(self, x, jac);
-        Ok(())
-    }
-}
-
 /// One-shot convenience: plan and solve with `opts`.
 ///
 /// # Errors
@@ -613,51 +430,4 @@ pub fn solve_steady_state(
     opts: IhbOptions,
 ) -> Result<SteadyState, IvtError> {
     IhbSolver::new(opts)?.solve(plant, op, None)
-}
-
-/// θ₁(τ) = C_sᵀ q_p and θ₁'(τ) = C_sᵀ D_p q_p (Eq. 152–153), one `sin_cos`
-/// and the angle-addition recurrence (error grows like k·ε, negligible for
-/// the n ≤ 500 used here).
-fn theta1_of(q: &[f64], tau: f64) -> (f64, f64) {
-    let n = q.len() / 2;
-    let (s1, c1) = tau.sin_cos();
-    let (mut s, mut c) = (s1, c1);
-    let (mut v, mut d) = (0.0, 0.0);
-    for k in 1..=n {
-        let (qc, qs) = (q[k - 1], q[n + k - 1]);
-        v += qc * c + qs * s;
-        d += k as f64 * (qs * c - qc * s);
-        (s, c) = (s * c1 + c * s1, c * c1 - s * s1);
-    }
-    (v, d)
-}
-
-/// Gauss–Legendre nodes and weights on [−1, 1] (Newton on P_m from the
-/// Chebyshev-like initial guesses; Abramowitz–Stegun 25.4.29).
-pub(crate) fn gauss_legendre(m: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut x = vec![0.0; m];
-    let mut w = vec![0.0; m];
-    for i in 0..m {
-        let mut z = (PI * (i as f64 + 0.75) / (m as f64 + 0.5)).cos();
-        let mut dp = 1.0;
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, z);
-            for k in 2..=m {
-                let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
-                p0 = p1;
-                p1 = p2;
-            }
-            let pm = if m == 0 { 1.0 } else { p1 };
-            let pm1 = if m <= 1 { 1.0 } else { p0 };
-            dp = m as f64 * (z * pm - pm1) / (z * z - 1.0);
-            let dz = pm / dp;
-            z -= dz;
-            if dz.abs() < 1e-16 {
-                break;
-            }
-        }
-        x[m - 1 - i] = z;
-        w[m - 1 - i] = 2.0 / ((1.0 - z * z) * dp * dp);
-    }
-    (x, w)
 }

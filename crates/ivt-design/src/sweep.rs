@@ -65,23 +65,23 @@ impl Grid {
                 requirement: "at most 100000 points (MAX_GRID_POINTS)",
             });
         }
-        if self.v_m.is_empty() {
+        let Some(&v_m0) = self.v_m.first() else {
             return Err(IvtError::EmptyGrid("no V_m values"));
-        }
-        if self.t_u.is_empty() {
+        };
+        let Some(&t_u0) = self.t_u.first() else {
             return Err(IvtError::EmptyGrid("no T_U values"));
-        }
+        };
         for &v in &self.v_m {
             OperatingPoint {
                 v_m: v,
-                t_u: self.t_u[0],
+                t_u: t_u0,
                 omega0: self.omega0,
             }
             .validate()?;
         }
         for &t in &self.t_u {
             OperatingPoint {
-                v_m: self.v_m[0],
+                v_m: v_m0,
                 t_u: t,
                 omega0: self.omega0,
             }

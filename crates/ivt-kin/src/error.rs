@@ -86,6 +86,17 @@ pub(crate) fn push<T>(out: &mut [T], count: &mut usize, value: T) -> Result<(), 
     Ok(())
 }
 
+/// The first `count` entries of a buffer filled by [`push`], or
+/// `BufferTooSmall` if it has fewer (a count from elsewhere).
+#[inline]
+pub(crate) fn filled<T>(out: &mut [T], count: usize) -> Result<&mut [T], KinError> {
+    let capacity = out.len();
+    out.get_mut(..count).ok_or(KinError::BufferTooSmall {
+        needed: count,
+        capacity,
+    })
+}
+
 /// `Ok(x)` if `x` is finite and `lo <= x < hi` (pass `f64::INFINITY` for no
 /// upper bound), else the matching error.
 #[inline]

@@ -9,7 +9,7 @@
 //! The designs here: [`SgivtNcg`] (Eq. 38, mean 1: a 1:1 pair), [`SmoothNcg`]
 //! (Eq. 42 and its refits), [`GivtNcg`] (Eq. 13, mean 3).
 
-use crate::error::{finite, in_range, positive, KinError};
+use crate::error::{filled, finite, in_range, positive, KinError};
 use crate::givt::{GivtGeometry, MAX_CORNERS, MODULE_PERIOD};
 use crate::quad::simpson;
 use crate::variant;
@@ -368,7 +368,7 @@ impl GivtNcg {
         let mean_r = geometry.average_module_ratio(r_o)?;
         let mut c = [0.0; MAX_CORNERS];
         let n = geometry.module_corners(r_o, &mut c)?;
-        for x in &mut c[..n] {
+        for x in filled(&mut c, n)? {
             *x /= 3.0; // θ' = θ/3
         }
         Ok(Self {
@@ -424,7 +424,8 @@ impl GearRatio for GivtNcg {
         3.0
     }
     fn corners(&self) -> &[f64] {
-        &self.corners[..self.n_corners]
+        // `new` checked n_corners against the buffer (`filled`).
+        self.corners.get(..self.n_corners).unwrap_or_default()
     }
 }
 

@@ -10,7 +10,7 @@ use crate::vector::dot;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::{factor, solve};
 use faer::perm::PermRef;
-use faer::{Conj, Mat, MatMut, Par};
+use faer::{Conj, Mat, MatMut, MatRef, Par};
 
 /// An `n × n` matrix factored in place, with its permutation and scratch.
 pub struct LuWorkspace {
@@ -69,12 +69,15 @@ impl LuWorkspace {
     }
 
     /// Copy the row-major `n × n` matrix `a` into [`LuWorkspace::mat`].
+    ///
+    /// # Errors
+    /// An `a` shorter than `n²` (a caller's bug) fills the matrix with NaN,
+    /// so the next [`LuWorkspace::factor`] reports `false`, instead of a panic.
     pub fn set_row_major(&mut self, a: &[f64]) {
         let n = self.dim();
-        for i in 0..n {
-            for j in 0..n {
-                self.mat[(i, j)] = a[i * n + j];
-            }
+        match a.get(..n * n) {
+            Some(a) => self.mat.copy_from(MatRef::from_row_major_slice(a, n, n)),
+            None => self.mat.fill(f64::NAN),
         }
     }
 
@@ -125,63 +128,104 @@ impl LuWorkspace {
     /// faer's blocked triangular solves, whose set-up dominates there
     /// (m = 83: ≈ 0.4 µs against ≈ 5 µs, measured, not asserted); the
     /// arithmetic is the same up to the order of the sums.
+    ///
+    /// # Errors
+    /// An `rhs` shorter than `n` (a caller's bug) is filled with NaN instead
+    /// of a panic.
     pub fn solve(&mut self, rhs: &mut [f64]) {
         let n = self.dim();
-        let y = &mut self.column[..n];
+        let Some(rhs) = rhs.get_mut(..n) else {
+            rhs.fill(f64::NAN);
+            return;
+        };
+        let (mat, y) = (&self.mat, &mut self.column);
         for (yi, &p) in y.iter_mut().zip(&self.perm) {
-            *yi = rhs[p];
+            *yi = rhs.get(p).copied().unwrap_or(f64::NAN);
         }
         // L y = P b, L unit lower triangular (below the diagonal of `mat`).
         for j in 0..n {
-            let (head, tail) = y.split_at_mut(j + 1);
-            let yj = head[j];
+            let Some((head, tail)) = y.split_at_mut_checked(j + 1) else {
+                break;
+            };
+            let yj = head.last().copied().unwrap_or(0.0);
             if yj != 0.0 {
-                let col = &self.mat.col_as_slice(j)[j + 1..n];
+                let col = mat.col_as_slice(j).get(j + 1..).unwrap_or_default();
                 tail.iter_mut().zip(col).for_each(|(t, l)| *t -= l * yj);
             }
         }
         // U x = y, U upper triangular (on and above the diagonal).
         for j in (0..n).rev() {
-            let col = &self.mat.col_as_slice(j)[..=j];
-            let (head, tail) = y.split_at_mut(j);
-            let xj = tail[0] / col[j];
-            tail[0] = xj;
+            let col = mat.col_as_slice(j);
+            let Some((head, tail)) = y.split_at_mut_checked(j) else {
+                break;
+            };
+            let (Some(yj), Some(&ujj)) = (tail.first_mut(), col.get(j)) else {
+                break;
+            };
+            let xj = *yj / ujj;
+            *yj = xj;
             if xj != 0.0 {
                 head.iter_mut().zip(col).for_each(|(h, u)| *h -= u * xj);
             }
         }
-        rhs[..n].copy_from_slice(y);
+        rhs.iter_mut().zip(y.iter()).for_each(|(r, yi)| *r = *yi);
     }
 
     /// Solve `Aᵀ x = rhs` in place with the last factorization (left null
     /// vectors, bordered systems): `Uᵀ z = b`, `Lᵀ w = z`, `x = Pᵀ w`, each
     /// row of `Uᵀ`, `Lᵀ` a contiguous column of the factor (dot products),
     /// as [`LuWorkspace::solve`].
+    ///
+    /// # Errors
+    /// As [`LuWorkspace::solve`]: a short `rhs` is filled with NaN.
     pub fn solve_transpose(&mut self, rhs: &mut [f64]) {
         let n = self.dim();
-        let w = &mut self.column[..n];
+        let Some(rhs) = rhs.get_mut(..n) else {
+            rhs.fill(f64::NAN);
+            return;
+        };
+        let (mat, w) = (&self.mat, &mut self.column);
         for i in 0..n {
-            let col = &self.mat.col_as_slice(i)[..=i];
-            let sum = dot(&col[..i], &w[..i]);
-            w[i] = (rhs[i] - sum) / col[i];
+            let col = mat.col_as_slice(i);
+            let Some((done, rest)) = w.split_at_mut_checked(i) else {
+                break;
+            };
+            let (Some(wi), Some(&uii), Some(&bi)) = (rest.first_mut(), col.get(i), rhs.get(i))
+            else {
+                break;
+            };
+            // `dot` runs over the common length: the first i entries of col.
+            *wi = (bi - dot(col, done)) / uii;
         }
         for i in (0..n).rev() {
-            let col = &self.mat.col_as_slice(i)[i + 1..n];
-            w[i] -= dot(col, &w[i + 1..]);
+            let col = mat.col_as_slice(i).get(i + 1..).unwrap_or_default();
+            let Some((head, rest)) = w.split_at_mut_checked(i + 1) else {
+                break;
+            };
+            if let Some(wi) = head.last_mut() {
+                *wi -= dot(col, rest);
+            }
         }
         for (wi, &p) in w.iter().zip(&self.perm) {
-            rhs[p] = *wi;
+            if let Some(r) = rhs.get_mut(p) {
+                *r = *wi;
+            }
         }
     }
 
     /// Solve `A X = B` (or `Aᵀ X = B` with `transpose`) in place for the
     /// columns of `rhs` (`n × k`, `k ≤ n`).
     ///
-    /// # Panics
-    /// If `rhs` has not `n` rows or has more than `n` columns.
-    pub fn solve_mat(&mut self, rhs: MatMut<'_, f64>, transpose: bool) {
+    /// # Errors
+    /// If `rhs` has not `n` rows or has more than `n` columns (a caller's
+    /// bug: the scratch covers `n` columns), it is filled with NaN instead of
+    /// a panic.
+    pub fn solve_mat(&mut self, mut rhs: MatMut<'_, f64>, transpose: bool) {
         let n = self.dim();
-        assert!(rhs.nrows() == n && rhs.ncols() <= n.max(1));
+        if rhs.nrows() != n || rhs.ncols() > n.max(1) {
+            rhs.fill(f64::NAN);
+            return;
+        }
         let perm = PermRef::new_checked(&self.perm, &self.perm_inv, n);
         let lu = self.mat.as_ref();
         let stack = MemStack::new(&mut self.mem);
@@ -200,10 +244,14 @@ impl LuWorkspace {
     /// (The product of triangular inverses bounds `‖X A − I‖` instead, and
     /// Broyden's parameter stepping stalls with it on a badly conditioned
     /// strongly nonlinear Duffing, ivt-hb's `strong_nonlinearity_up_to_eps_100`.)
-    /// Returns `false` if an entry is not finite.
+    /// Returns `false` if an entry is not finite, or if `out` is shorter than
+    /// `n²` (then filled with NaN).
     pub fn inverse_into(&mut self, out: &mut [f64]) -> bool {
         let n = self.dim();
-        let out = &mut out[..n * n];
+        let Some(out) = out.get_mut(..n * n) else {
+            out.fill(f64::NAN);
+            return false;
+        };
         out.fill(0.0);
         out.iter_mut().step_by(n + 1).for_each(|d| *d = 1.0);
         // Column-major storage of X is Xᵀ row-major: transpose in place.
@@ -368,5 +416,30 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A caller's size bug is reported, not a panic: a short matrix makes
+    /// `factor` fail, a short right-hand side or inverse comes back NaN /
+    /// `false`, and a `solve_mat` of the wrong shape is NaN.
+    #[test]
+    fn wrong_sizes_are_nan_not_panics() {
+        let mut lu = LuWorkspace::new(2);
+        assert!(!lu.factor_row_major(&[1.0, 2.0, 3.0]));
+        assert!(lu.factor_row_major(&[2.0, 0.0, 0.0, 4.0]));
+        let mut short = [1.0];
+        lu.solve(&mut short);
+        assert!(short[0].is_nan());
+        let mut short = [1.0];
+        lu.solve_transpose(&mut short);
+        assert!(short[0].is_nan());
+        let mut out = [0.0; 3];
+        assert!(!lu.inverse_into(&mut out));
+        let mut three = [1.0; 3];
+        lu.solve_mat(MatMut::from_column_major_slice_mut(&mut three, 3, 1), false);
+        assert!(three.iter().all(|v| v.is_nan()));
+        // A longer rhs: the first n entries are solved, the rest untouched.
+        let mut long = [2.0, 4.0, 7.0];
+        lu.solve(&mut long);
+        assert_eq!(long, [1.0, 1.0, 7.0]); // diag(2, 4)⁻¹ (2, 4)
     }
 }

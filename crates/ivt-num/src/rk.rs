@@ -84,11 +84,15 @@ impl<const S: usize, V: Storage> ExplicitRk<S, V> {
     where
         F: FnMut(f64, &[f64], &mut [f64]),
     {
-        for s in first..S {
+        let tab = self.tab;
+        for (s, (a_s, c_s)) in tab.a.iter().zip(&tab.c).enumerate().skip(first) {
             let (done, rest) = self.k.split_at_mut(s);
+            let Some(k_s) = rest.first_mut() else {
+                break;
+            };
             let tmp = self.tmp.as_mut();
             tmp.copy_from_slice(y);
-            for (a, kj) in self.tab.a[s].iter().zip(done.iter()) {
+            for (a, kj) in a_s.iter().zip(done.iter()) {
                 if *a != 0.0 {
                     let ha = h * a;
                     for (t, kj) in tmp.iter_mut().zip(kj.as_ref()) {
@@ -96,7 +100,7 @@ impl<const S: usize, V: Storage> ExplicitRk<S, V> {
                     }
                 }
             }
-            rhs(x + self.tab.c[s] * h, tmp, rest[0].as_mut());
+            rhs(x + c_s * h, tmp, k_s.as_mut());
         }
     }
 
@@ -142,8 +146,10 @@ impl<const S: usize, V: Storage> ExplicitRk<S, V> {
     /// F(x, y) when the caller has it (first same as last), else it is
     /// evaluated.
     ///
-    /// # Panics
-    /// If the tableau has no error weights.
+    /// # Errors
+    /// A tableau without error weights has no error estimate: the result is
+    /// infinite (no step is acceptable, so an adaptive driver stops with its
+    /// step-size error) instead of a panic.
     // The inputs of one step (x, y, F(x, y), h, tolerances, output) are
     // distinct; bundling them would only rename them.
     #[allow(clippy::too_many_arguments)]
@@ -161,7 +167,9 @@ impl<const S: usize, V: Storage> ExplicitRk<S, V> {
     where
         F: FnMut(f64, &[f64], &mut [f64]),
     {
-        let e = self.tab.e.expect("try_step needs an embedded pair");
+        let Some(e) = self.tab.e else {
+            return f64::INFINITY;
+        };
         let first = match k1 {
             Some(k1) => {
                 self.k[0].as_mut().copy_from_slice(k1);
@@ -186,9 +194,9 @@ impl<const S: usize, V: Storage> ExplicitRk<S, V> {
         }
         let n = y.len();
         let mut sum = 0.0;
-        for i in 0..n {
+        for (i, (y0i, y1i)) in y.iter().zip(y1.iter()).enumerate() {
             let err = h * self.weighted(&e, i);
-            let sc = tol.atol + tol.rtol * y[i].abs().max(y1[i].abs());
+            let sc = tol.atol + tol.rtol * y0i.abs().max(y1i.abs());
             sum += (err / sc) * (err / sc);
         }
         let err = (sum / n as f64).sqrt();
@@ -199,27 +207,29 @@ impl<const S: usize, V: Storage> ExplicitRk<S, V> {
         }
     }
 
-    /// Σ_j w_j k_j[i] over the nonzero weights, in stage order.
+    /// Σ_j w_j k_j[i] over the nonzero weights, in stage order (NaN if `i`
+    /// is beyond the state's dimension).
     #[inline(always)]
     fn weighted(&self, w: &[f64; S], i: usize) -> f64 {
         let mut s = 0.0;
         for (wj, kj) in w.iter().zip(&self.k) {
             if *wj != 0.0 {
-                s += wj * kj.as_ref()[i];
+                s += wj * kj.as_ref().get(i).copied().unwrap_or(f64::NAN);
             }
         }
         s
     }
 
-    /// Stage `i` of the last step (stage 0 is F at its start).
-    pub fn stage(&self, i: usize) -> &[f64] {
-        self.k[i].as_ref()
+    /// Stage `i` of the last step (stage 0 is F at its start); `None` if the
+    /// method has not `i + 1` stages.
+    pub fn stage(&self, i: usize) -> Option<&[f64]> {
+        self.k.get(i).map(AsRef::as_ref)
     }
 
     /// The last stage of the last step: F(x + h, y1) for an FSAL method, the
-    /// first stage of the next step.
+    /// first stage of the next step (empty only for a method without stages).
     pub fn last_stage(&self) -> &[f64] {
-        self.k[S - 1].as_ref()
+        self.k.last().map_or(&[], AsRef::as_ref)
     }
 
     /// Dense output of the last step from `y0` (start) to `y1` (end) of size
@@ -227,18 +237,25 @@ impl<const S: usize, V: Storage> ExplicitRk<S, V> {
     /// `y0 + s(Δ + (1−s)(β + s(Δ − h k_S − β + (1−s) h Σ d_i k_i)))` with
     /// `Δ = y1 − y0`, `β = h k_1 − Δ` (4th order and C¹ for DP5; HNW I, §II.6).
     ///
-    /// # Panics
-    /// If the tableau has no dense-output weights.
+    /// # Errors
+    /// A tableau without dense-output weights (or states shorter than `out`)
+    /// gives NaN in `out` instead of a panic.
     pub fn dense(&self, y0: &[f64], y1: &[f64], h: f64, s: f64, out: &mut [f64]) {
-        let d = self.tab.d.expect("dense output needs dense weights");
+        let (Some(d), Some(k1)) = (self.tab.d, self.k.first()) else {
+            out.fill(f64::NAN);
+            return;
+        };
+        out.fill(f64::NAN);
         let s1 = 1.0 - s;
-        let (k1, ks) = (self.k[0].as_ref(), self.k[S - 1].as_ref());
-        for i in 0..out.len() {
-            let ydiff = y1[i] - y0[i];
-            let bspl = h * k1[i] - ydiff;
-            let c3 = ydiff - h * ks[i] - bspl;
+        let (k1, ks) = (k1.as_ref(), self.last_stage());
+        let ends = y0.iter().zip(y1);
+        let stages = k1.iter().zip(ks);
+        for (i, (o, ((y0i, y1i), (k1i, ksi)))) in out.iter_mut().zip(ends.zip(stages)).enumerate() {
+            let ydiff = y1i - y0i;
+            let bspl = h * k1i - ydiff;
+            let c3 = ydiff - h * ksi - bspl;
             let c4 = h * self.weighted(&d, i);
-            out[i] = y0[i] + s * (ydiff + s1 * (bspl + s * (c3 + s1 * c4)));
+            *o = y0i + s * (ydiff + s1 * (bspl + s * (c3 + s1 * c4)));
         }
     }
 
@@ -257,11 +274,11 @@ impl<const S: usize, V: Storage> ExplicitRk<S, V> {
         F: FnMut(f64, &[f64], &mut [f64]),
     {
         let n = y.len() as f64;
-        let sc = |i: usize| tol.atol + tol.rtol * y[i].abs();
+        let sc = |yi: f64| tol.atol + tol.rtol * yi.abs();
         let (mut d0, mut d1) = (0.0, 0.0);
-        for i in 0..y.len() {
-            d0 += (y[i] / sc(i)).powi(2);
-            d1 += (k1[i] / sc(i)).powi(2);
+        for (yi, ki) in y.iter().zip(k1) {
+            d0 += (yi / sc(*yi)).powi(2);
+            d1 += (ki / sc(*yi)).powi(2);
         }
         let (d0, d1) = ((d0 / n).sqrt(), (d1 / n).sqrt());
         let h0 = if d0 < 1e-5 || d1 < 1e-5 {
@@ -270,14 +287,18 @@ impl<const S: usize, V: Storage> ExplicitRk<S, V> {
             0.01 * d0 / d1
         };
         let y1 = self.tmp.as_mut();
-        for i in 0..y1.len() {
-            y1[i] = y[i] + h0 * k1[i];
+        for ((y1i, yi), ki) in y1.iter_mut().zip(y).zip(k1) {
+            *y1i = yi + h0 * ki;
         }
-        let k2 = self.k[1].as_mut();
+        // Stage 1 is scratch here (stage 0 of a one-stage method).
+        let Some(k2) = self.k.get_mut(1.min(S.saturating_sub(1))) else {
+            return h0;
+        };
+        let k2 = k2.as_mut();
         rhs(x + h0, self.tmp.as_ref(), k2);
         let mut d2 = 0.0;
-        for i in 0..y.len() {
-            d2 += ((k2[i] - k1[i]) / sc(i)).powi(2);
+        for ((k2i, k1i), yi) in k2.iter().zip(k1).zip(y) {
+            d2 += ((k2i - k1i) / sc(*yi)).powi(2);
         }
         let d2 = (d2 / n).sqrt() / h0;
         let h1 = if d1.max(d2) <= 1e-15 {
@@ -298,5 +319,45 @@ pub fn step_factor(err: f64, order: u32) -> f64 {
         5.0
     } else {
         (0.9 * err.powf(-1.0 / order as f64)).clamp(0.2, 5.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tableau::{DP5, RK4};
+
+    /// Misuse is an answer, not a panic: RK4 has no error weights (an
+    /// infinite error: no step acceptable) nor dense weights (NaN), and it
+    /// has stages 0–3 only.
+    #[test]
+    fn missing_weights_and_stages_are_reported() {
+        let mut rk = ExplicitRk::<4, [f64; 1]>::new(&RK4);
+        let mut decay = |_: f64, y: &[f64], dy: &mut [f64]| dy[0] = -y[0];
+        let mut y1 = [0.0];
+        let tol = Tolerance::uniform(1e-6);
+        let err = rk.try_step(&mut decay, 0.0, &[1.0], None, 0.1, &tol, &mut y1);
+        assert_eq!(err, f64::INFINITY);
+        let mut out = [0.0];
+        rk.dense(&[1.0], &[0.9], 0.1, 0.5, &mut out);
+        assert!(out[0].is_nan());
+        assert!(rk.stage(3).is_some() && rk.stage(4).is_none());
+    }
+
+    /// DP5 dense output on y' = −y over h = 0.1 from y = 1: the midpoint
+    /// matches e^(−0.05) to 1e-8 (4th-order interpolant, error O(h⁵)), and an
+    /// output longer than the state gets NaN beyond it.
+    #[test]
+    fn dense_output_matches_the_exponential() {
+        let mut rk = ExplicitRk::<7, Vec<f64>>::with_dim(&DP5, 1);
+        let mut decay = |_: f64, y: &[f64], dy: &mut [f64]| dy[0] = -y[0];
+        let mut y1 = [0.0];
+        let tol = Tolerance::uniform(1e-6);
+        let err = rk.try_step(&mut decay, 0.0, &[1.0], None, 0.1, &tol, &mut y1);
+        assert!(err < 1.0);
+        let mut out = [0.0; 2];
+        rk.dense(&[1.0], &y1, 0.1, 0.5, &mut out);
+        assert!((out[0] - (-0.05f64).exp()).abs() < 1e-8, "{out:?}");
+        assert!(out[1].is_nan());
     }
 }

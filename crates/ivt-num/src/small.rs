@@ -13,10 +13,22 @@ use nalgebra::{DMatrix, DMatrixView, DMatrixViewMut, SMatrix};
 /// `c = a·b` for row-major `dim × dim` matrices (no allocation). Sizes 1–8
 /// (the state sizes `2·n_dof` of systems up to 4 DOF) use a product of
 /// compile-time size, which the compiler unrolls; larger ones nalgebra's gemm.
+/// Only the leading `dim²` entries of each slice are used.
 ///
-/// # Panics
-/// If a slice is shorter than `dim²`.
+/// # Errors
+/// A slice shorter than `dim²` is a caller's bug: `c` is filled with NaN,
+/// which every finiteness check downstream (Floquet multipliers, residuals)
+/// reports, instead of a panic.
 pub fn matmul(a: &[f64], b: &[f64], dim: usize, c: &mut [f64]) {
+    let d2 = dim * dim;
+    let (Some(a), Some(b)) = (a.get(..d2), b.get(..d2)) else {
+        c.fill(f64::NAN);
+        return;
+    };
+    let Some(c) = c.get_mut(..d2) else {
+        c.fill(f64::NAN);
+        return;
+    };
     match dim {
         1 => matmul_fixed::<1>(a, b, c),
         2 => matmul_fixed::<2>(a, b, c),
@@ -27,17 +39,15 @@ pub fn matmul(a: &[f64], b: &[f64], dim: usize, c: &mut [f64]) {
         7 => matmul_fixed::<7>(a, b, c),
         8 => matmul_fixed::<8>(a, b, c),
         _ => {
-            let d2 = dim * dim;
-            let at = DMatrixView::from_slice(&a[..d2], dim, dim);
-            let bt = DMatrixView::from_slice(&b[..d2], dim, dim);
-            DMatrixViewMut::from_slice(&mut c[..d2], dim, dim).gemm(1.0, &bt, &at, 0.0);
+            let at = DMatrixView::from_slice(a, dim, dim);
+            let bt = DMatrixView::from_slice(b, dim, dim);
+            DMatrixViewMut::from_slice(c, dim, dim).gemm(1.0, &bt, &at, 0.0);
         }
     }
 }
 
-/// [`matmul`] for a compile-time size `N`.
+/// [`matmul`] for a compile-time size `N` on slices of `N²` entries.
 fn matmul_fixed<const N: usize>(a: &[f64], b: &[f64], c: &mut [f64]) {
-    let (a, b, c) = (&a[..N * N], &b[..N * N], &mut c[..N * N]);
     for (ci, ai) in c.chunks_exact_mut(N).zip(a.chunks_exact(N)) {
         ci.fill(0.0);
         for (&aik, bk) in ai.iter().zip(b.chunks_exact(N)) {
@@ -52,36 +62,44 @@ fn matmul_fixed<const N: usize>(a: &[f64], b: &[f64], c: &mut [f64]) {
 /// or the inverse is not finite. Sizes 1–4 use nalgebra's fixed-size inverse
 /// on the stack (no allocation); larger sizes allocate (nalgebra's LU).
 ///
-/// # Panics
-/// If a slice is shorter than `dim²`.
+/// # Errors
+/// `false` too if a slice is shorter than `dim²` (a caller's bug; `out` is
+/// then filled with NaN), instead of a panic.
 pub fn inverse(a: &[f64], dim: usize, out: &mut [f64]) -> bool {
+    let d2 = dim * dim;
+    let Some(a) = a.get(..d2) else {
+        out.fill(f64::NAN);
+        return false;
+    };
+    let Some(out) = out.get_mut(..d2) else {
+        out.fill(f64::NAN);
+        return false;
+    };
     match dim {
         1 => inverse_fixed::<1>(a, out),
         2 => inverse_fixed::<2>(a, out),
         3 => inverse_fixed::<3>(a, out),
         4 => inverse_fixed::<4>(a, out),
-        _ => {
-            let d2 = dim * dim;
-            // Row-major `a` read column-major is `aᵀ`, and `(aᵀ)⁻¹ = (a⁻¹)ᵀ`
-            // written column-major is `a⁻¹` row-major.
-            match DMatrix::from_column_slice(dim, dim, &a[..d2]).try_inverse() {
-                Some(inv) => {
-                    out[..d2].copy_from_slice(inv.as_slice());
-                    out[..d2].iter().all(|v| v.is_finite())
-                }
-                None => false,
+        // Row-major `a` read column-major is `aᵀ`, and `(aᵀ)⁻¹ = (a⁻¹)ᵀ`
+        // written column-major is `a⁻¹` row-major.
+        _ => match DMatrix::from_column_slice(dim, dim, a).try_inverse() {
+            Some(inv) => {
+                out.copy_from_slice(inv.as_slice());
+                out.iter().all(|v| v.is_finite())
             }
-        }
+            None => false,
+        },
     }
 }
 
-/// [`inverse`] for a compile-time size `N` (stack storage).
+/// [`inverse`] for a compile-time size `N` (stack storage) on slices of `N²`
+/// entries.
 fn inverse_fixed<const N: usize>(a: &[f64], out: &mut [f64]) -> bool {
     // As in [`inverse`]: the transpose's inverse, read back column-major.
-    match SMatrix::<f64, N, N>::from_column_slice(&a[..N * N]).try_inverse() {
+    match SMatrix::<f64, N, N>::from_column_slice(a).try_inverse() {
         Some(inv) => {
-            out[..N * N].copy_from_slice(inv.as_slice());
-            out[..N * N].iter().all(|v| v.is_finite())
+            out.copy_from_slice(inv.as_slice());
+            out.iter().all(|v| v.is_finite())
         }
         None => false,
     }
@@ -168,5 +186,18 @@ mod tests {
                 assert_eq!(pq[i * 3 + j], want, "({i},{j})");
             }
         }
+    }
+
+    /// Slices shorter than dim² are reported (NaN product, `false` inverse)
+    /// instead of a panic.
+    #[test]
+    fn short_slices_are_reported() {
+        let mut c = [0.0; 4];
+        matmul(&[1.0; 3], &[1.0; 4], 2, &mut c);
+        assert!(c.iter().all(|v| v.is_nan()));
+        let mut out = [0.0; 4];
+        assert!(!inverse(&[1.0; 3], 2, &mut out));
+        assert!(out.iter().all(|v| v.is_nan()));
+        assert!(!inverse(&[1.0, 0.0, 0.0, 1.0], 2, &mut [0.0; 3]));
     }
 }

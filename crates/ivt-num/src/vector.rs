@@ -11,18 +11,13 @@ const LANES: usize = 8;
 /// (a different, not less accurate, rounding order than a left-to-right sum).
 pub fn dot(x: &[f64], y: &[f64]) -> f64 {
     let n = x.len().min(y.len());
-    let (x, y) = (&x[..n], &y[..n]);
+    let (x, y) = (x.get(..n).unwrap_or(x), y.get(..n).unwrap_or(y));
     let mut acc = [0.0; LANES];
-    let (xc, yc) = (x.chunks_exact(LANES), y.chunks_exact(LANES));
-    let tail: f64 = xc
-        .remainder()
-        .iter()
-        .zip(yc.remainder())
-        .map(|(a, b)| a * b)
-        .sum();
-    for (a, b) in xc.zip(yc) {
-        for k in 0..LANES {
-            acc[k] += a[k] * b[k];
+    let ((xc, xr), (yc, yr)) = (x.as_chunks::<LANES>(), y.as_chunks::<LANES>());
+    let tail: f64 = xr.iter().zip(yr).map(|(a, b)| a * b).sum();
+    for (a, b) in xc.iter().zip(yc) {
+        for ((s, a), b) in acc.iter_mut().zip(a).zip(b) {
+            *s += a * b;
         }
     }
     acc.iter().sum::<f64>() + tail
@@ -40,9 +35,14 @@ pub fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
     }
 }
 
-/// `y = A x` for row-major `A` (`rows×cols`).
+/// `y = A x` for row-major `A` (`rows×cols`), over the first `rows` entries
+/// of `y` and the whole rows `A` has (`cols = 0`: empty sums, `y = 0`).
 pub fn matvec(a: &[f64], rows: usize, cols: usize, x: &[f64], y: &mut [f64]) {
-    for (yi, row) in y[..rows].iter_mut().zip(a.chunks_exact(cols)) {
+    if cols == 0 {
+        y.iter_mut().take(rows).for_each(|v| *v = 0.0);
+        return;
+    }
+    for (yi, row) in y.iter_mut().take(rows).zip(a.chunks_exact(cols)) {
         *yi = dot(row, x);
     }
 }
@@ -83,5 +83,9 @@ mod tests {
         );
         assert_eq!(y, [-2.0, -2.0]);
         assert_eq!(norm2(&[3.0, 4.0]), 5.0);
+        // No columns: empty sums; y beyond `rows` untouched.
+        let mut y = [1.0; 3];
+        matvec(&[], 2, 0, &[], &mut y);
+        assert_eq!(y, [0.0, 0.0, 1.0]);
     }
 }

@@ -1,5 +1,7 @@
 //! Convergence orders of the tableaux through the one stepper, on problems
 //! with closed-form solutions.
+// Test code: the crate's panic lints guard shipped code only.
+#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 use ivt_num::rk::step_factor;
 use ivt_num::{ExplicitRk, Tolerance, DP5, RK4, RK6};

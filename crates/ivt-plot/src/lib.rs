@@ -191,8 +191,7 @@ pub fn line_plot(path: &Path, figure: &Figure<'_>) -> Result<(), PlotError> {
     }
     .draw(&root, err)?;
     let mut legend = false;
-    for (i, series) in figure.series.iter().enumerate() {
-        let color = PALETTE[i % PALETTE.len()];
+    for (series, &color) in figure.series.iter().zip(PALETTE.iter().cycle()) {
         let mut first = true;
         for piece in pieces(series.points) {
             let anno = match series.style {
@@ -269,14 +268,11 @@ pub fn heat_map(path: &Path, map: &HeatMap<'_>) -> Result<(), PlotError> {
             map.values.len()
         )));
     }
-    let half = |v: &[f64], k: usize| {
-        if v.len() == 1 {
-            0.5
-        } else if k + 1 < v.len() {
-            0.5 * (v[k + 1] - v[k])
-        } else {
-            0.5 * (v[k] - v[k - 1])
-        }
+    let (hx, hy) = (half_widths(map.xs), half_widths(map.ys));
+    // Outer edges of the first and last cells (the grid is not empty).
+    let span = |v: &[f64], h: &[f64]| match (v.first(), v.last(), h.first(), h.last()) {
+        (Some(v0), Some(v1), Some(h0), Some(h1)) => (v0 - h0, v1 + h1),
+        _ => (0.0, 1.0),
     };
     let (lo, hi) = finite_range(map.values.iter().copied());
     let title = format!(
@@ -289,45 +285,50 @@ pub fn heat_map(path: &Path, map: &HeatMap<'_>) -> Result<(), PlotError> {
         title: &title,
         caption_px: 20,
         y_label_area: 70,
-        x: (
-            map.xs[0] - half(map.xs, 0),
-            map.xs[nx - 1] + half(map.xs, nx - 1),
-        ),
-        y: (
-            map.ys[0] - half(map.ys, 0),
-            map.ys[ny - 1] + half(map.ys, ny - 1),
-        ),
+        x: span(map.xs, &hx),
+        y: span(map.ys, &hy),
         x_label: map.x_label,
         y_label: map.y_label,
         grid: false,
     }
     .draw(&root, err)?;
-    let cells = (0..ny).flat_map(|j| (0..nx).map(move |i| (i, j)));
+    let columns = || map.xs.iter().zip(&hx);
+    let rows = map.values.chunks_exact(nx).zip(map.ys.iter().zip(&hy));
+    let cells = rows.flat_map(|(row, y)| row.iter().zip(columns()).map(move |(v, x)| (*v, x, y)));
     chart
-        .draw_series(cells.map(|(i, j)| {
-            let v = map.values[j * nx + i];
+        .draw_series(cells.map(|(v, (&x, &hx), (&y, &hy))| {
             let color = if v.is_finite() {
                 let s = ((v - lo) / (hi - lo)).clamp(0.0, 1.0);
                 RGBColor((255.0 * s) as u8, 60, (255.0 * (1.0 - s)) as u8)
             } else {
                 RGBColor(200, 200, 200)
             };
-            let (x, y) = (map.xs[i], map.ys[j]);
-            Rectangle::new(
-                [
-                    (x - half(map.xs, i), y - half(map.ys, j)),
-                    (x + half(map.xs, i), y + half(map.ys, j)),
-                ],
-                color.filled(),
-            )
+            Rectangle::new([(x - hx, y - hy), (x + hx, y + hy)], color.filled())
         }))
         .map_err(|e| err(&e))?;
     root.present().map_err(|e| err(&e))
 }
 
+/// Half the width of each grid cell centred on `v[k]`: half the gap to the
+/// next abscissa, the last cell as wide as the one before it, and a single
+/// cell of width 1.
+fn half_widths(v: &[f64]) -> Vec<f64> {
+    let gaps = v.iter().zip(v.iter().skip(1)).map(|(a, b)| 0.5 * (b - a));
+    let last = gaps.clone().next_back().unwrap_or(0.5);
+    gaps.chain(std::iter::once(last)).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Cells centred on 0, 1, 3: half-widths ½, 1 and (like the one before) 1;
+    /// one abscissa alone gets ½.
+    #[test]
+    fn cell_half_widths() {
+        assert_eq!(half_widths(&[0.0, 1.0, 3.0]), [0.5, 1.0, 1.0]);
+        assert_eq!(half_widths(&[5.0]), [0.5]);
+    }
 
     fn png_ok(path: &Path) -> bool {
         let bytes = std::fs::read(path).unwrap_or_default();

@@ -94,16 +94,19 @@ pub fn encode(kind: u8, payload: &[u8], out: &mut [u8]) -> Result<usize, WireErr
         return Err(WireError::PayloadTooLong);
     }
     let n = payload.len() + OVERHEAD;
-    let Some(out) = out.get_mut(..n) else {
+    // sync, kind, length | payload | CRC (little-endian)
+    let Some((head, body, crc_bytes)) = out
+        .get_mut(..n)
+        .and_then(|out| out.split_first_chunk_mut::<3>())
+        .and_then(|(head, rest)| rest.split_last_chunk_mut::<2>().map(|(b, c)| (head, b, c)))
+    else {
         return Err(WireError::BufferTooSmall);
     };
     let len = payload.len() as u8;
-    out[0] = SYNC;
-    out[1] = kind;
-    out[2] = len;
-    out[3..3 + payload.len()].copy_from_slice(payload);
+    *head = [SYNC, kind, len];
+    body.copy_from_slice(payload); // n − OVERHEAD = payload.len() bytes
     let crc = crc16_update(crc16(&[kind, len]), payload);
-    out[n - 2..].copy_from_slice(&crc.to_le_bytes());
+    *crc_bytes = crc.to_le_bytes();
     Ok(n)
 }
 

@@ -277,7 +277,11 @@ impl QemuPil {
     /// I/O, time-out or a malformed frame.
     pub fn call(&mut self, req: &Request) -> Result<Reply, PilError> {
         let n = req.encode(&mut self.tx).map_err(PilError::Wire)?;
-        self.stream.write_all(&self.tx[..n])?;
+        let frame = self
+            .tx
+            .get(..n)
+            .ok_or(PilError::Wire(WireError::BufferTooSmall))?;
+        self.stream.write_all(frame)?;
         loop {
             if self.rx_pos == self.rx_len {
                 self.rx_len = match self.stream.read(&mut self.rx) {
@@ -300,7 +304,11 @@ impl QemuPil {
                 };
                 self.rx_pos = 0;
             }
-            let b = self.rx[self.rx_pos];
+            let Some(&b) = self.rx.get(self.rx_pos) else {
+                // Past the buffer (cannot follow a read): read afresh.
+                self.rx_pos = self.rx_len;
+                continue;
+            };
             self.rx_pos += 1;
             if let Some(frame) = self.dec.push(b) {
                 let f = frame.map_err(PilError::Wire)?;

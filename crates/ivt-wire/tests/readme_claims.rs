@@ -2,6 +2,8 @@
 //! crc_hi`, each message's kind byte and payload length, and the CRC over
 //! `kind len payload`, read back from encoded frames (the CRC's check value
 //! 0x29B1 is asserted in `frame::tests`).
+// Test code: the crate's panic lints guard shipped code only.
+#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 use ivt_ctrl::{Config, ControlOutput};
 use ivt_ctrl::{Plan, Selection, SequenceName};

@@ -222,8 +222,9 @@ impl Recording {
         if !self.theta0.is_finite() {
             return Err(bad("theta0", "must be finite"));
         }
-        let increasing =
-            |v: &[f64]| v.iter().all(|x| x.is_finite()) && v.windows(2).all(|w| w[0] <= w[1]);
+        let increasing = |v: &[f64]| {
+            v.iter().all(|x| x.is_finite()) && v.iter().zip(v.iter().skip(1)).all(|(a, b)| a <= b)
+        };
         if !increasing(&self.pulse_t) {
             return Err(bad("pulse_t", "must be finite and non-decreasing"));
         }

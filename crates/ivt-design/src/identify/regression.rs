@@ -89,13 +89,16 @@ pub fn instrumental_variables(
     };
     let ps = &bread * (zs.transpose() * y);
     let resid = y - &xs * &ps;
-    let score: Vec<DVector<f64>> = (0..n).map(|i| zs.row(i).transpose() * resid[i]).collect();
+    let score: Vec<DVector<f64>> = (zs.row_iter().zip(resid.iter()))
+        .map(|(z_i, r_i)| z_i.transpose() * *r_i)
+        .collect();
     let mut meat = DMatrix::<f64>::zeros(p, p);
     for (i, si) in score.iter().enumerate() {
         meat += si * si.transpose();
-        for l in 1..=lag.min(i) {
+        // score[i − l] for l = 1..=min(lag, i)
+        for (l, s_back) in (1..=lag.min(i)).zip(score.iter().take(i).rev()) {
             let w = 1.0 - l as f64 / (lag + 1) as f64;
-            let c = si * score[i - l].transpose() * w;
+            let c = si * s_back.transpose() * w;
             meat += &c + c.transpose();
         }
     }
@@ -103,9 +106,9 @@ pub fn instrumental_variables(
     let cov = &bread * meat * bread.transpose() * (n as f64 / dof);
     let t = student_t_975(dof);
     Ok(LsFit {
-        params: (0..p).map(|j| ps[j] / scale[j]).collect(),
-        half_width: (0..p)
-            .map(|j| t * cov[(j, j)].max(0.0).sqrt() / scale[j])
+        params: ps.iter().zip(&scale).map(|(p, s)| p / s).collect(),
+        half_width: (cov.diagonal().iter().zip(&scale))
+            .map(|(c, s)| t * c.max(0.0).sqrt() / s)
             .collect(),
         residual_rms: (resid.norm_squared() / n as f64).sqrt(),
         rows: n,

@@ -61,7 +61,7 @@ fn point_speed(t: &[f64], k: usize, m: usize, dtheta: f64) -> Option<f64> {
         b += phi * (ti - t0);
     }
     let c = a.lu().solve(&b)?;
-    let dt_dtheta = c[0] / dtheta;
+    let dt_dtheta = c.x / dtheta;
     (dt_dtheta > 0.0).then(|| 1.0 / dt_dtheta)
 }
 
