@@ -20,6 +20,7 @@ macro_rules! add_functions {
 mod args;
 mod callback_arrays;
 mod ctrl;
+mod ctrl_convert;
 mod design;
 mod error_slot;
 mod fields;
