@@ -28,6 +28,7 @@ mod gears;
 mod hb;
 mod hb_analyses;
 mod hb_elements;
+mod hb_folds;
 mod hb_large;
 mod hb_paths;
 mod hb_shared;
