@@ -246,6 +246,20 @@ fn identified_rig(seed: u64, name: &str, run: u64) -> (PlantParams, PathBuf, Val
     (p, dir, v, back)
 }
 
+/// `ivt ol solve` at (10 V, 4 N·m) on the plant file `file`.
+fn ol_solve_on(file: &str) -> (i32, Value) {
+    ivt(&[
+        "ol",
+        "solve",
+        "--vm",
+        "10",
+        "--tu",
+        "4",
+        "--plant-file",
+        file,
+    ])
+}
+
 /// The plant file written by `ivt rig identify --out` is a `[plant]` table
 /// that round-trips: its parameters carry the identified coefficients, a
 /// scene takes it as `[plant] file`, and `ivt ol solve --plant-file` on it
@@ -281,17 +295,7 @@ fn identified_plant_file_round_trips_into_scenes_and_design_tools() {
     let truth_toml = PlantSection::from_params(PresetName::Printed, &p).to_toml();
     std::fs::write(&truth_file, truth_toml).unwrap();
     let solve = |f: &Path| {
-        let args = [
-            "ol",
-            "solve",
-            "--vm",
-            "10",
-            "--tu",
-            "4",
-            "--plant-file",
-            f.to_str().unwrap(),
-        ];
-        let (code, v) = ivt(&args);
+        let (code, v) = ol_solve_on(f.to_str().unwrap());
         assert_eq!(code, 0, "{v}");
         assert_eq!(v["plant"].as_str().unwrap(), f.to_str().unwrap());
         v["r"].as_f64().unwrap()
@@ -299,17 +303,7 @@ fn identified_plant_file_round_trips_into_scenes_and_design_tools() {
     let (r_id, r_true) = (solve(&dir.join("plant.toml")), solve(&truth_file));
     eprintln!("r̄ identified {r_id} vs true {r_true}");
     assert!((r_id / r_true - 1.0).abs() < 0.02, "r̄ {r_id} vs {r_true}");
-    let missing = [
-        "ol",
-        "solve",
-        "--vm",
-        "10",
-        "--tu",
-        "4",
-        "--plant-file",
-        "/nonexistent.toml",
-    ];
-    let (code, v) = ivt(&missing);
+    let (code, v) = ol_solve_on("/nonexistent.toml");
     assert_eq!(code, 2);
     assert!(
         v["error"].as_str().unwrap().contains("nonexistent.toml"),

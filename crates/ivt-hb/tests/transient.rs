@@ -11,6 +11,7 @@ use ivt_hb::{
 };
 
 mod common;
+use common::assert_period;
 use common::shooting::newton_plane;
 
 /// `ẍ = accel(x, ẋ)` of each oscillator.
@@ -99,13 +100,11 @@ fn van_der_pol_and_rayleigh_from_the_default_and_other_states_match_shooting() {
         for state in [[1.0, 0.0], [0.05, 0.0], [3.0, -2.0]] {
             let lc = limit_cycle_from_state(&p, &hb, &state, &TransientOptions::default(), 1024)
                 .unwrap_or_else(|e| panic!("μ = {mu}, rayleigh {rayleigh}, {state:?}: {e}"));
-            let rel = (lc.period() - t_fine).abs() / t_fine;
-            eprintln!(
-                "rayleigh {rayleigh} μ = {mu} from {state:?}: T = {:.12} (shooting {t_fine:.12}), rel {rel:.1e}, {} Newton steps",
-                lc.period(),
-                lc.solution.stats.iterations
+            assert_period(
+                &lc,
+                t_fine,
+                &format!("rayleigh {rayleigh} μ = {mu} from {state:?}"),
             );
-            assert!(rel < 1e-8, "{} vs {t_fine}", lc.period());
             assert!(lc.stable(), "{:?}", lc.multipliers);
         }
     }

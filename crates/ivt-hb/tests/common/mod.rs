@@ -11,7 +11,7 @@ use ivt_hb::aft::eval_series;
 use ivt_hb::ode::{first_order, rk4};
 use ivt_hb::{
     c64, BackboneOptions, BroydenOptions, ClassicIhb, ContinuationOptions, HbOptions, HbSolution,
-    ModifiedIhb, PeriodicProblem,
+    LimitCycle, ModifiedIhb, PeriodicProblem,
 };
 use std::f64::consts::PI;
 
@@ -97,4 +97,16 @@ pub fn tight_backbone(from: f64, to: f64, ds: f64, ds_max: f64) -> BackboneOptio
         },
         ..BackboneOptions::default()
     }
+}
+
+/// `lc`'s period within 1e-8 relative of the shooting period `t_ref`
+/// (printed with the Newton steps under `label`).
+pub fn assert_period(lc: &LimitCycle, t_ref: f64, label: &str) {
+    let rel = (lc.period() - t_ref).abs() / t_ref;
+    eprintln!(
+        "{label}: HB period {:.13}, shooting {t_ref:.13}, rel {rel:.1e}, {} Newton steps",
+        lc.period(),
+        lc.solution.stats.iterations
+    );
+    assert!(rel < 1e-8, "{label}: {} vs {t_ref}", lc.period());
 }
