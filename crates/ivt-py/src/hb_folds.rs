@@ -100,8 +100,8 @@ fn continue_bifurcation<'py>(
         p_from,
         p_to,
         at,
-        ds: finite("ds", ds)?,
-        ds_max: finite("ds_max", ds_max)?,
+        ds,
+        ds_max,
         max_points: count("max_points", max_points)?,
     };
     let [m, c, k, g, f] = family_system(family, p_start)?;

@@ -128,6 +128,9 @@ def test_limit_cycle_equals_cli(cli: Callable[..., Dict[str, Any]]) -> None:
     ref = cli("hb", "limit-cycle", "--mu", "1")
     same(got, ref)
     assert got["stability"] == "stable" and abs(got["period"] - 6.6632868593) < 1e-9
+    # Weak Van der Pol (μ = 0.1): ω within 1e-2 of 1 (averaging).
+    lc = hb.limit_cycle(1.0, -0.1, 1.0, lambda x, v, th: 0.1 * x**2 * v, 1.0, amplitude=2.0)
+    assert lc["stability"] == "stable" and abs(lc["omega"] - 1.0) < 1e-2
     mu = 2.0
     got = hb.limit_cycle(1.0, -mu, 1.0, lambda x, v, th: mu * v * v * v / 3.0, 1.0,
                          n=40, samples=128, amplitude=0.5)
