@@ -40,23 +40,9 @@ from scipy.optimize import root
 
 import ivt
 
-XI, ALPHA, EPS, FORCE = 0.02, 1.0, 1.0, 0.1
-GRID = 256  # reference grid points over one period
-
-
-# ---------------------------------------------------------------------------
-# Timing
-
-
-def timed(fn, budget=0.5, max_runs=5):
-    """Best-of wall time: repeat fn until `budget` seconds or `max_runs` calls."""
-    best, spent, n, out = float("inf"), 0.0, 0, None
-    while n < 1 or (spent < budget and n < max_runs):
-        t0 = time.perf_counter()
-        out = fn()
-        dt = time.perf_counter() - t0
-        best, spent, n = min(best, dt), spent + dt, n + 1
-    return out, best
+from periodic_common import (ALPHA, EPS, FORCE, GRID, XI, hb_samples, ivt_to_pyharm, pyharm_input,
+                             pyharm_to_ivt, timed)
+from periodic_frc import chain_rows, duffing_frc_rows
 
 
 # ---------------------------------------------------------------------------
@@ -146,10 +132,6 @@ def series_error(ref, coeffs):
     x = np.asarray(ivt.hb.eval_series(np.asarray(coeffs, dtype=float), grid_tau(ref["omega"])))
     return float(np.max(np.abs(x - ref["x"])))
 
-
-def hb_samples(n):
-    """N of the AFT (2N time points): 2N > 4n keeps the cubic term alias-free."""
-    return 2 * n + 2
 
 
 def hb_guess(ref, n):
@@ -246,43 +228,6 @@ def scipy_shooting_rows(ref, rtols):
     return rows
 
 
-# ---------------------------------------------------------------------------
-# pyHarm (pyharm-os): the same systems through its input dictionary. pyHarm's
-# unknowns per harmonic block are all DOFs of [mean, cos 1, sin 1, cos 2, ...],
-# x = c0 + Σ c_k cos kωt + s_k sin kωt (its own DFT operator), ω last.
-
-
-def pyharm_input(m, c, k, cubic, force, n, nti, omega_from, omega_to, xtol, frc_options=None):
-    """Maestro input: one linear substructure (M, C, K), a cubic spring on DOF 0 to
-    ground, a cosine force on DOF 0; an 'frf' analysis (arc-length continuation,
-    scipy root/hybr corrector with xtol)."""
-    analysis = {"study": "frf", "puls_inf": omega_from, "puls_sup": omega_to, "verbose": False,
-                "solver_options": {"root": {"options": {"xtol": xtol}}}}
-    analysis.update(frc_options or {})
-    return {
-        "system": {"type": "Base", "nh": n, "nti": nti},
-        "substructures": {"sub": {"type": "substructure", "ndofs": 1,
-                                  "matrix": {"M": np.atleast_2d(m), "C": np.atleast_2d(c), "K": np.atleast_2d(k)}}},
-        "connectors": {
-            "cubic": {"type": "CubicSpring", "connect": {"sub": [0]}, "dirs": [0], "k": cubic},
-            "force": {"type": "CosinusForcing", "connect": {"sub": [0]}, "dirs": [0], "amp": force},
-        },
-        "analysis": {"frf": analysis},
-    }
-
-
-def pyharm_to_ivt(x, n, n_dof, dof=0):
-    """pyHarm unknowns (ω dropped) → ivt's [a0, a1..an, b1..bn] of one DOF."""
-    blocks = np.asarray(x[: n_dof * (2 * n + 1)]).reshape(2 * n + 1, n_dof)[:, dof]
-    return np.concatenate([[2 * blocks[0]], blocks[1::2], blocks[2::2]])
-
-
-def ivt_to_pyharm(q, n):
-    out = np.empty(2 * n + 1)
-    out[0], out[1::2], out[2::2] = q[0] / 2, q[1:n + 1], q[n + 1:]
-    return out
-
-
 def pyharm_point(omega, n, nti, guess, xtol):
     """One orbit: Maestro build excluded (pyHarm builds pandas tables and numba
     kernels once per system); the timed part is the corrector from the guess."""
@@ -313,144 +258,6 @@ def pyharm_rows(ref, ns, xtols):
             rows.append(dict(method="pyHarm (root/hybr)", n=n, tol=xtol, time=t,
                              err=series_error(ref, pyharm_to_ivt(x, n, 1))))
     return rows
-
-
-def pyharm_curve(m, c, k, cubic, n, omega_from, omega_to, ds_max):
-    """pyHarm FRC by its arc-length continuation (tangent predictor, root/hybr
-    corrector at xtol 1e-10), ds0 = ds_max / 5. Returns time, accepted points
-    as (ω, unknowns) and the number of ω turns (folds)."""
-    from pyHarm.Maestro import Maestro
-
-    n_dof = np.atleast_2d(m).shape[0]
-    mae = Maestro(pyharm_input(m, c, k, cubic, FORCE, n, 2 * hb_samples(n), omega_from, omega_to, 1e-10,
-                               dict(ds_max=ds_max, ds0=ds_max / 5)))
-    frf = mae.nls["frf"]
-    t0 = time.perf_counter()
-    frf.Solve()
-    elapsed = time.perf_counter() - t0
-    pts = [s.x for s in frf.SolList if s.flag_accepted]
-    omegas = np.array([x[-1] for x in pts])
-    amps = [math.hypot(*pyharm_to_ivt(x, n, n_dof)[[1, n + 1]]) for x in pts]
-    turns = omegas[1:-1][np.diff(np.sign(np.diff(omegas))) != 0].tolist()
-    return dict(time=elapsed, points=len(pts), omegas=omegas, xs=pts, peak=max(amps), folds=turns)
-
-
-# ---------------------------------------------------------------------------
-# FRC comparisons
-
-
-def fold_omegas(folds):
-    """ω of each fold: plain floats (duffing_frc) or dicts with "omega" (SPEC §6 frc)."""
-    return [float(f["omega"]) if isinstance(f, dict) else float(f) for f in folds]
-
-
-def duffing_frc_rows(n, ds_max):
-    """Thesis Duffing 0.2–3.0: ivt.hb.duffing_frc (its own step control, Hsu
-    stability at every point) against pyHarm's continuation (no stability)."""
-    out, t_ivt = timed(lambda: ivt.hb.duffing_frc(from_=0.2, to=3.0, n=n, samples=hb_samples(n), xi=XI,
-                                                  alpha=ALPHA, eps=EPS, force=FORCE), budget=1.0)
-    ph = pyharm_curve(1.0, 2 * XI, ALPHA, EPS, n, 0.2, 3.0, ds_max)
-    return dict(problem="Duffing FRC 0.2–3.0", n=n, samples=hb_samples(n),
-                ivt=dict(time=t_ivt, points=len(out["points"]), folds=fold_omegas(out["folds"]),
-                         peak=max(p["amplitude"] for p in out["points"]), stability=True),
-                pyharm=dict(time=ph["time"], points=ph["points"], folds=ph["folds"], peak=ph["peak"],
-                            ds_max=ds_max, stability=False))
-
-
-CHAIN_M = np.eye(2)
-CHAIN_C = 0.02 * np.eye(2)
-CHAIN_K = np.array([[2.0, -1.0], [-1.0, 2.0]])
-
-
-def chain_g(x, v, theta):
-    return [0.5 * x[0] ** 3, 0.0]
-
-
-def chain_g_vec(x, v, t):
-    out = np.zeros_like(x)
-    out[:, 0] = 0.5 * x[:, 0] ** 3
-    return out
-
-
-def chain_jac_vec(x, v, t):
-    """(∂g/∂x, ∂g/∂v) of chain_g_vec at the N samples: (N, 2, 2) and None."""
-    dg_dx = np.zeros((x.shape[0], 2, 2))
-    dg_dx[:, 0, 0] = 1.5 * x[:, 0] ** 2
-    return dg_dx, None
-
-
-def chain_f(theta):
-    return [FORCE * math.cos(theta), 0.0]
-
-
-def chain_diff(coeffs, x, n):
-    """Max coefficient difference between an ivt orbit (DOF-major [a0, a.., b..]
-    per DOF) and a pyHarm one."""
-    q = np.asarray(coeffs).reshape(2, 2 * n + 1)
-    return max(float(np.max(np.abs(q[d] - pyharm_to_ivt(x, n, 2, d)))) for d in range(2))
-
-
-def chain_rows(n, ds_max, omega_from, omega_to):
-    """2-DOF cubic chain. With ivt.hb.frc: whole curves side by side. Without it:
-    ivt.hb.solve (Python per-sample g) at every ω of pyHarm's path, in path order,
-    warm-started from the previous ivt orbit, and compared with pyHarm's orbit."""
-    ph = pyharm_curve(CHAIN_M, CHAIN_C, CHAIN_K, 0.5, n, omega_from, omega_to, ds_max)
-    row = dict(problem=f"2-DOF chain {omega_from}–{omega_to}", n=n, samples=hb_samples(n),
-               pyharm=dict(time=ph["time"], points=ph["points"], folds=ph["folds"], peak=ph["peak"],
-                           ds_max=ds_max, stability=False))
-    why = "no ivt.hb.frc on this build"
-    if hasattr(ivt.hb, "frc"):
-        try:
-            # events=False: folds only, the work of duffing_frc; events=True adds the
-            # period-doubling, Neimark–Sacker and branch-point tests at every point.
-            # jac: the user's ∂g/∂x (vectorized), used by every Jacobian assembly
-            # in place of differencing g.
-            for key, events, jac in (("ivt", False, None), ("ivt_events", True, None),
-                                     ("ivt_jac", False, chain_jac_vec), ("ivt_jac_events", True, chain_jac_vec)):
-                out, t = timed(lambda: ivt.hb.frc(CHAIN_M, CHAIN_C, CHAIN_K, chain_g_vec, chain_f, omega_from,
-                                                  omega_to, n=n, samples=hb_samples(n), velocity_dependent=False,
-                                                  vectorized=True, events=events, jac=jac),
-                               budget=1.0)
-                with_jac = ", vectorized jac" if jac is not None else ""
-                row[key] = dict(mode=f"ivt.hb.frc, vectorized g{with_jac}, events={events}", time=t,
-                                points=len(out["points"]), folds=fold_omegas(out["folds"]),
-                                peak=max(p["amplitude"] for p in out["points"]), stability=True)
-            return row
-        except Exception as e:  # an API this script does not know: say so, measure per-ω solves
-            why = f"ivt.hb.frc failed: {type(e).__name__}: {e}"
-            print(why, file=sys.stderr)
-    guess, diffs, t_total, solved, other_branch = None, [], 0.0, 0, []
-    for omega, x in zip(ph["omegas"], ph["xs"]):
-        t0 = time.perf_counter()
-        try:
-            sol = ivt.hb.solve(CHAIN_M, CHAIN_C, CHAIN_K, chain_g, float(omega), f=chain_f, n=n,
-                               samples=hb_samples(n), guess=guess, stability=False, velocity_dependent=False)
-        except ivt.hb.ConvergenceError:
-            t_total += time.perf_counter() - t0
-            guess = None
-            continue
-        t_total += time.perf_counter() - t0
-        solved += 1
-        guess = sol["coeffs"]
-        diffs.append(chain_diff(sol["coeffs"], x, n))
-        if diffs[-1] >= 1e-6:
-            other_branch.append((float(omega), x))
-    # Where the warm-started sweep landed elsewhere, is pyHarm's orbit an ivt orbit too?
-    # Untimed: solve again from pyHarm's orbit and compare.
-    same_when_seeded = 0
-    for omega, x in other_branch:
-        seed = np.concatenate([pyharm_to_ivt(x, n, 2, d) for d in range(2)])
-        try:
-            sol = ivt.hb.solve(CHAIN_M, CHAIN_C, CHAIN_K, chain_g, omega, f=chain_f, n=n, samples=hb_samples(n),
-                               guess=seed, stability=False, velocity_dependent=False)
-        except ivt.hb.ConvergenceError:
-            continue
-        same_when_seeded += chain_diff(sol["coeffs"], x, n) < 1e-6
-    row["ivt"] = dict(mode=f"ivt.hb.solve per ω ({why}), Python per-sample g", time=t_total,
-                      points=solved, folds=[], peak=None, stability=False,
-                      max_coeff_diff_vs_pyharm=max(diffs) if diffs else None,
-                      agree_1e6=sum(d < 1e-6 for d in diffs), agree_when_seeded=int(same_when_seeded))
-    return row
 
 
 # ---------------------------------------------------------------------------

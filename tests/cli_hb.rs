@@ -146,13 +146,13 @@ fn duffing_folds_reach_the_cusp() {
     let special = v["special"].as_array().unwrap();
     assert_eq!(special.len(), 1);
     assert_eq!(special[0]["kind"], "cusp");
-    let f = special[0]["force"].as_f64().unwrap();
+    let f = special[0]["p"].as_f64().unwrap();
     assert!((f / 0.0120510724 - 1.0).abs() < 1e-6, "{f}");
     let at: Vec<(f64, f64)> = v["at"]
         .as_array()
         .unwrap()
         .iter()
-        .map(|a| (a["force"].as_f64().unwrap(), a["omega"].as_f64().unwrap()))
+        .map(|a| (a["p"].as_f64().unwrap(), a["omega"].as_f64().unwrap()))
         .collect();
     assert_eq!(at.len(), 2, "{at:?}");
     for ((force, omega), want) in at.iter().zip([1.2589591460, 1.3297591465]) {
@@ -161,6 +161,45 @@ fn duffing_folds_reach_the_cusp() {
             "F = {force}: {omega} vs {want}"
         );
     }
+}
+
+/// `ivt hb limit-cycle`: the Van der Pol cycle at μ = 1 has the period
+/// 6.6632868593 (the classical value, e.g. by high-precision shooting; our
+/// own shooting check is crates/ivt-hb/tests/limit_cycle.rs) and is stable;
+/// differentiating Rayleigh's ÿ − μ(ẏ − ẏ³/3) + y = 0 shows that x = ẏ
+/// solves Van der Pol's equation with the same μ, so the periods agree.
+#[test]
+fn limit_cycles_of_van_der_pol_and_rayleigh() {
+    let (code, vdp) = run("--json hb limit-cycle --mu 1");
+    assert_eq!(code, 0, "{vdp}");
+    let period = vdp["period"].as_f64().unwrap();
+    assert!((period - 6.6632868593).abs() < 1e-9, "{period}");
+    assert_eq!(vdp["stability"], "stable");
+    let (code, ray) = run("--json hb limit-cycle --model rayleigh --mu 1");
+    assert_eq!(code, 0, "{ray}");
+    let other = ray["period"].as_f64().unwrap();
+    assert!((other - period).abs() < 1e-9, "{other} vs {period}");
+    let (code, v) = run("--json hb limit-cycle --model duffing");
+    assert_eq!((code, v["kind"].as_str()), (2, Some("usage")), "{v}");
+}
+
+/// `ivt hb duffing-backbone`: u'' + u + u³ = 0 has ω² = 1 + 3a²/4 + O(a⁴)
+/// (Lindstedt); at a1 = 0.1 the rest is below 1e-5.
+#[test]
+fn duffing_backbone_follows_lindstedt() {
+    let (code, v) = run("--json hb duffing-backbone --to 0.1");
+    assert_eq!(code, 0, "{v}");
+    assert_eq!(v["termination"], "left_interval");
+    let last = v["points"].as_array().unwrap().last().unwrap().clone();
+    let (a, omega) = (
+        last["amplitude"].as_f64().unwrap(),
+        last["omega"].as_f64().unwrap(),
+    );
+    assert!((a - 0.1).abs() < 1e-9, "{a}");
+    assert!(
+        (omega - (1.0 + 0.75 * a * a).sqrt()).abs() < 1e-5,
+        "{omega}"
+    );
 }
 
 #[test]

@@ -232,18 +232,41 @@ fn truncated_or_corrupt_recording_names_the_byte_offset() {
     }
 }
 
+/// The rig `perturbed(seed)` commissioned with ideal sensors (commissioning
+/// seed `run`) and identified into `dir/plant.toml`: the truth, the scratch
+/// directory, the JSON of `ivt rig identify` and the plant read back from the
+/// file it names.
+fn identified_rig(seed: u64, name: &str, run: u64) -> (PlantParams, PathBuf, Value, PlantParams) {
+    let p = perturbed(seed);
+    let dir = scratch(name);
+    let v = identify(&dir, &commission(&dir, &plant_body(&p), "ideal", run));
+    let file = dir.join("plant.toml");
+    assert_eq!(v["plant_file"].as_str().unwrap(), file.to_str().unwrap());
+    let back = PlantSection::from_file(&file).unwrap().params().unwrap();
+    (p, dir, v, back)
+}
+
+/// `ivt ol solve` at (10 V, 4 N·m) on the plant file `file`.
+fn ol_solve_on(file: &str) -> (i32, Value) {
+    ivt(&[
+        "ol",
+        "solve",
+        "--vm",
+        "10",
+        "--tu",
+        "4",
+        "--plant-file",
+        file,
+    ])
+}
+
 /// The plant file written by `ivt rig identify --out` is a `[plant]` table
 /// that round-trips: its parameters carry the identified coefficients, a
 /// scene takes it as `[plant] file`, and `ivt ol solve --plant-file` on it
 /// gives the true plant's r̄ to 2 % (against a plant file of the truth).
 #[test]
 fn identified_plant_file_round_trips_into_scenes_and_design_tools() {
-    let p = perturbed(41);
-    let dir = scratch("roundtrip");
-    let v = identify(&dir, &commission(&dir, &plant_body(&p), "ideal", 5));
-    let file = dir.join("plant.toml");
-    assert_eq!(v["plant_file"].as_str().unwrap(), file.to_str().unwrap());
-    let back = PlantSection::from_file(&file).unwrap().params().unwrap();
+    let (p, dir, v, back) = identified_rig(41, "roundtrip", 5);
     for (name, want) in truth(&p) {
         let got = match name {
             "motor_gain" => back.motor_gain(),
@@ -272,35 +295,15 @@ fn identified_plant_file_round_trips_into_scenes_and_design_tools() {
     let truth_toml = PlantSection::from_params(PresetName::Printed, &p).to_toml();
     std::fs::write(&truth_file, truth_toml).unwrap();
     let solve = |f: &Path| {
-        let args = [
-            "ol",
-            "solve",
-            "--vm",
-            "10",
-            "--tu",
-            "4",
-            "--plant-file",
-            f.to_str().unwrap(),
-        ];
-        let (code, v) = ivt(&args);
+        let (code, v) = ol_solve_on(f.to_str().unwrap());
         assert_eq!(code, 0, "{v}");
         assert_eq!(v["plant"].as_str().unwrap(), f.to_str().unwrap());
         v["r"].as_f64().unwrap()
     };
-    let (r_id, r_true) = (solve(&file), solve(&truth_file));
+    let (r_id, r_true) = (solve(&dir.join("plant.toml")), solve(&truth_file));
     eprintln!("r̄ identified {r_id} vs true {r_true}");
     assert!((r_id / r_true - 1.0).abs() < 0.02, "r̄ {r_id} vs {r_true}");
-    let missing = [
-        "ol",
-        "solve",
-        "--vm",
-        "10",
-        "--tu",
-        "4",
-        "--plant-file",
-        "/nonexistent.toml",
-    ];
-    let (code, v) = ivt(&missing);
+    let (code, v) = ol_solve_on("/nonexistent.toml");
     assert_eq!(code, 2);
     assert!(
         v["error"].as_str().unwrap().contains("nonexistent.toml"),
@@ -418,12 +421,7 @@ fn drive_static_errors_rpm(
 /// k = 3.53, k2 = 0.75 mm·rad⁻¹, max |μ| 0.089).
 #[test]
 fn law_refitted_on_the_identified_plant_holds_omega0_where_the_printed_design_does_not() {
-    let p = perturbed(29);
-    let dir = scratch("redesign");
-    let v = identify(&dir, &commission(&dir, &plant_body(&p), "ideal", 1));
-    let file = dir.join("plant.toml");
-    assert_eq!(v["plant_file"].as_str().unwrap(), file.to_str().unwrap());
-    let identified = PlantSection::from_file(&file).unwrap().params().unwrap();
+    let (p, _, _, identified) = identified_rig(29, "redesign", 1);
     let grid = ivt_design::sweep::Grid {
         v_m: ivt_design::sweep::range(6.0, 0.25, 11.0),
         t_u: ivt_design::sweep::range(1.0, 1.0, 9.0),

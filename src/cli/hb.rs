@@ -1,9 +1,11 @@
 //! `ivt hb ...`: harmonic balance (thesis §3.2) — Duffing by modified/classic IHB
 //! with Floquet stability, the Duffing frequency-response curve, and the
-//! Mathieu–Duffing period-doubling cascade. `--plot FILE.png` draws the curves.
+//! Mathieu–Duffing period-doubling cascade, the fold curve in (ω, F), limit
+//! cycles and the Duffing backbone. `--plot FILE.png` draws the curves.
 //! Each command parses its arguments, runs an `ivt_hb::jobs` job and prints
 //! its serialized result (the keys of `ivt.hb`'s dicts).
 
+mod autonomous;
 mod folds;
 
 use super::{CliError, Output};
@@ -23,6 +25,10 @@ pub enum HbCommand {
     DuffingFrc(FrcArgs),
     /// The folds of Duffing's frequency response followed in the force F, through the cusp.
     DuffingFolds(folds::FoldsArgs),
+    /// Limit cycle of Van der Pol's or Rayleigh's oscillator (ω unknown, §3.2.4) with its multipliers.
+    LimitCycle(autonomous::LimitCycleArgs),
+    /// Backbone curve (nonlinear normal mode) of the free Duffing oscillator u'' + αu + εu³ = 0.
+    DuffingBackbone(autonomous::BackboneArgs),
     /// Period-doubling cascade of the Mathieu–Duffing equation (§3.2.5).
     MathieuDuffing(MathieuArgs),
     /// Nonlinear string by STHB (§3.3): frequency–response curve with stability (Figs. 34–36).
@@ -146,6 +152,8 @@ pub fn run(cmd: HbCommand) -> Result<Output, CliError> {
         HbCommand::Duffing(a) => duffing(a),
         HbCommand::DuffingFrc(a) => duffing_frc(a),
         HbCommand::DuffingFolds(a) => folds::run(a),
+        HbCommand::LimitCycle(a) => autonomous::limit_cycle(a),
+        HbCommand::DuffingBackbone(a) => autonomous::backbone(a),
         HbCommand::MathieuDuffing(a) => mathieu(a),
         HbCommand::String(a) => super::string::run(a),
     }

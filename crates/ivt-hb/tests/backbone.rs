@@ -2,10 +2,10 @@
 //! its closed-form period (complete elliptic integral) and the first-order
 //! harmonic-balance law ω² = 1 + ¾αa².
 
+mod common;
+use common::tight_backbone;
 use ivt_hb::aft::eval_series;
-use ivt_hb::{
-    backbone, BackboneOptions, BroydenOptions, ContinuationOptions, Corrector, Duffing, HbOptions,
-};
+use ivt_hb::{backbone, BackboneOptions, Corrector, Duffing, HbOptions};
 
 /// Exact frequency of `ẍ + x + αx³ = 0` with `x(0) = A`, `ẋ(0) = 0`:
 /// `T = 4K(k)/√(1 + αA²)`, `k² = αA²/(2(1 + αA²))`, so
@@ -35,20 +35,8 @@ fn closed_form_within(corrector: Corrector) {
     let duffing = Duffing::new(0.0, 1.0, alpha, 0.0);
     let hb = HbOptions::new(15, 64);
     let opts = BackboneOptions {
-        amplitude_from: 0.01,
-        amplitude_to: 2.0,
-        continuation: ContinuationOptions {
-            ds: 0.02,
-            ds_max: 0.1,
-            broyden: BroydenOptions {
-                tol: 1e-12,
-                max_iter: 25,
-                ..BroydenOptions::default()
-            },
-            ..ContinuationOptions::default()
-        },
         corrector,
-        ..BackboneOptions::default()
+        ..tight_backbone(0.01, 2.0, 0.02, 0.1)
     };
     let bb = backbone(&duffing, &hb, 1.0, &[1.0], &opts).unwrap();
     assert!(

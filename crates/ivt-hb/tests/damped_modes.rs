@@ -3,9 +3,11 @@
 //! the exact (elliptic-integral) frequency of its free oscillation, and the
 //! undamped case against `backbone`.
 
+mod common;
+use common::tight_backbone;
 use ivt_hb::{
-    backbone, damped_modes, linear_mode, BackboneOptions, BroydenOptions, ContinuationOptions,
-    GeneralProblem, HbError, HbOptions, PeriodicProblem, Termination,
+    backbone, damped_modes, linear_mode, BackboneOptions, GeneralProblem, HbError, HbOptions,
+    PeriodicProblem, Termination,
 };
 use std::f64::consts::PI;
 
@@ -86,21 +88,7 @@ fn damped_duffing_has_the_exact_free_frequency_and_damping_c_over_2_omega() {
     let c = 0.04;
     let n = 21;
     let hb = HbOptions::new(n, 4 * n);
-    let opts = BackboneOptions {
-        amplitude_from: 0.01,
-        amplitude_to: 1.5,
-        continuation: ContinuationOptions {
-            ds: 0.1,
-            ds_max: 0.2,
-            broyden: BroydenOptions {
-                tol: 1e-12,
-                max_iter: 25,
-                ..BroydenOptions::default()
-            },
-            ..ContinuationOptions::default()
-        },
-        ..BackboneOptions::default()
-    };
+    let opts = tight_backbone(0.01, 1.5, 0.1, 0.2);
     let dm = damped_modes(&duffing(c), &hb, 0, &opts).unwrap();
     assert_eq!(dm.termination, Termination::LeftInterval);
     assert!(dm.points.len() >= 5, "{} points", dm.points.len());

@@ -11,7 +11,7 @@ use ivt_hb::{
 };
 
 mod common;
-use common::shooting::{period_map, period_map_jacobian};
+use common::shooting::{period_map, period_map_jacobian, solve3};
 
 /// `[P(y) − y, det(∂P/∂y − I)]` (∂P/∂y by central differences).
 fn fold_residual(force: f64, omega: f64, y: [f64; 2]) -> [f64; 3] {
@@ -50,25 +50,6 @@ fn newton3(residual: impl Fn([f64; 3]) -> [f64; 3], mut u: [f64; 3]) -> [f64; 3]
         }
     }
     u
-}
-
-/// Cramer's rule for a 3×3 system.
-fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
-    let det = |m: [[f64; 3]; 3]| {
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-    };
-    let d = det(a);
-    let mut x = [0.0; 3];
-    for k in 0..3 {
-        let mut m = a;
-        for i in 0..3 {
-            m[i][k] = b[i];
-        }
-        x[k] = det(m) / d;
-    }
-    x
 }
 
 /// The orbit's state (x(0), ẋ(0)) from its coefficients at ω.

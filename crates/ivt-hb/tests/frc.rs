@@ -9,6 +9,10 @@ use ivt_hb::{
 };
 use std::f64::consts::PI;
 
+mod common;
+use common::max_distance;
+use common::shooting::solve3;
+
 /// One period `T = 2π/ω_f` of Duffing's equation and its variational equation
 /// from `(u₀, v₀) = y0[..2]` at `ω_f = y0[2]`, by RK4 with `steps` steps per
 /// period (time integration, no harmonic balance): the end state `(u(T), v(T))`
@@ -94,21 +98,7 @@ fn shooting_fold(d: &Duffing, mut y: [f64; 3], steps: usize) -> [f64; 3] {
                 jac[i][k] = (rp[i] - rm[i]) / (2.0 * h);
             }
         }
-        // Cramer's rule for the 3×3 step.
-        let det3 = |a: [[f64; 3]; 3]| {
-            a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
-                - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
-                + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
-        };
-        let dj = det3(jac);
-        let mut step = [0.0; 3];
-        for (k, s) in step.iter_mut().enumerate() {
-            let mut a = jac;
-            for i in 0..3 {
-                a[i][k] = -r[i];
-            }
-            *s = det3(a) / dj;
-        }
+        let step = solve3(jac, r.map(|v| -v));
         for k in 0..3 {
             y[k] += step[k];
         }
@@ -220,12 +210,7 @@ fn duffing_frc_through_both_folds_with_flags_switching_at_them() {
     let mut reference = Vec::with_capacity(pts.len());
     for p in pts {
         let mu_ref = reference_multipliers(&d, &p.coeffs, p.omega_f, 4000);
-        let err = p
-            .multipliers
-            .iter()
-            .zip(&mu_ref)
-            .map(|(a, b)| (a - b).norm())
-            .fold(0.0, f64::max);
+        let err = max_distance(&p.multipliers, &mu_ref);
         worst = worst.max(err);
         assert!(
             err < MULTIPLIER_TOL,

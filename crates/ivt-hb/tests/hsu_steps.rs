@@ -8,6 +8,7 @@ mod common;
 
 use common::chain::cubic_chain;
 use common::counted::Counted;
+use common::max_distance;
 use faer::Mat;
 use ivt_hb::{
     frequency_response, AdaptiveHsu, BroydenStats, Corrector, Duffing, FamilyBranch, Frc,
@@ -31,12 +32,7 @@ fn errors<P: PeriodicProblem>(problem: &P, frc: &Frc, harmonics: usize) -> (f64,
             stats: BroydenStats::default(),
         };
         let want = reference.hsu(problem, &sol, HsuRule::Magnus4).multipliers;
-        let err = p
-            .multipliers
-            .iter()
-            .zip(&want)
-            .map(|(a, b)| (a - b).norm())
-            .fold(0.0, f64::max);
+        let err = max_distance(&p.multipliers, &want);
         let estimate = p.multiplier_error.expect("an estimate at every point");
         // The estimate meets the tolerance at every point (no point reached
         // the 4096 cap), and it is the error: the true one is within 2× of it

@@ -3,25 +3,20 @@
 //! an unknown, against shooting on the time integration.
 
 use ivt_hb::aft::eval_series;
+use ivt_hb::jobs::Oscillator;
 use ivt_hb::ode::rk4;
 use ivt_hb::{
-    limit_cycle, limit_cycle_branch, ContinuationOptions, GeneralProblem, HbError, HbOptions,
-    PeriodicProblem, StabilityKind, Termination,
+    limit_cycle, limit_cycle_branch, ContinuationOptions, HbError, HbOptions, PeriodicProblem,
+    StabilityKind, Termination,
 };
 use std::f64::consts::PI;
 
 mod common;
-use common::shooting::{central_jacobian, newton_step};
+use common::assert_period;
+use common::shooting::newton_plane;
 
 fn van_der_pol(mu: f64) -> impl PeriodicProblem {
-    GeneralProblem::new(
-        1,
-        vec![1.0],
-        vec![-mu],
-        vec![1.0],
-        move |x: &[f64], v: &[f64], _theta: f64, out: &mut [f64]| out[0] = mu * x[0] * x[0] * v[0],
-        |_theta: f64, out: &mut [f64]| out[0] = 0.0,
-    )
+    Oscillator::VanDerPol.problem(mu)
 }
 
 /// Shooting reference on the section ẋ = 0: unknowns `(x₀, T)`, residual
@@ -42,18 +37,10 @@ fn shooting_period(mu: f64, steps: usize) -> f64 {
         [y[0] - y0[0], y[1]]
     };
     // First-order estimates: amplitude 2, period 2π(1 + μ²/16).
-    let mut y = [2.0, 2.0 * PI * (1.0 + mu * mu / 16.0)];
-    for _ in 0..40 {
-        let r = flow(y);
-        let j = central_jacobian(flow, y, [1e-6 * y[0], 1e-6 * y[1]]);
-        let [dx, dt] = newton_step(j, r);
-        y[0] += dx;
-        y[1] += dt;
-        if dx.abs() < 1e-14 && dt.abs() < 1e-13 {
-            return y[1];
-        }
-    }
-    panic!("shooting did not converge for μ = {mu}");
+    let start = [2.0, 2.0 * PI * (1.0 + mu * mu / 16.0)];
+    let h = |y: [f64; 2]| [1e-6 * y[0], 1e-6 * y[1]];
+    newton_plane(flow, start, h, [1e-14, 1e-13])
+        .unwrap_or_else(|| panic!("shooting did not converge for μ = {mu}"))[1]
 }
 
 #[test]
@@ -71,13 +58,7 @@ fn van_der_pol_period_matches_shooting_and_multiplier_matches_liouville() {
             (t_ref - t_fine).abs() < 1e-11 * t_fine,
             "{t_ref} vs {t_fine}"
         );
-        let rel = (lc.period() - t_fine).abs() / t_fine;
-        eprintln!(
-            "μ = {mu}: HB period {:.13}, shooting {t_fine:.13}, rel {rel:.1e}, {} Newton steps",
-            lc.period(),
-            lc.solution.stats.iterations
-        );
-        assert!(rel < 1e-8, "μ = {mu}: {} vs {t_fine}", lc.period());
+        assert_period(&lc, t_fine, &format!("μ = {mu}"));
         // Phase condition b₁ = 0 holds; the amplitude is near 2.
         assert!(lc.solution.coeffs[n + 1].abs() < 1e-12);
         assert!((lc.solution.amplitude(0) - 2.0).abs() < 0.02);

@@ -3,6 +3,7 @@
 //! default start (1, 0) and from other states, their periods against shooting
 //! on an RK4 integration that shares no code with the transient or HB.
 
+use ivt_hb::jobs::Oscillator;
 use ivt_hb::ode::rk4;
 use ivt_hb::{
     limit_cycle_from_state, settle, GeneralProblem, HbError, HbOptions, PeriodicProblem,
@@ -10,7 +11,8 @@ use ivt_hb::{
 };
 
 mod common;
-use common::shooting::{central_jacobian, newton_step};
+use common::assert_period;
+use common::shooting::newton_plane;
 
 /// `ẍ = accel(x, ẋ)` of each oscillator.
 fn accel(rayleigh: bool, mu: f64) -> impl Fn(f64, f64) -> f64 + Copy {
@@ -25,20 +27,12 @@ fn accel(rayleigh: bool, mu: f64) -> impl Fn(f64, f64) -> f64 + Copy {
 
 /// The oscillator as a problem: C = −μ, K = 1 and the rest in g.
 fn problem(rayleigh: bool, mu: f64) -> impl PeriodicProblem {
-    GeneralProblem::new(
-        1,
-        vec![1.0],
-        vec![-mu],
-        vec![1.0],
-        move |x: &[f64], v: &[f64], _theta: f64, out: &mut [f64]| {
-            out[0] = if rayleigh {
-                mu * v[0].powi(3) / 3.0
-            } else {
-                mu * x[0] * x[0] * v[0]
-            }
-        },
-        |_theta: f64, out: &mut [f64]| out[0] = 0.0,
-    )
+    let model = if rayleigh {
+        Oscillator::Rayleigh
+    } else {
+        Oscillator::VanDerPol
+    };
+    model.problem(mu)
 }
 
 /// RK4 flow of `ẍ = a(x, ẋ)` over `t` in `steps` steps.
@@ -73,22 +67,12 @@ fn shooting_period(a: impl Fn(f64, f64) -> f64 + Copy, steps: usize) -> f64 {
     }
     let (t1, x1) = maxima[maxima.len() - 1];
     let (t0, _) = maxima[maxima.len() - 2];
-    let mut u = [x1, t1 - t0];
     let residual = |u: [f64; 2]| {
         let y = flow(a, [u[0], 0.0], u[1], steps);
         [y[0] - u[0], y[1]]
     };
-    for _ in 0..40 {
-        let r = residual(u);
-        let h = u.map(|v| 1e-6 * v.abs().max(1.0));
-        let [dx, dt] = newton_step(central_jacobian(residual, u, h), r);
-        u[0] += dx;
-        u[1] += dt;
-        if dx.abs() < 1e-13 && dt.abs() < 1e-12 {
-            return u[1];
-        }
-    }
-    panic!("shooting did not converge");
+    let h = |u: [f64; 2]| u.map(|v| 1e-6 * v.abs().max(1.0));
+    newton_plane(residual, [x1, t1 - t0], h, [1e-13, 1e-12]).expect("shooting converges")[1]
 }
 
 #[test]
@@ -116,13 +100,11 @@ fn van_der_pol_and_rayleigh_from_the_default_and_other_states_match_shooting() {
         for state in [[1.0, 0.0], [0.05, 0.0], [3.0, -2.0]] {
             let lc = limit_cycle_from_state(&p, &hb, &state, &TransientOptions::default(), 1024)
                 .unwrap_or_else(|e| panic!("μ = {mu}, rayleigh {rayleigh}, {state:?}: {e}"));
-            let rel = (lc.period() - t_fine).abs() / t_fine;
-            eprintln!(
-                "rayleigh {rayleigh} μ = {mu} from {state:?}: T = {:.12} (shooting {t_fine:.12}), rel {rel:.1e}, {} Newton steps",
-                lc.period(),
-                lc.solution.stats.iterations
+            assert_period(
+                &lc,
+                t_fine,
+                &format!("rayleigh {rayleigh} μ = {mu} from {state:?}"),
             );
-            assert!(rel < 1e-8, "{} vs {t_fine}", lc.period());
             assert!(lc.stable(), "{:?}", lc.multipliers);
         }
     }

@@ -1,24 +1,17 @@
 //! `ivt.hb.all_solutions` and `ivt.hb.damped_modes` (issue 27): every periodic
 //! solution at one frequency by deflated Newton ([`ivt_hb::all_solutions`]),
 //! and damped nonlinear modes by the extended periodic motion concept
-//! ([`ivt_hb::damped_modes`]), on a user system; `ivt.hb.continue_bifurcation`,
-//! the fold curve of a model family in two parameters ([`ivt_hb::fold_curve`]).
-//! The limit cycle from a state is `limit_cycle(..., x0=)`
+//! ([`ivt_hb::damped_modes`]), on a user system. Fold curves are in
+//! `hb_folds.rs`. The limit cycle from a state is `limit_cycle(..., x0=)`
 //! (`ivt_hb::jobs::limit_cycle`).
 
-use ivt_hb::{
-    AllSolutions, BackboneOptions, BroydenStats, ContinuationOptions, Corrector, DampedModes,
-    HbError, HbSolution, SearchOptions,
-};
+use ivt_hb::{AllSolutions, BackboneOptions, Corrector, DampedModes, SearchOptions};
 use numpy::IntoPyArray;
-use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
-use std::sync::Mutex;
 
 use crate::args::count;
 use crate::hb_shared::{finite, run_user, user_system_fn, UserArgs};
-use crate::user_problem::{user_problem, PyProblem};
 use ivt_hb::jobs::{pairs, stability_steps};
 
 /// One orbit of [`AllSolutions`] as `{"coeffs", "amplitude", "multipliers",
@@ -138,176 +131,8 @@ fn damped_modes<'py>(py, user, jac;
 }
 }
 
-/// A fold of the curve as `{"omega", "p", "amplitude" (max |x| of DOF 0),
-/// "coeffs"}`.
-fn fold_point_dict<'py>(
-    py: Python<'py>,
-    fp: &ivt_hb::FoldPoint,
-    harmonics: usize,
-) -> PyResult<Bound<'py, PyDict>> {
-    let orbit = HbSolution {
-        coeffs: fp.coeffs.clone(),
-        omega_f: fp.omega,
-        harmonics,
-        subharmonic: 1,
-        stats: BroydenStats::default(),
-    };
-    let d = PyDict::new(py);
-    d.set_item("omega", fp.omega)?;
-    d.set_item("p", fp.p)?;
-    d.set_item("amplitude", orbit.amplitude(0))?;
-    d.set_item("coeffs", orbit.coeffs.into_pyarray(py))?;
-    Ok(d)
-}
-
-/// The user system `family(p)` returns: a tuple (m, c, k, g, f).
-fn family_system<'py>(family: &Bound<'py, PyAny>, p: f64) -> PyResult<[Bound<'py, PyAny>; 5]> {
-    let t = family.call1((p,))?;
-    let parts: Vec<Bound<'py, PyAny>> = t.extract().map_err(|_| {
-        PyTypeError::new_err("argument `family` must return a tuple (m, c, k, g, f)")
-    })?;
-    let [m, c, k, g, f]: [Bound<'py, PyAny>; 5] = parts.try_into().map_err(|_| {
-        PyTypeError::new_err("argument `family` must return a tuple (m, c, k, g, f)")
-    })?;
-    Ok([m, c, k, g, f])
-}
-
-/// Two-parameter continuation of a fold of the frequency response of
-/// `family(p)` → (m, c, k, g, f) in (omega, p) (ivt_hb::fold_curve: the
-/// extended system R = 0, Φ_q v = 0, |v| = 1 followed in p, first towards
-/// `p_from`, until p leaves [p_from, p_to]). `start` is a fold of
-/// `frc(..., events=True)["bifurcations"]` (or `frc(...)["folds"]`) computed
-/// at p = `p_start`, with the same `n` and `samples`. Cusps (where two folds
-/// merge and the jump disappears) are located as turning points of the curve
-/// in p; the fold at each p of `at` is solved exactly (each crossing).
-/// Only folds this round (period-doubling and Neimark–Sacker curves are not
-/// built). An exception in `family` is re-raised; one in the `g` or `f` it
-/// returns for p ≠ p_start makes that point fail (the curve stops there).
-/// Returns {"kind": "fold", "points": [{"omega", "p", "amplitude",
-/// "coeffs"}...], "at": [...], "special": [{"kind": "cusp", "omega", "p",
-/// "amplitude", "coeffs"}...], "termination"}.
-#[pyfunction]
-#[pyo3(signature = (
-    family, start, p_from, p_to, at = Vec::new(), p_start = None, n = 20, samples = 64,
-    velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100,
-    ds = 0.02, ds_max = 0.05, max_points = 2000
-))]
-#[allow(clippy::too_many_arguments)]
-fn continue_bifurcation<'py>(
-    py: Python<'py>,
-    family: &Bound<'py, PyAny>,
-    start: &Bound<'py, PyDict>,
-    p_from: f64,
-    p_to: f64,
-    at: Vec<f64>,
-    p_start: Option<f64>,
-    #[pyo3(from_py_with = crate::args::int64)] n: i64,
-    #[pyo3(from_py_with = crate::args::int64)] samples: i64,
-    velocity_dependent: bool,
-    vectorized: bool,
-    rtol: f64,
-    max_iter: usize,
-    ds: f64,
-    ds_max: f64,
-    #[pyo3(from_py_with = crate::args::int64)] max_points: i64,
-) -> PyResult<Bound<'py, PyDict>> {
-    let p_start = finite(
-        "p_start",
-        p_start.ok_or_else(|| PyValueError::new_err("argument `p_start` is required"))?,
-    )?;
-    let kind: Option<String> = start.get_item("kind")?.map(|k| k.extract()).transpose()?;
-    if kind.as_deref().is_some_and(|k| k != "fold") {
-        return Err(PyValueError::new_err(
-            "argument `start` must be a fold: only fold curves are continued this round",
-        ));
-    }
-    let item = |key: &str| {
-        start
-            .get_item(key)?
-            .ok_or_else(|| PyValueError::new_err(format!("argument `start` needs \"{key}\"")))
-    };
-    let omega = finite("start[\"omega\"]", item("omega")?.extract()?)?;
-    let coeffs: Vec<f64> = item("coeffs")?
-        .extract::<numpy::PyArrayLike1<'_, f64, numpy::AllowTypeChange>>()
-        .map_err(|_| PyTypeError::new_err("start[\"coeffs\"] must be a 1-D array of floats"))?
-        .as_array()
-        .to_vec();
-    let [m, c, k, g, f] = family_system(family, p_start)?;
-    let user = UserArgs {
-        system: [&m, &c, &k, &g],
-        n,
-        samples,
-        velocity_dependent,
-        vectorized,
-        rtol,
-        max_iter,
-        jac: None,
-    };
-    let (first, opts) = user.setup(Some(&f), 1, 0.0)?;
-    let copts = ContinuationOptions {
-        ds: finite("ds", ds)?,
-        ds_max: finite("ds_max", ds_max)?,
-        max_points: count("max_points", max_points)?,
-        ..ContinuationOptions::default()
-    };
-    let family: Py<PyAny> = family.clone().unbind();
-    let failure: Mutex<Option<PyErr>> = Mutex::new(None);
-    let build = |p: f64| -> Result<PyProblem, HbError> {
-        Python::attach(|py| {
-            let [m, c, k, g, f] = family_system(family.bind(py), p)?;
-            user_problem(
-                &m,
-                &c,
-                &k,
-                &g,
-                Some(&f),
-                None,
-                velocity_dependent,
-                vectorized,
-            )
-        })
-        .map_err(|e| {
-            let message = e.to_string();
-            if let Ok(mut slot) = failure.lock() {
-                slot.get_or_insert(e);
-            }
-            HbError::InvalidInput(format!("family(p) failed: {message}"))
-        })
-    };
-    let curve = run_user(py, &first, |_| {
-        ivt_hb::fold_curve(
-            build, &opts, &coeffs, omega, p_start, p_from, p_to, &at, &copts,
-        )
-    });
-    if let Some(e) = failure.lock().ok().and_then(|mut s| s.take()) {
-        return Err(e);
-    }
-    let curve = curve?;
-    let list = |points: &[ivt_hb::FoldPoint]| -> PyResult<Bound<'py, PyList>> {
-        let l = PyList::empty(py);
-        for fp in points {
-            l.append(fold_point_dict(py, fp, opts.harmonics)?)?;
-        }
-        Ok(l)
-    };
-    let special = PyList::empty(py);
-    for cusp in &curve.cusps {
-        let d = fold_point_dict(py, cusp, opts.harmonics)?;
-        d.set_item("kind", "cusp")?;
-        special.append(d)?;
-    }
-    let d = PyDict::new(py);
-    d.set_item("kind", "fold")?;
-    d.set_item("points", list(&curve.points)?)?;
-    d.set_item("at", list(&curve.at)?)?;
-    d.set_item("special", special)?;
-    d.set_item("termination", curve.termination.as_str())?;
-    Ok(d)
-}
-
-/// Add `_all_solutions`, `damped_modes` and `continue_bifurcation` to the
-/// `hb` module.
+/// Add `_all_solutions` and `damped_modes` to the `hb` module.
 pub fn register(hb: &Bound<'_, PyModule>) -> PyResult<()> {
-    add_functions!(hb, [_all_solutions, damped_modes, continue_bifurcation]);
+    add_functions!(hb, [_all_solutions, damped_modes]);
     Ok(())
 }

@@ -20,6 +20,7 @@ macro_rules! add_functions {
 mod args;
 mod callback_arrays;
 mod ctrl;
+mod ctrl_convert;
 mod design;
 mod error_slot;
 mod fields;
@@ -27,6 +28,7 @@ mod gears;
 mod hb;
 mod hb_analyses;
 mod hb_elements;
+mod hb_folds;
 mod hb_large;
 mod hb_paths;
 mod hb_shared;

@@ -101,14 +101,52 @@ def test_string_curve_equals_cli(cli: Callable[..., Dict[str, Any]]) -> None:
     assert "negative spring" in got["boundary_note"]
 
 
-def test_python_only_jobs_use_words_not_debug_text() -> None:
-    """Limit cycle and backbone have no command line: their enums are words."""
-    bb = hb.backbone(1.0, 0.0, 1.0, lambda x, v, th: x**3, 1.0, [1.0], 0.01, 0.5,
-                     velocity_dependent=False)
-    assert bb["termination"] == "left_interval"
-    assert isinstance(bb["amplitude"], np.ndarray) and isinstance(bb["points"][0]["coeffs"], np.ndarray)
+def test_fold_curve_equals_cli(cli: Callable[..., Dict[str, Any]]) -> None:
+    got = hb.duffing_folds(n=15, at=[0.2, 0.3])
+    ref = cli("hb", "duffing-folds", "--n", "15", "--at", "0.2,0.3")
+    same(got, ref)
+    assert got["kind"] == "fold" and got["termination"] == "left_interval"
+    assert [s["kind"] for s in got["special"]] == ["cusp"]
+    # continue_bifurcation runs the same job on a user family: from the same
+    # start fold, the same curve to the solver's tolerance (another problem
+    # type, so not to the last bit).
+    family = lambda F: (1.0, 0.04, 1.0, hb.elements.cubic_spring(1.0),
+                        lambda th: F * np.cos(th))
+    start = {"kind": "fold", "omega": got["start_omega"], "coeffs": got["points"][0]["coeffs"]}
+    user = hb.continue_bifurcation(family, start, 0.0, 0.3, at=[0.2, 0.3], p_start=0.1, n=15,
+                                   max_points=5000)
+    assert set(user) == set(got)
+    np.testing.assert_allclose([a["omega"] for a in user["at"]], [a["omega"] for a in got["at"]],
+                               rtol=0, atol=1e-8)
+
+
+def test_limit_cycle_equals_cli(cli: Callable[..., Dict[str, Any]]) -> None:
+    """`ivt hb limit-cycle` builds M = 1, C = −μ, K = 1 and g as Python does
+    from (m, c, k, g): the same problem, the same arithmetic."""
+    mu = 1.0
+    got = hb.limit_cycle(1.0, -mu, 1.0, lambda x, v, th: mu * x * x * v, 1.0)
+    ref = cli("hb", "limit-cycle", "--mu", "1")
+    same(got, ref)
+    assert got["stability"] == "stable" and abs(got["period"] - 6.6632868593) < 1e-9
+    # Weak Van der Pol (μ = 0.1): ω within 1e-2 of 1 (averaging).
     lc = hb.limit_cycle(1.0, -0.1, 1.0, lambda x, v, th: 0.1 * x**2 * v, 1.0, amplitude=2.0)
     assert lc["stability"] == "stable" and abs(lc["omega"] - 1.0) < 1e-2
+    mu = 2.0
+    got = hb.limit_cycle(1.0, -mu, 1.0, lambda x, v, th: mu * v * v * v / 3.0, 1.0,
+                         n=40, samples=128, amplitude=0.5)
+    ref = cli("hb", "limit-cycle", "--model", "rayleigh", "--mu", "2", "--n", "40",
+              "--samples", "128", "--amplitude", "0.5")
+    same(got, ref)
+
+
+def test_backbone_equals_cli(cli: Callable[..., Dict[str, Any]]) -> None:
+    got = hb.backbone(1.0, 0.0, 1.0, lambda x, v, th: 1.0 * x * x * x, 1.0, [1.0], 0.01, 0.5,
+                      velocity_dependent=False)
+    ref = cli("hb", "duffing-backbone", "--to", "0.5")
+    same(got, ref)
+    assert got["termination"] == "left_interval"
+    assert isinstance(got["amplitude"], np.ndarray)
+    assert isinstance(got["points"][0]["coeffs"], np.ndarray)
 
 
 def test_elements_repr_is_the_python_call_not_debug_text() -> None:

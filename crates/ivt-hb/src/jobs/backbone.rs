@@ -7,8 +7,28 @@ use crate::backbone::{BackboneOptions, BackbonePoint};
 use crate::continuation::{Corrector, Termination};
 use crate::error::HbError;
 use crate::ihb::HbOptions;
-use crate::problem::PeriodicProblem;
+use crate::problem::{GeneralProblem, PeriodicProblem};
 use serde::Serialize;
+
+/// The undamped, unforced Duffing oscillator `u'' + αu + εu³ = 0` as the
+/// general problem `M = 1, C = 0, K = α, g = εu³` (velocity independent):
+/// the system of `ivt hb duffing-backbone`, built as Python builds it from
+/// `m, c, k, g`, so that both run the same arithmetic.
+pub fn free_duffing(alpha: f64, eps: f64) -> impl PeriodicProblem {
+    GeneralProblem::new(
+        1,
+        vec![1.0],
+        vec![0.0],
+        vec![alpha],
+        move |x: &[f64], _v: &[f64], _theta: f64, out: &mut [f64]| {
+            if let (Some(g), Some(&x)) = (out.first_mut(), x.first()) {
+                *g = eps * x * x * x;
+            }
+        },
+        |_theta: f64, out: &mut [f64]| out.fill(0.0),
+    )
+    .with_velocity_dependent(false)
+}
 
 /// The linear mode to start from and the amplitude interval.
 #[derive(Debug, Clone, PartialEq)]

@@ -5,9 +5,57 @@
 use super::{finite, pairs, stability_steps, Array};
 use crate::error::HbError;
 use crate::ihb::HbOptions;
-use crate::problem::PeriodicProblem;
+use crate::problem::{GeneralProblem, PeriodicProblem};
 use crate::stability::StabilityKind;
 use serde::Serialize;
+
+/// A self-excited oscillator of one DOF, `ẍ + x = μ h(x, ẋ)`, written as
+/// `M = 1`, `C = −μ`, `K = 1` and the rest in `g` (the CLI's `ivt hb
+/// limit-cycle --model`; Python builds the same system from `m, c, k, g`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Oscillator {
+    /// Van der Pol `ẍ − μ(1 − x²)ẋ + x = 0`: `g = μ x² ẋ`.
+    VanDerPol,
+    /// Rayleigh `ẍ − μ(ẋ − ẋ³/3) + x = 0`: `g = μ ẋ³/3`.
+    Rayleigh,
+}
+
+impl std::str::FromStr for Oscillator {
+    type Err = HbError;
+
+    /// `"van-der-pol"` or `"rayleigh"`.
+    fn from_str(s: &str) -> Result<Self, HbError> {
+        super::one_of(
+            "model",
+            s,
+            [
+                ("van-der-pol", Self::VanDerPol),
+                ("rayleigh", Self::Rayleigh),
+            ],
+        )
+    }
+}
+
+impl Oscillator {
+    /// The oscillator with parameter `mu` as a periodic problem (unforced).
+    pub fn problem(self, mu: f64) -> impl PeriodicProblem {
+        GeneralProblem::new(
+            1,
+            vec![1.0],
+            vec![-mu],
+            vec![1.0],
+            move |x: &[f64], v: &[f64], _theta: f64, out: &mut [f64]| {
+                if let (Some(g), Some(&x), Some(&v)) = (out.first_mut(), x.first(), v.first()) {
+                    *g = match self {
+                        Self::VanDerPol => mu * x * x * v,
+                        Self::Rayleigh => mu * v * v * v / 3.0,
+                    };
+                }
+            },
+            |_theta: f64, out: &mut [f64]| out.fill(0.0),
+        )
+    }
+}
 
 /// Where the iteration starts.
 #[derive(Debug, Clone, PartialEq)]
@@ -132,22 +180,13 @@ pub fn limit_cycle<P: PeriodicProblem>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::problem::GeneralProblem;
 
     #[test]
     fn weak_van_der_pol_has_amplitude_two_and_is_stable() {
         // Van der Pol x'' − μ(1 − x²)x' + x = 0 (C = −μ, g = μx²v): by
         // averaging the cycle is x ≈ 2 cos t for small μ (ω → 1, a1 → 2),
         // corrections O(μ²).
-        let mu = 0.05;
-        let p = GeneralProblem::new(
-            1,
-            vec![1.0],
-            vec![-mu],
-            vec![1.0],
-            move |x: &[f64], v: &[f64], _t: f64, g: &mut [f64]| g[0] = mu * x[0] * x[0] * v[0],
-            |_t: f64, out: &mut [f64]| out[0] = 0.0,
-        );
+        let p = Oscillator::VanDerPol.problem(0.05);
         let hb = HbOptions::new(8, 32);
         let c = limit_cycle(&p, &hb, &LimitCycleRequest::default()).unwrap();
         assert!((c.omega - 1.0).abs() < 1e-3, "{}", c.omega);

@@ -9,24 +9,30 @@
 //! |---|---|---|---|---|
 //! | orbit + stability (Eq. 56–67, 78) | [`OrbitRequest`] | [`Orbit`] | `hb duffing` | `duffing`, `mathieu_duffing`, `solve` |
 //! | FRC, with or without events (Eq. 68–77) | [`FrcRequest`] | [`FrcCurve`] | `hb duffing-frc [--events]` | `duffing_frc`, `frc` |
-//! | limit cycle (ω unknown) | [`LimitCycleRequest`] | [`Cycle`] | — | `limit_cycle` |
-//! | backbone | [`BackboneRequest`] | [`BackboneCurve`] | — | `backbone` |
+//! | fold curve in (ω, p) through cusps (Eq. 56, 61, 68–77) | [`FoldCurveRequest`] | [`FoldCurveResult`] | `hb duffing-folds` | `duffing_folds`, `continue_bifurcation` |
+//! | limit cycle (ω unknown) | [`LimitCycleRequest`] | [`Cycle`] | `hb limit-cycle` | `limit_cycle` |
+//! | backbone | [`BackboneRequest`] | [`BackboneCurve`] | `hb duffing-backbone` | `backbone` |
 //! | Mathieu–Duffing cascade (Eq. 81–85) | [`CascadeRequest`] | [`Cascade`] | `hb mathieu-duffing` | `mathieu_cascade` |
 //! | STHB string curve (Eq. 103–136) | [`StringRequest`] | [`StringCurve`] | `hb string` | `string` |
 
 mod array;
 pub mod backbone;
 pub mod cascade;
+pub mod fold_curve;
 pub mod frc;
 pub mod limit_cycle;
 pub mod orbit;
 pub mod string;
 
 pub use array::{pairs, Array, ARRAY_NAME};
-pub use backbone::{backbone, BackboneCurve, BackboneRequest, BackboneSample};
+pub use backbone::{backbone, free_duffing, BackboneCurve, BackboneRequest, BackboneSample};
 pub use cascade::{cascade, Cascade, CascadeRequest, THESIS_BETAS};
+pub use fold_curve::{
+    fold_curve, CurveFoldPoint, FoldCurveRequest, FoldCurveResult, FoldStart, SpecialKind,
+    SpecialPoint,
+};
 pub use frc::{frc, CurvePoint, EventRecord, FoldPoint, FrcCurve, FrcRequest};
-pub use limit_cycle::{limit_cycle, Cycle, LimitCycleRequest};
+pub use limit_cycle::{limit_cycle, Cycle, LimitCycleRequest, Oscillator};
 pub use orbit::{orbit, Method, Orbit, OrbitRequest};
 pub use string::{string, StringCurve, StringPoint, StringRequest};
 
@@ -37,6 +43,24 @@ use crate::error::HbError;
 /// the fastest harmonic's period with 8 Magnus-4 steps).
 pub fn stability_steps(harmonics: usize) -> usize {
     harmonics.saturating_mul(8).max(256)
+}
+
+/// The value of the two `choices` whose name is `value` (the `FromStr` of
+/// the jobs' enums); otherwise `Err(InvalidInput)` naming the argument
+/// `what` and both names.
+pub(crate) fn one_of<T: Copy>(
+    what: &str,
+    value: &str,
+    choices: [(&str, T); 2],
+) -> Result<T, HbError> {
+    let [(a, x), (b, y)] = choices;
+    match value {
+        v if v == a => Ok(x),
+        v if v == b => Ok(y),
+        other => Err(HbError::InvalidInput(format!(
+            "`{what}` = {other:?} must be '{a}' or '{b}'"
+        ))),
+    }
 }
 
 /// `Err(InvalidInput)` unless `v` is finite, naming the argument.

@@ -31,13 +31,11 @@ impl FromStr for Method {
 
     /// `"modified"` or `"classic"`.
     fn from_str(s: &str) -> Result<Self, HbError> {
-        match s {
-            "modified" => Ok(Self::Modified),
-            "classic" => Ok(Self::Classic),
-            other => Err(HbError::InvalidInput(format!(
-                "`method` = {other:?} must be 'modified' or 'classic'"
-            ))),
-        }
+        super::one_of(
+            "method",
+            s,
+            [("modified", Self::Modified), ("classic", Self::Classic)],
+        )
     }
 }
 

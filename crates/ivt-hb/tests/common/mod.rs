@@ -9,7 +9,10 @@ pub mod shooting;
 
 use ivt_hb::aft::eval_series;
 use ivt_hb::ode::{first_order, rk4};
-use ivt_hb::{ClassicIhb, HbOptions, HbSolution, ModifiedIhb, PeriodicProblem};
+use ivt_hb::{
+    c64, BackboneOptions, BroydenOptions, ClassicIhb, ContinuationOptions, HbOptions, HbSolution,
+    LimitCycle, ModifiedIhb, PeriodicProblem,
+};
 use std::f64::consts::PI;
 
 /// Max over all DOFs and 64 points of one period of |x_RK − x_HB|, RK4 with `per`
@@ -64,4 +67,46 @@ pub fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
         .zip(b)
         .map(|(x, y)| (x - y).abs())
         .fold(0.0, f64::max)
+}
+
+/// Largest distance |a_i − b_i| between two lists of multipliers, pairwise
+/// in order.
+pub fn max_distance(a: &[c64], b: &[c64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).norm())
+        .fold(0.0, f64::max)
+}
+
+/// Backbone (or damped-mode) options from amplitude `from` to `to` in
+/// arclength steps `ds` up to `ds_max`, each point converged to ‖r‖₂ ≤ 1e-12
+/// in at most 25 iterations.
+pub fn tight_backbone(from: f64, to: f64, ds: f64, ds_max: f64) -> BackboneOptions {
+    BackboneOptions {
+        amplitude_from: from,
+        amplitude_to: to,
+        continuation: ContinuationOptions {
+            ds,
+            ds_max,
+            broyden: BroydenOptions {
+                tol: 1e-12,
+                max_iter: 25,
+                ..BroydenOptions::default()
+            },
+            ..ContinuationOptions::default()
+        },
+        ..BackboneOptions::default()
+    }
+}
+
+/// `lc`'s period within 1e-8 relative of the shooting period `t_ref`
+/// (printed with the Newton steps under `label`).
+pub fn assert_period(lc: &LimitCycle, t_ref: f64, label: &str) {
+    let rel = (lc.period() - t_ref).abs() / t_ref;
+    eprintln!(
+        "{label}: HB period {:.13}, shooting {t_ref:.13}, rel {rel:.1e}, {} Newton steps",
+        lc.period(),
+        lc.solution.stats.iterations
+    );
+    assert!(rel < 1e-8, "{label}: {} vs {t_ref}", lc.period());
 }

@@ -50,6 +50,27 @@ pub fn central_jacobian(
     j
 }
 
+/// Newton in the plane on `residual` from `u`, the Jacobian by central
+/// differences with steps `h(u)`, until both components of a step are below
+/// `tol`: the root, or None after 40 steps.
+pub fn newton_plane(
+    residual: impl Fn([f64; 2]) -> [f64; 2],
+    mut u: [f64; 2],
+    h: impl Fn([f64; 2]) -> [f64; 2],
+    tol: [f64; 2],
+) -> Option<[f64; 2]> {
+    for _ in 0..40 {
+        let r = residual(u);
+        let step = newton_step(central_jacobian(&residual, u, h(u)), r);
+        u[0] += step[0];
+        u[1] += step[1];
+        if step[0].abs() < tol[0] && step[1].abs() < tol[1] {
+            return Some(u);
+        }
+    }
+    None
+}
+
 /// The Newton step `−J⁻¹ r` in the plane (Cramer's rule).
 pub fn newton_step(j: [[f64; 2]; 2], r: [f64; 2]) -> [f64; 2] {
     let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
@@ -57,4 +78,23 @@ pub fn newton_step(j: [[f64; 2]; 2], r: [f64; 2]) -> [f64; 2] {
         -(j[1][1] * r[0] - j[0][1] * r[1]) / det,
         -(j[0][0] * r[1] - j[1][0] * r[0]) / det,
     ]
+}
+
+/// Cramer's rule for a 3×3 system.
+pub fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
+    let det = |m: [[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let d = det(a);
+    let mut x = [0.0; 3];
+    for k in 0..3 {
+        let mut m = a;
+        for i in 0..3 {
+            m[i][k] = b[i];
+        }
+        x[k] = det(m) / d;
+    }
+    x
 }

@@ -32,6 +32,7 @@ __all__ = [
     "continue_bifurcation",
     "damped_modes",
     "duffing",
+    "duffing_folds",
     "duffing_frc",
     "eval_series",
     "frc",

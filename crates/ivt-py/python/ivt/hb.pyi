@@ -95,6 +95,16 @@ def duffing_frc(
     force: float = 0.1,
     events: bool = False,
 ) -> Dict[str, Any]: ...
+def duffing_folds(
+    force: float = 0.1,
+    force_from: float = 0.0,
+    force_to: float = 0.3,
+    at: Sequence[float] = ...,
+    from_: float = 0.5,
+    to: float = 2.5,
+    n: int = 20,
+    samples: int = 64,
+) -> Dict[str, Any]: ...
 def solve(
     m: Union[Matrix, SparseMatrix],
     c: Union[Matrix, SparseMatrix],

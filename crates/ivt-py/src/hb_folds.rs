@@ -1,0 +1,192 @@
+//! `ivt.hb.continue_bifurcation` and `ivt.hb.duffing_folds`: a fold of the
+//! frequency response followed in a second parameter p through its cusps, the
+//! job [`ivt_hb::jobs::fold_curve`] (the CLI's `ivt hb duffing-folds`), on a
+//! user family `family(p) -> (m, c, k, g, f)` or on Duffing's equation in F.
+
+use ivt_hb::jobs::{self, FoldCurveRequest, FoldStart};
+use ivt_hb::{Duffing, HbError};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::sync::Mutex;
+
+use crate::args::{count, int64};
+use crate::hb_shared::{finite, options, run, run_user, UserArgs};
+use crate::to_python::to_dict;
+use crate::user_problem::{user_problem, PyProblem};
+
+/// The user system `family(p)` returns: a tuple (m, c, k, g, f).
+fn family_system<'py>(family: &Bound<'py, PyAny>, p: f64) -> PyResult<[Bound<'py, PyAny>; 5]> {
+    let t = family.call1((p,))?;
+    let parts: Vec<Bound<'py, PyAny>> = t.extract().map_err(|_| {
+        PyTypeError::new_err("argument `family` must return a tuple (m, c, k, g, f)")
+    })?;
+    let [m, c, k, g, f]: [Bound<'py, PyAny>; 5] = parts.try_into().map_err(|_| {
+        PyTypeError::new_err("argument `family` must return a tuple (m, c, k, g, f)")
+    })?;
+    Ok([m, c, k, g, f])
+}
+
+/// The start fold of `continue_bifurcation`: ω and coefficients of a fold
+/// dict (`kind` "fold" when given).
+fn given_start(start: &Bound<'_, PyDict>) -> PyResult<FoldStart> {
+    let kind: Option<String> = start.get_item("kind")?.map(|k| k.extract()).transpose()?;
+    if kind.as_deref().is_some_and(|k| k != "fold") {
+        return Err(PyValueError::new_err(
+            "argument `start` must be a fold: only fold curves are continued this round",
+        ));
+    }
+    let item = |key: &str| {
+        start
+            .get_item(key)?
+            .ok_or_else(|| PyValueError::new_err(format!("argument `start` needs \"{key}\"")))
+    };
+    let omega = finite("start[\"omega\"]", item("omega")?.extract()?)?;
+    let coeffs: Vec<f64> = item("coeffs")?
+        .extract::<numpy::PyArrayLike1<'_, f64, numpy::AllowTypeChange>>()
+        .map_err(|_| PyTypeError::new_err("start[\"coeffs\"] must be a 1-D array of floats"))?
+        .as_array()
+        .to_vec();
+    Ok(FoldStart::Given { omega, coeffs })
+}
+
+/// Two-parameter continuation of a fold of the frequency response of
+/// `family(p)` → (m, c, k, g, f) in (omega, p) (ivt_hb::fold_curve: the
+/// extended system R = 0, Φ_q v = 0, |v| = 1 followed in p, first towards
+/// `p_from`, until p leaves [p_from, p_to]). `start` is a fold of
+/// `frc(..., events=True)["bifurcations"]` (or `frc(...)["folds"]`) computed
+/// at p = `p_start`, with the same `n` and `samples`. Cusps (where two folds
+/// merge and the jump disappears) are located as turning points of the curve
+/// in p; the fold at each p of `at` is solved exactly (each crossing).
+/// Only folds this round (period-doubling and Neimark–Sacker curves are not
+/// built). An exception in `family` is re-raised; one in the `g` or `f` it
+/// returns for p ≠ p_start makes that point fail (the curve stops there).
+/// Returns the job's [`ivt_hb::jobs::FoldCurveResult`]: {"kind": "fold",
+/// "start_omega", "points": [{"omega", "p", "amplitude", "coeffs"}...],
+/// "at": [...], "special": [{"kind": "cusp", "omega", "p", "amplitude",
+/// "coeffs"}...], "termination", "time_s"}.
+#[pyfunction]
+#[pyo3(signature = (
+    family, start, p_from, p_to, at = Vec::new(), p_start = None, n = 20, samples = 64,
+    velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100,
+    ds = 0.02, ds_max = 0.05, max_points = 2000
+))]
+#[allow(clippy::too_many_arguments)]
+fn continue_bifurcation<'py>(
+    py: Python<'py>,
+    family: &Bound<'py, PyAny>,
+    start: &Bound<'py, PyDict>,
+    p_from: f64,
+    p_to: f64,
+    at: Vec<f64>,
+    p_start: Option<f64>,
+    #[pyo3(from_py_with = int64)] n: i64,
+    #[pyo3(from_py_with = int64)] samples: i64,
+    velocity_dependent: bool,
+    vectorized: bool,
+    rtol: f64,
+    max_iter: usize,
+    ds: f64,
+    ds_max: f64,
+    #[pyo3(from_py_with = int64)] max_points: i64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let p_start = finite(
+        "p_start",
+        p_start.ok_or_else(|| PyValueError::new_err("argument `p_start` is required"))?,
+    )?;
+    let req = FoldCurveRequest {
+        start: given_start(start)?,
+        p_start,
+        p_from,
+        p_to,
+        at,
+        ds,
+        ds_max,
+        max_points: count("max_points", max_points)?,
+    };
+    let [m, c, k, g, f] = family_system(family, p_start)?;
+    let user = UserArgs {
+        system: [&m, &c, &k, &g],
+        n,
+        samples,
+        velocity_dependent,
+        vectorized,
+        rtol,
+        max_iter,
+        jac: None,
+    };
+    let (first, opts) = user.setup(Some(&f), 1, 0.0)?;
+    let family: Py<PyAny> = family.clone().unbind();
+    let failure: Mutex<Option<PyErr>> = Mutex::new(None);
+    let build = |p: f64| -> Result<PyProblem, HbError> {
+        Python::attach(|py| {
+            let [m, c, k, g, f] = family_system(family.bind(py), p)?;
+            user_problem(
+                &m,
+                &c,
+                &k,
+                &g,
+                Some(&f),
+                None,
+                velocity_dependent,
+                vectorized,
+            )
+        })
+        .map_err(|e| {
+            let message = e.to_string();
+            if let Ok(mut slot) = failure.lock() {
+                slot.get_or_insert(e);
+            }
+            HbError::InvalidInput(format!("family(p) failed: {message}"))
+        })
+    };
+    let curve = run_user(py, &first, |_| jobs::fold_curve(build, &opts, &req));
+    if let Some(e) = failure.lock().ok().and_then(|mut s| s.take()) {
+        return Err(e);
+    }
+    to_dict(py, &curve?)
+}
+
+/// The folds of the frequency response of the thesis Duffing (Eq. 49, ξ =
+/// 0.02, α = ε = 1) followed in the force F (p = F) through the cusp where
+/// the jump disappears: the dict of `ivt hb duffing-folds --json` (the same
+/// job, defaults and tolerance 1e-10). The start is the fold of largest ω_f
+/// on the FRC from `from_` to `to` at `force`; the curve goes first towards
+/// `force_from` and ends where F leaves [force_from, force_to]; the folds at
+/// each F of `at` are located exactly. GIL released.
+#[pyfunction]
+#[pyo3(signature = (
+    force = 0.1, force_from = 0.0, force_to = 0.3, at = vec![0.1, 0.2, 0.3], from_ = 0.5,
+    to = 2.5, n = 20, samples = 64
+))]
+#[allow(clippy::too_many_arguments)]
+fn duffing_folds<'py>(
+    py: Python<'py>,
+    force: f64,
+    force_from: f64,
+    force_to: f64,
+    at: Vec<f64>,
+    from_: f64,
+    to: f64,
+    #[pyo3(from_py_with = int64)] n: i64,
+    #[pyo3(from_py_with = int64)] samples: i64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let opts = options(n, samples, 1, 1e-10)?;
+    let req = FoldCurveRequest {
+        start: FoldStart::Search { from: from_, to },
+        p_start: finite("force", force)?,
+        p_from: force_from,
+        p_to: force_to,
+        at,
+        ..FoldCurveRequest::default()
+    };
+    let family = |f: f64| Ok(Duffing::new(0.02, 1.0, 1.0, f));
+    let curve = run(py, || jobs::fold_curve(family, &opts, &req))?;
+    to_dict(py, &curve)
+}
+
+/// Add `continue_bifurcation` and `duffing_folds` to the `hb` module.
+pub fn register(hb: &Bound<'_, PyModule>) -> PyResult<()> {
+    add_functions!(hb, [continue_bifurcation, duffing_folds]);
+    Ok(())
+}

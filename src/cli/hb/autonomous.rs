@@ -1,0 +1,135 @@
+//! `ivt hb limit-cycle` and `ivt hb duffing-backbone`: periodic orbits with
+//! the frequency an unknown (§3.2.4) — the limit cycle of a self-excited
+//! oscillator and the backbone of the free Duffing oscillator — through the
+//! jobs [`ivt_hb::jobs::limit_cycle`] and [`ivt_hb::jobs::backbone`] that
+//! `ivt.hb.limit_cycle` and `ivt.hb.backbone` run.
+
+use super::{to_json, CliError, Output};
+use clap::Args;
+use ivt_hb::jobs::{self, BackboneRequest, LimitCycleRequest, Oscillator};
+use ivt_hb::HbOptions;
+
+/// Harmonics and samples of the autonomous jobs (Python's defaults and
+/// tolerances: ‖r‖₂ ≤ 1e-9 relative to the force scale).
+#[derive(Args)]
+pub struct Resolution {
+    /// Harmonics n.
+    #[arg(long, default_value_t = 20)]
+    n: usize,
+    /// Half the number of AFT samples N (2N samples, N > n).
+    #[arg(long, default_value_t = 64)]
+    samples: usize,
+}
+
+impl Resolution {
+    fn options(&self) -> Result<HbOptions, CliError> {
+        if self.n == 0 || self.samples <= self.n {
+            return Err(CliError::Input(format!(
+                "--n must be ≥ 1 and --samples > --n, got n = {}, samples = {}",
+                self.n, self.samples
+            )));
+        }
+        Ok(HbOptions::new(self.n, self.samples))
+    }
+}
+
+/// `ivt hb limit-cycle` (defaults: Van der Pol, μ = 1, from x = 1).
+#[derive(Args)]
+pub struct LimitCycleArgs {
+    #[command(flatten)]
+    resolution: Resolution,
+    /// The oscillator: `van-der-pol` (ẍ − μ(1 − x²)ẋ + x = 0) or `rayleigh`
+    /// (ẍ − μ(ẋ − ẋ³/3) + x = 0).
+    #[arg(long, default_value = "van-der-pol")]
+    model: Oscillator,
+    /// Its parameter μ.
+    #[arg(long, default_value_t = 1.0)]
+    mu: f64,
+    /// x of the start state (x, 0) of the transient that settles onto the cycle.
+    #[arg(long, default_value_t = 1.0)]
+    amplitude: f64,
+}
+
+/// `ivt hb duffing-backbone` (defaults: the thesis α = ε = 1).
+#[derive(Args)]
+pub struct BackboneArgs {
+    #[command(flatten)]
+    resolution: Resolution,
+    /// Linear stiffness α (> 0; the linear mode has ω₀ = √α).
+    #[arg(long, default_value_t = 1.0)]
+    alpha: f64,
+    /// Cubic stiffness ε.
+    #[arg(long, default_value_t = 1.0)]
+    eps: f64,
+    /// First amplitude a1.
+    #[arg(long, default_value_t = 0.01)]
+    from: f64,
+    /// Last amplitude a1.
+    #[arg(long, default_value_t = 1.0)]
+    to: f64,
+}
+
+/// Run `ivt hb limit-cycle`.
+///
+/// # Errors
+/// [`CliError::Input`] for bad parameters, [`CliError::Failed`] when the
+/// transient comes to rest or Newton does not converge.
+pub fn limit_cycle(a: LimitCycleArgs) -> Result<Output, CliError> {
+    if !a.mu.is_finite() {
+        return Err(CliError::Input(format!("--mu = {} must be finite", a.mu)));
+    }
+    let req = LimitCycleRequest {
+        amplitude: a.amplitude,
+        ..LimitCycleRequest::default()
+    };
+    let problem = a.model.problem(a.mu);
+    let cycle = jobs::limit_cycle(&problem, &a.resolution.options()?, &req)?;
+    let human = format!(
+        "limit cycle, μ = {}: ω = {:.10}, period {:.10}, {} ({} Newton steps, ‖r‖ = {:.1e})\n",
+        a.mu,
+        cycle.omega,
+        cycle.period,
+        cycle.stability.name(),
+        cycle.iterations,
+        cycle.residual_norm
+    );
+    Ok(Output {
+        json: to_json(&cycle)?,
+        human,
+    })
+}
+
+/// Run `ivt hb duffing-backbone`.
+///
+/// # Errors
+/// [`CliError::Input`] for bad parameters, [`CliError::Failed`] when the
+/// path cannot start.
+pub fn backbone(a: BackboneArgs) -> Result<Output, CliError> {
+    if !(a.alpha.is_finite() && a.alpha > 0.0 && a.eps.is_finite()) {
+        return Err(CliError::Input(format!(
+            "--alpha = {} must be finite and > 0, --eps = {} finite",
+            a.alpha, a.eps
+        )));
+    }
+    let req = BackboneRequest {
+        omega0: a.alpha.sqrt(),
+        amplitude_from: a.from,
+        amplitude_to: a.to,
+        ..BackboneRequest::default()
+    };
+    let problem = jobs::free_duffing(a.alpha, a.eps);
+    let curve = jobs::backbone(&problem, &a.resolution.options()?, &req)?;
+    let last = curve.points.last();
+    let human = format!(
+        "Duffing backbone: {} points, a1 {} → {:?}, ω {:?}, {}\n",
+        curve.points.len(),
+        a.from,
+        last.map(|p| p.amplitude),
+        last.map(|p| p.omega),
+        curve.termination.as_str()
+    );
+    Ok(Output {
+        json: to_json(&curve)?,
+        human,
+    })
+}
