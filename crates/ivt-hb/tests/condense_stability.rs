@@ -6,26 +6,9 @@
 #[path = "common/beam.rs"]
 mod beam;
 
-use beam::{beam, full_beam, FORCE, OMEGA1};
-use faer::c64;
-use ivt_hb::condense::{condensed_response, CondensedFrcOptions};
-use ivt_hb::{AdaptiveHsu, HbOptions, HbSolution, HsuSteps};
-
-/// The Hausdorff distance between the multipliers of modulus ≥ 0.01 of two
-/// sets (each to its nearest in the whole other set).
-fn distance(a: &[c64], b: &[c64]) -> f64 {
-    let one_way = |x: &[c64], y: &[c64]| {
-        x.iter()
-            .filter(|z| z.norm() >= 0.01)
-            .map(|z| {
-                y.iter()
-                    .map(|w| (z - w).norm())
-                    .fold(f64::INFINITY, f64::min)
-            })
-            .fold(0.0f64, f64::max)
-    };
-    one_way(a, b).max(one_way(b, a))
-}
+use beam::{beam, full_beam, orbit, FORCE, OMEGA1};
+use ivt_hb::condense::{condensed_response, multiplier_distance, CondensedFrcOptions};
+use ivt_hb::{AdaptiveHsu, HbOptions, HsuSteps};
 
 #[test]
 fn reduced_multipliers_equal_the_full_systems_within_their_estimate() {
@@ -74,16 +57,10 @@ fn reduced_multipliers_equal_the_full_systems_within_their_estimate() {
     for &i in &picks {
         let p = &frc.points[i];
         let coeffs = branch.recover(&p.coeffs, p.omega_f, &all).unwrap().concat();
-        let sol = HbSolution {
-            coeffs,
-            omega_f: p.omega_f,
-            harmonics: hb.harmonics,
-            subharmonic: 1,
-            stats: Default::default(),
-        };
+        let sol = orbit(coeffs, p.omega_f, hb.harmonics);
         let reference = hsu.floquet(&full, &sol).unwrap();
         let reduced = p.floquet.as_ref().unwrap();
-        let d = distance(&reduced.floquet.multipliers, &reference.floquet.multipliers);
+        let d = multiplier_distance(&reduced.floquet.multipliers, &reference.floquet.multipliers);
         let estimate = reduced.error_estimate() + reference.error.unwrap();
         println!(
             "ω = {:.6}: |μ|max {:.9} (full {:.9}), distance {d:e}, estimate {estimate:e} (basis {})",

@@ -50,6 +50,33 @@ struct Large<'py> {
 }
 
 impl<'py> Large<'py> {
+    /// The settings of one call: matrices, `g` with its optional Jacobian,
+    /// the loads, the nonlinear DOFs, HB sizes, `[velocity_dependent,
+    /// vectorized]`.
+    fn new(
+        n_dof: usize,
+        (m, c, k): (Coo, Coo, Coo),
+        (g, jac): (Bound<'py, PyAny>, Option<Bound<'py, PyAny>>),
+        load: (Vec<f64>, Vec<f64>),
+        dofs: Vec<usize>,
+        hb: HbOptions,
+        [velocity_dependent, vectorized]: [bool; 2],
+    ) -> Self {
+        Self {
+            n_dof,
+            m,
+            c,
+            k,
+            g,
+            jac,
+            load,
+            dofs,
+            hb,
+            velocity_dependent,
+            vectorized,
+        }
+    }
+
     /// The local problem (zero matrices on the nonlinear DOFs, `g`, no `f`)
     /// and the structure, or a Python error.
     fn build(&self, py: Python<'py>) -> PyResult<(Structure, PyProblem)> {
@@ -198,19 +225,15 @@ fn frc_large<'py>(
     truncation_estimate: bool,
     stability: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let large = Large {
+    let large = Large::new(
         n_dof,
-        m,
-        c,
-        k,
-        g,
-        jac,
-        load: f,
-        dofs: nonlinear_dofs,
-        hb: hb_options(n, samples)?,
-        velocity_dependent,
-        vectorized,
-    };
+        (m, c, k),
+        (g, jac),
+        f,
+        nonlinear_dofs,
+        hb_options(n, samples)?,
+        [velocity_dependent, vectorized],
+    );
     let mut opts = CondensedFrcOptions {
         from: finite("omega_from", omega_from)?,
         to: finite("omega_to", omega_to)?,
@@ -278,19 +301,15 @@ fn solve_large<'py>(
     jac: Option<Bound<'py, PyAny>>,
     stability: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let large = Large {
+    let large = Large::new(
         n_dof,
-        m,
-        c,
-        k,
-        g,
-        jac,
-        load: f,
-        dofs: nonlinear_dofs,
-        hb: hb_options(n, samples)?,
-        velocity_dependent,
-        vectorized,
-    };
+        (m, c, k),
+        (g, jac),
+        f,
+        nonlinear_dofs,
+        hb_options(n, samples)?,
+        [velocity_dependent, vectorized],
+    );
     let omega = positive("omega", finite("omega", omega)?)?;
     let rtol = positive("rtol", rtol)?;
     let point = large.run(py, move |branch| {

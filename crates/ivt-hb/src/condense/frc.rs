@@ -14,6 +14,7 @@ use crate::continuation::{
     correct_at_fixed_lambda, pseudo_arclength_exact, ContinuationOptions, Termination,
 };
 use crate::error::HbError;
+use crate::fold::Branch;
 use crate::frc::{locate_turns, FrcFold};
 use crate::problem::PeriodicProblem;
 use crate::stability::HsuSteps;
@@ -215,6 +216,36 @@ pub fn condensed_response<P: PeriodicProblem>(
         folds,
         termination: path.termination,
     })
+}
+
+/// Corrects the condensed unknowns `q` at fixed ω_f by Newton on the exact
+/// condensed Jacobian until the residual (a displacement) is within `rtol`
+/// of the linear response ‖u_S‖₂ at ω_f; returns the steps taken.
+///
+/// # Errors
+/// As [`crate::continuation::correct_at_fixed_lambda`]; [`HbError::Singular`]
+/// when a dynamic stiffness is singular; [`HbError::InvalidInput`] for a `q`
+/// of the wrong length or a bad ω_f or `rtol`.
+pub fn correct_condensed<P: PeriodicProblem>(
+    branch: &mut CondensedBranch<P>,
+    q: &mut [f64],
+    omega_f: f64,
+    rtol: f64,
+) -> Result<usize, HbError> {
+    if !(omega_f.is_finite() && omega_f > 0.0 && rtol > 0.0) || q.len() != Branch::len(branch) {
+        return Err(HbError::InvalidInput(
+            "correct_condensed: ω_f > 0, rtol > 0 and one unknown per condensed coefficient".into(),
+        ));
+    }
+    let q_scale = load_scale(branch, omega_f)?;
+    let mut scaled = Scaled::new(branch, q_scale, omega_f, 0.01 * omega_f);
+    let mut x = scaled.scaled(q, omega_f);
+    let mut copts = ContinuationOptions::default();
+    copts.broyden.tol = rtol;
+    let steps = correct_at_fixed_lambda(&mut scaled, &mut x, &copts)?;
+    let (physical, _) = scaled.physical(&x[..q.len()], 0.0);
+    q.copy_from_slice(&physical);
+    Ok(steps)
 }
 
 /// ‖u_S‖₂ of harmonic p at ω_f (the linear response of the nonlinear DOFs:

@@ -34,7 +34,8 @@ pub use branch::CondensedBranch;
 pub use dynamic::{Factored, Structure};
 pub use estimate::truncation_error;
 pub use frc::{
-    condensed_response, CondensedFold, CondensedFrc, CondensedFrcOptions, CondensedPoint,
+    condensed_response, correct_condensed, CondensedFold, CondensedFrc, CondensedFrcOptions,
+    CondensedPoint,
 };
 pub use receptance::{Coupling, Receptances};
-pub use stability::{CondensedFloquet, ReducedStability, DEFAULT_BLOCKS};
+pub use stability::{multiplier_distance, CondensedFloquet, ReducedStability, DEFAULT_BLOCKS};

@@ -255,7 +255,10 @@ impl ReducedStability {
         }
         let (big, small) = (&results[0], &results[1]);
         Ok(CondensedFloquet {
-            truncation_error: hausdorff(&big.floquet.multipliers, &small.floquet.multipliers),
+            truncation_error: multiplier_distance(
+                &big.floquet.multipliers,
+                &small.floquet.multipliers,
+            ),
             hsu_error: big.error.unwrap_or(0.0),
             basis: self.levels[0].size,
             floquet: big.floquet.clone(),
@@ -263,10 +266,10 @@ impl ReducedStability {
     }
 }
 
-/// Hausdorff distance between the multipliers of modulus ≥
-/// [`COMPARED_MODULUS`] of `a` and those of `b` (each to its nearest in the
-/// whole other set).
-fn hausdorff(a: &[c64], b: &[c64]) -> f64 {
+/// Hausdorff distance between the multipliers of modulus ≥ 0.01 of `a`
+/// and those of `b` (each to its nearest in the whole other set): the
+/// truncation estimate, and the tests' distance to the full system's.
+pub fn multiplier_distance(a: &[c64], b: &[c64]) -> f64 {
     let one_way = |x: &[c64], y: &[c64]| {
         x.iter()
             .filter(|z| z.norm() >= COMPARED_MODULUS)

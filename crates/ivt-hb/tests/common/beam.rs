@@ -1,6 +1,7 @@
 //! The cantilever of issue 28 condensed onto its tip: k3 = 200 cubic spring
-//! from the tip to ground, the tip forced by `F cos ωt` (shared by the tests
-//! and the benches, `#[path]`-included there).
+//! from the tip to ground, the tip forced by `F cos ωt`, and the uncondensed
+//! beam the tests compare with (`#[path]`-included by the condense tests).
+#![allow(dead_code)] // each test binary uses its own subset
 
 use ivt_hb::condense::{CondensedBranch, Structure};
 use ivt_hb::models::cantilever;
@@ -62,12 +63,6 @@ pub fn beam(
 pub fn full_beam(n: usize) -> (impl PeriodicProblem, usize) {
     let b = cantilever(n, 1.0, 1.0, 1.0, 0.07, 2e-4).unwrap();
     let nd = b.model.n_dof();
-    let dense = |a: &faer::sparse::SparseColMat<usize, f64>| {
-        let d = a.to_dense();
-        (0..nd * nd)
-            .map(|i| d[(i / nd, i % nd)])
-            .collect::<Vec<f64>>()
-    };
     let tip = b.tip;
     let problem = GeneralProblem::new(
         nd,
@@ -89,4 +84,22 @@ pub fn full_beam(n: usize) -> (impl PeriodicProblem, usize) {
         dg[tip * nd + tip] = 3.0 * K3 * x[tip] * x[tip];
     });
     (problem, tip)
+}
+
+/// A sparse matrix as a dense row-major vector.
+pub fn dense(a: &faer::sparse::SparseColMat<usize, f64>) -> Vec<f64> {
+    let n = a.nrows();
+    let d = a.to_dense();
+    (0..n * a.ncols()).map(|i| d[(i / n, i % n)]).collect()
+}
+
+/// The period-one orbit of `coeffs` (all DOFs, `harmonics` each) at ω_f.
+pub fn orbit(coeffs: Vec<f64>, omega_f: f64, harmonics: usize) -> ivt_hb::HbSolution {
+    ivt_hb::HbSolution {
+        coeffs,
+        omega_f,
+        harmonics,
+        subharmonic: 1,
+        stats: Default::default(),
+    }
 }
