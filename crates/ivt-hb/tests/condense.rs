@@ -11,50 +11,17 @@ mod common;
 #[path = "common/dd.rs"]
 mod dd;
 
-use beam::{beam, FORCE, K3, OMEGA1};
+use beam::{beam, dense, full_beam, orbit, FORCE, OMEGA1};
 use common::orbit_defect;
 use faer::{c64, Mat};
-use ivt_hb::condense::{condensed_response, CondensedFrc, CondensedFrcOptions, Structure};
-use ivt_hb::continuation::correct_at_fixed_lambda;
+use ivt_hb::condense::{
+    condensed_response, correct_condensed, CondensedFrc, CondensedFrcOptions, Structure,
+};
 use ivt_hb::models::cantilever;
 use ivt_hb::{
-    locate_fold, ClassicIhb, ContinuationOptions, FamilyBranch, FoldOptions, Frequency,
-    GeneralProblem, HbOptions, HbSolution, PeriodicProblem,
+    locate_fold, ClassicIhb, FamilyBranch, FoldOptions, Frequency, GeneralProblem, HbOptions,
+    PeriodicProblem,
 };
-
-/// The uncondensed beam of `n` elements: dense M, C, K, the tip spring, the
-/// tip force.
-fn full_beam(n: usize) -> (impl PeriodicProblem, usize) {
-    let b = cantilever(n, 1.0, 1.0, 1.0, 0.07, 2e-4).unwrap();
-    let nd = b.model.n_dof();
-    let dense = |a: &faer::sparse::SparseColMat<usize, f64>| {
-        let d = a.to_dense();
-        (0..nd * nd)
-            .map(|i| d[(i / nd, i % nd)])
-            .collect::<Vec<f64>>()
-    };
-    let tip = b.tip;
-    let problem = GeneralProblem::new(
-        nd,
-        dense(&b.model.m),
-        dense(&b.model.c),
-        dense(&b.model.k),
-        move |x: &[f64], _v: &[f64], _t: f64, g: &mut [f64]| {
-            g.fill(0.0);
-            g[tip] = K3 * x[tip].powi(3);
-        },
-        move |theta: f64, f: &mut [f64]| {
-            f.fill(0.0);
-            f[tip] = FORCE * theta.cos();
-        },
-    )
-    .with_velocity_dependent(false)
-    .with_jacobian(move |x: &[f64], _v: &[f64], _t: f64, dg: &mut [f64]| {
-        dg.fill(0.0);
-        dg[tip * nd + tip] = 3.0 * K3 * x[tip] * x[tip];
-    });
-    (problem, tip)
-}
 
 /// The condensed curve of the `n`-element beam over 0.7–1.3 ω₁ with `hb`.
 fn curve(
@@ -168,13 +135,7 @@ fn condensed_orbits_solve_the_ode_by_rk4_at_n_4() {
     let mut checked = 0;
     for (_, p) in stable {
         let coeffs = all_dofs(&mut branch, &p.coeffs, p.omega_f);
-        let sol = HbSolution {
-            coeffs,
-            omega_f: p.omega_f,
-            harmonics: hb.harmonics,
-            subharmonic: 1,
-            stats: Default::default(),
-        };
+        let sol = orbit(coeffs, p.omega_f, hb.harmonics);
         let defect = orbit_defect(&full, &sol, 1 << 16);
         assert!(
             defect <= 1e-9 * p.amplitude,
@@ -249,15 +210,10 @@ fn truncation_estimate_covers_the_change_to_more_harmonics() {
     let high = HbOptions::new(11, 48).with_tolerances(1e-13, 0.0);
     let (frc, _) = curve(20, &low);
     let mut fine = beam(20, FORCE, &high);
-    let copts = ContinuationOptions {
-        broyden: ivt_hb::BroydenOptions::default().with_tol(1e-16),
-        ..ContinuationOptions::default()
-    };
     let mut worst_ratio = 0.0f64;
     for p in frc.points.iter().step_by(3) {
         let mut x = ivt_hb::aft::resize_harmonics(&p.coeffs, high.harmonics);
-        x.push(p.omega_f);
-        correct_at_fixed_lambda(&mut fine, &mut x, &copts).unwrap();
+        correct_condensed(&mut fine, &mut x, p.omega_f, 1e-14).unwrap();
         let coarse = ivt_hb::aft::resize_harmonics(&p.coeffs, high.harmonics);
         let scale = x
             .iter()
@@ -309,27 +265,19 @@ fn bladed_disk_curve_solves_the_uncondensed_equations() {
     let hb = HbOptions::new(5, 32);
     let mut branch =
         CondensedBranch::new(structure, vec![disk.tip], &load, &[], local, &hb).unwrap();
-    // Steps in rad/s: the path's arclength is dominated by ω here.
-    let mut opts = CondensedFrcOptions {
+    // The whole band at the default step control (in scaled unknowns: the
+    // path once took > 5000 steps to 1218 rad/s, the corrector's tolerance
+    // below the rounding of ω_f).
+    let opts = CondensedFrcOptions {
         from: 1150.0,
         to: 1260.0,
         ..CondensedFrcOptions::default()
     };
-    opts.continuation.ds = 0.5;
-    opts.continuation.ds_max = 2.0;
-    // The disk's closely spaced modes make the whole band thousands of
-    // steps at the default step control (5000 points reach 1218 rad/s,
-    // measured): 300 points here.
-    opts.continuation.max_points = 300;
     let frc = condensed_response(&mut branch, &opts).unwrap();
-    assert_eq!(frc.termination, ivt_hb::Termination::MaxPoints);
-    assert!(frc.points.last().unwrap().omega_f > 1160.0);
-    let dense = |a: &faer::sparse::SparseColMat<usize, f64>| {
-        let d = a.to_dense();
-        (0..nd * nd)
-            .map(|i| d[(i / nd, i % nd)])
-            .collect::<Vec<f64>>()
-    };
+    println!("{} points, {} folds", frc.points.len(), frc.folds.len());
+    assert_eq!(frc.termination, ivt_hb::Termination::LeftInterval);
+    assert!(frc.points.len() < 400, "{} points", frc.points.len());
+    assert!(frc.points.iter().all(|p| p.floquet.is_some()));
     let tip = disk.tip;
     let full = GeneralProblem::new(
         nd,

@@ -10,6 +10,7 @@ use ivt_hb::condense::{
     condensed_response, CondensedBranch, CondensedFrc, CondensedFrcOptions, CondensedPoint,
     Structure,
 };
+use ivt_hb::jobs::pairs;
 use ivt_hb::{HbError, HbOptions};
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::exceptions::PyValueError;
@@ -49,6 +50,33 @@ struct Large<'py> {
 }
 
 impl<'py> Large<'py> {
+    /// The settings of one call: matrices, `g` with its optional Jacobian,
+    /// the loads, the nonlinear DOFs, HB sizes, `[velocity_dependent,
+    /// vectorized]`.
+    fn new(
+        n_dof: usize,
+        (m, c, k): (Coo, Coo, Coo),
+        (g, jac): (Bound<'py, PyAny>, Option<Bound<'py, PyAny>>),
+        load: (Vec<f64>, Vec<f64>),
+        dofs: Vec<usize>,
+        hb: HbOptions,
+        [velocity_dependent, vectorized]: [bool; 2],
+    ) -> Self {
+        Self {
+            n_dof,
+            m,
+            c,
+            k,
+            g,
+            jac,
+            load,
+            dofs,
+            hb,
+            velocity_dependent,
+            vectorized,
+        }
+    }
+
     /// The local problem (zero matrices on the nonlinear DOFs, `g`, no `f`)
     /// and the structure, or a Python error.
     fn build(&self, py: Python<'py>) -> PyResult<(Structure, PyProblem)> {
@@ -116,8 +144,20 @@ fn point_dict<'py>(py: Python<'py>, p: &CondensedPoint) -> PyResult<Bound<'py, P
         "error_estimate",
         p.solve_error + p.truncation_error.unwrap_or(0.0),
     )?;
-    d.set_item("multipliers", py.None())?;
-    d.set_item("stable", py.None())?;
+    match &p.floquet {
+        Some(f) => {
+            d.set_item("multipliers", pairs(&f.floquet.multipliers))?;
+            d.set_item("stable", f.floquet.stable())?;
+            d.set_item("stability", f.floquet.kind.name())?;
+            d.set_item("multiplier_error", f.error_estimate())?;
+            d.set_item("stability_basis", f.basis)?;
+        }
+        None => {
+            for key in ["multipliers", "stable", "stability", "multiplier_error"] {
+                d.set_item(key, py.None())?;
+            }
+        }
+    }
     Ok(d)
 }
 
@@ -157,7 +197,7 @@ fn frc_dict<'py>(py: Python<'py>, frc: &CondensedFrc) -> PyResult<Bound<'py, PyD
     n_dof, m, c, k, g, f, omega_from, omega_to, nonlinear_dofs, amplitude_dof = None,
     record_dofs = Vec::new(), n = 7, samples = 32, velocity_dependent = true,
     vectorized = false, rtol = 1e-12, jac = None, ds = None, ds_min = None, ds_max = None,
-    truncation_estimate = true
+    truncation_estimate = true, stability = true
 ))]
 #[allow(clippy::too_many_arguments)]
 fn frc_large<'py>(
@@ -183,20 +223,17 @@ fn frc_large<'py>(
     ds_min: Option<f64>,
     ds_max: Option<f64>,
     truncation_estimate: bool,
+    stability: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let large = Large {
+    let large = Large::new(
         n_dof,
-        m,
-        c,
-        k,
-        g,
-        jac,
-        load: f,
-        dofs: nonlinear_dofs,
-        hb: hb_options(n, samples)?,
-        velocity_dependent,
-        vectorized,
-    };
+        (m, c, k),
+        (g, jac),
+        f,
+        nonlinear_dofs,
+        hb_options(n, samples)?,
+        [velocity_dependent, vectorized],
+    );
     let mut opts = CondensedFrcOptions {
         from: finite("omega_from", omega_from)?,
         to: finite("omega_to", omega_to)?,
@@ -204,6 +241,7 @@ fn frc_large<'py>(
         amplitude_dof,
         record_dofs,
         truncation_estimate,
+        stability_blocks: stability.then_some(ivt_hb::condense::DEFAULT_BLOCKS),
         ..CondensedFrcOptions::default()
     };
     let steps = [
@@ -232,13 +270,15 @@ fn positive(name: &str, v: f64) -> PyResult<f64> {
 
 /// One orbit of a large structure at `omega` (private: `ivt.hb.solve` calls
 /// it as [`frc_large`]): Newton on the condensed system from the linear
-/// response. Returns {"coeffs", "omega", "amplitude", "dof_coeffs",
-/// "solve_error", "iterations"}.
+/// response. Returns the point dict of [`frc_large`] ({"coeffs", "omega",
+/// "amplitude", "dof_coeffs", "solve_error", "truncation_error",
+/// "error_estimate", "multipliers", "stable", "stability",
+/// "multiplier_error"}).
 #[pyfunction]
 #[pyo3(signature = (
     n_dof, m, c, k, g, f, omega, nonlinear_dofs, amplitude_dof = None,
     record_dofs = Vec::new(), n = 7, samples = 32, velocity_dependent = true,
-    vectorized = false, rtol = 1e-12, jac = None
+    vectorized = false, rtol = 1e-12, jac = None, stability = true
 ))]
 #[allow(clippy::too_many_arguments)]
 fn solve_large<'py>(
@@ -259,20 +299,17 @@ fn solve_large<'py>(
     vectorized: bool,
     rtol: f64,
     jac: Option<Bound<'py, PyAny>>,
+    stability: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let large = Large {
+    let large = Large::new(
         n_dof,
-        m,
-        c,
-        k,
-        g,
-        jac,
-        load: f,
-        dofs: nonlinear_dofs,
-        hb: hb_options(n, samples)?,
-        velocity_dependent,
-        vectorized,
-    };
+        (m, c, k),
+        (g, jac),
+        f,
+        nonlinear_dofs,
+        hb_options(n, samples)?,
+        [velocity_dependent, vectorized],
+    );
     let omega = positive("omega", finite("omega", omega)?)?;
     let rtol = positive("rtol", rtol)?;
     let point = large.run(py, move |branch| {
@@ -284,6 +321,7 @@ fn solve_large<'py>(
             amplitude_dof,
             record_dofs,
             truncation_estimate: true,
+            stability_blocks: stability.then_some(ivt_hb::condense::DEFAULT_BLOCKS),
             continuation: ivt_hb::ContinuationOptions {
                 max_points: 1,
                 ..CondensedFrcOptions::default().continuation

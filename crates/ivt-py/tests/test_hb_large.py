@@ -55,8 +55,18 @@ def test_condensed_curve_with_located_folds_and_recovered_dofs():
         # The recovered tip is the condensed unknown itself (to the corrector's
         # tolerance, 1e-12 of the start's linear response ≈ 4e-15).
         assert np.allclose(p["dof_coeffs"][tip], p["coeffs"], rtol=0, atol=1e-13)
-        assert p["multipliers"] is None and p["stable"] is None
         assert 0 < p["error_estimate"] < 1e-7
+        # Floquet multipliers of the whole beam from the reduced basis
+        # (tests/condense_stability.rs: within their estimate of the full
+        # 80-state Hsu at N = 20).
+        assert p["multiplier_error"] < 1e-4
+        assert len(p["multipliers"]) == 2 * p["stability_basis"]
+    # Stable outside the folds, unstable (a real multiplier > 1) between.
+    first, second = (fold["index"] for fold in out["folds"])
+    stable = [p["stable"] for p in out["points"]]
+    assert all(stable[: first - 1]) and all(stable[second + 2 :])
+    assert not any(stable[first + 2 : second - 1])
+    assert all(p["stability"] == "fold" for p in out["points"][first + 2 : second - 1])
     assert np.array_equal(out["omega"], [p["omega"] for p in out["points"]])
 
 
@@ -117,11 +127,22 @@ def test_bad_large_inputs_raise_value_errors():
     f[tip] = F0
     with pytest.raises(ValueError, match="nonlinear_dofs"):
         ivt.hb.frc(m, c, k, spring, f, 2.0, 3.0)
-    with pytest.raises(ValueError, match="stability"):
-        ivt.hb.frc(m, c, k, spring, f, 2.0, 3.0, nonlinear_dofs=[tip], stability=True)
     with pytest.raises(ValueError):
         ivt.hb.frc(m, c, k, spring, f, 2.0, 3.0, nonlinear_dofs=[99])
     with pytest.raises(ValueError):
         ivt.hb.solve(m, c, k, spring, 2.0, f[:3], nonlinear_dofs=[tip])
     with pytest.raises(ValueError):
         ivt.hb.models.cantilever(0)
+
+
+def test_stability_false_skips_the_multipliers_and_keeps_the_folds():
+    m, c, k, tip = ivt.hb.models.cantilever(20)
+    f = np.zeros(m.shape[0])
+    f[tip] = F0
+    out = ivt.hb.frc(m, c, k, spring, f, 0.7 * W1, 1.3 * W1, jac=spring_jac,
+                     nonlinear_dofs=[tip], stability=False)
+    assert all(p["multipliers"] is None and p["stable"] is None for p in out["points"])
+    assert abs(out["folds"][0]["omega"] - 3.906984060533) < 1e-9
+    assert abs(out["folds"][1]["omega"] - 3.672391045809) < 1e-9
+    one = ivt.hb.solve(m, c, k, spring, 3.0, f, nonlinear_dofs=[tip])
+    assert one["stable"] is True and np.hypot(*one["multipliers"][0]) < 1.0

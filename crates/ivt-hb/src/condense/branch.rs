@@ -1,6 +1,6 @@
-//! The condensed harmonic-balance residual in ω_f as a path system: the glue
-//! between [`super::Receptances`] and the path machinery
-//! ([`PathSystem`] for the continuation, [`Branch`] for the folds).
+//! The condensed harmonic-balance residual in ω_f as a [`Branch`]: the glue
+//! between [`super::Receptances`] and the path machinery (the continuation
+//! and the fold locator see it in scaled unknowns, `scaled.rs`).
 //!
 //! Unknowns `q`: the harmonics of the nonlinear DOFs `S` only, in the layout of
 //! [`crate::HbResidual`] (`s` blocks `[a0, a1..an, b1..bn]`). The residual is
@@ -16,13 +16,12 @@
 
 use super::dynamic::Structure;
 use super::receptance::{Coupling, Receptances};
-use crate::continuation::PathSystem;
 use crate::error::HbError;
 use crate::fold::Branch;
 use crate::galerkin::GalerkinJacobian;
 use crate::ihb::{HbOptions, HbResidual};
 use crate::problem::PeriodicProblem;
-use faer::{c64, Mat, MatRef};
+use faer::{c64, Mat};
 
 /// The condensed HB problem of a sparse structure with a local nonlinearity.
 pub struct CondensedBranch<P: PeriodicProblem> {
@@ -35,7 +34,6 @@ pub struct CondensedBranch<P: PeriodicProblem> {
     cache: Option<Receptances>,
     /// The last failure to build receptances (reported by the drivers).
     failure: Option<HbError>,
-    rows: Vec<f64>,
     scratch: Vec<f64>,
 }
 
@@ -100,7 +98,6 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
             galerkin,
             cache: None,
             failure: None,
-            rows: vec![0.0; m * m],
             scratch: vec![0.0; m],
         })
     }
@@ -398,29 +395,5 @@ impl<P: PeriodicProblem> Branch for CondensedBranch<P> {
             b.combine(&rc.d_receptance, Some(&rc.d_response), None, &mut force);
             o.iter_mut().zip(&force).for_each(|(a, c)| *a += c);
         });
-    }
-}
-
-impl<P: PeriodicProblem> PathSystem for CondensedBranch<P> {
-    fn dim(&self) -> usize {
-        self.res.len()
-    }
-    fn residual(&mut self, u: &[f64], lambda: f64, r: &mut [f64]) {
-        Branch::residual(self, u, lambda, r);
-    }
-    fn residual_jacobian(&mut self, u: &[f64], lambda: f64, r: &mut [f64], jac: &mut Mat<f64>) {
-        Branch::residual(self, u, lambda, r);
-        PathSystem::jacobian(self, u, lambda, jac);
-    }
-    fn jacobian(&mut self, u: &[f64], lambda: f64, jac: &mut Mat<f64>) {
-        let m = u.len();
-        let mut rows = std::mem::take(&mut self.rows);
-        Branch::jacobian(self, u, lambda, &mut rows);
-        jac.as_mut()
-            .copy_from(MatRef::from_row_major_slice(&rows[..m * m], m, m));
-        self.rows = rows;
-    }
-    fn d_residual_d_lambda(&mut self, u: &[f64], lambda: f64, r_lambda: &mut [f64]) {
-        Branch::residual_lambda(self, u, lambda, 0.0, r_lambda);
     }
 }

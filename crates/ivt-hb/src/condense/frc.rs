@@ -7,13 +7,17 @@
 
 use super::branch::CondensedBranch;
 use super::estimate::truncation_error;
+use super::scaled::Scaled;
+use super::stability::{CondensedFloquet, ReducedStability, DEFAULT_BLOCKS};
 use crate::aft::{eval_series, Aft};
 use crate::continuation::{
-    correct_at_fixed_lambda, pseudo_arclength_exact, ContinuationOptions, PathPoint, Termination,
+    correct_at_fixed_lambda, pseudo_arclength_exact, ContinuationOptions, Termination,
 };
 use crate::error::HbError;
+use crate::fold::Branch;
 use crate::frc::{locate_turns, FrcFold};
 use crate::problem::PeriodicProblem;
+use crate::stability::HsuSteps;
 
 /// Options of a condensed frequency sweep.
 #[derive(Debug, Clone, PartialEq)]
@@ -23,7 +27,10 @@ pub struct CondensedFrcOptions {
     /// End frequency ω_f.
     pub to: f64,
     /// Path options (λ bounds are set from `from`/`to`; `broyden.tol` is set
-    /// from `rtol`).
+    /// from `rtol`). The path runs in scaled unknowns (`condense/scaled.rs`):
+    /// steps `ds` are in units of the sweep's width |to − from| in ω_f
+    /// (at least 1 % of ω_f) and
+    /// of the nonlinear DOFs' linear response at `from`.
     pub continuation: ContinuationOptions,
     /// Corrector tolerance (on the receptance-form residual, a displacement)
     /// relative to the linear response ‖u_S‖₂ at the start.
@@ -35,6 +42,10 @@ pub struct CondensedFrcOptions {
     /// Estimate the harmonic truncation error per point (one extra
     /// factorization per omitted harmonic, up to 2n per point).
     pub truncation_estimate: bool,
+    /// Floquet multipliers at every point from a reduced basis of this many
+    /// Krylov blocks ([`ReducedStability`]); `None`: none (folds are
+    /// located either way).
+    pub stability_blocks: Option<usize>,
 }
 
 impl Default for CondensedFrcOptions {
@@ -42,9 +53,13 @@ impl Default for CondensedFrcOptions {
         Self {
             from: 0.5,
             to: 1.5,
+            // Steps of at most 10 % of the sweep and of the scaled solution's
+            // norm: the relative step that resolves a light resonance
+            // (scaled.rs).
             continuation: ContinuationOptions {
                 ds: 0.02,
                 ds_max: 0.1,
+                ds_relative_scale: 1.0,
                 target_iter: 8,
                 second_order_predictor: true,
                 ..ContinuationOptions::default()
@@ -53,6 +68,7 @@ impl Default for CondensedFrcOptions {
             amplitude_dof: None,
             record_dofs: Vec::new(),
             truncation_estimate: true,
+            stability_blocks: Some(DEFAULT_BLOCKS),
         }
     }
 }
@@ -74,6 +90,8 @@ pub struct CondensedPoint {
     /// Estimated relative truncation error ([`truncation_error`]); `None` if
     /// not asked for.
     pub truncation_error: Option<f64>,
+    /// Floquet multipliers with their error estimates, when asked for.
+    pub floquet: Option<CondensedFloquet>,
 }
 
 /// A fold of a condensed curve: a [`FrcFold`] whose `amplitude` is that of
@@ -118,54 +136,72 @@ pub fn condensed_response<P: PeriodicProblem>(
     {
         return Err(HbError::InvalidInput(format!("DOF {bad} is out of range")));
     }
-    let m = crate::fold::Branch::len(branch);
-    let mut x = branch.linear_guess(opts.from)?;
-    x.push(opts.from);
-    let mut copts = opts.continuation.clone();
-    copts.lambda_min = opts.from.min(opts.to);
-    copts.lambda_max = opts.from.max(opts.to);
-    copts.broyden.tol = opts.rtol * load_scale(branch, opts.from)?;
-    let its = correct_at_fixed_lambda(branch, &mut x, &copts)?;
-    let direction = if opts.to > opts.from { 1.0 } else { -1.0 };
     let mut probe = Probe::new(branch, amp_dof, &opts.record_dofs)?;
+    let mut stability = opts
+        .stability_blocks
+        .map(|blocks| ReducedStability::new(branch, blocks, HsuSteps::default()))
+        .transpose()?;
+    let q0 = branch.linear_guess(opts.from)?;
+    let q_scale = load_scale(branch, opts.from)?;
+    // At least 1 % of ω_f: a one-point sweep (`solve`) keeps λ̃ ≤ 100.
+    let width = (opts.to - opts.from)
+        .abs()
+        .max(0.01 * opts.from.max(opts.to));
+    let mut scaled = Scaled::new(branch, q_scale, opts.from, width);
+    let m = q0.len();
+    let mut x = scaled.scaled(&q0, opts.from);
+    let mut copts = opts.continuation.clone();
+    copts.lambda_min = scaled.lambda(opts.from.min(opts.to));
+    copts.lambda_max = scaled.lambda(opts.from.max(opts.to));
+    // The residual is relative to q_scale already.
+    copts.broyden.tol = opts.rtol;
+    let its = correct_at_fixed_lambda(&mut scaled, &mut x, &copts)?;
+    let direction = if opts.to > opts.from { 1.0 } else { -1.0 };
     let mut points = Vec::new();
     let mut failed = None;
-    let path =
-        pseudo_arclength_exact(
-            branch,
-            &x,
-            its,
-            direction,
-            &copts,
-            |b, p: &PathPoint| match probe.point(b, &p.x[..m], p.lambda(), opts.truncation_estimate)
-            {
-                Ok(point) => {
-                    points.push(point);
-                    true
-                }
-                Err(e) => {
-                    failed = Some(e);
-                    false
-                }
-            },
-        )?;
+    let path = pseudo_arclength_exact(&mut scaled, &x, its, direction, &copts, |sc, p| {
+        let (q, omega_f) = sc.physical(&p.x[..m], p.lambda());
+        let point = probe.point(
+            sc.branch,
+            &q,
+            omega_f,
+            opts.truncation_estimate,
+            stability.as_mut(),
+        );
+        match point {
+            Ok(point) => {
+                points.push(point);
+                true
+            }
+            Err(e) => {
+                failed = Some(e);
+                false
+            }
+        }
+    })?;
+    let located = locate_turns(&mut scaled, &path);
+    let branch = scaled.branch;
     if let Some(e) = failed.or_else(|| branch.take_failure().filter(|_| points.is_empty())) {
         return Err(e);
     }
     let mut folds = Vec::with_capacity(path.folds.len());
-    for (turn, located) in path.folds.iter().zip(locate_turns(branch, &path)) {
+    for (turn, located) in path.folds.iter().zip(located) {
         let fold = match located {
-            Some((coeffs, omega_f)) => CondensedFold {
-                index: turn.index,
-                omega_f,
-                amplitude: probe.amplitude(branch, &coeffs, omega_f)?,
-                coeffs,
-                located: true,
-            },
+            Some((q, lambda)) => {
+                let coeffs: Vec<f64> = q.iter().map(|v| v * q_scale).collect();
+                let omega_f = opts.from + lambda * width;
+                CondensedFold {
+                    index: turn.index,
+                    omega_f,
+                    amplitude: probe.amplitude(branch, &coeffs, omega_f)?,
+                    coeffs,
+                    located: true,
+                }
+            }
             None => match points.get(turn.index) {
                 Some(near) => CondensedFold {
                     index: turn.index,
-                    omega_f: turn.lambda,
+                    omega_f: opts.from + turn.lambda * width,
                     amplitude: near.amplitude,
                     coeffs: near.coeffs.clone(),
                     located: false,
@@ -180,6 +216,36 @@ pub fn condensed_response<P: PeriodicProblem>(
         folds,
         termination: path.termination,
     })
+}
+
+/// Corrects the condensed unknowns `q` at fixed ω_f by Newton on the exact
+/// condensed Jacobian until the residual (a displacement) is within `rtol`
+/// of the linear response ‖u_S‖₂ at ω_f; returns the steps taken.
+///
+/// # Errors
+/// As [`crate::continuation::correct_at_fixed_lambda`]; [`HbError::Singular`]
+/// when a dynamic stiffness is singular; [`HbError::InvalidInput`] for a `q`
+/// of the wrong length or a bad ω_f or `rtol`.
+pub fn correct_condensed<P: PeriodicProblem>(
+    branch: &mut CondensedBranch<P>,
+    q: &mut [f64],
+    omega_f: f64,
+    rtol: f64,
+) -> Result<usize, HbError> {
+    if !(omega_f.is_finite() && omega_f > 0.0 && rtol > 0.0) || q.len() != Branch::len(branch) {
+        return Err(HbError::InvalidInput(
+            "correct_condensed: ω_f > 0, rtol > 0 and one unknown per condensed coefficient".into(),
+        ));
+    }
+    let q_scale = load_scale(branch, omega_f)?;
+    let mut scaled = Scaled::new(branch, q_scale, omega_f, 0.01 * omega_f);
+    let mut x = scaled.scaled(q, omega_f);
+    let mut copts = ContinuationOptions::default();
+    copts.broyden.tol = rtol;
+    let steps = correct_at_fixed_lambda(&mut scaled, &mut x, &copts)?;
+    let (physical, _) = scaled.physical(&x[..q.len()], 0.0);
+    q.copy_from_slice(&physical);
+    Ok(steps)
 }
 
 /// ‖u_S‖₂ of harmonic p at ω_f (the linear response of the nonlinear DOFs:
@@ -274,6 +340,7 @@ impl Probe {
         q: &[f64],
         omega_f: f64,
         truncation: bool,
+        stability: Option<&mut ReducedStability>,
     ) -> Result<CondensedPoint, HbError> {
         let amplitude = self.amplitude(branch, q, omega_f)?;
         let recovered = branch.recover(q, omega_f, &self.record)?;
@@ -283,6 +350,9 @@ impl Probe {
         } else {
             None
         };
+        let floquet = stability
+            .map(|st| st.floquet(branch, q, omega_f))
+            .transpose()?;
         Ok(CondensedPoint {
             omega_f,
             amplitude,
@@ -290,6 +360,7 @@ impl Probe {
             dof_coeffs: self.record.iter().copied().zip(recovered).collect(),
             solve_error,
             truncation_error,
+            floquet,
         })
     }
 }

@@ -18,17 +18,24 @@
 //!   and [`crate::fold::Branch`]; any DOF recovered on request.
 //! - [`condensed_response`]: the frequency-response curve with folds located
 //!   and per point the estimated solve and truncation errors.
+//! - [`ReducedStability`]: Floquet multipliers of the whole structure's
+//!   variational equation on a reduced basis (the Ritz vectors of `S`), with
+//!   the basis truncation's error estimated per orbit.
 
 mod branch;
 pub mod dynamic;
 mod estimate;
 mod frc;
 mod receptance;
+mod scaled;
+mod stability;
 
 pub use branch::CondensedBranch;
 pub use dynamic::{Factored, Structure};
 pub use estimate::truncation_error;
 pub use frc::{
-    condensed_response, CondensedFold, CondensedFrc, CondensedFrcOptions, CondensedPoint,
+    condensed_response, correct_condensed, CondensedFold, CondensedFrc, CondensedFrcOptions,
+    CondensedPoint,
 };
 pub use receptance::{Coupling, Receptances};
+pub use stability::{multiplier_distance, CondensedFloquet, ReducedStability, DEFAULT_BLOCKS};

@@ -1,10 +1,11 @@
 //! The cantilever of issue 28 condensed onto its tip: k3 = 200 cubic spring
-//! from the tip to ground, the tip forced by `F cos ωt` (shared by the tests
-//! and the benches, `#[path]`-included there).
+//! from the tip to ground, the tip forced by `F cos ωt`, and the uncondensed
+//! beam the tests compare with (`#[path]`-included by the condense tests).
+#![allow(dead_code)] // each test binary uses its own subset
 
 use ivt_hb::condense::{CondensedBranch, Structure};
 use ivt_hb::models::cantilever;
-use ivt_hb::{GeneralProblem, HbOptions};
+use ivt_hb::{GeneralProblem, HbOptions, PeriodicProblem};
 
 /// Cubic spring constant at the tip (issue 28).
 pub const K3: f64 = 200.0;
@@ -55,4 +56,50 @@ pub fn beam(
     load[model.tip] = force;
     CondensedBranch::new(structure, vec![model.tip], &load, &[], tip_problem(), hb)
         .expect("valid branch")
+}
+
+/// The uncondensed beam of `n` elements: dense M, C, K, the tip spring, the
+/// tip force.
+pub fn full_beam(n: usize) -> (impl PeriodicProblem, usize) {
+    let b = cantilever(n, 1.0, 1.0, 1.0, 0.07, 2e-4).unwrap();
+    let nd = b.model.n_dof();
+    let tip = b.tip;
+    let problem = GeneralProblem::new(
+        nd,
+        dense(&b.model.m),
+        dense(&b.model.c),
+        dense(&b.model.k),
+        move |x: &[f64], _v: &[f64], _t: f64, g: &mut [f64]| {
+            g.fill(0.0);
+            g[tip] = K3 * x[tip].powi(3);
+        },
+        move |theta: f64, f: &mut [f64]| {
+            f.fill(0.0);
+            f[tip] = FORCE * theta.cos();
+        },
+    )
+    .with_velocity_dependent(false)
+    .with_jacobian(move |x: &[f64], _v: &[f64], _t: f64, dg: &mut [f64]| {
+        dg.fill(0.0);
+        dg[tip * nd + tip] = 3.0 * K3 * x[tip] * x[tip];
+    });
+    (problem, tip)
+}
+
+/// A sparse matrix as a dense row-major vector.
+pub fn dense(a: &faer::sparse::SparseColMat<usize, f64>) -> Vec<f64> {
+    let n = a.nrows();
+    let d = a.to_dense();
+    (0..n * a.ncols()).map(|i| d[(i / n, i % n)]).collect()
+}
+
+/// The period-one orbit of `coeffs` (all DOFs, `harmonics` each) at ω_f.
+pub fn orbit(coeffs: Vec<f64>, omega_f: f64, harmonics: usize) -> ivt_hb::HbSolution {
+    ivt_hb::HbSolution {
+        coeffs,
+        omega_f,
+        harmonics,
+        subharmonic: 1,
+        stats: Default::default(),
+    }
 }

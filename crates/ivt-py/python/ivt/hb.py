@@ -169,8 +169,6 @@ def _large_call(native_name, sig, args, kwargs, extra):
     nk, k = _coo("k", a.k)
     if not n == nc == nk:
         raise ValueError(f"`m`, `c`, `k` must have one size, got {n}, {nc}, {nk}")
-    if given.get("stability", False):
-        raise ValueError("stability=True is not available for condensed models (yet): pass stability=False")
     kw = dict(
         amplitude_dof=extra.get("amplitude_dof"),
         record_dofs=[int(j) for j in (extra.get("record_dofs") or ())],
@@ -179,6 +177,7 @@ def _large_call(native_name, sig, args, kwargs, extra):
         velocity_dependent=bool(given.get("velocity_dependent", True)),
         vectorized=bool(given.get("vectorized", False)),
         jac=given.get("jac"),
+        stability=bool(given.get("stability", True)),
     )
     if "rtol" in given:
         kw["rtol"] = float(given["rtol"])
@@ -236,8 +235,12 @@ receptance-form residual, relative to the linear response). Each point then
 carries "solve_error", "truncation_error" and "error_estimate" (their sum, a
 relative error). `amplitude_dof=j`: "amplitude" is max |x_j(τ)|;
 `record_dofs=[...]`: each point carries "dof_coeffs": {j: [a0, a1..an,
-b1..bn]} (any model). Stability of condensed models is not computed
-("multipliers"/"stable" are None).
+b1..bn]} (any model). Stability (default on; `stability=False` skips it,
+folds are located either way): Floquet multipliers of the whole structure's
+variational equation on the Ritz vectors of the nonlinear DOFs (8 Krylov
+blocks of K⁻¹M from the static modes): "multipliers", "stable",
+"stability" and "multiplier_error" (basis truncation + Hsu estimates) per
+point.
 """
 
 frc = _with_large(_ivt.hb.frc)

@@ -1,0 +1,136 @@
+//! The condensed branch in scaled unknowns, the variables the path follower
+//! and the fold locator see: `q̃ = q/q_s` (q_s the linear response of the
+//! nonlinear DOFs at the start) and `λ̃ = ω_f/ω_s` (ω_s the sweep's width),
+//! the residual (a displacement) divided by q_s.
+//!
+//! Why: the correctors' tolerances are absolute on `[R; tᵀ(x − x_pred)]`.
+//! In physical units the constraint row carries λ's rounding, ε·ω_f, which
+//! for the bladed disk (ω_f ≈ 1200 rad/s, ε·ω_f ≈ 3e-13) is far above the
+//! residual's tolerance (1e-12 of a 1e-6 m response): the corrector could
+//! not converge and kept halving the step (> 5000 steps for the band). The
+//! arclength itself mixed metres and rad/s, so the step size meant
+//! something else on every model. Scaled, both rows are of order one and a
+//! step `ds` is a fraction of the sweep and of the start's response.
+
+use super::branch::CondensedBranch;
+use crate::continuation::PathSystem;
+use crate::fold::Branch;
+use crate::problem::PeriodicProblem;
+use faer::{Mat, MatRef};
+
+/// [`CondensedBranch`] seen in scaled unknowns (module docs).
+pub(crate) struct Scaled<'a, P: PeriodicProblem> {
+    pub(crate) branch: &'a mut CondensedBranch<P>,
+    q_scale: f64,
+    w_origin: f64,
+    w_scale: f64,
+    /// The physical unknowns of the last call.
+    q: Vec<f64>,
+    /// Row-major Jacobian scratch.
+    rows: Vec<f64>,
+}
+
+impl<'a, P: PeriodicProblem> Scaled<'a, P> {
+    /// `branch` with `q = q_scale·q̃`, `ω_f = w_origin + w_scale·λ̃` (scales
+    /// positive).
+    pub(crate) fn new(
+        branch: &'a mut CondensedBranch<P>,
+        q_scale: f64,
+        w_origin: f64,
+        w_scale: f64,
+    ) -> Self {
+        let m = Branch::len(branch);
+        Self {
+            branch,
+            q_scale,
+            w_origin,
+            w_scale,
+            q: vec![0.0; m],
+            rows: Vec::new(),
+        }
+    }
+
+    /// `(q, ω_f)` of the scaled `(q̃, λ̃)`.
+    pub(crate) fn physical(&self, q: &[f64], lambda: f64) -> (Vec<f64>, f64) {
+        (
+            q.iter().map(|v| v * self.q_scale).collect(),
+            self.omega(lambda),
+        )
+    }
+
+    /// The scaled point `[q̃, λ̃]` of `(q, ω_f)`.
+    pub(crate) fn scaled(&self, q: &[f64], omega_f: f64) -> Vec<f64> {
+        q.iter()
+            .map(|v| v / self.q_scale)
+            .chain([self.lambda(omega_f)])
+            .collect()
+    }
+
+    /// λ̃ of ω_f.
+    pub(crate) fn lambda(&self, omega_f: f64) -> f64 {
+        (omega_f - self.w_origin) / self.w_scale
+    }
+
+    /// ω_f of λ̃.
+    pub(crate) fn omega(&self, lambda: f64) -> f64 {
+        self.w_origin + lambda * self.w_scale
+    }
+
+    /// Stores the physical unknowns of `u` in `self.q`.
+    fn load(&mut self, u: &[f64]) {
+        self.q
+            .iter_mut()
+            .zip(u)
+            .for_each(|(q, v)| *q = v * self.q_scale);
+    }
+}
+
+impl<P: PeriodicProblem> Branch for Scaled<'_, P> {
+    fn len(&self) -> usize {
+        self.q.len()
+    }
+    fn residual(&mut self, q: &[f64], lambda: f64, r: &mut [f64]) {
+        self.load(q);
+        let omega_f = self.omega(lambda);
+        Branch::residual(self.branch, &self.q, omega_f, r);
+        r.iter_mut().for_each(|v| *v /= self.q_scale);
+    }
+    /// `∂R̃/∂q̃ = ∂R/∂q`: the two scales cancel.
+    fn jacobian(&mut self, q: &[f64], lambda: f64, jac: &mut [f64]) {
+        self.load(q);
+        let omega_f = self.omega(lambda);
+        Branch::jacobian(self.branch, &self.q, omega_f, jac);
+    }
+    fn residual_lambda(&mut self, q: &[f64], lambda: f64, h: f64, out: &mut [f64]) {
+        self.load(q);
+        let (w, omega_f) = (self.w_scale, self.omega(lambda));
+        Branch::residual_lambda(self.branch, &self.q, omega_f, h * w, out);
+        out.iter_mut().for_each(|v| *v *= w / self.q_scale);
+    }
+}
+
+/// The exact Jacobian for the continuation (Eq. 68–77 with Newton).
+impl<P: PeriodicProblem> PathSystem for Scaled<'_, P> {
+    fn dim(&self) -> usize {
+        self.q.len()
+    }
+    fn residual(&mut self, u: &[f64], lambda: f64, r: &mut [f64]) {
+        Branch::residual(self, u, lambda, r);
+    }
+    fn residual_jacobian(&mut self, u: &[f64], lambda: f64, r: &mut [f64], jac: &mut Mat<f64>) {
+        PathSystem::jacobian(self, u, lambda, jac);
+        Branch::residual(self, u, lambda, r);
+    }
+    fn jacobian(&mut self, u: &[f64], lambda: f64, jac: &mut Mat<f64>) {
+        let m = u.len();
+        let mut rows = std::mem::take(&mut self.rows);
+        rows.resize(m * m, 0.0);
+        Branch::jacobian(self, u, lambda, &mut rows);
+        jac.as_mut()
+            .copy_from(MatRef::from_row_major_slice(&rows, m, m));
+        self.rows = rows;
+    }
+    fn d_residual_d_lambda(&mut self, u: &[f64], lambda: f64, r_lambda: &mut [f64]) {
+        Branch::residual_lambda(self, u, lambda, 0.0, r_lambda);
+    }
+}
