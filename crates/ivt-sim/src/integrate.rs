@@ -101,16 +101,22 @@ impl<P: InputProfile> TimeSys<'_, P> {
     /// `dy = F(t, y)` with `y = [θ, ω, i_a]`.
     #[inline(always)]
     fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
+        // The stepper hands exactly DIM values; anything else is a bug that
+        // shows as a non-finite state (SimError::NotFinite), never a panic.
+        let ([th, om, ia], Ok(dy)) = (y, <&mut [f64; DIM]>::try_from(&mut *dy)) else {
+            dy.fill(f64::NAN);
+            return;
+        };
         let (v_m, t_u) = self.prof.at(t);
-        dy.copy_from_slice(&self.plant.derivatives(
+        *dy = self.plant.derivatives(
             self.seg,
-            &[y[0], y[1], y[2]],
+            &[*th, *om, *ia],
             &Inputs {
                 r: self.r,
                 v_m,
                 t_u,
             },
-        ));
+        );
     }
 }
 
@@ -163,8 +169,10 @@ impl AngleCache {
         }
         let a = AngleTerms::new(theta, seg);
         let k = self.next.get();
-        self.keys[k].set(key);
-        self.terms[k].set(a);
+        if let (Some(slot), Some(terms)) = (self.keys.get(k), self.terms.get(k)) {
+            slot.set(key);
+            terms.set(a);
+        }
         self.next.set(1 - k);
         a
     }
@@ -174,18 +182,23 @@ impl<P: InputProfile> AngleSys<'_, P> {
     /// `dz = dz/dθ` with `z = [t, ω, i_a]` (Eq. 162).
     #[inline(always)]
     fn rhs(&self, theta: f64, z: &[f64], dz: &mut [f64]) {
-        let (v_m, t_u) = self.prof.at(z[0]);
-        let d = self.plant.derivatives_with(
+        // As in the time domain: a wrong length shows as a non-finite state.
+        let ([t, om, ia], Ok(dz)) = (z, <&mut [f64; DIM]>::try_from(&mut *dz)) else {
+            dz.fill(f64::NAN);
+            return;
+        };
+        let (v_m, t_u) = self.prof.at(*t);
+        let [_, d_om, d_ia] = self.plant.derivatives_with(
             &self.cache.get(theta, self.seg),
-            &[theta, z[1], z[2]],
+            &[theta, *om, *ia],
             &Inputs {
                 r: self.r,
                 v_m,
                 t_u,
             },
         );
-        let inv = 1.0 / z[1];
-        dz.copy_from_slice(&[inv, d[1] * inv, d[2] * inv]);
+        let inv = 1.0 / om;
+        *dz = [inv, d_om * inv, d_ia * inv];
     }
 }
 

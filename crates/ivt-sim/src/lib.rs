@@ -1,4 +1,18 @@
 #![doc = include_str!("../README.md")]
+// No scene, stream or file may reach a panic in the simulator: every failure
+// is a typed `SimError`/`SceneError` (issue 30). Tests may unwrap.
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::indexing_slicing,
+        clippy::unreachable,
+        clippy::todo,
+        clippy::unimplemented
+    )
+)]
 
 pub mod atomic;
 pub mod backend;

@@ -236,9 +236,15 @@ pub fn ihb_steady_state(scene: &Scene) -> Result<SteadyMetrics, SimError> {
         .plant_params()
         .map_err(|e| SimError::Scene(e.to_string()))?;
     let c = &scene.controller;
+    let (Some(&[_, v_m]), Some(&[_, t_u])) = (scene.inputs.v_m.first(), scene.inputs.t_u.first())
+    else {
+        return Err(SimError::Scene(
+            "inputs.v_m and inputs.t_u need a knot".into(),
+        ));
+    };
     let op = OperatingPoint {
-        v_m: scene.inputs.v_m[0][1],
-        t_u: scene.inputs.t_u[0][1],
+        v_m,
+        t_u,
         omega0: scene.omega0_rad_s(),
     };
     let ihb = IhbSolver::new(IhbOptions::default())?.solve(&params, &op, None)?;
@@ -378,7 +384,7 @@ fn last_revolution(scene: &Scene, result: &RunResult) -> Option<SteadyMetrics> {
     if plant.len() < ppr + 1 || !last.omega_a.is_finite() {
         return None;
     }
-    let rev = &plant[plant.len() - ppr..];
+    let rev = plant.get(plant.len() - ppr..)?;
     let (lo, hi) = rev
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {

@@ -109,9 +109,18 @@ pub fn controller_config(scene: &Scene, r_max: f64) -> Option<Config> {
             max_speed: scene.stepper.max_speed as f32,
             accel: scene.stepper.accel as f32,
         },
-        initial_inputs: [scene.inputs.v_m[0][1] as f32, scene.inputs.t_u[0][1] as f32],
+        initial_inputs: [
+            first_value(&scene.inputs.v_m),
+            first_value(&scene.inputs.t_u),
+        ],
         ..Config::default()
     })
+}
+
+/// The value of a profile's first knot as the controller reads it (NaN for
+/// a profile without knots, which scene validation refuses).
+fn first_value(profile: &[[f64; 2]]) -> f32 {
+    profile.first().map_or(f32::NAN, |&[_, v]| v as f32)
 }
 
 /// What runs a scene: the closed-loop time integration ([`Simulation::run`])
