@@ -271,7 +271,8 @@ fn interrupt_once_staged(args: &[&str], out: &Path) -> (Option<i32>, Vec<String>
     (res.status.code(), left)
 }
 
-/// Ctrl-C during a simulation: exit 130 and no output (the partial MCAP and
+/// Ctrl-C during a simulation under `--json`: exit 2 (issue 30: one JSON
+/// error and exit 2, as every failure) and no output (the partial MCAP and
 /// the output directory this run created are removed).
 #[test]
 fn interrupted_sim_leaves_nothing() {
@@ -287,7 +288,7 @@ fn interrupted_sim_leaves_nothing() {
     std::fs::write(&scene, drive).unwrap();
     let (scene, out_arg) = (scene.to_str().unwrap(), out.to_str().unwrap());
     let (code, left) = interrupt_once_staged(&["--json", "sim", scene, "--out", out_arg], &out);
-    assert_eq!(code, Some(130));
+    assert_eq!(code, Some(2));
     assert!(left.is_empty(), "left behind: {left:?}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -303,7 +304,7 @@ fn interrupted_reproduce_leaves_nothing() {
     let out_arg = out.to_str().unwrap();
     let (code, left) =
         interrupt_once_staged(&["--json", "reproduce", "--quick", "--out", out_arg], &out);
-    assert_eq!(code, Some(130));
+    assert_eq!(code, Some(2));
     assert!(left.is_empty(), "left behind: {left:?}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -19,6 +19,7 @@ pub mod backend;
 pub mod commission;
 pub mod error;
 pub mod field;
+pub mod input;
 pub mod integrate;
 pub mod output;
 pub mod pil;

@@ -108,7 +108,7 @@ impl Simulation<'_> {
     /// A forced IHB route on a scene that cannot take it, or a failure of
     /// the route taken.
     pub fn answer(self) -> Result<SceneRun, SimError> {
-        answer(self.scene, self.route, self.progress)
+        answer(self.scene, self.route, self.progress, self.max_events)
     }
 
     /// The time integration ([`Simulation::run`]) as the scene's answer,
@@ -132,6 +132,7 @@ fn answer(
     scene: &Scene,
     force: Option<Route>,
     progress: Option<&mut dyn FnMut(f64)>,
+    max_events: f64,
 ) -> Result<SceneRun, SimError> {
     let wall = Instant::now();
     let asked = force.or_else(|| scene.outputs.route.forced());
@@ -170,7 +171,7 @@ fn answer(
             }
         }
     }
-    let (result, steady) = time_route(scene, progress)?;
+    let (result, steady) = time_route(scene, progress, max_events)?;
     Ok(SceneRun {
         route: Route::TimeIntegration,
         route_reason: reason,
@@ -342,10 +343,11 @@ pub fn ihb_steady_state(scene: &Scene) -> Result<SteadyMetrics, SimError> {
 fn time_route(
     scene: &Scene,
     progress: Option<&mut dyn FnMut(f64)>,
+    max_events: f64,
 ) -> Result<(RunResult, Option<SteadyMetrics>), SimError> {
     let run = |s: &Scene, progress: Option<&mut dyn FnMut(f64)>| match progress {
-        Some(p) => Simulation::new(s).progress(p).run(),
-        None => Simulation::new(s).run(),
+        Some(p) => Simulation::new(s).max_events(max_events).progress(p).run(),
+        None => Simulation::new(s).max_events(max_events).run(),
     };
     if !scene.outputs.steady_state {
         return Ok((run(scene, progress)?, None));
