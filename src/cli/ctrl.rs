@@ -8,6 +8,7 @@
 use super::{CliError, Output};
 use clap::{Args, Subcommand, ValueEnum};
 use ivt_ctrl::{units, AnyController, Config, ControlOutput, Gains, LawKind, OpenLoopPreset};
+use ivt_sim::pulse_log::{parse_pulse_log, PulseRow, MAX_LOG_BYTES};
 use ivt_sim::scene::keys::typed;
 use serde_json::json;
 use std::fmt::Write as _;
@@ -132,16 +133,6 @@ pub fn run(cmd: CtrlCommand) -> Result<Output, CliError> {
     }
 }
 
-/// One row of the log.
-struct Row {
-    ticks: u32,
-    inputs: Option<(f32, f32)>,
-}
-
-/// Most pulses of one replayed log: about 3 h at 100 rpm and 1200 PPR, and
-/// ~200 MB of JSON output.
-const MAX_PULSES: usize = 1_000_000;
-
 /// Refuse, by name and as typed, options that would make the replay
 /// meaningless: a zero or non-finite timer frequency, decimation, stall
 /// timeout or sample period, non-finite gains or set points, and any value
@@ -184,149 +175,13 @@ fn check_args(a: &ReplayArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Largest pulse log read \[bytes\]: [`MAX_PULSES`] rows of up to 64 bytes.
-const MAX_LOG_BYTES: u64 = 64 * MAX_PULSES as u64;
-
-/// Where each field is in a row: from the header by name (`ticks`, `vm` or
-/// `v_m`, `tu` or `t_u`, in any order), or `ticks[,vm,tu]` by position in a
-/// log without a header.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Columns {
-    ticks: usize,
-    inputs: Option<(usize, usize)>,
-    count: usize,
-}
-
-impl Columns {
-    /// The documented order, for a log without a header.
-    fn positional(count: usize) -> Option<Self> {
-        match count {
-            1 => Some(Self {
-                ticks: 0,
-                inputs: None,
-                count,
-            }),
-            3 => Some(Self {
-                ticks: 0,
-                inputs: Some((1, 2)),
-                count,
-            }),
-            _ => None,
-        }
-    }
-
-    /// The columns a header names; every name must be known and given once,
-    /// `ticks` is required, `vm` and `tu` come together.
-    fn from_header(names: &[&str]) -> Result<Self, String> {
-        let mut slots: [Option<usize>; 3] = [None; 3];
-        for (i, name) in names.iter().enumerate() {
-            let slot = match name.to_ascii_lowercase().as_str() {
-                "ticks" => 0,
-                "vm" | "v_m" => 1,
-                "tu" | "t_u" => 2,
-                _ => {
-                    return Err(format!(
-                        "unknown column {} (known: ticks, vm or v_m, tu or t_u)",
-                        ivt_sim::input::excerpt(name)
-                    ))
-                }
-            };
-            match slots.get_mut(slot) {
-                Some(s @ None) => *s = Some(i),
-                _ => {
-                    return Err(format!(
-                        "column {} is given twice",
-                        ivt_sim::input::excerpt(name)
-                    ))
-                }
-            }
-        }
-        let [ticks, vm, tu] = slots;
-        let ticks = ticks.ok_or("the header has no `ticks` column")?;
-        let inputs = match (vm, tu) {
-            (Some(v), Some(t)) => Some((v, t)),
-            (None, None) => None,
-            _ => return Err("the header names one of vm, tu without the other".into()),
-        };
-        Ok(Self {
-            ticks,
-            inputs,
-            count: names.len(),
-        })
-    }
-}
-
-fn parse_log(text: &str) -> Result<Vec<Row>, CliError> {
-    let mut rows = Vec::new();
-    let mut columns: Option<Columns> = None;
-    for (n, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let bad = |what: &str| {
-            CliError::Input(format!(
-                "line {}: {what}: {}",
-                n + 1,
-                ivt_sim::input::excerpt(line)
-            ))
-        };
-        let cols: Vec<&str> = line.split(',').map(str::trim).collect();
-        let first = cols.first().copied().unwrap_or("");
-        let layout = match columns {
-            Some(c) => c,
-            None if first.parse::<f64>().is_err() => {
-                // the header: the columns by name
-                columns = Some(Columns::from_header(&cols).map_err(|e| bad(&e))?);
-                continue;
-            }
-            None => {
-                let c = Columns::positional(cols.len()).ok_or_else(|| {
-                    bad("expected columns ticks[,vm,tu] (or a header naming them)")
-                })?;
-                columns = Some(c);
-                c
-            }
-        };
-        if cols.len() != layout.count {
-            return Err(bad(&format!(
-                "{} columns where the log has {}",
-                cols.len(),
-                layout.count
-            )));
-        }
-        let field = |i: usize| cols.get(i).copied().unwrap_or("");
-        let ticks: u64 = field(layout.ticks)
-            .parse()
-            .map_err(|_| bad("ticks is not an unsigned integer"))?;
-        let ticks =
-            u32::try_from(ticks).map_err(|_| bad("ticks exceeds u32 (log raw timer captures)"))?;
-        let inputs = match layout.inputs {
-            None => None,
-            Some((v, t)) => {
-                // Readings are passed through unchanged (NaN included): the
-                // controller's own validation is what is being replayed.
-                let v: f32 = field(v).parse().map_err(|_| bad("vm is not a number"))?;
-                let t: f32 = field(t).parse().map_err(|_| bad("tu is not a number"))?;
-                Some((v, t))
-            }
-        };
-        if rows.len() == MAX_PULSES {
-            return Err(CliError::Input(format!(
-                "the log has more than {MAX_PULSES} pulses (the JSON of more is hundreds of MB); split it"
-            )));
-        }
-        rows.push(Row { ticks, inputs });
-    }
-    if rows.is_empty() {
-        return Err(CliError::Input("the log has no pulses".into()));
-    }
-    Ok(rows)
-}
-
 /// The controller's outputs for every logged pulse, inputs replayed as
 /// logged (`default_inputs` until the first logged reading).
-fn simulate(mut c: AnyController, rows: &[Row], default_inputs: (f32, f32)) -> Vec<ControlOutput> {
+fn simulate(
+    mut c: AnyController,
+    rows: &[PulseRow],
+    default_inputs: (f32, f32),
+) -> Vec<ControlOutput> {
     c.update_inputs(default_inputs.0, default_inputs.1);
     let mut last = None;
     rows.iter()
@@ -348,7 +203,7 @@ fn replay(a: &ReplayArgs) -> Result<Output, CliError> {
     check_args(a)?;
     let text = ivt_sim::input::read_text_bounded(&a.log, MAX_LOG_BYTES)
         .map_err(|e| CliError::io(&a.log, e))?;
-    let rows = parse_log(&text)?;
+    let rows = parse_pulse_log(&text).map_err(|e| CliError::Input(e.to_string()))?;
     let config = Config {
         f_timer_hz: a.f_timer as f32,
         omega0: units::rpm_to_rad_s(a.omega0_rpm as f32),

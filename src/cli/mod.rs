@@ -163,6 +163,22 @@ pub fn write_figure(
     Ok(())
 }
 
+/// Parse `args` (program name first) as `ivt` does and, for the `kin`
+/// commands (pure, bounded, writing no file), run the command: the fuzz
+/// target of the argument vector (`fuzz/fuzz_targets/cli_args.rs`). Parse
+/// and command errors are returned as text; a panic is the bug it hunts.
+///
+/// # Errors
+/// The parse or command failure, one line.
+#[doc(hidden)]
+pub fn fuzz_args(args: &[std::ffi::OsString]) -> Result<(), String> {
+    let cli = Cli::try_parse_from(args).map_err(|e| e.kind().to_string())?;
+    match cli.command {
+        Some(Command::Kin(cmd)) => kin::run(cmd).map(|_| ()).map_err(|e| e.to_string()),
+        _ => Ok(()),
+    }
+}
+
 /// Exit status of every failure (argument, input, numerical, I/O).
 const EXIT_FAILURE: u8 = 2;
 

@@ -27,6 +27,7 @@ pub mod plant;
 pub mod plot;
 pub mod profile;
 pub mod progress;
+pub mod pulse_log;
 pub mod record;
 pub mod recording;
 pub mod run;
