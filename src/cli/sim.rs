@@ -33,7 +33,7 @@ pub struct SimArgs {
     /// Work budget of a time integration: the most encoder pulses + sensor
     /// readings + fixed RK4 steps the run may meet. The scene's count is
     /// estimated before anything runs and a scene above the limit is refused
-    /// with the estimate (the default, 1e9, is hours of wall time).
+    /// with the estimate (the default, 1e9, is ~40 min of wall time).
     #[arg(long, default_value_t = ivt_sim::scene::DEFAULT_MAX_EVENTS)]
     pub max_events: f64,
 }
