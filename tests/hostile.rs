@@ -18,37 +18,28 @@ const TIME_LIMIT: Duration = Duration::from_secs(20);
 const MEMORY_LIMIT_KB: u64 = 1536 * 1024;
 
 /// `ivt ARGS` under `ulimit -v` (a run that would grow past 1.5 GB aborts
-/// instead), with `shell_tail` appended to the command (e.g. `>&-`); the
+/// instead) and coreutils' `timeout` (a run past the time limit is killed and
+/// exits 124), with `shell_tail` appended to the command (e.g. `>&-`); the
 /// exit code, stdout, stderr and the wall time.
 fn run_limited(args: &[&str], shell_tail: &str) -> (Option<i32>, String, String, Duration) {
-    let script = format!("ulimit -v {MEMORY_LIMIT_KB}; exec \"$0\" \"$@\" {shell_tail}");
+    let secs = TIME_LIMIT.as_secs();
+    let script = format!(
+        "ulimit -v {MEMORY_LIMIT_KB}; exec timeout -s KILL {secs} \"$0\" \"$@\" {shell_tail}"
+    );
     let t0 = Instant::now();
-    let mut child = Command::new("sh")
-        .arg("-c")
-        .arg(script)
-        .arg(IVT)
+    let out = Command::new("sh")
+        .args(["-c", &script, IVT])
         .args(args)
         .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
+        .output()
         .unwrap();
-    loop {
-        if child.try_wait().unwrap().is_some() {
-            break;
-        }
-        if t0.elapsed() > TIME_LIMIT {
-            let _ = child.kill();
-            panic!("{args:?}: no exit within {TIME_LIMIT:?}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    let out = child.wait_with_output().unwrap();
+    let took = t0.elapsed();
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
     (
         out.status.code(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-        t0.elapsed(),
+        text(&out.stdout),
+        text(&out.stderr),
+        took,
     )
 }
 

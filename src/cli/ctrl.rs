@@ -153,12 +153,8 @@ fn check_args(a: &ReplayArgs) -> Result<(), CliError> {
     ];
     for (name, v) in positive.iter().chain(&finite) {
         if !ivt_sim::scene::keys::fits_f32(*v) {
-            return Err(CliError::Input(format!(
-                "{name} = {} does not fit the controller's f32 (finite, |v| in [{:e}, {:e}] or 0)",
-                typed(*v),
-                f32::MIN_POSITIVE,
-                f32::MAX
-            )));
+            let (shown, why) = (typed(*v), ivt_sim::scene::keys::NOT_F32);
+            return Err(CliError::Input(format!("{name} = {shown} {why}")));
         }
     }
     for (name, v) in positive {

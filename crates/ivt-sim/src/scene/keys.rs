@@ -65,6 +65,7 @@ const T_MAX: f64 = super::MAX_DURATION_S;
 /// Every number of a scene except the plant's parameters (those are
 /// `ivt_kin::plant::PlantParams::validate`'s, the one description of the
 /// plant) and the integers `encoder.ppr` (a list) and `outputs.channels[].every`.
+#[rustfmt::skip]
 pub const KEYS: &[Key] = &[
     key("duration_s", "s", Open(0.0), Closed(T_MAX), false),
     key("inputs.v_m[].t", "s", Closed(0.0), Closed(T_MAX), false),
@@ -76,75 +77,27 @@ pub const KEYS: &[Key] = &[
     key("integrator.rtol", "", Closed(1e-14), Open(1.0), false),
     key("integrator.atol", "", Closed(1e-14), Open(1.0), false),
     key("integrator.dtheta", "rad", Closed(1e-9), Closed(1.0), false),
-    key(
-        "integrator.omega_handover",
-        "rad/s",
-        Open(0.0),
-        Closed(1e4),
-        false,
-    ),
+    key("integrator.omega_handover", "rad/s", Open(0.0), Closed(1e4), false),
     key("encoder.f_timer_hz", "Hz", Open(0.0), Closed(1e9), true),
     key("encoder.jitter_s", "s", Closed(0.0), Closed(1.0), false),
     key("sensors.period_s", "s", Closed(1e-7), Closed(T_MAX), false),
     key("sensors.v_m_noise", "V", Closed(0.0), Closed(1e3), false),
     key("sensors.v_m_quantum", "V", Closed(0.0), Closed(1e3), false),
     key("sensors.t_u_noise", "N·m", Closed(0.0), Closed(1e3), false),
-    key(
-        "sensors.t_u_quantum",
-        "N·m",
-        Closed(0.0),
-        Closed(1e3),
-        false,
-    ),
+    key("sensors.t_u_quantum", "N·m", Closed(0.0), Closed(1e3), false),
     key("stepper.steps_per_rev", "", Open(0.0), Closed(1e6), true),
     key("stepper.max_speed", "steps/s", Open(0.0), Closed(1e7), true),
     key("stepper.accel", "steps/s²", Open(0.0), Closed(1e9), true),
     key("stepper.miss_prob", "", Closed(0.0), Closed(1.0), false),
     key("controller.omega0_rpm", "rpm", Open(0.0), Open(1e4), true),
-    key(
-        "controller.k_mm_per_rad",
-        "mm/rad",
-        Closed(-1e6),
-        Closed(1e6),
-        true,
-    ),
-    key(
-        "controller.k2_mm_per_rad",
-        "mm/rad",
-        Closed(-1e6),
-        Closed(1e6),
-        true,
-    ),
-    key(
-        "controller.k_prop_deg_per_rpm",
-        "deg/rpm",
-        Closed(-1e6),
-        Closed(1e6),
-        true,
-    ),
-    key(
-        "controller.prop_period_s",
-        "s",
-        Open(0.0),
-        Closed(1e3),
-        true,
-    ),
-    key(
-        "controller.r_schedule[].t",
-        "s",
-        Closed(0.0),
-        Closed(T_MAX),
-        false,
-    ),
+    key("controller.k_mm_per_rad", "mm/rad", Closed(-1e6), Closed(1e6), true),
+    key("controller.k2_mm_per_rad", "mm/rad", Closed(-1e6), Closed(1e6), true),
+    key("controller.k_prop_deg_per_rpm", "deg/rpm", Closed(-1e6), Closed(1e6), true),
+    key("controller.prop_period_s", "s", Open(0.0), Closed(1e3), true),
+    key("controller.r_schedule[].t", "s", Closed(0.0), Closed(T_MAX), false),
     key("metrics.from_s", "s", Closed(0.0), Closed(T_MAX), false),
     key("metrics.band", "", Open(0.0), Open(1.0), false),
-    key(
-        "metrics.static_window_s",
-        "s",
-        Open(0.0),
-        Closed(T_MAX),
-        false,
-    ),
+    key("metrics.static_window_s", "s", Open(0.0), Closed(T_MAX), false),
     key("outputs.max_bytes", "bytes", Open(0.0), Closed(1e15), false),
 ];
 
@@ -167,46 +120,26 @@ impl Key {
         } else {
             format!(" {}", self.unit)
         };
+        let shown = typed(value);
         if self.f32 && !fits_f32(value) {
-            return Err(Invalid::new(
-                at,
-                format!(
-                    "= {}{unit} does not fit the controller's f32 (finite, |v| in [{:e}, {:e}] or 0)",
-                    typed(value),
-                    f32::MIN_POSITIVE,
-                    f32::MAX
-                ),
-            ));
+            return Err(Invalid::new(at, format!("= {shown}{unit} {NOT_F32}")));
         }
-        let above = match self.min {
-            Closed(m) => value >= m,
-            Open(m) => value > m,
+        let (lo, above) = match self.min {
+            Closed(m) => ('[', value >= m),
+            Open(m) => ('(', value > m),
         };
-        let below = match self.max {
-            Closed(m) => value <= m,
-            Open(m) => value < m,
+        let (hi, below) = match self.max {
+            Closed(m) => (']', value <= m),
+            Open(m) => (')', value < m),
         };
         if value.is_finite() && above && below {
             return Ok(());
         }
-        let lo = if matches!(self.min, Closed(_)) {
-            '['
-        } else {
-            '('
-        };
-        let hi = if matches!(self.max, Closed(_)) {
-            ']'
-        } else {
-            ')'
-        };
+        let (min, max) = (typed(self.min.value()), typed(self.max.value()));
+        let range = format!("{lo}{min}, {max}{hi}{unit}");
         Err(Invalid::new(
             at,
-            format!(
-                "= {}{unit} is outside {lo}{}, {}{hi}{unit}",
-                typed(value),
-                typed(self.min.value()),
-                typed(self.max.value())
-            ),
+            format!("= {shown}{unit} is outside {range}"),
         ))
     }
 
@@ -244,6 +177,10 @@ pub fn typed(value: f64) -> String {
         exp
     }
 }
+
+/// What is wrong with a value [`fits_f32`] refuses.
+pub const NOT_F32: &str =
+    "does not fit the controller's f32 (finite, |v| in [1.1754944e-38, 3.4028235e38] or 0)";
 
 /// `value` as an `f32` is finite, and not flushed to 0 unless it is 0.
 #[must_use]
@@ -285,6 +222,8 @@ mod tests {
         assert!(check("controller.omega0_rpm", 100.0).is_ok());
         // 1e-50 is representable as f64 but flushes to 0 in f32
         assert!(!fits_f32(1e-50) && fits_f32(0.0) && fits_f32(-3.0e38));
+        // the bounds NOT_F32 states are f32's own
+        assert!(NOT_F32.contains(&format!("[{:e}, {:e}]", f32::MIN_POSITIVE, f32::MAX)));
         assert!(check("no.such.key", 1.0).is_err());
     }
 }
