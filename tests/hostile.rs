@@ -122,7 +122,8 @@ fn work_beyond_the_budget_is_refused_with_the_estimate() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// `ivt --json sim /dev/zero` grew to 4 GB: now at most 1 MiB + 1 byte is read.
+/// `ivt --json sim /dev/zero` grew to 4 GB: now at most 1 MiB + 1 byte is
+/// read (a pulse log 64 MB, a commissioning recording 512 MiB).
 #[test]
 fn endless_inputs_are_read_no_further_than_their_limit() {
     let e = refused(&["sim", "/dev/zero"], "input");
@@ -132,6 +133,8 @@ fn endless_inputs_are_read_no_further_than_their_limit() {
     );
     let e = refused(&["ctrl", "replay", "/dev/zero"], "io");
     assert!(e.contains("64000000 bytes"), "{e}");
+    let e = refused(&["rig", "identify", "/dev/zero"], "io");
+    assert!(e.contains("536870912 bytes"), "{e}");
 }
 
 /// A replay CSV is read by its header's names in any order (it was read by
