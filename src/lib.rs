@@ -13,8 +13,31 @@
 //! | [`wire`] | `ivt-wire` | byte frames shared by the firmware and the host |
 //!
 //! The `ivt` command line and `ivt reproduce` are the binary of this package
-//! (`src/main.rs`), not part of the library.
+//! (`src/main.rs`), not part of the library's API: their modules are here,
+//! hidden, only so that the fuzz target of the argument vector (`fuzz/`)
+//! can call them.
+//!
+//! No input may reach a panic in the command layer or the reproduction
+//! report: every failure is a `CliError` (exit 2) or a `ReproError`, which
+//! these lints enforce outside tests.
 #![warn(missing_docs)]
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::indexing_slicing,
+        clippy::unreachable,
+        clippy::todo,
+        clippy::unimplemented
+    )
+)]
+
+#[doc(hidden)]
+pub mod cli;
+#[doc(hidden)]
+pub mod reproduce;
 
 pub use ivt_ctrl as ctrl;
 pub use ivt_design as design;

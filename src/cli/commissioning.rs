@@ -73,6 +73,10 @@ struct Collected {
     meta: Option<BTreeMap<String, String>>,
 }
 
+/// Largest commissioning recording read \[bytes\]: 512 MiB, a third of the
+/// 1.5 GB a hostile input may cost (the recording is read whole).
+const MAX_RECORDING_BYTES: u64 = 512 << 20;
+
 /// Read a commissioning recording.
 ///
 /// # Errors
@@ -80,8 +84,8 @@ struct Collected {
 /// unparsable message: each with its byte offset), [`ReadError::Content`]
 /// (missing channel or metadata), [`ReadError::Io`].
 pub fn read(path: &Path) -> Result<Commissioning, ReadError> {
-    let bytes =
-        std::fs::read(path).map_err(|e| ReadError::Io(format!("{}: {e}", path.display())))?;
+    let bytes = ivt_sim::input::read_bounded(path, MAX_RECORDING_BYTES)
+        .map_err(|e| ReadError::Io(format!("{}: {e}", path.display())))?;
     let name = path.display().to_string();
     let corrupt = |why: String| ReadError::Corrupt {
         path: name.clone(),

@@ -1,13 +1,15 @@
 //! `ivt ctrl ...`: run the real `ivt-ctrl` controller offline.
 //!
 //! `ivt ctrl replay LOG.csv` feeds a recorded pulse log (columns
-//! `ticks[,vm,tu]`, one encoder pulse per row, optional header and `#`
-//! comments) through the controller exactly as the firmware would, and
+//! `ticks[,vm,tu]`, one encoder pulse per row, optional header naming them
+//! in any order, `#` comments) through the controller exactly as the firmware would, and
 //! writes its outputs per pulse (SPEC §6).
 
 use super::{CliError, Output};
 use clap::{Args, Subcommand, ValueEnum};
 use ivt_ctrl::{units, AnyController, Config, ControlOutput, Gains, LawKind, OpenLoopPreset};
+use ivt_sim::pulse_log::{parse_pulse_log, PulseRow, MAX_LOG_BYTES};
+use ivt_sim::scene::keys::typed;
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -65,7 +67,9 @@ impl From<OpenLoopArg> for OpenLoopPreset {
 /// Arguments of `ivt ctrl replay`.
 #[derive(Args)]
 pub struct ReplayArgs {
-    /// Pulse log: CSV with columns `ticks[,vm,tu]` (timer captures, V, N·m).
+    /// Pulse log: CSV with columns `ticks[,vm,tu]` (timer captures, V, N·m),
+    /// by name when it has a header (`ticks`, `vm`/`v_m`, `tu`/`t_u` in any
+    /// order), else in this order; at most 64 MB.
     pub log: PathBuf,
     /// Controller samples per revolution (see `--decimation`); supported:
     /// `ivt_ctrl::SUPPORTED_PPR` (16 … 4096; an unsupported value is refused
@@ -77,32 +81,32 @@ pub struct ReplayArgs {
     pub decimation: u16,
     /// Timer frequency of the ticks \[Hz\].
     #[arg(long, default_value_t = 1.0e6)]
-    pub f_timer: f32,
+    pub f_timer: f64,
     /// Target speed ω0 \[rpm\].
     #[arg(long, default_value_t = 100.0)]
-    pub omega0_rpm: f32,
+    pub omega0_rpm: f64,
     /// Feedback law.
     #[arg(long, value_enum, default_value_t = LawArg::Delay)]
     pub law: LawArg,
     /// Gain k as printed in the thesis \[mm·rad⁻¹\] (§4.3; read as mm of r per
     /// rad of θ per rad/s, see ivt_ctrl::units).
     #[arg(long, default_value_t = 0.01)]
-    pub k: f32,
+    pub k: f64,
     /// Gain k2 as printed in the thesis \[mm·rad⁻¹\].
     #[arg(long, default_value_t = 0.02)]
-    pub k2: f32,
+    pub k2: f64,
     /// Gain K of Eq. 189 \[deg of stepper per rpm\] (thesis: 50).
     #[arg(long, default_value_t = 50.0)]
-    pub k_prop: f32,
+    pub k_prop: f64,
     /// Sample period of Eq. 189 \[s\].
     #[arg(long, default_value_t = 0.1)]
-    pub prop_period: f32,
+    pub prop_period: f64,
     /// V_m \[V\] when the log has no vm column.
     #[arg(long, default_value_t = 8.0)]
-    pub vm: f32,
+    pub vm: f64,
     /// T_U \[N·m\] when the log has no tu column.
     #[arg(long, default_value_t = 8.0)]
-    pub tu: f32,
+    pub tu: f64,
     /// Open-loop law u_ol (Eq. 158–160 form): the refitted set or the printed one.
     #[arg(long, value_enum, default_value_t = OpenLoopArg::Refit)]
     pub open_loop: OpenLoopArg,
@@ -112,7 +116,7 @@ pub struct ReplayArgs {
     pub no_feedforward: bool,
     /// Stall timeout \[s\].
     #[arg(long, default_value_t = 0.5)]
-    pub stall_timeout: f32,
+    pub stall_timeout: f64,
     /// Write the per-pulse CSV here (default: stdout without `--json`).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -129,19 +133,10 @@ pub fn run(cmd: CtrlCommand) -> Result<Output, CliError> {
     }
 }
 
-/// One row of the log.
-struct Row {
-    ticks: u32,
-    inputs: Option<(f32, f32)>,
-}
-
-/// Most pulses of one replayed log: about 3 h at 100 rpm and 1200 PPR, and
-/// ~200 MB of JSON output.
-const MAX_PULSES: usize = 1_000_000;
-
-/// Refuse, by name, options that would make the replay meaningless: a zero
-/// or non-finite timer frequency, decimation, stall timeout or sample
-/// period, and non-finite gains or set points.
+/// Refuse, by name and as typed, options that would make the replay
+/// meaningless: a zero or non-finite timer frequency, decimation, stall
+/// timeout or sample period, non-finite gains or set points, and any value
+/// the controller's f32 cannot hold (`--k 1e300`).
 fn check_args(a: &ReplayArgs) -> Result<(), CliError> {
     let positive = [
         ("--f-timer", a.f_timer),
@@ -149,13 +144,6 @@ fn check_args(a: &ReplayArgs) -> Result<(), CliError> {
         ("--stall-timeout", a.stall_timeout),
         ("--prop-period", a.prop_period),
     ];
-    for (name, v) in positive {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(CliError::Input(format!(
-                "{name} must be finite and > 0, got {v}"
-            )));
-        }
-    }
     let finite = [
         ("--k", a.k),
         ("--k2", a.k2),
@@ -163,9 +151,18 @@ fn check_args(a: &ReplayArgs) -> Result<(), CliError> {
         ("--vm", a.vm),
         ("--tu", a.tu),
     ];
-    for (name, v) in finite {
-        if !v.is_finite() {
-            return Err(CliError::Input(format!("{name} must be finite, got {v}")));
+    for (name, v) in positive.iter().chain(&finite) {
+        if !ivt_sim::scene::keys::fits_f32(*v) {
+            let (shown, why) = (typed(*v), ivt_sim::scene::keys::NOT_F32);
+            return Err(CliError::Input(format!("{name} = {shown} {why}")));
+        }
+    }
+    for (name, v) in positive {
+        if v <= 0.0 {
+            return Err(CliError::Input(format!(
+                "{name} must be > 0, got {}",
+                typed(v)
+            )));
         }
     }
     if a.decimation == 0 {
@@ -174,51 +171,13 @@ fn check_args(a: &ReplayArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-fn parse_log(text: &str) -> Result<Vec<Row>, CliError> {
-    let mut rows = Vec::new();
-    for (n, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let cols: Vec<&str> = line.split(',').map(str::trim).collect();
-        let first = cols.first().copied().unwrap_or("");
-        if rows.is_empty() && first.parse::<f64>().is_err() {
-            continue; // header
-        }
-        let bad = |what: &str| CliError::Input(format!("line {}: {what}: {line:?}", n + 1));
-        let ticks: u64 = first
-            .parse()
-            .map_err(|_| bad("ticks is not an unsigned integer"))?;
-        let ticks =
-            u32::try_from(ticks).map_err(|_| bad("ticks exceeds u32 (log raw timer captures)"))?;
-        let inputs = match cols.as_slice() {
-            [_] => None,
-            [_, v, t] => {
-                // Readings are passed through unchanged (NaN included): the
-                // controller's own validation is what is being replayed.
-                let v: f32 = v.parse().map_err(|_| bad("vm is not a number"))?;
-                let t: f32 = t.parse().map_err(|_| bad("tu is not a number"))?;
-                Some((v, t))
-            }
-            _ => return Err(bad("expected columns ticks[,vm,tu]")),
-        };
-        if rows.len() == MAX_PULSES {
-            return Err(CliError::Input(format!(
-                "the log has more than {MAX_PULSES} pulses (the JSON of more is hundreds of MB); split it"
-            )));
-        }
-        rows.push(Row { ticks, inputs });
-    }
-    if rows.is_empty() {
-        return Err(CliError::Input("the log has no pulses".into()));
-    }
-    Ok(rows)
-}
-
 /// The controller's outputs for every logged pulse, inputs replayed as
 /// logged (`default_inputs` until the first logged reading).
-fn simulate(mut c: AnyController, rows: &[Row], default_inputs: (f32, f32)) -> Vec<ControlOutput> {
+fn simulate(
+    mut c: AnyController,
+    rows: &[PulseRow],
+    default_inputs: (f32, f32),
+) -> Vec<ControlOutput> {
     c.update_inputs(default_inputs.0, default_inputs.1);
     let mut last = None;
     rows.iter()
@@ -238,26 +197,27 @@ fn simulate(mut c: AnyController, rows: &[Row], default_inputs: (f32, f32)) -> V
 
 fn replay(a: &ReplayArgs) -> Result<Output, CliError> {
     check_args(a)?;
-    let text = std::fs::read_to_string(&a.log).map_err(|e| CliError::io(&a.log, e))?;
-    let rows = parse_log(&text)?;
+    let text = ivt_sim::input::read_text_bounded(&a.log, MAX_LOG_BYTES)
+        .map_err(|e| CliError::io(&a.log, e))?;
+    let rows = parse_pulse_log(&text).map_err(|e| CliError::Input(e.to_string()))?;
     let config = Config {
-        f_timer_hz: a.f_timer,
-        omega0: units::rpm_to_rad_s(a.omega0_rpm),
+        f_timer_hz: a.f_timer as f32,
+        omega0: units::rpm_to_rad_s(a.omega0_rpm as f32),
         decimation: a.decimation,
         law: a.law.into(),
         gains: Gains {
-            k_prop: units::prop_gain_from_deg_per_rpm(a.k_prop),
-            prop_period_s: a.prop_period,
-            ..Gains::from_thesis_mm_per_rad(a.k, a.k2)
+            k_prop: units::prop_gain_from_deg_per_rpm(a.k_prop as f32),
+            prop_period_s: a.prop_period as f32,
+            ..Gains::from_thesis_mm_per_rad(a.k as f32, a.k2 as f32)
         },
         open_loop: OpenLoopPreset::from(a.open_loop).coeffs(),
         feedforward: !a.no_feedforward,
-        stall_timeout_s: a.stall_timeout,
+        stall_timeout_s: a.stall_timeout as f32,
         ..Config::default()
     };
     let controller =
         AnyController::new(a.ppr, config).map_err(|e| CliError::Input(format!("--ppr: {e}")))?;
-    let outs = simulate(controller, &rows, (a.vm, a.tu));
+    let outs = simulate(controller, &rows, (a.vm as f32, a.tu as f32));
 
     let mut csv = String::from(
         "ticks,omega,omega_a,omega_T,r_ol,r_d,r,stepper_target,saturated,ready,fault\n",

@@ -163,6 +163,22 @@ pub fn write_figure(
     Ok(())
 }
 
+/// Parse `args` (program name first) as `ivt` does and, for the `kin`
+/// commands (pure, bounded, writing no file), run the command: the fuzz
+/// target of the argument vector (`fuzz/fuzz_targets/cli_args.rs`). Parse
+/// and command errors are returned as text; a panic is the bug it hunts.
+///
+/// # Errors
+/// The parse or command failure, one line.
+#[doc(hidden)]
+pub fn fuzz_args(args: &[std::ffi::OsString]) -> Result<(), String> {
+    let cli = Cli::try_parse_from(args).map_err(|e| e.kind().to_string())?;
+    match cli.command {
+        Some(Command::Kin(cmd)) => kin::run(cmd).map(|_| ()).map_err(|e| e.to_string()),
+        _ => Ok(()),
+    }
+}
+
 /// Exit status of every failure (argument, input, numerical, I/O).
 const EXIT_FAILURE: u8 = 2;
 
@@ -185,6 +201,11 @@ pub fn main() -> ExitCode {
     };
     let json = cli.json;
     JSON.store(json, Ordering::SeqCst);
+    if json && stdout_closed_at_start() {
+        // Nothing to print the answer on: refuse before any work is done.
+        note("error: stdout is closed (`>&-`): the JSON answer would be lost");
+        return ExitCode::from(EXIT_FAILURE);
+    }
     let result = match cli.command {
         Some(Command::Kin(cmd)) => kin::run(cmd),
         Some(Command::Sim(args)) => sim::run_file(&args, json),
@@ -205,8 +226,30 @@ pub fn main() -> ExitCode {
     }
 }
 
-/// Exit status after SIGINT/SIGTERM (128 + SIGINT, the shell's convention).
+/// Exit status after SIGINT/SIGTERM without `--json` (128 + SIGINT, the
+/// shell's convention); under `--json` an interruption is a failure like any
+/// other: its one JSON error and [`EXIT_FAILURE`] (SPEC §6, issue 30).
 const EXIT_INTERRUPTED: i32 = 130;
+
+/// Whether stdout was closed when the process started (`ivt --json ... >&-`).
+/// The Rust runtime reopens a closed fd 1 on `/dev/null` read-write
+/// (`sanitize_standard_fds`) and writes to it then succeed, so the closed
+/// descriptor shows only as fd 1 → `/dev/null` with access mode O_RDWR in
+/// `/proc/self/fdinfo/1` — a shell's `>/dev/null` and Rust's `Stdio::null()`
+/// open it write-only. A caller that hands a read-write `/dev/null` (Python's
+/// `subprocess.DEVNULL`) is taken for a closed stdout under `--json`; outside
+/// Linux (no /proc) nothing is detected.
+fn stdout_closed_at_start() -> bool {
+    let devnull = std::fs::read_link("/proc/self/fd/1")
+        .is_ok_and(|target| target == std::path::Path::new("/dev/null"));
+    devnull
+        && std::fs::read_to_string("/proc/self/fdinfo/1").is_ok_and(|info| {
+            info.lines()
+                .find_map(|l| l.strip_prefix("flags:"))
+                .and_then(|f| u32::from_str_radix(f.trim(), 8).ok())
+                .is_some_and(|flags| flags & 0o3 == 0o2)
+        })
+}
 
 /// `--json` is on the command line.
 static JSON: AtomicBool = AtomicBool::new(false);
@@ -216,7 +259,7 @@ static STDOUT_DONE: Mutex<bool> = Mutex::new(false);
 
 /// On SIGINT/SIGTERM, delete every staged (incomplete) output file and every
 /// directory the run created, print the one `{"error", "kind":
-/// "interrupted"}` object under `--json`, and exit 130 — or, while the rig
+/// "interrupted"}` object and exit 2 under `--json` (130 without) — or, while the rig
 /// recorder is running, let it stop reading and close its MCAP with a valid
 /// footer ([`ivt_sim::atomic::on_interrupt`]).
 fn install_interrupt_handler() {
@@ -228,14 +271,19 @@ fn install_interrupt_handler() {
         let mut done = STDOUT_DONE
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner);
-        if !*done && JSON.load(Ordering::SeqCst) {
+        let json = JSON.load(Ordering::SeqCst);
+        if !*done && json {
             let object = serde_json::json!({ "error": message, "kind": "interrupted" });
             let _ = write_stdout(&format!("{object}\n"));
         }
         *done = true;
         note(&format!("error: {message}"));
         // exits with the lock held: nothing else reaches stdout
-        std::process::exit(EXIT_INTERRUPTED);
+        std::process::exit(if json {
+            i32::from(EXIT_FAILURE)
+        } else {
+            EXIT_INTERRUPTED
+        });
     });
     if let Err(e) = installed {
         note(&format!("warning: no interrupt handler: {e}"));

@@ -7,6 +7,7 @@ use ivt_sim::progress::Progress;
 use ivt_sim::run::Simulation;
 use ivt_sim::scene::Scene;
 use ivt_sim::steady::{Route, SceneRun};
+use ivt_sim::SimError;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -29,6 +30,12 @@ pub struct SimArgs {
     /// scene by the IHB steady state or force the time integration.
     #[arg(long, value_enum)]
     pub route: Option<RouteArg>,
+    /// Work budget of a time integration: the most encoder pulses + sensor
+    /// readings + fixed RK4 steps the run may meet. The scene's count is
+    /// estimated before anything runs and a scene above the limit is refused
+    /// with the estimate (the default, 1e9, is ~40 min of wall time).
+    #[arg(long, default_value_t = ivt_sim::scene::DEFAULT_MAX_EVENTS)]
+    pub max_events: f64,
 }
 
 /// `--route` on the command line.
@@ -66,7 +73,13 @@ pub fn run_file(args: &SimArgs, json: bool) -> Result<Output, CliError> {
     } else {
         args.route.map(Route::from)
     };
-    run_scene(&scene, &args.out, json, args.pil, route)
+    if !(args.max_events.is_finite() && args.max_events > 0.0) {
+        return Err(CliError::Input(format!(
+            "--max-events must be finite and > 0, got {}",
+            ivt_sim::scene::keys::typed(args.max_events)
+        )));
+    }
+    run_scene(&scene, &args.out, json, args.pil, route, args.max_events)
 }
 
 /// `ivt` with no arguments: the default drive scene into `out/`.
@@ -76,7 +89,17 @@ pub fn run_file(args: &SimArgs, json: bool) -> Result<Output, CliError> {
 pub fn run_default(json: bool) -> Result<Output, CliError> {
     let scene = Scene::parse(DEFAULT_SCENE, "scenes/drive.toml")
         .map_err(|e| CliError::Input(e.to_string()))?;
-    run_scene(&scene, Path::new("out"), json, false, None)
+    let max_events = ivt_sim::scene::DEFAULT_MAX_EVENTS;
+    run_scene(&scene, Path::new("out"), json, false, None, max_events)
+}
+
+/// A simulator failure: a work budget exceeded or a scene refused is the
+/// user's input, the rest a failed run.
+fn sim_error(e: SimError) -> CliError {
+    match e {
+        SimError::Budget(_) | SimError::Scene(_) => CliError::Input(e.to_string()),
+        _ => CliError::Failed(e.to_string()),
+    }
 }
 
 fn run_scene(
@@ -85,15 +108,16 @@ fn run_scene(
     json: bool,
     pil: bool,
     route: Option<Route>,
+    max_events: f64,
 ) -> Result<Output, CliError> {
     let mut bar = Progress::new(!json && scene.duration_s >= 5.0, &scene.name);
-    let failed = |e: &dyn std::fmt::Display| CliError::Failed(e.to_string());
     let (answered, paths) = if pil {
-        let r = ivt_sim::pil::run_pil(scene, &mut |f| bar.update(f)).map_err(|e| failed(&e))?;
+        scene.check_events(max_events).map_err(CliError::Input)?;
+        let r = ivt_sim::pil::run_pil(scene, &mut |f| bar.update(f)).map_err(sim_error)?;
         bar.finish();
         let mut answered = SceneRun::time_integration(scene, r);
         answered.route_reason = "processor in the loop".into();
-        let paths = write_outputs(out, scene, &answered).map_err(|e| failed(&e))?;
+        let paths = write_outputs(out, scene, &answered).map_err(sim_error)?;
         (answered, paths)
     } else if !scene.outputs.steady_state && route != Some(Route::IhbSteadyState) {
         // A transient is asked for: the MCAP log is written by a thread while
@@ -102,21 +126,23 @@ fn run_scene(
         run_and_write(out, scene, |sink| {
             let r = Simulation::new(scene)
                 .route(route)
+                .max_events(max_events)
                 .progress(&mut |f| bar.update(f))
                 .sink(sink)
                 .answer_by_time_integration();
             bar.finish();
             r
         })
-        .map_err(|e| failed(&e))?
+        .map_err(sim_error)?
     } else {
         let answered = Simulation::new(scene)
             .route(route)
+            .max_events(max_events)
             .progress(&mut |f| bar.update(f))
             .answer()
-            .map_err(|e| failed(&e))?;
+            .map_err(sim_error)?;
         bar.finish();
-        let paths = write_outputs(out, scene, &answered).map_err(|e| failed(&e))?;
+        let paths = write_outputs(out, scene, &answered).map_err(sim_error)?;
         (answered, paths)
     };
     let summary = answered.summary_json(scene);

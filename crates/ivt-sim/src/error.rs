@@ -90,6 +90,10 @@ pub enum SimError {
     /// A telemetry stream with a truncated or corrupt frame (strict reading).
     #[error("telemetry: {0}")]
     TelemetryStream(ivt_wire::telemetry::StreamError),
+    /// The run would exceed its work budget ([`crate::scene::DEFAULT_MAX_EVENTS`]);
+    /// the message carries the estimate and the limit.
+    #[error("work budget: {0}")]
+    Budget(String),
     /// The telemetry timer rate is not a positive finite number.
     #[error("f_timer_hz must be positive and finite, got {0}")]
     BadTimer(f64),

@@ -1,10 +1,25 @@
 #![doc = include_str!("../README.md")]
+// No scene, stream or file may reach a panic in the simulator: every failure
+// is a typed `SimError`/`SceneError` (issue 30). Tests may unwrap.
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::indexing_slicing,
+        clippy::unreachable,
+        clippy::todo,
+        clippy::unimplemented
+    )
+)]
 
 pub mod atomic;
 pub mod backend;
 pub mod commission;
 pub mod error;
 pub mod field;
+pub mod input;
 pub mod integrate;
 pub mod output;
 pub mod pil;
@@ -12,6 +27,7 @@ pub mod plant;
 pub mod plot;
 pub mod profile;
 pub mod progress;
+pub mod pulse_log;
 pub mod record;
 pub mod recording;
 pub mod run;

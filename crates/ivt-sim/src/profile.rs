@@ -16,9 +16,9 @@ pub struct Pwl {
 
 impl Pwl {
     /// Profile through `knots`; the caller (scene validation) guarantees at
-    /// least one knot, finite values and strictly increasing times.
+    /// least one knot, finite values and strictly increasing times (without
+    /// knots the profile is NaN everywhere).
     pub fn new(knots: Vec<(f64, f64)>) -> Self {
-        debug_assert!(!knots.is_empty());
         Self {
             knots,
             hint: Cell::new(1),
@@ -30,28 +30,36 @@ impl Pwl {
         Self::new(vec![(0.0, v)])
     }
 
-    /// Value at `t`.
+    /// Value at `t`; NaN for a NaN `t` (or a profile without knots), so that
+    /// a diverged integration shows as a non-finite state, never a panic.
     #[inline]
     pub fn at(&self, t: f64) -> f64 {
-        let k = &self.knots;
-        if t <= k[0].0 {
-            return k[0].1;
-        }
-        let last = k[k.len() - 1];
-        if t >= last.0 {
-            return last.1;
-        }
-        // i = first knot with time > t (k[0].0 < t < last.0 so 1 ≤ i ≤ len−1)
-        let h = self.hint.get().clamp(1, k.len() - 1);
-        let i = if k[h - 1].0 <= t && t < k[h].0 {
-            h
-        } else {
-            let i = k.partition_point(|&(tk, _)| tk <= t);
-            self.hint.set(i);
-            i
+        let k = self.knots.as_slice();
+        let (Some(&(t_first, v_first)), Some(&(t_last, v_last))) = (k.first(), k.last()) else {
+            return f64::NAN;
         };
-        let (t0, v0) = k[i - 1];
-        let (t1, v1) = k[i];
+        if t.is_nan() {
+            return f64::NAN;
+        }
+        if t <= t_first {
+            return v_first;
+        }
+        if t >= t_last {
+            return v_last;
+        }
+        // segment i: knots i−1, i (k[0].0 < t < last.0 so 1 ≤ i ≤ len−1)
+        let segment = |i: usize| Some((*k.get(i.checked_sub(1)?)?, *k.get(i)?));
+        let ((t0, v0), (t1, v1)) = match segment(self.hint.get()) {
+            Some(s) if s.0 .0 <= t && t < s.1 .0 => s,
+            _ => {
+                let i = k.partition_point(|&(tk, _)| tk <= t);
+                self.hint.set(i);
+                match segment(i) {
+                    Some(s) => s,
+                    None => return f64::NAN,
+                }
+            }
+        };
         v0 + (v1 - v0) * (t - t0) / (t1 - t0)
     }
 
@@ -90,6 +98,10 @@ mod tests {
         assert_eq!(p.at(3.5), 6.0);
         assert_eq!(p.at(10.0), 6.0);
         assert_eq!(Pwl::constant(3.0).at(-5.0), 3.0);
+        // a diverged integration's NaN time is NaN, not a panic (issue 30)
+        assert!(Pwl::constant(3.0).at(f64::NAN).is_nan());
+        assert!(p.at(f64::NAN).is_nan());
+        assert!(Pwl::new(Vec::new()).at(1.0).is_nan());
         // the cached segment does not change answers for out-of-order queries
         let ts = [3.7, 1.2, 2.9, 0.5, 3.99, 1.01, 2.0];
         let fresh: Vec<f64> = ts

@@ -108,7 +108,7 @@ impl Simulation<'_> {
     /// A forced IHB route on a scene that cannot take it, or a failure of
     /// the route taken.
     pub fn answer(self) -> Result<SceneRun, SimError> {
-        answer(self.scene, self.route, self.progress)
+        answer(self.scene, self.route, self.progress, self.max_events)
     }
 
     /// The time integration ([`Simulation::run`]) as the scene's answer,
@@ -132,6 +132,7 @@ fn answer(
     scene: &Scene,
     force: Option<Route>,
     progress: Option<&mut dyn FnMut(f64)>,
+    max_events: f64,
 ) -> Result<SceneRun, SimError> {
     let wall = Instant::now();
     let asked = force.or_else(|| scene.outputs.route.forced());
@@ -170,7 +171,7 @@ fn answer(
             }
         }
     }
-    let (result, steady) = time_route(scene, progress)?;
+    let (result, steady) = time_route(scene, progress, max_events)?;
     Ok(SceneRun {
         route: Route::TimeIntegration,
         route_reason: reason,
@@ -236,9 +237,15 @@ pub fn ihb_steady_state(scene: &Scene) -> Result<SteadyMetrics, SimError> {
         .plant_params()
         .map_err(|e| SimError::Scene(e.to_string()))?;
     let c = &scene.controller;
+    let (Some(&[_, v_m]), Some(&[_, t_u])) = (scene.inputs.v_m.first(), scene.inputs.t_u.first())
+    else {
+        return Err(SimError::Scene(
+            "inputs.v_m and inputs.t_u need a knot".into(),
+        ));
+    };
     let op = OperatingPoint {
-        v_m: scene.inputs.v_m[0][1],
-        t_u: scene.inputs.t_u[0][1],
+        v_m,
+        t_u,
         omega0: scene.omega0_rad_s(),
     };
     let ihb = IhbSolver::new(IhbOptions::default())?.solve(&params, &op, None)?;
@@ -336,10 +343,11 @@ pub fn ihb_steady_state(scene: &Scene) -> Result<SteadyMetrics, SimError> {
 fn time_route(
     scene: &Scene,
     progress: Option<&mut dyn FnMut(f64)>,
+    max_events: f64,
 ) -> Result<(RunResult, Option<SteadyMetrics>), SimError> {
     let run = |s: &Scene, progress: Option<&mut dyn FnMut(f64)>| match progress {
-        Some(p) => Simulation::new(s).progress(p).run(),
-        None => Simulation::new(s).run(),
+        Some(p) => Simulation::new(s).max_events(max_events).progress(p).run(),
+        None => Simulation::new(s).max_events(max_events).run(),
     };
     if !scene.outputs.steady_state {
         return Ok((run(scene, progress)?, None));
@@ -378,7 +386,7 @@ fn last_revolution(scene: &Scene, result: &RunResult) -> Option<SteadyMetrics> {
     if plant.len() < ppr + 1 || !last.omega_a.is_finite() {
         return None;
     }
-    let rev = &plant[plant.len() - ppr..];
+    let rev = plant.get(plant.len() - ppr..)?;
     let (lo, hi) = rev
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {

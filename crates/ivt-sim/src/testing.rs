@@ -3,7 +3,10 @@
 //! that an atomic write left nothing behind).
 //!
 //! Not part of the simulator's API; these helpers panic on I/O errors,
-//! which is what a test wants.
+//! which is what a test wants. The crate's panic lints are lifted for this
+//! module alone: it is test code that integration tests of two packages
+//! share, and no library path calls it.
+#![allow(clippy::expect_used)]
 
 use std::path::{Path, PathBuf};
 

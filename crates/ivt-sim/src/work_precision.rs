@@ -68,19 +68,20 @@ pub fn solve(problem: &Problem, method: Method) -> (f64, u64) {
     let mut it = PlantIntegrator::new(plant, method, 0.0, 0.0, problem.omega_start, 0.0);
     it.omega_handover = 0.0; // ω > 0 throughout: angle domain from the start
     let mut t_at = [0.0; 2];
-    for (k, th) in [problem.theta_end - TAU, problem.theta_end]
-        .into_iter()
-        .enumerate()
+    for (slot, th) in t_at
+        .iter_mut()
+        .zip([problem.theta_end - TAU, problem.theta_end])
     {
         // the plant never stalls here; a failure would show as a NaN error
         if it.advance(&prof, problem.r, th, f64::INFINITY).is_err() {
             return (f64::NAN, 0);
         }
-        t_at[k] = it.t;
+        *slot = it.t;
     }
     let s = it.stats;
+    let [t_start, t_end] = t_at;
     (
-        TAU / (t_at[1] - t_at[0]),
+        TAU / (t_end - t_start),
         s.angle_steps + s.time_steps + s.rejected,
     )
 }

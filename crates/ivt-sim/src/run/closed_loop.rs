@@ -237,10 +237,12 @@ impl<'s> ClosedLoop<'s> {
     /// exact pulse times (NaN for the first revolution).
     fn encoder_pulse(&mut self) -> Pulse {
         let t = self.integ.t;
-        let len = self.ring.len();
+        let len = self.ring.len().max(1);
         let n = self.n_pulse as usize;
-        let oldest = self.ring[(n + 1) % len];
-        self.ring[n % len] = t;
+        let oldest = self.ring.get((n + 1) % len).copied().unwrap_or(f64::NAN);
+        if let Some(slot) = self.ring.get_mut(n % len) {
+            *slot = t;
+        }
         let omega_a = if n >= self.enc.ppr {
             std::f64::consts::TAU / (t - oldest)
         } else {

@@ -109,9 +109,18 @@ pub fn controller_config(scene: &Scene, r_max: f64) -> Option<Config> {
             max_speed: scene.stepper.max_speed as f32,
             accel: scene.stepper.accel as f32,
         },
-        initial_inputs: [scene.inputs.v_m[0][1] as f32, scene.inputs.t_u[0][1] as f32],
+        initial_inputs: [
+            first_value(&scene.inputs.v_m),
+            first_value(&scene.inputs.t_u),
+        ],
         ..Config::default()
     })
+}
+
+/// The value of a profile's first knot as the controller reads it (NaN for
+/// a profile without knots, which scene validation refuses).
+fn first_value(profile: &[[f64; 2]]) -> f32 {
+    profile.first().map_or(f32::NAN, |&[_, v]| v as f32)
 }
 
 /// What runs a scene: the closed-loop time integration ([`Simulation::run`])
@@ -124,6 +133,7 @@ pub struct Simulation<'a> {
     pub(crate) route: Option<Route>,
     pub(crate) progress: Option<&'a mut dyn FnMut(f64)>,
     sink: Option<&'a mut dyn FnMut(Sample)>,
+    pub(crate) max_events: f64,
 }
 
 impl<'a> Simulation<'a> {
@@ -136,6 +146,7 @@ impl<'a> Simulation<'a> {
             route: None,
             progress: None,
             sink: None,
+            max_events: crate::scene::DEFAULT_MAX_EVENTS,
         }
     }
 
@@ -171,13 +182,25 @@ impl<'a> Simulation<'a> {
         self
     }
 
+    /// Refuse a time integration of more than `max_events` events
+    /// ([`Scene::estimated_events`]; default [`crate::scene::DEFAULT_MAX_EVENTS`]).
+    #[must_use]
+    pub fn max_events(mut self, max_events: f64) -> Self {
+        self.max_events = max_events;
+        self
+    }
+
     /// The closed-loop time integration of the scene.
     ///
     /// # Errors
-    /// Scene, integration or controller-backend failures.
+    /// A scene over the work budget ([`Self::max_events`]), scene,
+    /// integration or controller-backend failures.
     pub fn run(self) -> Result<RunResult, SimError> {
         let wall = Instant::now();
         let scene = self.scene;
+        scene
+            .check_events(self.max_events)
+            .map_err(SimError::Budget)?;
         let backend = match self.backend {
             Some(b) => Some(b),
             None => default_backend(scene)?,

@@ -1,6 +1,7 @@
 //! `[controller]` (law, gains, feed-forward) and `[metrics]`.
 
-use super::inputs::profile_ok;
+use super::inputs::{knots, profile_ok};
+use super::keys::{check, Bound, Key};
 use super::Invalid;
 use ivt_ctrl::{LawKind, OpenLoopPreset};
 use serde::{Deserialize, Serialize};
@@ -91,6 +92,7 @@ pub struct ControllerSection {
     /// Open-loop coefficients: `"refit"` (default) or `"thesis"`.
     pub open_loop: OpenLoopLaw,
     /// r(t) for `law = "none"`: `[[t, r], ...]` \[s, m\].
+    #[serde(deserialize_with = "knots")]
     pub r_schedule: Vec<[f64; 2]>,
 }
 
@@ -112,26 +114,25 @@ impl Default for ControllerSection {
 
 impl ControllerSection {
     pub(super) fn validate(&self, r_max: f64) -> Result<(), Invalid> {
-        Invalid::check(
-            self.omega0_rpm.is_finite() && self.omega0_rpm > 0.0 && self.omega0_rpm < 1e4,
-            "controller.omega0_rpm",
-            || format!("must be in (0, 1e4) rpm, got {}", self.omega0_rpm),
-        )?;
-        for (v, key) in [
-            (self.k_mm_per_rad, "controller.k_mm_per_rad"),
-            (self.k2_mm_per_rad, "controller.k2_mm_per_rad"),
-            (self.k_prop_deg_per_rpm, "controller.k_prop_deg_per_rpm"),
-        ] {
-            Invalid::check(v.is_finite(), key, || format!("must be finite, got {v}"))?;
-        }
-        Invalid::positive(self.prop_period_s, "controller.prop_period_s", " s")?;
+        check("controller.omega0_rpm", self.omega0_rpm)?;
+        check("controller.k_mm_per_rad", self.k_mm_per_rad)?;
+        check("controller.k2_mm_per_rad", self.k2_mm_per_rad)?;
+        check("controller.k_prop_deg_per_rpm", self.k_prop_deg_per_rpm)?;
+        check("controller.prop_period_s", self.prop_period_s)?;
         if self.law == Law::None {
             Invalid::check(!self.r_schedule.is_empty(), "controller.r_schedule", || {
                 "is required when law = \"none\"".into()
             })?;
         }
         if !self.r_schedule.is_empty() {
-            profile_ok(&self.r_schedule, "controller.r_schedule", 0.0, r_max)?;
+            let r = Key {
+                name: "controller.r_schedule[]",
+                unit: "m",
+                min: Bound::Closed(0.0),
+                max: Bound::Closed(r_max),
+                f32: true,
+            };
+            profile_ok(&self.r_schedule, "controller.r_schedule", &r)?;
         }
         Ok(())
     }
@@ -163,12 +164,8 @@ impl Default for MetricsSection {
 
 impl MetricsSection {
     pub(super) fn validate(&self) -> Result<(), Invalid> {
-        Invalid::non_negative(self.from_s, "metrics.from_s", " s")?;
-        Invalid::check(
-            self.band.is_finite() && self.band > 0.0 && self.band < 1.0,
-            "metrics.band",
-            || format!("must be in (0, 1), got {}", self.band),
-        )?;
-        Invalid::positive(self.static_window_s, "metrics.static_window_s", " s")
+        check("metrics.from_s", self.from_s)?;
+        check("metrics.band", self.band)?;
+        check("metrics.static_window_s", self.static_window_s)
     }
 }

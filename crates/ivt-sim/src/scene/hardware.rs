@@ -1,6 +1,7 @@
 //! `[integrator]`, `[encoder]`, `[sensors]` and `[stepper]`: how the plant
 //! is integrated and what the controller sees of it.
 
+use super::keys::check;
 use super::Invalid;
 use ivt_ctrl::SUPPORTED_PPR;
 use serde::Deserialize;
@@ -46,16 +47,10 @@ impl Default for IntegratorSection {
 
 impl IntegratorSection {
     pub(super) fn validate(&self) -> Result<(), Invalid> {
-        for (v, key) in [
-            (self.rtol, "integrator.rtol"),
-            (self.atol, "integrator.atol"),
-        ] {
-            Invalid::check(v > 0.0 && v < 1.0, key, || {
-                format!("must be in (0, 1), got {v}")
-            })?;
-        }
-        Invalid::positive_at_most(self.dtheta, 1.0, "integrator.dtheta", " rad")?;
-        Invalid::positive(self.omega_handover, "integrator.omega_handover", " rad/s")
+        check("integrator.rtol", self.rtol)?;
+        check("integrator.atol", self.atol)?;
+        check("integrator.dtheta", self.dtheta)?;
+        check("integrator.omega_handover", self.omega_handover)
     }
 }
 
@@ -86,8 +81,8 @@ impl EncoderSection {
         Invalid::check(SUPPORTED_PPR.contains(&self.ppr), "encoder.ppr", || {
             format!("must be one of {SUPPORTED_PPR:?}, got {}", self.ppr)
         })?;
-        Invalid::positive_at_most(self.f_timer_hz, 1e9, "encoder.f_timer_hz", " Hz")?;
-        Invalid::non_negative(self.jitter_s, "encoder.jitter_s", " s")
+        check("encoder.f_timer_hz", self.f_timer_hz)?;
+        check("encoder.jitter_s", self.jitter_s)
     }
 }
 
@@ -130,16 +125,11 @@ impl SensorsSection {
     }
 
     pub(super) fn validate(&self) -> Result<(), Invalid> {
-        Invalid::positive(self.period_s, "sensors.period_s", " s")?;
-        for (v, key) in [
-            (self.v_m_noise, "sensors.v_m_noise"),
-            (self.v_m_quantum, "sensors.v_m_quantum"),
-            (self.t_u_noise, "sensors.t_u_noise"),
-            (self.t_u_quantum, "sensors.t_u_quantum"),
-        ] {
-            Invalid::non_negative(v, key, "")?;
-        }
-        Ok(())
+        check("sensors.period_s", self.period_s)?;
+        check("sensors.v_m_noise", self.v_m_noise)?;
+        check("sensors.v_m_quantum", self.v_m_quantum)?;
+        check("sensors.t_u_noise", self.t_u_noise)?;
+        check("sensors.t_u_quantum", self.t_u_quantum)
     }
 }
 
@@ -170,13 +160,9 @@ impl Default for StepperSection {
 
 impl StepperSection {
     pub(super) fn validate(&self) -> Result<(), Invalid> {
-        Invalid::positive(self.steps_per_rev, "stepper.steps_per_rev", "")?;
-        Invalid::positive(self.max_speed, "stepper.max_speed", " steps/s")?;
-        Invalid::positive(self.accel, "stepper.accel", " steps/s²")?;
-        Invalid::check(
-            (0.0..=1.0).contains(&self.miss_prob),
-            "stepper.miss_prob",
-            || format!("must be in [0, 1], got {}", self.miss_prob),
-        )
+        check("stepper.steps_per_rev", self.steps_per_rev)?;
+        check("stepper.max_speed", self.max_speed)?;
+        check("stepper.accel", self.accel)?;
+        check("stepper.miss_prob", self.miss_prob)
     }
 }

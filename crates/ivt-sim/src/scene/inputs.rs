@@ -1,22 +1,29 @@
 //! `[inputs]` (piecewise-linear V_m(t), T_U(t)) and `[initial]`.
 
+use super::keys::{self, Key};
 use super::Invalid;
-use serde::Deserialize;
+use serde::{Deserialize, Deserializer};
 
 /// `[inputs]`: piecewise-linear profiles as `[[t, value], ...]`.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct InputsSection {
     /// Motor voltage V_m(t) \[V\].
+    #[serde(deserialize_with = "knots")]
     pub v_m: Vec<[f64; 2]>,
     /// Brake torque T_U(t) \[N·m\].
+    #[serde(deserialize_with = "knots")]
     pub t_u: Vec<[f64; 2]>,
 }
 
 impl InputsSection {
     pub(super) fn validate(&self) -> Result<(), Invalid> {
-        profile_ok(&self.v_m, "inputs.v_m", f64::NEG_INFINITY, f64::INFINITY)?;
-        profile_ok(&self.t_u, "inputs.t_u", 0.0, f64::INFINITY)
+        for (p, key) in [(&self.v_m, "inputs.v_m"), (&self.t_u, "inputs.t_u")] {
+            let values = keys::find(&format!("{key}[]"))
+                .ok_or_else(|| Invalid::new(key, "has no description in scene::keys::KEYS"))?;
+            profile_ok(p, key, values)?;
+        }
+        Ok(())
     }
 }
 
@@ -37,47 +44,62 @@ pub struct InitialSection {
 
 impl InitialSection {
     pub(super) fn validate(&self, r_max: f64) -> Result<(), Invalid> {
-        Invalid::check(self.theta.is_finite(), "initial.theta", || {
-            format!("must be finite, got {}", self.theta)
-        })?;
-        Invalid::non_negative(self.omega, "initial.omega", "")?;
+        keys::check("initial.theta", self.theta)?;
+        keys::check("initial.omega", self.omega)?;
         Invalid::check((0.0..=r_max).contains(&self.r), "initial.r", || {
-            format!("must be in [0, r_max = {r_max}] m, got {}", self.r)
+            format!(
+                "= {} m is outside [0, r_max = {}] m",
+                keys::typed(self.r),
+                keys::typed(r_max)
+            )
         })
     }
 }
 
-/// A profile `[[t, value], ...]`: at least one knot, finite times ≥ 0
-/// increasing strictly, values in `[lo, hi]`.
-pub(super) fn profile_ok(p: &[[f64; 2]], key: &str, lo: f64, hi: f64) -> Result<(), Invalid> {
+/// A profile `[[t, value], ...]`: at least one knot, times in the range of
+/// `{key}[].t` ([`keys::KEYS`]) increasing strictly, values in `values`' range.
+pub(super) fn profile_ok(p: &[[f64; 2]], key: &str, values: &Key) -> Result<(), Invalid> {
     if p.is_empty() {
         return Err(Invalid::new(key, "needs at least one [t, value] knot"));
     }
+    let times = keys::find(&format!("{key}[].t"))
+        .ok_or_else(|| Invalid::new(key, "has no description in scene::keys::KEYS"))?;
     for (k, &[t, v]) in p.iter().enumerate() {
         let at = format!("{key}[{k}]");
-        if !(t.is_finite() && t >= 0.0) {
-            return Err(Invalid::new(
-                at,
-                format!("knot {k}: time must be finite and ≥ 0, got {t}"),
-            ));
-        }
-        if !(v.is_finite() && v >= lo && v <= hi) {
-            return Err(Invalid::new(
-                at,
-                format!("knot {k}: value {v} outside [{lo}, {hi}]"),
-            ));
-        }
+        times
+            .check_at(&at, t)
+            .map_err(|e| Invalid::new(at.clone(), format!("knot {k}: time {}", e.message)))?;
+        values
+            .check_at(&at, v)
+            .map_err(|e| Invalid::new(at.clone(), format!("knot {k}: value {}", e.message)))?;
         if let Some(prev) = k.checked_sub(1).and_then(|j| p.get(j)) {
             if t <= prev[0] {
                 return Err(Invalid::new(
                     at,
                     format!(
-                        "knot {k}: times must increase strictly ({} then {t})",
-                        prev[0]
+                        "knot {k}: times must increase strictly ({} then {})",
+                        keys::typed(prev[0]),
+                        keys::typed(t)
                     ),
                 ));
             }
         }
     }
     Ok(())
+}
+
+/// Deserialize `[[t, value], ...]`, refusing a knot with fewer or more than
+/// two numbers (serde's `[f64; 2]` would drop a third value silently).
+pub(super) fn knots<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
+    let raw = Vec::<Vec<f64>>::deserialize(d)?;
+    raw.into_iter()
+        .enumerate()
+        .map(|(k, knot)| match knot.as_slice() {
+            &[t, v] => Ok([t, v]),
+            other => Err(serde::de::Error::custom(format!(
+                "knot {k} has {} numbers; each knot is exactly [t, value]",
+                other.len()
+            ))),
+        })
+        .collect()
 }

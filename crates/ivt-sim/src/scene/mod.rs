@@ -7,13 +7,16 @@
 //! guide's Scenes chapter (docs/guide/src/controller/scenes.md) for the full key list and the limits ([`MAX_DURATION_S`],
 //! `[outputs] max_bytes`).
 
+mod budget;
 mod controller;
 mod hardware;
 mod inputs;
+pub mod keys;
 mod locate;
 mod outputs;
 mod plant;
 
+pub use budget::{EventEstimate, DEFAULT_MAX_EVENTS};
 pub use controller::{ControllerSection, Law, MetricsSection, OpenLoopLaw};
 pub use hardware::{
     EncoderSection, IntegratorMethod, IntegratorSection, SensorsSection, StepperSection,
@@ -67,29 +70,6 @@ impl Invalid {
         } else {
             Err(Self::new(key, message()))
         }
-    }
-
-    /// `value` must be finite and > 0 (`unit` follows the bound in the message).
-    fn positive(value: f64, key: &str, unit: &str) -> Result<(), Self> {
-        Self::check(value.is_finite() && value > 0.0, key, || {
-            format!("must be finite and > 0{unit}, got {value}")
-        })
-    }
-
-    /// `value` must be finite, > 0 and ≤ `max`.
-    fn positive_at_most(value: f64, max: f64, key: &str, unit: &str) -> Result<(), Self> {
-        Self::check(
-            value.is_finite() && value > 0.0 && value <= max,
-            key,
-            || format!("must be in (0, {max}]{unit}, got {value}"),
-        )
-    }
-
-    /// `value` must be finite and ≥ 0 (`unit` follows the bound in the message).
-    fn non_negative(value: f64, key: &str, unit: &str) -> Result<(), Self> {
-        Self::check(value.is_finite() && value >= 0.0, key, || {
-            format!("must be finite and ≥ 0{unit}, got {value}")
-        })
     }
 }
 
@@ -206,7 +186,7 @@ impl Scene {
     /// # Errors
     /// I/O or scene errors, one line.
     pub fn load(path: &std::path::Path) -> Result<Self, SceneError> {
-        let src = std::fs::read_to_string(path)
+        let src = crate::input::read_text_bounded(path, crate::input::MAX_SCENE_BYTES)
             .map_err(|e| SceneError(format!("{}: {e}", path.display())))?;
         let base = path.parent().unwrap_or(std::path::Path::new("."));
         Self::parse_in(&src, &path.display().to_string(), base)
@@ -293,18 +273,7 @@ impl Scene {
 
     /// All range and consistency checks, section by section.
     fn validate(&self) -> Result<(), Invalid> {
-        Invalid::check(
-            self.duration_s.is_finite()
-                && self.duration_s > 0.0
-                && self.duration_s <= MAX_DURATION_S,
-            "duration_s",
-            || {
-                format!(
-                    "must be in (0, {MAX_DURATION_S:e}] s, got {}",
-                    self.duration_s
-                )
-            },
-        )?;
+        keys::check("duration_s", self.duration_s)?;
         let params = self.plant.params()?;
         self.inputs.validate()?;
         self.initial.validate(params.r_max)?;

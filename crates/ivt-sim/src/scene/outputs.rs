@@ -143,6 +143,6 @@ impl OutputsSection {
                 || format!("\"{}\" is listed twice", ch.name.name()),
             )?;
         }
-        Invalid::positive(self.max_bytes, "outputs.max_bytes", "")
+        super::keys::check("outputs.max_bytes", self.max_bytes)
     }
 }

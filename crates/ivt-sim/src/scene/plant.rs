@@ -157,8 +157,8 @@ impl PlantSection {
     /// invalid parameter.
     pub fn from_file(path: &Path) -> Result<Self, SceneError> {
         let origin = path.display().to_string();
-        let src =
-            std::fs::read_to_string(path).map_err(|e| SceneError(format!("{origin}: {e}")))?;
+        let src = crate::input::read_text_bounded(path, crate::input::MAX_SCENE_BYTES)
+            .map_err(|e| SceneError(format!("{origin}: {e}")))?;
         Self::parse_file(&src, &origin)
     }
 

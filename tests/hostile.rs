@@ -1,0 +1,231 @@
+//! Every example of issue 30 in the simulator's, the replay's and the command
+//! layer's reach, through the `ivt` binary as a hostile user runs it: each ends
+//! in exit 2 with exactly one `{"error", "kind"}` object on stdout (or the
+//! correct answer), within 20 s and under a 1.5 GB address-space limit.
+//!
+//! Not here: `hb duffing-frc --from 1e-3 --to 2e-3` (the harmonic-balance
+//! engine's example) and the output-writer examples already covered by
+//! `tests/outputs.rs` (`--plot` in place, /dev/full replaced, SIGINT).
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+const IVT: &str = env!("CARGO_BIN_EXE_ivt");
+/// The issue's bounds for one hostile input.
+const TIME_LIMIT: Duration = Duration::from_secs(20);
+const MEMORY_LIMIT_KB: u64 = 1536 * 1024;
+
+/// `ivt ARGS` under `ulimit -v` (a run that would grow past 1.5 GB aborts
+/// instead) and coreutils' `timeout` (a run past the time limit is killed and
+/// exits 124), with `shell_tail` appended to the command (e.g. `>&-`); the
+/// exit code, stdout, stderr and the wall time.
+fn run_limited(args: &[&str], shell_tail: &str) -> (Option<i32>, String, String, Duration) {
+    let secs = TIME_LIMIT.as_secs();
+    let script = format!(
+        "ulimit -v {MEMORY_LIMIT_KB}; exec timeout -s KILL {secs} \"$0\" \"$@\" {shell_tail}"
+    );
+    let t0 = Instant::now();
+    let out = Command::new("sh")
+        .args(["-c", &script, IVT])
+        .args(args)
+        .stdin(Stdio::null())
+        .output()
+        .unwrap();
+    let took = t0.elapsed();
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    (
+        out.status.code(),
+        text(&out.stdout),
+        text(&out.stderr),
+        took,
+    )
+}
+
+/// `ivt --json ARGS` must refuse: exit 2, one JSON object with a string
+/// `error` and `kind`, nothing else on stdout, no panic; returns the error.
+fn refused(args: &[&str], kind: &str) -> String {
+    let mut argv = vec!["--json"];
+    argv.extend(args);
+    let (code, out, err, took) = run_limited(&argv, "");
+    assert!(!err.contains("panicked"), "{argv:?}: {err}");
+    assert_eq!(code, Some(2), "{argv:?}: stdout {out:?} stderr {err:?}");
+    let lines: Vec<&str> = out.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "{argv:?}: {out:?}");
+    let v: Value = serde_json::from_str(lines[0]).unwrap();
+    assert_eq!(v["kind"], kind, "{argv:?}: {v}");
+    assert!(took < TIME_LIMIT, "{argv:?}: {took:?}");
+    v["error"].as_str().unwrap().to_string()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    ivt_sim::testing::scratch_dir(&format!("hostile-{name}"))
+}
+
+const BASE: &str = "duration_s = 2.0\n[inputs]\nv_m = [[0.0, 8.0]]\nt_u = [[0.0, 4.0]]\n";
+
+fn scene(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(format!("{name}.toml"));
+    std::fs::write(&p, text).unwrap();
+    p.to_str().unwrap().to_string()
+}
+
+/// The issue's scenes: two former panics (profile.rs "min > max"), a spin,
+/// an f32 overflow that ran faulted with exit 0, a truncated knot. Each error
+/// names the key and shows the value as typed.
+#[test]
+fn hostile_scenes_are_refused_by_key_with_the_value_as_typed() {
+    let dir = scratch("scenes");
+    let out = dir.join("out");
+    let out = out.to_str().unwrap();
+    #[rustfmt::skip]
+    let cases = [
+        ("rtol", format!("{BASE}[integrator]\nrtol = 1e-300\natol = 1e-300\n"), "`integrator.rtol` = 1e-300"),
+        ("t_u", BASE.replace("t_u = [[0.0, 4.0]]", "t_u = [[0, 1e300]]"), "`inputs.t_u[0]` knot 0: value = 1e300"),
+        ("period", format!("{BASE}[sensors]\nperiod_s = 1e-300\n"), "`sensors.period_s` = 1e-300 s"),
+        ("k_f32", format!("{BASE}[controller]\nk_mm_per_rad = 1e300\n"), "`controller.k_mm_per_rad` = 1e300 mm/rad does not fit the controller's f32"),
+        ("knot3", BASE.replace("v_m = [[0.0, 8.0]]", "v_m = [[0.0, 8.6, 1.0]]"), "knot 0 has 3 numbers"),
+    ];
+    for (name, text, needle) in cases {
+        let path = scene(&dir, name, &text);
+        let e = refused(&["sim", &path, "--out", out], "input");
+        assert!(e.contains(needle), "{name}: {e}");
+    }
+    assert!(!Path::new(out).exists(), "a refused scene writes nothing");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A valid scene whose work is beyond the budget is refused with the
+/// estimate before it runs; `--max-events` raises the limit.
+#[test]
+fn work_beyond_the_budget_is_refused_with_the_estimate() {
+    let dir = scratch("budget");
+    // 1e6 s at 100 rpm and 4096 pulses/rev: 1e6 · (100/60) · 4096 = 6.827e9
+    // pulses, + 1e6 s / 0.01 s = 1e8 sensor readings = 6.927e9 events
+    let long = scene(
+        &dir,
+        "long",
+        &format!("{}[encoder]\nppr = 4096\n", BASE.replace("2.0", "1e6")),
+    );
+    let e = refused(&["sim", &long], "input");
+    assert!(
+        e.contains("about 6.927e9") && e.contains("--max-events"),
+        "{e}"
+    );
+    // 2 s at the defaults ≈ 4000 pulses + 200 readings: over a limit of 1000
+    let short = scene(&dir, "short", BASE);
+    let e = refused(&["sim", &short, "--max-events", "1000"], "input");
+    assert!(e.contains("about 4.200e3"), "{e}");
+    let e = refused(&["sim", &short, "--max-events", "0"], "input");
+    assert!(e.contains("--max-events"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `ivt --json sim /dev/zero` grew to 4 GB: now at most 1 MiB + 1 byte is
+/// read (a pulse log 64 MB, a commissioning recording 512 MiB).
+#[test]
+fn endless_inputs_are_read_no_further_than_their_limit() {
+    let e = refused(&["sim", "/dev/zero"], "input");
+    assert!(
+        e.contains("/dev/zero") && e.contains("1048576 bytes"),
+        "{e}"
+    );
+    let e = refused(&["ctrl", "replay", "/dev/zero"], "io");
+    assert!(e.contains("64000000 bytes"), "{e}");
+    let e = refused(&["rig", "identify", "/dev/zero"], "io");
+    assert!(e.contains("536870912 bytes"), "{e}");
+}
+
+/// A replay CSV is read by its header's names in any order (it was read by
+/// position), and a 10 MB bad line is echoed as 200 characters.
+#[test]
+fn replay_columns_by_name_and_short_echoes() {
+    let dir = scratch("replay");
+    let rows = [(100, 8.0, 4.0), (50_100, 8.0, 4.0), (100_100, 7.5, 4.5)];
+    let by_name = dir.join("by_name.csv");
+    let mut text = String::from("t_u,v_m,ticks\n");
+    for (ticks, v, t) in rows {
+        text.push_str(&format!("{t},{v},{ticks}\n"));
+    }
+    std::fs::write(&by_name, text).unwrap();
+    let positional = dir.join("positional.csv");
+    let mut text = String::new();
+    for (ticks, v, t) in rows {
+        text.push_str(&format!("{ticks},{v},{t}\n"));
+    }
+    std::fs::write(&positional, text).unwrap();
+    let replay = |p: &Path| -> Value {
+        let (code, out, err, _) =
+            run_limited(&["--json", "ctrl", "replay", p.to_str().unwrap()], "");
+        assert_eq!(code, Some(0), "{err}");
+        serde_json::from_str(&out).unwrap()
+    };
+    let (a, b) = (replay(&by_name), replay(&positional));
+    assert_eq!(a["pulses"], 3);
+    assert_eq!(a["r_ol"], b["r_ol"], "the same log by name and by position");
+    // u_ol depends on V_m: the 7.5 V row differs from the 8 V rows
+    assert_ne!(a["r_ol"][2], a["r_ol"][0]);
+
+    let long = dir.join("long.csv");
+    std::fs::write(&long, format!("ticks\n1{}\n", "9".repeat(10_000_000))).unwrap();
+    let e = refused(&["ctrl", "replay", long.to_str().unwrap()], "input");
+    assert!(
+        e.len() < 400 && e.contains("more chars"),
+        "{} chars",
+        e.len()
+    );
+    let e = refused(
+        &["ctrl", "replay", by_name.to_str().unwrap(), "--k", "1e300"],
+        "input",
+    );
+    assert!(
+        e.contains("--k = 1e300 does not fit the controller's f32"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Values in messages as typed: `--theta-ct 3600.0000001` was reported as
+/// 62.83185307354119 (radians).
+#[test]
+fn flags_are_reported_in_the_unit_typed() {
+    let e = refused(
+        &["kin", "sgivt-ratio", "--theta-ct", "3600.0000001"],
+        "input",
+    );
+    assert!(e.contains("--theta-ct = 3600.0000001 deg"), "{e}");
+    assert!(!e.contains("62.83"), "{e}");
+}
+
+/// `ivt --json kin plant >&-` exited 0 with its answer lost; a shell's
+/// `>/dev/null` (write-only) is still a success.
+#[test]
+fn a_closed_stdout_is_exit_2() {
+    let (code, _, err, _) = run_limited(&["--json", "kin", "plant"], ">&-");
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("stdout is closed"), "{err}");
+    let (code, _, err, _) = run_limited(&["--json", "kin", "plant"], ">/dev/null");
+    assert_eq!(code, Some(0), "{err}");
+}
+
+/// `--json --version` and `--json help` print one JSON object (done on main;
+/// kept here with the rest of the issue's examples).
+#[test]
+fn version_and_help_are_json() {
+    for args in [["--json", "--version"], ["--json", "help"]] {
+        let (code, out, _, _) = run_limited(&args, "");
+        assert_eq!(code, Some(0));
+        let v: Value = serde_json::from_str(out.trim()).unwrap();
+        assert!(v.is_object(), "{v}");
+    }
+}
+
+/// `ol fit --emit-rust /dev/full` replaced the device node with a regular
+/// file and exited 0 (fixed on main by the one output writer).
+#[test]
+fn a_device_is_never_replaced() {
+    let e = refused(&["ol", "fit", "--quiet", "--emit-rust", "/dev/full"], "io");
+    assert!(e.contains("not a regular file"), "{e}");
+    assert!(!Path::new("/dev/full").is_file());
+}
