@@ -199,7 +199,7 @@ fn scene_dict<'py>(py: Python<'py>, scene: &Bound<'py, PyAny>) -> PyResult<Bound
         scene.extract::<String>()?
     } else {
         let path: PathBuf = scene.extract()?;
-        std::fs::read_to_string(&path)
+        ivt_sim::input::read_text_bounded(&path, ivt_sim::input::MAX_SCENE_BYTES)
             .map_err(|e| PyValueError::new_err(format!("{}: {e}", path.display())))?
     };
     let table: toml::Table = toml::from_str(&text)

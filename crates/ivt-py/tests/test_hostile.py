@@ -56,6 +56,12 @@ def test_endless_file_is_read_no_further_than_its_limit() -> None:
     assert "1048576 bytes" in message, message
 
 
+def test_scene_dict_reads_an_endless_file_no_further_than_its_limit() -> None:
+    # ivt.sweep starts from scene_dict: the same bound as ivt.sim.run
+    message = timed(lambda: ivt.sim.scene_dict("/dev/zero"), ValueError)
+    assert "1048576 bytes" in message, message
+
+
 def test_work_beyond_the_budget_raises_runtime_error() -> None:
     # 1e6 s at 100 rpm, 4096 pulses/rev: 6.827e9 pulses + 1e8 readings
     text = BASE.replace("2.0", "1e6") + "[encoder]\nppr = 4096\n"
