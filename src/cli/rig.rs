@@ -9,10 +9,6 @@ use serde_json::json;
 use std::path::PathBuf;
 use std::time::Duration;
 
-/// Encoder samples per revolution the rig firmware is built for
-/// (`firmware/src/app.rs`, `PPR`), written into recordings.
-pub const FIRMWARE_PPR: u32 = 1200;
-
 /// `ivt rig ...`
 #[derive(Subcommand)]
 pub enum RigCommand {
@@ -85,7 +81,7 @@ fn record_cmd(a: &RecordArgs) -> Result<Output, CliError> {
         f_timer_hz: a.f_timer_hz,
         max_frames: a.frames,
         idle_timeout,
-        ppr: FIRMWARE_PPR,
+        ppr: ivt_sim::telemetry::FIRMWARE_PPR,
         strict: false,
     };
     let s = record(port, &a.out, &opts).map_err(|e| CliError::Failed(e.to_string()))?;

@@ -178,7 +178,7 @@ fn on_rig(
         // The rig sends a sample every 10 ms: the plan and one second more.
         max_frames: Some((f64::from(total) * 100.0).ceil() as u64 + 100),
         idle_timeout: Duration::from_secs(2),
-        ppr: super::rig::FIRMWARE_PPR,
+        ppr: ivt_sim::telemetry::FIRMWARE_PPR,
         strict: false,
     };
     let s = record(dev, &a.out, &opts).map_err(|e| CliError::Failed(e.to_string()))?;

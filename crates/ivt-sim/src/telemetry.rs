@@ -25,6 +25,10 @@ use ivt_wire::telemetry::{StreamError, StreamProblem, TelemetryFrame, TelemetryS
 use crate::error::SimError;
 use crate::recording::{Recording, RecordingMeta};
 
+/// Encoder samples per revolution the rig firmware is built for
+/// (`firmware/src/app.rs`, `PPR`), written into recordings of its telemetry.
+pub const FIRMWARE_PPR: u32 = 1200;
+
 /// When to stop, how to read time, and how to treat bad frames.
 #[derive(Clone, Debug)]
 pub struct RecordOptions {
