@@ -69,8 +69,8 @@ pub use ihb::{HbOptions, HbResidual, HbSolution, HbSolver};
 pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;
 pub use problem::{
-    central_difference_samples, Duffing, GeneralProblem, MathieuDuffing, Nonlinearity,
-    PeriodicProblem, WithJacobian,
+    central_difference_samples, AtFrequency, Duffing, Excitation, FrequencyExcitation,
+    GeneralProblem, MathieuDuffing, Nonlinearity, PeriodicProblem, WithJacobian,
 };
 pub use stability::{
     classify, AdaptiveHsu, Floquet, HsuEstimate, HsuSteps, StabilityAnalyzer, StabilityKind,
