@@ -13,6 +13,7 @@ pub mod classic;
 pub mod codim2;
 pub mod condense;
 pub mod continuation;
+pub mod cycle_branch;
 pub mod damped;
 pub mod deflation;
 pub mod elements;
@@ -24,6 +25,7 @@ pub mod fold;
 pub mod frc;
 pub mod galerkin;
 pub mod hill;
+pub mod hopf;
 mod hysteresis;
 pub mod ihb;
 pub mod jobs;
@@ -53,6 +55,7 @@ pub use continuation::{
     pseudo_arclength, pseudo_arclength_exact, ContinuationOptions, Corrector, Fold, Path,
     PathPoint, PathSystem, Termination,
 };
+pub use cycle_branch::{cycle_branch, CycleBranch, CycleBranchOptions};
 pub use damped::{damped_modes, linear_mode, DampedModePoint, DampedModes};
 pub use deflation::{all_solutions, AllSolutions, FoundSolution, SearchOptions, SearchReport};
 pub use elements::{Element, ElementProblem, Harmonic, Law};
@@ -65,6 +68,7 @@ pub use fold::{locate_fold, Branch, FoldLocation, FoldOptions};
 pub use frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
 pub use galerkin::GalerkinJacobian;
 pub use hill::{fourier_blocks, hill_multipliers, HillResult};
+pub use hopf::{hopf_points, HopfPoint};
 pub use ihb::{HbOptions, HbResidual, HbSolution, HbSolver};
 pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;

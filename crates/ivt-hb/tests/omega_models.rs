@@ -71,16 +71,9 @@ fn assert_folds_match_shooting(folds: &[(f64, Vec<f64>)]) {
 fn rotating_unbalance_folds_match_shooting() {
     let problem = unbalanced();
     let hb = HbOptions::new(15, 64);
-    let frc = frequency_response(
-        &problem,
-        &hb,
-        &FrcOptions {
-            from: 0.5,
-            to: 2.5,
-            ..FrcOptions::default()
-        },
-    )
-    .unwrap();
+    let mut sweep = FrcOptions::default();
+    (sweep.from, sweep.to) = (0.5, 2.5);
+    let frc = frequency_response(&problem, &hb, &sweep).unwrap();
     assert!(frc.folds.iter().all(|f| f.located));
     let folds: Vec<_> = frc
         .folds

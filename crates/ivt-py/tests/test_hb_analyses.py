@@ -174,3 +174,62 @@ def test_continue_bifurcation_reraises_the_family_error():
         hb.continue_bifurcation(family, start, 0.0, 0.3, p_start=0.1, n=15)
     with pytest.raises(ValueError, match="p_start"):
         hb.continue_bifurcation(family, start, 0.0, 0.3, n=15)
+
+
+def _unbalance_fold_by_shooting(omega0, y0):
+    """The fold of u'' + 0.04u' + u + u³ = 0.03 ω² cos ωt near (ω0, y0) by
+    shooting: Newton on [P(y) − y, det(∂P/∂y − I)] in (y, ω), the period map P
+    by DOP853 (rtol 1e-12), every Jacobian by central differences."""
+    def period_map(omega, y):
+        rhs = lambda t, y: [y[1], 0.03 * omega ** 2 * np.cos(omega * t) - 0.04 * y[1]
+                            - y[0] - y[0] ** 3]
+        return solve_ivp(rhs, (0, 2 * np.pi / omega), y, method="DOP853", rtol=1e-12,
+                         atol=1e-12).y[:, -1]
+
+    def residual(u):
+        y, omega = u[:2], u[2]
+        h = 1e-6
+        jac = np.column_stack([(period_map(omega, y + h * e) - period_map(omega, y - h * e))
+                               / (2 * h) for e in np.eye(2)]) - np.eye(2)
+        return np.r_[period_map(omega, y) - y, np.linalg.det(jac)]
+
+    u = np.r_[y0, omega0]
+    for _ in range(8):
+        r = residual(u)
+        jac = np.column_stack([(residual(u + 1e-5 * e) - residual(u - 1e-5 * e)) / 2e-5
+                               for e in np.eye(3)])
+        step = np.linalg.solve(jac, -r)
+        u = u + step
+        if np.max(np.abs(step)) < 1e-11:
+            break
+    return u[2]
+
+
+@pytest.mark.parametrize("vectorized", [False, True])
+def test_frc_with_an_omega_dependent_force_matches_shooting(vectorized):
+    # Rotating unbalance: f(θ, ω) = 0.03 ω² cos θ; ω is detected from the signature.
+    g = lambda x, v, theta: x ** 3
+    f = lambda theta, omega: 0.03 * omega ** 2 * np.cos(theta)
+    curve = hb.frc(1.0, 0.04, 1.0, g, f, 0.5, 2.5, n=15, vectorized=vectorized,
+                   velocity_dependent=False)
+    folds = [b for b in curve["bifurcations"] if b["kind"] == "fold"]
+    assert len(folds) == 2 and all(b["located"] for b in folds)
+    for b in folds:
+        y0 = [hb.eval_series(b["coeffs"], 0.0), b["omega"] * hb.eval_series(b["coeffs"], 0.0, order=1)]
+        reference = _unbalance_fold_by_shooting(b["omega"], y0)
+        assert abs(b["omega"] - reference) < 1e-7, (b["omega"], reference)
+
+
+def test_omega_in_g_is_passed_and_refused_where_there_is_no_frequency():
+    # g(x, v, θ, ω) = x³ + 0.04 ω x: solve at ω passes omega (the orbit
+    # equals that of the fixed law at that ω), limit_cycle has none to pass.
+    g = lambda x, v, theta, omega: x ** 3 + 0.04 * omega * x
+    fixed = lambda x, v, theta: x ** 3 + 0.04 * 1.3 * x
+    f = lambda theta: 0.1 * np.cos(theta)
+    a = hb.solve(1.0, 0.04, 1.0, g, 1.3, f=f, n=9)
+    b = hb.solve(1.0, 0.04, 1.0, fixed, 1.3, f=f, n=9)
+    assert np.max(np.abs(np.asarray(a["coeffs"]) - b["coeffs"])) < 1e-10
+    with pytest.raises(ValueError, match="omega"):
+        hb.limit_cycle(1.0, -1.0, 1.0, lambda x, v, theta, omega: x * x * v, 1.0)
+    with pytest.raises(TypeError, match="jac"):
+        hb.frc(1.0, 0.04, 1.0, g, f, 0.5, 2.5, jac=lambda x, v, th: (3 * x * x, 0 * v))

@@ -44,18 +44,6 @@ pub trait Nonlinearity {
     fn eval_samples_at(&self, x: &[f64], v: &[f64], theta: &[f64], _w: f64, out: &mut [f64]) {
         self.eval_samples(x, v, theta, out)
     }
-    /// The analytic Jacobian of `g(·, ω_f)` ([`Self::jacobian_samples`]'s
-    /// layout and return). Default: [`Self::jacobian_samples`].
-    fn jacobian_samples_at(
-        &self,
-        x: &[f64],
-        v: &[f64],
-        th: &[f64],
-        _w: f64,
-        dg: &mut [f64],
-    ) -> bool {
-        self.jacobian_samples(x, v, th, dg)
-    }
 }
 
 /// A [`Nonlinearity`] `g` with its analytic Jacobian `jacobian(x, v, θ, dg)`
@@ -88,18 +76,6 @@ where
     }
     fn eval_samples_at(&self, x: &[f64], v: &[f64], theta: &[f64], w: f64, out: &mut [f64]) {
         self.g.eval_samples_at(x, v, theta, w, out)
-    }
-    /// The Jacobian closure does not see ω_f: for a `g` that reads it, none
-    /// (the problem differences `g(·, ω_f)`).
-    fn jacobian_samples_at(
-        &self,
-        x: &[f64],
-        v: &[f64],
-        th: &[f64],
-        _w: f64,
-        dg: &mut [f64],
-    ) -> bool {
-        !self.g.frequency_dependent() && self.jacobian_samples(x, v, th, dg)
     }
 }
 
@@ -234,26 +210,22 @@ where
     fn nonlinear_samples_at(&self, x: &[f64], v: &[f64], th: &[f64], w: f64, out: &mut [f64]) {
         self.g.eval_samples_at(x, v, th, w, out)
     }
+    /// A `g` that reads ω_f is differenced at ω_f (its analytic Jacobian,
+    /// if any, does not see ω_f).
     fn nonlinear_jacobian_samples_at(
         &self,
         x: &[f64],
         v: &[f64],
-        th: &[f64],
+        t: &[f64],
         w: f64,
         dg: &mut [f64],
     ) {
         if !self.g.frequency_dependent() {
-            return self.nonlinear_jacobian_samples(x, v, th, dg);
+            return self.nonlinear_jacobian_samples(x, v, t, dg);
         }
-        let eval = |x: &[f64], v: &[f64], th: &[f64], g: &mut [f64]| {
-            self.g.eval_samples_at(x, v, th, w, g)
-        };
-        if !self.g.jacobian_samples_at(x, v, th, w, dg) {
-            return central_differences(self.n, self.velocity_dependent, eval, x, v, th, dg);
-        }
-        if !self.velocity_dependent {
-            zero_velocity_blocks(self.n, dg);
-        }
+        let eval =
+            |x: &[f64], v: &[f64], t: &[f64], g: &mut [f64]| self.g.eval_samples_at(x, v, t, w, g);
+        central_differences(self.n, self.velocity_dependent, eval, x, v, t, dg)
     }
     fn excitation_at(&self, theta: f64, omega_f: f64, out: &mut [f64]) {
         self.f.eval_at(theta, omega_f, out)

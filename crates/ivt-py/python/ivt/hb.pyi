@@ -11,9 +11,21 @@ from ._types import ArrayLike, FloatArray
 
 Method = Literal["modified", "classic"]
 Matrix = Union[float, npt.ArrayLike]
-Callback = Callable[[FloatArray, FloatArray, float], Union[float, Sequence[float], FloatArray]]
-VectorizedCallback = Callable[[FloatArray, FloatArray, FloatArray], npt.ArrayLike]
-Forcing = Callable[[float], Union[float, Sequence[float], FloatArray]]
+# ``g`` and ``f`` may also take the excitation frequency as a parameter named
+# ``omega`` (passed by ``frc`` and ``solve``): ``g(x, v, theta, omega)``,
+# ``f(theta, omega)``.
+Callback = Union[
+    Callable[[FloatArray, FloatArray, float], Union[float, Sequence[float], FloatArray]],
+    Callable[[FloatArray, FloatArray, float, float], Union[float, Sequence[float], FloatArray]],
+]
+VectorizedCallback = Union[
+    Callable[[FloatArray, FloatArray, FloatArray], npt.ArrayLike],
+    Callable[[FloatArray, FloatArray, FloatArray, float], npt.ArrayLike],
+]
+Forcing = Union[
+    Callable[[float], Union[float, Sequence[float], FloatArray]],
+    Callable[[float, float], Union[float, Sequence[float], FloatArray]],
+]
 # Large models (issue 28): scipy.sparse matrices (untyped here) and load
 # vectors F (F cos θ) or (F_cos, F_sin).
 SparseMatrix = Any
