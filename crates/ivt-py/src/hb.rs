@@ -331,6 +331,7 @@ pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     );
     crate::hb_paths::register(&m)?;
     crate::hb_analyses::register(&m)?;
+    crate::hb_bifurcation::register(&m)?;
     crate::hb_large::register(&m)?;
     crate::hb_string::register(&m)?;
     crate::hb_elements::register(&m)?;

@@ -8,17 +8,16 @@
 
 use ivt_hb::{
     AllSolutions, BackboneOptions, BroydenStats, ContinuationOptions, Corrector, DampedModes,
-    HbError, HbSolution, SearchOptions,
+    HbSolution, SearchOptions,
 };
 use numpy::IntoPyArray;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
-use std::sync::Mutex;
 
 use crate::args::count;
+use crate::hb_bifurcation::PyFamily;
 use crate::hb_shared::{finite, run_user, user_system_fn, UserArgs};
-use crate::user_problem::{user_problem, PyProblem};
 use ivt_hb::jobs::{pairs, stability_steps};
 
 /// One orbit of [`AllSolutions`] as `{"coeffs", "amplitude", "multipliers",
@@ -160,18 +159,6 @@ fn fold_point_dict<'py>(
     Ok(d)
 }
 
-/// The user system `family(p)` returns: a tuple (m, c, k, g, f).
-fn family_system<'py>(family: &Bound<'py, PyAny>, p: f64) -> PyResult<[Bound<'py, PyAny>; 5]> {
-    let t = family.call1((p,))?;
-    let parts: Vec<Bound<'py, PyAny>> = t.extract().map_err(|_| {
-        PyTypeError::new_err("argument `family` must return a tuple (m, c, k, g, f)")
-    })?;
-    let [m, c, k, g, f]: [Bound<'py, PyAny>; 5] = parts.try_into().map_err(|_| {
-        PyTypeError::new_err("argument `family` must return a tuple (m, c, k, g, f)")
-    })?;
-    Ok([m, c, k, g, f])
-}
-
 /// Two-parameter continuation of a fold of the frequency response of
 /// `family(p)` → (m, c, k, g, f) in (omega, p) (ivt_hb::fold_curve: the
 /// extended system R = 0, Φ_q v = 0, |v| = 1 followed in p, first towards
@@ -232,54 +219,28 @@ fn continue_bifurcation<'py>(
         .map_err(|_| PyTypeError::new_err("start[\"coeffs\"] must be a 1-D array of floats"))?
         .as_array()
         .to_vec();
-    let [m, c, k, g, f] = family_system(family, p_start)?;
-    let user = UserArgs {
-        system: [&m, &c, &k, &g],
-        n,
-        samples,
-        velocity_dependent,
-        vectorized,
-        rtol,
-        max_iter,
-        jac: None,
-    };
-    let (first, opts) = user.setup(Some(&f), 1, 0.0)?;
+    let fam = PyFamily::new(family, velocity_dependent, vectorized);
+    let (first, opts) = fam.first(py, p_start, n, samples, rtol, max_iter)?;
     let copts = ContinuationOptions {
         ds: finite("ds", ds)?,
         ds_max: finite("ds_max", ds_max)?,
         max_points: count("max_points", max_points)?,
         ..ContinuationOptions::default()
     };
-    let family: Py<PyAny> = family.clone().unbind();
-    let failure: Mutex<Option<PyErr>> = Mutex::new(None);
-    let build = |p: f64| -> Result<PyProblem, HbError> {
-        Python::attach(|py| {
-            let [m, c, k, g, f] = family_system(family.bind(py), p)?;
-            user_problem(
-                &m,
-                &c,
-                &k,
-                &g,
-                Some(&f),
-                None,
-                velocity_dependent,
-                vectorized,
-            )
-        })
-        .map_err(|e| {
-            let message = e.to_string();
-            if let Ok(mut slot) = failure.lock() {
-                slot.get_or_insert(e);
-            }
-            HbError::InvalidInput(format!("family(p) failed: {message}"))
-        })
-    };
     let curve = run_user(py, &first, |_| {
         ivt_hb::fold_curve(
-            build, &opts, &coeffs, omega, p_start, p_from, p_to, &at, &copts,
+            |p| fam.build(p),
+            &opts,
+            &coeffs,
+            omega,
+            p_start,
+            p_from,
+            p_to,
+            &at,
+            &copts,
         )
     });
-    if let Some(e) = failure.lock().ok().and_then(|mut s| s.take()) {
+    if let Some(e) = fam.take_error() {
         return Err(e);
     }
     let curve = curve?;

@@ -26,6 +26,7 @@ mod fields;
 mod gears;
 mod hb;
 mod hb_analyses;
+mod hb_bifurcation;
 mod hb_elements;
 mod hb_large;
 mod hb_paths;

@@ -233,3 +233,47 @@ def test_omega_in_g_is_passed_and_refused_where_there_is_no_frequency():
         hb.limit_cycle(1.0, -1.0, 1.0, lambda x, v, theta, omega: x * x * v, 1.0)
     with pytest.raises(TypeError, match="jac"):
         hb.frc(1.0, 0.04, 1.0, g, f, 0.5, 2.5, jac=lambda x, v, th: (3 * x * x, 0 * v))
+
+
+def _hopf_family(mu):
+    """x'' − (μ + x² − x⁴) x' + x = 0 as (m, c, k, g, f)."""
+    return 1.0, -mu, 1.0, lambda x, v, th: -(x * x - x ** 4) * v, None
+
+
+def _cycle_gap(mu, x0, period):
+    """y(T) − (x0, 0) of x'' = (μ + x² − x⁴) x' − x from (x0, 0) (DOP853, rtol 1e-12)."""
+    rhs = lambda t, y: [y[1], (mu + y[0] ** 2 - y[0] ** 4) * y[1] - y[0]]
+    y = solve_ivp(rhs, (0, period), [x0, 0.0], method="DOP853", rtol=1e-12, atol=1e-12).y[:, -1]
+    return np.array([y[0] - x0, y[1]])
+
+
+def test_cycle_branch_hopf_fold_and_the_two_cycles_against_time_integration():
+    out = hb.cycle_branch(_hopf_family, -0.2, 0.1, at=[-0.1], n=25, samples=128)
+    [hopf] = out["hopf"]
+    assert abs(hopf["p"]) < 1e-12 and abs(hopf["omega"] - 1.0) < 1e-12
+    assert hopf["subcritical"] and hopf["lyapunov"] > 0
+    [fold] = out["bifurcations"]
+    # The fold by shooting: Newton on [y(T) − y0, det ∂(y(T) − y0)/∂(x0, T)] in (x0, T, μ).
+    def residual(u):
+        gap = _cycle_gap(u[2], u[0], u[1])
+        j = np.column_stack([(_cycle_gap(u[2], *(u[:2] + h)) - _cycle_gap(u[2], *(u[:2] - h))) / 2e-6
+                             for h in 1e-6 * np.eye(2)])
+        return np.r_[gap, np.linalg.det(j)]
+    x0 = max(hb.eval_series(fold["coeffs"], t) for t in np.linspace(0, 2 * np.pi, 4001))
+    u = np.array([x0, 2 * np.pi / fold["omega"], fold["p"]])
+    for _ in range(6):
+        jac = np.column_stack([(residual(u + h) - residual(u - h)) / 2e-5 for h in 1e-5 * np.eye(3)])
+        step = np.linalg.solve(jac, -residual(u))
+        u = u + step
+        if np.max(np.abs(step)) < 1e-12:
+            break
+    assert abs(fold["p"] - u[2]) < 1e-8, (fold["p"], u[2])
+    # μ = −0.1: the large cycle attracts forward in time, the small one
+    # backward (x'' = a(x, −x') in reversed time); periods to 1e-8.
+    small, large = sorted(out["at"], key=lambda c: c["amplitude"])
+    accel = lambda x, v: (-0.1 + x * x - x ** 4) * v - x
+    assert large["stable"] and not small["stable"]
+    t_large = _period_by_integration(accel, y0=(1.5, 0.0))
+    t_small = _period_by_integration(lambda x, w: accel(x, -w), y0=(0.9, 0.0))
+    assert abs(large["period"] - t_large) < 1e-8 * t_large, (large["period"], t_large)
+    assert abs(small["period"] - t_small) < 1e-8 * t_small, (small["period"], t_small)

@@ -30,6 +30,7 @@ __all__ = [
     "all_solutions",
     "backbone",
     "continue_bifurcation",
+    "cycle_branch",
     "damped_modes",
     "duffing",
     "duffing_frc",

@@ -230,6 +230,23 @@ def continue_bifurcation(
     ds_max: float = 0.05,
     max_points: int = 2000,
 ) -> Dict[str, Any]: ...
+def cycle_branch(
+    family: Callable[[float], Sequence[Any]],
+    p_from: float,
+    p_to: float,
+    at: Sequence[float] = ...,
+    n: int = 20,
+    samples: int = 64,
+    velocity_dependent: bool = True,
+    vectorized: bool = False,
+    rtol: float = 1e-9,
+    max_iter: int = 100,
+    ds: float = 0.02,
+    ds_max: float = 0.05,
+    max_points: int = 2000,
+    grid: int = 100,
+    offset: float = 1e-2,
+) -> Dict[str, Any]: ...
 def damped_modes(
     m: Matrix,
     c: Matrix,
