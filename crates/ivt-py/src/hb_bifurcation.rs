@@ -136,8 +136,8 @@ fn cycle_dict<'py>(py: Python<'py>, p: f64, c: &LimitCycle) -> PyResult<Bound<'p
 #[pyfunction]
 #[pyo3(signature = (
     family, p_from, p_to, at = Vec::new(), n = 20, samples = 64,
-    velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100,
-    ds = 0.02, ds_max = 0.05, max_points = 2000, grid = 100, offset = 1e-2
+    velocity_dependent = true, vectorized = false, grid = 100, rtol = 1e-9, max_iter = 100,
+    ds = 0.02, ds_max = 0.05, max_points = 2000, offset = 1e-2
 ))]
 #[allow(clippy::too_many_arguments)]
 fn cycle_branch<'py>(
@@ -150,12 +150,12 @@ fn cycle_branch<'py>(
     #[pyo3(from_py_with = crate::args::int64)] samples: i64,
     velocity_dependent: bool,
     vectorized: bool,
+    #[pyo3(from_py_with = crate::args::int64)] grid: i64,
     rtol: f64,
     max_iter: usize,
     ds: f64,
     ds_max: f64,
     #[pyo3(from_py_with = crate::args::int64)] max_points: i64,
-    #[pyo3(from_py_with = crate::args::int64)] grid: i64,
     offset: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (p_from, p_to) = (finite("p_from", p_from)?, finite("p_to", p_to)?);

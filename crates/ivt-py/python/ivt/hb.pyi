@@ -239,12 +239,12 @@ def cycle_branch(
     samples: int = 64,
     velocity_dependent: bool = True,
     vectorized: bool = False,
+    grid: int = 100,
     rtol: float = 1e-9,
     max_iter: int = 100,
     ds: float = 0.02,
     ds_max: float = 0.05,
     max_points: int = 2000,
-    grid: int = 100,
     offset: float = 1e-2,
 ) -> Dict[str, Any]: ...
 def damped_modes(
