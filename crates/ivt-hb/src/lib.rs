@@ -50,7 +50,7 @@ pub use broyden::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
 };
 pub use classic::ClassicIhb;
-pub use codim2::{fold_curve, FoldCurve, FoldPoint};
+pub use codim2::{fold_curve, neimark_sacker_points, FoldCurve, FoldPoint, NeimarkSackerPoint};
 pub use continuation::{
     pseudo_arclength, pseudo_arclength_exact, ContinuationOptions, Corrector, Fold, Path,
     PathPoint, PathSystem, Termination,

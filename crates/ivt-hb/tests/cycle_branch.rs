@@ -6,13 +6,12 @@
 //! `det ∂(y(T) − y₀)/∂(x₀, T) = 0`; the non-trivial multiplier is
 //! `det ∂y(T)/∂y₀` (the other is 1).
 
-use ivt_hb::ode::rk4;
 use ivt_hb::{
     cycle_branch, CycleBranchOptions, GeneralProblem, HbError, HbOptions, PeriodicProblem,
 };
 
 mod common;
-use common::shooting::{central_jacobian, newton3, newton_step};
+use common::shooting::{central_jacobian, flow, newton3, newton_step};
 
 /// The family as `M = 1`, `C = −μ`, `K = 1`, `g = −(x² − x⁴)ẋ`.
 fn family(mu: f64) -> Result<impl PeriodicProblem, HbError> {
@@ -27,19 +26,14 @@ fn family(mu: f64) -> Result<impl PeriodicProblem, HbError> {
 }
 
 /// `y(T)` from `y₀` at μ (RK4, 4000 steps).
-fn flow(mu: f64, y0: [f64; 2], period: f64) -> [f64; 2] {
-    let mut y = y0;
-    let rhs = |_t: f64, y: &[f64], dy: &mut [f64]| {
-        dy[0] = y[1];
-        dy[1] = (mu + y[0] * y[0] - y[0].powi(4)) * y[1] - y[0];
-    };
-    rk4(rhs, 0.0, &mut y, period / 4000.0, 4000);
-    y
+fn flow_at(mu: f64, y0: [f64; 2], period: f64) -> [f64; 2] {
+    let rhs = |_t: f64, y: [f64; 2]| [y[1], (mu + y[0] * y[0] - y[0].powi(4)) * y[1] - y[0]];
+    flow(rhs, y0, period, 4000)
 }
 
 /// `y(T; (x₀, 0)) − (x₀, 0)`.
 fn gap(mu: f64, x0: f64, period: f64) -> [f64; 2] {
-    let y = flow(mu, [x0, 0.0], period);
+    let y = flow_at(mu, [x0, 0.0], period);
     [y[0] - x0, y[1]]
 }
 
@@ -59,7 +53,7 @@ fn cycle_by_shooting(mu: f64, mut u: [f64; 2]) -> [f64; 2] {
 
 /// The non-trivial multiplier `det ∂y(T)/∂y₀` of the cycle `(x₀, T)`.
 fn multiplier(mu: f64, x0: f64, period: f64) -> f64 {
-    let j = central_jacobian(|y| flow(mu, y, period), [x0, 0.0], [1e-6; 2]);
+    let j = central_jacobian(|y| flow_at(mu, y, period), [x0, 0.0], [1e-6; 2]);
     j[0][0] * j[1][1] - j[0][1] * j[1][0]
 }
 

@@ -113,3 +113,17 @@ pub fn orbit_state(coeffs: &[f64], omega: f64) -> [f64; 2] {
         omega * eval_series(coeffs, 0.0, 1),
     ]
 }
+
+/// `y(t_end)` of the planar system `y' = rhs(t, y)` from `y0` at t = 0 (RK4,
+/// `steps` steps).
+pub fn flow(
+    rhs: impl Fn(f64, [f64; 2]) -> [f64; 2],
+    y0: [f64; 2],
+    t_end: f64,
+    steps: usize,
+) -> [f64; 2] {
+    let mut y = y0;
+    let f = |t: f64, y: &[f64], dy: &mut [f64]| dy.copy_from_slice(&rhs(t, [y[0], y[1]]));
+    rk4(f, 0.0, &mut y, t_end / steps as f64, steps);
+    y
+}
