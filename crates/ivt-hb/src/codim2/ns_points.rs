@@ -1,17 +1,16 @@
 //! The Neimark–Sacker boundary of a forced family in (ω, p), sampled: at each
-//! requested p the frequency-response curve of `family(p)` is traced
-//! ([`trace`]) and each of its Neimark–Sacker points located on the engine's
-//! extended system ([`crate::bifurcation`]: a pair of Floquet multipliers on
-//! the unit circle). Not a continuation of the curve: a turn of the boundary
+//! requested p the frequency-response curve of `family(p)` is traced with
+//! its events ([`crate::jobs::frc`]) and each of its Neimark–Sacker points
+//! is located on the engine's extended system ([`crate::bifurcation`]: a
+//! pair of Floquet multipliers on the unit circle). Not a continuation of the curve: a turn of the boundary
 //! in p between two samples is not followed, and each sample costs a trace.
 
-use crate::bifurcation::{BifurcationError, BifurcationKind};
+use crate::bifurcation::BifurcationKind;
+use crate::continuation::Corrector;
 use crate::error::HbError;
-use crate::events::{trace, TraceOptions};
-use crate::family::{FamilyBranch, Frequency};
 use crate::ihb::HbOptions;
-use crate::modified::ModifiedIhb;
-use crate::problem::{AtFrequency, PeriodicProblem};
+use crate::jobs::{frc, FrcRequest};
+use crate::problem::PeriodicProblem;
 use faer::c64;
 
 /// A located Neimark–Sacker point of the FRC at one p.
@@ -45,26 +44,23 @@ where
     F: Fn(f64) -> Result<P, HbError>,
 {
     let mut found = Vec::new();
+    let req = FrcRequest {
+        from: omega_from,
+        to: omega_to,
+        events: true,
+        corrector: Corrector::Newton,
+    };
     for &p in ps {
-        let problem = family(p)?;
-        let at = AtFrequency::new(&problem, omega_from);
-        let start = ModifiedIhb::new(&at, hb.clone())?.solve(omega_from, None)?;
-        let mut branch = FamilyBranch::new(Frequency(&problem), hb, omega_from)?;
-        let opts = TraceOptions {
-            lambda_to: omega_to,
-            ..TraceOptions::default()
-        };
-        let traced = trace(&mut branch, &start.coeffs, omega_from, &opts).map_err(|e| match e {
-            BifurcationError::Hb(h) => h,
-            other => HbError::InvalidInput(other.to_string()),
-        })?;
-        for event in traced.events {
-            if let (BifurcationKind::NeimarkSacker, Ok(b)) = (event.kind, event.location) {
+        let curve = frc(&family(p)?, hb, &req)?;
+        for e in curve.bifurcations {
+            if let (BifurcationKind::NeimarkSacker, true, Some(omega), Some(q), Some(mu)) =
+                (e.kind, e.located, e.omega, e.coeffs, e.multipliers)
+            {
                 found.push(NeimarkSackerPoint {
                     p,
-                    omega: b.lambda,
-                    coeffs: b.q,
-                    multipliers: b.multipliers,
+                    omega,
+                    coeffs: q.0,
+                    multipliers: mu.iter().map(|[re, im]| c64::new(*re, *im)).collect(),
                 });
             }
         }
