@@ -1,6 +1,8 @@
 //! `ivt.hb.cycle_branch` (issue 27, item 2): the Hopf points of an
 //! autonomous user family and the limit-cycle branch born at the first
-//! ([`ivt_hb::cycle_branch`]), and [`PyFamily`], a Python `family(p)` as the
+//! ([`ivt_hb::cycle_branch`]); `ivt.hb.neimark_sacker_points`, the sampled
+//! Neimark–Sacker boundary of a forced family
+//! ([`ivt_hb::neimark_sacker_points`]); and [`PyFamily`], a Python `family(p)` as the
 //! fallible Rust family of ivt-hb's two-parameter functions.
 
 use ivt_hb::{ContinuationOptions, CycleBranchOptions, HbError, HbOptions, LimitCycle};
@@ -223,8 +225,64 @@ fn cycle_branch<'py>(
     Ok(d)
 }
 
-/// Add `cycle_branch` to the `hb` module.
+/// The Neimark–Sacker boundary of the forced family `family(p)` → (m, c, k,
+/// g, f) in (omega, p), sampled (ivt_hb::neimark_sacker_points): at each p of
+/// `ps` the frequency response from `omega_from` to `omega_to` is traced
+/// with its events, and each Neimark–Sacker point located on its extended
+/// system. Not a continuation: a turn of the boundary in p between samples is
+/// not followed. Returns [{"p", "omega", "coeffs", "multipliers"}...] in
+/// order of `ps`.
+#[pyfunction]
+#[pyo3(signature = (
+    family, omega_from, omega_to, ps, n = 20, samples = 64,
+    velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
+))]
+#[allow(clippy::too_many_arguments)]
+fn neimark_sacker_points<'py>(
+    py: Python<'py>,
+    family: &Bound<'py, PyAny>,
+    omega_from: f64,
+    omega_to: f64,
+    ps: Vec<f64>,
+    #[pyo3(from_py_with = crate::args::int64)] n: i64,
+    #[pyo3(from_py_with = crate::args::int64)] samples: i64,
+    velocity_dependent: bool,
+    vectorized: bool,
+    rtol: f64,
+    max_iter: usize,
+) -> PyResult<Bound<'py, PyList>> {
+    let (from, to) = (
+        finite("omega_from", omega_from)?,
+        finite("omega_to", omega_to)?,
+    );
+    let first_p = ps.first().copied();
+    let (Some(p0), true) = (first_p, from > 0.0 && to > 0.0 && from != to) else {
+        return Err(PyValueError::new_err(
+            "arguments `omega_from`, `omega_to` must be > 0 and distinct, `ps` not empty",
+        ));
+    };
+    let fam = PyFamily::new(family, velocity_dependent, vectorized);
+    let (first, hb) = fam.first(py, finite("ps[0]", p0)?, n, samples, rtol, max_iter)?;
+    let points = run_user(py, &first, |_| {
+        ivt_hb::neimark_sacker_points(|p| fam.build(p), &hb, from, to, &ps)
+    });
+    if let Some(e) = fam.take_error() {
+        return Err(e);
+    }
+    let list = PyList::empty(py);
+    for pt in points? {
+        let d = PyDict::new(py);
+        d.set_item("p", pt.p)?;
+        d.set_item("omega", pt.omega)?;
+        d.set_item("coeffs", pt.coeffs.into_pyarray(py))?;
+        d.set_item("multipliers", pairs(&pt.multipliers))?;
+        list.append(d)?;
+    }
+    Ok(list)
+}
+
+/// Add `cycle_branch` and `neimark_sacker_points` to the `hb` module.
 pub fn register(hb: &Bound<'_, PyModule>) -> PyResult<()> {
-    add_functions!(hb, [cycle_branch]);
+    add_functions!(hb, [cycle_branch, neimark_sacker_points]);
     Ok(())
 }

@@ -277,3 +277,33 @@ def test_cycle_branch_hopf_fold_and_the_two_cycles_against_time_integration():
     t_small = _period_by_integration(lambda x, w: accel(x, -w), y0=(0.9, 0.0))
     assert abs(large["period"] - t_large) < 1e-8 * t_large, (large["period"], t_large)
     assert abs(small["period"] - t_small) < 1e-8 * t_small, (small["period"], t_small)
+
+
+def test_neimark_sacker_points_of_forced_van_der_pol_against_shooting():
+    # x'' − 0.2(1 − x²)x' + x = F cos ωt: the issue's point (0.94525643, 0.2).
+    family = lambda F: (1.0, -0.2, 1.0, lambda x, v, th: 0.2 * x * x * v,
+                        lambda th: F * np.cos(th))
+    points = hb.neimark_sacker_points(family, 0.5, 1.6, [0.2], n=9, samples=32)
+    [pt] = [p for p in points if abs(p["omega"] - 0.945) < 0.01]
+    # Shooting: Newton on [P(y) − y, det ∂P/∂y − 1] in (y, ω) (DOP853, rtol 1e-12).
+    def period_map(w, y):
+        rhs = lambda t, y: [y[1], 0.2 * (1 - y[0] ** 2) * y[1] - y[0] + 0.2 * np.cos(w * t)]
+        return solve_ivp(rhs, (0, 2 * np.pi / w), y, method="DOP853", rtol=1e-12,
+                         atol=1e-12).y[:, -1]
+
+    def residual(u):
+        y, w = u[:2], u[2]
+        jac = np.column_stack([(period_map(w, y + h) - period_map(w, y - h)) / 2e-6
+                               for h in 1e-6 * np.eye(2)])
+        return np.r_[period_map(w, y) - y, np.linalg.det(jac) - 1.0]
+
+    c = pt["coeffs"]
+    u = np.array([hb.eval_series(c, 0.0), pt["omega"] * hb.eval_series(c, 0.0, order=1), pt["omega"]])
+    for _ in range(6):
+        jac = np.column_stack([(residual(u + h) - residual(u - h)) / 2e-5 for h in 1e-5 * np.eye(3)])
+        step = np.linalg.solve(jac, -residual(u))
+        u = u + step
+        if np.max(np.abs(step)) < 1e-12:
+            break
+    assert abs(pt["omega"] - u[2]) < 1e-7, (pt["omega"], u[2])
+    assert abs(pt["omega"] - 0.94525643) < 1e-8

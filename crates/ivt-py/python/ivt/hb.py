@@ -39,6 +39,7 @@ __all__ = [
     "limit_cycle",
     "mathieu_cascade",
     "mathieu_duffing",
+    "neimark_sacker_points",
     "solve",
     "string",
 ]

@@ -247,6 +247,18 @@ def cycle_branch(
     max_points: int = 2000,
     offset: float = 1e-2,
 ) -> Dict[str, Any]: ...
+def neimark_sacker_points(
+    family: Callable[[float], Sequence[Any]],
+    omega_from: float,
+    omega_to: float,
+    ps: Sequence[float],
+    n: int = 20,
+    samples: int = 64,
+    velocity_dependent: bool = True,
+    vectorized: bool = False,
+    rtol: float = 1e-9,
+    max_iter: int = 100,
+) -> List[Dict[str, Any]]: ...
 def damped_modes(
     m: Matrix,
     c: Matrix,
