@@ -9,7 +9,7 @@ use ivt_hb::{ContinuationOptions, CycleBranchOptions, HbError, HbOptions, LimitC
 use numpy::IntoPyArray;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{IntoPyDict, PyDict, PyList};
 use std::sync::Mutex;
 
 use crate::args::count;
@@ -189,10 +189,8 @@ fn cycle_branch<'py>(
     let branch = branch?;
     let hopf = PyList::empty(py);
     for h in &branch.hopf {
-        let d = PyDict::new(py);
-        d.set_item("p", h.p)?;
-        d.set_item("omega", h.omega)?;
-        d.set_item("lyapunov", h.lyapunov)?;
+        let items = [("p", h.p), ("omega", h.omega), ("lyapunov", h.lyapunov)];
+        let d = items.into_py_dict(py)?;
         d.set_item("subcritical", h.subcritical())?;
         hopf.append(d)?;
     }
@@ -234,22 +232,22 @@ fn cycle_branch<'py>(
 /// order of `ps`.
 #[pyfunction]
 #[pyo3(signature = (
-    family, omega_from, omega_to, ps, n = 20, samples = 64,
-    velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
+    family, ps, omega_from, omega_to, n = 20, samples = 64, rtol = 1e-9, max_iter = 100,
+    velocity_dependent = true, vectorized = false
 ))]
 #[allow(clippy::too_many_arguments)]
 fn neimark_sacker_points<'py>(
     py: Python<'py>,
     family: &Bound<'py, PyAny>,
+    ps: Vec<f64>,
     omega_from: f64,
     omega_to: f64,
-    ps: Vec<f64>,
     #[pyo3(from_py_with = crate::args::int64)] n: i64,
     #[pyo3(from_py_with = crate::args::int64)] samples: i64,
-    velocity_dependent: bool,
-    vectorized: bool,
     rtol: f64,
     max_iter: usize,
+    velocity_dependent: bool,
+    vectorized: bool,
 ) -> PyResult<Bound<'py, PyList>> {
     let (from, to) = (
         finite("omega_from", omega_from)?,

@@ -176,6 +176,19 @@ def test_continue_bifurcation_reraises_the_family_error():
         hb.continue_bifurcation(family, start, 0.0, 0.3, n=15)
 
 
+def _newton(residual, u, steps=8):
+    """Newton on residual(u) = 0 from u, central-difference Jacobian (step
+    1e-5), until a step is below 1e-12."""
+    for _ in range(steps):
+        jac = np.column_stack([(residual(u + h) - residual(u - h)) / 2e-5
+                               for h in 1e-5 * np.eye(len(u))])
+        step = np.linalg.solve(jac, -residual(u))
+        u = u + step
+        if np.max(np.abs(step)) < 1e-12:
+            break
+    return u
+
+
 def _unbalance_fold_by_shooting(omega0, y0):
     """The fold of u'' + 0.04u' + u + u³ = 0.03 ω² cos ωt near (ω0, y0) by
     shooting: Newton on [P(y) − y, det(∂P/∂y − I)] in (y, ω), the period map P
@@ -193,16 +206,7 @@ def _unbalance_fold_by_shooting(omega0, y0):
                                / (2 * h) for e in np.eye(2)]) - np.eye(2)
         return np.r_[period_map(omega, y) - y, np.linalg.det(jac)]
 
-    u = np.r_[y0, omega0]
-    for _ in range(8):
-        r = residual(u)
-        jac = np.column_stack([(residual(u + 1e-5 * e) - residual(u - 1e-5 * e)) / 2e-5
-                               for e in np.eye(3)])
-        step = np.linalg.solve(jac, -r)
-        u = u + step
-        if np.max(np.abs(step)) < 1e-11:
-            break
-    return u[2]
+    return _newton(residual, np.r_[y0, omega0])[2]
 
 
 @pytest.mark.parametrize("vectorized", [False, True])
@@ -260,13 +264,7 @@ def test_cycle_branch_hopf_fold_and_the_two_cycles_against_time_integration():
                              for h in 1e-6 * np.eye(2)])
         return np.r_[gap, np.linalg.det(j)]
     x0 = max(hb.eval_series(fold["coeffs"], t) for t in np.linspace(0, 2 * np.pi, 4001))
-    u = np.array([x0, 2 * np.pi / fold["omega"], fold["p"]])
-    for _ in range(6):
-        jac = np.column_stack([(residual(u + h) - residual(u - h)) / 2e-5 for h in 1e-5 * np.eye(3)])
-        step = np.linalg.solve(jac, -residual(u))
-        u = u + step
-        if np.max(np.abs(step)) < 1e-12:
-            break
+    u = _newton(residual, np.array([x0, 2 * np.pi / fold["omega"], fold["p"]]))
     assert abs(fold["p"] - u[2]) < 1e-8, (fold["p"], u[2])
     # μ = −0.1: the large cycle attracts forward in time, the small one
     # backward (x'' = a(x, −x') in reversed time); periods to 1e-8.
@@ -283,7 +281,7 @@ def test_neimark_sacker_points_of_forced_van_der_pol_against_shooting():
     # x'' − 0.2(1 − x²)x' + x = F cos ωt: the issue's point (0.94525643, 0.2).
     family = lambda F: (1.0, -0.2, 1.0, lambda x, v, th: 0.2 * x * x * v,
                         lambda th: F * np.cos(th))
-    points = hb.neimark_sacker_points(family, 0.5, 1.6, [0.2], n=9, samples=32)
+    points = hb.neimark_sacker_points(family, [0.2], 0.5, 1.6, n=9, samples=32)
     [pt] = [p for p in points if abs(p["omega"] - 0.945) < 0.01]
     # Shooting: Newton on [P(y) − y, det ∂P/∂y − 1] in (y, ω) (DOP853, rtol 1e-12).
     def period_map(w, y):
@@ -298,12 +296,7 @@ def test_neimark_sacker_points_of_forced_van_der_pol_against_shooting():
         return np.r_[period_map(w, y) - y, np.linalg.det(jac) - 1.0]
 
     c = pt["coeffs"]
-    u = np.array([hb.eval_series(c, 0.0), pt["omega"] * hb.eval_series(c, 0.0, order=1), pt["omega"]])
-    for _ in range(6):
-        jac = np.column_stack([(residual(u + h) - residual(u - h)) / 2e-5 for h in 1e-5 * np.eye(3)])
-        step = np.linalg.solve(jac, -residual(u))
-        u = u + step
-        if np.max(np.abs(step)) < 1e-12:
-            break
+    u = _newton(residual, np.array([hb.eval_series(c, 0.0),
+                                    pt["omega"] * hb.eval_series(c, 0.0, order=1), pt["omega"]]))
     assert abs(pt["omega"] - u[2]) < 1e-7, (pt["omega"], u[2])
     assert abs(pt["omega"] - 0.94525643) < 1e-8

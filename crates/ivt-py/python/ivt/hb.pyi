@@ -249,15 +249,15 @@ def cycle_branch(
 ) -> Dict[str, Any]: ...
 def neimark_sacker_points(
     family: Callable[[float], Sequence[Any]],
+    ps: Sequence[float],
     omega_from: float,
     omega_to: float,
-    ps: Sequence[float],
     n: int = 20,
     samples: int = 64,
-    velocity_dependent: bool = True,
-    vectorized: bool = False,
     rtol: float = 1e-9,
     max_iter: int = 100,
+    velocity_dependent: bool = True,
+    vectorized: bool = False,
 ) -> List[Dict[str, Any]]: ...
 def damped_modes(
     m: Matrix,
