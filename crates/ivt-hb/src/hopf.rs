@@ -340,6 +340,10 @@ fn complex_null_vector(a: &[f64], d: usize, omega: f64) -> Result<[Vec<f64>; 2],
     ])
 }
 
+/// The most grid intervals [`hopf_points`] accepts (each costs an
+/// equilibrium solve and an eigenvalue problem).
+pub const MAX_SAMPLES: usize = 100_000;
+
 /// The equilibria of `family(p)` from `x0` at `samples + 1` values of p
 /// from `p_from` to `p_to`, and the Hopf points between them (module docs).
 ///
@@ -357,10 +361,14 @@ where
     P: PeriodicProblem,
     F: Fn(f64) -> Result<P, HbError>,
 {
-    if !(p_from.is_finite() && p_to.is_finite() && p_from != p_to && samples > 0) {
-        return Err(HbError::InvalidInput(
-            "finite p_from ≠ p_to and at least one sample".into(),
-        ));
+    if !(p_from.is_finite()
+        && p_to.is_finite()
+        && p_from != p_to
+        && (1..=MAX_SAMPLES).contains(&samples))
+    {
+        return Err(HbError::InvalidInput(format!(
+            "finite p_from ≠ p_to and 1 to {MAX_SAMPLES} grid intervals"
+        )));
     }
     let state = |p: f64, x: &mut Vec<f64>| -> Result<usize, HbError> {
         let problem = family(p)?;
