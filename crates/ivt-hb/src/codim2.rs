@@ -23,6 +23,9 @@
 //! planned anew when `p` changes. `family(p)` returns a `Result`, so a family
 //! built from user callbacks can fail cleanly.
 
+mod ns_points;
+pub use ns_points::{neimark_sacker_points, NeimarkSackerPoint};
+
 use crate::continuation::{pseudo_arclength, ContinuationOptions, Path, Termination};
 use crate::error::HbError;
 use crate::galerkin::GalerkinJacobian;

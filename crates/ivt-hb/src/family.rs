@@ -13,7 +13,7 @@ use crate::continuation::{
 use crate::fold::{bilinear_lambda_difference, residual_lambda_difference, Branch};
 use crate::galerkin::{GalerkinForm, GalerkinJacobian};
 use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
-use crate::problem::PeriodicProblem;
+use crate::problem::{AtFrequency, PeriodicProblem};
 use crate::BroydenStats;
 use faer::{Mat, MatRef};
 
@@ -31,17 +31,19 @@ pub trait Family {
     }
 }
 
-/// The frequency family of one problem, `λ = ω_f` (frequency-response curves).
+/// The frequency family of one problem, `λ = ω_f` (frequency-response curves),
+/// the problem bound to each ω_f ([`AtFrequency`]: a model whose `g` or `f`
+/// reads ω_f is not [`Family::is_frequency`], its `∂R/∂λ` is differenced).
 #[derive(Debug, Clone, Copy)]
 pub struct Frequency<'a, P>(pub &'a P);
 
 impl<'a, P: PeriodicProblem> Family for Frequency<'a, P> {
-    type Problem = &'a P;
-    fn at(&self, lambda: f64) -> (&'a P, f64) {
-        (self.0, lambda)
+    type Problem = AtFrequency<'a, P>;
+    fn at(&self, lambda: f64) -> (AtFrequency<'a, P>, f64) {
+        (AtFrequency::new(self.0, lambda), lambda)
     }
     fn is_frequency(&self) -> bool {
-        true
+        !self.0.frequency_dependent()
     }
 }
 

@@ -14,7 +14,7 @@ use crate::family::{FamilyBranch, Frequency};
 use crate::fold::{locate_fold, FoldOptions};
 use crate::ihb::{HbError, HbOptions, HbSolution};
 use crate::modified::ModifiedIhb;
-use crate::problem::PeriodicProblem;
+use crate::problem::{AtFrequency, PeriodicProblem};
 use crate::stability::{AdaptiveHsu, HsuSteps, StabilityKind};
 use faer::c64;
 
@@ -132,7 +132,8 @@ pub fn frequency_response<P: PeriodicProblem>(
             "sweep bounds must be positive, finite and distinct".into(),
         ));
     }
-    let start: HbSolution = ModifiedIhb::new(problem, hb.clone())?.solve(opts.from, None)?;
+    let at_start = AtFrequency::new(problem, opts.from);
+    let start: HbSolution = ModifiedIhb::new(&at_start, hb.clone())?.solve(opts.from, None)?;
     let mut family = FamilyBranch::new(Frequency(problem), hb, opts.from)?;
     let m = start.coeffs.len();
     let mut x0 = start.coeffs.clone();
@@ -141,7 +142,7 @@ pub fn frequency_response<P: PeriodicProblem>(
     copts.lambda_min = opts.from.min(opts.to);
     copts.lambda_max = opts.from.max(opts.to);
     let direction = if opts.to > opts.from { 1.0 } else { -1.0 };
-    let mut hsu = AdaptiveHsu::new(problem, hb.harmonics, opts.stability)?;
+    let mut hsu = AdaptiveHsu::new(&at_start, hb.harmonics, opts.stability)?;
     let mut probe = AmplitudeProbe::new(hb)?;
     let mut points = Vec::new();
     let mut failed = None;
@@ -159,9 +160,9 @@ pub fn frequency_response<P: PeriodicProblem>(
             if failed.is_some() {
                 return;
             }
-            let (_, sol) = branch.solution(&p.x[..m], p.lambda());
+            let (at, sol) = branch.solution(&p.x[..m], p.lambda());
             let known = branch.jacobian_samples_at(&p.x);
-            match hsu.floquet_with_samples(problem, &sol, known) {
+            match hsu.floquet_with_samples(&at, &sol, known) {
                 Ok(fl) => points.push(FrcPoint {
                     omega_f: sol.omega_f,
                     amplitude: probe.of(&sol.coeffs),

@@ -13,6 +13,7 @@ pub mod classic;
 pub mod codim2;
 pub mod condense;
 pub mod continuation;
+pub mod cycle_branch;
 pub mod damped;
 pub mod deflation;
 pub mod elements;
@@ -24,6 +25,7 @@ pub mod fold;
 pub mod frc;
 pub mod galerkin;
 pub mod hill;
+pub mod hopf;
 mod hysteresis;
 pub mod ihb;
 pub mod jobs;
@@ -48,11 +50,12 @@ pub use broyden::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
 };
 pub use classic::ClassicIhb;
-pub use codim2::{fold_curve, FoldCurve, FoldPoint};
+pub use codim2::{fold_curve, neimark_sacker_points, FoldCurve, FoldPoint, NeimarkSackerPoint};
 pub use continuation::{
     pseudo_arclength, pseudo_arclength_exact, ContinuationOptions, Corrector, Fold, Path,
     PathPoint, PathSystem, Termination,
 };
+pub use cycle_branch::{cycle_branch, CycleBranch, CycleBranchOptions};
 pub use damped::{damped_modes, linear_mode, DampedModePoint, DampedModes};
 pub use deflation::{all_solutions, AllSolutions, FoundSolution, SearchOptions, SearchReport};
 pub use elements::{Element, ElementProblem, Harmonic, Law};
@@ -65,12 +68,13 @@ pub use fold::{locate_fold, Branch, FoldLocation, FoldOptions};
 pub use frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
 pub use galerkin::GalerkinJacobian;
 pub use hill::{fourier_blocks, hill_multipliers, HillResult};
+pub use hopf::{hopf_points, HopfPoint};
 pub use ihb::{HbOptions, HbResidual, HbSolution, HbSolver};
 pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;
 pub use problem::{
-    central_difference_samples, Duffing, GeneralProblem, MathieuDuffing, Nonlinearity,
-    PeriodicProblem, WithJacobian,
+    central_difference_samples, AtFrequency, Duffing, Excitation, FrequencyExcitation,
+    GeneralProblem, MathieuDuffing, Nonlinearity, PeriodicProblem, WithJacobian,
 };
 pub use stability::{
     classify, AdaptiveHsu, Floquet, HsuEstimate, HsuSteps, StabilityAnalyzer, StabilityKind,

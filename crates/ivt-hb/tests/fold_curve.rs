@@ -4,14 +4,13 @@
 //! HB): a fold is a fixed point of the period map with det(∂P/∂y − I) = 0;
 //! the cusp is the extremum of F along the curve of such points.
 
-use ivt_hb::aft::eval_series;
 use ivt_hb::{
     fold_curve, frequency_response, ContinuationOptions, Duffing, FrcOptions, HbError, HbOptions,
     Termination,
 };
 
 mod common;
-use common::shooting::{period_map, period_map_jacobian, solve3};
+use common::shooting::{newton3, orbit_state as state, period_map, period_map_jacobian};
 
 /// `[P(y) − y, det(∂P/∂y − I)]` (∂P/∂y by central differences).
 fn fold_residual(force: f64, omega: f64, y: [f64; 2]) -> [f64; 3] {
@@ -22,41 +21,6 @@ fn fold_residual(force: f64, omega: f64, y: [f64; 2]) -> [f64; 3] {
         p[0] - y[0],
         p[1] - y[1],
         j[0][0] * j[1][1] - j[0][1] * j[1][0],
-    ]
-}
-
-/// Newton with a central-difference Jacobian on three unknowns `u` of
-/// `residual(u) = 0`.
-fn newton3(residual: impl Fn([f64; 3]) -> [f64; 3], mut u: [f64; 3]) -> [f64; 3] {
-    for _ in 0..30 {
-        let r = residual(u);
-        let mut j = [[0.0; 3]; 3];
-        for k in 0..3 {
-            let h = 1e-5 * u[k].abs().max(0.1);
-            let (mut up, mut um) = (u, u);
-            up[k] += h;
-            um[k] -= h;
-            let (a, b) = (residual(up), residual(um));
-            for i in 0..3 {
-                j[i][k] = (a[i] - b[i]) / (2.0 * h);
-            }
-        }
-        let d = solve3(j, [-r[0], -r[1], -r[2]]);
-        for k in 0..3 {
-            u[k] += d[k];
-        }
-        if d.iter().all(|x| x.abs() < 1e-12) {
-            return u;
-        }
-    }
-    u
-}
-
-/// The orbit's state (x(0), ẋ(0)) from its coefficients at ω.
-fn state(coeffs: &[f64], omega: f64) -> [f64; 2] {
-    [
-        eval_series(coeffs, 0.0, 0),
-        omega * eval_series(coeffs, 0.0, 1),
     ]
 }
 

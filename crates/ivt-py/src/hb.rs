@@ -6,7 +6,7 @@
 //! (the keys of the CLI's JSON, [`crate::to_python`]).
 
 use ivt_hb::jobs::{self, CascadeRequest, FrcRequest, LimitCycleRequest, OrbitRequest};
-use ivt_hb::{Duffing, MathieuDuffing};
+use ivt_hb::{AtFrequency, Duffing, MathieuDuffing};
 use numpy::PyArrayLike1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -230,7 +230,10 @@ fn solve<'py>(py, user, jac;
 ) {
     let (problem, opts) = user.setup(f, subharmonic, tol)?;
     let req = orbit_request(py, omega_f, method, guess, stability)?;
-    let orbit = run_user(py, &problem, |p| jobs::orbit(p, &opts, &req))?;
+    // Bound to ω_f: a `g` or `f` that reads `omega` gets it.
+    let orbit = run_user(py, &problem, |p| {
+        jobs::orbit(&AtFrequency::new(p, req.omega_f), &opts, &req)
+    })?;
     to_dict(py, &orbit)
 }
 }
@@ -329,6 +332,7 @@ pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     crate::hb_paths::register(&m)?;
     crate::hb_analyses::register(&m)?;
     crate::hb_folds::register(&m)?;
+    crate::hb_bifurcation::register(&m)?;
     crate::hb_large::register(&m)?;
     crate::hb_string::register(&m)?;
     crate::hb_elements::register(&m)?;

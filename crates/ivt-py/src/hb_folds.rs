@@ -4,28 +4,15 @@
 //! user family `family(p) -> (m, c, k, g, f)` or on Duffing's equation in F.
 
 use ivt_hb::jobs::{self, FoldCurveRequest, FoldStart};
-use ivt_hb::{Duffing, HbError};
+use ivt_hb::Duffing;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::sync::Mutex;
 
 use crate::args::{count, int64};
-use crate::hb_shared::{finite, options, run, run_user, UserArgs};
+use crate::hb_bifurcation::PyFamily;
+use crate::hb_shared::{finite, options, run, run_user};
 use crate::to_python::to_dict;
-use crate::user_problem::{user_problem, PyProblem};
-
-/// The user system `family(p)` returns: a tuple (m, c, k, g, f).
-fn family_system<'py>(family: &Bound<'py, PyAny>, p: f64) -> PyResult<[Bound<'py, PyAny>; 5]> {
-    let t = family.call1((p,))?;
-    let parts: Vec<Bound<'py, PyAny>> = t.extract().map_err(|_| {
-        PyTypeError::new_err("argument `family` must return a tuple (m, c, k, g, f)")
-    })?;
-    let [m, c, k, g, f]: [Bound<'py, PyAny>; 5] = parts.try_into().map_err(|_| {
-        PyTypeError::new_err("argument `family` must return a tuple (m, c, k, g, f)")
-    })?;
-    Ok([m, c, k, g, f])
-}
 
 /// The start fold of `continue_bifurcation`: ω and coefficients of a fold
 /// dict (`kind` "fold" when given).
@@ -104,44 +91,10 @@ fn continue_bifurcation<'py>(
         ds_max,
         max_points: count("max_points", max_points)?,
     };
-    let [m, c, k, g, f] = family_system(family, p_start)?;
-    let user = UserArgs {
-        system: [&m, &c, &k, &g],
-        n,
-        samples,
-        velocity_dependent,
-        vectorized,
-        rtol,
-        max_iter,
-        jac: None,
-    };
-    let (first, opts) = user.setup(Some(&f), 1, 0.0)?;
-    let family: Py<PyAny> = family.clone().unbind();
-    let failure: Mutex<Option<PyErr>> = Mutex::new(None);
-    let build = |p: f64| -> Result<PyProblem, HbError> {
-        Python::attach(|py| {
-            let [m, c, k, g, f] = family_system(family.bind(py), p)?;
-            user_problem(
-                &m,
-                &c,
-                &k,
-                &g,
-                Some(&f),
-                None,
-                velocity_dependent,
-                vectorized,
-            )
-        })
-        .map_err(|e| {
-            let message = e.to_string();
-            if let Ok(mut slot) = failure.lock() {
-                slot.get_or_insert(e);
-            }
-            HbError::InvalidInput(format!("family(p) failed: {message}"))
-        })
-    };
-    let curve = run_user(py, &first, |_| jobs::fold_curve(build, &opts, &req));
-    if let Some(e) = failure.lock().ok().and_then(|mut s| s.take()) {
+    let fam = PyFamily::new(family, velocity_dependent, vectorized);
+    let (first, opts) = fam.first(py, p_start, n, samples, rtol, max_iter)?;
+    let curve = run_user(py, &first, |_| jobs::fold_curve(|p| fam.build(p), &opts, &req));
+    if let Some(e) = fam.take_error() {
         return Err(e);
     }
     to_dict(py, &curve?)

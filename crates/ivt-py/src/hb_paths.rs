@@ -23,6 +23,10 @@ user_system_fn! {
 /// be an `ivt.hb.elements` composition); `vectorized=True`: g(x, v, theta) gets
 /// x, v of shape (N, n_dof) and theta of shape (N,) (all 2·samples AFT
 /// samples at once, or another grid, see `solve`) and returns (N, n_dof).
+/// A `g` or `f` with a parameter named `omega` (`g(x, v, theta, omega)`,
+/// `f(theta, omega)`: a rotating unbalance, a frequency-dependent load) gets
+/// ω_f as that keyword, and the path's ∂R/∂ω_f includes its ω-dependence
+/// (`jac` must then be None).
 /// Returns the job's [`ivt_hb::jobs::FrcCurve`]: {"points": [{"omega",
 /// "coeffs", "amplitude", "multipliers", "multiplier_error", "stable",
 /// "stability", "kind"}...], "folds": [{"omega",

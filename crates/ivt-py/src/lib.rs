@@ -27,6 +27,7 @@ mod fields;
 mod gears;
 mod hb;
 mod hb_analyses;
+mod hb_bifurcation;
 mod hb_elements;
 mod hb_folds;
 mod hb_large;

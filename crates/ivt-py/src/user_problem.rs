@@ -5,21 +5,93 @@
 //! system is an ivt-hb [`GeneralProblem`]; this module adds the Python calls
 //! and the capture of the first exception a callback raised. An optional
 //! Python `jac` ([`PyJacobian`]) replaces the differences of a Python `g`;
-//! elements bring their own analytic Jacobian.
+//! elements bring their own analytic Jacobian. `g` and `f` may read the
+//! excitation frequency: a parameter named `omega` in their signature gets ω_f
+//! as a keyword (ivt-hb's frequency-dependent models, [`reads_omega`]).
 
 use crate::callback_arrays::{float_array, SampleArrays};
 use crate::error_slot::{failed, record, ErrorSlot};
 use crate::hb_elements::Elements;
 use crate::user_jacobian::PyJacobian;
 use ivt_hb::problem::{per_sample, Nonlinearity};
-use ivt_hb::{ElementProblem, GeneralProblem, HbOptions, PeriodicProblem};
+use ivt_hb::{ElementProblem, Excitation, GeneralProblem, HbOptions, PeriodicProblem};
 use numpy::{IntoPyArray, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use std::sync::Arc;
 
-/// The excitation `f(θ)` of a user system (a Python callable or none).
-type PyExcitation = Box<dyn Fn(f64, &mut [f64]) + Send + Sync>;
+/// The excitation `f(θ)` or `f(θ, omega=ω_f)` of a user system (a Python
+/// callable or none) and the error slot.
+pub(crate) struct PyExcitation {
+    f: Option<Py<PyAny>>,
+    omega: bool,
+    error: ErrorSlot,
+}
+
+impl Excitation for PyExcitation {
+    fn eval(&self, theta: f64, out: &mut [f64]) {
+        self.eval_with(theta, None, out)
+    }
+    fn eval_at(&self, theta: f64, omega_f: f64, out: &mut [f64]) {
+        self.eval_with(theta, Some(omega_f), out)
+    }
+    fn frequency_dependent(&self) -> bool {
+        self.omega
+    }
+}
+
+impl PyExcitation {
+    /// `f(θ)`, with `omega=ω_f` when `f` reads it (NaN and an error without ω_f).
+    fn eval_with(&self, theta: f64, omega_f: Option<f64>, out: &mut [f64]) {
+        let Some(f) = &self.f else {
+            return out.fill(0.0);
+        };
+        let omega = self.omega.then_some(omega_f);
+        call_into(
+            &self.error,
+            f,
+            |py| pyo3::types::PyTuple::new(py, [theta]),
+            omega,
+            out,
+        )
+    }
+}
+
+/// The excitation frequency a callback that reads `omega` is given:
+/// `None` when it does not read it, `Some(None)` when it does but the caller
+/// has no ω_f (an error: only `frc` and `solve` pass it).
+type OmegaArg = Option<Option<f64>>;
+
+/// Whether the callable has a parameter named `omega` (then it is called with
+/// `omega=ω_f`); `false` when its signature cannot be read.
+fn reads_omega(func: &Bound<'_, PyAny>) -> bool {
+    let py = func.py();
+    py.import("inspect")
+        .and_then(|m| m.call_method1("signature", (func,)))
+        .and_then(|sig| sig.getattr("parameters"))
+        .and_then(|params| params.contains("omega"))
+        .unwrap_or(false)
+}
+
+/// `omega=ω_f` as keywords, or the error of a callback that reads `omega`
+/// called where there is no excitation frequency.
+fn omega_kwargs(
+    py: Python<'_>,
+    omega: OmegaArg,
+) -> PyResult<Option<Bound<'_, pyo3::types::PyDict>>> {
+    match omega {
+        None => Ok(None),
+        Some(None) => Err(PyValueError::new_err(
+            "a callback reads `omega`, but this function has no excitation frequency \
+             (only `frc` and `solve` pass omega)",
+        )),
+        Some(Some(w)) => {
+            let kw = pyo3::types::PyDict::new(py);
+            kw.set_item("omega", w)?;
+            Ok(Some(kw))
+        }
+    }
+}
 
 /// The nonlinearity of a user system: a Python callable (with its Python
 /// Jacobian, if given), or Rust elements (an [`ElementProblem`] without
@@ -56,6 +128,15 @@ impl Nonlinearity for UserG {
         }
         true
     }
+    fn frequency_dependent(&self) -> bool {
+        matches!(&self.law, UserLaw::Python(g, _) if g.omega)
+    }
+    fn eval_samples_at(&self, x: &[f64], v: &[f64], theta: &[f64], w: f64, out: &mut [f64]) {
+        match &self.law {
+            UserLaw::Python(g, _) => g.eval_with(x, v, theta, Some(w), out),
+            UserLaw::Elements(e) => e.nonlinear_samples(x, v, theta, out),
+        }
+    }
 }
 
 /// A user system: the ivt-hb general problem (∂g from `jac` or the elements,
@@ -69,16 +150,19 @@ pub(crate) struct PyNonlinearity {
     g: Py<PyAny>,
     n: usize,
     vectorized: bool,
+    /// `g` reads `omega` ([`reads_omega`]).
+    omega: bool,
     arrays: SampleArrays,
     error: ErrorSlot,
 }
 
-/// Calls `func(*args)` and writes its `out.len()` floats into `out` (NaN and the
+/// Calls `func(*args)` (with `omega=ω_f`, see [`OmegaArg`]) and writes its `out.len()` floats into `out` (NaN and the
 /// exception recorded on error).
 fn call_into(
     slot: &ErrorSlot,
     func: &Py<PyAny>,
     args: impl FnOnce(Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyTuple>>,
+    omega: OmegaArg,
     out: &mut [f64],
 ) {
     if failed(slot) {
@@ -87,7 +171,9 @@ fn call_into(
     }
     let n = out.len();
     let r = Python::attach(|py| -> PyResult<()> {
-        let res = func.bind(py).call1(args(py)?)?;
+        let res = func
+            .bind(py)
+            .call(args(py)?, omega_kwargs(py, omega)?.as_ref())?;
         let v: Vec<f64> = if let Ok(x) = res.extract::<f64>() {
             vec![x]
         } else {
@@ -110,7 +196,14 @@ fn call_into(
 
 impl PyNonlinearity {
     /// One call of a vectorized `g` on `theta.len()` samples (sample-major).
-    fn call_vectorized(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+    fn call_vectorized(
+        &self,
+        x: &[f64],
+        v: &[f64],
+        theta: &[f64],
+        omega: OmegaArg,
+        out: &mut [f64],
+    ) {
         if failed(&self.error) {
             out.fill(f64::NAN);
             return;
@@ -118,7 +211,8 @@ impl PyNonlinearity {
         let (n, ns) = (self.n, theta.len());
         let r = Python::attach(|py| -> PyResult<()> {
             let [xs, vs, ths] = self.arrays.args(py, n, x, v, theta)?;
-            let res = self.g.bind(py).call1((xs, vs, ths))?;
+            let kw = omega_kwargs(py, omega)?;
+            let res = self.g.bind(py).call((xs, vs, ths), kw.as_ref())?;
             let (shape, values) = float_array(&res).ok_or_else(|| {
                 PyTypeError::new_err("vectorized `g` must return an array of floats")
             })?;
@@ -137,12 +231,29 @@ impl PyNonlinearity {
     }
 }
 
-impl Nonlinearity for PyNonlinearity {
-    fn eval(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
+impl PyNonlinearity {
+    /// `g` on all samples, with `omega=ω_f` when it reads it (`omega_f`:
+    /// the caller's excitation frequency, if it has one).
+    fn eval_with(
+        &self,
+        x: &[f64],
+        v: &[f64],
+        theta: &[f64],
+        omega_f: Option<f64>,
+        out: &mut [f64],
+    ) {
+        let omega = self.omega.then_some(omega_f);
         if self.vectorized {
-            self.call_vectorized(x, v, &[theta], out);
-            return;
+            self.call_vectorized(x, v, theta, omega, out);
+        } else {
+            per_sample(self.n, x, v, theta, out, |x, v, th, out| {
+                self.call_one(x, v, th, omega, out)
+            });
         }
+    }
+
+    /// One call of a per-sample `g`.
+    fn call_one(&self, x: &[f64], v: &[f64], theta: f64, omega: OmegaArg, out: &mut [f64]) {
         call_into(
             &self.error,
             &self.g,
@@ -156,17 +267,18 @@ impl Nonlinearity for PyNonlinearity {
                     ],
                 )
             },
+            omega,
             out,
         );
     }
+}
+
+impl Nonlinearity for PyNonlinearity {
+    fn eval(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
+        self.eval_with(x, v, &[theta], None, out)
+    }
     fn eval_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
-        if self.vectorized {
-            self.call_vectorized(x, v, theta, out);
-        } else {
-            per_sample(self.n, x, v, theta, out, |x, v, th, out| {
-                self.eval(x, v, th, out)
-            });
-        }
+        self.eval_with(x, v, theta, None, out)
     }
 }
 
@@ -256,14 +368,16 @@ pub(crate) fn user_problem(
         }
     }
     let error = ErrorSlot::default();
-    let excitation: PyExcitation = match f {
-        Some(f) => {
-            let (f, slot) = (f.clone().unbind(), Arc::clone(&error));
-            Box::new(move |theta, out| {
-                call_into(&slot, &f, |py| pyo3::types::PyTuple::new(py, [theta]), out)
-            })
-        }
-        None => Box::new(|_, out| out.fill(0.0)),
+    let g_omega = elements.is_none() && reads_omega(g);
+    if g_omega && jac.is_some() {
+        return Err(PyTypeError::new_err(
+            "argument `jac` must be None when `g` reads `omega` (its differences are taken at each omega)",
+        ));
+    }
+    let excitation = PyExcitation {
+        f: f.map(|f| f.clone().unbind()),
+        omega: f.is_some_and(reads_omega),
+        error: Arc::clone(&error),
     };
     let (g, velocity_dependent) = match elements {
         Some(list) => {
@@ -278,6 +392,7 @@ pub(crate) fn user_problem(
                     g: g.clone().unbind(),
                     n: nm,
                     vectorized,
+                    omega: g_omega,
                     arrays: SampleArrays::default(),
                     error: Arc::clone(&error),
                 },
@@ -289,7 +404,10 @@ pub(crate) fn user_problem(
         ),
     };
     let g = UserG { law: g, error };
-    Ok(GeneralProblem::new(nm, m, c, k, g, excitation).with_velocity_dependent(velocity_dependent))
+    let unforced = |_: f64, out: &mut [f64]| out.fill(0.0);
+    Ok(GeneralProblem::new(nm, m, c, k, g, unforced)
+        .with_excitation(excitation)
+        .with_velocity_dependent(velocity_dependent))
 }
 
 /// The first exception a callback raised during a run, if any.

@@ -174,3 +174,129 @@ def test_continue_bifurcation_reraises_the_family_error():
         hb.continue_bifurcation(family, start, 0.0, 0.3, p_start=0.1, n=15)
     with pytest.raises(ValueError, match="p_start"):
         hb.continue_bifurcation(family, start, 0.0, 0.3, n=15)
+
+
+def _newton(residual, u, steps=8):
+    """Newton on residual(u) = 0 from u, central-difference Jacobian (step
+    1e-5), until a step is below 1e-12."""
+    for _ in range(steps):
+        jac = np.column_stack([(residual(u + h) - residual(u - h)) / 2e-5
+                               for h in 1e-5 * np.eye(len(u))])
+        step = np.linalg.solve(jac, -residual(u))
+        u = u + step
+        if np.max(np.abs(step)) < 1e-12:
+            break
+    return u
+
+
+def _unbalance_fold_by_shooting(omega0, y0):
+    """The fold of u'' + 0.04u' + u + u³ = 0.03 ω² cos ωt near (ω0, y0) by
+    shooting: Newton on [P(y) − y, det(∂P/∂y − I)] in (y, ω), the period map P
+    by DOP853 (rtol 1e-12), every Jacobian by central differences."""
+    def period_map(omega, y):
+        rhs = lambda t, y: [y[1], 0.03 * omega ** 2 * np.cos(omega * t) - 0.04 * y[1]
+                            - y[0] - y[0] ** 3]
+        return solve_ivp(rhs, (0, 2 * np.pi / omega), y, method="DOP853", rtol=1e-12,
+                         atol=1e-12).y[:, -1]
+
+    def residual(u):
+        y, omega = u[:2], u[2]
+        h = 1e-6
+        jac = np.column_stack([(period_map(omega, y + h * e) - period_map(omega, y - h * e))
+                               / (2 * h) for e in np.eye(2)]) - np.eye(2)
+        return np.r_[period_map(omega, y) - y, np.linalg.det(jac)]
+
+    return _newton(residual, np.r_[y0, omega0])[2]
+
+
+@pytest.mark.parametrize("vectorized", [False, True])
+def test_frc_with_an_omega_dependent_force_matches_shooting(vectorized):
+    # Rotating unbalance: f(θ, ω) = 0.03 ω² cos θ; ω is detected from the signature.
+    g = lambda x, v, theta: x ** 3
+    f = lambda theta, omega: 0.03 * omega ** 2 * np.cos(theta)
+    curve = hb.frc(1.0, 0.04, 1.0, g, f, 0.5, 2.5, n=15, vectorized=vectorized,
+                   velocity_dependent=False)
+    folds = [b for b in curve["bifurcations"] if b["kind"] == "fold"]
+    assert len(folds) == 2 and all(b["located"] for b in folds)
+    for b in folds:
+        y0 = [hb.eval_series(b["coeffs"], 0.0), b["omega"] * hb.eval_series(b["coeffs"], 0.0, order=1)]
+        reference = _unbalance_fold_by_shooting(b["omega"], y0)
+        assert abs(b["omega"] - reference) < 1e-7, (b["omega"], reference)
+
+
+def test_omega_in_g_is_passed_and_refused_where_there_is_no_frequency():
+    # g(x, v, θ, ω) = x³ + 0.04 ω x: solve at ω passes omega (the orbit
+    # equals that of the fixed law at that ω), limit_cycle has none to pass.
+    g = lambda x, v, theta, omega: x ** 3 + 0.04 * omega * x
+    fixed = lambda x, v, theta: x ** 3 + 0.04 * 1.3 * x
+    f = lambda theta: 0.1 * np.cos(theta)
+    a = hb.solve(1.0, 0.04, 1.0, g, 1.3, f=f, n=9)
+    b = hb.solve(1.0, 0.04, 1.0, fixed, 1.3, f=f, n=9)
+    assert np.max(np.abs(np.asarray(a["coeffs"]) - b["coeffs"])) < 1e-10
+    with pytest.raises(ValueError, match="omega"):
+        hb.limit_cycle(1.0, -1.0, 1.0, lambda x, v, theta, omega: x * x * v, 1.0)
+    with pytest.raises(TypeError, match="jac"):
+        hb.frc(1.0, 0.04, 1.0, g, f, 0.5, 2.5, jac=lambda x, v, th: (3 * x * x, 0 * v))
+
+
+def _hopf_family(mu):
+    """x'' − (μ + x² − x⁴) x' + x = 0 as (m, c, k, g, f)."""
+    return 1.0, -mu, 1.0, lambda x, v, th: -(x * x - x ** 4) * v, None
+
+
+def _cycle_gap(mu, x0, period):
+    """y(T) − (x0, 0) of x'' = (μ + x² − x⁴) x' − x from (x0, 0) (DOP853, rtol 1e-12)."""
+    rhs = lambda t, y: [y[1], (mu + y[0] ** 2 - y[0] ** 4) * y[1] - y[0]]
+    y = solve_ivp(rhs, (0, period), [x0, 0.0], method="DOP853", rtol=1e-12, atol=1e-12).y[:, -1]
+    return np.array([y[0] - x0, y[1]])
+
+
+def test_cycle_branch_hopf_fold_and_the_two_cycles_against_time_integration():
+    out = hb.cycle_branch(_hopf_family, -0.2, 0.1, at=[-0.1], n=25, samples=128)
+    [hopf] = out["hopf"]
+    assert abs(hopf["p"]) < 1e-12 and abs(hopf["omega"] - 1.0) < 1e-12
+    assert hopf["subcritical"] and hopf["lyapunov"] > 0
+    [fold] = out["bifurcations"]
+    # The fold by shooting: Newton on [y(T) − y0, det ∂(y(T) − y0)/∂(x0, T)] in (x0, T, μ).
+    def residual(u):
+        gap = _cycle_gap(u[2], u[0], u[1])
+        j = np.column_stack([(_cycle_gap(u[2], *(u[:2] + h)) - _cycle_gap(u[2], *(u[:2] - h))) / 2e-6
+                             for h in 1e-6 * np.eye(2)])
+        return np.r_[gap, np.linalg.det(j)]
+    x0 = max(hb.eval_series(fold["coeffs"], t) for t in np.linspace(0, 2 * np.pi, 4001))
+    u = _newton(residual, np.array([x0, 2 * np.pi / fold["omega"], fold["p"]]))
+    assert abs(fold["p"] - u[2]) < 1e-8, (fold["p"], u[2])
+    # μ = −0.1: the large cycle attracts forward in time, the small one
+    # backward (x'' = a(x, −x') in reversed time); periods to 1e-8.
+    small, large = sorted(out["at"], key=lambda c: c["amplitude"])
+    accel = lambda x, v: (-0.1 + x * x - x ** 4) * v - x
+    assert large["stable"] and not small["stable"]
+    t_large = _period_by_integration(accel, y0=(1.5, 0.0))
+    t_small = _period_by_integration(lambda x, w: accel(x, -w), y0=(0.9, 0.0))
+    assert abs(large["period"] - t_large) < 1e-8 * t_large, (large["period"], t_large)
+    assert abs(small["period"] - t_small) < 1e-8 * t_small, (small["period"], t_small)
+
+
+def test_neimark_sacker_points_of_forced_van_der_pol_against_shooting():
+    # x'' − 0.2(1 − x²)x' + x = F cos ωt: the issue's point (0.94525643, 0.2).
+    family = lambda F: (1.0, -0.2, 1.0, lambda x, v, th: 0.2 * x * x * v,
+                        lambda th: F * np.cos(th))
+    points = hb.neimark_sacker_points(family, [0.2], 0.5, 1.6, n=9, samples=32)
+    [pt] = [p for p in points if abs(p["omega"] - 0.945) < 0.01]
+    # Shooting: Newton on [P(y) − y, det ∂P/∂y − 1] in (y, ω) (DOP853, rtol 1e-12).
+    def period_map(w, y):
+        rhs = lambda t, y: [y[1], 0.2 * (1 - y[0] ** 2) * y[1] - y[0] + 0.2 * np.cos(w * t)]
+        return solve_ivp(rhs, (0, 2 * np.pi / w), y, method="DOP853", rtol=1e-12,
+                         atol=1e-12).y[:, -1]
+
+    def residual(u):
+        y, w = u[:2], u[2]
+        jac = np.column_stack([(period_map(w, y + h) - period_map(w, y - h)) / 2e-6
+                               for h in 1e-6 * np.eye(2)])
+        return np.r_[period_map(w, y) - y, np.linalg.det(jac) - 1.0]
+
+    c = pt["coeffs"]
+    u = _newton(residual, np.array([hb.eval_series(c, 0.0),
+                                    pt["omega"] * hb.eval_series(c, 0.0, order=1), pt["omega"]]))
+    assert abs(pt["omega"] - u[2]) < 1e-7, (pt["omega"], u[2])
+    assert abs(pt["omega"] - 0.94525643) < 1e-8

@@ -13,7 +13,7 @@ use crate::events::{trace, Event, TraceOptions};
 use crate::family::{FamilyBranch, Frequency};
 use crate::frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
 use crate::ihb::HbOptions;
-use crate::problem::PeriodicProblem;
+use crate::problem::{AtFrequency, PeriodicProblem};
 use crate::stability::StabilityKind;
 use crate::ModifiedIhb;
 use serde::Serialize;
@@ -173,7 +173,8 @@ pub fn frc<P: PeriodicProblem>(
     let t0 = Instant::now();
     let defaults = FrcOptions::default();
     let (curve, events) = if req.events {
-        let start = ModifiedIhb::new(problem, hb.clone())?.solve(req.from, None)?;
+        let at_start = AtFrequency::new(problem, req.from);
+        let start = ModifiedIhb::new(&at_start, hb.clone())?.solve(req.from, None)?;
         let opts = TraceOptions {
             lambda_to: req.to,
             continuation: defaults.continuation,

@@ -2,6 +2,7 @@
 //! central-difference Jacobian, and the RK4 period map of the thesis Duffing
 //! (Eq. 49) for the fold-curve and all-solutions tests.
 
+use ivt_hb::aft::eval_series;
 use ivt_hb::ode::{first_order, rk4};
 use ivt_hb::Duffing;
 use std::f64::consts::PI;
@@ -80,6 +81,33 @@ pub fn newton_step(j: [[f64; 2]; 2], r: [f64; 2]) -> [f64; 2] {
     ]
 }
 
+/// Newton with a central-difference Jacobian on three unknowns `u` of
+/// `residual(u) = 0`.
+pub fn newton3(residual: impl Fn([f64; 3]) -> [f64; 3], mut u: [f64; 3]) -> [f64; 3] {
+    for _ in 0..30 {
+        let r = residual(u);
+        let mut j = [[0.0; 3]; 3];
+        for k in 0..3 {
+            let h = 1e-5 * u[k].abs().max(0.1);
+            let (mut up, mut um) = (u, u);
+            up[k] += h;
+            um[k] -= h;
+            let (a, b) = (residual(up), residual(um));
+            for i in 0..3 {
+                j[i][k] = (a[i] - b[i]) / (2.0 * h);
+            }
+        }
+        let d = solve3(j, [-r[0], -r[1], -r[2]]);
+        for k in 0..3 {
+            u[k] += d[k];
+        }
+        if d.iter().all(|x| x.abs() < 1e-12) {
+            return u;
+        }
+    }
+    u
+}
+
 /// Cramer's rule for a 3×3 system.
 pub fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
     let det = |m: [[f64; 3]; 3]| {
@@ -97,4 +125,26 @@ pub fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
         x[k] = det(m) / d;
     }
     x
+}
+
+/// The orbit's state (x(0), ẋ(0)) from its coefficients at ω.
+pub fn orbit_state(coeffs: &[f64], omega: f64) -> [f64; 2] {
+    [
+        eval_series(coeffs, 0.0, 0),
+        omega * eval_series(coeffs, 0.0, 1),
+    ]
+}
+
+/// `y(t_end)` of the planar system `y' = rhs(t, y)` from `y0` at t = 0 (RK4,
+/// `steps` steps).
+pub fn flow(
+    rhs: impl Fn(f64, [f64; 2]) -> [f64; 2],
+    y0: [f64; 2],
+    t_end: f64,
+    steps: usize,
+) -> [f64; 2] {
+    let mut y = y0;
+    let f = |t: f64, y: &[f64], dy: &mut [f64]| dy.copy_from_slice(&rhs(t, [y[0], y[1]]));
+    rk4(f, 0.0, &mut y, t_end / steps as f64, steps);
+    y
 }

@@ -30,6 +30,7 @@ __all__ = [
     "all_solutions",
     "backbone",
     "continue_bifurcation",
+    "cycle_branch",
     "damped_modes",
     "duffing",
     "duffing_folds",
@@ -39,6 +40,7 @@ __all__ = [
     "limit_cycle",
     "mathieu_cascade",
     "mathieu_duffing",
+    "neimark_sacker_points",
     "solve",
     "string",
 ]

@@ -14,9 +14,21 @@ from ._types import ArrayLike, FloatArray
 
 Method = Literal["modified", "classic"]
 Matrix = Union[float, npt.ArrayLike]
-Callback = Callable[[FloatArray, FloatArray, float], Union[float, Sequence[float], FloatArray]]
-VectorizedCallback = Callable[[FloatArray, FloatArray, FloatArray], npt.ArrayLike]
-Forcing = Callable[[float], Union[float, Sequence[float], FloatArray]]
+# ``g`` and ``f`` may also take the excitation frequency as a parameter named
+# ``omega`` (passed by ``frc`` and ``solve``): ``g(x, v, theta, omega)``,
+# ``f(theta, omega)``.
+Callback = Union[
+    Callable[[FloatArray, FloatArray, float], Union[float, Sequence[float], FloatArray]],
+    Callable[[FloatArray, FloatArray, float, float], Union[float, Sequence[float], FloatArray]],
+]
+VectorizedCallback = Union[
+    Callable[[FloatArray, FloatArray, FloatArray], npt.ArrayLike],
+    Callable[[FloatArray, FloatArray, FloatArray, float], npt.ArrayLike],
+]
+Forcing = Union[
+    Callable[[float], Union[float, Sequence[float], FloatArray]],
+    Callable[[float, float], Union[float, Sequence[float], FloatArray]],
+]
 # Large models (issue 28): scipy.sparse matrices (untyped here) and load
 # vectors F (F cos θ) or (F_cos, F_sin).
 SparseMatrix = Any
@@ -231,6 +243,35 @@ def continue_bifurcation(
     ds_max: float = 0.05,
     max_points: int = 2000,
 ) -> Dict[str, Any]: ...
+def cycle_branch(
+    family: Callable[[float], Sequence[Any]],
+    p_from: float,
+    p_to: float,
+    at: Sequence[float] = ...,
+    n: int = 20,
+    samples: int = 64,
+    velocity_dependent: bool = True,
+    vectorized: bool = False,
+    grid: int = 100,
+    rtol: float = 1e-9,
+    max_iter: int = 100,
+    ds: float = 0.02,
+    ds_max: float = 0.05,
+    max_points: int = 2000,
+    offset: float = 1e-2,
+) -> Dict[str, Any]: ...
+def neimark_sacker_points(
+    family: Callable[[float], Sequence[Any]],
+    ps: Sequence[float],
+    omega_from: float,
+    omega_to: float,
+    n: int = 20,
+    samples: int = 64,
+    rtol: float = 1e-9,
+    max_iter: int = 100,
+    velocity_dependent: bool = True,
+    vectorized: bool = False,
+) -> List[Dict[str, Any]]: ...
 def damped_modes(
     m: Matrix,
     c: Matrix,

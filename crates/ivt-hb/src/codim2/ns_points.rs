@@ -1,0 +1,69 @@
+//! The Neimark–Sacker boundary of a forced family in (ω, p), sampled: at each
+//! requested p the frequency-response curve of `family(p)` is traced with
+//! its events ([`crate::jobs::frc`]) and each of its Neimark–Sacker points
+//! is located on the engine's extended system ([`crate::bifurcation`]: a
+//! pair of Floquet multipliers on the unit circle). Not a continuation of the curve: a turn of the boundary
+//! in p between two samples is not followed, and each sample costs a trace.
+
+use crate::bifurcation::BifurcationKind;
+use crate::continuation::Corrector;
+use crate::error::HbError;
+use crate::ihb::HbOptions;
+use crate::jobs::{frc, FrcRequest};
+use crate::problem::PeriodicProblem;
+use faer::c64;
+
+/// A located Neimark–Sacker point of the FRC at one p.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NeimarkSackerPoint {
+    /// The second parameter.
+    pub p: f64,
+    /// Excitation frequency ω_f.
+    pub omega: f64,
+    /// Fourier coefficients of the orbit.
+    pub coeffs: Vec<f64>,
+    /// Its Floquet multipliers (the critical pair on the unit circle first).
+    pub multipliers: Vec<c64>,
+}
+
+/// The located Neimark–Sacker points of the FRC of `family(p)` from
+/// `omega_from` to `omega_to`, for each p of `ps`, in order (module docs).
+/// A point whose location failed is left out.
+///
+/// # Errors
+/// `family`'s error; the start or trace failures of each FRC.
+pub fn neimark_sacker_points<P, F>(
+    family: F,
+    hb: &HbOptions,
+    omega_from: f64,
+    omega_to: f64,
+    ps: &[f64],
+) -> Result<Vec<NeimarkSackerPoint>, HbError>
+where
+    P: PeriodicProblem,
+    F: Fn(f64) -> Result<P, HbError>,
+{
+    let mut found = Vec::new();
+    let req = FrcRequest {
+        from: omega_from,
+        to: omega_to,
+        events: true,
+        corrector: Corrector::Newton,
+    };
+    for &p in ps {
+        let curve = frc(&family(p)?, hb, &req)?;
+        for e in curve.bifurcations {
+            if let (BifurcationKind::NeimarkSacker, true, Some(omega), Some(q), Some(mu)) =
+                (e.kind, e.located, e.omega, e.coeffs, e.multipliers)
+            {
+                found.push(NeimarkSackerPoint {
+                    p,
+                    omega,
+                    coeffs: q.0,
+                    multipliers: mu.iter().map(|[re, im]| c64::new(*re, *im)).collect(),
+                });
+            }
+        }
+    }
+    Ok(found)
+}

@@ -1,0 +1,318 @@
+//! The limit cycles born at a Hopf point, followed in the parameter
+//! (issue 27, item 2): [`cycle_branch`] finds the Hopf points of the
+//! equilibria of an autonomous family ([`crate::hopf`]), starts the cycle
+//! branch from the first one by its normal form, and follows it with
+//! [`limit_cycle_branch`] (HB with ω unknown and the phase condition b₁ = 0,
+//! Eq. 61, pseudo-arclength Eq. 68–77) with Floquet stability at every point;
+//! its folds (turning points in p) are located by Newton on the fold system
+//! of the cycle equations ([`locate_fold`]).
+//!
+//! The start: with the normal form `ż = (β(p) + iω) z + c₁ z|z|²`
+//! (`β = Re λ`, `l₁ = Re c₁/ω`) the cycle at p has `|z|² = −β/(ω l₁)` and
+//! `y(t) ≈ y* + 2 Re(z e^{iωt} q)`, on the side of p where `−β/l₁ > 0`; it is
+//! taken at `p_H ± offset·|p_to − p_from|` and refined by [`limit_cycle`].
+
+use crate::autonomous::{limit_cycle, limit_cycle_branch, LimitCycle};
+use crate::continuation::{ContinuationOptions, Termination};
+use crate::error::HbError;
+use crate::fold::{locate_fold, Branch, FoldOptions};
+use crate::galerkin::GalerkinJacobian;
+use crate::hopf::{equilibrium, hopf_points, Field, HopfPoint};
+use crate::ihb::{HbOptions, HbResidual, HbSolution};
+use crate::problem::PeriodicProblem;
+use crate::BroydenStats;
+
+mod member;
+use member::Member;
+
+/// Options of [`cycle_branch`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct CycleBranchOptions {
+    /// Intervals of the grid of p on which the equilibria are followed and
+    /// Hopf points bracketed.
+    pub samples: usize,
+    /// The start's distance from the Hopf point, relative to `|p_to − p_from|`.
+    pub offset: f64,
+    /// Path-following options of the cycle branch (λ bounds are set).
+    pub continuation: ContinuationOptions,
+    /// Hsu sub-intervals of each cycle's multipliers (> n).
+    pub stability_steps: usize,
+    /// Values of p at which the cycles are solved exactly (each crossing).
+    pub at: Vec<f64>,
+}
+
+impl Default for CycleBranchOptions {
+    fn default() -> Self {
+        Self {
+            samples: 100,
+            offset: 1e-2,
+            continuation: ContinuationOptions {
+                ds: 0.02,
+                ds_max: 0.05,
+                max_points: 2000,
+                ..ContinuationOptions::default()
+            },
+            stability_steps: 512,
+            at: Vec::new(),
+        }
+    }
+}
+
+/// The cycle branch of a family.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CycleBranch {
+    /// Hopf points of the equilibria in `[p_from, p_to]`, in order of p
+    /// from `p_from`.
+    pub hopf: Vec<HopfPoint>,
+    /// `(p, cycle)` of the branch from the first Hopf point, in path order.
+    pub points: Vec<(f64, LimitCycle)>,
+    /// Folds of the branch: `(p, orbit)` located on the fold system.
+    pub folds: Vec<(f64, HbSolution)>,
+    /// The cycles at each p of [`CycleBranchOptions::at`], each crossing.
+    pub at: Vec<(f64, LimitCycle)>,
+    /// Why tracing stopped (`None`: no Hopf point, nothing traced).
+    pub termination: Option<Termination>,
+}
+
+/// The Hopf points of `family(p)` (autonomous: no excitation) for p in
+/// `[p_from, p_to]` (equilibria followed from `x = 0`), and the cycle
+/// branch of the first, with its folds (module docs).
+///
+/// # Errors
+/// [`HbError::InvalidInput`] for bounds, options or sizes; `family(p_from)`'s
+/// error; the start cycle's failure ([`limit_cycle`]). Later, a `p` where
+/// `family` fails is a failed step of the path.
+pub fn cycle_branch<P, F>(
+    family: F,
+    hb: &HbOptions,
+    p_from: f64,
+    p_to: f64,
+    opts: &CycleBranchOptions,
+) -> Result<CycleBranch, HbError>
+where
+    P: PeriodicProblem,
+    F: Fn(f64) -> Result<P, HbError>,
+{
+    if !(opts.offset > 0.0 && opts.offset < 1.0) {
+        return Err(HbError::InvalidInput("offset must lie in (0, 1)".into()));
+    }
+    let n_dof = family(p_from)?.n_dof();
+    let hopf = hopf_points(&family, &vec![0.0; n_dof], p_from, p_to, opts.samples)?;
+    let mut out = CycleBranch {
+        hopf,
+        points: Vec::new(),
+        folds: Vec::new(),
+        at: Vec::new(),
+        termination: None,
+    };
+    let Some(first) = out.hopf.first() else {
+        return Ok(out);
+    };
+    let (lo, hi) = (p_from.min(p_to), p_from.max(p_to));
+    let (p_start, start) = start_cycle(&family, hb, first, opts.offset * (hi - lo), opts)?;
+    let member = |p: f64| Member::new(family(p).ok(), n_dof);
+    // First away from the Hopf point; if the branch turns back past the
+    // start, on to the other end.
+    let far = if p_start > first.p { hi } else { lo };
+    let leg = limit_cycle_branch(
+        member,
+        hb,
+        &start,
+        p_start,
+        far,
+        &opts.continuation,
+        opts.stability_steps,
+    )?;
+    out.points = leg.points;
+    out.termination = Some(leg.termination);
+    let back = out.points.last().map(|(p, c)| (*p, c.clone()));
+    if let Some((p_last, cycle)) = back {
+        let other = if far == hi { lo } else { hi };
+        if (p_last - p_start).abs() < (p_last - far).abs() && p_last != other {
+            let leg = limit_cycle_branch(
+                member,
+                hb,
+                &cycle,
+                p_last,
+                other,
+                &opts.continuation,
+                opts.stability_steps,
+            )?;
+            out.points.extend(leg.points.into_iter().skip(1));
+            out.termination = Some(leg.termination);
+        }
+    }
+    let mut system = CycleSystem::new(&member, hb, p_start)?;
+    out.folds = locate_folds(&mut system, &out.points);
+    out.at = cycles_at(&member, hb, &out.points, &opts.at, opts.stability_steps);
+    Ok(out)
+}
+
+/// The cycle near the Hopf point `hopf` at `p_H ± distance` by its normal
+/// form, refined by [`limit_cycle`]: `(p, cycle)`.
+fn start_cycle<P, F>(
+    family: &F,
+    hb: &HbOptions,
+    hopf: &HopfPoint,
+    distance: f64,
+    opts: &CycleBranchOptions,
+) -> Result<(f64, LimitCycle), HbError>
+where
+    P: PeriodicProblem,
+    F: Fn(f64) -> Result<P, HbError>,
+{
+    let n = hb.harmonics;
+    let l = 2 * n + 1;
+    for side in [-1.0, 1.0] {
+        let p = hopf.p + side * distance;
+        let problem = family(p)?;
+        let mut x = hopf.equilibrium.clone();
+        equilibrium(&problem, &mut x)?;
+        let d = 2 * x.len();
+        let beta = crate::floquet::eigenvalues(&Field::new(&problem)?.linearisation(&x), d)
+            .iter()
+            .filter(|e| e.im > 0.0)
+            .min_by(|a, b| {
+                (a.im - hopf.omega)
+                    .abs()
+                    .total_cmp(&(b.im - hopf.omega).abs())
+            })
+            .map(|e| e.re)
+            .unwrap_or(f64::NAN);
+        let radius2 = -beta / (hopf.omega * hopf.lyapunov);
+        if !(radius2 > 0.0 && radius2.is_finite()) {
+            continue;
+        }
+        let rho = radius2.sqrt();
+        let [q_re, q_im] = &hopf.eigenvector;
+        let mut guess = vec![0.0; x.len() * l];
+        for (dof, xd) in x.iter().enumerate() {
+            guess[dof * l] = 2.0 * xd;
+            guess[dof * l + 1] = 2.0 * rho * q_re[dof];
+            guess[dof * l + n + 1] = -2.0 * rho * q_im[dof];
+        }
+        let cycle = limit_cycle(&problem, hb, hopf.omega, &guess, opts.stability_steps)?;
+        return Ok((p, cycle));
+    }
+    Err(HbError::InvalidInput(
+        "no side of the Hopf point has cycles (l₁ = 0 or β does not change sign)".into(),
+    ))
+}
+
+/// The folds of the branch `points` (where p turns), each located by
+/// [`locate_fold`] from the turning point; a failed location is left out.
+fn locate_folds<B: Branch>(system: &mut B, points: &[(f64, LimitCycle)]) -> Vec<(f64, HbSolution)> {
+    let mut folds = Vec::new();
+    for w in points.windows(3) {
+        let (a, b, c) = (w[0].0, w[1].0, w[2].0);
+        if (b - a) * (c - b) >= 0.0 {
+            continue;
+        }
+        let sol = &w[1].1.solution;
+        let mut u = sol.coeffs.clone();
+        u.push(sol.omega_f);
+        if let Ok(f) = locate_fold(system, &u, b, &FoldOptions::default()) {
+            let m = f.q.len() - 1;
+            let solution = HbSolution {
+                coeffs: f.q[..m].to_vec(),
+                omega_f: f.q[m],
+                harmonics: sol.harmonics,
+                subharmonic: 1,
+                stats: BroydenStats::default(),
+            };
+            folds.push((f.lambda, solution));
+        }
+    }
+    folds
+}
+
+/// The cycles at each p of `at` where the branch crosses it, by
+/// [`limit_cycle`] from the interpolation of the two points around it
+/// (failures left out).
+fn cycles_at<P: PeriodicProblem>(
+    member: &impl Fn(f64) -> P,
+    hb: &HbOptions,
+    points: &[(f64, LimitCycle)],
+    at: &[f64],
+    steps: usize,
+) -> Vec<(f64, LimitCycle)> {
+    let mut found = Vec::new();
+    for &p in at {
+        for w in points.windows(2) {
+            let ((pa, ca), (pb, cb)) = (&w[0], &w[1]);
+            if (pa - p) * (pb - p) > 0.0 || pa == pb {
+                continue;
+            }
+            let t = (p - pa) / (pb - pa);
+            let (sa, sb) = (&ca.solution, &cb.solution);
+            let q: Vec<f64> = sa
+                .coeffs
+                .iter()
+                .zip(&sb.coeffs)
+                .map(|(a, b)| a + t * (b - a))
+                .collect();
+            let omega = sa.omega_f + t * (sb.omega_f - sa.omega_f);
+            if let Ok(c) = limit_cycle(&member(p), hb, omega, &q, steps) {
+                found.push((p, c));
+            }
+        }
+    }
+    found
+}
+
+/// The cycle equations `[R(q, ω; p); b₁] = 0` in the unknowns `u = {q, ω}`
+/// as a [`Branch`] in p (the fold locator's system).
+struct CycleSystem<'f, F> {
+    family: &'f F,
+    res: HbResidual,
+    galerkin: GalerkinJacobian,
+    jq: Vec<f64>,
+    rp: Vec<f64>,
+    rm: Vec<f64>,
+    phase: usize,
+}
+
+impl<'f, P: PeriodicProblem, F: Fn(f64) -> P> CycleSystem<'f, F> {
+    fn new(family: &'f F, hb: &HbOptions, p: f64) -> Result<Self, HbError> {
+        let res = HbResidual::new(&family(p), hb)?;
+        let m = res.len();
+        Ok(Self {
+            family,
+            galerkin: GalerkinJacobian::new(&res),
+            res,
+            jq: vec![0.0; m * m],
+            rp: vec![0.0; m],
+            rm: vec![0.0; m],
+            phase: hb.harmonics + 1,
+        })
+    }
+}
+
+impl<P: PeriodicProblem, F: Fn(f64) -> P> Branch for CycleSystem<'_, F> {
+    fn len(&self) -> usize {
+        self.res.len() + 1
+    }
+    fn residual(&mut self, u: &[f64], p: f64, r: &mut [f64]) {
+        let m = self.res.len();
+        self.res
+            .eval(&(self.family)(p), &u[..m], u[m], 1.0, &mut r[..m]);
+        r[m] = u[self.phase];
+    }
+    /// `[[Φ_q, ∂R/∂ω], [e_{b₁}ᵀ, 0]]`, `∂R/∂ω` by a central difference.
+    fn jacobian(&mut self, u: &[f64], p: f64, jac: &mut [f64]) {
+        let m = self.res.len();
+        let problem = (self.family)(p);
+        let (q, omega) = (&u[..m], u[m]);
+        self.galerkin
+            .assemble(&mut self.res, &problem, q, omega, 1.0, &mut self.jq);
+        let h = 1e-6 * omega;
+        self.res.eval(&problem, q, omega + h, 1.0, &mut self.rp);
+        self.res.eval(&problem, q, omega - h, 1.0, &mut self.rm);
+        jac.fill(0.0);
+        for i in 0..m {
+            jac[i * (m + 1)..i * (m + 1) + m].copy_from_slice(&self.jq[i * m..(i + 1) * m]);
+            jac[i * (m + 1) + m] = (self.rp[i] - self.rm[i]) / (2.0 * h);
+        }
+        jac[m * (m + 1) + self.phase] = 1.0;
+    }
+}

@@ -1,0 +1,71 @@
+//! A member of a family that may fail: the problem at p, or where the family
+//! fails a problem of the same size that is NaN everywhere, so that the path
+//! follower rejects the step (as the fold curve's NaN residual,
+//! [`crate::codim2`]).
+
+use crate::problem::PeriodicProblem;
+
+/// `family(p)`, or NaN of `n` DOFs where it failed.
+pub(super) struct Member<P> {
+    problem: Option<P>,
+    n: usize,
+    nan: Vec<f64>,
+}
+
+impl<P: PeriodicProblem> Member<P> {
+    pub(super) fn new(problem: Option<P>, n: usize) -> Self {
+        let nan = match problem {
+            Some(_) => Vec::new(),
+            None => vec![f64::NAN; n * n],
+        };
+        Self { problem, n, nan }
+    }
+}
+
+impl<P: PeriodicProblem> PeriodicProblem for Member<P> {
+    fn n_dof(&self) -> usize {
+        self.problem.as_ref().map_or(self.n, P::n_dof)
+    }
+    fn mass(&self) -> &[f64] {
+        self.problem.as_ref().map_or(&self.nan, P::mass)
+    }
+    fn damping(&self) -> &[f64] {
+        self.problem.as_ref().map_or(&self.nan, P::damping)
+    }
+    fn stiffness(&self) -> &[f64] {
+        self.problem.as_ref().map_or(&self.nan, P::stiffness)
+    }
+    fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
+        match &self.problem {
+            Some(p) => p.nonlinear(x, v, theta, out),
+            None => out.fill(f64::NAN),
+        }
+    }
+    fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+        match &self.problem {
+            Some(p) => p.nonlinear_samples(x, v, theta, out),
+            None => out.fill(f64::NAN),
+        }
+    }
+    fn excitation(&self, theta: f64, out: &mut [f64]) {
+        match &self.problem {
+            Some(p) => p.excitation(theta, out),
+            None => out.fill(f64::NAN),
+        }
+    }
+    fn velocity_dependent(&self) -> bool {
+        self.problem.as_ref().is_none_or(P::velocity_dependent)
+    }
+    fn nonlinear_jacobian(&self, x: &[f64], v: &[f64], theta: f64, dg: &mut [f64]) {
+        match &self.problem {
+            Some(p) => p.nonlinear_jacobian(x, v, theta, dg),
+            None => dg.fill(f64::NAN),
+        }
+    }
+    fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
+        match &self.problem {
+            Some(p) => p.nonlinear_jacobian_samples(x, v, theta, dg),
+            None => dg.fill(f64::NAN),
+        }
+    }
+}

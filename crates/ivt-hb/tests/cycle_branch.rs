@@ -1,0 +1,133 @@
+//! Hopf point and cycle branch (issue 27, item 2) of
+//! `ẍ − (μ + x² − x⁴)ẋ + x = 0`: the subcritical Hopf point at μ = 0, the
+//! cycle branch from it, its fold and the two cycles at μ = −0.1, against
+//! time integration (RK4, no HB): a cycle through `(x₀, 0)` of period T
+//! solves `y(T; x₀, μ) = (x₀, 0)`; a fold of cycles adds
+//! `det ∂(y(T) − y₀)/∂(x₀, T) = 0`; the non-trivial multiplier is
+//! `det ∂y(T)/∂y₀` (the other is 1).
+
+use ivt_hb::{
+    cycle_branch, CycleBranchOptions, GeneralProblem, HbError, HbOptions, PeriodicProblem,
+};
+
+mod common;
+use common::shooting::{central_jacobian, flow, newton3, newton_step};
+
+/// The family as `M = 1`, `C = −μ`, `K = 1`, `g = −(x² − x⁴)ẋ`.
+fn family(mu: f64) -> Result<impl PeriodicProblem, HbError> {
+    Ok(GeneralProblem::new(
+        1,
+        vec![1.0],
+        vec![-mu],
+        vec![1.0],
+        |x: &[f64], v: &[f64], _th: f64, g: &mut [f64]| g[0] = -(x[0] * x[0] - x[0].powi(4)) * v[0],
+        |_: f64, f: &mut [f64]| f.fill(0.0),
+    ))
+}
+
+/// `y(T)` from `y₀` at μ (RK4, 4000 steps).
+fn flow_at(mu: f64, y0: [f64; 2], period: f64) -> [f64; 2] {
+    let rhs = |_t: f64, y: [f64; 2]| [y[1], (mu + y[0] * y[0] - y[0].powi(4)) * y[1] - y[0]];
+    flow(rhs, y0, period, 4000)
+}
+
+/// `y(T; (x₀, 0)) − (x₀, 0)`.
+fn gap(mu: f64, x0: f64, period: f64) -> [f64; 2] {
+    let y = flow_at(mu, [x0, 0.0], period);
+    [y[0] - x0, y[1]]
+}
+
+/// The cycle through `(x₀, 0)` at μ by Newton in `(x₀, T)`.
+fn cycle_by_shooting(mu: f64, mut u: [f64; 2]) -> [f64; 2] {
+    for _ in 0..30 {
+        let r = gap(mu, u[0], u[1]);
+        let j = central_jacobian(|u| gap(mu, u[0], u[1]), u, [1e-6; 2]);
+        let d = newton_step(j, r);
+        u = [u[0] + d[0], u[1] + d[1]];
+        if d[0].abs().max(d[1].abs()) < 1e-13 {
+            break;
+        }
+    }
+    u
+}
+
+/// The non-trivial multiplier `det ∂y(T)/∂y₀` of the cycle `(x₀, T)`.
+fn multiplier(mu: f64, x0: f64, period: f64) -> f64 {
+    let j = central_jacobian(|y| flow_at(mu, y, period), [x0, 0.0], [1e-6; 2]);
+    j[0][0] * j[1][1] - j[0][1] * j[1][0]
+}
+
+/// `(x₀, 0)` of an HB orbit: its maximum of x over τ, found on the samples
+/// and polished (the phase of `x₀` is free).
+fn turning_state(coeffs: &[f64]) -> f64 {
+    (0..20000)
+        .map(|i| ivt_hb::aft::eval_series(coeffs, std::f64::consts::TAU * i as f64 / 20000.0, 0))
+        .fold(f64::MIN, f64::max)
+}
+
+#[test]
+fn subcritical_hopf_cycle_branch_and_fold_match_time_integration() {
+    let hb = HbOptions::new(25, 128);
+    let opts = CycleBranchOptions {
+        at: vec![-0.1],
+        ..CycleBranchOptions::default()
+    };
+    let branch = cycle_branch(family, &hb, -0.2, 0.1, &opts).unwrap();
+    assert_eq!(branch.hopf.len(), 1);
+    let hopf = &branch.hopf[0];
+    assert!(
+        hopf.p.abs() < 1e-12 && (hopf.omega - 1.0).abs() < 1e-12,
+        "{hopf:?}"
+    );
+    assert!(hopf.subcritical(), "l₁ = {}", hopf.lyapunov);
+    // The fold of cycles: one, against shooting on (x₀, T, μ).
+    assert_eq!(
+        branch.folds.len(),
+        1,
+        "{:?}",
+        branch.folds.iter().map(|f| f.0).collect::<Vec<_>>()
+    );
+    let (mu_fold, orbit) = &branch.folds[0];
+    let guess = [
+        turning_state(&orbit.coeffs),
+        std::f64::consts::TAU / orbit.omega_f,
+        *mu_fold,
+    ];
+    let u = newton3(
+        |u| {
+            let r = gap(u[2], u[0], u[1]);
+            let j = central_jacobian(|w| gap(u[2], w[0], w[1]), [u[0], u[1]], [1e-6; 2]);
+            [r[0], r[1], j[0][0] * j[1][1] - j[0][1] * j[1][0]]
+        },
+        guess,
+    );
+    eprintln!(
+        "fold: HB μ = {mu_fold:.12}, shooting {:.12}, |Δ| {:.1e}",
+        u[2],
+        (mu_fold - u[2]).abs()
+    );
+    assert!((mu_fold - u[2]).abs() < 1e-8, "{mu_fold} vs {}", u[2]);
+    // μ = −0.1: the small unstable cycle and the large stable one.
+    assert_eq!(branch.at.len(), 2);
+    let mut cycles: Vec<_> = branch.at.iter().map(|(_, c)| c).collect();
+    cycles.sort_by(|a, b| a.solution.amplitude(0).total_cmp(&b.solution.amplitude(0)));
+    for (cycle, stable) in cycles.iter().zip([false, true]) {
+        let x0 = turning_state(&cycle.solution.coeffs);
+        let [x_ref, t_ref] = cycle_by_shooting(-0.1, [x0, cycle.period()]);
+        let mult = multiplier(-0.1, x_ref, t_ref);
+        eprintln!(
+            "μ = −0.1: x₀ {x0:.10} (shooting {x_ref:.10}), T {:.12} (shooting {t_ref:.12}), multiplier {mult:.6}",
+            cycle.period()
+        );
+        assert!((cycle.period() - t_ref).abs() < 1e-8 * t_ref);
+        assert_eq!(cycle.stable(), stable);
+        assert_eq!(mult < 1.0, stable, "multiplier {mult}");
+    }
+    // Along the branch, the stability changes only at the fold.
+    let changes = branch
+        .points
+        .windows(2)
+        .filter(|w| w[0].1.stable() != w[1].1.stable())
+        .count();
+    assert_eq!(changes, 1);
+}
