@@ -81,9 +81,21 @@ def all_solutions(
 # --- large structures (issue 28): condensation onto the nonlinear DOFs -------
 
 import inspect as _inspect
+import operator as _operator
 from types import SimpleNamespace as _Namespace
 
 import numpy as _np
+
+
+def _index(name, value):
+    """An integer argument as the native functions take it: an int or a numpy
+    integer, not a bool and not a float (TypeError naming the argument)."""
+    if isinstance(value, bool):
+        raise TypeError(f"argument `{name}` must be an integer, not bool")
+    try:
+        return _operator.index(value)
+    except TypeError:
+        raise TypeError(f"argument `{name}` must be an integer, got {value!r}") from None
 
 _LARGE_KEYS = ("nonlinear_dofs", "amplitude_dof", "record_dofs")
 
@@ -173,9 +185,9 @@ def _large_call(native_name, sig, args, kwargs, extra):
         raise ValueError(f"`m`, `c`, `k` must have one size, got {n}, {nc}, {nk}")
     kw = dict(
         amplitude_dof=extra.get("amplitude_dof"),
-        record_dofs=[int(j) for j in (extra.get("record_dofs") or ())],
-        n=int(given.get("n", 7)),
-        samples=int(given.get("samples", 32)),
+        record_dofs=[_index("record_dofs", j) for j in (extra.get("record_dofs") or ())],
+        n=_index("n", given.get("n", 7)),
+        samples=_index("samples", given.get("samples", 32)),
         velocity_dependent=bool(given.get("velocity_dependent", True)),
         vectorized=bool(given.get("vectorized", False)),
         jac=given.get("jac"),
@@ -184,7 +196,7 @@ def _large_call(native_name, sig, args, kwargs, extra):
     if "rtol" in given:
         kw["rtol"] = float(given["rtol"])
     f = _loads(a.f, n) if a.f is not None else ([0.0] * n, [0.0] * n)
-    dofs = [int(j) for j in dofs]
+    dofs = [_index("nonlinear_dofs", j) for j in dofs]
     if native_name == "frc":
         for key in ("ds", "ds_min", "ds_max"):
             if given.get(key) is not None:
