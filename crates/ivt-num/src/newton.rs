@@ -10,8 +10,9 @@
 //! and `F` evaluated once more at the result), or the system's own test
 //! ([`NewtonSystem::check_step`], asked after every accepted step: a step
 //! relative to a scale of its choosing, a noise floor, a divergence rule).
-//! Failing: a singular Jacobian, a non-finite residual, no decrease along
-//! the step, or `max_iter` steps; every error carries the `‖F‖₂` history.
+//! Failing: a singular Jacobian, a non-finite residual (at the start or at
+//! the shortest trial step), no decrease along the step, or `max_iter`
+//! steps; every error carries the `‖F‖₂` history.
 //!
 //! Every Newton iteration of the workspace is this one: the HB orbit
 //! (classic IHB), the exact-Jacobian corrector and start of a path, the
@@ -437,6 +438,10 @@ pub fn newton_bordered<S: NewtonSystem + ?Sized>(
             break;
         }
         let Some(t) = line_search(sys, &border, x, ws, opts, norm, &mut stats)? else {
+            if !norm2(&ws.r_trial).is_finite() {
+                // The shortest trial left the domain of F.
+                return Err(non_finite(it, &ws.history));
+            }
             return Err(NewtonError::NoDescent {
                 iteration: it,
                 history: ws.history.clone(),
