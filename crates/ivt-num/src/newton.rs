@@ -259,6 +259,12 @@ impl NewtonWorkspace {
         &self.r
     }
 
+    /// The `‖F‖₂` history of the last solve (first entry: the initial
+    /// guess; one per accepted step).
+    pub fn history(&self) -> &[f64] {
+        &self.history
+    }
+
     /// Sign of the determinant of the last factored (bordered) Jacobian.
     pub fn det_sign(&self) -> f64 {
         self.lu.det_sign()

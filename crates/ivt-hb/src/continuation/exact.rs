@@ -17,8 +17,11 @@
 
 use faer::Mat;
 use ivt_num::vector::{dot, norm2};
-use ivt_num::BorderedLu;
+use ivt_num::{
+    newton_bordered, Border, BorderedLu, NewtonOptions, NewtonSystem, NewtonWorkspace, StepCheck,
+};
 use std::borrow::Cow;
+use std::convert::Infallible;
 
 use super::{non_finite_start, turn, ContinuationOptions, Fold, Path, PathPoint};
 use super::{SolveError, Termination};
@@ -274,6 +277,8 @@ struct Corrector {
     /// `jac` was assembled at `u` as Newton converged there: the tangent at
     /// that point reuses it instead of assembling it again.
     jac_at_u: bool,
+    /// Buffers of the Newton corrector.
+    newton: NewtonWorkspace,
     tol: f64,
     max_newton: usize,
 }
@@ -288,6 +293,7 @@ impl Corrector {
             rhs: vec![0.0; m + 1],
             u: vec![0.0; m + 1],
             jac_at_u: false,
+            newton: NewtonWorkspace::bordered(m + 1, 1),
             tol: opts.broyden.tol,
             max_newton: opts.broyden.max_iter,
         }
@@ -421,9 +427,10 @@ impl Corrector {
         })
     }
 
-    /// Newton on `[R(u); constraint] = 0` from [`Self::start`], refactoring each
-    /// iteration.
-    /// Returns the iteration count.
+    /// Newton ([`ivt_num::newton_bordered`], full steps, the constraint as
+    /// the border row) on `[R(u); constraint] = 0` from [`Self::start`];
+    /// diverged once ‖F‖ grows after the second step. Leaves `jac` at the
+    /// solution for the tangent. Returns the iteration count.
     fn newton<S: PathSystem>(
         &mut self,
         sys: &mut S,
@@ -431,43 +438,94 @@ impl Corrector {
     ) -> Result<usize, SolveError> {
         let m = self.jac.nrows();
         let row = pred.row();
-        let mut history = Vec::new();
-        for it in 0..=self.max_newton {
-            let u = std::mem::take(&mut self.u);
-            self.assemble(sys, &u);
-            self.u = u;
-            let constraint = pred.constraint(&self.u);
-            if let Some(done) = settle(&mut history, norm2(&self.r).hypot(constraint), self.tol) {
-                self.jac_at_u = done.is_ok();
-                return done;
-            }
-            if it == self.max_newton || (it >= 2 && history[it] > history[it - 1]) {
-                break;
-            }
-            let u = std::mem::take(&mut self.u);
-            let factored = self.factor(sys, &u, &row);
-            self.u = u;
-            if !factored {
-                return Err(SolveError::SingularJacobian {
-                    iteration: it,
-                    history,
-                });
-            }
-            self.rhs[..m].copy_from_slice(&self.r);
-            self.rhs[m] = constraint;
-            if self.aug.solve(&mut self.rhs).is_err() {
-                return Err(SolveError::SingularJacobian {
-                    iteration: it,
-                    history,
-                });
-            }
-            for (x, d) in self.u.iter_mut().zip(&self.rhs) {
-                *x -= d;
-            }
+        let value = pred.constraint_offset(&row);
+        let border = Border {
+            rows: &row,
+            values: &[value],
+        };
+        let nopts = NewtonOptions {
+            ftol: self.tol,
+            max_iter: self.max_newton,
+            max_halvings: 0,
+            accept_no_descent: true,
+            ..NewtonOptions::default()
+        };
+        let mut corrected = ExactNewton {
+            system: sys,
+            jac: &mut self.jac,
+            r_lambda: &mut self.r_lambda,
+            m,
+        };
+        let result = newton_bordered(
+            &mut corrected,
+            border,
+            &mut self.u,
+            &mut self.newton,
+            &nopts,
+        );
+        // The last residual evaluation assembled `jac` at `u`.
+        self.jac_at_u = result.is_ok();
+        if let Some(r) = self.newton.residual().get(..m) {
+            self.r.copy_from_slice(r);
         }
-        Err(SolveError::NonConvergence {
-            iterations: history.len() - 1,
-            history,
+        result
+            .map(|stats| stats.iterations)
+            .map_err(SolveError::from)
+    }
+}
+
+/// A [`PathSystem`] as the `m` rows `R(u, λ)` of a bordered
+/// [`NewtonSystem`] in `x = (u, λ)`: each residual assembles `J` with it
+/// (the string's Jacobian costs little beyond its residual), the Jacobian
+/// is `[J, R_λ]` row-major.
+struct ExactNewton<'a, S> {
+    system: &'a mut S,
+    jac: &'a mut Mat<f64>,
+    r_lambda: &'a mut [f64],
+    m: usize,
+}
+
+impl<S: PathSystem> NewtonSystem for ExactNewton<'_, S> {
+    type Error = Infallible;
+
+    fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
+        if let Some((u, &[lambda])) = x.split_at_checked(self.m) {
+            self.system.residual_jacobian(u, lambda, r, self.jac);
+        } else {
+            r.fill(f64::NAN);
+        }
+        Ok(())
+    }
+
+    fn jacobian(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), Infallible> {
+        let m = self.m;
+        if let Some((u, &[lambda])) = x.split_at_checked(m) {
+            self.system.d_residual_d_lambda(u, lambda, self.r_lambda);
+        }
+        for (i, (row, r_l)) in out
+            .chunks_exact_mut(m + 1)
+            .zip(self.r_lambda.iter())
+            .enumerate()
+        {
+            for (j, v) in row.iter_mut().take(m).enumerate() {
+                *v = self.jac[(i, j)];
+            }
+            row[m] = *r_l;
+        }
+        Ok(())
+    }
+
+    /// Diverged when ‖F‖ rises after the second step (the corrector halves
+    /// the path step instead).
+    fn check_step(
+        &mut self,
+        _x: &[f64],
+        _step: &[f64],
+        history: &[f64],
+    ) -> Result<StepCheck, Infallible> {
+        Ok(match history {
+            [_, .., before, now] if now > before => StepCheck::Diverged,
+            _ => StepCheck::Continue,
         })
     }
 }
@@ -491,6 +549,15 @@ impl Prediction<'_> {
                 Cow::Owned(row)
             }
             None => Cow::Borrowed(self.tangent),
+        }
+    }
+
+    /// `d` of the constraint written as the border row `rowᵀu = d`:
+    /// `tᵀu_pred`, or `λ_fix`.
+    fn constraint_offset(&self, row: &[f64]) -> f64 {
+        match self.fix {
+            Some(l) => l,
+            None => dot(row, self.u_pred),
         }
     }
 
