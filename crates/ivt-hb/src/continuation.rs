@@ -15,6 +15,7 @@ use crate::error::HbError;
 use ivt_num::vector::{dot, norm2};
 use ivt_num::LuWorkspace;
 
+mod corrector;
 mod exact;
 mod start;
 pub use exact::{pseudo_arclength_exact, PathSystem};
