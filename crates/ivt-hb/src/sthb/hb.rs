@@ -443,7 +443,8 @@ impl StringHb {
     /// Newton–Raphson (step a6, [`ivt_num::newton`]) with step halving on
     /// `‖R‖` (the full step is kept if no halving helps; the history shows
     /// it), from the guess in `a`, overwritten by the solution.
-    /// Converged when `‖R‖ ≤ tol (1 + y0)`.
+    /// Converged when `‖R‖ ≤ tol (1 + y0)`; [`Self::s_spectrum`] is then
+    /// that of the solution.
     ///
     /// # Errors
     /// [`HbError::NoConvergence`] with the residual history after `max_iter`
@@ -479,10 +480,15 @@ impl StringHb {
         self.newton = ws;
         self.jac = jac;
         match result {
-            Ok(stats) => Ok(SolveStats {
-                iterations: stats.iterations,
-                history,
-            }),
+            Ok(stats) => {
+                // Leave Ŝ_p at the solution (the last residual was a trial's,
+                // without it): the stability functions read it.
+                self.balance(a, true);
+                Ok(SolveStats {
+                    iterations: stats.iterations,
+                    history,
+                })
+            }
             Err(NewtonError::SingularJacobian { .. } | NewtonError::BorderSize { .. }) => {
                 Err(HbError::Singular { omega })
             }
