@@ -370,7 +370,7 @@ where
             ws.set_jacobian(&b)
         } else {
             let mut col: Vec<f64> = (0..m).map(|i| jac[i * n1 + m]).collect();
-            col.push(row[m]);
+            col.push(ws.jacobian()[m * n1 + m]);
             ws.replace_col(m, &col)
                 .and_then(|()| ws.replace_row(m, row))
         };
