@@ -22,8 +22,7 @@ use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
 use crate::stability::{classify, StabilityAnalyzer, StabilityKind};
 use faer::c64;
-use ivt_num::vector::norm2;
-use ivt_num::BorderedLu;
+use ivt_num::{newton_bordered, Border, NewtonOptions, NewtonSystem, NewtonWorkspace, StepCheck};
 
 /// A converged limit cycle.
 #[derive(Debug, Clone, PartialEq)]
@@ -188,7 +187,7 @@ pub fn limit_cycle<P: PeriodicProblem>(
         ));
     }
     crate::ihb::validate_omega(omega_guess)?;
-    let mut res = HbResidual::new(problem, hb)?;
+    let res = HbResidual::new(problem, hb)?;
     let m = res.len();
     let n = hb.harmonics;
     let q_guess = guess.iter().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -197,108 +196,46 @@ pub fn limit_cycle<P: PeriodicProblem>(
             "guess must have {m} finite entries, not all zero"
         )));
     }
-    let mut galerkin = GalerkinJacobian::new(&res);
-    let n1 = m + 1;
+    let mut r = vec![0.0; m];
+    let tol = hb.residual_tol(res.force_scale(problem, guess, omega_guess, &mut r));
     let phase = n + 1; // b₁ of DOF 0
-    let mut q = guess.to_vec();
-    let mut omega = omega_guess;
-    let (mut r, mut rp, mut rm) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
-    let mut jac = vec![0.0; m * m];
-    let mut r_omega = vec![0.0; m];
-    // The phase condition b₁ = 0 (DOF 0) as the border row, ω as the border column.
-    let mut phase_row = vec![0.0; m];
-    phase_row[phase] = 1.0;
-    let mut lu = BorderedLu::new(m, 1);
-    let mut step = vec![0.0; n1];
-    let (mut q_trial, mut r_trial) = (vec![0.0; m], vec![0.0; m]);
-    let norm_f = |r: &[f64], q: &[f64]| (norm2(r).powi(2) + q[phase] * q[phase]).sqrt();
-    let tol = hb.residual_tol(res.force_scale(problem, &q, omega, &mut r));
-    res.eval(problem, &q, omega, 1.0, &mut r);
-    let mut norm = norm_f(&r, &q);
-    let mut history = vec![norm];
-    let mut stats = BroydenStats {
-        iterations: 0,
-        residual_evals: 1,
-        jacobian_refreshes: 0,
-        residual_norm: norm,
+    let mut system = Cycle {
+        galerkin: GalerkinJacobian::new(&res),
+        res,
+        problem,
+        m,
+        jac: vec![0.0; m * m],
+        r_omega: (vec![0.0; m], vec![0.0; m]),
+        tol,
+        q_guess,
     };
-    let mut last_step = f64::INFINITY;
-    loop {
-        if !norm.is_finite() {
-            return Err(HbError::Solve(SolveError::NonFinite {
-                iteration: stats.iterations,
-                history,
-            }));
-        }
-        if norm <= tol && last_step <= 1e-10 {
-            break;
-        }
-        if stats.iterations >= hb.broyden.max_iter {
-            return Err(HbError::Solve(SolveError::NonConvergence {
-                iterations: stats.iterations,
-                history,
-            }));
-        }
-        stats.iterations += 1;
-        galerkin.assemble(&mut res, problem, &q, omega, 1.0, &mut jac);
-        stats.jacobian_refreshes += 1;
-        let h = 1e-6 * omega;
-        res.eval(problem, &q, omega + h, 1.0, &mut rp);
-        res.eval(problem, &q, omega - h, 1.0, &mut rm);
-        stats.residual_evals += 2;
-        for i in 0..m {
-            r_omega[i] = (rp[i] - rm[i]) / (2.0 * h);
-        }
-        step[..m].iter_mut().zip(&r).for_each(|(s, r)| *s = -r);
-        step[m] = -q[phase];
-        if lu
-            .factor(&jac, &r_omega, &phase_row, &[0.0])
-            .and_then(|()| lu.solve(&mut step))
-            .is_err()
-        {
-            return Err(HbError::Solve(SolveError::SingularJacobian {
-                iteration: stats.iterations,
-                history,
-            }));
-        }
-        // Damped step: halve while ‖F‖ does not decrease (or ω would turn ≤ 0).
-        let mut t = 1.0;
-        let mut accepted = false;
-        for _ in 0..=hb.broyden.max_backtracks {
-            let w = omega + t * step[m];
-            if w > 0.0 {
-                for i in 0..m {
-                    q_trial[i] = q[i] + t * step[i];
-                }
-                res.eval(problem, &q_trial, w, 1.0, &mut r_trial);
-                stats.residual_evals += 1;
-                let nt = norm_f(&r_trial, &q_trial);
-                if nt.is_finite() && (nt < norm || nt <= tol) {
-                    accepted = true;
-                    norm = nt;
-                    break;
-                }
-            }
-            t *= 0.5;
-        }
-        if !accepted {
-            return Err(HbError::Solve(SolveError::NonConvergence {
-                iterations: stats.iterations,
-                history,
-            }));
-        }
-        let q_scale = q_trial.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let dq = step[..m].iter().fold(0.0f64, |a, v| a.max(v.abs())) * t;
-        last_step = (dq / q_scale.max(f64::MIN_POSITIVE)).max((t * step[m] / omega).abs());
-        omega += t * step[m];
-        q.copy_from_slice(&q_trial);
-        std::mem::swap(&mut r, &mut r_trial);
-        history.push(norm);
-        if q_scale <= 1e-8 * q_guess {
-            return Err(HbError::Equilibrium);
-        }
-    }
-    stats.residual_norm = norm;
+    let mut x = guess.to_vec();
+    x.push(omega_guess);
+    // The phase condition b₁ = 0 (DOF 0) as the border row.
+    let mut phase_row = vec![0.0; m + 1];
+    phase_row[phase] = 1.0;
+    let border = Border {
+        rows: &phase_row,
+        values: &[0.0],
+    };
+    let nopts = NewtonOptions {
+        ftol: 0.0,
+        max_iter: hb.broyden.max_iter,
+        max_halvings: hb.broyden.max_backtracks,
+        accept_below: tol,
+        ..NewtonOptions::default()
+    };
+    let mut ws = NewtonWorkspace::bordered(m + 1, 1);
+    let stats = newton_bordered(&mut system, border, &mut x, &mut ws, &nopts)
+        .map_err(|e| SolveError::from_newton(e).map_or_else(|e| e, HbError::Solve))?;
+    let omega = x.pop().unwrap_or(omega_guess);
+    let q = x;
+    let stats = BroydenStats {
+        iterations: stats.iterations,
+        residual_evals: stats.residual_evals + 2 * stats.jacobian_evals,
+        jacobian_refreshes: stats.jacobian_evals,
+        residual_norm: stats.residual_norm,
+    };
     let solution = HbSolution {
         coeffs: q,
         omega_f: omega,
@@ -307,4 +244,97 @@ pub fn limit_cycle<P: PeriodicProblem>(
         stats,
     };
     classify_cycle(problem, solution, stability_steps)
+}
+
+/// `R(q, ω) = 0` of an autonomous problem in `x = (q, ω)` for
+/// [`ivt_num::newton_bordered`] (the phase condition is the border row):
+/// Jacobian `[Φ_q, ∂R/∂ω]` with `∂R/∂ω` by a central difference relative to
+/// ω. A trial with ω ≤ 0 is outside the domain (NaN residual).
+struct Cycle<'a, P> {
+    res: HbResidual,
+    galerkin: GalerkinJacobian,
+    problem: &'a P,
+    /// Unknowns of `q`.
+    m: usize,
+    jac: Vec<f64>,
+    r_omega: (Vec<f64>, Vec<f64>),
+    /// Residual tolerance `atol + rtol·S`.
+    tol: f64,
+    /// ‖guess‖∞: an orbit 1e-8 of it has collapsed onto the equilibrium.
+    q_guess: f64,
+}
+
+impl<P: PeriodicProblem> NewtonSystem for Cycle<'_, P> {
+    type Error = HbError;
+
+    fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), HbError> {
+        match x
+            .split_at_checked(self.m)
+            .and_then(|(q, w)| Some(q).zip(w.first()))
+        {
+            Some((q, &w)) if w > 0.0 => self.res.eval(self.problem, q, w, 1.0, r),
+            _ => r.fill(f64::NAN),
+        }
+        Ok(())
+    }
+
+    fn jacobian(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), HbError> {
+        let m = self.m;
+        let Some((q, omega)) = x.split_at_checked(m) else {
+            return Err(HbError::InvalidInput(
+                "limit cycle: unknowns of the wrong size".into(),
+            ));
+        };
+        let omega = omega.first().copied().unwrap_or(f64::NAN);
+        let (rp, rm) = (&mut self.r_omega.0, &mut self.r_omega.1);
+        self.galerkin
+            .assemble(&mut self.res, self.problem, q, omega, 1.0, &mut self.jac);
+        let h = 1e-6 * omega;
+        self.res.eval(self.problem, q, omega + h, 1.0, rp);
+        self.res.eval(self.problem, q, omega - h, 1.0, rm);
+        for (((row, j_row), p), mi) in out
+            .chunks_exact_mut(m + 1)
+            .zip(self.jac.chunks_exact(m))
+            .zip(rp.iter())
+            .zip(rm.iter())
+        {
+            row[..m].copy_from_slice(j_row);
+            row[m] = (p - mi) / (2.0 * h);
+        }
+        Ok(())
+    }
+
+    /// Converged when ‖[R; b₁]‖₂ ≤ tol and the last step is below 1e-10
+    /// relative to ‖q‖∞ and ω; an orbit collapsed onto `x = 0` is
+    /// [`HbError::Equilibrium`].
+    fn check_step(
+        &mut self,
+        x: &[f64],
+        step: &[f64],
+        history: &[f64],
+    ) -> Result<StepCheck, HbError> {
+        let (Some((q, omega)), Some((dq, d_omega))) =
+            (x.split_at_checked(self.m), step.split_at_checked(self.m))
+        else {
+            return Ok(StepCheck::Continue);
+        };
+        let q_scale = q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if q_scale <= 1e-8 * self.q_guess {
+            return Err(HbError::Equilibrium);
+        }
+        let omega_before = omega.first().zip(d_omega.first()).map(|(w, d)| w - d);
+        let dq = dq.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let last_step = (dq / q_scale.max(f64::MIN_POSITIVE)).max(
+            d_omega
+                .first()
+                .zip(omega_before)
+                .map_or(f64::INFINITY, |(d, w)| (d / w).abs()),
+        );
+        let norm = history.last().copied().unwrap_or(f64::INFINITY);
+        Ok(if norm <= self.tol && last_step <= 1e-10 {
+            StepCheck::Converged
+        } else {
+            StepCheck::Continue
+        })
+    }
 }

@@ -25,12 +25,18 @@
 use crate::broyden::SolveError;
 use crate::family::{Family, FamilyBranch};
 use crate::floquet::{eigenvalues, monodromy_uniform, HsuRule};
-use crate::fold::{null_vector, residual_lambda_difference as residual_lambda, Branch};
+use crate::fold::{
+    extended_step_check, null_vector, residual_lambda_difference as residual_lambda, Branch,
+};
 use crate::ihb::HbError;
 use crate::stability::StabilityAnalyzer;
 use faer::c64;
 use ivt_num::vector::norm2;
-use ivt_num::{BorderedError, BorderedLu, LuWorkspace};
+use ivt_num::{
+    newton, BorderedError, BorderedLu, LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace,
+    StepCheck,
+};
+use std::convert::Infallible;
 use thiserror::Error;
 
 /// The kind of a located bifurcation.
@@ -273,19 +279,6 @@ pub(crate) fn put_jacobian(dst: &mut [f64], stride: usize, jac: &[f64], r_lambda
     }
 }
 
-/// Appends ‖F‖ to the Newton history; a non-finite norm ends the iteration
-/// with the history.
-pub(crate) fn record(history: &mut Vec<f64>, norm: f64) -> Result<(), BifurcationError> {
-    history.push(norm);
-    if norm.is_finite() {
-        return Ok(());
-    }
-    Err(solve_error(SolveError::NonFinite {
-        iteration: history.len() - 1,
-        history: std::mem::take(history),
-    }))
-}
-
 pub(crate) fn lambda_step(opts: &BifurcationOptions, lambda: f64) -> f64 {
     opts.fd_step * lambda.abs().max(1e-3)
 }
@@ -327,14 +320,16 @@ pub(crate) fn border_null_vectors(
 /// Result of [`extended_newton`]: `(q, λ, iterations)`.
 pub(crate) type Converged = (Vec<f64>, f64, usize);
 
-/// Newton on `[R(q, λ) + Σⱼ μⱼ bⱼ; ψ(q, λ)] = 0`, unknowns `{q, λ, μ}` with
-/// `k = unfold.len() + 1` test functions `ψ` (the unfoldings `μ` make it square).
+/// Newton ([`ivt_num::newton()`]) on `[R(q, λ) + Σⱼ μⱼ bⱼ; ψ(q, λ)] = 0`,
+/// unknowns `{q, λ, μ}` with `k = unfold.len() + 1` test functions `ψ` (the
+/// unfoldings `μ` make it square). Full steps; stops by
+/// [`crate::fold::extended_step_check`].
 pub(crate) fn extended_newton<B, T>(
     branch: &mut B,
     q0: &[f64],
     lambda0: f64,
     unfold: &[Vec<f64>],
-    mut tests: T,
+    tests: T,
     opts: &BifurcationOptions,
 ) -> Result<Converged, BifurcationError>
 where
@@ -343,94 +338,129 @@ where
 {
     let m = branch.len();
     let k = unfold.len() + 1;
-    let n = m + k;
-    let (mut q, mut lambda, mut mu) = (q0.to_vec(), lambda0, vec![0.0; k - 1]);
-    let (mut r, mut psi) = (vec![0.0; m], vec![0.0; k]);
-    let (mut psi_p, mut psi_m) = (vec![0.0; k], vec![0.0; k]);
-    let mut jac = vec![0.0; m * m];
-    let mut r_lambda = vec![0.0; m];
-    let mut newton = vec![0.0; n * n];
-    let mut newton_lu = BorderedLu::new(m, k);
-    let mut step = vec![0.0; n];
-    let mut history: Vec<f64> = Vec::with_capacity(opts.max_iter + 1);
-    for it in 0..=opts.max_iter {
-        branch.residual(&q, lambda, &mut r);
-        for (b, mu_j) in unfold.iter().zip(&mu) {
+    let mut x = q0.to_vec();
+    x.push(lambda0);
+    x.resize(m + k, 0.0);
+    let mut system = Extended {
+        branch,
+        unfold,
+        tests,
+        opts,
+        m,
+        jac: vec![0.0; m * m],
+        r_lambda: vec![0.0; m],
+        psi: (vec![0.0; k], vec![0.0; k]),
+        qt: vec![0.0; m],
+    };
+    let nopts = NewtonOptions {
+        ftol: 0.0,
+        max_iter: opts.max_iter,
+        max_halvings: 0,
+        accept_no_descent: true,
+        accept_near_singular: true,
+        ..NewtonOptions::default()
+    };
+    let stats = newton(
+        &mut system,
+        &mut x,
+        &mut NewtonWorkspace::new(m + k),
+        &nopts,
+    )
+    .map_err(|e| solve_error(SolveError::from(e)))?;
+    let lambda = x.get(m).copied().unwrap_or(lambda0);
+    x.truncate(m);
+    Ok((x, lambda, stats.iterations))
+}
+
+/// The extended system of [`extended_newton`] as a [`NewtonSystem`]:
+/// `[J, R_λ, b]` analytic in `q` with `R_λ` by [`lambda_step`], the
+/// test-function rows by central differences in `q` and λ.
+struct Extended<'a, B, T> {
+    branch: &'a mut B,
+    unfold: &'a [Vec<f64>],
+    tests: T,
+    opts: &'a BifurcationOptions,
+    m: usize,
+    jac: Vec<f64>,
+    r_lambda: Vec<f64>,
+    psi: (Vec<f64>, Vec<f64>),
+    qt: Vec<f64>,
+}
+
+impl<B, T> NewtonSystem for Extended<'_, B, T>
+where
+    B: Branch,
+    T: FnMut(&mut B, &[f64], f64, &mut [f64]),
+{
+    type Error = Infallible;
+
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), Infallible> {
+        let m = self.m;
+        let (q, rest) = x.split_at(m);
+        let (lambda, mu) = (rest[0], &rest[1..]);
+        let (r, psi) = out.split_at_mut(m);
+        self.branch.residual(q, lambda, r);
+        for (b, mu_j) in self.unfold.iter().zip(mu) {
             r.iter_mut().zip(b).for_each(|(ri, bi)| *ri += mu_j * bi);
         }
-        tests(branch, &q, lambda, &mut psi);
-        record(
-            &mut history,
-            (norm2(&r).powi(2) + norm2(&psi).powi(2)).sqrt(),
-        )?;
-        if it == opts.max_iter {
-            break;
-        }
-        branch.jacobian(&q, lambda, &mut jac);
-        let h_lambda = lambda_step(opts, lambda);
-        residual_lambda(branch, &q, lambda, h_lambda, &mut r_lambda);
+        (self.tests)(self.branch, q, lambda, psi);
+        Ok(())
+    }
+
+    fn jacobian(&mut self, x: &[f64], newton: &mut [f64]) -> Result<(), Infallible> {
+        let m = self.m;
+        let n = x.len();
+        let (q, lambda) = (&x[..m], x[m]);
+        self.branch.jacobian(q, lambda, &mut self.jac);
+        let h_lambda = lambda_step(self.opts, lambda);
+        residual_lambda(self.branch, q, lambda, h_lambda, &mut self.r_lambda);
         newton.fill(0.0);
-        put_jacobian(&mut newton, n, &jac, &r_lambda);
-        for i in 0..m {
-            for (j, b) in unfold.iter().enumerate() {
-                newton[i * n + m + 1 + j] = b[i];
+        put_jacobian(newton, n, &self.jac, &self.r_lambda);
+        for (i, row) in newton.chunks_exact_mut(n).take(m).enumerate() {
+            for (j, b) in self.unfold.iter().enumerate() {
+                row[m + 1 + j] = b[i];
             }
         }
         // Test-function rows by central differences in q and λ.
         let q_scale = q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let mut qt = q.clone();
+        self.qt.copy_from_slice(q);
+        let (psi_p, psi_m) = (&mut self.psi.0, &mut self.psi.1);
         for col in 0..=m {
             let h = if col < m {
-                opts.fd_step * q[col].abs().max(q_scale).max(f64::MIN_POSITIVE)
+                self.opts.fd_step * q[col].abs().max(q_scale).max(f64::MIN_POSITIVE)
             } else {
                 h_lambda
             };
             if col < m {
-                qt[col] = q[col] + h;
-                tests(branch, &qt, lambda, &mut psi_p);
-                qt[col] = q[col] - h;
-                tests(branch, &qt, lambda, &mut psi_m);
-                qt[col] = q[col];
+                self.qt[col] = q[col] + h;
+                (self.tests)(self.branch, &self.qt, lambda, psi_p);
+                self.qt[col] = q[col] - h;
+                (self.tests)(self.branch, &self.qt, lambda, psi_m);
+                self.qt[col] = q[col];
             } else {
-                tests(branch, &q, lambda + h, &mut psi_p);
-                tests(branch, &q, lambda - h, &mut psi_m);
+                (self.tests)(self.branch, q, lambda + h, psi_p);
+                (self.tests)(self.branch, q, lambda - h, psi_m);
             }
-            for t in 0..k {
-                newton[(m + t) * n + col] = (psi_p[t] - psi_m[t]) / (2.0 * h);
+            for (t, (p, mi)) in psi_p.iter().zip(psi_m.iter()).enumerate() {
+                newton[(m + t) * n + col] = (p - mi) / (2.0 * h);
             }
         }
-        for i in 0..m {
-            step[i] = -r[i];
-        }
-        for t in 0..k {
-            step[m + t] = -psi[t];
-        }
-        let (top, bottom) = newton.split_at(m * n);
-        let solved =
-            factored(newton_lu.factor_rows(top, bottom)) && newton_lu.solve(&mut step).is_ok();
-        if !solved || !step.iter().all(|x| x.is_finite()) {
-            return Err(solve_error(SolveError::SingularJacobian {
-                iteration: it,
-                history,
-            }));
-        }
-        q.iter_mut().zip(&step).for_each(|(x, d)| *x += d);
-        lambda += step[m];
-        mu.iter_mut().zip(&step[m + 1..]).for_each(|(x, d)| *x += d);
-        let dq = step[..m].iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let below = |tol: f64| {
-            dq <= tol * q_scale.max(f64::MIN_POSITIVE)
-                && step[m].abs() <= tol * lambda.abs().max(1e-3)
-        };
-        let stalled = it > 0 && history[it] > 0.25 * history[it - 1];
-        if below(opts.step_tol) || (stalled && below(opts.noise_tol)) {
-            return Ok((q, lambda, it + 1));
-        }
+        Ok(())
     }
-    Err(solve_error(SolveError::NonConvergence {
-        iterations: opts.max_iter,
-        history,
-    }))
+
+    fn check_step(
+        &mut self,
+        x: &[f64],
+        step: &[f64],
+        history: &[f64],
+    ) -> Result<StepCheck, Infallible> {
+        Ok(extended_step_check(
+            (x, step, self.m),
+            history,
+            (self.opts.step_tol, self.opts.noise_tol),
+            1e-3,
+        ))
+    }
 }
 
 /// Locates the period doubling (multiplier −1) or Neimark–Sacker point (complex

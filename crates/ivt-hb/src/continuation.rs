@@ -15,6 +15,7 @@ use crate::error::HbError;
 use ivt_num::vector::{dot, norm2};
 use ivt_num::LuWorkspace;
 
+mod corrector;
 mod exact;
 mod start;
 pub use exact::{pseudo_arclength_exact, PathSystem};
@@ -40,7 +41,8 @@ pub struct ContinuationOptions {
     pub ds_relative_scale: f64,
     /// Maximum number of points (including the start).
     pub max_points: usize,
-    /// Stop once λ leaves `[lambda_min, lambda_max]` (that point is kept).
+    /// The interval of λ: a step that would leave it is corrected on the
+    /// bound instead, and the path ends there (no point outside).
     pub lambda_min: f64,
     /// See `lambda_min`.
     pub lambda_max: f64,
@@ -322,13 +324,33 @@ where
     let mut x = vec![0.0; n1];
     let mut ds = opts.ds;
     let mut fresh = true;
+    // A corrected point fell outside the interval: redo the step onto the bound.
+    let mut force_landing = false;
+    let mut e_lambda = vec![0.0; n1];
+    e_lambda[m] = 1.0;
     let termination = loop {
         if points.len() >= opts.max_points {
             break Termination::MaxPoints;
         }
+        // A step that would leave [lambda_min, lambda_max] is shortened to
+        // reach the bound and corrected on λ = bound (no point outside).
+        let bound = if xd[m] > 0.0 {
+            opts.lambda_max
+        } else {
+            opts.lambda_min
+        };
+        let to_bound = (bound - xp[m]) / xd[m];
+        let landing = (to_bound.is_finite() && (force_landing || to_bound <= ds)).then_some(bound);
+        let step = if landing.is_some() { to_bound } else { ds };
+        if step.is_nan() || step <= 0.0 {
+            break Termination::LeftInterval;
+        }
         // Predictor (Eq. 71) and B_λ by one finite difference at the prediction.
         for i in 0..n1 {
-            x[i] = xp[i] + xd[i] * ds;
+            x[i] = xp[i] + xd[i] * step;
+        }
+        if let Some(l) = landing {
+            x[m] = l;
         }
         let h = opts.broyden.fd_step * x[m].abs().max(1.0);
         residual(&x, &mut r0);
@@ -340,25 +362,32 @@ where
         }
         // B_x = [[B_q, B_λ], [x_dᵀ]] (Eq. 72). After a successful step only the
         // λ column and the augmenting row change: two Sherman–Morrison updates.
+        // The constraint row: the secant, or e_λ when landing.
+        let row = if landing.is_some() { &e_lambda } else { &xd };
         let set = if fresh {
             b[..m * n1].copy_from_slice(&jac);
-            b[m * n1..].copy_from_slice(&xd);
+            b[m * n1..].copy_from_slice(row);
             ws.set_jacobian(&b)
         } else {
             let mut col: Vec<f64> = (0..m).map(|i| jac[i * n1 + m]).collect();
             col.push(ws.jacobian()[m * n1 + m]);
             ws.replace_col(m, &col)
-                .and_then(|()| ws.replace_row(m, &xd))
+                .and_then(|()| ws.replace_row(m, row))
         };
         fresh = false;
         let (xp_c, xd_c) = (xp.clone(), xd.clone());
         let mut aug = |xv: &[f64], r: &mut [f64]| {
             residual(xv, &mut r[..m]);
-            let mut g = 0.0;
-            for i in 0..n1 {
-                g += xd_c[i] * (xv[i] - xp_c[i]);
-            }
-            r[m] = g - ds;
+            r[m] = match landing {
+                Some(l) => xv[m] - l,
+                None => {
+                    let mut g = 0.0;
+                    for i in 0..n1 {
+                        g += xd_c[i] * (xv[i] - xp_c[i]);
+                    }
+                    g - step
+                }
+            };
         };
         let outcome = match set {
             Ok(()) => broyden_solve(&mut aug, &mut x, &mut ws, &opts.broyden),
@@ -372,7 +401,7 @@ where
                     .map(|(a, b)| (a - b) * (a - b))
                     .sum::<f64>()
                     .sqrt();
-                dist <= 3.0 * ds
+                dist <= 3.0 * step
             }
             Err(_) => false,
         };
@@ -390,6 +419,11 @@ where
             continue;
         }
         let iters = outcome.map(|s| s.iterations).unwrap_or(0);
+        if landing.is_none() && (x[m] < opts.lambda_min || x[m] > opts.lambda_max) {
+            force_landing = true;
+            fresh = true;
+            continue;
+        }
         // Carry B_q forward.
         for i in 0..m {
             jac[i * n1..i * n1 + m].copy_from_slice(&ws.jacobian()[i * n1..i * n1 + m]);
@@ -433,7 +467,7 @@ where
         if !on_point(points.last().expect("just pushed")) {
             break Termination::Stopped;
         }
-        if lam < opts.lambda_min || lam > opts.lambda_max {
+        if landing.is_some() || lam < opts.lambda_min || lam > opts.lambda_max {
             break Termination::LeftInterval;
         }
         if iters * 2 <= opts.target_iter {
@@ -529,5 +563,29 @@ mod tests {
             "{:?}",
             path.folds
         );
+    }
+
+    /// A first step (0.3) far longer than the interval λ ∈ [0.8, 0.85] on
+    /// the circle x² + λ² = 1: the path ends on λ = 0.85 exactly, on the
+    /// circle (x = −√(1 − 0.85²)), and no point lies outside the interval.
+    /// Before, the first point was kept at λ ≈ 0.8 + 0.3·0.6.
+    #[test]
+    fn a_long_step_lands_on_the_bound_and_never_leaves_the_interval() {
+        let res = |x: &[f64], r: &mut [f64]| r[0] = x[0] * x[0] + x[1] * x[1] - 1.0;
+        let opts = ContinuationOptions {
+            ds: 0.3,
+            lambda_min: 0.8,
+            lambda_max: 0.85,
+            ..Default::default()
+        };
+        let path = pseudo_arclength(res, &[-0.6, 0.8], None, 1.0, &opts, |_| true).unwrap();
+        assert_eq!(path.termination, Termination::LeftInterval);
+        for p in &path.points {
+            assert!((0.8..=0.85).contains(&p.lambda()), "{:?}", path.points);
+        }
+        let last = path.points.last().unwrap();
+        assert!((last.lambda() - 0.85).abs() <= 1e-15, "{last:?}");
+        let x_exact = -(1.0f64 - 0.85 * 0.85).sqrt();
+        assert!((last.x[0] - x_exact).abs() < 1e-9, "{last:?}");
     }
 }

@@ -18,7 +18,9 @@
 use crate::broyden::SolveError;
 use crate::ihb::HbError;
 use ivt_num::vector::norm2;
-use ivt_num::{BorderedLu, LuWorkspace};
+use ivt_num::StepCheck;
+use ivt_num::{newton, BorderedLu, LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace};
+use std::convert::Infallible;
 
 /// A one-parameter family of square systems `R(q, λ) = 0` with `∂R/∂q`.
 pub trait Branch {
@@ -272,86 +274,157 @@ pub fn locate_fold<B: Branch>(
         b: vec![1.0 / (m as f64).sqrt(); m],
         c: vec![1.0 / (m as f64).sqrt(); m],
     };
-    let singular = |iteration, history: &[f64]| {
-        HbError::Solve(SolveError::SingularJacobian {
-            iteration,
-            history: history.to_vec(),
-        })
-    };
     // Borders: the approximate left/right null vectors of J at the start.
     branch.jacobian(q0, lambda0, &mut bd.jac);
     let mut lu = LuWorkspace::new(m);
     // J is near-singular at a fold: only a non-finite factor is refused here.
     lu.factor_row_major(&bd.jac);
     if !null_vector(&mut lu, &mut bd.c, false) || !null_vector(&mut lu, &mut bd.b, true) {
-        return Err(singular(0, &[]));
+        return Err(HbError::Solve(SolveError::SingularJacobian {
+            iteration: 0,
+            history: Vec::new(),
+        }));
     }
-    let mut q = q0.to_vec();
-    let mut lambda = lambda0;
-    let mut r = vec![0.0; m];
-    let mut r_lambda = vec![0.0; m];
-    let (mut v, mut w, mut grad) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
-    let mut newton_lu = BorderedLu::new(m, 1);
-    let mut step = vec![0.0; n1];
-    let mut history = Vec::with_capacity(opts.max_iter + 1);
-    for it in 0..=opts.max_iter {
-        branch.residual(&q, lambda, &mut r);
-        // The first step's J is the one the borders came from.
-        let g = bd.solve_pair(branch, (&q, lambda), it == 0, &mut v, &mut w);
-        let norm = (norm2(&r).powi(2) + g * g).sqrt();
-        history.push(norm);
-        if !norm.is_finite() {
-            return Err(HbError::Solve(SolveError::NonFinite {
-                iteration: it,
-                history,
-            }));
-        }
-        if it == opts.max_iter {
-            break;
-        }
-        // Newton matrix [[J, R_λ], [g_q, g_λ]], bordered: J from the bordered
-        // solve, and g_(q, λ) = −wᵀ J_(q, λ) v (Govaerts) with [v; g], [w; g]
-        // its solutions.
-        let q_scale = q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let h_lambda = opts.fd_step * lambda.abs().max(f64::MIN_POSITIVE);
-        branch.residual_lambda(&q, lambda, h_lambda, &mut r_lambda);
-        let g_lambda = -branch.bilinear_lambda(&q, lambda, h_lambda, &w, &v);
-        branch.jacobian_gradient(&q, lambda, &w, &v, &mut grad);
-        grad.iter_mut().for_each(|x| *x = -*x);
-        for i in 0..m {
-            step[i] = -r[i];
-        }
-        step[m] = -g;
-        if newton_lu
-            .factor(&bd.jac, &r_lambda, &grad, &[g_lambda])
-            .and_then(|()| newton_lu.solve(&mut step))
-            .is_err()
+    let mut x = q0.to_vec();
+    x.push(lambda0);
+    let mut system = FoldSystem {
+        branch,
+        bd,
+        jac_current: true,
+        fd_step: opts.fd_step,
+        r_lambda: vec![0.0; m],
+        v: vec![0.0; m],
+        w: vec![0.0; m],
+        grad: vec![0.0; m],
+        step_tol: opts.step_tol,
+        noise_tol: opts.noise_tol,
+    };
+    let nopts = NewtonOptions {
+        ftol: 0.0,
+        max_iter: opts.max_iter,
+        max_halvings: 0,
+        accept_no_descent: true,
+        ..NewtonOptions::default()
+    };
+    let mut ws = NewtonWorkspace::new(n1);
+    let stats = newton(&mut system, &mut x, &mut ws, &nopts).map_err(SolveError::from)?;
+    let residual_norm = norm2(ws.residual().get(..m).unwrap_or_default());
+    let lambda = x.pop().unwrap_or(lambda0);
+    Ok(FoldLocation {
+        q: x,
+        lambda,
+        iterations: stats.iterations,
+        residual_norm,
+    })
+}
+
+/// The minimally extended system `[R(q, λ); g(q, λ)] = 0` in `x = (q, λ)`
+/// for [`ivt_num::newton()`]: the residual solves the bordered pair (so the
+/// Jacobian reuses `J`, `v` and `w` of the same point), the Jacobian is
+/// `[[J, R_λ], [g_q, g_λ]]` with `g_(q, λ) = −wᵀ J_(q, λ) v` (Govaerts).
+struct FoldSystem<'a, B> {
+    branch: &'a mut B,
+    bd: Bordered,
+    /// `bd.jac` already holds `J` at the next residual point (the start).
+    jac_current: bool,
+    fd_step: f64,
+    r_lambda: Vec<f64>,
+    v: Vec<f64>,
+    w: Vec<f64>,
+    grad: Vec<f64>,
+    step_tol: f64,
+    noise_tol: f64,
+}
+
+impl<B: Branch> NewtonSystem for FoldSystem<'_, B> {
+    type Error = Infallible;
+
+    fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
+        let m = self.bd.m;
+        let (q, lambda) = (&x[..m], x[m]);
+        self.branch.residual(q, lambda, &mut r[..m]);
+        let current = std::mem::replace(&mut self.jac_current, false);
+        r[m] = self
+            .bd
+            .solve_pair(self.branch, (q, lambda), current, &mut self.v, &mut self.w);
+        Ok(())
+    }
+
+    fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> Result<(), Infallible> {
+        let m = self.bd.m;
+        let (q, lambda) = (&x[..m], x[m]);
+        let h_lambda = self.fd_step * lambda.abs().max(f64::MIN_POSITIVE);
+        let branch = &mut *self.branch;
+        branch.residual_lambda(q, lambda, h_lambda, &mut self.r_lambda);
+        let g_lambda = -branch.bilinear_lambda(q, lambda, h_lambda, &self.w, &self.v);
+        branch.jacobian_gradient(q, lambda, &self.w, &self.v, &mut self.grad);
+        let n1 = m + 1;
+        for ((row, j_row), r_l) in jac
+            .chunks_exact_mut(n1)
+            .zip(self.bd.jac.chunks_exact(m))
+            .zip(&self.r_lambda)
         {
-            return Err(singular(it, &history));
+            row[..m].copy_from_slice(j_row);
+            row[m] = *r_l;
         }
-        for i in 0..m {
-            q[i] += step[i];
-        }
-        lambda += step[m];
-        let dq = step[..m].iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let below = |tol: f64| {
-            dq <= tol * q_scale.max(f64::MIN_POSITIVE) && step[m].abs() <= tol * lambda.abs()
-        };
-        let stalled = it > 0 && norm > 0.25 * history[it - 1];
-        if below(opts.step_tol) || (stalled && below(opts.noise_tol)) {
-            branch.residual(&q, lambda, &mut r);
-            return Ok(FoldLocation {
-                q,
-                lambda,
-                iterations: it + 1,
-                residual_norm: norm2(&r),
-            });
-        }
+        let last = &mut jac[m * n1..];
+        last.iter_mut().zip(&self.grad).for_each(|(o, g)| *o = -g);
+        last[m] = g_lambda;
+        Ok(())
     }
-    Err(HbError::Solve(SolveError::NonConvergence {
-        iterations: opts.max_iter,
-        history,
-    }))
+
+    fn check_step(
+        &mut self,
+        x: &[f64],
+        step: &[f64],
+        history: &[f64],
+    ) -> Result<StepCheck, Infallible> {
+        Ok(extended_step_check(
+            (x, step, self.bd.m),
+            history,
+            (self.step_tol, self.noise_tol),
+            f64::MIN_POSITIVE,
+        ))
+    }
+}
+
+/// The stopping rule of the extended-system Newton iterations (folds,
+/// bifurcations): the step `(Δq, Δλ)` below `step_tol` relative to ‖q‖∞
+/// (before the step) and to `max(|λ|, lambda_floor)`, or below `noise_tol`
+/// once ‖F‖ no longer falls by 4× per step — the noise floor of the
+/// finite differences in their Jacobians (a user `g` without an analytic
+/// Jacobian). `x` is `(q, λ, …)` after the step with `q` of `m` entries,
+/// `history` the ‖F‖ history up to the point after the step.
+pub(crate) fn extended_step_check(
+    (x, step, m): (&[f64], &[f64], usize),
+    history: &[f64],
+    (step_tol, noise_tol): (f64, f64),
+    lambda_floor: f64,
+) -> StepCheck {
+    let (Some(q), Some(dq), Some(lambda), Some(d_lambda)) =
+        (x.get(..m), step.get(..m), x.get(m), step.get(m))
+    else {
+        return StepCheck::Continue;
+    };
+    let q_scale = q
+        .iter()
+        .zip(dq)
+        .fold(0.0f64, |a, (qi, d)| a.max((qi - d).abs()));
+    let dq = dq.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let below = |tol: f64| {
+        dq <= tol * q_scale.max(f64::MIN_POSITIVE)
+            && d_lambda.abs() <= tol * lambda.abs().max(lambda_floor)
+    };
+    // ‖F‖ at the point the step left, against the one before it.
+    let stalled = match history {
+        [.., before, left, _] => *left > 0.25 * before,
+        _ => false,
+    };
+    if below(step_tol) || (stalled && below(noise_tol)) {
+        StepCheck::Converged
+    } else {
+        StepCheck::Continue
+    }
 }
 
 #[cfg(test)]

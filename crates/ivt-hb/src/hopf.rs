@@ -2,7 +2,7 @@
 //! `M ẍ + C ẋ + K x + g(x, ẋ) = 0` at parameter p ([`crate::cycle_branch`]
 //! starts the limit cycles born there).
 //!
-//! An equilibrium solves `K x + g(x, 0) = 0` (Newton, [`ivt_num::newton`]);
+//! An equilibrium solves `K x + g(x, 0) = 0` (Newton, [`ivt_num::newton()`]);
 //! its linearisation in `y = (x, ẋ)` is
 //!
 //! `A = [[0, I], [−M⁻¹(K + ∂g/∂x), −M⁻¹(C + ∂g/∂v)]]`.

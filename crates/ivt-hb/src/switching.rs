@@ -59,6 +59,7 @@ pub fn switch_branch<B: Branch>(
         max_iter: opts.max_iter,
         max_halvings: 0,
         accept_no_descent: true,
+        ..NewtonOptions::default()
     };
     let border = Border {
         rows: direction,

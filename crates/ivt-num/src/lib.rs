@@ -49,7 +49,7 @@ pub use bordered::{BorderedError, BorderedLu};
 pub use lu::LuWorkspace;
 pub use newton::{
     newton, newton_bordered, Border, NewtonError, NewtonOptions, NewtonStats, NewtonSystem,
-    NewtonWorkspace,
+    NewtonWorkspace, StepCheck,
 };
 pub use rk::{ExplicitRk, Tolerance};
 pub use tableau::{Tableau, DP5, RK4, RK6};

@@ -7,11 +7,19 @@
 //!
 //! Stopping: `‖F(x)‖₂ ≤ ftol` (residual test), or a full step with
 //! `|Δx_i| ≤ rtol·|x_i| + atol` for every `i` (step test; the step is taken
-//! and `F` evaluated once more at the result). Failing: a singular
-//! Jacobian, a non-finite residual, no decrease along the step, or
-//! `max_iter` steps; every error carries the `‖F‖₂` history.
+//! and `F` evaluated once more at the result), or the system's own test
+//! ([`NewtonSystem::check_step`], asked after every accepted step: a step
+//! relative to a scale of its choosing, a noise floor, a divergence rule).
+//! Failing: a singular Jacobian, a non-finite residual (at the start or at
+//! the shortest trial step), no decrease along the step, or `max_iter`
+//! steps; every error carries the `‖F‖₂` history.
+//!
+//! Every Newton iteration of the workspace is this one: the HB orbit
+//! (classic IHB), the exact-Jacobian corrector and start of a path, the
+//! fold and bifurcation locators on their extended systems, limit cycles,
+//! branch switching, the STHB string and the θ-shooting of ivt-design.
 
-use crate::bordered::BorderedLu;
+use crate::bordered::{BorderedError, BorderedLu};
 use thiserror::Error;
 
 /// A system `F: Rⁿ → Rᵐ` with its Jacobian: square (`m = n`) for
@@ -32,6 +40,34 @@ pub trait NewtonSystem {
     /// # Errors
     /// As [`Self::residual`].
     fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> Result<(), Self::Error>;
+    /// The caller's stopping rule beside `ftol` and the step test, asked
+    /// after each accepted step that left `‖F‖₂ > ftol`: `x` is the new
+    /// point, `step` the step taken to reach it (damping included),
+    /// `history` the `‖F‖₂` history (its last entry at `x`). Default:
+    /// [`StepCheck::Continue`].
+    ///
+    /// # Errors
+    /// Any failure of the caller's own (e.g. the iteration collapsed onto a
+    /// trivial solution); it ends the iteration ([`NewtonError::Eval`]).
+    fn check_step(
+        &mut self,
+        _x: &[f64],
+        _step: &[f64],
+        _history: &[f64],
+    ) -> Result<StepCheck, Self::Error> {
+        Ok(StepCheck::Continue)
+    }
+}
+
+/// Verdict of [`NewtonSystem::check_step`] on an accepted step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StepCheck {
+    /// Iterate on.
+    Continue,
+    /// Stop: the point is the solution.
+    Converged,
+    /// Stop: the iteration diverges ([`NewtonError::NonConvergence`]).
+    Diverged,
 }
 
 /// Options of [`newton`].
@@ -53,6 +89,18 @@ pub struct NewtonOptions {
     /// anyway instead of failing, to leave a shallow local minimum of `‖F‖`
     /// from a cold start. Default `false`.
     pub accept_no_descent: bool,
+    /// With `accept_no_descent`: take the full step instead of the
+    /// shortest (the classic "keep the Newton step if no halving helps").
+    /// Default `false`.
+    pub full_step_without_descent: bool,
+    /// A trial with `‖F‖₂ ≤ accept_below` is accepted even without descent
+    /// (below the noise floor of `F` a rise is not divergence). Default 0.
+    pub accept_below: f64,
+    /// Accept a factorization whose pivots are below `n·ε` of the largest
+    /// (singular to rounding) and check the step for finiteness instead:
+    /// extended systems at a bifurcation are regular in exact arithmetic but
+    /// may be badly scaled. Default `false`.
+    pub accept_near_singular: bool,
 }
 
 impl Default for NewtonOptions {
@@ -64,6 +112,9 @@ impl Default for NewtonOptions {
             max_iter: 50,
             max_halvings: 8,
             accept_no_descent: false,
+            full_step_without_descent: false,
+            accept_below: 0.0,
+            accept_near_singular: false,
         }
     }
 }
@@ -208,6 +259,12 @@ impl NewtonWorkspace {
         &self.r
     }
 
+    /// The `‖F‖₂` history of the last solve (first entry: the initial
+    /// guess; one per accepted step).
+    pub fn history(&self) -> &[f64] {
+        &self.history
+    }
+
     /// Sign of the determinant of the last factored (bordered) Jacobian.
     pub fn det_sign(&self) -> f64 {
         self.lu.det_sign()
@@ -236,6 +293,45 @@ fn bordered_residual<S: NewtonSystem + ?Sized>(
 
 fn norm2(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// Backtracking along `ws.dx` from `x`: `t = 1, ½, ¼, …` until `‖F‖₂`
+/// falls below `norm` (or below `opts.accept_below`). The accepted trial
+/// point and residual are left in `ws.x_trial`, `ws.r_trial`; returns its
+/// `t`, or `None` when no trial is acceptable under `opts`.
+fn line_search<S: NewtonSystem + ?Sized>(
+    sys: &mut S,
+    border: &Border,
+    x: &[f64],
+    ws: &mut NewtonWorkspace,
+    opts: &NewtonOptions,
+    norm: f64,
+    stats: &mut NewtonStats,
+) -> Result<Option<f64>, NewtonError<S::Error>> {
+    let mut t = 1.0;
+    let mut trial_at = |t: f64, ws: &mut NewtonWorkspace, stats: &mut NewtonStats| {
+        for ((xt, xi), d) in ws.x_trial.iter_mut().zip(x).zip(&ws.dx) {
+            *xt = xi + t * d;
+        }
+        stats.residual_evals += 1;
+        bordered_residual(sys, border, &ws.x_trial, &mut ws.r_trial)
+            .map_err(NewtonError::Eval)
+            .map(|()| norm2(&ws.r_trial))
+    };
+    for k in 0..=opts.max_halvings {
+        let trial = trial_at(t, ws, stats)?;
+        let descent = trial < norm || trial <= opts.accept_below;
+        let last = k == opts.max_halvings;
+        if trial.is_finite() && (descent || (last && opts.accept_no_descent)) {
+            if !descent && opts.full_step_without_descent && t < 1.0 {
+                trial_at(1.0, ws, stats)?;
+                return Ok(Some(1.0));
+            }
+            return Ok(Some(t));
+        }
+        t *= 0.5;
+    }
+    Ok(None)
 }
 
 /// Solves the square system `F(x) = 0` by damped Newton from the guess `x`
@@ -300,7 +396,8 @@ pub fn newton_bordered<S: NewtonSystem + ?Sized>(
     if !norm.is_finite() {
         return Err(non_finite(0, &ws.history));
     }
-    while norm > opts.ftol {
+    let mut converged = norm <= opts.ftol;
+    while !converged {
         if stats.iterations >= opts.max_iter {
             return Err(NewtonError::NonConvergence {
                 iterations: stats.iterations,
@@ -315,7 +412,12 @@ pub fn newton_bordered<S: NewtonSystem + ?Sized>(
             iteration: it,
             history: history.to_vec(),
         };
-        if ws.lu.factor_rows(&ws.jac, border.rows).is_err() {
+        let factored = match ws.lu.factor_rows(&ws.jac, border.rows) {
+            Ok(()) => true,
+            Err(BorderedError::Singular) => opts.accept_near_singular,
+            Err(BorderedError::Size { .. }) => false,
+        };
+        if !factored {
             return Err(singular(&ws.history));
         }
         ws.dx.iter_mut().zip(&ws.r).for_each(|(d, r)| *d = -r);
@@ -341,25 +443,11 @@ pub fn newton_bordered<S: NewtonSystem + ?Sized>(
             }
             break;
         }
-        // Backtracking: t = 1, ½, ¼, … until ‖F‖ falls.
-        let mut t = 1.0;
-        let mut accepted = None;
-        for k in 0..=opts.max_halvings {
-            for ((xt, xi), d) in ws.x_trial.iter_mut().zip(x.iter()).zip(&ws.dx) {
-                *xt = xi + t * d;
+        let Some(t) = line_search(sys, &border, x, ws, opts, norm, &mut stats)? else {
+            if !norm2(&ws.r_trial).is_finite() {
+                // The shortest trial left the domain of F.
+                return Err(non_finite(it, &ws.history));
             }
-            bordered_residual(sys, &border, &ws.x_trial, &mut ws.r_trial)
-                .map_err(NewtonError::Eval)?;
-            stats.residual_evals += 1;
-            let trial = norm2(&ws.r_trial);
-            let last = k == opts.max_halvings;
-            if trial.is_finite() && (trial < norm || (last && opts.accept_no_descent)) {
-                accepted = Some(trial);
-                break;
-            }
-            t *= 0.5;
-        }
-        let Some(trial) = accepted else {
             return Err(NewtonError::NoDescent {
                 iteration: it,
                 history: ws.history.clone(),
@@ -367,215 +455,32 @@ pub fn newton_bordered<S: NewtonSystem + ?Sized>(
         };
         x.copy_from_slice(&ws.x_trial);
         std::mem::swap(&mut ws.r, &mut ws.r_trial);
-        norm = trial;
+        norm = norm2(&ws.r);
         ws.history.push(norm);
+        if !norm.is_finite() {
+            return Err(non_finite(it, &ws.history));
+        }
+        converged = norm <= opts.ftol;
+        if !converged {
+            ws.dx.iter_mut().for_each(|d| *d *= t);
+            match sys
+                .check_step(x, &ws.dx, &ws.history)
+                .map_err(NewtonError::Eval)?
+            {
+                StepCheck::Continue => {}
+                StepCheck::Converged => converged = true,
+                StepCheck::Diverged => {
+                    return Err(NewtonError::NonConvergence {
+                        iterations: it,
+                        history: ws.history.clone(),
+                    })
+                }
+            }
+        }
     }
     stats.residual_norm = norm;
     Ok(stats)
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `F = (x₀² + x₁² − 4, x₀ − x₁)`: root `(√2, √2)`.
-    struct Circle {
-        jacobians_at_last_residual: bool,
-        last: Vec<f64>,
-    }
-
-    impl NewtonSystem for Circle {
-        type Error = ();
-        fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), ()> {
-            r[0] = x[0] * x[0] + x[1] * x[1] - 4.0;
-            r[1] = x[0] - x[1];
-            self.last = x.to_vec();
-            Ok(())
-        }
-        fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> Result<(), ()> {
-            self.jacobians_at_last_residual &= self.last == x;
-            jac.copy_from_slice(&[2.0 * x[0], 2.0 * x[1], 1.0, -1.0]);
-            Ok(())
-        }
-    }
-
-    /// From (3, 1): quadratic convergence to √2 (the error squares each step:
-    /// 6 steps reach 1e-15), the Jacobian is always asked at the last
-    /// residual point, and the history falls monotonically.
-    #[test]
-    fn converges_quadratically_on_a_circle() {
-        let mut sys = Circle {
-            jacobians_at_last_residual: true,
-            last: Vec::new(),
-        };
-        let mut x = [3.0, 1.0];
-        let mut ws = NewtonWorkspace::new(2);
-        let opts = NewtonOptions {
-            ftol: 1e-14,
-            ..Default::default()
-        };
-        let stats = newton(&mut sys, &mut x, &mut ws, &opts).unwrap();
-        let s2 = 2f64.sqrt();
-        assert!(
-            (x[0] - s2).abs() < 1e-15 && (x[1] - s2).abs() < 1e-15,
-            "{x:?}"
-        );
-        assert!(
-            stats.iterations <= 6 && stats.residual_norm <= 1e-14,
-            "{stats:?}"
-        );
-        assert!(sys.jacobians_at_last_residual);
-        assert_eq!(stats.jacobian_evals, stats.iterations);
-    }
-
-    /// The circle `x₀² + x₁² = 4` closed by the border row `x₀ − x₁ = 0`
-    /// takes the same steps as the square system `Circle` that has that row
-    /// in its Jacobian (same history to rounding), and lands on the closed
-    /// form `(√2, √2)`. Two border rows on three unknowns (`x₂ = 0.5`,
-    /// `x₀ + x₁ = 1` with `F = x₀² − x₁ + x₂`): the root of `x₀² + x₀ − 0.5`,
-    /// `x₀ = (−1 + √3)/2`.
-    #[test]
-    fn border_rows_close_the_system() {
-        struct Arc;
-        impl NewtonSystem for Arc {
-            type Error = ();
-            fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), ()> {
-                r[0] = x[0] * x[0] + x[1] * x[1] - 4.0;
-                Ok(())
-            }
-            fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> Result<(), ()> {
-                jac.copy_from_slice(&[2.0 * x[0], 2.0 * x[1]]);
-                Ok(())
-            }
-        }
-        let opts = NewtonOptions {
-            ftol: 1e-14,
-            ..Default::default()
-        };
-        let mut square = Circle {
-            jacobians_at_last_residual: true,
-            last: Vec::new(),
-        };
-        let mut x_sq = [3.0, 1.0];
-        let mut ws_sq = NewtonWorkspace::new(2);
-        newton(&mut square, &mut x_sq, &mut ws_sq, &opts).unwrap();
-        let mut x = [3.0, 1.0];
-        let mut ws = NewtonWorkspace::new(2);
-        let border = Border {
-            rows: &[1.0, -1.0],
-            values: &[0.0],
-        };
-        let stats = newton_bordered(&mut Arc, border, &mut x, &mut ws, &opts).unwrap();
-        assert_eq!(ws.history.len(), ws_sq.history.len());
-        for (a, b) in ws.history.iter().zip(&ws_sq.history) {
-            assert!((a - b).abs() <= 1e-13 * b.max(1.0), "{:?}", ws.history);
-        }
-        let s2 = 2f64.sqrt();
-        assert!(
-            (x[0] - s2).abs() < 1e-15 && (x[1] - s2).abs() < 1e-15,
-            "{x:?} {stats:?}"
-        );
-
-        struct Parabola;
-        impl NewtonSystem for Parabola {
-            type Error = ();
-            fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), ()> {
-                r[0] = x[0] * x[0] - x[1] + x[2];
-                Ok(())
-            }
-            fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> Result<(), ()> {
-                jac.copy_from_slice(&[2.0 * x[0], -1.0, 1.0]);
-                Ok(())
-            }
-        }
-        let mut x = [1.0, 0.0, 0.0];
-        let border = Border {
-            rows: &[0.0, 0.0, 1.0, 1.0, 1.0, 0.0],
-            values: &[0.5, 1.0],
-        };
-        newton_bordered(&mut Parabola, border, &mut x, &mut ws, &opts).unwrap();
-        let root = (3f64.sqrt() - 1.0) / 2.0;
-        assert!(
-            (x[0] - root).abs() < 1e-15 && (x[1] - (1.0 - root)).abs() < 1e-15,
-            "{x:?}"
-        );
-        assert_eq!(x[2], 0.5);
-        let bad = Border {
-            rows: &[1.0],
-            values: &[0.0],
-        };
-        assert!(matches!(
-            newton_bordered(&mut Parabola, bad, &mut x, &mut ws, &opts),
-            Err(NewtonError::BorderSize {
-                rows: 1,
-                values: 1,
-                unknowns: 3
-            })
-        ));
-    }
-
-    /// `F = atan(x)` from x = 1.5: the full Newton step overshoots to
-    /// |x| > 1.5 (undamped Newton diverges from |x| > 1.39); halving restores
-    /// descent and the root 0 is reached. With the step test on (rtol = 0,
-    /// atol = 1e-12) and the residual test off, the iteration stops on a
-    /// step below 1e-12 and evaluates F there.
-    #[test]
-    fn damping_rescues_atan_and_the_step_test_stops() {
-        let mut f = Scalar(|x: f64| (x.atan(), 1.0 / (1.0 + x * x)));
-        let mut x = [1.5];
-        let mut ws = NewtonWorkspace::new(1);
-        let opts = NewtonOptions {
-            ftol: 0.0,
-            atol: 1e-12,
-            ..Default::default()
-        };
-        let stats = newton(&mut f, &mut x, &mut ws, &opts).unwrap();
-        assert!(x[0].abs() < 1e-12, "{x:?} {stats:?}");
-        assert!(stats.residual_evals > stats.iterations + 1, "{stats:?}");
-        assert_eq!(ws.residual()[0], x[0].atan());
-    }
-
-    /// `F = x² + 1` has no root: the residual has a minimum at 0 where the
-    /// Jacobian is singular; from 0.5 the line search runs out of descent or
-    /// the Jacobian turns singular, an error either way, with the history.
-    #[test]
-    fn no_root_is_an_error_with_history() {
-        let mut f = Scalar(|x: f64| (x * x + 1.0, 2.0 * x));
-        let mut x = [0.5];
-        let err = newton(
-            &mut f,
-            &mut x,
-            &mut NewtonWorkspace::new(1),
-            &Default::default(),
-        )
-        .unwrap_err();
-        assert!(!err.history().is_empty(), "{err:?}");
-        assert!(!matches!(err, NewtonError::Eval(())), "{err:?}");
-        let mut nan = [f64::NAN];
-        let err = newton(
-            &mut f,
-            &mut nan,
-            &mut NewtonWorkspace::new(1),
-            &Default::default(),
-        );
-        assert!(matches!(
-            err,
-            Err(NewtonError::NonFinite { iteration: 0, .. })
-        ));
-    }
-
-    /// A scalar function with its derivative.
-    struct Scalar<F>(F);
-
-    impl<F: FnMut(f64) -> (f64, f64)> NewtonSystem for Scalar<F> {
-        type Error = ();
-        fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), ()> {
-            r[0] = (self.0)(x[0]).0;
-            Ok(())
-        }
-        fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> Result<(), ()> {
-            jac[0] = (self.0)(x[0]).1;
-            Ok(())
-        }
-    }
-}
+mod tests;

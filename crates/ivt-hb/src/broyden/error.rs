@@ -58,12 +58,16 @@ impl SolveError {
     }
 }
 
-/// A failed [`ivt_num::newton()`] on an infallible system, in this crate's
-/// terms: a line search without descent is a non-convergence.
-impl From<ivt_num::NewtonError<std::convert::Infallible>> for SolveError {
-    fn from(e: ivt_num::NewtonError<std::convert::Infallible>) -> Self {
+impl SolveError {
+    /// A failed [`ivt_num::newton()`] in this crate's terms (a line search
+    /// without descent is a non-convergence), or the system's own error
+    /// ([`ivt_num::NewtonError::Eval`]) as `Err`.
+    ///
+    /// # Errors
+    /// The system's own error, unchanged.
+    pub fn from_newton<E>(e: ivt_num::NewtonError<E>) -> Result<Self, E> {
         use ivt_num::NewtonError as N;
-        match e {
+        Ok(match e {
             N::NonConvergence {
                 iterations,
                 history,
@@ -87,7 +91,14 @@ impl From<ivt_num::NewtonError<std::convert::Infallible>> for SolveError {
                 expected: values * unknowns,
                 got: rows,
             },
-            N::Eval(never) => match never {},
-        }
+            N::Eval(e) => return Err(e),
+        })
+    }
+}
+
+/// A failed [`ivt_num::newton()`] on an infallible system ([`SolveError::from_newton`]).
+impl From<ivt_num::NewtonError<std::convert::Infallible>> for SolveError {
+    fn from(e: ivt_num::NewtonError<std::convert::Infallible>) -> Self {
+        Self::from_newton(e).unwrap_or_else(|never| match never {})
     }
 }

@@ -11,14 +11,15 @@
 //! curvature of the last two tangents, the chord's matrix is assembled and
 //! factored at the prediction, and that LU (bordered by the tangent) gives the
 //! next point's tangent. A step about to leave
-//! `[lambda_min, lambda_max]` is corrected on `λ = bound` instead, so the path
-//! ends exactly on the bound. A sign change of the tangent's λ component marks
+//! `[lambda_min, lambda_max]` (predicted or corrected past a bound) is
+//! corrected on `λ = bound` instead, so the path ends exactly on the bound
+//! and no point lies outside. A sign change of the tangent's λ component marks
 //! a fold.
 
+use super::corrector::{ExactNewton, Prediction};
 use faer::Mat;
 use ivt_num::vector::{dot, norm2};
-use ivt_num::BorderedLu;
-use std::borrow::Cow;
+use ivt_num::{newton, BorderedLu, NewtonOptions, NewtonWorkspace};
 
 use super::{non_finite_start, turn, ContinuationOptions, Fold, Path, PathPoint};
 use super::{SolveError, Termination};
@@ -159,6 +160,8 @@ where
                 &mut curvature,
             );
         let kappa = norm2(&curvature);
+        let outside = |l: f64| l < opts.lambda_min || l > opts.lambda_max;
+        let mut force_landing = false;
         let err = loop {
             for (p, (xi, ti)) in u_pred.iter_mut().zip(x.iter().zip(&tangent)) {
                 *p = xi + step * ti;
@@ -168,9 +171,9 @@ where
                     *p += 0.5 * step * step * c;
                 }
             }
-            let clip = if tangent[m] > 0.0 && u_pred[m] > opts.lambda_max {
+            let clip = if tangent[m] > 0.0 && (force_landing || u_pred[m] > opts.lambda_max) {
                 Some(opts.lambda_max)
-            } else if tangent[m] < 0.0 && u_pred[m] < opts.lambda_min {
+            } else if tangent[m] < 0.0 && (force_landing || u_pred[m] < opts.lambda_min) {
                 Some(opts.lambda_min)
             } else {
                 None
@@ -205,6 +208,10 @@ where
                 }
             };
             match attempt {
+                Ok(_) if clip.is_none() && !force_landing && outside(corrector.u[m]) => {
+                    // Corrected past a bound: redo the step onto it.
+                    force_landing = true;
+                }
                 Ok(weighted) => {
                     landed = clip.is_some();
                     // Not after landing: bordered by e_{m+1}, the LU's
@@ -274,6 +281,8 @@ struct Corrector {
     /// `jac` was assembled at `u` as Newton converged there: the tangent at
     /// that point reuses it instead of assembling it again.
     jac_at_u: bool,
+    /// Buffers of the Newton corrector.
+    newton: NewtonWorkspace,
     tol: f64,
     max_newton: usize,
 }
@@ -288,6 +297,7 @@ impl Corrector {
             rhs: vec![0.0; m + 1],
             u: vec![0.0; m + 1],
             jac_at_u: false,
+            newton: NewtonWorkspace::new(m + 1),
             tol: opts.broyden.tol,
             max_newton: opts.broyden.max_iter,
         }
@@ -421,90 +431,38 @@ impl Corrector {
         })
     }
 
-    /// Newton on `[R(u); constraint] = 0` from [`Self::start`], refactoring each
-    /// iteration.
-    /// Returns the iteration count.
+    /// Newton ([`ivt_num::newton()`], full steps) on `[R(u); constraint] = 0`
+    /// from [`Self::start`]; diverged once ‖F‖ grows after the second step.
+    /// Leaves `jac` at the solution for the tangent. Returns the iteration
+    /// count.
     fn newton<S: PathSystem>(
         &mut self,
         sys: &mut S,
         pred: &Prediction,
     ) -> Result<usize, SolveError> {
         let m = self.jac.nrows();
-        let row = pred.row();
-        let mut history = Vec::new();
-        for it in 0..=self.max_newton {
-            let u = std::mem::take(&mut self.u);
-            self.assemble(sys, &u);
-            self.u = u;
-            let constraint = pred.constraint(&self.u);
-            if let Some(done) = settle(&mut history, norm2(&self.r).hypot(constraint), self.tol) {
-                self.jac_at_u = done.is_ok();
-                return done;
-            }
-            if it == self.max_newton || (it >= 2 && history[it] > history[it - 1]) {
-                break;
-            }
-            let u = std::mem::take(&mut self.u);
-            let factored = self.factor(sys, &u, &row);
-            self.u = u;
-            if !factored {
-                return Err(SolveError::SingularJacobian {
-                    iteration: it,
-                    history,
-                });
-            }
-            self.rhs[..m].copy_from_slice(&self.r);
-            self.rhs[m] = constraint;
-            if self.aug.solve(&mut self.rhs).is_err() {
-                return Err(SolveError::SingularJacobian {
-                    iteration: it,
-                    history,
-                });
-            }
-            for (x, d) in self.u.iter_mut().zip(&self.rhs) {
-                *x -= d;
-            }
+        let nopts = NewtonOptions {
+            ftol: self.tol,
+            max_iter: self.max_newton,
+            max_halvings: 0,
+            accept_no_descent: true,
+            ..NewtonOptions::default()
+        };
+        let mut corrected = ExactNewton {
+            system: sys,
+            jac: &mut self.jac,
+            r_lambda: &mut self.r_lambda,
+            pred,
+        };
+        let result = newton(&mut corrected, &mut self.u, &mut self.newton, &nopts);
+        // The last residual evaluation assembled `jac` at `u`.
+        self.jac_at_u = result.is_ok();
+        if let Some(r) = self.newton.residual().get(..m) {
+            self.r.copy_from_slice(r);
         }
-        Err(SolveError::NonConvergence {
-            iterations: history.len() - 1,
-            history,
-        })
-    }
-}
-
-/// A predicted point and the constraint that closes the corrector's system.
-struct Prediction<'a> {
-    u_pred: &'a [f64],
-    tangent: &'a [f64],
-    /// Correct on `λ = fix` (landing on a bound) instead of `tᵀ(u − u_pred) = 0`.
-    fix: Option<f64>,
-}
-
-impl Prediction<'_> {
-    /// The constraint's gradient: the tangent (borrowed, no copy per point),
-    /// or `e_{m+1}` on `λ = fix`.
-    fn row(&self) -> Cow<'_, [f64]> {
-        match self.fix {
-            Some(_) => {
-                let mut row = vec![0.0; self.tangent.len()];
-                row[self.tangent.len() - 1] = 1.0;
-                Cow::Owned(row)
-            }
-            None => Cow::Borrowed(self.tangent),
-        }
-    }
-
-    /// The constraint `tᵀ(u − u_pred)`, or `λ − λ_fix`.
-    fn constraint(&self, u: &[f64]) -> f64 {
-        match self.fix {
-            Some(l) => u[u.len() - 1] - l,
-            None => self
-                .tangent
-                .iter()
-                .zip(u.iter().zip(self.u_pred))
-                .map(|(t, (a, b))| t * (a - b))
-                .sum(),
-        }
+        result
+            .map(|stats| stats.iterations)
+            .map_err(SolveError::from)
     }
 }
 
@@ -569,5 +527,30 @@ mod tests {
         fn d_residual_d_lambda(&mut self, _u: &[f64], lambda: f64, r_lambda: &mut [f64]) {
             r_lambda[0] = 2.0 * lambda;
         }
+    }
+
+    /// The long-step case of the Broyden driver's test on the exact path:
+    /// a step of 0.3 on x² + λ² = 1 over λ ∈ [0.8, 0.85] lands on λ = 0.85
+    /// exactly (x = −√(1 − 0.85²)); no point lies outside the interval.
+    #[test]
+    fn a_long_step_lands_on_the_bound_and_never_leaves_the_interval() {
+        let opts = ContinuationOptions {
+            ds: 0.3,
+            lambda_min: 0.8,
+            lambda_max: 0.85,
+            ..Default::default()
+        };
+        let path =
+            pseudo_arclength_exact(&mut Circle, &[-0.6, 0.8], 0, 1.0, &opts, |_, _| true).unwrap();
+        assert_eq!(path.termination, Termination::LeftInterval);
+        for p in &path.points {
+            assert!((0.8..=0.85).contains(&p.lambda()), "{:?}", path.points);
+        }
+        let last = path.points.last().unwrap();
+        assert_eq!(last.lambda(), 0.85);
+        assert!(
+            (last.x[0] + (1.0f64 - 0.85 * 0.85).sqrt()).abs() < 1e-9,
+            "{last:?}"
+        );
     }
 }

@@ -1,4 +1,4 @@
-//! The start of an exact-Jacobian path: Newton at fixed λ ([`ivt_num::newton`]).
+//! The start of an exact-Jacobian path: Newton at fixed λ ([`ivt_num::newton()`]).
 
 use faer::Mat;
 use ivt_num::{newton, NewtonError, NewtonOptions, NewtonSystem, NewtonWorkspace};

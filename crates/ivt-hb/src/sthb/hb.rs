@@ -6,12 +6,13 @@ use faer::Mat;
 use realfft::num_complex::Complex;
 use rustdct::DctPlanner;
 
-use super::lu::LuWorkspace;
 use super::spatial::{Spatial, DIRECT_MAX_MODES};
 use super::toeplitz::{add_real_toeplitz, BlockLayout, PeriodicSpectrum};
 use super::{Boundary, StringParams};
 use crate::aft::RealFftPair;
 use crate::error::HbError;
+use ivt_num::{newton, NewtonError, NewtonOptions, NewtonSystem, NewtonWorkspace};
+use std::convert::Infallible;
 
 /// Newton–Raphson statistics of one converged solve.
 #[derive(Clone, Debug, PartialEq)]
@@ -49,7 +50,10 @@ pub struct StringHb {
     e_proj: Vec<f64>,
     nl: Vec<f64>,
     toeplitz_scratch: Vec<Complex<f64>>,
-    pub(crate) lu: LuWorkspace,
+    /// Buffers of the Newton solve ([`Self::solve`]).
+    newton: NewtonWorkspace,
+    /// The assembled Jacobian of the Newton solve.
+    jac: Mat<f64>,
 }
 
 impl StringHb {
@@ -101,7 +105,8 @@ impl StringHb {
             e_proj,
             nl: vec![0.0; dim],
             toeplitz_scratch: Vec::new(),
-            lu: LuWorkspace::new(dim),
+            newton: NewtonWorkspace::new(dim),
+            jac: Mat::zeros(0, 0),
             p: params,
         })
     }
@@ -435,9 +440,11 @@ impl StringHb {
         self.toeplitz_scratch = scratch;
     }
 
-    /// Newton–Raphson (step a6) with step halving on `‖R‖`, from the guess in `a`,
-    /// overwritten by the solution.
-    /// Converged when `‖R‖ ≤ tol (1 + y0)`.
+    /// Newton–Raphson (step a6, [`ivt_num::newton()`]) with step halving on
+    /// `‖R‖` (the full step is kept if no halving helps; the history shows
+    /// it), from the guess in `a`, overwritten by the solution.
+    /// Converged when `‖R‖ ≤ tol (1 + y0)`; [`Self::s_spectrum`] is then
+    /// that of the solution.
     ///
     /// # Errors
     /// [`HbError::NoConvergence`] with the residual history after `max_iter`
@@ -450,68 +457,51 @@ impl StringHb {
         max_iter: usize,
     ) -> Result<SolveStats, HbError> {
         let dim = self.dim();
-        let (mut r, mut step, mut trial) = (vec![0.0; dim], vec![0.0; dim], vec![0.0; dim]);
-        let mut history = Vec::with_capacity(max_iter + 1);
-        let target = tol * (1.0 + self.p.y0.abs());
-        let mut jac = std::mem::replace(&mut self.lu.mat, Mat::zeros(0, 0));
-        let result = (|| {
-            for it in 0..=max_iter {
+        let opts = NewtonOptions {
+            ftol: tol * (1.0 + self.p.y0.abs()),
+            max_iter,
+            max_halvings: 7,
+            accept_no_descent: true,
+            full_step_without_descent: true,
+            ..NewtonOptions::default()
+        };
+        let mut ws = std::mem::replace(&mut self.newton, NewtonWorkspace::new(0));
+        let mut jac = std::mem::replace(&mut self.jac, Mat::zeros(0, 0));
+        if jac.nrows() != dim {
+            jac = Mat::zeros(dim, dim);
+        }
+        let mut system = FixedOmega {
+            hb: self,
+            omega,
+            jac: &mut jac,
+        };
+        let result = newton(&mut system, a, &mut ws, &opts);
+        let history = ws.history().to_vec();
+        self.newton = ws;
+        self.jac = jac;
+        match result {
+            Ok(stats) => {
+                // Leave Ŝ_p at the solution (the last residual was a trial's,
+                // without it): the stability functions read it.
                 self.balance(a, true);
-                self.finish_residual(a, omega, &mut r);
-                let norm = norm2(&r);
-                history.push(norm);
-                if !norm.is_finite() {
-                    return Err(HbError::NonFinite { omega });
-                }
-                if norm <= target {
-                    return Ok(SolveStats {
-                        iterations: it,
-                        history: history.clone(),
-                    });
-                }
-                if it == max_iter {
-                    break;
-                }
-                self.fill_jacobian(omega, &mut jac);
-                std::mem::swap(&mut self.lu.mat, &mut jac);
-                let ok = self.lu.factor();
-                if ok {
-                    self.lu.solve(&mut r);
-                }
-                std::mem::swap(&mut self.lu.mat, &mut jac);
-                if !ok {
-                    return Err(HbError::Singular { omega });
-                }
-                // Backtracking: halve the Newton step while ‖R‖ does not decrease
-                // (the full step is kept if no halving helps; the history shows it).
-                step.copy_from_slice(&r);
-                let mut lambda = 1.0;
-                for _ in 0..8 {
-                    for ((t, x), d) in trial.iter_mut().zip(a.iter()).zip(&step) {
-                        *t = x - lambda * d;
-                    }
-                    self.balance(&trial, false);
-                    self.finish_residual(&trial, omega, &mut r);
-                    if norm2(&r) < norm {
-                        break;
-                    }
-                    lambda *= 0.5;
-                }
-                if norm2(&r) >= norm {
-                    lambda = 1.0;
-                }
-                for (x, d) in a.iter_mut().zip(&step) {
-                    *x -= lambda * d;
-                }
+                Ok(SolveStats {
+                    iterations: stats.iterations,
+                    history,
+                })
             }
-            Err(HbError::NoConvergence {
-                method: "Newton",
-                omega,
-                history: history.clone(),
-            })
-        })();
-        self.lu.mat = jac;
-        result
+            Err(NewtonError::SingularJacobian { .. } | NewtonError::BorderSize { .. }) => {
+                Err(HbError::Singular { omega })
+            }
+            Err(NewtonError::NonFinite { .. }) => Err(HbError::NonFinite { omega }),
+            Err(NewtonError::NonConvergence { .. } | NewtonError::NoDescent { .. }) => {
+                Err(HbError::NoConvergence {
+                    method: "Newton",
+                    omega,
+                    history,
+                })
+            }
+            Err(NewtonError::Eval(never)) => match never {},
+        }
     }
 
     /// The spectrum `Ŝ_p` of `S(t) = ∂ℒ/∂Q` from the last Jacobian evaluation (Eq. 129).
@@ -525,7 +515,33 @@ impl StringHb {
     }
 }
 
-/// Euclidean norm.
-pub(crate) fn norm2(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+/// The string's residual at fixed ω as a [`NewtonSystem`]: trial residuals
+/// skip the Jacobian's spectrum; the Jacobian re-balances with it at the
+/// accepted point (`J = J_lin − S_𝒯`, Eq. 115–125).
+struct FixedOmega<'a> {
+    hb: &'a mut StringHb,
+    omega: f64,
+    jac: &'a mut Mat<f64>,
+}
+
+impl NewtonSystem for FixedOmega<'_> {
+    type Error = Infallible;
+
+    fn residual(&mut self, a: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
+        self.hb.balance(a, false);
+        self.hb.finish_residual(a, self.omega, r);
+        Ok(())
+    }
+
+    fn jacobian(&mut self, a: &[f64], out: &mut [f64]) -> Result<(), Infallible> {
+        self.hb.balance(a, true);
+        self.hb.fill_jacobian(self.omega, self.jac);
+        let dim = self.jac.ncols();
+        for (i, row) in out.chunks_exact_mut(dim.max(1)).enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = self.jac[(i, j)];
+            }
+        }
+        Ok(())
+    }
 }

@@ -32,7 +32,6 @@
 
 pub mod frc;
 mod hb;
-mod lu;
 pub mod modal;
 mod reduced;
 mod spatial;
