@@ -162,18 +162,24 @@ impl BorderedLu {
         self.finish()
     }
 
+    /// B (m rows of k), Cᵀ (k rows of m) and D (k rows of k), row-major, into
+    /// the matrix beside J (their sizes are checked by the callers).
     fn put_borders(&mut self, b: &[f64], c: &[f64], d: &[f64]) {
         let (m, k) = (self.m, self.k);
         let a = &mut self.lu.mat;
-        for i in 0..m {
-            for j in 0..k {
-                a[(i, m + j)] = b[i * k + j];
-                a[(m + j, i)] = c[j * m + i];
+        for (i, row) in b.chunks_exact(k.max(1)).take(m).enumerate() {
+            for (j, v) in row.iter().enumerate() {
+                a[(i, m + j)] = *v;
             }
         }
-        for i in 0..k {
-            for j in 0..k {
-                a[(m + i, m + j)] = d[i * k + j];
+        for (j, row) in c.chunks_exact(m.max(1)).take(k).enumerate() {
+            for (i, v) in row.iter().enumerate() {
+                a[(m + j, i)] = *v;
+            }
+        }
+        for (i, row) in d.chunks_exact(k.max(1)).take(k).enumerate() {
+            for (j, v) in row.iter().enumerate() {
+                a[(m + i, m + j)] = *v;
             }
         }
     }

@@ -34,9 +34,6 @@
 //! (workspace-based, no allocation in loops); nalgebra only for small
 //! fixed-size algebra and `expm`.
 
-// bordered.rs is the engine helper's (issue #30 round): its three indexing
-// sites are made lint-clean on that branch; this allow goes at the merge.
-#[allow(clippy::indexing_slicing)]
 pub mod bordered;
 pub mod lu;
 pub mod newton;
