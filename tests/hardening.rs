@@ -13,7 +13,7 @@ use ivt_sim::testing::listing;
 use serde_json::Value;
 use std::path::Path;
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// Every command of the list, each refused cleanly (by kind and with
 /// the offending argument named), within a minute, before any allocation.
