@@ -93,7 +93,9 @@ fn continue_bifurcation<'py>(
     };
     let fam = PyFamily::new(family, velocity_dependent, vectorized);
     let (first, opts) = fam.first(py, p_start, n, samples, rtol, max_iter)?;
-    let curve = run_user(py, &first, |_| jobs::fold_curve(|p| fam.build(p), &opts, &req));
+    let curve = run_user(py, &first, |_| {
+        jobs::fold_curve(|p| fam.build(p), &opts, &req)
+    });
     if let Some(e) = fam.take_error() {
         return Err(e);
     }
