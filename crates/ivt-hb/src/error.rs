@@ -106,13 +106,13 @@ pub enum HbError {
     /// so its stability is unknown (e.g. ω_f so small that one period spans
     /// far more time than the steps resolve).
     #[error(
-        "the Floquet multipliers at ω_f = {omega} are not finite (Hsu's method over {steps} \
-         steps of one period 2π/ω_f); the stability of this solution is unknown"
+        "the Floquet multipliers at ω_f = {omega} are not finite (Hsu's method over at most \
+         {steps} steps of one period 2π/ω_f); the stability of this solution is unknown"
     )]
     NonFiniteMultipliers {
         /// Excitation frequency.
         omega: f64,
-        /// Hsu sub-intervals of the period.
+        /// Hsu sub-intervals of the period (the cap, for adaptive Hsu).
         steps: usize,
     },
 }

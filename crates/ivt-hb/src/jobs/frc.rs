@@ -5,7 +5,7 @@
 //! IHB and [`crate::trace`] locates every fold, period doubling,
 //! Neimark–Sacker point and branch point as the path passes it.
 
-use super::{pairs, Array};
+use super::{finite_pairs, pairs, Array};
 use crate::bifurcation::{BifurcationError, BifurcationKind};
 use crate::continuation::{Corrector, Termination};
 use crate::error::HbError;
@@ -14,6 +14,7 @@ use crate::family::{FamilyBranch, Frequency};
 use crate::frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
 use crate::ihb::HbOptions;
 use crate::problem::{AtFrequency, PeriodicProblem};
+use crate::stability::HsuSteps;
 use crate::stability::StabilityKind;
 use crate::ModifiedIhb;
 use serde::Serialize;
@@ -172,6 +173,13 @@ pub fn frc<P: PeriodicProblem>(
     req.validate()?;
     let t0 = Instant::now();
     let defaults = FrcOptions::default();
+    // The Hsu sub-intervals' cap, named when a point's multipliers are not
+    // finite (its stability unknown: the curve is an error, not a point
+    // reported unstable).
+    let hsu_cap = match defaults.stability {
+        HsuSteps::Tolerance { max, .. } => max,
+        HsuSteps::Fixed(steps) => steps,
+    };
     let (curve, events) = if req.events {
         let at_start = AtFrequency::new(problem, req.from);
         let start = ModifiedIhb::new(&at_start, hb.clone())?.solve(req.from, None)?;
@@ -200,6 +208,9 @@ pub fn frc<P: PeriodicProblem>(
         let events = curve.folds.iter().map(|f| fold_event(f, &curve)).collect();
         (curve, events)
     };
+    for p in &curve.points {
+        finite_pairs(&p.multipliers, p.omega_f, hsu_cap)?;
+    }
     Ok(FrcCurve {
         points: curve.points.iter().map(point).collect(),
         folds: curve.folds.iter().map(fold).collect(),

@@ -2,7 +2,7 @@
 //! frequency ω an unknown and the phase condition b1 = 0 on DOF 0 (§3.2.4,
 //! Newton with the Galerkin Jacobian), its multipliers by Hsu (Eq. 78).
 
-use super::{finite, pairs, stability_steps, Array};
+use super::{finite, finite_pairs, stability_steps, Array};
 use crate::error::HbError;
 use crate::ihb::HbOptions;
 use crate::problem::{GeneralProblem, PeriodicProblem};
@@ -169,7 +169,7 @@ pub fn limit_cycle<P: PeriodicProblem>(
         omega: lc.omega(),
         period: lc.period(),
         coeffs: Array(lc.solution.coeffs.clone()),
-        multipliers: pairs(&lc.multipliers),
+        multipliers: finite_pairs(&lc.multipliers, lc.omega(), steps)?,
         stable: lc.stable(),
         stability: lc.kind,
         iterations: lc.solution.stats.iterations,

@@ -4,7 +4,7 @@
 //! multipliers by Hsu's method (Eq. 78) over [`super::stability_steps`]
 //! Magnus-4 steps.
 
-use super::{pairs, stability_steps, Array};
+use super::{finite_pairs, stability_steps, Array};
 use crate::error::HbError;
 use crate::floquet::HsuRule;
 use crate::ihb::{HbOptions, HbSolution, HbSolver};
@@ -147,17 +147,11 @@ pub fn orbit<P: PeriodicProblem>(
             &sol,
             HsuRule::Magnus4,
         );
-        if !f
-            .multipliers
-            .iter()
-            .all(|m| m.re.is_finite() && m.im.is_finite())
-        {
-            return Err(HbError::NonFiniteMultipliers {
-                omega: req.omega_f,
-                steps,
-            });
-        }
-        (pairs(&f.multipliers), Some(f.stable()), Some(f.kind))
+        (
+            finite_pairs(&f.multipliers, req.omega_f, steps)?,
+            Some(f.stable()),
+            Some(f.kind),
+        )
     } else {
         (Vec::new(), None, None)
     };
@@ -189,6 +183,28 @@ mod tests {
         assert_eq!("modified".parse::<Method>(), Ok(Method::Modified));
         let e = "newton".parse::<Method>().unwrap_err();
         assert_eq!(e.kind(), "input");
+    }
+
+    #[test]
+    fn an_overflowing_monodromy_is_an_error_not_an_unstable_verdict() {
+        // Linear, ξ = −20, ω_f = 0.01: the orbit exists (HB is exact), but
+        // its multipliers are e^{±20·2π/0.01} = overflow → stability unknown.
+        let d = Duffing::new(-20.0, 1.0, 0.0, 0.1);
+        let hb = HbOptions::new(5, 16).with_tol(1e-10);
+        let req = OrbitRequest {
+            omega_f: 0.01,
+            ..OrbitRequest::default()
+        };
+        match orbit(&d, &hb, &req) {
+            Err(e @ HbError::NonFiniteMultipliers { .. }) => assert_eq!(e.kind(), "failed"),
+            other => panic!("expected NonFiniteMultipliers, got {other:?}"),
+        }
+        // Without stability the same orbit is an answer.
+        let plain = OrbitRequest {
+            stability: false,
+            ..req
+        };
+        assert!(orbit(&d, &hb, &plain).is_ok());
     }
 
     #[test]
