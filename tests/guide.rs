@@ -151,3 +151,33 @@ fn fence_reader_sees_languages_and_bare_fences() {
         ]
     );
 }
+
+/// Issue 31's limits: the root README ≤ 10 KB (the two commands, the crate
+/// map, the links), each crate's and the firmware's ≤ 8 KB (what it is, one
+/// example, where its chapter is); the tables live in the guide.
+#[test]
+fn readmes_stay_short() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let size = |p: &Path| std::fs::metadata(p).map(|m| m.len()).unwrap_or(u64::MAX);
+    let readme = root.join("README.md");
+    assert!(
+        size(&readme) <= 10 * 1024,
+        "{}: {} bytes",
+        readme.display(),
+        size(&readme)
+    );
+    let mut crates: Vec<PathBuf> = std::fs::read_dir(root.join("crates"))
+        .unwrap()
+        .map(|e| e.unwrap().path().join("README.md"))
+        .collect();
+    crates.push(root.join("firmware/README.md"));
+    assert!(crates.len() >= 10, "{crates:?}");
+    for readme in crates {
+        assert!(
+            size(&readme) <= 8 * 1024,
+            "{}: {} bytes",
+            readme.display(),
+            size(&readme)
+        );
+    }
+}

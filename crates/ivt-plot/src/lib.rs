@@ -1,14 +1,4 @@
-//! PNG figures for the IVT toolkit, shared by the CLI, the simulator and the
-//! reproduction report, so that every crate draws with one font setup and one
-//! look.
-//!
-//! Pure Rust: plotters' bitmap backend with an embedded font (a subset of
-//! DejaVu Sans with Greek letters, licence in `assets/DejaVu-LICENSE.txt`)
-//! registered at run time — no fontconfig/freetype needed at build time.
-//!
-//! - [`line_plot`]: x–y curves and markers; a NaN point breaks a curve, which
-//!   is how stable and unstable branches are drawn as separate pieces.
-//! - [`heat_map`]: a value on a rectangular grid (e.g. a stability map).
+#![doc = include_str!("../README.md")]
 
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
