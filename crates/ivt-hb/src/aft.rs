@@ -111,14 +111,14 @@ fn poison(out: &mut [f64]) {
 
 /// The parts `(a0, [a1..an], [b1..bn])` of a series `[a0, a.., b..]` (`None` if
 /// empty). An even length leaves one extra trailing entry in the `b` part.
-fn split_series(coeffs: &[f64]) -> Option<(f64, &[f64], &[f64])> {
+pub(crate) fn split_series(coeffs: &[f64]) -> Option<(f64, &[f64], &[f64])> {
     let (&a0, rest) = coeffs.split_first()?;
     let (a, b) = rest.split_at(rest.len() / 2);
     Some((a0, a, b))
 }
 
 /// [`split_series`] for writing.
-fn split_series_mut(coeffs: &mut [f64]) -> Option<(&mut f64, &mut [f64], &mut [f64])> {
+pub(crate) fn split_series_mut(coeffs: &mut [f64]) -> Option<(&mut f64, &mut [f64], &mut [f64])> {
     let (a0, rest) = coeffs.split_first_mut()?;
     let half = rest.len() / 2;
     let (a, b) = rest.split_at_mut(half);
@@ -365,6 +365,17 @@ pub fn resize_harmonics(coeffs: &[f64], n_to: usize) -> Vec<f64> {
         }
     }
     out
+}
+
+/// Replaces the series `[a0, a.., b..]` of `u(τ)` by that of `u(τ + φ)`:
+/// harmonic k turns by kφ.
+pub fn shift_time(coeffs: &mut [f64], phi: f64) {
+    if let Some((_, cos, sin)) = split_series_mut(coeffs) {
+        for (k, (a, b)) in cos.iter_mut().zip(sin.iter_mut()).enumerate() {
+            let (s, c) = ((k + 1) as f64 * phi).sin_cos();
+            (*a, *b) = (*a * c + *b * s, *b * c - *a * s);
+        }
+    }
 }
 
 /// Re-expresses a series in τ as one in τ/`factor` (period `factor·2π`): harmonic k

@@ -6,6 +6,18 @@
 //! analysed by Hsu's method (Eq. 80) and by Hill's method; the two must agree.
 //! Classification: stable (all |μ| < 1), fold (a real μ > 1), period doubling (a
 //! real μ < −1), Neimark–Sacker (a complex pair outside the unit circle).
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::indexing_slicing,
+        clippy::unreachable,
+        clippy::todo,
+        clippy::unimplemented
+    )
+)]
 
 use crate::aft::Aft;
 use crate::error::HbError;
@@ -113,8 +125,9 @@ impl StabilityAnalyzer {
     /// (`steps > harmonics`; 256 is enough for flags, 4096 for 1e-9 agreement).
     ///
     /// # Errors
-    /// [`HbError::AftTooFewSamples`] if `steps ≤ harmonics`. A singular mass matrix gives NaN
-    /// multipliers, which classify as unstable.
+    /// [`HbError::AftTooFewSamples`] if `steps ≤ harmonics`,
+    /// [`HbError::InvalidInput`] for a problem without DOFs. A singular mass matrix
+    /// gives NaN multipliers, which classify as unstable.
     pub fn new<P: PeriodicProblem>(
         problem: &P,
         harmonics: usize,
@@ -122,6 +135,9 @@ impl StabilityAnalyzer {
     ) -> Result<Self, HbError> {
         let aft = Aft::new(harmonics, steps)?;
         let nd = problem.n_dof();
+        if nd == 0 {
+            return Err(HbError::InvalidInput("n_dof must be positive".into()));
+        }
         let minv =
             ivt_num::lu::inverse(problem.mass(), nd).unwrap_or_else(|| vec![f64::NAN; nd * nd]);
         let dim = 2 * nd;
@@ -179,20 +195,39 @@ impl StabilityAnalyzer {
         }
         let (c, k) = (problem.damping(), problem.stiffness());
         let n2 = nd * nd;
-        for j in 0..ns {
-            let (dgx, dgv) = self.dg[2 * j * n2..2 * (j + 1) * n2].split_at(n2);
-            let th = &mut self.theta[j * d2..(j + 1) * d2];
+        // nd ≥ 1 (checked in `new`); a problem whose C or K is not nd×nd gives NaN
+        // (unstable), as a singular mass does.
+        if nd == 0 || c.len() != n2 || k.len() != n2 || self.theta.len() != ns * d2 {
+            self.theta.fill(f64::NAN);
+            return &self.theta;
+        }
+        for (dg, th) in self
+            .dg
+            .chunks_exact(2 * n2)
+            .zip(self.theta.chunks_exact_mut(d2))
+        {
+            let (dgx, dgv) = dg.split_at(n2);
             th.fill(0.0);
-            for i in 0..nd {
-                th[i * dim + nd + i] = 1.0;
-                for e in 0..nd {
+            let (upper, lower) = th.split_at_mut(nd * dim);
+            // Upper rows [0 | I].
+            for (row, one) in upper.chunks_exact_mut(dim).zip(nd..) {
+                if let Some(x) = row.get_mut(one) {
+                    *x = 1.0;
+                }
+            }
+            // Lower rows [−M⁻¹(K + G_x)/ω² | −M⁻¹(C + G_v)/ω].
+            for (row, minv_row) in lower.chunks_exact_mut(dim).zip(self.minv.chunks_exact(nd)) {
+                let (row_k, row_c) = row.split_at_mut(nd);
+                for (e, (tk, tc)) in row_k.iter_mut().zip(row_c.iter_mut()).enumerate() {
                     let (mut sk, mut sc) = (0.0, 0.0);
-                    for l in 0..nd {
-                        sk += self.minv[i * nd + l] * (k[l * nd + e] + dgx[l * nd + e]);
-                        sc += self.minv[i * nd + l] * (c[l * nd + e] + dgv[l * nd + e]);
+                    let col = |a| column(a, e, nd);
+                    let terms = col(k).zip(col(dgx)).zip(col(c).zip(col(dgv)));
+                    for (&m, ((kk, gx), (cc, gv))) in minv_row.iter().zip(terms) {
+                        sk += m * (kk + gx);
+                        sc += m * (cc + gv);
                     }
-                    th[(nd + i) * dim + e] = -sk / (omega * omega);
-                    th[(nd + i) * dim + nd + e] = -sc / omega;
+                    *tk = -sk / (omega * omega);
+                    *tc = -sc / omega;
                 }
             }
         }
@@ -247,7 +282,7 @@ impl StabilityAnalyzer {
         let dim = 2 * self.nd;
         let ns = 2 * self.steps;
         let kmax = (2 * h).min((ns - 1) / 2);
-        let blocks = fourier_blocks(dim, &self.theta, ns, kmax);
+        let blocks = fourier_blocks(dim, &self.theta, ns, kmax)?;
         let res = hill_multipliers(dim, &blocks, h)?;
         Ok(Floquet::new(res.multipliers))
     }
@@ -388,25 +423,20 @@ impl AdaptiveHsu {
         known: Option<&[f64]>,
     ) -> Result<HsuEstimate, HbError> {
         let HsuSteps::Tolerance { tol, .. } = self.control else {
-            let an = &mut self.levels[0];
+            let an = level_mut(&mut self.levels, problem, self.harmonics, self.base, 0)?;
             return Ok(HsuEstimate {
                 floquet: an.hsu_with(problem, sol, HsuRule::Magnus4, known),
                 steps: self.base,
                 error: None,
             });
         };
-        let dim = 2 * self.levels[0].nd;
+        let dim = 2 * problem.n_dof();
         let period = 2.0 * std::f64::consts::PI;
         let mut level = self.level;
         // Multipliers of the level below, when it was just computed.
         let mut coarse: Option<Vec<c64>> = None;
         loop {
-            while self.levels.len() <= level {
-                let steps = self.base << self.levels.len();
-                self.levels
-                    .push(StabilityAnalyzer::new(problem, self.harmonics, steps)?);
-            }
-            let an = &mut self.levels[level];
+            let an = level_mut(&mut self.levels, problem, self.harmonics, self.base, level)?;
             an.theta_samples_with(problem, sol, known);
             monodromy_uniform(
                 dim,
@@ -444,6 +474,29 @@ impl AdaptiveHsu {
             level += 1;
         }
     }
+}
+
+/// Column `e` of a row-major matrix with `nd` columns (`nd ≥ 1`).
+fn column(a: &[f64], e: usize, nd: usize) -> impl Iterator<Item = f64> + '_ {
+    a.iter().skip(e).step_by(nd).copied()
+}
+
+/// The analyzer of `level` of [`AdaptiveHsu`] (`base·2^level` sub-intervals),
+/// made with the levels below it on first use.
+fn level_mut<'a, P: PeriodicProblem>(
+    levels: &'a mut Vec<StabilityAnalyzer>,
+    problem: &P,
+    harmonics: usize,
+    base: usize,
+    level: usize,
+) -> Result<&'a mut StabilityAnalyzer, HbError> {
+    while levels.len() <= level {
+        let steps = base << levels.len();
+        levels.push(StabilityAnalyzer::new(problem, harmonics, steps)?);
+    }
+    levels
+        .get_mut(level)
+        .ok_or_else(|| HbError::InvalidInput(format!("no Hsu level {level}")))
 }
 
 /// Richardson estimate of the error of the multipliers `fine` of `S` Magnus-4
