@@ -13,18 +13,10 @@
 //! Slice lengths are the callers' contract (checked by `debug_assert` in tests). A
 //! slice of the wrong length in a release build is not a panic: the output is
 //! filled with NaN, which the solvers report as [`HbError::NonFinite`].
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::indexing_slicing,
-        clippy::unreachable,
-        clippy::todo,
-        clippy::unimplemented
-    )
-)]
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::error::HbError;
 use realfft::num_complex::Complex;
@@ -442,5 +434,52 @@ mod tests {
     #[test]
     fn too_few_samples_is_an_error() {
         assert!(Aft::new(8, 8).is_err());
+    }
+
+    #[test]
+    fn resize_embed_and_shift_move_the_right_harmonics() {
+        // [a0, a1, a2, b1, b2].
+        let c = [1.0, 2.0, 3.0, 4.0, 5.0];
+        assert_eq!(resize_harmonics(&c, 1), [1.0, 2.0, 4.0]);
+        assert_eq!(resize_harmonics(&c, 3), [1.0, 2.0, 3.0, 0.0, 4.0, 5.0, 0.0]);
+        // Harmonic k → 2k; a2 → harmonic 4 is dropped at n_to = 3.
+        assert_eq!(
+            embed_subharmonic(&c, 2, 4),
+            [1.0, 0.0, 2.0, 0.0, 3.0, 0.0, 4.0, 0.0, 5.0]
+        );
+        assert_eq!(
+            embed_subharmonic(&c, 2, 3),
+            [1.0, 0.0, 2.0, 0.0, 0.0, 4.0, 0.0]
+        );
+        assert_eq!(embed_subharmonic(&c, 3, 6)[3], 2.0);
+        // u(τ + φ) against the direct sum.
+        let mut shifted = c;
+        shift_time(&mut shifted, 0.7);
+        for tau in [0.0, 0.3, 2.0, 4.5] {
+            let want = eval_series(&c, tau + 0.7, 0);
+            assert!((eval_series(&shifted, tau, 0) - want).abs() < 1e-14);
+        }
+        assert!(eval_series(&[], 0.0, 0).is_nan());
+        assert_eq!(resize_harmonics(&[], 1), [0.0; 3]);
+    }
+
+    /// A slice of the wrong length is NaN in a release build (a
+    /// `debug_assert` stops a debug build first).
+    #[cfg(not(debug_assertions))]
+    #[test]
+    fn wrong_lengths_give_nan_not_a_panic() {
+        let mut aft = Aft::new(2, 4).unwrap();
+        let mut s = vec![0.0; 8];
+        aft.synthesize(&[1.0, 2.0], &mut s);
+        assert!(s.iter().all(|v| v.is_nan()));
+        let mut c = vec![0.0; 5];
+        aft.analyze(&[1.0; 7], &mut c);
+        assert!(c.iter().all(|v| v.is_nan()));
+        let mut short = vec![0.0; 3];
+        aft.analyze(&[1.0; 8], &mut short);
+        assert!(short.iter().all(|v| v.is_nan()));
+        let mut out = vec![0.0; 4];
+        derivative_coeffs(&[1.0; 5], 1, &mut out);
+        assert!(out.iter().all(|v| v.is_nan()));
     }
 }

@@ -6,18 +6,10 @@
 //! appears shifted by all integers `i m`; the fundamental ones are those whose
 //! eigenvectors are most centred in the harmonic index (the weighted mean index of
 //! `|c_k|²` closest to 0). Multipliers are `μ = exp(2πλ)`.
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::indexing_slicing,
-        clippy::unreachable,
-        clippy::todo,
-        clippy::unimplemented
-    )
-)]
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::error::HbError;
 use faer::c64;
@@ -170,6 +162,18 @@ mod tests {
             );
         }
         let blocks = fourier_blocks(2, &samples, m, 4).unwrap();
+        // Θ̂_{−k} = conj Θ̂_k: Θ̂_{±1} of entry (1, 0) is −0.4/2 (the cos τ term).
+        assert!((blocks[3 * 4 + 2].re + 0.2).abs() < 1e-14 && blocks[3 * 4 + 2].im.abs() < 1e-14);
+        assert!((blocks[5 * 4 + 2].re + 0.2).abs() < 1e-14);
+        for (kind, m, kmax, len) in [
+            ("m ≤ 2K", 8, 4, 32),
+            ("short", 64, 4, 255),
+            ("dim 0", 64, 4, 0),
+        ] {
+            let dim = if kind == "dim 0" { 0 } else { 2 };
+            let r = fourier_blocks(dim, &vec![0.0; len], m, kmax);
+            assert!(matches!(r, Err(HbError::InvalidInput(_))), "{kind}");
+        }
         let hill = hill_multipliers(2, &blocks, 16).unwrap();
         for (a, b) in hsu.iter().zip(&hill.multipliers) {
             assert!((a - b).norm() < 1e-9, "{hsu:?} vs {:?}", hill.multipliers);
