@@ -236,7 +236,7 @@ fn monodromy_sized<const N: usize>(
     let mut omega = vec![0.0; d2];
     let mut step = vec![0.0; d2];
     let mut prod = vec![0.0; d2];
-    let mut prod_swapped = vec![0.0; d2];
+    let mut comm = vec![0.0; dim];
     let mut scratch = vec![0.0; expm_scratch_len(dim)];
     let Some(q) = q.get_mut(..d2) else {
         return q.fill(f64::NAN);
@@ -255,14 +255,22 @@ fn monodromy_sized<const N: usize>(
             HsuRule::Left => omega.iter_mut().zip(t1).for_each(|(o, t)| *o = h * t),
             HsuRule::Midpoint => omega.iter_mut().zip(th).for_each(|(o, t)| *o = h * t),
             HsuRule::Magnus4 => {
-                // − (h²/12) [Θ₀, Θ₁] = − (h²/12) (Θ₀Θ₁ − Θ₁Θ₀)
-                matmul(t0, t1, dim, &mut prod);
-                matmul(t1, t0, dim, &mut prod_swapped);
+                for (o, ((x0, xh), x1)) in omega.iter_mut().zip(t0.iter().zip(th).zip(t1)) {
+                    *o = h / 6.0 * (x0 + 4.0 * xh + x1);
+                }
+                // − (h²/12) [Θ₀, Θ₁], row i: Σ_l Θ₀[i][l] Θ₁[l][:] − Θ₁[i][l] Θ₀[l][:].
                 let c = h * h / 12.0;
-                let thetas = t0.iter().zip(th).zip(t1);
-                let comm = prod.iter().zip(prod_swapped.iter());
-                for ((o, ((x0, xh), x1)), (p, ps)) in omega.iter_mut().zip(thetas).zip(comm) {
-                    *o = h / 6.0 * (x0 + 4.0 * xh + x1) - c * (p - ps);
+                let rows = t0.chunks_exact(dim).zip(t1.chunks_exact(dim));
+                for (o_row, (t0_row, t1_row)) in omega.chunks_exact_mut(dim).zip(rows.clone()) {
+                    comm.fill(0.0);
+                    for ((a0, a1), (r0, r1)) in t0_row.iter().zip(t1_row).zip(rows.clone()) {
+                        for ((s, x1), x0) in comm.iter_mut().zip(r1).zip(r0) {
+                            *s += a0 * x1 - a1 * x0;
+                        }
+                    }
+                    for (o, s) in o_row.iter_mut().zip(comm.iter()) {
+                        *o -= c * s;
+                    }
                 }
             }
         }

@@ -18,6 +18,7 @@ use crate::hill::{fourier_blocks, hill_multipliers};
 use crate::ihb::HbSolution;
 use crate::problem::PeriodicProblem;
 use faer::c64;
+use ivt_num::small::matmul;
 
 /// What the leading multiplier says.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -189,10 +190,19 @@ impl StabilityAnalyzer {
         let n2 = nd * nd;
         // nd ≥ 1 (checked in `new`); a problem whose C or K is not nd×nd gives NaN
         // (unstable), as a singular mass does.
-        if nd == 0 || c.len() != n2 || k.len() != n2 || self.theta.len() != ns * d2 {
+        if nd == 0
+            || c.len() != n2
+            || k.len() != n2
+            || self.minv.len() != n2
+            || self.theta.len() != ns * d2
+        {
             self.theta.fill(f64::NAN);
             return &self.theta;
         }
+        // K + G_x, C + G_v and their products with M⁻¹ at one sample (every
+        // slice n_dof², as ivt_num's matmul needs).
+        let (mut stiff, mut damp) = (vec![0.0; n2], vec![0.0; n2]);
+        let (mut minv_stiff, mut minv_damp) = (vec![0.0; n2], vec![0.0; n2]);
         for (dg, th) in self
             .dg
             .chunks_exact(2 * n2)
@@ -208,18 +218,22 @@ impl StabilityAnalyzer {
                 }
             }
             // Lower rows [−M⁻¹(K + G_x)/ω² | −M⁻¹(C + G_v)/ω].
-            for (row, minv_row) in lower.chunks_exact_mut(dim).zip(self.minv.chunks_exact(nd)) {
+            for (s, (a, b)) in stiff.iter_mut().zip(k.iter().zip(dgx)) {
+                *s = a + b;
+            }
+            for (s, (a, b)) in damp.iter_mut().zip(c.iter().zip(dgv)) {
+                *s = a + b;
+            }
+            matmul(&self.minv, &stiff, nd, &mut minv_stiff);
+            matmul(&self.minv, &damp, nd, &mut minv_damp);
+            let products = minv_stiff.chunks_exact(nd).zip(minv_damp.chunks_exact(nd));
+            for (row, (pk, pc)) in lower.chunks_exact_mut(dim).zip(products) {
                 let (row_k, row_c) = row.split_at_mut(nd);
-                for (e, (tk, tc)) in row_k.iter_mut().zip(row_c.iter_mut()).enumerate() {
-                    let (mut sk, mut sc) = (0.0, 0.0);
-                    let col = |a| column(a, e, nd);
-                    let terms = col(k).zip(col(dgx)).zip(col(c).zip(col(dgv)));
-                    for (&m, ((kk, gx), (cc, gv))) in minv_row.iter().zip(terms) {
-                        sk += m * (kk + gx);
-                        sc += m * (cc + gv);
-                    }
-                    *tk = -sk / (omega * omega);
-                    *tc = -sc / omega;
+                for (t, p) in row_k.iter_mut().zip(pk) {
+                    *t = -p / (omega * omega);
+                }
+                for (t, p) in row_c.iter_mut().zip(pc) {
+                    *t = -p / omega;
                 }
             }
         }
@@ -466,11 +480,6 @@ impl AdaptiveHsu {
             level += 1;
         }
     }
-}
-
-/// Column `e` of a row-major matrix with `nd` columns (`nd ≥ 1`).
-fn column(a: &[f64], e: usize, nd: usize) -> impl Iterator<Item = f64> + '_ {
-    a.iter().skip(e).step_by(nd).copied()
 }
 
 /// The analyzer of `level` of [`AdaptiveHsu`] (`base·2^level` sub-intervals),
