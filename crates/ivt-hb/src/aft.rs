@@ -9,6 +9,14 @@
 //! The *Galerkin* residual of Eq. 55/61, `r = (1/π)∫ C_s f dτ` with
 //! `C_s = {1/2, cos τ…, sin τ…}`, equals the Fourier coefficients of `f` except that
 //! its first entry is `a0/2` (the mean): see [`Aft::galerkin`].
+//!
+//! Slice lengths are the callers' contract (checked by `debug_assert` in tests). A
+//! slice of the wrong length in a release build is not a panic: the output is
+//! filled with NaN, which the solvers report as [`HbError::NonFinite`].
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::error::HbError;
 use realfft::num_complex::Complex;
@@ -51,21 +59,62 @@ impl RealFftPair {
         }
     }
 
-    /// Unnormalised DFT of `samples` (`len`) into [`Self::spectrum`].
+    /// Unnormalised DFT of `samples` (`len`) into [`Self::spectrum`] (NaN if
+    /// `samples` is not `len` long).
     pub(crate) fn forward_from(&mut self, samples: &[f64]) {
+        debug_assert_eq!(samples.len(), self.samples.len());
+        if samples.len() != self.samples.len() {
+            self.spectrum.fill(Complex::new(f64::NAN, f64::NAN));
+            return;
+        }
         self.samples.copy_from_slice(samples);
-        self.fwd
+        // The buffers were made by the plan itself and `samples` was checked, so
+        // realfft's only errors (buffer lengths) cannot occur; NaN if they did.
+        if self
+            .fwd
             .process_with_scratch(&mut self.samples, &mut self.spectrum, &mut self.scratch)
-            .expect("sizes fixed at planning");
+            .is_err()
+        {
+            self.spectrum.fill(Complex::new(f64::NAN, f64::NAN));
+        }
     }
 
     /// `x_i = Σ_K X_K e^{+jKτ_i}` over the Hermitian extension of
-    /// [`Self::spectrum`] into `samples` (`len`).
+    /// [`Self::spectrum`] into `samples` (`len`; NaN if it is not `len` long).
     pub(crate) fn inverse_into(&mut self, samples: &mut [f64]) {
-        self.inv
+        debug_assert_eq!(samples.len(), self.samples.len());
+        match self
+            .inv
             .process_with_scratch(&mut self.spectrum, samples, &mut self.scratch)
-            .expect("sizes fixed at planning; DC and Nyquist imaginary parts are zero");
+        {
+            // A real signal's spectrum has no imaginary part at DC and Nyquist:
+            // realfft drops one there and still transforms (its InputValues).
+            Ok(()) | Err(realfft::FftError::InputValues(..)) => {}
+            Err(_) => poison(samples),
+        }
     }
+}
+
+/// Marks an output whose input broke the length contract: NaN, so the solvers
+/// stop with [`HbError::NonFinite`] instead of using a wrong number.
+fn poison(out: &mut [f64]) {
+    out.fill(f64::NAN);
+}
+
+/// The parts `(a0, [a1..an], [b1..bn])` of a series `[a0, a.., b..]` (`None` if
+/// empty). An even length leaves one extra trailing entry in the `b` part.
+pub(crate) fn split_series(coeffs: &[f64]) -> Option<(f64, &[f64], &[f64])> {
+    let (&a0, rest) = coeffs.split_first()?;
+    let (a, b) = rest.split_at(rest.len() / 2);
+    Some((a0, a, b))
+}
+
+/// [`split_series`] for writing.
+pub(crate) fn split_series_mut(coeffs: &mut [f64]) -> Option<(&mut f64, &mut [f64], &mut [f64])> {
+    let (a0, rest) = coeffs.split_first_mut()?;
+    let half = rest.len() / 2;
+    let (a, b) = rest.split_at_mut(half);
+    Some((a0, a, b))
 }
 
 impl std::fmt::Debug for Aft {
@@ -79,7 +128,12 @@ impl std::fmt::Debug for Aft {
 
 impl Clone for Aft {
     fn clone(&self) -> Self {
-        Self::new(self.n, self.n_half).expect("sizes were valid")
+        // The sizes were validated by `new`.
+        Self {
+            n: self.n,
+            n_half: self.n_half,
+            fft: RealFftPair::new(2 * self.n_half),
+        }
     }
 }
 
@@ -133,13 +187,21 @@ impl Aft {
         let n = self.n;
         debug_assert_eq!(coeffs.len(), 2 * n + 1);
         debug_assert_eq!(samples.len(), 2 * self.n_half);
-        self.fft.spectrum.fill(Complex::new(0.0, 0.0));
+        let Some((a0, cos, sin)) = split_series(coeffs).filter(|(_, c, _)| c.len() == n) else {
+            return poison(samples);
+        };
+        let spectrum = &mut self.fft.spectrum;
+        spectrum.fill(Complex::new(0.0, 0.0));
         // realfft's inverse gives x_i = Σ_K X_K e^{+jKτ_i} over the full Hermitian
         // spectrum, so a_k cos + b_k sin needs X_k = (a_k − j b_k)/2, X_0 = a0/2.
-        self.fft.spectrum[0] = Complex::new(if order == 0 { 0.5 * coeffs[0] } else { 0.0 }, 0.0);
-        for k in 1..=n {
-            let (a, b) = derivative_pair(coeffs[k], coeffs[n + k], k, order);
-            self.fft.spectrum[k] = Complex::new(0.5 * a, -0.5 * b);
+        let Some((x0, xk)) = spectrum.split_first_mut() else {
+            return poison(samples);
+        };
+        *x0 = Complex::new(if order == 0 { 0.5 * a0 } else { 0.0 }, 0.0);
+        // N > n, so the N spectrum bins after X_0 hold all n harmonics.
+        for (k, ((x, &a), &b)) in xk.iter_mut().zip(cos).zip(sin).enumerate() {
+            let (a, b) = derivative_pair(a, b, k + 1, order);
+            *x = Complex::new(0.5 * a, -0.5 * b);
         }
         self.fft.inverse_into(samples);
     }
@@ -158,8 +220,11 @@ impl Aft {
         column: &mut [f64],
     ) {
         let l = self.coeff_len();
-        for d in 0..n_dof {
-            let qd = &q[d * l..(d + 1) * l];
+        if q.len() != n_dof * l {
+            debug_assert_eq!(q.len(), n_dof * l);
+            return poison(out);
+        }
+        for (d, qd) in q.chunks_exact(l).enumerate() {
             if n_dof == 1 {
                 self.synthesize_derivative(qd, order, out);
                 out.iter_mut().for_each(|u| *u *= scale);
@@ -199,10 +264,16 @@ impl Aft {
         debug_assert_eq!(coeffs.len(), 2 * n + 1);
         self.fft.forward_from(samples);
         let scale = 1.0 / self.n_half as f64;
-        coeffs[0] = self.fft.spectrum[0].re * scale;
-        for k in 1..=n {
-            coeffs[k] = self.fft.spectrum[k].re * scale;
-            coeffs[n + k] = -self.fft.spectrum[k].im * scale;
+        let Some((c0, cos, sin)) = split_series_mut(coeffs).filter(|(_, c, _)| c.len() == n) else {
+            return poison(coeffs);
+        };
+        let Some((x0, xk)) = self.fft.spectrum.split_first() else {
+            return poison(coeffs);
+        };
+        *c0 = x0.re * scale;
+        for ((x, a), b) in xk.iter().zip(cos).zip(sin) {
+            *a = x.re * scale;
+            *b = -x.im * scale;
         }
     }
 
@@ -217,7 +288,9 @@ impl Aft {
     /// [`Self::analyze`] but the first entry is the mean `a0/2`.
     pub fn galerkin(&mut self, samples: &[f64], out: &mut [f64]) {
         self.analyze(samples, out);
-        out[0] *= 0.5;
+        if let Some(mean) = out.first_mut() {
+            *mean *= 0.5;
+        }
     }
 }
 
@@ -233,23 +306,34 @@ pub fn derivative_pair(a: f64, b: f64, k: usize, order: u32) -> (f64, f64) {
 }
 
 /// Coefficients of the `order`-th τ-derivative of a series (`[a0, a.., b..]`).
+/// `out` has the length of `coeffs` (NaN otherwise).
 pub fn derivative_coeffs(coeffs: &[f64], order: u32, out: &mut [f64]) {
-    let n = (coeffs.len() - 1) / 2;
-    out[0] = if order == 0 { coeffs[0] } else { 0.0 };
-    for k in 1..=n {
-        let (a, b) = derivative_pair(coeffs[k], coeffs[n + k], k, order);
-        out[k] = a;
-        out[n + k] = b;
+    debug_assert_eq!(coeffs.len(), out.len());
+    if coeffs.len() != out.len() {
+        return poison(out);
+    }
+    let (Some((a0, cos, sin)), Some((o0, out_cos, out_sin))) =
+        (split_series(coeffs), split_series_mut(out))
+    else {
+        return;
+    };
+    *o0 = if order == 0 { a0 } else { 0.0 };
+    for (k, (((&a, &b), oa), ob)) in cos.iter().zip(sin).zip(out_cos).zip(out_sin).enumerate() {
+        (*oa, *ob) = derivative_pair(a, b, k + 1, order);
     }
 }
 
 /// Evaluates the series `[a0, a.., b..]` (or its `order`-th derivative) at τ directly
-/// (O(n), for off-grid points such as Hsu's quadrature nodes).
+/// (O(n), for off-grid points such as Hsu's quadrature nodes). NaN for an empty
+/// `coeffs`.
 pub fn eval_series(coeffs: &[f64], tau: f64, order: u32) -> f64 {
-    let n = (coeffs.len() - 1) / 2;
-    let mut s = if order == 0 { 0.5 * coeffs[0] } else { 0.0 };
-    for k in 1..=n {
-        let (a, b) = derivative_pair(coeffs[k], coeffs[n + k], k, order);
+    let Some((a0, cos, sin)) = split_series(coeffs) else {
+        return f64::NAN;
+    };
+    let mut s = if order == 0 { 0.5 * a0 } else { 0.0 };
+    for (k, (&a, &b)) in cos.iter().zip(sin).enumerate() {
+        let k = k + 1;
+        let (a, b) = derivative_pair(a, b, k, order);
         let (sn, cs) = (k as f64 * tau).sin_cos();
         s += a * cs + b * sn;
     }
@@ -258,27 +342,52 @@ pub fn eval_series(coeffs: &[f64], tau: f64, order: u32) -> f64 {
 
 /// The series `[a0, a1..an, b1..bn]` with `n_to` harmonics (truncated or
 /// zero-padded), e.g. to seed a solve at another n from a converged solution.
+/// An empty `coeffs` is the zero series.
 pub fn resize_harmonics(coeffs: &[f64], n_to: usize) -> Vec<f64> {
-    let n = (coeffs.len() - 1) / 2;
     let mut out = vec![0.0; 2 * n_to + 1];
-    out[0] = coeffs[0];
-    let kmax = n.min(n_to);
-    out[1..=kmax].copy_from_slice(&coeffs[1..=kmax]);
-    out[n_to + 1..=n_to + kmax].copy_from_slice(&coeffs[n + 1..=n + kmax]);
+    if let (Some((a0, cos, sin)), Some((o0, out_cos, out_sin))) =
+        (split_series(coeffs), split_series_mut(&mut out))
+    {
+        *o0 = a0;
+        for (o, &a) in out_cos.iter_mut().zip(cos) {
+            *o = a;
+        }
+        for (o, &b) in out_sin.iter_mut().zip(sin.iter().take(cos.len())) {
+            *o = b;
+        }
+    }
     out
+}
+
+/// Replaces the series `[a0, a.., b..]` of `u(τ)` by that of `u(τ + φ)`:
+/// harmonic k turns by kφ.
+pub fn shift_time(coeffs: &mut [f64], phi: f64) {
+    if let Some((_, cos, sin)) = split_series_mut(coeffs) {
+        for (k, (a, b)) in cos.iter_mut().zip(sin.iter_mut()).enumerate() {
+            let (s, c) = ((k + 1) as f64 * phi).sin_cos();
+            (*a, *b) = (*a * c + *b * s, *b * c - *a * s);
+        }
+    }
 }
 
 /// Re-expresses a series in τ as one in τ/`factor` (period `factor·2π`): harmonic k
 /// moves to `factor·k`, keeping `n_to` harmonics. Used to start period-2p solutions
 /// from period-p ones (§3.2.5: `a_{2j}^{(2)} = a_j^{(1)}`).
+/// An empty `coeffs` is the zero series.
 pub fn embed_subharmonic(coeffs: &[f64], factor: usize, n_to: usize) -> Vec<f64> {
-    let n = (coeffs.len() - 1) / 2;
     let mut out = vec![0.0; 2 * n_to + 1];
-    out[0] = coeffs[0];
-    for k in 1..=n {
-        if factor * k <= n_to {
-            out[factor * k] = coeffs[k];
-            out[n_to + factor * k] = coeffs[n + k];
+    if let (Some((a0, cos, sin)), Some((o0, out_cos, out_sin))) =
+        (split_series(coeffs), split_series_mut(&mut out))
+    {
+        *o0 = a0;
+        // Harmonic k lands on harmonic factor·k (index factor·k − 1 of a part).
+        let moved = out_cos.iter_mut().zip(out_sin.iter_mut());
+        for ((oa, ob), (&a, &b)) in moved
+            .skip(factor.saturating_sub(1))
+            .step_by(factor.max(1))
+            .zip(cos.iter().zip(sin))
+        {
+            (*oa, *ob) = (a, b);
         }
     }
     out
@@ -325,5 +434,52 @@ mod tests {
     #[test]
     fn too_few_samples_is_an_error() {
         assert!(Aft::new(8, 8).is_err());
+    }
+
+    #[test]
+    fn resize_embed_and_shift_move_the_right_harmonics() {
+        // [a0, a1, a2, b1, b2].
+        let c = [1.0, 2.0, 3.0, 4.0, 5.0];
+        assert_eq!(resize_harmonics(&c, 1), [1.0, 2.0, 4.0]);
+        assert_eq!(resize_harmonics(&c, 3), [1.0, 2.0, 3.0, 0.0, 4.0, 5.0, 0.0]);
+        // Harmonic k → 2k; a2 → harmonic 4 is dropped at n_to = 3.
+        assert_eq!(
+            embed_subharmonic(&c, 2, 4),
+            [1.0, 0.0, 2.0, 0.0, 3.0, 0.0, 4.0, 0.0, 5.0]
+        );
+        assert_eq!(
+            embed_subharmonic(&c, 2, 3),
+            [1.0, 0.0, 2.0, 0.0, 0.0, 4.0, 0.0]
+        );
+        assert_eq!(embed_subharmonic(&c, 3, 6)[3], 2.0);
+        // u(τ + φ) against the direct sum.
+        let mut shifted = c;
+        shift_time(&mut shifted, 0.7);
+        for tau in [0.0, 0.3, 2.0, 4.5] {
+            let want = eval_series(&c, tau + 0.7, 0);
+            assert!((eval_series(&shifted, tau, 0) - want).abs() < 1e-14);
+        }
+        assert!(eval_series(&[], 0.0, 0).is_nan());
+        assert_eq!(resize_harmonics(&[], 1), [0.0; 3]);
+    }
+
+    /// A slice of the wrong length is NaN in a release build (a
+    /// `debug_assert` stops a debug build first).
+    #[cfg(not(debug_assertions))]
+    #[test]
+    fn wrong_lengths_give_nan_not_a_panic() {
+        let mut aft = Aft::new(2, 4).unwrap();
+        let mut s = vec![0.0; 8];
+        aft.synthesize(&[1.0, 2.0], &mut s);
+        assert!(s.iter().all(|v| v.is_nan()));
+        let mut c = vec![0.0; 5];
+        aft.analyze(&[1.0; 7], &mut c);
+        assert!(c.iter().all(|v| v.is_nan()));
+        let mut short = vec![0.0; 3];
+        aft.analyze(&[1.0; 8], &mut short);
+        assert!(short.iter().all(|v| v.is_nan()));
+        let mut out = vec![0.0; 4];
+        derivative_coeffs(&[1.0; 5], 1, &mut out);
+        assert!(out.iter().all(|v| v.is_nan()));
     }
 }

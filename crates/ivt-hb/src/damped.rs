@@ -12,6 +12,10 @@
 //!
 //! The linear mode (the start) is the `mode`-th eigenpair of `M⁻¹K` by
 //! increasing frequency.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::backbone::{modal_path, BackboneOptions};
 use crate::continuation::Termination;
@@ -67,7 +71,14 @@ pub fn linear_mode<P: PeriodicProblem>(
     })?;
     let k = problem.stiffness();
     let a = faer::Mat::<f64>::from_fn(nd, nd, |i, j| {
-        (0..nd).map(|e| minv[i * nd + e] * k[e * nd + j]).sum()
+        // NaN if K is not nd×nd.
+        (0..nd)
+            .map(|e| {
+                minv.get(i * nd + e)
+                    .zip(k.get(e * nd + j))
+                    .map_or(f64::NAN, |(m, k)| m * k)
+            })
+            .sum()
     });
     let eig = a
         .eigen()
@@ -75,7 +86,11 @@ pub fn linear_mode<P: PeriodicProblem>(
     let (s, u) = (eig.S(), eig.U());
     let mut order: Vec<usize> = (0..nd).collect();
     order.sort_by(|&i, &j| s[i].re.total_cmp(&s[j].re));
-    let col = order[mode];
+    let Some(&col) = order.get(mode) else {
+        return Err(HbError::InvalidInput(format!(
+            "mode {mode} does not exist: the problem has {nd} DOFs"
+        )));
+    };
     let lambda = s[col];
     if !(lambda.re > 0.0 && lambda.im.abs() <= 1e-10 * lambda.re) {
         return Err(HbError::InvalidInput(format!(

@@ -18,6 +18,10 @@
 //! runs until one fails, at most `max_iter` Newton steps per run, and iterates
 //! leaving the box `‖q‖∞ ≤ max_amplitude` abandoned. "Exhausted" means every
 //! start's last run found nothing new within these bounds, not a proof.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::error::HbError;
 use crate::floquet::HsuRule;
@@ -261,16 +265,9 @@ impl<'p, P: PeriodicProblem> Deflated<'p, P> {
             for quarter in 0..4 {
                 // Rotate every harmonic h by h·quarter·π/2 (a time shift of the
                 // shape; for a forced problem a different orbit).
-                let mut q = vec![0.0; m];
-                for (d, block) in shape.chunks_exact(l).enumerate() {
-                    q[d * l] = amp * block[0];
-                    for h in 1..=n {
-                        let phi = h as f64 * quarter as f64 * std::f64::consts::FRAC_PI_2;
-                        let (s, c) = phi.sin_cos();
-                        let (a, b) = (block[h], block[n + h]);
-                        q[d * l + h] = amp * (a * c + b * s);
-                        q[d * l + n + h] = amp * (b * c - a * s);
-                    }
+                let mut q: Vec<f64> = shape.iter().map(|v| amp * v).collect();
+                for block in q.chunks_exact_mut(l) {
+                    crate::aft::shift_time(block, quarter as f64 * std::f64::consts::FRAC_PI_2);
                 }
                 starts.push(q);
             }

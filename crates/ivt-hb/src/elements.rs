@@ -12,6 +12,12 @@
 //! ([`PeriodicProblem::nonlinear`]) has no history and gives its virgin loading
 //! curve `clamp(kδ, −F_s, F_s)`, so a time integration of an [`ElementProblem`]
 //! with a Jenkins element does not model it.
+//!
+//! A sample slice of the wrong length (a caller's bug) gives NaN, not a panic.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::problem::{matrix_getters, per_sample, PeriodicProblem};
 
@@ -211,8 +217,20 @@ impl ElementProblem {
         })
     }
 
+    /// `x_a − x_b` of element `e` (NaN if `x` is short).
     fn relative(e: &Element, x: &[f64]) -> f64 {
-        x[e.a] - e.b.map_or(0.0, |b| x[b])
+        let at = |i: usize| x.get(i).copied().unwrap_or(f64::NAN);
+        at(e.a) - e.b.map_or(0.0, at)
+    }
+}
+
+/// `out[i] += v`, or all of `out` NaN if it has no entry `i` (a caller's size
+/// bug: the DOFs of the elements and the forcing are `< n`, checked in
+/// [`ElementProblem::new`]).
+fn add_at(out: &mut [f64], i: usize, v: f64) {
+    match out.get_mut(i) {
+        Some(o) => *o += v,
+        None => out.fill(f64::NAN),
     }
 }
 
@@ -223,9 +241,9 @@ impl ElementProblem {
         out.fill(0.0);
         for e in self.elements.iter().filter(|e| pick(e.law)) {
             let (f, _, _) = e.law.eval(Self::relative(e, x), Self::relative(e, v));
-            out[e.a] += f;
+            add_at(out, e.a, f);
             if let Some(b) = e.b {
-                out[b] -= f;
+                add_at(out, b, -f);
             }
         }
     }
@@ -237,8 +255,8 @@ impl ElementProblem {
         let (dg_dx, dg_dv) = dg.split_at_mut(n * n);
         // δ = x_a − x_b: ∂g_a/∂x_a = F', ∂g_a/∂x_b = −F', ∂g_b = −∂g_a.
         let mut add = |i: usize, j: usize, s: f64| {
-            dg_dx[i * n + j] += s * fx;
-            dg_dv[i * n + j] += s * fv;
+            add_at(dg_dx, i * n + j, s * fx);
+            add_at(dg_dv, i * n + j, s * fv);
         };
         add(e.a, e.a, 1.0);
         if let Some(b) = e.b {
@@ -272,34 +290,41 @@ impl ElementProblem {
         let ranges = crate::hysteresis::period_ranges(theta);
         let mut delta = vec![0.0; theta.len()];
         let (mut force, mut tangent) = (vec![0.0; theta.len()], vec![0.0; theta.len()]);
+        // n ≥ 1 (checked in `new`); x holds n values per sample.
+        let x_ok = x.len() == n * theta.len();
         for e in self.elements.iter().filter(|e| e.law.hysteretic()) {
             let Law::Jenkins { k, slip_force } = e.law else {
                 continue;
             };
-            for (i, d) in delta.iter_mut().enumerate() {
-                *d = Self::relative(e, &x[i * n..(i + 1) * n]);
+            delta.fill(f64::NAN);
+            if x_ok {
+                for (d, xi) in delta.iter_mut().zip(x.chunks_exact(n)) {
+                    *d = Self::relative(e, xi);
+                }
             }
             for r in &ranges {
-                crate::hysteresis::jenkins_period(
-                    k,
-                    slip_force,
-                    &delta[r.clone()],
-                    &mut force[r.clone()],
-                    &mut tangent[r.clone()],
-                );
+                let (Some(d), Some(f), Some(t)) = (
+                    delta.get(r.clone()),
+                    force.get_mut(r.clone()),
+                    tangent.get_mut(r.clone()),
+                ) else {
+                    force.fill(f64::NAN);
+                    continue;
+                };
+                crate::hysteresis::jenkins_period(k, slip_force, d, f, t);
             }
             if let Some(out) = out.as_deref_mut() {
-                for (i, f) in force.iter().enumerate() {
-                    out[i * n + e.a] += f;
+                for (o, f) in out.chunks_exact_mut(n).zip(&force) {
+                    add_at(o, e.a, *f);
                     if let Some(b) = e.b {
-                        out[i * n + b] -= f;
+                        add_at(o, b, -f);
                     }
                 }
             }
             if let Some(dg) = dg.as_deref_mut() {
                 let w = 2 * n * n;
-                for (i, t) in tangent.iter().enumerate() {
-                    self.add_tangent(e, *t, 0.0, &mut dg[i * w..(i + 1) * w]);
+                for (d, t) in dg.chunks_exact_mut(w).zip(&tangent) {
+                    self.add_tangent(e, *t, 0.0, d);
                 }
             }
         }
@@ -330,7 +355,7 @@ impl PeriodicProblem for ElementProblem {
     fn excitation(&self, theta: f64, out: &mut [f64]) {
         out.fill(0.0);
         for h in &self.forcing {
-            out[h.dof] += h.amplitude * (theta + h.phase).cos();
+            add_at(out, h.dof, h.amplitude * (theta + h.phase).cos());
         }
     }
     fn velocity_dependent(&self) -> bool {

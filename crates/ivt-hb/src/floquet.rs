@@ -6,6 +6,14 @@
 //! [`HsuRule::Left`]). The default [`HsuRule::Magnus4`] uses the fourth-order Magnus
 //! step `Ω = (h/6)(Θ₀ + 4Θ_½ + Θ₁) − (h²/12)[Θ₀, Θ₁]` on the same uniform grid,
 //! which reaches 1e-9 agreement with Hill's method at a few thousand steps.
+//!
+//! Slice lengths are the callers' contract; a slice too short in a release build
+//! is not a panic: the result is NaN, which the stability checks report as
+//! [`crate::HbError::NonFiniteMultipliers`].
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use faer::c64;
 use ivt_num::small::matmul;
@@ -36,7 +44,11 @@ const EXPM_TAYLOR: [f64; 13] = {
     let mut c = [1.0; 13];
     let mut k = 1;
     while k < 13 {
-        c[k] = c[k - 1] / k as f64;
+        // A const item: an index out of range is a compile error, not a panic.
+        #[allow(clippy::indexing_slicing)]
+        {
+            c[k] = c[k - 1] / k as f64;
+        }
         k += 1;
     }
     c
@@ -69,10 +81,12 @@ macro_rules! by_size {
 /// exponential of every Hsu sub-interval). `scratch` needs
 /// [`expm_scratch_len`] entries; nothing is allocated.
 ///
-/// # Panics
 /// If `scratch` is shorter than [`expm_scratch_len`]`(dim)` (for `dim > 2`)
-/// or `a`, `out` shorter than `dim²`.
+/// or `a` shorter than `dim²`, `out` is NaN.
 pub fn expm(a: &[f64], dim: usize, out: &mut [f64], scratch: &mut [f64]) {
+    if dim == 0 {
+        return;
+    }
     if dim == 2 {
         expm2(a, out);
         return;
@@ -85,9 +99,14 @@ pub fn expm(a: &[f64], dim: usize, out: &mut [f64], scratch: &mut [f64]) {
 fn expm_sized<const N: usize>(a: &[f64], dim: usize, out: &mut [f64], scratch: &mut [f64]) {
     let dim = if N == 0 { dim } else { N };
     let d2 = dim * dim;
-    let (a, out) = (&a[..d2], &mut out[..d2]);
+    let Some(out) = out.get_mut(..d2) else {
+        return out.fill(f64::NAN);
+    };
+    let (Some(a), Some(scratch), true) = (a.get(..d2), scratch.get_mut(..5 * d2), dim > 0) else {
+        return out.fill(f64::NAN);
+    };
     let norm1 = (0..dim)
-        .map(|j| (0..dim).map(|i| a[i * dim + j].abs()).sum::<f64>())
+        .map(|j| a.iter().skip(j).step_by(dim).map(|x| x.abs()).sum::<f64>())
         .fold(0.0, f64::max);
     let s = if norm1 > EXPM_THETA {
         (norm1 / EXPM_THETA).log2().ceil() as i32
@@ -95,7 +114,7 @@ fn expm_sized<const N: usize>(a: &[f64], dim: usize, out: &mut [f64], scratch: &
         0
     };
     let scale = 0.5f64.powi(s);
-    let (a1, rest) = scratch[..5 * d2].split_at_mut(d2);
+    let (a1, rest) = scratch.split_at_mut(d2);
     let (a2, rest) = rest.split_at_mut(d2);
     let (a3, rest) = rest.split_at_mut(d2);
     let (a4, tmp) = rest.split_at_mut(d2);
@@ -103,26 +122,25 @@ fn expm_sized<const N: usize>(a: &[f64], dim: usize, out: &mut [f64], scratch: &
     matmul(a1, a1, dim, a2);
     matmul(a2, a1, dim, a3);
     matmul(a2, a2, dim, a4);
-    let c = &EXPM_TAYLOR;
+    let [c0, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, c11, c12] = EXPM_TAYLOR;
     // B_i = c[4i] I + c[4i+1] A + c[4i+2] A² + c[4i+3] A³ (B₂ adds c[12] A⁴).
-    let block = |i: usize, b: &mut [f64]| {
-        for (k, v) in b.iter_mut().enumerate() {
-            *v = c[4 * i + 1] * a1[k] + c[4 * i + 2] * a2[k] + c[4 * i + 3] * a3[k];
-            if i == 2 {
-                *v += c[12] * a4[k];
+    let block = |[ci, ci1, ci2, ci3]: [f64; 4], a4_coeff: Option<f64>, b: &mut [f64]| {
+        let powers = a1.iter().zip(a2.iter()).zip(a3.iter()).zip(a4.iter());
+        for (v, (((x1, x2), x3), x4)) in b.iter_mut().zip(powers) {
+            *v = ci1 * x1 + ci2 * x2 + ci3 * x3;
+            if let Some(c) = a4_coeff {
+                *v += c * x4;
             }
         }
-        for d in 0..dim {
-            b[d * dim + d] += c[4 * i];
-        }
+        b.iter_mut().step_by(dim + 1).for_each(|v| *v += ci);
     };
     // out = B₂; tmp = A⁴ B₂ + B₁; out = A⁴ tmp + B₀.
-    block(2, out);
+    block([c8, c9, c10, c11], Some(c12), out);
     matmul(a4, out, dim, tmp);
-    block(1, out);
+    block([c4, c5, c6, c7], None, out);
     tmp.iter_mut().zip(out.iter()).for_each(|(t, b)| *t += b);
     matmul(a4, tmp, dim, out);
-    block(0, tmp);
+    block([c0, c1, c2, c3], None, tmp);
     out.iter_mut().zip(tmp.iter()).for_each(|(o, b)| *o += b);
     for _ in 0..s {
         matmul(out, out, dim, tmp);
@@ -132,9 +150,16 @@ fn expm_sized<const N: usize>(a: &[f64], dim: usize, out: &mut [f64], scratch: &
 
 /// Closed-form exponential of a 2×2 matrix: with `μ = tr/2` and `δ² = μ² − det`,
 /// `exp(A) = e^μ [cosh δ · I + (sinh δ/δ)(A − μI)]` (δ imaginary → cos/sin).
+/// `out` is NaN if `a` has fewer than 4 entries.
 fn expm2(a: &[f64], out: &mut [f64]) {
-    let mu = 0.5 * (a[0] + a[3]);
-    let det = a[0] * a[3] - a[1] * a[2];
+    let Some(out) = out.first_chunk_mut::<4>() else {
+        return out.fill(f64::NAN);
+    };
+    let Some(&[a0, a1, a2, a3]) = a.first_chunk::<4>() else {
+        return out.fill(f64::NAN);
+    };
+    let mu = 0.5 * (a0 + a3);
+    let det = a0 * a3 - a1 * a2;
     let d2 = mu * mu - det;
     let (c, s) = if d2.abs() < 1e-8 {
         // Series to O(d2³): cosh δ = 1 + d2/2 + d2²/24, sinh δ/δ = 1 + d2/6 + d2²/120.
@@ -150,16 +175,18 @@ fn expm2(a: &[f64], out: &mut [f64]) {
         (d.cos(), d.sin() / d)
     };
     let e = mu.exp();
-    out[0] = e * (c + s * (a[0] - mu));
-    out[1] = e * s * a[1];
-    out[2] = e * s * a[2];
-    out[3] = e * (c + s * (a[3] - mu));
+    *out = [
+        e * (c + s * (a0 - mu)),
+        e * s * a1,
+        e * s * a2,
+        e * (c + s * (a3 - mu)),
+    ];
 }
 
 /// Monodromy matrix (Eq. 80) from Θ sampled on a uniform grid: `theta` holds
 /// `2·steps` row-major `dim×dim` samples at `τ_j = j·period/(2·steps)`,
 /// `j = 0..2·steps−1` (the sample at τ = period is the one at 0). One Hsu step spans
-/// two grid intervals. Result in `q` (`dim²`).
+/// two grid intervals. Result in `q` (`dim²`; NaN if `theta` is short).
 pub fn monodromy_uniform(
     dim: usize,
     theta: &[f64],
@@ -209,35 +236,40 @@ fn monodromy_sized<const N: usize>(
     let mut omega = vec![0.0; d2];
     let mut step = vec![0.0; d2];
     let mut prod = vec![0.0; d2];
+    let mut comm = vec![0.0; dim];
     let mut scratch = vec![0.0; expm_scratch_len(dim)];
-    let q = &mut q[..d2];
+    let Some(q) = q.get_mut(..d2) else {
+        return q.fill(f64::NAN);
+    };
     q.fill(0.0);
-    for i in 0..dim {
-        q[i * dim + i] = 1.0;
-    }
+    q.iter_mut().step_by(dim + 1).for_each(|v| *v = 1.0);
     let at = |j: usize| {
-        let j = (j * stride) % samples;
-        &theta[j * d2..(j + 1) * d2]
+        let j = (j * stride) % samples.max(1);
+        theta.get(j * d2..(j + 1) * d2)
     };
     for s in 0..steps {
-        let (t0, th, t1) = (at(2 * s), at(2 * s + 1), at(2 * s + 2));
+        let (Some(t0), Some(th), Some(t1)) = (at(2 * s), at(2 * s + 1), at(2 * s + 2)) else {
+            return q.fill(f64::NAN);
+        };
         match rule {
             HsuRule::Left => omega.iter_mut().zip(t1).for_each(|(o, t)| *o = h * t),
             HsuRule::Midpoint => omega.iter_mut().zip(th).for_each(|(o, t)| *o = h * t),
             HsuRule::Magnus4 => {
-                for i in 0..d2 {
-                    omega[i] = h / 6.0 * (t0[i] + 4.0 * th[i] + t1[i]);
+                for (o, ((x0, xh), x1)) in omega.iter_mut().zip(t0.iter().zip(th).zip(t1)) {
+                    *o = h / 6.0 * (x0 + 4.0 * xh + x1);
                 }
-                // − (h²/12) [Θ₀, Θ₁]
+                // − (h²/12) [Θ₀, Θ₁], row i: Σ_l Θ₀[i][l] Θ₁[l][:] − Θ₁[i][l] Θ₀[l][:].
                 let c = h * h / 12.0;
-                for i in 0..dim {
-                    for j in 0..dim {
-                        let mut comm = 0.0;
-                        for l in 0..dim {
-                            comm += t0[i * dim + l] * t1[l * dim + j]
-                                - t1[i * dim + l] * t0[l * dim + j];
+                let rows = t0.chunks_exact(dim).zip(t1.chunks_exact(dim));
+                for (o_row, (t0_row, t1_row)) in omega.chunks_exact_mut(dim).zip(rows.clone()) {
+                    comm.fill(0.0);
+                    for ((a0, a1), (r0, r1)) in t0_row.iter().zip(t1_row).zip(rows.clone()) {
+                        for ((s, x1), x0) in comm.iter_mut().zip(r1).zip(r0) {
+                            *s += a0 * x1 - a1 * x0;
                         }
-                        omega[i * dim + j] -= c * comm;
+                    }
+                    for (o, s) in o_row.iter_mut().zip(comm.iter()) {
+                        *o -= c * s;
                     }
                 }
             }
@@ -265,11 +297,8 @@ pub fn monodromy_hsu<F: FnMut(f64, &mut [f64])>(
     let d2 = dim * dim;
     let m = 2 * steps;
     let mut samples = vec![0.0; m * d2];
-    for j in 0..m {
-        theta(
-            j as f64 * period / m as f64,
-            &mut samples[j * d2..(j + 1) * d2],
-        );
+    for (j, sample) in samples.chunks_exact_mut(d2.max(1)).enumerate() {
+        theta(j as f64 * period / m as f64, sample);
     }
     let mut q = vec![0.0; d2];
     monodromy_uniform(dim, &samples, steps, period, rule, &mut q);
@@ -278,10 +307,14 @@ pub fn monodromy_hsu<F: FnMut(f64, &mut [f64])>(
 
 /// Eigenvalues of a real row-major `dim×dim` matrix (faer), i.e. the Floquet
 /// multipliers when applied to the monodromy matrix. Sorted by decreasing modulus.
+/// NaN if `a` has fewer than `dim²` entries or the eigensolver fails.
 pub fn eigenvalues(a: &[f64], dim: usize) -> Vec<c64> {
-    if dim == 2 {
+    if a.len() < dim * dim {
+        return vec![c64::new(f64::NAN, f64::NAN); dim];
+    }
+    if let (2, Some(&[a0, a1, a2, a3])) = (dim, a.first_chunk::<4>()) {
         // Closed form for the single-DOF case (the FRC hot path): λ² − tr λ + det = 0.
-        let (tr, det) = (a[0] + a[3], a[0] * a[3] - a[1] * a[2]);
+        let (tr, det) = (a0 + a3, a0 * a3 - a1 * a2);
         let disc = 0.25 * tr * tr - det;
         let mut ev = if disc >= 0.0 {
             let r = disc.sqrt();
@@ -300,7 +333,9 @@ pub fn eigenvalues(a: &[f64], dim: usize) -> Vec<c64> {
         sort_by_modulus(&mut ev);
         return ev;
     }
-    let mat = faer::Mat::<f64>::from_fn(dim, dim, |i, j| a[i * dim + j]);
+    let mat = faer::Mat::<f64>::from_fn(dim, dim, |i, j| {
+        a.get(i * dim + j).copied().unwrap_or(f64::NAN)
+    });
     let mut ev = mat
         .eigenvalues()
         .unwrap_or_else(|_| vec![c64::new(f64::NAN, f64::NAN); dim]);
@@ -323,15 +358,8 @@ pub const MODULUS_TIE: f64 = 1e-10;
 /// its rounding.
 pub fn sort_by_modulus(v: &mut [c64]) {
     v.sort_by(|a, b| b.norm().total_cmp(&a.norm()));
-    let mut start = 0;
-    while start < v.len() {
-        let mut end = start + 1;
-        while end < v.len() && v[end - 1].norm() - v[end].norm() <= MODULUS_TIE * v[end - 1].norm()
-        {
-            end += 1;
-        }
-        v[start..end].sort_by(|a, b| a.im.total_cmp(&b.im));
-        start = end;
+    for run in v.chunk_by_mut(|a, b| a.norm() - b.norm() <= MODULUS_TIE * a.norm()) {
+        run.sort_by(|a, b| a.im.total_cmp(&b.im));
     }
 }
 

@@ -6,6 +6,10 @@
 //! appears shifted by all integers `i m`; the fundamental ones are those whose
 //! eigenvectors are most centred in the harmonic index (the weighted mean index of
 //! `|c_k|²` closest to 0). Multipliers are `μ = exp(2πλ)`.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::error::HbError;
 use faer::c64;
@@ -22,29 +26,51 @@ pub struct HillResult {
 
 /// Fourier blocks `Θ̂_k`, `k = −K..K`, of a real periodic matrix sampled on a uniform
 /// grid: `samples` holds `m` row-major `dim×dim` matrices at `τ_j = 2πj/m`.
-/// Output layout: block `k` at `(k+K)·dim²`. Needs `m > 2K`.
-pub fn fourier_blocks(dim: usize, samples: &[f64], m: usize, kmax: usize) -> Vec<c64> {
+/// Output layout: block `k` at `(k+K)·dim²`.
+///
+/// # Errors
+/// [`HbError::InvalidInput`] unless `m > 2K`, `dim ≥ 1` and `samples` holds
+/// `m·dim²` entries.
+pub fn fourier_blocks(
+    dim: usize,
+    samples: &[f64],
+    m: usize,
+    kmax: usize,
+) -> Result<Vec<c64>, HbError> {
     let d2 = dim * dim;
-    assert!(m > 2 * kmax, "need more samples than 2K");
+    if m <= 2 * kmax || d2 == 0 || samples.len() != m * d2 {
+        return Err(HbError::InvalidInput(format!(
+            "Fourier blocks need m > 2K samples of dim² = {d2} ≥ 1 entries \
+             (got m = {m}, K = {kmax}, {} entries)",
+            samples.len()
+        )));
+    }
     let mut planner = RealFftPlanner::<f64>::new();
     let fft = planner.plan_fft_forward(m);
     let mut input = vec![0.0; m];
     let mut spec = fft.make_output_vec();
     let mut out = vec![c64::new(0.0, 0.0); (2 * kmax + 1) * d2];
+    // Block k = 0 is out[K·d2..]: the negative blocks before it, in reverse.
+    let (negative, non_negative) = out.split_at_mut(kmax * d2);
     for e in 0..d2 {
-        for j in 0..m {
-            input[j] = samples[j * d2 + e];
+        for (x, s) in input.iter_mut().zip(samples.iter().skip(e).step_by(d2)) {
+            *x = *s;
         }
         fft.process(&mut input, &mut spec)
-            .expect("sizes fixed at planning");
-        for k in 0..=kmax {
-            let v = spec[k] / m as f64;
-            let v = c64::new(v.re, v.im);
-            out[(kmax + k) * d2 + e] = v;
-            out[(kmax - k) * d2 + e] = v.conj();
+            .map_err(|err| HbError::InvalidInput(format!("Fourier blocks: {err}")))?;
+        // Real Θ: Θ̂_{−k} = conj Θ̂_k.
+        let plus = non_negative.iter_mut().skip(e).step_by(d2);
+        let minus = negative.iter_mut().rev().skip(d2 - 1 - e).step_by(d2);
+        for (x, plus) in spec.iter().zip(plus).take(kmax + 1) {
+            let v = x / m as f64;
+            *plus = c64::new(v.re, v.im);
+        }
+        for (x, minus) in spec.iter().skip(1).zip(minus).take(kmax) {
+            let v = x / m as f64;
+            *minus = c64::new(v.re, -v.im);
         }
     }
-    out
+    Ok(out)
 }
 
 /// Hill exponents and multipliers from the Fourier blocks `theta_hat` (`k = −K..K`,
@@ -72,7 +98,11 @@ pub fn hill_multipliers(dim: usize, theta_hat: &[c64], h: usize) -> Result<HillR
         let (jb, j) = (c / dim, c % dim);
         let diff = kb as i64 - jb as i64;
         let mut v = if diff.unsigned_abs() as usize <= kmax {
-            theta_hat[((diff + kmax as i64) as usize) * d2 + i * dim + j]
+            // < (2K+1)·d2 = theta_hat.len() (checked above).
+            theta_hat
+                .get(((diff + kmax as i64) as usize) * d2 + i * dim + j)
+                .copied()
+                .unwrap_or(c64::new(f64::NAN, f64::NAN))
         } else {
             c64::new(0.0, 0.0)
         };
@@ -131,7 +161,19 @@ mod tests {
                 &mut samples[j * 4..j * 4 + 4],
             );
         }
-        let blocks = fourier_blocks(2, &samples, m, 4);
+        let blocks = fourier_blocks(2, &samples, m, 4).unwrap();
+        // Θ̂_{−k} = conj Θ̂_k: Θ̂_{±1} of entry (1, 0) is −0.4/2 (the cos τ term).
+        assert!((blocks[3 * 4 + 2].re + 0.2).abs() < 1e-14 && blocks[3 * 4 + 2].im.abs() < 1e-14);
+        assert!((blocks[5 * 4 + 2].re + 0.2).abs() < 1e-14);
+        for (kind, m, kmax, len) in [
+            ("m ≤ 2K", 8, 4, 32),
+            ("short", 64, 4, 255),
+            ("dim 0", 64, 4, 0),
+        ] {
+            let dim = if kind == "dim 0" { 0 } else { 2 };
+            let r = fourier_blocks(dim, &vec![0.0; len], m, kmax);
+            assert!(matches!(r, Err(HbError::InvalidInput(_))), "{kind}");
+        }
         let hill = hill_multipliers(2, &blocks, 16).unwrap();
         for (a, b) in hsu.iter().zip(&hill.multipliers) {
             assert!((a - b).norm() < 1e-9, "{hsu:?} vs {:?}", hill.multipliers);

@@ -17,6 +17,10 @@
 //! phase's force on δ at its reversal, so the Galerkin Jacobian of a problem
 //! with hysteretic elements, and the folds and Floquet multipliers computed
 //! from it, are approximations (the orbits are not: they solve the residual).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 /// The Jenkins force and local tangent at the samples `delta` of one period
 /// (see the module docs), into `force` and `tangent` (`delta.len()` each).
@@ -52,10 +56,10 @@ fn play(z: f64, delta: f64, half: f64) -> f64 {
 pub(crate) fn period_ranges(theta: &[f64]) -> Vec<std::ops::Range<usize>> {
     let mut ranges = Vec::new();
     let mut start = 0;
-    for i in 1..theta.len() {
-        if theta[i] <= theta[i - 1] {
-            ranges.push(start..i);
-            start = i;
+    for (i, (prev, next)) in theta.iter().zip(theta.iter().skip(1)).enumerate() {
+        if next <= prev {
+            ranges.push(start..i + 1);
+            start = i + 1;
         }
     }
     if start < theta.len() {

@@ -8,8 +8,15 @@
 //!
 //! with the linear part applied exactly in the frequency domain and `g` by AFT
 //! (Eq. 62–65); `s ∈ [0, 1]` scales the nonlinearity for parameter stepping (§3.2.2).
+//!
+//! Slice lengths are the callers' contract: a vector of the wrong length gives a
+//! NaN output (reported by the solvers as [`HbError::NonFinite`]), not a panic.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
-use crate::aft::Aft;
+use crate::aft::{split_series, split_series_mut, Aft};
 use crate::broyden::{BroydenOptions, BroydenStats};
 pub(crate) use crate::error::HbError;
 use crate::problem::PeriodicProblem;
@@ -126,17 +133,20 @@ impl HbSolution {
     pub fn omega(&self) -> f64 {
         self.omega_f / self.subharmonic as f64
     }
-    /// Coefficients of DOF `d`.
+    /// Coefficients of DOF `d` (empty if there is no DOF `d`).
     pub fn dof(&self, d: usize) -> &[f64] {
         let l = 2 * self.harmonics + 1;
-        &self.coeffs[d * l..(d + 1) * l]
+        self.coeffs.chunks_exact(l).nth(d).unwrap_or_default()
     }
-    /// `x_d` at physical time `t`.
+    /// `x_d` at physical time `t` (NaN if there is no DOF `d`).
     pub fn x_at(&self, d: usize, t: f64) -> f64 {
         crate::aft::eval_series(self.dof(d), self.omega() * t, 0)
     }
-    /// Amplitude `max_τ |x_d|` sampled at 512 points.
+    /// Amplitude `max_τ |x_d|` sampled at 512 points (NaN if there is no DOF `d`).
     pub fn amplitude(&self, d: usize) -> f64 {
+        if self.dof(d).is_empty() {
+            return f64::NAN;
+        }
         (0..512)
             .map(|i| {
                 crate::aft::eval_series(
@@ -256,15 +266,15 @@ impl HbResidual {
                 .collect(),
             aft,
         };
-        for (i, &theta) in s.thetas.iter().enumerate() {
-            problem.excitation(theta, &mut s.gs[i * nd..(i + 1) * nd]);
+        // nd ≥ 1 and l ≥ 1 (validated).
+        for (g, &theta) in s.gs.chunks_exact_mut(nd).zip(&s.thetas) {
+            problem.excitation(theta, g);
         }
         if !s.gs.iter().all(|v| v.is_finite()) {
             return Err(HbError::InvalidInput("excitation is not finite".into()));
         }
-        for d in 0..nd {
-            s.aft
-                .galerkin_state(&s.gs, nd, d, &mut s.exc[d * l..(d + 1) * l], &mut s.column);
+        for (d, exc) in s.exc.chunks_exact_mut(l).enumerate() {
+            s.aft.galerkin_state(&s.gs, nd, d, exc, &mut s.column);
         }
         Ok(s)
     }
@@ -335,7 +345,8 @@ impl HbResidual {
         &self.exc
     }
 
-    /// `r = L(ω) q` — the exact Galerkin projection of `ω²M x'' + ωC x' + K x`.
+    /// `r = L(ω) q` — the exact Galerkin projection of `ω²M x'' + ωC x' + K x`
+    /// (NaN if `q`, `r` or the problem's matrices have the wrong size).
     pub fn apply_linear<P: PeriodicProblem>(
         &self,
         problem: &P,
@@ -343,27 +354,42 @@ impl HbResidual {
         omega: f64,
         r: &mut [f64],
     ) {
-        let (nd, n) = (self.n_dof, self.n);
-        let l = 2 * n + 1;
+        let nd = self.n_dof;
+        let l = 2 * self.n + 1;
         let (m, c, k) = (problem.mass(), problem.damping(), problem.stiffness());
-        for d in 0..nd {
-            let mut r0 = 0.0;
-            for e in 0..nd {
-                r0 += k[d * nd + e] * q[e * l];
-            }
-            r[d * l] = 0.5 * r0;
-            for h in 1..=n {
-                let kw = h as f64 * omega;
-                let (mut ra, mut rb) = (0.0, 0.0);
-                for e in 0..nd {
-                    let stiff = k[d * nd + e] - kw * kw * m[d * nd + e];
-                    let damp = kw * c[d * nd + e];
-                    let (a, b) = (q[e * l + h], q[e * l + n + h]);
-                    ra += stiff * a + damp * b;
-                    rb += stiff * b - damp * a;
+        let len = nd * l;
+        let sizes_ok = nd > 0
+            && q.len() == len
+            && r.len() == len
+            && [m, c, k].iter().all(|a| a.len() == nd * nd);
+        debug_assert!(sizes_ok, "apply_linear: sizes do not match the residual");
+        if !sizes_ok {
+            return r.fill(f64::NAN);
+        }
+        r.fill(0.0);
+        let rows = k
+            .chunks_exact(nd)
+            .zip(m.chunks_exact(nd))
+            .zip(c.chunks_exact(nd));
+        for (rd, ((k_row, m_row), c_row)) in r.chunks_exact_mut(l).zip(rows) {
+            let Some((r0, ra, rb)) = split_series_mut(rd) else {
+                continue;
+            };
+            let couplings = k_row.iter().zip(m_row).zip(c_row);
+            for (((&kde, &mde), &cde), qe) in couplings.zip(q.chunks_exact(l)) {
+                let Some((a0, qa, qb)) = split_series(qe) else {
+                    continue;
+                };
+                // The mean's Galerkin weight is 1/2 (Eq. 55).
+                *r0 += 0.5 * kde * a0;
+                let harmonics = ra.iter_mut().zip(rb.iter_mut()).zip(qa.iter().zip(qb));
+                for (h, ((ra, rb), (&a, &b))) in harmonics.enumerate() {
+                    let kw = (h + 1) as f64 * omega;
+                    let stiff = kde - kw * kw * mde;
+                    let damp = kw * cde;
+                    *ra += stiff * a + damp * b;
+                    *rb += stiff * b - damp * a;
                 }
-                r[d * l + h] = ra;
-                r[d * l + n + h] = rb;
             }
         }
     }
@@ -378,8 +404,8 @@ impl HbResidual {
         s: f64,
         r: &mut [f64],
     ) {
-        let (nd, n) = (self.n_dof, self.n);
-        let l = 2 * n + 1;
+        let nd = self.n_dof;
+        let l = 2 * self.n + 1;
         let omega = omega_f / self.p as f64;
         self.apply_linear(problem, q, omega, r);
         for (ri, ei) in r.iter_mut().zip(&self.exc) {
@@ -391,10 +417,10 @@ impl HbResidual {
         // g at all samples in one call, sample-major (`2N×n_dof`).
         self.synthesize_states(q, omega, self.velocity);
         problem.nonlinear_samples(&self.xs, &self.vs, &self.thetas, &mut self.gs);
-        for d in 0..nd {
+        for (d, rd) in r.chunks_exact_mut(l).enumerate() {
             self.aft
                 .galerkin_state(&self.gs, nd, d, &mut self.rg, &mut self.column);
-            for (ri, gi) in r[d * l..(d + 1) * l].iter_mut().zip(&self.rg) {
+            for (ri, gi) in rd.iter_mut().zip(&self.rg) {
                 *ri += s * gi;
             }
         }
@@ -403,33 +429,46 @@ impl HbResidual {
     /// The linear Jacobian `B_{q,0} = L(ω)` of Eq. 60 (row-major, `len×len`),
     /// written straight into `b0`: harmonic k couples only `a_k`, `b_k` of all DOFs.
     /// Allocation-free (the classic Newton loop and the Broyden refresh call it).
+    /// NaN if `b0` or the problem's matrices have the wrong size.
     pub fn linear_matrix<P: PeriodicProblem>(&self, problem: &P, omega: f64, b0: &mut [f64]) {
         let (nd, n) = (self.n_dof, self.n);
         let l = 2 * n + 1;
         let len = nd * l;
-        b0.fill(0.0);
         let (m, c, k) = (problem.mass(), problem.damping(), problem.stiffness());
-        for d in 0..nd {
-            for e in 0..nd {
-                b0[d * l * len + e * l] = 0.5 * k[d * nd + e];
-                for h in 1..=n {
-                    let kw = h as f64 * omega;
-                    let stiff = k[d * nd + e] - kw * kw * m[d * nd + e];
-                    let damp = kw * c[d * nd + e];
-                    let (ra, rb) = ((d * l + h) * len, (d * l + n + h) * len);
-                    let (ca, cb) = (e * l + h, e * l + n + h);
-                    b0[ra + ca] = stiff;
-                    b0[ra + cb] = damp;
-                    b0[rb + ca] = -damp;
-                    b0[rb + cb] = stiff;
-                }
+        let sizes_ok = b0.len() == len * len && [m, c, k].iter().all(|a| a.len() == nd * nd);
+        debug_assert!(sizes_ok, "linear_matrix: sizes do not match the residual");
+        if !sizes_ok {
+            return b0.fill(f64::NAN);
+        }
+        b0.fill(0.0);
+        // Every index below is < len² (checked above).
+        let mut set = |row: usize, col: usize, v: f64| {
+            if let Some(x) = b0.get_mut(row * len + col) {
+                *x = v;
+            }
+        };
+        let entries = k.iter().zip(m).zip(c).enumerate();
+        for (de, ((&kde, &mde), &cde)) in entries {
+            let (d, e) = (de / nd, de % nd);
+            set(d * l, e * l, 0.5 * kde);
+            for h in 1..=n {
+                let kw = h as f64 * omega;
+                let stiff = kde - kw * kw * mde;
+                let damp = kw * cde;
+                let (ra, rb) = (d * l + h, d * l + n + h);
+                let (ca, cb) = (e * l + h, e * l + n + h);
+                set(ra, ca, stiff);
+                set(ra, cb, damp);
+                set(rb, ca, -damp);
+                set(rb, cb, stiff);
             }
         }
     }
 
     /// [`Self::linear_matrix`] and its inverse `h0`, inverted block by block (one
     /// `2·n_dof` block per harmonic). Returns `false` (and leaves `h0` incomplete) if
-    /// a block is singular, e.g. at a linear resonance.
+    /// a block is singular, e.g. at a linear resonance, or `b0`, `h0` have the
+    /// wrong size.
     pub fn linear_jacobian<P: PeriodicProblem>(
         &self,
         problem: &P,
@@ -442,6 +481,9 @@ impl HbResidual {
         let l = 2 * n + 1;
         let len = nd * l;
         h0.fill(0.0);
+        if b0.len() != len * len || h0.len() != len * len {
+            return false;
+        }
         let bs = 2 * nd;
         let mut blk = vec![0.0; bs * bs];
         let mut inv = vec![0.0; bs * bs];
@@ -450,21 +492,27 @@ impl HbResidual {
         for h in 0..=n {
             // Index list of the block: h = 0 → {a0 of each dof}; h ≥ 1 → {a_h…, b_h…}.
             let size = if h == 0 { nd } else { bs };
-            for d in 0..nd {
-                idx[d] = d * l + h;
-                if h > 0 {
-                    idx[nd + d] = d * l + n + h;
+            let (cos_idx, sin_idx) = idx.split_at_mut(nd);
+            for (d, (ia, ib)) in cos_idx.iter_mut().zip(sin_idx.iter_mut()).enumerate() {
+                (*ia, *ib) = (d * l + h, d * l + n + h);
+            }
+            let (Some(blk), Some(inv)) = (blk.get_mut(..size * size), inv.get_mut(..size * size))
+            else {
+                return false;
+            };
+            let block = idx.iter().take(size);
+            // Every index is < len² (checked above); NaN would mark a slip.
+            for (row, &i) in blk.chunks_exact_mut(size).zip(block.clone()) {
+                for (x, &j) in row.iter_mut().zip(block.clone()) {
+                    *x = b0.get(i * len + j).copied().unwrap_or(f64::NAN);
                 }
             }
-            for i in 0..size {
-                for j in 0..size {
-                    blk[i * size + j] = b0[idx[i] * len + idx[j]];
-                }
-            }
-            if ivt_num::small::inverse(&blk[..size * size], size, &mut inv[..size * size]) {
-                for i in 0..size {
-                    for j in 0..size {
-                        h0[idx[i] * len + idx[j]] = inv[i * size + j];
+            if ivt_num::small::inverse(blk, size, inv) {
+                for (row, &i) in inv.chunks_exact(size).zip(block.clone()) {
+                    for (&x, &j) in row.iter().zip(block.clone()) {
+                        if let Some(y) = h0.get_mut(i * len + j) {
+                            *y = x;
+                        }
                     }
                 }
             } else {
@@ -501,5 +549,26 @@ impl HbResidual {
     /// Whether `g` depends on the velocity (the problem's flag at construction).
     pub(crate) fn velocity_dependent(&self) -> bool {
         self.velocity
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_missing_dof_is_nan_not_a_panic() {
+        // x = cos τ: one DOF, one harmonic.
+        let sol = HbSolution {
+            coeffs: vec![0.0, 1.0, 0.0],
+            omega_f: 1.0,
+            harmonics: 1,
+            subharmonic: 1,
+            stats: BroydenStats::default(),
+        };
+        assert_eq!(sol.dof(0), [0.0, 1.0, 0.0]);
+        assert!((sol.amplitude(0) - 1.0).abs() < 1e-12);
+        assert!((sol.x_at(0, 0.5) - 0.5f64.cos()).abs() < 1e-15);
+        assert!(sol.dof(1).is_empty() && sol.x_at(1, 0.0).is_nan() && sol.amplitude(1).is_nan());
     }
 }

@@ -3,6 +3,10 @@
 //! parameter stepping in the nonlinearity (ε from 0 in steps, reusing the last
 //! Broyden matrix) when the direct iteration fails, and pseudo-arclength in the
 //! stepping parameter when that path folds.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::broyden::{broyden_solve, BroydenStats, BroydenWorkspace, System};
 use crate::continuation::{pseudo_arclength, ContinuationOptions};
@@ -131,9 +135,10 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
             .linear_jacobian(&self.problem, omega, &mut self.b0, &mut self.h0);
         let seed = |ws: &mut BroydenWorkspace, h0: &[f64]| {
             if invertible {
-                ws.set_inverse_jacobian(h0).expect("sizes match");
+                ws.set_inverse_jacobian(h0)
             } else {
                 ws.clear_jacobian();
+                Ok(())
             }
         };
         if !use_guess {
@@ -144,9 +149,12 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
             }
         }
         // Tolerance atol + rtol·S (HbOptions), S from the forcing or the start.
-        let scale = self
-            .res
-            .force_scale(&self.problem, q, omega, &mut self.b0[..m]);
+        let Some(scratch) = self.b0.get_mut(..m) else {
+            return Err(HbError::InvalidInput(format!(
+                "linear Jacobian buffer holds fewer than {m} entries"
+            )));
+        };
+        let scale = self.res.force_scale(&self.problem, q, omega, scratch);
         let broyden = crate::BroydenOptions {
             tol: self.opts.residual_tol(scale),
             ..self.opts.broyden.clone()
@@ -166,7 +174,7 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         };
         let mut last_err = None;
         if opts.homotopy_steps == 0 {
-            seed(ws, &self.h0);
+            seed(ws, &self.h0)?;
             match broyden_solve(&mut sys, q, ws, &broyden) {
                 Ok(stats) => return Ok(stats),
                 Err(e) => last_err = Some(e),
@@ -190,7 +198,7 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         let mut ds = 1.0 / opts.homotopy_steps.max(8) as f64;
         let mut s_done = 0.0;
         q.copy_from_slice(&start);
-        seed(ws, &self.h0);
+        seed(ws, &self.h0)?;
         let mut q_ok = start;
         let mut total = BroydenStats::default();
         while s_done < 1.0 {
@@ -236,10 +244,13 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         };
         let mut crossing: Option<(Vec<f64>, Vec<f64>)> = None;
         let mut prev: Option<Vec<f64>> = None;
-        let m1 = m;
         let res = &mut *sys.res;
         let traced = pseudo_arclength(
-            |x: &[f64], r: &mut [f64]| res.eval(problem, &x[..m1], omega_f, x[m1], r),
+            // x = [q, s]: the coefficients and the stepping parameter.
+            |x: &[f64], r: &mut [f64]| match x.split_last() {
+                Some((&s, q)) => res.eval(problem, q, omega_f, s, r),
+                None => r.fill(f64::NAN),
+            },
             &x0,
             None,
             1.0,
@@ -253,15 +264,17 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
                 true
             },
         );
-        if let (Ok(_), Some((a, b))) = (traced, crossing) {
-            let (sa, sb) = (a[m], b[m]);
+        let crossing = crossing
+            .as_ref()
+            .map(|(a, b)| (a.split_last(), b.split_last()));
+        if let (Ok(_), Some((Some((&sa, qa)), Some((&sb, qb))))) = (traced, crossing) {
             let t = if sb != sa {
                 (1.0 - sa) / (sb - sa)
             } else {
                 1.0
             };
-            for i in 0..m {
-                q[i] = a[i] + t * (b[i] - a[i]);
+            for ((qi, &ai), &bi) in q.iter_mut().zip(qa).zip(qb) {
+                *qi = ai + t * (bi - ai);
             }
             ws.clear_jacobian();
             sys.s = 1.0;
@@ -270,7 +283,15 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
                 Err(e) => last_err = Some(e),
             }
         }
-        Err(HbError::Solve(last_err.expect("at least one attempt ran")))
+        // Every path to here ran at least one failed attempt.
+        Err(last_err.map_or_else(
+            || HbError::NoConvergence {
+                method: "modified IHB",
+                omega: omega_f,
+                history: Vec::new(),
+            },
+            HbError::Solve,
+        ))
     }
 }
 

@@ -1,6 +1,10 @@
 //! A plain fixed-step classical Runge–Kutta integration: the independent time-domain
 //! reference for the HB tests and the Mathieu–Duffing check (it shares no code with
 //! the harmonic-balance path).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::problem::PeriodicProblem;
 use ivt_num::{ExplicitRk, RK4};
@@ -20,31 +24,38 @@ pub fn rk4<F: FnMut(f64, &[f64], &mut [f64])>(
 /// First-order form `y = [x, ẋ]` of a [`PeriodicProblem`] in physical time with
 /// excitation frequency `omega_f`: `M ẍ = f(ω_f t) − C ẋ − K x − g(x, ẋ, ω_f t)`.
 ///
-/// # Panics
-/// If the mass matrix is singular.
+/// A singular mass matrix, a problem whose `C` or `K` is not `n_dof×n_dof` or a
+/// state that is not `2·n_dof` long gives NaN derivatives (the integration then
+/// ends in NaN, never in a wrong number).
 pub fn first_order<P: PeriodicProblem>(
     problem: &P,
     omega_f: f64,
 ) -> impl FnMut(f64, &[f64], &mut [f64]) + '_ {
     let nd = problem.n_dof();
-    let minv = ivt_num::lu::inverse(problem.mass(), nd).expect("mass matrix must be invertible");
+    let minv = ivt_num::lu::inverse(problem.mass(), nd).unwrap_or_else(|| vec![f64::NAN; nd * nd]);
     let (mut g, mut f, mut acc) = (vec![0.0; nd], vec![0.0; nd], vec![0.0; nd]);
     move |t, y, dy| {
+        let (c, k) = (problem.damping(), problem.stiffness());
+        let n2 = nd * nd;
+        if nd == 0 || y.len() != 2 * nd || dy.len() != 2 * nd || c.len() != n2 || k.len() != n2 {
+            return dy.fill(f64::NAN);
+        }
         let (x, v) = y.split_at(nd);
         let theta = omega_f * t;
         problem.nonlinear(x, v, theta, &mut g);
         problem.excitation(theta, &mut f);
-        let (c, k) = (problem.damping(), problem.stiffness());
-        for i in 0..nd {
-            let mut s = f[i] - g[i];
-            for j in 0..nd {
-                s -= c[i * nd + j] * v[j] + k[i * nd + j] * x[j];
+        let rows = c.chunks_exact(nd).zip(k.chunks_exact(nd));
+        for ((a, (fi, gi)), (c_row, k_row)) in acc.iter_mut().zip(f.iter().zip(&g)).zip(rows) {
+            let mut s = fi - gi;
+            for ((cij, kij), (vj, xj)) in c_row.iter().zip(k_row).zip(v.iter().zip(x)) {
+                s -= cij * vj + kij * xj;
             }
-            acc[i] = s;
+            *a = s;
         }
-        for i in 0..nd {
-            dy[i] = v[i];
-            dy[nd + i] = (0..nd).map(|j| minv[i * nd + j] * acc[j]).sum();
+        let (dx, dv) = dy.split_at_mut(nd);
+        dx.copy_from_slice(v);
+        for (d, m_row) in dv.iter_mut().zip(minv.chunks_exact(nd)) {
+            *d = m_row.iter().zip(&acc).map(|(m, a)| m * a).sum();
         }
     }
 }

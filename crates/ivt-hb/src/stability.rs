@@ -6,6 +6,10 @@
 //! analysed by Hsu's method (Eq. 80) and by Hill's method; the two must agree.
 //! Classification: stable (all |μ| < 1), fold (a real μ > 1), period doubling (a
 //! real μ < −1), Neimark–Sacker (a complex pair outside the unit circle).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::aft::Aft;
 use crate::error::HbError;
@@ -14,6 +18,7 @@ use crate::hill::{fourier_blocks, hill_multipliers};
 use crate::ihb::HbSolution;
 use crate::problem::PeriodicProblem;
 use faer::c64;
+use ivt_num::small::matmul;
 
 /// What the leading multiplier says.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -113,8 +118,9 @@ impl StabilityAnalyzer {
     /// (`steps > harmonics`; 256 is enough for flags, 4096 for 1e-9 agreement).
     ///
     /// # Errors
-    /// [`HbError::AftTooFewSamples`] if `steps ≤ harmonics`. A singular mass matrix gives NaN
-    /// multipliers, which classify as unstable.
+    /// [`HbError::AftTooFewSamples`] if `steps ≤ harmonics`,
+    /// [`HbError::InvalidInput`] for a problem without DOFs. A singular mass matrix
+    /// gives NaN multipliers, which classify as unstable.
     pub fn new<P: PeriodicProblem>(
         problem: &P,
         harmonics: usize,
@@ -122,6 +128,9 @@ impl StabilityAnalyzer {
     ) -> Result<Self, HbError> {
         let aft = Aft::new(harmonics, steps)?;
         let nd = problem.n_dof();
+        if nd == 0 {
+            return Err(HbError::InvalidInput("n_dof must be positive".into()));
+        }
         let minv =
             ivt_num::lu::inverse(problem.mass(), nd).unwrap_or_else(|| vec![f64::NAN; nd * nd]);
         let dim = 2 * nd;
@@ -179,20 +188,52 @@ impl StabilityAnalyzer {
         }
         let (c, k) = (problem.damping(), problem.stiffness());
         let n2 = nd * nd;
-        for j in 0..ns {
-            let (dgx, dgv) = self.dg[2 * j * n2..2 * (j + 1) * n2].split_at(n2);
-            let th = &mut self.theta[j * d2..(j + 1) * d2];
+        // nd ≥ 1 (checked in `new`); a problem whose C or K is not nd×nd gives NaN
+        // (unstable), as a singular mass does.
+        if nd == 0
+            || c.len() != n2
+            || k.len() != n2
+            || self.minv.len() != n2
+            || self.theta.len() != ns * d2
+        {
+            self.theta.fill(f64::NAN);
+            return &self.theta;
+        }
+        // K + G_x, C + G_v and their products with M⁻¹ at one sample (every
+        // slice n_dof², as ivt_num's matmul needs).
+        let (mut stiff, mut damp) = (vec![0.0; n2], vec![0.0; n2]);
+        let (mut minv_stiff, mut minv_damp) = (vec![0.0; n2], vec![0.0; n2]);
+        for (dg, th) in self
+            .dg
+            .chunks_exact(2 * n2)
+            .zip(self.theta.chunks_exact_mut(d2))
+        {
+            let (dgx, dgv) = dg.split_at(n2);
             th.fill(0.0);
-            for i in 0..nd {
-                th[i * dim + nd + i] = 1.0;
-                for e in 0..nd {
-                    let (mut sk, mut sc) = (0.0, 0.0);
-                    for l in 0..nd {
-                        sk += self.minv[i * nd + l] * (k[l * nd + e] + dgx[l * nd + e]);
-                        sc += self.minv[i * nd + l] * (c[l * nd + e] + dgv[l * nd + e]);
-                    }
-                    th[(nd + i) * dim + e] = -sk / (omega * omega);
-                    th[(nd + i) * dim + nd + e] = -sc / omega;
+            let (upper, lower) = th.split_at_mut(nd * dim);
+            // Upper rows [0 | I].
+            for (row, one) in upper.chunks_exact_mut(dim).zip(nd..) {
+                if let Some(x) = row.get_mut(one) {
+                    *x = 1.0;
+                }
+            }
+            // Lower rows [−M⁻¹(K + G_x)/ω² | −M⁻¹(C + G_v)/ω].
+            for (s, (a, b)) in stiff.iter_mut().zip(k.iter().zip(dgx)) {
+                *s = a + b;
+            }
+            for (s, (a, b)) in damp.iter_mut().zip(c.iter().zip(dgv)) {
+                *s = a + b;
+            }
+            matmul(&self.minv, &stiff, nd, &mut minv_stiff);
+            matmul(&self.minv, &damp, nd, &mut minv_damp);
+            let products = minv_stiff.chunks_exact(nd).zip(minv_damp.chunks_exact(nd));
+            for (row, (pk, pc)) in lower.chunks_exact_mut(dim).zip(products) {
+                let (row_k, row_c) = row.split_at_mut(nd);
+                for (t, p) in row_k.iter_mut().zip(pk) {
+                    *t = -p / (omega * omega);
+                }
+                for (t, p) in row_c.iter_mut().zip(pc) {
+                    *t = -p / omega;
                 }
             }
         }
@@ -247,7 +288,7 @@ impl StabilityAnalyzer {
         let dim = 2 * self.nd;
         let ns = 2 * self.steps;
         let kmax = (2 * h).min((ns - 1) / 2);
-        let blocks = fourier_blocks(dim, &self.theta, ns, kmax);
+        let blocks = fourier_blocks(dim, &self.theta, ns, kmax)?;
         let res = hill_multipliers(dim, &blocks, h)?;
         Ok(Floquet::new(res.multipliers))
     }
@@ -388,25 +429,20 @@ impl AdaptiveHsu {
         known: Option<&[f64]>,
     ) -> Result<HsuEstimate, HbError> {
         let HsuSteps::Tolerance { tol, .. } = self.control else {
-            let an = &mut self.levels[0];
+            let an = level_mut(&mut self.levels, problem, self.harmonics, self.base, 0)?;
             return Ok(HsuEstimate {
                 floquet: an.hsu_with(problem, sol, HsuRule::Magnus4, known),
                 steps: self.base,
                 error: None,
             });
         };
-        let dim = 2 * self.levels[0].nd;
+        let dim = 2 * problem.n_dof();
         let period = 2.0 * std::f64::consts::PI;
         let mut level = self.level;
         // Multipliers of the level below, when it was just computed.
         let mut coarse: Option<Vec<c64>> = None;
         loop {
-            while self.levels.len() <= level {
-                let steps = self.base << self.levels.len();
-                self.levels
-                    .push(StabilityAnalyzer::new(problem, self.harmonics, steps)?);
-            }
-            let an = &mut self.levels[level];
+            let an = level_mut(&mut self.levels, problem, self.harmonics, self.base, level)?;
             an.theta_samples_with(problem, sol, known);
             monodromy_uniform(
                 dim,
@@ -444,6 +480,24 @@ impl AdaptiveHsu {
             level += 1;
         }
     }
+}
+
+/// The analyzer of `level` of [`AdaptiveHsu`] (`base·2^level` sub-intervals),
+/// made with the levels below it on first use.
+fn level_mut<'a, P: PeriodicProblem>(
+    levels: &'a mut Vec<StabilityAnalyzer>,
+    problem: &P,
+    harmonics: usize,
+    base: usize,
+    level: usize,
+) -> Result<&'a mut StabilityAnalyzer, HbError> {
+    while levels.len() <= level {
+        let steps = base << levels.len();
+        levels.push(StabilityAnalyzer::new(problem, harmonics, steps)?);
+    }
+    levels
+        .get_mut(level)
+        .ok_or_else(|| HbError::InvalidInput(format!("no Hsu level {level}")))
 }
 
 /// Richardson estimate of the error of the multipliers `fine` of `S` Magnus-4

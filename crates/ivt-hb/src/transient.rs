@@ -11,6 +11,10 @@
 //! period). The period is then `t_i − t_{i−k}`. A start in the basin of the
 //! equilibrium ends with [`HbError::Equilibrium`], one that never settles with
 //! [`HbError::Transient`]; no start needs Fourier coefficients or a frequency.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::autonomous::{limit_cycle, LimitCycle};
 use crate::error::HbError;
@@ -115,12 +119,14 @@ pub fn settle<P: PeriodicProblem>(
                 reason: "no periodic attractor within the step limit",
             });
         }
-        let before = flow.y[v0];
+        // The first velocity (validated: the state holds 2·n_dof values).
+        let velocity = |y: &[f64]| y.get(v0).copied().unwrap_or(f64::NAN);
+        let before = velocity(&flow.y);
         flow.step()?;
         if norm_inf(&flow.k1) <= rest {
             return Err(HbError::Equilibrium);
         }
-        if !(before > 0.0 && flow.y[v0] <= 0.0) {
+        if !(before > 0.0 && velocity(&flow.y) <= 0.0) {
             continue;
         }
         let s = flow.root(v0);
@@ -134,8 +140,7 @@ pub fn settle<P: PeriodicProblem>(
         if size <= 1e-8 * largest {
             return Err(HbError::Equilibrium);
         }
-        for k in 1..=opts.max_returns.min(crossings.len()) {
-            let (tk, sk) = &crossings[crossings.len() - k];
+        for (k, (tk, sk)) in crossings.iter().rev().take(opts.max_returns).enumerate() {
             let dist = section
                 .iter()
                 .zip(sk)
@@ -145,7 +150,7 @@ pub fn settle<P: PeriodicProblem>(
                     state: section,
                     period: t - tk,
                     time: t,
-                    returns: k,
+                    returns: k + 1,
                 });
             }
         }
@@ -189,39 +194,26 @@ pub fn fourier_start<P: PeriodicProblem>(
         } else {
             flow.dense(s.clamp(0.0, 1.0), &mut y);
         }
-        for d in 0..nd {
-            samples[d * ns + j] = y[d];
+        for (sample, yd) in samples.iter_mut().skip(j).step_by(ns).zip(&y) {
+            *sample = *yd;
         }
         j += 1;
     }
     let mut guess = vec![0.0; nd * l];
-    for d in 0..nd {
-        aft.analyze(
-            &samples[d * ns..(d + 1) * ns],
-            &mut guess[d * l..(d + 1) * l],
-        );
+    for (dof_samples, dof_guess) in samples.chunks_exact(ns).zip(guess.chunks_exact_mut(l)) {
+        aft.analyze(dof_samples, dof_guess);
     }
     // Shift the time origin to where the phase condition b₁ = 0 of DOF 0
     // holds (with a₁ > 0): the section (a maximum) is there only for a pure
     // cosine, and Newton should not have to turn the whole orbit.
     let n = hb.harmonics;
     if let (Some(&a1), Some(&b1)) = (guess.get(1), guess.get(n + 1)) {
-        shift_time(&mut guess, n, b1.atan2(a1));
-    }
-    Ok(guess)
-}
-
-/// Replaces the series (`[a0, a.., b..]` blocks) of `u(τ)` by those of
-/// `u(τ + φ)`: harmonic k turns by kφ.
-fn shift_time(q: &mut [f64], n: usize, phi: f64) {
-    for block in q.chunks_exact_mut(2 * n + 1) {
-        for k in 1..=n {
-            let (s, c) = (k as f64 * phi).sin_cos();
-            let (a, b) = (block[k], block[n + k]);
-            block[k] = a * c + b * s;
-            block[n + k] = b * c - a * s;
+        let phi = b1.atan2(a1);
+        for block in guess.chunks_exact_mut(l) {
+            crate::aft::shift_time(block, phi);
         }
     }
+    Ok(guess)
 }
 
 /// Checks the state and the problem; returns the state's size `‖state‖∞`.
@@ -363,7 +355,7 @@ impl<'p> Flow<Rhs<'p>> {
         for _ in 0..60 {
             let mid = 0.5 * (lo + hi);
             self.dense(mid, &mut u);
-            if u[i] > 0.0 {
+            if u.get(i).is_some_and(|&v| v > 0.0) {
                 lo = mid;
             } else {
                 hi = mid;

@@ -10,6 +10,10 @@
 //! most [`HILL_MAX_DIM`] rows; above that the confirmation is the monodromy
 //! with half the step ([`monodromy_refined`]), whose Richardson error estimate
 //! is the point's `multiplier_error`.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::reduced::ReducedString;
 use super::stability::{
@@ -81,6 +85,22 @@ pub struct StringFrc {
     pub hill_calls: usize,
 }
 
+/// The error of a path point without the `n` coefficients before its ω (the
+/// continuation makes none: every point holds `[a, ω]`).
+fn empty_point() -> HbError {
+    HbError::InvalidInput("a path point lacks its coefficients".into())
+}
+
+/// The coefficients `a` of a path point `[a, ω]` with `n` of them.
+///
+/// # Errors
+/// [`HbError::InvalidInput`] if the point holds fewer than `n + 1` values.
+pub(super) fn coefficients(p: &PathPoint, n: usize) -> Result<&[f64], HbError> {
+    p.x.get(..n)
+        .filter(|_| p.x.len() > n)
+        .ok_or_else(empty_point)
+}
+
 /// Follows the branch of periodic responses from `omega_from` to `omega_to`
 /// (either direction), starting from rest at `omega_from`, calling `on_point`
 /// with the problem linearized at each point. Returns the path and the Jacobian
@@ -139,9 +159,13 @@ where
     // Back to the full coefficients (zeros outside the subspace), then ω.
     let n = system.hb.dim();
     for p in &mut path.points {
+        let Some((&omega, reduced)) = p.x.split_last() else {
+            return Err(empty_point());
+        };
         let mut full = vec![0.0; n + 1];
-        system.sub.embed(&p.x[..p.x.len() - 1], &mut full[..n]);
-        full[n] = p.lambda();
+        let (coeffs, last) = full.split_at_mut(n);
+        system.sub.embed(reduced, coeffs);
+        last.fill(omega);
         p.x = full;
     }
     // `solve` assembles once more than it iterates (the converged check).
@@ -214,45 +238,50 @@ pub fn frequency_response(
         .points
         .iter()
         .zip(verdicts)
-        .map(|(p, (s, error))| FrcPoint {
-            omega_f: p.lambda(),
-            amplitude: hb.complex_norm(&p.x[..n]),
-            kind: s.kind,
-            multipliers: s.multipliers,
-            multiplier_error: error,
-            coeffs: p.x[..n].to_vec(),
+        .map(|(p, (s, error))| {
+            let coeffs = coefficients(p, n)?;
+            Ok(FrcPoint {
+                omega_f: p.lambda(),
+                amplitude: hb.complex_norm(coeffs),
+                kind: s.kind,
+                multipliers: s.multipliers,
+                multiplier_error: error,
+                coeffs: coeffs.to_vec(),
+            })
         })
-        .collect::<Vec<_>>();
+        .collect::<Result<Vec<_>, HbError>>()?;
     let mut branch = ReducedString::new(hb);
     let mut q = vec![0.0; branch.sub.dim()];
     let folds = path
         .folds
         .iter()
         .map(|f| {
-            let near = &points[f.index];
+            let near = points.get(f.index).ok_or_else(empty_point)?;
             branch.sub.gather(&near.coeffs, &mut q);
-            match locate_fold(&mut branch, &q, near.omega_f, &FoldOptions::default()) {
-                Ok(loc) => {
-                    let mut coeffs = vec![0.0; n];
-                    branch.sub.embed(&loc.q, &mut coeffs);
-                    FrcFold {
-                        index: f.index,
-                        omega_f: loc.lambda,
-                        amplitude: branch.hb.complex_norm(&coeffs),
-                        coeffs,
-                        located: true,
+            Ok(
+                match locate_fold(&mut branch, &q, near.omega_f, &FoldOptions::default()) {
+                    Ok(loc) => {
+                        let mut coeffs = vec![0.0; n];
+                        branch.sub.embed(&loc.q, &mut coeffs);
+                        FrcFold {
+                            index: f.index,
+                            omega_f: loc.lambda,
+                            amplitude: branch.hb.complex_norm(&coeffs),
+                            coeffs,
+                            located: true,
+                        }
                     }
-                }
-                Err(_) => FrcFold {
-                    index: f.index,
-                    omega_f: f.lambda,
-                    amplitude: near.amplitude,
-                    coeffs: near.coeffs.clone(),
-                    located: false,
+                    Err(_) => FrcFold {
+                        index: f.index,
+                        omega_f: f.lambda,
+                        amplitude: near.amplitude,
+                        coeffs: near.coeffs.clone(),
+                        located: false,
+                    },
                 },
-            }
+            )
         })
-        .collect();
+        .collect::<Result<_, HbError>>()?;
     Ok(StringFrc {
         frc: Frc {
             points,

@@ -8,6 +8,10 @@
 //! [`PeriodicProblem`] of the general engine (`M = I`, `C = c_d I`,
 //! `K = diag(n²π²)`, `g = −ℒ(q)`, `f = y0 cos θ` on mode 1), for the
 //! "traditional route": the same curve by the modified IHB + continuation.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use ivt_num::{ExplicitRk, RK4};
 use std::f64::consts::PI;
@@ -66,7 +70,9 @@ impl ModalString {
         let nm = params.modes;
         let diag = |f: &dyn Fn(usize) -> f64| {
             let mut m = vec![0.0; nm * nm];
-            (0..nm).for_each(|i| m[i * nm + i] = f(i));
+            for (i, x) in m.iter_mut().step_by(nm + 1).enumerate() {
+                *x = f(i);
+            }
             m
         };
         Self {
@@ -81,69 +87,101 @@ impl ModalString {
     /// The engine's coefficient vector (`N` blocks `[a0, a1..aM, b1..bM]` with
     /// `x = a0/2 + Σ a_k cos kτ + b_k sin kτ`) of an STHB solution `a`
     /// (harmonic-major, [`super::StringHb::index`], constant term without the ½).
+    /// NaN if `a` does not hold `modes·(2·harmonics + 1)` values.
     pub fn engine_coeffs(&self, a: &[f64]) -> Vec<f64> {
         let (n, m) = (self.params.modes, self.params.harmonics);
         let l = 2 * m + 1;
-        let mut q = vec![0.0; n * l];
-        for d in 0..n {
-            q[d * l] = 2.0 * a[d];
-            for k in 1..=m {
-                q[d * l + k] = a[(2 * k - 1) * n + d];
-                q[d * l + m + k] = a[2 * k * n + d];
+        let mut q = vec![f64::NAN; n * l];
+        if n == 0 || a.len() != n * l {
+            return q;
+        }
+        // Row h of `a` holds harmonic row h of every mode.
+        for (h, row) in a.chunks_exact(n).enumerate() {
+            let (slot, scale) = engine_slot(h, m);
+            for (qd, &x) in q.chunks_exact_mut(l).zip(row) {
+                if let Some(y) = qd.get_mut(slot) {
+                    *y = scale * x;
+                }
             }
         }
         q
     }
 
-    /// Inverse of [`Self::engine_coeffs`].
+    /// Inverse of [`Self::engine_coeffs`] (NaN if `q` does not hold
+    /// `modes·(2·harmonics + 1)` values).
     pub fn sthb_coeffs(&self, q: &[f64]) -> Vec<f64> {
         let (n, m) = (self.params.modes, self.params.harmonics);
         let l = 2 * m + 1;
-        let mut a = vec![0.0; n * l];
-        for d in 0..n {
-            a[d] = 0.5 * q[d * l];
-            for k in 1..=m {
-                a[(2 * k - 1) * n + d] = q[d * l + k];
-                a[2 * k * n + d] = q[d * l + m + k];
+        let mut a = vec![f64::NAN; n * l];
+        if n == 0 || q.len() != n * l {
+            return a;
+        }
+        for (h, row) in a.chunks_exact_mut(n).enumerate() {
+            let (slot, scale) = engine_slot(h, m);
+            for (x, qd) in row.iter_mut().zip(q.chunks_exact(l)) {
+                *x = qd.get(slot).map_or(f64::NAN, |y| y / scale);
             }
         }
         a
     }
 
-    /// `ℒ(q)` into `out`.
+    /// `ℒ(q)` into `out` (NaN if `q` or `out` is not `N` long).
     pub fn nonlinear(&self, q: &[f64], out: &mut [f64]) {
+        let n = self.params.modes;
+        if q.len() != n || out.len() != n {
+            return out.fill(f64::NAN);
+        }
         out.fill(0.0);
-        for &(n, a, b, c, k) in &self.terms {
-            out[n] += k * q[a] * q[b] * q[c];
+        // Every index of `terms` is < N (built in `new`).
+        let at = |i: usize| q.get(i).copied().unwrap_or(f64::NAN);
+        for &(r, a, b, c, k) in &self.terms {
+            if let Some(o) = out.get_mut(r) {
+                *o += k * at(a) * at(b) * at(c);
+            }
         }
     }
 
-    /// `∂ℒ/∂q` (row-major `N × N`) into `out`.
+    /// `∂ℒ/∂q` (row-major `N × N`) into `out` (NaN if `q` is not `N` long or
+    /// `out` not `N²`).
     pub fn nonlinear_jacobian(&self, q: &[f64], out: &mut [f64]) {
         let n = self.params.modes;
+        if q.len() != n || out.len() != n * n {
+            return out.fill(f64::NAN);
+        }
         out.fill(0.0);
+        let at = |i: usize| q.get(i).copied().unwrap_or(f64::NAN);
         for &(r, a, b, c, k) in &self.terms {
-            out[r * n + a] += k * q[b] * q[c];
-            out[r * n + b] += k * q[a] * q[c];
-            out[r * n + c] += k * q[a] * q[b];
+            for (col, x, y) in [(a, b, c), (b, a, c), (c, a, b)] {
+                if let Some(o) = out.get_mut(r * n + col) {
+                    *o += k * at(x) * at(y);
+                }
+            }
         }
     }
 
     /// State derivative of `y = (q, q̇)` at normalized time `t` for frequency `omega`.
+    /// NaN if `y`, `dy` are not `2N` long or `scratch` is shorter than `N`.
     pub fn rhs(&self, omega: f64, t: f64, y: &[f64], dy: &mut [f64], scratch: &mut [f64]) {
         let n = self.params.modes;
+        let Some(scratch) = scratch.get_mut(..n) else {
+            return dy.fill(f64::NAN);
+        };
+        if y.len() != 2 * n || dy.len() != 2 * n {
+            return dy.fill(f64::NAN);
+        }
         let (q, v) = y.split_at(n);
         self.nonlinear(q, scratch);
-        for i in 0..n {
+        let (dq, dv) = dy.split_at_mut(n);
+        dq.copy_from_slice(v);
+        let modes = dv.iter_mut().zip(v.iter().zip(q)).zip(scratch.iter());
+        for (i, ((dvi, (vi, qi)), li)) in modes.enumerate() {
             let kappa = ((i + 1) as f64 * PI).powi(2);
             let f = if i == 0 {
                 self.params.y0 * t.cos()
             } else {
                 0.0
             };
-            dy[i] = v[i];
-            dy[n + i] =
-                (f - omega * self.params.cd * v[i] - kappa * q[i] + scratch[i]) / (omega * omega);
+            *dvi = (f - omega * self.params.cd * vi - kappa * qi + li) / (omega * omega);
         }
     }
 
@@ -158,6 +196,18 @@ impl ModalString {
         for _ in 0..periods {
             rk.fixed_steps(&mut rhs, 0.0, h, steps_per_period, y);
         }
+    }
+}
+
+/// The engine's slot (index in a DOF block `[a0, a1..aM, b1..bM]`) of STHB
+/// harmonic row `h` (`0`: constant, `2k − 1`: cos kt, `2k`: sin kt) and the
+/// factor from STHB to engine (2 for the constant: the engine stores `a0`, STHB
+/// `a0/2`).
+fn engine_slot(h: usize, m: usize) -> (usize, f64) {
+    match h {
+        0 => (0, 2.0),
+        h if h % 2 == 1 => (h.div_ceil(2), 1.0),
+        h => (m + h / 2, 1.0),
     }
 }
 
@@ -183,7 +233,9 @@ impl PeriodicProblem for ModalString {
     }
     fn excitation(&self, theta: f64, out: &mut [f64]) {
         out.fill(0.0);
-        out[0] = self.params.y0 * theta.cos();
+        if let Some(first) = out.first_mut() {
+            *first = self.params.y0 * theta.cos();
+        }
     }
     displacement_jacobian!(|s, x, _theta, dg_dx| {
         ModalString::nonlinear_jacobian(s, x, dg_dx);

@@ -7,6 +7,10 @@
 //! method (Eq. 66–67) with the exact augmenting row. It is seeded once with the
 //! exact STHB Jacobian `[J | ∂R/∂ω]` at the start point; afterwards only
 //! rank-one updates (and the engine's Jacobian refresh if Broyden stalls).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use faer::Mat;
 
@@ -50,12 +54,14 @@ pub fn spring_frequency_response(
     let (mut r, mut r_w, mut jac) = (vec![0.0; n], vec![0.0; n], Mat::<f64>::zeros(n, n));
     hb.residual_jacobian(&a, omega_from, &mut r, &mut jac);
     hb.d_residual_d_omega(&a, omega_from, &mut r_w);
+    // Row i of [J | R_ω].
     let mut jac0 = vec![0.0; n * (n + 1)];
-    for i in 0..n {
-        for j in 0..n {
-            jac0[i * (n + 1) + j] = jac[(i, j)];
+    for ((i, row), rw) in jac0.chunks_exact_mut(n + 1).enumerate().zip(&r_w) {
+        let (row_j, row_w) = row.split_at_mut(n);
+        for (j, x) in row_j.iter_mut().enumerate() {
+            *x = jac[(i, j)];
         }
-        jac0[i * (n + 1) + n] = r_w[i];
+        row_w.fill(*rw);
     }
     let mut start = a.clone();
     start.push(omega_from);
@@ -67,22 +73,28 @@ pub fn spring_frequency_response(
         target_iter: 10,
         ..Default::default()
     };
-    let residual = |x: &[f64], out: &mut [f64]| hb.residual(&x[..n], x[n], out);
+    // x = [a, ω].
+    let residual = |x: &[f64], out: &mut [f64]| match x.split_last() {
+        Some((&omega, a)) => hb.residual(a, omega, out),
+        None => out.fill(f64::NAN),
+    };
     let path = pseudo_arclength(residual, &start, Some(&jac0), 1.0, &opts, |p| {
         if std::env::var_os("IVT_STHB_TRACE").is_some() {
             eprintln!("spring point ω = {:.5} its {}", p.lambda(), p.iterations);
         }
         true
     })?;
-    let points: Vec<SpringPoint> = path
+    let points = path
         .points
         .iter()
-        .map(|p| SpringPoint {
-            omega: p.lambda(),
-            norm: hb.complex_norm(&p.x[..n]),
-            iterations: p.iterations,
+        .map(|p| {
+            Ok(SpringPoint {
+                omega: p.lambda(),
+                norm: hb.complex_norm(super::frc::coefficients(p, n)?),
+                iterations: p.iterations,
+            })
         })
-        .collect();
+        .collect::<Result<Vec<_>, HbError>>()?;
     if let Termination::StepTooSmall(e) = path.termination {
         let last = points.last().map_or(omega_from, |p| p.omega);
         return Err(HbError::Stalled {

@@ -12,6 +12,10 @@
 //!   `Im λ ∈ (−½, ½]` and the multipliers are `exp(2πλ)`.
 //! * [`monodromy`] — RK4 over one period of the same `A(t)`; `O(N³)` per step,
 //!   cheap enough for every continuation point, with Hill to confirm.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use std::f64::consts::PI;
 
@@ -63,17 +67,27 @@ impl Stability {
 
     /// The multiplier of largest modulus.
     pub fn critical(&self) -> Complex<f64> {
-        self.multipliers[0]
+        // Never empty (`from_multipliers` refuses that); NaN if it were.
+        self.multipliers
+            .first()
+            .copied()
+            .unwrap_or(Complex::new(f64::NAN, f64::NAN))
     }
 
     /// Classifies by the leading multiplier of `multipliers` (non-empty,
     /// decreasing modulus).
-    fn from_multipliers(multipliers: Vec<Complex<f64>>, method: StabilityMethod) -> Self {
-        Self {
-            kind: crate::stability::classify(&multipliers[..1]),
+    fn from_multipliers(
+        multipliers: Vec<Complex<f64>>,
+        method: StabilityMethod,
+    ) -> Result<Self, HbError> {
+        let Some(critical) = multipliers.get(..1) else {
+            return Err(HbError::Eigen("no Floquet multiplier".into()));
+        };
+        Ok(Self {
+            kind: crate::stability::classify(critical),
             multipliers,
             method,
-        }
+        })
     }
 }
 
@@ -98,8 +112,8 @@ impl Linearization {
         let n = hb.params().modes;
         let spec = hb.s_spectrum();
         let mut stiffness = vec![0.0; n * n];
-        for i in 0..n {
-            stiffness[i * n + i] = ((i + 1) as f64 * PI).powi(2);
+        for (i, k) in stiffness.iter_mut().step_by(n + 1).enumerate() {
+            *k = ((i + 1) as f64 * PI).powi(2);
         }
         let Some((e, c)) = hb.tau_coupling() else {
             return Ok(Self {
@@ -107,6 +121,13 @@ impl Linearization {
                 s: spec.clone(),
             });
         };
+        if e.len() != n || c.len() != n {
+            return Err(HbError::InvalidInput(format!(
+                "spring boundary: Tau coupling vectors of {} and {} entries for {n} modes",
+                e.len(),
+                c.len()
+            )));
+        }
         let denom = 1.0 + c.iter().zip(&e).map(|(a, b)| a * b).sum::<f64>();
         if denom.abs() < 1e-12 {
             return Err(HbError::InvalidInput(
@@ -116,29 +137,35 @@ impl Linearization {
         // M⁻¹ X = X − e (cᵀX)/(1 + cᵀe), applied column by column.
         let apply_minv = |col: &mut dyn FnMut(usize) -> Complex<f64>, out: &mut [Complex<f64>]| {
             let mut ctx = Complex::new(0.0, 0.0);
-            for i in 0..n {
-                out[i] = col(i);
-                ctx += out[i] * c[i];
+            for (i, (o, ci)) in out.iter_mut().zip(&c).enumerate() {
+                *o = col(i);
+                ctx += *o * ci;
             }
-            for i in 0..n {
-                out[i] -= ctx * (e[i] / denom);
+            for (o, ei) in out.iter_mut().zip(&e) {
+                *o -= ctx * (ei / denom);
             }
         };
         let mut col = vec![Complex::new(0.0, 0.0); n];
         let mut k_new = vec![0.0; n * n];
+        let nan = Complex::new(f64::NAN, f64::NAN);
         for j in 0..n {
-            apply_minv(&mut |i| Complex::new(stiffness[i * n + j], 0.0), &mut col);
-            for i in 0..n {
-                k_new[i * n + j] = col[i].re;
+            let k_col = |i: usize| stiffness.get(i * n + j).copied().unwrap_or(f64::NAN);
+            apply_minv(&mut |i| Complex::new(k_col(i), 0.0), &mut col);
+            for (k, x) in k_new.iter_mut().skip(j).step_by(n).zip(&col) {
+                *k = x.re;
             }
         }
         let mut s = PeriodicSpectrum::zeros(n, n, spec.ms, spec.p_max);
         for p in 0..=spec.p_max {
-            let at = |i: usize, j: usize| spec.data[(p * spec.rows + i) * spec.cols + j];
-            for j in 0..n {
-                apply_minv(&mut |i| at(i, j) + at(i, n) * c[j], &mut col);
-                for i in 0..n {
-                    *s.at_mut(p, i, j) = col[i];
+            let at =
+                |i: usize, j: usize| spec.data.get(spec.index(p, i, j)).copied().unwrap_or(nan);
+            for (j, &cj) in c.iter().enumerate() {
+                apply_minv(&mut |i| at(i, j) + at(i, n) * cj, &mut col);
+                for (i, x) in col.iter().enumerate() {
+                    let k = s.index(p, i, j);
+                    if let Some(y) = s.data.get_mut(k) {
+                        *y = *x;
+                    }
                 }
             }
         }
@@ -166,8 +193,8 @@ pub fn hill_exponents(hb: &StringHb, omega: f64) -> Result<Vec<Complex<f64>>, Hb
         let o = g * blk;
         for i in 0..n {
             h[(o + i, o + n + i)] = 1.0;
-            for j in 0..n {
-                h[(o + n + i, o + j)] = -lin.stiffness[i * n + j] / (omega * omega);
+            for (j, kij) in lin.stiffness.iter().skip(i * n).take(n).enumerate() {
+                h[(o + n + i, o + j)] = -kij / (omega * omega);
             }
             h[(o + n + i, o + n + i)] = -cd / omega;
         }
@@ -231,22 +258,24 @@ pub fn hill(hb: &StringHb, omega: f64) -> Result<Stability, HbError> {
             }
         })
         .collect();
-    Ok(Stability::from_multipliers(
-        multipliers,
-        StabilityMethod::Hill,
-    ))
+    Stability::from_multipliers(multipliers, StabilityMethod::Hill)
 }
 
 /// `S(t)[idx, idx]` from its spectrum at time `t` (row-major `k × k`,
 /// `k = idx.len()`, into `out`).
 fn s_at(s: &PeriodicSpectrum, t: f64, idx: &[usize], out: &mut [f64]) {
-    let nc = s.rows * s.cols;
-    let entries = || {
-        idx.iter()
-            .flat_map(|&i| idx.iter().map(move |&j| i * s.cols + j))
+    let entries = |p: usize| {
+        idx.iter().flat_map(move |&i| {
+            idx.iter().map(move |&j| {
+                s.data
+                    .get(s.index(p, i, j))
+                    .copied()
+                    .unwrap_or(Complex::new(f64::NAN, f64::NAN))
+            })
+        })
     };
-    for (o, e) in out.iter_mut().zip(entries()) {
-        *o = s.data[e].re;
+    for (o, z) in out.iter_mut().zip(entries(0)) {
+        *o = z.re;
     }
     let base = Complex::from_polar(1.0, t);
     let mut rot = Complex::new(1.0, 0.0);
@@ -254,9 +283,8 @@ fn s_at(s: &PeriodicSpectrum, t: f64, idx: &[usize], out: &mut [f64]) {
         rot *= base;
         let w = if 2 * p == s.ms { 1.0 } else { 2.0 };
         let e = rot * w;
-        let block = &s.data[p * nc..(p + 1) * nc];
-        for (o, k) in out.iter_mut().zip(entries()) {
-            *o += (block[k] * e).re;
+        for (o, z) in out.iter_mut().zip(entries(p)) {
+            *o += (z * e).re;
         }
     }
 }
@@ -280,16 +308,18 @@ fn s_on_grid(
     let ifft = RealFftPlanner::<f64>::new().plan_fft_inverse(len);
     let (mut spec, mut out) = (ifft.make_input_vec(), ifft.make_output_vec());
     let mut scratch = ifft.make_scratch_vec();
-    let nc = s.rows * s.cols;
+    let nan = Complex::new(f64::NAN, f64::NAN);
     for (i, &fi) in idx.iter().enumerate() {
         for (j, &fj) in idx.iter().enumerate() {
-            let e = fi * s.cols + fj;
+            let at = |p: usize| s.data.get(s.index(p, fi, fj)).copied().unwrap_or(nan);
             spec.fill(Complex::new(0.0, 0.0));
-            spec[0] = Complex::new(s.data[e].re, 0.0);
+            if let Some(x0) = spec.first_mut() {
+                *x0 = Complex::new(at(0).re, 0.0);
+            }
             for (p, x) in spec.iter_mut().enumerate().take(s.p_max + 1).skip(1) {
                 // The FFT doubles every bin below len/2; s_at's Nyquist bin has weight 1.
                 let w = if 2 * p == s.ms { 0.5 } else { 1.0 };
-                *x = s.data[p * nc + e] * w;
+                *x = at(p) * w;
             }
             if ifft
                 .process_with_scratch(&mut spec, &mut out, &mut scratch)
@@ -328,6 +358,9 @@ fn block_monodromy(
 ) -> Mat<f64> {
     let (full, cd) = (hb.params().modes, hb.params().cd);
     let n = idx.len();
+    if n == 0 {
+        return Mat::zeros(0, 0);
+    }
     let s = &lin.s;
     let d = 2 * n;
     let h = 2.0 * PI / steps as f64;
@@ -335,25 +368,35 @@ fn block_monodromy(
     // B(t) = (S̃(t) − K̃)/ω² at the 2·steps + 1 half-step nodes, stored
     // column-major so that B x is a sum of columns (vectorized axpys).
     let mut b = vec![0.0; (2 * steps + 1) * n * n];
-    let stiffness = |i: usize, j: usize| lin.stiffness[idx[i] * full + idx[j]];
-    if !s_on_grid(s, steps, idx, |node, i, j, v| {
-        b[node * n * n + j * n + i] = (v - stiffness(i, j)) * w2;
-    }) {
+    // K̃_ij of the block's coordinates (NaN marks an index slip).
+    let stiffness = |i: usize, j: usize| {
+        let (Some(fi), Some(fj)) = (idx.get(i), idx.get(j)) else {
+            return f64::NAN;
+        };
+        lin.stiffness
+            .get(fi * full + fj)
+            .copied()
+            .unwrap_or(f64::NAN)
+    };
+    // Column-major entry (i, j) of node `node` (every index < b.len()).
+    let put = |b: &mut [f64], node: usize, i: usize, j: usize, v: f64| {
+        if let Some(x) = b.get_mut(node * n * n + j * n + i) {
+            *x = (v - stiffness(i, j)) * w2;
+        }
+    };
+    if !s_on_grid(s, steps, idx, |node, i, j, v| put(&mut b, node, i, j, v)) {
         let mut row_major = vec![0.0; n * n];
-        for (node, chunk) in b.chunks_exact_mut(n * n).enumerate() {
+        for node in 0..=2 * steps {
             s_at(s, node as f64 * 0.5 * h, idx, &mut row_major);
             for (e, v) in row_major.iter().enumerate() {
-                let (i, j) = (e / n, e % n);
-                chunk[j * n + i] = (v - stiffness(i, j)) * w2;
+                put(&mut b, node, e / n, e % n, *v);
             }
         }
     }
     let damp = cd / omega;
     // Y = [X; V] column by column; f(Y) = [V; B X − damp V].
     let mut y = vec![0.0; d * d];
-    for i in 0..d {
-        y[i * d + i] = 1.0;
-    }
+    y.iter_mut().step_by(d + 1).for_each(|v| *v = 1.0);
     let f = |bn: &[f64], y: &[f64], out: &mut [f64]| {
         for (yc, oc) in y.chunks_exact(d).zip(out.chunks_exact_mut(d)) {
             let (x, v) = yc.split_at(n);
@@ -372,10 +415,13 @@ fn block_monodromy(
     // Stage times are multiples of h/2: the node index of B.
     let mut rhs = |t: f64, y: &[f64], out: &mut [f64]| {
         let k = (2.0 * t / h).round() as usize;
-        f(&b[k * n * n..(k + 1) * n * n], y, out);
+        match b.get(k * n * n..(k + 1) * n * n) {
+            Some(bn) => f(bn, y, out),
+            None => out.fill(f64::NAN),
+        }
     };
     ExplicitRk::with_dim(&RK4, d * d).fixed_steps(&mut rhs, 0.0, h, steps, &mut y);
-    Mat::from_fn(d, d, |i, j| y[j * d + i])
+    Mat::from_fn(d, d, |i, j| y.get(j * d + i).copied().unwrap_or(f64::NAN))
 }
 
 /// The odd and the even sine modes (0-based indices even, odd) when the
@@ -445,10 +491,10 @@ fn multipliers_with_steps(
 /// # Errors
 /// As [`monodromy_multipliers`].
 pub fn monodromy(hb: &StringHb, omega: f64) -> Result<Stability, HbError> {
-    Ok(Stability::from_multipliers(
+    Stability::from_multipliers(
         monodromy_multipliers(hb, omega)?,
         StabilityMethod::Monodromy,
-    ))
+    )
 }
 
 /// Largest Hill matrix, `2N(2M + 1)`, whose dense eigenproblem ([`hill`]) a
@@ -477,9 +523,7 @@ pub fn monodromy_refined(
     coarse: &Stability,
 ) -> Result<(Stability, f64), HbError> {
     let fine = multipliers_with_steps(hb, omega, 2 * default_steps(hb, omega))?;
-    let error = (coarse.critical().norm() - fine[0].norm()).abs();
-    Ok((
-        Stability::from_multipliers(fine, StabilityMethod::MonodromyRefined),
-        error,
-    ))
+    let fine = Stability::from_multipliers(fine, StabilityMethod::MonodromyRefined)?;
+    let error = (coarse.critical().norm() - fine.critical().norm()).abs();
+    Ok((fine, error))
 }

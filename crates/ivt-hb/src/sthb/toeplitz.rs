@@ -17,6 +17,10 @@
 //! When `Ŝ_r` are the DFT coefficients of `M_s` samples (index `r mod M_s`), the
 //! table is the exact derivative of the sampled (alternating frequency–time)
 //! projection, aliasing included.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use faer::MatMut;
 use realfft::num_complex::Complex;
@@ -62,7 +66,12 @@ impl PeriodicSpectrum {
         if p > self.p_max {
             return Complex::new(0.0, 0.0);
         }
-        let v = self.data[(p * self.rows + i) * self.cols + j];
+        // NaN for an entry (i, j) outside the matrix.
+        let v = self
+            .data
+            .get(self.index(p, i, j))
+            .copied()
+            .unwrap_or(Complex::new(f64::NAN, f64::NAN));
         if conj {
             v.conj()
         } else {
@@ -70,9 +79,22 @@ impl PeriodicSpectrum {
         }
     }
 
+    /// The position of `Ŝ_p[i][j]` in [`Self::data`].
+    pub(crate) fn index(&self, p: usize, i: usize, j: usize) -> usize {
+        (p * self.rows + i) * self.cols + j
+    }
+
     /// Mutable `Ŝ_p[i][j]`.
+    ///
+    /// # Panics
+    /// If `p > p_max`, `i ≥ rows` or `j ≥ cols` (a caller's size bug; the
+    /// panic-free access is `data.get_mut(index(p, i, j))`).
+    // The one panic left in this file: its callers in `sthb/hb.rs` take the
+    // reference directly.
+    #[allow(clippy::indexing_slicing)]
     pub fn at_mut(&mut self, p: usize, i: usize, j: usize) -> &mut Complex<f64> {
-        &mut self.data[(p * self.rows + i) * self.cols + j]
+        let k = self.index(p, i, j);
+        &mut self.data[k]
     }
 }
 
@@ -111,7 +133,12 @@ pub fn add_real_toeplitz(
             }
         }
     }
-    let blk = |r: isize| &scratch[(r + 2 * m) as usize * nb..][..nb];
+    // Block r of the scratch (every |r| ≤ 2M was pushed above).
+    let blk = |r: isize| {
+        let start = (r + 2 * m) as usize * nb;
+        scratch.get(start..start + nb).unwrap_or_default()
+    };
+    let nan = Complex::new(f64::NAN, f64::NAN);
     let mut add = |h: usize, g: usize, i: usize, j: usize, v: f64| {
         let r = h * layout.row_block + layout.row_off + i;
         let c = g * layout.col_block + layout.col_off + j;
@@ -124,7 +151,8 @@ pub fn add_real_toeplitz(
             let (gc, gs) = ((2 * l - 1).max(0) as usize, (2 * l) as usize);
             for i in 0..rows {
                 for j in 0..cols {
-                    let (d, su) = (d[i * cols + j], su[i * cols + j]);
+                    let at = |b: &[Complex<f64>]| b.get(i * cols + j).copied().unwrap_or(nan);
+                    let (d, su) = (at(d), at(su));
                     // Table in the module docs.
                     match (k == 0, l == 0) {
                         (true, true) => add(0, 0, i, j, d.re),
