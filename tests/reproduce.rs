@@ -61,7 +61,7 @@ const EQ192: &str = "src/reproduce/rig.rs::eq192_needs_exponent_k_plus_1";
 const FIG42: &str = "tests/ch4_plant.rs::fig42_multipliers_on_thesis_ch4_confirmed_by_simulation";
 const HSU: &str = "tests/ch4_causes.rs::hsu_transformation_matrix_is_not_the_cause";
 const RATIO: &str =
-    "tests/ch4_causes.rs::printed_gain_ratio_floors_the_multiplier_at_exp_minus_half";
+    "tests/ch4_causes_law.rs::printed_gain_ratio_floors_the_multiplier_at_exp_minus_half";
 
 /// Reproduced rows carry the thesis value ± half a printed unit (the
 /// reproduce criterion itself); "differs" rows a window around ours that

@@ -24,7 +24,7 @@ const FIG42_MU1_TEST: &str = "tests/ch4_causes.rs::hsu_transformation_matrix_is_
 /// The test showing that the printed gain ratio k2 = 2k keeps max |μ| above
 /// e^{−1/2} ≈ 0.607 on thesis-ch4, above Fig. 42's 0.4871.
 const FIG42_MU2_TEST: &str =
-    "tests/ch4_causes.rs::printed_gain_ratio_floors_the_multiplier_at_exp_minus_half";
+    "tests/ch4_causes_law.rs::printed_gain_ratio_floors_the_multiplier_at_exp_minus_half";
 
 pub(super) fn gamma_hat(plant: &PlantParams, law: &OpenLoopLaw, v: f64, t: f64) -> f64 {
     // §4.2.2, the equation after Eq. 170: Γ̂ = −9.8√2 r_f + (k_t/R_a V_m − 2√2 T_U r_f/(π r_u))/√2.
@@ -210,16 +210,16 @@ const FIG42_MU1_CAUSE: &str = "not found by computation. Ours is confirmed by si
      k_t and k_e scaled separately, the inertias scaled and G = m_r g, each keeping r̄, where the inertia scales \
      that give 0.7776 give 0.599 or 0.515 for the second case \
      (`tests/ch4_causes.rs::nearby_plants_keeping_r_bar_are_not_the_cause`); a unit factor on one gain and the \
-     nearby operating points (`tests/ch4_causes.rs::printed_gain_ratio_floors_the_multiplier_at_exp_minus_half`); \
+     nearby operating points (`tests/ch4_causes_law.rs::printed_gain_ratio_floors_the_multiplier_at_exp_minus_half`); \
      a delay over a half or a quarter revolution (0.734 / 0.550, 0.753 / 0.672; \
-     `tests/ch4_causes.rs::quarter_or_half_revolution_delay_is_not_the_cause`); the law sampled 4…80 times per \
+     `tests/ch4_causes_law.rs::quarter_or_half_revolution_delay_is_not_the_cause`); the law sampled 4…80 times per \
      revolution (0.785…0.787), linearizing about the averaged orbit (ω̄ ≡ ω0: 0.794; 𝒜 averaged over θ: 0.792) \
      or about the orbit at Eq. 158's r_f = 0.024195 m (0.792, or 0.785 with its own mean speed in K) \
-     (`tests/ch4_causes.rs::sampled_law_averaged_orbit_or_eq158_r_is_not_the_cause`); Table 1 gives no armature \
+     (`tests/ch4_causes_law.rs::sampled_law_averaged_orbit_or_eq158_r_is_not_the_cause`); Table 1 gives no armature \
      inductance to add; and Hsu's transformation matrix (Eq. 80, the method §4.3 cites), which for N_Q = 8…1000 \
      never comes below ours. Both printed numbers hold only with the gains scaled separately, k × 0.786 and \
      k2 × 0.523 (ratio k2/k = 1.33, not 2), which no unit reading gives \
-     (`tests/ch4_causes.rs::both_printed_multipliers_need_another_gain_ratio`): they belong to other gains or \
+     (`tests/ch4_causes_law.rs::both_printed_multipliers_need_another_gain_ratio`): they belong to other gains or \
      another plant";
 
 /// Why thesis-ch4 misses Fig. 42's 0.4871 (k = 0.06, k2 = 0.12 mm·rad⁻¹).

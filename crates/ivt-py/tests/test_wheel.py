@@ -61,3 +61,48 @@ def test_fresh_venv_runs_a_shipped_scene(tmp_path: Path) -> None:
     assert 1.0e5 < res["pulses"] < 1.4e5, res["pulses"]
     # the algebraic armature current (L_a = 0) is logged, not 0.0
     assert res["ia"] > 0.1, res["ia"]
+
+
+@needs_wheel
+def test_fresh_venv_runs_every_chapter_as_a_user_copies_it(tmp_path: Path) -> None:
+    """Issue 31: each chapter's example, copied into a fresh venv as a user
+    would (the wheel + numpy + scipy, nothing of the repository importable),
+    runs as shown: each chapter becomes one script, its Python blocks in
+    order and its `$ ivt ...` lines as shell commands between them (the same
+    lines test_guide.py runs, the same NOT_RUN list), run by the fresh venv's
+    Python in an empty directory holding `scenes/` as a checkout does."""
+    from test_guide import GUIDE, NOT_RUN, as_ivt, blocks, commands, ivt_bin
+
+    venv = tmp_path / "venv"
+    subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
+    py = venv / "bin" / "python"
+    pip = [str(py), "-m", "pip", "install", "-q", "--disable-pip-version-check"]
+    subprocess.run([*pip, str(WHEEL), "numpy", "scipy"], check=True, cwd=tmp_path)
+    exe = ivt_bin()
+    repo = Path(__file__).resolve().parents[3]
+    ran = 0
+    for chapter in sorted(GUIDE.rglob("*.md")):
+        parts = []
+        for lang, _, body in blocks(chapter.read_text()):
+            if lang == "python":
+                parts.append(body)
+            elif lang == "console":
+                for cmd in map(as_ivt, commands(body)):
+                    if not any(cmd.startswith(p) for p in NOT_RUN):
+                        parts.append(
+                            "__import__('subprocess').run("
+                            f"{cmd!r}, shell=True, check=True, executable='/bin/bash')\n"
+                        )
+        if not any(lang == "python" for lang, _, _ in blocks(chapter.read_text())):
+            continue
+        work = tmp_path / chapter.relative_to(GUIDE).with_suffix("").as_posix().replace("/", "-")
+        work.mkdir()
+        (work / "scenes").symlink_to(repo / "scenes", target_is_directory=True)
+        (work / "example.py").write_text("".join(parts))
+        run = subprocess.run(
+            [str(py), "example.py"], cwd=work, capture_output=True, text=True,
+            env={"PATH": f"{exe.parent}{os.pathsep}{os.environ.get('PATH', '')}", "HOME": str(tmp_path)},
+        )
+        assert run.returncode == 0, f"{chapter.name}:\n{run.stdout[-2000:]}\n{run.stderr[-3000:]}"
+        ran += 1
+    assert ran >= 10, ran
