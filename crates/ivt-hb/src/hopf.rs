@@ -1,5 +1,5 @@
 //! Hopf points of the equilibria of an autonomous family (issue 27, item 2):
-//! `M ẍ + C ẋ + K x + g(x, ẋ) = 0` at parameter p ([`crate::cycle_branch`]
+//! `M ẍ + C ẋ + K x + g(x, ẋ) = 0` at parameter p ([`crate::cycle_branch()`]
 //! starts the limit cycles born there).
 //!
 //! An equilibrium solves `K x + g(x, 0) = 0` (Newton, [`ivt_num::newton()`]);

@@ -6,7 +6,7 @@
 //! `ω = ω_f/p`, so θ = pτ). The user gives `M`, `C`, `K` (row-major `n_dof×n_dof`),
 //! the nonlinear/parametric part `g` in the time domain, the excitation `f`, and
 //! optionally the derivatives of `g` (default: central differences). `g` and `f`
-//! may also read ω_f ([`PeriodicProblem::frequency_dependent`], [`omega`]).
+//! may also read ω_f ([`PeriodicProblem::frequency_dependent`], [`AtFrequency`]).
 
 mod general;
 mod omega;
