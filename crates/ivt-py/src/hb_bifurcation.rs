@@ -88,7 +88,7 @@ impl PyFamily {
         n: i64,
         samples: i64,
         rtol: f64,
-        max_iter: usize,
+        max_iter: i64,
     ) -> PyResult<(PyProblem, HbOptions)> {
         let [m, c, k, g, f] = family_system(self.family.bind(py), p)?;
         let user = UserArgs {
@@ -98,7 +98,7 @@ impl PyFamily {
             velocity_dependent: self.velocity_dependent,
             vectorized: self.vectorized,
             rtol,
-            max_iter,
+            max_iter: crate::args::count("max_iter", max_iter)?,
             jac: None,
         };
         user.setup((!f.is_none()).then_some(&f), 1, 0.0)
@@ -154,7 +154,7 @@ fn cycle_branch<'py>(
     vectorized: bool,
     #[pyo3(from_py_with = crate::args::int64)] grid: i64,
     rtol: f64,
-    max_iter: usize,
+    #[pyo3(from_py_with = crate::args::int64)] max_iter: i64,
     ds: f64,
     ds_max: f64,
     #[pyo3(from_py_with = crate::args::int64)] max_points: i64,
@@ -245,7 +245,7 @@ fn neimark_sacker_points<'py>(
     #[pyo3(from_py_with = crate::args::int64)] n: i64,
     #[pyo3(from_py_with = crate::args::int64)] samples: i64,
     rtol: f64,
-    max_iter: usize,
+    #[pyo3(from_py_with = crate::args::int64)] max_iter: i64,
     velocity_dependent: bool,
     vectorized: bool,
 ) -> PyResult<Bound<'py, PyList>> {

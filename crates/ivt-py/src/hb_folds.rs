@@ -72,7 +72,7 @@ fn continue_bifurcation<'py>(
     velocity_dependent: bool,
     vectorized: bool,
     rtol: f64,
-    max_iter: usize,
+    #[pyo3(from_py_with = crate::args::int64)] max_iter: i64,
     ds: f64,
     ds_max: f64,
     #[pyo3(from_py_with = int64)] max_points: i64,

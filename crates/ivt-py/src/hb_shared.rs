@@ -144,11 +144,13 @@ macro_rules! user_system_fn {
             #[pyo3(from_py_with = crate::args::int64)] n: i64,
             #[pyo3(from_py_with = crate::args::int64)] samples: i64,
             $( $(#[$pb($($pb_args)*)])* $brg: $bty, )+
-            velocity_dependent: bool, vectorized: bool, rtol: f64, max_iter: usize,
+            velocity_dependent: bool, vectorized: bool, rtol: f64,
+            #[pyo3(from_py_with = crate::args::int64)] max_iter: i64,
             $( $jac: Option<&Bound<$lt, PyAny>>, )?
         ) -> PyResult<Bound<$lt, PyDict>> {
             let $user = UserArgs {
-                system: [m, c, k, g], n, samples, velocity_dependent, vectorized, rtol, max_iter,
+                system: [m, c, k, g], n, samples, velocity_dependent, vectorized, rtol,
+                max_iter: crate::args::count("max_iter", max_iter)?,
                 jac: None $( .or($jac) )?,
             };
             $body

@@ -88,14 +88,18 @@ import numpy as _np
 
 
 def _index(name, value):
-    """An integer argument as the native functions take it: an int or a numpy
-    integer, not a bool and not a float (TypeError naming the argument)."""
+    """A count or DOF index as the native functions take it: an int or a numpy
+    integer, not a bool and not a float (TypeError), not negative (ValueError),
+    the error naming the argument."""
     if isinstance(value, bool):
         raise TypeError(f"argument `{name}` must be an integer, not bool")
     try:
-        return _operator.index(value)
+        index = _operator.index(value)
     except TypeError:
         raise TypeError(f"argument `{name}` must be an integer, got {value!r}") from None
+    if index < 0:
+        raise ValueError(f"argument `{name}` must be >= 0, got {index}")
+    return index
 
 _LARGE_KEYS = ("nonlinear_dofs", "amplitude_dof", "record_dofs")
 
@@ -153,7 +157,10 @@ def _dense_dofs(entry, n_dof, amplitude_dof, record_dofs):
     """dof_coeffs / amplitude of a dense solution's point (all DOFs known)."""
     coeffs = _np.asarray(entry["coeffs"])
     blocks = coeffs.reshape(n_dof, -1)
-    for j in list(record_dofs or ()) + ([] if amplitude_dof is None else [amplitude_dof]):
+    record_dofs = [_index("record_dofs", j) for j in (record_dofs or ())]
+    if amplitude_dof is not None:
+        amplitude_dof = _index("amplitude_dof", amplitude_dof)
+    for j in record_dofs + ([] if amplitude_dof is None else [amplitude_dof]):
         if not 0 <= j < n_dof:
             raise ValueError(f"DOF {j} is out of range for {n_dof} DOFs")
     entry["dof_coeffs"] = {int(j): blocks[j].copy() for j in (record_dofs or ())}
@@ -184,7 +191,9 @@ def _large_call(native_name, sig, args, kwargs, extra):
     if not n == nc == nk:
         raise ValueError(f"`m`, `c`, `k` must have one size, got {n}, {nc}, {nk}")
     kw = dict(
-        amplitude_dof=extra.get("amplitude_dof"),
+        amplitude_dof=(
+            None if extra.get("amplitude_dof") is None else _index("amplitude_dof", extra["amplitude_dof"])
+        ),
         record_dofs=[_index("record_dofs", j) for j in (extra.get("record_dofs") or ())],
         n=_index("n", given.get("n", 7)),
         samples=_index("samples", given.get("samples", 32)),
