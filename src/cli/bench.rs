@@ -10,7 +10,7 @@ pub enum BenchCommand {
     /// Error in ω_a after ≈ 10 s vs run time for the plant integrators (DP5 over
     /// tolerances 1e-3…1e-12, RK4 over angle steps); bench/work_precision.py adds scipy.
     WorkPrecision {
-        /// Timing budget per row [s] (best-of-N within it, N ≥ 3).
+        /// Timing budget per row, in seconds (best-of-N within it, N ≥ 3).
         #[arg(long, default_value_t = 0.2)]
         budget: f64,
     },

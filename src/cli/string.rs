@@ -63,7 +63,7 @@ pub struct StringArgs {
     plot: Option<PathBuf>,
 }
 
-/// Trace the curve (the job [`ivt_hb::jobs::string`]) and report
+/// Trace the curve (the job [`ivt_hb::jobs::string()`]) and report
 /// `{"points": [{"omega", "norm", "stable", "kind", "max_multiplier",
 /// "method"}...], "jacobians", "hill_calls", "stop", "solve_time_s"}` (and
 /// `boundary_note` for a spring of k0 > 1).

@@ -3,7 +3,7 @@
 //! toolkit can compute, each with a verdict — and write `REPRODUCTION.md`.
 //!
 //! One module per chapter; each appends [`Row`]s and figures to a
-//! [`Context`]. The library APIs are called directly (never the CLI). A
+//! `Context`. The library APIs are called directly (never the CLI). A
 //! chapter whose engine is not in this build reports its rows as
 //! [`Verdict::NotComputable`] and its figures as missing, with the reason —
 //! never a made-up number.

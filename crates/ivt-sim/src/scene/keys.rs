@@ -9,7 +9,7 @@
 //! they refuse what no rig can mean (`t_u = 1e300`) and what the integrator
 //! cannot honour (`rtol = 1e-300`: below ~1e-14 DP5's error estimate is
 //! round-off, Hairer–Nørsett–Wanner §II.4), not unusual but valid studies.
-//! How much work a valid scene asks for is [`super::budget`]'s job.
+//! How much work a valid scene asks for is [`Scene::estimated_events`](super::Scene::estimated_events)'s job.
 
 use super::Invalid;
 
