@@ -37,8 +37,16 @@ pub fn pairs(mu: &[c64]) -> Vec<[f64; 2]> {
 /// # Errors
 /// [`HbError::NonFiniteMultipliers`].
 pub fn finite_pairs(mu: &[c64], omega: f64, steps: usize) -> Result<Vec<[f64; 2]>, HbError> {
+    check_finite(mu, omega, steps).map(|()| pairs(mu))
+}
+
+/// [`finite_pairs`]'s check alone (no copy of the multipliers).
+///
+/// # Errors
+/// [`HbError::NonFiniteMultipliers`].
+pub fn check_finite(mu: &[c64], omega: f64, steps: usize) -> Result<(), HbError> {
     if mu.iter().all(|m| m.re.is_finite() && m.im.is_finite()) {
-        Ok(pairs(mu))
+        Ok(())
     } else {
         Err(HbError::NonFiniteMultipliers { omega, steps })
     }

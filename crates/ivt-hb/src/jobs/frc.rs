@@ -5,7 +5,7 @@
 //! IHB and [`crate::trace`] locates every fold, period doubling,
 //! Neimark–Sacker point and branch point as the path passes it.
 
-use super::{finite_pairs, pairs, Array};
+use super::{check_finite, pairs, Array};
 use crate::bifurcation::{BifurcationError, BifurcationKind};
 use crate::continuation::{Corrector, Termination};
 use crate::error::HbError;
@@ -209,7 +209,7 @@ pub fn frc<P: PeriodicProblem>(
         (curve, events)
     };
     for p in &curve.points {
-        finite_pairs(&p.multipliers, p.omega_f, hsu_cap)?;
+        check_finite(&p.multipliers, p.omega_f, hsu_cap)?;
     }
     Ok(FrcCurve {
         points: curve.points.iter().map(point).collect(),

@@ -24,7 +24,7 @@ pub mod limit_cycle;
 pub mod orbit;
 pub mod string;
 
-pub use array::{finite_pairs, pairs, Array, ARRAY_NAME};
+pub use array::{check_finite, finite_pairs, pairs, Array, ARRAY_NAME};
 pub use backbone::{backbone, free_duffing, BackboneCurve, BackboneRequest, BackboneSample};
 pub use cascade::{cascade, Cascade, CascadeRequest, THESIS_BETAS};
 pub use fold_curve::{
