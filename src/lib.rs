@@ -19,20 +19,8 @@
 //!
 //! No input may reach a panic in the command layer or the reproduction
 //! report: every failure is a `CliError` (exit 2) or a `ReproError`, which
-//! these lints enforce outside tests.
+//! the panic lints of Cargo.toml's `[lints]` enforce outside tests.
 #![warn(missing_docs)]
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::indexing_slicing,
-        clippy::unreachable,
-        clippy::todo,
-        clippy::unimplemented
-    )
-)]
 
 #[doc(hidden)]
 pub mod cli;

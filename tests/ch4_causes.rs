@@ -4,6 +4,8 @@
 //! thesis-ch4 0.7866 and 0.6044. Each test takes one hypothesis for how the
 //! thesis computed its number and shows it does not give the printed digits
 //! of both multipliers (A0's b3 of §3.2.5 is in `tests/a0_causes.rs`).
+// A test may expect (the package's panic lints guard library code).
+#![allow(clippy::expect_used)]
 
 // The feedback law and its gains: `tests/ch4_causes_law.rs`.
 

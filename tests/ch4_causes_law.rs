@@ -4,6 +4,8 @@
 //! and its gains (the printed ratio k2 = 2k, a delay over part of a
 //! revolution, the law sampled as a controller runs it, another orbit, the
 //! gain scales both printed numbers determine).
+// A test may expect and index (the package's panic lints guard library code).
+#![allow(clippy::expect_used, clippy::indexing_slicing)]
 
 #[path = "common/fig42.rs"]
 mod fig42;

@@ -1,6 +1,8 @@
 //! `--plant thesis-ch4` end to end: `ivt ol solve` (modified IHB) against an
 //! independent θ-shooting of Eq. 151 (RK6 + Newton, `ivt_design::shooting`),
 //! and the plant name echoed in the JSON of every command that takes a plant.
+// A test may expect (the package's panic lints guard library code).
+#![allow(clippy::expect_used)]
 
 use ivt_design::shooting::{shoot_steady_state, ShootingOptions};
 use ivt_design::OperatingPoint;

@@ -6,6 +6,8 @@
 //! the default drive scene's `out/drive.mcap` and on a simulated rig's
 //! commissioning recording (`ivt rig commission --sim`), which has the rig's
 //! channels.
+// A test may expect, index and panic (the package's panic lints guard library code).
+#![allow(clippy::expect_used, clippy::indexing_slicing, clippy::panic)]
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

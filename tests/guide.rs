@@ -6,6 +6,8 @@
 //! - every fenced block is ```rust (a doctest), ```python or ```console (run by
 //!   crates/ivt-py/tests/test_guide.py) or ```text (output shown); any other
 //!   fence, a bare one or ```rust,ignore included, is refused here.
+// A test may expect (the package's panic lints guard library code).
+#![allow(clippy::expect_used)]
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};

@@ -4,6 +4,8 @@
 //! without a panic, failed commands leave no file behind (interrupted ones:
 //! `tests/interrupts.rs`), and `ol solve` is accurate by default. The
 //! bounded proptests that keep it so are in `hardening_fuzz.rs`.
+// A test may unwrap (the package's panic lints guard library code).
+#![allow(clippy::unwrap_used)]
 
 #[path = "common/contract.rs"]
 mod contract;

@@ -6,6 +6,8 @@
 //! Not here: `hb duffing-frc --from 1e-3 --to 2e-3` (the harmonic-balance
 //! engine's example) and the output-writer examples already covered by
 //! `tests/outputs.rs` (`--plot` in place, /dev/full replaced, SIGINT).
+// A test may index and unwrap (the package's panic lints guard library code).
+#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};

@@ -4,6 +4,8 @@
 //! the old one whole, concurrent runs into one directory all succeed, an
 //! interrupted `--json` run prints one JSON error and removes what it
 //! created, and `--version`/`help` answer in JSON under `--json`.
+// A test may panic and unwrap (the package's panic lints guard library code).
+#![allow(clippy::panic, clippy::unwrap_used)]
 
 use ivt_sim::testing::{listing, scratch_dir};
 use serde_json::Value;

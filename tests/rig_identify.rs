@@ -3,6 +3,8 @@
 //! `ivt_ctrl::commission` run by the controller in the simulator's loop), its
 //! recording identified by `ivt rig identify`, the plant file used by the
 //! design tools.
+// A test may index and unwrap (the package's panic lints guard library code).
+#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 use ivt_kin::plant::PlantParams;
 use ivt_sim::scene::{PlantSection, PresetName};

@@ -3,6 +3,8 @@
 //! status and its one JSON object. Included by `tests/hardening.rs` and
 //! `tests/hardening_fuzz.rs` (`#[path]`), which use different parts of it.
 #![allow(dead_code)]
+// A test may index and unwrap (the package's panic lints guard library code).
+#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 use ivt_sim::testing::scratch_dir;
 use serde_json::Value;

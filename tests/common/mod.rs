@@ -1,5 +1,7 @@
 //! What the integration tests of the `ivt` binary share: running it under
 //! `--json` and reading its one JSON object.
+// A test may expect (the package's panic lints guard library code).
+#![allow(clippy::expect_used)]
 
 use std::ffi::OsStr;
 use std::process::Command;

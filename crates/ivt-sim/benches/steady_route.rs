@@ -4,6 +4,8 @@
 //! same scene (20 s from ω = 10 rad/s, last revolution measured). Also the
 //! saturated case (V_m = 7 V, T_U = 8 N·m), where the route adds a secant
 //! on ω0 over IHB solves.
+// A bench may expect (the package's panic lints guard library code).
+#![allow(clippy::expect_used)]
 
 use ivt_sim::run::Simulation;
 use ivt_sim::scene::Scene;

@@ -1,6 +1,8 @@
 //! The feasible band on the printed plant by direct integration: for each
 //! T_U, the V_m at which the steady ω_a equals ω0 = 100 rpm with r = 0 and
 //! with r = r_max (bisection on V_m; steady ω_a from the angle-domain run).
+// An example may unwrap (the package's panic lints guard library code).
+#![allow(clippy::unwrap_used)]
 use ivt_kin::plant::PlantParams;
 use ivt_sim::integrate::{ConstantInputs, Method, PlantIntegrator, Tolerance};
 use ivt_sim::plant::Plant;

@@ -10,6 +10,8 @@
 //! the MCAP writer thread works while the loop runs). For each: best wall time,
 //! best CPU time of the loop's thread, and the mean CPU time of the whole process
 //! per run (so the writer thread's share is `process − loop`).
+// An example may expect (the package's panic lints guard library code).
+#![allow(clippy::expect_used)]
 
 use ivt_sim::run::Simulation;
 use ivt_sim::scene::Scene;

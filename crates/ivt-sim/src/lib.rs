@@ -1,18 +1,7 @@
 #![doc = include_str!("../README.md")]
 // No scene, stream or file may reach a panic in the simulator: every failure
-// is a typed `SimError`/`SceneError` (issue 30). Tests may unwrap.
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::indexing_slicing,
-        clippy::unreachable,
-        clippy::todo,
-        clippy::unimplemented
-    )
-)]
+// is a typed `SimError`/`SceneError` (issue 30; the panic lints of
+// Cargo.toml). Tests may unwrap.
 
 pub mod atomic;
 pub mod backend;

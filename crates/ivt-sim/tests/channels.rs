@@ -4,6 +4,8 @@
 //! `ivt.name` whose properties are the channel's fields, one CSV per channel
 //! whose header is the field list, and a PNG with a panel per plot. Adding a
 //! channel to the table is checked here without editing this test.
+// A test may expect (the package's panic lints guard library code).
+#![allow(clippy::expect_used)]
 
 use ivt_sim::output::{json_schema, write_all};
 use ivt_sim::record::{Channel, Panel, PlantSample, Record};

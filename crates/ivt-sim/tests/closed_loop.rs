@@ -1,5 +1,7 @@
 //! Closed loop through the SIL backend (the `ivt-ctrl` controller), scenes
 //! and outputs. Scenes come from `scenes/` so that what is tested is what ships.
+// A test may index and unwrap (the package's panic lints guard library code).
+#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 use ivt_sim::record::Channel;
 use ivt_sim::run::{RunResult, Simulation};

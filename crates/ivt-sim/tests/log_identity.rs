@@ -8,6 +8,8 @@
 //! first-same-as-last in the angle domain, the DP5 start-up in the time
 //! domain with dense-output corner landing (every run starts from rest), and
 //! the armature current as a state (L_a > 0).
+// A test may expect (the package's panic lints guard library code).
+#![allow(clippy::expect_used)]
 
 use ivt_sim::record::Sample;
 use ivt_sim::run::Simulation;

@@ -9,6 +9,8 @@
 //! lies far above it), so u_ol does not change across the step and r_d alone
 //! must travel the whole Δr̄ at the loop's rate — the transient of the
 //! no-feed-forward loop. Same gains (k = 2, k2 = 1 mm·rad⁻¹), same stepper.
+// A test may index and unwrap (the package's panic lints guard library code).
+#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 use ivt_sim::record::Channel;
 use ivt_sim::run::{RunResult, Simulation};

@@ -4,6 +4,8 @@
 //! must give the same numbers (an independent method: the closed loop from
 //! rest through the real controller, measured on its last revolution).
 //! Timing belongs to `benches/steady_route.rs`.
+// A test may unwrap (the package's panic lints guard library code).
+#![allow(clippy::unwrap_used)]
 
 use ivt_sim::record::Channel;
 use ivt_sim::run::Simulation;
