@@ -211,23 +211,37 @@ pub(crate) fn monodromy_strided(
     rule: HsuRule,
     q: &mut [f64],
 ) {
-    by_size!(
+    let grid = ThetaGrid {
         dim,
-        monodromy_sized(dim, theta, samples, stride, period, rule, q)
-    );
+        theta,
+        samples,
+        stride,
+        period,
+    };
+    by_size!(dim, monodromy_sized(grid, rule, q));
 }
 
-/// [`monodromy_strided`] with the size `N` known at compile time, or read
-/// from `dim` for `N = 0`.
-fn monodromy_sized<const N: usize>(
+/// The uniform Θ samples [`monodromy_strided`] reads: `samples` row-major
+/// `dim×dim` matrices over one `period`, every `stride`-th of them used.
+#[derive(Clone, Copy)]
+struct ThetaGrid<'a> {
     dim: usize,
-    theta: &[f64],
+    theta: &'a [f64],
     samples: usize,
     stride: usize,
     period: f64,
-    rule: HsuRule,
-    q: &mut [f64],
-) {
+}
+
+/// [`monodromy_strided`] with the size `N` known at compile time, or read
+/// from `grid.dim` for `N = 0`.
+fn monodromy_sized<const N: usize>(grid: ThetaGrid<'_>, rule: HsuRule, q: &mut [f64]) {
+    let ThetaGrid {
+        dim,
+        theta,
+        samples,
+        stride,
+        period,
+    } = grid;
     let dim = if N == 0 { dim } else { N };
     let d2 = dim * dim;
     let steps = samples / (2 * stride);
