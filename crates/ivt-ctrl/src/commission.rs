@@ -527,16 +527,14 @@ mod tests {
         };
         cfg.gains.k_prop = 1e-4; // m per rad/s: one increment stays far from the bounds
         let mut c = Controller::<16>::new(cfg);
-        let plan = Plan {
-            step: StepPlan {
-                range_deg: [100.0, 200.0],
-                points: 2,
-                hold_s: 1.0,
-                law_s: 1.0,
-                inputs: [8.0, 8.0],
-                t_u_step: 8.0,
-            },
-            ..Plan::default()
+        let mut plan = Plan::default();
+        plan.step = StepPlan {
+            range_deg: [100.0, 200.0],
+            points: 2,
+            hold_s: 1.0,
+            law_s: 1.0,
+            inputs: [8.0, 8.0],
+            ..plan.step
         };
         let mut seq = Sequencer::new(plan, Selection::only(SequenceName::Step), 1.0e6);
         // 10 rad/s at 16 pulses/rev: a pulse every 39 269 µs.

@@ -9,7 +9,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use ivt_ctrl::commission::{Plan, Selection, SequenceName, StepPlan};
+use ivt_ctrl::commission::{Plan, Selection, SequenceName};
 use ivt_sim::commission::{load_plant_file, run_sil, CommissionOptions, SensorModel};
 use serde_json::Value;
 
@@ -182,17 +182,12 @@ fn sil_recording_follows_the_plan() {
 /// A short plan for the slower runs: the hold (pulse log) and a step test of
 /// two angles with its law stages, 3.3 s in all.
 fn short_plan() -> (Plan, Selection) {
-    let mut plan = Plan {
-        step: StepPlan {
-            range_deg: [300.0, 700.0],
-            points: 2,
-            hold_s: 0.6,
-            law_s: 0.8,
-            inputs: [8.6, 6.0],
-            t_u_step: 8.0,
-        },
-        ..Plan::default()
-    };
+    // The step test at the default set-points, on two angles.
+    let mut plan = Plan::default();
+    plan.step.range_deg = [300.0, 700.0];
+    plan.step.points = 2;
+    plan.step.hold_s = 0.6;
+    plan.step.law_s = 0.8;
     plan.hold.hold_s = 0.5;
     plan.hold.theta_ct_deg = 600.0;
     let sel =
