@@ -33,6 +33,13 @@ impl<const N: usize> Put<N> {
             self.f32(x);
         }
     }
+    /// One flag byte: bit i is `bits[i]` (bit 0 first; at most eight).
+    pub(crate) fn flags(&mut self, bits: &[bool]) {
+        let byte = (0u8..8)
+            .zip(bits)
+            .fold(0u8, |byte, (i, &on)| byte | u8::from(on) << i);
+        self.bytes(&[byte]);
+    }
     pub(crate) fn done(&self) -> &[u8] {
         &self.buf[..self.at.min(N)]
     }
@@ -70,6 +77,16 @@ impl Get<'_> {
     pub(crate) fn f32s<const N: usize>(&mut self) -> [f32; N] {
         core::array::from_fn(|_| self.f32())
     }
+    /// The first `N` bits of a flag byte [`Put::flags`] wrote (bit 0 first;
+    /// a bit past the eighth reads false).
+    pub(crate) fn flags<const N: usize>(&mut self) -> [bool; N] {
+        let byte = self.u8();
+        let mut bits = [false; N];
+        for (i, bit) in (0u8..8).zip(bits.iter_mut()) {
+            *bit = byte >> i & 1 != 0;
+        }
+        bits
+    }
 }
 
 /// A reader over `payload` after checking that it is `len` bytes long.
@@ -84,5 +101,26 @@ pub(crate) fn expect_len(kind: u8, payload: &[u8], len: usize) -> Result<Get<'_>
             kind,
             len: payload.len() as u8,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Get, Put};
+
+    #[test]
+    fn flag_bytes_are_bit_zero_first() {
+        let mut p = Put::<3>::new();
+        p.flags(&[true, false, true]); // 0b101, the Output flags of msg.rs's table
+        p.flags(&[false, true]); // 0b10
+        p.flags(&[true; 9]); // a ninth flag has no bit
+        assert_eq!(p.done(), &[0b101, 0b10, 0xFF]);
+        let mut g = Get { p: p.done() };
+        assert_eq!(g.flags::<3>(), [true, false, true]);
+        assert_eq!(g.flags::<2>(), [false, true]);
+        assert_eq!(
+            g.flags::<9>(),
+            [true, true, true, true, true, true, true, true, false]
+        );
     }
 }

@@ -216,14 +216,14 @@ impl Request {
 fn put_output<const N: usize>(p: &mut Put<N>, o: &ControlOutput) {
     p.f32s(&[o.omega, o.omega_a, o.omega_t, o.r_ol, o.r_d, o.r]);
     p.bytes(&o.stepper_target.to_le_bytes());
-    let flags = o.saturated as u8 | (o.ready as u8) << 1 | (o.inputs_clamped as u8) << 2;
-    p.bytes(&[flags, o.fault.code(), o.ol_region.code()]);
+    p.flags(&[o.saturated, o.ready, o.inputs_clamped]);
+    p.bytes(&[o.fault.code(), o.ol_region.code()]);
 }
 
 fn get_output(g: &mut Get<'_>) -> Result<ControlOutput, WireError> {
     let [omega, omega_a, omega_t, r_ol, r_d, r] = g.f32s();
     let stepper_target = g.i32();
-    let flags = g.u8();
+    let [saturated, ready, inputs_clamped] = g.flags();
     Ok(ControlOutput {
         omega,
         omega_a,
@@ -232,9 +232,9 @@ fn get_output(g: &mut Get<'_>) -> Result<ControlOutput, WireError> {
         r_d,
         r,
         stepper_target,
-        saturated: flags & 1 != 0,
-        ready: flags & 2 != 0,
-        inputs_clamped: flags & 4 != 0,
+        saturated,
+        ready,
+        inputs_clamped,
         fault: Fault::from_code(g.u8()).ok_or(WireError::BadValue)?,
         ol_region: OlRegion::from_code(g.u8()).ok_or(WireError::BadValue)?,
     })
@@ -273,7 +273,7 @@ impl Reply {
             } => {
                 put_output(&mut p, &out);
                 p.u32(stage);
-                p.bytes(&[started as u8 | (pulse_log as u8) << 1 | (done as u8) << 2]);
+                p.flags(&[started, pulse_log, done]);
                 K_R_SEQUENCED
             }
         };
@@ -304,13 +304,13 @@ impl Reply {
                 let mut g = expect_len(kind, payload, SEQUENCED_LEN)?;
                 let out = get_output(&mut g)?;
                 let stage = g.u32();
-                let flags = g.u8();
+                let flags: [bool; 3] = g.flags();
                 Reply::Sequenced {
                     out,
                     stage,
-                    started: flags & 1 != 0,
-                    pulse_log: flags & 2 != 0,
-                    done: flags & 4 != 0,
+                    started: flags[0],
+                    pulse_log: flags[1],
+                    done: flags[2],
                 }
             }
             other => return Err(WireError::UnknownKind(other)),

@@ -173,7 +173,7 @@ impl TelemetryFrame {
                 p.bytes(&[s.sequence.code()]);
                 p.u16(s.index);
                 p.f32(s.theta_ct_deg);
-                p.bytes(&[u8::from(s.hold) | u8::from(s.pulse_log) << 1]);
+                p.flags(&[s.hold, s.pulse_log]);
                 K_STAGE
             }
         };
@@ -230,14 +230,14 @@ impl TelemetryFrame {
                 let sequence = SequenceName::from_code(g.u8()).ok_or(WireError::BadValue)?;
                 let index = g.u16();
                 let theta_ct_deg = g.f32();
-                let flags = g.u8();
+                let [hold, pulse_log] = g.flags();
                 Self::Stage(StageStart {
                     time_ticks,
                     sequence,
                     index,
                     theta_ct_deg,
-                    hold: flags & 1 != 0,
-                    pulse_log: flags & 2 != 0,
+                    hold,
+                    pulse_log,
                 })
             }
             _ => {
