@@ -268,13 +268,7 @@ mod tests {
     /// all three ways of giving the blocks.
     #[test]
     fn equals_elimination_on_the_assembled_matrix() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut next = crate::test_rng::uniform(0x9e37_79b9_7f4a_7c15u64);
         for m in [1usize, 5, 40] {
             for k in [0usize, 1, 2] {
                 let n = m + k;

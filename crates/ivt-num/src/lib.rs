@@ -40,6 +40,8 @@ pub mod newton;
 pub mod rk;
 pub mod small;
 pub mod tableau;
+#[cfg(test)]
+mod test_rng;
 pub mod vector;
 
 pub use bordered::{BorderedError, BorderedLu};

@@ -134,10 +134,7 @@ impl LuWorkspace {
     /// of a panic.
     pub fn solve(&mut self, rhs: &mut [f64]) {
         let n = self.dim();
-        let Some(rhs) = rhs.get_mut(..n) else {
-            rhs.fill(f64::NAN);
-            return;
-        };
+        let Some(rhs) = leading(rhs, n) else { return };
         let (mat, y) = (&self.mat, &mut self.column);
         for (yi, &p) in y.iter_mut().zip(&self.perm) {
             *yi = rhs.get(p).copied().unwrap_or(f64::NAN);
@@ -180,10 +177,7 @@ impl LuWorkspace {
     /// As [`LuWorkspace::solve`]: a short `rhs` is filled with NaN.
     pub fn solve_transpose(&mut self, rhs: &mut [f64]) {
         let n = self.dim();
-        let Some(rhs) = rhs.get_mut(..n) else {
-            rhs.fill(f64::NAN);
-            return;
-        };
+        let Some(rhs) = leading(rhs, n) else { return };
         let (mat, w) = (&self.mat, &mut self.column);
         for i in 0..n {
             let col = mat.col_as_slice(i);
@@ -263,6 +257,16 @@ impl LuWorkspace {
         }
         out.iter().all(|v| v.is_finite())
     }
+}
+
+/// The first `n` entries of a right-hand side, or None after filling a
+/// shorter `rhs` with NaN (a caller's bug reported in the result, not a panic).
+fn leading(rhs: &mut [f64], n: usize) -> Option<&mut [f64]> {
+    if rhs.len() < n {
+        rhs.fill(f64::NAN);
+        return None;
+    }
+    rhs.get_mut(..n)
 }
 
 /// Inverse of the row-major `n × n` matrix `a`, row-major (set-up use: it
@@ -368,13 +372,7 @@ mod tests {
     /// level (≤ 1e-12·‖A‖·‖x‖).
     #[test]
     fn one_vector_substitution_equals_the_blocked_solve() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut next = crate::test_rng::uniform(0x2545_f491_4f6c_dd1du64);
         for n in [1, 2, 3, 7, 42, 83, 170] {
             // Small diagonal: partial pivoting must swap rows.
             let a: Vec<f64> = (0..n * n)
