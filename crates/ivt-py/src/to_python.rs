@@ -112,6 +112,16 @@ impl<'py> MapSer<'py> {
     }
 }
 
+/// The `Serializer` methods of the scalars Python takes as they are (`int`,
+/// `float`, `bool`, a one-character `str`, `bytes`).
+macro_rules! scalar_methods {
+    ($($method:ident: $t:ty),+ $(,)?) => {$(
+        fn $method(self, v: $t) -> Res<'py> {
+            self.any(v)
+        }
+    )+};
+}
+
 impl<'py> ser::Serializer for Ser<'py> {
     type Ok = Bound<'py, PyAny>;
     type Error = Error;
@@ -123,47 +133,16 @@ impl<'py> ser::Serializer for Ser<'py> {
     type SerializeStruct = MapSer<'py>;
     type SerializeStructVariant = MapSer<'py>;
 
-    fn serialize_bool(self, v: bool) -> Res<'py> {
-        self.any(v)
-    }
-    fn serialize_i8(self, v: i8) -> Res<'py> {
-        self.any(v)
-    }
-    fn serialize_i16(self, v: i16) -> Res<'py> {
-        self.any(v)
-    }
-    fn serialize_i32(self, v: i32) -> Res<'py> {
-        self.any(v)
-    }
-    fn serialize_i64(self, v: i64) -> Res<'py> {
-        self.any(v)
-    }
-    fn serialize_u8(self, v: u8) -> Res<'py> {
-        self.any(v)
-    }
-    fn serialize_u16(self, v: u16) -> Res<'py> {
-        self.any(v)
-    }
-    fn serialize_u32(self, v: u32) -> Res<'py> {
-        self.any(v)
-    }
-    fn serialize_u64(self, v: u64) -> Res<'py> {
-        self.any(v)
-    }
+    scalar_methods!(
+        serialize_bool: bool, serialize_char: char, serialize_f64: f64, serialize_bytes: &[u8],
+        serialize_i8: i8, serialize_i16: i16, serialize_i32: i32, serialize_i64: i64,
+        serialize_u8: u8, serialize_u16: u16, serialize_u32: u32, serialize_u64: u64,
+    );
     fn serialize_f32(self, v: f32) -> Res<'py> {
         self.any(f64::from(v))
     }
-    fn serialize_f64(self, v: f64) -> Res<'py> {
-        self.any(v)
-    }
-    fn serialize_char(self, v: char) -> Res<'py> {
-        self.any(v)
-    }
     fn serialize_str(self, v: &str) -> Res<'py> {
         Ok(PyString::new(self.py, v).into_any())
-    }
-    fn serialize_bytes(self, v: &[u8]) -> Res<'py> {
-        self.any(v)
     }
     fn serialize_none(self) -> Res<'py> {
         Ok(self.py.None().into_bound(self.py))
