@@ -4,9 +4,10 @@
 
 use super::{CliError, Output};
 use clap::{Args, Subcommand};
-use ivt_sim::telemetry::{record, RecordOptions};
+use ivt_sim::telemetry::{record, RecordOptions, RecordSummary, FIRMWARE_PPR};
 use serde_json::json;
-use std::path::PathBuf;
+use std::io::Read;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 /// `ivt rig ...`
@@ -71,20 +72,10 @@ fn record_cmd(a: &RecordArgs) -> Result<Output, CliError> {
                 a.idle_timeout_s
             ))
         })?;
-    let port = serialport::new(&a.port, a.baud)
-        .timeout(Duration::from_millis(100))
-        .open()
-        .map_err(|e| CliError::Failed(format!("{}: {e}", a.port)))?;
+    let port = open_port(&a.port, a.baud)?;
     // Tell whoever waits (a test driving the firmware) that the port is open.
     super::note(&format!("recording from {}", a.port));
-    let opts = RecordOptions {
-        f_timer_hz: a.f_timer_hz,
-        max_frames: a.frames,
-        idle_timeout,
-        ppr: ivt_sim::telemetry::FIRMWARE_PPR,
-        strict: false,
-    };
-    let s = record(port, &a.out, &opts).map_err(|e| CliError::Failed(e.to_string()))?;
+    let s = record_live(port, &a.out, a.f_timer_hz, a.frames, idle_timeout)?;
     let human = format!(
         "{} telemetry frames ({} bad) over {:.3} s → {}\n",
         s.frames,
@@ -104,4 +95,35 @@ fn record_cmd(a: &RecordArgs) -> Result<Output, CliError> {
         }),
         human,
     })
+}
+
+/// Opens the rig's serial port (reads time out after 100 ms, so that the
+/// recorder sees the port idle).
+pub(super) fn open_port(
+    port: &str,
+    baud: u32,
+) -> Result<Box<dyn serialport::SerialPort>, CliError> {
+    serialport::new(port, baud)
+        .timeout(Duration::from_millis(100))
+        .open()
+        .map_err(|e| CliError::Failed(format!("{port}: {e}")))
+}
+
+/// Records a live port's telemetry into `out`: the firmware's PPR in the
+/// metadata, bad frames counted and skipped (not `strict`).
+pub(super) fn record_live<R: Read>(
+    src: R,
+    out: &Path,
+    f_timer_hz: f64,
+    max_frames: Option<u64>,
+    idle_timeout: Duration,
+) -> Result<RecordSummary, CliError> {
+    let opts = RecordOptions {
+        f_timer_hz,
+        max_frames,
+        idle_timeout,
+        ppr: FIRMWARE_PPR,
+        strict: false,
+    };
+    record(src, out, &opts).map_err(|e| CliError::Failed(e.to_string()))
 }

@@ -8,7 +8,6 @@ use super::{CliError, Output};
 use clap::{Args, ValueEnum};
 use ivt_ctrl::commission::{Plan, Selection, SequenceName};
 use ivt_sim::commission::{load_plant_file, run_sil, CommissionOptions, SensorModel};
-use ivt_sim::telemetry::{record, RecordOptions};
 use serde_json::json;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -158,10 +157,7 @@ fn on_rig(
     selection: Selection,
     plan: &Plan,
 ) -> Result<Output, CliError> {
-    let mut dev = serialport::new(port, a.baud)
-        .timeout(Duration::from_millis(100))
-        .open()
-        .map_err(|e| CliError::Failed(format!("{port}: {e}")))?;
+    let mut dev = super::rig::open_port(port, a.baud)?;
     let mut frame = [0u8; ivt_wire::MAX_FRAME];
     let n = ivt_wire::Request::Commission {
         selection,
@@ -173,15 +169,15 @@ fn on_rig(
         .map_err(|e| CliError::Failed(format!("{port}: {e}")))?;
     super::note(&format!("commissioning started on {port}"));
     let total = plan.duration_s(selection, ivt_ctrl::Config::default().open_loop.r_max);
-    let opts = RecordOptions {
-        f_timer_hz: a.f_timer_hz,
-        // The rig sends a sample every 10 ms: the plan and one second more.
-        max_frames: Some((f64::from(total) * 100.0).ceil() as u64 + 100),
-        idle_timeout: Duration::from_secs(2),
-        ppr: ivt_sim::telemetry::FIRMWARE_PPR,
-        strict: false,
-    };
-    let s = record(dev, &a.out, &opts).map_err(|e| CliError::Failed(e.to_string()))?;
+    // The rig sends a sample every 10 ms: the plan and one second more.
+    let max_frames = (f64::from(total) * 100.0).ceil() as u64 + 100;
+    let s = super::rig::record_live(
+        dev,
+        &a.out,
+        a.f_timer_hz,
+        Some(max_frames),
+        Duration::from_secs(2),
+    )?;
     let human = format!(
         "{} telemetry frames ({} bad) over {:.1} s of a {:.0} s plan → {}\n",
         s.frames,
