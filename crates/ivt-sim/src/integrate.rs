@@ -97,14 +97,24 @@ struct TimeSys<'a, P> {
     prof: &'a P,
 }
 
+/// The stepper's state and derivative as `DIM`-arrays, or None after filling
+/// `dy` with NaN: the stepper hands exactly DIM values, so any other length
+/// is a bug that shows as a non-finite state (SimError::NotFinite), never a
+/// panic.
+#[inline(always)]
+fn state<'a>(y: &'a [f64], dy: &'a mut [f64]) -> Option<(&'a [f64; DIM], &'a mut [f64; DIM])> {
+    if y.len() != DIM || dy.len() != DIM {
+        dy.fill(f64::NAN);
+        return None;
+    }
+    Some((y.try_into().ok()?, dy.try_into().ok()?))
+}
+
 impl<P: InputProfile> TimeSys<'_, P> {
     /// `dy = F(t, y)` with `y = [θ, ω, i_a]`.
     #[inline(always)]
     fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
-        // The stepper hands exactly DIM values; anything else is a bug that
-        // shows as a non-finite state (SimError::NotFinite), never a panic.
-        let ([th, om, ia], Ok(dy)) = (y, <&mut [f64; DIM]>::try_from(&mut *dy)) else {
-            dy.fill(f64::NAN);
+        let Some(([th, om, ia], dy)) = state(y, dy) else {
             return;
         };
         let (v_m, t_u) = self.prof.at(t);
@@ -182,9 +192,7 @@ impl<P: InputProfile> AngleSys<'_, P> {
     /// `dz = dz/dθ` with `z = [t, ω, i_a]` (Eq. 162).
     #[inline(always)]
     fn rhs(&self, theta: f64, z: &[f64], dz: &mut [f64]) {
-        // As in the time domain: a wrong length shows as a non-finite state.
-        let ([t, om, ia], Ok(dz)) = (z, <&mut [f64; DIM]>::try_from(&mut *dz)) else {
-            dz.fill(f64::NAN);
+        let Some(([t, om, ia], dz)) = state(z, dz) else {
             return;
         };
         let (v_m, t_u) = self.prof.at(*t);
