@@ -6,14 +6,14 @@
 
 use ivt_sim::integrate::{Method, Tolerance};
 use ivt_sim::scene::Scene;
+use ivt_sim::testing::shipped_scene;
 
 fn main() {
     divan::main();
 }
 
 fn drive() -> Scene {
-    let src = include_str!("../../../scenes/drive.toml");
-    Scene::parse(src, "drive.toml").expect("shipped scene parses")
+    shipped_scene("drive.toml")
 }
 
 /// The closed loop alone (no channels, no files).

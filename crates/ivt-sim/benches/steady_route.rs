@@ -10,14 +10,14 @@
 use ivt_sim::run::Simulation;
 use ivt_sim::scene::Scene;
 use ivt_sim::steady::{ihb_steady_state, Route};
+use ivt_sim::testing::shipped_scene;
 
 fn main() {
     divan::main();
 }
 
 fn scene() -> Scene {
-    let src = include_str!("../../../scenes/steady_state.toml");
-    Scene::parse(src, "steady_state.toml").expect("shipped scene parses")
+    shipped_scene("steady_state.toml")
 }
 
 fn saturated() -> Scene {

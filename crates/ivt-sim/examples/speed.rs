@@ -15,6 +15,7 @@
 
 use ivt_sim::run::Simulation;
 use ivt_sim::scene::Scene;
+use ivt_sim::testing::shipped_scene;
 use std::path::Path;
 use std::time::Instant;
 
@@ -39,8 +40,7 @@ fn main() {
         .nth(1)
         .and_then(|a| a.parse().ok())
         .unwrap_or(15);
-    let src = include_str!("../../../scenes/drive.toml");
-    let mut scene = Scene::parse(src, "scenes/drive.toml").expect("shipped scene parses");
+    let mut scene = shipped_scene("drive.toml");
     scene.outputs.plots.clear();
     let dir = std::env::temp_dir().join("ivt-sim-speed");
     println!("mode      best wall   best loop-thread CPU   process CPU per run");

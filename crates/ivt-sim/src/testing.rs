@@ -1,6 +1,7 @@
-//! Test support shared by this crate's tests and the workspace's CLI tests:
-//! fresh scratch directories and sorted directory listings (used to prove
-//! that an atomic write left nothing behind).
+//! Test support shared by this crate's tests, benches and examples and the
+//! workspace's CLI tests: fresh scratch directories, sorted directory
+//! listings (used to prove that an atomic write left nothing behind) and the
+//! shipped scenes.
 //!
 //! Not part of the simulator's API; these helpers panic on I/O errors,
 //! which is what a test wants. The crate's panic lints are lifted for this
@@ -8,6 +9,7 @@
 //! share, and no library path calls it.
 #![allow(clippy::expect_used)]
 
+use crate::scene::Scene;
 use std::path::{Path, PathBuf};
 
 /// A fresh, empty directory `ivt-{name}-{pid}` under the system temporary
@@ -38,4 +40,16 @@ pub fn listing(dir: &Path) -> Vec<String> {
         .collect();
     v.sort();
     v
+}
+
+/// The scene `file` of the repository's `scenes/` directory, as shipped (so
+/// that what is tested or timed is what ships).
+///
+/// # Panics
+/// If the file cannot be read or does not parse.
+pub fn shipped_scene(file: &str) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(file);
+    Scene::load(&path).expect("shipped scene parses")
 }

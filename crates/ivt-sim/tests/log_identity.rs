@@ -14,6 +14,7 @@
 use ivt_sim::record::Sample;
 use ivt_sim::run::Simulation;
 use ivt_sim::scene::{IntegratorMethod, Scene};
+use ivt_sim::testing::shipped_scene;
 
 /// FNV-1a, 64 bit.
 fn fnv(hash: &mut u64, bytes: &[u8]) {
@@ -60,8 +61,7 @@ fn fingerprint(scene: &Scene) -> (u64, usize) {
 }
 
 fn drive() -> Scene {
-    let src = include_str!("../../../scenes/drive.toml");
-    Scene::parse(src, "drive.toml").expect("shipped scene parses")
+    shipped_scene("drive.toml")
 }
 
 /// The default scene as shipped: RK4 with one step per pulse after a DP5
