@@ -494,7 +494,7 @@ pub fn turn_estimate(a: &PathPoint, b: &PathPoint, c: &PathPoint) -> Vec<f64> {
 
 /// [`turn_estimate`] and which of the three points (0, 1, 2) lies nearest
 /// the turn in arclength.
-fn turn(a: &PathPoint, b: &PathPoint, c: &PathPoint) -> (Vec<f64>, usize) {
+pub(crate) fn turn(a: &PathPoint, b: &PathPoint, c: &PathPoint) -> (Vec<f64>, usize) {
     let dist = |p: &PathPoint, q: &PathPoint| {
         p.x.iter()
             .zip(&q.x)

@@ -15,11 +15,9 @@
 //!    unknowns; `a_1` is then the continuation parameter.
 
 use crate::aft::{embed_subharmonic, resize_harmonics};
-use crate::bifurcation::{
-    locate_multiplier_crossing, BifurcationError, BifurcationKind, BifurcationOptions,
-};
 use crate::broyden::{broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace};
 use crate::continuation::{pseudo_arclength, ContinuationOptions};
+use crate::events::{locate_multiplier_crossing, BifurcationError, BifurcationKind, LocateOptions};
 use crate::family::FamilyBranch;
 use crate::floquet::HsuRule;
 use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
@@ -195,9 +193,9 @@ fn locate_period_doubling(
         BifurcationKind::PeriodDoubling,
         q,
         beta,
-        &BifurcationOptions {
+        &LocateOptions {
             stability_steps: opts.hsu_steps_per_harmonic * hb.harmonics,
-            ..BifurcationOptions::default()
+            ..LocateOptions::default()
         },
     )
     .map_err(|e| match e {

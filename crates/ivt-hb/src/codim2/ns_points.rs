@@ -5,9 +5,9 @@
 //! pair of Floquet multipliers on the unit circle). Not a continuation of the curve: a turn of the boundary
 //! in p between two samples is not followed, and each sample costs a trace.
 
-use crate::bifurcation::BifurcationKind;
 use crate::continuation::Corrector;
 use crate::error::HbError;
+use crate::events::BifurcationKind;
 use crate::ihb::HbOptions;
 use crate::jobs::{frc, FrcRequest};
 use crate::problem::PeriodicProblem;
