@@ -487,7 +487,7 @@ where
 /// `c` around a fold: the quadratic through them in chord arclength s,
 /// evaluated where its λ(s) is extremal (`b` itself if λ(s) is straight).
 /// Off the path by O(Δη³) rather than the O(Δη) of the nearest point: the
-/// start for [`crate::fold::locate_fold`].
+/// start for [`crate::locate_fold`].
 pub fn turn_estimate(a: &PathPoint, b: &PathPoint, c: &PathPoint) -> Vec<f64> {
     turn(a, b, c).0
 }

@@ -6,7 +6,7 @@
 //!    coefficients (n = 9) and followed in β by pseudo-arclength continuation
 //!    with Hsu multipliers at every point.
 //! 2. The crossing μ = −1, bracketed by two path points, is located by Newton
-//!    on the extended system of [`crate::bifurcation`] (the branch in β with
+//!    on the extended system of [`crate::events`] (the branch in β with
 //!    the bordered test function of Φ + I), as every event of [`crate::trace`].
 //! 3. The period-2p branch is entered with the controlled-amplitude scheme of
 //!    Eq. 84–85: the solution is embedded with harmonic k → 2k

@@ -238,16 +238,16 @@ impl<F: Family> Detector<F> for Fold {
         BifurcationKind::Fold
     }
 
-    fn test(&mut self, _branch: &mut FamilyBranch<F>, path: &PathSoFar, k: usize) -> f64 {
-        path.points.get(k).map_or(f64::NAN, |p| p.dlambda)
-    }
-
     fn start(&self, path: &PathSoFar) -> Option<usize> {
         let k = path.len().checked_sub(3)?;
         let [a, b, c] = path.points.get(k..)? else {
             return None;
         };
         Some(k + turn(a, b, c).1)
+    }
+
+    fn test(&mut self, _branch: &mut FamilyBranch<F>, path: &PathSoFar, k: usize) -> f64 {
+        path.points.get(k).map_or(f64::NAN, |p| p.dlambda)
     }
 
     /// [`locate_fold`] with a step tolerance of at most [`FOLD_STEP_TOL`],

@@ -49,8 +49,8 @@ use crate::family::{Family, FamilyBranch};
 use crate::ihb::HbError;
 
 /// Locates the period doubling (multiplier −1) or Neimark–Sacker point (complex
-/// pair on the unit circle) nearest the converged orbit `(q0, λ0)` of `branch`:
-/// [`PeriodDoubling::locate_at`] or [`NeimarkSacker::locate_at`] by `kind`.
+/// pair on the unit circle) nearest the converged orbit `(q0, λ0)` of `branch`,
+/// as the [`PeriodDoubling`] and [`NeimarkSacker`] detectors locate them.
 ///
 /// # Errors
 /// [`BifurcationError::Hb`] for another kind, sizes, a singular bordered or
@@ -65,8 +65,13 @@ pub fn locate_multiplier_crossing<F: Family>(
     opts: &LocateOptions,
 ) -> Result<Bifurcation, BifurcationError> {
     match kind {
-        BifurcationKind::PeriodDoubling => PeriodDoubling::locate_at(branch, q0, lambda0, opts),
-        BifurcationKind::NeimarkSacker => NeimarkSacker::locate_at(branch, q0, lambda0, opts),
+        BifurcationKind::PeriodDoubling => {
+            let matrix = (kind, period_doubling::shifted_monodromy as _);
+            multipliers::locate_crossing(branch, matrix, q0, lambda0, opts)
+        }
+        BifurcationKind::NeimarkSacker => {
+            neimark_sacker::locate_neimark_sacker(branch, (q0, lambda0), opts)
+        }
         BifurcationKind::Fold | BifurcationKind::BranchPoint => Err(HbError::InvalidInput(
             "locate_multiplier_crossing takes period doubling or Neimark–Sacker".into(),
         )

@@ -18,7 +18,7 @@ use crate::continuation::PathPoint;
 use crate::family::{Family, FamilyBranch};
 use crate::floquet::{eigenvalues, monodromy_uniform, HsuRule};
 use crate::ihb::HbError;
-use crate::stability::{AdaptiveHsu, HsuSteps, StabilityAnalyzer};
+use crate::stability::{AdaptiveHsu, StabilityAnalyzer};
 use faer::c64;
 use ivt_num::BorderedLu;
 
@@ -29,21 +29,9 @@ pub struct Multipliers {
 }
 
 impl Multipliers {
-    /// Plans the monodromy of `branch`'s orbits at `lambda0`.
-    ///
-    /// # Errors
-    /// As [`AdaptiveHsu::new`].
-    pub fn new<F: Family>(
-        branch: &FamilyBranch<F>,
-        lambda0: f64,
-        steps: HsuSteps,
-    ) -> Result<Self, HbError> {
-        let hsu = AdaptiveHsu::new(
-            &branch.family().at(lambda0).0,
-            branch.options().harmonics,
-            steps,
-        )?;
-        Ok(Self { hsu })
+    /// The observer computing each point's monodromy with `hsu`.
+    pub fn new(hsu: AdaptiveHsu) -> Self {
+        Self { hsu }
     }
 
     /// The arrived `point` with its multipliers. Where the branch's last

@@ -56,34 +56,31 @@ fn complex(p: &TracedPoint) -> bool {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct NeimarkSacker;
 
-impl NeimarkSacker {
-    /// Locates the Neimark–Sacker point nearest the converged orbit
-    /// `(q0, λ0)`.
-    ///
-    /// # Errors
-    /// [`BifurcationError::Hb`] for sizes, a singular bordered or extended
-    /// system (with the history), non-convergence;
-    /// [`BifurcationError::NeutralSaddle`] when the search ends on a real
-    /// pair `μ, 1/μ`.
-    pub fn locate_at<F: Family>(
-        branch: &mut FamilyBranch<F>,
-        q0: &[f64],
-        lambda0: f64,
-        opts: &LocateOptions,
-    ) -> Result<Bifurcation, BifurcationError> {
-        let kind = (BifurcationKind::NeimarkSacker, compound_minus_identity as _);
-        let found = locate_crossing(branch, kind, q0, lambda0, opts)?;
-        let on_circle = found
-            .multipliers
-            .iter()
-            .any(|z| (z.norm() - 1.0).abs() < 1e-6 && z.im.abs() > 1e-6);
-        if !on_circle {
-            return Err(BifurcationError::NeutralSaddle {
-                lambda: found.lambda,
-            });
-        }
-        Ok(found)
+/// Locates the Neimark–Sacker point nearest the converged orbit `start =
+/// (q0, λ0)`.
+///
+/// # Errors
+/// [`BifurcationError::Hb`] for sizes, a singular bordered or extended
+/// system (with the history), non-convergence;
+/// [`BifurcationError::NeutralSaddle`] when the search ends on a real pair
+/// `μ, 1/μ`.
+pub(crate) fn locate_neimark_sacker<F: Family>(
+    branch: &mut FamilyBranch<F>,
+    (q0, lambda0): (&[f64], f64),
+    opts: &LocateOptions,
+) -> Result<Bifurcation, BifurcationError> {
+    let kind = (BifurcationKind::NeimarkSacker, compound_minus_identity as _);
+    let found = locate_crossing(branch, kind, q0, lambda0, opts)?;
+    let on_circle = found
+        .multipliers
+        .iter()
+        .any(|z| (z.norm() - 1.0).abs() < 1e-6 && z.im.abs() > 1e-6);
+    if !on_circle {
+        return Err(BifurcationError::NeutralSaddle {
+            lambda: found.lambda,
+        });
     }
+    Ok(found)
 }
 
 impl<F: Family> Detector<F> for NeimarkSacker {
@@ -103,7 +100,6 @@ impl<F: Family> Detector<F> for NeimarkSacker {
     }
 
     fn locate(&mut self, at: Start<'_, F>) -> Result<Bifurcation, BifurcationError> {
-        let (q, lambda) = at.point()?;
-        Self::locate_at(at.branch, q, lambda, at.opts)
+        locate_neimark_sacker(at.branch, at.point()?, at.opts)
     }
 }

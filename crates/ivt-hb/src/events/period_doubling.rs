@@ -7,9 +7,7 @@
 #![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
 #![cfg_attr(not(test), deny(clippy::unimplemented))]
 
-use super::detector::{
-    Bifurcation, BifurcationError, BifurcationKind, Detector, LocateOptions, PathSoFar, Start,
-};
+use super::detector::{Bifurcation, BifurcationError, BifurcationKind, Detector, PathSoFar, Start};
 use super::multipliers::locate_crossing;
 use crate::family::{Family, FamilyBranch};
 use faer::c64;
@@ -34,23 +32,6 @@ fn indicator(mu: &[c64]) -> f64 {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct PeriodDoubling;
 
-impl PeriodDoubling {
-    /// Locates the period doubling nearest the converged orbit `(q0, λ0)`.
-    ///
-    /// # Errors
-    /// [`BifurcationError::Hb`] for sizes, a singular bordered or extended
-    /// system (with the history), non-convergence.
-    pub fn locate_at<F: Family>(
-        branch: &mut FamilyBranch<F>,
-        q0: &[f64],
-        lambda0: f64,
-        opts: &LocateOptions,
-    ) -> Result<Bifurcation, BifurcationError> {
-        let kind = (BifurcationKind::PeriodDoubling, shifted_monodromy as _);
-        locate_crossing(branch, kind, q0, lambda0, opts)
-    }
-}
-
 impl<F: Family> Detector<F> for PeriodDoubling {
     fn kind(&self) -> BifurcationKind {
         BifurcationKind::PeriodDoubling
@@ -62,6 +43,7 @@ impl<F: Family> Detector<F> for PeriodDoubling {
 
     fn locate(&mut self, at: Start<'_, F>) -> Result<Bifurcation, BifurcationError> {
         let (q, lambda) = at.point()?;
-        Self::locate_at(at.branch, q, lambda, at.opts)
+        let kind = (BifurcationKind::PeriodDoubling, shifted_monodromy as _);
+        locate_crossing(at.branch, kind, q, lambda, at.opts)
     }
 }

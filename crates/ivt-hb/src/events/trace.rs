@@ -20,7 +20,7 @@ use crate::continuation::{ContinuationOptions, Corrector, PathPoint, Termination
 use crate::family::{Family, FamilyBranch};
 use crate::fold::Branch;
 use crate::ihb::HbError;
-use crate::stability::HsuSteps;
+use crate::stability::{AdaptiveHsu, HsuSteps};
 
 /// Options of [`trace`].
 #[derive(Debug, Clone, PartialEq)]
@@ -82,7 +82,7 @@ impl<F: Family> EventObserver<F> {
     /// `stability`, events located with `opts`.
     ///
     /// # Errors
-    /// As [`Multipliers::new`].
+    /// As [`AdaptiveHsu::new`].
     pub fn new(
         branch: &FamilyBranch<F>,
         lambda0: f64,
@@ -97,7 +97,11 @@ impl<F: Family> EventObserver<F> {
         ];
         let n = detectors.len();
         Ok(Self {
-            multipliers: Multipliers::new(branch, lambda0, stability)?,
+            multipliers: Multipliers::new(AdaptiveHsu::new(
+                &branch.family().at(lambda0).0,
+                branch.options().harmonics,
+                stability,
+            )?),
             detectors,
             tests: vec![f64::NAN; n],
             pending: Vec::new(),
