@@ -237,3 +237,53 @@ pub fn trace<F: Family>(
         termination: path.termination,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::family::Frequency;
+    use crate::frc::FrcOptions;
+    use crate::ihb::HbOptions;
+    use crate::{BifurcationKind, Duffing, ModifiedIhb};
+
+    #[test]
+    fn folds_are_located_as_the_points_arrive_not_after_the_path() {
+        // Fig. 29 (Duffing, ξ = 0.02, F = 0.1) followed by the exact
+        // corrector, which hands each point over as it is reached: each fold
+        // is returned by the observer at most two points after its start
+        // (the point nearest the turn), long before the path ends, at the
+        // shooting values 1.6548121 and 1.1687244 (tests/frc.rs).
+        let d = Duffing::new(0.02, 1.0, 1.0, 0.1);
+        let hb = HbOptions::new(20, 64).with_tol(1e-10);
+        let start = ModifiedIhb::new(&d, hb.clone())
+            .unwrap()
+            .solve(0.2, None)
+            .unwrap();
+        let mut branch = FamilyBranch::new(Frequency(&d), &hb, 0.2).unwrap();
+        let opts = LocateOptions::default();
+        let mut observer = EventObserver::new(&branch, 0.2, HsuSteps::default(), &opts).unwrap();
+        let mut copts = FrcOptions::default().continuation;
+        (copts.lambda_min, copts.lambda_max) = (0.2, 3.0);
+        let mut x0 = start.coeffs.clone();
+        x0.push(0.2);
+        let mut arrived = Vec::new();
+        let mut count = 0;
+        let path = branch
+            .follow(&x0, 0, 1.0, &copts, Corrector::Newton, |b, p| {
+                let found = observer.on_point(b, p).unwrap();
+                arrived.extend(found.into_iter().map(|e| (count, e)));
+                count += 1;
+            })
+            .unwrap();
+        assert_eq!(path.termination, Termination::LeftInterval);
+        let n = path.points.len();
+        assert_eq!(arrived.len(), 2, "{arrived:?}");
+        for ((at, e), want) in arrived.iter().zip([1.6548121, 1.1687244]) {
+            assert_eq!(e.kind, BifurcationKind::Fold);
+            assert!(e.index < *at && *at <= e.index + 2, "{at} {e:?}");
+            assert!(*at + 10 < n, "{at} of {n}");
+            let lambda = e.location.as_ref().unwrap().lambda;
+            assert!((lambda - want).abs() < 1e-7, "{lambda} vs {want}");
+        }
+    }
+}
