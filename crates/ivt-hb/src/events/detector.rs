@@ -69,7 +69,7 @@ impl Default for LocateOptions {
 
 impl LocateOptions {
     /// The options of a fold located on its own ([`crate::locate_fold`]):
-    /// step tolerance [`FOLD_STEP_TOL`], 25 Newton steps.
+    /// step tolerance 1e-12, 25 Newton steps.
     pub fn fold() -> Self {
         Self {
             step_tol: FOLD_STEP_TOL,

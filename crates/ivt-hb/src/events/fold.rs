@@ -250,7 +250,7 @@ impl<F: Family> Detector<F> for Fold {
         path.points.get(k).map_or(f64::NAN, |p| p.dlambda)
     }
 
-    /// [`locate_fold`] with a step tolerance of at most [`FOLD_STEP_TOL`],
+    /// [`locate_fold`] with a step tolerance of at most 1e-12,
     /// then the multipliers there.
     fn locate(&mut self, at: Start<'_, F>) -> Result<Bifurcation, BifurcationError> {
         let (q, lambda) = at.point()?;
