@@ -79,6 +79,22 @@ impl LocateOptions {
     }
 }
 
+/// One point of the traced branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TracedPoint {
+    /// Fourier coefficients.
+    pub q: Vec<f64>,
+    /// Parameter λ.
+    pub lambda: f64,
+    /// Floquet multipliers (Hsu), decreasing modulus.
+    pub multipliers: Vec<c64>,
+    /// Error estimate of their monodromy ([`crate::HsuEstimate::error`]):
+    /// `None` for fixed Hsu steps.
+    pub multiplier_error: Option<f64>,
+    /// Stability class.
+    pub kind: StabilityKind,
+}
+
 /// A located bifurcation.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Bifurcation {
@@ -167,22 +183,6 @@ pub trait Observer<F: Family> {
         branch: &mut FamilyBranch<F>,
         point: &PathPoint,
     ) -> Result<Vec<Event>, HbError>;
-}
-
-/// One point of the traced branch.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TracedPoint {
-    /// Fourier coefficients.
-    pub q: Vec<f64>,
-    /// Parameter λ.
-    pub lambda: f64,
-    /// Floquet multipliers (Hsu), decreasing modulus.
-    pub multipliers: Vec<c64>,
-    /// Error estimate of their monodromy ([`crate::HsuEstimate::error`]):
-    /// `None` for fixed Hsu steps.
-    pub multiplier_error: Option<f64>,
-    /// Stability class.
-    pub kind: StabilityKind,
 }
 
 /// The path as far as it has arrived, as the detectors see it: each accepted

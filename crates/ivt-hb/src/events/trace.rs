@@ -253,8 +253,8 @@ mod tests {
         // is returned by the observer at most two points after its start
         // (the point nearest the turn), long before the path ends, at the
         // shooting values 1.6548121 and 1.1687244 (tests/frc.rs).
-        let d = Duffing::new(0.02, 1.0, 1.0, 0.1);
         let hb = HbOptions::new(20, 64).with_tol(1e-10);
+        let d = Duffing::new(0.02, 1.0, 1.0, 0.1);
         let start = ModifiedIhb::new(&d, hb.clone())
             .unwrap()
             .solve(0.2, None)
