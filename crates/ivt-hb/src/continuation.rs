@@ -487,14 +487,14 @@ where
 /// `c` around a fold: the quadratic through them in chord arclength s,
 /// evaluated where its λ(s) is extremal (`b` itself if λ(s) is straight).
 /// Off the path by O(Δη³) rather than the O(Δη) of the nearest point: the
-/// start for [`crate::fold::locate_fold`].
+/// start for [`crate::locate_fold`].
 pub fn turn_estimate(a: &PathPoint, b: &PathPoint, c: &PathPoint) -> Vec<f64> {
     turn(a, b, c).0
 }
 
 /// [`turn_estimate`] and which of the three points (0, 1, 2) lies nearest
 /// the turn in arclength.
-fn turn(a: &PathPoint, b: &PathPoint, c: &PathPoint) -> (Vec<f64>, usize) {
+pub(crate) fn turn(a: &PathPoint, b: &PathPoint, c: &PathPoint) -> (Vec<f64>, usize) {
     let dist = |p: &PathPoint, q: &PathPoint| {
         p.x.iter()
             .zip(&q.x)

@@ -15,7 +15,8 @@
 use crate::autonomous::{limit_cycle, limit_cycle_branch, LimitCycle};
 use crate::continuation::{ContinuationOptions, Termination};
 use crate::error::HbError;
-use crate::fold::{locate_fold, Branch, FoldOptions};
+use crate::events::{locate_fold, LocateOptions};
+use crate::fold::Branch;
 use crate::galerkin::GalerkinJacobian;
 use crate::hopf::{equilibrium, hopf_points, Field, HopfPoint};
 use crate::ihb::{HbOptions, HbResidual, HbSolution};
@@ -211,7 +212,7 @@ fn locate_folds<B: Branch>(system: &mut B, points: &[(f64, LimitCycle)]) -> Vec<
         let sol = &w[1].1.solution;
         let mut u = sol.coeffs.clone();
         u.push(sol.omega_f);
-        if let Ok(f) = locate_fold(system, &u, b, &FoldOptions::default()) {
+        if let Ok(f) = locate_fold(system, &u, b, &LocateOptions::fold()) {
             let m = f.q.len() - 1;
             let solution = HbSolution {
                 coeffs: f.q[..m].to_vec(),

@@ -7,11 +7,9 @@
 //! ([`crate::continuation::turn_estimate`]).
 
 use crate::aft::Aft;
-use crate::bifurcation::BifurcationKind;
 use crate::continuation::{turn_estimate, ContinuationOptions, Corrector, Path, Termination};
-use crate::events::Trace;
+use crate::events::{locate_fold, BifurcationKind, LocateOptions, Trace};
 use crate::family::{FamilyBranch, Frequency};
-use crate::fold::{locate_fold, FoldOptions};
 use crate::ihb::{HbError, HbOptions, HbSolution};
 use crate::modified::ModifiedIhb;
 use crate::problem::{AtFrequency, PeriodicProblem};
@@ -208,7 +206,7 @@ pub(crate) fn locate_turns<B: crate::fold::Branch>(
             let around = path.points.get(turn.bracket..turn.bracket + 3)?;
             let start = turn_estimate(&around[0], &around[1], &around[2]);
             let (q0, lambda0) = (start.get(..m)?, *start.get(m)?);
-            locate_fold(branch, q0, lambda0, &FoldOptions::default())
+            locate_fold(branch, q0, lambda0, &LocateOptions::fold())
                 .ok()
                 .map(|f| (f.q, f.lambda))
         })

@@ -6,8 +6,6 @@
 pub mod aft;
 pub mod autonomous;
 pub mod backbone;
-pub mod bifurcation;
-pub mod branch_point;
 pub mod broyden;
 pub mod classic;
 pub mod codim2;
@@ -42,10 +40,6 @@ pub mod transient;
 pub use aft::Aft;
 pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
 pub use backbone::{backbone, Backbone, BackboneOptions, BackbonePoint};
-pub use bifurcation::{
-    locate_multiplier_crossing, Bifurcation, BifurcationError, BifurcationKind, BifurcationOptions,
-};
-pub use branch_point::locate_branch_point;
 pub use broyden::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
 };
@@ -60,11 +54,15 @@ pub use damped::{damped_modes, linear_mode, DampedModePoint, DampedModes};
 pub use deflation::{all_solutions, AllSolutions, FoundSolution, SearchOptions, SearchReport};
 pub use elements::{Element, ElementProblem, Harmonic, Law};
 pub use error::HbError;
-pub use events::{trace, Event, Trace, TraceOptions, TracedPoint};
+pub use events::{
+    locate_branch_point, locate_fold, locate_multiplier_crossing, trace, Bifurcation,
+    BifurcationError, BifurcationKind, Event, FoldLocation, LocateOptions, Trace, TraceOptions,
+    TracedPoint,
+};
 pub use faer::c64;
 pub use family::{Family, FamilyBranch, Frequency};
 pub use floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
-pub use fold::{locate_fold, Branch, FoldLocation, FoldOptions};
+pub use fold::Branch;
 pub use frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
 pub use galerkin::GalerkinJacobian;
 pub use hill::{fourier_blocks, hill_multipliers, HillResult};

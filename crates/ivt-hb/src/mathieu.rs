@@ -6,7 +6,7 @@
 //!    coefficients (n = 9) and followed in β by pseudo-arclength continuation
 //!    with Hsu multipliers at every point.
 //! 2. The crossing μ = −1, bracketed by two path points, is located by Newton
-//!    on the extended system of [`crate::bifurcation`] (the branch in β with
+//!    on the extended system of [`crate::events`] (the branch in β with
 //!    the bordered test function of Φ + I), as every event of [`crate::trace`].
 //! 3. The period-2p branch is entered with the controlled-amplitude scheme of
 //!    Eq. 84–85: the solution is embedded with harmonic k → 2k
@@ -15,11 +15,9 @@
 //!    unknowns; `a_1` is then the continuation parameter.
 
 use crate::aft::{embed_subharmonic, resize_harmonics};
-use crate::bifurcation::{
-    locate_multiplier_crossing, BifurcationError, BifurcationKind, BifurcationOptions,
-};
 use crate::broyden::{broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace};
 use crate::continuation::{pseudo_arclength, ContinuationOptions};
+use crate::events::{locate_multiplier_crossing, BifurcationError, BifurcationKind, LocateOptions};
 use crate::family::FamilyBranch;
 use crate::floquet::HsuRule;
 use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
@@ -195,9 +193,9 @@ fn locate_period_doubling(
         BifurcationKind::PeriodDoubling,
         q,
         beta,
-        &BifurcationOptions {
+        &LocateOptions {
             stability_steps: opts.hsu_steps_per_harmonic * hb.harmonics,
-            ..BifurcationOptions::default()
+            ..LocateOptions::default()
         },
     )
     .map_err(|e| match e {

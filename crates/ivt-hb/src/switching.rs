@@ -1,17 +1,21 @@
-//! Branch switching at a located bifurcation ([`crate::bifurcation`]):
+//! Branch switching at a located bifurcation ([`crate::events`]):
 //! [`switch_branch`] steps from the bifurcation along a direction transversal to
 //! the known branch and corrects onto the new one (the second null vector at a
 //! branch point, [`crate::Bifurcation::second_direction`]; at a period doubling
 //! the odd-harmonic null vector of the period-2 Galerkin Jacobian,
 //! [`period_doubled_start`]).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
-use crate::bifurcation::{
-    check_start, dot, lambda_step, put_jacobian, solve_error, Bifurcation, BifurcationError,
-    BifurcationKind, BifurcationOptions,
-};
 use crate::broyden::SolveError;
+use crate::events::extended::{
+    check_start, lambda_step, null_vector, put_jacobian, singular_at_start, solve_error,
+};
+use crate::events::{dot, Bifurcation, BifurcationError, BifurcationKind, LocateOptions};
 use crate::family::{Family, FamilyBranch};
-use crate::fold::{null_vector, residual_lambda_difference as residual_lambda, Branch};
+use crate::fold::{residual_lambda_difference, Branch};
 use crate::ihb::{HbError, HbOptions};
 use ivt_num::vector::norm2;
 use ivt_num::{newton_bordered, Border, LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace};
@@ -30,7 +34,7 @@ pub fn switch_branch<B: Branch>(
     lambda: f64,
     direction: &[f64],
     h: f64,
-    opts: &BifurcationOptions,
+    opts: &LocateOptions,
 ) -> Result<(Vec<f64>, f64), BifurcationError> {
     check_start(branch, q, lambda)?;
     let m = branch.len();
@@ -73,8 +77,7 @@ pub fn switch_branch<B: Branch>(
         &nopts,
     )
     .map_err(|e| solve_error(SolveError::from(e)))?;
-    let lambda = x[m];
-    x.truncate(m);
+    let lambda = x.pop().unwrap_or(lambda);
     Ok((x, lambda))
 }
 
@@ -82,7 +85,7 @@ pub fn switch_branch<B: Branch>(
 /// `[R_q, R_λ]` (`R_λ` by the central difference of [`lambda_step`]).
 struct BranchWithLambda<'a, B> {
     branch: &'a mut B,
-    opts: &'a BifurcationOptions,
+    opts: &'a LocateOptions,
     jac: Vec<f64>,
     r_lambda: Vec<f64>,
 }
@@ -91,18 +94,20 @@ impl<B: Branch> NewtonSystem for BranchWithLambda<'_, B> {
     type Error = Infallible;
 
     fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
-        let m = self.r_lambda.len();
-        self.branch.residual(&x[..m], x[m], r);
+        if let Some((&lambda, q)) = x.split_last() {
+            self.branch.residual(q, lambda, r);
+        }
         Ok(())
     }
 
     fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> Result<(), Infallible> {
-        let m = self.r_lambda.len();
-        let (q, lambda) = (&x[..m], x[m]);
+        let Some((&lambda, q)) = x.split_last() else {
+            return Ok(());
+        };
         self.branch.jacobian(q, lambda, &mut self.jac);
         let h = lambda_step(self.opts, lambda);
-        residual_lambda(self.branch, q, lambda, h, &mut self.r_lambda);
-        put_jacobian(jac, m + 1, &self.jac, &self.r_lambda);
+        residual_lambda_difference(self.branch, q, lambda, h, &mut self.r_lambda);
+        put_jacobian(jac, q.len() + 1, &self.jac, &self.r_lambda);
         Ok(())
     }
 }
@@ -123,7 +128,7 @@ pub fn period_doubled_start<F: Family>(
     hb: &HbOptions,
     pd: &Bifurcation,
     h: f64,
-    opts: &BifurcationOptions,
+    opts: &LocateOptions,
 ) -> Result<(FamilyBranch<F>, Vec<f64>, f64), BifurcationError> {
     if pd.kind != BifurcationKind::PeriodDoubling {
         return Err(HbError::InvalidInput("not a period-doubling point".into()).into());
@@ -157,12 +162,13 @@ pub fn period_doubled_start<F: Family>(
     let mut lu = LuWorkspace::new(m2);
     lu.factor_row_major(&jac);
     if !null_vector(&mut lu, &mut v, false) {
-        return Err(solve_error(SolveError::SingularJacobian {
-            iteration: 0,
-            history: Vec::new(),
-        }));
+        return Err(solve_error(singular_at_start()));
     }
-    let mut d: Vec<f64> = (0..m2).map(|i| if odd(i) { v[i] } else { 0.0 }).collect();
+    let mut d: Vec<f64> = v
+        .iter()
+        .enumerate()
+        .map(|(i, vi)| if odd(i) { *vi } else { 0.0 })
+        .collect();
     let nd = norm2(&d);
     d.iter_mut().for_each(|x| *x /= nd);
     d.push(0.0);

@@ -6,9 +6,9 @@ use ivt_hb::aft::{eval_series, resize_harmonics};
 use ivt_hb::mathieu::THESIS_A0;
 use ivt_hb::ode::{first_order, rk4};
 use ivt_hb::{
-    period_doubled_start, switch_branch, trace, BifurcationKind, BifurcationOptions,
-    ContinuationOptions, Corrector, Family, FamilyBranch, GeneralProblem, HbOptions,
-    MathieuDuffing, ModifiedIhb, PeriodicProblem, Trace, TraceOptions,
+    period_doubled_start, switch_branch, trace, BifurcationKind, ContinuationOptions, Corrector,
+    Family, FamilyBranch, GeneralProblem, HbOptions, LocateOptions, MathieuDuffing, ModifiedIhb,
+    PeriodicProblem, Trace, TraceOptions,
 };
 
 /// The forcing-frequency family `ω_f ↦ (problem, ω_f)` and its trace with the
@@ -197,7 +197,7 @@ fn mathieu_duffing_period_doubling_matches_shooting_and_switches_to_period_two()
     // Period-2 branch: its first point is an orbit of period 2T (RK4 over 2T from
     // the HB state follows the HB orbit) and not of period T.
     let (br2, q2, b2) =
-        period_doubled_start(family, &hb, pd, 0.05, &BifurcationOptions::default()).unwrap();
+        period_doubled_start(family, &hb, pd, 0.05, &LocateOptions::default()).unwrap();
     let (_, sol2) = br2.solution(&q2, b2);
     // Supercritical: the period-2 branch exists beyond β₁.
     assert!(b2 > pd.lambda, "{b2}");
@@ -398,7 +398,7 @@ fn symmetric_chain_branch_point_matches_shooting_and_switches_to_the_asymmetric_
         bp.lambda,
         &d,
         0.05,
-        &BifurcationOptions::default(),
+        &LocateOptions::default(),
     )
     .unwrap();
     let (_, sol) = branch.solution(&q, w);

@@ -19,7 +19,7 @@ use ivt_hb::condense::{
 };
 use ivt_hb::models::cantilever;
 use ivt_hb::{
-    locate_fold, ClassicIhb, FamilyBranch, FoldOptions, Frequency, GeneralProblem, HbOptions,
+    locate_fold, ClassicIhb, FamilyBranch, Frequency, GeneralProblem, HbOptions, LocateOptions,
     PeriodicProblem,
 };
 
@@ -96,7 +96,7 @@ fn against_uncondensed(n: usize, full_rtol: f64, coeff_tol: f64, residual_tol: f
     let mut family = FamilyBranch::new(Frequency(&full), &hb, frc.folds[0].omega_f).unwrap();
     for fold in &frc.folds {
         let q = all_dofs(&mut branch, &fold.coeffs, fold.omega_f);
-        let located = locate_fold(&mut family, &q, fold.omega_f, &FoldOptions::default()).unwrap();
+        let located = locate_fold(&mut family, &q, fold.omega_f, &LocateOptions::fold()).unwrap();
         let rel = (located.lambda - fold.omega_f).abs() / fold.omega_f;
         assert!(
             rel <= 1e-10,

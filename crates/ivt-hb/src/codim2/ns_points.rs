@@ -1,13 +1,13 @@
 //! The Neimark–Sacker boundary of a forced family in (ω, p), sampled: at each
 //! requested p the frequency-response curve of `family(p)` is traced with
 //! its events ([`crate::jobs::frc`]) and each of its Neimark–Sacker points
-//! is located on the engine's extended system ([`crate::bifurcation`]: a
+//! is located on the engine's extended system ([`crate::events`]: a
 //! pair of Floquet multipliers on the unit circle). Not a continuation of the curve: a turn of the boundary
 //! in p between two samples is not followed, and each sample costs a trace.
 
-use crate::bifurcation::BifurcationKind;
 use crate::continuation::Corrector;
 use crate::error::HbError;
+use crate::events::BifurcationKind;
 use crate::ihb::HbOptions;
 use crate::jobs::{frc, FrcRequest};
 use crate::problem::PeriodicProblem;

@@ -6,10 +6,10 @@
 //! `family(p_start)` over an interval.
 
 use super::{finite, Array};
-use crate::bifurcation::BifurcationKind;
 use crate::codim2::FoldPoint as CurveFold;
 use crate::continuation::{ContinuationOptions, Termination};
 use crate::error::HbError;
+use crate::events::BifurcationKind;
 use crate::frc::{frequency_response, FrcOptions};
 use crate::ihb::{HbOptions, HbSolution};
 use crate::problem::PeriodicProblem;

@@ -6,10 +6,9 @@
 //! Neimark–Sacker point and branch point as the path passes it.
 
 use super::{check_finite, pairs, Array};
-use crate::bifurcation::{BifurcationError, BifurcationKind};
 use crate::continuation::{Corrector, Termination};
 use crate::error::HbError;
-use crate::events::{trace, Event, TraceOptions};
+use crate::events::{trace, BifurcationError, BifurcationKind, Event, TraceOptions};
 use crate::family::{FamilyBranch, Frequency};
 use crate::frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
 use crate::ihb::HbOptions;

@@ -25,7 +25,7 @@ use crate::continuation::{
     pseudo_arclength_exact, ContinuationOptions, Path, PathPoint, Termination,
 };
 use crate::error::HbError;
-use crate::fold::{locate_fold, FoldOptions};
+use crate::events::{locate_fold, LocateOptions};
 use crate::frc::{Frc, FrcFold, FrcPoint};
 
 /// Settings of a string curve.
@@ -259,7 +259,7 @@ pub fn frequency_response(
             let near = points.get(f.index).ok_or_else(empty_point)?;
             branch.sub.gather(&near.coeffs, &mut q);
             Ok(
-                match locate_fold(&mut branch, &q, near.omega_f, &FoldOptions::default()) {
+                match locate_fold(&mut branch, &q, near.omega_f, &LocateOptions::fold()) {
                     Ok(loc) => {
                         let mut coeffs = vec![0.0; n];
                         branch.sub.embed(&loc.q, &mut coeffs);

@@ -1,0 +1,289 @@
+//! What every event shares: its kind, its located result, the options of the
+//! locators, and the [`Detector`] trait an event implements — a test function
+//! evaluated at each accepted path point and a locator (Newton on a minimally
+//! extended system, Govaerts' bordering) started where the test changes sign.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
+use crate::continuation::PathPoint;
+use crate::family::{Family, FamilyBranch};
+use crate::ihb::HbError;
+use crate::stability::StabilityKind;
+use faer::c64;
+use ivt_num::vector::norm2;
+use thiserror::Error;
+
+/// The kind of a located bifurcation (in the order [`crate::trace`] reports
+/// events found between the same two points).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BifurcationKind {
+    /// A turning point in λ (a real multiplier through +1), located by
+    /// [`crate::locate_fold`].
+    Fold,
+    /// A real Floquet multiplier through −1.
+    PeriodDoubling,
+    /// A complex pair of multipliers through the unit circle.
+    NeimarkSacker,
+    /// Two branches cross (rank loss of `[∂R/∂q, ∂R/∂λ]`).
+    BranchPoint,
+}
+
+/// Options of the event locators (Newton on the extended systems) and of the
+/// multipliers reported at a located event.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LocateOptions {
+    /// Hsu sub-intervals of the monodromy matrix (Magnus4; > harmonics).
+    pub stability_steps: usize,
+    /// Stop when the Newton step is below this, relative to ‖q‖∞ and |λ|.
+    pub step_tol: f64,
+    /// Also stop when the step is below this (relative) and the residual no
+    /// longer falls by 4× per step: the noise floor of the finite differences
+    /// (e.g. a user `g` without analytic Jacobian).
+    pub noise_tol: f64,
+    /// Maximum Newton steps.
+    pub max_iter: usize,
+    /// Relative central-difference step for `∂R/∂λ` and the test functions.
+    pub fd_step: f64,
+}
+
+/// The fold locator's step tolerance: its extended system has the analytic
+/// gradient `−wᵀ J_q v` (Govaerts), so it converges below the 1e-11 of the
+/// differenced test functions of the other events.
+pub(crate) const FOLD_STEP_TOL: f64 = 1e-12;
+
+impl Default for LocateOptions {
+    /// The options of period doubling, Neimark–Sacker and branch points.
+    fn default() -> Self {
+        Self {
+            stability_steps: 2048,
+            step_tol: 1e-11,
+            noise_tol: 1e-8,
+            max_iter: 30,
+            fd_step: 1e-6,
+        }
+    }
+}
+
+impl LocateOptions {
+    /// The options of a fold located on its own ([`crate::locate_fold`]):
+    /// step tolerance 1e-12, 25 Newton steps.
+    pub fn fold() -> Self {
+        Self {
+            step_tol: FOLD_STEP_TOL,
+            max_iter: 25,
+            ..Self::default()
+        }
+    }
+}
+
+/// One point of the traced branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TracedPoint {
+    /// Fourier coefficients.
+    pub q: Vec<f64>,
+    /// Parameter λ.
+    pub lambda: f64,
+    /// Floquet multipliers (Hsu), decreasing modulus.
+    pub multipliers: Vec<c64>,
+    /// Error estimate of their monodromy ([`crate::HsuEstimate::error`]):
+    /// `None` for fixed Hsu steps.
+    pub multiplier_error: Option<f64>,
+    /// Stability class.
+    pub kind: StabilityKind,
+}
+
+/// A located bifurcation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bifurcation {
+    /// What it is.
+    pub kind: BifurcationKind,
+    /// The orbit at the bifurcation.
+    pub q: Vec<f64>,
+    /// The parameter at the bifurcation.
+    pub lambda: f64,
+    /// Floquet multipliers there (Hsu), decreasing modulus.
+    pub multipliers: Vec<c64>,
+    /// Branch point only: an orthonormal basis of the null space of
+    /// `[∂R/∂q, ∂R/∂λ]` (two vectors of `m + 1` entries); empty otherwise.
+    pub null_vectors: Vec<Vec<f64>>,
+    /// Newton steps taken.
+    pub iterations: usize,
+    /// ‖R(q, λ)‖₂ at the result.
+    pub residual_norm: f64,
+}
+
+impl Bifurcation {
+    /// Branch point: the unit direction of the null space orthogonal to
+    /// `tangent` (the tangent of the branch that was followed, `m + 1`
+    /// entries): the initial direction of the other branch. `None` for other
+    /// kinds.
+    pub fn second_direction(&self, tangent: &[f64]) -> Option<Vec<f64>> {
+        let [v1, v2] = self.null_vectors.as_slice() else {
+            return None;
+        };
+        let (a, b) = (dot(tangent, v1), dot(tangent, v2));
+        // In span{v1, v2} the direction orthogonal to (a, b) is (−b, a).
+        let mut d: Vec<f64> = v1.iter().zip(v2).map(|(x, y)| -b * x + a * y).collect();
+        let n = norm2(&d);
+        if n == 0.0 || !n.is_finite() {
+            return None;
+        }
+        d.iter_mut().for_each(|x| *x /= n);
+        Some(d)
+    }
+}
+
+/// `aᵀb`.
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// Errors of bifurcation location.
+#[derive(Debug, Clone, Error, PartialEq)]
+pub enum BifurcationError {
+    /// Sizes, solves or Newton failures (with the residual history).
+    #[error(transparent)]
+    Hb(#[from] HbError),
+    /// The Neimark–Sacker test converged to a real pair `μ, 1/μ`.
+    #[error(
+        "neutral saddle at λ = {lambda} (real multipliers μ and 1/μ), not a Neimark–Sacker point"
+    )]
+    NeutralSaddle {
+        /// Where.
+        lambda: f64,
+    },
+}
+
+/// An event between points `index` and `index + 1` of a traced path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Event {
+    /// What changed.
+    pub kind: BifurcationKind,
+    /// The point before the change (the Newton start).
+    pub index: usize,
+    /// The located bifurcation, or why it could not be located.
+    pub location: Result<Bifurcation, BifurcationError>,
+}
+
+/// Watches a path as its points arrive (as BifurcationKit's event
+/// detection does): called once per accepted point, in path order, it
+/// returns the events that point completes, already located.
+pub trait Observer<F: Family> {
+    /// Takes the newest accepted `point` of the path followed on `branch`.
+    ///
+    /// # Errors
+    /// A failure that ends the observation (e.g. the point's multipliers);
+    /// an event that cannot be located is not one, it carries its error in
+    /// [`Event::location`].
+    fn on_point(
+        &mut self,
+        branch: &mut FamilyBranch<F>,
+        point: &PathPoint,
+    ) -> Result<Vec<Event>, HbError>;
+}
+
+/// The path as far as it has arrived, as the detectors see it: each accepted
+/// point (from the continuation driver) with its multipliers (from the
+/// Floquet observer, [`crate::events::Multipliers`]), in path order.
+#[derive(Debug, Clone, Default)]
+pub struct PathSoFar {
+    /// The driver's points `{q, λ}` with their secant λ component and
+    /// branch-point sign.
+    pub points: Vec<PathPoint>,
+    /// The same points with their multipliers.
+    pub traced: Vec<TracedPoint>,
+}
+
+impl PathSoFar {
+    /// Number of points that have arrived.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// True before the first point.
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// Point `k` split into `(q, λ)`, or `None` past the end.
+    pub fn q_lambda(&self, k: usize) -> Option<(&[f64], f64)> {
+        let x = &self.points.get(k)?.x;
+        let (lambda, q) = x.split_last()?;
+        Some((q, *lambda))
+    }
+
+    /// The multipliers of point `k`, or `None` past the end.
+    pub fn multipliers(&self, k: usize) -> Option<&[c64]> {
+        self.traced.get(k).map(|p| p.multipliers.as_slice())
+    }
+
+    /// Unit secant from point `k` to point `k + 1`, `None` past the end or
+    /// for two equal points.
+    pub fn secant(&self, k: usize) -> Option<Vec<f64>> {
+        let (a, b) = (self.points.get(k)?, self.points.get(k + 1)?);
+        let mut t: Vec<f64> = b.x.iter().zip(&a.x).map(|(p, q)| p - q).collect();
+        let n = norm2(&t);
+        if n == 0.0 || !n.is_finite() {
+            return None;
+        }
+        t.iter_mut().for_each(|v| *v /= n);
+        Some(t)
+    }
+}
+
+/// One kind of event on a branch of a [`Family`]: a test function evaluated
+/// at every accepted point, whose sign change between two consecutive points
+/// brackets the event, and the locator started there. Adding an event is one
+/// file implementing this trait; [`crate::trace`] runs every detector as the
+/// points arrive.
+pub trait Detector<F: Family> {
+    /// The kind located.
+    fn kind(&self) -> BifurcationKind;
+
+    /// The test function at point `k` of `path` (`k` < `path.len()`; it may
+    /// use the points before and, for `k = 0`, the point after). Called once
+    /// per point; a zero or NaN never brackets an event.
+    fn test(&mut self, branch: &mut FamilyBranch<F>, path: &PathSoFar, k: usize) -> f64;
+
+    /// The sign changed between the two newest points: the index of the
+    /// locator's start, or `None` when this is no event of the kind (yet).
+    /// Default: the older of the two points.
+    fn start(&self, path: &PathSoFar) -> Option<usize> {
+        path.len().checked_sub(2)
+    }
+
+    /// Locates the event from the start point `at.index`.
+    ///
+    /// # Errors
+    /// Sizes, a singular extended system or non-convergence of its Newton
+    /// iteration (with the residual history); per kind as documented there.
+    fn locate(&mut self, at: Start<'_, F>) -> Result<Bifurcation, BifurcationError>;
+}
+
+/// Where a locator starts: the branch, the path so far, the index of the
+/// start point (`index + 1` < `path.len()`) and the options.
+pub struct Start<'a, F: Family> {
+    /// The branch followed.
+    pub branch: &'a mut FamilyBranch<F>,
+    /// The path so far.
+    pub path: &'a PathSoFar,
+    /// The start point.
+    pub index: usize,
+    /// The locator's options.
+    pub opts: &'a LocateOptions,
+}
+
+impl<'a, F: Family> Start<'a, F> {
+    /// The start point `(q, λ)`.
+    ///
+    /// # Errors
+    /// [`HbError::InvalidInput`] if `index` is past the path.
+    pub fn point(&self) -> Result<(&'a [f64], f64), HbError> {
+        let path: &'a PathSoFar = self.path;
+        path.q_lambda(self.index)
+            .ok_or_else(|| HbError::InvalidInput(format!("no path point {}", self.index)))
+    }
+}

@@ -1,0 +1,405 @@
+//! The Newton iteration every event locator runs: on a minimally extended
+//! system `[R(q, λ) + Σⱼ μⱼ bⱼ; ψ(q, λ)] = 0` (Govaerts' bordering: `ψ` the
+//! test functions of a bordered matrix that turns singular at the event, `μ`
+//! unfoldings that make the system square) through [`ivt_num::newton()`],
+//! stopped by one [`StepRule`], with the small pieces the locators share
+//! (borders from inverse iteration, the `[R_q, R_λ]` blocks, the result).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
+use super::detector::{Bifurcation, BifurcationError, BifurcationKind, LocateOptions};
+use crate::broyden::SolveError;
+use crate::fold::{residual_lambda_difference, Branch};
+use crate::ihb::HbError;
+use faer::c64;
+use ivt_num::vector::norm2;
+use ivt_num::{
+    newton, BorderedError, LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace, StepCheck,
+};
+use std::convert::Infallible;
+
+/// A Newton failure of a locator as a [`BifurcationError`].
+pub(crate) fn solve_error(e: SolveError) -> BifurcationError {
+    BifurcationError::Hb(HbError::Solve(e))
+}
+
+/// The error of a singular matrix before the first Newton step.
+pub(crate) fn singular_at_start() -> SolveError {
+    SolveError::SingularJacobian {
+        iteration: 0,
+        history: Vec::new(),
+    }
+}
+
+/// Refuses a start `(q0, λ0)` of the wrong size, of an empty branch, or not
+/// finite.
+///
+/// # Errors
+/// [`HbError::InvalidInput`] for sizes, [`SolveError::NonFinite`] for NaN or ∞.
+pub(crate) fn check_start<B: Branch>(branch: &B, q0: &[f64], lambda0: f64) -> Result<(), HbError> {
+    if q0.len() != branch.len() || q0.is_empty() {
+        return Err(HbError::InvalidInput(format!(
+            "start must have {} entries (at least one), got {}",
+            branch.len(),
+            q0.len()
+        )));
+    }
+    if !(lambda0.is_finite() && q0.iter().all(|v| v.is_finite())) {
+        return Err(HbError::Solve(SolveError::NonFinite {
+            iteration: 0,
+            history: Vec::new(),
+        }));
+    }
+    Ok(())
+}
+
+/// The located bifurcation with its residual norm ‖R(q, λ)‖₂.
+pub(crate) fn finish<B: Branch>(
+    branch: &mut B,
+    kind: BifurcationKind,
+    (q, lambda): (Vec<f64>, f64),
+    multipliers: Vec<c64>,
+    null_vectors: Vec<Vec<f64>>,
+    iterations: usize,
+) -> Bifurcation {
+    let mut r = vec![0.0; q.len()];
+    branch.residual(&q, lambda, &mut r);
+    Bifurcation {
+        kind,
+        q,
+        lambda,
+        multipliers,
+        null_vectors,
+        iterations,
+        residual_norm: norm2(&r),
+    }
+}
+
+/// Two steps of inverse iteration with the factored `J` (or `Jᵀ`) from `v`,
+/// normalised; `false` if the iterate vanishes or is not finite.
+pub(crate) fn null_vector(lu: &mut LuWorkspace, v: &mut [f64], transpose: bool) -> bool {
+    for _ in 0..2 {
+        if transpose {
+            lu.solve_transpose(v);
+        } else {
+            lu.solve(v);
+        }
+        let n = norm2(v);
+        if n == 0.0 || !n.is_finite() {
+            return false;
+        }
+        v.iter_mut().for_each(|x| *x /= n);
+    }
+    true
+}
+
+/// Right and left near-null vectors of the near-singular square row-major `a`,
+/// refined in place from their seeds; only a non-finite factor is refused.
+///
+/// # Errors
+/// [`SolveError::SingularJacobian`] when inverse iteration breaks down.
+pub(crate) fn border_null_vectors(
+    a: &[f64],
+    right: &mut [f64],
+    left: &mut [f64],
+) -> Result<(), SolveError> {
+    let mut lu = LuWorkspace::new(right.len());
+    // `a` is near-singular at an event: only a non-finite factor is refused.
+    lu.factor_row_major(a);
+    if !null_vector(&mut lu, right, false) || !null_vector(&mut lu, left, true) {
+        return Err(singular_at_start());
+    }
+    Ok(())
+}
+
+/// A factorization usable for solves: regular, or singular to rounding
+/// (inverse iteration and test functions at a bifurcation accept it and
+/// check the solution); not one refused for its sizes.
+pub(crate) fn factored(result: Result<(), BorderedError>) -> bool {
+    matches!(result, Ok(()) | Err(BorderedError::Singular))
+}
+
+/// Writes `[J | R_λ]` (`m` rows) into the first `m + 1` columns of the row-major
+/// matrix `dst` with row stride `stride` (> `m`).
+pub(crate) fn put_jacobian(dst: &mut [f64], stride: usize, jac: &[f64], r_lambda: &[f64]) {
+    let m = r_lambda.len();
+    if m == 0 || stride <= m {
+        return;
+    }
+    for ((row, j_row), r_l) in dst
+        .chunks_exact_mut(stride)
+        .zip(jac.chunks_exact(m))
+        .zip(r_lambda)
+    {
+        if let Some((head, rest)) = row.split_at_mut_checked(m) {
+            head.copy_from_slice(j_row);
+            if let Some(c) = rest.first_mut() {
+                *c = *r_l;
+            }
+        }
+    }
+}
+
+/// The central-difference step in λ of the locators' `∂R/∂λ` and test
+/// functions: `fd_step·max(|λ|, 1e-3)`.
+pub(crate) fn lambda_step(opts: &LocateOptions, lambda: f64) -> f64 {
+    opts.fd_step * lambda.abs().max(1e-3)
+}
+
+/// The blocks `R_q` (row-major `m×m`) and `R_λ` of `[R_q, R_λ]` at `(q, λ)`,
+/// `R_λ` by a central difference with [`lambda_step`].
+pub(crate) fn jacobian_blocks<B: Branch>(
+    branch: &mut B,
+    q: &[f64],
+    lambda: f64,
+    opts: &LocateOptions,
+) -> (Vec<f64>, Vec<f64>) {
+    let m = q.len();
+    let mut jac = vec![0.0; m * m];
+    let mut r_lambda = vec![0.0; m];
+    branch.jacobian(q, lambda, &mut jac);
+    residual_lambda_difference(branch, q, lambda, lambda_step(opts, lambda), &mut r_lambda);
+    (jac, r_lambda)
+}
+
+/// The stopping rule of every extended-system Newton iteration (folds and
+/// bifurcations): the step `(Δq, Δλ)` below `step_tol` relative to ‖q‖∞
+/// (before the step) and to `max(|λ|, lambda_floor)`, or below `noise_tol`
+/// once ‖F‖ no longer falls by 4× per step — the noise floor of the finite
+/// differences in their Jacobians (a user `g` without an analytic
+/// Jacobian). Full Newton steps, no residual test.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct StepRule {
+    /// Unknowns `q` (the entries before λ).
+    pub(crate) m: usize,
+    /// See [`LocateOptions::step_tol`].
+    pub(crate) step_tol: f64,
+    /// See [`LocateOptions::noise_tol`].
+    pub(crate) noise_tol: f64,
+    /// Smallest |λ| the λ step is taken relative to.
+    pub(crate) lambda_floor: f64,
+}
+
+impl StepRule {
+    /// The options of [`ivt_num::newton()`] under this rule: full steps, at
+    /// most `max_iter`, stopped by [`Self::check`] only.
+    pub(crate) fn newton_options(max_iter: usize, accept_near_singular: bool) -> NewtonOptions {
+        NewtonOptions {
+            ftol: 0.0,
+            max_iter,
+            max_halvings: 0,
+            accept_no_descent: true,
+            accept_near_singular,
+            ..NewtonOptions::default()
+        }
+    }
+
+    /// The verdict after a step: `x` is `(q, λ, …)` after the step with `q`
+    /// of `m` entries, `history` the ‖F‖ history up to the point after it.
+    pub(crate) fn check(&self, x: &[f64], step: &[f64], history: &[f64]) -> StepCheck {
+        let m = self.m;
+        let (Some(q), Some(dq), Some(lambda), Some(d_lambda)) =
+            (x.get(..m), step.get(..m), x.get(m), step.get(m))
+        else {
+            return StepCheck::Continue;
+        };
+        let q_scale = q
+            .iter()
+            .zip(dq)
+            .fold(0.0f64, |a, (qi, d)| a.max((qi - d).abs()));
+        let dq = dq.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let below = |tol: f64| {
+            dq <= tol * q_scale.max(f64::MIN_POSITIVE)
+                && d_lambda.abs() <= tol * lambda.abs().max(self.lambda_floor)
+        };
+        // ‖F‖ at the point the step left, against the one before it.
+        let stalled = match history {
+            [.., before, left, _] => *left > 0.25 * before,
+            _ => false,
+        };
+        if below(self.step_tol) || (stalled && below(self.noise_tol)) {
+            StepCheck::Converged
+        } else {
+            StepCheck::Continue
+        }
+    }
+}
+
+/// An extended system stopped by its [`StepRule`]: the one
+/// [`NewtonSystem::check_step`] of the locators.
+pub(crate) struct Ruled<S> {
+    pub(crate) system: S,
+    pub(crate) rule: StepRule,
+}
+
+impl<S: NewtonSystem> NewtonSystem for Ruled<S> {
+    type Error = S::Error;
+
+    fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), S::Error> {
+        self.system.residual(x, r)
+    }
+
+    fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> Result<(), S::Error> {
+        self.system.jacobian(x, jac)
+    }
+
+    fn check_step(&mut self, x: &[f64], step: &[f64], h: &[f64]) -> Result<StepCheck, S::Error> {
+        Ok(self.rule.check(x, step, h))
+    }
+}
+
+/// Result of [`extended_newton`]: `(q, λ, iterations)`.
+pub(crate) type Converged = (Vec<f64>, f64, usize);
+
+/// Newton ([`ivt_num::newton()`]) on `[R(q, λ) + Σⱼ μⱼ bⱼ; ψ(q, λ)] = 0`,
+/// unknowns `{q, λ, μ}` with `k = unfold.len() + 1` test functions `ψ` (the
+/// unfoldings `μ` make it square). Full steps; stops by [`StepRule`].
+///
+/// # Errors
+/// [`BifurcationError::Hb`] with the ‖F‖ history for a singular extended
+/// matrix, non-finite values or no convergence within `max_iter` steps.
+pub(crate) fn extended_newton<B, T>(
+    branch: &mut B,
+    (q0, lambda0): (&[f64], f64),
+    unfold: &[Vec<f64>],
+    tests: T,
+    opts: &LocateOptions,
+) -> Result<Converged, BifurcationError>
+where
+    B: Branch,
+    T: FnMut(&mut B, &[f64], f64, &mut [f64]),
+{
+    let m = branch.len();
+    let k = unfold.len() + 1;
+    let mut x = q0.to_vec();
+    x.push(lambda0);
+    x.resize(m + k, 0.0);
+    let mut system = Ruled {
+        system: Extended {
+            branch,
+            unfold,
+            tests,
+            opts,
+            m,
+            jac: vec![0.0; m * m],
+            r_lambda: vec![0.0; m],
+            psi: (vec![0.0; k], vec![0.0; k]),
+            qt: vec![0.0; m],
+        },
+        rule: StepRule {
+            m,
+            step_tol: opts.step_tol,
+            noise_tol: opts.noise_tol,
+            lambda_floor: 1e-3,
+        },
+    };
+    let nopts = StepRule::newton_options(opts.max_iter, true);
+    let stats = newton(
+        &mut system,
+        &mut x,
+        &mut NewtonWorkspace::new(m + k),
+        &nopts,
+    )
+    .map_err(|e| solve_error(SolveError::from(e)))?;
+    let lambda = x.get(m).copied().unwrap_or(lambda0);
+    x.truncate(m);
+    Ok((x, lambda, stats.iterations))
+}
+
+/// The extended system of [`extended_newton`] as a [`NewtonSystem`]:
+/// `[J, R_λ, b]` analytic in `q` with `R_λ` by [`lambda_step`], the
+/// test-function rows by central differences in `q` and λ.
+struct Extended<'a, B, T> {
+    branch: &'a mut B,
+    unfold: &'a [Vec<f64>],
+    tests: T,
+    opts: &'a LocateOptions,
+    m: usize,
+    jac: Vec<f64>,
+    r_lambda: Vec<f64>,
+    psi: (Vec<f64>, Vec<f64>),
+    qt: Vec<f64>,
+}
+
+impl<B, T> NewtonSystem for Extended<'_, B, T>
+where
+    B: Branch,
+    T: FnMut(&mut B, &[f64], f64, &mut [f64]),
+{
+    type Error = Infallible;
+
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), Infallible> {
+        let m = self.m;
+        let (Some((q, rest)), Some((r, psi))) =
+            (x.split_at_checked(m), out.split_at_mut_checked(m))
+        else {
+            out.fill(f64::NAN);
+            return Ok(());
+        };
+        let Some((&lambda, mu)) = rest.split_first() else {
+            out.fill(f64::NAN);
+            return Ok(());
+        };
+        self.branch.residual(q, lambda, r);
+        for (b, mu_j) in self.unfold.iter().zip(mu) {
+            r.iter_mut().zip(b).for_each(|(ri, bi)| *ri += mu_j * bi);
+        }
+        (self.tests)(self.branch, q, lambda, psi);
+        Ok(())
+    }
+
+    fn jacobian(&mut self, x: &[f64], newton: &mut [f64]) -> Result<(), Infallible> {
+        let m = self.m;
+        let n = x.len();
+        let (Some(q), Some(&lambda)) = (x.get(..m), x.get(m)) else {
+            newton.fill(f64::NAN);
+            return Ok(());
+        };
+        self.branch.jacobian(q, lambda, &mut self.jac);
+        let h_lambda = lambda_step(self.opts, lambda);
+        residual_lambda_difference(self.branch, q, lambda, h_lambda, &mut self.r_lambda);
+        newton.fill(0.0);
+        put_jacobian(newton, n, &self.jac, &self.r_lambda);
+        for (i, row) in newton.chunks_exact_mut(n).take(m).enumerate() {
+            let unfold_cols = row.iter_mut().skip(m + 1);
+            for (entry, b) in unfold_cols.zip(self.unfold) {
+                *entry = b.get(i).copied().unwrap_or(f64::NAN);
+            }
+        }
+        // Test-function rows by central differences in q and λ.
+        let q_scale = q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        self.qt.copy_from_slice(q);
+        let (psi_p, psi_m) = (&mut self.psi.0, &mut self.psi.1);
+        for col in 0..=m {
+            let h = match (q.get(col), self.qt.get_mut(col)) {
+                (Some(&qc), Some(slot)) => {
+                    let h = self.opts.fd_step * qc.abs().max(q_scale).max(f64::MIN_POSITIVE);
+                    *slot = qc + h;
+                    (self.tests)(self.branch, &self.qt, lambda, psi_p);
+                    if let Some(slot) = self.qt.get_mut(col) {
+                        *slot = qc - h;
+                    }
+                    (self.tests)(self.branch, &self.qt, lambda, psi_m);
+                    if let Some(slot) = self.qt.get_mut(col) {
+                        *slot = qc;
+                    }
+                    h
+                }
+                _ => {
+                    (self.tests)(self.branch, q, lambda + h_lambda, psi_p);
+                    (self.tests)(self.branch, q, lambda - h_lambda, psi_m);
+                    h_lambda
+                }
+            };
+            let rows = newton.chunks_exact_mut(n).skip(m);
+            for (row, (p, mi)) in rows.zip(psi_p.iter().zip(psi_m.iter())) {
+                if let Some(entry) = row.get_mut(col) {
+                    *entry = (p - mi) / (2.0 * h);
+                }
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,289 @@
+//! A branch of a [`Family`] followed by pseudo-arclength continuation (Eq. 68–77)
+//! and watched by an [`EventObserver`]: each accepted point gets its Floquet
+//! multipliers (Hsu, Eq. 80) as it arrives, every [`Detector`] evaluates its
+//! test function there, and an event whose test changed sign is located at
+//! once by its extended system.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
+use super::branch_point::BranchPoint;
+use super::detector::{
+    BifurcationError, Detector, Event, LocateOptions, Observer, PathSoFar, Start, TracedPoint,
+};
+use super::fold::Fold;
+use super::multipliers::Multipliers;
+use super::neimark_sacker::NeimarkSacker;
+use super::period_doubling::PeriodDoubling;
+use crate::continuation::{ContinuationOptions, Corrector, PathPoint, Termination};
+use crate::family::{Family, FamilyBranch};
+use crate::fold::Branch;
+use crate::ihb::HbError;
+use crate::stability::{AdaptiveHsu, HsuSteps};
+
+/// Options of [`trace`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct TraceOptions {
+    /// End of the parameter interval (the path stops once it leaves
+    /// `[min(λ₀, lambda_to), max(λ₀, lambda_to)]`).
+    pub lambda_to: f64,
+    /// Path following (its λ bounds are set from λ₀ and `lambda_to`).
+    pub continuation: ContinuationOptions,
+    /// Hsu sub-intervals of the path points' multipliers (by default chosen
+    /// per point for multipliers to 1e-6).
+    pub stability: HsuSteps,
+    /// Options of the located events.
+    pub locate: LocateOptions,
+    /// The path's corrector ([`Corrector::Broyden`] by default).
+    pub corrector: Corrector,
+}
+
+impl Default for TraceOptions {
+    fn default() -> Self {
+        Self {
+            lambda_to: 1.0,
+            continuation: ContinuationOptions::default(),
+            stability: HsuSteps::default(),
+            locate: LocateOptions::default(),
+            corrector: Corrector::Broyden,
+        }
+    }
+}
+
+/// A traced branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trace {
+    /// Points in path order.
+    pub points: Vec<TracedPoint>,
+    /// Events in path order (by start point, then kind).
+    pub events: Vec<Event>,
+    /// Why the path stopped.
+    pub termination: Termination,
+}
+
+/// The observer of [`trace`]: the multipliers of each point, then fold,
+/// period doubling, Neimark–Sacker and branch point as detectors.
+pub struct EventObserver<F: Family> {
+    multipliers: Multipliers,
+    detectors: Vec<Box<dyn Detector<F>>>,
+    /// Each detector's test at the newest point.
+    tests: Vec<f64>,
+    /// Brackets waiting for the point after their start: (detector, start).
+    pending: Vec<(usize, usize)>,
+    /// Each detector's last bracketed start (one event per start and kind).
+    last_start: Vec<Option<usize>>,
+    path: PathSoFar,
+    opts: LocateOptions,
+}
+
+impl<F: Family> EventObserver<F> {
+    /// The observer of a path of `branch` from `lambda0`: multipliers with
+    /// `stability`, events located with `opts`.
+    ///
+    /// # Errors
+    /// As [`AdaptiveHsu::new`].
+    pub fn new(
+        branch: &FamilyBranch<F>,
+        lambda0: f64,
+        stability: HsuSteps,
+        opts: &LocateOptions,
+    ) -> Result<Self, HbError> {
+        let detectors: Vec<Box<dyn Detector<F>>> = vec![
+            Box::new(Fold),
+            Box::new(PeriodDoubling),
+            Box::new(NeimarkSacker),
+            Box::new(BranchPoint::new(opts)),
+        ];
+        let n = detectors.len();
+        Ok(Self {
+            multipliers: Multipliers::new(AdaptiveHsu::new(
+                &branch.family().at(lambda0).0,
+                branch.options().harmonics,
+                stability,
+            )?),
+            detectors,
+            tests: vec![f64::NAN; n],
+            pending: Vec::new(),
+            last_start: vec![None; n],
+            path: PathSoFar::default(),
+            opts: opts.clone(),
+        })
+    }
+
+    /// The points observed, with their multipliers.
+    pub fn into_points(self) -> Vec<TracedPoint> {
+        self.path.traced
+    }
+}
+
+impl<F: Family> Observer<F> for EventObserver<F> {
+    fn on_point(
+        &mut self,
+        branch: &mut FamilyBranch<F>,
+        point: &PathPoint,
+    ) -> Result<Vec<Event>, HbError> {
+        let traced = self.multipliers.at(branch, point)?;
+        self.path.points.push(point.clone());
+        self.path.traced.push(traced);
+        let Some(newest) = self.path.len().checked_sub(1).filter(|&k| k > 0) else {
+            // The first point's tests may need the second (a secant).
+            return Ok(Vec::new());
+        };
+        let path = &self.path;
+        for (d, det) in self.detectors.iter_mut().enumerate() {
+            if newest == 1 {
+                if let Some(t) = self.tests.get_mut(d) {
+                    *t = det.test(branch, path, 0);
+                }
+            }
+            let value = det.test(branch, path, newest);
+            let Some(before) = self.tests.get_mut(d).map(|t| std::mem::replace(t, value)) else {
+                continue;
+            };
+            if before * value >= 0.0 || before.is_nan() || value.is_nan() {
+                continue;
+            }
+            let start = det.start(path);
+            let last = self.last_start.get_mut(d);
+            if let (Some(start), Some(last)) = (start, last) {
+                if *last != Some(start) {
+                    *last = Some(start);
+                    self.pending.push((d, start));
+                }
+            }
+        }
+        let len = path.len();
+        let (ready, waiting): (Vec<_>, Vec<_>) = std::mem::take(&mut self.pending)
+            .into_iter()
+            .partition(|(_, start)| start + 1 < len);
+        self.pending = waiting;
+        let mut events = Vec::with_capacity(ready.len());
+        for (d, index) in ready {
+            let Some(det) = self.detectors.get_mut(d) else {
+                continue;
+            };
+            let at = Start {
+                branch: &mut *branch,
+                path,
+                index,
+                opts: &self.opts,
+            };
+            events.push(Event {
+                kind: det.kind(),
+                index,
+                location: det.locate(at),
+            });
+        }
+        Ok(events)
+    }
+}
+
+/// Follows `branch` from the orbit `q0` at `lambda0` (corrected first) towards
+/// `opts.lambda_to`, with multipliers at every point, and locates its events
+/// as the points arrive ([`EventObserver`]).
+///
+/// # Errors
+/// [`BifurcationError::Hb`] if the start cannot be used or a point's
+/// multipliers fail; events that cannot be located carry their error in
+/// [`Event::location`].
+pub fn trace<F: Family>(
+    branch: &mut FamilyBranch<F>,
+    q0: &[f64],
+    lambda0: f64,
+    opts: &TraceOptions,
+) -> Result<Trace, BifurcationError> {
+    let m = branch.len();
+    if q0.len() != m || !opts.lambda_to.is_finite() || opts.lambda_to == lambda0 {
+        return Err(HbError::InvalidInput(format!(
+            "start must have {m} entries and lambda_to be finite and differ from λ₀"
+        ))
+        .into());
+    }
+    let mut x0 = q0.to_vec();
+    x0.push(lambda0);
+    let mut copts = opts.continuation.clone();
+    copts.lambda_min = lambda0.min(opts.lambda_to);
+    copts.lambda_max = lambda0.max(opts.lambda_to);
+    let mut observer = EventObserver::new(branch, lambda0, opts.stability, &opts.locate)?;
+    let mut events = Vec::new();
+    let mut failed = None;
+    // The one call of the continuation driver: the observer sees each
+    // point as it is reached.
+    let path = branch.follow(
+        &x0,
+        0,
+        opts.lambda_to - lambda0,
+        &copts,
+        opts.corrector,
+        |branch, p| {
+            if failed.is_none() {
+                match observer.on_point(branch, p) {
+                    Ok(found) => events.extend(found),
+                    Err(e) => failed = Some(e),
+                }
+            }
+        },
+    )?;
+    if let Some(e) = failed {
+        return Err(e.into());
+    }
+    // An event is reported when the point after its start has arrived; a
+    // fold's start may precede a bracket reported before it.
+    events.sort_by_key(|e| (e.index, e.kind));
+    Ok(Trace {
+        points: observer.into_points(),
+        events,
+        termination: path.termination,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::family::Frequency;
+    use crate::frc::FrcOptions;
+    use crate::ihb::HbOptions;
+    use crate::{BifurcationKind, Duffing, ModifiedIhb};
+
+    #[test]
+    fn folds_are_located_as_the_points_arrive_not_after_the_path() {
+        // Fig. 29 (Duffing, ξ = 0.02, F = 0.1) followed by the exact
+        // corrector, which hands each point over as it is reached: each fold
+        // is returned by the observer at most two points after its start
+        // (the point nearest the turn), long before the path ends, at the
+        // shooting values 1.6548121 and 1.1687244 (tests/frc.rs).
+        let hb = HbOptions::new(20, 64).with_tol(1e-10);
+        let d = Duffing::new(0.02, 1.0, 1.0, 0.1);
+        let start = ModifiedIhb::new(&d, hb.clone())
+            .unwrap()
+            .solve(0.2, None)
+            .unwrap();
+        let mut branch = FamilyBranch::new(Frequency(&d), &hb, 0.2).unwrap();
+        let opts = LocateOptions::default();
+        let mut observer = EventObserver::new(&branch, 0.2, HsuSteps::default(), &opts).unwrap();
+        let mut copts = FrcOptions::default().continuation;
+        (copts.lambda_min, copts.lambda_max) = (0.2, 3.0);
+        let mut x0 = start.coeffs.clone();
+        x0.push(0.2);
+        let mut arrived = Vec::new();
+        let mut count = 0;
+        let path = branch
+            .follow(&x0, 0, 1.0, &copts, Corrector::Newton, |b, p| {
+                let found = observer.on_point(b, p).unwrap();
+                arrived.extend(found.into_iter().map(|e| (count, e)));
+                count += 1;
+            })
+            .unwrap();
+        assert_eq!(path.termination, Termination::LeftInterval);
+        let n = path.points.len();
+        assert_eq!(arrived.len(), 2, "{arrived:?}");
+        for ((at, e), want) in arrived.iter().zip([1.6548121, 1.1687244]) {
+            assert_eq!(e.kind, BifurcationKind::Fold);
+            assert!(e.index < *at && *at <= e.index + 2, "{at} {e:?}");
+            assert!(*at + 10 < n, "{at} of {n}");
+            let lambda = e.location.as_ref().unwrap().lambda;
+            assert!((lambda - want).abs() < 1e-7, "{lambda} vs {want}");
+        }
+    }
+}
