@@ -178,18 +178,8 @@ pub fn summary() -> Result<Output, CliError> {
 
 fn sgivt_ratio(theta_ct_deg: f64, points: usize) -> Result<Output, CliError> {
     check_points(points, 0)?;
+    super::check_flag("--theta-ct", "kin.theta_ct_deg", theta_ct_deg)?;
     let g = SgivtGeometry::prototype();
-    // Checked in the unit typed (degrees), against the same bound the
-    // geometry checks in radians (its 1e-12 relative slack included).
-    let max_deg = ivt_kin::units::rad_to_deg(g.theta_ct_max);
-    if !(theta_ct_deg.is_finite() && theta_ct_deg >= 0.0 && theta_ct_deg <= max_deg * (1.0 + 1e-12))
-    {
-        return Err(CliError::Input(format!(
-            "--theta-ct = {} deg is outside [0, {}] deg (θ_CT of the prototype, §4.4.2)",
-            ivt_sim::scene::keys::typed(theta_ct_deg),
-            ivt_sim::scene::keys::typed(max_deg)
-        )));
-    }
     let th = deg_to_rad(theta_ct_deg);
     let e = g.crank_length(th).map_err(kin_err)?;
     let r_avg = g.average_ratio(e).map_err(kin_err)?;
