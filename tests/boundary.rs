@@ -118,6 +118,9 @@ fn commands(flag: &str, key: &str, log: &str, scene: &str) -> Vec<Vec<String>> {
     let replay = with(&["ctrl", "replay", log], &[]);
     match (flag, key) {
         ("--theta-ct", _) => vec![with(&["kin", "sgivt-ratio"], &[])],
+        ("--r-mm" | "--l1-mm" | "--r-output-mm", _) => vec![with(&["kin", "givt-ratio"], &[])],
+        ("--tolerance" | "--corner-deg", _) => vec![with(&["kin", "arcs"], &[])],
+        ("--r-sun" | "--r-planet", _) => vec![with(&["kin", "direction"], &[])],
         ("--vm", _) => vec![
             with(&["ol", "solve", "--tu=1.5"], &[]),
             with(&["stability", "--tu=1.5"], &[]),
@@ -194,4 +197,23 @@ fn every_cli_flag_is_refused_with_the_tables_text() {
         }
     }
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The GIVT's r < l1 (Eq. 8 divides by |l1 − r|) is relational, so not a
+/// range: refused naming both flags in the unit typed (it was reported in
+/// metres as `r`); the widest l1 of the table still gives a finite answer.
+#[test]
+fn givt_r_below_l1_in_the_unit_typed() {
+    let _serial = serial();
+    let (code, obj) = contract(&["--json", "kin", "givt-ratio", "--r-mm", "60"], QUICK).unwrap();
+    assert_eq!(code, 2);
+    assert_eq!(
+        obj["error"],
+        "--r-mm = 60 mm is out of domain: must be < --l1-mm = 50 mm (Eq. 8 divides by |l1 − r|)"
+    );
+    let args = ["--json", "kin", "givt-ratio", "--l1-mm", "1000"];
+    let (code, obj) = contract(&args, QUICK).unwrap();
+    assert_eq!(code, 0, "{obj}");
+    let avg = obj["average_module_ratio"].as_f64().unwrap();
+    assert!(avg.is_finite() && avg > 0.0, "{obj}");
 }

@@ -160,6 +160,13 @@ pub const KEYS: &[Key] = &[
     plant("plant.r_max", "m", Open(0.0), 1e2),
     // Set by the CLI and Python only.
     other("kin.theta_ct_deg", "deg", (Closed(0.0), Closed(3600.0)), false),
+    other("kin.givt_r_mm", "mm", (Closed(0.0), Closed(1e3)), false),
+    other("kin.givt_l1_mm", "mm", (Open(0.0), Closed(1e3)), false),
+    other("kin.givt_r_output_mm", "mm", (Open(0.0), Closed(1e3)), false),
+    other("kin.arc_tolerance", "", (Open(0.0), Open(1.0)), false),
+    other("kin.arc_corner_deg", "deg", (Open(0.0), Closed(90.0)), false),
+    other("kin.r_sun", "", (Open(0.0), Closed(1e6)), false),
+    other("kin.r_planet", "", (Open(0.0), Closed(1e6)), false),
     other("controller.omega0", "rad/s", (Open(0.0), Open(1e3)), true),
     other("controller.k_si", "m·s/rad²", (Closed(-1e3), Closed(1e3)), true),
     other("controller.k2_si", "m·s/rad²", (Closed(-1e3), Closed(1e3)), true),
@@ -204,15 +211,23 @@ const fn py(name: &'static str, key: &'static str) -> Alias {
     }
 }
 
-/// The CLI flags and Python arguments of [`KEYS`]' quantities: `ivt kin`,
+/// The CLI flags and Python arguments of [`KEYS`]' quantities: `ivt kin`
+/// (θ_CT, the GIVT's lengths in mm, the arc fit, the direction module),
 /// `ivt ol`, `ivt stability(-map)`, `ivt ctrl replay`, `ivt sim`;
-/// `ivt.kin.Plant`, `ivt.design`, `ivt.ctrl.Controller`. (A scene passed to
+/// `ivt.kin.Plant`, `ivt.kin.direction`, `ivt.design`, `ivt.ctrl.Controller`. (A scene passed to
 /// `ivt sim` or `ivt.sim.run` is checked under its scene keys; a plant file
 /// under `plant.<field>`.) Gains under `--si`/`si=True` and the controller's
 /// own SI keywords are the `_si` keys.
 #[rustfmt::skip]
 pub const ALIASES: &[Alias] = &[
     cli("--theta-ct", "kin.theta_ct_deg"),
+    cli("--r-mm", "kin.givt_r_mm"),
+    cli("--l1-mm", "kin.givt_l1_mm"),
+    cli("--r-output-mm", "kin.givt_r_output_mm"),
+    cli("--tolerance", "kin.arc_tolerance"),
+    cli("--corner-deg", "kin.arc_corner_deg"),
+    cli("--r-sun", "kin.r_sun"),
+    cli("--r-planet", "kin.r_planet"),
     cli("--vm", "inputs.v_m[]"),
     cli("--tu", "inputs.t_u[]"),
     cli("--vm-from", "inputs.v_m[]"),
@@ -229,6 +244,8 @@ pub const ALIASES: &[Alias] = &[
     cli("--f-timer", "encoder.f_timer_hz"),
     cli("--stall-timeout", "controller.stall_timeout_s"),
     cli("--max-events", "budget.max_events"),
+    py("r_sun", "kin.r_sun"),
+    py("r_planet", "kin.r_planet"),
     py("v_m", "inputs.v_m[]"),
     py("t_u", "inputs.t_u[]"),
     py("omega0_rpm", "controller.omega0_rpm"),
