@@ -44,46 +44,41 @@ fn toml_number(v: f64) -> String {
 }
 
 /// A minimal valid scene with scene key `key` set to `v`, and where the
-/// refusal is reported (`at`, and the words before the refusal).
+/// refusal is reported (`at`, and the words before the refusal). A profile's
+/// key (`inputs.v_m[]`, `….t` for its times) sets its one knot.
 fn scene_with(key: &str, v: f64) -> (String, String, &'static str) {
     let v = toml_number(v);
-    let mut inputs = ("[[0.0, 8.0]]".to_string(), "[[0.0, 6.0]]".to_string());
+    let mut inputs = [
+        ("v_m", "[[0.0, 8.0]]".to_string()),
+        ("t_u", "[[0.0, 6.0]]".to_string()),
+    ];
     let (mut top, mut sections) = (String::from("duration_s = 1.0\n"), String::new());
-    let (at, words) = match key {
-        "duration_s" => {
-            top = format!("duration_s = {v}\n");
-            (key.to_string(), "")
-        }
-        "inputs.v_m[]" => {
-            inputs.0 = format!("[[0.0, {v}]]");
-            ("inputs.v_m[0]".into(), "knot 0: value ")
-        }
-        "inputs.v_m[].t" => {
-            inputs.0 = format!("[[{v}, 8.0]]");
-            ("inputs.v_m[0]".into(), "knot 0: time ")
-        }
-        "inputs.t_u[]" => {
-            inputs.1 = format!("[[0.0, {v}]]");
-            ("inputs.t_u[0]".into(), "knot 0: value ")
-        }
-        "inputs.t_u[].t" => {
-            inputs.1 = format!("[[{v}, 6.0]]");
-            ("inputs.t_u[0]".into(), "knot 0: time ")
-        }
-        "controller.r_schedule[].t" => {
-            sections = format!("[controller]\nlaw = \"none\"\nr_schedule = [[{v}, 0.0]]\n");
-            ("controller.r_schedule[0]".into(), "knot 0: time ")
-        }
-        _ => {
-            let (section, field) = key.split_once('.').expect("section.field");
-            sections = format!("[{section}]\n{field} = {v}\n");
-            (key.to_string(), "")
-        }
+    let profile = match key.strip_suffix("[].t") {
+        Some(p) => Some((p, format!("[[{v}, 0.0]]"), "knot 0: time ")),
+        None => key
+            .strip_suffix("[]")
+            .map(|p| (p, format!("[[0.0, {v}]]"), "knot 0: value ")),
     };
-    let text = format!(
-        "{top}[inputs]\nv_m = {}\nt_u = {}\n{sections}",
-        inputs.0, inputs.1
-    );
+    let (at, words) = if let Some((profile, knot, words)) = profile {
+        let (section, field) = profile.split_once('.').expect("section.field");
+        match inputs
+            .iter_mut()
+            .find(|(name, _)| section == "inputs" && *name == field)
+        {
+            Some(slot) => slot.1 = knot,
+            // controller.r_schedule: a schedule only law "none" reads
+            None => sections = format!("[{section}]\nlaw = \"none\"\n{field} = {knot}\n"),
+        }
+        (format!("{profile}[0]"), words)
+    } else if let Some((section, field)) = key.split_once('.') {
+        sections = format!("[{section}]\n{field} = {v}\n");
+        (key.to_string(), "")
+    } else {
+        top = format!("{key} = {v}\n");
+        (key.to_string(), "")
+    };
+    let [(_, v_m), (_, t_u)] = inputs;
+    let text = format!("{top}[inputs]\nv_m = {v_m}\nt_u = {t_u}\n{sections}");
     (text, at, words)
 }
 
@@ -162,15 +157,15 @@ fn every_cli_alias_has_a_command() {
     }
 }
 
-/// Every CLI flag, out of range on both sides and NaN, refused as input
-/// with `{flag} {refusal}`: the flag as typed, the value as typed, and for a
-/// scene's quantity the very text the scene prints after its key.
+// Every CLI flag, out of range on both sides and NaN, is refused as input
+// with `{flag} {refusal}` (the flag and the value as typed; for a scene's
+// quantity the very text the scene prints after its key).
 #[test]
 fn every_cli_flag_is_refused_with_the_tables_text() {
-    let _serial = serial();
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/drive.toml");
     let dir = tmp("boundary");
     let log = replay_log(&dir);
-    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/drive.toml");
+    let _serial = serial();
     for a in ALIASES.iter().filter(|a| a.boundary == Boundary::Cli) {
         let key = ivt_kin::params::find(a.key).expect("alias of a key");
         for v in outside(key) {
