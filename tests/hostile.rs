@@ -182,7 +182,7 @@ fn replay_columns_by_name_and_short_echoes() {
         "input",
     );
     assert!(
-        e.contains("--k = 1e300 does not fit the controller's f32"),
+        e.contains("--k = 1e300 mm/rad does not fit the controller's f32"),
         "{e}"
     );
     std::fs::remove_dir_all(&dir).unwrap();

@@ -9,7 +9,6 @@ use super::{CliError, Output};
 use clap::{Args, Subcommand, ValueEnum};
 use ivt_ctrl::{units, AnyController, Config, ControlOutput, Gains, LawKind, OpenLoopPreset};
 use ivt_sim::pulse_log::{parse_pulse_log, PulseRow, MAX_LOG_BYTES};
-use ivt_sim::scene::keys::typed;
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -134,36 +133,27 @@ pub fn run(cmd: CtrlCommand) -> Result<Output, CliError> {
 }
 
 /// Refuse, by name and as typed, options that would make the replay
-/// meaningless: a zero or non-finite timer frequency, decimation, stall
-/// timeout or sample period, non-finite gains or set points, and any value
-/// the controller's f32 cannot hold (`--k 1e300`).
+/// meaningless: each number outside its key's range in [`ivt_kin::params`]
+/// (a zero timer frequency, stall timeout or sample period, any value the
+/// controller's f32 cannot hold: `--k 1e300`), and a zero decimation.
 fn check_args(a: &ReplayArgs) -> Result<(), CliError> {
-    let positive = [
-        ("--f-timer", a.f_timer),
-        ("--omega0-rpm", a.omega0_rpm),
-        ("--stall-timeout", a.stall_timeout),
-        ("--prop-period", a.prop_period),
+    let keyed = [
+        ("--f-timer", "encoder.f_timer_hz", a.f_timer),
+        ("--omega0-rpm", "controller.omega0_rpm", a.omega0_rpm),
+        (
+            "--stall-timeout",
+            "controller.stall_timeout_s",
+            a.stall_timeout,
+        ),
+        ("--prop-period", "controller.prop_period_s", a.prop_period),
+        ("--k", "controller.k_mm_per_rad", a.k),
+        ("--k2", "controller.k2_mm_per_rad", a.k2),
+        ("--k-prop", "controller.k_prop_deg_per_rpm", a.k_prop),
+        ("--vm", "inputs.v_m[]", a.vm),
+        ("--tu", "inputs.t_u[]", a.tu),
     ];
-    let finite = [
-        ("--k", a.k),
-        ("--k2", a.k2),
-        ("--k-prop", a.k_prop),
-        ("--vm", a.vm),
-        ("--tu", a.tu),
-    ];
-    for (name, v) in positive.iter().chain(&finite) {
-        if !ivt_sim::scene::keys::fits_f32(*v) {
-            let (shown, why) = (typed(*v), ivt_sim::scene::keys::NOT_F32);
-            return Err(CliError::Input(format!("{name} = {shown} {why}")));
-        }
-    }
-    for (name, v) in positive {
-        if v <= 0.0 {
-            return Err(CliError::Input(format!(
-                "{name} must be > 0, got {}",
-                typed(v)
-            )));
-        }
+    for (flag, key, v) in keyed {
+        super::check_flag(flag, key, v)?;
     }
     if a.decimation == 0 {
         return Err(CliError::Input("--decimation must be ≥ 1".into()));

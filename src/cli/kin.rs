@@ -9,6 +9,7 @@ use ivt_kin::ncg::{
     fourier_coefficient, fourier_coefficient_eq38, pitch_profile, GearRatio, GivtNcg, PitchPoint,
     SgivtNcg, SmoothNcg, EQ42_PRINTED,
 };
+use ivt_kin::params::Typed;
 use ivt_kin::plant::PlantParams;
 use ivt_kin::sgivt::{output_ripple, SgivtGeometry, R_AVG_SLOPE_PRINTED_PER_DEG};
 use ivt_kin::units::{deg_to_rad, m_to_inch, rad_to_deg};
@@ -178,18 +179,8 @@ pub fn summary() -> Result<Output, CliError> {
 
 fn sgivt_ratio(theta_ct_deg: f64, points: usize) -> Result<Output, CliError> {
     check_points(points, 0)?;
+    super::check_flag("--theta-ct", "kin.theta_ct_deg", theta_ct_deg)?;
     let g = SgivtGeometry::prototype();
-    // Checked in the unit typed (degrees), against the same bound the
-    // geometry checks in radians (its 1e-12 relative slack included).
-    let max_deg = ivt_kin::units::rad_to_deg(g.theta_ct_max);
-    if !(theta_ct_deg.is_finite() && theta_ct_deg >= 0.0 && theta_ct_deg <= max_deg * (1.0 + 1e-12))
-    {
-        return Err(CliError::Input(format!(
-            "--theta-ct = {} deg is outside [0, {}] deg (θ_CT of the prototype, §4.4.2)",
-            ivt_sim::scene::keys::typed(theta_ct_deg),
-            ivt_sim::scene::keys::typed(max_deg)
-        )));
-    }
     let th = deg_to_rad(theta_ct_deg);
     let e = g.crank_length(th).map_err(kin_err)?;
     let r_avg = g.average_ratio(e).map_err(kin_err)?;
@@ -228,6 +219,16 @@ fn sgivt_ratio(theta_ct_deg: f64, points: usize) -> Result<Output, CliError> {
 
 fn givt_ratio(r_mm: f64, l1_mm: f64, r_output_mm: f64, points: usize) -> Result<Output, CliError> {
     check_points(points, 0)?;
+    super::check_flag("--r-mm", "kin.givt_r_mm", r_mm)?;
+    super::check_flag("--l1-mm", "kin.givt_l1_mm", l1_mm)?;
+    super::check_flag("--r-output-mm", "kin.givt_r_output_mm", r_output_mm)?;
+    if r_mm >= l1_mm {
+        return Err(CliError::Input(format!(
+            "--r-mm = {} mm is out of domain: must be < --l1-mm = {} mm (Eq. 8 divides by |l1 − r|)",
+            Typed(r_mm),
+            Typed(l1_mm)
+        )));
+    }
     let g = GivtGeometry {
         l1: l1_mm * 1e-3,
         r_output: r_output_mm * 1e-3,
@@ -355,6 +356,8 @@ fn arcs(
     tolerance: f64,
     corner_deg: f64,
 ) -> Result<Output, CliError> {
+    super::check_flag("--tolerance", "kin.arc_tolerance", tolerance)?;
+    super::check_flag("--corner-deg", "kin.arc_corner_deg", corner_deg)?;
     let opts = ArcOptions {
         tolerance,
         corner_half_width: deg_to_rad(corner_deg),
@@ -466,6 +469,8 @@ fn fourier(harmonics: u32) -> Result<Output, CliError> {
 }
 
 fn direction(r_sun: f64, r_planet: f64) -> Result<Output, CliError> {
+    super::check_flag("--r-sun", "kin.r_sun", r_sun)?;
+    super::check_flag("--r-planet", "kin.r_planet", r_planet)?;
     let m = DirectionModule { r_sun, r_planet };
     let f = m.speeds(DirectionMode::Forward, 1.0).map_err(kin_err)?;
     let r = m.speeds(DirectionMode::Reverse, 1.0).map_err(kin_err)?;

@@ -64,6 +64,17 @@ impl CliError {
     }
 }
 
+/// Check `value`, given as `flag`, against key `key` of the one description
+/// of user-settable numbers ([`ivt_kin::params`]; the pair must be one of its
+/// `ALIASES`): `--theta-ct = 3600.0000001 deg is outside [0, 3600] deg`.
+///
+/// # Errors
+/// [`CliError::Input`] naming the flag and the value as typed.
+pub fn check_flag(flag: &'static str, key: &str, value: f64) -> Result<(), CliError> {
+    ivt_kin::params::check_as(ivt_kin::params::Boundary::Cli, flag, key, value)
+        .map_err(|refused| CliError::Input(format!("{flag} {refused}")))
+}
+
 /// A harmonic-balance error: `input` or `failed` as
 /// [`ivt_hb::HbError::kind`] says.
 impl From<ivt_hb::HbError> for CliError {

@@ -177,6 +177,7 @@ pub fn run(cmd: OlCommand) -> Result<Output, CliError> {
 }
 
 fn solve(a: SolveArgs) -> Result<Output, CliError> {
+    operating_point_flags(a.vm, a.tu, a.omega0_rpm)?;
     let plant = a.plant.params()?;
     let op = OperatingPoint {
         v_m: a.vm,
@@ -218,13 +219,25 @@ fn solve(a: SolveArgs) -> Result<Output, CliError> {
     Ok(Output { json, human })
 }
 
+/// `--vm`, `--tu` and `--omega0-rpm` of one operating point, each checked
+/// through its key (shared by `ol solve` and `stability`).
+///
+/// # Errors
+/// [`CliError::Input`] naming the flag and the value as typed.
+pub fn operating_point_flags(vm: f64, tu: f64, omega0_rpm: f64) -> Result<(), CliError> {
+    super::check_flag("--vm", "inputs.v_m[]", vm)?;
+    super::check_flag("--tu", "inputs.t_u[]", tu)?;
+    super::check_flag("--omega0-rpm", "controller.omega0_rpm", omega0_rpm)
+}
+
 /// The grid of `table`/`fit` from its arguments, validated.
 fn grid_of(a: &GridArgs) -> Result<Grid, CliError> {
-    if !(a.omega0_rpm.is_finite() && a.omega0_rpm > 0.0) {
-        return Err(CliError::Input(format!(
-            "--omega0-rpm must be finite and > 0, got {}",
-            a.omega0_rpm
-        )));
+    super::check_flag("--omega0-rpm", "controller.omega0_rpm", a.omega0_rpm)?;
+    for (flag, v) in [("--vm-from", a.vm_from), ("--vm-to", a.vm_to)] {
+        super::check_flag(flag, "inputs.v_m[]", v)?;
+    }
+    for (flag, v) in [("--tu-from", a.tu_from), ("--tu-to", a.tu_to)] {
+        super::check_flag(flag, "inputs.t_u[]", v)?;
     }
     let grid = Grid {
         v_m: sweep::axis("--vm-step", a.vm_from, a.vm_step, a.vm_to)?,

@@ -73,12 +73,7 @@ pub fn run_file(args: &SimArgs, json: bool) -> Result<Output, CliError> {
     } else {
         args.route.map(Route::from)
     };
-    if !(args.max_events.is_finite() && args.max_events > 0.0) {
-        return Err(CliError::Input(format!(
-            "--max-events must be finite and > 0, got {}",
-            ivt_sim::scene::keys::typed(args.max_events)
-        )));
-    }
+    super::check_flag("--max-events", "budget.max_events", args.max_events)?;
     run_scene(&scene, &args.out, json, args.pil, route, args.max_events)
 }
 

@@ -55,15 +55,24 @@ pub struct Common {
 }
 
 impl Common {
-    fn gains(&self) -> FeedbackGains {
-        if self.si {
+    /// The gains, each checked through its key (thesis mm·rad⁻¹, or SI
+    /// under `--si`).
+    fn gains(&self) -> Result<FeedbackGains, CliError> {
+        let (k, k2) = if self.si {
+            ("controller.k_si", "controller.k2_si")
+        } else {
+            ("controller.k_mm_per_rad", "controller.k2_mm_per_rad")
+        };
+        super::check_flag("--k", k, self.k)?;
+        super::check_flag("--k2", k2, self.k2)?;
+        Ok(if self.si {
             FeedbackGains {
                 k: self.k,
                 k2: self.k2,
             }
         } else {
             FeedbackGains::from_thesis_mm_per_rad(self.k, self.k2)
-        }
+        })
     }
     /// The discretization, validated ([`DelayOptions::validate`]).
     fn opts(&self) -> Result<DelayOptions, CliError> {
@@ -75,14 +84,8 @@ impl Common {
         Ok(opts)
     }
     fn omega0(&self) -> Result<f64, CliError> {
-        if self.omega0_rpm.is_finite() && self.omega0_rpm > 0.0 {
-            Ok(rpm_to_rad_s(self.omega0_rpm))
-        } else {
-            Err(CliError::Input(format!(
-                "--omega0-rpm must be finite and > 0, got {}",
-                self.omega0_rpm
-            )))
-        }
+        super::check_flag("--omega0-rpm", "controller.omega0_rpm", self.omega0_rpm)?;
+        Ok(rpm_to_rad_s(self.omega0_rpm))
     }
 }
 
@@ -111,13 +114,14 @@ pub struct MapArgs {
 /// # Errors
 /// Bad input or solver failure.
 pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
+    super::ol::operating_point_flags(a.vm, a.tu, a.common.omega0_rpm)?;
     let op = OperatingPoint {
         v_m: a.vm,
         t_u: a.tu,
         omega0: a.common.omega0()?,
     };
     op.validate()?;
-    let g = a.common.gains();
+    let g = a.common.gains()?;
     let plant = a.common.plant.params()?;
     let t0 = std::time::Instant::now();
     let s = delay_stability(&plant, &op, g, &a.common.opts()?)?;
@@ -170,12 +174,12 @@ pub fn run(a: StabilityArgs) -> Result<Output, CliError> {
 /// Bad input, an empty grid, or every point failed.
 pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
     let grid = Grid {
-        v_m: grid_axis("--vm", &a.vm)?,
-        t_u: grid_axis("--tu", &a.tu)?,
+        v_m: grid_axis("--vm", "inputs.v_m[]", &a.vm)?,
+        t_u: grid_axis("--tu", "inputs.t_u[]", &a.tu)?,
         omega0: a.common.omega0()?,
     };
     let plant = a.common.plant.params()?;
-    let g = a.common.gains();
+    let g = a.common.gains()?;
     let t0 = std::time::Instant::now();
     let map = grid_stability_map(&plant, &grid, a.feasible_only, g, &a.common.opts()?)?;
     let dt = t0.elapsed().as_secs_f64();
@@ -217,12 +221,15 @@ pub fn run_map(a: MapArgs) -> Result<Output, CliError> {
     Ok(Output { json, human })
 }
 
-/// One `FROM STEP TO` axis of `stability-map`, refused by name when it is not
-/// finite, not increasing or longer than [`ivt_design::sweep::MAX_AXIS_POINTS`].
-fn grid_axis(name: &'static str, v: &[f64]) -> Result<Vec<f64>, CliError> {
+/// One `FROM STEP TO` axis of `stability-map`, refused by name when FROM or
+/// TO is outside `key`'s range, or the axis is not increasing or longer than
+/// [`ivt_design::sweep::MAX_AXIS_POINTS`].
+fn grid_axis(name: &'static str, key: &str, v: &[f64]) -> Result<Vec<f64>, CliError> {
     let &[from, step, to] = v else {
         return Err(CliError::Input(format!("{name} takes FROM STEP TO")));
     };
+    super::check_flag(name, key, from)?;
+    super::check_flag(name, key, to)?;
     Ok(axis(name, from, step, to)?)
 }
 

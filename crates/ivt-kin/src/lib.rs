@@ -16,6 +16,8 @@
 //! - [`units`]: inch/degree/rpm helpers for the edges.
 //! - [`variant`]: the modulation `f(θ)` of the noncircular gears (Eq. 43, 139)
 //!   and the speeds of the SGIVT variant (Eq. 44–47).
+//! - [`params`]: every user-settable number described once (key, unit,
+//!   range, f32), with the CLI flags and Python arguments that set it.
 //! - [`plant`]: Table 1 parameters and the coefficients of the dynamic
 //!   equation Eq. 151.
 #![doc = ""]
@@ -27,6 +29,7 @@ pub mod arcs;
 pub mod error;
 pub mod givt;
 pub mod ncg;
+pub mod params;
 pub mod plant;
 mod quad;
 pub mod sgivt;

@@ -11,7 +11,7 @@
 //! θ is the angle of the driven noncircular gear, r the roller eccentricity,
 //! V_m the motor voltage and T_U the brake torque (SI units throughout).
 
-use crate::variant;
+use crate::{params, variant};
 use core::f64::consts::{PI, SQRT_2};
 
 /// How the gravity term G(θ) of Eq. 151 is formed.
@@ -169,13 +169,13 @@ impl PlantParams {
         &self,
         theta: f64,
         f: f64,
-        f_theta: f64,
+        ft: f64,
         r: f64,
         v_m: f64,
         t_u: f64,
     ) -> PlantTerms {
         let (s, c) = (libm::sin(theta), libm::cos(theta));
-        self.terms_with_trig(s, c, f, f_theta, r, v_m, t_u)
+        self.terms_with_trig(s, c, f, ft, r, v_m, t_u)
     }
 
     /// As [`Self::terms_with_f`] with sin θ and cos θ also known (harmonic
@@ -215,35 +215,30 @@ impl PlantParams {
         self.terms(theta, r, v_m, t_u).acceleration(omega, r)
     }
 
-    /// Check that every parameter is finite and physically meaningful.
+    /// Check every parameter against its range in [`params::KEYS`]
+    /// (`plant.<field>`: finite, > 0 where a zero divides or is no machine,
+    /// >= 0 where 0 neglects the term, below a physical ceiling).
     ///
     /// # Errors
-    /// Names the first offending parameter.
+    /// Names the first offending parameter, in Table 1 order.
     pub fn validate(&self) -> Result<(), ParamError> {
-        /// `[("field", self.field), ...]`: each parameter with its own name.
+        /// `[("field", "plant.field", self.field), ...]`.
         macro_rules! named {
-            ($($field:ident),*) => { [$((stringify!($field), self.$field)),*] };
+            ($($field:ident),*) => {
+                [$((stringify!($field), concat!("plant.", stringify!($field)), self.$field)),*]
+            };
         }
-        let positive = named!(r_a, k_e, k_t, j_n1, j_n2, j_crk, r_u, r_max, sun_to_planet);
-        let non_negative = named!(l_a, j_inshaft, j_carrier, j_ring, m_r, m_dr, j_u, g);
-        check_all(&positive, "finite and > 0", |v| v > 0.0)?;
-        check_all(&non_negative, "finite and >= 0", |v| v >= 0.0)
-    }
-}
-
-/// The first of `values` that is not finite or fails `ok`, as a [`ParamError`].
-fn check_all(
-    values: &[(&'static str, f64)],
-    requirement: &'static str,
-    ok: impl Fn(f64) -> bool,
-) -> Result<(), ParamError> {
-    match values.iter().find(|(_, v)| !(v.is_finite() && ok(*v))) {
-        Some(&(name, value)) => Err(ParamError {
-            name,
-            value,
-            requirement,
-        }),
-        None => Ok(()),
+        #[rustfmt::skip]
+        let all = named!(r_a, k_e, k_t, l_a, j_n1, j_n2, j_inshaft, j_carrier, j_ring,
+                         j_crk, m_r, m_dr, j_u, r_u, g, sun_to_planet, r_max);
+        for (name, key, value) in all {
+            params::check(key, value).map_err(|refused| ParamError {
+                name,
+                value,
+                refused,
+            })?;
+        }
+        Ok(())
     }
 }
 
@@ -291,24 +286,20 @@ impl PlantPreset {
     }
 }
 
-/// A plant parameter outside its valid range.
+/// A plant parameter outside its range ([`params::KEYS`]' `plant.<field>`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ParamError {
     /// Field name in [`PlantParams`].
     pub name: &'static str,
     /// The offending value.
     pub value: f64,
-    /// What it must satisfy.
-    pub requirement: &'static str,
+    /// The refusal: the value as typed and the range.
+    pub refused: params::Refused,
 }
 
 impl core::fmt::Display for ParamError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(
-            f,
-            "plant parameter `{}` = {} must be {}",
-            self.name, self.value, self.requirement
-        )
+        write!(f, "plant parameter `{}` {}", self.name, self.refused)
     }
 }
 

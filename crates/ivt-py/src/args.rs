@@ -4,10 +4,26 @@
 //! raises a `ValueError` that names the argument and the range, where pyo3's
 //! own conversion raises an `OverflowError` naming neither. Upper limits of
 //! the numerics are checked by the Rust crates, before they allocate.
+//! Float arguments that set a physical quantity are checked through its key
+//! in [`ivt_kin::params`] ([`check_arg`]).
 
+use ivt_kin::params::{check_as, Boundary};
 use pyo3::exceptions::{PyOverflowError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBool;
+
+/// Check float argument `name` against key `key` of the one description of
+/// user-settable numbers ([`ivt_kin::params`]; the pair must be one of its
+/// `ALIASES`): the text after the name is the scene's and the CLI's for the
+/// same quantity.
+///
+/// # Errors
+/// `ValueError`: "argument `name` = 1e300 mm/rad does not fit the
+/// controller's f32 …" or "… is outside [lo, hi] unit", the value as typed.
+pub fn check_arg(name: &'static str, key: &str, value: f64) -> PyResult<()> {
+    check_as(Boundary::Python, name, key, value)
+        .map_err(|refused| PyValueError::new_err(format!("argument `{name}` {refused}")))
+}
 
 /// An integer type an argument converts to, with its range.
 pub trait IntRange: TryFrom<i128> {

@@ -11,7 +11,7 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::args::{count, int, opt_int};
+use crate::args::{check_arg, count, int, opt_int};
 use crate::ctrl_convert::{
     fault_name, inputs_from_py, law_kind, law_name, open_loop_from_py, open_loop_to_py,
     output_dict, region_name, ticks_from_py, SIGNALS,
@@ -52,22 +52,22 @@ impl Controller {
     #[allow(clippy::too_many_arguments)]
     fn new(
         #[pyo3(from_py_with = int)] ppr: i128,
-        f_timer_hz: Option<f32>,
-        omega0: Option<f32>,
-        omega0_rpm: Option<f32>,
+        f_timer_hz: Option<f64>,
+        omega0: Option<f64>,
+        omega0_rpm: Option<f64>,
         #[pyo3(from_py_with = opt_int)] decimation: Option<i128>,
         law: Option<&str>,
-        k: Option<f32>,
-        k2: Option<f32>,
-        k_prop: Option<f32>,
-        prop_period_s: Option<f32>,
+        k: Option<f64>,
+        k2: Option<f64>,
+        k_prop: Option<f64>,
+        prop_period_s: Option<f64>,
         open_loop: Option<&Bound<'_, PyAny>>,
         feedforward: Option<bool>,
         steps_per_metre: Option<f32>,
         #[pyo3(from_py_with = opt_int)] offset_steps: Option<i128>,
-        stepper_max_speed: Option<f32>,
-        stepper_accel: Option<f32>,
-        stall_timeout_s: Option<f32>,
+        stepper_max_speed: Option<f64>,
+        stepper_accel: Option<f64>,
+        stall_timeout_s: Option<f64>,
         omega_max: Option<f32>,
         safe_r: Option<f32>,
         v_m_valid: Option<[f32; 2]>,
@@ -88,6 +88,26 @@ impl Controller {
                 "give `omega0` [rad/s] or `omega0_rpm`, not both",
             ));
         }
+        // each float that sets a quantity of ivt_kin::params, checked
+        // through its key as typed, then held as the controller's f32
+        let keyed = |name: &'static str, key: &str, v: Option<f64>| -> PyResult<Option<f32>> {
+            v.map(|v| check_arg(name, key, v).map(|()| v as f32))
+                .transpose()
+        };
+        let f_timer_hz = keyed("f_timer_hz", "encoder.f_timer_hz", f_timer_hz)?;
+        let omega0 = keyed("omega0", "controller.omega0", omega0)?;
+        let omega0_rpm = keyed("omega0_rpm", "controller.omega0_rpm", omega0_rpm)?;
+        let k = keyed("k", "controller.k_si", k)?;
+        let k2 = keyed("k2", "controller.k2_si", k2)?;
+        let k_prop = keyed("k_prop", "controller.k_prop_si", k_prop)?;
+        let prop_period_s = keyed("prop_period_s", "controller.prop_period_s", prop_period_s)?;
+        let stepper_max_speed = keyed("stepper_max_speed", "stepper.max_speed", stepper_max_speed)?;
+        let stepper_accel = keyed("stepper_accel", "stepper.accel", stepper_accel)?;
+        let stall_timeout_s = keyed(
+            "stall_timeout_s",
+            "controller.stall_timeout_s",
+            stall_timeout_s,
+        )?;
         let mut overrides: Vec<Override> = Vec::new();
         macro_rules! set {
             ($opt:expr, $name:literal, |$c:ident, $v:ident| $body:expr) => {

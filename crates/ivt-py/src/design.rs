@@ -3,7 +3,7 @@
 //! Keys follow `ivt ol solve`, `ivt ol table`, `ivt ol fit`, `ivt stability` and
 //! `ivt stability-map` (`--json`).
 
-use crate::args::{count, int};
+use crate::args::{check_arg, count, int};
 use crate::kin::Plant;
 use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
 use ivt_design::fit::{LawError, PolyForm};
@@ -54,12 +54,11 @@ fn plant_of(plant: Option<&Bound<'_, PyAny>>) -> PyResult<(PlantParams, String)>
     Ok((params, name.into()))
 }
 
+/// One operating point, each argument checked through its key.
 fn operating_point(v_m: f64, t_u: f64, omega0_rpm: f64) -> PyResult<OperatingPoint> {
-    if !(omega0_rpm.is_finite() && omega0_rpm > 0.0) {
-        return Err(PyValueError::new_err(format!(
-            "argument `omega0_rpm` = {omega0_rpm} must be finite and > 0"
-        )));
-    }
+    check_arg("v_m", "inputs.v_m[]", v_m)?;
+    check_arg("t_u", "inputs.t_u[]", t_u)?;
+    check_arg("omega0_rpm", "controller.omega0_rpm", omega0_rpm)?;
     let op = OperatingPoint {
         v_m,
         t_u,
@@ -69,13 +68,16 @@ fn operating_point(v_m: f64, t_u: f64, omega0_rpm: f64) -> PyResult<OperatingPoi
     Ok(op)
 }
 
-/// The (V_m, T_U) grid of `(from, step, to)` axes at ω0, validated (each
-/// axis at most `MAX_AXIS_POINTS` values, checked before allocation).
+/// The (V_m, T_U) grid of `(from, step, to)` axes at ω0, validated (the
+/// axes' ends and ω0 through their keys, each axis at most
+/// `MAX_AXIS_POINTS` values, checked before allocation).
 fn grid_of(v_m: (f64, f64, f64), t_u: (f64, f64, f64), omega0_rpm: f64) -> PyResult<Grid> {
-    if !(omega0_rpm.is_finite() && omega0_rpm > 0.0) {
-        return Err(PyValueError::new_err(format!(
-            "argument `omega0_rpm` = {omega0_rpm} must be finite and > 0"
-        )));
+    check_arg("omega0_rpm", "controller.omega0_rpm", omega0_rpm)?;
+    for v in [v_m.0, v_m.2] {
+        check_arg("v_m", "inputs.v_m[]", v)?;
+    }
+    for v in [t_u.0, t_u.2] {
+        check_arg("t_u", "inputs.t_u[]", v)?;
     }
     let grid = Grid {
         v_m: sweep::axis("v_m", v_m.0, v_m.1, v_m.2).map_err(design_err)?,
@@ -88,7 +90,7 @@ fn grid_of(v_m: (f64, f64, f64), t_u: (f64, f64, f64), omega0_rpm: f64) -> PyRes
 
 /// The delay loop of `stability` and `stability_map`: the plant (and the
 /// name the result echoes), the feedback gains (thesis mm·rad⁻¹, or SI with
-/// `si`; refused by name unless finite) and the Chebyshev Tau discretization
+/// `si`; each checked through its key) and the Chebyshev Tau discretization
 /// of order `n` (validated; the message names `n` and `chebyshev_order`).
 fn delay_loop<'py>(
     plant: Option<&Bound<'py, PyAny>>,
@@ -98,12 +100,13 @@ fn delay_loop<'py>(
     n: i128,
 ) -> PyResult<(PlantParams, String, FeedbackGains, DelayOptions)> {
     let (params, plant_name) = plant_of(plant)?;
-    for (name, v) in [("k", k), ("k2", k2)] {
-        if !v.is_finite() {
-            return Err(PyValueError::new_err(format!(
-                "argument `{name}` = {v} must be finite"
-            )));
-        }
+    let keys = if si {
+        ["controller.k_si", "controller.k2_si"]
+    } else {
+        ["controller.k_mm_per_rad", "controller.k2_mm_per_rad"]
+    };
+    for ((name, v), key) in [("k", k), ("k2", k2)].into_iter().zip(keys) {
+        check_arg(name, key, v)?;
     }
     let gains = if si {
         FeedbackGains { k, k2 }
@@ -117,6 +120,20 @@ fn delay_loop<'py>(
     opts.validate()
         .map_err(|e| PyValueError::new_err(format!("argument `n`: {e}")))?;
     Ok((params, plant_name, gains, opts))
+}
+
+/// What `ol_table` and `ol_fit` share: the plant (and its echoed name), the
+/// IHB options and the grid, each validated.
+fn grid_job(
+    plant: Option<&Bound<'_, PyAny>>,
+    harmonics: i128,
+    v_m: (f64, f64, f64),
+    t_u: (f64, f64, f64),
+    omega0_rpm: f64,
+) -> PyResult<(PlantParams, String, IhbOptions, Grid)> {
+    let (params, plant_name) = plant_of(plant)?;
+    let opts = ihb_options(harmonics)?;
+    Ok((params, plant_name, opts, grid_of(v_m, t_u, omega0_rpm)?))
 }
 
 fn ihb_options(harmonics: i128) -> PyResult<IhbOptions> {
@@ -230,9 +247,7 @@ fn ol_table<'py>(
     #[pyo3(from_py_with = int)] harmonics: i128,
     plant: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (params, plant_name) = plant_of(plant)?;
-    let opts = ihb_options(harmonics)?;
-    let grid = grid_of(v_m, t_u, omega0_rpm)?;
+    let (params, plant_name, opts, grid) = grid_job(plant, harmonics, v_m, t_u, omega0_rpm)?;
     let pts = py
         .detach(|| sweep::sweep(&params, &grid, opts, || ()))
         .map_err(design_err)?;
@@ -284,17 +299,15 @@ fn ol_table<'py>(
     plant = None, full = false
 ))]
 fn ol_fit<'py>(
-    py: Python<'py>,
     v_m: (f64, f64, f64),
     t_u: (f64, f64, f64),
     omega0_rpm: f64,
     #[pyo3(from_py_with = int)] harmonics: i128,
     plant: Option<&Bound<'py, PyAny>>,
     full: bool,
+    py: Python<'py>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (params, plant_name) = plant_of(plant)?;
-    let opts = ihb_options(harmonics)?;
-    let grid = grid_of(v_m, t_u, omega0_rpm)?;
+    let (params, plant_name, opts, grid) = grid_job(plant, harmonics, v_m, t_u, omega0_rpm)?;
     let form = if full {
         PolyForm::Full
     } else {

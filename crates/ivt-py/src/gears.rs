@@ -1,7 +1,7 @@
 //! `ivt.kin` continued: the GIVT (§2.1) and SGIVT (§2.2) mechanisms, the
 //! noncircular-gear pitch profiles (Eq. 13–17, 38–42) and unit helpers.
 
-use crate::args::{count, int};
+use crate::args::{check_arg, count, int};
 use crate::fields::{self, Field};
 use crate::vectorize::{map, map1, map2};
 use ivt_kin::givt::{DirectionMode, DirectionModule, GivtGeometry};
@@ -281,6 +281,8 @@ fn ncg_ratio<'py>(
 #[pyfunction]
 #[pyo3(signature = (r_sun = 1.0, r_planet = 1.0))]
 fn direction<'py>(py: Python<'py>, r_sun: f64, r_planet: f64) -> PyResult<Bound<'py, PyDict>> {
+    check_arg("r_sun", "kin.r_sun", r_sun)?;
+    check_arg("r_planet", "kin.r_planet", r_planet)?;
     let m = DirectionModule { r_sun, r_planet };
     let fwd = m.speeds(DirectionMode::Forward, 1.0).map_err(kin_err)?;
     let rev = m.speeds(DirectionMode::Reverse, 1.0).map_err(kin_err)?;

@@ -1,6 +1,7 @@
 //! `ivt.kin`: kinematics of the SGIVT variant (§2.3) and the plant
 //! coefficients of Eq. 151, vectorized over numpy arrays.
 
+use crate::args::check_arg;
 use crate::fields::{self, Field};
 use crate::vectorize::{map, map1, map2};
 use ivt_kin::plant::{GravityModel, PlantParams};
@@ -45,7 +46,6 @@ fn mean_f_squared() -> f64 {
 #[pyfunction]
 #[pyo3(signature = (omega, omega_c, d_s = 1.0, d_p = 1.0))]
 fn ring_speeds<'py>(
-    py: Python<'py>,
     omega: &Bound<'py, PyAny>,
     omega_c: &Bound<'py, PyAny>,
     d_s: f64,
@@ -56,9 +56,11 @@ fn ring_speeds<'py>(
             "arguments `d_s` = {d_s}, `d_p` = {d_p} must be finite with d_s + 2 d_p != 0"
         )));
     }
-    map2(py, [("omega", omega), ("omega_c", omega_c)], |[w, wc]| {
-        variant::ring_speeds(w, wc, d_s, d_p)
-    })
+    map2(
+        omega.py(),
+        [("omega", omega), ("omega_c", omega_c)],
+        |[w, wc]| variant::ring_speeds(w, wc, d_s, d_p),
+    )
 }
 
 /// Driver speeds (v_d1, v_d2) = (ω r sin θ, ω r cos θ) [m/s], Eq. 45–46.
@@ -76,16 +78,6 @@ fn driver_speeds<'py>(
     )
 }
 
-fn check_r_u(r_u: f64) -> PyResult<()> {
-    if r_u.is_finite() && r_u > 0.0 {
-        Ok(())
-    } else {
-        Err(PyValueError::new_err(format!(
-            "argument `r_u` = {r_u} must be finite and > 0"
-        )))
-    }
-}
-
 /// Output-shaft speed ω_U = max(|v_d1|, |v_d2|)/r_u [rad/s], Eq. 47.
 ///
 /// r_u defaults to the printed output gear radius (Table 1, 0.0222 m).
@@ -98,7 +90,7 @@ fn output_speed<'py>(
     r: &Bound<'py, PyAny>,
     r_u: f64,
 ) -> PyResult<Bound<'py, PyAny>> {
-    check_r_u(r_u)?;
+    check_arg("r_u", "plant.r_u", r_u)?;
     map1(
         py,
         [("theta", theta), ("omega", omega), ("r", r)],
@@ -109,13 +101,11 @@ fn output_speed<'py>(
 /// The constant output-to-motor speed ratio ω_U/ω_m = 2√2 r/(π r_u), Eq. 47.
 #[pyfunction]
 #[pyo3(signature = (r, r_u = R_U_PRINTED))]
-fn output_to_motor_ratio<'py>(
-    py: Python<'py>,
-    r: &Bound<'py, PyAny>,
-    r_u: f64,
-) -> PyResult<Bound<'py, PyAny>> {
-    check_r_u(r_u)?;
-    map1(py, [("r", r)], |[r]| variant::output_to_motor_ratio(r, r_u))
+fn output_to_motor_ratio<'py>(r: &Bound<'py, PyAny>, r_u: f64) -> PyResult<Bound<'py, PyAny>> {
+    check_arg("r_u", "plant.r_u", r_u)?;
+    map1(r.py(), [("r", r)], |[r]| {
+        variant::output_to_motor_ratio(r, r_u)
+    })
 }
 
 /// The numeric Table 1 parameters by their Rust (and Python) names.
@@ -154,9 +144,10 @@ fn apply_overrides(
         };
         Ok(true)
     })?;
+    // the keywords are the fields' names: each checked under its own key
     params
         .validate()
-        .map_err(|e| PyValueError::new_err(e.to_string()))
+        .map_err(|e| PyValueError::new_err(format!("argument `{}` {}", e.name, e.refused)))
 }
 
 /// The parameters of a plant file (a `[plant]` table: preset + overrides,
@@ -270,13 +261,12 @@ plant_methods! {
     /// g, f_m, f1, f2.
     fn terms<'py>(
         &self,
-        py: Python<'py>,
         theta: &Bound<'py, PyAny>,
         r: &Bound<'py, PyAny>,
         v_m: &Bound<'py, PyAny>,
         t_u: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let p = self.params;
+        let (py, p) = (theta.py(), self.params);
         let outs = map(
             py,
             [("theta", theta), ("r", r), ("v_m", v_m), ("t_u", t_u)],

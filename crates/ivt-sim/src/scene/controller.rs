@@ -1,7 +1,7 @@
 //! `[controller]` (law, gains, feed-forward) and `[metrics]`.
 
-use super::inputs::{knots, profile_ok};
-use super::keys::{check, Bound, Key};
+use super::inputs::{knots, profile_ok, within_r_max};
+use super::keys::{check, fits_f32, Typed, NOT_F32};
 use super::Invalid;
 use ivt_ctrl::{LawKind, OpenLoopPreset};
 use serde::{Deserialize, Serialize};
@@ -125,14 +125,15 @@ impl ControllerSection {
             })?;
         }
         if !self.r_schedule.is_empty() {
-            let r = Key {
-                name: "controller.r_schedule[]",
-                unit: "m",
-                min: Bound::Closed(0.0),
-                max: Bound::Closed(r_max),
-                f32: true,
+            // the controller holds r as an f32
+            let r_ok = |r: f64| {
+                if fits_f32(r) {
+                    within_r_max(r, r_max)
+                } else {
+                    Err(format!("= {} m {NOT_F32}", Typed(r)))
+                }
             };
-            profile_ok(&self.r_schedule, "controller.r_schedule", &r)?;
+            profile_ok(&self.r_schedule, "controller.r_schedule", r_ok)?;
         }
         Ok(())
     }

@@ -1,6 +1,6 @@
 //! `[inputs]` (piecewise-linear V_m(t), T_U(t)) and `[initial]`.
 
-use super::keys::{self, Key};
+use super::keys;
 use super::Invalid;
 use serde::{Deserialize, Deserializer};
 
@@ -19,9 +19,8 @@ pub struct InputsSection {
 impl InputsSection {
     pub(super) fn validate(&self) -> Result<(), Invalid> {
         for (p, key) in [(&self.v_m, "inputs.v_m"), (&self.t_u, "inputs.t_u")] {
-            let values = keys::find(&format!("{key}[]"))
-                .ok_or_else(|| Invalid::new(key, "has no description in scene::keys::KEYS"))?;
-            profile_ok(p, key, values)?;
+            let values = keys::described(&format!("{key}[]"))?;
+            profile_ok(p, key, |v| values.check(v).map_err(|e| e.to_string()))?;
         }
         Ok(())
     }
@@ -46,32 +45,42 @@ impl InitialSection {
     pub(super) fn validate(&self, r_max: f64) -> Result<(), Invalid> {
         keys::check("initial.theta", self.theta)?;
         keys::check("initial.omega", self.omega)?;
-        Invalid::check((0.0..=r_max).contains(&self.r), "initial.r", || {
-            format!(
-                "= {} m is outside [0, r_max = {}] m",
-                keys::typed(self.r),
-                keys::typed(r_max)
-            )
-        })
+        within_r_max(self.r, r_max).map_err(|why| Invalid::new("initial.r", why))
+    }
+}
+
+/// An eccentricity in `[0, r_max]` (the plant's own bound, so not one of
+/// [`keys::KEYS`]), else why not, as typed.
+pub(super) fn within_r_max(r: f64, r_max: f64) -> Result<(), String> {
+    if (0.0..=r_max).contains(&r) {
+        Ok(())
+    } else {
+        Err(format!(
+            "= {} m is outside [0, r_max = {}] m",
+            keys::typed(r),
+            keys::typed(r_max)
+        ))
     }
 }
 
 /// A profile `[[t, value], ...]`: at least one knot, times in the range of
-/// `{key}[].t` ([`keys::KEYS`]) increasing strictly, values in `values`' range.
-pub(super) fn profile_ok(p: &[[f64; 2]], key: &str, values: &Key) -> Result<(), Invalid> {
+/// `{key}[].t` ([`keys::KEYS`]) increasing strictly, each value accepted by
+/// `value_ok` (which says why not, as typed).
+pub(super) fn profile_ok(
+    p: &[[f64; 2]],
+    key: &str,
+    value_ok: impl Fn(f64) -> Result<(), String>,
+) -> Result<(), Invalid> {
     if p.is_empty() {
         return Err(Invalid::new(key, "needs at least one [t, value] knot"));
     }
-    let times = keys::find(&format!("{key}[].t"))
-        .ok_or_else(|| Invalid::new(key, "has no description in scene::keys::KEYS"))?;
+    let times = keys::described(&format!("{key}[].t"))?;
     for (k, &[t, v]) in p.iter().enumerate() {
         let at = format!("{key}[{k}]");
         times
-            .check_at(&at, t)
-            .map_err(|e| Invalid::new(at.clone(), format!("knot {k}: time {}", e.message)))?;
-        values
-            .check_at(&at, v)
-            .map_err(|e| Invalid::new(at.clone(), format!("knot {k}: value {}", e.message)))?;
+            .check(t)
+            .map_err(|e| Invalid::new(at.clone(), format!("knot {k}: time {e}")))?;
+        value_ok(v).map_err(|e| Invalid::new(at.clone(), format!("knot {k}: value {e}")))?;
         if let Some(prev) = k.checked_sub(1).and_then(|j| p.get(j)) {
             if t <= prev[0] {
                 return Err(Invalid::new(

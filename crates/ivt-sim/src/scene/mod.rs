@@ -28,9 +28,7 @@ pub use plant::{Gravity, PlantSection, PresetName};
 use ivt_kin::plant::PlantParams;
 use serde::Deserialize;
 
-/// Longest simulated time a scene may ask for \[s\]: 10⁶ s (11.6 days) at the
-/// measured ≈ 20× real time of the default scene is ~14 h of wall time.
-pub const MAX_DURATION_S: f64 = 1e6;
+pub use ivt_kin::params::MAX_DURATION_S;
 
 /// Rough size of one recorded field \[bytes\]: a CSV number or a JSON
 /// `"key":value` pair of the MCAP message before compression.

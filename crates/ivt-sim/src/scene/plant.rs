@@ -275,16 +275,13 @@ impl PlantSection {
                 *slot = v;
             }
         }
-        params.validate().map_err(|e| {
-            Invalid::new(
-                format!("plant.{}", e.name),
-                format!("= {} must be {}", e.value, e.requirement),
-            )
-        })?;
+        params
+            .validate()
+            .map_err(|e| Invalid::new(format!("plant.{}", e.name), e.refused.to_string()))?;
         Invalid::check(params.l_a == 0.0 || params.l_a >= 1e-7, "plant.l_a", || {
             format!(
                 "= {} H: below 1e-7 H the current mode (R_a/L_a > 2e6 /s) is too stiff for the explicit integrators; use 0 (Eq. 138)",
-                params.l_a
+                super::keys::typed(params.l_a)
             )
         })?;
         Ok(params)
