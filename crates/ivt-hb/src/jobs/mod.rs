@@ -14,6 +14,7 @@
 //! | backbone | [`BackboneRequest`] | [`BackboneCurve`] | `hb duffing-backbone` | `backbone` |
 //! | Mathieu–Duffing cascade (Eq. 81–85) | [`CascadeRequest`] | [`Cascade`] | `hb mathieu-duffing` | `mathieu_cascade` |
 //! | STHB string curve (Eq. 103–136) | [`StringRequest`] | [`StringCurve`] | `hb string` | `string` |
+//! | branch switching at a period doubling or branch point (Eq. 56, 61, 68–77) | [`SwitchRequest`] | [`SwitchedBranch`] | `hb switch` | `switch_branch` |
 
 mod array;
 pub mod backbone;
@@ -23,6 +24,7 @@ pub mod frc;
 pub mod limit_cycle;
 pub mod orbit;
 pub mod string;
+pub mod switch;
 
 pub use array::{check_finite, finite_pairs, pairs, Array, ARRAY_NAME};
 pub use backbone::{backbone, free_duffing, BackboneCurve, BackboneRequest, BackboneSample};
@@ -35,6 +37,7 @@ pub use frc::{frc, CurvePoint, EventRecord, FoldPoint, FrcCurve, FrcRequest};
 pub use limit_cycle::{limit_cycle, Cycle, LimitCycleRequest, Oscillator};
 pub use orbit::{orbit, Method, Orbit, OrbitRequest};
 pub use string::{string, StringCurve, StringPoint, StringRequest};
+pub use switch::{switch, SwitchRequest, SwitchStart, SwitchedBranch};
 
 use crate::error::HbError;
 
