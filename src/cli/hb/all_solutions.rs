@@ -1,0 +1,98 @@
+//! `ivt hb all-solutions`: every period-one orbit of Duffing's equation
+//! (Eq. 49, the thesis's ξ = 0.02, α = ε = 1, F = 0.1) at one ω_f by
+//! deflated Newton, with stability, by the job
+//! [`ivt_hb::jobs::all_solutions`] that `ivt.hb.all_solutions` runs.
+
+use super::autonomous::Resolution;
+use super::{to_json, CliError, Output};
+use clap::Args;
+use ivt_hb::jobs::{self, AllSolutionsRequest};
+use ivt_hb::{GeneralProblem, PeriodicProblem};
+
+/// `ivt hb all-solutions` (defaults: the thesis Duffing at ω_f = 1.4).
+#[derive(Args)]
+pub struct AllSolutionsArgs {
+    #[command(flatten)]
+    resolution: Resolution,
+    /// Excitation frequency ω_f.
+    #[arg(long, default_value_t = 1.4)]
+    omega: f64,
+    /// Damping ratio ξ.
+    #[arg(long, default_value_t = 0.02)]
+    xi: f64,
+    /// Linear stiffness α.
+    #[arg(long, default_value_t = 1.0)]
+    alpha: f64,
+    /// Cubic stiffness ε.
+    #[arg(long, default_value_t = 1.0)]
+    eps: f64,
+    /// Forcing amplitude F.
+    #[arg(long, default_value_t = 0.1)]
+    force: f64,
+    /// The search box: max |coefficient|.
+    #[arg(long, default_value_t = 10.0)]
+    max_amplitude: f64,
+}
+
+/// Duffing as a user system: M = 1, C = 2ξ, K = α, g = ε x³, f = F cos θ
+/// (the arithmetic of the Python callbacks `eps * x * x * x`,
+/// `F * math.cos(th)`).
+fn duffing(xi: f64, alpha: f64, eps: f64, force: f64) -> impl PeriodicProblem {
+    GeneralProblem::new(
+        1,
+        vec![1.0],
+        vec![2.0 * xi],
+        vec![alpha],
+        move |x: &[f64], _v: &[f64], _t: f64, g: &mut [f64]| {
+            if let (Some(x), Some(g)) = (x.first(), g.first_mut()) {
+                *g = eps * x * x * x;
+            }
+        },
+        move |t: f64, f: &mut [f64]| {
+            if let Some(f) = f.first_mut() {
+                *f = force * t.cos();
+            }
+        },
+    )
+    .with_velocity_dependent(false)
+}
+
+/// Run `ivt hb all-solutions`.
+///
+/// # Errors
+/// [`CliError::Input`] for bad parameters, [`CliError::Failed`] for a
+/// failed stability analysis.
+pub fn run(a: AllSolutionsArgs) -> Result<Output, CliError> {
+    let params = [a.xi, a.alpha, a.eps, a.force];
+    if params.iter().any(|v| !v.is_finite()) {
+        return Err(CliError::Input(format!(
+            "--xi, --alpha, --eps, --force = {params:?} must be finite"
+        )));
+    }
+    let req = AllSolutionsRequest {
+        omega: a.omega,
+        max_amplitude: a.max_amplitude,
+        ..AllSolutionsRequest::default()
+    };
+    let problem = duffing(a.xi, a.alpha, a.eps, a.force);
+    let all = jobs::all_solutions(&problem, &a.resolution.options()?, &req)?;
+    let mut human = format!(
+        "{} orbit(s) at ω_f = {} ({} starts, {} runs, {})\n",
+        all.solutions.len(),
+        a.omega,
+        all.search.starts,
+        all.search.runs,
+        if all.search.exhausted {
+            "nothing more within the bounds"
+        } else {
+            "search not exhausted"
+        }
+    );
+    for s in &all.solutions {
+        human += &format!("  amplitude {:.8}: {}\n", s.amplitude, s.stability.name());
+    }
+    Ok(Output {
+        json: to_json(&all)?,
+        human,
+    })
+}
