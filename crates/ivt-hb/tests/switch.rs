@@ -29,19 +29,16 @@ fn well() -> impl PeriodicProblem {
 /// tests/bifurcation.rs): the symmetric response loses the anti-phase mode's
 /// stability at a pitchfork.
 fn chain() -> impl PeriodicProblem {
+    let (stiff, damp) = ([1.1, 0.1, 0.1, 1.1], 0.02);
     GeneralProblem::new(
         2,
         vec![1.0, 0.0, 0.0, 1.0],
-        vec![0.02, 0.0, 0.0, 0.02],
-        vec![1.1, 0.1, 0.1, 1.1],
+        vec![damp, 0.0, 0.0, damp],
+        stiff.to_vec(),
         |x: &[f64], _v: &[f64], _t: f64, g: &mut [f64]| {
-            g[0] = x[0].powi(3);
-            g[1] = x[1].powi(3);
+            g.iter_mut().zip(x).for_each(|(gi, xi)| *gi = xi.powi(3))
         },
-        |t: f64, f: &mut [f64]| {
-            f[0] = 0.05 * t.cos();
-            f[1] = 0.05 * t.cos();
-        },
+        |t: f64, f: &mut [f64]| f.fill(0.05 * t.cos()),
     )
     .with_velocity_dependent(false)
 }

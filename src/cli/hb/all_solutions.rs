@@ -3,8 +3,7 @@
 //! deflated Newton, with stability, by the job
 //! [`ivt_hb::jobs::all_solutions`] that `ivt.hb.all_solutions` runs.
 
-use super::autonomous::Resolution;
-use super::{to_json, CliError, Output};
+use super::{to_json, CliError, DuffingParams, Output};
 use clap::Args;
 use ivt_hb::jobs::{self, AllSolutionsRequest};
 use ivt_hb::{GeneralProblem, PeriodicProblem};
@@ -12,23 +11,12 @@ use ivt_hb::{GeneralProblem, PeriodicProblem};
 /// `ivt hb all-solutions` (defaults: the thesis Duffing at ω_f = 1.4).
 #[derive(Args)]
 pub struct AllSolutionsArgs {
+    /// The model and the resolution (`--tol` absolute).
     #[command(flatten)]
-    resolution: Resolution,
+    params: DuffingParams,
     /// Excitation frequency ω_f.
     #[arg(long, default_value_t = 1.4)]
     omega: f64,
-    /// Damping ratio ξ.
-    #[arg(long, default_value_t = 0.02)]
-    xi: f64,
-    /// Linear stiffness α.
-    #[arg(long, default_value_t = 1.0)]
-    alpha: f64,
-    /// Cubic stiffness ε.
-    #[arg(long, default_value_t = 1.0)]
-    eps: f64,
-    /// Forcing amplitude F.
-    #[arg(long, default_value_t = 0.1)]
-    force: f64,
     /// The search box: max |coefficient|.
     #[arg(long, default_value_t = 10.0)]
     max_amplitude: f64,
@@ -63,19 +51,15 @@ fn duffing(xi: f64, alpha: f64, eps: f64, force: f64) -> impl PeriodicProblem {
 /// [`CliError::Input`] for bad parameters, [`CliError::Failed`] for a
 /// failed stability analysis.
 pub fn run(a: AllSolutionsArgs) -> Result<Output, CliError> {
-    let params = [a.xi, a.alpha, a.eps, a.force];
-    if params.iter().any(|v| !v.is_finite()) {
-        return Err(CliError::Input(format!(
-            "--xi, --alpha, --eps, --force = {params:?} must be finite"
-        )));
-    }
+    let p = &a.params;
+    p.problem()?;
     let req = AllSolutionsRequest {
         omega: a.omega,
         max_amplitude: a.max_amplitude,
         ..AllSolutionsRequest::default()
     };
-    let problem = duffing(a.xi, a.alpha, a.eps, a.force);
-    let all = jobs::all_solutions(&problem, &a.resolution.options()?, &req)?;
+    let problem = duffing(p.xi, p.alpha, p.eps, p.force);
+    let all = jobs::all_solutions(&problem, &p.options()?, &req)?;
     let mut human = format!(
         "{} orbit(s) at ω_f = {} ({} starts, {} runs, {})\n",
         all.solutions.len(),

@@ -7,7 +7,7 @@
 use super::autonomous::Resolution;
 use super::{to_json, CliError, Output};
 use clap::Args;
-use ivt_hb::jobs::{self, SwitchRequest, SwitchStart};
+use ivt_hb::jobs::{self, FrcRequest, SwitchRequest, SwitchStart};
 use ivt_hb::{BifurcationKind, Corrector, GeneralProblem, PeriodicProblem};
 
 /// `ivt hb switch` (defaults: c = 0.1, F = 0.5, the FRC from ω_f = 3.6 down
@@ -76,10 +76,12 @@ pub fn run(a: SwitchArgs) -> Result<Output, CliError> {
     }
     let hb = a.resolution.options()?;
     let req = SwitchRequest {
-        start: SwitchStart::Search {
+        start: SwitchStart::Search(FrcRequest {
             from: a.from,
             to: a.to,
-        },
+            events: true,
+            corrector: Corrector::Newton,
+        }),
         to: a.branch_to,
         step: a.step,
         corrector: Corrector::Newton,

@@ -44,24 +44,19 @@ use std::time::Instant;
 /// Where the switch happens.
 #[derive(Debug, Clone, PartialEq)]
 pub enum SwitchStart {
-    /// A located event of `frc(..., events=True)` (with the same harmonics
-    /// and samples): its kind, ω_f and coefficients.
+    /// A located period doubling or branch point of `frc(..., events=True)`
+    /// (with the same harmonics and samples) by its ω_f and coefficients.
     Given {
-        /// A period doubling or a branch point.
+        /// [`BifurcationKind::PeriodDoubling`] or [`BifurcationKind::BranchPoint`].
         kind: BifurcationKind,
-        /// ω_f of the event.
+        /// ω_f there.
         omega: f64,
-        /// Its coefficients.
+        /// The orbit there.
         coeffs: Vec<f64>,
     },
-    /// The first located period doubling or branch point of the FRC traced
-    /// with events from `from` to `to`.
-    Search {
-        /// Start of that FRC.
-        from: f64,
-        /// End of that FRC.
-        to: f64,
-    },
+    /// The first located period doubling or branch point of this FRC (its
+    /// `events` taken as true).
+    Search(FrcRequest),
 }
 
 /// The bifurcation, the end of the new branch and the path's corrector.
@@ -83,7 +78,11 @@ impl Default for SwitchRequest {
     /// first step of 5 % of the orbit, the Newton–chord corrector.
     fn default() -> Self {
         Self {
-            start: SwitchStart::Search { from: 0.5, to: 3.0 },
+            start: SwitchStart::Search(FrcRequest {
+                from: 0.5,
+                to: 3.0,
+                ..FrcRequest::default()
+            }),
             to: 2.0,
             step: 0.05,
             corrector: Corrector::Newton,
@@ -124,13 +123,7 @@ impl SwitchRequest {
                 }
                 Ok(())
             }
-            SwitchStart::Search { from, to: end } => FrcRequest {
-                from: *from,
-                to: *end,
-                events: true,
-                corrector: self.corrector,
-            }
-            .validate(),
+            SwitchStart::Search(frc) => frc.validate(),
         }
     }
 }
@@ -198,7 +191,7 @@ pub fn switch<P: PeriodicProblem>(
             omega,
             coeffs,
         } => (*kind, *omega, coeffs.clone()),
-        SwitchStart::Search { from, to } => first_event(problem, hb, *from, *to, req.corrector)?,
+        SwitchStart::Search(frc) => first_event(problem, hb, frc)?,
     };
     let family = Frequency(problem);
     let opts = BifurcationOptions::default();
@@ -250,20 +243,16 @@ pub fn switch<P: PeriodicProblem>(
     })
 }
 
-/// The first located period doubling or branch point of the FRC of `problem`
-/// from `from` to `to`: `(kind, ω_f, coefficients)`.
+/// The first located period doubling or branch point of the FRC `frc` of
+/// `problem` (traced with events): `(kind, ω_f, coefficients)`.
 fn first_event<P: PeriodicProblem>(
     problem: &P,
     hb: &HbOptions,
-    from: f64,
-    to: f64,
-    corrector: Corrector,
+    frc: &FrcRequest,
 ) -> Result<(BifurcationKind, f64, Vec<f64>), HbError> {
     let req = FrcRequest {
-        from,
-        to,
         events: true,
-        corrector,
+        ..frc.clone()
     };
     let curve = super::frc(problem, hb, &req)?;
     curve
@@ -273,7 +262,8 @@ fn first_event<P: PeriodicProblem>(
         .find_map(|e| Some((e.kind, e.omega?, e.coeffs?.0)))
         .ok_or_else(|| {
             HbError::InvalidInput(format!(
-                "the FRC from ω_f = {from} to {to} has no located period doubling or branch point"
+                "the FRC from ω_f = {} to {} has no located period doubling or branch point",
+                req.from, req.to
             ))
         })
 }
