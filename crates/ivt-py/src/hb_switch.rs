@@ -1,6 +1,6 @@
 //! `ivt.hb.switch_branch` (issue 27 item 2): from a period doubling or a
 //! branch point of `frc(..., events=True)` onto the new branch, continued in
-//! ω_f — the job [`ivt_hb::jobs::switch`] (the CLI's `ivt hb switch`).
+//! ω_f — the job [`ivt_hb::jobs::switch()`] (the CLI's `ivt hb switch`).
 
 use ivt_hb::jobs::{self, SwitchRequest, SwitchStart};
 use ivt_hb::{BifurcationKind, Corrector};

@@ -1,7 +1,7 @@
 //! `ivt hb all-solutions`: every period-one orbit of Duffing's equation
 //! (Eq. 49, the thesis's ξ = 0.02, α = ε = 1, F = 0.1) at one ω_f by
 //! deflated Newton, with stability, by the job
-//! [`ivt_hb::jobs::all_solutions`] that `ivt.hb.all_solutions` runs.
+//! [`ivt_hb::jobs::all_solutions()`] that `ivt.hb.all_solutions` runs.
 
 use super::{to_json, CliError, DuffingParams, Output};
 use clap::Args;

@@ -1,7 +1,7 @@
 //! `ivt hb cycle-branch`: the Hopf point of ẍ − (μ + x² − x⁴)ẋ + x = 0
 //! (issue 27: subcritical at μ = 0) and the limit-cycle branch born there,
 //! with its stability and its fold, by the job
-//! [`ivt_hb::jobs::cycle_branch`] that `ivt.hb.cycle_branch` runs.
+//! [`ivt_hb::jobs::cycle_branch()`] that `ivt.hb.cycle_branch` runs.
 
 use super::autonomous::Resolution;
 use super::{to_json, CliError, Output};

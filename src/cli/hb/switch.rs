@@ -1,7 +1,7 @@
 //! `ivt hb switch`: branch switching at the first period doubling of the
 //! twin-well Duffing oscillator about its well (ẍ + cẋ + 2x + 3x² + x³ =
 //! F cos ω_f t, x = u − 1 of ü + cu̇ − u + u³ = F cos ω_f t) onto its
-//! period-2 branch, by the job [`ivt_hb::jobs::switch`] that
+//! period-2 branch, by the job [`ivt_hb::jobs::switch()`] that
 //! `ivt.hb.switch_branch` runs.
 
 use super::autonomous::Resolution;

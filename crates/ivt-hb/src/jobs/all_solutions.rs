@@ -1,5 +1,5 @@
 //! Every periodic solution at one excitation frequency that deflated Newton
-//! finds within bounded starts ([`crate::all_solutions`]), each with its
+//! finds within bounded starts ([`crate::all_solutions()`]), each with its
 //! Floquet multipliers (Hsu, Eq. 78) and verdict, and the search's bounds.
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 #![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
@@ -85,7 +85,7 @@ pub struct AllSolutionsResult {
 ///
 /// # Errors
 /// [`HbError::InvalidInput`] for a non-finite frequency or box;
-/// [`crate::all_solutions`]'s.
+/// [`crate::all_solutions()`]'s.
 pub fn all_solutions<P: PeriodicProblem>(
     problem: &P,
     hb: &HbOptions,

@@ -1,5 +1,5 @@
 //! Hopf points of an autonomous family and the limit-cycle branch born at
-//! the first ([`crate::cycle_branch`]: equilibria followed in p, the Hopf
+//! the first ([`crate::cycle_branch()`]: equilibria followed in p, the Hopf
 //! point's first Lyapunov coefficient, the cycle branch by HB with ω unknown
 //! and Eq. 68–77, Floquet stability (Hsu) and its folds located).
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
@@ -61,7 +61,7 @@ impl Default for CycleBranchRequest {
 impl CycleBranchRequest {
     /// # Errors
     /// [`HbError::InvalidInput`] for a non-finite number or equal ends (the
-    /// grid, the steps and the offset are checked by [`crate::cycle_branch`]).
+    /// grid, the steps and the offset are checked by [`crate::cycle_branch()`]).
     pub fn validate(&self) -> Result<(), HbError> {
         for (name, v) in [
             ("p_from", self.p_from),
@@ -166,7 +166,7 @@ pub struct CycleBranchResult {
 /// The Hopf points of `family(p)` and the cycle branch of the first.
 ///
 /// # Errors
-/// [`CycleBranchRequest::validate`]'s and [`crate::cycle_branch`]'s.
+/// [`CycleBranchRequest::validate`]'s and [`crate::cycle_branch()`]'s.
 pub fn cycle_branch<P, F>(
     family: F,
     hb: &HbOptions,

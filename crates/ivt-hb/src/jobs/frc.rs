@@ -198,7 +198,7 @@ pub fn frc<P: PeriodicProblem>(
 /// The curve of `branch` (a frequency family, planned with the options the
 /// points' coefficients have) traced with events by [`crate::trace`] from
 /// the orbit `start = (q, ω_f)` to `to`, as [`frc`] returns it (also the
-/// new branch of [`super::switch`]); `t0` starts the job's wall time.
+/// new branch of [`super::switch()`]); `t0` starts the job's wall time.
 ///
 /// # Errors
 /// The trace's ([`trace_error`]) and [`assemble`]'s.

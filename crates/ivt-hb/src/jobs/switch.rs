@@ -1,6 +1,6 @@
 //! Branch switching (issue 27 item 2): from a period doubling or a branch
 //! point of a frequency-response curve onto the new branch, continued in ω_f
-//! with its own events as [`super::frc`] traces the first one.
+//! with its own events as [`super::frc()`] traces the first one.
 //!
 //! - **Period doubling**: the orbit is re-expressed with period 2T and the
 //!   odd-harmonic null vector of the period-2 Galerkin Jacobian (Eq. 56) is the
