@@ -5,8 +5,11 @@
 //! Each command parses its arguments, runs an `ivt_hb::jobs` job and prints
 //! its serialized result (the keys of `ivt.hb`'s dicts).
 
+mod all_solutions;
 mod autonomous;
+mod cycle_branch;
 mod folds;
+mod switch;
 
 use super::{CliError, Output};
 use clap::{Args, Subcommand};
@@ -29,6 +32,12 @@ pub enum HbCommand {
     LimitCycle(autonomous::LimitCycleArgs),
     /// Backbone curve (nonlinear normal mode) of the free Duffing oscillator u'' + αu + εu³ = 0.
     DuffingBackbone(autonomous::BackboneArgs),
+    /// Hopf point and limit-cycle branch of ẍ − (μ + x² − x⁴)ẋ + x = 0, with stability and folds.
+    CycleBranch(cycle_branch::CycleBranchArgs),
+    /// Every period-one orbit of Duffing's equation at one ω_f (deflated Newton), with stability.
+    AllSolutions(all_solutions::AllSolutionsArgs),
+    /// Branch switching at a period doubling of the Duffing oscillator in a well: its period-2 branch.
+    Switch(switch::SwitchArgs),
     /// Period-doubling cascade of the Mathieu–Duffing equation (§3.2.5).
     MathieuDuffing(MathieuArgs),
     /// Nonlinear string by STHB (§3.3): frequency–response curve with stability (Figs. 34–36).
@@ -154,6 +163,9 @@ pub fn run(cmd: HbCommand) -> Result<Output, CliError> {
         HbCommand::DuffingFolds(a) => folds::run(a),
         HbCommand::LimitCycle(a) => autonomous::limit_cycle(a),
         HbCommand::DuffingBackbone(a) => autonomous::backbone(a),
+        HbCommand::CycleBranch(a) => cycle_branch::run(a),
+        HbCommand::AllSolutions(a) => all_solutions::run(a),
+        HbCommand::Switch(a) => switch::run(a),
         HbCommand::MathieuDuffing(a) => mathieu(a),
         HbCommand::String(a) => super::string::run(a),
     }

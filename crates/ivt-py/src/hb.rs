@@ -335,6 +335,7 @@ pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     crate::hb_bifurcation::register(&m)?;
     crate::hb_large::register(&m)?;
     crate::hb_string::register(&m)?;
+    crate::hb_switch::register(&m)?;
     crate::hb_elements::register(&m)?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     parent.add_submodule(&m)

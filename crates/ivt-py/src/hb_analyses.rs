@@ -1,34 +1,20 @@
 //! `ivt.hb.all_solutions` and `ivt.hb.damped_modes` (issue 27): every periodic
-//! solution at one frequency by deflated Newton ([`ivt_hb::all_solutions`]),
+//! solution at one frequency by deflated Newton (the job
+//! [`ivt_hb::jobs::all_solutions()`] of `ivt hb all-solutions`),
 //! and damped nonlinear modes by the extended periodic motion concept
 //! ([`ivt_hb::damped_modes`]), on a user system. Fold curves are in
 //! `hb_folds.rs`. The limit cycle from a state is `limit_cycle(..., x0=)`
 //! (`ivt_hb::jobs::limit_cycle`).
 
-use ivt_hb::{AllSolutions, BackboneOptions, Corrector, DampedModes, SearchOptions};
+use ivt_hb::jobs::{self, AllSolutionsRequest};
+use ivt_hb::{BackboneOptions, Corrector, DampedModes};
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
 
 use crate::args::count;
 use crate::hb_shared::{finite, run_user, user_system_fn, UserArgs};
-use ivt_hb::jobs::{pairs, stability_steps};
-
-/// One orbit of [`AllSolutions`] as `{"coeffs", "amplitude", "multipliers",
-/// "stable", "stability"}` (amplitude: max |x| of DOF 0).
-fn solutions_list<'py>(py: Python<'py>, all: &AllSolutions) -> PyResult<Bound<'py, PyList>> {
-    let list = PyList::empty(py);
-    for s in &all.solutions {
-        let d = PyDict::new(py);
-        d.set_item("coeffs", s.solution.coeffs.clone().into_pyarray(py))?;
-        d.set_item("amplitude", s.solution.amplitude(0))?;
-        d.set_item("multipliers", pairs(&s.multipliers))?;
-        d.set_item("stable", s.kind == ivt_hb::StabilityKind::Stable)?;
-        d.set_item("stability", s.kind.name())?;
-        list.append(d)?;
-    }
-    Ok(list)
-}
+use crate::to_python::to_dict;
 
 user_system_fn! {
 /// Every period-one solution of `M x'' + C x' + K x + g(x, v, θ) = f(θ)` at
@@ -54,27 +40,16 @@ fn _all_solutions<'py>(py, user, jac;
     tol: f64 = 0.0,
 ) {
     let (problem, opts) = user.setup(f, 1, tol)?;
-    let search = SearchOptions {
-        max_amplitude: finite("max_amplitude", max_amplitude)?,
+    let req = AllSolutionsRequest {
+        omega,
+        max_amplitude,
         amplitudes: count("amplitudes", amplitudes)?,
-        max_iter: count("newton_steps", newton_steps)?,
-        stability_steps: stability_steps(opts.harmonics),
-        ..SearchOptions::default()
+        newton_steps: count("newton_steps", newton_steps)?,
     };
-    let omega = finite("omega", omega)?;
-    let all = run_user(py, &problem, |p| ivt_hb::all_solutions(p, &opts, omega, &search))?;
-    let report = PyDict::new(py);
-    report.set_item("starts", all.report.starts)?;
-    report.set_item("runs", all.report.runs)?;
-    report.set_item("max_amplitude", all.report.max_amplitude)?;
-    report.set_item("newton_steps", all.report.max_iter)?;
-    report.set_item("exhausted", all.report.exhausted)?;
     // `ivt.hb.all_solutions` makes this an `AllSolutions` (a list with a
     // `search` attribute).
-    let out = PyDict::new(py);
-    out.set_item("solutions", solutions_list(py, &all)?)?;
-    out.set_item("search", report)?;
-    Ok(out)
+    let all = run_user(py, &problem, |p| jobs::all_solutions(p, &opts, &req))?;
+    to_dict(py, &all)
 }
 }
 

@@ -1,21 +1,23 @@
 //! `ivt.hb.cycle_branch` (issue 27, item 2): the Hopf points of an
 //! autonomous user family and the limit-cycle branch born at the first
-//! ([`ivt_hb::cycle_branch`]); `ivt.hb.neimark_sacker_points`, the sampled
-//! Neimark–Sacker boundary of a forced family
+//! (the job [`ivt_hb::jobs::cycle_branch()`] of `ivt hb cycle-branch`);
+//! `ivt.hb.neimark_sacker_points`, the sampled Neimark–Sacker boundary of a forced family
 //! ([`ivt_hb::neimark_sacker_points`]); and [`PyFamily`], a Python `family(p)` as the
 //! fallible Rust family of ivt-hb's two-parameter functions.
 
-use ivt_hb::{ContinuationOptions, CycleBranchOptions, HbError, HbOptions, LimitCycle};
+use ivt_hb::jobs::{self, CycleBranchRequest};
+use ivt_hb::{HbError, HbOptions};
 use numpy::IntoPyArray;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{IntoPyDict, PyDict, PyList};
+use pyo3::types::{PyDict, PyList};
 use std::sync::Mutex;
 
 use crate::args::count;
 use crate::hb_shared::{finite, run_user, UserArgs};
+use crate::to_python::to_dict;
 use crate::user_problem::{user_problem, PyProblem};
-use ivt_hb::jobs::{pairs, stability_steps};
+use ivt_hb::jobs::pairs;
 
 /// The user system `family(p)` returns: a tuple (m, c, k, g, f).
 pub(crate) fn family_system<'py>(
@@ -105,21 +107,6 @@ impl PyFamily {
     }
 }
 
-/// A cycle as `{"p", "omega", "period", "amplitude" (max |x| of DOF 0),
-/// "stable", "stability", "multipliers", "coeffs"}`.
-fn cycle_dict<'py>(py: Python<'py>, p: f64, c: &LimitCycle) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("p", p)?;
-    d.set_item("omega", c.omega())?;
-    d.set_item("period", c.period())?;
-    d.set_item("amplitude", c.solution.amplitude(0))?;
-    d.set_item("stable", c.stable())?;
-    d.set_item("stability", c.kind.name())?;
-    d.set_item("multipliers", pairs(&c.multipliers))?;
-    d.set_item("coeffs", c.solution.coeffs.clone().into_pyarray(py))?;
-    Ok(d)
-}
-
 /// Hopf points and the limit-cycle branch of the autonomous family
 /// `family(p)` → (m, c, k, g, f) (f None) for p in [p_from, p_to]
 /// (ivt_hb::cycle_branch): the equilibria (from x = 0) are followed on
@@ -166,61 +153,25 @@ fn cycle_branch<'py>(
             "arguments `p_from` and `p_to` must differ",
         ));
     }
+    let req = CycleBranchRequest {
+        p_from,
+        p_to,
+        at,
+        grid: count("grid", grid)?,
+        ds,
+        ds_max,
+        max_points: count("max_points", max_points)?,
+        offset,
+    };
     let fam = PyFamily::new(family, velocity_dependent, vectorized);
     let (first, hb) = fam.first(py, p_from, n, samples, rtol, max_iter)?;
-    let opts = CycleBranchOptions {
-        samples: count("grid", grid)?,
-        offset: finite("offset", offset)?,
-        continuation: ContinuationOptions {
-            ds: finite("ds", ds)?,
-            ds_max: finite("ds_max", ds_max)?,
-            max_points: count("max_points", max_points)?,
-            ..ContinuationOptions::default()
-        },
-        stability_steps: stability_steps(hb.harmonics),
-        at,
-    };
     let branch = run_user(py, &first, |_| {
-        ivt_hb::cycle_branch(|p| fam.build(p), &hb, p_from, p_to, &opts)
+        jobs::cycle_branch(|p| fam.build(p), &hb, &req)
     });
     if let Some(e) = fam.take_error() {
         return Err(e);
     }
-    let branch = branch?;
-    let hopf = PyList::empty(py);
-    for h in &branch.hopf {
-        let items = [("p", h.p), ("omega", h.omega), ("lyapunov", h.lyapunov)];
-        let d = items.into_py_dict(py)?;
-        d.set_item("subcritical", h.subcritical())?;
-        hopf.append(d)?;
-    }
-    let cycles = |list: &[(f64, LimitCycle)]| -> PyResult<Bound<'py, PyList>> {
-        let l = PyList::empty(py);
-        for (p, c) in list {
-            l.append(cycle_dict(py, *p, c)?)?;
-        }
-        Ok(l)
-    };
-    let folds = PyList::empty(py);
-    for (p, orbit) in &branch.folds {
-        let d = PyDict::new(py);
-        d.set_item("kind", "fold")?;
-        d.set_item("p", p)?;
-        d.set_item("omega", orbit.omega_f)?;
-        d.set_item("amplitude", orbit.amplitude(0))?;
-        d.set_item("coeffs", orbit.coeffs.clone().into_pyarray(py))?;
-        folds.append(d)?;
-    }
-    let d = PyDict::new(py);
-    d.set_item("hopf", hopf)?;
-    d.set_item("points", cycles(&branch.points)?)?;
-    d.set_item("bifurcations", folds)?;
-    d.set_item("at", cycles(&branch.at)?)?;
-    d.set_item(
-        "termination",
-        branch.termination.as_ref().map(|t| t.as_str()),
-    )?;
-    Ok(d)
+    to_dict(py, &branch?)
 }
 
 /// The Neimark–Sacker boundary of the forced family `family(p)` → (m, c, k,

@@ -34,6 +34,7 @@ mod hb_large;
 mod hb_paths;
 mod hb_shared;
 mod hb_string;
+mod hb_switch;
 mod kin;
 mod sim;
 mod to_python;

@@ -9,7 +9,7 @@ use super::{check_finite, pairs, Array};
 use crate::continuation::{Corrector, Termination};
 use crate::error::HbError;
 use crate::events::{trace, BifurcationError, BifurcationKind, Event, TraceOptions};
-use crate::family::{FamilyBranch, Frequency};
+use crate::family::{Family, FamilyBranch, Frequency};
 use crate::frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
 use crate::ihb::HbOptions;
 use crate::problem::{AtFrequency, PeriodicProblem};
@@ -171,41 +171,76 @@ pub fn frc<P: PeriodicProblem>(
 ) -> Result<FrcCurve<FoldPoint>, HbError> {
     req.validate()?;
     let t0 = Instant::now();
-    let defaults = FrcOptions::default();
-    // The Hsu sub-intervals' cap, named when a point's multipliers are not
-    // finite (its stability unknown: the curve is an error, not a point
-    // reported unstable).
-    let hsu_cap = match defaults.stability {
-        HsuSteps::Tolerance { max, .. } => max,
-        HsuSteps::Fixed(steps) => steps,
-    };
-    let (curve, events) = if req.events {
+    if req.events {
         let at_start = AtFrequency::new(problem, req.from);
         let start = ModifiedIhb::new(&at_start, hb.clone())?.solve(req.from, None)?;
-        let opts = TraceOptions {
-            lambda_to: req.to,
-            continuation: defaults.continuation,
-            corrector: req.corrector,
-            ..TraceOptions::default()
-        };
         let mut branch = FamilyBranch::new(Frequency(problem), hb, req.from)?;
-        let traced = trace(&mut branch, &start.coeffs, req.from, &opts).map_err(|e| match e {
-            BifurcationError::Hb(h) => h,
-            other => HbError::InvalidInput(other.to_string()),
-        })?;
-        let curve = Frc::from_trace(&traced, hb)?;
-        let events = traced.events.iter().map(|e| event(e, &curve)).collect();
-        (curve, events)
-    } else {
-        let opts = FrcOptions {
-            from: req.from,
-            to: req.to,
-            corrector: req.corrector,
-            ..defaults
-        };
-        let curve = frequency_response(problem, hb, &opts)?;
-        let events = curve.folds.iter().map(|f| fold_event(f, &curve)).collect();
-        (curve, events)
+        return traced_curve(
+            &mut branch,
+            (&start.coeffs, req.from),
+            req.to,
+            req.corrector,
+            t0,
+        );
+    }
+    let opts = FrcOptions {
+        from: req.from,
+        to: req.to,
+        corrector: req.corrector,
+        ..FrcOptions::default()
+    };
+    let curve = frequency_response(problem, hb, &opts)?;
+    let events = curve.folds.iter().map(|f| fold_event(f, &curve)).collect();
+    assemble(curve, events, t0)
+}
+
+/// The curve of `branch` (a frequency family, planned with the options the
+/// points' coefficients have) traced with events by [`crate::trace`] from
+/// the orbit `start = (q, ω_f)` to `to`, as [`frc`] returns it (also the
+/// new branch of [`super::switch()`]); `t0` starts the job's wall time.
+///
+/// # Errors
+/// The trace's ([`trace_error`]) and [`assemble`]'s.
+pub(super) fn traced_curve<F: Family>(
+    branch: &mut FamilyBranch<F>,
+    start: (&[f64], f64),
+    to: f64,
+    corrector: Corrector,
+    t0: Instant,
+) -> Result<FrcCurve<FoldPoint>, HbError> {
+    let opts = TraceOptions {
+        lambda_to: to,
+        continuation: FrcOptions::default().continuation,
+        corrector,
+        ..TraceOptions::default()
+    };
+    let traced = trace(branch, start.0, start.1, &opts).map_err(trace_error)?;
+    let curve = Frc::from_trace(&traced, branch.options())?;
+    let events = traced.events.iter().map(|e| event(e, &curve)).collect();
+    assemble(curve, events, t0)
+}
+
+/// A bifurcation error as the jobs report it: the [`HbError`] it carries, or
+/// its message as an input error.
+pub(super) fn trace_error(e: BifurcationError) -> HbError {
+    match e {
+        BifurcationError::Hb(h) => h,
+        other => HbError::InvalidInput(other.to_string()),
+    }
+}
+
+/// The job's result from a traced `curve` and its `events`: every point's
+/// multipliers checked finite (a point whose stability is unknown makes the
+/// curve an error, naming the Hsu sub-intervals' cap, not a point reported
+/// unstable).
+fn assemble(
+    curve: Frc,
+    events: Vec<EventRecord>,
+    t0: Instant,
+) -> Result<FrcCurve<FoldPoint>, HbError> {
+    let hsu_cap = match FrcOptions::default().stability {
+        HsuSteps::Tolerance { max, .. } => max,
+        HsuSteps::Fixed(steps) => steps,
     };
     for p in &curve.points {
         check_finite(&p.multipliers, p.omega_f, hsu_cap)?;

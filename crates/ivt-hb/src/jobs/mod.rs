@@ -14,19 +14,31 @@
 //! | backbone | [`BackboneRequest`] | [`BackboneCurve`] | `hb duffing-backbone` | `backbone` |
 //! | Mathieu–Duffing cascade (Eq. 81–85) | [`CascadeRequest`] | [`Cascade`] | `hb mathieu-duffing` | `mathieu_cascade` |
 //! | STHB string curve (Eq. 103–136) | [`StringRequest`] | [`StringCurve`] | `hb string` | `string` |
+//! | Hopf points and the cycle branch (issue 27) | [`CycleBranchRequest`] | [`CycleBranchResult`] | `hb cycle-branch` | `cycle_branch` |
+//! | every solution at one ω_f by deflation (issue 27) | [`AllSolutionsRequest`] | [`AllSolutionsResult`] | `hb all-solutions` | `all_solutions` |
+//! | branch switching at a period doubling or branch point (Eq. 56, 61, 68–77) | [`SwitchRequest`] | [`SwitchedBranch`] | `hb switch` | `switch_branch` |
 
+pub mod all_solutions;
 mod array;
 pub mod backbone;
 pub mod cascade;
+pub mod cycle_branch;
 pub mod fold_curve;
 pub mod frc;
 pub mod limit_cycle;
 pub mod orbit;
 pub mod string;
+pub mod switch;
 
+pub use all_solutions::{
+    all_solutions, AllSolutionsRequest, AllSolutionsResult, FoundOrbit, SearchBounds,
+};
 pub use array::{check_finite, finite_pairs, pairs, Array, ARRAY_NAME};
 pub use backbone::{backbone, free_duffing, BackboneCurve, BackboneRequest, BackboneSample};
 pub use cascade::{cascade, Cascade, CascadeRequest, THESIS_BETAS};
+pub use cycle_branch::{
+    cycle_branch, CycleBranchRequest, CycleBranchResult, CycleFold, CycleRecord, HopfRecord,
+};
 pub use fold_curve::{
     fold_curve, CurveFoldPoint, FoldCurveRequest, FoldCurveResult, FoldStart, SpecialKind,
     SpecialPoint,
@@ -35,6 +47,7 @@ pub use frc::{frc, CurvePoint, EventRecord, FoldPoint, FrcCurve, FrcRequest};
 pub use limit_cycle::{limit_cycle, Cycle, LimitCycleRequest, Oscillator};
 pub use orbit::{orbit, Method, Orbit, OrbitRequest};
 pub use string::{string, StringCurve, StringPoint, StringRequest};
+pub use switch::{switch, SwitchRequest, SwitchStart, SwitchedBranch};
 
 use crate::error::HbError;
 

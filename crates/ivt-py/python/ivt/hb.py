@@ -43,6 +43,7 @@ __all__ = [
     "neimark_sacker_points",
     "solve",
     "string",
+    "switch_branch",
 ]
 
 _NATIVE = [name for name in __all__ if name not in ("AllSolutions", "all_solutions")]

@@ -206,3 +206,23 @@ class models:
         alpha: float = 0.07,
         beta: float = 2e-4,
     ) -> Tuple[SparseMatrix, SparseMatrix, SparseMatrix, int]: ...
+
+# Branch switching (issue 27 item 2, crates/ivt-py/src/hb_switch.rs).
+def switch_branch(
+    m: Matrix,
+    c: Matrix,
+    k: Matrix,
+    g: Union[Callback, VectorizedCallback, Elements],
+    f: Optional[Forcing],
+    at: Dict[str, Any],
+    to: float,
+    n: int = 20,
+    samples: int = 64,
+    step: float = 0.05,
+    tol: float = 0.0,
+    velocity_dependent: bool = True,
+    vectorized: bool = False,
+    rtol: float = 1e-9,
+    max_iter: int = 100,
+    jac: Optional[Jacobian] = None,
+) -> Dict[str, Any]: ...

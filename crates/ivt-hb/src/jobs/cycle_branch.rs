@@ -1,0 +1,224 @@
+//! Hopf points of an autonomous family and the limit-cycle branch born at
+//! the first ([`crate::cycle_branch()`]: equilibria followed in p, the Hopf
+//! point's first Lyapunov coefficient, the cycle branch by HB with ω unknown
+//! and Eq. 68–77, Floquet stability (Hsu) and its folds located).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
+use super::{finite, pairs, stability_steps, Array};
+use crate::autonomous::LimitCycle;
+use crate::events::BifurcationKind;
+use crate::continuation::{ContinuationOptions, Termination};
+use crate::cycle_branch::{cycle_branch as trace_cycles, CycleBranchOptions};
+use crate::error::HbError;
+use crate::ihb::HbOptions;
+use crate::problem::PeriodicProblem;
+use crate::stability::StabilityKind;
+use serde::Serialize;
+
+/// The interval of p, the grid of the Hopf search and the path's steps.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CycleBranchRequest {
+    /// The equilibria are followed from this p …
+    pub p_from: f64,
+    /// … to this one (≠ `p_from`).
+    pub p_to: f64,
+    /// p at which the cycles are solved exactly (each crossing).
+    pub at: Vec<f64>,
+    /// Intervals of the equilibria's grid in p.
+    pub grid: usize,
+    /// First arclength step of the cycle branch.
+    pub ds: f64,
+    /// Largest arclength step.
+    pub ds_max: f64,
+    /// Most path points.
+    pub max_points: usize,
+    /// The first cycle's distance from the Hopf point, relative to
+    /// `|p_to − p_from|`.
+    pub offset: f64,
+}
+
+impl Default for CycleBranchRequest {
+    /// The example's interval μ ∈ [−0.2, 0.1], a grid of 100, steps
+    /// 0.02 to 0.05, 2000 points, the start 1 % of the interval from the
+    /// Hopf point.
+    fn default() -> Self {
+        Self {
+            p_from: -0.2,
+            p_to: 0.1,
+            at: Vec::new(),
+            grid: 100,
+            ds: 0.02,
+            ds_max: 0.05,
+            max_points: 2000,
+            offset: 1e-2,
+        }
+    }
+}
+
+impl CycleBranchRequest {
+    /// # Errors
+    /// [`HbError::InvalidInput`] for a non-finite number or equal ends (the
+    /// grid, the steps and the offset are checked by [`crate::cycle_branch()`]).
+    pub fn validate(&self) -> Result<(), HbError> {
+        for (name, v) in [
+            ("p_from", self.p_from),
+            ("p_to", self.p_to),
+            ("ds", self.ds),
+            ("ds_max", self.ds_max),
+            ("offset", self.offset),
+        ] {
+            finite(name, v)?;
+        }
+        if self.p_from == self.p_to {
+            return Err(HbError::InvalidInput(
+                "`p_from` and `p_to` must differ".into(),
+            ));
+        }
+        if let Some(p) = self.at.iter().find(|p| !p.is_finite()) {
+            return Err(HbError::InvalidInput(format!("`at` = {p} must be finite")));
+        }
+        Ok(())
+    }
+}
+
+/// A Hopf point of the equilibria.
+#[derive(Debug, Clone, Serialize)]
+pub struct HopfRecord {
+    /// Where.
+    pub p: f64,
+    /// The crossing eigenvalues' frequency.
+    pub omega: f64,
+    /// First Lyapunov coefficient.
+    pub lyapunov: f64,
+    /// `lyapunov > 0`: the cycles born there are unstable.
+    pub subcritical: bool,
+}
+
+/// A limit cycle of the branch.
+#[derive(Debug, Clone, Serialize)]
+pub struct CycleRecord {
+    /// The parameter.
+    pub p: f64,
+    /// Response frequency ω.
+    pub omega: f64,
+    /// 2π/ω.
+    pub period: f64,
+    /// max |x| of DOF 0.
+    pub amplitude: f64,
+    /// All non-trivial multipliers inside the unit circle.
+    pub stable: bool,
+    /// Their class.
+    pub stability: StabilityKind,
+    /// Floquet multipliers `[[re, im], ...]` (the trivial +1 included).
+    pub multipliers: Vec<[f64; 2]>,
+    /// Coefficients of the orbit.
+    pub coeffs: Array<f64>,
+}
+
+impl CycleRecord {
+    fn new(p: f64, c: &LimitCycle) -> Self {
+        Self {
+            p,
+            omega: c.omega(),
+            period: c.period(),
+            amplitude: c.solution.amplitude(0),
+            stable: c.stable(),
+            stability: c.kind,
+            multipliers: pairs(&c.multipliers),
+            coeffs: Array(c.solution.coeffs.clone()),
+        }
+    }
+}
+
+/// A fold of the cycle branch.
+#[derive(Debug, Clone, Serialize)]
+pub struct CycleFold {
+    /// Always [`BifurcationKind::Fold`].
+    pub kind: BifurcationKind,
+    /// Where.
+    pub p: f64,
+    /// Its ω.
+    pub omega: f64,
+    /// max |x| of DOF 0.
+    pub amplitude: f64,
+    /// Its coefficients.
+    pub coeffs: Array<f64>,
+}
+
+/// The keys of `ivt.hb.cycle_branch` and `ivt hb cycle-branch --json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct CycleBranchResult {
+    /// Hopf points in order of p from `p_from`.
+    pub hopf: Vec<HopfRecord>,
+    /// The branch from the first Hopf point, in path order.
+    pub points: Vec<CycleRecord>,
+    /// Its folds.
+    pub bifurcations: Vec<CycleFold>,
+    /// The cycles at each p of `at`.
+    pub at: Vec<CycleRecord>,
+    /// Why tracing stopped (None: no Hopf point).
+    pub termination: Option<Termination>,
+}
+
+/// The Hopf points of `family(p)` and the cycle branch of the first.
+///
+/// # Errors
+/// [`CycleBranchRequest::validate`]'s and [`crate::cycle_branch()`]'s.
+pub fn cycle_branch<P, F>(
+    family: F,
+    hb: &HbOptions,
+    req: &CycleBranchRequest,
+) -> Result<CycleBranchResult, HbError>
+where
+    P: PeriodicProblem,
+    F: Fn(f64) -> Result<P, HbError>,
+{
+    req.validate()?;
+    let opts = CycleBranchOptions {
+        samples: req.grid,
+        offset: req.offset,
+        continuation: ContinuationOptions {
+            ds: req.ds,
+            ds_max: req.ds_max,
+            max_points: req.max_points,
+            ..ContinuationOptions::default()
+        },
+        stability_steps: stability_steps(hb.harmonics),
+        at: req.at.clone(),
+    };
+    let branch = trace_cycles(family, hb, req.p_from, req.p_to, &opts)?;
+    let cycles = |list: &[(f64, LimitCycle)]| {
+        list.iter()
+            .map(|(p, c)| CycleRecord::new(*p, c))
+            .collect::<Vec<_>>()
+    };
+    Ok(CycleBranchResult {
+        hopf: branch
+            .hopf
+            .iter()
+            .map(|h| HopfRecord {
+                p: h.p,
+                omega: h.omega,
+                lyapunov: h.lyapunov,
+                subcritical: h.subcritical(),
+            })
+            .collect(),
+        points: cycles(&branch.points),
+        bifurcations: branch
+            .folds
+            .iter()
+            .map(|(p, orbit)| CycleFold {
+                kind: BifurcationKind::Fold,
+                p: *p,
+                omega: orbit.omega_f,
+                amplitude: orbit.amplitude(0),
+                coeffs: Array(orbit.coeffs.clone()),
+            })
+            .collect(),
+        at: cycles(&branch.at),
+        termination: branch.termination,
+    })
+}

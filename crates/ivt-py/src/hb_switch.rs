@@ -1,0 +1,93 @@
+//! `ivt.hb.switch_branch` (issue 27 item 2): from a period doubling or a
+//! branch point of `frc(..., events=True)` onto the new branch, continued in
+//! ω_f — the job [`ivt_hb::jobs::switch()`] (the CLI's `ivt hb switch`).
+
+use ivt_hb::jobs::{self, SwitchRequest, SwitchStart};
+use ivt_hb::{BifurcationKind, Corrector};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::hb_shared::{finite, run_user, user_system_fn, UserArgs};
+use crate::to_python::to_dict;
+
+/// The event `at` (an entry of `frc(..., events=True)["bifurcations"]`) as
+/// the job's start: its kind, ω_f and coefficients; an event whose location
+/// failed is refused with its reason.
+fn given_event(at: &Bound<'_, PyDict>) -> PyResult<SwitchStart> {
+    let item = |key: &str| {
+        at.get_item(key)?
+            .ok_or_else(|| PyValueError::new_err(format!("argument `at` needs \"{key}\"")))
+    };
+    let name: String = item("kind")?.extract()?;
+    let kind = match name.as_str() {
+        "period_doubling" => BifurcationKind::PeriodDoubling,
+        "branch_point" => BifurcationKind::BranchPoint,
+        "fold" => BifurcationKind::Fold,
+        "neimark_sacker" => BifurcationKind::NeimarkSacker,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "argument `at` has kind {other:?}: not an event of `frc`"
+            )))
+        }
+    };
+    let located: Option<bool> = at.get_item("located")?.map(|v| v.extract()).transpose()?;
+    if located == Some(false) {
+        let why: Option<String> = at.get_item("error")?.and_then(|v| v.extract().ok());
+        return Err(PyValueError::new_err(format!(
+            "argument `at` ({name}) was not located: {}",
+            why.unwrap_or_default()
+        )));
+    }
+    let omega = finite("at[\"omega\"]", item("omega")?.extract()?)?;
+    let coeffs: Vec<f64> = item("coeffs")?
+        .extract::<numpy::PyArrayLike1<'_, f64, numpy::AllowTypeChange>>()
+        .map_err(|_| PyTypeError::new_err("at[\"coeffs\"] must be a 1-D array of floats"))?
+        .as_array()
+        .to_vec();
+    Ok(SwitchStart::Given {
+        kind,
+        omega,
+        coeffs,
+    })
+}
+
+user_system_fn! {
+/// Branch switching on the frequency response of a user system `M x'' + C x'
+/// + K x + g(x, v, θ) = f(θ)`: `at` is a period doubling or a branch point of
+/// `frc(m, c, k, g, f, ..., events=True)["bifurcations"]` (same n, samples,
+/// tol; a fold or a Neimark–Sacker point is a ValueError naming it). At a
+/// period doubling the period-2 branch starts from the odd-harmonic null
+/// vector of the period-2 Galerkin Jacobian (its coeffs then have 2n
+/// harmonics of ω_f/2); at a branch point the branch nearer ω_f = const of
+/// the two through it (the symmetry-breaking branch of a pitchfork). Its
+/// first point is `step`·‖coeffs‖ away; it is then continued to `to` (on the
+/// side where it leaves, else a ValueError) with its own events, as `frc`.
+/// Returns the job's [`ivt_hb::jobs::SwitchedBranch`]: the keys of `frc`
+/// ("points", "folds", "bifurcations", "termination", "omega", "amplitude",
+/// "stable", "time_s") and "kind" (of `at`), "start_omega", "harmonics",
+/// "subharmonic" (2 after a period doubling). GIL released between callbacks.
+fn switch_branch<'py>(py, user, jac;
+    f: Option<&Bound<'py, PyAny>>,
+    at: &Bound<'py, PyDict>,
+    to: f64;
+    step: f64 = 0.05,
+    tol: f64 = 0.0,
+) {
+    let (problem, opts) = user.setup(f, 1, tol)?;
+    let req = SwitchRequest {
+        start: given_event(at)?,
+        to,
+        step,
+        corrector: Corrector::Newton,
+    };
+    let branch = run_user(py, &problem, |p| jobs::switch(p, &opts, &req))?;
+    to_dict(py, &branch)
+}
+}
+
+/// Add `switch_branch` to the `hb` module.
+pub fn register(hb: &Bound<'_, PyModule>) -> PyResult<()> {
+    add_functions!(hb, [switch_branch]);
+    Ok(())
+}
