@@ -14,6 +14,10 @@
 //! | backbone | [`BackboneRequest`] | [`BackboneCurve`] | `hb duffing-backbone` | `backbone` |
 //! | Mathieu–Duffing cascade (Eq. 81–85) | [`CascadeRequest`] | [`Cascade`] | `hb mathieu-duffing` | `mathieu_cascade` |
 //! | STHB string curve (Eq. 103–136) | [`StringRequest`] | [`StringCurve`] | `hb string` | `string` |
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 mod array;
 pub mod backbone;
