@@ -49,20 +49,27 @@ pub struct GalerkinJacobian {
 }
 
 /// `C_l = Σ_i g(τ_i) cos lτ_i` and `S_l = Σ_i g(τ_i) sin lτ_i` for `l = −n..2n`
-/// (`C_{−l} = C_l`, `S_{−l} = −S_l`), stored at `n + l`.
+/// (`C_{−l} = C_l`, `S_{−l} = −S_l`), stored at `n + l`, and again in reverse
+/// order (`l` at `2n − l`) so that a row reads both `C_{j+k}` and `C_{j−k}`
+/// forward in `k`.
 #[derive(Debug, Clone)]
 struct CosSinSums {
     n: usize,
     cos: Vec<f64>,
     sin: Vec<f64>,
+    cos_rev: Vec<f64>,
+    sin_rev: Vec<f64>,
 }
 
 impl CosSinSums {
     fn new(n: usize) -> Self {
+        let sums = vec![0.0; 3 * n + 1];
         Self {
             n,
-            cos: vec![0.0; 3 * n + 1],
-            sin: vec![0.0; 3 * n + 1],
+            cos: sums.clone(),
+            sin: sums.clone(),
+            cos_rev: sums.clone(),
+            sin_rev: sums,
         }
     }
 
@@ -95,6 +102,14 @@ impl CosSinSums {
             *c_neg = *c;
             *s_neg = -*s;
         }
+        for (rev, sums) in [
+            (&mut self.cos_rev, &self.cos),
+            (&mut self.sin_rev, &self.sin),
+        ] {
+            rev.iter_mut()
+                .zip(sums.iter().rev())
+                .for_each(|(r, v)| *r = *v);
+        }
     }
 
     /// Adds to `row` (columns `a_0, a_1..a_n, b_1..b_n` of one DOF) the sums of the
@@ -102,17 +117,27 @@ impl CosSinSums {
     /// `C_s` (`x`) or against the derivative columns `C_s' = {0, −k sin, k cos}`.
     /// With `(P_k, Q_k)` = the sums against `(cos kτ, sin kτ)`, the derivative
     /// columns get `(−k Q_k, k P_k)`, and `a_0` (weight ½) gets `½ P_0`.
-    /// The sums of harmonic `k` are `C_{j∓k}`, `S_{j∓k}`: the window
-    /// `n + j − n ..= n + j + n` of the stored sums, read outward from its centre.
+    /// For `k = 1..n`, `C_{j+k}` is at `n + j + k` of the sums and `C_{j−k}` at
+    /// `2n − j + k` of the reversed sums: two forward windows of `n` entries.
     /// NaN in `row` if `j > n` or `row` is not `2n + 1` long.
     fn add_row(&self, row: &mut [f64], j: usize, sin_row: bool, x: bool) {
         let n = self.n;
-        let (Some((cos_minus, cos_plus)), Some((sin_minus, sin_plus))) =
-            (window(&self.cos, j, n), window(&self.sin, j, n))
+        let (plus, minus) = (Some(n + j), (2 * n).checked_sub(j));
+        let windows = (
+            window(&self.cos, plus, n),
+            window(&self.sin, plus, n),
+            window(&self.cos_rev, minus, n),
+            window(&self.sin_rev, minus, n),
+        );
+        let centre = (self.cos.get(n + j), self.sin.get(n + j));
+        let (
+            (Some(cos_plus), Some(sin_plus), Some(cos_minus), Some(sin_minus)),
+            (Some(&c0), Some(&s0)),
+        ) = (windows, centre)
         else {
             return row.fill(f64::NAN);
         };
-        if row.len() != 2 * n + 1 {
+        if row.len() != 2 * n + 1 || j > n {
             return row.fill(f64::NAN);
         }
         let cj = if j == 0 { 0.5 } else { 1.0 };
@@ -128,24 +153,22 @@ impl CosSinSums {
             return;
         };
         if x {
-            // k = 0: C_{j−0} = C_{j+0} = the window's centre.
-            let (c0, s0) = (cos_plus.first(), sin_plus.first());
-            if let (Some(&c), Some(&s)) = (c0, s0) {
-                *a0 += 0.5 * sums(c, c, s, s).0;
-            }
+            // k = 0: C_{j−0} = C_{j+0}.
+            *a0 += 0.5 * sums(c0, c0, s0, s0).0;
         }
-        let cos_pairs = cos_minus.iter().rev().zip(cos_plus.iter().skip(1));
-        let sin_pairs = sin_minus.iter().rev().zip(sin_plus.iter().skip(1));
         let columns = head.iter_mut().zip(tail.iter_mut());
-        for (k, ((a, b), ((&cm, &cp), (&sm, &sp)))) in
-            (1usize..).zip(columns.zip(cos_pairs.zip(sin_pairs)))
-        {
+        let pairs = cos_minus
+            .iter()
+            .zip(cos_plus)
+            .zip(sin_minus.iter().zip(sin_plus));
+        let mut kf = 0.0;
+        for ((a, b), ((&cm, &cp), (&sm, &sp))) in columns.zip(pairs) {
+            kf += 1.0;
             let (p, q) = sums(cm, cp, sm, sp);
             if x {
                 *a += p;
                 *b += q;
             } else {
-                let kf = k as f64;
                 *a -= kf * q;
                 *b += kf * p;
             }
@@ -153,12 +176,9 @@ impl CosSinSums {
     }
 }
 
-/// The stored sums `n + j − n ..= n + j + n` split before their centre
-/// `n + j`: `C_{j−k}` is the `k`-th entry of the first part from its end,
-/// `C_{j+k}` the `k`-th of the second (`None` if `j > n`).
-fn window(sums: &[f64], j: usize, n: usize) -> Option<(&[f64], &[f64])> {
-    let centred = sums.get(j..=j + 2 * n)?;
-    Some((centred.get(..n)?, centred.get(n..)?))
+/// Entries `start + 1 ..= start + n` of `sums` (`None` past its end).
+fn window(sums: &[f64], start: Option<usize>, n: usize) -> Option<&[f64]> {
+    start.and_then(|s| sums.get(s + 1..=s + n))
 }
 
 impl GalerkinJacobian {

@@ -56,13 +56,22 @@ impl HopfPoint {
 /// The equilibrium of `problem` near `x` (overwritten).
 ///
 /// # Errors
-/// [`HbError::InvalidInput`] when Newton does not converge.
+/// [`HbError::InvalidInput`] when Newton does not converge or `x` does not
+/// hold `n_dof` entries, [`HbError::Size`] unless `K` is `n_dof×n_dof`.
 pub fn equilibrium<P: PeriodicProblem>(problem: &P, x: &mut [f64]) -> Result<(), HbError> {
     let n = problem.n_dof();
     if x.len() != n {
         return Err(HbError::InvalidInput(format!(
             "the equilibrium has {n} entries"
         )));
+    }
+    let k = problem.stiffness().len();
+    if k != n * n {
+        return Err(HbError::Size {
+            what: "K",
+            expected: n * n,
+            got: k,
+        });
     }
     let opts = NewtonOptions {
         ftol: 1e-13,
@@ -409,7 +418,8 @@ pub const MAX_SAMPLES: usize = 100_000;
 ///
 /// # Errors
 /// [`HbError::InvalidInput`] for bounds, sizes, a singular mass matrix, or
-/// an equilibrium Newton does not find; `family`'s error.
+/// an equilibrium Newton does not find; [`HbError::Size`] for a matrix that
+/// is not `n_dof×n_dof`; `family`'s error.
 pub fn hopf_points<P, F>(
     family: &F,
     x0: &[f64],
@@ -567,5 +577,16 @@ mod tests {
             }
         );
         assert_eq!(err.kind(), "input");
+        let mut problem = family(0.0).unwrap();
+        problem.k.push(0.0);
+        let err = equilibrium(&problem, &mut [0.0]).unwrap_err();
+        assert_eq!(
+            err,
+            HbError::Size {
+                what: "K",
+                expected: 1,
+                got: 2
+            }
+        );
     }
 }

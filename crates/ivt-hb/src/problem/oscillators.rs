@@ -8,6 +8,7 @@
 use super::{displacement_jacobian, matrix_getters, PeriodicProblem};
 
 /// `out[0] = law(x[0])` of a one-DOF force; NaN in `out` if `x` is empty.
+#[inline]
 fn one_dof(x: &[f64], out: &mut [f64], law: impl FnOnce(f64) -> f64) {
     match (x.first(), out.first_mut()) {
         (Some(&u), Some(o)) => *o = law(u),
@@ -77,6 +78,7 @@ impl Duffing {
 
 impl PeriodicProblem for Duffing {
     matrix_getters!(1, linear);
+    #[inline]
     fn nonlinear(&self, x: &[f64], _v: &[f64], _theta: f64, out: &mut [f64]) {
         one_dof(x, out, |u| self.eps * u * u * u);
     }
@@ -116,6 +118,7 @@ impl MathieuDuffing {
 
 impl PeriodicProblem for MathieuDuffing {
     matrix_getters!(1, linear);
+    #[inline]
     fn nonlinear(&self, x: &[f64], _v: &[f64], theta: f64, out: &mut [f64]) {
         one_dof(x, out, |u| {
             -self.beta * theta.sin() * u + self.gamma * u * u * u
