@@ -11,6 +11,10 @@
 //! (`β = Re λ`, `l₁ = Re c₁/ω`) the cycle at p has `|z|² = −β/(ω l₁)` and
 //! `y(t) ≈ y* + 2 Re(z e^{iωt} q)`, on the side of p where `−β/l₁ > 0`; it is
 //! taken at `p_H ± offset·|p_to − p_from|` and refined by [`limit_cycle`].
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::autonomous::{limit_cycle, limit_cycle_branch, LimitCycle};
 use crate::continuation::{ContinuationOptions, Termination};
@@ -186,11 +190,16 @@ where
         }
         let rho = radius2.sqrt();
         let [q_re, q_im] = &hopf.eigenvector;
+        // Per DOF: a₀ = 2x*, a₁ = 2ρ Re q, b₁ = −2ρ Im q (the DOF rows of q).
         let mut guess = vec![0.0; x.len() * l];
-        for (dof, xd) in x.iter().enumerate() {
-            guess[dof * l] = 2.0 * xd;
-            guess[dof * l + 1] = 2.0 * rho * q_re[dof];
-            guess[dof * l + n + 1] = -2.0 * rho * q_im[dof];
+        let dofs = x.iter().zip(q_re).zip(q_im);
+        for (coeffs, ((xd, qr), qi)) in guess.chunks_exact_mut(l).zip(dofs) {
+            let entries = [(0, 2.0 * xd), (1, 2.0 * rho * qr), (n + 1, -2.0 * rho * qi)];
+            for (k, value) in entries {
+                if let Some(c) = coeffs.get_mut(k) {
+                    *c = value;
+                }
+            }
         }
         let cycle = limit_cycle(&problem, hb, hopf.omega, &guess, opts.stability_steps)?;
         return Ok((p, cycle));
@@ -205,18 +214,25 @@ where
 fn locate_folds<B: Branch>(system: &mut B, points: &[(f64, LimitCycle)]) -> Vec<(f64, HbSolution)> {
     let mut folds = Vec::new();
     for w in points.windows(3) {
-        let (a, b, c) = (w[0].0, w[1].0, w[2].0);
+        let [(a, _), (b, turning), (c, _)] = w else {
+            continue;
+        };
         if (b - a) * (c - b) >= 0.0 {
             continue;
         }
-        let sol = &w[1].1.solution;
+        let sol = &turning.solution;
         let mut u = sol.coeffs.clone();
         u.push(sol.omega_f);
-        if let Ok(f) = locate_fold(system, &u, b, &LocateOptions::fold()) {
-            let m = f.q.len() - 1;
+        let located = locate_fold(system, &u, *b, &LocateOptions::fold());
+        // The fold's unknowns are `[q; ω]`.
+        if let Some((f, (&omega_f, q))) = located
+            .as_ref()
+            .ok()
+            .and_then(|f| Some((f, f.q.split_last()?)))
+        {
             let solution = HbSolution {
-                coeffs: f.q[..m].to_vec(),
-                omega_f: f.q[m],
+                coeffs: q.to_vec(),
+                omega_f,
                 harmonics: sol.harmonics,
                 subharmonic: 1,
                 stats: BroydenStats::default(),
@@ -240,7 +256,9 @@ fn cycles_at<P: PeriodicProblem>(
     let mut found = Vec::new();
     for &p in at {
         for w in points.windows(2) {
-            let ((pa, ca), (pb, cb)) = (&w[0], &w[1]);
+            let [(pa, ca), (pb, cb)] = w else {
+                continue;
+            };
             if (pa - p) * (pb - p) > 0.0 || pa == pb {
                 continue;
             }
@@ -293,27 +311,46 @@ impl<P: PeriodicProblem, F: Fn(f64) -> P> Branch for CycleSystem<'_, F> {
     fn len(&self) -> usize {
         self.res.len() + 1
     }
+    /// `[R(q, ω; p); b₁]` (NaN unless `u` and `r` hold `m + 1` entries).
     fn residual(&mut self, u: &[f64], p: f64, r: &mut [f64]) {
         let m = self.res.len();
-        self.res
-            .eval(&(self.family)(p), &u[..m], u[m], 1.0, &mut r[..m]);
-        r[m] = u[self.phase];
+        let (Some((&omega, q)), Some((b1, r_q))) = (u.split_last(), r.split_last_mut()) else {
+            return r.fill(f64::NAN);
+        };
+        if q.len() != m || r_q.len() != m {
+            return r.fill(f64::NAN);
+        }
+        self.res.eval(&(self.family)(p), q, omega, 1.0, r_q);
+        *b1 = u.get(self.phase).copied().unwrap_or(f64::NAN);
     }
-    /// `[[Φ_q, ∂R/∂ω], [e_{b₁}ᵀ, 0]]`, `∂R/∂ω` by a central difference.
+    /// `[[Φ_q, ∂R/∂ω], [e_{b₁}ᵀ, 0]]`, `∂R/∂ω` by a central difference (NaN
+    /// unless `u` holds `m + 1` entries and `jac` `(m + 1)²`).
     fn jacobian(&mut self, u: &[f64], p: f64, jac: &mut [f64]) {
         let m = self.res.len();
+        let Some((&omega, q)) = u.split_last() else {
+            return jac.fill(f64::NAN);
+        };
+        if q.len() != m || jac.len() != (m + 1) * (m + 1) {
+            return jac.fill(f64::NAN);
+        }
         let problem = (self.family)(p);
-        let (q, omega) = (&u[..m], u[m]);
         self.galerkin
             .assemble(&mut self.res, &problem, q, omega, 1.0, &mut self.jq);
         let h = 1e-6 * omega;
         self.res.eval(&problem, q, omega + h, 1.0, &mut self.rp);
         self.res.eval(&problem, q, omega - h, 1.0, &mut self.rm);
         jac.fill(0.0);
-        for i in 0..m {
-            jac[i * (m + 1)..i * (m + 1) + m].copy_from_slice(&self.jq[i * m..(i + 1) * m]);
-            jac[i * (m + 1) + m] = (self.rp[i] - self.rm[i]) / (2.0 * h);
+        // Rows `m + 1` long (`m ≥ 1`): `[Φ_q row, ∂R/∂ω]`, then the phase row.
+        let (top, phase_row) = jac.split_at_mut(m * (m + 1));
+        let columns = self.jq.chunks_exact(m).zip(self.rp.iter().zip(&self.rm));
+        for (row, (jq_row, (rp, rm))) in top.chunks_exact_mut(m + 1).zip(columns) {
+            if let Some((d_omega, head)) = row.split_last_mut() {
+                head.copy_from_slice(jq_row);
+                *d_omega = (rp - rm) / (2.0 * h);
+            }
         }
-        jac[m * (m + 1) + self.phase] = 1.0;
+        if let Some(entry) = phase_row.get_mut(self.phase) {
+            *entry = 1.0;
+        }
     }
 }

@@ -1,6 +1,10 @@
 //! The crate's error type. The outcome of a failed Broyden solve
 //! ([`SolveError`]) nests in it by `#[from]`, so a failed path or solve keeps its
 //! residual history.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::broyden::SolveError;
 use thiserror::Error;
@@ -11,6 +15,16 @@ pub enum HbError {
     /// Invalid sizes or parameters.
     #[error("invalid input: {0}")]
     InvalidInput(String),
+    /// An array does not have the size the problem asks for.
+    #[error("invalid input: {what} has {got} entries, expected {expected}")]
+    Size {
+        /// Which array.
+        what: &'static str,
+        /// The entries it must hold.
+        expected: usize,
+        /// The entries it holds.
+        got: usize,
+    },
     /// Eq. 62 needs `N > n` (2N samples resolve harmonics below N without
     /// aliasing of the linear terms).
     #[error("AFT needs N > n (got N = {n_half}, n = {harmonics})")]
@@ -127,6 +141,7 @@ impl HbError {
     pub fn kind(&self) -> &'static str {
         match self {
             Self::InvalidInput(_)
+            | Self::Size { .. }
             | Self::AftTooFewSamples { .. }
             | Self::AftTooManySamples { .. } => "input",
             Self::Solve(_)

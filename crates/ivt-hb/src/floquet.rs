@@ -39,20 +39,31 @@ pub fn expm_scratch_len(dim: usize) -> usize {
 /// then below `θ¹³/13! · e^θ ≈ 3e-18`, under the rounding of the sum.
 const EXPM_THETA: f64 = 0.25;
 
-/// Taylor coefficients 1/k! of [`expm`]'s degree-12 polynomial.
-const EXPM_TAYLOR: [f64; 13] = {
-    let mut c = [1.0; 13];
-    let mut k = 1;
-    while k < 13 {
-        // A const item: an index out of range is a compile error, not a panic.
-        #[allow(clippy::indexing_slicing)]
-        {
-            c[k] = c[k - 1] / k as f64;
-        }
-        k += 1;
+/// `1/k!` as `(1/(k−1)!)/k`, the rounding of a running division.
+const fn inverse_factorial(k: usize) -> f64 {
+    if k == 0 {
+        1.0
+    } else {
+        inverse_factorial(k - 1) / k as f64
     }
-    c
-};
+}
+
+/// Taylor coefficients 1/k! of [`expm`]'s degree-12 polynomial.
+const EXPM_TAYLOR: [f64; 13] = [
+    inverse_factorial(0),
+    inverse_factorial(1),
+    inverse_factorial(2),
+    inverse_factorial(3),
+    inverse_factorial(4),
+    inverse_factorial(5),
+    inverse_factorial(6),
+    inverse_factorial(7),
+    inverse_factorial(8),
+    inverse_factorial(9),
+    inverse_factorial(10),
+    inverse_factorial(11),
+    inverse_factorial(12),
+];
 
 /// Calls `$f::<N>(args)` with the compile-time size `N = $dim` for sizes
 /// 1–8 (the state sizes `2·n_dof` of systems up to 4 DOF: every loop over
@@ -380,6 +391,20 @@ pub fn sort_by_modulus(v: &mut [c64]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn taylor_coefficients_are_the_running_division_and_one_over_k_factorial() {
+        let mut running = 1.0;
+        let mut factorial = 1.0;
+        for (k, &c) in EXPM_TAYLOR.iter().enumerate() {
+            if k > 0 {
+                running /= k as f64;
+                factorial *= k as f64;
+            }
+            assert_eq!(c.to_bits(), running.to_bits(), "k = {k}");
+            assert!((c * factorial - 1.0).abs() < 1e-15, "k = {k}");
+        }
+    }
 
     #[test]
     fn expm_of_rotation_generator() {

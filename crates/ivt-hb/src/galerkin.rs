@@ -14,10 +14,23 @@
 //! real FFT of the 2N samples; `l > N` read from bin `2N − l`). This is the same
 //! discrete sum, aliasing included, so the assembly equals the quadrature to
 //! rounding in O(2N log 2N + (2n+1)²) per block instead of O(2N·(2n+1)²).
+//!
+//! The bilinear form `wᵀΦ_q v` of the fold test, sampled without assembling
+//! `Φ_q`, is [`form`]. A `jac` of the wrong size is not a panic: it is filled
+//! with NaN, which the solvers report as [`crate::HbError::NonFinite`].
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
+mod form;
+
+pub(crate) use form::GalerkinForm;
 
 use crate::aft::Aft;
 use crate::ihb::HbResidual;
 use crate::problem::PeriodicProblem;
+use realfft::num_complex::Complex;
 
 /// The exact Galerkin Jacobian `Φ_q` (Eq. 56) of the residual at nonlinearity
 /// scale `s`, with its scratch: the classic IHB's Newton matrix, the modified
@@ -36,52 +49,67 @@ pub struct GalerkinJacobian {
 }
 
 /// `C_l = Σ_i g(τ_i) cos lτ_i` and `S_l = Σ_i g(τ_i) sin lτ_i` for `l = −n..2n`
-/// (`C_{−l} = C_l`, `S_{−l} = −S_l`), stored at `n + l`.
+/// (`C_{−l} = C_l`, `S_{−l} = −S_l`), stored at `n + l`, and again in reverse
+/// order (`l` at `2n − l`) so that a row reads both `C_{j+k}` and `C_{j−k}`
+/// forward in `k`.
 #[derive(Debug, Clone)]
 struct CosSinSums {
     n: usize,
     cos: Vec<f64>,
     sin: Vec<f64>,
+    cos_rev: Vec<f64>,
+    sin_rev: Vec<f64>,
 }
 
 impl CosSinSums {
     fn new(n: usize) -> Self {
+        let sums = vec![0.0; 3 * n + 1];
         Self {
             n,
-            cos: vec![0.0; 3 * n + 1],
-            sin: vec![0.0; 3 * n + 1],
+            cos: sums.clone(),
+            sin: sums.clone(),
+            cos_rev: sums.clone(),
+            sin_rev: sums,
         }
     }
 
     /// The sums of `samples` times `scale`, from one real FFT: `X_l = C_l − i S_l`
-    /// for `l ≤ N`, and `X_l = conj(X_{2N−l})` beyond the Nyquist bin.
+    /// for `l ≤ N`, and `X_l = conj(X_{2N−l})` beyond the Nyquist bin (NaN where
+    /// the spectrum has no such bin: fewer than `2n` samples).
     fn fill(&mut self, aft: &mut Aft, samples: &[f64], scale: f64) {
         let spectrum = aft.spectrum(samples);
         let (n, ns) = (self.n, samples.len());
-        for l in 0..=2 * n {
-            let (x, sign) = if 2 * l <= ns {
-                (spectrum[l], -1.0)
+        let mid = n.min(self.cos.len()).min(self.sin.len());
+        let (negative_cos, cos) = self.cos.split_at_mut(mid);
+        let (negative_sin, sin) = self.sin.split_at_mut(mid);
+        for (l, (c, s)) in cos.iter_mut().zip(sin.iter_mut()).enumerate() {
+            let (bin, sign) = if 2 * l <= ns {
+                (Some(l), -1.0)
             } else {
-                (spectrum[ns - l], 1.0)
+                (ns.checked_sub(l), 1.0)
             };
-            self.cos[n + l] = scale * x.re;
-            self.sin[n + l] = sign * scale * x.im;
+            let nan = Complex::new(f64::NAN, f64::NAN);
+            let x = bin.and_then(|b| spectrum.get(b)).copied().unwrap_or(nan);
+            *c = scale * x.re;
+            *s = sign * scale * x.im;
         }
-        for l in 1..=n {
-            self.cos[n - l] = self.cos[n + l];
-            self.sin[n - l] = -self.sin[n + l];
+        // C_{−l} = C_l, S_{−l} = −S_l for l = 1..n, stored at n − l.
+        let mirrored = negative_cos
+            .iter_mut()
+            .rev()
+            .zip(negative_sin.iter_mut().rev());
+        for ((c_neg, s_neg), (c, s)) in mirrored.zip(cos.iter().zip(sin.iter()).skip(1)) {
+            *c_neg = *c;
+            *s_neg = -*s;
         }
-    }
-
-    /// `(C_{j−k}, C_{j+k}, S_{j−k}, S_{j+k})`.
-    fn pair(&self, j: usize, k: usize) -> (f64, f64, f64, f64) {
-        let (minus, plus) = (self.n + j - k, self.n + j + k);
-        (
-            self.cos[minus],
-            self.cos[plus],
-            self.sin[minus],
-            self.sin[plus],
-        )
+        for (rev, sums) in [
+            (&mut self.cos_rev, &self.cos),
+            (&mut self.sin_rev, &self.sin),
+        ] {
+            rev.iter_mut()
+                .zip(sums.iter().rev())
+                .for_each(|(r, v)| *r = *v);
+        }
     }
 
     /// Adds to `row` (columns `a_0, a_1..a_n, b_1..b_n` of one DOF) the sums of the
@@ -89,33 +117,68 @@ impl CosSinSums {
     /// `C_s` (`x`) or against the derivative columns `C_s' = {0, −k sin, k cos}`.
     /// With `(P_k, Q_k)` = the sums against `(cos kτ, sin kτ)`, the derivative
     /// columns get `(−k Q_k, k P_k)`, and `a_0` (weight ½) gets `½ P_0`.
+    /// For `k = 1..n`, `C_{j+k}` is at `n + j + k` of the sums and `C_{j−k}` at
+    /// `2n − j + k` of the reversed sums: two forward windows of `n` entries.
+    /// NaN in `row` if `j > n` or `row` is not `2n + 1` long.
     fn add_row(&self, row: &mut [f64], j: usize, sin_row: bool, x: bool) {
+        let n = self.n;
+        let (plus, minus) = (Some(n + j), (2 * n).checked_sub(j));
+        let windows = (
+            window(&self.cos, plus, n),
+            window(&self.sin, plus, n),
+            window(&self.cos_rev, minus, n),
+            window(&self.sin_rev, minus, n),
+        );
+        let centre = (self.cos.get(n + j), self.sin.get(n + j));
+        let (
+            (Some(cos_plus), Some(sin_plus), Some(cos_minus), Some(sin_minus)),
+            (Some(&c0), Some(&s0)),
+        ) = (windows, centre)
+        else {
+            return row.fill(f64::NAN);
+        };
+        if row.len() != 2 * n + 1 || j > n {
+            return row.fill(f64::NAN);
+        }
         let cj = if j == 0 { 0.5 } else { 1.0 };
-        let sums = |k: usize| {
-            let (cm, cp, sm, sp) = self.pair(j, k);
+        let sums = |cm: f64, cp: f64, sm: f64, sp: f64| {
             if sin_row {
                 (sp + sm, cm - cp)
             } else {
                 (cj * (cm + cp), cj * (sp - sm))
             }
         };
-        let (head, tail) = row.split_at_mut(self.n + 1);
+        let (head, tail) = row.split_at_mut(n + 1);
+        let Some((a0, head)) = head.split_first_mut() else {
+            return;
+        };
         if x {
-            head[0] += 0.5 * sums(0).0;
+            // k = 0: C_{j−0} = C_{j+0}.
+            *a0 += 0.5 * sums(c0, c0, s0, s0).0;
         }
-        for (i, (a, b)) in head[1..].iter_mut().zip(tail.iter_mut()).enumerate() {
-            let k = i + 1;
-            let (p, q) = sums(k);
+        let columns = head.iter_mut().zip(tail.iter_mut());
+        let pairs = cos_minus
+            .iter()
+            .zip(cos_plus)
+            .zip(sin_minus.iter().zip(sin_plus));
+        let mut kf = 0.0;
+        for ((a, b), ((&cm, &cp), (&sm, &sp))) in columns.zip(pairs) {
+            kf += 1.0;
+            let (p, q) = sums(cm, cp, sm, sp);
             if x {
                 *a += p;
                 *b += q;
             } else {
-                let kf = k as f64;
                 *a -= kf * q;
                 *b += kf * p;
             }
         }
     }
+}
+
+/// Entries `start + 1 ..= start + n` of `sums` (`None` past its end).
+fn window(sums: &[f64], start: Option<usize>, n: usize) -> Option<&[f64]> {
+    start.and_then(|s| sums.get(s + 1..=s + n))
 }
 
 impl GalerkinJacobian {
@@ -140,7 +203,8 @@ impl GalerkinJacobian {
     /// Writes `Φ_q(q)` (row-major `m×m`, DOF-major unknowns) into `jac`: `L(ω)`,
     /// then `s·(1/π)∫ C_s (G_x C_sᵀ + ω G_v C_s'ᵀ) dτ` added per DOF block `(d, e)`
     /// from one FFT of `∂g_d/∂x_e` and, for a velocity-dependent problem, one of
-    /// `ω ∂g_d/∂v_e`; identically zero samples are skipped.
+    /// `ω ∂g_d/∂v_e`; identically zero samples are skipped. `jac` is NaN if it is
+    /// not `m×m` or this scratch was made for another size of residual.
     pub fn assemble<P: PeriodicProblem>(
         &mut self,
         res: &mut HbResidual,
@@ -150,26 +214,30 @@ impl GalerkinJacobian {
         s: f64,
         jac: &mut [f64],
     ) {
-        res.linear_matrix(problem, omega_f / res.subharmonic() as f64, jac);
-        if s == 0.0 {
-            return;
-        }
         let (nd, n) = (res.n_dof(), res.harmonics());
         let l = 2 * n + 1;
         let len = nd * l;
         let n2 = nd * nd;
+        let same_size = self.dg.len() == 2 * res.n_samples() * n2 && self.x_sums.n == n;
+        if jac.len() != len * len || !same_size || n2 == 0 {
+            return jac.fill(f64::NAN);
+        }
+        res.linear_matrix(problem, omega_f / res.subharmonic() as f64, jac);
+        if s == 0.0 {
+            return;
+        }
         let omega = omega_f / res.subharmonic() as f64;
         let velocity = res.velocity_dependent();
         res.jacobian_samples(problem, q, omega, &mut self.dg);
         // (1/π)·(2π/2N)·½: the sums' weight with the ½ of the product formulas.
         let w = s / self.column.len() as f64;
-        for d in 0..nd {
+        // Rows of DOF d (`l·len` entries each, `len ≥ 1`), then row a of the block.
+        for (d, block_rows) in jac.chunks_exact_mut(l * len).enumerate() {
             for e in 0..nd {
+                // Entry (d, e) of `[G_x | G_v]` at every sample (`2n_dof² ≥ 1` apart).
                 let gather = |offset: usize, column: &mut [f64]| {
-                    let samples = self.dg.chunks_exact(2 * n2);
-                    for (c, block) in column.iter_mut().zip(samples) {
-                        *c = block[offset + d * nd + e];
-                    }
+                    let entry = self.dg.iter().skip(offset + d * nd + e).step_by(2 * n2);
+                    column.iter_mut().zip(entry).for_each(|(c, g)| *c = *g);
                     column.iter().any(|&g| g != 0.0)
                 };
                 let has_x = gather(0, &mut self.column);
@@ -180,9 +248,13 @@ impl GalerkinJacobian {
                 if has_v {
                     self.v_sums.fill(res.aft_mut(), &self.column, w * omega);
                 }
-                for a in 0..l {
-                    let start = (d * l + a) * len + e * l;
-                    let row = &mut jac[start..start + l];
+                let block = block_rows
+                    .chunks_exact_mut(len)
+                    .map(|r| r.get_mut(e * l..(e + 1) * l));
+                for (a, row) in block.enumerate() {
+                    let Some(row) = row else {
+                        continue;
+                    };
                     let parts = [(has_x, &self.x_sums, true), (has_v, &self.v_sums, false)];
                     for (_, sums, x) in parts.into_iter().filter(|part| part.0) {
                         let (j, sin_row) = if a <= n { (a, false) } else { (a - n, true) };
@@ -194,230 +266,9 @@ impl GalerkinJacobian {
     }
 }
 
-/// `C_s(τ_i) = {1/2, cos kτ_i, sin kτ_i}` in rows `i < 2N` and its τ-derivative in
-/// rows `2N + i` (`2·2N·(2n+1)`): the basis sampled on the AFT grid.
-pub(crate) fn quadrature_basis(n: usize, ns: usize) -> Vec<f64> {
-    let l = 2 * n + 1;
-    let mut basis = vec![0.0; 2 * ns * l];
-    // k·τ_i = 2π·(k·i mod 2N)/2N: one sin/cos table of the 2N grid angles serves
-    // every harmonic (and reduces the angle exactly).
-    let table: Vec<(f64, f64)> = (0..ns)
-        .map(|j| (std::f64::consts::PI * j as f64 / (ns / 2) as f64).sin_cos())
-        .collect();
-    for i in 0..ns {
-        basis[i * l] = 0.5;
-        for k in 1..=n {
-            let (sn, cs) = table[(k * i) % ns];
-            basis[i * l + k] = cs;
-            basis[i * l + n + k] = sn;
-            basis[(ns + i) * l + k] = -(k as f64) * sn;
-            basis[(ns + i) * l + n + k] = k as f64 * cs;
-        }
-    }
-    basis
-}
-
-/// The nonlinear part of `wᵀΦ_q v` without assembling `Φ_q` (the fold test of
-/// [`crate::FamilyBranch`]), and its gradient in `q`, with all scratch.
-#[derive(Debug, Clone)]
-pub(crate) struct GalerkinForm {
-    n_dof: usize,
-    p: f64,
-    velocity: bool,
-    basis: Vec<f64>,
-    thetas: Vec<f64>,
-    /// Sample-major (`2N·n_dof`): the orbit `x`, `ẋ`, the syntheses `w̃`, `ṽ`, `ṽ'`,
-    /// and a displaced copy of `x` or `ẋ`.
-    xs: Vec<f64>,
-    vs: Vec<f64>,
-    wt: Vec<f64>,
-    vt: Vec<f64>,
-    vdt: Vec<f64>,
-    moved: Vec<f64>,
-    dg: Vec<f64>,
-    /// Per sample: ψᵢ at the orbit and displaced ±, the difference steps.
-    at: Vec<f64>,
-    plus: Vec<f64>,
-    minus: Vec<f64>,
-    steps: Vec<f64>,
-}
-
-/// `w̃`, `ṽ`, `ṽ'` sampled: the vectors of one bilinear form.
-struct Syntheses<'a> {
-    wt: &'a [f64],
-    vt: &'a [f64],
-    vdt: &'a [f64],
-}
-
-impl GalerkinForm {
-    /// Scratch for `res`'s size and the problem it evaluates.
-    pub(crate) fn new<P: PeriodicProblem>(res: &HbResidual, problem: &P) -> Self {
-        let (nd, n, ns) = (res.n_dof(), res.harmonics(), res.n_samples());
-        let p = res.subharmonic() as f64;
-        let states = vec![0.0; ns * nd];
-        Self {
-            n_dof: nd,
-            p,
-            velocity: problem.velocity_dependent(),
-            basis: quadrature_basis(n, ns),
-            thetas: (0..ns)
-                .map(|i| p * 2.0 * std::f64::consts::PI * i as f64 / ns as f64)
-                .collect(),
-            xs: states.clone(),
-            vs: states.clone(),
-            wt: states.clone(),
-            vt: states.clone(),
-            vdt: states.clone(),
-            moved: states,
-            dg: vec![0.0; 2 * ns * nd * nd],
-            at: vec![0.0; ns],
-            plus: vec![0.0; ns],
-            minus: vec![0.0; ns],
-            steps: vec![0.0; ns],
-        }
-    }
-
-    /// The nonlinear part of `wᵀJv`: `(2/2N) Σᵢ ψᵢ` with
-    /// `ψᵢ = w̃ᵀ(G_x ṽ + ω G_v ṽ')` at sample τᵢ (`w̃`, `ṽ`, `ṽ'` the syntheses of
-    /// `w`, `v` and `v'`, Eq. 56's sum). With `grad`, also its gradient in `q`:
-    /// `∂ψᵢ/∂x`, `∂ψᵢ/∂ẋ` by central differences of `∂g` (steps relative to the
-    /// orbit's scale) projected back on the basis — O(2N·m), where differencing
-    /// assembled Jacobians would cost 2m assemblies. `∂g` is taken at all samples
-    /// per call (`nonlinear_jacobian_samples`): 1 + 2·n_dof calls (twice that with
-    /// velocity dependence) whatever the number of samples. Allocation-free if the
-    /// problem's `nonlinear_jacobian_samples` is.
-    pub(crate) fn value<P: PeriodicProblem>(
-        &mut self,
-        problem: &P,
-        q: &[f64],
-        lambda: f64,
-        w: &[f64],
-        v: &[f64],
-        grad: Option<&mut [f64]>,
-    ) -> f64 {
-        let Self {
-            n_dof: nd,
-            p,
-            velocity,
-            basis,
-            thetas,
-            xs,
-            vs,
-            wt,
-            vt,
-            vdt,
-            moved,
-            dg,
-            at,
-            plus,
-            minus,
-            steps,
-        } = self;
-        let nd = *nd;
-        let l = q.len() / nd;
-        let ns = thetas.len();
-        let omega = lambda / *p;
-        let synth = |c: &[f64], row: &[f64]| c.iter().zip(row).map(|(a, b)| a * b).sum::<f64>();
-        // Sample-major x(τᵢ), ẋ(τᵢ) of the orbit and the syntheses of w, v, v'.
-        for i in 0..ns {
-            let (cs, ds) = basis_rows(basis, l, ns, i);
-            for d in 0..nd {
-                let (k, dof) = (i * nd + d, d * l..(d + 1) * l);
-                xs[k] = synth(&q[dof.clone()], cs);
-                vs[k] = omega * synth(&q[dof.clone()], ds);
-                wt[k] = synth(&w[dof.clone()], cs);
-                vt[k] = synth(&v[dof.clone()], cs);
-                vdt[k] = synth(&v[dof], ds);
-            }
-        }
-        let tilde = Syntheses { wt, vt, vdt };
-        let weight = 2.0 / ns as f64;
-        psi(problem, (xs, vs), thetas, dg, &tilde, omega, at);
-        let total = weight * at.iter().sum::<f64>();
-        let Some(out) = grad else {
-            return total;
-        };
-        out.fill(0.0);
-        let scale = |u: &[f64]| u.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        let (x_scale, v_scale) = (scale(xs), scale(vs));
-        for f in 0..nd {
-            for wrt_v in [false, true] {
-                if wrt_v && !*velocity {
-                    continue;
-                }
-                let (base, u_scale) = if wrt_v {
-                    (&*vs, v_scale)
-                } else {
-                    (&*xs, x_scale)
-                };
-                for (i, h) in steps.iter_mut().enumerate() {
-                    *h = 1e-6 * base[i * nd + f].abs().max(u_scale).max(f64::MIN_POSITIVE);
-                }
-                moved.copy_from_slice(base);
-                for (sign, dst) in [(1.0, &mut *plus), (-1.0, &mut *minus)] {
-                    for i in 0..ns {
-                        moved[i * nd + f] = base[i * nd + f] + sign * steps[i];
-                    }
-                    let states: (&[f64], &[f64]) = if wrt_v { (xs, moved) } else { (moved, vs) };
-                    psi(problem, states, thetas, dg, &tilde, omega, dst);
-                }
-                let factor = if wrt_v { weight * omega } else { weight };
-                let target = &mut out[f * l..(f + 1) * l];
-                for i in 0..ns {
-                    let d_psi = factor * (plus[i] - minus[i]) / (2.0 * steps[i]);
-                    let (cs, ds) = basis_rows(basis, l, ns, i);
-                    let row = if wrt_v { ds } else { cs };
-                    target
-                        .iter_mut()
-                        .zip(row)
-                        .for_each(|(o, c)| *o += d_psi * c);
-                }
-            }
-        }
-        total
-    }
-}
-
-/// ψᵢ = w̃ᵀ(G_x ṽ + ω G_v ṽ') of every sample at the states `(x, ẋ)`, from one
-/// batched `∂g` into `dg`.
-fn psi<P: PeriodicProblem>(
-    problem: &P,
-    (x, xv): (&[f64], &[f64]),
-    thetas: &[f64],
-    dg: &mut [f64],
-    tilde: &Syntheses,
-    omega: f64,
-    out: &mut [f64],
-) {
-    let nd = problem.n_dof();
-    let n2 = nd * nd;
-    problem.nonlinear_jacobian_samples(x, xv, thetas, dg);
-    for (i, o) in out.iter_mut().enumerate() {
-        let mut acc = 0.0;
-        for d in 0..nd {
-            for e in 0..nd {
-                let (gx, gv) = (
-                    dg[2 * i * n2 + d * nd + e],
-                    dg[2 * i * n2 + n2 + d * nd + e],
-                );
-                acc += tilde.wt[i * nd + d]
-                    * (gx * tilde.vt[i * nd + e] + omega * gv * tilde.vdt[i * nd + e]);
-            }
-        }
-        *o = acc;
-    }
-}
-
-/// `C_s(τ_i)` and `C_s'(τ_i)` from the quadrature table of `ns` samples.
-fn basis_rows(basis: &[f64], l: usize, ns: usize, i: usize) -> (&[f64], &[f64]) {
-    (
-        &basis[i * l..(i + 1) * l],
-        &basis[(ns + i) * l..(ns + i + 1) * l],
-    )
-}
-
 #[cfg(test)]
 mod tests {
+    use super::form::{basis_rows, quadrature_basis};
     use super::*;
     use crate::elements::{Element, ElementProblem, Harmonic, Law};
     use crate::fold::Branch;
@@ -444,8 +295,7 @@ mod tests {
         res.jacobian_samples(problem, q, omega, &mut dg);
         let mut jac = vec![0.0; len * len];
         let w = 2.0 * s / ns as f64;
-        for i in 0..ns {
-            let (cs, ds) = basis_rows(&basis, l, ns, i);
+        for (i, (cs, ds)) in basis_rows(&basis, l).enumerate() {
             for d in 0..nd {
                 for e in 0..nd {
                     let gx = w * dg[2 * i * n2 + d * nd + e];
@@ -656,5 +506,32 @@ mod tests {
             (value - assembled).abs() <= 1e-12 * scale,
             "{value} vs {assembled}"
         );
+        // Vectors of the wrong length: NaN, not a panic.
+        assert!(branch.bilinear(&q, 1.1, &w[1..], &v).is_nan());
+        assert!(branch.bilinear(&q[1..], 1.1, &w, &v).is_nan());
+        let mut grad = vec![0.0; m - 1];
+        branch.jacobian_gradient(&q, 1.1, &w, &v, &mut grad);
+        assert!(grad.iter().all(|g| g.is_nan()));
+    }
+
+    #[test]
+    fn a_jacobian_of_the_wrong_size_or_scratch_of_another_residual_is_nan_not_a_panic() {
+        let duffing = Duffing::fig28();
+        let mut res = HbResidual::new(&duffing, &HbOptions::new(5, 16)).unwrap();
+        let m = res.len();
+        let q = vec![0.1; m];
+        let mut galerkin = GalerkinJacobian::new(&res);
+        let mut short = vec![0.0; m * m - 1];
+        galerkin.assemble(&mut res, &duffing, &q, 1.0, 1.0, &mut short);
+        assert!(short.iter().all(|v| v.is_nan()));
+        // Scratch for 7 harmonics used on a 5-harmonic residual.
+        let other = HbResidual::new(&duffing, &HbOptions::new(7, 16)).unwrap();
+        let mut foreign = GalerkinJacobian::new(&other);
+        let mut jac = vec![0.0; m * m];
+        foreign.assemble(&mut res, &duffing, &q, 1.0, 1.0, &mut jac);
+        assert!(jac.iter().all(|v| v.is_nan()));
+        // The right sizes give finite entries.
+        galerkin.assemble(&mut res, &duffing, &q, 1.0, 1.0, &mut jac);
+        assert!(jac.iter().all(|v| v.is_finite()));
     }
 }

@@ -20,6 +20,10 @@
 //! central differences of the field, polarised): `l₁ > 0` subcritical (an
 //! unstable cycle on the side where the equilibrium is stable), `l₁ < 0`
 //! supercritical.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::error::HbError;
 use crate::floquet::eigenvalues;
@@ -52,13 +56,22 @@ impl HopfPoint {
 /// The equilibrium of `problem` near `x` (overwritten).
 ///
 /// # Errors
-/// [`HbError::InvalidInput`] when Newton does not converge.
+/// [`HbError::InvalidInput`] when Newton does not converge or `x` does not
+/// hold `n_dof` entries, [`HbError::Size`] unless `K` is `n_dof×n_dof`.
 pub fn equilibrium<P: PeriodicProblem>(problem: &P, x: &mut [f64]) -> Result<(), HbError> {
     let n = problem.n_dof();
     if x.len() != n {
         return Err(HbError::InvalidInput(format!(
             "the equilibrium has {n} entries"
         )));
+    }
+    let k = problem.stiffness().len();
+    if k != n * n {
+        return Err(HbError::Size {
+            what: "K",
+            expected: n * n,
+            got: k,
+        });
     }
     let opts = NewtonOptions {
         ftol: 1e-13,
@@ -83,9 +96,9 @@ impl<P: PeriodicProblem> NewtonSystem for Statics<'_, P> {
         let n = x.len();
         let zero = vec![0.0; n];
         self.0.nonlinear_samples(x, &zero, &[0.0], r);
-        let k = self.0.stiffness();
-        for (i, ri) in r.iter_mut().enumerate() {
-            *ri += (0..n).map(|j| k[i * n + j] * x[j]).sum::<f64>();
+        // `K` is `n×n` (checked by `Field::new` and the solvers' validation).
+        for (ri, k_row) in r.iter_mut().zip(self.0.stiffness().chunks_exact(n.max(1))) {
+            *ri += dot(k_row, x);
         }
         Ok(())
     }
@@ -111,25 +124,47 @@ pub(crate) struct Field<'a, P> {
 impl<'a, P: PeriodicProblem> Field<'a, P> {
     pub(crate) fn new(problem: &'a P) -> Result<Self, HbError> {
         let n = problem.n_dof();
+        if n == 0 {
+            return Err(HbError::InvalidInput("n_dof must be positive".into()));
+        }
+        for (what, matrix) in [
+            ("M", problem.mass()),
+            ("C", problem.damping()),
+            ("K", problem.stiffness()),
+        ] {
+            if matrix.len() != n * n {
+                return Err(HbError::Size {
+                    what,
+                    expected: n * n,
+                    got: matrix.len(),
+                });
+            }
+        }
         let minv = ivt_num::lu::inverse(problem.mass(), n)
             .ok_or_else(|| HbError::InvalidInput("the mass matrix is singular".into()))?;
         Ok(Self { problem, minv, n })
     }
 
-    /// `F(y) = [ẋ; −M⁻¹(C ẋ + K x + g(x, ẋ))]`.
+    /// `F(y) = [ẋ; −M⁻¹(C ẋ + K x + g(x, ẋ))]` (`y` holds `2n` entries; NaN
+    /// if it does not).
     fn eval(&self, y: &[f64]) -> Vec<f64> {
         let n = self.n;
-        let (x, v) = y.split_at(n);
+        let (Some(x), Some(v)) = (y.get(..n), y.get(n..)) else {
+            return vec![f64::NAN; 2 * n];
+        };
+        if v.len() != n {
+            return vec![f64::NAN; 2 * n];
+        }
         let mut force = vec![0.0; n];
         self.problem.nonlinear_samples(x, v, &[0.0], &mut force);
         let (c, k) = (self.problem.damping(), self.problem.stiffness());
-        for (i, f) in force.iter_mut().enumerate() {
-            *f += (0..n)
-                .map(|j| c[i * n + j] * v[j] + k[i * n + j] * x[j])
-                .sum::<f64>();
+        // `n ≥ 1` and `C`, `K` are `n×n` (`Field::new`).
+        let rows = c.chunks_exact(n).zip(k.chunks_exact(n));
+        for (f, (c_row, k_row)) in force.iter_mut().zip(rows) {
+            *f += dot(c_row, v) + dot(k_row, x);
         }
         let mut out = v.to_vec();
-        out.extend((0..n).map(|i| -(0..n).map(|j| self.minv[i * n + j] * force[j]).sum::<f64>()));
+        out.extend(self.minv.chunks_exact(n).map(|row| -dot(row, &force)));
         out
     }
 
@@ -153,15 +188,26 @@ impl<'a, P: PeriodicProblem> Field<'a, P> {
         {
             let sum: Vec<f64> = linear.iter().zip(nonlinear).map(|(l, g)| l + g).collect();
             for j in 0..n {
+                // `n ≥ 1` (`Field::new`).
                 let column: Vec<f64> = sum.iter().skip(j).step_by(n).copied().collect();
                 ivt_num::vector::matvec(&self.minv, n, n, &column, &mut col);
-                for (i, v) in col.iter().enumerate() {
-                    a[(n + i) * d + block * n + j] = -v;
+                // Rows n + i, column block·n + j.
+                let lower = a
+                    .chunks_exact_mut(d)
+                    .skip(n)
+                    .map(|row| row.get_mut(block * n + j));
+                for (entry, v) in lower.zip(&col) {
+                    if let Some(entry) = entry {
+                        *entry = -v;
+                    }
                 }
             }
         }
-        for i in 0..n {
-            a[i * d + n + i] = 1.0;
+        // The identity in rows i < n, column n + i.
+        for (i, row) in a.chunks_exact_mut(d).take(n).enumerate() {
+            if let Some(entry) = row.get_mut(n + i) {
+                *entry = 1.0;
+            }
         }
         a
     }
@@ -173,8 +219,10 @@ impl<'a, P: PeriodicProblem> Field<'a, P> {
             self.eval(&axpy(y0, -h, u)),
             self.eval(y0),
         );
-        (0..p.len())
-            .map(|i| (p[i] - 2.0 * c[i] + m[i]) / (h * h))
+        p.iter()
+            .zip(&m)
+            .zip(&c)
+            .map(|((p, m), c)| (p - 2.0 * c + m) / (h * h))
             .collect()
     }
 
@@ -182,8 +230,10 @@ impl<'a, P: PeriodicProblem> Field<'a, P> {
     fn cubic(&self, y0: &[f64], u: &[f64], h: f64) -> Vec<f64> {
         let f = |s: f64| self.eval(&axpy(y0, s * h, u));
         let (p2, p1, m1, m2) = (f(2.0), f(1.0), f(-1.0), f(-2.0));
-        (0..p1.len())
-            .map(|i| (p2[i] - 2.0 * p1[i] + 2.0 * m1[i] - m2[i]) / (2.0 * h * h * h))
+        p2.iter()
+            .zip(&p1)
+            .zip(m1.iter().zip(&m2))
+            .map(|((p2, p1), (m1, m2))| (p2 - 2.0 * p1 + 2.0 * m1 - m2) / (2.0 * h * h * h))
             .collect()
     }
 }
@@ -211,11 +261,19 @@ pub(crate) fn lyapunov(
 ) -> Result<(f64, [Vec<f64>; 2]), HbError> {
     let d = 2 * field.n;
     let a = field.linearisation(x);
-    let at: Vec<f64> = (0..d * d).map(|k| a[(k % d) * d + k / d]).collect();
+    // Aᵀ: entry k = (i, j) = (k / d, k % d) is A's (j, i) (`d ≥ 2`).
+    let at: Vec<f64> = (0..d * d)
+        .map(|k| a.get((k % d) * d + k / d).copied().unwrap_or(f64::NAN))
+        .collect();
     let [qa, qb] = complex_null_vector(&a, d, omega)?;
     // ⟨q, q⟩ = 1 and q of DOF 0 real: multiply by e^{−iφ}, φ = arg q₀.
     let norm = (dot(&qa, &qa) + dot(&qb, &qb)).sqrt();
-    let phi = qb[0].atan2(qa[0]);
+    let (Some(&qb0), Some(&qa0)) = (qb.first(), qa.first()) else {
+        return Err(HbError::InvalidInput(
+            "no eigenvector at the Hopf point".into(),
+        ));
+    };
+    let phi = qb0.atan2(qa0);
     let (cs, sn) = (phi.cos() / norm, phi.sin() / norm);
     let q_re: Vec<f64> = qa.iter().zip(&qb).map(|(r, i)| cs * r + sn * i).collect();
     let q_im: Vec<f64> = qa.iter().zip(&qb).map(|(r, i)| cs * i - sn * r).collect();
@@ -248,25 +306,20 @@ pub(crate) fn lyapunov(
     // C(q, q, q̄) = C(a,a,a) + C(a,b,b) + i[C(a,a,b) + C(b,b,b)] with
     // C(a,a,b) = [c(a+b) − c(a−b) − 2c(b)]/6, C(a,b,b) = [c(a+b) + c(a−b) − 2c(a)]/6.
     let (caaa, cbbb, cs_, cd) = (c(&q_re), c(&q_im), c(&sum), c(&diff));
-    let c_re: Vec<f64> = (0..d)
-        .map(|i| caaa[i] + (cs_[i] + cd[i] - 2.0 * caaa[i]) / 6.0)
+    let parts = || caaa.iter().zip(&cbbb).zip(cs_.iter().zip(&cd));
+    let c_re: Vec<f64> = parts()
+        .map(|((aaa, _), (s, d))| aaa + (s + d - 2.0 * aaa) / 6.0)
         .collect();
-    let c_im: Vec<f64> = (0..d)
-        .map(|i| (cs_[i] - cd[i] - 2.0 * cbbb[i]) / 6.0 + cbbb[i])
+    let c_im: Vec<f64> = parts()
+        .map(|((_, bbb), (s, d))| (s - d - 2.0 * bbb) / 6.0 + bbb)
         .collect();
     // A⁻¹ B(q, q̄) (real) and (2iω − A)⁻¹ B(q, q) (complex, as a real 2d system).
     let mut s1 = b_qqbar;
     solve(&a, d, &mut s1)?;
-    let mut big = vec![0.0; 4 * d * d];
-    for i in 0..d {
-        for j in 0..d {
-            big[i * 2 * d + j] = -a[i * d + j];
-            big[(d + i) * 2 * d + d + j] = -a[i * d + j];
-        }
-        big[i * 2 * d + d + i] = -2.0 * omega;
-        big[(d + i) * 2 * d + i] = 2.0 * omega;
-    }
-    let mut s2: Vec<f64> = b_qq[0].iter().chain(&b_qq[1]).copied().collect();
+    // [[−A, −2ω I], [2ω I, −A]] (row-major 2d×2d).
+    let big = real_form(&a, d, -1.0, -2.0 * omega);
+    let [b_qq_re, b_qq_im] = &b_qq;
+    let mut s2: Vec<f64> = b_qq_re.iter().chain(b_qq_im).copied().collect();
     solve(&big, 2 * d, &mut s2)?;
     // B(q, s1) = [B(q+s1) − B(q−s1)]/4 by parts (s1 real).
     let bpol = |u: &[f64], w: &[f64]| -> Vec<f64> {
@@ -286,8 +339,9 @@ pub(crate) fn lyapunov(
         bpol(&q_im, u),
     );
     let t3 = [axpy(&au, 1.0, &bw), axpy(&aw, -1.0, &bu)];
-    let value = inner(&p_re, &p_im, &c_re, &c_im).0 - 2.0 * inner(&p_re, &p_im, &t2[0], &t2[1]).0
-        + inner(&p_re, &p_im, &t3[0], &t3[1]).0;
+    let ([t2_re, t2_im], [t3_re, t3_im]) = (&t2, &t3);
+    let value = inner(&p_re, &p_im, &c_re, &c_im).0 - 2.0 * inner(&p_re, &p_im, t2_re, t2_im).0
+        + inner(&p_re, &p_im, t3_re, t3_im).0;
     Ok((value / (2.0 * omega), [q_re, q_im]))
 }
 
@@ -313,18 +367,33 @@ fn solve(a: &[f64], n: usize, b: &mut [f64]) -> Result<(), HbError> {
     Ok(())
 }
 
+/// The row-major `2d×2d` real form `[[s·a, w I], [−w I, s·a]]` of the complex
+/// matrix `s·a − i w I` (`a` row-major `d×d`; NaN where `a` is short).
+fn real_form(a: &[f64], d: usize, s: f64, w: f64) -> Vec<f64> {
+    (0..4 * d * d)
+        .map(|k| {
+            // `k < 4d²`, so `d ≥ 1` here.
+            let (i, j) = (k / (2 * d), k % (2 * d));
+            let (ii, jj) = (i % d, j % d);
+            match (i < d, j < d) {
+                (true, true) | (false, false) => {
+                    s * a.get(ii * d + jj).copied().unwrap_or(f64::NAN)
+                }
+                (true, false) if ii == jj => w,
+                (false, true) if ii == jj => -w,
+                _ => 0.0,
+            }
+        })
+        .collect()
+}
+
 /// A null vector `(Re, Im)` of `a − iω I` (`a` row-major `d×d`): the right
 /// singular vector of the smallest singular value of the real form
 /// `[[a, ω I], [−ω I, a]]`.
 fn complex_null_vector(a: &[f64], d: usize, omega: f64) -> Result<[Vec<f64>; 2], HbError> {
+    let form = real_form(a, d, 1.0, omega);
     let big = faer::Mat::<f64>::from_fn(2 * d, 2 * d, |i, j| {
-        let (bi, bj, ii, jj) = (i / d, j / d, i % d, j % d);
-        match (bi, bj) {
-            (0, 0) | (1, 1) => a[ii * d + jj],
-            (0, 1) if ii == jj => omega,
-            (1, 0) if ii == jj => -omega,
-            _ => 0.0,
-        }
+        form.get(i * 2 * d + j).copied().unwrap_or(f64::NAN)
     });
     let svd = big
         .svd()
@@ -349,7 +418,8 @@ pub const MAX_SAMPLES: usize = 100_000;
 ///
 /// # Errors
 /// [`HbError::InvalidInput`] for bounds, sizes, a singular mass matrix, or
-/// an equilibrium Newton does not find; `family`'s error.
+/// an equilibrium Newton does not find; [`HbError::Size`] for a matrix that
+/// is not `n_dof×n_dof`; `family`'s error.
 pub fn hopf_points<P, F>(
     family: &F,
     x0: &[f64],
@@ -441,6 +511,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::problem::matrix_getters;
     use crate::GeneralProblem;
 
     /// `ẍ − (μ + x² − x⁴)ẋ + x = 0` as `C = −μ`, `g = −(x² − x⁴)v`.
@@ -469,5 +540,53 @@ mod tests {
         assert!((h.omega - 1.0).abs() < 1e-12, "{}", h.omega);
         assert!(h.subcritical());
         assert!((h.lyapunov - 0.25).abs() < 1e-5, "{}", h.lyapunov);
+    }
+
+    /// A linear oscillator whose mass "matrix" has two entries for one DOF.
+    struct WrongMass {
+        n: usize,
+        m: Vec<f64>,
+        c: Vec<f64>,
+        k: Vec<f64>,
+    }
+
+    impl PeriodicProblem for WrongMass {
+        matrix_getters!();
+        fn nonlinear(&self, _x: &[f64], _v: &[f64], _theta: f64, out: &mut [f64]) {
+            out.fill(0.0);
+        }
+    }
+
+    #[test]
+    fn a_mass_matrix_of_the_wrong_size_is_a_size_error() {
+        let family = |_: f64| -> Result<_, HbError> {
+            Ok(WrongMass {
+                n: 1,
+                m: vec![1.0, 0.0],
+                c: vec![0.1],
+                k: vec![1.0],
+            })
+        };
+        let err = hopf_points(&family, &[0.0], -0.2, 0.1, 3).unwrap_err();
+        assert_eq!(
+            err,
+            HbError::Size {
+                what: "M",
+                expected: 1,
+                got: 2
+            }
+        );
+        assert_eq!(err.kind(), "input");
+        let mut problem = family(0.0).unwrap();
+        problem.k.push(0.0);
+        let err = equilibrium(&problem, &mut [0.0]).unwrap_err();
+        assert_eq!(
+            err,
+            HbError::Size {
+                what: "K",
+                expected: 1,
+                got: 2
+            }
+        );
     }
 }

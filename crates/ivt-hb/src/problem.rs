@@ -7,11 +7,21 @@
 //! the nonlinear/parametric part `g` in the time domain, the excitation `f`, and
 //! optionally the derivatives of `g` (default: central differences). `g` and `f`
 //! may also read ω_f ([`PeriodicProblem::frequency_dependent`], [`AtFrequency`]).
+//!
+//! Slice lengths are the callers' contract; a slice of the wrong length in the
+//! default methods and helpers here is not a panic: the output is NaN, which the
+//! solvers report as [`crate::HbError::NonFinite`].
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 mod general;
 mod omega;
+mod oscillators;
 pub use general::{GeneralProblem, Nonlinearity, WithJacobian};
 pub use omega::{AtFrequency, Excitation, FrequencyExcitation, REFERENCE_FREQUENCY};
+pub use oscillators::{Duffing, MathieuDuffing};
 
 /// `n_dof` (the field `n`, or a literal), `mass`, `damping`, `stiffness` of a
 /// problem that stores the row-major matrices `m`, `c`, `k` as fields.
@@ -94,33 +104,26 @@ pub trait PeriodicProblem {
     /// `[∂g/∂x | ∂g/∂v]` (`2·n_dof²`, one sample of
     /// [`Self::nonlinear_jacobian_samples`]). Default: central differences with
     /// the step `1e-6·max(|x_j|, 1)` (one sample carries no orbit scale; the
-    /// engine's assemblies call [`Self::nonlinear_jacobian_samples`]).
+    /// engine's assemblies call [`Self::nonlinear_jacobian_samples`]). NaN in
+    /// `dg` unless `x`, `v` hold `n_dof` and `dg` `2·n_dof²` entries.
     fn nonlinear_jacobian(&self, x: &[f64], v: &[f64], theta: f64, dg: &mut [f64]) {
         let n = self.n_dof();
+        if x.len() != n || v.len() != n || dg.len() != 2 * n * n {
+            return dg.fill(f64::NAN);
+        }
         let (dg_dx, dg_dv) = dg.split_at_mut(n * n);
         let mut xp = x.to_vec();
         let mut vp = v.to_vec();
         let mut gp = vec![0.0; n];
         let mut gm = vec![0.0; n];
         for j in 0..n {
-            let h = 1e-6 * x[j].abs().max(1.0);
-            xp[j] = x[j] + h;
-            self.nonlinear(&xp, v, theta, &mut gp);
-            xp[j] = x[j] - h;
-            self.nonlinear(&xp, v, theta, &mut gm);
-            xp[j] = x[j];
-            for i in 0..n {
-                dg_dx[i * n + j] = (gp[i] - gm[i]) / (2.0 * h);
-            }
-            let h = 1e-6 * v[j].abs().max(1.0);
-            vp[j] = v[j] + h;
-            self.nonlinear(x, &vp, theta, &mut gp);
-            vp[j] = v[j] - h;
-            self.nonlinear(x, &vp, theta, &mut gm);
-            vp[j] = v[j];
-            for i in 0..n {
-                dg_dv[i * n + j] = (gp[i] - gm[i]) / (2.0 * h);
-            }
+            // Column j of each block: entries j, j + n, … (`n ≥ 1` in this loop).
+            let column = dg_dx.iter_mut().skip(j).step_by(n);
+            let at_x = |xp: &[f64], g: &mut [f64]| self.nonlinear(xp, v, theta, g);
+            difference_column(&mut xp, j, at_x, (&mut gp, &mut gm), column);
+            let column = dg_dv.iter_mut().skip(j).step_by(n);
+            let at_v = |vp: &[f64], g: &mut [f64]| self.nonlinear(x, vp, theta, g);
+            difference_column(&mut vp, j, at_v, (&mut gp, &mut gm), column);
         }
     }
     /// `∂g/∂x` and `∂g/∂v` at `theta.len()` samples at once: `x`, `v` sample-major as
@@ -174,12 +177,42 @@ pub trait PeriodicProblem {
     }
 }
 
+/// Central difference of `g` in entry `j` of `point` (step `1e-6·max(|u_j|, 1)`)
+/// into `column` (`g(u + h e_j) − g(u − h e_j)) / 2h` by `eval(point, g)`, with
+/// `(g₊, g₋)` as scratch; `point` is restored.
+fn difference_column<'a>(
+    point: &mut [f64],
+    j: usize,
+    mut eval: impl FnMut(&[f64], &mut [f64]),
+    (gp, gm): (&mut [f64], &mut [f64]),
+    column: impl Iterator<Item = &'a mut f64>,
+) {
+    let Some(u) = point.get(j).copied() else {
+        return column.for_each(|d| *d = f64::NAN);
+    };
+    let h = 1e-6 * u.abs().max(1.0);
+    for (sign, g) in [(1.0, &mut *gp), (-1.0, &mut *gm)] {
+        if let Some(p) = point.get_mut(j) {
+            *p = u + sign * h;
+        }
+        eval(point, g);
+    }
+    if let Some(p) = point.get_mut(j) {
+        *p = u;
+    }
+    for (d, (a, b)) in column.zip(gp.iter().zip(gm.iter())) {
+        *d = (a - b) / (2.0 * h);
+    }
+}
+
 /// Calls a one-sample function `f(x_i, v_i, θ_i, out_i)` on each of
 /// `theta.len()` sample-major samples: `x`, `v` hold `n` entries per sample and
 /// `out` an equal share per sample (`n` for `g`; `2n²` for the Jacobian blocks
 /// `[∂g/∂x | ∂g/∂v]`, the layout of
 /// [`PeriodicProblem::nonlinear_jacobian_samples`]). The default way to
-/// evaluate all AFT samples.
+/// evaluate all AFT samples. `out` is NaN (and `f` not called) if `n` is zero,
+/// `x` or `v` holds fewer than `n` entries per sample, or `out` fewer than one
+/// per sample.
 pub fn per_sample(
     n: usize,
     x: &[f64],
@@ -188,15 +221,17 @@ pub fn per_sample(
     out: &mut [f64],
     mut f: impl FnMut(&[f64], &[f64], f64, &mut [f64]),
 ) {
-    let width = out.len() / theta.len().max(1);
-    for (i, &th) in theta.iter().enumerate() {
-        let s = i * n..(i + 1) * n;
-        f(
-            &x[s.clone()],
-            &v[s],
-            th,
-            &mut out[i * width..(i + 1) * width],
-        );
+    let ns = theta.len();
+    if ns == 0 {
+        return;
+    }
+    let width = out.len() / ns;
+    if n == 0 || width == 0 || x.len() < n * ns || v.len() < n * ns {
+        return out.fill(f64::NAN);
+    }
+    let samples = x.chunks_exact(n).zip(v.chunks_exact(n)).zip(theta);
+    for (((x, v), &th), out) in samples.zip(out.chunks_exact_mut(width)) {
+        f(x, v, th, out);
     }
 }
 
@@ -204,8 +239,11 @@ pub fn per_sample(
 /// velocity Jacobian of a force declared independent of `v`.
 fn zero_velocity_blocks(n: usize, dg: &mut [f64]) {
     let n2 = n * n;
+    if n2 == 0 {
+        return;
+    }
     for block in dg.chunks_mut(2 * n2) {
-        block[n2..].fill(0.0);
+        block.iter_mut().skip(n2).for_each(|d| *d = 0.0);
     }
 }
 
@@ -254,6 +292,15 @@ pub(crate) fn central_differences(
     dg: &mut [f64],
 ) {
     let ns = theta.len();
+    if n == 0 || ns == 0 {
+        return;
+    }
+    let (Some(x), Some(v)) = (x.get(..n * ns), v.get(..n * ns)) else {
+        return dg.fill(f64::NAN);
+    };
+    if dg.len() < 2 * n * n * ns {
+        return dg.fill(f64::NAN);
+    }
     // Perturbation k = (wrt_v, j, sign): x₀⁺, x₀⁻, x₁⁺, …, then v₀⁺, … .
     let wrt: &[bool] = if with_v { &[false, true] } else { &[false] };
     let copies = 2 * n * wrt.len();
@@ -270,10 +317,10 @@ pub(crate) fn central_differences(
             steps.push(h);
             for sign in [1.0, -1.0] {
                 let start = if wrt_v { vs.len() } else { xs.len() };
-                xs.extend_from_slice(&x[..n * ns]);
-                vs.extend_from_slice(&v[..n * ns]);
+                xs.extend_from_slice(x);
+                vs.extend_from_slice(v);
                 let moved = if wrt_v { &mut vs } else { &mut xs };
-                for m in moved[start..].iter_mut().skip(j).step_by(n) {
+                for m in moved.iter_mut().skip(start + j).step_by(n) {
                     *m += sign * h;
                 }
                 thetas.extend_from_slice(theta);
@@ -282,14 +329,18 @@ pub(crate) fn central_differences(
     }
     let mut g = vec![0.0; copies * n * ns];
     eval(&xs, &vs, &thetas, &mut g);
+    // `n, ns ≥ 1`: every chunk size below is positive.
     let copy = n * ns;
-    for (pair, &h) in steps.iter().enumerate() {
+    for (pair, (g_pm, &h)) in g.chunks_exact(2 * copy).zip(&steps).enumerate() {
         let (wrt_v, j) = (pair >= n, pair % n);
-        let (gp, gm) = (&g[2 * pair * copy..], &g[(2 * pair + 1) * copy..]);
+        let (gp, gm) = g_pm.split_at(copy);
         let block = if wrt_v { n * n } else { 0 };
-        for i in 0..ns {
-            for r in 0..n {
-                dg[2 * i * n * n + block + r * n + j] = (gp[i * n + r] - gm[i * n + r]) / (2.0 * h);
+        let samples = gp.chunks_exact(n).zip(gm.chunks_exact(n));
+        for (sample, (gp, gm)) in dg.chunks_exact_mut(2 * n * n).zip(samples) {
+            // Column j of the block: rows r at `block + r·n + j`.
+            let column = sample.iter_mut().skip(block + j).step_by(n);
+            for (d, (a, b)) in column.zip(gp.iter().zip(gm)) {
+                *d = (a - b) / (2.0 * h);
             }
         }
     }
@@ -303,118 +354,13 @@ pub(crate) fn central_differences(
 fn orbit_scale(u: &[f64], n: usize, j: usize) -> f64 {
     let max = |it: &mut dyn Iterator<Item = &f64>| it.fold(0.0f64, |a, b| a.max(b.abs()));
     [
-        max(&mut u.iter().skip(j).step_by(n)),
+        max(&mut u.iter().skip(j).step_by(n.max(1))),
         max(&mut u.iter()),
         1.0,
     ]
     .into_iter()
     .find(|s| *s > 0.0 && s.is_finite())
     .unwrap_or(1.0)
-}
-
-/// The linear part `ü + 2ξ u̇ + k u` of a one-DOF oscillator with unit mass.
-#[derive(Debug, Clone, PartialEq)]
-struct UnitMass {
-    m: [f64; 1],
-    c: [f64; 1],
-    k: [f64; 1],
-}
-
-impl UnitMass {
-    /// Damping ratio ξ and stiffness `k`.
-    fn new(xi: f64, k: f64) -> Self {
-        Self {
-            m: [1.0],
-            c: [2.0 * xi],
-            k: [k],
-        }
-    }
-}
-
-/// Duffing's equation Eq. 49: `ü + 2ξ u̇ + α u + ε u³ = F cos(ω_f t)`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Duffing {
-    linear: UnitMass,
-    /// Nonlinear stiffness ε.
-    pub eps: f64,
-    /// Forcing amplitude F.
-    pub force: f64,
-}
-
-impl Duffing {
-    /// Duffing oscillator with damping ratio ξ, stiffness α, nonlinearity ε, force F.
-    pub fn new(xi: f64, alpha: f64, eps: f64, force: f64) -> Self {
-        Self {
-            linear: UnitMass::new(xi, alpha),
-            eps,
-            force,
-        }
-    }
-    /// The parameters of Fig. 28/29: ξ = 0.02, α = 1, ε = 1, F = 0.1.
-    pub fn fig28() -> Self {
-        Self::new(0.02, 1.0, 1.0, 0.1)
-    }
-    /// Damping ratio ξ.
-    pub fn xi(&self) -> f64 {
-        0.5 * self.linear.c[0]
-    }
-    /// Linear stiffness α.
-    pub fn alpha(&self) -> f64 {
-        self.linear.k[0]
-    }
-    /// Whether all parameters are finite.
-    pub fn is_finite(&self) -> bool {
-        [self.linear.c[0], self.linear.k[0], self.eps, self.force]
-            .iter()
-            .all(|v| v.is_finite())
-    }
-}
-
-impl PeriodicProblem for Duffing {
-    matrix_getters!(1, linear);
-    fn nonlinear(&self, x: &[f64], _v: &[f64], _theta: f64, out: &mut [f64]) {
-        out[0] = self.eps * x[0] * x[0] * x[0];
-    }
-    fn excitation(&self, theta: f64, out: &mut [f64]) {
-        out[0] = self.force * theta.cos();
-    }
-    displacement_jacobian!(|s, x, _theta, dg_dx| dg_dx[0] = 3.0 * s.eps * x[0] * x[0]);
-}
-
-/// Mathieu–Duffing equation Eq. 81: `ü + 2ξ̂ u̇ − (α̂ + β sin Ωt) u + γ u³ = 0`
-/// (θ = Ωt is the excitation phase, so ω_f = Ω).
-#[derive(Debug, Clone, PartialEq)]
-pub struct MathieuDuffing {
-    linear: UnitMass,
-    /// Parametric amplitude β.
-    pub beta: f64,
-    /// Cubic stiffness γ.
-    pub gamma: f64,
-}
-
-impl MathieuDuffing {
-    /// With damping ratio ξ̂, stiffness α̂ (enters as −α̂), β and γ.
-    pub fn new(xi: f64, alpha: f64, beta: f64, gamma: f64) -> Self {
-        Self {
-            linear: UnitMass::new(xi, -alpha),
-            beta,
-            gamma,
-        }
-    }
-    /// The thesis case §3.2.5: ξ̂ = 0.125, α̂ = 1, γ = 1 (Ω = 2 is the frequency).
-    pub fn thesis(beta: f64) -> Self {
-        Self::new(0.125, 1.0, beta, 1.0)
-    }
-}
-
-impl PeriodicProblem for MathieuDuffing {
-    matrix_getters!(1, linear);
-    fn nonlinear(&self, x: &[f64], _v: &[f64], theta: f64, out: &mut [f64]) {
-        out[0] = -self.beta * theta.sin() * x[0] + self.gamma * x[0] * x[0] * x[0];
-    }
-    displacement_jacobian!(|s, x, theta, dg_dx| {
-        dg_dx[0] = -s.beta * theta.sin() + 3.0 * s.gamma * x[0] * x[0]
-    });
 }
 
 /// A borrowed problem is a problem (lets solvers borrow problems that are not
@@ -468,5 +414,90 @@ impl<P: PeriodicProblem + ?Sized> PeriodicProblem for &P {
     }
     fn excitation_at(&self, theta: f64, omega_f: f64, out: &mut [f64]) {
         (**self).excitation_at(theta, omega_f, out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `g = x₀³ + x₀x₁ + v₁` on two DOFs, without an analytic Jacobian.
+    struct Cubic {
+        n: usize,
+        m: Vec<f64>,
+        c: Vec<f64>,
+        k: Vec<f64>,
+    }
+
+    impl PeriodicProblem for Cubic {
+        matrix_getters!();
+        fn nonlinear(&self, x: &[f64], v: &[f64], _theta: f64, out: &mut [f64]) {
+            out[0] = x[0].powi(3) + x[0] * x[1] + v[1];
+            out[1] = 0.0;
+        }
+    }
+
+    fn cubic() -> Cubic {
+        let eye = vec![1.0, 0.0, 0.0, 1.0];
+        Cubic {
+            n: 2,
+            m: eye.clone(),
+            c: vec![0.0; 4],
+            k: eye,
+        }
+    }
+
+    #[test]
+    fn default_jacobian_is_the_closed_form_and_nan_for_wrong_sizes() {
+        let p = cubic();
+        let (x, v) = ([0.5, 2.0], [0.0, 1.0]);
+        let mut dg = [0.0; 8];
+        p.nonlinear_jacobian(&x, &v, 0.0, &mut dg);
+        // ∂g₀/∂x = (3x₀² + x₁, x₀) = (2.75, 0.5), ∂g₀/∂v = (0, 1); row 1 zero.
+        let exact = [2.75, 0.5, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0];
+        for (a, b) in dg.iter().zip(exact) {
+            assert!((a - b).abs() < 1e-8, "{dg:?}");
+        }
+        let mut short = [0.0; 7];
+        p.nonlinear_jacobian(&x, &v, 0.0, &mut short);
+        assert!(short.iter().all(|d| d.is_nan()));
+        p.nonlinear_jacobian(&x[..1], &v, 0.0, &mut dg);
+        assert!(dg.iter().all(|d| d.is_nan()));
+    }
+
+    #[test]
+    fn per_sample_and_central_differences_of_short_states_give_nan() {
+        let p = cubic();
+        let theta = [0.0, 1.0];
+        // Two samples need 4 entries of x and v.
+        let (x, v) = ([0.5, 2.0, 0.1], [0.0; 4]);
+        let mut g = [0.0; 4];
+        p.nonlinear_samples(&x, &v, &theta, &mut g);
+        assert!(g.iter().all(|e| e.is_nan()));
+        let mut dg = [0.0; 16];
+        central_difference_samples(&p, &x, &v, &theta, &mut dg);
+        assert!(dg.iter().all(|e| e.is_nan()));
+        let mut out = [0.0; 2];
+        per_sample(0, &[], &[], &theta, &mut out, |_, _, _, _| {});
+        assert!(out.iter().all(|e| e.is_nan()));
+        // The right sizes: one call per sample.
+        per_sample(
+            1,
+            &[3.0, 4.0],
+            &[0.0; 2],
+            &theta,
+            &mut out,
+            |x, _, th, o| o[0] = x[0] + th,
+        );
+        assert_eq!(out, [3.0, 5.0]);
+    }
+
+    #[test]
+    fn one_dof_models_without_a_state_give_nan() {
+        let mut out = [0.0];
+        Duffing::fig28().nonlinear(&[], &[], 0.0, &mut out);
+        assert!(out[0].is_nan());
+        MathieuDuffing::thesis(1.0).nonlinear(&[], &[], 0.0, &mut out);
+        assert!(out[0].is_nan());
     }
 }

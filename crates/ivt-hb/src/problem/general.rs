@@ -2,6 +2,10 @@
 //! closure, or a type evaluating all AFT samples at once, with or without an
 //! analytic Jacobian) and an excitation; either may read the excitation
 //! frequency ω_f ([`super::omega`]).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::omega::Excitation;
 use super::{
@@ -107,15 +111,10 @@ where
     F: Fn(f64, &mut [f64]),
 {
     /// `M`, `C`, `K` row-major `n×n`; `g(x, v, θ, out)`, `f(θ, out)` (an
-    /// [`Excitation`] that reads ω_f: [`Self::with_excitation`]).
-    ///
-    /// # Panics
-    /// If a matrix is not `n×n`.
+    /// [`Excitation`] that reads ω_f: [`Self::with_excitation`]). The sizes are
+    /// checked where the problem is solved: a matrix that is not `n×n` is an
+    /// [`crate::HbError::InvalidInput`] of the solver (e.g. `"M must be 2×2"`).
     pub fn new(n: usize, m: Vec<f64>, c: Vec<f64>, k: Vec<f64>, g: G, f: F) -> Self {
-        assert!(
-            m.len() == n * n && c.len() == n * n && k.len() == n * n,
-            "M, C, K must be n×n"
-        );
         Self {
             n,
             m,
@@ -328,5 +327,14 @@ mod tests {
         problem.nonlinear_jacobian_samples(&x, &v, &[0.0, 1.0], &mut dg);
         assert_eq!(&dg[..8], &[0.5, 0.5, 0.5, 0.5, 0.0, 0.0, 0.0, 0.0]);
         assert_eq!(&dg[8..], &[-2.0, -2.0, -2.0, -2.0, 0.0, 0.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn a_matrix_that_is_not_n_by_n_is_the_solvers_input_error() {
+        let g = |_x: &[f64], _v: &[f64], _th: f64, out: &mut [f64]| out.fill(0.0);
+        let f = |_: f64, out: &mut [f64]| out.fill(0.0);
+        let problem = GeneralProblem::new(2, vec![1.0; 3], vec![0.0; 4], vec![1.0; 4], g, f);
+        let err = HbResidual::new(&problem, &HbOptions::new(3, 8)).unwrap_err();
+        assert_eq!(err, crate::HbError::InvalidInput("M must be 2×2".into()));
     }
 }

@@ -1,4 +1,12 @@
 //! The STHB residual (Eq. 116) and exact Jacobian (Eq. 115–125) of the string.
+//!
+//! Vectors of the wrong length (`a`, `out` not [`StringHb::dim`] long) are not a
+//! panic: the residual is NaN, which the Newton solve reports as
+//! [`HbError::NonFinite`].
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use std::f64::consts::PI;
 
@@ -11,17 +19,9 @@ use super::toeplitz::{add_real_toeplitz, BlockLayout, PeriodicSpectrum};
 use super::{Boundary, StringParams};
 use crate::aft::RealFftPair;
 use crate::error::HbError;
-use ivt_num::{newton, NewtonError, NewtonOptions, NewtonSystem, NewtonWorkspace};
-use std::convert::Infallible;
+use ivt_num::NewtonWorkspace;
 
-/// Newton–Raphson statistics of one converged solve.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SolveStats {
-    /// Newton iterations (Jacobian factorizations).
-    pub iterations: usize,
-    /// Residual norm at each iteration, the last one converged.
-    pub history: Vec<f64>,
-}
+mod solve;
 
 /// STHB discretization of Eq. 103 for one parameter set: FFT/DCT/DST plans,
 /// grid buffers and the Jacobian storage, made once and reused.
@@ -85,7 +85,7 @@ impl StringHb {
         let mut e = (1..ns).map(|k| k as f64 / ns as f64).collect::<Vec<_>>();
         let mut scr = vec![0.0; dst.get_scratch_len()];
         dst.process_dst1_with_scratch(&mut e, &mut scr);
-        let e_proj = e[..n].iter().map(|v| 2.0 / ns as f64 * v).collect();
+        let e_proj = e.iter().take(n).map(|v| 2.0 / ns as f64 * v).collect();
         let dim = nq * (2 * m + 1);
         Ok(Self {
             nq,
@@ -141,12 +141,17 @@ impl StringHb {
         s.sqrt()
     }
 
-    /// Coordinate `q_n(t)` of the solution `a` at normalized time `t`.
+    /// Coordinate `q_n(t)` of the solution `a` at normalized time `t` (NaN if
+    /// `a` has no such coordinate).
     pub fn coordinate_at(&self, a: &[f64], n: usize, t: f64) -> f64 {
-        let mut q = a[self.index(0, n)];
+        if n >= self.nq {
+            return f64::NAN;
+        }
+        let at = |h: usize| a.get(self.index(h, n)).copied().unwrap_or(f64::NAN);
+        let mut q = at(0);
         for k in 1..=self.p.harmonics {
             let kt = k as f64 * t;
-            q += a[self.index(2 * k - 1, n)] * kt.cos() + a[self.index(2 * k, n)] * kt.sin();
+            q += at(2 * k - 1) * kt.cos() + at(2 * k) * kt.sin();
         }
         q
     }
@@ -165,9 +170,18 @@ impl StringHb {
 
     /// Apply `J_lin(ω)` (Eq. 115, plus the Tau rows of Eq. 134–135) to `a`,
     /// or its derivative `∂J_lin/∂ω` when `d_omega`.
+    /// NaN in `out` unless `a` and `out` are [`Self::dim`] long.
     fn apply_linear(&self, a: &[f64], omega: f64, d_omega: bool, out: &mut [f64]) {
+        if a.len() != self.dim() || out.len() != self.dim() {
+            return out.fill(f64::NAN);
+        }
         out.fill(0.0);
-        self.for_each_linear(omega, d_omega, |r, c, v| out[r] += v * a[c]);
+        // Every (row, col) of `J_lin` is below `dim` (`Self::index`).
+        self.for_each_linear(omega, d_omega, |r, c, v| {
+            if let (Some(o), Some(x)) = (out.get_mut(r), a.get(c)) {
+                *o += v * x;
+            }
+        });
     }
 
     /// Visit the nonzero entries `(row, col, value)` of `J_lin` or `∂J_lin/∂ω`.
@@ -204,7 +218,7 @@ impl StringHb {
                 f(rs, rc, -damp(kf));
                 if spring_col {
                     // ω² e q̈_{N+1} + ω c_d e q̇_{N+1} projected on sin nπx (Eq. 135).
-                    let e = self.e_proj[j];
+                    let e = self.e_proj.get(j).copied().unwrap_or(f64::NAN);
                     let (cc, cs) = (self.index(2 * k - 1, n), self.index(2 * k, n));
                     f(rc, cc, e * mass(kf));
                     f(rs, cs, e * mass(kf));
@@ -244,11 +258,12 @@ impl StringHb {
         let row = self.index(0, n);
         let mut b = vec![0.0; n + 1];
         self.for_each_linear(1.0, false, |r, c, v| {
-            if r == row {
-                b[c] += v;
+            if let Some(bc) = b.get_mut(c).filter(|_| r == row) {
+                *bc += v;
             }
         });
-        let c = b[..n].iter().map(|v| -v / b[n]).collect();
+        let (b_spring, b_modes) = b.split_last()?;
+        let c = b_modes.iter().map(|v| -v / b_spring).collect();
         Some((self.e_proj.clone(), c))
     }
 
@@ -270,96 +285,138 @@ impl StringHb {
             self.p.kd,
         );
         let nq = self.nq;
+        // `ms > 2M + 1`, `ns > 2N + 1` (`StringParams::validate`): every chunk
+        // and step below is positive. `a` of the wrong length reads as NaN.
+        let coeff = |h: usize, j: usize| a.get(h * nq + j).copied().unwrap_or(f64::NAN);
+        let Self {
+            spatial,
+            fft,
+            q_t,
+            wx,
+            wxx,
+            g,
+            g2,
+            gamma_t,
+            b_t,
+            c_t,
+            b_hat,
+            c_hat,
+            nl,
+            ..
+        } = self;
         // 1. q_j(t_i) by inverse real FFT (t_i = 2πi/M_s).
-        for j in 0..nq {
-            self.fft.spectrum.fill(Complex::new(0.0, 0.0));
-            self.fft.spectrum[0] = Complex::new(a[j], 0.0);
-            for k in 1..=m {
-                self.fft.spectrum[k] =
-                    Complex::new(0.5 * a[(2 * k - 1) * nq + j], -0.5 * a[2 * k * nq + j]);
+        for (j, q_j) in q_t.chunks_exact_mut(ms).enumerate().take(nq) {
+            fft.spectrum.fill(Complex::new(0.0, 0.0));
+            let Some((constant, harmonics)) = fft.spectrum.split_first_mut() else {
+                q_j.fill(f64::NAN);
+                continue;
+            };
+            *constant = Complex::new(coeff(0, j), 0.0);
+            for (k, x) in (1..=m).zip(harmonics) {
+                *x = Complex::new(0.5 * coeff(2 * k - 1, j), -0.5 * coeff(2 * k, j));
             }
-            self.fft.inverse_into(&mut self.q_t[j * ms..(j + 1) * ms]);
+            fft.inverse_into(q_j);
         }
         // 2. Grid values per time sample, spatial balance by DST-I / DCT-I.
         let scale = 2.0 / ns as f64;
         for i in 0..ms {
-            self.wx.fill(0.0);
-            self.wxx.fill(0.0);
-            for j in 0..n {
-                let q = self.q_t[j * ms + i];
+            // Sample i of every coordinate: entries i, i + M_s, … of `q_t`.
+            let mut q_i = q_t.iter().skip(i).step_by(ms);
+            wx.fill(0.0);
+            wxx.fill(0.0);
+            let modes = wx.iter_mut().skip(1).zip(wxx.iter_mut());
+            for (j, ((wx, wxx), q)) in modes.zip(q_i.by_ref().take(n)).enumerate() {
                 let k = (j + 1) as f64 * PI;
-                self.wx[j + 1] = k * q;
-                self.wxx[j] = -k * k * q;
+                *wx = k * q;
+                *wxx = -k * k * q;
             }
             // w_x(x_k) = Σ nπ q_n cos(nπk/N_s), k = 0..N_s (DCT-I); w_xx on the interior (DST-I).
-            self.spatial.cosine(&mut self.wx, n + 1, ns + 1);
-            self.spatial.sine(&mut self.wxx, n, ns - 1);
+            spatial.cosine(wx, n + 1, ns + 1);
+            spatial.sine(wxx, n, ns - 1);
             if nq > n {
-                let qe = self.q_t[n * ms + i];
-                self.wx.iter_mut().for_each(|v| *v += qe);
+                // q_{N+1}(t_i), the next after the N modes.
+                let qe = q_i.next().copied().unwrap_or(f64::NAN);
+                wx.iter_mut().for_each(|v| *v += qe);
             }
-            for k in 1..ns {
-                self.g[k - 1] = kd * self.wx[k] * self.wx[k] * self.wxx[k - 1];
+            // Interior points k = 1..N_s − 1: w_x at k, w_xx at k − 1.
+            let interior = || wx.iter().skip(1).zip(wxx.iter());
+            for (g, (wx, wxx)) in g.iter_mut().zip(interior()) {
+                *g = kd * wx * wx * wxx;
             }
-            self.spatial.sine(&mut self.g, ns - 1, n);
-            for j in 0..n {
-                self.gamma_t[j * ms + i] = scale * self.g[j];
+            spatial.sine(g, ns - 1, n);
+            let gamma_i = gamma_t.iter_mut().skip(i).step_by(ms);
+            for (gt, g) in gamma_i.zip(g.iter()).take(n) {
+                *gt = scale * g;
             }
             if jacobian {
-                for k in 1..ns {
-                    self.g[k - 1] = 2.0 * kd * self.wx[k] * self.wxx[k - 1];
+                for (g, (wx, wxx)) in g.iter_mut().zip(interior()) {
+                    *g = 2.0 * kd * wx * wxx;
                 }
-                for k in 0..=ns {
-                    self.g2[k] = kd * self.wx[k] * self.wx[k];
+                for (g2, wx) in g2.iter_mut().zip(wx.iter()) {
+                    *g2 = kd * wx * wx;
                 }
-                self.spatial.sine(&mut self.g, ns - 1, 2 * n);
-                self.spatial.cosine(&mut self.g2, ns + 1, 2 * n + 1);
-                for r in 0..2 * n {
-                    self.b_t[r * ms + i] = scale * self.g[r];
+                spatial.sine(g, ns - 1, 2 * n);
+                spatial.cosine(g2, ns + 1, 2 * n + 1);
+                let b_i = b_t.iter_mut().skip(i).step_by(ms);
+                for (b, g) in b_i.zip(g.iter()).take(2 * n) {
+                    *b = scale * g;
                 }
-                for r in 0..=2 * n {
-                    self.c_t[r * ms + i] = scale * self.g2[r];
+                let c_i = c_t.iter_mut().skip(i).step_by(ms);
+                for (c, g2) in c_i.zip(g2.iter()).take(2 * n + 1) {
+                    *c = scale * g2;
                 }
             }
         }
         // 3. Temporal balance of Γ: L(a) in the real basis.
         let inv_ms = 1.0 / ms as f64;
-        for j in 0..n {
-            self.fft.forward_from(&self.gamma_t[j * ms..(j + 1) * ms]);
-            self.nl[j] = self.fft.spectrum[0].re * inv_ms;
+        let nan = Complex::new(f64::NAN, f64::NAN);
+        for (j, gamma_j) in gamma_t.chunks_exact(ms).enumerate().take(n) {
+            fft.forward_from(gamma_j);
+            let spectrum = |k: usize| fft.spectrum.get(k).copied().unwrap_or(nan);
+            let mut put = |h: usize, v: f64| {
+                if let Some(x) = nl.get_mut(h * nq + j) {
+                    *x = v;
+                }
+            };
+            put(0, spectrum(0).re * inv_ms);
             for k in 1..=m {
-                self.nl[(2 * k - 1) * nq + j] = 2.0 * self.fft.spectrum[k].re * inv_ms;
-                self.nl[2 * k * nq + j] = -2.0 * self.fft.spectrum[k].im * inv_ms;
+                put(2 * k - 1, 2.0 * spectrum(k).re * inv_ms);
+                put(2 * k, -2.0 * spectrum(k).im * inv_ms);
             }
         }
-        for j in 0..nq - n {
-            for h in 0..2 * m + 1 {
-                self.nl[h * nq + n + j] = 0.0;
-            }
+        // The spring coordinate has no nonlinear term (its row is Eq. 134).
+        for row in nl.chunks_exact_mut(nq) {
+            row.iter_mut().skip(n).for_each(|v| *v = 0.0);
         }
         if !jacobian {
             return;
         }
         let pm = self.s_hat.p_max;
-        for (rows, hat) in [(&self.b_t, &mut self.b_hat), (&self.c_t, &mut self.c_hat)] {
-            for (r, row) in rows.chunks_exact(ms).enumerate() {
-                self.fft.forward_from(row);
-                for p in 0..=pm {
-                    hat[r * (pm + 1) + p] = self.fft.spectrum[p] * inv_ms;
+        for (rows, hat) in [(&*b_t, &mut *b_hat), (&*c_t, &mut *c_hat)] {
+            for (row, hat_row) in rows.chunks_exact(ms).zip(hat.chunks_exact_mut(pm + 1)) {
+                fft.forward_from(row);
+                // `p_max ≤ M_s/2`: the spectrum holds every p ≤ p_max.
+                for (h, x) in hat_row.iter_mut().zip(&fft.spectrum) {
+                    *h = x * inv_ms;
                 }
             }
         }
         // 4. Ŝ_p = M1 β1 + M2 β2 G2 (Eq. 122–125) with Γ1 expanded to sine modes 1..2N
         //    and Γ2 to cosine modes 0..2N, which makes the products exact on the grid.
+        let (b_hat, c_hat) = (&self.b_hat, &self.c_hat);
         let b = |i: usize, p: usize| -> Complex<f64> {
-            if i == 0 {
-                Complex::new(0.0, 0.0)
-            } else {
-                self.b_hat[(i - 1) * (pm + 1) + p]
+            match i.checked_sub(1) {
+                None => Complex::new(0.0, 0.0),
+                Some(i) => b_hat.get(i * (pm + 1) + p).copied().unwrap_or(nan),
             }
         };
-        let c = |i: usize, p: usize| self.c_hat[i * (pm + 1) + p];
-        let mut s = std::mem::replace(&mut self.s_hat, PeriodicSpectrum::zeros(0, 0, 1, 0));
+        let c = |i: usize, p: usize| c_hat.get(i * (pm + 1) + p).copied().unwrap_or(nan);
+        let s = &mut self.s_hat;
+        let mut set = |p: usize, i: usize, j: usize, v: Complex<f64>| {
+            if let Some(x) = s.at_mut(p, i, j) {
+                *x = v;
+            }
+        };
         for p in 0..=pm {
             for r in 1..=n {
                 for j in 1..=n {
@@ -372,15 +429,14 @@ impl StringHb {
                     let jp = j as f64 * PI;
                     let s1 = (b(sum, p) + b(dif, p) * sgn) * (0.5 * jp);
                     let s2 = (c(dif, p) - c(sum, p)) * (-0.5 * jp * jp);
-                    *s.at_mut(p, r - 1, j - 1) = s1 + s2;
+                    set(p, r - 1, j - 1, s1 + s2);
                 }
                 if nq > n {
                     // ∂w_x/∂q_{N+1} = e'(x) = 1.
-                    *s.at_mut(p, r - 1, n) = b(r, p);
+                    set(p, r - 1, n, b(r, p));
                 }
             }
         }
-        self.s_hat = s;
     }
 
     /// Residual `R(a) = J_lin a − L(a) − f̂` (Eq. 116; Tau rows Eq. 134 for the spring).
@@ -395,7 +451,9 @@ impl StringHb {
             *o -= l;
         }
         // f̂: y0 cos t on the first sine mode.
-        out[self.index(1, 0)] -= self.p.y0;
+        if let Some(o) = out.get_mut(self.index(1, 0)) {
+            *o -= self.p.y0;
+        }
     }
 
     /// Residual `R(a)` into `out` with the spectrum `Ŝ_p` of the Jacobian
@@ -406,7 +464,7 @@ impl StringHb {
     }
 
     /// Residual and exact Jacobian `J = J_lin − S_𝒯` (Eq. 115–125) into `jac`
-    /// (`dim × dim`, overwritten).
+    /// (`dim × dim`, overwritten; resized if it has another shape).
     pub fn residual_jacobian(
         &mut self,
         a: &[f64],
@@ -420,7 +478,12 @@ impl StringHb {
     }
 
     pub(super) fn fill_jacobian(&mut self, omega: f64, jac: &mut Mat<f64>) {
+        let dim = self.dim();
+        if (jac.nrows(), jac.ncols()) != (dim, dim) {
+            *jac = Mat::zeros(dim, dim);
+        }
         jac.fill(0.0);
+        // Every (row, col) of `J_lin` is below `dim` (`Self::index`).
         self.for_each_linear(omega, false, |r, c, v| jac[(r, c)] += v);
         let layout = BlockLayout {
             row_block: self.nq,
@@ -440,70 +503,6 @@ impl StringHb {
         self.toeplitz_scratch = scratch;
     }
 
-    /// Newton–Raphson (step a6, [`ivt_num::newton()`]) with step halving on
-    /// `‖R‖` (the full step is kept if no halving helps; the history shows
-    /// it), from the guess in `a`, overwritten by the solution.
-    /// Converged when `‖R‖ ≤ tol (1 + y0)`; [`Self::s_spectrum`] is then
-    /// that of the solution.
-    ///
-    /// # Errors
-    /// [`HbError::NoConvergence`] with the residual history after `max_iter`
-    /// iterations, [`HbError::Singular`] or [`HbError::NonFinite`].
-    pub fn solve(
-        &mut self,
-        omega: f64,
-        a: &mut [f64],
-        tol: f64,
-        max_iter: usize,
-    ) -> Result<SolveStats, HbError> {
-        let dim = self.dim();
-        let opts = NewtonOptions {
-            ftol: tol * (1.0 + self.p.y0.abs()),
-            max_iter,
-            max_halvings: 7,
-            accept_no_descent: true,
-            full_step_without_descent: true,
-            ..NewtonOptions::default()
-        };
-        let mut ws = std::mem::replace(&mut self.newton, NewtonWorkspace::new(0));
-        let mut jac = std::mem::replace(&mut self.jac, Mat::zeros(0, 0));
-        if jac.nrows() != dim {
-            jac = Mat::zeros(dim, dim);
-        }
-        let mut system = FixedOmega {
-            hb: self,
-            omega,
-            jac: &mut jac,
-        };
-        let result = newton(&mut system, a, &mut ws, &opts);
-        let history = ws.history().to_vec();
-        self.newton = ws;
-        self.jac = jac;
-        match result {
-            Ok(stats) => {
-                // Leave Ŝ_p at the solution (the last residual was a trial's,
-                // without it): the stability functions read it.
-                self.balance(a, true);
-                Ok(SolveStats {
-                    iterations: stats.iterations,
-                    history,
-                })
-            }
-            Err(NewtonError::SingularJacobian { .. } | NewtonError::BorderSize { .. }) => {
-                Err(HbError::Singular { omega })
-            }
-            Err(NewtonError::NonFinite { .. }) => Err(HbError::NonFinite { omega }),
-            Err(NewtonError::NonConvergence { .. } | NewtonError::NoDescent { .. }) => {
-                Err(HbError::NoConvergence {
-                    method: "Newton",
-                    omega,
-                    history,
-                })
-            }
-            Err(NewtonError::Eval(never)) => match never {},
-        }
-    }
-
     /// The spectrum `Ŝ_p` of `S(t) = ∂ℒ/∂Q` from the last Jacobian evaluation (Eq. 129).
     pub fn s_spectrum(&self) -> &PeriodicSpectrum {
         &self.s_hat
@@ -515,33 +514,46 @@ impl StringHb {
     }
 }
 
-/// The string's residual at fixed ω as a [`NewtonSystem`]: trial residuals
-/// skip the Jacobian's spectrum; the Jacobian re-balances with it at the
-/// accepted point (`J = J_lin − S_𝒯`, Eq. 115–125).
-struct FixedOmega<'a> {
-    hb: &'a mut StringHb,
-    omega: f64,
-    jac: &'a mut Mat<f64>,
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-impl NewtonSystem for FixedOmega<'_> {
-    type Error = Infallible;
-
-    fn residual(&mut self, a: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
-        self.hb.balance(a, false);
-        self.hb.finish_residual(a, self.omega, r);
-        Ok(())
+    #[test]
+    fn vectors_of_the_wrong_length_give_nan_and_another_shape_of_jacobian_is_resized() {
+        let params = StringParams {
+            modes: 2,
+            harmonics: 3,
+            ns: 16,
+            ms: 16,
+            boundary: Boundary::Spring { k0: 3.0 },
+            ..Default::default()
+        };
+        let mut hb = StringHb::new(params).unwrap();
+        let dim = hb.dim();
+        let a: Vec<f64> = (0..dim).map(|i| 0.01 * (i as f64 + 1.0).sin()).collect();
+        let mut out = vec![0.0; dim];
+        hb.residual(&a[1..], 2.0, &mut out);
+        assert!(out.iter().all(|v| v.is_nan()));
+        let mut short = vec![0.0; dim - 1];
+        hb.residual(&a, 2.0, &mut short);
+        assert!(short.iter().all(|v| v.is_nan()));
+        // A coordinate beyond N + 1 (the spring's) has no value.
+        assert!(hb.coordinate_at(&a, 2, 0.3).is_finite());
+        assert!(hb.coordinate_at(&a, 3, 0.3).is_nan());
+        // The Jacobian into a 1×1 matrix: resized, and equal to the dim×dim one.
+        let (mut small, mut full) = (Mat::zeros(1, 1), Mat::zeros(dim, dim));
+        hb.residual_jacobian(&a, 2.0, &mut out, &mut small);
+        hb.residual_jacobian(&a, 2.0, &mut out, &mut full);
+        assert_eq!((small.nrows(), small.ncols()), (dim, dim));
+        assert!(small == full && out.iter().all(|v| v.is_finite()));
     }
 
-    fn jacobian(&mut self, a: &[f64], out: &mut [f64]) -> Result<(), Infallible> {
-        self.hb.balance(a, true);
-        self.hb.fill_jacobian(self.omega, self.jac);
-        let dim = self.jac.ncols();
-        for (i, row) in out.chunks_exact_mut(dim.max(1)).enumerate() {
-            for (j, v) in row.iter_mut().enumerate() {
-                *v = self.jac[(i, j)];
-            }
-        }
-        Ok(())
+    #[test]
+    fn spectrum_entries_outside_the_matrix_are_none() {
+        let mut s = PeriodicSpectrum::zeros(2, 3, 8, 2);
+        assert!(s.at_mut(2, 1, 2).is_some());
+        assert!(s.at_mut(3, 0, 0).is_none());
+        assert!(s.at_mut(0, 2, 0).is_none());
+        assert!(s.at_mut(0, 0, 3).is_none());
     }
 }

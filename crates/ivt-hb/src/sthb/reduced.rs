@@ -16,6 +16,10 @@
 //! (1/64 of a dense LU's work), half of the spring's, the same iterates. The
 //! other blocks matter only to stability, which keeps the full `S(t)` of the
 //! embedded response (monodromy, Hill).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use faer::Mat;
 use ivt_num::vector::dot;
@@ -65,8 +69,11 @@ impl Subspace {
             .flat_map(|&h| coords.iter().map(move |&c| hb.index(h, c)))
             .collect();
         let mut position = vec![OUTSIDE; hb.dim()];
+        // Every `hb.index(h, c)` of a slot and coordinate is below `dim`.
         for (r, &f) in full_index.iter().enumerate() {
-            position[f] = r;
+            if let Some(p) = position.get_mut(f) {
+                *p = r;
+            }
         }
         Self {
             coords,
@@ -85,14 +92,17 @@ impl Subspace {
     pub(super) fn embed(&self, reduced: &[f64], full: &mut [f64]) {
         full.fill(0.0);
         for (&f, v) in self.full_index.iter().zip(reduced) {
-            full[f] = *v;
+            if let Some(x) = full.get_mut(f) {
+                *x = *v;
+            }
         }
     }
 
-    /// The subspace's entries of `full` into `reduced`.
+    /// The subspace's entries of `full` into `reduced` (NaN where `full` is
+    /// short).
     pub(super) fn gather(&self, full: &[f64], reduced: &mut [f64]) {
         for (r, &f) in reduced.iter_mut().zip(&self.full_index) {
-            *r = full[f];
+            *r = full.get(f).copied().unwrap_or(f64::NAN);
         }
     }
 }
@@ -152,8 +162,9 @@ impl<'a> ReducedString<'a> {
         }
         jac.fill(0.0);
         let pos = &self.sub.position;
+        let at = |k: usize| pos.get(k).copied().unwrap_or(OUTSIDE);
         self.hb.for_each_linear(omega, false, |r, c, v| {
-            let (pr, pc) = (pos[r], pos[c]);
+            let (pr, pc) = (at(r), at(c));
             if pr != OUTSIDE && pc != OUTSIDE {
                 jac[(pr, pc)] += v;
             }

@@ -1,5 +1,9 @@
 //! The spatial balance of STHB (Eq. 94, 97): DST-I on the interior grid
 //! points and DCT-I on the closed grid, by rustdct or by direct partial sums.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -72,30 +76,38 @@ impl Spatial {
             self.dct.process_dct1_with_scratch(buf, &mut self.scratch);
             return;
         }
-        let len = buf.len();
-        if nin == len {
-            buf[0] *= 0.5;
-            buf[len - 1] *= 0.5;
+        if nin == buf.len() {
+            if let Some(first) = buf.first_mut() {
+                *first *= 0.5;
+            }
+            if let Some(last) = buf.last_mut() {
+                *last *= 0.5;
+            }
         }
         Self::partial(&self.cos_t, &mut self.tmp, buf, nin, nout);
     }
 
-    /// `buf ← T buf` for the symmetric table `T` (rows of length `buf.len()`).
+    /// `buf ← T buf` for the symmetric table `T` (rows of length `buf.len()`);
+    /// NaN if `buf` is empty or longer than the scratch `tmp`.
     fn partial(table: &[f64], tmp: &mut [f64], buf: &mut [f64], nin: usize, nout: usize) {
         let len = buf.len();
+        let Some(inputs) = tmp.get_mut(..len).filter(|_| len > 0) else {
+            return buf.fill(f64::NAN);
+        };
         let rows = table.chunks_exact(len);
         if nin < len {
             // Synthesis: few inputs, all outputs.
-            tmp[..nin].copy_from_slice(&buf[..nin]);
+            let (inputs, _) = inputs.split_at_mut(nin);
+            inputs.iter_mut().zip(buf.iter()).for_each(|(t, x)| *t = *x);
             buf.fill(0.0);
-            for (x, row) in tmp[..nin].iter().zip(rows) {
+            for (x, row) in inputs.iter().zip(rows) {
                 buf.iter_mut().zip(row).for_each(|(o, t)| *o += x * t);
             }
         } else {
             // Projection: all inputs, few outputs.
-            tmp[..len].copy_from_slice(buf);
-            for (o, row) in buf[..nout].iter_mut().zip(rows) {
-                *o = row.iter().zip(&tmp[..len]).map(|(t, x)| t * x).sum();
+            inputs.copy_from_slice(buf);
+            for (o, row) in buf.iter_mut().take(nout).zip(rows) {
+                *o = row.iter().zip(inputs.iter()).map(|(t, x)| t * x).sum();
             }
         }
     }

@@ -84,17 +84,13 @@ impl PeriodicSpectrum {
         (p * self.rows + i) * self.cols + j
     }
 
-    /// Mutable `Ŝ_p[i][j]`.
-    ///
-    /// # Panics
-    /// If `p > p_max`, `i ≥ rows` or `j ≥ cols` (a caller's size bug; the
-    /// panic-free access is `data.get_mut(index(p, i, j))`).
-    // The one panic left in this file: its callers in `sthb/hb.rs` take the
-    // reference directly.
-    #[allow(clippy::indexing_slicing)]
-    pub fn at_mut(&mut self, p: usize, i: usize, j: usize) -> &mut Complex<f64> {
+    /// Mutable `Ŝ_p[i][j]`; `None` unless `p ≤ p_max`, `i < rows` and `j < cols`.
+    pub fn at_mut(&mut self, p: usize, i: usize, j: usize) -> Option<&mut Complex<f64>> {
+        if p > self.p_max || i >= self.rows || j >= self.cols {
+            return None;
+        }
         let k = self.index(p, i, j);
-        &mut self.data[k]
+        self.data.get_mut(k)
     }
 }
 
