@@ -121,31 +121,26 @@ pub fn trace<F: Family>(
     let mut failed = None;
     // Multipliers as each point is reached (see `frequency_response`: where
     // the last Galerkin assembly is the point's, Hsu takes its ∂g samples).
-    let path = branch.follow(
-        &x0,
-        0,
-        opts.lambda_to - lambda0,
-        &copts,
-        opts.corrector,
-        |branch, p| {
-            if failed.is_some() {
-                return;
-            }
-            let (q, lambda) = (&p.x[..m], p.lambda());
-            let (problem, sol) = branch.solution(q, lambda);
-            let known = branch.jacobian_samples_at(&p.x);
-            match hsu.floquet_with_samples(&problem, &sol, known) {
-                Ok(fl) => points.push(TracedPoint {
-                    q: q.to_vec(),
-                    lambda,
-                    multipliers: fl.floquet.multipliers,
-                    multiplier_error: fl.error,
-                    kind: fl.floquet.kind,
-                }),
-                Err(e) => failed = Some(e),
-            }
-        },
-    )?;
+    let stepper = branch.stepper(&x0, 0, opts.lambda_to - lambda0, &copts, opts.corrector)?;
+    let path = stepper.run(|branch, p| {
+        if failed.is_some() {
+            return false;
+        }
+        let (q, lambda) = (&p.x[..m], p.lambda());
+        let (problem, sol) = branch.solution(q, lambda);
+        let known = branch.jacobian_samples_at(&p.x);
+        match hsu.floquet_with_samples(&problem, &sol, known) {
+            Ok(fl) => points.push(TracedPoint {
+                q: q.to_vec(),
+                lambda,
+                multipliers: fl.floquet.multipliers,
+                multiplier_error: fl.error,
+                kind: fl.floquet.kind,
+            }),
+            Err(e) => failed = Some(e),
+        }
+        true
+    });
     if let Some(e) = failed {
         return Err(e.into());
     }

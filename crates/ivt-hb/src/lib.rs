@@ -7,6 +7,7 @@ pub mod aft;
 pub mod autonomous;
 pub mod backbone;
 pub mod bifurcation;
+pub mod branch;
 pub mod branch_point;
 pub mod broyden;
 pub mod classic;
@@ -45,6 +46,7 @@ pub use backbone::{backbone, Backbone, BackboneOptions, BackbonePoint};
 pub use bifurcation::{
     locate_multiplier_crossing, Bifurcation, BifurcationError, BifurcationKind, BifurcationOptions,
 };
+pub use branch::{Branch, ResidualBranch};
 pub use branch_point::locate_branch_point;
 pub use broyden::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
@@ -52,8 +54,8 @@ pub use broyden::{
 pub use classic::ClassicIhb;
 pub use codim2::{fold_curve, neimark_sacker_points, FoldCurve, FoldPoint, NeimarkSackerPoint};
 pub use continuation::{
-    pseudo_arclength, pseudo_arclength_exact, ContinuationOptions, Corrector, Fold, Path,
-    PathPoint, PathSystem, Termination,
+    BroydenCorrector, ContinuationOptions, Corrector, Fold, NewtonCorrector, Path, PathCorrector,
+    PathPoint, Step, Stepper, Termination,
 };
 pub use cycle_branch::{cycle_branch, CycleBranch, CycleBranchOptions};
 pub use damped::{damped_modes, linear_mode, DampedModePoint, DampedModes};
@@ -64,7 +66,7 @@ pub use events::{trace, Event, Trace, TraceOptions, TracedPoint};
 pub use faer::c64;
 pub use family::{Family, FamilyBranch, Frequency};
 pub use floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
-pub use fold::{locate_fold, Branch, FoldLocation, FoldOptions};
+pub use fold::{locate_fold, FoldLocation, FoldOptions};
 pub use frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
 pub use galerkin::GalerkinJacobian;
 pub use hill::{fourier_blocks, hill_multipliers, HillResult};
