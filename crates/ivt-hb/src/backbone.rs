@@ -101,18 +101,18 @@ pub fn backbone<P: PeriodicProblem>(
             "a backbone needs an undamped, unforced problem (C = 0, f = 0)".into(),
         ));
     }
-    modal_path(problem, hb, omega0, mode, opts)
+    modal_path(problem, hb, (omega0, mode), opts)
 }
 
 /// The path of [`backbone`] without its check `C = 0`: with damping, the
 /// unfolding `κ M ẋ` is the extended periodic motion concept's negative modal
 /// damping (Krack 2015), and [`crate::damped`] reads `ζ = −κ/(2ω)` off it.
-/// Arguments and errors as [`backbone`] (all checked here except `C = 0`).
+/// Arguments (`linear` = `(omega0, mode)`) and errors as [`backbone`] (all
+/// checked here except `C = 0`).
 pub(crate) fn modal_path<P: PeriodicProblem>(
     problem: &P,
     hb: &HbOptions,
-    omega0: f64,
-    mode: &[f64],
+    (omega0, mode): (f64, &[f64]),
     opts: &BackboneOptions,
 ) -> Result<Backbone, HbError> {
     let nd = problem.n_dof();
