@@ -5,6 +5,7 @@
 //! value as typed. Table-driven: a key or flag added to the table without a
 //! way to reach it here fails `every_cli_alias_has_a_command`.
 //! (Python's arguments: crates/ivt-py/tests/test_boundary.py.)
+#![allow(clippy::expect_used)]
 
 #[path = "common/contract.rs"]
 mod contract;

@@ -2,6 +2,7 @@
 //! 27): their JSON keys and values (closed forms where there are; the
 //! independent references of the jobs are in crates/ivt-hb/tests), and one
 //! JSON error with exit 2 for bad flags.
+#![allow(clippy::panic)]
 
 #[path = "common/contract.rs"]
 mod contract;

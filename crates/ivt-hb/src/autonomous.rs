@@ -11,11 +11,16 @@
 //! +1 (the phase shift); the orbit is classified by the others.
 //!
 //! [`limit_cycle_branch`] follows a limit cycle in a parameter μ of a family of
-//! problems by the engine's pseudo-arclength continuation ([`pseudo_arclength`],
+//! problems by the engine's pseudo-arclength continuation ([`Stepper`],
 //! Eq. 68–77) on `[R(q, ω; μ); b₁] = 0` with unknowns `{q, ω, μ}`.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
+use crate::branch::ResidualBranch;
 use crate::broyden::{BroydenStats, SolveError};
-use crate::continuation::{pseudo_arclength, ContinuationOptions, Termination};
+use crate::continuation::{BroydenCorrector, ContinuationOptions, Stepper, Termination};
 use crate::floquet::HsuRule;
 use crate::galerkin::GalerkinJacobian;
 use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
@@ -99,25 +104,44 @@ where
     let mut copts = opts.clone();
     copts.lambda_min = mu_from.min(mu_to);
     copts.lambda_max = mu_from.max(mu_to);
-    let path = pseudo_arclength(
-        |x: &[f64], r: &mut [f64]| {
-            let problem = family(x[m + 1]);
-            res.eval(&problem, &x[..m], x[m], 1.0, &mut r[..m]);
-            r[m] = x[phase];
-        },
-        &x0,
-        None,
-        mu_to - mu_from,
-        &copts,
-        |_| true,
-    )?;
+    let path = {
+        let m_len = x0.len().saturating_sub(1);
+        // x = {q, ω, μ}: the HB residual at μ and the phase condition b₁ = 0.
+        let mut residual_branch = ResidualBranch::new(m_len, |x: &[f64], r: &mut [f64]| {
+            match (x.split_at_checked(m), r.split_at_mut_checked(m)) {
+                (Some((q, &[omega, mu])), Some((r_q, [r_phase]))) => {
+                    res.eval(&family(mu), q, omega, 1.0, r_q);
+                    *r_phase = x.get(phase).copied().unwrap_or(f64::NAN);
+                }
+                _ => r.fill(f64::NAN),
+            }
+        });
+        let corrector = Box::new(BroydenCorrector::new(m_len, &copts.broyden, None));
+        Stepper::new(
+            &mut residual_branch,
+            corrector,
+            &x0,
+            0,
+            mu_to - mu_from,
+            &copts,
+        )?
+        .run(|_, _| true)
+    };
     let mut points = Vec::with_capacity(path.points.len());
     for p in &path.points {
         let mu = p.lambda();
         let problem = family(mu);
+        let (coeffs, omega_f) = match p.x.split_at_checked(m) {
+            Some((q, [omega, _])) => (q.to_vec(), *omega),
+            _ => {
+                return Err(HbError::InvalidInput(
+                    "limit cycle: point of the wrong size".into(),
+                ))
+            }
+        };
         let solution = HbSolution {
-            coeffs: p.x[..m].to_vec(),
-            omega_f: p.x[m],
+            coeffs,
+            omega_f,
             harmonics: hb.harmonics,
             subharmonic: 1,
             stats: BroydenStats {
@@ -213,7 +237,9 @@ pub fn limit_cycle<P: PeriodicProblem>(
     x.push(omega_guess);
     // The phase condition b₁ = 0 (DOF 0) as the border row.
     let mut phase_row = vec![0.0; m + 1];
-    phase_row[phase] = 1.0;
+    if let Some(b1) = phase_row.get_mut(phase) {
+        *b1 = 1.0;
+    }
     let border = Border {
         rows: &phase_row,
         values: &[0.0],
@@ -298,8 +324,10 @@ impl<P: PeriodicProblem> NewtonSystem for Cycle<'_, P> {
             .zip(rp.iter())
             .zip(rm.iter())
         {
-            row[..m].copy_from_slice(j_row);
-            row[m] = (p - mi) / (2.0 * h);
+            if let Some((left, [last])) = row.split_at_mut_checked(m) {
+                left.copy_from_slice(j_row);
+                *last = (p - mi) / (2.0 * h);
+            }
         }
         Ok(())
     }

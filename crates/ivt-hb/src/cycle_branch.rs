@@ -17,10 +17,10 @@
 #![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::autonomous::{limit_cycle, limit_cycle_branch, LimitCycle};
+use crate::branch::Branch;
 use crate::continuation::{ContinuationOptions, Termination};
 use crate::error::HbError;
 use crate::events::{locate_fold, LocateOptions};
-use crate::fold::Branch;
 use crate::galerkin::GalerkinJacobian;
 use crate::hopf::{equilibrium, hopf_points, Field, HopfPoint};
 use crate::ihb::{HbOptions, HbResidual, HbSolution};

@@ -131,7 +131,7 @@ pub fn damped_modes<P: PeriodicProblem>(
             opts.dof
         )));
     }
-    let path = modal_path(problem, hb, omega0, &shape, opts)?;
+    let path = modal_path(problem, hb, (omega0, &shape), opts)?;
     let points = path
         .points
         .into_iter()

@@ -5,17 +5,20 @@
 //! A family maps λ to a problem and its excitation frequency ω_f. The excitation
 //! `f(θ)` is projected once (it is part of the planned residual), so it must not
 //! depend on λ; [`FamilyBranch::new`] checks this.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
+use crate::branch::{bilinear_lambda_difference, residual_lambda_difference, Branch};
 use crate::continuation::{
-    correct_at_fixed_lambda, pseudo_arclength, pseudo_arclength_exact, ContinuationOptions,
-    Corrector, Path, PathPoint, PathSystem,
+    correct_at_fixed_lambda, BroydenCorrector, ContinuationOptions, Corrector, NewtonCorrector,
+    Stepper,
 };
-use crate::fold::{bilinear_lambda_difference, residual_lambda_difference, Branch};
 use crate::galerkin::{GalerkinForm, GalerkinJacobian};
 use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::{AtFrequency, PeriodicProblem};
 use crate::BroydenStats;
-use faer::{Mat, MatRef};
 
 /// A one-parameter family of periodic problems.
 pub trait Family {
@@ -66,12 +69,6 @@ pub struct FamilyBranch<F: Family> {
     form: GalerkinForm,
     /// `L v` of [`Branch::bilinear`]; scratch of the frequency family's `∂R/∂λ`.
     lv: Vec<f64>,
-    /// Row-major `∂R/∂q` scratch of the [`PathSystem`] assembly.
-    rows: Vec<f64>,
-    /// `(q, λ)` of the last [`PathSystem::residual_jacobian`] and its residual,
-    /// reused by the forward difference in λ at the same point.
-    last_at: Vec<f64>,
-    last_r: Vec<f64>,
     /// `(q, λ)` of the last Galerkin assembly, whose `∂g` samples
     /// [`FamilyBranch::jacobian_samples_at`] hands out.
     galerkin_at: Vec<f64>,
@@ -110,9 +107,6 @@ impl<F: Family> FamilyBranch<F> {
             galerkin,
             form,
             lv: vec![0.0; m],
-            rows: vec![0.0; m * m],
-            last_at: Vec::with_capacity(m + 1),
-            last_r: vec![0.0; m],
             galerkin_at: Vec::with_capacity(m + 1),
         })
     }
@@ -127,53 +121,41 @@ impl<F: Family> FamilyBranch<F> {
         &self.family
     }
 
-    /// Follows the branch from the converged point `start` (`q` then λ) in the
+    /// The path of the branch from the converged point `start` (`q` then λ) in the
     /// direction of increasing λ if `direction > 0`, with `corrector`:
     /// Broyden on the secant model (Eq. 68–77; `start` is corrected first) or
-    /// Newton–chord on the exact Galerkin Jacobian
-    /// ([`pseudo_arclength_exact`]; `start_iterations` is the start's count).
+    /// chord–Newton on the exact Galerkin Jacobian ([`NewtonCorrector`];
+    /// `start_iterations` is the start's count).
     ///
-    /// `on_point(branch, point)` is called once for every point, in path
-    /// order. With Newton it is called as the point is reached, after its
-    /// tangent: where the branch's last Galerkin assembly is that point's (a
-    /// point Newton corrected, or every point without
-    /// [`ContinuationOptions::second_order_predictor`], whose chord assembles
-    /// at the prediction), [`Self::jacobian_samples_at`] gives its `∂g`
-    /// samples without another evaluation of `g` (the path points' stability
-    /// uses them). With Broyden it is called after the path is traced.
+    /// Each point is handed out ([`Stepper::next`]) as it is reached, with
+    /// Newton after its tangent: where the branch's last Galerkin assembly
+    /// is that point's (a point Newton corrected, or every point without
+    /// [`ContinuationOptions::second_order_predictor`], whose chord
+    /// assembles at the prediction), [`Self::jacobian_samples_at`] gives its
+    /// `∂g` samples without another evaluation of `g` (the path points'
+    /// stability uses them).
     ///
     /// # Errors
-    /// As [`pseudo_arclength`] / [`pseudo_arclength_exact`].
-    pub fn follow(
+    /// As [`Stepper::new`] and [`correct_at_fixed_lambda`].
+    pub fn stepper(
         &mut self,
         start: &[f64],
         start_iterations: usize,
         direction: f64,
         opts: &ContinuationOptions,
         corrector: Corrector,
-        mut on_point: impl FnMut(&mut Self, &PathPoint),
-    ) -> Result<Path, HbError> {
+    ) -> Result<Stepper<'_, Self>, HbError> {
         let m = self.res.len();
         match corrector {
             Corrector::Broyden => {
-                let path = pseudo_arclength(
-                    |x: &[f64], r: &mut [f64]| Branch::residual(self, &x[..m], x[m], r),
-                    start,
-                    None,
-                    direction,
-                    opts,
-                    |_| true,
-                )?;
-                path.points.iter().for_each(|p| on_point(self, p));
-                Ok(path)
+                let broyden = Box::new(BroydenCorrector::new(m, &opts.broyden, None));
+                Stepper::new(self, broyden, start, 0, direction, opts)
             }
             Corrector::Newton => {
                 let mut x = start.to_vec();
                 let its = correct_at_fixed_lambda(self, &mut x, opts)?;
-                pseudo_arclength_exact(self, &x, start_iterations + its, direction, opts, |b, p| {
-                    on_point(b, p);
-                    true
-                })
+                let newton = Box::new(NewtonCorrector::new(m, opts));
+                Stepper::new(self, newton, &x, start_iterations + its, direction, opts)
             }
         }
     }
@@ -273,62 +255,10 @@ impl<F: Family> Branch for FamilyBranch<F> {
     }
 }
 
-/// The branch as a [`PathSystem`]: the exact Galerkin Jacobian (Eq. 56) and
-/// `∂R/∂λ` by a forward difference of relative step 1e-7 (it enters only the
-/// tangent and the chord corrector's matrix, not the converged points; it
-/// reuses the residual of the last assembly at the same point, so it costs one
-/// residual evaluation).
-impl<F: Family> PathSystem for FamilyBranch<F> {
-    fn dim(&self) -> usize {
-        self.res.len()
-    }
-    fn residual(&mut self, u: &[f64], lambda: f64, r: &mut [f64]) {
-        Branch::residual(self, u, lambda, r);
-    }
-    fn residual_jacobian(&mut self, u: &[f64], lambda: f64, r: &mut [f64], jac: &mut Mat<f64>) {
-        Branch::residual(self, u, lambda, r);
-        PathSystem::jacobian(self, u, lambda, jac);
-        self.last_at.clear();
-        self.last_at.extend_from_slice(u);
-        self.last_at.push(lambda);
-        self.last_r.copy_from_slice(r);
-    }
-    /// The Galerkin Jacobian alone: it needs `∂g` at the samples, not `R`.
-    fn jacobian(&mut self, u: &[f64], lambda: f64, jac: &mut Mat<f64>) {
-        let m = u.len();
-        let mut rows = std::mem::take(&mut self.rows);
-        Branch::jacobian(self, u, lambda, &mut rows);
-        jac.as_mut()
-            .copy_from(MatRef::from_row_major_slice(&rows[..m * m], m, m));
-        self.rows = rows;
-    }
-    fn d_residual_d_lambda(&mut self, u: &[f64], lambda: f64, r_lambda: &mut [f64]) {
-        let m = u.len();
-        if self.only_linear_part_moves() {
-            self.linear_lambda_derivative(u, lambda, r_lambda);
-            return;
-        }
-        let same =
-            self.last_at.len() == m + 1 && self.last_at[..m] == *u && self.last_at[m] == lambda;
-        if !same {
-            let mut r0 = std::mem::take(&mut self.last_r);
-            Branch::residual(self, u, lambda, &mut r0);
-            self.last_r = r0;
-            self.last_at.clear();
-            self.last_at.extend_from_slice(u);
-            self.last_at.push(lambda);
-        }
-        let h = 1e-7 * lambda.abs().max(1.0);
-        Branch::residual(self, u, lambda + h, r_lambda);
-        for (a, b) in r_lambda.iter_mut().zip(&self.last_r) {
-            *a = (*a - b) / h;
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::branch::path_lambda_step;
     use crate::problem::{Duffing, MathieuDuffing};
 
     /// `∂R/∂λ` by a central difference of the whole residual, step `h`.
@@ -361,7 +291,7 @@ mod tests {
             let m = branch.len();
             let q: Vec<f64> = (0..m).map(|i| 0.3 / (1.0 + i as f64)).collect();
             let mut exact = vec![0.0; m];
-            PathSystem::d_residual_d_lambda(&mut branch, &q, 1.3, &mut exact);
+            Branch::residual_lambda(&mut branch, &q, 1.3, path_lambda_step(1.3), &mut exact);
             let fd = central(&mut branch, &q, 1.3, 1e-4);
             let scale = fd.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             let err = exact
@@ -387,8 +317,8 @@ mod tests {
 
     #[test]
     fn other_families_keep_the_residual_difference() {
-        // λ = β of Mathieu–Duffing moves the stiffness, not ω_f: the forward
-        // difference of the residual (O(1e-7) relative) is used.
+        // λ = β of Mathieu–Duffing moves the stiffness, not ω_f: the central
+        // difference of the residual with the path's step is used.
         let mut branch = FamilyBranch::new(
             |b: f64| (MathieuDuffing::thesis(b), 2.0),
             &HbOptions::new(7, 32),
@@ -398,7 +328,7 @@ mod tests {
         let m = branch.len();
         let q: Vec<f64> = (0..m).map(|i| 0.3 / (1.0 + i as f64)).collect();
         let mut d = vec![0.0; m];
-        PathSystem::d_residual_d_lambda(&mut branch, &q, 4.0, &mut d);
+        Branch::residual_lambda(&mut branch, &q, 4.0, path_lambda_step(4.0), &mut d);
         let fd = central(&mut branch, &q, 4.0, 1e-4);
         let scale = fd.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         assert!(scale > 0.0);

@@ -2,12 +2,16 @@
 //! pseudo-arclength continuation ([`crate::continuation`], Eq. 68–77), with the
 //! Floquet multipliers (Hsu, Eq. 80) and stability class at every point. Each
 //! turn of the path is then located by Newton on the extended system of
-//! [`crate::fold`] (the fold itself, not a bracket between two points),
+//! [`crate::events::fold`] (the fold itself, not a bracket between two points),
 //! started from the quadratic through the three path points around the turn
 //! ([`crate::continuation::turn_estimate`]).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::aft::Aft;
-use crate::continuation::{turn_estimate, ContinuationOptions, Corrector, Path, Termination};
+use crate::continuation::{turn_estimate, ContinuationOptions, Corrector, Path, Step, Termination};
 use crate::events::{locate_fold, BifurcationKind, LocateOptions, Trace};
 use crate::family::{FamilyBranch, Frequency};
 use crate::ihb::{HbError, HbOptions, HbSolution};
@@ -142,40 +146,46 @@ pub fn frequency_response<P: PeriodicProblem>(
     let direction = if opts.to > opts.from { 1.0 } else { -1.0 };
     let mut hsu = AdaptiveHsu::new(&at_start, hb.harmonics, opts.stability)?;
     let mut probe = AmplitudeProbe::new(hb)?;
-    let mut points = Vec::new();
-    let mut failed = None;
     // Each point's multipliers as it is reached: where the branch's last
     // Galerkin assembly is the point's (a Newton-corrected point, or every
     // point without the second-order predictor), its ∂g samples serve Hsu's
     // level of the same grid without another evaluation of g.
-    let path = family.follow(
-        &x0,
-        start.stats.iterations,
-        direction,
-        &copts,
-        opts.corrector,
-        |branch, p| {
-            if failed.is_some() {
-                return;
-            }
-            let (at, sol) = branch.solution(&p.x[..m], p.lambda());
+    let mut points = Vec::new();
+    let path = {
+        let mut stepper = family.stepper(
+            &x0,
+            start.stats.iterations,
+            direction,
+            &copts,
+            opts.corrector,
+        )?;
+        let (mut path_points, mut turns) = (Vec::new(), Vec::new());
+        let termination = loop {
+            let p = match stepper.next() {
+                Step::Point(p) => p,
+                Step::Stop(termination) => break termination,
+            };
+            turns.extend(stepper.fold());
+            let branch = stepper.branch();
+            let (at, sol) = branch.solution(p.x.get(..m).unwrap_or_default(), p.lambda());
             let known = branch.jacobian_samples_at(&p.x);
-            match hsu.floquet_with_samples(&at, &sol, known) {
-                Ok(fl) => points.push(FrcPoint {
-                    omega_f: sol.omega_f,
-                    amplitude: probe.of(&sol.coeffs),
-                    kind: fl.floquet.kind,
-                    multipliers: fl.floquet.multipliers,
-                    multiplier_error: fl.error,
-                    coeffs: sol.coeffs,
-                }),
-                Err(e) => failed = Some(e),
-            }
-        },
-    )?;
-    if let Some(e) = failed {
-        return Err(e);
-    }
+            let fl = hsu.floquet_with_samples(&at, &sol, known)?;
+            points.push(FrcPoint {
+                omega_f: sol.omega_f,
+                amplitude: probe.of(&sol.coeffs),
+                kind: fl.floquet.kind,
+                multipliers: fl.floquet.multipliers,
+                multiplier_error: fl.error,
+                coeffs: sol.coeffs,
+            });
+            path_points.push(p);
+        };
+        Path {
+            points: path_points,
+            folds: turns,
+            termination,
+        }
+    };
     let mut folds = Vec::with_capacity(path.folds.len());
     for (turn, located) in path.folds.iter().zip(locate_turns(&mut family, &path)) {
         if let Some(near) = points.get(turn.index) {
@@ -195,7 +205,7 @@ pub fn frequency_response<P: PeriodicProblem>(
 /// not converge (or the turn has no three points around it). One entry per
 /// `path.folds`, in order; shared by [`frequency_response`] and
 /// [`crate::condense::condensed_response`].
-pub(crate) fn locate_turns<B: crate::fold::Branch>(
+pub(crate) fn locate_turns<B: crate::branch::Branch>(
     branch: &mut B,
     path: &Path,
 ) -> Vec<Option<(Vec<f64>, f64)>> {
@@ -203,8 +213,10 @@ pub(crate) fn locate_turns<B: crate::fold::Branch>(
     path.folds
         .iter()
         .map(|turn| {
-            let around = path.points.get(turn.bracket..turn.bracket + 3)?;
-            let start = turn_estimate(&around[0], &around[1], &around[2]);
+            let [a, b, c] = path.points.get(turn.bracket..turn.bracket + 3)? else {
+                return None;
+            };
+            let start = turn_estimate(a, b, c);
             let (q0, lambda0) = (start.get(..m)?, *start.get(m)?);
             locate_fold(branch, q0, lambda0, &LocateOptions::fold())
                 .ok()
@@ -270,7 +282,8 @@ impl AmplitudeProbe {
 
     fn of(&mut self, q: &[f64]) -> f64 {
         let l = self.aft.coeff_len();
-        self.aft.synthesize(&q[..l], &mut self.samples);
+        self.aft
+            .synthesize(q.get(..l).unwrap_or_default(), &mut self.samples);
         self.samples.iter().fold(0.0f64, |a, v| a.max(v.abs()))
     }
 

@@ -270,8 +270,8 @@ impl GalerkinJacobian {
 mod tests {
     use super::form::{basis_rows, quadrature_basis};
     use super::*;
+    use crate::branch::Branch;
     use crate::elements::{Element, ElementProblem, Harmonic, Law};
-    use crate::fold::Branch;
     use crate::ihb::HbOptions;
     use crate::problem::{matrix_getters, Duffing, GeneralProblem, MathieuDuffing};
     use crate::FamilyBranch;

@@ -6,6 +6,7 @@
 pub mod aft;
 pub mod autonomous;
 pub mod backbone;
+pub mod branch;
 pub mod broyden;
 pub mod classic;
 pub mod codim2;
@@ -19,7 +20,6 @@ mod error;
 pub mod events;
 pub mod family;
 pub mod floquet;
-pub mod fold;
 pub mod frc;
 pub mod galerkin;
 pub mod hill;
@@ -40,14 +40,15 @@ pub mod transient;
 pub use aft::Aft;
 pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
 pub use backbone::{backbone, Backbone, BackboneOptions, BackbonePoint};
+pub use branch::{Branch, ResidualBranch};
 pub use broyden::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
 };
 pub use classic::ClassicIhb;
 pub use codim2::{fold_curve, neimark_sacker_points, FoldCurve, FoldPoint, NeimarkSackerPoint};
 pub use continuation::{
-    pseudo_arclength, pseudo_arclength_exact, ContinuationOptions, Corrector, Fold, Path,
-    PathPoint, PathSystem, Termination,
+    BroydenCorrector, ContinuationOptions, Corrector, Fold, NewtonCorrector, Path, PathCorrector,
+    PathPoint, Step, Stepper, Termination,
 };
 pub use cycle_branch::{cycle_branch, CycleBranch, CycleBranchOptions};
 pub use damped::{damped_modes, linear_mode, DampedModePoint, DampedModes};
@@ -62,7 +63,6 @@ pub use events::{
 pub use faer::c64;
 pub use family::{Family, FamilyBranch, Frequency};
 pub use floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
-pub use fold::Branch;
 pub use frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
 pub use galerkin::GalerkinJacobian;
 pub use hill::{fourier_blocks, hill_multipliers, HillResult};

@@ -13,10 +13,15 @@
 //!    (`a_{2j}^{(2)} = a_j^{(1)}`), the amplitude `a_1` of the new lowest harmonic is
 //!    prescribed (non-zero forces the new branch) and β takes its slot among the
 //!    unknowns; `a_1` is then the continuation parameter.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::aft::{embed_subharmonic, resize_harmonics};
+use crate::branch::ResidualBranch;
 use crate::broyden::{broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace};
-use crate::continuation::{pseudo_arclength, ContinuationOptions};
+use crate::continuation::{BroydenCorrector, ContinuationOptions, Stepper};
 use crate::events::{locate_multiplier_crossing, BifurcationError, BifurcationKind, LocateOptions};
 use crate::family::FamilyBranch;
 use crate::floquet::HsuRule;
@@ -137,13 +142,13 @@ struct Controlled {
 impl Controlled {
     fn eval(&mut self, y: &[f64], a_c: f64, r: &mut [f64]) {
         self.q.copy_from_slice(y);
-        self.q[self.c] = a_c;
-        self.p.beta = y[self.c];
+        set(&mut self.q, self.c, a_c);
+        self.p.beta = y.get(self.c).copied().unwrap_or(f64::NAN);
         self.res.eval(&self.p, &self.q, self.omega, 1.0, r);
     }
     fn solution(&self, y: &[f64], a_c: f64, harmonics: usize, period: usize) -> (HbSolution, f64) {
         let mut q = y.to_vec();
-        q[self.c] = a_c;
+        set(&mut q, self.c, a_c);
         let stats = BroydenStats::default();
         (
             HbSolution {
@@ -153,9 +158,21 @@ impl Controlled {
                 subharmonic: period,
                 stats,
             },
-            y[self.c],
+            y.get(self.c).copied().unwrap_or(f64::NAN),
         )
     }
+}
+
+/// `x[k] = v` (nothing for `k` out of range).
+fn set(x: &mut [f64], k: usize, v: f64) {
+    if let Some(e) = x.get_mut(k) {
+        *e = v;
+    }
+}
+
+/// A path point `x` as its unknowns and its parameter (the last entry).
+fn split_param(x: &[f64]) -> (&[f64], f64) {
+    x.split_last().map_or((&[][..], f64::NAN), |(l, q)| (q, *l))
 }
 
 /// Of two bracketing path points with period-doubling indicators `ga`, `gb`,
@@ -244,7 +261,6 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
     let guess = resize_harmonics(&THESIS_A0, n1);
     let start = ModifiedIhb::new(problem.clone(), hb1.clone())?.solve(opts.omega, Some(&guess))?;
     let mut res = HbResidual::new(&problem, &hb1)?;
-    let m = res.len();
     let mut x0 = start.coeffs.clone();
     x0.push(opts.beta0);
     let mut an = StabilityAnalyzer::new(&problem, n1, opts.hsu_steps_per_harmonic * n1)?;
@@ -272,27 +288,31 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
         };
         pd_indicator(&an.hsu(p, &sol, HsuRule::Magnus4).multipliers)
     };
-    pseudo_arclength(
-        |x: &[f64], r: &mut [f64]| {
+    {
+        let m_len = x0.len().saturating_sub(1);
+        let mut residual_branch = ResidualBranch::new(m_len, |x: &[f64], r: &mut [f64]| {
             let mut pp = problem.clone();
-            pp.beta = x[m];
-            res.eval(&pp, &x[..m], opts.omega, 1.0, r)
-        },
-        &x0,
-        None,
-        1.0,
-        &copts,
-        |pt| {
-            p.beta = pt.lambda();
-            let (g, _) = stab(&mut an, &p, &pt.x[..m], n1, 1);
-            bracket.push(&pt.x, g)
-        },
-    )
+            let (q, beta) = split_param(x);
+            pp.beta = beta;
+            res.eval(&pp, q, opts.omega, 1.0, r)
+        });
+        let corrector = Box::new(BroydenCorrector::new(m_len, &copts.broyden, None));
+        Stepper::new(&mut residual_branch, corrector, &x0, 0, 1.0, &copts).map(|stepper| {
+            stepper.run(|_, pt| {
+                p.beta = pt.lambda();
+                let (g, _) = stab(&mut an, &p, split_param(&pt.x).0, n1, 1);
+                bracket.push(&pt.x, g)
+            })
+        })
+    }
     .map_err(|e| HbError::InvalidInput(format!("period-1 continuation: {e}")))?;
     let ((xa, ga), (xb, gb)) = bracket
         .found
         .ok_or_else(|| HbError::InvalidInput("period-1 branch never reached μ = −1".into()))?;
-    let (q, beta) = nearer(&xa, ga, &xb, gb, |x| (x[..m].to_vec(), x[m]));
+    let (q, beta) = nearer(&xa, ga, &xb, gb, |x| {
+        let (q, beta) = split_param(x);
+        (q.to_vec(), beta)
+    });
     let mut crit = locate_period_doubling(opts, &hb1, 1, &q, beta)?;
     out.push(crit.clone());
     // --- period 2, 4, …: controlled amplitude a_1.
@@ -303,7 +323,7 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
         let hb = HbOptions::new(new_n, 4 * new_n).with_subharmonic(new_period);
         let mut y = embed_subharmonic(&crit.solution.coeffs, 2, new_n);
         let c = 1; // a_1 of the new lowest harmonic
-        y[c] = crit.beta;
+        set(&mut y, c, crit.beta);
         let l = y.len();
         let mut pp = MathieuDuffing::new(opts.xi, opts.alpha, crit.beta, opts.gamma);
         let mut ctl = Controlled {
@@ -345,26 +365,29 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
         };
         let mut bracket = PdBracket::default();
         // Skip the start region where the new branch's multiplier is still ≈ +1.
-        pseudo_arclength(
-            |x: &[f64], r: &mut [f64]| ctl.eval(&x[..l], x[l], r),
-            &x0,
-            None,
-            1.0,
-            &copts,
-            |pt| {
-                pp.beta = pt.x[c];
-                let mut q = pt.x[..l].to_vec();
-                q[c] = pt.lambda();
+        {
+            let m_len = x0.len().saturating_sub(1);
+            let mut residual_branch = ResidualBranch::new(m_len, |x: &[f64], r: &mut [f64]| {
+                let (y, a) = split_param(x);
+                ctl.eval(y, a, r)
+            });
+            let corrector = Box::new(BroydenCorrector::new(m_len, &copts.broyden, None));
+            Stepper::new(&mut residual_branch, corrector, &x0, 0, 1.0, &copts)?.run(|_, pt| {
+                let (y, a) = split_param(&pt.x);
+                pp.beta = y.get(c).copied().unwrap_or(f64::NAN);
+                let mut q = y.to_vec();
+                set(&mut q, c, a);
                 let (g, _) = stab(&mut an2, &pp, &q, new_n, new_period);
                 bracket.push(&pt.x, g)
-            },
-        )?;
+            })
+        };
         let ((xa, ga), (xb, gb)) = bracket.found.ok_or_else(|| {
             HbError::InvalidInput(format!("period-{new_period} branch never reached μ = −1"))
         })?;
         // The bracketing points as orbits of the period-2p branch in β.
         let (q, beta) = nearer(&xa, ga, &xb, gb, |x| {
-            let (sol, beta) = ctl.solution(&x[..l], x[l], new_n, new_period);
+            let (y, a) = split_param(x);
+            let (sol, beta) = ctl.solution(y, a, new_n, new_period);
             (sol.coeffs, beta)
         });
         crit = locate_period_doubling(opts, &hb, new_period, &q, beta)?;

@@ -9,13 +9,13 @@
 #![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
 #![cfg_attr(not(test), deny(clippy::unimplemented))]
 
+use crate::branch::{residual_lambda_difference, Branch};
 use crate::broyden::SolveError;
 use crate::events::extended::{
     check_start, lambda_step, null_vector, put_jacobian, singular_at_start, solve_error,
 };
 use crate::events::{dot, Bifurcation, BifurcationError, BifurcationKind, LocateOptions};
 use crate::family::{Family, FamilyBranch};
-use crate::fold::{residual_lambda_difference, Branch};
 use crate::ihb::{HbError, HbOptions};
 use ivt_num::vector::norm2;
 use ivt_num::{newton_bordered, Border, LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace};

@@ -9,11 +9,10 @@ mod common;
 use common::chain::cubic_chain;
 use common::counted::Counted;
 use common::max_distance;
-use faer::Mat;
 use ivt_hb::{
-    frequency_response, AdaptiveHsu, BroydenStats, Corrector, Duffing, FamilyBranch, Frc,
+    frequency_response, AdaptiveHsu, Branch, BroydenStats, Corrector, Duffing, FamilyBranch, Frc,
     FrcOptions, Frequency, HbError, HbOptions, HbSolution, HsuRule, HsuSteps, ModifiedIhb,
-    PathSystem, PeriodicProblem, StabilityAnalyzer,
+    PeriodicProblem, StabilityAnalyzer,
 };
 
 /// Worst multiplier error over the curve against 8192 steps, and the steps
@@ -122,8 +121,8 @@ fn galerkin_jacobian_samples_serve_hsu_on_the_same_grid() {
         let m = sol.coeffs.len();
         let mut x = sol.coeffs.clone();
         x.push(omega);
-        let mut jac = Mat::zeros(m, m);
-        PathSystem::jacobian(&mut branch, &x[..m], omega, &mut jac);
+        let mut jac = vec![0.0; m * m];
+        Branch::jacobian(&mut branch, &x[..m], omega, &mut jac);
         let mut elsewhere = x.clone();
         elsewhere[0] += 1e-9;
         assert!(branch.jacobian_samples_at(&elsewhere).is_none());

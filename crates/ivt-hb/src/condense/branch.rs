@@ -16,8 +16,8 @@
 
 use super::dynamic::Structure;
 use super::receptance::{Coupling, Receptances};
+use crate::branch::Branch;
 use crate::error::HbError;
-use crate::fold::Branch;
 use crate::galerkin::GalerkinJacobian;
 use crate::ihb::{HbOptions, HbResidual};
 use crate::problem::PeriodicProblem;

@@ -1,5 +1,5 @@
 //! Frequency-response curves of a condensed structure: the exact-Jacobian
-//! pseudo-arclength continuation (Eq. 68–77, [`pseudo_arclength_exact`]) of
+//! pseudo-arclength continuation (Eq. 68–77, [`NewtonCorrector`]) of
 //! [`CondensedBranch`] in ω_f, each fold located by Newton on the extended
 //! system ([`locate_fold`]) of the condensed Jacobian, any DOF recovered per
 //! point, and per point the estimated errors of the linear solves and of the
@@ -10,11 +10,11 @@ use super::estimate::truncation_error;
 use super::scaled::Scaled;
 use super::stability::{CondensedFloquet, ReducedStability, DEFAULT_BLOCKS};
 use crate::aft::{eval_series, Aft};
+use crate::branch::Branch;
 use crate::continuation::{
-    correct_at_fixed_lambda, pseudo_arclength_exact, ContinuationOptions, Termination,
+    correct_at_fixed_lambda, ContinuationOptions, NewtonCorrector, Stepper, Termination,
 };
 use crate::error::HbError;
-use crate::fold::Branch;
 use crate::frc::{locate_turns, FrcFold};
 use crate::problem::PeriodicProblem;
 use crate::stability::HsuSteps;
@@ -159,26 +159,37 @@ pub fn condensed_response<P: PeriodicProblem>(
     let direction = if opts.to > opts.from { 1.0 } else { -1.0 };
     let mut points = Vec::new();
     let mut failed = None;
-    let path = pseudo_arclength_exact(&mut scaled, &x, its, direction, &copts, |sc, p| {
-        let (q, omega_f) = sc.physical(&p.x[..m], p.lambda());
-        let point = probe.point(
-            sc.branch,
-            &q,
-            omega_f,
-            opts.truncation_estimate,
-            stability.as_mut(),
-        );
-        match point {
-            Ok(point) => {
-                points.push(point);
-                true
+    let path = {
+        let m_len = scaled.len();
+        Stepper::new(
+            &mut scaled,
+            Box::new(NewtonCorrector::new(m_len, &copts)),
+            &x,
+            its,
+            direction,
+            &copts,
+        )?
+        .run(|sc, p| {
+            let (q, omega_f) = sc.physical(&p.x[..m], p.lambda());
+            let point = probe.point(
+                sc.branch,
+                &q,
+                omega_f,
+                opts.truncation_estimate,
+                stability.as_mut(),
+            );
+            match point {
+                Ok(point) => {
+                    points.push(point);
+                    true
+                }
+                Err(e) => {
+                    failed = Some(e);
+                    false
+                }
             }
-            Err(e) => {
-                failed = Some(e);
-                false
-            }
-        }
-    })?;
+        })
+    };
     let located = locate_turns(&mut scaled, &path);
     let branch = scaled.branch;
     if let Some(e) = failed.or_else(|| branch.take_failure().filter(|_| points.is_empty())) {

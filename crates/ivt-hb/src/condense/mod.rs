@@ -14,8 +14,8 @@
 //!   refinement in double-double residuals so the fine mesh's κ ~ N⁴ costs no
 //!   accuracy ([`dynamic`]).
 //! - [`Receptances`]: `D̃_h`, the condensed load and their ω-derivatives.
-//! - [`CondensedBranch`]: the condensed residual as a [`crate::PathSystem`]
-//!   and [`crate::fold::Branch`]; any DOF recovered on request.
+//! - [`CondensedBranch`]: the condensed residual as a [`crate::Branch`];
+//!   any DOF recovered on request.
 //! - [`condensed_response`]: the frequency-response curve with folds located
 //!   and per point the estimated solve and truncation errors.
 //! - [`ReducedStability`]: Floquet multipliers of the whole structure's

@@ -13,10 +13,8 @@
 //! step `ds` is a fraction of the sweep and of the start's response.
 
 use super::branch::CondensedBranch;
-use crate::continuation::PathSystem;
-use crate::fold::Branch;
+use crate::branch::Branch;
 use crate::problem::PeriodicProblem;
-use faer::{Mat, MatRef};
 
 /// [`CondensedBranch`] seen in scaled unknowns (module docs).
 pub(crate) struct Scaled<'a, P: PeriodicProblem> {
@@ -26,8 +24,6 @@ pub(crate) struct Scaled<'a, P: PeriodicProblem> {
     w_scale: f64,
     /// The physical unknowns of the last call.
     q: Vec<f64>,
-    /// Row-major Jacobian scratch.
-    rows: Vec<f64>,
 }
 
 impl<'a, P: PeriodicProblem> Scaled<'a, P> {
@@ -46,7 +42,6 @@ impl<'a, P: PeriodicProblem> Scaled<'a, P> {
             w_origin,
             w_scale,
             q: vec![0.0; m],
-            rows: Vec::new(),
         }
     }
 
@@ -106,31 +101,5 @@ impl<P: PeriodicProblem> Branch for Scaled<'_, P> {
         let (w, omega_f) = (self.w_scale, self.omega(lambda));
         Branch::residual_lambda(self.branch, &self.q, omega_f, h * w, out);
         out.iter_mut().for_each(|v| *v *= w / self.q_scale);
-    }
-}
-
-/// The exact Jacobian for the continuation (Eq. 68–77 with Newton).
-impl<P: PeriodicProblem> PathSystem for Scaled<'_, P> {
-    fn dim(&self) -> usize {
-        self.q.len()
-    }
-    fn residual(&mut self, u: &[f64], lambda: f64, r: &mut [f64]) {
-        Branch::residual(self, u, lambda, r);
-    }
-    fn residual_jacobian(&mut self, u: &[f64], lambda: f64, r: &mut [f64], jac: &mut Mat<f64>) {
-        PathSystem::jacobian(self, u, lambda, jac);
-        Branch::residual(self, u, lambda, r);
-    }
-    fn jacobian(&mut self, u: &[f64], lambda: f64, jac: &mut Mat<f64>) {
-        let m = u.len();
-        let mut rows = std::mem::take(&mut self.rows);
-        rows.resize(m * m, 0.0);
-        Branch::jacobian(self, u, lambda, &mut rows);
-        jac.as_mut()
-            .copy_from(MatRef::from_row_major_slice(&rows, m, m));
-        self.rows = rows;
-    }
-    fn d_residual_d_lambda(&mut self, u: &[f64], lambda: f64, r_lambda: &mut [f64]) {
-        Branch::residual_lambda(self, u, lambda, 0.0, r_lambda);
     }
 }

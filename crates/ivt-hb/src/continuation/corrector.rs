@@ -1,112 +1,155 @@
-//! The corrector's system of the exact-Jacobian path: the predicted point
-//! and its constraint ([`Prediction`]), and `[R(u, λ); constraint] = 0` as a
-//! bordered [`NewtonSystem`] ([`ExactNewton`]) for the Newton corrector of
-//! [`super::exact`] (thesis Eq. 72 with the exact Jacobian).
+//! The corrector of a continuation step: from the prediction back onto the
+//! branch, closing `R(u, λ) = 0` by the arclength constraint (Eq. 72) or,
+//! landing on a bound, by `λ = bound`. One trait, [`PathCorrector`], one
+//! file per method: Broyden on the secant model (`broyden.rs`, Eq. 68–77),
+//! chord iterations on the tangent's factorization (`chord.rs`) and Newton on
+//! the exact bordered Jacobian (`newton.rs`, the chord's fallback).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
-use faer::Mat;
-use ivt_num::{NewtonSystem, StepCheck};
 use std::borrow::Cow;
-use std::convert::Infallible;
 
-use super::PathSystem;
+use crate::branch::Branch;
+use crate::broyden::SolveError;
+use crate::error::HbError;
 
-/// `[R(u, λ); constraint] = 0` in `x = (u, λ)` as a square
-/// [`NewtonSystem`]: each residual assembles `J` with it (the string's
-/// Jacobian costs little beyond its residual); the Jacobian is
-/// `[[J, R_λ], [rowᵀ]]` row-major. The constraint is evaluated as
-/// `tᵀ(u − u_pred)`, not as `tᵀu − tᵀu_pred`, which would lose its last
-/// digits to cancellation when λ is large.
-pub(super) struct ExactNewton<'a, S> {
-    pub(super) system: &'a mut S,
-    pub(super) jac: &'a mut Mat<f64>,
-    pub(super) r_lambda: &'a mut [f64],
-    pub(super) pred: &'a Prediction<'a>,
-}
+mod broyden;
+mod chord;
+mod newton;
+pub use broyden::BroydenCorrector;
+pub use newton::NewtonCorrector;
 
-impl<S: PathSystem> NewtonSystem for ExactNewton<'_, S> {
-    type Error = Infallible;
-
-    fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
-        let m = self.r_lambda.len();
-        match (x.split_at_checked(m), r.split_at_mut_checked(m)) {
-            (Some((u, &[lambda])), Some((r_u, [r_c]))) => {
-                self.system.residual_jacobian(u, lambda, r_u, self.jac);
-                *r_c = self.pred.constraint(x);
-            }
-            _ => r.fill(f64::NAN),
-        }
-        Ok(())
-    }
-
-    fn jacobian(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), Infallible> {
-        let m = self.r_lambda.len();
-        if let Some((u, &[lambda])) = x.split_at_checked(m) {
-            self.system.d_residual_d_lambda(u, lambda, self.r_lambda);
-        }
-        let row = self.pred.row();
-        let mut rows = out.chunks_exact_mut(m + 1);
-        // r_lambda first: zip must not pull (and drop) the constraint row.
-        for (i, (r_l, out_row)) in self.r_lambda.iter().zip(rows.by_ref()).enumerate() {
-            for (j, v) in out_row.iter_mut().take(m).enumerate() {
-                *v = self.jac[(i, j)];
-            }
-            if let Some(last) = out_row.last_mut() {
-                *last = *r_l;
-            }
-        }
-        if let Some(last_row) = rows.next() {
-            last_row.copy_from_slice(&row);
-        }
-        Ok(())
-    }
-
-    /// Diverged when ‖F‖ rises after the second step (the corrector halves
-    /// the path step instead).
-    fn check_step(
-        &mut self,
-        _x: &[f64],
-        _step: &[f64],
-        history: &[f64],
-    ) -> Result<StepCheck, Infallible> {
-        Ok(match history {
-            [_, .., before, now] if now > before => StepCheck::Diverged,
-            _ => StepCheck::Continue,
-        })
-    }
-}
-
-/// A predicted point and the constraint that closes the corrector's system.
-pub(super) struct Prediction<'a> {
-    pub(super) u_pred: &'a [f64],
-    pub(super) tangent: &'a [f64],
-    /// Correct on `λ = fix` (landing on a bound) instead of `tᵀ(u − u_pred) = 0`.
-    pub(super) fix: Option<f64>,
+/// One step's prediction and the constraint that closes the corrector's
+/// system.
+#[derive(Debug, Clone, Copy)]
+pub struct Prediction<'a> {
+    /// The last point on the path (`u` then λ).
+    pub x_prev: &'a [f64],
+    /// The unit direction at it (secant or tangent): the constraint's gradient.
+    pub direction: &'a [f64],
+    /// The predicted point.
+    pub u_pred: &'a [f64],
+    /// The arclength step Δη.
+    pub step: f64,
+    /// Correct on `λ = fix` (landing on a bound) instead of the arclength
+    /// constraint.
+    pub fix: Option<f64>,
 }
 
 impl Prediction<'_> {
-    /// The constraint's gradient: the tangent (borrowed, no copy per point),
-    /// or `e_{m+1}` on `λ = fix`.
-    pub(super) fn row(&self) -> Cow<'_, [f64]> {
+    /// The constraint's gradient: the direction (borrowed, no copy per
+    /// point), or `e_{m+1}` on `λ = fix`.
+    pub fn row(&self) -> Cow<'_, [f64]> {
         match self.fix {
             Some(_) => {
-                let mut row = vec![0.0; self.tangent.len()];
-                row[self.tangent.len() - 1] = 1.0;
+                let mut row = vec![0.0; self.direction.len()];
+                if let Some(last) = row.last_mut() {
+                    *last = 1.0;
+                }
                 Cow::Owned(row)
             }
-            None => Cow::Borrowed(self.tangent),
+            None => Cow::Borrowed(self.direction),
         }
     }
 
-    /// The constraint `tᵀ(u − u_pred)`, or `λ − λ_fix`.
-    pub(super) fn constraint(&self, u: &[f64]) -> f64 {
+    /// The constraint `dᵀ(u − u_pred)`, or `λ − λ_fix`. Evaluated as a
+    /// difference of points, not as `dᵀu − dᵀu_pred`, which would lose its
+    /// last digits to cancellation when λ is large.
+    pub fn constraint(&self, u: &[f64]) -> f64 {
         match self.fix {
-            Some(l) => u[u.len() - 1] - l,
+            Some(l) => u.last().map_or(f64::NAN, |v| v - l),
             None => self
-                .tangent
+                .direction
                 .iter()
                 .zip(u.iter().zip(self.u_pred))
                 .map(|(t, (a, b))| t * (a - b))
                 .sum(),
         }
+    }
+}
+
+/// A converged correction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Corrected {
+    /// Iterations reported with the point ([`super::PathPoint::iterations`]).
+    pub iterations: usize,
+    /// The effort the step rule reads (a Newton iteration counts as two
+    /// chord iterations).
+    pub effort: usize,
+}
+
+/// The outcome of [`PathCorrector::correct`].
+pub type Correction = Result<Corrected, SolveError>;
+
+/// The outcome of [`PathCorrector::direction`].
+pub type Found = Result<(), DirectionError>;
+
+/// Why the direction at an accepted point is not available.
+#[derive(Debug, Clone, PartialEq)]
+pub enum DirectionError {
+    /// The corrector went backwards along the path: the step is redone
+    /// shorter, and the error ends the path if it cannot be.
+    Backwards(SolveError),
+    /// The bordered matrix of the tangent is singular: the path ends.
+    Singular,
+}
+
+/// Why a step is redone.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Retry {
+    /// The corrector failed: the step is halved.
+    Failed,
+    /// The point was rejected (outside the interval, or backwards): the step
+    /// is redone without the corrector's state of the rejected attempt.
+    Rejected,
+}
+
+/// A corrector of the continuation stepper ([`super::Stepper`]): the start's
+/// direction, the correction of each prediction, and the direction at each
+/// accepted point.
+pub trait PathCorrector<B: Branch> {
+    /// Prepares the path at its start `x` (`u` then λ; a corrector that needs
+    /// a converged start corrects it here at fixed λ) and writes the unit
+    /// direction there into `dir`, whose λ component gives its sign on entry.
+    ///
+    /// # Errors
+    /// [`HbError::ContinuationStart`] if the start cannot be converged,
+    /// [`HbError::SingularStart`] if it has no tangent.
+    fn start(&mut self, branch: &mut B, x: &mut [f64], dir: &mut [f64]) -> Result<(), HbError>;
+
+    /// Corrects the prediction `pred` into `x` (`u` then λ).
+    ///
+    /// # Errors
+    /// The corrector's failure (the step is then halved).
+    fn correct(&mut self, branch: &mut B, pred: &Prediction<'_>, x: &mut [f64]) -> Correction;
+
+    /// The unit direction at the accepted point `x` (reached from `x_prev`)
+    /// into `dir`, which holds the previous direction on entry.
+    ///
+    /// # Errors
+    /// [`DirectionError`].
+    fn direction(&mut self, branch: &mut B, x_prev: &[f64], x: &[f64], dir: &mut [f64]) -> Found;
+
+    /// The step from `x_prev` is redone ([`Retry`]).
+    fn retry(&mut self, branch: &mut B, x_prev: &[f64], why: Retry);
+
+    /// The sign of `det [[R_q, R_λ], [tᵀ]]` at the last accepted point when
+    /// the corrector factored that matrix ([`super::PathPoint::bordered_sign`]).
+    fn bordered_sign(&self) -> Option<f64> {
+        None
+    }
+
+    /// The effort ([`Corrected::effort`]) from which the step rule shrinks
+    /// the step: above `target_iter` (Broyden's many cheap iterations).
+    fn shrink_at(&self, target_iter: usize) -> usize {
+        target_iter + 1
+    }
+
+    /// Whether the predictor adds the curvature term
+    /// ([`super::ContinuationOptions::second_order_predictor`]).
+    fn second_order(&self) -> bool {
+        false
     }
 }

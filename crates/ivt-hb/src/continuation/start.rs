@@ -1,20 +1,23 @@
 //! The start of an exact-Jacobian path: Newton at fixed λ ([`ivt_num::newton()`]).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
-use faer::Mat;
+use crate::branch::Branch;
 use ivt_num::{newton, NewtonError, NewtonOptions, NewtonSystem, NewtonWorkspace};
 use std::convert::Infallible;
 
-use super::{ContinuationOptions, PathSystem, SolveError};
+use super::{ContinuationOptions, SolveError};
 use crate::error::HbError;
 
-/// A [`PathSystem`] at fixed λ as a square [`NewtonSystem`] in `u`.
+/// A [`Branch`] at fixed λ as a square [`NewtonSystem`] in `u`.
 struct FixedLambda<'a, S> {
     system: &'a mut S,
     lambda: f64,
-    jac: Mat<f64>,
 }
 
-impl<S: PathSystem> NewtonSystem for FixedLambda<'_, S> {
+impl<S: Branch> NewtonSystem for FixedLambda<'_, S> {
     type Error = Infallible;
 
     fn residual(&mut self, u: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
@@ -23,20 +26,14 @@ impl<S: PathSystem> NewtonSystem for FixedLambda<'_, S> {
     }
 
     fn jacobian(&mut self, u: &[f64], jac: &mut [f64]) -> Result<(), Infallible> {
-        self.system.jacobian(u, self.lambda, &mut self.jac);
-        let m = self.jac.nrows();
-        for (i, row) in jac.chunks_exact_mut(m.max(1)).enumerate() {
-            for (j, v) in row.iter_mut().enumerate() {
-                *v = self.jac[(i, j)];
-            }
-        }
+        self.system.jacobian(u, self.lambda, jac);
         Ok(())
     }
 }
 
 /// Newton on `R(u, λ) = 0` at the λ of `x` (`u` then λ, corrected in place) to
 /// `opts.broyden.tol` within `opts.broyden.max_iter` steps, for any
-/// [`PathSystem`] (the first point of [`super::pseudo_arclength_exact`] must
+/// [`Branch`] (the start of a [`super::NewtonCorrector`] path must
 /// be converged). The Jacobian is assembled only when the residual misses the
 /// tolerance; every step is taken in full (no line search: the start is a
 /// converged orbit of another method, already close). Returns the steps taken.
@@ -45,22 +42,18 @@ impl<S: PathSystem> NewtonSystem for FixedLambda<'_, S> {
 /// [`HbError::ContinuationStart`] with the residual history when Newton does
 /// not converge; [`HbError::SingularStart`] for a singular Jacobian;
 /// [`HbError::InvalidInput`] when `x` has not `m + 1` entries.
-pub fn correct_at_fixed_lambda<S: PathSystem>(
+pub fn correct_at_fixed_lambda<S: Branch>(
     system: &mut S,
     x: &mut [f64],
     opts: &ContinuationOptions,
 ) -> Result<usize, HbError> {
-    let m = system.dim();
+    let m = system.len();
     let Some((&mut lambda, u)) = x.split_last_mut().filter(|(_, u)| u.len() == m) else {
         return Err(HbError::InvalidInput(
             "continuation start must hold m unknowns and λ".into(),
         ));
     };
-    let mut fixed = FixedLambda {
-        system,
-        lambda,
-        jac: Mat::zeros(m, m),
-    };
+    let mut fixed = FixedLambda { system, lambda };
     let nopts = NewtonOptions {
         ftol: opts.broyden.tol,
         max_iter: opts.broyden.max_iter,

@@ -18,8 +18,8 @@ use super::extended::{
     lambda_step, put_jacobian, solve_error,
 };
 use super::multipliers::Monodromy;
+use crate::branch::{residual_lambda_difference, Branch};
 use crate::family::{Family, FamilyBranch};
-use crate::fold::{residual_lambda_difference, Branch};
 use crate::ihb::HbError;
 use ivt_num::vector::norm2;
 use ivt_num::BorderedLu;

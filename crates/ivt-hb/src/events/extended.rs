@@ -10,8 +10,8 @@
 #![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::detector::{Bifurcation, BifurcationError, BifurcationKind, LocateOptions};
+use crate::branch::{residual_lambda_difference, Branch};
 use crate::broyden::SolveError;
-use crate::fold::{residual_lambda_difference, Branch};
 use crate::ihb::HbError;
 use faer::c64;
 use ivt_num::vector::norm2;

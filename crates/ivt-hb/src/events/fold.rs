@@ -25,10 +25,10 @@ use super::detector::{
 };
 use super::extended::{check_start, finish, null_vector, singular_at_start, Ruled, StepRule};
 use super::multipliers::Monodromy;
+use crate::branch::Branch;
 use crate::broyden::SolveError;
 use crate::continuation::turn;
 use crate::family::{Family, FamilyBranch};
-use crate::fold::Branch;
 use crate::ihb::HbError;
 use ivt_num::vector::norm2;
 use ivt_num::{newton, BorderedLu, LuWorkspace, NewtonSystem, NewtonWorkspace};

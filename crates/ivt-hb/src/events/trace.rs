@@ -16,9 +16,9 @@ use super::fold::Fold;
 use super::multipliers::Multipliers;
 use super::neimark_sacker::NeimarkSacker;
 use super::period_doubling::PeriodDoubling;
-use crate::continuation::{ContinuationOptions, Corrector, PathPoint, Termination};
+use crate::branch::Branch;
+use crate::continuation::{ContinuationOptions, Corrector, PathPoint, Step, Termination};
 use crate::family::{Family, FamilyBranch};
-use crate::fold::Branch;
 use crate::ihb::HbError;
 use crate::stability::{AdaptiveHsu, HsuSteps};
 
@@ -207,34 +207,22 @@ pub fn trace<F: Family>(
     copts.lambda_max = lambda0.max(opts.lambda_to);
     let mut observer = EventObserver::new(branch, lambda0, opts.stability, &opts.locate)?;
     let mut events = Vec::new();
-    let mut failed = None;
-    // The one call of the continuation driver: the observer sees each
-    // point as it is reached.
-    let path = branch.follow(
-        &x0,
-        0,
-        opts.lambda_to - lambda0,
-        &copts,
-        opts.corrector,
-        |branch, p| {
-            if failed.is_none() {
-                match observer.on_point(branch, p) {
-                    Ok(found) => events.extend(found),
-                    Err(e) => failed = Some(e),
-                }
-            }
-        },
-    )?;
-    if let Some(e) = failed {
-        return Err(e.into());
-    }
+    // The one continuation driver: the observer sees each point as it is
+    // reached, and its error ends the path.
+    let mut stepper = branch.stepper(&x0, 0, opts.lambda_to - lambda0, &copts, opts.corrector)?;
+    let termination = loop {
+        match stepper.next() {
+            Step::Point(p) => events.extend(observer.on_point(stepper.branch(), &p)?),
+            Step::Stop(t) => break t,
+        }
+    };
     // An event is reported when the point after its start has arrived; a
     // fold's start may precede a bracket reported before it.
     events.sort_by_key(|e| (e.index, e.kind));
     Ok(Trace {
         points: observer.into_points(),
         events,
-        termination: path.termination,
+        termination,
     })
 }
 
@@ -269,12 +257,14 @@ mod tests {
         let mut arrived = Vec::new();
         let mut count = 0;
         let path = branch
-            .follow(&x0, 0, 1.0, &copts, Corrector::Newton, |b, p| {
+            .stepper(&x0, 0, 1.0, &copts, Corrector::Newton)
+            .unwrap()
+            .run(|b, p| {
                 let found = observer.on_point(b, p).unwrap();
                 arrived.extend(found.into_iter().map(|e| (count, e)));
                 count += 1;
-            })
-            .unwrap();
+                true
+            });
         assert_eq!(path.termination, Termination::LeftInterval);
         let n = path.points.len();
         assert_eq!(arrived.len(), 2, "{arrived:?}");

@@ -9,10 +9,10 @@
 
 use super::{finite, pairs, stability_steps, Array};
 use crate::autonomous::LimitCycle;
-use crate::events::BifurcationKind;
 use crate::continuation::{ContinuationOptions, Termination};
 use crate::cycle_branch::{cycle_branch as trace_cycles, CycleBranchOptions};
 use crate::error::HbError;
+use crate::events::BifurcationKind;
 use crate::ihb::HbOptions;
 use crate::problem::PeriodicProblem;
 use crate::stability::StabilityKind;

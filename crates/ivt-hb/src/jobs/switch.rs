@@ -26,12 +26,12 @@
 
 use super::frc::{trace_error, traced_curve};
 use super::{finite, FoldPoint, FrcCurve, FrcRequest};
-use crate::events::extended::{border_null_vectors, jacobian_blocks, put_jacobian};
-use crate::events::{dot, Bifurcation, BifurcationKind, LocateOptions};
+use crate::branch::Branch;
 use crate::continuation::Corrector;
 use crate::error::HbError;
+use crate::events::extended::{border_null_vectors, jacobian_blocks, put_jacobian};
+use crate::events::{dot, Bifurcation, BifurcationKind, LocateOptions};
 use crate::family::{Family, FamilyBranch, Frequency};
-use crate::fold::Branch;
 use crate::ihb::HbOptions;
 use crate::problem::PeriodicProblem;
 use crate::switching::{period_doubled_start, switch_branch};

@@ -1,6 +1,6 @@
 //! Frequency–response curves ‖a‖(ω) of the string (Figs. 34–36): the STHB
 //! residual followed in ω by the engine's exact-Jacobian pseudo-arclength
-//! ([`pseudo_arclength_exact`], Eq. 68–77 with the exact `J` of Eq. 115–125),
+//! ([`NewtonCorrector`], Eq. 68–77 with the exact `J` of Eq. 115–125),
 //! with a stability verdict per point.
 //!
 //! Stability per point: the RK4 monodromy matrix (cheap, `O(N³)` per step);
@@ -20,9 +20,10 @@ use super::stability::{
     hill, hill_dim, monodromy, monodromy_refined, Stability, StabilityMethod, HILL_MAX_DIM,
 };
 use super::StringHb;
+use crate::branch::Branch;
 use crate::broyden::BroydenOptions;
 use crate::continuation::{
-    pseudo_arclength_exact, ContinuationOptions, Path, PathPoint, Termination,
+    ContinuationOptions, NewtonCorrector, Path, PathPoint, Stepper, Termination,
 };
 use crate::error::HbError;
 use crate::events::{locate_fold, LocateOptions};
@@ -141,14 +142,18 @@ where
     copts.lambda_min = omega_from.min(omega_to);
     copts.lambda_max = omega_from.max(omega_to);
     let direction = if omega_to >= omega_from { 1.0 } else { -1.0 };
-    let mut path = pseudo_arclength_exact(
-        &mut system,
-        &reduced,
-        first.iterations,
-        direction,
-        &copts,
-        on_point,
-    )?;
+    let mut path = {
+        let m_len = system.len();
+        Stepper::new(
+            &mut system,
+            Box::new(NewtonCorrector::new(m_len, &copts)),
+            &reduced,
+            first.iterations,
+            direction,
+            &copts,
+        )?
+        .run(on_point)
+    };
     if let Termination::StepTooSmall(e) = &path.termination {
         return Err(HbError::Stalled {
             omega: path.points.last().map_or(omega_from, PathPoint::lambda),

@@ -21,13 +21,12 @@
 #![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
 #![cfg_attr(not(test), deny(clippy::unimplemented))]
 
-use faer::Mat;
+use faer::{Mat, MatMut};
 use ivt_num::vector::dot;
 
 use super::toeplitz::add_real_toeplitz_odd;
 use super::{Boundary, StringHb};
-use crate::continuation::PathSystem;
-use crate::fold::Branch;
+use crate::branch::Branch;
 
 /// Marks a full index outside the subspace.
 const OUTSIDE: usize = usize::MAX;
@@ -107,8 +106,8 @@ impl Subspace {
     }
 }
 
-/// [`StringHb`] restricted to its invariant subspace, as a path in ω
-/// ([`PathSystem`]) and as a [`Branch`] for the bordered fold system, with the
+/// [`StringHb`] restricted to its invariant subspace, as a [`Branch`] in ω
+/// (the path and the bordered fold system), with the
 /// exact Jacobian's block of the subspace (Eq. 115–125) and exact derivatives
 /// of the fold test function: `∂R/∂ω = ∂J_lin/∂ω a` (the balanced term does
 /// not depend on ω), `∂(wᵀJv)/∂ω = wᵀ ∂J_lin/∂ω v`, and `∂(wᵀJv)/∂a` from
@@ -124,7 +123,8 @@ pub(super) struct ReducedString<'a> {
     full_r: Vec<f64>,
     /// The full Jacobian, only when the harmonics are not reduced (odd `M_s`).
     full_jac: Mat<f64>,
-    jac: Mat<f64>,
+    /// Row-major `m × m` scratch of [`Self::jacobian_transpose_times`].
+    jac: Vec<f64>,
     r: Vec<f64>,
 }
 
@@ -141,7 +141,7 @@ impl<'a> ReducedString<'a> {
             } else {
                 Mat::zeros(n, n)
             },
-            jac: Mat::zeros(m, m),
+            jac: vec![0.0; m * m],
             r: vec![0.0; m],
             hb,
             sub,
@@ -150,7 +150,7 @@ impl<'a> ReducedString<'a> {
     }
 
     /// The subspace's block of `J` at the last linearization into `jac`.
-    fn fill_jacobian(&mut self, omega: f64, jac: &mut Mat<f64>) {
+    fn fill_jacobian(&mut self, omega: f64, mut jac: MatMut<'_, f64>) {
         if !self.sub.odd_harmonics {
             self.hb.fill_jacobian(omega, &mut self.full_jac);
             for (r, &fr) in self.sub.full_index.iter().enumerate() {
@@ -174,45 +174,23 @@ impl<'a> ReducedString<'a> {
             self.hb.params().harmonics,
             -1.0,
             &self.sub.coords,
-            jac.as_mut(),
+            jac,
         );
     }
 
     /// `J(a)ᵀ w` (reduced) into `out`.
     fn jacobian_transpose_times(&mut self, a: &[f64], omega: f64, w: &[f64], out: &mut [f64]) {
-        let mut jac = std::mem::replace(&mut self.jac, Mat::zeros(0, 0));
+        let mut jac = std::mem::take(&mut self.jac);
         let mut r = std::mem::take(&mut self.r);
         self.residual_jacobian(a, omega, &mut r, &mut jac);
-        for (j, o) in out.iter_mut().enumerate() {
-            *o = w.iter().enumerate().map(|(i, y)| jac[(i, j)] * y).sum();
+        out.fill(0.0);
+        for (row, y) in jac.chunks_exact(out.len().max(1)).zip(w) {
+            for (o, v) in out.iter_mut().zip(row) {
+                *o += v * y;
+            }
         }
         self.jac = jac;
         self.r = r;
-    }
-}
-
-impl PathSystem for ReducedString<'_> {
-    fn dim(&self) -> usize {
-        self.sub.dim()
-    }
-    fn residual(&mut self, u: &[f64], lambda: f64, r: &mut [f64]) {
-        self.sub.embed(u, &mut self.full);
-        self.hb.residual(&self.full, lambda, &mut self.full_r);
-        self.sub.gather(&self.full_r, r);
-    }
-    fn residual_jacobian(&mut self, u: &[f64], lambda: f64, r: &mut [f64], jac: &mut Mat<f64>) {
-        self.jacobians += 1;
-        self.sub.embed(u, &mut self.full);
-        self.hb
-            .residual_linearized(&self.full, lambda, &mut self.full_r);
-        self.sub.gather(&self.full_r, r);
-        self.fill_jacobian(lambda, jac);
-    }
-    fn d_residual_d_lambda(&mut self, u: &[f64], lambda: f64, r_lambda: &mut [f64]) {
-        self.sub.embed(u, &mut self.full);
-        self.hb
-            .d_residual_d_omega(&self.full, lambda, &mut self.full_r);
-        self.sub.gather(&self.full_r, r_lambda);
     }
 }
 
@@ -221,28 +199,36 @@ impl Branch for ReducedString<'_> {
         self.sub.dim()
     }
     fn residual(&mut self, q: &[f64], lambda: f64, r: &mut [f64]) {
-        PathSystem::residual(self, q, lambda, r);
+        self.sub.embed(q, &mut self.full);
+        self.hb.residual(&self.full, lambda, &mut self.full_r);
+        self.sub.gather(&self.full_r, r);
     }
-    fn jacobian(&mut self, q: &[f64], lambda: f64, out: &mut [f64]) {
-        let mut jac = std::mem::replace(&mut self.jac, Mat::zeros(0, 0));
+    /// `J` alone costs the linearization that gives `R` too.
+    fn jacobian(&mut self, q: &[f64], lambda: f64, jac: &mut [f64]) {
         let mut r = std::mem::take(&mut self.r);
-        self.residual_jacobian(q, lambda, &mut r, &mut jac);
-        let m = r.len();
-        for (i, row) in out.chunks_exact_mut(m).enumerate() {
-            for (j, v) in row.iter_mut().enumerate() {
-                *v = jac[(i, j)];
-            }
-        }
-        self.jac = jac;
+        self.residual_jacobian(q, lambda, &mut r, jac);
         self.r = r;
     }
+    fn residual_jacobian(&mut self, q: &[f64], lambda: f64, r: &mut [f64], jac: &mut [f64]) {
+        self.jacobians += 1;
+        self.sub.embed(q, &mut self.full);
+        self.hb
+            .residual_linearized(&self.full, lambda, &mut self.full_r);
+        self.sub.gather(&self.full_r, r);
+        let m = r.len();
+        self.fill_jacobian(lambda, MatMut::from_row_major_slice_mut(jac, m, m));
+    }
+    /// Exact: `∂J_lin/∂ω a` (the balanced term does not depend on ω).
     fn residual_lambda(&mut self, q: &[f64], lambda: f64, _h: f64, out: &mut [f64]) {
-        self.d_residual_d_lambda(q, lambda, out);
+        self.sub.embed(q, &mut self.full);
+        self.hb
+            .d_residual_d_omega(&self.full, lambda, &mut self.full_r);
+        self.sub.gather(&self.full_r, out);
     }
     fn bilinear_lambda(&mut self, _q: &[f64], lambda: f64, _h: f64, w: &[f64], v: &[f64]) -> f64 {
         // ∂J/∂ω = ∂J_lin/∂ω, and ∂R/∂ω at `v` is ∂J_lin/∂ω v.
         let mut jv = std::mem::take(&mut self.r);
-        self.d_residual_d_lambda(v, lambda, &mut jv);
+        self.residual_lambda(v, lambda, 0.0, &mut jv);
         let value = dot(w, &jv);
         self.r = jv;
         value
@@ -274,7 +260,7 @@ impl Branch for ReducedString<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fold::fd_jacobian_gradient;
+    use crate::branch::fd_jacobian_gradient;
     use crate::sthb::StringParams;
 
     /// A response on the branch from rest at `omega` (in the subspace).
@@ -324,7 +310,7 @@ mod tests {
                 .map(|i| a[i].abs())
                 .fold(0.0, f64::max);
             assert!(outside < 1e-14, "{p:?}: {outside:e} outside");
-            let (mut rr, mut red) = (vec![0.0; m], Mat::zeros(m, m));
+            let (mut rr, mut red) = (vec![0.0; m], vec![0.0; m * m]);
             sys.residual_jacobian(&q, 3.8, &mut rr, &mut red);
             let pos = &sys.sub.position;
             for i in 0..n {
@@ -333,7 +319,7 @@ mod tests {
                     let err = match (pos[i], pos[j]) {
                         (OUTSIDE, OUTSIDE) => 0.0,
                         (OUTSIDE, _) | (_, OUTSIDE) => v.abs(),
-                        (ri, rj) => (red[(ri, rj)] - v).abs(),
+                        (ri, rj) => (red[ri * m + rj] - v).abs(),
                     };
                     assert!(err <= 1e-13 * scale, "{p:?} ({i}, {j}): {err:e}");
                 }
@@ -370,7 +356,7 @@ mod tests {
             // ∂(wᵀJv)/∂ω against the central difference of wᵀJv in ω.
             let h = 1e-4;
             let exact_w = sys.bilinear_lambda(&q, 3.8, h, &w, &v);
-            let fd_w = crate::fold::bilinear_lambda_difference(&mut sys, &q, 3.8, h, &w, &v);
+            let fd_w = crate::branch::bilinear_lambda_difference(&mut sys, &q, 3.8, h, &w, &v);
             assert!((exact_w - fd_w).abs() <= 1e-6 * exact_w.abs().max(1.0));
         }
     }

@@ -3,7 +3,7 @@
 //!
 //! The residual is [`StringHb`] with [`super::Boundary::Spring`] (Tau rows
 //! Eq. 134–136); the path follower is the engine's
-//! [`crate::continuation::pseudo_arclength`], whose corrector is Broyden's
+//! [`crate::continuation::Stepper`] with [`crate::continuation::BroydenCorrector`]: Broyden's
 //! method (Eq. 66–67) with the exact augmenting row. It is seeded once with the
 //! exact STHB Jacobian `[J | ∂R/∂ω]` at the start point; afterwards only
 //! rank-one updates (and the engine's Jacobian refresh if Broyden stalls).
@@ -14,7 +14,8 @@
 
 use faer::Mat;
 
-use crate::continuation::{pseudo_arclength, ContinuationOptions, Termination};
+use crate::branch::ResidualBranch;
+use crate::continuation::{BroydenCorrector, ContinuationOptions, Stepper, Termination};
 
 use super::{StringHb, StringParams};
 use crate::error::HbError;
@@ -78,12 +79,17 @@ pub fn spring_frequency_response(
         Some((&omega, a)) => hb.residual(a, omega, out),
         None => out.fill(f64::NAN),
     };
-    let path = pseudo_arclength(residual, &start, Some(&jac0), 1.0, &opts, |p| {
-        if std::env::var_os("IVT_STHB_TRACE").is_some() {
-            eprintln!("spring point ω = {:.5} its {}", p.lambda(), p.iterations);
-        }
-        true
-    })?;
+    let path = {
+        let m_len = start.len().saturating_sub(1);
+        let mut residual_branch = ResidualBranch::new(m_len, residual);
+        let corrector = Box::new(BroydenCorrector::new(m_len, &opts.broyden, Some(&jac0)));
+        Stepper::new(&mut residual_branch, corrector, &start, 0, 1.0, &opts)?.run(|_, p| {
+            if std::env::var_os("IVT_STHB_TRACE").is_some() {
+                eprintln!("spring point ω = {:.5} its {}", p.lambda(), p.iterations);
+            }
+            true
+        })
+    };
     let points = path
         .points
         .iter()

@@ -2,7 +2,7 @@
 //! against differences of the assembled Jacobian.
 
 use super::*;
-use crate::fold::fd_jacobian_gradient;
+use crate::branch::fd_jacobian_gradient;
 use crate::ihb::HbOptions;
 use crate::problem::PeriodicProblem;
 
