@@ -139,10 +139,12 @@ fn point_dict<'py>(py: Python<'py>, p: &CondensedPoint) -> PyResult<Bound<'py, P
     }
     d.set_item("dof_coeffs", dofs)?;
     d.set_item("solve_error", p.solve_error)?;
+    d.set_item("data_error", p.data_error)?;
+    d.set_item("orbit_error", p.orbit_error)?;
     d.set_item("truncation_error", p.truncation_error)?;
     d.set_item(
         "error_estimate",
-        p.solve_error + p.truncation_error.unwrap_or(0.0),
+        p.orbit_error + p.truncation_error.unwrap_or(0.0),
     )?;
     match &p.floquet {
         Some(f) => {
@@ -271,7 +273,7 @@ fn positive(name: &str, v: f64) -> PyResult<f64> {
 /// One orbit of a large structure at `omega` (private: `ivt.hb.solve` calls
 /// it as [`frc_large`]): Newton on the condensed system from the linear
 /// response. Returns the point dict of [`frc_large`] ({"coeffs", "omega",
-/// "amplitude", "dof_coeffs", "solve_error", "truncation_error",
+/// "amplitude", "dof_coeffs", "solve_error", "data_error", "orbit_error", "truncation_error",
 /// "error_estimate", "multipliers", "stable", "stability",
 /// "multiplier_error"}).
 #[pyfunction]

@@ -20,6 +20,11 @@ use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{c64, Mat, MatMut, MatRef};
 
+/// Units of rounding (ε) per stored entry of `M` and `C` in
+/// [`Structure::data_error`]: an assembled entry is a sum of element
+/// products (`α·m_e + β·k_e` over two elements: four roundings of ε/2).
+pub const DATA_ULPS: f64 = 2.0;
+
 /// Refinement steps at most per solve.
 const MAX_REFINEMENTS: usize = 8;
 
@@ -226,6 +231,34 @@ impl Structure {
                 out[rows[p]] += values[p] * xj;
             }
         }
+    }
+
+    /// The first-order relative change of the receptances `x_a = X[dofs[a], a]`
+    /// (`X = D(w)⁻¹ E_S`, the columns of `x`) when each stored entry of `M`
+    /// and `C` moves by [`DATA_ULPS`] units of rounding:
+    /// `δH_aa ≤ DATA_ULPS·ε Σ_ij |X_ia| (w²|M_ij| + w|C_ij|) |X_ja|` (with
+    /// `D⁻ᵀ = D⁻¹`; for a non-symmetric structure the same sum is taken as
+    /// the estimate). What rounding the element formulas into the stored
+    /// matrices moves: the model's own data error, which no solver of the
+    /// stored matrices removes. `K` counts as exact (the cantilever's are
+    /// integers): its rounding would weigh κ(K)·ε.
+    pub fn data_error(&self, w: f64, x: MatRef<'_, c64>, dofs: &[usize]) -> f64 {
+        let rows = self.pattern.row_idx();
+        let mut worst = 0.0f64;
+        for (a, &d) in dofs.iter().enumerate().take(x.ncols()) {
+            let col = x.col(a);
+            let mut sum = 0.0;
+            for (j, xj) in col.iter().enumerate() {
+                for p in self.pattern.col_range(j) {
+                    let weight = w * w * self.m[p].abs() + w * self.c[p].abs();
+                    sum += col[rows[p]].norm() * weight * xj.norm();
+                }
+            }
+            let h = col.iter().nth(d).map_or(0.0, |z| z.norm());
+            let rel = DATA_ULPS * f64::EPSILON * sum / h;
+            worst = worst.max(if rel.is_nan() { f64::INFINITY } else { rel });
+        }
+        worst
     }
 
     /// `out = (−2wM + iC) X`: `∂D/∂w` applied to the columns of `x`.

@@ -35,6 +35,9 @@ pub struct Receptances {
     pub responses: Vec<Mat<c64>>,
     /// Largest estimated relative error of the refined solves.
     pub solve_error: f64,
+    /// Largest relative change of `H_SS` from the rounding of the stored
+    /// `M` and `C` ([`Structure::data_error`]).
+    pub data_error: f64,
 }
 
 /// Where the receptances act: the nonlinear DOFs, the load vector and its
@@ -80,11 +83,13 @@ impl Receptances {
             d_response: Vec::with_capacity(harmonics + 1),
             responses: Vec::with_capacity(harmonics + 1),
             solve_error: 0.0,
+            data_error: 0.0,
         };
         for h in 0..=harmonics {
             let w = h as f64 * omega_f / p;
             let part = harmonic(structure, coupling, h, w, h as f64 / p)?;
             out.solve_error = out.solve_error.max(part.error);
+            out.data_error = out.data_error.max(part.data_error);
             out.receptance.push(part.receptance);
             out.response.push(part.response);
             out.d_receptance.push(part.d_receptance);
@@ -103,6 +108,7 @@ struct Harmonic {
     d_response: Mat<c64>,
     responses: Mat<c64>,
     error: f64,
+    data_error: f64,
 }
 
 /// The condensed data of harmonic `h` at `w = hω`; `dw` = ∂w/∂ω_f.
@@ -145,6 +151,7 @@ fn harmonic(
             }
         }
     }
+    let data_error = structure.data_error(w, u.subcols(0, s), &coupling.dofs);
     let receptance = Mat::<c64>::from_fn(s, s, |a, b| u[(coupling.dofs[a], b)]);
     let response = Mat::<c64>::from_fn(s, 1, |a, _| u[(coupling.dofs[a], s)]);
     // ∂H_SS/∂ω_f = −Wᵀ D′ U_S, ∂u_S/∂ω_f = −Wᵀ D′ u with W = D⁻ᵀ e_S.
@@ -176,5 +183,6 @@ fn harmonic(
         d_response,
         responses: u,
         error,
+        data_error,
     })
 }

@@ -3,6 +3,8 @@
 //! of the fine cantilever (an independent method: no LU of faer, no
 //! refinement, twice the working precision).
 
+#![allow(dead_code)] // each test binary uses its own subset
+
 use faer::sparse::SparseColMatRef;
 
 /// A double-double `hi + lo`, |lo| ≤ ulp(hi)/2.
