@@ -5,7 +5,7 @@
 
 use faer::c64;
 use ivt_hb::condense::{Coupling, Receptances, Structure};
-use ivt_hb::models::cantilever;
+use ivt_hb::models::{cantilever, BeamProperties};
 
 fn main() {
     divan::main();
@@ -13,7 +13,7 @@ fn main() {
 
 #[divan::bench(args = [50, 250, 500, 1000])]
 fn receptances_n7(bencher: divan::Bencher, n_elements: usize) {
-    let beam = cantilever(n_elements, 1.0, 1.0, 1.0, 0.07, 2e-4).expect("valid beam");
+    let beam = cantilever(n_elements, &BeamProperties::default()).expect("valid beam");
     let s = &beam.model;
     let structure = Structure::new(s.m.as_ref(), s.c.as_ref(), s.k.as_ref()).expect("structure");
     let mut load = vec![c64::new(0.0, 0.0); s.n_dof()];
@@ -35,7 +35,7 @@ fn receptances_n7(bencher: divan::Bencher, n_elements: usize) {
 fn beam_curve_n500(bencher: divan::Bencher) {
     use ivt_hb::condense::{condensed_response, CondensedBranch, CondensedFrcOptions};
     use ivt_hb::{GeneralProblem, HbOptions};
-    let beam = cantilever(500, 1.0, 1.0, 1.0, 0.07, 2e-4).expect("valid beam");
+    let beam = cantilever(500, &BeamProperties::default()).expect("valid beam");
     let s = &beam.model;
     let structure = Structure::new(s.m.as_ref(), s.c.as_ref(), s.k.as_ref()).expect("structure");
     let mut load = vec![0.0; s.n_dof()];

@@ -352,7 +352,14 @@ fn cantilever_coo<'py>(
     alpha: f64,
     beta: f64,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let beam = ivt_hb::models::cantilever(n_elements, length, ei, rho_a, alpha, beta)
+    let props = ivt_hb::models::BeamProperties {
+        length,
+        ei,
+        rho_a,
+        alpha,
+        beta,
+    };
+    let beam = ivt_hb::models::cantilever(n_elements, &props)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     let mats = beam.model.triplets().map(|t| {
         let rows: Vec<usize> = t.iter().map(|e| e.0).collect();

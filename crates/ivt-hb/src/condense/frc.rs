@@ -5,6 +5,11 @@
 //! point, and per point the estimated errors of the linear solves and of the
 //! harmonic truncation.
 
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
 use super::branch::CondensedBranch;
 use super::estimate::truncation_error;
 use super::scaled::Scaled;
@@ -135,7 +140,8 @@ pub fn condensed_response<P: PeriodicProblem>(
         ));
     }
     let n_dof = branch.structure().n_dof();
-    let amp_dof = opts.amplitude_dof.unwrap_or(branch.dofs()[0]);
+    let first = branch.dofs().first().copied().unwrap_or(0);
+    let amp_dof = opts.amplitude_dof.unwrap_or(first);
     if let Some(bad) = opts
         .record_dofs
         .iter()
@@ -168,7 +174,7 @@ pub fn condensed_response<P: PeriodicProblem>(
     let mut points = Vec::new();
     let mut failed = None;
     let path = pseudo_arclength_exact(&mut scaled, &x, its, direction, &copts, |sc, p| {
-        let (q, omega_f) = sc.physical(&p.x[..m], p.lambda());
+        let (q, omega_f) = sc.physical(p.x.get(..m).unwrap_or_default(), p.lambda());
         let point = probe.point(
             sc.branch,
             &q,
@@ -251,8 +257,8 @@ pub fn correct_condensed<P: PeriodicProblem>(
     let mut copts = ContinuationOptions::default();
     copts.broyden.tol = rtol;
     let steps = correct_at_fixed_lambda(&mut scaled, &mut x, &copts)?;
-    let (physical, _) = scaled.physical(&x[..q.len()], 0.0);
-    q.copy_from_slice(&physical);
+    let (physical, _) = scaled.physical(&x, 0.0);
+    q.iter_mut().zip(&physical).for_each(|(a, b)| *a = *b);
     Ok(steps)
 }
 
@@ -264,10 +270,10 @@ fn load_scale<P: PeriodicProblem>(
 ) -> Result<f64, HbError> {
     let p = branch.options().subharmonic;
     let rc = branch.receptances(omega_f)?;
-    let f = &rc.response[p];
-    let norm = (0..f.nrows())
-        .map(|i| f[(i, 0)].norm_sqr())
-        .sum::<f64>()
+    let norm = rc
+        .response
+        .get(p)
+        .map_or(0.0, |f| f.col(0).iter().map(|z| z.norm_sqr()).sum::<f64>())
         .sqrt();
     Ok(if norm > 0.0 { norm } else { 1.0 })
 }
@@ -316,8 +322,9 @@ fn orbit_error<P: PeriodicProblem>(
     for (i, row) in bordered.chunks_exact_mut(k).enumerate() {
         match (jac.get(i * m..(i + 1) * m), r_omega.get(i)) {
             (Some(j), Some(&w)) => {
-                row[..m].copy_from_slice(j);
-                row[m] = w;
+                row.iter_mut()
+                    .zip(j.iter().chain([&w]))
+                    .for_each(|(a, b)| *a = *b);
             }
             _ => row.copy_from_slice(&tangent),
         }
@@ -425,7 +432,7 @@ impl Probe {
     ) -> Result<f64, HbError> {
         let l = self.aft.coeff_len();
         match self.amp_local {
-            Some(d) => Ok(self.max_abs(&q[d * l..(d + 1) * l])),
+            Some(d) => Ok(self.max_abs(q.get(d * l..(d + 1) * l).unwrap_or_default())),
             None => {
                 let coeffs = branch.recover(q, omega_f, &[self.amp_dof])?;
                 Ok(coeffs.first().map(|c| self.max_abs(c)).unwrap_or(0.0))
@@ -443,8 +450,8 @@ impl Probe {
     ) -> Result<CondensedPoint, HbError> {
         let amplitude = self.amplitude(branch, q, omega_f)?;
         let recovered = branch.recover(q, omega_f, &self.record)?;
-        let rc = branch.receptances(omega_f)?;
-        let (solve_error, data_error) = (rc.solve_error, rc.data_error);
+        let solve_error = branch.receptances(omega_f)?.solve_error;
+        let data_error = branch.data_error(omega_f)?;
         let orbit_error = orbit_error(branch, q, omega_f, solve_error + data_error);
         let truncation_error = if truncation {
             Some(truncation_error(branch, q, omega_f)?)
