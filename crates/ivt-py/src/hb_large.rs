@@ -227,15 +227,8 @@ fn frc_large<'py>(
     truncation_estimate: bool,
     stability: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let large = Large::new(
-        n_dof,
-        (m, c, k),
-        (g, jac),
-        f,
-        nonlinear_dofs,
-        hb_options(n, samples)?,
-        [velocity_dependent, vectorized],
-    );
+    let (hb, flags) = (hb_options(n, samples)?, [velocity_dependent, vectorized]);
+    let large = Large::new(n_dof, (m, c, k), (g, jac), f, nonlinear_dofs, hb, flags);
     let mut opts = CondensedFrcOptions {
         from: finite("omega_from", omega_from)?,
         to: finite("omega_to", omega_to)?,
@@ -278,40 +271,33 @@ fn positive(name: &str, v: f64) -> PyResult<f64> {
 /// "multiplier_error"}).
 #[pyfunction]
 #[pyo3(signature = (
-    n_dof, m, c, k, g, f, omega, nonlinear_dofs, amplitude_dof = None,
-    record_dofs = Vec::new(), n = 7, samples = 32, velocity_dependent = true,
-    vectorized = false, rtol = 1e-12, jac = None, stability = true
+    n_dof, m, c, k, g, f, omega, nonlinear_dofs, stability = true, rtol = 1e-12,
+    jac = None, record_dofs = Vec::new(), amplitude_dof = None, vectorized = false,
+    velocity_dependent = true, samples = 32, n = 7
 ))]
 #[allow(clippy::too_many_arguments)]
 fn solve_large<'py>(
-    py: Python<'py>,
     n_dof: usize,
     m: Coo,
     c: Coo,
+    py: Python<'py>,
     k: Coo,
     g: Bound<'py, PyAny>,
     f: (Vec<f64>, Vec<f64>),
     omega: f64,
     nonlinear_dofs: Vec<usize>,
-    amplitude_dof: Option<usize>,
-    record_dofs: Vec<usize>,
-    n: usize,
-    samples: usize,
-    velocity_dependent: bool,
-    vectorized: bool,
+    stability: bool,
     rtol: f64,
     jac: Option<Bound<'py, PyAny>>,
-    stability: bool,
+    record_dofs: Vec<usize>,
+    amplitude_dof: Option<usize>,
+    vectorized: bool,
+    velocity_dependent: bool,
+    samples: usize,
+    n: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let large = Large::new(
-        n_dof,
-        (m, c, k),
-        (g, jac),
-        f,
-        nonlinear_dofs,
-        hb_options(n, samples)?,
-        [velocity_dependent, vectorized],
-    );
+    let (hb, flags) = (hb_options(n, samples)?, [velocity_dependent, vectorized]);
+    let large = Large::new(n_dof, (m, c, k), (g, jac), f, nonlinear_dofs, hb, flags);
     let omega = positive("omega", finite("omega", omega)?)?;
     let rtol = positive("rtol", rtol)?;
     let point = large.run(py, move |branch| {
