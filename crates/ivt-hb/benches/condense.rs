@@ -5,7 +5,7 @@
 
 use faer::c64;
 use ivt_hb::condense::{Coupling, Receptances, Structure};
-use ivt_hb::models::cantilever;
+use ivt_hb::models::{cantilever, BeamProperties};
 
 fn main() {
     divan::main();
@@ -13,7 +13,7 @@ fn main() {
 
 #[divan::bench(args = [50, 250, 500, 1000])]
 fn receptances_n7(bencher: divan::Bencher, n_elements: usize) {
-    let beam = cantilever(n_elements, 1.0, 1.0, 1.0, 0.07, 2e-4).expect("valid beam");
+    let beam = cantilever(n_elements, &BeamProperties::default()).expect("valid beam");
     let s = &beam.model;
     let structure = Structure::new(s.m.as_ref(), s.c.as_ref(), s.k.as_ref()).expect("structure");
     let mut load = vec![c64::new(0.0, 0.0); s.n_dof()];
@@ -26,4 +26,49 @@ fn receptances_n7(bencher: divan::Bencher, n_elements: usize) {
     bencher.bench_local(|| {
         Receptances::new(&structure, &coupling, 7, divan::black_box(3.7)).expect("receptances")
     });
+}
+
+/// The acceptance curve of issue 28: the N = 500 cantilever (1000 DOFs),
+/// 0.7–1.3 ω₁, n = 7, folds, truncation estimates and multipliers at every
+/// point (what `ivt.hb.frc` runs, without Python's callbacks).
+#[divan::bench(sample_count = 3)]
+fn beam_curve_n500(bencher: divan::Bencher) {
+    use ivt_hb::condense::{condensed_response, CondensedBranch, CondensedFrcOptions};
+    use ivt_hb::{GeneralProblem, HbOptions};
+    let beam = cantilever(500, &BeamProperties::default()).expect("valid beam");
+    let s = &beam.model;
+    let structure = Structure::new(s.m.as_ref(), s.c.as_ref(), s.k.as_ref()).expect("structure");
+    let mut load = vec![0.0; s.n_dof()];
+    load[beam.tip] = 0.005;
+    let w1 = 3.516_015_268_066_119;
+    let opts = CondensedFrcOptions {
+        from: 0.7 * w1,
+        to: 1.3 * w1,
+        ..CondensedFrcOptions::default()
+    };
+    bencher.bench_local(|| {
+        let zero = || vec![0.0];
+        let local = GeneralProblem::new(1, zero(), zero(), zero(), spring, unforced)
+            .with_velocity_dependent(false);
+        let mut branch = CondensedBranch::new(
+            structure.clone(),
+            vec![beam.tip],
+            &load,
+            &[],
+            local,
+            &HbOptions::new(7, 32),
+        )
+        .expect("branch");
+        condensed_response(&mut branch, &opts).expect("curve")
+    });
+}
+
+/// The tip's cubic spring 200 x³.
+fn spring(x: &[f64], _v: &[f64], _t: f64, g: &mut [f64]) {
+    g[0] = 200.0 * x[0].powi(3);
+}
+
+/// No force on the local DOF (the load vector carries it).
+fn unforced(_t: f64, f: &mut [f64]) {
+    f[0] = 0.0;
 }

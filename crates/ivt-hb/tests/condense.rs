@@ -17,7 +17,7 @@ use faer::{c64, Mat};
 use ivt_hb::condense::{
     condensed_response, correct_condensed, CondensedFrc, CondensedFrcOptions, Structure,
 };
-use ivt_hb::models::cantilever;
+use ivt_hb::models::{cantilever, BeamProperties};
 use ivt_hb::{
     locate_fold, ClassicIhb, FamilyBranch, Frequency, GeneralProblem, HbOptions, LocateOptions,
     PeriodicProblem,
@@ -158,7 +158,7 @@ fn refined_receptances_equal_a_double_double_elimination() {
     // 7e-12 for N = 50 (measured), which no solver of the stored matrices
     // can undo.
     for n in [50usize, 500] {
-        let b = cantilever(n, 1.0, 1.0, 1.0, 0.07, 2e-4).unwrap();
+        let b = cantilever(n, &BeamProperties::default()).unwrap();
         let s = &b.model;
         let st = Structure::new(s.m.as_ref(), s.c.as_ref(), s.k.as_ref()).unwrap();
         for w in [0.0, 3.3, OMEGA1, 3.9, 11.0, 15.4, 22.0] {

@@ -139,10 +139,12 @@ fn point_dict<'py>(py: Python<'py>, p: &CondensedPoint) -> PyResult<Bound<'py, P
     }
     d.set_item("dof_coeffs", dofs)?;
     d.set_item("solve_error", p.solve_error)?;
+    d.set_item("data_error", p.data_error)?;
+    d.set_item("orbit_error", p.orbit_error)?;
     d.set_item("truncation_error", p.truncation_error)?;
     d.set_item(
         "error_estimate",
-        p.solve_error + p.truncation_error.unwrap_or(0.0),
+        p.orbit_error + p.truncation_error.unwrap_or(0.0),
     )?;
     match &p.floquet {
         Some(f) => {
@@ -225,15 +227,8 @@ fn frc_large<'py>(
     truncation_estimate: bool,
     stability: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let large = Large::new(
-        n_dof,
-        (m, c, k),
-        (g, jac),
-        f,
-        nonlinear_dofs,
-        hb_options(n, samples)?,
-        [velocity_dependent, vectorized],
-    );
+    let (hb, flags) = (hb_options(n, samples)?, [velocity_dependent, vectorized]);
+    let large = Large::new(n_dof, (m, c, k), (g, jac), f, nonlinear_dofs, hb, flags);
     let mut opts = CondensedFrcOptions {
         from: finite("omega_from", omega_from)?,
         to: finite("omega_to", omega_to)?,
@@ -271,45 +266,38 @@ fn positive(name: &str, v: f64) -> PyResult<f64> {
 /// One orbit of a large structure at `omega` (private: `ivt.hb.solve` calls
 /// it as [`frc_large`]): Newton on the condensed system from the linear
 /// response. Returns the point dict of [`frc_large`] ({"coeffs", "omega",
-/// "amplitude", "dof_coeffs", "solve_error", "truncation_error",
+/// "amplitude", "dof_coeffs", "solve_error", "data_error", "orbit_error", "truncation_error",
 /// "error_estimate", "multipliers", "stable", "stability",
 /// "multiplier_error"}).
 #[pyfunction]
 #[pyo3(signature = (
-    n_dof, m, c, k, g, f, omega, nonlinear_dofs, amplitude_dof = None,
-    record_dofs = Vec::new(), n = 7, samples = 32, velocity_dependent = true,
-    vectorized = false, rtol = 1e-12, jac = None, stability = true
+    n_dof, m, c, k, g, f, omega, nonlinear_dofs, stability = true, rtol = 1e-12,
+    jac = None, record_dofs = Vec::new(), amplitude_dof = None, vectorized = false,
+    velocity_dependent = true, samples = 32, n = 7
 ))]
 #[allow(clippy::too_many_arguments)]
 fn solve_large<'py>(
-    py: Python<'py>,
     n_dof: usize,
     m: Coo,
     c: Coo,
+    py: Python<'py>,
     k: Coo,
     g: Bound<'py, PyAny>,
     f: (Vec<f64>, Vec<f64>),
     omega: f64,
     nonlinear_dofs: Vec<usize>,
-    amplitude_dof: Option<usize>,
-    record_dofs: Vec<usize>,
-    n: usize,
-    samples: usize,
-    velocity_dependent: bool,
-    vectorized: bool,
+    stability: bool,
     rtol: f64,
     jac: Option<Bound<'py, PyAny>>,
-    stability: bool,
+    record_dofs: Vec<usize>,
+    amplitude_dof: Option<usize>,
+    vectorized: bool,
+    velocity_dependent: bool,
+    samples: usize,
+    n: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let large = Large::new(
-        n_dof,
-        (m, c, k),
-        (g, jac),
-        f,
-        nonlinear_dofs,
-        hb_options(n, samples)?,
-        [velocity_dependent, vectorized],
-    );
+    let (hb, flags) = (hb_options(n, samples)?, [velocity_dependent, vectorized]);
+    let large = Large::new(n_dof, (m, c, k), (g, jac), f, nonlinear_dofs, hb, flags);
     let omega = positive("omega", finite("omega", omega)?)?;
     let rtol = positive("rtol", rtol)?;
     let point = large.run(py, move |branch| {
@@ -350,7 +338,14 @@ fn cantilever_coo<'py>(
     alpha: f64,
     beta: f64,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let beam = ivt_hb::models::cantilever(n_elements, length, ei, rho_a, alpha, beta)
+    let props = ivt_hb::models::BeamProperties {
+        length,
+        ei,
+        rho_a,
+        alpha,
+        beta,
+    };
+    let beam = ivt_hb::models::cantilever(n_elements, &props)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     let mats = beam.model.triplets().map(|t| {
         let rows: Vec<usize> = t.iter().map(|e| e.0).collect();

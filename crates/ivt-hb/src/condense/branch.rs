@@ -14,6 +14,11 @@
 //! `I + H ∂G/∂q` with the local Galerkin Jacobian (Eq. 56), and `∂R/∂ω_f` is
 //! exact (`∂H/∂ω_f` from transposed solves).
 
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
 use super::dynamic::Structure;
 use super::receptance::{Coupling, Receptances};
 use crate::branch::Branch;
@@ -80,7 +85,10 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
             return Err(HbError::InvalidInput("load vectors must be finite".into()));
         }
         let load = (0..n)
-            .map(|i| c64::new(load_cos[i], -load_sin.get(i).copied().unwrap_or(0.0)))
+            .map(|i| {
+                let cos = load_cos.get(i).copied().unwrap_or(0.0);
+                c64::new(cos, -load_sin.get(i).copied().unwrap_or(0.0))
+            })
             .collect();
         let res = HbResidual::new(&local, hb)?;
         let galerkin = GalerkinJacobian::new(&res);
@@ -135,8 +143,14 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
     fn ensure(&mut self, omega_f: f64) -> Result<(), HbError> {
         let fresh = self.cache.as_ref().is_some_and(|c| c.omega_f == omega_f);
         if !fresh {
-            self.cache = None;
-            let r = Receptances::new(&self.structure, &self.coupling, self.hb.harmonics, omega_f)?;
+            let previous = self.cache.take();
+            let r = Receptances::reusing(
+                &self.structure,
+                &self.coupling,
+                self.hb.harmonics,
+                omega_f,
+                previous,
+            )?;
             self.cache = Some(r);
         }
         Ok(())
@@ -147,6 +161,16 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
         self.cache
             .as_ref()
             .ok_or_else(|| HbError::InvalidInput("receptances missing".into()))
+    }
+
+    /// The relative change of the receptances at ω_f from the rounding of
+    /// the stored `M` and `C` ([`Receptances::data_error`]).
+    ///
+    /// # Errors
+    /// As [`Self::receptances`].
+    pub fn data_error(&mut self, omega_f: f64) -> Result<f64, HbError> {
+        self.ensure(omega_f)?;
+        Ok(self.cached()?.data_error(&self.structure, &self.coupling))
     }
 
     /// Takes the last receptance failure seen by the path callbacks (which
@@ -170,10 +194,10 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
         self.ensure(omega_f)?;
         let rc = self.cached()?;
         let mut q = vec![0.0; s * l];
-        let u = &rc.responses[p];
-        for (d, &dof) in self.coupling.dofs.iter().enumerate() {
-            q[d * l + p] = u[(dof, s)].re;
-            q[d * l + n + p] = -u[(dof, s)].im;
+        if let Some(u) = rc.responses.get(p) {
+            for (d, &dof) in self.coupling.dofs.iter().enumerate() {
+                put_harmonic(&mut q, n, d, p, u[(dof, s)]);
+            }
         }
         Ok(q)
     }
@@ -206,27 +230,18 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
             .iter()
             .map(|&j| {
                 let mut coeffs = vec![0.0; l];
-                for h in 0..=n {
-                    let u = &rc.responses[h];
+                for (h, u) in rc.responses.iter().enumerate().take(n + 1) {
                     let mut x = if h == p {
                         u[(j, s)]
                     } else {
                         c64::new(0.0, 0.0)
                     };
                     for b in 0..s {
-                        let g = if h == 0 {
-                            c64::new(force[b * l], 0.0)
-                        } else {
-                            c64::new(force[b * l + h], -force[b * l + n + h])
-                        };
-                        x -= u[(j, b)] * g;
+                        x -= u[(j, b)] * harmonic(force, n, b, h);
                     }
-                    if h == 0 {
-                        coeffs[0] = 2.0 * x.re;
-                    } else {
-                        coeffs[h] = x.re;
-                        coeffs[n + h] = -x.im;
-                    }
+                    // X_0 = a0/2.
+                    let x = if h == 0 { 2.0 * x } else { x };
+                    put_harmonic(&mut coeffs, n, 0, h, x);
                 }
                 coeffs
             })
@@ -245,35 +260,20 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
         out: &mut [f64],
     ) {
         let (s, n) = (self.coupling.dofs.len(), self.hb.harmonics);
-        let l = 2 * n + 1;
-        let mut g = vec![c64::new(0.0, 0.0); s];
         let zero = c64::new(0.0, 0.0);
-        for h in 0..=n {
-            for (b, gb) in g.iter_mut().enumerate() {
-                *gb = if h == 0 {
-                    c64::new(out[b * l], 0.0)
-                } else {
-                    c64::new(out[b * l + h], -out[b * l + n + h])
-                };
-            }
+        for (h, hm) in receptance.iter().enumerate().take(n + 1) {
+            let g: Vec<c64> = (0..s).map(|b| harmonic(out, n, b, h)).collect();
             for d in 0..s {
-                let mut z = response.map_or(zero, |u| -u[h][(d, 0)]);
+                let mut z = response.and_then(|u| u.get(h)).map_or(zero, |u| -u[(d, 0)]);
                 if let Some(q) = q {
-                    z += if h == 0 {
-                        c64::new(0.5 * q[d * l], 0.0)
-                    } else {
-                        c64::new(q[d * l + h], -q[d * l + n + h])
-                    };
+                    // X_0 = a0/2.
+                    let x = harmonic(q, n, d, h);
+                    z += if h == 0 { 0.5 * x } else { x };
                 }
                 for (b, gb) in g.iter().enumerate() {
-                    z += receptance[h][(d, b)] * gb;
+                    z += hm[(d, b)] * gb;
                 }
-                if h == 0 {
-                    out[d * l] = z.re;
-                } else {
-                    out[d * l + h] = z.re;
-                    out[d * l + n + h] = -z.im;
-                }
+                put_harmonic(out, n, d, h, z);
             }
         }
     }
@@ -284,41 +284,54 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
         let l = 2 * n + 1;
         let m = s * l;
         let mut rows = vec![0.0; 2 * s * m];
-        for h in 0..=n {
+        let copy = |rows: &mut [f64], slot: usize, jac: &[f64], row: usize| {
+            let dst = rows.get_mut(slot * m..(slot + 1) * m);
+            if let (Some(dst), Some(src)) = (dst, jac.get(row * m..(row + 1) * m)) {
+                dst.copy_from_slice(src);
+            }
+        };
+        for (h, hm) in rc.receptance.iter().enumerate().take(n + 1) {
             // The rows of G_h (a then b for each local DOF) before overwriting.
             for b in 0..s {
-                let (ra, rb) = (b * l + h, b * l + n + h);
-                rows[b * m..(b + 1) * m].copy_from_slice(&jac[ra * m..(ra + 1) * m]);
+                copy(&mut rows, b, jac, b * l + h);
                 if h > 0 {
-                    rows[(s + b) * m..(s + b + 1) * m].copy_from_slice(&jac[rb * m..(rb + 1) * m]);
+                    copy(&mut rows, s + b, jac, b * l + n + h);
                 }
             }
+            let at = |i: usize| rows.get(i).copied().unwrap_or(0.0);
             for d in 0..s {
                 let (ra, rb) = (d * l + h, d * l + n + h);
                 for c in 0..m {
                     let (mut re, mut im) = (0.0, 0.0);
                     for b in 0..s {
-                        let z = rc.receptance[h][(d, b)];
-                        let ja = rows[b * m + c];
+                        let z = hm[(d, b)];
+                        let ja = at(b * m + c);
                         if h == 0 {
                             re += z.re * ja;
                         } else {
-                            let jb = rows[(s + b) * m + c];
+                            let jb = at((s + b) * m + c);
                             // H (J_a − i J_b): real part, and minus the imaginary part.
                             re += z.re * ja + z.im * jb;
                             im += z.re * jb - z.im * ja;
                         }
                     }
-                    jac[ra * m + c] = re;
-                    if h > 0 {
-                        jac[rb * m + c] = im;
+                    if let Some(v) = jac.get_mut(ra * m + c) {
+                        *v = re;
+                    }
+                    if let Some(v) = jac.get_mut(rb * m + c).filter(|_| h > 0) {
+                        *v = im;
                     }
                 }
-                if h == 0 {
-                    jac[ra * m + ra] += 0.5;
+                // X_0 = a0/2: the identity's first entry is ½.
+                let diagonal = if h == 0 {
+                    [(ra, 0.5)].to_vec()
                 } else {
-                    jac[ra * m + ra] += 1.0;
-                    jac[rb * m + rb] += 1.0;
+                    vec![(ra, 1.0), (rb, 1.0)]
+                };
+                for (r, v) in diagonal {
+                    if let Some(e) = jac.get_mut(r * m + r) {
+                        *e += v;
+                    }
                 }
             }
         }
@@ -367,6 +380,34 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
             *o = (*o - m) / (2.0 * h);
         }
         self.scratch = minus;
+    }
+}
+
+/// The complex harmonic `h` of block `d` of `v` (blocks `[a0, a1..an,
+/// b1..bn]`): `a_h − i b_h`, `a0` for `h = 0` (0 past the end).
+fn harmonic(v: &[f64], n: usize, d: usize, h: usize) -> c64 {
+    let l = 2 * n + 1;
+    let get = |i: usize| v.get(d * l + i).copied().unwrap_or(0.0);
+    if h == 0 {
+        c64::new(get(0), 0.0)
+    } else {
+        c64::new(get(h), -get(n + h))
+    }
+}
+
+/// Stores `z` as harmonic `h` of block `d` of `v` ([`harmonic`]'s inverse;
+/// `Re z` alone for `h = 0`).
+fn put_harmonic(v: &mut [f64], n: usize, d: usize, h: usize, z: c64) {
+    let l = 2 * n + 1;
+    let parts = if h == 0 {
+        [(0, z.re), (0, z.re)]
+    } else {
+        [(h, z.re), (n + h, -z.im)]
+    };
+    for (i, x) in parts {
+        if let Some(e) = v.get_mut(d * l + i) {
+            *e = x;
+        }
     }
 }
 

@@ -14,20 +14,32 @@
 //! 2005, Dot2), so each refinement step gains the digits the rounded LU
 //! loses, and the size of the last correction estimates the error left.
 
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
+use super::band::{BandLu, MAX_HALF_BANDWIDTH};
 use crate::error::HbError;
 use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::linalg::solvers::{Lu as SparseLu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{c64, Mat, MatMut, MatRef};
+
+/// Units of rounding (ε) per stored entry of `M` and `C` in
+/// [`Structure::data_error`]: an assembled entry is a sum of element
+/// products (`α·m_e + β·k_e` over two elements: four roundings of ε/2).
+pub const DATA_ULPS: f64 = 2.0;
 
 /// Refinement steps at most per solve.
 const MAX_REFINEMENTS: usize = 8;
 
-/// Sparse `M`, `C`, `K` on one (union) pattern, with its symbolic LU.
+/// Sparse `M`, `C`, `K` on one (union) pattern, with the factorization
+/// chosen for it.
 #[derive(Debug, Clone)]
 pub struct Structure {
     pattern: SymbolicSparseColMat<usize>,
-    symbolic: SymbolicLu<usize>,
+    solver: Solver,
     /// `M`, `C`, `K` all symmetric: `D⁻ᵀ = D⁻¹` (no transposed solves).
     symmetric: bool,
     m: Vec<f64>,
@@ -35,14 +47,47 @@ pub struct Structure {
     k: Vec<f64>,
 }
 
+/// How `D(w)` is factored: a band LU when the DOFs are numbered along a
+/// narrow band (half-bandwidth ≤ [`MAX_HALF_BANDWIDTH`]: the cantilever's
+/// is 3), else faer's sparse LU with one symbolic analysis per structure.
+#[derive(Debug, Clone)]
+enum Solver {
+    /// Lower and upper half-bandwidths.
+    Band(usize, usize),
+    Sparse(SymbolicLu<usize>),
+}
+
+/// A numeric factorization of `D(w)`.
+#[derive(Debug)]
+enum Lu {
+    Band(BandLu),
+    Sparse(Box<SparseLu<usize, c64>>),
+}
+
+impl Lu {
+    fn solve_in_place(&self, rhs: MatMut<'_, c64>) {
+        match self {
+            Self::Band(lu) => lu.solve_in_place(rhs),
+            Self::Sparse(lu) => lu.solve_in_place(rhs),
+        }
+    }
+
+    fn solve_transpose_in_place(&self, rhs: MatMut<'_, c64>) {
+        match self {
+            Self::Band(lu) => lu.solve_transpose_in_place(rhs),
+            Self::Sparse(lu) => lu.solve_transpose_in_place(rhs),
+        }
+    }
+}
+
 /// `D(w)` factored at one frequency, with its entries in double-double for
 /// the refinement's residuals.
 #[derive(Debug)]
 pub struct Factored {
-    lu: Lu<usize, c64>,
+    lu: Lu,
     /// Per pattern entry: `−K + w²M` and `wC`, exact to double-double.
-    real: Vec<Dd>,
-    imag: Vec<Dd>,
+    real: Vec<SplitDd>,
+    imag: Vec<SplitDd>,
 }
 
 impl Structure {
@@ -68,7 +113,7 @@ impl Structure {
                 "M, C, K have non-finite entries".into(),
             ));
         }
-        let mut col_ptr = vec![0usize; n + 1];
+        let mut col_ptr = vec![0usize];
         let mut rows = Vec::new();
         let mut column = Vec::new();
         for j in 0..n {
@@ -79,31 +124,39 @@ impl Structure {
             column.sort_unstable();
             column.dedup();
             rows.extend_from_slice(&column);
-            col_ptr[j + 1] = rows.len();
+            col_ptr.push(rows.len());
         }
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows);
         let values = |a: &SparseColMatRef<'_, usize, f64>| {
             let mut out = vec![0.0; pattern.row_idx().len()];
             for j in 0..n {
                 let range = pattern.col_range(j);
-                let slots = &pattern.row_idx()[range.clone()];
+                let slots = pattern.row_idx().get(range.clone()).unwrap_or_default();
                 let entries = a.symbolic().row_idx_of_col_raw(j).iter();
                 for (i, v) in entries.zip(a.val_of_col(j)) {
                     // The union pattern holds every row of every matrix.
-                    if let Ok(pos) = slots.binary_search(i) {
-                        out[range.start + pos] += v;
+                    let slot = slots.binary_search(i).ok();
+                    if let Some(o) = slot.and_then(|pos| out.get_mut(range.start + pos)) {
+                        *o += v;
                     }
                 }
             }
             out
         };
         let (mv, cv, kv) = (values(&m), values(&c), values(&k));
-        let symbolic = SymbolicLu::try_new(pattern.as_ref())
-            .map_err(|e| HbError::InvalidInput(format!("sparse LU analysis failed: {e:?}")))?;
+        let (kl, ku) = bandwidths(&pattern);
+        let solver =
+            if kl.max(ku) <= MAX_HALF_BANDWIDTH {
+                Solver::Band(kl, ku)
+            } else {
+                Solver::Sparse(SymbolicLu::try_new(pattern.as_ref()).map_err(|e| {
+                    HbError::InvalidInput(format!("sparse LU analysis failed: {e:?}"))
+                })?)
+            };
         let symmetric = [&mv, &cv, &kv].iter().all(|v| is_symmetric(&pattern, v));
         Ok(Self {
             pattern,
-            symbolic,
+            solver,
             symmetric,
             m: mv,
             c: cv,
@@ -149,17 +202,36 @@ impl Structure {
     /// # Errors
     /// [`HbError::Singular`] (with `omega = w`) when the numeric LU fails.
     pub fn factor(&self, w: f64) -> Result<Factored, HbError> {
-        let vals: Vec<c64> = (0..self.k.len())
-            .map(|i| c64::new(self.k[i] - w * w * self.m[i], w * self.c[i]))
+        let vals: Vec<c64> = (self.k.iter().zip(&self.m).zip(&self.c))
+            .map(|((k, m), c)| c64::new(k - w * w * m, w * c))
             .collect();
-        let d = SparseColMatRef::new(self.pattern.as_ref(), &vals);
-        let lu = Lu::try_new_with_symbolic(self.symbolic.clone(), d)
-            .map_err(|_| HbError::Singular { omega: w })?;
+        let lu = match &self.solver {
+            Solver::Band(kl, ku) => {
+                let entries = entries(&self.pattern)
+                    .zip(&vals)
+                    .map(|((i, j), v)| (i, j, *v));
+                Lu::Band(BandLu::factor(self.n_dof(), (*kl, *ku), entries, w)?)
+            }
+            Solver::Sparse(symbolic) => {
+                let d = SparseColMatRef::new(self.pattern.as_ref(), &vals);
+                Lu::Sparse(Box::new(
+                    SparseLu::try_new_with_symbolic(symbolic.clone(), d)
+                        .map_err(|_| HbError::Singular { omega: w })?,
+                ))
+            }
+        };
         let w2 = Dd::product(w, w);
-        let real = (0..self.k.len())
-            .map(|i| w2.scale(self.m[i]).add(-self.k[i]))
+        let real = self
+            .m
+            .iter()
+            .zip(&self.k)
+            .map(|(&m, &k)| SplitDd::from(w2.scale(m).add(-k)))
             .collect();
-        let imag = self.c.iter().map(|&c| Dd::product(w, c)).collect();
+        let imag = self
+            .c
+            .iter()
+            .map(|&c| SplitDd::from(Dd::product(w, c)))
+            .collect();
         Ok(Factored { lu, real, imag })
     }
 
@@ -220,25 +292,59 @@ impl Structure {
             Part::Stiffness => &self.k,
         };
         out.fill(0.0);
-        let rows = self.pattern.row_idx();
-        for (j, xj) in x.iter().enumerate().take(self.n_dof()) {
-            for p in self.pattern.col_range(j) {
-                out[rows[p]] += values[p] * xj;
+        for ((i, j), a) in entries(&self.pattern).zip(values) {
+            if let (Some(o), Some(xj)) = (out.get_mut(i), x.get(j)) {
+                *o += a * xj;
             }
         }
+    }
+
+    /// The first-order relative change of the receptances `x_a = X[dofs[a], a]`
+    /// (`X = D(w)⁻¹ E_S`, the columns of `x`) when each stored entry of `M`
+    /// and `C` moves by [`DATA_ULPS`] units of rounding:
+    /// `δH_aa ≤ DATA_ULPS·ε Σ_ij |X_ia| (w²|M_ij| + w|C_ij|) |X_ja|` (with
+    /// `D⁻ᵀ = D⁻¹`; for a non-symmetric structure the same sum is taken as
+    /// the estimate). What rounding the element formulas into the stored
+    /// matrices moves: the model's own data error, which no solver of the
+    /// stored matrices removes. `K` counts as exact (the cantilever's are
+    /// integers): its rounding would weigh κ(K)·ε.
+    pub fn data_error(&self, w: f64, x: MatRef<'_, c64>, dofs: &[usize]) -> f64 {
+        if w == 0.0 {
+            return 0.0;
+        }
+        let rows = self.pattern.row_idx();
+        let mut worst = 0.0f64;
+        let mut size = vec![0.0; self.n_dof()];
+        for (a, &d) in dofs.iter().enumerate().take(x.ncols()) {
+            size.iter_mut()
+                .zip(x.col(a).iter())
+                .for_each(|(s, z)| *s = z.norm());
+            let mut sum = 0.0;
+            for (j, sj) in size.iter().enumerate() {
+                let range = self.pattern.col_range(j);
+                let entries = rows.get(range.clone()).into_iter().flatten();
+                let weights = self.m.get(range.clone()).into_iter().flatten();
+                let damping = self.c.get(range).into_iter().flatten();
+                for ((&i, m), c) in entries.zip(weights).zip(damping) {
+                    let si = size.get(i).copied().unwrap_or(0.0);
+                    sum += si * (w * w * m.abs() + w * c.abs()) * sj;
+                }
+            }
+            let h = size.get(d).copied().unwrap_or(0.0);
+            let rel = DATA_ULPS * f64::EPSILON * sum / h;
+            worst = worst.max(if rel.is_nan() { f64::INFINITY } else { rel });
+        }
+        worst
     }
 
     /// `out = (−2wM + iC) X`: `∂D/∂w` applied to the columns of `x`.
     pub fn apply_derivative(&self, w: f64, x: MatRef<'_, c64>, mut out: MatMut<'_, c64>) {
         out.fill(c64::new(0.0, 0.0));
-        for col in 0..x.ncols() {
-            for j in 0..self.n_dof() {
-                let xj = x[(j, col)];
-                for p in self.pattern.col_range(j) {
-                    let i = self.pattern.row_idx()[p];
-                    let d = c64::new(-2.0 * w * self.m[p], self.c[p]);
-                    out[(i, col)] += d * xj;
-                }
+        for col in 0..x.ncols().min(out.ncols()) {
+            let stored = entries(&self.pattern).zip(self.m.iter().zip(&self.c));
+            for ((i, j), (m, c)) in stored {
+                let d = c64::new(-2.0 * w * m, *c);
+                out[(i, col)] += d * x[(j, col)];
             }
         }
     }
@@ -262,28 +368,32 @@ impl Structure {
         let col_ptr = self.pattern.col_ptr();
         let rows = self.pattern.row_idx();
         for col in 0..x.ncols() {
-            for i in 0..n {
-                re[i] = Dd::from(b[(i, col)].re);
-                im[i] = Dd::from(b[(i, col)].im);
+            for ((r, i), z) in re.iter_mut().zip(im.iter_mut()).zip(b.col(col).iter()) {
+                *r = Dd::from(z.re);
+                *i = Dd::from(z.im);
             }
-            for j in 0..n {
-                let xj = x[(j, col)];
-                let range = col_ptr[j]..col_ptr[j + 1];
-                let entries = rows[range.clone()]
-                    .iter()
-                    .zip(&factored.real[range.clone()])
-                    .zip(&factored.imag[range]);
-                for ((&i, &a), &c) in entries {
+            for (xj, bounds) in x.col(col).iter().zip(col_ptr.windows(2)) {
+                let range = match bounds {
+                    [start, end] => *start..*end,
+                    _ => continue,
+                };
+                // Each x_j split once for all its column's entries.
+                let (xr, xi) = (Split::of(xj.re), Split::of(xj.im));
+                let entries = rows.get(range.clone()).unwrap_or_default().iter();
+                let real = factored.real.get(range.clone()).unwrap_or_default();
+                let imag = factored.imag.get(range).unwrap_or_default();
+                for ((&i, a), c) in entries.zip(real).zip(imag) {
                     // (−K + w²M) x − iwC x.
-                    let (ri, ii) = (&mut re[i], &mut im[i]);
-                    ri.add_dd_product(a, xj.re);
-                    ri.add_dd_product(c, xj.im);
-                    ii.add_dd_product(a, xj.im);
-                    ii.add_dd_product(c.neg(), xj.re);
+                    if let (Some(ri), Some(ii)) = (re.get_mut(i), im.get_mut(i)) {
+                        ri.add_split_product(a, xr);
+                        ri.add_split_product(c, xi);
+                        ii.add_split_product(a, xi);
+                        ii.sub_split_product(c, xr);
+                    }
                 }
             }
-            for i in 0..n {
-                out[(i, col)] = c64::new(re[i].value(), im[i].value());
+            for (i, (r, m)) in re.iter().zip(&im).enumerate() {
+                out[(i, col)] = c64::new(r.value(), m.value());
             }
         }
     }
@@ -300,18 +410,34 @@ pub enum Part {
     Stiffness,
 }
 
+/// The lower and upper half-bandwidths `(max i − j, max j − i)` of `pattern`.
+fn bandwidths(pattern: &SymbolicSparseColMat<usize>) -> (usize, usize) {
+    entries(pattern).fold((0, 0), |(kl, ku), (i, j)| {
+        (kl.max(i.saturating_sub(j)), ku.max(j.saturating_sub(i)))
+    })
+}
+
+/// The `(row, column)` of every stored entry of `pattern`, in storage order.
+fn entries(pattern: &SymbolicSparseColMat<usize>) -> impl Iterator<Item = (usize, usize)> + '_ {
+    (0..pattern.ncols()).flat_map(move |j| {
+        let rows = pattern
+            .row_idx()
+            .get(pattern.col_range(j))
+            .unwrap_or_default();
+        rows.iter().map(move |&i| (i, j))
+    })
+}
+
 /// Whether the values `v` on `pattern` form a symmetric matrix.
 fn is_symmetric(pattern: &SymbolicSparseColMat<usize>, v: &[f64]) -> bool {
     let rows = pattern.row_idx();
-    (0..pattern.ncols()).all(|j| {
-        pattern.col_range(j).all(|p| {
-            let i = rows[p];
-            let mirror = pattern.col_range(i);
-            match rows[mirror.clone()].binary_search(&j) {
-                Ok(q) => v[mirror.start + q] == v[p],
-                Err(_) => v[p] == 0.0,
-            }
-        })
+    entries(pattern).zip(v).all(|((i, j), a)| {
+        let mirror = pattern.col_range(i);
+        let column = rows.get(mirror.clone()).unwrap_or_default();
+        match column.binary_search(&j) {
+            Ok(q) => v.get(mirror.start + q) == Some(a),
+            Err(_) => *a == 0.0,
+        }
     })
 }
 
@@ -358,6 +484,44 @@ fn split(a: f64) -> (f64, f64) {
     (hi, a - hi)
 }
 
+/// A double with its Veltkamp halves (split once, used in many products).
+#[derive(Debug, Clone, Copy)]
+struct Split {
+    v: f64,
+    hi: f64,
+    lo: f64,
+}
+
+impl Split {
+    #[inline(always)]
+    fn of(v: f64) -> Self {
+        let (hi, lo) = split(v);
+        Self { v, hi, lo }
+    }
+
+    /// `a·b − fl(a·b)` exactly, `p = fl(a·b)`.
+    #[inline(always)]
+    fn product_error(self, b: Self, p: f64) -> f64 {
+        ((self.hi * b.hi - p) + self.hi * b.lo + self.lo * b.hi) + self.lo * b.lo
+    }
+}
+
+/// A double-double entry `hi + lo` of `D(w)` with `hi` split.
+#[derive(Debug, Clone, Copy)]
+struct SplitDd {
+    hi: Split,
+    lo: f64,
+}
+
+impl From<Dd> for SplitDd {
+    fn from(d: Dd) -> Self {
+        Self {
+            hi: Split::of(d.hi),
+            lo: d.lo,
+        }
+    }
+}
+
 /// A double-double accumulator `hi + lo` (Dot2: error-free transformations).
 #[derive(Debug, Clone, Copy, Default)]
 struct Dd {
@@ -372,17 +536,6 @@ impl From<f64> for Dd {
 }
 
 impl Dd {
-    /// `self += a·b` with the product's and the sum's rounding errors kept.
-    fn add_product(&mut self, a: f64, b: f64) {
-        let p = a * b;
-        let ep = product_error(a, b, p);
-        let s = self.hi + p;
-        let bb = s - self.hi;
-        let es = (self.hi - (s - bb)) + (p - bb);
-        self.hi = s;
-        self.lo += ep + es;
-    }
-
     /// `a·b` exactly (as `hi + lo`).
     fn product(a: f64, b: f64) -> Self {
         let hi = a * b;
@@ -410,17 +563,30 @@ impl Dd {
         p
     }
 
-    fn neg(self) -> Self {
-        Self {
-            hi: -self.hi,
-            lo: -self.lo,
-        }
+    /// `self += a·b` for a double-double `a` (both split already).
+    #[inline(always)]
+    fn add_split_product(&mut self, a: &SplitDd, b: Split) {
+        let p = a.hi.v * b.v;
+        let ep = a.hi.product_error(b, p);
+        self.add_exact(p, ep + a.lo * b.v);
     }
 
-    /// `self += a·b` for a double-double `a`.
-    fn add_dd_product(&mut self, a: Self, b: f64) {
-        self.add_product(a.hi, b);
-        self.lo += a.lo * b;
+    /// `self −= a·b` for a double-double `a` (both split already).
+    #[inline(always)]
+    fn sub_split_product(&mut self, a: &SplitDd, b: Split) {
+        let p = a.hi.v * b.v;
+        let ep = a.hi.product_error(b, p);
+        self.add_exact(-p, -(ep + a.lo * b.v));
+    }
+
+    /// `self += p + e` with `p`'s sum error kept (`e` a small correction).
+    #[inline(always)]
+    fn add_exact(&mut self, p: f64, e: f64) {
+        let s = self.hi + p;
+        let bb = s - self.hi;
+        let es = (self.hi - (s - bb)) + (p - bb);
+        self.hi = s;
+        self.lo += e + es;
     }
 
     fn value(self) -> f64 {

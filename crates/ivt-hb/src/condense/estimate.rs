@@ -9,6 +9,11 @@
 //! orbit by 2e-8 while the 6th and 7th alone suggest 4e-14. The receptances
 //! of these harmonics come from the plain LU (an estimate needs no more).
 
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
 use super::branch::CondensedBranch;
 use crate::aft::Aft;
 use crate::error::HbError;
@@ -48,17 +53,18 @@ pub fn truncation_error<P: PeriodicProblem>(
     let lw = wide.coeff_len();
     let nw = n_half - 1;
     let mut spectra = vec![0.0; s * lw];
-    for d in 0..s {
-        wide.galerkin_state(&gs, s, d, &mut spectra[d * lw..(d + 1) * lw], &mut column);
+    for (d, spectrum) in spectra.chunks_exact_mut(lw).enumerate() {
+        wide.galerkin_state(&gs, s, d, spectrum, &mut column);
     }
+    // G_h of local DOF b (0 past the spectrum).
+    let at = |b: usize, h: usize| {
+        let get = |i: usize| spectra.get(b * lw + i).copied().unwrap_or(0.0);
+        c64::new(get(h), -get(nw + h))
+    };
     let structure = branch.structure();
     // Harmonics `g` does not excite (to rounding: the even ones of an odd `g`
     // on an odd orbit) need no factorization.
-    let size = |h: usize| {
-        (0..s)
-            .map(|b| spectra[b * lw + h].hypot(spectra[b * lw + nw + h]))
-            .fold(0.0f64, f64::max)
-    };
+    let size = |h: usize| (0..s).map(|b| at(b, h).norm()).fold(0.0f64, f64::max);
     let largest = (0..=nw).map(size).fold(0.0f64, f64::max);
     let mut worst = 0.0f64;
     for h in (n + 1..=top).filter(|&h| size(h) > 1e-13 * largest) {
@@ -68,12 +74,9 @@ pub fn truncation_error<P: PeriodicProblem>(
             u[(d, b)] = c64::new(1.0, 0.0);
         }
         structure.solve_plain(&factored, u.as_mut());
-        for a in 0..s {
-            let mut x = c64::new(0.0, 0.0);
-            for b in 0..s {
-                let g = c64::new(spectra[b * lw + h], -spectra[b * lw + nw + h]);
-                x -= u[(branch.dofs()[a], b)] * g;
-            }
+        for &dof in branch.dofs() {
+            let row = u.as_ref().row(dof);
+            let x: c64 = row.iter().enumerate().map(|(b, ub)| -ub * at(b, h)).sum();
             worst = worst.max(x.norm());
         }
     }

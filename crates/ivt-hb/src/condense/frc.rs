@@ -5,6 +5,11 @@
 //! point, and per point the estimated errors of the linear solves and of the
 //! harmonic truncation.
 
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
 use super::branch::CondensedBranch;
 use super::estimate::truncation_error;
 use super::scaled::Scaled;
@@ -87,6 +92,14 @@ pub struct CondensedPoint {
     pub dof_coeffs: Vec<(usize, Vec<f64>)>,
     /// Estimated relative error of the receptances (the refined solves).
     pub solve_error: f64,
+    /// Relative change of the receptances from the rounding of the stored
+    /// `M` and `C` ([`crate::condense::Structure::data_error`]).
+    pub data_error: f64,
+    /// Estimated relative error of the orbit (and of the amplitude when it
+    /// is a nonlinear DOF's) at this ω_f from the corrector's residual and
+    /// the receptances' errors (solve + data): the bound of `J⁻¹δR`, `J` the condensed Jacobian
+    /// ([`orbit_error`]).
+    pub orbit_error: f64,
     /// Estimated relative truncation error ([`truncation_error`]); `None` if
     /// not asked for.
     pub truncation_error: Option<f64>,
@@ -127,7 +140,8 @@ pub fn condensed_response<P: PeriodicProblem>(
         ));
     }
     let n_dof = branch.structure().n_dof();
-    let amp_dof = opts.amplitude_dof.unwrap_or(branch.dofs()[0]);
+    let first = branch.dofs().first().copied().unwrap_or(0);
+    let amp_dof = opts.amplitude_dof.unwrap_or(first);
     if let Some(bad) = opts
         .record_dofs
         .iter()
@@ -170,7 +184,7 @@ pub fn condensed_response<P: PeriodicProblem>(
             &copts,
         )?
         .run(|sc, p| {
-            let (q, omega_f) = sc.physical(&p.x[..m], p.lambda());
+            let (q, omega_f) = sc.physical(p.x.get(..m).unwrap_or_default(), p.lambda());
             let point = probe.point(
                 sc.branch,
                 &q,
@@ -254,8 +268,8 @@ pub fn correct_condensed<P: PeriodicProblem>(
     let mut copts = ContinuationOptions::default();
     copts.broyden.tol = rtol;
     let steps = correct_at_fixed_lambda(&mut scaled, &mut x, &copts)?;
-    let (physical, _) = scaled.physical(&x[..q.len()], 0.0);
-    q.copy_from_slice(&physical);
+    let (physical, _) = scaled.physical(&x, 0.0);
+    q.iter_mut().zip(&physical).for_each(|(a, b)| *a = *b);
     Ok(steps)
 }
 
@@ -267,12 +281,104 @@ fn load_scale<P: PeriodicProblem>(
 ) -> Result<f64, HbError> {
     let p = branch.options().subharmonic;
     let rc = branch.receptances(omega_f)?;
-    let f = &rc.response[p];
-    let norm = (0..f.nrows())
-        .map(|i| f[(i, 0)].norm_sqr())
-        .sum::<f64>()
+    let norm = rc
+        .response
+        .get(p)
+        .map_or(0.0, |f| f.col(0).iter().map(|z| z.norm_sqr()).sum::<f64>())
         .sqrt();
     Ok(if norm > 0.0 { norm } else { 1.0 })
+}
+
+/// The first-order relative error of the condensed orbit `q` at ω_f as a
+/// point of the curve, when the residual is `R(q)` (the corrector's
+/// tolerance) and the receptances carry the relative error
+/// `receptance_error` = e. The perturbed point moves by `A⁻¹[δR; 0]` with
+/// the bordered Jacobian `A = [J ∂R/∂ω_f; tᵀ 0]` (`t` the curve's tangent:
+/// the move normal to the curve; at fixed ω_f, `J⁻¹δR`, would be ill-posed
+/// at a fold), `δR = −R(q) + Σ_h δR_h`, `δR_h = δH_h (F_h − G_h) = ε_h X_h`
+/// for some complex |ε_h| ≤ e (`X_h = H_h(F_h − G_h)`; for several
+/// nonlinear DOFs the same form per DOF, first order), so
+/// `‖δq‖₁ ≤ ‖A⁻¹R‖₁ + e Σ_(d,h) (‖A⁻¹ v_dh‖₁ + ‖A⁻¹ v′_dh‖₁)` over the `q`
+/// rows, `v_dh` the rows of `X_h` of DOF d and `v′_dh` those of `iX_h`;
+/// relative to max_τ |x_S(τ)| ≥ max|q|/2 (a Fourier coefficient is at most
+/// twice the maximum). Infinite where `A` is singular.
+fn orbit_error<P: PeriodicProblem>(
+    branch: &mut CondensedBranch<P>,
+    q: &[f64],
+    omega_f: f64,
+    receptance_error: f64,
+) -> f64 {
+    let m = q.len();
+    let n = branch.options().harmonics;
+    let l = 2 * n + 1;
+    let mut r = vec![0.0; m];
+    let mut jac = vec![0.0; m * m];
+    let mut r_omega = vec![0.0; m];
+    Branch::residual(branch, q, omega_f, &mut r);
+    Branch::jacobian(branch, q, omega_f, &mut jac);
+    Branch::residual_lambda(branch, q, omega_f, 0.0, &mut r_omega);
+    // The tangent (t_q, 1) with J t_q = −∂R/∂ω_f, normalized.
+    let Some(j_inv) = ivt_num::lu::inverse(&jac, m) else {
+        return f64::INFINITY;
+    };
+    let mut tangent: Vec<f64> = j_inv
+        .chunks_exact(m)
+        .map(|row| -ivt_num::vector::dot(row, &r_omega))
+        .chain([1.0])
+        .collect();
+    let norm = ivt_num::vector::norm2(&tangent);
+    tangent.iter_mut().for_each(|t| *t /= norm);
+    let k = m + 1;
+    let mut bordered = vec![0.0; k * k];
+    for (i, row) in bordered.chunks_exact_mut(k).enumerate() {
+        match (jac.get(i * m..(i + 1) * m), r_omega.get(i)) {
+            (Some(j), Some(&w)) => {
+                row.iter_mut()
+                    .zip(j.iter().chain([&w]))
+                    .for_each(|(a, b)| *a = *b);
+            }
+            _ => row.copy_from_slice(&tangent),
+        }
+    }
+    let Some(full) = ivt_num::lu::inverse(&bordered, k) else {
+        return f64::INFINITY;
+    };
+    // The q rows and the R columns of A⁻¹ (row-major m×k, last column unused).
+    let inverse: Vec<f64> = full.chunks_exact(k).take(m).flatten().copied().collect();
+    // ‖A⁻¹ v‖₁ (q rows) for v given by its non-zero entries.
+    let applied = |entries: &[(usize, f64)]| -> f64 {
+        inverse
+            .chunks_exact(k)
+            .map(|row| {
+                entries
+                    .iter()
+                    .map(|&(j, v)| row.get(j).map_or(0.0, |a| a * v))
+                    .sum::<f64>()
+                    .abs()
+            })
+            .sum()
+    };
+    let dense: Vec<(usize, f64)> = r.iter().copied().enumerate().collect();
+    let mut bound = applied(&dense);
+    for d in 0..m / l {
+        let at = |i: usize| q.get(d * l + i).copied().unwrap_or(0.0);
+        // h = 0: X_0 = a0/2, real (D(0) is real).
+        bound += receptance_error * applied(&[(d * l, 0.5 * at(0))]);
+        for h in 1..=n {
+            let (ra, rb) = (d * l + h, d * l + n + h);
+            let (a, b) = (at(h), at(n + h));
+            // X = a − ib in the rows (a, b); iX = b + ia in them as (b, −a).
+            bound +=
+                receptance_error * (applied(&[(ra, a), (rb, b)]) + applied(&[(ra, b), (rb, -a)]));
+        }
+    }
+    let scale = q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let err = 2.0 * bound / scale;
+    if err.is_nan() {
+        f64::INFINITY
+    } else {
+        err
+    }
 }
 
 /// The per-point quantities: amplitude, recorded DOFs, error estimates.
@@ -337,7 +443,7 @@ impl Probe {
     ) -> Result<f64, HbError> {
         let l = self.aft.coeff_len();
         match self.amp_local {
-            Some(d) => Ok(self.max_abs(&q[d * l..(d + 1) * l])),
+            Some(d) => Ok(self.max_abs(q.get(d * l..(d + 1) * l).unwrap_or_default())),
             None => {
                 let coeffs = branch.recover(q, omega_f, &[self.amp_dof])?;
                 Ok(coeffs.first().map(|c| self.max_abs(c)).unwrap_or(0.0))
@@ -356,6 +462,8 @@ impl Probe {
         let amplitude = self.amplitude(branch, q, omega_f)?;
         let recovered = branch.recover(q, omega_f, &self.record)?;
         let solve_error = branch.receptances(omega_f)?.solve_error;
+        let data_error = branch.data_error(omega_f)?;
+        let orbit_error = orbit_error(branch, q, omega_f, solve_error + data_error);
         let truncation_error = if truncation {
             Some(truncation_error(branch, q, omega_f)?)
         } else {
@@ -370,6 +478,8 @@ impl Probe {
             coeffs: q.to_vec(),
             dof_coeffs: self.record.iter().copied().zip(recovered).collect(),
             solve_error,
+            data_error,
+            orbit_error,
             truncation_error,
             floquet,
         })

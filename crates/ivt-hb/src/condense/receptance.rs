@@ -13,6 +13,11 @@
 //! any DOF is recovered as `X_j = U_F,j − U_S,j G`. The ω-derivatives come
 //! from `∂H/∂ω = −H D′ H` with transposed solves (no second factorization).
 
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
 use super::dynamic::Structure;
 use crate::error::HbError;
 use faer::{c64, Mat};
@@ -35,6 +40,8 @@ pub struct Receptances {
     pub responses: Vec<Mat<c64>>,
     /// Largest estimated relative error of the refined solves.
     pub solve_error: f64,
+    /// The static harmonic's share of `solve_error` (reused with it).
+    static_error: f64,
 }
 
 /// Where the receptances act: the nonlinear DOFs, the load vector and its
@@ -71,6 +78,24 @@ impl Receptances {
         harmonics: usize,
         omega_f: f64,
     ) -> Result<Self, HbError> {
+        Self::reusing(structure, coupling, harmonics, omega_f, None)
+    }
+
+    /// [`Self::new`], the static harmonic (`h = 0`, `D(0) = K`: the same at
+    /// every ω_f) taken from `previous` when it has one for this load.
+    ///
+    /// # Errors
+    /// As [`Self::new`].
+    pub fn reusing(
+        structure: &Structure,
+        coupling: &Coupling,
+        harmonics: usize,
+        omega_f: f64,
+        previous: Option<Self>,
+    ) -> Result<Self, HbError> {
+        // The static column carries the load only at a static load.
+        let reusable = coupling.load_harmonic != 0;
+        let mut previous = previous.filter(|_| reusable);
         let p = coupling.load_harmonic as f64;
         let mut out = Self {
             omega_f,
@@ -80,10 +105,21 @@ impl Receptances {
             d_response: Vec::with_capacity(harmonics + 1),
             responses: Vec::with_capacity(harmonics + 1),
             solve_error: 0.0,
+            static_error: 0.0,
         };
         for h in 0..=harmonics {
             let w = h as f64 * omega_f / p;
-            let part = harmonic(structure, coupling, h, w, h as f64 / p)?;
+            let reused = previous
+                .as_mut()
+                .filter(|_| h == 0)
+                .and_then(Self::take_static);
+            let part = match reused {
+                Some(part) => part,
+                None => harmonic(structure, coupling, h, w, h as f64 / p)?,
+            };
+            if h == 0 {
+                out.static_error = part.error;
+            }
             out.solve_error = out.solve_error.max(part.error);
             out.receptance.push(part.receptance);
             out.response.push(part.response);
@@ -92,6 +128,36 @@ impl Receptances {
             out.responses.push(part.responses);
         }
         Ok(out)
+    }
+}
+
+impl Receptances {
+    /// Largest relative change of `H_SS` over the harmonics from the
+    /// rounding of the stored `M` and `C` ([`Structure::data_error`]; asked
+    /// per point, not per corrector step).
+    pub fn data_error(&self, structure: &Structure, coupling: &Coupling) -> f64 {
+        let (s, p) = (coupling.dofs.len(), coupling.load_harmonic as f64);
+        self.responses
+            .iter()
+            .enumerate()
+            .map(|(h, u)| {
+                let w = h as f64 * self.omega_f / p;
+                structure.data_error(w, u.subcols(0, s), &coupling.dofs)
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// The static harmonic's share, moved out (`None` if there is none).
+    fn take_static(&mut self) -> Option<Harmonic> {
+        let take = |v: &mut Vec<Mat<c64>>| (!v.is_empty()).then(|| v.swap_remove(0));
+        Some(Harmonic {
+            receptance: take(&mut self.receptance)?,
+            response: take(&mut self.response)?,
+            d_receptance: take(&mut self.d_receptance)?,
+            d_response: take(&mut self.d_response)?,
+            responses: take(&mut self.responses)?,
+            error: self.static_error,
+        })
     }
 }
 
@@ -138,15 +204,22 @@ fn harmonic(
     }
     if loaded && !own_load {
         for (b, &d) in coupling.dofs.iter().enumerate() {
-            let f = coupling.load[d];
+            let f = coupling.load.get(d).copied().unwrap_or_default();
             for i in 0..n {
                 let v = u[(i, b)] * f;
                 u[(i, s)] += v;
             }
         }
     }
-    let receptance = Mat::<c64>::from_fn(s, s, |a, b| u[(coupling.dofs[a], b)]);
-    let response = Mat::<c64>::from_fn(s, 1, |a, _| u[(coupling.dofs[a], s)]);
+    let at = |a: usize, b: usize| {
+        coupling
+            .dofs
+            .get(a)
+            .filter(|&&d| d < u.nrows() && b < u.ncols())
+            .map_or(c64::new(0.0, 0.0), |&d| u[(d, b)])
+    };
+    let receptance = Mat::<c64>::from_fn(s, s, at);
+    let response = Mat::<c64>::from_fn(s, 1, |a, _| at(a, s));
     // ∂H_SS/∂ω_f = −Wᵀ D′ U_S, ∂u_S/∂ω_f = −Wᵀ D′ u with W = D⁻ᵀ e_S.
     let (d_receptance, d_response) = if dw == 0.0 {
         (Mat::zeros(s, s), Mat::zeros(s, 1))

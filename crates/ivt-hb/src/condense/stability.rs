@@ -19,6 +19,11 @@
 //! bounds the larger basis's error while the Krylov space converges), plus
 //! Hsu's own Richardson estimate.
 
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
 use super::branch::CondensedBranch;
 use super::dynamic::{Part, Structure};
 use crate::error::HbError;
@@ -86,7 +91,7 @@ impl<P: PeriodicProblem> ReducedProblem<'_, P> {
     fn to_dofs(&self, z: &[f64]) -> Vec<f64> {
         let (r, s) = (self.reduced.size, self.s);
         z.chunks_exact(r)
-            .flat_map(|zi| (0..s).map(move |a| dot(&self.reduced.at_dofs[a * r..(a + 1) * r], zi)))
+            .flat_map(|zi| (0..s).map(move |a| dot(row(&self.reduced.at_dofs, a, r), zi)))
             .collect()
     }
 }
@@ -116,7 +121,7 @@ impl<P: PeriodicProblem> PeriodicProblem for ReducedProblem<'_, P> {
         for (o, gi) in out.chunks_exact_mut(r).zip(g.chunks_exact(s)) {
             for (i, oi) in o.iter_mut().enumerate() {
                 *oi = (0..s)
-                    .map(|a| self.reduced.at_dofs[a * r + i] * gi[a])
+                    .map(|a| at(&self.reduced.at_dofs, a * r + i) * at(gi, a))
                     .sum();
             }
         }
@@ -141,12 +146,18 @@ impl<P: PeriodicProblem> PeriodicProblem for ReducedProblem<'_, P> {
                 // half = G V_S (s×r), o = V_Sᵀ half.
                 for a in 0..s {
                     for j in 0..r {
-                        half[a * r + j] = (0..s).map(|b| g[a * s + b] * vsm[b * r + j]).sum();
+                        if let Some(e) = half.get_mut(a * r + j) {
+                            *e = (0..s).map(|b| at(g, a * s + b) * at(vsm, b * r + j)).sum();
+                        }
                     }
                 }
                 for i in 0..r {
                     for j in 0..r {
-                        o[i * r + j] = (0..s).map(|a| vsm[a * r + i] * half[a * r + j]).sum();
+                        if let Some(e) = o.get_mut(i * r + j) {
+                            *e = (0..s)
+                                .map(|a| at(vsm, a * r + i) * at(&half, a * r + j))
+                                .sum();
+                        }
                     }
                 }
             }
@@ -233,9 +244,9 @@ impl ReducedStability {
             let mut coeffs = vec![0.0; r * l];
             for (i, zi) in coeffs.chunks_exact_mut(l).enumerate() {
                 for a in 0..s {
-                    let w = reduced.lift[i * s + a];
+                    let w = at(&reduced.lift, i * s + a);
                     zi.iter_mut()
-                        .zip(&q[a * l..(a + 1) * l])
+                        .zip(row(q, a, l))
                         .for_each(|(z, x)| *z += w * x);
                 }
             }
@@ -253,7 +264,9 @@ impl ReducedStability {
             };
             results.push(hsu.floquet(&problem, &sol)?);
         }
-        let (big, small) = (&results[0], &results[1]);
+        let [big, small] = results.as_slice() else {
+            return Err(HbError::InvalidInput("two stability bases expected".into()));
+        };
         Ok(CondensedFloquet {
             truncation_error: multiplier_distance(
                 &big.floquet.multipliers,
@@ -294,7 +307,9 @@ fn krylov_basis(
     let n = structure.n_dof();
     let k = structure.factor(0.0)?;
     let solve = |columns: &[Vec<f64>]| -> Result<Vec<Vec<f64>>, HbError> {
-        let mut rhs = Mat::<c64>::from_fn(n, columns.len(), |i, j| c64::new(columns[j][i], 0.0));
+        let mut rhs = Mat::<c64>::from_fn(n, columns.len(), |i, j| {
+            c64::new(columns.get(j).map_or(0.0, |c| at(c, i)), 0.0)
+        });
         let error = structure.solve_refined(&k, rhs.as_mut());
         if !error.is_finite() {
             return Err(HbError::Singular { omega: 0.0 });
@@ -337,7 +352,7 @@ fn krylov_basis(
             break;
         }
         sizes.push(basis.len());
-        block = solve(&mass_basis[start..])?;
+        block = solve(mass_basis.get(start..).unwrap_or_default())?;
     }
     Ok((basis, sizes))
 }
@@ -357,7 +372,9 @@ fn reduce<P: PeriodicProblem>(
         for (j, v) in basis.iter().enumerate() {
             structure.times(part, v, &mut product);
             for (i, u) in basis.iter().enumerate() {
-                out[i * r + j] = dot(u, &product);
+                if let Some(e) = out.get_mut(i * r + j) {
+                    *e = dot(u, &product);
+                }
             }
         }
         out
@@ -369,7 +386,7 @@ fn reduce<P: PeriodicProblem>(
     );
     let at_dofs: Vec<f64> = dofs
         .iter()
-        .flat_map(|&d| basis.iter().map(move |v| v[d]))
+        .flat_map(|&d| basis.iter().map(move |v| at(v, d)))
         .collect();
     let full = Reduced {
         size: r,
@@ -393,11 +410,11 @@ fn truncate<P: PeriodicProblem>(
     let r = full.size;
     let lead = |a: &[f64]| -> Vec<f64> {
         (0..size * size)
-            .map(|e| a[(e / size) * r + e % size])
+            .map(|e| at(a, (e / size) * r + e % size))
             .collect()
     };
     let at_dofs: Vec<f64> = (0..s * size)
-        .map(|e| full.at_dofs[(e / size) * r + e % size])
+        .map(|e| at(&full.at_dofs, (e / size) * r + e % size))
         .collect();
     let (mut m, mut c, mut k) = (lead(&full.m), lead(&full.c), lead(&full.k));
     if full.lift.is_empty() {
@@ -412,10 +429,14 @@ fn truncate<P: PeriodicProblem>(
                     let mut sum = 0.0;
                     for x in 0..s {
                         for y in 0..s {
-                            sum += at_dofs[x * size + i] * a[x * s + y] * at_dofs[y * size + j];
+                            sum += at(&at_dofs, x * size + i)
+                                * at(a, x * s + y)
+                                * at(&at_dofs, y * size + j);
                         }
                     }
-                    out[i * size + j] += sum;
+                    if let Some(e) = out.get_mut(i * size + j) {
+                        *e += sum;
+                    }
                 }
             }
         }
@@ -425,10 +446,7 @@ fn truncate<P: PeriodicProblem>(
     let gram: Vec<f64> = (0..s * s)
         .map(|e| {
             let (a, b) = (e / s, e % s);
-            dot(
-                &at_dofs[a * size..(a + 1) * size],
-                &at_dofs[b * size..(b + 1) * size],
-            )
+            dot(row(&at_dofs, a, size), row(&at_dofs, b, size))
         })
         .collect();
     let inverse = ivt_num::lu::inverse(&gram, s).ok_or_else(|| {
@@ -438,7 +456,7 @@ fn truncate<P: PeriodicProblem>(
         .map(|e| {
             let (i, a) = (e / s, e % s);
             (0..s)
-                .map(|b| at_dofs[b * size + i] * inverse[b * s + a])
+                .map(|b| at(&at_dofs, b * size + i) * at(&inverse, b * s + a))
                 .sum()
         })
         .collect();
@@ -450,4 +468,14 @@ fn truncate<P: PeriodicProblem>(
         at_dofs,
         lift,
     })
+}
+
+/// `v[i]`, or 0 past the end.
+fn at(v: &[f64], i: usize) -> f64 {
+    v.get(i).copied().unwrap_or(0.0)
+}
+
+/// Row `i` of the row-major `v` with rows of `len` (empty past the end).
+fn row(v: &[f64], i: usize, len: usize) -> &[f64] {
+    v.get(i * len..(i + 1) * len).unwrap_or_default()
 }

@@ -2,6 +2,11 @@
 //! three DOFs (disk, blade root, blade tip), disks of neighbouring sectors
 //! coupled cyclically.
 
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
 use super::{from_triplets, SparseModel};
 use crate::error::HbError;
 
@@ -35,12 +40,10 @@ pub fn bladed_disk() -> Result<BladedDisk, HbError> {
     let n = 3 * SECTORS;
     let (mut m, mut k) = (Vec::new(), Vec::new());
     for s in 0..SECTORS {
-        for a in 0..3 {
-            m.push((3 * s + a, 3 * s + a, mass[a]));
-            for b in 0..3 {
-                if sector[a][b] != 0.0 {
-                    k.push((3 * s + a, 3 * s + b, sector[a][b]));
-                }
+        for (a, (&ma, row)) in mass.iter().zip(&sector).enumerate() {
+            m.push((3 * s + a, 3 * s + a, ma));
+            for (b, &v) in row.iter().enumerate().filter(|(_, v)| **v != 0.0) {
+                k.push((3 * s + a, 3 * s + b, v));
             }
         }
         // The coupling spring between this disk and the next one.

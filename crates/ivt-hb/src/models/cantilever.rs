@@ -1,6 +1,11 @@
 //! The benchmark beam of issue 28: an Euler–Bernoulli cantilever, clamped at
 //! x = 0, of N equal Hermite-cubic elements with consistent mass.
 
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
 use super::{from_triplets, SparseModel};
 use crate::error::HbError;
 
@@ -13,10 +18,43 @@ pub struct Cantilever {
     pub tip: usize,
 }
 
-/// The cantilever of `n_elements` Hermite-cubic elements (length `length`,
-/// bending stiffness `ei`, mass per length `rho_a`), clamped at x = 0, with
-/// Rayleigh damping `C = alpha·M + beta·K` (issue 28: L = EI = ρA = 1,
-/// α = 0.07, β = 2e-4).
+/// A uniform beam's properties.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BeamProperties {
+    /// Length L.
+    pub length: f64,
+    /// Bending stiffness EI.
+    pub ei: f64,
+    /// Mass per length ρA.
+    pub rho_a: f64,
+    /// Rayleigh damping `C = alpha·M + beta·K`: α.
+    pub alpha: f64,
+    /// β.
+    pub beta: f64,
+}
+
+impl Default for BeamProperties {
+    /// Issue 28's beam: L = EI = ρA = 1, α = 0.07, β = 2e-4.
+    fn default() -> Self {
+        Self {
+            length: 1.0,
+            ei: 1.0,
+            rho_a: 1.0,
+            alpha: 0.07,
+            beta: 2e-4,
+        }
+    }
+}
+
+/// The DOFs of element `e`'s end nodes `[w_e, θ_e, w_e+1, θ_e+1]` (node e
+/// owns DOFs 2e − 2 and 2e − 1; node 0 is clamped: `None`).
+pub fn element_dofs(e: usize) -> [Option<usize>; 4] {
+    let left = (2 * e).checked_sub(2);
+    [left, left.map(|d| d + 1), Some(2 * e), Some(2 * e + 1)]
+}
+
+/// The cantilever of `n_elements` Hermite-cubic elements with the
+/// properties `beam`, clamped at x = 0.
 ///
 /// Element matrices (h = L/N): `K_e = EI/h³ [[12, 6h, −12, 6h], [6h, 4h², −6h, 2h²],
 /// [−12, −6h, 12, −6h], [6h, 2h², −6h, 4h²]]`, `M_e = ρA h/420 [[156, 22h, 54, −13h],
@@ -29,14 +67,14 @@ pub struct Cantilever {
 /// # Errors
 /// [`HbError::InvalidInput`] for no elements or non-positive / non-finite
 /// parameters.
-pub fn cantilever(
-    n_elements: usize,
-    length: f64,
-    ei: f64,
-    rho_a: f64,
-    alpha: f64,
-    beta: f64,
-) -> Result<Cantilever, HbError> {
+pub fn cantilever(n_elements: usize, beam: &BeamProperties) -> Result<Cantilever, HbError> {
+    let BeamProperties {
+        length,
+        ei,
+        rho_a,
+        alpha,
+        beta,
+    } = *beam;
     let positive = [length, ei, rho_a]
         .iter()
         .all(|v| v.is_finite() && *v > 0.0);
@@ -95,23 +133,14 @@ pub fn cantilever(
     let n_dof = 2 * n_elements;
     let (mut m, mut c, mut k) = (Vec::new(), Vec::new(), Vec::new());
     for e in 0..n_elements {
-        // Element e joins node e (clamped for e = 0) and node e + 1; node j ≥ 1
-        // owns DOFs 2j − 2 (w) and 2j − 1 (θ).
-        let dofs = [
-            2 * e as isize - 2,
-            2 * e as isize - 1,
-            2 * e as isize,
-            2 * e as isize + 1,
-        ];
-        for (a, &ra) in dofs.iter().enumerate() {
-            for (b, &cb) in dofs.iter().enumerate() {
-                if ra < 0 || cb < 0 {
-                    continue;
+        let dofs = element_dofs(e);
+        for (ra, (me_row, ke_row)) in dofs.iter().zip(me.iter().zip(&ke)) {
+            for (cb, (&mv, &kv)) in dofs.iter().zip(me_row.iter().zip(ke_row)) {
+                if let (Some(i), Some(j)) = (*ra, *cb) {
+                    m.push((i, j, mv));
+                    k.push((i, j, kv));
+                    c.push((i, j, alpha * mv + beta * kv));
                 }
-                let (i, j) = (ra as usize, cb as usize);
-                m.push((i, j, me[a][b]));
-                k.push((i, j, ke[a][b]));
-                c.push((i, j, alpha * me[a][b] + beta * ke[a][b]));
             }
         }
     }
@@ -135,7 +164,12 @@ mod tests {
     fn first_frequency_converges_to_the_euler_bernoulli_value() {
         // Clamped–free beam: ω₁ = (1.8751041)² √(EI/(ρA L⁴)) = 3.5160153.
         // Hermite cubics converge as h⁴ from above: N = 10 within 1e-6.
-        let beam = cantilever(10, 1.0, 1.0, 1.0, 0.0, 0.0).unwrap();
+        let props = BeamProperties {
+            alpha: 0.0,
+            beta: 0.0,
+            ..BeamProperties::default()
+        };
+        let beam = cantilever(10, &props).unwrap();
         let (m, k) = (beam.model.m.to_dense(), beam.model.k.to_dense());
         let n = m.nrows();
         // Eigenvalues of M⁻¹K (dense; real and positive).

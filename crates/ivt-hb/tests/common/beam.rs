@@ -4,7 +4,7 @@
 #![allow(dead_code)] // each test binary uses its own subset
 
 use ivt_hb::condense::{CondensedBranch, Structure};
-use ivt_hb::models::cantilever;
+use ivt_hb::models::{cantilever, BeamProperties};
 use ivt_hb::{GeneralProblem, HbOptions, PeriodicProblem};
 
 /// Cubic spring constant at the tip (issue 28).
@@ -49,7 +49,7 @@ pub fn beam(
     force: f64,
     hb: &HbOptions,
 ) -> CondensedBranch<impl ivt_hb::PeriodicProblem> {
-    let model = cantilever(n_elements, 1.0, 1.0, 1.0, 0.07, 2e-4).expect("valid beam");
+    let model = cantilever(n_elements, &BeamProperties::default()).expect("valid beam");
     let s = &model.model;
     let structure = Structure::new(s.m.as_ref(), s.c.as_ref(), s.k.as_ref()).expect("structure");
     let mut load = vec![0.0; s.n_dof()];
@@ -61,7 +61,7 @@ pub fn beam(
 /// The uncondensed beam of `n` elements: dense M, C, K, the tip spring, the
 /// tip force.
 pub fn full_beam(n: usize) -> (impl PeriodicProblem, usize) {
-    let b = cantilever(n, 1.0, 1.0, 1.0, 0.07, 2e-4).unwrap();
+    let b = cantilever(n, &BeamProperties::default()).unwrap();
     let nd = b.model.n_dof();
     let tip = b.tip;
     let problem = GeneralProblem::new(
