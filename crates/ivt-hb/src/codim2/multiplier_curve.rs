@@ -100,8 +100,11 @@ pub struct BifurcationCurve {
 }
 
 /// Follows the period doubling or Neimark–Sacker point `start` of the FRC of
-/// `family(start.p)` in `p`, first towards `p_from`, until `p` leaves
-/// `[min(p_from, p_to), max(p_from, p_to)]`; the point at each `p` of `at`
+/// `family(start.p)` in `p`, first towards `p_from` until `p` leaves
+/// `[min(p_from, p_to), max(p_from, p_to)]` or the curve ends (a 1:1 or 1:2
+/// resonance); unless that path turned back and left at `p_to`, then from
+/// the start towards `p_to`. Points are in path order from the
+/// `p_from` end; `termination` is that of the last path. The point at each `p` of `at`
 /// and the strong resonances are located (module docs). `hb` must be the
 /// options `start` was computed with.
 ///
@@ -161,8 +164,7 @@ where
     let towards_from = if p_from < p_start { -1.0 } else { 1.0 };
     let theta_index = m + 1;
     // A Neimark–Sacker path through θ = 0 or π (1:1, 1:2) continues on the
-    // conjugate pair back along the same curve: it stops at the point past
-    // it, and the curve is then followed from the start the other way.
+    // conjugate pair back along the same curve: it stops at the point past.
     let trace = |sys: &mut MultiplierSystem<'_, F>, direction: f64| {
         pseudo_arclength(
             |x: &[f64], r: &mut [f64]| sys.residual(x, r),
@@ -174,7 +176,14 @@ where
         )
     };
     let first = trace(&mut sys, towards_from)?;
-    let (mut path, termination) = if first.termination == Termination::Stopped {
+    // Unless the first path turned and left the interval at `p_to`, the
+    // curve is followed from the start towards `p_to` too.
+    let at_p_to = first.termination == Termination::LeftInterval
+        && first
+            .points
+            .last()
+            .is_some_and(|pt| (pt.lambda() - p_to).abs() < (pt.lambda() - p_from).abs());
+    let (mut path, termination) = if !at_p_to {
         let second = trace(&mut sys, -towards_from)?;
         let mut joined: Vec<PathPoint> = first.points.into_iter().rev().collect();
         joined.extend(second.points.into_iter().skip(1));
