@@ -211,3 +211,28 @@ fn a_curve_without_a_fold_is_a_json_error() {
         "{v}"
     );
 }
+
+/// `ivt hb vdp-torus`: the Neimark–Sacker curve of the forced Van der Pol
+/// oscillator (μ = 0.2) from the point (0.94525643, 0.2). References
+/// by shooting in crates/ivt-hb/tests/ns_curve.rs: the NS point at F = 0.3
+/// at ω = 0.8980504973, the 1:1 end at F = 0.1924005859.
+#[test]
+fn vdp_torus_curve_ends_at_the_one_to_one_resonance() {
+    let (code, v) = run("--json hb vdp-torus --n 9 --samples 32 --force-to 0.3 --at 0.2,0.3");
+    assert_eq!(code, 0, "{v}");
+    assert_eq!(v["kind"], "neimark_sacker");
+    assert_eq!(v["termination"], "left_interval");
+    let special = v["special"].as_array().unwrap();
+    assert_eq!(special.len(), 1, "{special:?}");
+    assert_eq!(special[0]["kind"], "resonance_1_1");
+    assert!((special[0]["p"].as_f64().unwrap() - 0.1924005859).abs() < 1e-7);
+    let omegas: Vec<f64> = v["at"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a["omega"].as_f64().unwrap())
+        .collect();
+    assert_eq!(omegas.len(), 2, "{omegas:?}");
+    assert!((omegas[0] - 0.94525643).abs() < 1e-8);
+    assert!((omegas[1] - 0.8980504973).abs() < 1e-7);
+}

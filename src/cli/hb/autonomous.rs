@@ -22,7 +22,7 @@ pub struct Resolution {
 }
 
 impl Resolution {
-    fn options(&self) -> Result<HbOptions, CliError> {
+    pub(super) fn options(&self) -> Result<HbOptions, CliError> {
         if self.n == 0 || self.samples <= self.n {
             return Err(CliError::Input(format!(
                 "--n must be ≥ 1 and --samples > --n, got n = {}, samples = {}",
