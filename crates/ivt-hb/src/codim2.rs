@@ -100,16 +100,7 @@ where
     P: PeriodicProblem,
     F: Fn(f64) -> Result<P, HbError>,
 {
-    let (lo, hi) = (p_from.min(p_to), p_from.max(p_to));
-    if ![p_start, p_from, p_to, omega].iter().all(|v| v.is_finite())
-        || lo == hi
-        || !(lo..=hi).contains(&p_start)
-        || omega <= 0.0
-    {
-        return Err(HbError::InvalidInput(
-            "fold curve: finite p_from ≠ p_to with p_start between them, ω > 0".into(),
-        ));
-    }
+    let (lo, hi) = path_interval("fold curve", omega, p_start, p_from, p_to)?;
     let mut sys = FoldSystem::new(&family, hb, p_start)?;
     let m = sys.m;
     if start.len() != m {
@@ -204,6 +195,28 @@ fn locate_cusp<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
     let mut point = sys.point(&x)?;
     point.p = fold.lambda;
     Some(point)
+}
+
+/// The interval `[lo, hi]` of `p` of a curve of `what` from `(ω, p_start)`.
+///
+/// # Errors
+/// [`HbError::InvalidInput`] unless all are finite, `p_from ≠ p_to`,
+/// `p_start` lies between them and ω > 0.
+pub(crate) fn path_interval(
+    what: &str,
+    omega: f64,
+    p_start: f64,
+    p_from: f64,
+    p_to: f64,
+) -> Result<(f64, f64), HbError> {
+    let (lo, hi) = (p_from.min(p_to), p_from.max(p_to));
+    let finite = [p_start, p_from, p_to, omega].iter().all(|v| v.is_finite());
+    if finite && lo != hi && (lo..=hi).contains(&p_start) && omega > 0.0 {
+        return Ok((lo, hi));
+    }
+    Err(HbError::InvalidInput(format!(
+        "{what}: finite p_from ≠ p_to with the start's p between them, ω > 0"
+    )))
 }
 
 /// Each pair of consecutive points of `path` whose component `index` brackets a

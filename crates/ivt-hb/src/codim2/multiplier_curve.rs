@@ -38,8 +38,8 @@
 #![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
 #![cfg_attr(not(test), deny(clippy::unimplemented))]
 
-use super::crossings;
 use super::fixed::{solve_fixed, CurveSystem};
+use super::{crossings, path_interval};
 use crate::bifurcation::{BifurcationKind, BifurcationOptions};
 use crate::continuation::{pseudo_arclength, ContinuationOptions, PathPoint, Termination};
 use crate::error::HbError;
@@ -115,7 +115,7 @@ pub struct BifurcationCurve {
 /// the path's start failures as [`pseudo_arclength`]'s. Later, a `p` where
 /// `family` fails is a failed step, and a failed location of an `at` point
 /// or resonance is left out (the curve is kept).
-pub fn bifurcation_curve<P, F>(
+pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
     family: F,
     hb: &HbOptions,
     start: &CurveStart,
@@ -123,24 +123,9 @@ pub fn bifurcation_curve<P, F>(
     p_to: f64,
     at: &[f64],
     opts: &ContinuationOptions,
-) -> Result<BifurcationCurve, HbError>
-where
-    P: PeriodicProblem,
-    F: Fn(f64) -> Result<P, HbError>,
-{
-    let (lo, hi) = (p_from.min(p_to), p_from.max(p_to));
+) -> Result<BifurcationCurve, HbError> {
     let p_start = start.p;
-    if ![p_start, p_from, p_to, start.omega]
-        .iter()
-        .all(|v| v.is_finite())
-        || lo == hi
-        || !(lo..=hi).contains(&p_start)
-        || start.omega <= 0.0
-    {
-        return Err(HbError::InvalidInput(
-            "bifurcation curve: finite p_from ≠ p_to with the start's p between them, ω > 0".into(),
-        ));
-    }
+    let (lo, hi) = path_interval("bifurcation curve", start.omega, p_start, p_from, p_to)?;
     let ns = match start.kind {
         BifurcationKind::PeriodDoubling => false,
         BifurcationKind::NeimarkSacker => true,
