@@ -213,3 +213,30 @@ fn a_curve_without_a_fold_is_a_json_error() {
         "{v}"
     );
 }
+
+/// `ivt hb vdp-torus`: the Neimark–Sacker curve of the forced Van der Pol
+/// oscillator (μ = 0.2) from the point (0.94525643, 0.2). References
+/// by shooting in crates/ivt-hb/tests/ns_curve.rs: the NS point at F = 0.3
+/// at ω = 0.8980504973, the 1:1 end at F = 0.1924005859.
+#[test]
+fn vdp_torus_curve_ends_at_the_one_to_one_resonance() {
+    let (code, v) = run("--json hb vdp-torus --n 9 --samples 32 --force-to 0.3 --at 0.2,0.3");
+    assert_eq!(code, 0, "{v}");
+    let words = [&v["kind"], &v["termination"], &v["special"][0]["kind"]];
+    assert_eq!(words, ["neimark_sacker", "left_interval", "resonance_1_1"]);
+    assert_eq!(v["special"].as_array().map(Vec::len), Some(1));
+    // (F, ω) of the 1:1 end and of the two `at` points against shooting.
+    let want = [
+        (&v["special"][0], 0.1924005859, None),
+        (&v["at"][0], 0.2, Some(0.94525643)),
+        (&v["at"][1], 0.3, Some(0.8980504973)),
+    ];
+    for (point, force, omega) in want {
+        let got = |key: &str| point[key].as_f64().unwrap_or(f64::NAN);
+        assert!((got("p") - force).abs() < 1e-7, "{point}");
+        assert!(
+            omega.is_none_or(|w| (got("omega") - w).abs() < 1e-7),
+            "{point}"
+        );
+    }
+}

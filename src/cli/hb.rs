@@ -10,6 +10,7 @@ mod autonomous;
 mod cycle_branch;
 mod folds;
 mod switch;
+mod torus;
 
 use super::{CliError, Output};
 use clap::{Args, Subcommand};
@@ -28,6 +29,8 @@ pub enum HbCommand {
     DuffingFrc(FrcArgs),
     /// The folds of Duffing's frequency response followed in the force F, through the cusp.
     DuffingFolds(folds::FoldsArgs),
+    /// The Neimark–Sacker curve of the forced Van der Pol oscillator in (ω_f, F), to its 1:1 end.
+    VdpTorus(torus::TorusArgs),
     /// Limit cycle of Van der Pol's or Rayleigh's oscillator (ω unknown, §3.2.4) with its multipliers.
     LimitCycle(autonomous::LimitCycleArgs),
     /// Backbone curve (nonlinear normal mode) of the free Duffing oscillator u'' + αu + εu³ = 0.
@@ -161,6 +164,7 @@ pub fn run(cmd: HbCommand) -> Result<Output, CliError> {
         HbCommand::Duffing(a) => duffing(a),
         HbCommand::DuffingFrc(a) => duffing_frc(a),
         HbCommand::DuffingFolds(a) => folds::run(a),
+        HbCommand::VdpTorus(a) => torus::run(a),
         HbCommand::LimitCycle(a) => autonomous::limit_cycle(a),
         HbCommand::DuffingBackbone(a) => autonomous::backbone(a),
         HbCommand::CycleBranch(a) => cycle_branch::run(a),

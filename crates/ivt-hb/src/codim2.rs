@@ -22,18 +22,32 @@
 //! Here the excitation may depend on `p` (a force amplitude): the residual is
 //! planned anew when `p` changes. `family(p)` returns a `Result`, so a family
 //! built from user callbacks can fail cleanly.
+//!
+//! Period-doubling and Neimark–Sacker curves are in [`multiplier_curve`]
+//! ([`bifurcation_curve`]); the fixed-`p` solve all curves share is
+//! `fixed.rs`.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
+mod fixed;
+mod fold_system;
+pub mod multiplier_curve;
 mod ns_points;
+pub use multiplier_curve::{bifurcation_curve, BifurcationCurve, CurvePoint, CurveStart};
 pub use ns_points::{neimark_sacker_points, NeimarkSackerPoint};
 
 use crate::branch::ResidualBranch;
-use crate::continuation::{BroydenCorrector, ContinuationOptions, Path, Stepper, Termination};
+use crate::continuation::{
+    BroydenCorrector, ContinuationOptions, Path, PathPoint, Stepper, Termination,
+};
 use crate::error::HbError;
-use crate::galerkin::GalerkinJacobian;
-use crate::ihb::{HbOptions, HbResidual};
+use crate::ihb::HbOptions;
 use crate::problem::PeriodicProblem;
+use fixed::{solve_fixed, CurveSystem};
+use fold_system::FoldSystem;
 use ivt_num::vector::norm2;
-use ivt_num::{LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace};
 
 /// One fold on the curve.
 #[derive(Debug, Clone, PartialEq)]
@@ -89,16 +103,7 @@ where
     P: PeriodicProblem,
     F: Fn(f64) -> Result<P, HbError>,
 {
-    let (lo, hi) = (p_from.min(p_to), p_from.max(p_to));
-    if ![p_start, p_from, p_to, omega].iter().all(|v| v.is_finite())
-        || lo == hi
-        || !(lo..=hi).contains(&p_start)
-        || omega <= 0.0
-    {
-        return Err(HbError::InvalidInput(
-            "fold curve: finite p_from ≠ p_to with p_start between them, ω > 0".into(),
-        ));
-    }
+    let (lo, hi) = path_interval("fold curve", omega, p_start, p_from, p_to)?;
     let mut sys = FoldSystem::new(&family, hb, p_start)?;
     let m = sys.m;
     if start.len() != m {
@@ -126,18 +131,18 @@ where
         .iter()
         .filter_map(|f| locate_cusp(&mut sys, &path, f.bracket, &copts))
         .collect();
-    let mut located = Vec::new();
-    for &p in at {
-        for w in path.points.windows(2) {
-            let (a, b) = (w[0].lambda(), w[1].lambda());
-            if (a - p) * (b - p) <= 0.0 && a != b {
-                if let Some(fp) = sys.solve_at(&w[0].x, &w[1].x, p) {
-                    located.push(fp);
-                }
-            }
-        }
-    }
-    let points = path.points.iter().map(|pt| sys.point(&pt.x)).collect();
+    let scale = norm2(start);
+    let located = crossings(&path.points, at, x0.len() - 1)
+        .filter_map(|(a, b, p)| {
+            let x = solve_fixed(&mut sys, (a, b), 2 * m + 1, p, scale)?;
+            sys.point(&x)
+        })
+        .collect();
+    let points = path
+        .points
+        .iter()
+        .filter_map(|pt| sys.point(&pt.x))
+        .collect();
     Ok(FoldCurve {
         points,
         at: located,
@@ -189,182 +194,50 @@ fn locate_cusp<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
     if let Some(last) = x.last_mut() {
         *last = fold.lambda;
     }
-    let mut point = sys.point(&x);
+    let mut point = sys.point(&x)?;
     point.p = fold.lambda;
     Some(point)
 }
 
-/// The fold system of one family, with the residual planned at the last `p`.
-struct FoldSystem<'f, F> {
-    family: &'f F,
-    hb: HbOptions,
-    /// `p` the residual and Jacobian scratch were planned for.
-    planned: f64,
-    res: HbResidual,
-    galerkin: GalerkinJacobian,
-    jac: Vec<f64>,
-    /// Unknowns `m` of `q` (and of `v`).
-    m: usize,
+/// The interval `[lo, hi]` of `p` of a curve of `what` from `(ω, p_start)`.
+///
+/// # Errors
+/// [`HbError::InvalidInput`] unless all are finite, `p_from ≠ p_to`,
+/// `p_start` lies between them and ω > 0.
+pub(crate) fn path_interval(
+    what: &str,
+    omega: f64,
+    p_start: f64,
+    p_from: f64,
+    p_to: f64,
+) -> Result<(f64, f64), HbError> {
+    let (lo, hi) = (p_from.min(p_to), p_from.max(p_to));
+    let finite = [p_start, p_from, p_to, omega].iter().all(|v| v.is_finite());
+    if finite && lo != hi && (lo..=hi).contains(&p_start) && omega > 0.0 {
+        return Ok((lo, hi));
+    }
+    Err(HbError::InvalidInput(format!(
+        "{what}: finite p_from ≠ p_to with the start's p between them, ω > 0"
+    )))
 }
 
-impl<'f, P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> FoldSystem<'f, F> {
-    fn new(family: &'f F, hb: &HbOptions, p: f64) -> Result<Self, HbError> {
-        let res = HbResidual::new(&family(p)?, hb)?;
-        let m = res.len();
-        Ok(Self {
-            family,
-            hb: hb.clone(),
-            planned: p,
-            galerkin: GalerkinJacobian::new(&res),
-            res,
-            jac: vec![0.0; m * m],
-            m,
+/// Each pair of consecutive points of `path` whose component `index` brackets a
+/// value of `values`, with that value: `(a, b, value)`, values in the order
+/// given, pairs in path order.
+pub(crate) fn crossings<'p>(
+    path: &'p [PathPoint],
+    values: &'p [f64],
+    index: usize,
+) -> impl Iterator<Item = (&'p [f64], &'p [f64], f64)> + 'p {
+    values.iter().flat_map(move |&v| {
+        path.windows(2).filter_map(move |w| {
+            let [a, b] = w else { return None };
+            let (ya, yb) = (*a.x.get(index)?, *b.x.get(index)?);
+            // Strictly inside, or at the window's end (or the path's start):
+            // a point exactly at `v` counts once.
+            let first = std::ptr::eq(a, path.first()?);
+            let hit = (ya - v) * (yb - v) < 0.0 || yb == v || (first && ya == v);
+            (hit && ya != yb).then_some((a.x.as_slice(), b.x.as_slice(), v))
         })
-    }
-
-    /// Plans the residual for `p` (the excitation may depend on it); `None`
-    /// where the family fails.
-    fn plan(&mut self, p: f64) -> Option<P> {
-        let problem = (self.family)(p).ok()?;
-        if p != self.planned {
-            self.res = HbResidual::new(&problem, &self.hb).ok()?;
-            self.planned = p;
-        }
-        Some(problem)
-    }
-
-    /// `[R; Φ_q v; (vᵀv − 1)/2]` at `x = [q, v, ω, p]` (NaN if `p` cannot be
-    /// planned, which the path follower rejects).
-    fn residual(&mut self, x: &[f64], r: &mut [f64]) {
-        let m = self.m;
-        let (q, rest) = x.split_at(m);
-        let (v, wp) = rest.split_at(m);
-        let (omega, p) = (wp[0], wp[1]);
-        let Some(problem) = self.plan(p) else {
-            r.fill(f64::NAN);
-            return;
-        };
-        self.res.eval(&problem, q, omega, 1.0, &mut r[..m]);
-        self.galerkin
-            .assemble(&mut self.res, &problem, q, omega, 1.0, &mut self.jac);
-        ivt_num::vector::matvec(&self.jac, m, m, v, &mut r[m..2 * m]);
-        r[2 * m] = 0.5 * (ivt_num::vector::dot(v, v) - 1.0);
-    }
-
-    /// A unit null vector of `Φ_q` at a located fold, by two steps of inverse
-    /// iteration.
-    fn null_vector(&mut self, q: &[f64], omega: f64, p: f64) -> Result<Vec<f64>, HbError> {
-        let problem = self
-            .plan(p)
-            .ok_or_else(|| HbError::InvalidInput("the family fails at p_start".into()))?;
-        self.galerkin
-            .assemble(&mut self.res, &problem, q, omega, 1.0, &mut self.jac);
-        let mut lu = LuWorkspace::new(self.m);
-        let mut v = vec![1.0; self.m];
-        if lu.factor_row_major(&self.jac) {
-            for _ in 0..2 {
-                lu.solve(&mut v);
-                let norm = norm2(&v);
-                if !(norm.is_finite() && norm > 0.0) {
-                    return Err(HbError::SingularStart { lambda: p });
-                }
-                v.iter_mut().for_each(|x| *x /= norm);
-            }
-        }
-        Ok(v)
-    }
-
-    /// The fold at `x = [q, v, ω, p]`.
-    fn point(&self, x: &[f64]) -> FoldPoint {
-        let m = self.m;
-        FoldPoint {
-            omega: x[2 * m],
-            p: x[2 * m + 1],
-            coeffs: x[..m].to_vec(),
-            null_vector: x[m..2 * m].to_vec(),
-        }
-    }
-
-    /// The fold at fixed `p` from the linear interpolation of the path points
-    /// `a`, `b` that bracket it (Newton on `{q, v, ω}`, central-difference
-    /// Jacobian).
-    fn solve_at(&mut self, a: &[f64], b: &[f64], p: f64) -> Option<FoldPoint> {
-        let n = 2 * self.m + 1;
-        let (pa, pb) = (a[n], b[n]);
-        let t = (p - pa) / (pb - pa);
-        let mut y: Vec<f64> = a[..n]
-            .iter()
-            .zip(&b[..n])
-            .map(|(u, w)| u + t * (w - u))
-            .collect();
-        let scale = norm2(&a[..self.m]).max(f64::MIN_POSITIVE);
-        let mut fixed = FixedP {
-            sys: self,
-            p,
-            x: vec![0.0; n + 1],
-            rp: vec![0.0; n],
-            rm: vec![0.0; n],
-        };
-        let opts = NewtonOptions {
-            ftol: 1e-12 * scale.max(1.0),
-            ..NewtonOptions::default()
-        };
-        ivt_num::newton(&mut fixed, &mut y, &mut NewtonWorkspace::new(n), &opts).ok()?;
-        y.push(p);
-        Some(self.point(&y))
-    }
-}
-
-/// The fold system at a fixed `p` as a square Newton system in `{q, v, ω}`.
-struct FixedP<'s, 'f, F> {
-    sys: &'s mut FoldSystem<'f, F>,
-    p: f64,
-    x: Vec<f64>,
-    rp: Vec<f64>,
-    rm: Vec<f64>,
-}
-
-impl<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> FixedP<'_, '_, F> {
-    fn eval(&mut self, y: &[f64], out: Which) {
-        let n = y.len();
-        self.x[..n].copy_from_slice(y);
-        self.x[n] = self.p;
-        let r = match out {
-            Which::Plus => &mut self.rp,
-            Which::Minus => &mut self.rm,
-        };
-        self.sys.residual(&self.x, r);
-    }
-}
-
-/// Which scratch residual [`FixedP::eval`] writes.
-#[derive(Clone, Copy)]
-enum Which {
-    Plus,
-    Minus,
-}
-
-impl<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> NewtonSystem for FixedP<'_, '_, F> {
-    type Error = std::convert::Infallible;
-    fn residual(&mut self, y: &[f64], r: &mut [f64]) -> Result<(), Self::Error> {
-        self.eval(y, Which::Plus);
-        r.copy_from_slice(&self.rp);
-        Ok(())
-    }
-    fn jacobian(&mut self, y: &[f64], jac: &mut [f64]) -> Result<(), Self::Error> {
-        let n = y.len();
-        let mut yp = y.to_vec();
-        for j in 0..n {
-            let h = 1e-7 * y[j].abs().max(1e-3);
-            yp[j] = y[j] + h;
-            self.eval(&yp, Which::Plus);
-            yp[j] = y[j] - h;
-            self.eval(&yp, Which::Minus);
-            yp[j] = y[j];
-            for i in 0..n {
-                jac[i * n + j] = (self.rp[i] - self.rm[i]) / (2.0 * h);
-            }
-        }
-        Ok(())
-    }
+    })
 }

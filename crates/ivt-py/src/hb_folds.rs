@@ -4,7 +4,7 @@
 //! user family `family(p) -> (m, c, k, g, f)` or on Duffing's equation in F.
 
 use ivt_hb::jobs::{self, FoldCurveRequest, FoldStart};
-use ivt_hb::Duffing;
+use ivt_hb::{BifurcationKind, Duffing};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -14,15 +14,21 @@ use crate::hb_bifurcation::PyFamily;
 use crate::hb_shared::{finite, options, run, run_user};
 use crate::to_python::to_dict;
 
-/// The start fold of `continue_bifurcation`: ω and coefficients of a fold
-/// dict (`kind` "fold" when given).
-fn given_start(start: &Bound<'_, PyDict>) -> PyResult<FoldStart> {
+/// The kind and start point of `continue_bifurcation`: ω and coefficients of
+/// a fold, period-doubling or Neimark–Sacker dict (`kind` "fold" when
+/// absent).
+fn given_start(start: &Bound<'_, PyDict>) -> PyResult<(BifurcationKind, FoldStart)> {
     let kind: Option<String> = start.get_item("kind")?.map(|k| k.extract()).transpose()?;
-    if kind.as_deref().is_some_and(|k| k != "fold") {
-        return Err(PyValueError::new_err(
-            "argument `start` must be a fold: only fold curves are continued this round",
-        ));
-    }
+    let kind = match kind.as_deref() {
+        None | Some("fold") => BifurcationKind::Fold,
+        Some("period_doubling") => BifurcationKind::PeriodDoubling,
+        Some("neimark_sacker") => BifurcationKind::NeimarkSacker,
+        Some(other) => {
+            return Err(PyValueError::new_err(format!(
+                "argument `start` must be a fold, period_doubling or neimark_sacker point, not {other:?}"
+            )))
+        }
+    };
     let item = |key: &str| {
         start
             .get_item(key)?
@@ -34,24 +40,30 @@ fn given_start(start: &Bound<'_, PyDict>) -> PyResult<FoldStart> {
         .map_err(|_| PyTypeError::new_err("start[\"coeffs\"] must be a 1-D array of floats"))?
         .as_array()
         .to_vec();
-    Ok(FoldStart::Given { omega, coeffs })
+    Ok((kind, FoldStart::Given { omega, coeffs }))
 }
 
-/// Two-parameter continuation of a fold of the frequency response of
-/// `family(p)` → (m, c, k, g, f) in (omega, p) (ivt_hb::fold_curve: the
-/// extended system R = 0, Φ_q v = 0, |v| = 1 followed in p, first towards
-/// `p_from`, until p leaves [p_from, p_to]). `start` is a fold of
-/// `frc(..., events=True)["bifurcations"]` (or `frc(...)["folds"]`) computed
-/// at p = `p_start`, with the same `n` and `samples`. Cusps (where two folds
-/// merge and the jump disappears) are located as turning points of the curve
-/// in p; the fold at each p of `at` is solved exactly (each crossing).
-/// Only folds this round (period-doubling and Neimark–Sacker curves are not
-/// built). An exception in `family` is re-raised; one in the `g` or `f` it
-/// returns for p ≠ p_start makes that point fail (the curve stops there).
-/// Returns the job's [`ivt_hb::jobs::FoldCurveResult`]: {"kind": "fold",
-/// "start_omega", "points": [{"omega", "p", "amplitude", "coeffs"}...],
-/// "at": [...], "special": [{"kind": "cusp", "omega", "p", "amplitude",
-/// "coeffs"}...], "termination", "time_s"}.
+/// Two-parameter continuation of a fold, period doubling or Neimark–Sacker
+/// point of the frequency response of `family(p)` → (m, c, k, g, f) in
+/// (omega, p), the job [`ivt_hb::jobs::fold_curve`]. `start` is an entry of
+/// `frc(..., events=True)["bifurcations"]` (or of `frc(...)["folds"]`)
+/// computed at p = `p_start`, with the same `n` and `samples`; its "kind"
+/// says what is followed. Folds (ivt_hb::fold_curve: R = 0, Φ_q v = 0,
+/// |v| = 1 followed in p, first towards `p_from`, until p leaves
+/// [p_from, p_to]): cusps (where two folds merge and the jump disappears)
+/// are located as turning points of the curve in p. Period doublings and
+/// Neimark–Sacker points (ivt_hb::codim2::bifurcation_curve: R = 0 with the
+/// critical eigenvector of the monodromy matrix, followed both ways from the
+/// start): each point carries the angle θ of its critical multipliers
+/// e^{±iθ}, and on an NS curve the resonances 1:1 and 1:2 (its ends on a fold
+/// or PD curve) and 1:3, 1:4 are located. The point at each p of `at` is
+/// solved exactly (each crossing). An exception in `family` is re-raised;
+/// one in the `g` or `f` it returns for p ≠ p_start makes that point fail
+/// (the curve stops there). Returns the job's
+/// [`ivt_hb::jobs::FoldCurveResult`]: {"kind", "start_omega", "points":
+/// [{"omega", "p", "amplitude", "coeffs", "angle" (not on folds)}...],
+/// "at": [...], "special": [{"kind": "cusp" | "resonance_1_1" | ...,
+/// "omega", "p", "amplitude", "coeffs"}...], "termination", "time_s"}.
 #[pyfunction]
 #[pyo3(signature = (
     family, start, p_from, p_to, at = Vec::new(), p_start = None, n = 20, samples = 64,
@@ -81,8 +93,10 @@ fn continue_bifurcation<'py>(
         "p_start",
         p_start.ok_or_else(|| PyValueError::new_err("argument `p_start` is required"))?,
     )?;
+    let (kind, start) = given_start(start)?;
     let req = FoldCurveRequest {
-        start: given_start(start)?,
+        kind,
+        start,
         p_start,
         p_from,
         p_to,

@@ -1,13 +1,20 @@
-//! Fold curve (codimension 2): a fold of the frequency response of a model
-//! family `family(p)` followed in (ω, p) through its cusps
+//! Bifurcation curves (codimension 2) of a model family `family(p)` in
+//! (ω, p): a fold of the frequency response followed through its cusps
 //! ([`crate::fold_curve`]: the extended system `R = 0`, `Φ_q v = 0`,
-//! `|v| = 1` of Eq. 56/61 continued by Eq. 68–77 in `p`). The start is a
-//! given fold, or the fold of largest ω_f located on the FRC of
-//! `family(p_start)` over an interval.
+//! `|v| = 1` of Eq. 56/61 continued by Eq. 68–77 in `p`), or a period
+//! doubling or Neimark–Sacker point to the ends of its curve with the strong
+//! resonances on it ([`crate::codim2::bifurcation_curve`]: `R = 0` with the
+//! critical eigenvector of the monodromy matrix, Eq. 80). The start is a
+//! given point, or the point of that kind of largest ω_f located on the FRC
+//! of `family(p_start)` over an interval.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
-use super::{finite, Array};
-use crate::codim2::FoldPoint as CurveFold;
-use crate::continuation::{ContinuationOptions, Termination};
+use super::{finite, Array, FrcRequest};
+use crate::codim2::{bifurcation_curve, CurvePoint, CurveStart};
+use crate::continuation::{ContinuationOptions, Corrector, Termination};
 use crate::error::HbError;
 use crate::events::BifurcationKind;
 use crate::frc::{frequency_response, FrcOptions};
@@ -16,19 +23,21 @@ use crate::problem::PeriodicProblem;
 use serde::Serialize;
 use std::time::Instant;
 
-/// Where the fold curve starts.
+/// Where the curve starts.
 #[derive(Debug, Clone, PartialEq)]
 pub enum FoldStart {
-    /// A located fold of the FRC of `family(p_start)` (with the same
-    /// harmonics and samples): its ω_f and coefficients.
+    /// A located point of the request's kind on the FRC of
+    /// `family(p_start)` (with the same harmonics and samples): its ω_f and
+    /// coefficients.
     Given {
-        /// ω_f of the fold.
+        /// ω_f of the point.
         omega: f64,
         /// Its coefficients.
         coeffs: Vec<f64>,
     },
-    /// The located fold of largest ω_f on the FRC of `family(p_start)`
-    /// traced from `from` to `to`.
+    /// The located point of the request's kind of largest ω_f on the FRC of
+    /// `family(p_start)` traced from `from` to `to` (with its events unless
+    /// the kind is a fold).
     Search {
         /// Start of the FRC.
         from: f64,
@@ -37,10 +46,13 @@ pub enum FoldStart {
     },
 }
 
-/// The start, the interval of `p` and the path's steps.
+/// The kind, the start, the interval of `p` and the path's steps.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FoldCurveRequest {
-    /// The start fold.
+    /// What is followed: a fold, a period doubling or a Neimark–Sacker
+    /// point (not a branch point).
+    pub kind: BifurcationKind,
+    /// The start point.
     pub start: FoldStart,
     /// `p` of the start.
     pub p_start: f64,
@@ -63,6 +75,7 @@ impl Default for FoldCurveRequest {
     /// p = 0.1, followed from p = 0 to 0.3 in steps up to 0.05.
     fn default() -> Self {
         Self {
+            kind: BifurcationKind::Fold,
             start: FoldStart::Search { from: 0.5, to: 2.5 },
             p_start: 0.1,
             p_from: 0.0,
@@ -81,12 +94,17 @@ impl FoldCurveRequest {
     /// (the interval and the start fold are checked by
     /// [`crate::fold_curve`]).
     pub fn validate(&self) -> Result<(), HbError> {
+        if self.kind == BifurcationKind::BranchPoint {
+            return Err(HbError::InvalidInput(
+                "branch points are not continued in two parameters".into(),
+            ));
+        }
         match &self.start {
             FoldStart::Given { omega, coeffs } => {
                 finite("omega", *omega)?;
                 if coeffs.iter().any(|c| !c.is_finite()) {
                     return Err(HbError::InvalidInput(
-                        "the start fold's coefficients must be finite".into(),
+                        "the start point's coefficients must be finite".into(),
                     ));
                 }
             }
@@ -114,10 +132,10 @@ impl FoldCurveRequest {
     }
 }
 
-/// One fold on the curve.
+/// One point of the curve.
 #[derive(Debug, Clone, Serialize)]
 pub struct CurveFoldPoint {
-    /// ω_f of the fold.
+    /// ω_f of the point.
     pub omega: f64,
     /// The second parameter.
     pub p: f64,
@@ -125,14 +143,30 @@ pub struct CurveFoldPoint {
     pub amplitude: f64,
     /// Coefficients of the orbit there.
     pub coeffs: Array<f64>,
+    /// Angle θ of the critical multipliers `e^{±iθ}` (π on a
+    /// period-doubling curve); absent on a fold curve.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub angle: Option<f64>,
 }
 
-/// What a special point of a fold curve is.
+/// What a special point of a curve is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SpecialKind {
     /// Two folds merge (a turning point of the curve in `p`).
     Cusp,
+    /// A Neimark–Sacker curve ends on a fold curve (θ = 0).
+    #[serde(rename = "resonance_1_1")]
+    Resonance1To1,
+    /// A Neimark–Sacker curve ends on a period-doubling curve (θ = π).
+    #[serde(rename = "resonance_1_2")]
+    Resonance1To2,
+    /// θ = 2π/3 on a Neimark–Sacker curve.
+    #[serde(rename = "resonance_1_3")]
+    Resonance1To3,
+    /// θ = π/2 on a Neimark–Sacker curve.
+    #[serde(rename = "resonance_1_4")]
+    Resonance1To4,
 }
 
 /// A special point of the curve.
@@ -145,19 +179,22 @@ pub struct SpecialPoint {
     pub point: CurveFoldPoint,
 }
 
-/// A fold curve: the keys of `ivt hb duffing-folds --json` and of the dicts
-/// of `ivt.hb.duffing_folds` and `ivt.hb.continue_bifurcation`.
+/// A bifurcation curve: the keys of `ivt hb duffing-folds --json`,
+/// `ivt hb vdp-torus --json` and of the dicts of `ivt.hb.duffing_folds` and
+/// `ivt.hb.continue_bifurcation`.
 #[derive(Debug, Clone, Serialize)]
 pub struct FoldCurveResult {
-    /// The bifurcation followed (a fold).
+    /// The bifurcation followed.
     pub kind: BifurcationKind,
-    /// The start fold's ω_f.
+    /// The start point's ω_f.
     pub start_omega: f64,
     /// Points in path order.
     pub points: Vec<CurveFoldPoint>,
     /// The fold at each requested `p`, each crossing, in path order.
     pub at: Vec<CurveFoldPoint>,
-    /// Cusps in path order.
+    /// Cusps in path order (fold curves); resonances 1:1, 1:2, 1:3, 1:4
+    /// in that order (Neimark–Sacker curves); none on period-doubling
+    /// curves.
     pub special: Vec<SpecialPoint>,
     /// Why the path stopped.
     pub termination: Termination,
@@ -165,12 +202,13 @@ pub struct FoldCurveResult {
     pub time_s: f64,
 }
 
-/// The fold curve of `family` from `req`'s start.
+/// The curve of `req.kind` of `family` from `req`'s start.
 ///
 /// # Errors
 /// [`FoldCurveRequest::validate`]'s; `family(p_start)`'s; with
 /// [`FoldStart::Search`], the FRC's and [`HbError::InvalidInput`] when it has
-/// no located fold; [`crate::fold_curve`]'s.
+/// no located point of the kind; [`crate::fold_curve`]'s or
+/// [`crate::codim2::bifurcation_curve`]'s.
 pub fn fold_curve<P, F>(
     family: F,
     hb: &HbOptions,
@@ -184,26 +222,7 @@ where
     let t0 = Instant::now();
     let (omega, coeffs) = match &req.start {
         FoldStart::Given { omega, coeffs } => (*omega, coeffs.clone()),
-        FoldStart::Search { from, to } => {
-            let opts = FrcOptions {
-                from: *from,
-                to: *to,
-                ..FrcOptions::default()
-            };
-            let frc = frequency_response(&family(req.p_start)?, hb, &opts)?;
-            let fold = frc
-                .folds
-                .iter()
-                .filter(|f| f.located)
-                .max_by(|x, y| x.omega_f.total_cmp(&y.omega_f))
-                .ok_or_else(|| {
-                    HbError::InvalidInput(format!(
-                        "the FRC from ω_f = {from} to {to} at p = {} has no located fold to start from",
-                        req.p_start
-                    ))
-                })?;
-            (fold.omega_f, fold.coeffs.clone())
-        }
+        FoldStart::Search { from, to } => search_start(&family, hb, req, *from, *to)?,
     };
     let copts = ContinuationOptions {
         ds: req.ds,
@@ -211,50 +230,150 @@ where
         max_points: req.max_points,
         ..ContinuationOptions::default()
     };
-    let curve = crate::fold_curve(
-        family,
-        hb,
-        &coeffs,
-        omega,
-        req.p_start,
-        req.p_from,
-        req.p_to,
-        &req.at,
-        &copts,
-    )?;
-    let sample = |f: &CurveFold| sample(f, hb.harmonics);
-    Ok(FoldCurveResult {
-        kind: BifurcationKind::Fold,
-        start_omega: omega,
-        points: curve.points.iter().map(sample).collect(),
-        at: curve.at.iter().map(sample).collect(),
-        special: curve
-            .cusps
-            .iter()
-            .map(|c| SpecialPoint {
-                kind: SpecialKind::Cusp,
-                point: sample(c),
+    let h = hb.harmonics;
+    let (points, at, special, termination) = if req.kind == BifurcationKind::Fold {
+        let curve = crate::fold_curve(
+            family,
+            hb,
+            &coeffs,
+            omega,
+            req.p_start,
+            req.p_from,
+            req.p_to,
+            &req.at,
+            &copts,
+        )?;
+        let fold = |f: &crate::FoldPoint| sample(f.omega, f.p, &f.coeffs, None, h);
+        let cusps = curve.cusps.iter().map(|c| SpecialPoint {
+            kind: SpecialKind::Cusp,
+            point: fold(c),
+        });
+        (
+            curve.points.iter().map(fold).collect(),
+            curve.at.iter().map(fold).collect(),
+            cusps.collect(),
+            curve.termination,
+        )
+    } else {
+        let start = CurveStart {
+            kind: req.kind,
+            coeffs,
+            omega,
+            p: req.p_start,
+        };
+        let curve = bifurcation_curve(family, hb, &start, req.p_from, req.p_to, &req.at, &copts)?;
+        let point = |c: &CurvePoint| sample(c.omega, c.p, &c.coeffs, Some(c.angle), h);
+        let special = curve.resonances.iter().filter_map(|(order, c)| {
+            let kind = match order {
+                1 => SpecialKind::Resonance1To1,
+                2 => SpecialKind::Resonance1To2,
+                3 => SpecialKind::Resonance1To3,
+                4 => SpecialKind::Resonance1To4,
+                _ => return None,
+            };
+            Some(SpecialPoint {
+                kind,
+                point: point(c),
             })
-            .collect(),
-        termination: curve.termination,
+        });
+        (
+            curve.points.iter().map(point).collect(),
+            curve.at.iter().map(point).collect(),
+            special.collect(),
+            curve.termination,
+        )
+    };
+    Ok(FoldCurveResult {
+        kind: req.kind,
+        start_omega: omega,
+        points,
+        at,
+        special,
+        termination,
         time_s: t0.elapsed().as_secs_f64(),
     })
 }
 
-/// A fold of the curve with its amplitude ([`HbSolution::amplitude`]).
-fn sample(f: &CurveFold, harmonics: usize) -> CurveFoldPoint {
+/// The located point of `req.kind` of largest ω_f on the FRC of
+/// `family(req.p_start)` from `from` to `to`: its ω_f and coefficients.
+fn search_start<P, F>(
+    family: &F,
+    hb: &HbOptions,
+    req: &FoldCurveRequest,
+    from: f64,
+    to: f64,
+) -> Result<(f64, Vec<f64>), HbError>
+where
+    P: PeriodicProblem,
+    F: Fn(f64) -> Result<P, HbError>,
+{
+    let problem = family(req.p_start)?;
+    let best = if req.kind == BifurcationKind::Fold {
+        let opts = FrcOptions {
+            from,
+            to,
+            ..FrcOptions::default()
+        };
+        frequency_response(&problem, hb, &opts)?
+            .folds
+            .into_iter()
+            .filter(|f| f.located)
+            .map(|f| (f.omega_f, f.coeffs))
+            .max_by(|x, y| x.0.total_cmp(&y.0))
+    } else {
+        let frc = FrcRequest {
+            from,
+            to,
+            events: true,
+            corrector: Corrector::Newton,
+        };
+        super::frc(&problem, hb, &frc)?
+            .bifurcations
+            .into_iter()
+            .filter(|e| e.kind == req.kind && e.located)
+            .filter_map(|e| Some((e.omega?, e.coeffs?.0)))
+            .max_by(|x, y| x.0.total_cmp(&y.0))
+    };
+    best.ok_or_else(|| {
+        HbError::InvalidInput(format!(
+            "the FRC from ω_f = {from} to {to} at p = {} has no located {} to start from",
+            req.p_start,
+            kind_name(req.kind)
+        ))
+    })
+}
+
+/// The words of the kind in messages.
+fn kind_name(kind: BifurcationKind) -> &'static str {
+    match kind {
+        BifurcationKind::Fold => "fold",
+        BifurcationKind::PeriodDoubling => "period doubling",
+        BifurcationKind::NeimarkSacker => "Neimark–Sacker point",
+        BifurcationKind::BranchPoint => "branch point",
+    }
+}
+
+/// A point of the curve with its amplitude ([`HbSolution::amplitude`]).
+fn sample(
+    omega: f64,
+    p: f64,
+    coeffs: &[f64],
+    angle: Option<f64>,
+    harmonics: usize,
+) -> CurveFoldPoint {
     let orbit = HbSolution {
-        coeffs: f.coeffs.clone(),
-        omega_f: f.omega,
+        coeffs: coeffs.to_vec(),
+        omega_f: omega,
         harmonics,
         subharmonic: 1,
         stats: Default::default(),
     };
     CurveFoldPoint {
-        omega: f.omega,
-        p: f.p,
+        omega,
+        p,
         amplitude: orbit.amplitude(0),
         coeffs: Array(orbit.coeffs),
+        angle,
     }
 }
 
@@ -284,6 +403,57 @@ mod tests {
         }
         assert_eq!(c.special.len(), 1);
         assert!((c.special[0].point.p / 0.0120510724 - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn van_der_pol_torus_curve_ends_at_the_shooting_resonance() {
+        // ẍ − 0.2(1 − x²)ẋ + x = F cos ω_f t from its Neimark–Sacker point at
+        // F = 0.2: by shooting (tests/ns_curve.rs) the NS point at F = 0.3 is
+        // at ω_f = 0.8980504973 and the 1:1 end at F = 0.1924005859.
+        let family = |f: f64| {
+            Ok(crate::GeneralProblem::new(
+                1,
+                vec![1.0],
+                vec![-0.2],
+                vec![1.0],
+                |x: &[f64], v: &[f64], _t: f64, g: &mut [f64]| g[0] = 0.2 * x[0] * x[0] * v[0],
+                move |t: f64, out: &mut [f64]| out[0] = f * t.cos(),
+            ))
+        };
+        let req = FoldCurveRequest {
+            kind: BifurcationKind::NeimarkSacker,
+            start: FoldStart::Search { from: 0.5, to: 1.6 },
+            p_start: 0.2,
+            p_from: 0.0,
+            p_to: 0.3,
+            at: vec![0.3],
+            ds: 0.01,
+            ds_max: 0.02,
+            max_points: 400,
+        };
+        let c = fold_curve(family, &HbOptions::new(9, 32), &req).unwrap();
+        assert_eq!(c.kind, BifurcationKind::NeimarkSacker);
+        assert!((c.start_omega - 0.94525643).abs() < 1e-8);
+        assert_eq!(c.termination, Termination::LeftInterval);
+        assert_eq!(c.at.len(), 1);
+        assert!((c.at[0].omega - 0.8980504973).abs() < 1e-7);
+        assert!(c.points.iter().all(|p| p.angle.is_some_and(|a| a > 0.0)));
+        let [r] = c.special.as_slice() else {
+            panic!("{:?}", c.special)
+        };
+        assert_eq!(r.kind, SpecialKind::Resonance1To1);
+        assert!((r.point.p - 0.1924005859).abs() < 1e-7);
+    }
+
+    #[test]
+    fn a_branch_point_curve_is_an_input_error() {
+        let family = |f: f64| Ok(Duffing::new(0.02, 1.0, 1.0, f));
+        let req = FoldCurveRequest {
+            kind: BifurcationKind::BranchPoint,
+            ..FoldCurveRequest::default()
+        };
+        let e = fold_curve(family, &HbOptions::new(10, 32), &req).unwrap_err();
+        assert!(e.to_string().contains("branch points"), "{e}");
     }
 
     #[test]

@@ -9,7 +9,7 @@
 //! |---|---|---|---|---|
 //! | orbit + stability (Eq. 56–67, 78) | [`OrbitRequest`] | [`Orbit`] | `hb duffing` | `duffing`, `mathieu_duffing`, `solve` |
 //! | FRC, with or without events (Eq. 68–77) | [`FrcRequest`] | [`FrcCurve`] | `hb duffing-frc [--events]` | `duffing_frc`, `frc` |
-//! | fold curve in (ω, p) through cusps (Eq. 56, 61, 68–77) | [`FoldCurveRequest`] | [`FoldCurveResult`] | `hb duffing-folds` | `duffing_folds`, `continue_bifurcation` |
+//! | fold, period-doubling and Neimark–Sacker curves in (ω, p) (Eq. 56, 61, 68–80) | [`FoldCurveRequest`] | [`FoldCurveResult`] | `hb duffing-folds`, `hb vdp-torus` | `duffing_folds`, `continue_bifurcation` |
 //! | limit cycle (ω unknown) | [`LimitCycleRequest`] | [`Cycle`] | `hb limit-cycle` | `limit_cycle` |
 //! | backbone | [`BackboneRequest`] | [`BackboneCurve`] | `hb duffing-backbone` | `backbone` |
 //! | Mathieu–Duffing cascade (Eq. 81–85) | [`CascadeRequest`] | [`Cascade`] | `hb mathieu-duffing` | `mathieu_cascade` |

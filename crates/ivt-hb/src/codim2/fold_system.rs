@@ -1,0 +1,126 @@
+//! The fold system of a family `family(p)` (Keller; the fold systems of
+//! AUTO and MATCONT): `R(q, ω; p) = 0` (Eq. 61), `Φ_q(q, ω; p) v = 0`
+//! (Eq. 56), `(vᵀv − 1)/2 = 0` in the path vector `x = [q, v, ω, p]`, with
+//! the residual planned anew when `p` changes (the excitation may depend on
+//! it).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
+use super::fixed::CurveSystem;
+use super::FoldPoint;
+use crate::error::HbError;
+use crate::events::extended::null_vector;
+use crate::galerkin::GalerkinJacobian;
+use crate::ihb::{HbOptions, HbResidual};
+use crate::problem::PeriodicProblem;
+use ivt_num::LuWorkspace;
+
+/// The fold system of one family, with the residual planned at the last `p`.
+pub(super) struct FoldSystem<'f, F> {
+    family: &'f F,
+    hb: HbOptions,
+    /// `p` the residual and Jacobian scratch were planned for.
+    planned: f64,
+    res: HbResidual,
+    galerkin: GalerkinJacobian,
+    jac: Vec<f64>,
+    /// Unknowns `m` of `q` (and of `v`).
+    pub(super) m: usize,
+}
+
+impl<'f, P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> FoldSystem<'f, F> {
+    pub(super) fn new(family: &'f F, hb: &HbOptions, p: f64) -> Result<Self, HbError> {
+        let res = HbResidual::new(&family(p)?, hb)?;
+        let m = res.len();
+        Ok(Self {
+            family,
+            hb: hb.clone(),
+            planned: p,
+            galerkin: GalerkinJacobian::new(&res),
+            res,
+            jac: vec![0.0; m * m],
+            m,
+        })
+    }
+
+    /// Plans the residual for `p` (the excitation may depend on it); `None`
+    /// where the family fails.
+    fn plan(&mut self, p: f64) -> Option<P> {
+        let problem = (self.family)(p).ok()?;
+        if p != self.planned {
+            self.res = HbResidual::new(&problem, &self.hb).ok()?;
+            self.planned = p;
+        }
+        Some(problem)
+    }
+
+    /// `[R; Φ_q v; (vᵀv − 1)/2]` at `x = [q, v, ω, p]`; `None` if the sizes
+    /// disagree or `p` cannot be planned.
+    fn try_residual(&mut self, x: &[f64], r: &mut [f64]) -> Option<()> {
+        let m = self.m;
+        let (q, rest) = x.split_at_checked(m)?;
+        let (v, &[omega, p]) = rest.split_at_checked(m)? else {
+            return None;
+        };
+        let (r_orbit, rest) = r.split_at_mut_checked(m)?;
+        let (r_null, [r_norm]) = rest.split_at_mut_checked(m)? else {
+            return None;
+        };
+        let problem = self.plan(p)?;
+        self.res.eval(&problem, q, omega, 1.0, r_orbit);
+        self.galerkin
+            .assemble(&mut self.res, &problem, q, omega, 1.0, &mut self.jac);
+        ivt_num::vector::matvec(&self.jac, m, m, v, r_null);
+        *r_norm = 0.5 * (ivt_num::vector::dot(v, v) - 1.0);
+        Some(())
+    }
+
+    /// A unit null vector of `Φ_q` at a located fold, by two steps of inverse
+    /// iteration.
+    pub(super) fn null_vector(
+        &mut self,
+        q: &[f64],
+        omega: f64,
+        p: f64,
+    ) -> Result<Vec<f64>, HbError> {
+        let problem = self
+            .plan(p)
+            .ok_or_else(|| HbError::InvalidInput("the family fails at p_start".into()))?;
+        self.galerkin
+            .assemble(&mut self.res, &problem, q, omega, 1.0, &mut self.jac);
+        let mut lu = LuWorkspace::new(self.m);
+        let mut v = vec![1.0 / (self.m as f64).sqrt(); self.m];
+        // A factor singular to rounding still serves inverse iteration (the
+        // solve is checked instead).
+        lu.factor_row_major(&self.jac);
+        if !null_vector(&mut lu, &mut v, false) {
+            return Err(HbError::SingularStart { lambda: p });
+        }
+        Ok(v)
+    }
+
+    /// The fold at `x = [q, v, ω, p]` (`None` if `x` is short).
+    pub(super) fn point(&self, x: &[f64]) -> Option<FoldPoint> {
+        let m = self.m;
+        let (q, rest) = x.split_at_checked(m)?;
+        let (v, &[omega, p]) = rest.split_at_checked(m)? else {
+            return None;
+        };
+        Some(FoldPoint {
+            omega,
+            p,
+            coeffs: q.to_vec(),
+            null_vector: v.to_vec(),
+        })
+    }
+}
+
+impl<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> CurveSystem for FoldSystem<'_, F> {
+    fn residual(&mut self, x: &[f64], r: &mut [f64]) {
+        if self.try_residual(x, r).is_none() {
+            r.fill(f64::NAN);
+        }
+    }
+}

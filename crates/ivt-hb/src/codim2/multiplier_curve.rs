@@ -1,0 +1,473 @@
+//! Period-doubling and Neimark–Sacker curves of a forced family in (ω, p)
+//! (issue 27, item 1): how the point where a Floquet multiplier leaves the
+//! unit circle at −1, or a complex pair leaves it at `e^{±iθ}`, moves with a
+//! second parameter `p` of `family(p)`.
+//!
+//! Along such a curve the HB orbit solves `R(q, ω; p) = 0` (Eq. 61) and the
+//! monodromy matrix Φ of its linearisation (Hsu's method, Eq. 80, Magnus-4
+//! on the grid of the bifurcation locators) has the critical multiplier. The
+//! critical eigenvector is an unknown — the standard augmented systems of
+//! period-doubling and torus curves (Kuznetsov, *Elements of Applied
+//! Bifurcation Theory*, §10.3; the PD/NS curves of cycles of AUTO and
+//! MATCONT):
+//!
+//! - **Period doubling**: `R = 0`, `(Φ + I) v = 0`, `(vᵀv − 1)/2 = 0`, path
+//!   vector `[q, ω, v, p]`.
+//! - **Neimark–Sacker**: `Φ (v_r + i v_i) = e^{iθ} (v_r + i v_i)` in real
+//!   form, `(Φ − cos θ I) v_r + sin θ v_i = 0` and
+//!   `−sin θ v_r + (Φ − cos θ I) v_i = 0`, with `(|v_r|² + |v_i|² − 1)/2 = 0`
+//!   and the phase `v_r⁰·v_i − v_i⁰·v_r = 0` (`Im ⟨v⁰, v⟩ = 0`, `v⁰` the
+//!   start's eigenvector); path vector `[q, ω, θ, v_r, v_i, p]`.
+//!
+//! Each system has one equation fewer than unknowns and is followed by the
+//! engine's pseudo-arclength continuation ([`Stepper`], Eq. 68–77)
+//! with `p` as the path parameter (Φ's derivatives by the path's finite
+//! differences). The point at each `p` of `at` is solved at that `p` by
+//! Newton (`fixed.rs`). On a Neimark–Sacker curve the strong resonances 1:3
+//! and 1:4 (θ = 2π/3, π/2) it crosses are located the same way at fixed θ.
+//! At the resonances 1:1 and 1:2 (θ = 0 or π) the NS curve ends on a fold or
+//! a period-doubling curve: past them the path would run back along the
+//! same curve on the conjugate pair, so it stops at the first point past
+//! (θ leaves (0, π)) and the curve is then followed from the start the
+//! other way. There the fixed-θ system is singular (every point of the fold
+//! or PD curve solves it); as `p`, ω and `q` are even functions of θ − θ_e
+//! on the curve, the end is extrapolated from the points at θ_e ± h and
+//! θ_e ± 2h.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
+use super::fixed::{solve_fixed, CurveSystem};
+use super::{crossings, path_interval};
+use crate::branch::ResidualBranch;
+use crate::continuation::{BroydenCorrector, ContinuationOptions, PathPoint, Stepper, Termination};
+use crate::error::HbError;
+use crate::events::extended::null_vector;
+use crate::events::{BifurcationKind, LocateOptions};
+use crate::floquet::{eigenvalues, monodromy_uniform, HsuRule};
+use crate::ihb::{HbOptions, HbResidual, HbSolution};
+use crate::problem::PeriodicProblem;
+use crate::stability::StabilityAnalyzer;
+use ivt_num::vector::{dot, norm2};
+use ivt_num::LuWorkspace;
+use std::f64::consts::{PI, TAU};
+
+/// A located period doubling or Neimark–Sacker point of the FRC of
+/// `family(p)` to start a curve from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurveStart {
+    /// [`BifurcationKind::PeriodDoubling`] or
+    /// [`BifurcationKind::NeimarkSacker`].
+    pub kind: BifurcationKind,
+    /// Fourier coefficients of the orbit there.
+    pub coeffs: Vec<f64>,
+    /// Its excitation frequency ω_f.
+    pub omega: f64,
+    /// Its `p`.
+    pub p: f64,
+}
+
+/// One point of a period-doubling or Neimark–Sacker curve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurvePoint {
+    /// Excitation frequency ω_f.
+    pub omega: f64,
+    /// The second parameter.
+    pub p: f64,
+    /// Fourier coefficients of the orbit.
+    pub coeffs: Vec<f64>,
+    /// Angle θ ∈ (0, π) of the critical multipliers `e^{±iθ}` (π for a
+    /// period doubling).
+    pub angle: f64,
+}
+
+/// A period-doubling or Neimark–Sacker curve in (ω, p).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BifurcationCurve {
+    /// What the curve's points are.
+    pub kind: BifurcationKind,
+    /// Points in path order.
+    pub points: Vec<CurvePoint>,
+    /// The point at each requested `p`, each time the curve crosses it, in
+    /// path order.
+    pub at: Vec<CurvePoint>,
+    /// Strong resonances on a Neimark–Sacker curve, with their order: 1:1
+    /// and 1:2 where the curve ends (θ = 0 on a fold curve, θ = π on a
+    /// period-doubling curve), 1:3 and 1:4 where it crosses θ = 2π/3, π/2.
+    pub resonances: Vec<(u32, CurvePoint)>,
+    /// Why tracing stopped.
+    pub termination: Termination,
+}
+
+/// Follows the period doubling or Neimark–Sacker point `start` of the FRC of
+/// `family(start.p)` in `p`, first towards `p_from` until `p` leaves
+/// `[min(p_from, p_to), max(p_from, p_to)]` or the curve ends (a 1:1 or 1:2
+/// resonance); unless that path turned back and left at `p_to`, then from
+/// the start towards `p_to`. Points are in path order from the
+/// `p_from` end; `termination` is that of the last path. The point at each `p` of `at`
+/// and the strong resonances are located (module docs). `hb` must be the
+/// options `start` was computed with.
+///
+/// # Errors
+/// [`HbError::InvalidInput`] for sizes, bounds (`start.p` must lie in the
+/// interval), a kind other than the two, or a start whose monodromy matrix
+/// has no such multiplier near the unit circle; `family(start.p)`'s error;
+/// the path's start failures as [`Stepper`]'s. Later, a `p` where
+/// `family` fails is a failed step, and a failed location of an `at` point
+/// or resonance is left out (the curve is kept).
+pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
+    family: F,
+    hb: &HbOptions,
+    start: &CurveStart,
+    p_from: f64,
+    p_to: f64,
+    at: &[f64],
+    opts: &ContinuationOptions,
+) -> Result<BifurcationCurve, HbError> {
+    let p_start = start.p;
+    let (lo, hi) = path_interval("bifurcation curve", start.omega, p_start, p_from, p_to)?;
+    let ns = match start.kind {
+        BifurcationKind::PeriodDoubling => false,
+        BifurcationKind::NeimarkSacker => true,
+        other => {
+            return Err(HbError::InvalidInput(format!(
+                "bifurcation_curve follows period doublings and Neimark–Sacker points, not {other:?} (fold_curve follows folds)"
+            )))
+        }
+    };
+    let mut sys = MultiplierSystem::new(&family, hb, p_start, ns)?;
+    let m = sys.m;
+    if start.coeffs.len() != m || start.coeffs.iter().any(|c| !c.is_finite()) {
+        return Err(HbError::InvalidInput(format!(
+            "the start must have {m} finite coefficients"
+        )));
+    }
+    let x0 = sys.start_vector(&start.coeffs, start.omega, p_start)?;
+    let mut copts = opts.clone();
+    copts.lambda_min = lo;
+    copts.lambda_max = hi;
+    let towards_from = if p_from < p_start { -1.0 } else { 1.0 };
+    let theta_index = m + 1;
+    // A Neimark–Sacker path through θ = 0 or π (1:1, 1:2) continues on the
+    // conjugate pair back along the same curve: it stops at the point past.
+    let trace = |sys: &mut MultiplierSystem<'_, F>, direction: f64| {
+        let m_len = x0.len().saturating_sub(1);
+        let mut residual_branch =
+            ResidualBranch::new(m_len, |x: &[f64], r: &mut [f64]| sys.residual(x, r));
+        let corrector = Box::new(BroydenCorrector::new(m_len, &copts.broyden, None));
+        Stepper::new(&mut residual_branch, corrector, &x0, 0, direction, &copts).map(|stepper| {
+            stepper.run(|_, pt| !ns || pt.x.get(theta_index).is_none_or(|t| t.sin() > 0.0))
+        })
+    };
+    let first = trace(&mut sys, towards_from)?;
+    // Unless the first path turned and left the interval at `p_to`, the
+    // curve is followed from the start towards `p_to` too.
+    let at_p_to = first.termination == Termination::LeftInterval
+        && first
+            .points
+            .last()
+            .is_some_and(|pt| (pt.lambda() - p_to).abs() < (pt.lambda() - p_from).abs());
+    let (mut path, termination) = if !at_p_to {
+        let second = trace(&mut sys, -towards_from)?;
+        let mut joined: Vec<PathPoint> = first.points.into_iter().rev().collect();
+        joined.extend(second.points.into_iter().skip(1));
+        (joined, second.termination)
+    } else {
+        (first.points, first.termination)
+    };
+    let scale = norm2(&start.coeffs);
+    let p_index = x0.len() - 1;
+    let mut solve = |path: &[PathPoint], index: usize, values: &[f64]| -> Vec<CurvePoint> {
+        crossings(path, values, index)
+            .filter_map(|(a, b, v)| {
+                let x = solve_fixed(&mut sys, (a, b), index, v, scale)?;
+                sys.point(&x)
+            })
+            .collect()
+    };
+    let located = solve(&path, p_index, at);
+    let mut resonances = Vec::new();
+    if ns {
+        // An end at θ = 0 or π: the NS system degenerates there (every
+        // point of the fold or PD curve solves it), and p, ω, q are even in
+        // θ − θ_e: Richardson from the points at θ_e ± h and ± 2h (inside).
+        let past = |pt: &PathPoint| pt.x.get(theta_index).is_some_and(|t| t.sin() <= 0.0);
+        for (order, end, inward) in [(1, 0.0, 1.0), (2, PI, -1.0)] {
+            let reached = path
+                .iter()
+                .filter(|pt| past(pt))
+                .any(|pt| pt.x.get(theta_index).is_some_and(|t| (t - end).abs() < 0.5));
+            let h = inward * RESONANCE_STEP;
+            let near = solve(&path, theta_index, &[end + h]);
+            let far = solve(&path, theta_index, &[end + 2.0 * h]);
+            if let (true, Some(a), Some(b)) = (reached, near.first(), far.first()) {
+                resonances.push((order, richardson(a, b, end)));
+            }
+        }
+        for (order, theta) in [(3, TAU / 3.0), (4, PI / 2.0)] {
+            let found = solve(&path, theta_index, &[theta]);
+            resonances.extend(found.into_iter().map(|pt| (order, pt)));
+        }
+    }
+    // The points past a 1:1 or 1:2 end are not on the curve.
+    path.retain(|pt| !ns || pt.x.get(theta_index).is_none_or(|t| t.sin() > 0.0));
+    let points = path.iter().filter_map(|pt| sys.point(&pt.x)).collect();
+    Ok(BifurcationCurve {
+        kind: start.kind,
+        points,
+        at: located,
+        resonances,
+        termination,
+    })
+}
+
+/// The offset `h` of θ from a 1:1 or 1:2 end of the points its location
+/// extrapolates from: the error of the extrapolation is O(h⁴), that of the
+/// two points, solved where the system is singular as θ → θ_e, about
+/// 1e-11/h (measured on the forced Van der Pol, tests/ns_curve.rs).
+const RESONANCE_STEP: f64 = 5e-3;
+
+/// The point at θ_e from the points `a` at θ_e ± h and `b` at θ_e ± 2h of a
+/// curve even in θ − θ_e: `(4a − b)/3` (Richardson, error O(h⁴)).
+fn richardson(a: &CurvePoint, b: &CurvePoint, theta: f64) -> CurvePoint {
+    let mix = |x: f64, y: f64| (4.0 * x - y) / 3.0;
+    CurvePoint {
+        omega: mix(a.omega, b.omega),
+        p: mix(a.p, b.p),
+        coeffs: a
+            .coeffs
+            .iter()
+            .zip(&b.coeffs)
+            .map(|(x, y)| mix(*x, *y))
+            .collect(),
+        angle: theta,
+    }
+}
+
+/// The monodromy matrix Φ of an HB orbit (Hsu, Magnus-4, the locators'
+/// [`LocateOptions::stability_steps`]).
+struct Monodromy {
+    analyzer: StabilityAnalyzer,
+    steps: usize,
+    dim: usize,
+    phi: Vec<f64>,
+    orbit: HbSolution,
+}
+
+impl Monodromy {
+    fn new<P: PeriodicProblem>(problem: &P, hb: &HbOptions) -> Result<Self, HbError> {
+        let steps = LocateOptions::default().stability_steps;
+        let dim = 2 * problem.n_dof();
+        Ok(Self {
+            analyzer: StabilityAnalyzer::new(problem, hb.harmonics, steps)?,
+            steps,
+            dim,
+            phi: vec![0.0; dim * dim],
+            orbit: HbSolution {
+                coeffs: Vec::new(),
+                omega_f: 1.0,
+                harmonics: hb.harmonics,
+                subharmonic: hb.subharmonic,
+                stats: Default::default(),
+            },
+        })
+    }
+
+    /// Φ (row-major `dim×dim`) of the orbit `q` at ω_f.
+    fn eval<P: PeriodicProblem>(&mut self, problem: &P, q: &[f64], omega: f64) -> &[f64] {
+        self.orbit.coeffs.clear();
+        self.orbit.coeffs.extend_from_slice(q);
+        self.orbit.omega_f = omega;
+        let theta = self.analyzer.theta_samples(problem, &self.orbit);
+        let (d, s) = (self.dim, self.steps);
+        monodromy_uniform(d, theta, s, TAU, HsuRule::Magnus4, &mut self.phi);
+        &self.phi
+    }
+}
+
+/// The PD or NS system of one family, planned at the last `p`.
+struct MultiplierSystem<'f, F> {
+    family: &'f F,
+    hb: HbOptions,
+    planned: f64,
+    res: HbResidual,
+    mono: Monodromy,
+    /// Neimark–Sacker (else period doubling).
+    ns: bool,
+    /// Unknowns of `q`.
+    m: usize,
+    /// The start's eigenvector `[v_r⁰, v_i⁰]` (the NS phase condition).
+    reference: Vec<f64>,
+}
+
+impl<'f, P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> MultiplierSystem<'f, F> {
+    fn new(family: &'f F, hb: &HbOptions, p: f64, ns: bool) -> Result<Self, HbError> {
+        let problem = family(p)?;
+        let res = HbResidual::new(&problem, hb)?;
+        Ok(Self {
+            family,
+            hb: hb.clone(),
+            planned: p,
+            m: res.len(),
+            res,
+            mono: Monodromy::new(&problem, hb)?,
+            ns,
+            reference: Vec::new(),
+        })
+    }
+
+    /// Plans the residual and the monodromy for `p`; `None` where the
+    /// family fails.
+    fn plan(&mut self, p: f64) -> Option<P> {
+        let problem = (self.family)(p).ok()?;
+        if p != self.planned {
+            self.res = HbResidual::new(&problem, &self.hb).ok()?;
+            self.mono = Monodromy::new(&problem, &self.hb).ok()?;
+            self.planned = p;
+        }
+        Some(problem)
+    }
+
+    /// The path vector at the start: the critical multiplier of Φ (the real
+    /// one nearest −1, or the upper one of the complex pair nearest the unit
+    /// circle) and a unit eigenvector by inverse iteration.
+    fn start_vector(&mut self, q: &[f64], omega: f64, p: f64) -> Result<Vec<f64>, HbError> {
+        let problem = self
+            .plan(p)
+            .ok_or_else(|| HbError::InvalidInput("the family fails at the start's p".into()))?;
+        let dim = self.mono.dim;
+        let phi = self.mono.eval(&problem, q, omega).to_vec();
+        let mu = eigenvalues(&phi, dim);
+        let no_multiplier = |what: &str| {
+            HbError::InvalidInput(format!(
+                "the start's monodromy matrix has no {what} (multipliers {mu:?})"
+            ))
+        };
+        let (theta, a) = if self.ns {
+            let z = mu
+                .iter()
+                .filter(|z| z.im > 1e-9 && (z.norm() - 1.0).abs() < 1e-3)
+                .min_by(|a, b| (a.norm() - 1.0).abs().total_cmp(&(b.norm() - 1.0).abs()))
+                .ok_or_else(|| no_multiplier("complex pair on the unit circle"))?;
+            let theta = z.arg();
+            (Some(theta), eigen_matrix(&phi, dim, Some(theta)))
+        } else {
+            mu.iter()
+                .filter(|z| z.im == 0.0 && (z.re + 1.0).abs() < 1e-3)
+                .min_by(|a, b| (a.re + 1.0).abs().total_cmp(&(b.re + 1.0).abs()))
+                .ok_or_else(|| no_multiplier("multiplier −1"))?;
+            (None, eigen_matrix(&phi, dim, None))
+        };
+        let n = a.len().isqrt();
+        let mut lu = LuWorkspace::new(n);
+        // Singular to rounding at a located point: inverse iteration still
+        // serves (its result is checked).
+        lu.factor_row_major(&a);
+        let mut v = vec![1.0 / (n as f64).sqrt(); n];
+        if !null_vector(&mut lu, &mut v, false) {
+            return Err(HbError::SingularStart { lambda: p });
+        }
+        self.reference = if self.ns { v.clone() } else { Vec::new() };
+        let mut x = q.to_vec();
+        x.push(omega);
+        x.extend(theta);
+        x.extend_from_slice(&v);
+        x.push(p);
+        Ok(x)
+    }
+
+    /// The residual (module docs) at the path vector `x`; `None` if the
+    /// sizes disagree or `p` cannot be planned.
+    fn try_residual(&mut self, x: &[f64], r: &mut [f64]) -> Option<()> {
+        let (q, rest) = x.split_at_checked(self.m)?;
+        let (&omega, rest) = rest.split_first()?;
+        let (&p, rest) = rest.split_last()?;
+        let (r_orbit, r_eigen) = r.split_at_mut_checked(self.m)?;
+        let problem = self.plan(p)?;
+        self.res.eval(&problem, q, omega, 1.0, r_orbit);
+        let d = self.mono.dim;
+        let phi = self.mono.eval(&problem, q, omega);
+        if !self.ns {
+            let (r_v, [r_norm]) = r_eigen.split_at_mut_checked(d)? else {
+                return None;
+            };
+            // (Φ + I) v.
+            for ((ri, row), vi) in r_v.iter_mut().zip(phi.chunks_exact(d)).zip(rest) {
+                *ri = dot(row, rest) + vi;
+            }
+            *r_norm = 0.5 * (dot(rest, rest) - 1.0);
+            return (rest.len() == d).then_some(());
+        }
+        let (&theta, v) = rest.split_first()?;
+        let (vr, vi) = v.split_at_checked(d)?;
+        let (r_re, rest_r) = r_eigen.split_at_mut_checked(d)?;
+        let (r_im, [r_norm, r_phase]) = rest_r.split_at_mut_checked(d)? else {
+            return None;
+        };
+        let (s, c) = theta.sin_cos();
+        // Φ v_r − c v_r + s v_i and Φ v_i − s v_r − c v_i.
+        for (i, row) in phi.chunks_exact(d).enumerate() {
+            let (a, b) = (*vr.get(i)?, *vi.get(i)?);
+            *r_re.get_mut(i)? = dot(row, vr) - c * a + s * b;
+            *r_im.get_mut(i)? = dot(row, vi) - s * a - c * b;
+        }
+        *r_norm = 0.5 * (dot(v, v) - 1.0);
+        let (wr, wi) = self.reference.split_at_checked(d)?;
+        *r_phase = dot(wr, vi) - dot(wi, vr);
+        (vi.len() == d).then_some(())
+    }
+
+    /// The curve's point at the path vector `x` (`None` if `x` is short).
+    fn point(&self, x: &[f64]) -> Option<CurvePoint> {
+        let (q, rest) = x.split_at_checked(self.m)?;
+        let (&omega, rest) = rest.split_first()?;
+        let angle = if self.ns { *rest.first()? } else { PI };
+        Some(CurvePoint {
+            omega,
+            p: *rest.last()?,
+            coeffs: q.to_vec(),
+            angle,
+        })
+    }
+}
+
+impl<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> CurveSystem for MultiplierSystem<'_, F> {
+    fn residual(&mut self, x: &[f64], r: &mut [f64]) {
+        if self.try_residual(x, r).is_none() {
+            r.fill(f64::NAN);
+        }
+    }
+}
+
+/// The real matrix whose null space holds the critical eigenvector:
+/// `Φ + I` (`dim×dim`, period doubling, `theta` None) or
+/// `[[Φ − cos θ I, sin θ I], [−sin θ I, Φ − cos θ I]]` (`2dim×2dim`, acting
+/// on `[v_r; v_i]`).
+fn eigen_matrix(phi: &[f64], dim: usize, theta: Option<f64>) -> Vec<f64> {
+    let Some(theta) = theta else {
+        let mut a = phi.to_vec();
+        a.iter_mut().step_by(dim + 1).for_each(|e| *e += 1.0);
+        return a;
+    };
+    let (s, c) = theta.sin_cos();
+    let n = 2 * dim;
+    let mut a = vec![0.0; n * n];
+    for (i, row) in phi.chunks_exact(dim).enumerate() {
+        for (j, &e) in row.iter().enumerate() {
+            let diag = if i == j { c } else { 0.0 };
+            let off = if i == j { s } else { 0.0 };
+            for (r, col, val) in [
+                (i, j, e - diag),
+                (i + dim, j + dim, e - diag),
+                (i, j + dim, off),
+                (i + dim, j, -off),
+            ] {
+                if let Some(x) = a.get_mut(r * n + col) {
+                    *x = val;
+                }
+            }
+        }
+    }
+    a
+}
