@@ -98,7 +98,7 @@ def test_symmetry_breaking_branch_point_against_scipy() -> None:
     bp = bps[0]
     q = np.asarray(bp["coeffs"]).reshape(2, 2 * n + 1)
     # On the symmetric orbit, to the locator's accuracy: its Newton stops once
-    # the step is below 1e-8 relative (BifurcationOptions.noise_tol) and the
+    # the step is below 1e-8 relative (LocateOptions.noise_tol) and the
     # residual no longer falls; measured 1.0e-10.
     assert np.max(np.abs(q[0] - q[1])) < 1e-8 * np.max(np.abs(q))
 

@@ -256,8 +256,10 @@ the linear DOFs decouple exactly; sparse LU of the dynamic stiffness with
 refinement in double-double residuals) and `g(x, v, theta)` sees x, v of those
 DOFs only. Defaults there: n = 7, samples = 32, rtol = 1e-12 (on the
 receptance-form residual, relative to the linear response). Each point then
-carries "solve_error", "truncation_error" and "error_estimate" (their sum, a
-relative error). `amplitude_dof=j`: "amplitude" is max |x_j(τ)|;
+carries "solve_error" (the refined solves'), "orbit_error" (the orbit's error
+from the corrector residual and the refined solves), "data_error" (the first-order effect of storing M and C in
+double precision), "truncation_error" and "error_estimate" (orbit_error +
+truncation_error, a relative error). `amplitude_dof=j`: "amplitude" is max |x_j(τ)|;
 `record_dofs=[...]`: each point carries "dof_coeffs": {j: [a0, a1..an,
 b1..bn]} (any model). Stability (default on; `stability=False` skips it,
 folds are located either way): Floquet multipliers of the whole structure's
