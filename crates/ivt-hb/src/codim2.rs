@@ -31,10 +31,12 @@
 #![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
 #![cfg_attr(not(test), deny(clippy::unimplemented))]
 
+pub mod cycle_fold;
 mod fixed;
 mod fold_system;
 pub mod multiplier_curve;
 mod ns_points;
+pub use cycle_fold::{cycle_fold_curve, CycleFoldCurve, CycleFoldPoint};
 pub use multiplier_curve::{bifurcation_curve, BifurcationCurve, CurvePoint, CurveStart};
 pub use ns_points::{neimark_sacker_points, NeimarkSackerPoint};
 

@@ -27,7 +27,7 @@ use crate::ihb::{HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
 use crate::BroydenStats;
 
-mod member;
+pub(crate) mod member;
 use member::Member;
 
 /// Options of [`cycle_branch`].
@@ -281,7 +281,7 @@ fn cycles_at<P: PeriodicProblem>(
 
 /// The cycle equations `[R(q, ω; p); b₁] = 0` in the unknowns `u = {q, ω}`
 /// as a [`Branch`] in p (the fold locator's system).
-struct CycleSystem<'f, F> {
+pub(crate) struct CycleSystem<'f, F> {
     family: &'f F,
     res: HbResidual,
     galerkin: GalerkinJacobian,
@@ -292,7 +292,7 @@ struct CycleSystem<'f, F> {
 }
 
 impl<'f, P: PeriodicProblem, F: Fn(f64) -> P> CycleSystem<'f, F> {
-    fn new(family: &'f F, hb: &HbOptions, p: f64) -> Result<Self, HbError> {
+    pub(crate) fn new(family: &'f F, hb: &HbOptions, p: f64) -> Result<Self, HbError> {
         let res = HbResidual::new(&family(p), hb)?;
         let m = res.len();
         Ok(Self {

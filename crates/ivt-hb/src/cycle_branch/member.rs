@@ -10,14 +10,14 @@
 use crate::problem::PeriodicProblem;
 
 /// `family(p)`, or NaN of `n` DOFs where it failed.
-pub(super) struct Member<P> {
+pub(crate) struct Member<P> {
     problem: Option<P>,
     n: usize,
     nan: Vec<f64>,
 }
 
 impl<P: PeriodicProblem> Member<P> {
-    pub(super) fn new(problem: Option<P>, n: usize) -> Self {
+    pub(crate) fn new(problem: Option<P>, n: usize) -> Self {
         let nan = match problem {
             Some(_) => Vec::new(),
             None => vec![f64::NAN; n * n],

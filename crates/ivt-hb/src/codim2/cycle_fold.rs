@@ -1,0 +1,252 @@
+//! Folds of limit cycles of an autonomous family in two parameters (issue
+//! 27, item 1): how a fold of the cycle branch of [`crate::cycle_branch`]
+//! (a turning point in μ) moves with a second parameter ν of a family
+//! `family(μ, ν)`.
+//!
+//! A limit cycle solves the HB residual `R(q, ω; μ, ν) = 0` (Eq. 61) with ω
+//! unknown and the phase condition `b₁ = 0` (the cycle equations of
+//! [`crate::cycle_branch`]); with `u = {q, ω}` its Jacobian is the bordered
+//! matrix `J = [[Φ_q, ∂R/∂ω], [e_{b₁}ᵀ, 0]]` (Φ_q: Eq. 56). A fold of cycles
+//! in μ is a point where `J` is singular, so the extended system (Keller;
+//! the fold systems of AUTO and MATCONT, as [`super::fold_curve`] uses for
+//! forced folds)
+//!
+//! `R = 0`,  `b₁ = 0`,  `J v = 0`,  `(vᵀv − 1)/2 = 0`
+//!
+//! in the path vector `x = [q, ω, v, μ, ν]` has one equation fewer than
+//! unknowns and is followed by the engine's pseudo-arclength continuation
+//! ([`Stepper`], Eq. 68–77) with ν as the path parameter, μ solved along. A
+//! cusp of cycle folds (two folds merging) is a turning point of this curve in
+//! ν: it is reported at the path's fold estimate (the vertex of the parabola
+//! through the three points around the turn), not refined further. The fold
+//! at each requested ν is solved at fixed ν by Newton (`fixed.rs`).
+//!
+//! Other codimension-two points are not detected: a Bautin (generalised
+//! Hopf) point, where the fold curve meets the Hopf curve at zero amplitude,
+//! shows as the amplitude of [`CycleFoldPoint::coeffs`] tending to zero near
+//! the end of the curve; the path stops before it (the HB cycle degenerates).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
+#![cfg_attr(not(test), deny(clippy::unimplemented))]
+
+use std::cell::Cell;
+
+use super::fixed::{solve_fixed, CurveSystem};
+use super::{crossings, path_interval};
+use crate::branch::{Branch, ResidualBranch};
+use crate::continuation::{BroydenCorrector, ContinuationOptions, Stepper, Termination};
+use crate::cycle_branch::member::Member;
+use crate::cycle_branch::CycleSystem;
+use crate::error::HbError;
+use crate::events::extended::null_vector;
+use crate::ihb::{HbOptions, HbSolution};
+use crate::problem::PeriodicProblem;
+use ivt_num::vector::{dot, matvec, norm2};
+use ivt_num::LuWorkspace;
+
+/// One fold of limit cycles on the curve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CycleFoldPoint {
+    /// The first parameter at the fold (solved along).
+    pub mu: f64,
+    /// The second parameter (the path parameter).
+    pub nu: f64,
+    /// Angular frequency of the cycle at the fold.
+    pub omega: f64,
+    /// Fourier coefficients of the cycle at the fold (phase `b₁ = 0`).
+    pub coeffs: Vec<f64>,
+    /// The unit null vector of the bordered Jacobian in `(q, ω)`.
+    pub null_vector: Vec<f64>,
+}
+
+/// A curve of folds of limit cycles in (μ, ν).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CycleFoldCurve {
+    /// Points in path order.
+    pub points: Vec<CycleFoldPoint>,
+    /// The fold at each requested ν, each time the curve crosses it, in path
+    /// order.
+    pub at: Vec<CycleFoldPoint>,
+    /// Cusps: turning points of the curve in ν (the path's estimate).
+    pub cusps: Vec<CycleFoldPoint>,
+    /// Why tracing stopped.
+    pub termination: Termination,
+}
+
+/// Follows the fold of limit cycles of `family(μ, ν)` (autonomous: no
+/// excitation) at `start` (a located fold of [`crate::cycle_branch`] at
+/// `(mu, nu_start)`: its coefficients with phase `b₁ = 0` and ω) in ν,
+/// first towards `nu_from`, until ν leaves `[min(nu_from, nu_to),
+/// max(nu_from, nu_to)]`; the folds at each ν of `at` are solved exactly and
+/// the cusps reported (module docs).
+///
+/// # Errors
+/// [`HbError::InvalidInput`] for sizes or bounds (`nu_start` must lie in the
+/// interval); `family(mu, nu_start)`'s error; [`HbError::SingularStart`]
+/// if no null vector is found at the start; the start's failures as
+/// [`Stepper::new`]'s. Later, a (μ, ν) where `family` fails is a failed step,
+/// and a failed `at` point is left out (the curve is kept).
+#[allow(clippy::too_many_arguments)]
+pub fn cycle_fold_curve<P, F>(
+    family: F,
+    hb: &HbOptions,
+    start: &HbSolution,
+    mu: f64,
+    nu_start: f64,
+    nu_from: f64,
+    nu_to: f64,
+    at: &[f64],
+    opts: &ContinuationOptions,
+) -> Result<CycleFoldCurve, HbError>
+where
+    P: PeriodicProblem,
+    F: Fn(f64, f64) -> Result<P, HbError>,
+{
+    let omega = start.omega_f;
+    let (lo, hi) = path_interval("cycle fold curve", omega, nu_start, nu_from, nu_to)?;
+    if !mu.is_finite() {
+        return Err(HbError::InvalidInput(
+            "cycle fold curve: μ must be finite".into(),
+        ));
+    }
+    let n_dof = family(mu, nu_start)?.n_dof();
+    let nu = Cell::new(nu_start);
+    let member = |m: f64| Member::new(family(m, nu.get()).ok(), n_dof);
+    let mut sys = CycleFoldSystem::new(CycleSystem::new(&member, hb, mu)?, &nu);
+    let m1 = sys.m1;
+    if start.coeffs.len() + 1 != m1 {
+        return Err(HbError::InvalidInput(format!(
+            "the start fold must have {} coefficients",
+            m1.saturating_sub(1)
+        )));
+    }
+    let mut u0 = start.coeffs.clone();
+    u0.push(omega);
+    let v0 = sys.null_vector(&u0, mu)?;
+    let mut x0 = u0;
+    x0.extend_from_slice(&v0);
+    x0.extend([mu, nu_start]);
+    let mut copts = opts.clone();
+    copts.lambda_min = lo;
+    copts.lambda_max = hi;
+    let direction = if nu_from < nu_start { -1.0 } else { 1.0 };
+    let path = {
+        let m_len = x0.len().saturating_sub(1);
+        let mut residual_branch =
+            ResidualBranch::new(m_len, |x: &[f64], r: &mut [f64]| sys.residual(x, r));
+        let corrector = Box::new(BroydenCorrector::new(m_len, &copts.broyden, None));
+        Stepper::new(&mut residual_branch, corrector, &x0, 0, direction, &copts)?.run(|_, _| true)
+    };
+    let cusps = path
+        .folds
+        .iter()
+        .filter_map(|f| {
+            let mut point = sys.point(&path.points.get(f.index)?.x)?;
+            point.nu = f.lambda;
+            Some(point)
+        })
+        .collect();
+    let scale = norm2(&start.coeffs);
+    let nu_index = x0.len() - 1;
+    let located = crossings(&path.points, at, nu_index)
+        .filter_map(|(a, b, value)| {
+            let x = solve_fixed(&mut sys, (a, b), nu_index, value, scale)?;
+            sys.point(&x)
+        })
+        .collect();
+    let points = path
+        .points
+        .iter()
+        .filter_map(|pt| sys.point(&pt.x))
+        .collect();
+    Ok(CycleFoldCurve {
+        points,
+        at: located,
+        cusps,
+        termination: path.termination,
+    })
+}
+
+/// The extended system of a cycle fold: the cycle equations of
+/// [`CycleSystem`] in `u = {q, ω}` at μ, with ν set through the shared cell
+/// the family reads, and the null vector of their Jacobian.
+struct CycleFoldSystem<'f, 'c, F> {
+    cycle: CycleSystem<'f, F>,
+    nu: &'c Cell<f64>,
+    /// The bordered Jacobian `J` (row-major, `m1 × m1`).
+    jac: Vec<f64>,
+    /// Unknowns `m1 = m + 1` of `u` (and of `v`).
+    m1: usize,
+}
+
+impl<'f, 'c, P: PeriodicProblem, F: Fn(f64) -> Member<P>> CycleFoldSystem<'f, 'c, F> {
+    fn new(cycle: CycleSystem<'f, F>, nu: &'c Cell<f64>) -> Self {
+        let m1 = cycle.len();
+        Self {
+            cycle,
+            nu,
+            jac: vec![0.0; m1 * m1],
+            m1,
+        }
+    }
+
+    /// `[R; b₁; J v; (vᵀv − 1)/2]` at `x = [u, v, μ, ν]`; `None` if the
+    /// sizes disagree.
+    fn try_residual(&mut self, x: &[f64], r: &mut [f64]) -> Option<()> {
+        let m1 = self.m1;
+        let (u, rest) = x.split_at_checked(m1)?;
+        let (v, &[mu, nu]) = rest.split_at_checked(m1)? else {
+            return None;
+        };
+        let (r_cycle, rest) = r.split_at_mut_checked(m1)?;
+        let (r_null, [r_norm]) = rest.split_at_mut_checked(m1)? else {
+            return None;
+        };
+        self.nu.set(nu);
+        self.cycle.residual(u, mu, r_cycle);
+        self.cycle.jacobian(u, mu, &mut self.jac);
+        matvec(&self.jac, m1, m1, v, r_null);
+        *r_norm = 0.5 * (dot(v, v) - 1.0);
+        Some(())
+    }
+
+    /// A unit null vector of `J` at a located fold `u` at μ (ν as set), by
+    /// two steps of inverse iteration.
+    fn null_vector(&mut self, u: &[f64], mu: f64) -> Result<Vec<f64>, HbError> {
+        self.cycle.jacobian(u, mu, &mut self.jac);
+        let mut lu = LuWorkspace::new(self.m1);
+        let mut v = vec![1.0 / (self.m1 as f64).sqrt(); self.m1];
+        // A factor singular to rounding still serves inverse iteration (the
+        // solve is checked instead).
+        lu.factor_row_major(&self.jac);
+        if !null_vector(&mut lu, &mut v, false) {
+            return Err(HbError::SingularStart { lambda: mu });
+        }
+        Ok(v)
+    }
+
+    /// The fold at `x = [u, v, μ, ν]` (`None` if `x` is short).
+    fn point(&self, x: &[f64]) -> Option<CycleFoldPoint> {
+        let (u, rest) = x.split_at_checked(self.m1)?;
+        let (v, &[mu, nu]) = rest.split_at_checked(self.m1)? else {
+            return None;
+        };
+        let (&omega, q) = u.split_last()?;
+        Some(CycleFoldPoint {
+            mu,
+            nu,
+            omega,
+            coeffs: q.to_vec(),
+            null_vector: v.to_vec(),
+        })
+    }
+}
+
+impl<P: PeriodicProblem, F: Fn(f64) -> Member<P>> CurveSystem for CycleFoldSystem<'_, '_, F> {
+    fn residual(&mut self, x: &[f64], r: &mut [f64]) {
+        if self.try_residual(x, r).is_none() {
+            r.fill(f64::NAN);
+        }
+    }
+}
