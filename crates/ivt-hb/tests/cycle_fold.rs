@@ -71,17 +71,24 @@ fn cycle_fold_curve_matches_shooting_in_nu() {
         family,
         &hb,
         start,
-        *mu0,
-        1.0,
-        0.3,
-        1.5,
+        (*mu0, 1.0),
+        (0.3, 1.5),
         &[0.35, 0.5, 0.7, 0.9, 1.0],
         &opts,
     )
     .unwrap();
-    let up =
-        cycle_fold_curve(family, &hb, start, *mu0, 1.0, 1.5, 0.3, &[1.2, 1.45], &opts).unwrap();
-    let nus = |c: &ivt_hb::codim2::CycleFoldCurve| c.at.iter().map(|p| p.nu).collect::<Vec<_>>();
+    let up = cycle_fold_curve(
+        family,
+        &hb,
+        start,
+        (*mu0, 1.0),
+        (1.5, 0.3),
+        &[1.2, 1.45],
+        &opts,
+    )
+    .unwrap();
+    let nus =
+        |c: &ivt_hb::codim2::CycleFoldCurve| c.at.iter().map(|p| p.fold.p).collect::<Vec<_>>();
     assert_eq!(
         nus(&down),
         [0.35, 0.5, 0.7, 0.9, 1.0],
@@ -94,28 +101,30 @@ fn cycle_fold_curve_matches_shooting_in_nu() {
         assert!(curve.cusps.is_empty());
         let last = curve.points.last().unwrap();
         assert!(
-            last.nu <= 0.3 + 1e-9 || last.nu >= 1.5 - 1e-9,
+            last.fold.p <= 0.3 + 1e-9 || last.fold.p >= 1.5 - 1e-9,
             "{}",
-            last.nu
+            last.fold.p
         );
     }
-    for point in down.at.iter().chain(&up.at) {
+    for cycle_fold in down.at.iter().chain(&up.at) {
+        let point = &cycle_fold.fold;
+        let mu = cycle_fold.mu;
         let guess = [
             turning_state(&point.coeffs),
             std::f64::consts::TAU / point.omega,
-            point.mu,
+            mu,
         ];
-        let [_, _, mu_ref] = fold_by_shooting(point.nu, guess);
-        let averaging = -point.nu * point.nu / 8.0;
+        let [_, _, mu_ref] = fold_by_shooting(point.p, guess);
+        let averaging = -point.p * point.p / 8.0;
         eprintln!(
             "ν = {:.2}: HB μ = {:.12}, shooting {mu_ref:.12}, |Δ| {:.1e}, averaging {averaging:.6}",
-            point.nu,
-            point.mu,
-            (point.mu - mu_ref).abs()
+            point.p,
+            mu,
+            (mu - mu_ref).abs()
         );
-        assert!((point.mu - mu_ref).abs() < 1e-8, "{} vs {mu_ref}", point.mu);
-        assert!((point.mu - averaging).abs() < 0.05 * averaging.abs());
+        assert!((mu - mu_ref).abs() < 1e-8, "{} vs {mu_ref}", mu);
+        assert!((mu - averaging).abs() < 0.05 * averaging.abs());
     }
-    let at_one = down.at.iter().find(|p| p.nu == 1.0).unwrap();
+    let at_one = down.at.iter().find(|p| p.fold.p == 1.0).unwrap();
     assert!((at_one.mu - -0.124993216903).abs() < 1e-8, "{}", at_one.mu);
 }

@@ -23,7 +23,7 @@
 //!
 //! Other codimension-two points are not detected: a Bautin (generalised
 //! Hopf) point, where the fold curve meets the Hopf curve at zero amplitude,
-//! shows as the amplitude of [`CycleFoldPoint::coeffs`] tending to zero near
+//! shows as the amplitude of the coefficients tending to zero near
 //! the end of the curve; the path stops before it (the HB cycle degenerates).
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 #![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
@@ -33,7 +33,7 @@
 use std::cell::Cell;
 
 use super::fixed::{solve_fixed, CurveSystem};
-use super::{crossings, path_interval};
+use super::{crossings, path_interval, FoldPoint};
 use crate::branch::{Branch, ResidualBranch};
 use crate::continuation::{BroydenCorrector, ContinuationOptions, Stepper, Termination};
 use crate::cycle_branch::member::Member;
@@ -50,14 +50,10 @@ use ivt_num::LuWorkspace;
 pub struct CycleFoldPoint {
     /// The first parameter at the fold (solved along).
     pub mu: f64,
-    /// The second parameter (the path parameter).
-    pub nu: f64,
-    /// Angular frequency of the cycle at the fold.
-    pub omega: f64,
-    /// Fourier coefficients of the cycle at the fold (phase `b₁ = 0`).
-    pub coeffs: Vec<f64>,
-    /// The unit null vector of the bordered Jacobian in `(q, ω)`.
-    pub null_vector: Vec<f64>,
+    /// The fold with `p` = ν (the path parameter), ω the cycle's angular
+    /// frequency, its coefficients (phase `b₁ = 0`) and the unit null vector
+    /// of the bordered Jacobian in `(q, ω)`.
+    pub fold: FoldPoint,
 }
 
 /// A curve of folds of limit cycles in (μ, ν).
@@ -77,8 +73,8 @@ pub struct CycleFoldCurve {
 /// Follows the fold of limit cycles of `family(μ, ν)` (autonomous: no
 /// excitation) at `start` (a located fold of [`crate::cycle_branch`] at
 /// `(mu, nu_start)`: its coefficients with phase `b₁ = 0` and ω) in ν,
-/// first towards `nu_from`, until ν leaves `[min(nu_from, nu_to),
-/// max(nu_from, nu_to)]`; the folds at each ν of `at` are solved exactly and
+/// first towards `nu_from` of `(nu_from, nu_to)`, until ν leaves the
+/// interval between them; the folds at each ν of `at` are solved exactly and
 /// the cusps reported (module docs).
 ///
 /// # Errors
@@ -87,15 +83,12 @@ pub struct CycleFoldCurve {
 /// if no null vector is found at the start; the start's failures as
 /// [`Stepper::new`]'s. Later, a (μ, ν) where `family` fails is a failed step,
 /// and a failed `at` point is left out (the curve is kept).
-#[allow(clippy::too_many_arguments)]
 pub fn cycle_fold_curve<P, F>(
     family: F,
     hb: &HbOptions,
     start: &HbSolution,
-    mu: f64,
-    nu_start: f64,
-    nu_from: f64,
-    nu_to: f64,
+    (mu, nu_start): (f64, f64),
+    (nu_from, nu_to): (f64, f64),
     at: &[f64],
     opts: &ContinuationOptions,
 ) -> Result<CycleFoldCurve, HbError>
@@ -143,7 +136,7 @@ where
         .iter()
         .filter_map(|f| {
             let mut point = sys.point(&path.points.get(f.index)?.x)?;
-            point.nu = f.lambda;
+            point.fold.p = f.lambda;
             Some(point)
         })
         .collect();
@@ -233,13 +226,13 @@ impl<'f, 'c, P: PeriodicProblem, F: Fn(f64) -> Member<P>> CycleFoldSystem<'f, 'c
             return None;
         };
         let (&omega, q) = u.split_last()?;
-        Some(CycleFoldPoint {
-            mu,
-            nu,
+        let fold = FoldPoint {
             omega,
+            p: nu,
             coeffs: q.to_vec(),
             null_vector: v.to_vec(),
-        })
+        };
+        Some(CycleFoldPoint { mu, fold })
     }
 }
 
