@@ -333,6 +333,7 @@ pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     crate::hb_analyses::register(&m)?;
     crate::hb_folds::register(&m)?;
     crate::hb_bifurcation::register(&m)?;
+    crate::hb_cycle_fold::register(&m)?;
     crate::hb_large::register(&m)?;
     crate::hb_string::register(&m)?;
     crate::hb_switch::register(&m)?;

@@ -28,6 +28,7 @@ mod gears;
 mod hb;
 mod hb_analyses;
 mod hb_bifurcation;
+mod hb_cycle_fold;
 mod hb_elements;
 mod hb_folds;
 mod hb_large;

@@ -31,6 +31,7 @@ __all__ = [
     "backbone",
     "continue_bifurcation",
     "cycle_branch",
+    "cycle_fold_curve",
     "damped_modes",
     "duffing",
     "duffing_folds",

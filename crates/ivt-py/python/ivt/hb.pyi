@@ -226,3 +226,12 @@ def switch_branch(
     max_iter: int = 100,
     jac: Optional[Jacobian] = None,
 ) -> Dict[str, Any]: ...
+
+# Folds of limit cycles in two parameters (issue 27 item 1, crates/ivt-py/src/hb_cycle_fold.rs).
+def cycle_fold_curve(
+    family: Callable[[float, float], Any],
+    nu_from: float, nu_to: float, mu_from: float, mu_to: float, at: Sequence[float] = ...,
+    n: int = 20, samples: int = 64,
+    velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
+    ds: float = 0.02, ds_max: float = 0.05, max_points: int = 2000,
+) -> Dict[str, Any]: ...

@@ -1,0 +1,182 @@
+//! `ivt.hb.cycle_fold_curve` (issue 27, item 1): a fold of limit cycles of an
+//! autonomous user family `family(mu, nu)` followed in ν
+//! ([`ivt_hb::codim2::cycle_fold_curve`]), started from the first fold of the
+//! cycle branch in μ at ν = `nu_from` ([`ivt_hb::cycle_branch`]).
+
+use ivt_hb::codim2::{cycle_fold_curve as follow, CycleFoldPoint};
+use ivt_hb::{cycle_branch, ContinuationOptions, CycleBranchOptions, HbError, HbSolution};
+use numpy::IntoPyArray;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::sync::Mutex;
+
+use crate::args::count;
+use crate::hb_bifurcation::PyFamily;
+use crate::hb_shared::{finite, run_user};
+
+/// `family(mu, nu)` as the one-parameter [`PyFamily`] `partial(family, mu)`
+/// of ν; the first exception it raised is kept.
+struct PyFamily2 {
+    family: Py<PyAny>,
+    partial: Py<PyAny>,
+    velocity_dependent: bool,
+    vectorized: bool,
+    failure: Mutex<Option<PyErr>>,
+}
+
+impl PyFamily2 {
+    fn at_mu(&self, py: Python<'_>, mu: f64) -> PyResult<PyFamily> {
+        let one = self.partial.bind(py).call1((self.family.bind(py), mu))?;
+        Ok(PyFamily::new(
+            &one,
+            self.velocity_dependent,
+            self.vectorized,
+        ))
+    }
+
+    fn build(&self, mu: f64, nu: f64) -> Result<crate::user_problem::PyProblem, HbError> {
+        let fam = Python::attach(|py| self.at_mu(py, mu))
+            .map_err(|e| HbError::InvalidInput(format!("family failed: {e}")))?;
+        fam.build(nu).inspect_err(|_| {
+            if let (Some(e), Ok(mut slot)) = (fam.take_error(), self.failure.lock()) {
+                slot.get_or_insert(e);
+            }
+        })
+    }
+
+    fn take_error(&self) -> Option<PyErr> {
+        self.failure.lock().ok().and_then(|mut s| s.take())
+    }
+}
+
+/// One fold as {"mu", "nu", "omega", "amplitude", "coeffs"} (`n` harmonics).
+fn point_dict<'py>(py: Python<'py>, pt: &CycleFoldPoint, n: usize) -> PyResult<Bound<'py, PyDict>> {
+    let orbit = HbSolution {
+        coeffs: pt.fold.coeffs.clone(),
+        omega_f: pt.fold.omega,
+        harmonics: n,
+        subharmonic: 1,
+        stats: Default::default(),
+    };
+    let d = PyDict::new(py);
+    d.set_item("mu", pt.mu)?;
+    d.set_item("nu", pt.fold.p)?;
+    d.set_item("omega", pt.fold.omega)?;
+    d.set_item("amplitude", orbit.amplitude(0))?;
+    d.set_item("coeffs", pt.fold.coeffs.clone().into_pyarray(py))?;
+    Ok(d)
+}
+
+/// The fold of limit cycles of the autonomous family `family(mu, nu)` →
+/// (m, c, k, g, None) followed in ν from `nu_from` towards `nu_to`
+/// (ivt_hb::codim2::cycle_fold_curve: the cycle equations with ω unknown and
+/// the phase condition, plus a unit null vector of their Jacobian in (q, ω),
+/// pseudo-arclength in ν, μ solved along). The start is the first fold of
+/// the cycle branch of `family(mu, nu_from)` for mu in [mu_from, mu_to]
+/// (as `cycle_branch`). The folds at each ν of `at` are solved exactly.
+/// Returns {"points": [{"mu", "nu", "omega", "amplitude", "coeffs"}...],
+/// "at": [...], "special": [{"kind": "cusp", ...}...] (turning points in
+/// ν, the path's estimate), "termination"}.
+#[pyfunction]
+#[pyo3(signature = (
+    family, nu_from, nu_to, mu_from, mu_to, at = Vec::new(), n = 20, samples = 64,
+    velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100,
+    ds = 0.02, ds_max = 0.05, max_points = 2000
+))]
+#[allow(clippy::too_many_arguments)]
+fn cycle_fold_curve<'py>(
+    py: Python<'py>,
+    family: &Bound<'py, PyAny>,
+    nu_from: f64,
+    nu_to: f64,
+    mu_from: f64,
+    mu_to: f64,
+    at: Vec<f64>,
+    #[pyo3(from_py_with = crate::args::int64)] n: i64,
+    #[pyo3(from_py_with = crate::args::int64)] samples: i64,
+    velocity_dependent: bool,
+    vectorized: bool,
+    rtol: f64,
+    #[pyo3(from_py_with = crate::args::int64)] max_iter: i64,
+    ds: f64,
+    ds_max: f64,
+    #[pyo3(from_py_with = crate::args::int64)] max_points: i64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (nu_from, nu_to) = (finite("nu_from", nu_from)?, finite("nu_to", nu_to)?);
+    let (mu_from, mu_to) = (finite("mu_from", mu_from)?, finite("mu_to", mu_to)?);
+    if nu_from == nu_to || mu_from == mu_to {
+        return Err(PyValueError::new_err(
+            "arguments `nu_from`, `nu_to` must differ, and `mu_from`, `mu_to`",
+        ));
+    }
+    let fam = PyFamily2 {
+        family: family.clone().unbind(),
+        partial: py.import("functools")?.getattr("partial")?.unbind(),
+        velocity_dependent,
+        vectorized,
+        failure: Mutex::new(None),
+    };
+    // The user system at (mu_from, nu_from) sets the HB options.
+    let (first, hb) = fam
+        .at_mu(py, mu_from)?
+        .first(py, nu_from, n, samples, rtol, max_iter)?;
+    let continuation = ContinuationOptions {
+        ds,
+        ds_max,
+        max_points: count("max_points", max_points)?,
+        ..ContinuationOptions::default()
+    };
+    let curve = run_user(py, &first, |_| {
+        let family = |mu: f64, nu: f64| fam.build(mu, nu);
+        let branch = cycle_branch(
+            |mu| family(mu, nu_from),
+            &hb,
+            mu_from,
+            mu_to,
+            &CycleBranchOptions::default(),
+        )?;
+        let Some((mu, start)) = branch.folds.first() else {
+            return Err(HbError::InvalidInput(
+                "the cycle branch at nu_from has no fold in [mu_from, mu_to]".into(),
+            ));
+        };
+        // The path goes first towards the first of the pair: nu_to.
+        follow(
+            family,
+            &hb,
+            start,
+            (*mu, nu_from),
+            (nu_to, nu_from),
+            &at,
+            &continuation,
+        )
+    });
+    if let Some(e) = fam.take_error() {
+        return Err(e);
+    }
+    let curve = curve?;
+    let list = |pts: &[CycleFoldPoint]| -> PyResult<Bound<'py, PyList>> {
+        let list = PyList::empty(py);
+        for pt in pts {
+            list.append(point_dict(py, pt, hb.harmonics)?)?;
+        }
+        Ok(list)
+    };
+    let special = list(&curve.cusps)?;
+    for d in special.iter() {
+        d.set_item("kind", "cusp")?;
+    }
+    let out = PyDict::new(py);
+    out.set_item("points", list(&curve.points)?)?;
+    out.set_item("at", list(&curve.at)?)?;
+    out.set_item("special", special)?;
+    out.set_item("termination", curve.termination.as_str())?;
+    Ok(out)
+}
+
+/// Add `cycle_fold_curve` to the `hb` module.
+pub fn register(hb: &Bound<'_, PyModule>) -> PyResult<()> {
+    add_functions!(hb, [cycle_fold_curve]);
+    Ok(())
+}
