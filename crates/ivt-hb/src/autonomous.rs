@@ -11,16 +11,15 @@
 //! +1 (the phase shift); the orbit is classified by the others.
 //!
 //! [`limit_cycle_branch`] follows a limit cycle in a parameter μ of a family of
-//! problems by the engine's pseudo-arclength continuation ([`Stepper`],
+//! problems by the engine's pseudo-arclength continuation ([`crate::continuation::Stepper`],
 //! Eq. 68–77) on `[R(q, ω; μ); b₁] = 0` with unknowns `{q, ω, μ}`.
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 #![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
 #![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
 #![cfg_attr(not(test), deny(clippy::unimplemented))]
 
-use crate::branch::ResidualBranch;
 use crate::broyden::{BroydenStats, SolveError};
-use crate::continuation::{BroydenCorrector, ContinuationOptions, Stepper, Termination};
+use crate::continuation::{follow_residual, ContinuationOptions, Termination};
 use crate::floquet::HsuRule;
 use crate::galerkin::GalerkinJacobian;
 use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
@@ -104,29 +103,16 @@ where
     let mut copts = opts.clone();
     copts.lambda_min = mu_from.min(mu_to);
     copts.lambda_max = mu_from.max(mu_to);
-    let path = {
-        let m_len = x0.len().saturating_sub(1);
-        // x = {q, ω, μ}: the HB residual at μ and the phase condition b₁ = 0.
-        let mut residual_branch = ResidualBranch::new(m_len, |x: &[f64], r: &mut [f64]| {
-            match (x.split_at_checked(m), r.split_at_mut_checked(m)) {
-                (Some((q, &[omega, mu])), Some((r_q, [r_phase]))) => {
-                    res.eval(&family(mu), q, omega, 1.0, r_q);
-                    *r_phase = x.get(phase).copied().unwrap_or(f64::NAN);
-                }
-                _ => r.fill(f64::NAN),
+    // x = {q, ω, μ}: the HB residual at μ and the phase condition b₁ = 0.
+    let residual =
+        |x: &[f64], r: &mut [f64]| match (x.split_at_checked(m), r.split_at_mut_checked(m)) {
+            (Some((q, &[omega, mu])), Some((r_q, [r_phase]))) => {
+                res.eval(&family(mu), q, omega, 1.0, r_q);
+                *r_phase = x.get(phase).copied().unwrap_or(f64::NAN);
             }
-        });
-        let corrector = Box::new(BroydenCorrector::new(m_len, &copts.broyden, None));
-        Stepper::new(
-            &mut residual_branch,
-            corrector,
-            &x0,
-            0,
-            mu_to - mu_from,
-            &copts,
-        )?
-        .run(|_, _| true)
-    };
+            _ => r.fill(f64::NAN),
+        };
+    let path = follow_residual(residual, &x0, None, mu_to - mu_from, &copts, |_| true)?;
     let mut points = Vec::with_capacity(path.points.len());
     for p in &path.points {
         let mu = p.lambda();

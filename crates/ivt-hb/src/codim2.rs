@@ -12,7 +12,7 @@
 //! (a unit null vector: a fixed normalisation `cᵀv = 1` lets `v` grow without
 //! bound where it turns away from `c`, as it does through a cusp) has the unknowns `{q, v, ω}` and `p`; it is
 //! followed by the engine's pseudo-arclength continuation
-//! ([`Stepper`], Eq. 68–77) with `p` as the path parameter. A cusp is a
+//! ([`crate::continuation::Stepper`], Eq. 68–77) with `p` as the path parameter. A cusp is a
 //! turning point of this curve in `p` (there the two folds of the FRC merge):
 //! the path's fold detection brackets it and a second, short path with a
 //! hundredth of the step through the bracket locates it (parabola through the
@@ -40,10 +40,7 @@ pub use cycle_fold::{cycle_fold_curve, CycleFoldCurve, CycleFoldPoint};
 pub use multiplier_curve::{bifurcation_curve, BifurcationCurve, CurvePoint, CurveStart};
 pub use ns_points::{neimark_sacker_points, NeimarkSackerPoint};
 
-use crate::branch::ResidualBranch;
-use crate::continuation::{
-    BroydenCorrector, ContinuationOptions, Path, PathPoint, Stepper, Termination,
-};
+use crate::continuation::{follow_residual, ContinuationOptions, Path, PathPoint, Termination};
 use crate::error::HbError;
 use crate::ihb::HbOptions;
 use crate::problem::PeriodicProblem;
@@ -86,7 +83,7 @@ pub struct FoldCurve {
 /// # Errors
 /// [`HbError::InvalidInput`] for sizes or bounds (`p_start` must lie in the
 /// interval); `family(p_start)`'s error; the start's failures as
-/// [`Stepper::new`]'s. Later, a `p` where `family` fails is a failed
+/// [`follow_residual`]'s. Later, a `p` where `family` fails is a failed
 /// step, and a failed location of an `at` point or cusp is left out (the
 /// curve is kept).
 #[allow(clippy::too_many_arguments)]
@@ -121,13 +118,8 @@ where
     copts.lambda_min = lo;
     copts.lambda_max = hi;
     let direction = if p_from < p_start { -1.0 } else { 1.0 };
-    let path = {
-        let m_len = x0.len().saturating_sub(1);
-        let mut residual_branch =
-            ResidualBranch::new(m_len, |x: &[f64], r: &mut [f64]| sys.residual(x, r));
-        let corrector = Box::new(BroydenCorrector::new(m_len, &copts.broyden, None));
-        Stepper::new(&mut residual_branch, corrector, &x0, 0, direction, &copts)?.run(|_, _| true)
-    };
+    let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
+    let path = follow_residual(residual, &x0, None, direction, &copts, |_| true)?;
     let cusps = path
         .folds
         .iter()
@@ -177,20 +169,14 @@ fn locate_cusp<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
     fine.max_points = 500;
     let dir = if a.dlambda < 0.0 { -1.0 } else { 1.0 };
     let mut turned = false;
-    let local = {
-        let m_len = a.x.len().saturating_sub(1);
-        let mut residual_branch =
-            ResidualBranch::new(m_len, |x: &[f64], r: &mut [f64]| sys.residual(x, r));
-        let corrector = Box::new(BroydenCorrector::new(m_len, &fine.broyden, None));
-        Stepper::new(&mut residual_branch, corrector, &a.x, 0, dir, &fine)
-            .ok()?
-            .run(|_, pt| {
-                // Stop two points after the turn.
-                let stop = turned;
-                turned = turned || pt.dlambda * dir < 0.0;
-                !stop
-            })
-    };
+    let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
+    let local = follow_residual(residual, &a.x, None, dir, &fine, |pt| {
+        // Stop two points after the turn.
+        let stop = turned;
+        turned = turned || pt.dlambda * dir < 0.0;
+        !stop
+    })
+    .ok()?;
     let fold = local.folds.first()?;
     let mut x = local.points.get(fold.index)?.x.clone();
     if let Some(last) = x.last_mut() {

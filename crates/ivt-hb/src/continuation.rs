@@ -17,12 +17,14 @@ use ivt_num::vector::norm2;
 
 pub mod corrector;
 mod predictor;
+mod residual_path;
 mod start;
 mod step_control;
 mod stepper;
 #[cfg(test)]
 mod tests;
 pub use corrector::{BroydenCorrector, NewtonCorrector, PathCorrector};
+pub use residual_path::follow_residual;
 pub use start::correct_at_fixed_lambda;
 pub use stepper::{Step, Stepper};
 

@@ -1,10 +1,10 @@
 //! Frequency-response curves (Fig. 29): the modified-IHB residual followed in ω_f by
 //! pseudo-arclength continuation ([`crate::continuation`], Eq. 68–77), with the
 //! Floquet multipliers (Hsu, Eq. 80) and stability class at every point. Each
-//! turn of the path is then located by Newton on the extended system of
-//! [`crate::events::fold`] (the fold itself, not a bracket between two points),
-//! started from the quadratic through the three path points around the turn
-//! ([`crate::continuation::turn_estimate`]).
+//! turn of the path is located as the points arrive, through the
+//! [`crate::events::Fold`] detector of an [`EventObserver`]: Newton on the
+//! extended system of [`crate::events::fold`] (the fold itself, not a bracket
+//! between two points), started from the path point nearest the turn.
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 #![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
 #![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
@@ -12,12 +12,15 @@
 
 use crate::aft::Aft;
 use crate::continuation::{turn_estimate, ContinuationOptions, Corrector, Path, Step, Termination};
-use crate::events::{locate_fold, BifurcationKind, LocateOptions, Trace};
+use crate::events::{
+    locate_fold, BifurcationKind, Detector, Event, EventObserver, Fold, LocateOptions, Observer,
+    Trace,
+};
 use crate::family::{FamilyBranch, Frequency};
 use crate::ihb::{HbError, HbOptions, HbSolution};
 use crate::modified::ModifiedIhb;
 use crate::problem::{AtFrequency, PeriodicProblem};
-use crate::stability::{AdaptiveHsu, HsuSteps, StabilityKind};
+use crate::stability::{HsuSteps, StabilityKind};
 use faer::c64;
 
 /// Options of a frequency sweep.
@@ -137,66 +140,60 @@ pub fn frequency_response<P: PeriodicProblem>(
     let at_start = AtFrequency::new(problem, opts.from);
     let start: HbSolution = ModifiedIhb::new(&at_start, hb.clone())?.solve(opts.from, None)?;
     let mut family = FamilyBranch::new(Frequency(problem), hb, opts.from)?;
-    let m = start.coeffs.len();
     let mut x0 = start.coeffs.clone();
     x0.push(opts.from);
     let mut copts = opts.continuation.clone();
     copts.lambda_min = opts.from.min(opts.to);
     copts.lambda_max = opts.from.max(opts.to);
     let direction = if opts.to > opts.from { 1.0 } else { -1.0 };
-    let mut hsu = AdaptiveHsu::new(&at_start, hb.harmonics, opts.stability)?;
-    let mut probe = AmplitudeProbe::new(hb)?;
-    // Each point's multipliers as it is reached: where the branch's last
-    // Galerkin assembly is the point's (a Newton-corrected point, or every
-    // point without the second-order predictor), its ∂g samples serve Hsu's
-    // level of the same grid without another evaluation of g.
-    let mut points = Vec::new();
-    let path = {
-        let mut stepper = family.stepper(
-            &x0,
-            start.stats.iterations,
-            direction,
-            &copts,
-            opts.corrector,
-        )?;
-        let (mut path_points, mut turns) = (Vec::new(), Vec::new());
-        let termination = loop {
-            let p = match stepper.next() {
-                Step::Point(p) => p,
-                Step::Stop(termination) => break termination,
-            };
-            turns.extend(stepper.fold());
-            let branch = stepper.branch();
-            let (at, sol) = branch.solution(p.x.get(..m).unwrap_or_default(), p.lambda());
-            let known = branch.jacobian_samples_at(&p.x);
-            let fl = hsu.floquet_with_samples(&at, &sol, known)?;
-            points.push(FrcPoint {
-                omega_f: sol.omega_f,
-                amplitude: probe.of(&sol.coeffs),
-                kind: fl.floquet.kind,
-                multipliers: fl.floquet.multipliers,
-                multiplier_error: fl.error,
-                coeffs: sol.coeffs,
-            });
-            path_points.push(p);
-        };
-        Path {
-            points: path_points,
-            folds: turns,
-            termination,
+    // Each point's multipliers and the fold detector's test as the point
+    // arrives ([`EventObserver`]): where the branch's last Galerkin assembly
+    // is the point's (a Newton-corrected point, or every point without the
+    // second-order predictor), its ∂g samples serve Hsu's level of the same
+    // grid without another evaluation of g; a fold is located once the
+    // point after its start has arrived.
+    let detectors: Vec<Box<dyn Detector<Frequency<'_, P>>>> = vec![Box::new(Fold::position_only())];
+    let locate = LocateOptions::fold();
+    let mut observer =
+        EventObserver::with_detectors(&family, opts.from, opts.stability, &locate, detectors)?;
+    let (mut events, mut turns) = (Vec::new(), Vec::new());
+    let mut stepper = family.stepper(
+        &x0,
+        start.stats.iterations,
+        direction,
+        &copts,
+        opts.corrector,
+    )?;
+    let termination = loop {
+        match stepper.next() {
+            Step::Point(p) => {
+                turns.extend(stepper.fold());
+                events.extend(observer.on_point(stepper.branch(), &p)?);
+            }
+            Step::Stop(t) => break t,
         }
     };
-    let mut folds = Vec::with_capacity(path.folds.len());
-    for (turn, located) in path.folds.iter().zip(locate_turns(&mut family, &path)) {
-        if let Some(near) = points.get(turn.index) {
-            folds.push(probe.fold(turn.index, located, near, turn.lambda));
+    // A turn at the path's last point has no point after it to start its
+    // locator: it stays unlocated, at the stepper's estimate.
+    for turn in &turns {
+        if !events.iter().any(|e| e.index == turn.index) {
+            events.push(Event {
+                kind: BifurcationKind::Fold,
+                index: turn.index,
+                location: Err(HbError::InvalidInput("the path ended at the turn".into()).into()),
+            });
         }
     }
-    Ok(Frc {
-        points,
-        folds,
-        termination: path.termination,
-    })
+    events.sort_by_key(|e| e.index);
+    let trace = Trace {
+        points: observer.into_points(),
+        events,
+        termination,
+    };
+    // A fold that could not be located keeps the parabola's ω_f through the
+    // three points around its turn (the stepper's estimate).
+    let estimate = |index: usize| turns.iter().find(|t| t.index == index).map(|t| t.lambda);
+    Frc::assemble(&trace, hb, estimate)
 }
 
 /// Each fold of `path` located by [`locate_fold`] (Newton on the extended
@@ -233,6 +230,16 @@ impl Frc {
     /// # Errors
     /// [`HbError`] if `hb`'s AFT sizes are invalid.
     pub fn from_trace(trace: &Trace, hb: &HbOptions) -> Result<Self, HbError> {
+        Self::assemble(trace, hb, |_| None)
+    }
+
+    /// [`Frc::from_trace`], an unlocated fold at `estimate(index)` (ω_f), or
+    /// at its point's ω_f where that is `None`.
+    fn assemble(
+        trace: &Trace,
+        hb: &HbOptions,
+        estimate: impl Fn(usize) -> Option<f64>,
+    ) -> Result<Self, HbError> {
         let mut probe = AmplitudeProbe::new(hb)?;
         let points: Vec<FrcPoint> = trace
             .points
@@ -253,7 +260,8 @@ impl Frc {
             .filter_map(|e| {
                 let near = points.get(e.index)?;
                 let located = e.location.as_ref().ok().map(|b| (b.q.clone(), b.lambda));
-                Some(probe.fold(e.index, located, near, near.omega_f))
+                let omega = estimate(e.index).unwrap_or(near.omega_f);
+                Some(probe.fold(e.index, located, near, omega))
             })
             .collect();
         Ok(Self {

@@ -19,9 +19,8 @@
 #![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::aft::{embed_subharmonic, resize_harmonics};
-use crate::branch::ResidualBranch;
 use crate::broyden::{broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace};
-use crate::continuation::{BroydenCorrector, ContinuationOptions, Stepper};
+use crate::continuation::{follow_residual, ContinuationOptions};
 use crate::events::{locate_multiplier_crossing, BifurcationError, BifurcationKind, LocateOptions};
 use crate::family::FamilyBranch;
 use crate::floquet::HsuRule;
@@ -288,23 +287,17 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
         };
         pd_indicator(&an.hsu(p, &sol, HsuRule::Magnus4).multipliers)
     };
-    {
-        let m_len = x0.len().saturating_sub(1);
-        let mut residual_branch = ResidualBranch::new(m_len, |x: &[f64], r: &mut [f64]| {
-            let mut pp = problem.clone();
-            let (q, beta) = split_param(x);
-            pp.beta = beta;
-            res.eval(&pp, q, opts.omega, 1.0, r)
-        });
-        let corrector = Box::new(BroydenCorrector::new(m_len, &copts.broyden, None));
-        Stepper::new(&mut residual_branch, corrector, &x0, 0, 1.0, &copts).map(|stepper| {
-            stepper.run(|_, pt| {
-                p.beta = pt.lambda();
-                let (g, _) = stab(&mut an, &p, split_param(&pt.x).0, n1, 1);
-                bracket.push(&pt.x, g)
-            })
-        })
-    }
+    let residual = |x: &[f64], r: &mut [f64]| {
+        let mut pp = problem.clone();
+        let (q, beta) = split_param(x);
+        pp.beta = beta;
+        res.eval(&pp, q, opts.omega, 1.0, r)
+    };
+    follow_residual(residual, &x0, None, 1.0, &copts, |pt| {
+        p.beta = pt.lambda();
+        let (g, _) = stab(&mut an, &p, split_param(&pt.x).0, n1, 1);
+        bracket.push(&pt.x, g)
+    })
     .map_err(|e| HbError::InvalidInput(format!("period-1 continuation: {e}")))?;
     let ((xa, ga), (xb, gb)) = bracket
         .found
@@ -365,22 +358,18 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
         };
         let mut bracket = PdBracket::default();
         // Skip the start region where the new branch's multiplier is still ≈ +1.
-        {
-            let m_len = x0.len().saturating_sub(1);
-            let mut residual_branch = ResidualBranch::new(m_len, |x: &[f64], r: &mut [f64]| {
-                let (y, a) = split_param(x);
-                ctl.eval(y, a, r)
-            });
-            let corrector = Box::new(BroydenCorrector::new(m_len, &copts.broyden, None));
-            Stepper::new(&mut residual_branch, corrector, &x0, 0, 1.0, &copts)?.run(|_, pt| {
-                let (y, a) = split_param(&pt.x);
-                pp.beta = y.get(c).copied().unwrap_or(f64::NAN);
-                let mut q = y.to_vec();
-                set(&mut q, c, a);
-                let (g, _) = stab(&mut an2, &pp, &q, new_n, new_period);
-                bracket.push(&pt.x, g)
-            })
+        let residual = |x: &[f64], r: &mut [f64]| {
+            let (y, a) = split_param(x);
+            ctl.eval(y, a, r)
         };
+        follow_residual(residual, &x0, None, 1.0, &copts, |pt| {
+            let (y, a) = split_param(&pt.x);
+            pp.beta = y.get(c).copied().unwrap_or(f64::NAN);
+            let mut q = y.to_vec();
+            set(&mut q, c, a);
+            let (g, _) = stab(&mut an2, &pp, &q, new_n, new_period);
+            bracket.push(&pt.x, g)
+        })?;
         let ((xa, ga), (xb, gb)) = bracket.found.ok_or_else(|| {
             HbError::InvalidInput(format!("period-{new_period} branch never reached μ = −1"))
         })?;

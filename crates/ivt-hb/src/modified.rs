@@ -8,9 +8,8 @@
 #![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
 #![cfg_attr(not(test), deny(clippy::unimplemented))]
 
-use crate::branch::ResidualBranch;
 use crate::broyden::{broyden_solve, BroydenStats, BroydenWorkspace, System};
-use crate::continuation::{BroydenCorrector, ContinuationOptions, Stepper};
+use crate::continuation::{follow_residual, ContinuationOptions};
 use crate::galerkin::GalerkinJacobian;
 use crate::ihb::{validate_omega, HbError, HbOptions, HbResidual, HbSolution, HbSolver};
 use crate::problem::PeriodicProblem;
@@ -247,26 +246,18 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         let mut prev: Option<Vec<f64>> = None;
         let res = &mut *sys.res;
         // x = [q, s]: the coefficients and the stepping parameter.
-        let traced = {
-            let m_len = x0.len().saturating_sub(1);
-            let mut residual_branch =
-                ResidualBranch::new(m_len, |x: &[f64], r: &mut [f64]| match x.split_last() {
-                    Some((&s, q)) => res.eval(problem, q, omega_f, s, r),
-                    None => r.fill(f64::NAN),
-                });
-            let corrector = Box::new(BroydenCorrector::new(m_len, &copts.broyden, None));
-            Stepper::new(&mut residual_branch, corrector, &x0, 0, 1.0, &copts).map(|stepper| {
-                stepper.run(|_, pt| {
-                    if pt.lambda() >= 1.0 {
-                        crossing =
-                            Some((prev.take().unwrap_or_else(|| pt.x.clone()), pt.x.clone()));
-                        return false;
-                    }
-                    prev = Some(pt.x.clone());
-                    true
-                })
-            })
+        let residual = |x: &[f64], r: &mut [f64]| match x.split_last() {
+            Some((&s, q)) => res.eval(problem, q, omega_f, s, r),
+            None => r.fill(f64::NAN),
         };
+        let traced = follow_residual(residual, &x0, None, 1.0, &copts, |pt| {
+            if pt.lambda() >= 1.0 {
+                crossing = Some((prev.take().unwrap_or_else(|| pt.x.clone()), pt.x.clone()));
+                return false;
+            }
+            prev = Some(pt.x.clone());
+            true
+        });
         let crossing = crossing
             .as_ref()
             .map(|(a, b)| (a.split_last(), b.split_last()));

@@ -20,7 +20,7 @@
 //!   start's eigenvector); path vector `[q, ω, θ, v_r, v_i, p]`.
 //!
 //! Each system has one equation fewer than unknowns and is followed by the
-//! engine's pseudo-arclength continuation ([`Stepper`], Eq. 68–77)
+//! engine's pseudo-arclength continuation ([`crate::continuation::Stepper`], Eq. 68–77)
 //! with `p` as the path parameter (Φ's derivatives by the path's finite
 //! differences). The point at each `p` of `at` is solved at that `p` by
 //! Newton (`fixed.rs`). On a Neimark–Sacker curve the strong resonances 1:3
@@ -40,8 +40,7 @@
 
 use super::fixed::{solve_fixed, CurveSystem};
 use super::{crossings, path_interval};
-use crate::branch::ResidualBranch;
-use crate::continuation::{BroydenCorrector, ContinuationOptions, PathPoint, Stepper, Termination};
+use crate::continuation::{follow_residual, ContinuationOptions, PathPoint, Termination};
 use crate::error::HbError;
 use crate::events::extended::null_vector;
 use crate::events::{BifurcationKind, LocateOptions};
@@ -113,7 +112,7 @@ pub struct BifurcationCurve {
 /// [`HbError::InvalidInput`] for sizes, bounds (`start.p` must lie in the
 /// interval), a kind other than the two, or a start whose monodromy matrix
 /// has no such multiplier near the unit circle; `family(start.p)`'s error;
-/// the path's start failures as [`Stepper`]'s. Later, a `p` where
+/// the path's start failures as [`follow_residual`]'s. Later, a `p` where
 /// `family` fails is a failed step, and a failed location of an `at` point
 /// or resonance is left out (the curve is kept).
 pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
@@ -152,12 +151,9 @@ pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
     // A Neimark–Sacker path through θ = 0 or π (1:1, 1:2) continues on the
     // conjugate pair back along the same curve: it stops at the point past.
     let trace = |sys: &mut MultiplierSystem<'_, F>, direction: f64| {
-        let m_len = x0.len().saturating_sub(1);
-        let mut residual_branch =
-            ResidualBranch::new(m_len, |x: &[f64], r: &mut [f64]| sys.residual(x, r));
-        let corrector = Box::new(BroydenCorrector::new(m_len, &copts.broyden, None));
-        Stepper::new(&mut residual_branch, corrector, &x0, 0, direction, &copts).map(|stepper| {
-            stepper.run(|_, pt| !ns || pt.x.get(theta_index).is_none_or(|t| t.sin() > 0.0))
+        let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
+        follow_residual(residual, &x0, None, direction, &copts, |pt| {
+            !ns || pt.x.get(theta_index).is_none_or(|t| t.sin() > 0.0)
         })
     };
     let first = trace(&mut sys, towards_from)?;

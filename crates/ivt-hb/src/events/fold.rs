@@ -230,8 +230,33 @@ impl<B: Branch> NewtonSystem for FoldSystem<'_, B> {
 /// point ([`crate::PathPoint::dlambda`]) changes sign; the locator starts from
 /// the point nearest the turn of the parabola through the three points around
 /// it ([`crate::continuation::turn_estimate`]).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Fold;
+#[derive(Debug, Clone, Copy)]
+pub struct Fold {
+    /// Whether a located fold carries its multipliers.
+    multipliers: bool,
+}
+
+impl Default for Fold {
+    /// [`Fold::new`].
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Fold {
+    /// The detector of [`crate::trace`]: each located fold with its
+    /// multipliers (Hsu, `LocateOptions::stability_steps`).
+    pub fn new() -> Self {
+        Self { multipliers: true }
+    }
+
+    /// The detector of a curve whose points carry their own multipliers
+    /// ([`crate::frequency_response`]): each located fold is its orbit and λ
+    /// alone (no monodromy at the fold).
+    pub fn position_only() -> Self {
+        Self { multipliers: false }
+    }
+}
 
 impl<F: Family> Detector<F> for Fold {
     fn kind(&self) -> BifurcationKind {
@@ -251,7 +276,7 @@ impl<F: Family> Detector<F> for Fold {
     }
 
     /// [`locate_fold`] with a step tolerance of at most 1e-12,
-    /// then the multipliers there.
+    /// then the multipliers there (unless [`Fold::position_only`]).
     fn locate(&mut self, at: Start<'_, F>) -> Result<Bifurcation, BifurcationError> {
         let (q, lambda) = at.point()?;
         let (branch, opts) = (at.branch, at.opts);
@@ -260,8 +285,12 @@ impl<F: Family> Detector<F> for Fold {
             ..opts.clone()
         };
         let f = locate_fold(branch, q, lambda, &fold_opts)?;
-        let mut mono = Monodromy::new(branch, f.lambda, opts.stability_steps)?;
-        let multipliers = mono.multipliers(branch, &f.q, f.lambda);
+        let multipliers = if self.multipliers {
+            let mut mono = Monodromy::new(branch, f.lambda, opts.stability_steps)?;
+            mono.multipliers(branch, &f.q, f.lambda)
+        } else {
+            Vec::new()
+        };
         Ok(finish(
             branch,
             BifurcationKind::Fold,

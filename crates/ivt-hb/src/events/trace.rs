@@ -79,7 +79,7 @@ pub struct EventObserver<F: Family> {
 
 impl<F: Family> EventObserver<F> {
     /// The observer of a path of `branch` from `lambda0`: multipliers with
-    /// `stability`, events located with `opts`.
+    /// `stability`, every event located with `opts`.
     ///
     /// # Errors
     /// As [`AdaptiveHsu::new`].
@@ -90,11 +90,26 @@ impl<F: Family> EventObserver<F> {
         opts: &LocateOptions,
     ) -> Result<Self, HbError> {
         let detectors: Vec<Box<dyn Detector<F>>> = vec![
-            Box::new(Fold),
+            Box::new(Fold::new()),
             Box::new(PeriodDoubling),
             Box::new(NeimarkSacker),
             Box::new(BranchPoint::new(opts)),
         ];
+        Self::with_detectors(branch, lambda0, stability, opts, detectors)
+    }
+
+    /// The observer of [`EventObserver::new`] running `detectors` only (e.g.
+    /// the frequency response's [`Fold::position_only`]).
+    ///
+    /// # Errors
+    /// As [`AdaptiveHsu::new`].
+    pub fn with_detectors(
+        branch: &FamilyBranch<F>,
+        lambda0: f64,
+        stability: HsuSteps,
+        opts: &LocateOptions,
+        detectors: Vec<Box<dyn Detector<F>>>,
+    ) -> Result<Self, HbError> {
         let n = detectors.len();
         Ok(Self {
             multipliers: Multipliers::new(AdaptiveHsu::new(

@@ -14,8 +14,7 @@
 
 use faer::Mat;
 
-use crate::branch::ResidualBranch;
-use crate::continuation::{BroydenCorrector, ContinuationOptions, Stepper, Termination};
+use crate::continuation::{follow_residual, ContinuationOptions, Termination};
 
 use super::{StringHb, StringParams};
 use crate::error::HbError;
@@ -79,17 +78,12 @@ pub fn spring_frequency_response(
         Some((&omega, a)) => hb.residual(a, omega, out),
         None => out.fill(f64::NAN),
     };
-    let path = {
-        let m_len = start.len().saturating_sub(1);
-        let mut residual_branch = ResidualBranch::new(m_len, residual);
-        let corrector = Box::new(BroydenCorrector::new(m_len, &opts.broyden, Some(&jac0)));
-        Stepper::new(&mut residual_branch, corrector, &start, 0, 1.0, &opts)?.run(|_, p| {
-            if std::env::var_os("IVT_STHB_TRACE").is_some() {
-                eprintln!("spring point ω = {:.5} its {}", p.lambda(), p.iterations);
-            }
-            true
-        })
-    };
+    let path = follow_residual(residual, &start, Some(&jac0), 1.0, &opts, |p| {
+        if std::env::var_os("IVT_STHB_TRACE").is_some() {
+            eprintln!("spring point ω = {:.5} its {}", p.lambda(), p.iterations);
+        }
+        true
+    })?;
     let points = path
         .points
         .iter()
