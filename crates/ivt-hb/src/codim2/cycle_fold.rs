@@ -34,16 +34,15 @@ use std::cell::Cell;
 
 use super::fixed::{solve_fixed, CurveSystem};
 use super::{crossings, path_interval, FoldPoint};
-use crate::branch::{Branch, ResidualBranch};
-use crate::continuation::{BroydenCorrector, ContinuationOptions, Stepper, Termination};
+use crate::branch::Branch;
+use crate::continuation::{follow_residual, ContinuationOptions, Termination};
 use crate::cycle_branch::member::Member;
 use crate::cycle_branch::CycleSystem;
 use crate::error::HbError;
-use crate::events::extended::null_vector;
+use crate::events::extended::unit_null_vector;
 use crate::ihb::{HbOptions, HbSolution};
 use crate::problem::PeriodicProblem;
 use ivt_num::vector::{dot, matvec, norm2};
-use ivt_num::LuWorkspace;
 
 /// One fold of limit cycles on the curve.
 #[derive(Debug, Clone, PartialEq)]
@@ -81,7 +80,7 @@ pub struct CycleFoldCurve {
 /// [`HbError::InvalidInput`] for sizes or bounds (`nu_start` must lie in the
 /// interval); `family(mu, nu_start)`'s error; [`HbError::SingularStart`]
 /// if no null vector is found at the start; the start's failures as
-/// [`Stepper::new`]'s. Later, a (μ, ν) where `family` fails is a failed step,
+/// [`follow_residual`]'s. Later, a (μ, ν) where `family` fails is a failed step,
 /// and a failed `at` point is left out (the curve is kept).
 pub fn cycle_fold_curve<P, F>(
     family: F,
@@ -124,13 +123,14 @@ where
     copts.lambda_min = lo;
     copts.lambda_max = hi;
     let direction = if nu_from < nu_start { -1.0 } else { 1.0 };
-    let path = {
-        let m_len = x0.len().saturating_sub(1);
-        let mut residual_branch =
-            ResidualBranch::new(m_len, |x: &[f64], r: &mut [f64]| sys.residual(x, r));
-        let corrector = Box::new(BroydenCorrector::new(m_len, &copts.broyden, None));
-        Stepper::new(&mut residual_branch, corrector, &x0, 0, direction, &copts)?.run(|_, _| true)
-    };
+    let path = follow_residual(
+        |x: &[f64], r: &mut [f64]| sys.residual(x, r),
+        &x0,
+        None,
+        direction,
+        &copts,
+        |_| true,
+    )?;
     let cusps = path
         .folds
         .iter()
@@ -208,15 +208,7 @@ impl<'f, 'c, P: PeriodicProblem, F: Fn(f64) -> Member<P>> CycleFoldSystem<'f, 'c
     /// two steps of inverse iteration.
     fn null_vector(&mut self, u: &[f64], mu: f64) -> Result<Vec<f64>, HbError> {
         self.cycle.jacobian(u, mu, &mut self.jac);
-        let mut lu = LuWorkspace::new(self.m1);
-        let mut v = vec![1.0 / (self.m1 as f64).sqrt(); self.m1];
-        // A factor singular to rounding still serves inverse iteration (the
-        // solve is checked instead).
-        lu.factor_row_major(&self.jac);
-        if !null_vector(&mut lu, &mut v, false) {
-            return Err(HbError::SingularStart { lambda: mu });
-        }
-        Ok(v)
+        unit_null_vector(&self.jac, self.m1).ok_or(HbError::SingularStart { lambda: mu })
     }
 
     /// The fold at `x = [u, v, μ, ν]` (`None` if `x` is short).

@@ -11,11 +11,10 @@
 use super::fixed::CurveSystem;
 use super::FoldPoint;
 use crate::error::HbError;
-use crate::events::extended::null_vector;
+use crate::events::extended::unit_null_vector;
 use crate::galerkin::GalerkinJacobian;
 use crate::ihb::{HbOptions, HbResidual};
 use crate::problem::PeriodicProblem;
-use ivt_num::LuWorkspace;
 
 /// The fold system of one family, with the residual planned at the last `p`.
 pub(super) struct FoldSystem<'f, F> {
@@ -90,15 +89,7 @@ impl<'f, P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> FoldSystem<'f, F>
             .ok_or_else(|| HbError::InvalidInput("the family fails at p_start".into()))?;
         self.galerkin
             .assemble(&mut self.res, &problem, q, omega, 1.0, &mut self.jac);
-        let mut lu = LuWorkspace::new(self.m);
-        let mut v = vec![1.0 / (self.m as f64).sqrt(); self.m];
-        // A factor singular to rounding still serves inverse iteration (the
-        // solve is checked instead).
-        lu.factor_row_major(&self.jac);
-        if !null_vector(&mut lu, &mut v, false) {
-            return Err(HbError::SingularStart { lambda: p });
-        }
-        Ok(v)
+        unit_null_vector(&self.jac, self.m).ok_or(HbError::SingularStart { lambda: p })
     }
 
     /// The fold at `x = [q, v, ω, p]` (`None` if `x` is short).

@@ -95,6 +95,17 @@ pub(crate) fn null_vector(lu: &mut LuWorkspace, v: &mut [f64], transpose: bool) 
     true
 }
 
+/// A unit null vector of the near-singular row-major `m×m` matrix `jac`: two
+/// steps of inverse iteration ([`null_vector`]) from the uniform seed; `None`
+/// if they break down. A factor singular to rounding still serves (the solve
+/// is checked instead).
+pub(crate) fn unit_null_vector(jac: &[f64], m: usize) -> Option<Vec<f64>> {
+    let mut lu = LuWorkspace::new(m);
+    let mut v = vec![1.0 / (m as f64).sqrt(); m];
+    lu.factor_row_major(jac);
+    null_vector(&mut lu, &mut v, false).then_some(v)
+}
+
 /// Right and left near-null vectors of the near-singular square row-major `a`,
 /// refined in place from their seeds; only a non-finite factor is refused.
 ///
