@@ -5,10 +5,6 @@
 //! [`crate::events::fold`] (the fold itself, not a bracket between two points),
 //! started from the quadratic through the three path points around the turn
 //! ([`crate::continuation::turn_estimate`]).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::aft::Aft;
 use crate::continuation::{turn_estimate, ContinuationOptions, Corrector, Path, Step, Termination};
