@@ -2,6 +2,7 @@
 //! of the cantilever at one frequency (one sparse LU and refined solves per
 //! harmonic, n = 7), against the number of elements. `cargo bench -p ivt-hb
 //! --bench condense`; the whole-curve scaling study is bench/large_scaling.py.
+#![allow(clippy::expect_used, clippy::indexing_slicing)]
 
 use faer::c64;
 use ivt_hb::condense::{Coupling, Receptances, Structure};

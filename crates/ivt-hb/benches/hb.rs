@@ -2,6 +2,7 @@
 //! from the linear guess), the classic Newton IHB beside it, and the full
 //! frequency-response curve 0.2–3.0 with a stability flag at every point, with
 //! either corrector, for the Duffing and for the 2-DOF chain of issue 17.
+#![allow(clippy::unwrap_used)]
 
 use ivt_hb::{
     frequency_response, ClassicIhb, Corrector, Duffing, FrcOptions, GalerkinJacobian, HbOptions,

@@ -3,6 +3,7 @@
 //! methods, and the "traditional route" (the hand-derived modal model through
 //! the general engine) on the same point and curve.
 //! Run: `cargo bench -p ivt-hb --bench sthb`.
+#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 use divan::Bencher;
 use faer::linalg::solvers::Solve;

@@ -3,6 +3,7 @@
 //!
 //! `cargo run --release -p ivt-hb --example friction_damper` prints
 //! `ω_f amplitude stable` along the curve 0.6 ≤ ω_f ≤ 1.4.
+#![allow(clippy::expect_used)]
 
 use ivt_hb::{frequency_response, Element, ElementProblem, FrcOptions, Harmonic, HbOptions, Law};
 

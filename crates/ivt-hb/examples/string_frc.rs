@@ -1,5 +1,6 @@
 //! Frequency–response curve of the nonlinear string (Figs. 34–35):
 //! `cargo run --release -p ivt-hb --example string_frc -- KD N FROM TO`.
+#![allow(clippy::expect_used, clippy::indexing_slicing)]
 use ivt_hb::sthb::frc::{frequency_response, trace, StringFrcOptions};
 use ivt_hb::sthb::{StringHb, StringParams};
 

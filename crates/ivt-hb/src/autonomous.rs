@@ -13,10 +13,6 @@
 //! [`limit_cycle_branch`] follows a limit cycle in a parameter μ of a family of
 //! problems by the engine's pseudo-arclength continuation ([`crate::continuation::Stepper`],
 //! Eq. 68–77) on `[R(q, ω; μ); b₁] = 0` with unknowns `{q, ω, μ}`.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::broyden::{BroydenStats, SolveError};
 use crate::continuation::{follow_residual, ContinuationOptions, Termination};

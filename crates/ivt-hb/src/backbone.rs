@@ -12,11 +12,6 @@
 //! is the continuation parameter (pseudo-arclength, Eq. 68–77). The problem
 //! must be undamped and unforced (`C = 0`, `f = 0`; checked).
 
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
-
 use crate::branch::Branch;
 use crate::continuation::{
     correct_at_fixed_lambda, BroydenCorrector, ContinuationOptions, Corrector, NewtonCorrector,

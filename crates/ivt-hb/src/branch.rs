@@ -12,10 +12,6 @@
 //! difference with the caller's step ([`residual_lambda_difference`],
 //! [`bilinear_lambda_difference`]); a branch that knows them exactly (the
 //! frequency family, the STHB string) overrides them.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 /// A one-parameter family of square systems `R(q, λ) = 0` with `∂R/∂q`.
 pub trait Branch {

@@ -7,10 +7,6 @@
 //! rule (`step_control.rs`: the corrector's effort, halving on failure, the
 //! cap [`ContinuationOptions::step_cap`], landing on the bounds of λ). A sign
 //! change of the direction's λ component marks a fold (turning point).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::broyden::{BroydenOptions, SolveError};
 use ivt_num::vector::norm2;

@@ -11,10 +11,6 @@
 //! (`β = Re λ`, `l₁ = Re c₁/ω`) the cycle at p has `|z|² = −β/(ω l₁)` and
 //! `y(t) ≈ y* + 2 Re(z e^{iωt} q)`, on the side of p where `−β/l₁ > 0`; it is
 //! taken at `p_H ± offset·|p_to − p_from|` and refined by [`limit_cycle`].
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::autonomous::{limit_cycle, limit_cycle_branch, LimitCycle};
 use crate::branch::Branch;

@@ -12,10 +12,6 @@
 //!
 //! The linear mode (the start) is the `mode`-th eigenpair of `M⁻¹K` by
 //! increasing frequency.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::backbone::{modal_path, BackboneOptions};
 use crate::continuation::Termination;

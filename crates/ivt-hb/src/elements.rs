@@ -14,10 +14,6 @@
 //! with a Jenkins element does not model it.
 //!
 //! A sample slice of the wrong length (a caller's bug) gives NaN, not a panic.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::problem::{matrix_getters, per_sample, PeriodicProblem};
 

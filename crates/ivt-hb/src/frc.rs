@@ -5,10 +5,6 @@
 //! [`crate::events::Fold`] detector of an [`EventObserver`]: Newton on the
 //! extended system of [`crate::events::fold`] (the fold itself, not a bracket
 //! between two points), started from the path point nearest the turn.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::aft::Aft;
 use crate::continuation::{turn_estimate, ContinuationOptions, Corrector, Path, Step, Termination};

@@ -6,10 +6,6 @@
 //! appears shifted by all integers `i m`; the fundamental ones are those whose
 //! eigenvectors are most centred in the harmonic index (the weighted mean index of
 //! `|c_k|²` closest to 0). Multipliers are `μ = exp(2πλ)`.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::error::HbError;
 use faer::c64;

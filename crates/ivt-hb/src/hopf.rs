@@ -20,10 +20,6 @@
 //! central differences of the field, polarised): `l₁ > 0` subcritical (an
 //! unstable cycle on the side where the equilibrium is stable), `l₁ < 0`
 //! supercritical.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::error::HbError;
 use crate::floquet::eigenvalues;

@@ -17,10 +17,6 @@
 //! phase's force on δ at its reversal, so the Galerkin Jacobian of a problem
 //! with hysteretic elements, and the folds and Floquet multipliers computed
 //! from it, are approximations (the orbits are not: they solve the residual).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 /// The Jenkins force and local tangent at the samples `delta` of one period
 /// (see the module docs), into `force` and `tangent` (`delta.len()` each).

@@ -11,10 +11,6 @@
 //!
 //! Slice lengths are the callers' contract: a vector of the wrong length gives a
 //! NaN output (reported by the solvers as [`HbError::NonFinite`]), not a panic.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::aft::{split_series, split_series_mut, Aft};
 use crate::broyden::{BroydenOptions, BroydenStats};

@@ -6,10 +6,6 @@
 //! keeps one matrix at 128 MiB and a Newton step (an `O(m³)` LU) near a
 //! second. The FFT buffers hold `2N` samples per DOF: [`MAX_SAMPLES`] = 2²²
 //! keeps each buffer at 32 MiB.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 /// Most unknowns `n_dof·(2n+1)` of one harmonic-balance system (IHB, STHB,
 /// Hill): a dense `m × m` f64 matrix is then at most 128 MiB.

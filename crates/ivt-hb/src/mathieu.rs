@@ -13,10 +13,6 @@
 //!    (`a_{2j}^{(2)} = a_j^{(1)}`), the amplitude `a_1` of the new lowest harmonic is
 //!    prescribed (non-zero forces the new branch) and β takes its slot among the
 //!    unknowns; `a_1` is then the continuation parameter.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::aft::{embed_subharmonic, resize_harmonics};
 use crate::broyden::{broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace};

@@ -3,10 +3,6 @@
 //! parameter stepping in the nonlinearity (ε from 0 in steps, reusing the last
 //! Broyden matrix) when the direct iteration fails, and pseudo-arclength in the
 //! stepping parameter when that path folds.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::broyden::{broyden_solve, BroydenStats, BroydenWorkspace, System};
 use crate::continuation::{follow_residual, ContinuationOptions};

@@ -6,10 +6,6 @@
 //! analysed by Hsu's method (Eq. 80) and by Hill's method; the two must agree.
 //! Classification: stable (all |μ| < 1), fold (a real μ > 1), period doubling (a
 //! real μ < −1), Neimark–Sacker (a complex pair outside the unit circle).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::aft::Aft;
 use crate::error::HbError;

@@ -4,10 +4,6 @@
 //! branch point, [`crate::Bifurcation::second_direction`]; at a period doubling
 //! the odd-harmonic null vector of the period-2 Galerkin Jacobian,
 //! [`period_doubled_start`]).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::branch::{residual_lambda_difference, Branch};
 use crate::broyden::SolveError;

@@ -11,10 +11,6 @@
 //! period). The period is then `t_i − t_{i−k}`. A start in the basin of the
 //! equilibrium ends with [`HbError::Equilibrium`], one that never settles with
 //! [`HbError::Transient`]; no start needs Fourier coefficients or a frequency.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::autonomous::{limit_cycle, LimitCycle};
 use crate::error::HbError;

@@ -1,6 +1,7 @@
 //! Backbone curve of the undamped Duffing oscillator `ẍ + x + αx³ = 0` against
 //! its closed-form period (complete elliptic integral) and the first-order
 //! harmonic-balance law ω² = 1 + ¾αa².
+#![allow(clippy::unwrap_used)]
 
 mod common;
 use common::tight_backbone;

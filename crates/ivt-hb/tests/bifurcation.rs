@@ -1,6 +1,7 @@
 //! Period doubling, Neimark–Sacker and branch points located on traced branches
 //! and checked against shooting with Floquet multipliers (RK4 with variational
 //! equations, sharing no code with the HB path) and time integration.
+#![allow(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used)]
 
 use ivt_hb::aft::{eval_series, resize_harmonics};
 use ivt_hb::mathieu::THESIS_A0;

@@ -4,6 +4,7 @@
 //! RK4 time integration of the full ODE (N = 4), the refined receptances of
 //! the fine mesh against a double-double band elimination (N = 50, 500), and
 //! the per-point truncation estimate against more harmonics.
+#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 #[path = "common/beam.rs"]
 mod beam;

@@ -2,6 +2,7 @@
 //! issue 17: the same located folds, and the Newton–chord corrector calls `g`
 //! about a sixth as often per point as Broyden's (the reason user systems use
 //! it), half of that owed to its second-order predictor.
+#![allow(clippy::unwrap_used)]
 
 mod common;
 

@@ -5,6 +5,7 @@
 //! solves `y(T; x₀, μ) = (x₀, 0)`; a fold of cycles adds
 //! `det ∂(y(T) − y₀)/∂(x₀, T) = 0`; the non-trivial multiplier is
 //! `det ∂y(T)/∂y₀` (the other is 1).
+#![allow(clippy::indexing_slicing)]
 
 use ivt_hb::{
     cycle_branch, CycleBranchOptions, GeneralProblem, HbError, HbOptions, PeriodicProblem,

@@ -2,6 +2,7 @@
 //! limit against the linear modes in closed form, a damped Duffing against
 //! the exact (elliptic-integral) frequency of its free oscillation, and the
 //! undamped case against `backbone`.
+#![allow(clippy::indexing_slicing)]
 
 mod common;
 use common::tight_backbone;

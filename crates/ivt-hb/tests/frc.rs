@@ -1,5 +1,6 @@
 //! Fig. 29: the Duffing frequency-response curve 0.2 ≤ ω_f ≤ 3 (ξ = 0.02, α = 1,
 //! ε = 1, F = 0.1, n = 20, N = 64) through both folds of the hardening peak.
+#![allow(clippy::indexing_slicing, clippy::panic)]
 
 use ivt_hb::aft::eval_series;
 use ivt_hb::ode::rk4;

@@ -3,6 +3,7 @@
 //! against an independent reference (8192 Magnus-4 steps, whose own error is
 //! below 1e-12: fourth order from 5.6e-7 at 256 steps), on the Duffing curve
 //! (closed-form 2×2 exponential) and the 2-DOF chain (4×4 Taylor).
+#![allow(clippy::expect_used, clippy::unwrap_used)]
 
 mod common;
 

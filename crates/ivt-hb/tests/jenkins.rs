@@ -1,6 +1,7 @@
 //! The Jenkins element (issue 27, item 6): its first harmonic against the
 //! describing function in closed form, and a forced oscillator's orbit against
 //! time integration of the hysteretic ODE, with the order of convergence in n.
+#![allow(clippy::unwrap_used)]
 
 use ivt_hb::aft::eval_series;
 use ivt_hb::{Element, ElementProblem, Harmonic, HbOptions, HbResidual, Law, ModifiedIhb};

@@ -11,6 +11,7 @@
 //! a difference Jacobian, more harmonics than the curve (n = 11), and each
 //! fold as the extremum of ω along the curve parametrized by the phase of
 //! the first harmonic (a parabola through three points, three times).
+#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 #[path = "common/beam.rs"]
 mod beam;

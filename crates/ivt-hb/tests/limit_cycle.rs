@@ -1,6 +1,7 @@
 //! Autonomous orbits: the unforced Van der Pol limit cycle
 //! `ẍ − μ(1 − x²)ẋ + x = 0` (C = −μ, K = 1, g = μx²ẋ) by HB with the frequency as
 //! an unknown, against shooting on the time integration.
+#![allow(clippy::indexing_slicing, clippy::panic)]
 
 use ivt_hb::aft::eval_series;
 use ivt_hb::jobs::Oscillator;

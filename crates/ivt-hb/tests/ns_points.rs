@@ -4,6 +4,7 @@
 //! (0.94525643, 0.2): each point against shooting on RK4 (no HB): a fixed
 //! point of the period map whose Jacobian has determinant 1 (the product of
 //! a complex pair on the unit circle) and half trace cos θ.
+#![allow(clippy::indexing_slicing)]
 
 use ivt_hb::codim2::{bifurcation_curve, CurveStart};
 use ivt_hb::{

@@ -4,6 +4,7 @@
 //! force's ω-dependence) against shooting on RK4 (no HB): a fold is a fixed
 //! point of the period map with det(∂P/∂y − I) = 0, the force at each trial
 //! ω being `0.03 ω²`.
+#![allow(clippy::indexing_slicing)]
 
 use ivt_hb::jobs::{self, FrcRequest};
 use ivt_hb::{

@@ -6,6 +6,7 @@
 //! harmonic the curve is a circle of that diameter, 1571 long, which the old
 //! absolute cap `ds_max = 0.08` could not climb within `max_points` (the
 //! default curve stopped at 359).
+#![allow(clippy::unwrap_used)]
 
 use ivt_hb::{frequency_response, Corrector, Duffing, FrcOptions, HbOptions, Termination};
 

@@ -4,6 +4,7 @@
 //! same after the change of variable). The user path (`GeneralProblem`: closures,
 //! ∂g by central differences over all samples) must give exactly that for
 //! amplitudes of micrometres, of 10 nm and of 1e8, with the default tolerances.
+#![allow(clippy::indexing_slicing)]
 
 use ivt_hb::{
     frequency_response, Duffing, FrcOptions, GeneralProblem, HbOptions, HsuRule, ModifiedIhb,

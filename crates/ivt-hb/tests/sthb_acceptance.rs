@@ -1,5 +1,6 @@
 //! STHB acceptance (issue 4): independent Galerkin time integration, Hill
 //! against monodromy, Figs. 34–36 behaviour, stress.
+#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 use ivt_hb::sthb::frc::{frequency_response, trace, StringFrcOptions};
 use ivt_hb::sthb::modal::ModalString;

@@ -1,5 +1,6 @@
 //! STHB core checks: linear limit (Eq. 115), exact Jacobian against finite
 //! differences (Eq. 119–125), Newton convergence.
+#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 use faer::Mat;
 use ivt_hb::sthb::{Boundary, StringHb, StringParams};

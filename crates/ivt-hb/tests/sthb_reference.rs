@@ -10,6 +10,7 @@
 //! `‖a‖`, the verdict and `|μ|` of its critical multiplier with the method, and
 //! the located folds. The values are path independent: the check re-solves at
 //! each reference ω from the nearest point of the new curve.
+#![allow(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used)]
 
 use ivt_hb::sthb::frc::{frequency_response, StringFrc, StringFrcOptions};
 use ivt_hb::sthb::stability::StabilityMethod;

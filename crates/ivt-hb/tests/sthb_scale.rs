@@ -1,6 +1,7 @@
 //! STHB at scale (issue 28, item 4): the refined monodromy's error estimate
 //! against a 8×-step RK4, and
 //! the scaling driver of `bench/sthb_scaling.sh` (ignored; prints JSON lines).
+#![allow(clippy::unwrap_used)]
 
 use faer::Mat;
 use ivt_hb::sthb::frc::{frequency_response, StringFrcOptions};

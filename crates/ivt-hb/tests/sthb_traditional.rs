@@ -2,6 +2,7 @@
 //! (`ModalString`, closed-form cubic tensor) solved as a `PeriodicProblem` by
 //! the general engine (modified IHB, Broyden, pseudo-arclength, Hsu), against
 //! the STHB route on the same curve (N = 5, k_d = 10, c_d = 0.8, y0 = 0.5, M = 19).
+#![allow(clippy::unwrap_used)]
 
 use ivt_hb::frc::{frequency_response as engine_frc, FrcOptions};
 use ivt_hb::sthb::frc::{trace, StringFrcOptions};

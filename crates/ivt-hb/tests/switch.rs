@@ -2,6 +2,12 @@
 //! Newton on the period map, sharing no code with the HB path): the period-2
 //! branch of a forced Duffing oscillator in a well, born at a period doubling,
 //! and the symmetry-breaking branch of a symmetric 2-DOF chain at a pitchfork.
+#![allow(
+    clippy::indexing_slicing,
+    clippy::panic,
+    clippy::unreachable,
+    clippy::unwrap_used
+)]
 
 use ivt_hb::aft::eval_series;
 use ivt_hb::jobs::{self, SwitchRequest, SwitchStart, SwitchedBranch};

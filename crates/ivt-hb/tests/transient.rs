@@ -2,6 +2,7 @@
 //! `ẍ − μ(1 − x²)ẋ + x = 0` and Rayleigh `ẍ − μ(ẋ − ẋ³/3) + x = 0` from the
 //! default start (1, 0) and from other states, their periods against shooting
 //! on an RK4 integration that shares no code with the transient or HB.
+#![allow(clippy::expect_used, clippy::indexing_slicing)]
 
 use ivt_hb::jobs::Oscillator;
 use ivt_hb::ode::rk4;

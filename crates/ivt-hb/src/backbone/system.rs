@@ -1,8 +1,4 @@
 //! The backbone equations as a [`Branch`] in the prescribed amplitude.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::branch::{path_lambda_step, Branch};
 use crate::family::{FamilyBranch, Frequency};

@@ -116,3 +116,79 @@ fn nan_input_is_an_error() {
         Err(SolveError::NonFinite { .. })
     ));
 }
+
+/// `B·H` for row-major `m×m` matrices, by the textbook triple loop.
+fn product(b: &[f64], h: &[f64], m: usize) -> Vec<f64> {
+    let mut p = vec![0.0; m * m];
+    for i in 0..m {
+        for j in 0..m {
+            p[i * m + j] = (0..m).map(|k| b[i * m + k] * h[k * m + j]).sum();
+        }
+    }
+    p
+}
+
+#[test]
+fn replaced_row_and_column_keep_h_the_inverse_of_b() {
+    // Sherman–Morrison after each replacement against (a) B'·H' = I and (b) a
+    // fresh LU inversion of the same B'. B₀ is diagonally dominant (cond ≈ 3),
+    // so both hold to a few ε: 1e-13.
+    let m = 4;
+    let b0: Vec<f64> = (0..m * m)
+        .map(|k| {
+            if k % (m + 1) == 0 {
+                6.0
+            } else {
+                (k % 3) as f64 - 1.0
+            }
+        })
+        .collect();
+    let mut ws = BroydenWorkspace::new(m);
+    ws.set_jacobian(&b0).unwrap();
+    ws.replace_col(1, &[0.5, 7.0, -1.0, 2.0]).unwrap();
+    ws.replace_row(3, &[1.0, -2.0, 0.25, 5.0]).unwrap();
+    let b = ws.jacobian().to_vec();
+    assert_eq!(
+        &b[4..8],
+        &[b0[4], 7.0, b0[6], b0[7]],
+        "column 1 entry of row 1"
+    );
+    assert_eq!(&b[12..16], &[1.0, -2.0, 0.25, 5.0], "row 3");
+    assert_eq!(b[1], 0.5);
+    let h = ws.inverse_jacobian().to_vec();
+    for (k, p) in product(&b, &h, m).iter().enumerate() {
+        let eye = if k % (m + 1) == 0 { 1.0 } else { 0.0 };
+        assert!((p - eye).abs() < 1e-13, "B·H at {k}: {p}");
+    }
+    let mut fresh = BroydenWorkspace::new(m);
+    fresh.set_jacobian(&b).unwrap();
+    for (a, e) in h.iter().zip(fresh.inverse_jacobian()) {
+        assert!((a - e).abs() < 1e-13, "{a} vs {e}");
+    }
+}
+
+#[test]
+fn a_row_or_column_outside_the_workspace_is_a_dimension_error() {
+    let mut ws = BroydenWorkspace::new(3);
+    ws.set_jacobian(&[2.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 2.0])
+        .unwrap();
+    let dim = |expected, got| Err(SolveError::Dimension { expected, got });
+    // Index 3 would need 4 unknowns; a row of 2 entries is 2 unknowns.
+    assert_eq!(ws.replace_row(3, &[1.0; 3]), dim(3, 4));
+    assert_eq!(ws.replace_col(usize::MAX, &[1.0; 3]), dim(3, usize::MAX));
+    assert_eq!(ws.replace_row(0, &[1.0; 2]), dim(3, 2));
+    assert_eq!(ws.replace_col(0, &[1.0; 4]), dim(3, 4));
+    // Refused calls leave B and H as they were.
+    assert_eq!(
+        ws.jacobian(),
+        &[2.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 2.0]
+    );
+    assert_eq!(ws.inverse_jacobian()[4], 0.5);
+    // A zero-size workspace has no row 0 and solves its empty system at once.
+    let mut empty = BroydenWorkspace::new(0);
+    assert_eq!(empty.replace_row(0, &[]), dim(0, 1));
+    assert_eq!(empty.replace_col(0, &[]), dim(0, 1));
+    let mut none = |_: &[f64], _: &mut [f64]| {};
+    let stats = broyden_solve(&mut none, &mut [], &mut empty, &BroydenOptions::default());
+    assert_eq!(stats.map(|s| s.iterations), Ok(0));
+}

@@ -25,10 +25,6 @@
 //! Hopf) point, where the fold curve meets the Hopf curve at zero amplitude,
 //! shows as the amplitude of the coefficients tending to zero near
 //! the end of the curve; the path stops before it (the HB cycle degenerates).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use std::cell::Cell;
 

@@ -6,10 +6,6 @@
 //! is solved by Newton ([`ivt_num::newton()`]) with a central-difference
 //! Jacobian from the linear interpolation of the two path points that
 //! bracket the value.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use ivt_num::{NewtonOptions, NewtonSystem, NewtonWorkspace};
 

@@ -3,10 +3,6 @@
 //! (Eq. 56), `(vᵀv − 1)/2 = 0` in the path vector `x = [q, v, ω, p]`, with
 //! the residual planned anew when `p` changes (the excitation may depend on
 //! it).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::fixed::CurveSystem;
 use super::FoldPoint;

@@ -33,10 +33,6 @@
 //! or PD curve solves it); as `p`, ω and `q` are even functions of θ − θ_e
 //! on the curve, the end is extrapolated from the points at θ_e ± h and
 //! θ_e ± 2h.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::fixed::{solve_fixed, CurveSystem};
 use super::{crossings, path_interval};

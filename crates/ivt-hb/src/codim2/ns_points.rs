@@ -5,10 +5,6 @@
 //! pair of Floquet multipliers on the unit circle). Not a continuation of the curve: a turn of the boundary
 //! in p between two samples is not followed, and each sample costs a trace
 //! (the continuation is [`super::bifurcation_curve`]).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::continuation::Corrector;
 use crate::error::HbError;

@@ -5,11 +5,6 @@
 //! `O(n·kl·(kl + ku))` with no symbolic analysis, no allocation per column
 //! and contiguous rows. Pivoting widens `U`'s upper band to `kl + ku`.
 
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
-
 use crate::error::HbError;
 use faer::{c64, MatMut};
 

@@ -14,11 +14,6 @@
 //! `I + H ∂G/∂q` with the local Galerkin Jacobian (Eq. 56), and `∂R/∂ω_f` is
 //! exact (`∂H/∂ω_f` from transposed solves).
 
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
-
 use super::dynamic::Structure;
 use super::receptance::{Coupling, Receptances};
 use crate::branch::Branch;

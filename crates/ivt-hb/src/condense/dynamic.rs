@@ -14,11 +14,6 @@
 //! 2005, Dot2), so each refinement step gains the digits the rounded LU
 //! loses, and the size of the last correction estimates the error left.
 
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
-
 use super::band::{BandLu, MAX_HALF_BANDWIDTH};
 use crate::error::HbError;
 use faer::linalg::solvers::Solve;

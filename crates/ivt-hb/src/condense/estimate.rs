@@ -9,11 +9,6 @@
 //! orbit by 2e-8 while the 6th and 7th alone suggest 4e-14. The receptances
 //! of these harmonics come from the plain LU (an estimate needs no more).
 
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
-
 use super::branch::CondensedBranch;
 use crate::aft::Aft;
 use crate::error::HbError;

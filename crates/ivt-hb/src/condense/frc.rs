@@ -5,11 +5,6 @@
 //! point, and per point the estimated errors of the linear solves and of the
 //! harmonic truncation.
 
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
-
 use super::branch::CondensedBranch;
 use super::estimate::truncation_error;
 use super::scaled::Scaled;

@@ -22,11 +22,6 @@
 //!   variational equation on a reduced basis (the Ritz vectors of `S`), with
 //!   the basis truncation's error estimated per orbit.
 
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
-
 mod band;
 mod branch;
 pub mod dynamic;

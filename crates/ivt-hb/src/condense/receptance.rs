@@ -13,11 +13,6 @@
 //! any DOF is recovered as `X_j = U_F,j − U_S,j G`. The ω-derivatives come
 //! from `∂H/∂ω = −H D′ H` with transposed solves (no second factorization).
 
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
-
 use super::dynamic::Structure;
 use crate::error::HbError;
 use faer::{c64, Mat};

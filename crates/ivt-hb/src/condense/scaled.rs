@@ -12,11 +12,6 @@
 //! something else on every model. Scaled, both rows are of order one and a
 //! step `ds` is a fraction of the sweep and of the start's response.
 
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
-
 use super::branch::CondensedBranch;
 use crate::branch::Branch;
 use crate::problem::PeriodicProblem;

@@ -19,11 +19,6 @@
 //! bounds the larger basis's error while the Krylov space converges), plus
 //! Hsu's own Richardson estimate.
 
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
-
 use super::branch::CondensedBranch;
 use super::dynamic::{Part, Structure};
 use crate::error::HbError;

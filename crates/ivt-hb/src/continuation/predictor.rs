@@ -3,10 +3,6 @@
 //! of the exact ones), `x + Δη d`, with the second-order term `½Δη² κ` of
 //! [`super::ContinuationOptions::second_order_predictor`], `κ` the curvature
 //! of the last two directions.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use ivt_num::vector::norm2;
 

@@ -2,10 +2,6 @@
 //! subproblem assembled by the caller, e.g. an extended or phase-conditioned
 //! system), followed by the one [`Stepper`] with the thesis's Broyden
 //! corrector (Eq. 72–77, [`BroydenCorrector`]).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::{BroydenCorrector, ContinuationOptions, Path, PathPoint, Stepper};
 use crate::branch::ResidualBranch;

@@ -1,8 +1,4 @@
 //! The start of an exact-Jacobian path: Newton at fixed λ ([`ivt_num::newton()`]).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::branch::Branch;
 use ivt_num::{newton, NewtonError, NewtonOptions, NewtonSystem, NewtonWorkspace};

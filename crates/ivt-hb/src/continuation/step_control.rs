@@ -2,10 +2,6 @@
 //! step Δη adapted to the corrector's effort, halved on a failed corrector,
 //! capped by [`ContinuationOptions::step_cap`], and shortened to land on a
 //! bound of `[lambda_min, lambda_max]` instead of stepping past it.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::ContinuationOptions;
 

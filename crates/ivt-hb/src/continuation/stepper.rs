@@ -3,10 +3,6 @@
 //! rule ([`super::step_control`]) and a [`PathCorrector`]. A caller that
 //! watches points as they arrive (stability, events) loops over `next()`;
 //! [`Stepper::run`] collects the whole [`Path`].
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::corrector::{DirectionError, PathCorrector, Prediction, Retry};
 use super::predictor::{curvature_between, predict};

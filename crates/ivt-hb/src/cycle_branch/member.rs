@@ -2,10 +2,6 @@
 //! fails a problem of the same size that is NaN everywhere, so that the path
 //! follower rejects the step (as the fold curve's NaN residual,
 //! [`crate::codim2`]).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::problem::PeriodicProblem;
 

@@ -5,10 +5,6 @@
 //! minimally extended system with two test functions from the two-column
 //! bordering `[[R_q, R_λ, b], [Cᵀ, 0]]` (one [`ivt_num::BorderedLu`]) and an
 //! unfolding `R + μ b = 0` that makes it square and regular.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::detector::{
     dot, Bifurcation, BifurcationError, BifurcationKind, Detector, LocateOptions, PathSoFar, Start,

@@ -4,10 +4,6 @@
 //! unfoldings that make the system square) through [`ivt_num::newton()`],
 //! stopped by one [`StepRule`], with the small pieces the locators share
 //! (borders from inverse iteration, the `[R_q, R_λ]` blocks, the result).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::detector::{Bifurcation, BifurcationError, BifurcationKind, LocateOptions};
 use crate::branch::{residual_lambda_difference, Branch};

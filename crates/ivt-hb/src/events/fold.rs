@@ -14,10 +14,6 @@
 //! On a traced path ([`Fold`]) the test function is the λ component of the
 //! secant into each point (pseudo-arclength, Eq. 68–77): it changes sign where
 //! the path turns in λ, and the locator starts from the point nearest the turn.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::detector::{
     Bifurcation, BifurcationError, BifurcationKind, Detector, LocateOptions, PathSoFar, Start,

@@ -19,10 +19,6 @@
 //! `∂R/∂q` is the exact Galerkin Jacobian (Eq. 56); `∂R/∂λ` and the derivatives
 //! of the test functions are central differences. Branch switching at the
 //! located points is in [`crate::switching`].
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 pub mod branch_point;
 mod detector;

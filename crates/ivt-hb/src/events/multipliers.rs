@@ -5,10 +5,6 @@
 //! a multiplier crossing: Newton on `R = 0` and the bordered test function of
 //! a matrix built from Φ that turns singular at the crossing (`Φ + I`,
 //! `Φ⊙Φ − I`).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::detector::{Bifurcation, BifurcationError, BifurcationKind, LocateOptions, TracedPoint};
 use super::extended::{

@@ -5,10 +5,6 @@
 //! (bialternate product) of the monodromy matrix, whose eigenvalues are the
 //! products `μᵢμⱼ`, `i < j`. A real pair `μ, 1/μ` (neutral saddle) is also a
 //! zero of that test and is reported as [`BifurcationError::NeutralSaddle`].
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::detector::{
     Bifurcation, BifurcationError, BifurcationKind, Detector, LocateOptions, PathSoFar, Start,

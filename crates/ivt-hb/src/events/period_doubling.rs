@@ -2,10 +2,6 @@
 //! traced path the test `Re Π(μᵢ + 1)` of the points' multipliers changes
 //! sign; the locator solves `R = 0` with the bordered test function of
 //! `Φ + I` (Φ the monodromy matrix), singular exactly at the crossing.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::detector::{Bifurcation, BifurcationError, BifurcationKind, Detector, PathSoFar, Start};
 use super::multipliers::locate_crossing;

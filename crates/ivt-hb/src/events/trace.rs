@@ -3,10 +3,6 @@
 //! multipliers (Hsu, Eq. 80) as it arrives, every [`Detector`] evaluates its
 //! test function there, and an event whose test changed sign is located at
 //! once by its extended system.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::branch_point::BranchPoint;
 use super::detector::{

@@ -5,10 +5,6 @@
 //! Slice lengths are the callers' contract; a slice of the wrong length is not a
 //! panic: the value (and gradient) is NaN, which the solvers report as
 //! [`crate::HbError::NonFinite`].
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::ihb::HbResidual;
 use crate::problem::PeriodicProblem;

@@ -1,10 +1,6 @@
 //! Every periodic solution at one excitation frequency that deflated Newton
 //! finds within bounded starts ([`crate::all_solutions()`]), each with its
 //! Floquet multipliers (Hsu, Eq. 78) and verdict, and the search's bounds.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::{finite, pairs, stability_steps, Array};
 use crate::deflation::{all_solutions as deflated, SearchOptions};

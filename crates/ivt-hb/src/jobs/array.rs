@@ -1,8 +1,4 @@
 //! Numbers the results carry as columns: JSON lists, numpy arrays in Python.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use crate::{c64, HbError};
 use serde::{Serialize, Serializer};

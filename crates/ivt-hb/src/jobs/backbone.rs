@@ -1,10 +1,6 @@
 //! Backbone curve (nonlinear normal mode) of an undamped, unforced system,
 //! followed in amplitude from a linear mode with ω unknown (phase condition
 //! b1 = 0, a fictitious damping κ unfolding the family: [`crate::backbone()`]).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::{finite, Array};
 use crate::backbone::{BackboneOptions, BackbonePoint};

@@ -1,10 +1,6 @@
 //! The period-doubling cascade of the Mathieu–Duffing equation Eq. 81
 //! (§3.2.5, Eq. 81–85): β at the first three period doublings, each where a
 //! Floquet multiplier crosses −1 along the branch in β.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::{finite, pairs};
 use crate::error::HbError;

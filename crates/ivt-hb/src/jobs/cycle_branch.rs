@@ -2,10 +2,6 @@
 //! the first ([`crate::cycle_branch()`]: equilibria followed in p, the Hopf
 //! point's first Lyapunov coefficient, the cycle branch by HB with ω unknown
 //! and Eq. 68–77, Floquet stability (Hsu) and its folds located).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::{finite, pairs, stability_steps, Array};
 use crate::autonomous::LimitCycle;

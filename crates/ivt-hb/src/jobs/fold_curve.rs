@@ -7,10 +7,6 @@
 //! critical eigenvector of the monodromy matrix, Eq. 80). The start is a
 //! given point, or the point of that kind of largest ω_f located on the FRC
 //! of `family(p_start)` over an interval.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::{finite, Array, FrcRequest};
 use crate::codim2::{bifurcation_curve, CurvePoint, CurveStart};

@@ -4,10 +4,6 @@
 //! their extended system; with events the start is solved by the modified
 //! IHB and [`crate::trace`] locates every fold, period doubling,
 //! Neimark–Sacker point and branch point as the path passes it.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::{check_finite, pairs, Array};
 use crate::continuation::{Corrector, Termination};

@@ -1,10 +1,6 @@
 //! Limit cycle of an autonomous system: harmonic balance with the response
 //! frequency ω an unknown and the phase condition b1 = 0 on DOF 0 (§3.2.4,
 //! Newton with the Galerkin Jacobian), its multipliers by Hsu (Eq. 78).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::{finite, finite_pairs, stability_steps, Array};
 use crate::error::HbError;

@@ -18,10 +18,6 @@
 //! | every solution at one ω_f by deflation (issue 27) | [`AllSolutionsRequest`] | [`AllSolutionsResult`] | `hb all-solutions` | `all_solutions` |
 //! | branch switching at a period doubling or branch point (Eq. 56, 61, 68–77) | [`SwitchRequest`] | [`SwitchedBranch`] | `hb switch` | `switch_branch` |
 //!
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 pub mod all_solutions;
 mod array;

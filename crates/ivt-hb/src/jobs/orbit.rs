@@ -3,10 +3,6 @@
 //! (§3.2.1, Newton with the Galerkin Jacobian Eq. 56–61), then its Floquet
 //! multipliers by Hsu's method (Eq. 78) over [`super::stability_steps`]
 //! Magnus-4 steps.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::{finite_pairs, stability_steps, Array};
 use crate::error::HbError;

@@ -19,10 +19,6 @@
 //! [`crate::switch_branch`] corrects the first point at a distance
 //! `step · ‖q‖₂` from the bifurcation; the path then runs towards `to`, which
 //! must lie on the side where the new branch leaves.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::frc::{trace_error, traced_curve};
 use super::{finite, FoldPoint, FrcCurve, FrcRequest};

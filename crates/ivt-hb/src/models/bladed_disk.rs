@@ -2,11 +2,6 @@
 //! three DOFs (disk, blade root, blade tip), disks of neighbouring sectors
 //! coupled cyclically.
 
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
-
 use super::{from_triplets, SparseModel};
 use crate::error::HbError;
 

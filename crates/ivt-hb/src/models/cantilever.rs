@@ -1,11 +1,6 @@
 //! The benchmark beam of issue 28: an Euler–Bernoulli cantilever, clamped at
 //! x = 0, of N equal Hermite-cubic elements with consistent mass.
 
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
-
 use super::{from_triplets, SparseModel};
 use crate::error::HbError;
 

@@ -2,10 +2,6 @@
 //! closure, or a type evaluating all AFT samples at once, with or without an
 //! analytic Jacobian) and an excitation; either may read the excitation
 //! frequency ω_f ([`super::omega`]).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::omega::Excitation;
 use super::{

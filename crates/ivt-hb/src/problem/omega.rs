@@ -16,10 +16,6 @@
 //! model at ω_f (the same Galerkin projection on the same grid), its
 //! ω_f-derivative `∂R/∂ω_f` includes the ω-dependence of `g` and `f`, and the
 //! force scale of the tolerance is that of `f(·, ω_r)`.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::PeriodicProblem;
 

@@ -1,9 +1,5 @@
 //! The one-DOF oscillators of the thesis as [`PeriodicProblem`]s: Duffing's
 //! equation (Eq. 49) and the Mathieu–Duffing equation (Eq. 81).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::{displacement_jacobian, matrix_getters, PeriodicProblem};
 

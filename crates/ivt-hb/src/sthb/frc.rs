@@ -10,10 +10,6 @@
 //! most [`HILL_MAX_DIM`] rows; above that the confirmation is the monodromy
 //! with half the step ([`monodromy_refined`]), whose Richardson error estimate
 //! is the point's `multiplier_error`.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::reduced::ReducedString;
 use super::stability::{

@@ -29,10 +29,6 @@
 //! singularity are the same; the Toeplitz blocks `S_m` of Eq. 99 map to the real
 //! blocks in [`toeplitz`]. The norm reported for Figs. 34–35 is the Euclidean
 //! norm of the complex `a` (Eq. 114), see [`StringHb::complex_norm`].
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 pub mod frc;
 mod hb;

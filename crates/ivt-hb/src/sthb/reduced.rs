@@ -16,10 +16,6 @@
 //! (1/64 of a dense LU's work), half of the spring's, the same iterates. The
 //! other blocks matter only to stability, which keeps the full `S(t)` of the
 //! embedded response (monodromy, Hill).
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use faer::{Mat, MatMut};
 use ivt_num::vector::dot;

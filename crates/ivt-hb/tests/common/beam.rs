@@ -2,6 +2,7 @@
 //! from the tip to ground, the tip forced by `F cos ωt`, and the uncondensed
 //! beam the tests compare with (`#[path]`-included by the condense tests).
 #![allow(dead_code)] // each test binary uses its own subset
+#![allow(clippy::expect_used, clippy::indexing_slicing, clippy::unwrap_used)]
 
 use ivt_hb::condense::{CondensedBranch, Structure};
 use ivt_hb::models::{cantilever, BeamProperties};

@@ -1,6 +1,7 @@
 //! The 2-DOF cubic chain of issue 17 and the guide's FRC chapter (M = I, K = [[2, −1],
 //! [−1, 2]], C = 0.02 I, g = [0.5 x₁³, 0], f = [0.1 cos θ, 0]) with a Rust
 //! element: shared by the tests and the benches (`#[path]`-included there).
+#![allow(clippy::expect_used)]
 
 use ivt_hb::{Element, ElementProblem, Harmonic, Law};
 

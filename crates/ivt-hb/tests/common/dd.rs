@@ -2,7 +2,7 @@
 //! elimination in it: the extended-precision reference for the receptances
 //! of the fine cantilever (an independent method: no LU of faer, no
 //! refinement, twice the working precision).
-
+#![allow(clippy::indexing_slicing)]
 #![allow(dead_code)] // each test binary uses its own subset
 
 use faer::sparse::SparseColMatRef;

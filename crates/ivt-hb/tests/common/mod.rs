@@ -2,6 +2,7 @@
 //! orbit, the one-line modified-IHB solve and the 2-DOF cubic chain (also with
 //! call counters).
 #![allow(dead_code)] // each test binary uses its own subset
+#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 pub mod chain;
 pub mod counted;

@@ -1,6 +1,7 @@
 //! Shooting, the references without HB: Newton in the plane with a
 //! central-difference Jacobian, and the RK4 period map of the thesis Duffing
 //! (Eq. 49) for the fold-curve and all-solutions tests.
+#![allow(clippy::indexing_slicing)]
 
 use ivt_hb::aft::eval_series;
 use ivt_hb::ode::{first_order, rk4};

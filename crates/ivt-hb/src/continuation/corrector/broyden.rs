@@ -6,10 +6,6 @@
 //! ([`BroydenWorkspace::exact_rows`], Eq. 77). The direction at a point is the
 //! secant from its predecessor (Eq. 71). The branch is seen through its
 //! residual alone (the adapter `residual_of`): no Jacobian is assembled.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::{Corrected, Correction, DirectionError, Found, PathCorrector, Prediction, Retry};
 use crate::branch::Branch;

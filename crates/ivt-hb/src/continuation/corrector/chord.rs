@@ -5,10 +5,6 @@
 //! Sherman–Morrison), superlinear where the plain chord contracts linearly.
 //! The first attempt of [`super::NewtonCorrector`], whose Newton takes over
 //! where the chord does not contract.
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
-#![cfg_attr(not(test), deny(clippy::panic, clippy::indexing_slicing))]
-#![cfg_attr(not(test), deny(clippy::unreachable, clippy::todo))]
-#![cfg_attr(not(test), deny(clippy::unimplemented))]
 
 use super::Prediction;
 use crate::branch::Branch;
