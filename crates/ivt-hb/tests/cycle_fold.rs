@@ -6,8 +6,8 @@
 //! fold of cycles adds `det ∂(y(T) − y₀)/∂(x₀, T) = 0`, solved by Newton in
 //! `(x₀, T, μ)`. Averaging gives the fold near `μ = −ν²/8` (a loose check of
 //! the curve's shape).
-
 #![allow(clippy::indexing_slicing)]
+
 use ivt_hb::codim2::cycle_fold_curve;
 use ivt_hb::{
     cycle_branch, ContinuationOptions, GeneralProblem, HbError, HbOptions, PeriodicProblem,

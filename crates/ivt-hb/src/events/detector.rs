@@ -27,6 +27,18 @@ pub enum BifurcationKind {
     BranchPoint,
 }
 
+impl BifurcationKind {
+    /// The kind in words, for messages ("period doubling").
+    pub fn words(self) -> &'static str {
+        match self {
+            Self::Fold => "fold",
+            Self::PeriodDoubling => "period doubling",
+            Self::NeimarkSacker => "Neimark–Sacker point",
+            Self::BranchPoint => "branch point",
+        }
+    }
+}
+
 /// Options of the event locators (Newton on the extended systems) and of the
 /// multipliers reported at a located event.
 #[derive(Debug, Clone, PartialEq)]

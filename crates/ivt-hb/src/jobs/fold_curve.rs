@@ -334,19 +334,9 @@ where
         HbError::InvalidInput(format!(
             "the FRC from ω_f = {from} to {to} at p = {} has no located {} to start from",
             req.p_start,
-            kind_name(req.kind)
+            req.kind.words()
         ))
     })
-}
-
-/// The words of the kind in messages.
-fn kind_name(kind: BifurcationKind) -> &'static str {
-    match kind {
-        BifurcationKind::Fold => "fold",
-        BifurcationKind::PeriodDoubling => "period doubling",
-        BifurcationKind::NeimarkSacker => "Neimark–Sacker point",
-        BifurcationKind::BranchPoint => "branch point",
-    }
 }
 
 /// A point of the curve with its amplitude ([`HbSolution::amplitude`]).

@@ -129,18 +129,8 @@ fn switchable(kind: BifurcationKind) -> Result<(), HbError> {
         BifurcationKind::PeriodDoubling | BifurcationKind::BranchPoint => Ok(()),
         other => Err(HbError::InvalidInput(format!(
             "cannot switch branches at a {}: only at a period doubling or a branch point",
-            kind_name(other)
+            other.words()
         ))),
-    }
-}
-
-/// The name of a kind in a message.
-fn kind_name(kind: BifurcationKind) -> &'static str {
-    match kind {
-        BifurcationKind::Fold => "fold",
-        BifurcationKind::PeriodDoubling => "period doubling",
-        BifurcationKind::NeimarkSacker => "Neimark–Sacker point",
-        BifurcationKind::BranchPoint => "branch point",
     }
 }
 
@@ -222,7 +212,7 @@ pub fn switch<P: PeriodicProblem>(
         return Err(HbError::InvalidInput(format!(
             "the new branch leaves the {} at ω_f = {omega} towards ω_f = {w1}: \
              `to` = {} must lie on that side",
-            kind_name(kind),
+            kind.words(),
             req.to
         )));
     }
