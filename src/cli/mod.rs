@@ -20,6 +20,7 @@ pub mod reproduce;
 pub mod rig;
 pub mod rig_commission;
 pub mod rig_identify;
+mod rig_port;
 pub mod sim;
 pub mod stability;
 pub mod string;

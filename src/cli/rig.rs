@@ -2,12 +2,11 @@
 //! (or the QEMU image's UART1 on a pty) into the simulator's MCAP channels;
 //! `ivt rig commission` is in `rig_commission.rs`.
 
+use super::rig_port::{open_port, record_live};
 use super::{CliError, Output};
 use clap::{Args, Subcommand};
-use ivt_sim::telemetry::{record, RecordOptions, RecordSummary, FIRMWARE_PPR};
 use serde_json::json;
-use std::io::Read;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Duration;
 
 /// `ivt rig ...`
@@ -95,35 +94,4 @@ fn record_cmd(a: &RecordArgs) -> Result<Output, CliError> {
         }),
         human,
     })
-}
-
-/// Opens the rig's serial port (reads time out after 100 ms, so that the
-/// recorder sees the port idle).
-pub(super) fn open_port(
-    port: &str,
-    baud: u32,
-) -> Result<Box<dyn serialport::SerialPort>, CliError> {
-    serialport::new(port, baud)
-        .timeout(Duration::from_millis(100))
-        .open()
-        .map_err(|e| CliError::Failed(format!("{port}: {e}")))
-}
-
-/// Records a live port's telemetry into `out`: the firmware's PPR in the
-/// metadata, bad frames counted and skipped (not `strict`).
-pub(super) fn record_live<R: Read>(
-    src: R,
-    out: &Path,
-    f_timer_hz: f64,
-    max_frames: Option<u64>,
-    idle_timeout: Duration,
-) -> Result<RecordSummary, CliError> {
-    let opts = RecordOptions {
-        f_timer_hz,
-        max_frames,
-        idle_timeout,
-        ppr: FIRMWARE_PPR,
-        strict: false,
-    };
-    record(src, out, &opts).map_err(|e| CliError::Failed(e.to_string()))
 }

@@ -157,7 +157,7 @@ fn on_rig(
     selection: Selection,
     plan: &Plan,
 ) -> Result<Output, CliError> {
-    let mut dev = super::rig::open_port(port, a.baud)?;
+    let mut dev = super::rig_port::open_port(port, a.baud)?;
     let mut frame = [0u8; ivt_wire::MAX_FRAME];
     let n = ivt_wire::Request::Commission {
         selection,
@@ -171,7 +171,7 @@ fn on_rig(
     let total = plan.duration_s(selection, ivt_ctrl::Config::default().open_loop.r_max);
     // The rig sends a sample every 10 ms: the plan and one second more.
     let max_frames = (f64::from(total) * 100.0).ceil() as u64 + 100;
-    let s = super::rig::record_live(
+    let s = super::rig_port::record_live(
         dev,
         &a.out,
         a.f_timer_hz,

@@ -16,7 +16,7 @@
 //! rounding in O(2N log 2N + (2n+1)²) per block instead of O(2N·(2n+1)²).
 //!
 //! The bilinear form `wᵀΦ_q v` of the fold test, sampled without assembling
-//! `Φ_q`, is [`form`]. A `jac` of the wrong size is not a panic: it is filled
+//! `Φ_q`, is `form.rs`. A `jac` of the wrong size is not a panic: it is filled
 //! with NaN, which the solvers report as [`crate::HbError::NonFinite`].
 
 mod form;

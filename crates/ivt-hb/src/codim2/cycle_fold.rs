@@ -1,11 +1,11 @@
 //! Folds of limit cycles of an autonomous family in two parameters (issue
-//! 27, item 1): how a fold of the cycle branch of [`crate::cycle_branch`]
+//! 27, item 1): how a fold of the cycle branch of [`crate::cycle_branch()`]
 //! (a turning point in μ) moves with a second parameter ν of a family
 //! `family(μ, ν)`.
 //!
 //! A limit cycle solves the HB residual `R(q, ω; μ, ν) = 0` (Eq. 61) with ω
 //! unknown and the phase condition `b₁ = 0` (the cycle equations of
-//! [`crate::cycle_branch`]); with `u = {q, ω}` its Jacobian is the bordered
+//! [`crate::cycle_branch()`]); with `u = {q, ω}` its Jacobian is the bordered
 //! matrix `J = [[Φ_q, ∂R/∂ω], [e_{b₁}ᵀ, 0]]` (Φ_q: Eq. 56). A fold of cycles
 //! in μ is a point where `J` is singular, so the extended system (Keller;
 //! the fold systems of AUTO and MATCONT, as [`super::fold_curve`] uses for
@@ -15,7 +15,7 @@
 //!
 //! in the path vector `x = [q, ω, v, μ, ν]` has one equation fewer than
 //! unknowns and is followed by the engine's pseudo-arclength continuation
-//! ([`Stepper`], Eq. 68–77) with ν as the path parameter, μ solved along. A
+//! ([`crate::continuation::Stepper`], Eq. 68–77) with ν as the path parameter, μ solved along. A
 //! cusp of cycle folds (two folds merging) is a turning point of this curve in
 //! ν: it is reported at the path's fold estimate (the vertex of the parabola
 //! through the three points around the turn), not refined further. The fold
@@ -66,7 +66,7 @@ pub struct CycleFoldCurve {
 }
 
 /// Follows the fold of limit cycles of `family(μ, ν)` (autonomous: no
-/// excitation) at `start` (a located fold of [`crate::cycle_branch`] at
+/// excitation) at `start` (a located fold of [`crate::cycle_branch()`] at
 /// `(mu, nu_start)`: its coefficients with phase `b₁ = 0` and ω) in ν,
 /// first towards `nu_from` of `(nu_from, nu_to)`, until ν leaves the
 /// interval between them; the folds at each ν of `at` are solved exactly and

@@ -93,7 +93,7 @@ pub struct CondensedPoint {
     /// Estimated relative error of the orbit (and of the amplitude when it
     /// is a nonlinear DOF's) at this ω_f from the corrector's residual and
     /// the receptances' errors (solve + data): the bound of `J⁻¹δR`, `J` the condensed Jacobian
-    /// ([`orbit_error`]).
+    /// (`orbit_error`).
     pub orbit_error: f64,
     /// Estimated relative truncation error ([`truncation_error`]); `None` if
     /// not asked for.
