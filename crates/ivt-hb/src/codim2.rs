@@ -40,7 +40,7 @@ use crate::continuation::{follow_residual, ContinuationOptions, Path, PathPoint,
 use crate::error::HbError;
 use crate::ihb::HbOptions;
 use crate::problem::PeriodicProblem;
-use fixed::{solve_fixed, CurveSystem};
+use fixed::{solve_crossings, CurveSystem};
 use fold_system::FoldSystem;
 use ivt_num::vector::norm2;
 
@@ -57,18 +57,50 @@ pub struct FoldPoint {
     pub null_vector: Vec<f64>,
 }
 
-/// A fold curve in (ω, p).
+/// A curve of folds: of the FRC in (ω, p) ([`FoldCurve`]) or of limit
+/// cycles in (μ, ν) ([`CycleFoldCurve`]).
 #[derive(Debug, Clone, PartialEq)]
-pub struct FoldCurve {
+pub struct Curve<T> {
     /// Points in path order.
-    pub points: Vec<FoldPoint>,
-    /// The fold at each requested `p`, each time the curve crosses it, in
-    /// path order.
-    pub at: Vec<FoldPoint>,
-    /// Cusps: turning points of the curve in `p`.
-    pub cusps: Vec<FoldPoint>,
+    pub points: Vec<T>,
+    /// The fold at each requested value of the path parameter, each time the
+    /// curve crosses it, in path order.
+    pub at: Vec<T>,
+    /// Cusps: turning points of the curve in its path parameter.
+    pub cusps: Vec<T>,
     /// Why tracing stopped.
     pub termination: Termination,
+}
+
+/// A fold curve in (ω, p).
+pub type FoldCurve = Curve<FoldPoint>;
+
+/// The curve of `sys` along `path` with the given `cusps`: each path point
+/// mapped to its point and the points at each value of `at` of the path
+/// parameter (the last component) solved at fixed value.
+fn fold_curve_of<S: CurveSystem>(
+    sys: &mut S,
+    path: Path,
+    at: &[f64],
+    cusps: Vec<S::Point>,
+    scale: f64,
+) -> Curve<S::Point> {
+    let p_index = path
+        .points
+        .first()
+        .map_or(0, |pt| pt.x.len().saturating_sub(1));
+    let located = solve_crossings(sys, &path.points, at, p_index, scale);
+    let points = path
+        .points
+        .iter()
+        .filter_map(|pt| sys.point(&pt.x))
+        .collect();
+    Curve {
+        points,
+        at: located,
+        cusps,
+        termination: path.termination,
+    }
 }
 
 /// Follows the fold of the FRC of `family(p_start)` at `(start, omega)` (a
@@ -110,35 +142,14 @@ where
     let mut x0 = start.to_vec();
     x0.extend_from_slice(&v0);
     x0.extend([omega, p_start]);
-    let mut copts = opts.clone();
-    copts.lambda_min = lo;
-    copts.lambda_max = hi;
-    let direction = if p_from < p_start { -1.0 } else { 1.0 };
-    let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
-    let path = follow_residual(residual, &x0, None, direction, &copts, |_| true)?;
+    let copts = bounded(opts, (lo, hi));
+    let path = follow_curve(&mut sys, &x0, p_from, &copts)?;
     let cusps = path
         .folds
         .iter()
         .filter_map(|f| locate_cusp(&mut sys, &path, f.bracket, &copts))
         .collect();
-    let scale = norm2(start);
-    let located = crossings(&path.points, at, x0.len() - 1)
-        .filter_map(|(a, b, p)| {
-            let x = solve_fixed(&mut sys, (a, b), 2 * m + 1, p, scale)?;
-            sys.point(&x)
-        })
-        .collect();
-    let points = path
-        .points
-        .iter()
-        .filter_map(|pt| sys.point(&pt.x))
-        .collect();
-    Ok(FoldCurve {
-        points,
-        at: located,
-        cusps,
-        termination: path.termination,
-    })
+    Ok(fold_curve_of(&mut sys, path, at, cusps, norm2(start)))
 }
 
 /// The turning point in `p` near `path.points[bracket..bracket + 3]`: a
@@ -181,6 +192,31 @@ fn locate_cusp<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
     let mut point = sys.point(&x)?;
     point.p = fold.lambda;
     Some(point)
+}
+
+/// `opts` with the path parameter bounded to `[lo, hi]`.
+fn bounded(opts: &ContinuationOptions, (lo, hi): (f64, f64)) -> ContinuationOptions {
+    let mut copts = opts.clone();
+    copts.lambda_min = lo;
+    copts.lambda_max = hi;
+    copts
+}
+
+/// The path of the curve of `sys` from `x0` (the path parameter last), first
+/// towards the path parameter `towards`, to its end or the bounds of `opts`.
+///
+/// # Errors
+/// The start's failures as [`follow_residual`]'s.
+fn follow_curve<S: CurveSystem>(
+    sys: &mut S,
+    x0: &[f64],
+    towards: f64,
+    opts: &ContinuationOptions,
+) -> Result<Path, HbError> {
+    let start = x0.last().copied().unwrap_or(towards);
+    let direction = if towards < start { -1.0 } else { 1.0 };
+    let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
+    follow_residual(residual, x0, None, direction, opts, |_| true)
 }
 
 /// The interval `[lo, hi]` of `p` of a curve of `what` from `(ω, p_start)`.

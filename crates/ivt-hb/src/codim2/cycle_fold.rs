@@ -28,17 +28,18 @@
 
 use std::cell::Cell;
 
-use super::fixed::{solve_fixed, CurveSystem};
-use super::{crossings, path_interval, FoldPoint};
+use super::fixed::CurveSystem;
+use super::fold_system::{null_rows, split_fold_residual, split_fold_vector};
+use super::{bounded, fold_curve_of, follow_curve, path_interval, Curve, FoldPoint};
 use crate::branch::Branch;
-use crate::continuation::{follow_residual, ContinuationOptions, Termination};
+use crate::continuation::ContinuationOptions;
 use crate::cycle_branch::member::Member;
 use crate::cycle_branch::CycleSystem;
 use crate::error::HbError;
 use crate::events::extended::unit_null_vector;
 use crate::ihb::{HbOptions, HbSolution};
 use crate::problem::PeriodicProblem;
-use ivt_num::vector::{dot, matvec, norm2};
+use ivt_num::vector::norm2;
 
 /// One fold of limit cycles on the curve.
 #[derive(Debug, Clone, PartialEq)]
@@ -51,19 +52,9 @@ pub struct CycleFoldPoint {
     pub fold: FoldPoint,
 }
 
-/// A curve of folds of limit cycles in (μ, ν).
-#[derive(Debug, Clone, PartialEq)]
-pub struct CycleFoldCurve {
-    /// Points in path order.
-    pub points: Vec<CycleFoldPoint>,
-    /// The fold at each requested ν, each time the curve crosses it, in path
-    /// order.
-    pub at: Vec<CycleFoldPoint>,
-    /// Cusps: turning points of the curve in ν (the path's estimate).
-    pub cusps: Vec<CycleFoldPoint>,
-    /// Why tracing stopped.
-    pub termination: Termination,
-}
+/// A curve of folds of limit cycles in (μ, ν); its cusps are turning points
+/// in ν (the path's estimate).
+pub type CycleFoldCurve = Curve<CycleFoldPoint>;
 
 /// Follows the fold of limit cycles of `family(μ, ν)` (autonomous: no
 /// excitation) at `start` (a located fold of [`crate::cycle_branch()`] at
@@ -76,7 +67,7 @@ pub struct CycleFoldCurve {
 /// [`HbError::InvalidInput`] for sizes or bounds (`nu_start` must lie in the
 /// interval); `family(mu, nu_start)`'s error; [`HbError::SingularStart`]
 /// if no null vector is found at the start; the start's failures as
-/// [`follow_residual`]'s. Later, a (μ, ν) where `family` fails is a failed step,
+/// [`follow_residual`](crate::continuation::follow_residual)'s. Later, a (μ, ν) where `family` fails is a failed step,
 /// and a failed `at` point is left out (the curve is kept).
 pub fn cycle_fold_curve<P, F>(
     family: F,
@@ -115,18 +106,7 @@ where
     let mut x0 = u0;
     x0.extend_from_slice(&v0);
     x0.extend([mu, nu_start]);
-    let mut copts = opts.clone();
-    copts.lambda_min = lo;
-    copts.lambda_max = hi;
-    let direction = if nu_from < nu_start { -1.0 } else { 1.0 };
-    let path = follow_residual(
-        |x: &[f64], r: &mut [f64]| sys.residual(x, r),
-        &x0,
-        None,
-        direction,
-        &copts,
-        |_| true,
-    )?;
+    let path = follow_curve(&mut sys, &x0, nu_from, &bounded(opts, (lo, hi)))?;
     let cusps = path
         .folds
         .iter()
@@ -136,25 +116,13 @@ where
             Some(point)
         })
         .collect();
-    let scale = norm2(&start.coeffs);
-    let nu_index = x0.len() - 1;
-    let located = crossings(&path.points, at, nu_index)
-        .filter_map(|(a, b, value)| {
-            let x = solve_fixed(&mut sys, (a, b), nu_index, value, scale)?;
-            sys.point(&x)
-        })
-        .collect();
-    let points = path
-        .points
-        .iter()
-        .filter_map(|pt| sys.point(&pt.x))
-        .collect();
-    Ok(CycleFoldCurve {
-        points,
-        at: located,
+    Ok(fold_curve_of(
+        &mut sys,
+        path,
+        at,
         cusps,
-        termination: path.termination,
-    })
+        norm2(&start.coeffs),
+    ))
 }
 
 /// The extended system of a cycle fold: the cycle equations of
@@ -180,39 +148,32 @@ impl<'f, 'c, P: PeriodicProblem, F: Fn(f64) -> Member<P>> CycleFoldSystem<'f, 'c
         }
     }
 
-    /// `[R; b₁; J v; (vᵀv − 1)/2]` at `x = [u, v, μ, ν]`; `None` if the
-    /// sizes disagree.
-    fn try_residual(&mut self, x: &[f64], r: &mut [f64]) -> Option<()> {
-        let m1 = self.m1;
-        let (u, rest) = x.split_at_checked(m1)?;
-        let (v, &[mu, nu]) = rest.split_at_checked(m1)? else {
-            return None;
-        };
-        let (r_cycle, rest) = r.split_at_mut_checked(m1)?;
-        let (r_null, [r_norm]) = rest.split_at_mut_checked(m1)? else {
-            return None;
-        };
-        self.nu.set(nu);
-        self.cycle.residual(u, mu, r_cycle);
-        self.cycle.jacobian(u, mu, &mut self.jac);
-        matvec(&self.jac, m1, m1, v, r_null);
-        *r_norm = 0.5 * (dot(v, v) - 1.0);
-        Some(())
-    }
-
     /// A unit null vector of `J` at a located fold `u` at μ (ν as set), by
     /// two steps of inverse iteration.
     fn null_vector(&mut self, u: &[f64], mu: f64) -> Result<Vec<f64>, HbError> {
         self.cycle.jacobian(u, mu, &mut self.jac);
         unit_null_vector(&self.jac, self.m1).ok_or(HbError::SingularStart { lambda: mu })
     }
+}
+
+impl<P: PeriodicProblem, F: Fn(f64) -> Member<P>> CurveSystem for CycleFoldSystem<'_, '_, F> {
+    type Point = CycleFoldPoint;
+
+    /// `[R; b₁; J v; (vᵀv − 1)/2]` at `x = [u, v, μ, ν]`; `None` if the
+    /// sizes disagree.
+    fn try_residual(&mut self, x: &[f64], r: &mut [f64]) -> Option<()> {
+        let (u, v, mu, nu) = split_fold_vector(x, self.m1)?;
+        let (r_cycle, r_null, r_norm) = split_fold_residual(r, self.m1)?;
+        self.nu.set(nu);
+        self.cycle.residual(u, mu, r_cycle);
+        self.cycle.jacobian(u, mu, &mut self.jac);
+        null_rows(&self.jac, v, r_null, r_norm);
+        Some(())
+    }
 
     /// The fold at `x = [u, v, μ, ν]` (`None` if `x` is short).
     fn point(&self, x: &[f64]) -> Option<CycleFoldPoint> {
-        let (u, rest) = x.split_at_checked(self.m1)?;
-        let (v, &[mu, nu]) = rest.split_at_checked(self.m1)? else {
-            return None;
-        };
+        let (u, v, mu, nu) = split_fold_vector(x, self.m1)?;
         let (&omega, q) = u.split_last()?;
         let fold = FoldPoint {
             omega,
@@ -221,13 +182,5 @@ impl<'f, 'c, P: PeriodicProblem, F: Fn(f64) -> Member<P>> CycleFoldSystem<'f, 'c
             null_vector: v.to_vec(),
         };
         Some(CycleFoldPoint { mu, fold })
-    }
-}
-
-impl<P: PeriodicProblem, F: Fn(f64) -> Member<P>> CurveSystem for CycleFoldSystem<'_, '_, F> {
-    fn residual(&mut self, x: &[f64], r: &mut [f64]) {
-        if self.try_residual(x, r).is_none() {
-            r.fill(f64::NAN);
-        }
     }
 }

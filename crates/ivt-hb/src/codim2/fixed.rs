@@ -7,14 +7,47 @@
 //! Jacobian from the linear interpolation of the two path points that
 //! bracket the value.
 
+use crate::continuation::PathPoint;
 use ivt_num::{NewtonOptions, NewtonSystem, NewtonWorkspace};
 
 /// The extended system of a curve: `n − 1` equations in the path vector `x`
 /// of `n` entries (`p` last).
 pub(crate) trait CurveSystem {
-    /// The residual at `x` into `r` (`n − 1` entries); NaN where it cannot
-    /// be evaluated (the family fails at that `p`).
-    fn residual(&mut self, x: &[f64], r: &mut [f64]);
+    /// What a point of the curve reports.
+    type Point;
+
+    /// The residual at `x` into `r` (`n − 1` entries); `None` where it
+    /// cannot be evaluated (sizes disagree or the family fails at that `p`).
+    fn try_residual(&mut self, x: &[f64], r: &mut [f64]) -> Option<()>;
+
+    /// The curve's point at the path vector `x` (`None` if `x` is short).
+    fn point(&self, x: &[f64]) -> Option<Self::Point>;
+
+    /// [`Self::try_residual`], NaN where it cannot be evaluated (a failed
+    /// step to the path).
+    fn residual(&mut self, x: &[f64], r: &mut [f64]) {
+        if self.try_residual(x, r).is_none() {
+            r.fill(f64::NAN);
+        }
+    }
+}
+
+/// The point of `sys` at each crossing of component `index` of `path` with
+/// a value of `values` ([`super::crossings`]), solved there by
+/// [`solve_fixed`]; crossings whose solve fails are left out.
+pub(crate) fn solve_crossings<S: CurveSystem>(
+    sys: &mut S,
+    path: &[PathPoint],
+    values: &[f64],
+    index: usize,
+    scale: f64,
+) -> Vec<S::Point> {
+    super::crossings(path, values, index)
+        .filter_map(|(a, b, v)| {
+            let x = solve_fixed(sys, (a, b), index, v, scale)?;
+            sys.point(&x)
+        })
+        .collect()
 }
 
 /// The point of `sys` with `x[index] = value`, from the path points `a` and

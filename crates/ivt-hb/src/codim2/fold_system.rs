@@ -11,6 +11,7 @@ use crate::events::extended::unit_null_vector;
 use crate::galerkin::GalerkinJacobian;
 use crate::ihb::{HbOptions, HbResidual};
 use crate::problem::PeriodicProblem;
+use ivt_num::vector::{dot, matvec};
 
 /// The fold system of one family, with the residual planned at the last `p`.
 pub(super) struct FoldSystem<'f, F> {
@@ -51,27 +52,6 @@ impl<'f, P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> FoldSystem<'f, F>
         Some(problem)
     }
 
-    /// `[R; Φ_q v; (vᵀv − 1)/2]` at `x = [q, v, ω, p]`; `None` if the sizes
-    /// disagree or `p` cannot be planned.
-    fn try_residual(&mut self, x: &[f64], r: &mut [f64]) -> Option<()> {
-        let m = self.m;
-        let (q, rest) = x.split_at_checked(m)?;
-        let (v, &[omega, p]) = rest.split_at_checked(m)? else {
-            return None;
-        };
-        let (r_orbit, rest) = r.split_at_mut_checked(m)?;
-        let (r_null, [r_norm]) = rest.split_at_mut_checked(m)? else {
-            return None;
-        };
-        let problem = self.plan(p)?;
-        self.res.eval(&problem, q, omega, 1.0, r_orbit);
-        self.galerkin
-            .assemble(&mut self.res, &problem, q, omega, 1.0, &mut self.jac);
-        ivt_num::vector::matvec(&self.jac, m, m, v, r_null);
-        *r_norm = 0.5 * (ivt_num::vector::dot(v, v) - 1.0);
-        Some(())
-    }
-
     /// A unit null vector of `Φ_q` at a located fold, by two steps of inverse
     /// iteration.
     pub(super) fn null_vector(
@@ -87,14 +67,28 @@ impl<'f, P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> FoldSystem<'f, F>
             .assemble(&mut self.res, &problem, q, omega, 1.0, &mut self.jac);
         unit_null_vector(&self.jac, self.m).ok_or(HbError::SingularStart { lambda: p })
     }
+}
+
+impl<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> CurveSystem for FoldSystem<'_, F> {
+    type Point = FoldPoint;
+
+    /// `[R; Φ_q v; (vᵀv − 1)/2]` at `x = [q, v, ω, p]`; `None` if the sizes
+    /// disagree or `p` cannot be planned.
+    fn try_residual(&mut self, x: &[f64], r: &mut [f64]) -> Option<()> {
+        let m = self.m;
+        let (q, v, omega, p) = split_fold_vector(x, m)?;
+        let (r_orbit, r_null, r_norm) = split_fold_residual(r, m)?;
+        let problem = self.plan(p)?;
+        self.res.eval(&problem, q, omega, 1.0, r_orbit);
+        self.galerkin
+            .assemble(&mut self.res, &problem, q, omega, 1.0, &mut self.jac);
+        null_rows(&self.jac, v, r_null, r_norm);
+        Some(())
+    }
 
     /// The fold at `x = [q, v, ω, p]` (`None` if `x` is short).
-    pub(super) fn point(&self, x: &[f64]) -> Option<FoldPoint> {
-        let m = self.m;
-        let (q, rest) = x.split_at_checked(m)?;
-        let (v, &[omega, p]) = rest.split_at_checked(m)? else {
-            return None;
-        };
+    fn point(&self, x: &[f64]) -> Option<FoldPoint> {
+        let (q, v, omega, p) = split_fold_vector(x, self.m)?;
         Some(FoldPoint {
             omega,
             p,
@@ -104,10 +98,33 @@ impl<'f, P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> FoldSystem<'f, F>
     }
 }
 
-impl<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> CurveSystem for FoldSystem<'_, F> {
-    fn residual(&mut self, x: &[f64], r: &mut [f64]) {
-        if self.try_residual(x, r).is_none() {
-            r.fill(f64::NAN);
-        }
-    }
+/// The parts `(u, v, a, b)` of the path vector `x = [u, v, a, b]` of a fold
+/// system, `u` and its null vector `v` of `m` entries each; `None` if the
+/// sizes disagree.
+pub(super) fn split_fold_vector(x: &[f64], m: usize) -> Option<(&[f64], &[f64], f64, f64)> {
+    let (u, rest) = x.split_at_checked(m)?;
+    let (v, &[a, b]) = rest.split_at_checked(m)? else {
+        return None;
+    };
+    Some((u, v, a, b))
+}
+
+/// The rows `(r_u, r_null, r_norm)` of the residual `[R; J v; (vᵀv − 1)/2]`
+/// of a fold system with `m` unknowns in `u`; `None` if the sizes disagree.
+pub(super) fn split_fold_residual(
+    r: &mut [f64],
+    m: usize,
+) -> Option<(&mut [f64], &mut [f64], &mut f64)> {
+    let (r_u, rest) = r.split_at_mut_checked(m)?;
+    let (r_null, [r_norm]) = rest.split_at_mut_checked(m)? else {
+        return None;
+    };
+    Some((r_u, r_null, r_norm))
+}
+
+/// The null-vector rows of a fold system: `J v` (`J` row-major, square in
+/// the size of `v`) into `r_null` and the norm `(vᵀv − 1)/2`.
+pub(super) fn null_rows(jac: &[f64], v: &[f64], r_null: &mut [f64], r_norm: &mut f64) {
+    matvec(jac, v.len(), v.len(), v, r_null);
+    *r_norm = 0.5 * (dot(v, v) - 1.0);
 }

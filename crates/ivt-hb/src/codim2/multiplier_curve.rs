@@ -34,8 +34,8 @@
 //! on the curve, the end is extrapolated from the points at θ_e ± h and
 //! θ_e ± 2h.
 
-use super::fixed::{solve_fixed, CurveSystem};
-use super::{crossings, path_interval};
+use super::fixed::{solve_crossings, CurveSystem};
+use super::{bounded, path_interval};
 use crate::continuation::{follow_residual, ContinuationOptions, PathPoint, Termination};
 use crate::error::HbError;
 use crate::events::extended::null_vector;
@@ -139,9 +139,7 @@ pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
         )));
     }
     let x0 = sys.start_vector(&start.coeffs, start.omega, p_start)?;
-    let mut copts = opts.clone();
-    copts.lambda_min = lo;
-    copts.lambda_max = hi;
+    let copts = bounded(opts, (lo, hi));
     let towards_from = if p_from < p_start { -1.0 } else { 1.0 };
     let theta_index = m + 1;
     // A Neimark–Sacker path through θ = 0 or π (1:1, 1:2) continues on the
@@ -170,13 +168,8 @@ pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
     };
     let scale = norm2(&start.coeffs);
     let p_index = x0.len() - 1;
-    let mut solve = |path: &[PathPoint], index: usize, values: &[f64]| -> Vec<CurvePoint> {
-        crossings(path, values, index)
-            .filter_map(|(a, b, v)| {
-                let x = solve_fixed(&mut sys, (a, b), index, v, scale)?;
-                sys.point(&x)
-            })
-            .collect()
+    let mut solve = |path: &[PathPoint], index: usize, values: &[f64]| {
+        solve_crossings(&mut sys, path, values, index, scale)
     };
     let located = solve(&path, p_index, at);
     let mut resonances = Vec::new();
@@ -368,6 +361,10 @@ impl<'f, P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> MultiplierSystem<
         x.push(p);
         Ok(x)
     }
+}
+
+impl<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> CurveSystem for MultiplierSystem<'_, F> {
+    type Point = CurvePoint;
 
     /// The residual (module docs) at the path vector `x`; `None` if the
     /// sizes disagree or `p` cannot be planned.
@@ -421,14 +418,6 @@ impl<'f, P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> MultiplierSystem<
             coeffs: q.to_vec(),
             angle,
         })
-    }
-}
-
-impl<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> CurveSystem for MultiplierSystem<'_, F> {
-    fn residual(&mut self, x: &[f64], r: &mut [f64]) {
-        if self.try_residual(x, r).is_none() {
-            r.fill(f64::NAN);
-        }
     }
 }
 
