@@ -230,6 +230,15 @@ fn add_at(out: &mut [f64], i: usize, v: f64) {
     }
 }
 
+/// What [`ElementProblem::at_samples`] evaluates.
+#[derive(Clone, Copy)]
+enum Quantity {
+    /// The forces `g`.
+    Force,
+    /// The Jacobian blocks `[∂g/∂x | ∂g/∂v]`.
+    Tangent,
+}
+
 impl ElementProblem {
     /// Adds the forces of the elements for which `pick(law)` holds at one
     /// sample into `out` (zeroed first).
@@ -326,6 +335,25 @@ impl ElementProblem {
         }
     }
 
+    /// The forces (`n` per sample) or the Jacobian blocks (`2n²` per sample)
+    /// of all elements at all samples into `out`: the memoryless laws sample
+    /// by sample, the hysteretic ones over each period
+    /// ([`Self::add_hysteretic`]).
+    fn at_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64], what: Quantity) {
+        let hysteresis = self.has_hysteresis();
+        let memoryless = |law: Law| !(hysteresis && law.hysteretic());
+        per_sample(self.n, x, v, theta, out, |x, v, _, o| match what {
+            Quantity::Force => self.forces(x, v, o, memoryless),
+            Quantity::Tangent => self.tangents(x, v, o, memoryless),
+        });
+        if hysteresis {
+            match what {
+                Quantity::Force => self.add_hysteretic(x, theta, Some(out), None),
+                Quantity::Tangent => self.add_hysteretic(x, theta, None, Some(out)),
+            }
+        }
+    }
+
     /// Whether any element is hysteretic.
     fn has_hysteresis(&self) -> bool {
         self.elements.iter().any(|e| e.law.hysteretic())
@@ -338,15 +366,7 @@ impl PeriodicProblem for ElementProblem {
         self.forces(x, v, out, |_| true);
     }
     fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
-        if !self.has_hysteresis() {
-            return per_sample(self.n, x, v, theta, out, |x, v, _, o| {
-                self.forces(x, v, o, |_| true)
-            });
-        }
-        per_sample(self.n, x, v, theta, out, |x, v, _, o| {
-            self.forces(x, v, o, |law| !law.hysteretic())
-        });
-        self.add_hysteretic(x, theta, Some(out), None);
+        self.at_samples(x, v, theta, out, Quantity::Force);
     }
     fn excitation(&self, theta: f64, out: &mut [f64]) {
         out.fill(0.0);
@@ -361,15 +381,7 @@ impl PeriodicProblem for ElementProblem {
         self.tangents(x, v, dg, |_| true);
     }
     fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
-        if !self.has_hysteresis() {
-            return per_sample(self.n, x, v, theta, dg, |x, v, _, d| {
-                self.tangents(x, v, d, |_| true)
-            });
-        }
-        per_sample(self.n, x, v, theta, dg, |x, v, _, d| {
-            self.tangents(x, v, d, |law| !law.hysteretic())
-        });
-        self.add_hysteretic(x, theta, None, Some(dg));
+        self.at_samples(x, v, theta, dg, Quantity::Tangent);
     }
 }
 

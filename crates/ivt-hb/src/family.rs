@@ -274,6 +274,24 @@ mod tests {
             .collect()
     }
 
+    /// `∂R/∂λ` of `branch` at `(q, λ)` (the path's step) against
+    /// [`central`] with `h` = 1e-4: the column, max |Δ| and max |difference|.
+    fn against_central<F: Family>(
+        branch: &mut FamilyBranch<F>,
+        q: &[f64],
+        lambda: f64,
+    ) -> (Vec<f64>, f64, f64) {
+        let mut exact = vec![0.0; q.len()];
+        Branch::residual_lambda(branch, q, lambda, path_lambda_step(lambda), &mut exact);
+        let fd = central(branch, q, lambda, 1e-4);
+        let scale = fd.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let err = exact
+            .iter()
+            .zip(&fd)
+            .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+        (exact, err, scale)
+    }
+
     #[test]
     fn frequency_family_derivative_is_the_linear_parts_exactly() {
         // Duffing at ω_f = 1.3 (p = 1) and with p = 3 (the derivative carries
@@ -286,14 +304,7 @@ mod tests {
             let mut branch = FamilyBranch::new(Frequency(&duffing), &hb, 1.3).unwrap();
             let m = branch.len();
             let q: Vec<f64> = (0..m).map(|i| 0.3 / (1.0 + i as f64)).collect();
-            let mut exact = vec![0.0; m];
-            Branch::residual_lambda(&mut branch, &q, 1.3, path_lambda_step(1.3), &mut exact);
-            let fd = central(&mut branch, &q, 1.3, 1e-4);
-            let scale = fd.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            let err = exact
-                .iter()
-                .zip(&fd)
-                .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+            let (exact, err, scale) = against_central(&mut branch, &q, 1.3);
             assert!(err <= 1e-8 * scale, "p = {p}: {err:e} of {scale:e}");
             // The fold system's λ entries take the same path: the residual's
             // column, and ∂(wᵀJv)/∂λ against the difference of the whole form.
@@ -323,15 +334,8 @@ mod tests {
         .unwrap();
         let m = branch.len();
         let q: Vec<f64> = (0..m).map(|i| 0.3 / (1.0 + i as f64)).collect();
-        let mut d = vec![0.0; m];
-        Branch::residual_lambda(&mut branch, &q, 4.0, path_lambda_step(4.0), &mut d);
-        let fd = central(&mut branch, &q, 4.0, 1e-4);
-        let scale = fd.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let (_, err, scale) = against_central(&mut branch, &q, 4.0);
         assert!(scale > 0.0);
-        let err = d
-            .iter()
-            .zip(&fd)
-            .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
         assert!(err <= 1e-6 * scale, "{err:e} of {scale:e}");
     }
 }

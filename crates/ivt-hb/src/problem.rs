@@ -48,6 +48,35 @@ macro_rules! matrix_getters {
 }
 pub(crate) use matrix_getters;
 
+/// `n_dof`, `mass`, `damping`, `stiffness` and `velocity_dependent` of a
+/// problem that wraps another, read from the inner problem `$inner` (`$s`
+/// stands for `self`).
+macro_rules! forward_matrices {
+    (|$s:ident| $inner:expr) => {
+        fn n_dof(&self) -> usize {
+            let $s = self;
+            $inner.n_dof()
+        }
+        fn mass(&self) -> &[f64] {
+            let $s = self;
+            $inner.mass()
+        }
+        fn damping(&self) -> &[f64] {
+            let $s = self;
+            $inner.damping()
+        }
+        fn stiffness(&self) -> &[f64] {
+            let $s = self;
+            $inner.stiffness()
+        }
+        fn velocity_dependent(&self) -> bool {
+            let $s = self;
+            $inner.velocity_dependent()
+        }
+    };
+}
+use forward_matrices;
+
 /// `velocity_dependent() = false` and a `nonlinear_jacobian` that writes `∂g/∂x`
 /// by `$body` (`$s` stands for `self`) and zeroes `∂g/∂v`: the trait items of a
 /// force that depends on displacement and phase only.
@@ -362,18 +391,7 @@ fn orbit_scale(u: &[f64], n: usize, j: usize) -> f64 {
 /// A borrowed problem is a problem (lets solvers borrow problems that are not
 /// `Clone`, e.g. [`GeneralProblem`] with closures).
 impl<P: PeriodicProblem + ?Sized> PeriodicProblem for &P {
-    fn n_dof(&self) -> usize {
-        (**self).n_dof()
-    }
-    fn mass(&self) -> &[f64] {
-        (**self).mass()
-    }
-    fn damping(&self) -> &[f64] {
-        (**self).damping()
-    }
-    fn stiffness(&self) -> &[f64] {
-        (**self).stiffness()
-    }
+    forward_matrices!(|s| (**s));
     fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
         (**self).nonlinear(x, v, theta, out)
     }
@@ -382,9 +400,6 @@ impl<P: PeriodicProblem + ?Sized> PeriodicProblem for &P {
     }
     fn excitation(&self, theta: f64, out: &mut [f64]) {
         (**self).excitation(theta, out)
-    }
-    fn velocity_dependent(&self) -> bool {
-        (**self).velocity_dependent()
     }
     fn nonlinear_jacobian(&self, x: &[f64], v: &[f64], theta: f64, dg: &mut [f64]) {
         (**self).nonlinear_jacobian(x, v, theta, dg)

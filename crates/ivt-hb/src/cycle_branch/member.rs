@@ -20,6 +20,14 @@ impl<P: PeriodicProblem> Member<P> {
         };
         Self { problem, n, nan }
     }
+
+    /// `eval(problem, out)` at the member, or NaN where the family failed.
+    fn or_nan(&self, out: &mut [f64], eval: impl FnOnce(&P, &mut [f64])) {
+        match &self.problem {
+            Some(p) => eval(p, out),
+            None => out.fill(f64::NAN),
+        }
+    }
 }
 
 impl<P: PeriodicProblem> PeriodicProblem for Member<P> {
@@ -36,36 +44,21 @@ impl<P: PeriodicProblem> PeriodicProblem for Member<P> {
         self.problem.as_ref().map_or(&self.nan, P::stiffness)
     }
     fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
-        match &self.problem {
-            Some(p) => p.nonlinear(x, v, theta, out),
-            None => out.fill(f64::NAN),
-        }
+        self.or_nan(out, |p, out| p.nonlinear(x, v, theta, out))
     }
     fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
-        match &self.problem {
-            Some(p) => p.nonlinear_samples(x, v, theta, out),
-            None => out.fill(f64::NAN),
-        }
+        self.or_nan(out, |p, out| p.nonlinear_samples(x, v, theta, out))
     }
     fn excitation(&self, theta: f64, out: &mut [f64]) {
-        match &self.problem {
-            Some(p) => p.excitation(theta, out),
-            None => out.fill(f64::NAN),
-        }
+        self.or_nan(out, |p, out| p.excitation(theta, out))
     }
     fn velocity_dependent(&self) -> bool {
         self.problem.as_ref().is_none_or(P::velocity_dependent)
     }
     fn nonlinear_jacobian(&self, x: &[f64], v: &[f64], theta: f64, dg: &mut [f64]) {
-        match &self.problem {
-            Some(p) => p.nonlinear_jacobian(x, v, theta, dg),
-            None => dg.fill(f64::NAN),
-        }
+        self.or_nan(dg, |p, dg| p.nonlinear_jacobian(x, v, theta, dg))
     }
     fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
-        match &self.problem {
-            Some(p) => p.nonlinear_jacobian_samples(x, v, theta, dg),
-            None => dg.fill(f64::NAN),
-        }
+        self.or_nan(dg, |p, dg| p.nonlinear_jacobian_samples(x, v, theta, dg))
     }
 }

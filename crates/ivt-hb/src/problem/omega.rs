@@ -17,7 +17,7 @@
 //! ω_f-derivative `∂R/∂ω_f` includes the ω-dependence of `g` and `f`, and the
 //! force scale of the tolerance is that of `f(·, ω_r)`.
 
-use super::PeriodicProblem;
+use super::{forward_matrices, PeriodicProblem};
 
 /// ω_r of [`AtFrequency`]: the frequency whose excitation `f(θ, ω_r)` is
 /// projected once (the rest of `f(θ, ω_f)` enters with `g`).
@@ -64,18 +64,7 @@ impl<'a, P: PeriodicProblem + ?Sized> AtFrequency<'a, P> {
 }
 
 impl<P: PeriodicProblem + ?Sized> PeriodicProblem for AtFrequency<'_, P> {
-    fn n_dof(&self) -> usize {
-        self.problem.n_dof()
-    }
-    fn mass(&self) -> &[f64] {
-        self.problem.mass()
-    }
-    fn damping(&self) -> &[f64] {
-        self.problem.damping()
-    }
-    fn stiffness(&self) -> &[f64] {
-        self.problem.stiffness()
-    }
+    forward_matrices!(|s| s.problem);
     fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
         if self.dependent {
             self.nonlinear_samples(x, v, &[theta], out)
@@ -98,9 +87,6 @@ impl<P: PeriodicProblem + ?Sized> PeriodicProblem for AtFrequency<'_, P> {
         } else {
             self.problem.excitation(theta, out)
         }
-    }
-    fn velocity_dependent(&self) -> bool {
-        self.problem.velocity_dependent()
     }
     /// The moved excitation does not depend on `x`, `v`: `∂g̃ = ∂g(·, ω_f)`.
     fn nonlinear_jacobian(&self, x: &[f64], v: &[f64], theta: f64, dg: &mut [f64]) {

@@ -85,40 +85,40 @@ impl ModalString {
     /// (harmonic-major, [`super::StringHb::index`], constant term without the ½).
     /// NaN if `a` does not hold `modes·(2·harmonics + 1)` values.
     pub fn engine_coeffs(&self, a: &[f64]) -> Vec<f64> {
-        let (n, m) = (self.params.modes, self.params.harmonics);
-        let l = 2 * m + 1;
-        let mut q = vec![f64::NAN; n * l];
-        if n == 0 || a.len() != n * l {
-            return q;
-        }
-        // Row h of `a` holds harmonic row h of every mode.
-        for (h, row) in a.chunks_exact(n).enumerate() {
-            let (slot, scale) = engine_slot(h, m);
-            for (qd, &x) in q.chunks_exact_mut(l).zip(row) {
-                if let Some(y) = qd.get_mut(slot) {
-                    *y = scale * x;
-                }
-            }
-        }
-        q
+        self.convert(a, true)
     }
 
     /// Inverse of [`Self::engine_coeffs`] (NaN if `q` does not hold
     /// `modes·(2·harmonics + 1)` values).
     pub fn sthb_coeffs(&self, q: &[f64]) -> Vec<f64> {
+        self.convert(q, false)
+    }
+
+    /// [`Self::engine_coeffs`] of `from` (`to_engine`) or its inverse: entry
+    /// `(h, d)` of the harmonic-major STHB layout (row `h` holds harmonic row
+    /// `h` of every mode `d`) is slot [`engine_slot`] of DOF block `d`.
+    fn convert(&self, from: &[f64], to_engine: bool) -> Vec<f64> {
         let (n, m) = (self.params.modes, self.params.harmonics);
         let l = 2 * m + 1;
-        let mut a = vec![f64::NAN; n * l];
-        if n == 0 || q.len() != n * l {
-            return a;
+        let mut to = vec![f64::NAN; n * l];
+        if n == 0 || from.len() != n * l {
+            return to;
         }
-        for (h, row) in a.chunks_exact_mut(n).enumerate() {
+        for h in 0..l {
             let (slot, scale) = engine_slot(h, m);
-            for (x, qd) in row.iter_mut().zip(q.chunks_exact(l)) {
-                *x = qd.get(slot).map_or(f64::NAN, |y| y / scale);
+            for d in 0..n {
+                let (sthb, engine) = (h * n + d, d * l + slot);
+                let (src, dst) = if to_engine {
+                    (sthb, engine)
+                } else {
+                    (engine, sthb)
+                };
+                if let (Some(&x), Some(y)) = (from.get(src), to.get_mut(dst)) {
+                    *y = if to_engine { scale * x } else { x / scale };
+                }
             }
         }
-        a
+        to
     }
 
     /// `ℒ(q)` into `out` (NaN if `q` or `out` is not `N` long).
