@@ -2,7 +2,7 @@
 //! (§3.2.5, Eq. 81–85): β at the first three period doublings, each where a
 //! Floquet multiplier crosses −1 along the branch in β.
 
-use super::{finite, pairs};
+use super::{all_finite, pairs, positive};
 use crate::error::HbError;
 use crate::mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 use serde::Serialize;
@@ -44,16 +44,12 @@ impl CascadeRequest {
     /// # Errors
     /// [`HbError::InvalidInput`] for a non-finite parameter or Ω ≤ 0.
     pub fn validate(&self) -> Result<(), HbError> {
-        finite("xi", self.xi)?;
-        finite("alpha", self.alpha)?;
-        finite("gamma", self.gamma)?;
-        if !(self.omega.is_finite() && self.omega > 0.0) {
-            return Err(HbError::InvalidInput(format!(
-                "`omega` = {} must be finite and > 0",
-                self.omega
-            )));
-        }
-        Ok(())
+        all_finite(&[
+            ("xi", self.xi),
+            ("alpha", self.alpha),
+            ("gamma", self.gamma),
+        ])?;
+        positive("omega", self.omega).map(|_| ())
     }
 }
 

@@ -3,7 +3,7 @@
 //! point's first Lyapunov coefficient, the cycle branch by HB with ω unknown
 //! and Eq. 68–77, Floquet stability (Hsu) and its folds located).
 
-use super::{finite, pairs, stability_steps, Array};
+use super::{all_finite, pairs, stability_steps, Array};
 use crate::autonomous::LimitCycle;
 use crate::continuation::{ContinuationOptions, Termination};
 use crate::cycle_branch::{cycle_branch as trace_cycles, CycleBranchOptions};
@@ -59,15 +59,13 @@ impl CycleBranchRequest {
     /// [`HbError::InvalidInput`] for a non-finite number or equal ends (the
     /// grid, the steps and the offset are checked by [`crate::cycle_branch()`]).
     pub fn validate(&self) -> Result<(), HbError> {
-        for (name, v) in [
+        all_finite(&[
             ("p_from", self.p_from),
             ("p_to", self.p_to),
             ("ds", self.ds),
             ("ds_max", self.ds_max),
             ("offset", self.offset),
-        ] {
-            finite(name, v)?;
-        }
+        ])?;
         if self.p_from == self.p_to {
             return Err(HbError::InvalidInput(
                 "`p_from` and `p_to` must differ".into(),

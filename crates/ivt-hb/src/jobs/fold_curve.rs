@@ -8,7 +8,7 @@
 //! given point, or the point of that kind of largest ω_f located on the FRC
 //! of `family(p_start)` over an interval.
 
-use super::{finite, Array, FrcRequest};
+use super::{all_finite, finite, Array, FrcRequest};
 use crate::codim2::{bifurcation_curve, CurvePoint, CurveStart};
 use crate::continuation::{ContinuationOptions, Corrector, Termination};
 use crate::error::HbError;
@@ -109,15 +109,13 @@ impl FoldCurveRequest {
                 finite("to", *to)?;
             }
         }
-        for (name, v) in [
+        all_finite(&[
             ("p_start", self.p_start),
             ("p_from", self.p_from),
             ("p_to", self.p_to),
             ("ds", self.ds),
             ("ds_max", self.ds_max),
-        ] {
-            finite(name, v)?;
-        }
+        ])?;
         if let Some(p) = self.at.iter().find(|p| !p.is_finite()) {
             return Err(HbError::InvalidInput(format!("`at` = {p} must be finite")));
         }

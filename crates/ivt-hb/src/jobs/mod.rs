@@ -88,6 +88,25 @@ pub(crate) fn finite(name: &str, v: f64) -> Result<f64, HbError> {
     }
 }
 
+/// `v` if it is finite and positive; otherwise `Err(InvalidInput)` naming
+/// `name`.
+pub(crate) fn positive(name: &str, v: f64) -> Result<f64, HbError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(HbError::InvalidInput(format!(
+            "`{name}` = {v} must be finite and > 0"
+        )))
+    }
+}
+
+/// [`finite`] of each named value, the first failure returned.
+pub(crate) fn all_finite(values: &[(&str, f64)]) -> Result<(), HbError> {
+    values
+        .iter()
+        .try_for_each(|&(name, v)| finite(name, v).map(|_| ()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -4,7 +4,7 @@
 //! multipliers by Hsu's method (Eq. 78) over [`super::stability_steps`]
 //! Magnus-4 steps.
 
-use super::{finite_pairs, stability_steps, Array};
+use super::{finite_pairs, positive, stability_steps, Array};
 use crate::error::HbError;
 use crate::floquet::HsuRule;
 use crate::ihb::{HbOptions, HbSolution, HbSolver};
@@ -68,13 +68,7 @@ impl OrbitRequest {
     /// # Errors
     /// [`HbError::InvalidInput`] for a non-finite or non-positive ω_f.
     pub fn validate(&self) -> Result<(), HbError> {
-        if !(self.omega_f.is_finite() && self.omega_f > 0.0) {
-            return Err(HbError::InvalidInput(format!(
-                "`omega_f` = {} must be finite and > 0",
-                self.omega_f
-            )));
-        }
-        Ok(())
+        positive("omega_f", self.omega_f).map(|_| ())
     }
 }
 
