@@ -12,7 +12,7 @@ use ivt_hb::{
 };
 
 mod common;
-use common::shooting::{central_jacobian, flow, newton3, newton_step};
+use common::shooting::{central_jacobian, flow, newton3, newton_step, turning_state};
 
 /// The family as `M = 1`, `C = −μ`, `K = 1`, `g = −(x² − x⁴)ẋ`.
 fn family(mu: f64) -> Result<impl PeriodicProblem, HbError> {
@@ -56,14 +56,6 @@ fn cycle_by_shooting(mu: f64, mut u: [f64; 2]) -> [f64; 2] {
 fn multiplier(mu: f64, x0: f64, period: f64) -> f64 {
     let j = central_jacobian(|y| flow_at(mu, y, period), [x0, 0.0], [1e-6; 2]);
     j[0][0] * j[1][1] - j[0][1] * j[1][0]
-}
-
-/// `(x₀, 0)` of an HB orbit: its maximum of x over τ, found on the samples
-/// and polished (the phase of `x₀` is free).
-fn turning_state(coeffs: &[f64]) -> f64 {
-    (0..20000)
-        .map(|i| ivt_hb::aft::eval_series(coeffs, std::f64::consts::TAU * i as f64 / 20000.0, 0))
-        .fold(f64::MIN, f64::max)
 }
 
 #[test]

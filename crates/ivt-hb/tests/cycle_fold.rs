@@ -9,12 +9,10 @@
 #![allow(clippy::indexing_slicing)]
 
 use ivt_hb::codim2::cycle_fold_curve;
-use ivt_hb::{
-    cycle_branch, ContinuationOptions, GeneralProblem, HbError, HbOptions, PeriodicProblem,
-};
+use ivt_hb::{cycle_branch, GeneralProblem, HbError, HbOptions, PeriodicProblem};
 
 mod common;
-use common::shooting::{central_jacobian, flow, newton3};
+use common::shooting::{central_jacobian, flow, newton3, turning_state};
 
 /// The family as `M = 1`, `C = −μ`, `K = 1`, `g = −(νx² − x⁴)ẋ`.
 fn family(mu: f64, nu: f64) -> Result<impl PeriodicProblem, HbError> {
@@ -49,25 +47,13 @@ fn fold_by_shooting(nu: f64, guess: [f64; 3]) -> [f64; 3] {
     )
 }
 
-/// The maximum of x over the HB orbit (the turning state `(x₀, 0)`).
-fn turning_state(coeffs: &[f64]) -> f64 {
-    (0..20000)
-        .map(|i| ivt_hb::aft::eval_series(coeffs, std::f64::consts::TAU * i as f64 / 20000.0, 0))
-        .fold(f64::MIN, f64::max)
-}
-
 #[test]
 fn cycle_fold_curve_matches_shooting_in_nu() {
     let hb = HbOptions::new(25, 128);
     let branch = cycle_branch(|mu| family(mu, 1.0), &hb, -0.2, 0.1, &Default::default()).unwrap();
     assert_eq!(branch.folds.len(), 1);
     let (mu0, start) = &branch.folds[0];
-    let opts = ContinuationOptions {
-        ds: 0.02,
-        ds_max: 0.05,
-        max_points: 2000,
-        ..ContinuationOptions::default()
-    };
+    let opts = common::curve_steps(2000);
     let down = cycle_fold_curve(
         family,
         &hb,

@@ -5,12 +5,13 @@
 //! the cusp is the extremum of F along the curve of such points.
 
 use ivt_hb::{
-    fold_curve, frequency_response, ContinuationOptions, Duffing, FrcOptions, HbError, HbOptions,
-    Termination,
+    fold_curve, frequency_response, Duffing, FrcOptions, HbError, HbOptions, Termination,
 };
 
 mod common;
-use common::shooting::{newton3, orbit_state as state, period_map, period_map_jacobian};
+use common::shooting::{
+    assert_omega_matches_shooting, newton3, orbit_state as state, period_map, period_map_jacobian,
+};
 
 /// `[P(y) − y, det(∂P/∂y − I)]` (∂P/∂y by central differences).
 fn fold_residual(force: f64, omega: f64, y: [f64; 2]) -> [f64; 3] {
@@ -43,12 +44,7 @@ fn duffing_fold_curve_through_the_cusp_matches_shooting() {
         .iter()
         .max_by(|a, b| a.omega_f.total_cmp(&b.omega_f))
         .unwrap();
-    let opts = ContinuationOptions {
-        ds: 0.02,
-        ds_max: 0.05,
-        max_points: 2000,
-        ..ContinuationOptions::default()
-    };
+    let opts = common::curve_steps(2000);
     let curve = fold_curve(
         family,
         &hb,
@@ -77,20 +73,7 @@ fn duffing_fold_curve_through_the_cusp_matches_shooting() {
             |u| fold_residual(fp.p, u[2], [u[0], u[1]]),
             [y[0], y[1], fp.omega],
         );
-        eprintln!(
-            "F = {}: fold ω {:.10} (shooting {:.10}), |Δω| {:.1e}",
-            fp.p,
-            fp.omega,
-            u[2],
-            (fp.omega - u[2]).abs()
-        );
-        assert!(
-            (fp.omega - u[2]).abs() < 1e-7,
-            "F = {}: {} vs {}",
-            fp.p,
-            fp.omega,
-            u[2]
-        );
+        assert_omega_matches_shooting("fold", fp.p, fp.omega, u[2]);
     }
     // The cusp: F is extremal along the fold curve; by shooting, minimise F over
     // the curve parametrised by x(0) (golden section on [x_c ± 0.01]).

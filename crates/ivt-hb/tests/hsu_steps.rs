@@ -50,19 +50,27 @@ fn errors<P: PeriodicProblem>(problem: &P, frc: &Frc, harmonics: usize) -> (f64,
     (worst, steps)
 }
 
+/// [`errors`] of `frc` (20 harmonics), asserted: the worst multiplier error
+/// ≤ 2e-6, and off resonance 42 sub-intervals (2(n + 1)) are enough (at
+/// least 10 points); the steps.
+fn checked_steps<P: PeriodicProblem>(name: &str, problem: &P, frc: &Frc) -> Vec<usize> {
+    let (worst, steps) = errors(problem, frc, 20);
+    eprintln!("{name}: worst multiplier error {worst:.1e}, steps {steps:?}");
+    assert!(worst <= 2e-6);
+    assert!(
+        steps.iter().filter(|&&s| s == 42).count() >= 10,
+        "{steps:?}"
+    );
+    steps
+}
+
 #[test]
 fn every_point_meets_the_multiplier_tolerance_with_fewer_steps_off_resonance() {
     let duffing = Duffing::fig28();
     let frc =
         frequency_response(&duffing, &HbOptions::new(20, 64), &FrcOptions::default()).unwrap();
-    let (worst, steps) = errors(&duffing, &frc, 20);
-    eprintln!("Duffing: worst multiplier error {worst:.1e}, steps {steps:?}");
-    assert!(worst <= 2e-6);
-    // Off resonance 42 sub-intervals (2(n + 1)) are enough; at the peak more.
-    assert!(
-        steps.iter().filter(|&&s| s == 42).count() >= 10,
-        "{steps:?}"
-    );
+    let steps = checked_steps("Duffing", &duffing, &frc);
+    // At the peak more than 42.
     assert!(steps.iter().any(|&s| s >= 168), "{steps:?}");
 
     let chain = cubic_chain();
@@ -71,13 +79,7 @@ fn every_point_meets_the_multiplier_tolerance_with_fewer_steps_off_resonance() {
         ..FrcOptions::default()
     };
     let frc = frequency_response(&chain, &HbOptions::new(20, 84), &opts).unwrap();
-    let (worst, steps) = errors(&chain, &frc, 20);
-    eprintln!("chain: worst multiplier error {worst:.1e}");
-    assert!(worst <= 2e-6);
-    assert!(
-        steps.iter().filter(|&&s| s == 42).count() >= 10,
-        "{steps:?}"
-    );
+    checked_steps("chain", &chain, &frc);
 }
 
 #[test]

@@ -13,7 +13,9 @@ use ivt_hb::{
 };
 
 mod common;
-use common::shooting::{central_jacobian, flow, newton3, orbit_state};
+use common::shooting::{
+    assert_omega_matches_shooting, central_jacobian, flow, newton3, orbit_state,
+};
 
 /// The family in F.
 fn van_der_pol(force: f64) -> Result<impl PeriodicProblem, HbError> {
@@ -67,20 +69,7 @@ fn neimark_sacker_boundary_points_match_shooting() {
     for pt in &points {
         let y = orbit_state(&pt.coeffs, pt.omega);
         let u = newton3(|u| ns_residual(pt.p, u), [y[0], y[1], pt.omega]);
-        eprintln!(
-            "F = {}: NS ω {:.10} (shooting {:.10}), |Δω| {:.1e}",
-            pt.p,
-            pt.omega,
-            u[2],
-            (pt.omega - u[2]).abs()
-        );
-        assert!(
-            (pt.omega - u[2]).abs() < 1e-7,
-            "F = {}: {} vs {}",
-            pt.p,
-            pt.omega,
-            u[2]
-        );
+        assert_omega_matches_shooting("NS", pt.p, pt.omega, u[2]);
         assert!((pt.multipliers[0].norm() - 1.0).abs() < 1e-9 && pt.multipliers[0].im.abs() > 0.0);
     }
     // The point (0.94525643, 0.2) is on the boundary.

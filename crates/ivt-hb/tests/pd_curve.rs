@@ -6,8 +6,8 @@
 
 use ivt_hb::codim2::{bifurcation_curve, CurveStart};
 use ivt_hb::{
-    period_doubling_cascade, BifurcationKind, CascadeOptions, ContinuationOptions, HbError,
-    HbOptions, MathieuDuffing, Termination,
+    period_doubling_cascade, BifurcationKind, CascadeOptions, HbError, HbOptions, MathieuDuffing,
+    Termination,
 };
 
 mod common;
@@ -52,12 +52,7 @@ fn mathieu_duffing_period_doubling_curve_matches_shooting() {
     };
     let family =
         |beta: f64| -> Result<MathieuDuffing, HbError> { Ok(MathieuDuffing::thesis(beta)) };
-    let opts = ContinuationOptions {
-        ds: 0.02,
-        ds_max: 0.05,
-        max_points: 400,
-        ..ContinuationOptions::default()
-    };
+    let opts = common::curve_steps(400);
     let hb = HbOptions::new(n, 4 * n);
     let curve = bifurcation_curve(family, &hb, &start, 4.0, 6.0, &[4.5, 5.0, 5.5], &opts).unwrap();
     assert_eq!(curve.termination, Termination::LeftInterval);

@@ -79,6 +79,17 @@ pub fn max_distance(a: &[c64], b: &[c64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The path options of the two-parameter curves: steps `ds` = 0.02 up to
+/// `ds_max` = 0.05, at most `max_points` points.
+pub fn curve_steps(max_points: usize) -> ContinuationOptions {
+    ContinuationOptions {
+        ds: 0.02,
+        ds_max: 0.05,
+        max_points,
+        ..ContinuationOptions::default()
+    }
+}
+
 /// Backbone (or damped-mode) options from amplitude `from` to `to` in
 /// arclength steps `ds` up to `ds_max`, each point converged to ‖r‖₂ ≤ 1e-12
 /// in at most 25 iterations.

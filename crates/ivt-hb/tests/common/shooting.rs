@@ -136,6 +136,27 @@ pub fn orbit_state(coeffs: &[f64], omega: f64) -> [f64; 2] {
     ]
 }
 
+/// `x₀` of the turning state `(x₀, 0)` of an HB orbit: its maximum of x
+/// over τ on 20000 samples (the phase of an autonomous cycle is free).
+pub fn turning_state(coeffs: &[f64]) -> f64 {
+    (0..20000)
+        .map(|i| eval_series(coeffs, std::f64::consts::TAU * i as f64 / 20000.0, 0))
+        .fold(f64::MIN, f64::max)
+}
+
+/// Asserts that the HB frequency `omega` of a located `what` point at `F = p`
+/// is shooting's `shooting` within 1e-7 (both printed).
+pub fn assert_omega_matches_shooting(what: &str, p: f64, omega: f64, shooting: f64) {
+    eprintln!(
+        "F = {p}: {what} ω {omega:.10} (shooting {shooting:.10}), |Δω| {:.1e}",
+        (omega - shooting).abs()
+    );
+    assert!(
+        (omega - shooting).abs() < 1e-7,
+        "F = {p}: {omega} vs {shooting}"
+    );
+}
+
 /// `y(t_end)` of the planar system `y' = rhs(t, y)` from `y0` at t = 0 (RK4,
 /// `steps` steps).
 pub fn flow(
