@@ -4,9 +4,7 @@
 //! HB): a fold is a fixed point of the period map with det(∂P/∂y − I) = 0;
 //! the cusp is the extremum of F along the curve of such points.
 
-use ivt_hb::{
-    fold_curve, frequency_response, Duffing, FrcOptions, HbError, HbOptions, Termination,
-};
+use ivt_hb::{fold_curve, Duffing, HbError, HbOptions, Termination};
 
 mod common;
 use common::shooting::{
@@ -29,16 +27,7 @@ fn fold_residual(force: f64, omega: f64, y: [f64; 2]) -> [f64; 3] {
 fn duffing_fold_curve_through_the_cusp_matches_shooting() {
     let family = |f: f64| -> Result<Duffing, HbError> { Ok(Duffing::new(0.02, 1.0, 1.0, f)) };
     let hb = HbOptions::new(15, 64);
-    let frc = frequency_response(
-        &Duffing::new(0.02, 1.0, 1.0, 0.1),
-        &hb,
-        &FrcOptions {
-            from: 0.5,
-            to: 2.5,
-            ..FrcOptions::default()
-        },
-    )
-    .unwrap();
+    let frc = common::frc_between(&Duffing::new(0.02, 1.0, 1.0, 0.1), &hb, 0.5, 2.5);
     let start = frc
         .folds
         .iter()

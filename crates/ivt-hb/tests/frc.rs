@@ -118,16 +118,7 @@ fn duffing_folds_located_to_shooting_accuracy_in_both_directions() {
     let d = Duffing::fig28();
     let hb = HbOptions::new(20, 64);
     let up = frequency_response(&d, &hb, &FrcOptions::default()).unwrap();
-    let down = frequency_response(
-        &d,
-        &hb,
-        &FrcOptions {
-            from: 3.0,
-            to: 0.2,
-            ..FrcOptions::default()
-        },
-    )
-    .unwrap();
+    let down = common::frc_between(&d, &hb, 3.0, 0.2);
     assert_eq!(up.folds.len(), 2, "{:?}", up.folds);
     assert_eq!(down.folds.len(), 2, "{:?}", down.folds);
     let mut analyzer = StabilityAnalyzer::new(&d, 20, 4096).unwrap();

@@ -7,9 +7,11 @@
 #![allow(clippy::indexing_slicing)]
 
 use ivt_hb::{
-    frequency_response, Duffing, FrcOptions, GeneralProblem, HbOptions, HsuRule, ModifiedIhb,
-    PeriodicProblem, StabilityAnalyzer, StabilityKind,
+    Duffing, GeneralProblem, HbOptions, HsuRule, ModifiedIhb, PeriodicProblem, StabilityAnalyzer,
+    StabilityKind,
 };
+
+mod common;
 
 /// Fig. 28's Duffing (ξ = 0.02, α = ε = 1, F = 0.1) in the length unit `1/L`.
 fn scaled(l: f64) -> impl PeriodicProblem {
@@ -39,16 +41,7 @@ fn middle_branch_is_the_same_orbit_and_verdict_at_micrometre_and_nanometre_scale
     let hb = HbOptions::new(20, 64);
     // The unstable middle branch at ω_f ≈ 1.4 from the built-in Duffing FRC
     // (exact ∂g): the orbit scipy shooting and the thesis call a saddle.
-    let frc = frequency_response(
-        &Duffing::fig28(),
-        &hb,
-        &FrcOptions {
-            from: 0.2,
-            to: 3.0,
-            ..FrcOptions::default()
-        },
-    )
-    .unwrap();
+    let frc = common::frc_between(&Duffing::fig28(), &hb, 0.2, 3.0);
     let mid = frc
         .points
         .iter()

@@ -11,8 +11,8 @@ pub mod shooting;
 use ivt_hb::aft::eval_series;
 use ivt_hb::ode::{first_order, rk4};
 use ivt_hb::{
-    c64, BackboneOptions, BroydenOptions, ClassicIhb, ContinuationOptions, HbOptions, HbSolution,
-    LimitCycle, ModifiedIhb, PeriodicProblem,
+    c64, frequency_response, BackboneOptions, BroydenOptions, ClassicIhb, ContinuationOptions, Frc,
+    FrcOptions, HbOptions, HbSolution, LimitCycle, ModifiedIhb, PeriodicProblem,
 };
 use std::f64::consts::PI;
 
@@ -77,6 +77,17 @@ pub fn max_distance(a: &[c64], b: &[c64]) -> f64 {
         .zip(b)
         .map(|(x, y)| (x - y).norm())
         .fold(0.0, f64::max)
+}
+
+/// The frequency-response curve of `problem` from ω_f = `from` to `to`, the
+/// other options default.
+pub fn frc_between<P: PeriodicProblem>(problem: &P, hb: &HbOptions, from: f64, to: f64) -> Frc {
+    let opts = FrcOptions {
+        from,
+        to,
+        ..FrcOptions::default()
+    };
+    frequency_response(problem, hb, &opts).unwrap()
 }
 
 /// The path options of the two-parameter curves: steps `ds` = 0.02 up to
