@@ -218,6 +218,25 @@ fn frc_event<P: PeriodicProblem>(
     (start, omega)
 }
 
+/// The branch switched onto at the first located `kind` event of the FRC of
+/// `p` from `from` to `to`, with the event's ω_f (asserted within 1e-4 of
+/// `expected`), after the switch towards `from` (the side the new branch does
+/// not leave to) was refused by name.
+fn switched<P: PeriodicProblem>(
+    p: &P,
+    hb: &HbOptions,
+    (from, to): (f64, f64),
+    kind: BifurcationKind,
+    expected: f64,
+) -> (SwitchedBranch, f64) {
+    let (start, omega) = frc_event(p, hb, (from, to), kind);
+    assert!((omega - expected).abs() < 1e-4, "{omega}");
+    let e = switch_to(p, hb, &start, from).unwrap_err();
+    assert_eq!(e.kind(), "input");
+    assert!(e.to_string().contains("must lie on that side"), "{e}");
+    (switch_to(p, hb, &start, to).unwrap(), omega)
+}
+
 /// The new branch towards `to`, or the job's error.
 fn switch_to<P: PeriodicProblem>(
     p: &P,
@@ -238,14 +257,15 @@ fn period_two_branch_of_the_duffing_well_is_a_period_two_orbit_by_shooting() {
     let p = well();
     let hb = HbOptions::new(10, 32);
     // The forced orbit doubles at ω_f = 2.93667 and 2.60375 (measured).
-    let (start, w_pd) = frc_event(&p, &hb, (3.6, 2.2), BifurcationKind::PeriodDoubling);
-    assert!((w_pd - 2.93667).abs() < 1e-4, "{w_pd}");
     // The period-2 branch is born towards lower ω_f (subcritical in ω_f):
     // `to` above it is refused by name.
-    let e = switch_to(&p, &hb, &start, 3.6).unwrap_err();
-    assert_eq!(e.kind(), "input");
-    assert!(e.to_string().contains("must lie on that side"), "{e}");
-    let b = switch_to(&p, &hb, &start, 2.2).unwrap();
+    let (b, w_pd) = switched(
+        &p,
+        &hb,
+        (3.6, 2.2),
+        BifurcationKind::PeriodDoubling,
+        2.93667,
+    );
     assert_eq!(b.kind, BifurcationKind::PeriodDoubling);
     assert_eq!((b.harmonics, b.subharmonic), (20, 2));
     assert_eq!(b.curve.termination, ivt_hb::Termination::LeftInterval);
@@ -274,11 +294,7 @@ fn symmetry_breaking_branch_of_the_chain_is_asymmetric_by_shooting() {
     let hb = HbOptions::new(9, 32);
     // The pitchfork at ω_f = 1.02624 (tests/bifurcation.rs checks it by
     // shooting to 1e-9).
-    let (start, w_bp) = frc_event(&p, &hb, (0.8, 2.5), BifurcationKind::BranchPoint);
-    assert!((w_bp - 1.02624).abs() < 1e-4, "{w_bp}");
-    let e = switch_to(&p, &hb, &start, 0.8).unwrap_err();
-    assert!(e.to_string().contains("must lie on that side"), "{e}");
-    let b = switch_to(&p, &hb, &start, 2.5).unwrap();
+    let (b, w_bp) = switched(&p, &hb, (0.8, 2.5), BifurcationKind::BranchPoint, 1.02624);
     assert_eq!((b.kind, b.subharmonic), (BifurcationKind::BranchPoint, 1));
     let l = 2 * hb.harmonics + 1;
     // The new branch is the asymmetric one (x₁ ≠ x₂; measured max
