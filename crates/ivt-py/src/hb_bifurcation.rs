@@ -70,16 +70,47 @@ impl PyFamily {
         })
         .map_err(|e| {
             let message = e.to_string();
-            if let Ok(mut slot) = self.failure.lock() {
-                slot.get_or_insert(e);
-            }
+            self.keep_error(e);
             HbError::InvalidInput(format!("family(p) failed: {message}"))
         })
+    }
+
+    /// Keep `e` as the family's exception unless one is kept already.
+    pub(crate) fn keep_error(&self, e: PyErr) {
+        if let Ok(mut slot) = self.failure.lock() {
+            slot.get_or_insert(e);
+        }
+    }
+
+    /// This family, taken as `family(mu, p)`, with its first argument fixed
+    /// at `mu` by `partial` (`functools.partial`): a one-parameter family
+    /// with the same flags and an error slot of its own.
+    pub(crate) fn with_first(&self, partial: &Bound<'_, PyAny>, mu: f64) -> PyResult<PyFamily> {
+        let one = partial.call1((self.family.bind(partial.py()), mu))?;
+        Ok(Self::new(&one, self.velocity_dependent, self.vectorized))
     }
 
     /// The first exception `family` raised, if any.
     pub(crate) fn take_error(&self) -> Option<PyErr> {
         self.failure.lock().ok().and_then(|mut s| s.take())
+    }
+
+    /// Run `job` with the HB options of `first` (from [`Self::first`]) with
+    /// the GIL released, as [`run_user`] on the first user system; then the
+    /// first exception `family` raised, if any, is the error (it caused the
+    /// job's failure), else the job's own result.
+    pub(crate) fn run<T: Send>(
+        &self,
+        py: Python<'_>,
+        first: (PyProblem, HbOptions),
+        job: impl FnOnce(&HbOptions) -> Result<T, HbError> + Send,
+    ) -> PyResult<T> {
+        let (problem, hb) = first;
+        let result = run_user(py, &problem, |_| job(&hb));
+        if let Some(e) = self.take_error() {
+            return Err(e);
+        }
+        result
     }
 
     /// The user system at `p` and HB options from the shared keywords.
@@ -164,14 +195,11 @@ fn cycle_branch<'py>(
         offset,
     };
     let fam = PyFamily::new(family, velocity_dependent, vectorized);
-    let (first, hb) = fam.first(py, p_from, n, samples, rtol, max_iter)?;
-    let branch = run_user(py, &first, |_| {
-        jobs::cycle_branch(|p| fam.build(p), &hb, &req)
-    });
-    if let Some(e) = fam.take_error() {
-        return Err(e);
-    }
-    to_dict(py, &branch?)
+    let first = fam.first(py, p_from, n, samples, rtol, max_iter)?;
+    let branch = fam.run(py, first, |hb| {
+        jobs::cycle_branch(|p| fam.build(p), hb, &req)
+    })?;
+    to_dict(py, &branch)
 }
 
 /// The Neimark–Sacker boundary of the forced family `family(p)` → (m, c, k,
@@ -211,15 +239,12 @@ fn neimark_sacker_points<'py>(
         ));
     };
     let fam = PyFamily::new(family, velocity_dependent, vectorized);
-    let (first, hb) = fam.first(py, finite("ps[0]", p0)?, n, samples, rtol, max_iter)?;
-    let points = run_user(py, &first, |_| {
-        ivt_hb::neimark_sacker_points(|p| fam.build(p), &hb, from, to, &ps)
-    });
-    if let Some(e) = fam.take_error() {
-        return Err(e);
-    }
+    let first = fam.first(py, finite("ps[0]", p0)?, n, samples, rtol, max_iter)?;
+    let points = fam.run(py, first, |hb| {
+        ivt_hb::neimark_sacker_points(|p| fam.build(p), hb, from, to, &ps)
+    })?;
     let list = PyList::empty(py);
-    for pt in points? {
+    for pt in points {
         let d = PyDict::new(py);
         d.set_item("p", pt.p)?;
         d.set_item("omega", pt.omega)?;

@@ -9,44 +9,31 @@ use numpy::IntoPyArray;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use std::sync::Mutex;
 
 use crate::args::count;
 use crate::hb_bifurcation::PyFamily;
-use crate::hb_shared::{finite, run_user};
+use crate::hb_shared::finite;
 
 /// `family(mu, nu)` as the one-parameter [`PyFamily`] `partial(family, mu)`
-/// of ν; the first exception it raised is kept.
+/// of ν; the first exception it raised is kept in the slot of `family`.
 struct PyFamily2 {
-    family: Py<PyAny>,
+    family: PyFamily,
     partial: Py<PyAny>,
-    velocity_dependent: bool,
-    vectorized: bool,
-    failure: Mutex<Option<PyErr>>,
 }
 
 impl PyFamily2 {
     fn at_mu(&self, py: Python<'_>, mu: f64) -> PyResult<PyFamily> {
-        let one = self.partial.bind(py).call1((self.family.bind(py), mu))?;
-        Ok(PyFamily::new(
-            &one,
-            self.velocity_dependent,
-            self.vectorized,
-        ))
+        self.family.with_first(self.partial.bind(py), mu)
     }
 
     fn build(&self, mu: f64, nu: f64) -> Result<crate::user_problem::PyProblem, HbError> {
         let fam = Python::attach(|py| self.at_mu(py, mu))
             .map_err(|e| HbError::InvalidInput(format!("family failed: {e}")))?;
         fam.build(nu).inspect_err(|_| {
-            if let (Some(e), Ok(mut slot)) = (fam.take_error(), self.failure.lock()) {
-                slot.get_or_insert(e);
+            if let Some(e) = fam.take_error() {
+                self.family.keep_error(e);
             }
         })
-    }
-
-    fn take_error(&self) -> Option<PyErr> {
-        self.failure.lock().ok().and_then(|mut s| s.take())
     }
 }
 
@@ -111,27 +98,25 @@ fn cycle_fold_curve<'py>(
         ));
     }
     let fam = PyFamily2 {
-        family: family.clone().unbind(),
+        family: PyFamily::new(family, velocity_dependent, vectorized),
         partial: py.import("functools")?.getattr("partial")?.unbind(),
-        velocity_dependent,
-        vectorized,
-        failure: Mutex::new(None),
     };
     // The user system at (mu_from, nu_from) sets the HB options.
-    let (first, hb) = fam
+    let first = fam
         .at_mu(py, mu_from)?
         .first(py, nu_from, n, samples, rtol, max_iter)?;
+    let harmonics = first.1.harmonics;
     let continuation = ContinuationOptions {
         ds,
         ds_max,
         max_points: count("max_points", max_points)?,
         ..ContinuationOptions::default()
     };
-    let curve = run_user(py, &first, |_| {
+    let curve = fam.family.run(py, first, |hb| {
         let family = |mu: f64, nu: f64| fam.build(mu, nu);
         let branch = cycle_branch(
             |mu| family(mu, nu_from),
-            &hb,
+            hb,
             mu_from,
             mu_to,
             &CycleBranchOptions::default(),
@@ -144,22 +129,18 @@ fn cycle_fold_curve<'py>(
         // The path goes first towards the first of the pair: nu_to.
         follow(
             family,
-            &hb,
+            hb,
             start,
             (*mu, nu_from),
             (nu_to, nu_from),
             &at,
             &continuation,
         )
-    });
-    if let Some(e) = fam.take_error() {
-        return Err(e);
-    }
-    let curve = curve?;
+    })?;
     let list = |pts: &[CycleFoldPoint]| -> PyResult<Bound<'py, PyList>> {
         let list = PyList::empty(py);
         for pt in pts {
-            list.append(point_dict(py, pt, hb.harmonics)?)?;
+            list.append(point_dict(py, pt, harmonics)?)?;
         }
         Ok(list)
     };

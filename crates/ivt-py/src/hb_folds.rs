@@ -5,13 +5,13 @@
 
 use ivt_hb::jobs::{self, FoldCurveRequest, FoldStart};
 use ivt_hb::{BifurcationKind, Duffing};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::args::{count, int64};
 use crate::hb_bifurcation::PyFamily;
-use crate::hb_shared::{finite, options, run, run_user};
+use crate::hb_shared::{finite, given_point, options, run};
 use crate::to_python::to_dict;
 
 /// The kind and start point of `continue_bifurcation`: ω and coefficients of
@@ -29,17 +29,7 @@ fn given_start(start: &Bound<'_, PyDict>) -> PyResult<(BifurcationKind, FoldStar
             )))
         }
     };
-    let item = |key: &str| {
-        start
-            .get_item(key)?
-            .ok_or_else(|| PyValueError::new_err(format!("argument `start` needs \"{key}\"")))
-    };
-    let omega = finite("start[\"omega\"]", item("omega")?.extract()?)?;
-    let coeffs: Vec<f64> = item("coeffs")?
-        .extract::<numpy::PyArrayLike1<'_, f64, numpy::AllowTypeChange>>()
-        .map_err(|_| PyTypeError::new_err("start[\"coeffs\"] must be a 1-D array of floats"))?
-        .as_array()
-        .to_vec();
+    let (omega, coeffs) = given_point(start, "start")?;
     Ok((kind, FoldStart::Given { omega, coeffs }))
 }
 
@@ -106,14 +96,9 @@ fn continue_bifurcation<'py>(
         max_points: count("max_points", max_points)?,
     };
     let fam = PyFamily::new(family, velocity_dependent, vectorized);
-    let (first, opts) = fam.first(py, p_start, n, samples, rtol, max_iter)?;
-    let curve = run_user(py, &first, |_| {
-        jobs::fold_curve(|p| fam.build(p), &opts, &req)
-    });
-    if let Some(e) = fam.take_error() {
-        return Err(e);
-    }
-    to_dict(py, &curve?)
+    let first = fam.first(py, p_start, n, samples, rtol, max_iter)?;
+    let curve = fam.run(py, first, |hb| jobs::fold_curve(|p| fam.build(p), hb, &req))?;
+    to_dict(py, &curve)
 }
 
 /// The folds of the frequency response of the thesis Duffing (Eq. 49, ξ =

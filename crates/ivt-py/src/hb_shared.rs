@@ -10,7 +10,7 @@ use ivt_hb::{HbError, HbOptions};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyList;
+use pyo3::types::{PyDict, PyList};
 
 use crate::args::count;
 use crate::user_problem::{callback_error, user_problem, with_tolerances, PyProblem};
@@ -105,13 +105,38 @@ pub(crate) fn finite(name: &str, v: f64) -> PyResult<f64> {
 
 /// The `guess` keyword: a 1-D array-like of floats, or None.
 pub(crate) fn guess_vec(guess: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<f64>>> {
-    guess
-        .map(|g| {
-            g.extract::<numpy::PyArrayLike1<'_, f64, numpy::AllowTypeChange>>()
-                .map(|a| a.as_array().to_vec())
-                .map_err(|_| PyTypeError::new_err("argument `guess` must be a 1-D array of floats"))
-        })
-        .transpose()
+    guess.map(|g| float_vec(g, "argument `guess`")).transpose()
+}
+
+/// A 1-D array-like of floats as a vector; `what` names it in the TypeError.
+fn float_vec(v: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+    v.extract::<numpy::PyArrayLike1<'_, f64, numpy::AllowTypeChange>>()
+        .map(|a| a.as_array().to_vec())
+        .map_err(|_| PyTypeError::new_err(format!("{what} must be a 1-D array of floats")))
+}
+
+/// The entry `key` of the dict argument `arg`; a missing one is a
+/// ValueError naming both.
+pub(crate) fn dict_item<'py>(
+    dict: &Bound<'py, PyDict>,
+    arg: &str,
+    key: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    dict.get_item(key)?
+        .ok_or_else(|| PyValueError::new_err(format!("argument `{arg}` needs \"{key}\"")))
+}
+
+/// ω and the coefficients of the point given as the dict argument `arg`
+/// (an entry of `frc(...)["folds"]` or `["bifurcations"]`): its finite
+/// "omega" and its "coeffs", a 1-D array of floats.
+pub(crate) fn given_point(dict: &Bound<'_, PyDict>, arg: &str) -> PyResult<(f64, Vec<f64>)> {
+    let omega = dict_item(dict, arg, "omega")?.extract()?;
+    let omega = finite(&format!("{arg}[\"omega\"]"), omega)?;
+    let coeffs = float_vec(
+        &dict_item(dict, arg, "coeffs")?,
+        &format!("{arg}[\"coeffs\"]"),
+    )?;
+    Ok((omega, coeffs))
 }
 
 /// A `#[pyfunction]` on a user system `M x'' + C x' + K x + g(x, v, θ) =
