@@ -4,16 +4,9 @@
 // A test may unwrap (the package's panic lints guard library code).
 #![allow(clippy::unwrap_used)]
 
-use serde_json::Value;
-use std::process::Command;
-
-const IVT: &str = env!("CARGO_BIN_EXE_ivt");
-
-fn run(args: &[&str]) -> (i32, Value) {
-    let out = Command::new(IVT).arg("--json").args(args).output().unwrap();
-    let v = serde_json::from_slice(&out.stdout).unwrap_or(Value::Null);
-    (out.status.code().unwrap_or(-1), v)
-}
+#[path = "common/rig.rs"]
+mod rig;
+use rig::{commission_sim, ivt};
 
 #[test]
 fn sim_commissioning_writes_the_recording_and_refuses_bad_input() {
@@ -21,7 +14,7 @@ fn sim_commissioning_writes_the_recording_and_refuses_bad_input() {
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("hold.mcap");
     let o = out.to_str().unwrap();
-    let (code, v) = run(&[
+    let (code, v) = ivt(&[
         "rig",
         "commission",
         "--sim",
@@ -42,23 +35,15 @@ fn sim_commissioning_writes_the_recording_and_refuses_bad_input() {
     let plant = dir.join("bad.toml");
     std::fs::write(&plant, "[plant]\nk_t = -1.0\n").unwrap();
     let bad = dir.join("bad.mcap");
-    let (code, v) = run(&[
-        "rig",
-        "commission",
-        "--sim",
-        "--plant-file",
-        plant.to_str().unwrap(),
-        "--out",
-        bad.to_str().unwrap(),
-    ]);
+    let (code, v) = commission_sim(&plant, &bad, &[]);
     assert_eq!((code, v["kind"].as_str()), (2, Some("input")), "{v}");
     assert!(v["error"].as_str().unwrap().contains("bad.toml"), "{v}");
     assert!(!bad.exists());
 
     // --pil needs --sim; --port excludes --sim.
-    let (code, _) = run(&["rig", "commission", "--pil", "--out", bad.to_str().unwrap()]);
+    let (code, _) = ivt(&["rig", "commission", "--pil", "--out", bad.to_str().unwrap()]);
     assert_eq!(code, 2);
-    let (code, _) = run(&[
+    let (code, _) = ivt(&[
         "rig",
         "commission",
         "--sim",

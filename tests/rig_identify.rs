@@ -11,23 +11,15 @@ use ivt_sim::scene::{PlantSection, PresetName};
 use ivt_sim::sensors::Rng;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::Command;
+
+#[path = "common/rig.rs"]
+mod rig;
+use rig::{commission_sim, ivt};
 
 fn scratch(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("ivt-rig-identify-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     d
-}
-
-/// `ivt --json ARGS` → (exit status, JSON).
-fn ivt(args: &[&str]) -> (i32, Value) {
-    let out = Command::new(env!("CARGO_BIN_EXE_ivt"))
-        .arg("--json")
-        .args(args)
-        .output()
-        .unwrap();
-    let v = serde_json::from_slice(&out.stdout).unwrap_or(Value::Null);
-    (out.status.code().unwrap_or(-1), v)
 }
 
 /// Table 1 with k_t, k_e, R_a, the inertias and the brake gain (through
@@ -69,19 +61,7 @@ fn commission(dir: &Path, plant_body: &str, sensors: &str, seed: u64) -> Vec<u8>
     std::fs::write(&plant, format!("[plant]\n{plant_body}\n")).unwrap();
     let out = dir.join("commission.mcap");
     let seed = seed.to_string();
-    let (code, v) = ivt(&[
-        "rig",
-        "commission",
-        "--sim",
-        "--plant-file",
-        plant.to_str().unwrap(),
-        "--sensors",
-        sensors,
-        "--seed",
-        &seed,
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (code, v) = commission_sim(&plant, &out, &["--sensors", sensors, "--seed", &seed]);
     assert_eq!(code, 0, "{v}");
     std::fs::read(&out).unwrap()
 }

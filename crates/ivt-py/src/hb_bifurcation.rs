@@ -2,110 +2,18 @@
 //! autonomous user family and the limit-cycle branch born at the first
 //! (the job [`ivt_hb::jobs::cycle_branch()`] of `ivt hb cycle-branch`);
 //! `ivt.hb.neimark_sacker_points`, the sampled Neimark–Sacker boundary of a forced family
-//! ([`ivt_hb::neimark_sacker_points`]); and [`PyFamily`], a Python `family(p)` as the
-//! fallible Rust family of ivt-hb's two-parameter functions.
+//! ([`ivt_hb::neimark_sacker_points`]), on a Python `family(p)` ([`PyFamily`]).
 
-use ivt_hb::jobs::{self, CycleBranchRequest};
-use ivt_hb::{HbError, HbOptions};
+use ivt_hb::jobs::{self, pairs, CycleBranchRequest};
 use numpy::IntoPyArray;
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use std::sync::Mutex;
 
 use crate::args::count;
-use crate::hb_shared::{finite, run_user, UserArgs};
+use crate::hb_family::PyFamily;
+use crate::hb_shared::{finite, HbKeys};
 use crate::to_python::to_dict;
-use crate::user_problem::{user_problem, PyProblem};
-use ivt_hb::jobs::pairs;
-
-/// The user system `family(p)` returns: a tuple (m, c, k, g, f).
-pub(crate) fn family_system<'py>(
-    family: &Bound<'py, PyAny>,
-    p: f64,
-) -> PyResult<[Bound<'py, PyAny>; 5]> {
-    let wrong = || PyTypeError::new_err("argument `family` must return a tuple (m, c, k, g, f)");
-    let parts: Vec<Bound<'py, PyAny>> = family.call1((p,))?.extract().map_err(|_| wrong())?;
-    parts.try_into().map_err(|_| wrong())
-}
-
-/// A Python `family(p)` → (m, c, k, g, f) as a fallible family of user
-/// systems; the first exception it raised is kept ([`Self::take_error`]).
-pub(crate) struct PyFamily {
-    family: Py<PyAny>,
-    velocity_dependent: bool,
-    vectorized: bool,
-    failure: Mutex<Option<PyErr>>,
-}
-
-impl PyFamily {
-    pub(crate) fn new(
-        family: &Bound<'_, PyAny>,
-        velocity_dependent: bool,
-        vectorized: bool,
-    ) -> Self {
-        Self {
-            family: family.clone().unbind(),
-            velocity_dependent,
-            vectorized,
-            failure: Mutex::new(None),
-        }
-    }
-
-    /// The user system at `p` (`f` None: unforced).
-    pub(crate) fn build(&self, p: f64) -> Result<PyProblem, HbError> {
-        Python::attach(|py| {
-            let [m, c, k, g, f] = family_system(self.family.bind(py), p)?;
-            let f = (!f.is_none()).then_some(&f);
-            user_problem(
-                &m,
-                &c,
-                &k,
-                &g,
-                f,
-                None,
-                self.velocity_dependent,
-                self.vectorized,
-            )
-        })
-        .map_err(|e| {
-            let message = e.to_string();
-            if let Ok(mut slot) = self.failure.lock() {
-                slot.get_or_insert(e);
-            }
-            HbError::InvalidInput(format!("family(p) failed: {message}"))
-        })
-    }
-
-    /// The first exception `family` raised, if any.
-    pub(crate) fn take_error(&self) -> Option<PyErr> {
-        self.failure.lock().ok().and_then(|mut s| s.take())
-    }
-
-    /// The user system at `p` and HB options from the shared keywords.
-    pub(crate) fn first(
-        &self,
-        py: Python<'_>,
-        p: f64,
-        n: i64,
-        samples: i64,
-        rtol: f64,
-        max_iter: i64,
-    ) -> PyResult<(PyProblem, HbOptions)> {
-        let [m, c, k, g, f] = family_system(self.family.bind(py), p)?;
-        let user = UserArgs {
-            system: [&m, &c, &k, &g],
-            n,
-            samples,
-            velocity_dependent: self.velocity_dependent,
-            vectorized: self.vectorized,
-            rtol,
-            max_iter: crate::args::count("max_iter", max_iter)?,
-            jac: None,
-        };
-        user.setup((!f.is_none()).then_some(&f), 1, 0.0)
-    }
-}
 
 /// Hopf points and the limit-cycle branch of the autonomous family
 /// `family(p)` → (m, c, k, g, f) (f None) for p in [p_from, p_to]
@@ -163,15 +71,13 @@ fn cycle_branch<'py>(
         max_points: count("max_points", max_points)?,
         offset,
     };
-    let fam = PyFamily::new(family, velocity_dependent, vectorized);
-    let (first, hb) = fam.first(py, p_from, n, samples, rtol, max_iter)?;
-    let branch = run_user(py, &first, |_| {
-        jobs::cycle_branch(|p| fam.build(p), &hb, &req)
-    });
-    if let Some(e) = fam.take_error() {
-        return Err(e);
-    }
-    to_dict(py, &branch?)
+    let keys = HbKeys::new(n, samples, velocity_dependent, vectorized, rtol, max_iter)?;
+    let fam = PyFamily::new(family, keys);
+    let first = fam.first(py, p_from)?;
+    let branch = fam.run(py, first, |hb| {
+        jobs::cycle_branch(|p| fam.build(p), hb, &req)
+    })?;
+    to_dict(py, &branch)
 }
 
 /// The Neimark–Sacker boundary of the forced family `family(p)` → (m, c, k,
@@ -210,16 +116,14 @@ fn neimark_sacker_points<'py>(
             "arguments `omega_from`, `omega_to` must be > 0 and distinct, `ps` not empty",
         ));
     };
-    let fam = PyFamily::new(family, velocity_dependent, vectorized);
-    let (first, hb) = fam.first(py, finite("ps[0]", p0)?, n, samples, rtol, max_iter)?;
-    let points = run_user(py, &first, |_| {
-        ivt_hb::neimark_sacker_points(|p| fam.build(p), &hb, from, to, &ps)
-    });
-    if let Some(e) = fam.take_error() {
-        return Err(e);
-    }
+    let keys = HbKeys::new(n, samples, velocity_dependent, vectorized, rtol, max_iter)?;
+    let fam = PyFamily::new(family, keys);
+    let first = fam.first(py, finite("ps[0]", p0)?)?;
+    let points = fam.run(py, first, |hb| {
+        ivt_hb::neimark_sacker_points(|p| fam.build(p), hb, from, to, &ps)
+    })?;
     let list = PyList::empty(py);
-    for pt in points? {
+    for pt in points {
         let d = PyDict::new(py);
         d.set_item("p", pt.p)?;
         d.set_item("omega", pt.omega)?;

@@ -9,44 +9,30 @@ use numpy::IntoPyArray;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use std::sync::Mutex;
 
-use crate::args::count;
-use crate::hb_bifurcation::PyFamily;
-use crate::hb_shared::{finite, run_user};
+use crate::hb_family::{family_fn, PyFamily};
+use crate::hb_shared::finite;
 
 /// `family(mu, nu)` as the one-parameter [`PyFamily`] `partial(family, mu)`
-/// of ν; the first exception it raised is kept.
-struct PyFamily2 {
-    family: Py<PyAny>,
+/// of ν; the first exception it raised is kept in the slot of `family`.
+struct PyFamily2<'a> {
+    family: &'a PyFamily,
     partial: Py<PyAny>,
-    velocity_dependent: bool,
-    vectorized: bool,
-    failure: Mutex<Option<PyErr>>,
 }
 
-impl PyFamily2 {
+impl PyFamily2<'_> {
     fn at_mu(&self, py: Python<'_>, mu: f64) -> PyResult<PyFamily> {
-        let one = self.partial.bind(py).call1((self.family.bind(py), mu))?;
-        Ok(PyFamily::new(
-            &one,
-            self.velocity_dependent,
-            self.vectorized,
-        ))
+        self.family.with_first(self.partial.bind(py), mu)
     }
 
     fn build(&self, mu: f64, nu: f64) -> Result<crate::user_problem::PyProblem, HbError> {
         let fam = Python::attach(|py| self.at_mu(py, mu))
             .map_err(|e| HbError::InvalidInput(format!("family failed: {e}")))?;
         fam.build(nu).inspect_err(|_| {
-            if let (Some(e), Ok(mut slot)) = (fam.take_error(), self.failure.lock()) {
-                slot.get_or_insert(e);
+            if let Some(e) = fam.take_error() {
+                self.family.keep_error(e);
             }
         })
-    }
-
-    fn take_error(&self) -> Option<PyErr> {
-        self.failure.lock().ok().and_then(|mut s| s.take())
     }
 }
 
@@ -68,6 +54,7 @@ fn point_dict<'py>(py: Python<'py>, pt: &CycleFoldPoint, n: usize) -> PyResult<B
     Ok(d)
 }
 
+family_fn! {
 /// The fold of limit cycles of the autonomous family `family(mu, nu)` →
 /// (m, c, k, g, None) followed in ν from `nu_from` towards `nu_to`
 /// (ivt_hb::codim2::cycle_fold_curve: the cycle equations with ω unknown and
@@ -78,31 +65,13 @@ fn point_dict<'py>(py: Python<'py>, pt: &CycleFoldPoint, n: usize) -> PyResult<B
 /// Returns {"points": [{"mu", "nu", "omega", "amplitude", "coeffs"}...],
 /// "at": [...], "special": [{"kind": "cusp", ...}...] (turning points in
 /// ν, the path's estimate), "termination"}.
-#[pyfunction]
-#[pyo3(signature = (
-    family, nu_from, nu_to, mu_from, mu_to, at = Vec::new(), n = 20, samples = 64,
-    velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100,
-    ds = 0.02, ds_max = 0.05, max_points = 2000
-))]
-#[allow(clippy::too_many_arguments)]
-fn cycle_fold_curve<'py>(
-    py: Python<'py>,
-    family: &Bound<'py, PyAny>,
+fn cycle_fold_curve<'py>(py, args) [
     nu_from: f64,
     nu_to: f64,
     mu_from: f64,
     mu_to: f64,
-    at: Vec<f64>,
-    #[pyo3(from_py_with = crate::args::int64)] n: i64,
-    #[pyo3(from_py_with = crate::args::int64)] samples: i64,
-    velocity_dependent: bool,
-    vectorized: bool,
-    rtol: f64,
-    #[pyo3(from_py_with = crate::args::int64)] max_iter: i64,
-    ds: f64,
-    ds_max: f64,
-    #[pyo3(from_py_with = crate::args::int64)] max_points: i64,
-) -> PyResult<Bound<'py, PyDict>> {
+    at: Vec<f64> = (Vec::new())
+] {
     let (nu_from, nu_to) = (finite("nu_from", nu_from)?, finite("nu_to", nu_to)?);
     let (mu_from, mu_to) = (finite("mu_from", mu_from)?, finite("mu_to", mu_to)?);
     if nu_from == nu_to || mu_from == mu_to {
@@ -111,27 +80,23 @@ fn cycle_fold_curve<'py>(
         ));
     }
     let fam = PyFamily2 {
-        family: family.clone().unbind(),
+        family: &args.family,
         partial: py.import("functools")?.getattr("partial")?.unbind(),
-        velocity_dependent,
-        vectorized,
-        failure: Mutex::new(None),
     };
     // The user system at (mu_from, nu_from) sets the HB options.
-    let (first, hb) = fam
-        .at_mu(py, mu_from)?
-        .first(py, nu_from, n, samples, rtol, max_iter)?;
+    let first = fam.at_mu(py, mu_from)?.first(py, nu_from)?;
+    let harmonics = first.1.harmonics;
     let continuation = ContinuationOptions {
-        ds,
-        ds_max,
-        max_points: count("max_points", max_points)?,
+        ds: args.ds,
+        ds_max: args.ds_max,
+        max_points: args.max_points,
         ..ContinuationOptions::default()
     };
-    let curve = run_user(py, &first, |_| {
+    let curve = fam.family.run(py, first, |hb| {
         let family = |mu: f64, nu: f64| fam.build(mu, nu);
         let branch = cycle_branch(
             |mu| family(mu, nu_from),
-            &hb,
+            hb,
             mu_from,
             mu_to,
             &CycleBranchOptions::default(),
@@ -144,22 +109,18 @@ fn cycle_fold_curve<'py>(
         // The path goes first towards the first of the pair: nu_to.
         follow(
             family,
-            &hb,
+            hb,
             start,
             (*mu, nu_from),
             (nu_to, nu_from),
             &at,
             &continuation,
         )
-    });
-    if let Some(e) = fam.take_error() {
-        return Err(e);
-    }
-    let curve = curve?;
+    })?;
     let list = |pts: &[CycleFoldPoint]| -> PyResult<Bound<'py, PyList>> {
         let list = PyList::empty(py);
         for pt in pts {
-            list.append(point_dict(py, pt, hb.harmonics)?)?;
+            list.append(point_dict(py, pt, harmonics)?)?;
         }
         Ok(list)
     };
@@ -173,6 +134,7 @@ fn cycle_fold_curve<'py>(
     out.set_item("special", special)?;
     out.set_item("termination", curve.termination.as_str())?;
     Ok(out)
+}
 }
 
 /// Add `cycle_fold_curve` to the `hb` module.

@@ -5,13 +5,13 @@
 
 use ivt_hb::jobs::{self, FoldCurveRequest, FoldStart};
 use ivt_hb::{BifurcationKind, Duffing};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::args::{count, int64};
-use crate::hb_bifurcation::PyFamily;
-use crate::hb_shared::{finite, options, run, run_user};
+use crate::args::int64;
+use crate::hb_family::family_fn;
+use crate::hb_shared::{finite, given_point, options, run};
 use crate::to_python::to_dict;
 
 /// The kind and start point of `continue_bifurcation`: ω and coefficients of
@@ -29,20 +29,11 @@ fn given_start(start: &Bound<'_, PyDict>) -> PyResult<(BifurcationKind, FoldStar
             )))
         }
     };
-    let item = |key: &str| {
-        start
-            .get_item(key)?
-            .ok_or_else(|| PyValueError::new_err(format!("argument `start` needs \"{key}\"")))
-    };
-    let omega = finite("start[\"omega\"]", item("omega")?.extract()?)?;
-    let coeffs: Vec<f64> = item("coeffs")?
-        .extract::<numpy::PyArrayLike1<'_, f64, numpy::AllowTypeChange>>()
-        .map_err(|_| PyTypeError::new_err("start[\"coeffs\"] must be a 1-D array of floats"))?
-        .as_array()
-        .to_vec();
+    let (omega, coeffs) = given_point(start, "start")?;
     Ok((kind, FoldStart::Given { omega, coeffs }))
 }
 
+family_fn! {
 /// Two-parameter continuation of a fold, period doubling or Neimark–Sacker
 /// point of the frequency response of `family(p)` → (m, c, k, g, f) in
 /// (omega, p), the job [`ivt_hb::jobs::fold_curve`]. `start` is an entry of
@@ -64,31 +55,13 @@ fn given_start(start: &Bound<'_, PyDict>) -> PyResult<(BifurcationKind, FoldStar
 /// [{"omega", "p", "amplitude", "coeffs", "angle" (not on folds)}...],
 /// "at": [...], "special": [{"kind": "cusp" | "resonance_1_1" | ...,
 /// "omega", "p", "amplitude", "coeffs"}...], "termination", "time_s"}.
-#[pyfunction]
-#[pyo3(signature = (
-    family, start, p_from, p_to, at = Vec::new(), p_start = None, n = 20, samples = 64,
-    velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100,
-    ds = 0.02, ds_max = 0.05, max_points = 2000
-))]
-#[allow(clippy::too_many_arguments)]
-fn continue_bifurcation<'py>(
-    py: Python<'py>,
-    family: &Bound<'py, PyAny>,
+fn continue_bifurcation<'py>(py, args) [
     start: &Bound<'py, PyDict>,
     p_from: f64,
     p_to: f64,
-    at: Vec<f64>,
-    p_start: Option<f64>,
-    #[pyo3(from_py_with = int64)] n: i64,
-    #[pyo3(from_py_with = int64)] samples: i64,
-    velocity_dependent: bool,
-    vectorized: bool,
-    rtol: f64,
-    #[pyo3(from_py_with = crate::args::int64)] max_iter: i64,
-    ds: f64,
-    ds_max: f64,
-    #[pyo3(from_py_with = int64)] max_points: i64,
-) -> PyResult<Bound<'py, PyDict>> {
+    at: Vec<f64> = (Vec::new()),
+    p_start: Option<f64> = None
+] {
     let p_start = finite(
         "p_start",
         p_start.ok_or_else(|| PyValueError::new_err("argument `p_start` is required"))?,
@@ -101,19 +74,15 @@ fn continue_bifurcation<'py>(
         p_from,
         p_to,
         at,
-        ds,
-        ds_max,
-        max_points: count("max_points", max_points)?,
+        ds: args.ds,
+        ds_max: args.ds_max,
+        max_points: args.max_points,
     };
-    let fam = PyFamily::new(family, velocity_dependent, vectorized);
-    let (first, opts) = fam.first(py, p_start, n, samples, rtol, max_iter)?;
-    let curve = run_user(py, &first, |_| {
-        jobs::fold_curve(|p| fam.build(p), &opts, &req)
-    });
-    if let Some(e) = fam.take_error() {
-        return Err(e);
-    }
-    to_dict(py, &curve?)
+    let fam = &args.family;
+    let first = fam.first(py, p_start)?;
+    let curve = fam.run(py, first, |hb| jobs::fold_curve(|p| fam.build(p), hb, &req))?;
+    to_dict(py, &curve)
+}
 }
 
 /// The folds of the frequency response of the thesis Duffing (Eq. 49, ξ =

@@ -3,14 +3,16 @@
 //! the `ConvergenceError` exception and the mapping of ivt-hb errors onto
 //! Python exceptions by [`ivt_hb::HbError::kind`], the GIL-released runs that
 //! re-raise a callback's exception (the error slot of the user problem), the
-//! argument checks that name the Python argument, and the `user_system_fn!`
-//! signature of every user-system function.
+//! argument checks that name the Python argument (and the point dicts a
+//! continuation starts from), and the `user_system_fn!` signature of every
+//! user-system function, written once with `hb_family::family_fn!` as
+//! `hb_keywords_fn!` (the keywords both share).
 
 use ivt_hb::{HbError, HbOptions};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyList;
+use pyo3::types::{PyDict, PyList};
 
 use crate::args::count;
 use crate::user_problem::{callback_error, user_problem, with_tolerances, PyProblem};
@@ -105,14 +107,120 @@ pub(crate) fn finite(name: &str, v: f64) -> PyResult<f64> {
 
 /// The `guess` keyword: a 1-D array-like of floats, or None.
 pub(crate) fn guess_vec(guess: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<f64>>> {
-    guess
-        .map(|g| {
-            g.extract::<numpy::PyArrayLike1<'_, f64, numpy::AllowTypeChange>>()
-                .map(|a| a.as_array().to_vec())
-                .map_err(|_| PyTypeError::new_err("argument `guess` must be a 1-D array of floats"))
-        })
-        .transpose()
+    guess.map(|g| float_vec(g, "argument `guess`")).transpose()
 }
+
+/// A 1-D array-like of floats as a vector; `what` names it in the TypeError.
+fn float_vec(v: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+    v.extract::<numpy::PyArrayLike1<'_, f64, numpy::AllowTypeChange>>()
+        .map(|a| a.as_array().to_vec())
+        .map_err(|_| PyTypeError::new_err(format!("{what} must be a 1-D array of floats")))
+}
+
+/// The entry `key` of the dict argument `arg`; a missing one is a
+/// ValueError naming both.
+pub(crate) fn dict_item<'py>(
+    dict: &Bound<'py, PyDict>,
+    arg: &str,
+    key: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    dict.get_item(key)?
+        .ok_or_else(|| PyValueError::new_err(format!("argument `{arg}` needs \"{key}\"")))
+}
+
+/// ω and the coefficients of the point given as the dict argument `arg`
+/// (an entry of `frc(...)["folds"]` or `["bifurcations"]`): its finite
+/// "omega" and its "coeffs", a 1-D array of floats.
+pub(crate) fn given_point(dict: &Bound<'_, PyDict>, arg: &str) -> PyResult<(f64, Vec<f64>)> {
+    let omega = dict_item(dict, arg, "omega")?.extract()?;
+    let omega = finite(&format!("{arg}[\"omega\"]"), omega)?;
+    let coeffs = float_vec(
+        &dict_item(dict, arg, "coeffs")?,
+        &format!("{arg}[\"coeffs\"]"),
+    )?;
+    Ok((omega, coeffs))
+}
+
+/// The harmonic-balance keywords every user-system and family function
+/// shares: `n`, `samples`, `velocity_dependent`, `vectorized`, `rtol` and
+/// `max_iter` (checked).
+#[derive(Clone, Copy)]
+pub(crate) struct HbKeys {
+    pub(crate) n: i64,
+    pub(crate) samples: i64,
+    pub(crate) velocity_dependent: bool,
+    pub(crate) vectorized: bool,
+    pub(crate) rtol: f64,
+    pub(crate) max_iter: usize,
+}
+
+impl HbKeys {
+    /// The keywords as given; `max_iter` must be ≥ 0.
+    pub(crate) fn new(
+        n: i64,
+        samples: i64,
+        velocity_dependent: bool,
+        vectorized: bool,
+        rtol: f64,
+        max_iter: i64,
+    ) -> PyResult<Self> {
+        Ok(Self {
+            n,
+            samples,
+            velocity_dependent,
+            vectorized,
+            rtol,
+            max_iter: count("max_iter", max_iter)?,
+        })
+    }
+}
+
+/// The `#[pyfunction]` behind [`user_system_fn!`] and
+/// `hb_family::family_fn!`, returning a dict. Python parameters: the
+/// `head` ones, the function's own (`name: type [= default]`), `n=20,
+/// samples=64`, its own again (`mid`), `velocity_dependent=True,
+/// vectorized=False, rtol=1e-9, max_iter=100`, then the `tail` ones. Those
+/// six reach the body as the [`HbKeys`] named `$keys`; the head and tail
+/// parameters are named (for the body) by the calling macro. A default is
+/// one token tree (a literal, `None`, or an expression in parentheses), so
+/// that pyo3 still shows literal defaults in the Python signature.
+macro_rules! hb_keywords_fn {
+    (
+        $(#[$doc:meta])*
+        fn $name:ident<$lt:lifetime>($py:ident, $keys:ident);
+        head [$($head_sig:tt)*] [$($head_param:tt)*];
+        own [$( $(#[$pa:ident($($pa_args:tt)*)])* $arg:ident: $ty:ty $(= $default:tt)? ),*];
+        mid [$( $(#[$pb:ident($($pb_args:tt)*)])* $brg:ident: $bty:ty $(= $bdefault:tt)? ),*];
+        tail [$($tail_sig:tt)*] [$($tail_param:tt)*];
+        $body:block
+    ) => {
+        $(#[$doc])*
+        #[pyfunction]
+        #[pyo3(signature = (
+            $($head_sig)* $($arg $(= $default)?,)* n = 20, samples = 64, $($brg $(= $bdefault)?,)*
+            velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
+            $($tail_sig)*
+        ))]
+        #[allow(clippy::too_many_arguments, clippy::field_reassign_with_default)]
+        fn $name<$lt>(
+            $py: Python<$lt>,
+            $($head_param)*
+            $( $(#[$pa($($pa_args)*)])* $arg: $ty, )*
+            #[pyo3(from_py_with = crate::args::int64)] n: i64,
+            #[pyo3(from_py_with = crate::args::int64)] samples: i64,
+            $( $(#[$pb($($pb_args)*)])* $brg: $bty, )*
+            velocity_dependent: bool, vectorized: bool, rtol: f64,
+            #[pyo3(from_py_with = crate::args::int64)] max_iter: i64,
+            $($tail_param)*
+        ) -> PyResult<Bound<$lt, PyDict>> {
+            let $keys = $crate::hb_shared::HbKeys::new(
+                n, samples, velocity_dependent, vectorized, rtol, max_iter,
+            )?;
+            $body
+        }
+    };
+}
+pub(crate) use hb_keywords_fn;
 
 /// A `#[pyfunction]` on a user system `M x'' + C x' + K x + g(x, v, θ) =
 /// f(θ)` returning a dict. Python parameters: `m, c, k, g`, the function's
@@ -129,31 +237,20 @@ macro_rules! user_system_fn {
             $( $(#[$pb:ident($($pb_args:tt)*)])* $brg:ident: $bty:ty $(= $bdefault:tt)? ),+ $(,)?
         ) $body:block
     ) => {
-        $(#[$doc])*
-        #[pyfunction]
-        #[pyo3(signature = (
-            m, c, k, g, $($arg $(= $default)?,)+ n = 20, samples = 64, $($brg $(= $bdefault)?,)+
-            velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
-            $(, $jac = None)?
-        ))]
-        #[allow(clippy::too_many_arguments, clippy::field_reassign_with_default)]
-        fn $name<$lt>(
-            $py: Python<$lt>,
-            m: &Bound<$lt, PyAny>, c: &Bound<$lt, PyAny>, k: &Bound<$lt, PyAny>, g: &Bound<$lt, PyAny>,
-            $( $(#[$pa($($pa_args)*)])* $arg: $ty, )+
-            #[pyo3(from_py_with = crate::args::int64)] n: i64,
-            #[pyo3(from_py_with = crate::args::int64)] samples: i64,
-            $( $(#[$pb($($pb_args)*)])* $brg: $bty, )+
-            velocity_dependent: bool, vectorized: bool, rtol: f64,
-            #[pyo3(from_py_with = crate::args::int64)] max_iter: i64,
-            $( $jac: Option<&Bound<$lt, PyAny>>, )?
-        ) -> PyResult<Bound<$lt, PyDict>> {
-            let $user = UserArgs {
-                system: [m, c, k, g], n, samples, velocity_dependent, vectorized, rtol,
-                max_iter: crate::args::count("max_iter", max_iter)?,
-                jac: None $( .or($jac) )?,
-            };
-            $body
+        $crate::hb_shared::hb_keywords_fn! {
+            $(#[$doc])*
+            fn $name<$lt>($py, keys);
+            head [m, c, k, g,] [
+                m: &Bound<$lt, PyAny>, c: &Bound<$lt, PyAny>, k: &Bound<$lt, PyAny>,
+                g: &Bound<$lt, PyAny>,
+            ];
+            own [$( $(#[$pa($($pa_args)*)])* $arg: $ty $(= $default)? ),+];
+            mid [$( $(#[$pb($($pb_args)*)])* $brg: $bty $(= $bdefault)? ),+];
+            tail [$(, $jac = None)?] [$( $jac: Option<&Bound<$lt, PyAny>>, )?];
+            {
+                let $user = UserArgs { system: [m, c, k, g], keys, jac: None $( .or($jac) )? };
+                $body
+            }
         }
     };
 }
@@ -161,15 +258,10 @@ pub(crate) use user_system_fn;
 
 /// The arguments every user-system function shares: the system `[m, c, k, g]`,
 /// `g`'s optional Jacobian `jac` (always None where the keyword is not offered)
-/// and the harmonic-balance settings.
+/// and the harmonic-balance keywords.
 pub(crate) struct UserArgs<'a, 'py> {
     pub(crate) system: [&'a Bound<'py, PyAny>; 4],
-    pub(crate) n: i64,
-    pub(crate) samples: i64,
-    pub(crate) velocity_dependent: bool,
-    pub(crate) vectorized: bool,
-    pub(crate) rtol: f64,
-    pub(crate) max_iter: usize,
+    pub(crate) keys: HbKeys,
     pub(crate) jac: Option<&'a Bound<'py, PyAny>>,
 }
 
@@ -190,13 +282,11 @@ impl UserArgs<'_, '_> {
             g,
             f,
             self.jac,
-            self.velocity_dependent,
-            self.vectorized,
+            self.keys.velocity_dependent,
+            self.keys.vectorized,
         )?;
-        let opts = options(self.n, self.samples, subharmonic, 1.0)?;
-        Ok((
-            problem,
-            with_tolerances(opts, tol, self.rtol, self.max_iter)?,
-        ))
+        let k = &self.keys;
+        let opts = options(k.n, k.samples, subharmonic, 1.0)?;
+        Ok((problem, with_tolerances(opts, tol, k.rtol, k.max_iter)?))
     }
 }

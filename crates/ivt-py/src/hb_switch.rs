@@ -4,22 +4,18 @@
 
 use ivt_hb::jobs::{self, SwitchRequest, SwitchStart};
 use ivt_hb::{BifurcationKind, Corrector};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::hb_shared::{finite, run_user, user_system_fn, UserArgs};
+use crate::hb_shared::{dict_item, given_point, run_user, user_system_fn, UserArgs};
 use crate::to_python::to_dict;
 
 /// The event `at` (an entry of `frc(..., events=True)["bifurcations"]`) as
 /// the job's start: its kind, ω_f and coefficients; an event whose location
 /// failed is refused with its reason.
 fn given_event(at: &Bound<'_, PyDict>) -> PyResult<SwitchStart> {
-    let item = |key: &str| {
-        at.get_item(key)?
-            .ok_or_else(|| PyValueError::new_err(format!("argument `at` needs \"{key}\"")))
-    };
-    let name: String = item("kind")?.extract()?;
+    let name: String = dict_item(at, "at", "kind")?.extract()?;
     let kind = match name.as_str() {
         "period_doubling" => BifurcationKind::PeriodDoubling,
         "branch_point" => BifurcationKind::BranchPoint,
@@ -39,12 +35,7 @@ fn given_event(at: &Bound<'_, PyDict>) -> PyResult<SwitchStart> {
             why.unwrap_or_default()
         )));
     }
-    let omega = finite("at[\"omega\"]", item("omega")?.extract()?)?;
-    let coeffs: Vec<f64> = item("coeffs")?
-        .extract::<numpy::PyArrayLike1<'_, f64, numpy::AllowTypeChange>>()
-        .map_err(|_| PyTypeError::new_err("at[\"coeffs\"] must be a 1-D array of floats"))?
-        .as_array()
-        .to_vec();
+    let (omega, coeffs) = given_point(at, "at")?;
     Ok(SwitchStart::Given {
         kind,
         omega,

@@ -30,6 +30,7 @@ mod hb_analyses;
 mod hb_bifurcation;
 mod hb_cycle_fold;
 mod hb_elements;
+mod hb_family;
 mod hb_folds;
 mod hb_large;
 mod hb_paths;

@@ -29,3 +29,23 @@ def test_cycle_fold_curve_refuses_equal_bounds():
         assert "nu_from" in str(e)
     else:
         raise AssertionError("equal nu bounds must be refused")
+
+
+def test_cycle_fold_curve_reraises_the_family_exception():
+    """An exception `family` raises during the curve (ν ≠ nu_from) is the
+    error, not the failed point it caused."""
+
+    class Boom(Exception):
+        pass
+
+    def failing(mu, nu):
+        if nu < 0.9:
+            raise Boom(f"no system at nu = {nu}")
+        return family(mu, nu)
+
+    try:
+        hb.cycle_fold_curve(failing, 1.0, 0.45, -0.2, 0.1, n=25, samples=128, vectorized=True)
+    except Boom as e:
+        assert "no system at nu" in str(e)
+    else:
+        raise AssertionError("the family's exception must be re-raised")
