@@ -14,7 +14,6 @@ use crate::hill::{fourier_blocks, hill_multipliers};
 use crate::ihb::HbSolution;
 use crate::problem::PeriodicProblem;
 use faer::c64;
-use ivt_num::small::matmul;
 
 /// What the leading multiplier says.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -195,10 +194,8 @@ impl StabilityAnalyzer {
             self.theta.fill(f64::NAN);
             return &self.theta;
         }
-        // K + G_x, C + G_v and their products with M⁻¹ at one sample (every
-        // slice n_dof², as ivt_num's matmul needs).
-        let (mut stiff, mut damp) = (vec![0.0; n2], vec![0.0; n2]);
-        let (mut minv_stiff, mut minv_damp) = (vec![0.0; n2], vec![0.0; n2]);
+        // Lower rows [−M⁻¹(K + G_x)/ω² | −M⁻¹(C + G_v)/ω], one entry at a time
+        // from the columns of K + G_x and C + G_v (no allocation per sample).
         for (dg, th) in self
             .dg
             .chunks_exact(2 * n2)
@@ -213,23 +210,23 @@ impl StabilityAnalyzer {
                     *x = 1.0;
                 }
             }
-            // Lower rows [−M⁻¹(K + G_x)/ω² | −M⁻¹(C + G_v)/ω].
-            for (s, (a, b)) in stiff.iter_mut().zip(k.iter().zip(dgx)) {
-                *s = a + b;
-            }
-            for (s, (a, b)) in damp.iter_mut().zip(c.iter().zip(dgv)) {
-                *s = a + b;
-            }
-            matmul(&self.minv, &stiff, nd, &mut minv_stiff);
-            matmul(&self.minv, &damp, nd, &mut minv_damp);
-            let products = minv_stiff.chunks_exact(nd).zip(minv_damp.chunks_exact(nd));
-            for (row, (pk, pc)) in lower.chunks_exact_mut(dim).zip(products) {
+            for (row, minv_row) in lower.chunks_exact_mut(dim).zip(self.minv.chunks_exact(nd)) {
                 let (row_k, row_c) = row.split_at_mut(nd);
-                for (t, p) in row_k.iter_mut().zip(pk) {
-                    *t = -p / (omega * omega);
-                }
-                for (t, p) in row_c.iter_mut().zip(pc) {
-                    *t = -p / omega;
+                for (e, (tk, tc)) in row_k.iter_mut().zip(row_c.iter_mut()).enumerate() {
+                    let column = |a: &[f64], b: &[f64]| -> f64 {
+                        minv_row
+                            .iter()
+                            .zip(
+                                a.iter()
+                                    .skip(e)
+                                    .step_by(nd)
+                                    .zip(b.iter().skip(e).step_by(nd)),
+                            )
+                            .map(|(m, (x, y))| m * (x + y))
+                            .sum()
+                    };
+                    *tk = -column(k, dgx) / (omega * omega);
+                    *tc = -column(c, dgv) / omega;
                 }
             }
         }

@@ -48,6 +48,11 @@ pub fn matmul(a: &[f64], b: &[f64], dim: usize, c: &mut [f64]) {
 
 /// [`matmul`] for a compile-time size `N` on slices of `N²` entries.
 fn matmul_fixed<const N: usize>(a: &[f64], b: &[f64], c: &mut [f64]) {
+    // Re-sliced to the compile-time length N², so that the loops below unroll
+    // (`matmul` has checked the lengths; a short slice is left untouched).
+    let (Some(a), Some(b), Some(c)) = (a.get(..N * N), b.get(..N * N), c.get_mut(..N * N)) else {
+        return;
+    };
     for (ci, ai) in c.chunks_exact_mut(N).zip(a.chunks_exact(N)) {
         ci.fill(0.0);
         for (&aik, bk) in ai.iter().zip(b.chunks_exact(N)) {
