@@ -15,7 +15,7 @@
 //! Eq. 68–77) on `[R(q, ω; μ); b₁] = 0` with unknowns `{q, ω, μ}`.
 
 use crate::broyden::{BroydenStats, SolveError};
-use crate::continuation::{follow_residual, ContinuationOptions, Termination};
+use crate::continuation::{follow_residual, ContinuationOptions, PathPoint, Termination};
 use crate::floquet::HsuRule;
 use crate::galerkin::GalerkinJacobian;
 use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
@@ -81,6 +81,26 @@ where
     P: PeriodicProblem,
     F: Fn(f64) -> P,
 {
+    let span = (mu_from, mu_to);
+    limit_cycle_leg(family, hb, start, span, opts, stability_steps, |_| true)
+}
+
+/// [`limit_cycle_branch`] handing each path point `{q, ω, μ}` to
+/// `on_point` as it arrives (`false` stops the path): the hook of an
+/// observer ([`crate::cycle_branch`]'s fold events).
+pub(crate) fn limit_cycle_leg<P, F>(
+    family: F,
+    hb: &HbOptions,
+    start: &LimitCycle,
+    (mu_from, mu_to): (f64, f64),
+    opts: &ContinuationOptions,
+    stability_steps: usize,
+    on_point: impl FnMut(&PathPoint) -> bool,
+) -> Result<LimitCycleBranch, HbError>
+where
+    P: PeriodicProblem,
+    F: Fn(f64) -> P,
+{
     if !(mu_from.is_finite() && mu_to.is_finite() && mu_from != mu_to) {
         return Err(HbError::InvalidInput(
             "parameter bounds must be finite and distinct".into(),
@@ -108,7 +128,7 @@ where
             }
             _ => r.fill(f64::NAN),
         };
-    let path = follow_residual(residual, &x0, None, mu_to - mu_from, &copts, |_| true)?;
+    let path = follow_residual(residual, &x0, None, mu_to - mu_from, &copts, on_point)?;
     let mut points = Vec::with_capacity(path.points.len());
     for p in &path.points {
         let mu = p.lambda();

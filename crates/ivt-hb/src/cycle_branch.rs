@@ -2,21 +2,22 @@
 //! (issue 27, item 2): [`cycle_branch`] finds the Hopf points of the
 //! equilibria of an autonomous family ([`crate::hopf`]), starts the cycle
 //! branch from the first one by its normal form, and follows it with
-//! [`limit_cycle_branch`] (HB with ω unknown and the phase condition b₁ = 0,
-//! Eq. 61, pseudo-arclength Eq. 68–77) with Floquet stability at every point;
-//! its folds (turning points in p) are located by Newton on the fold system
-//! of the cycle equations ([`locate_fold`]).
+//! [`crate::limit_cycle_branch`] (HB with ω unknown and the phase condition
+//! b₁ = 0, Eq. 61, pseudo-arclength Eq. 68–77) with Floquet stability at every
+//! point; its folds (turning points in p) are located as the points arrive,
+//! by the [`Fold`] detector: Newton on the fold system of the cycle equations
+//! ([`crate::locate_fold`]).
 //!
 //! The start: with the normal form `ż = (β(p) + iω) z + c₁ z|z|²`
 //! (`β = Re λ`, `l₁ = Re c₁/ω`) the cycle at p has `|z|² = −β/(ω l₁)` and
 //! `y(t) ≈ y* + 2 Re(z e^{iωt} q)`, on the side of p where `−β/l₁ > 0`; it is
 //! taken at `p_H ± offset·|p_to − p_from|` and refined by [`limit_cycle`].
 
-use crate::autonomous::{limit_cycle, limit_cycle_branch, LimitCycle};
+use crate::autonomous::{limit_cycle, limit_cycle_leg, LimitCycle};
 use crate::branch::Branch;
-use crate::continuation::{ContinuationOptions, Termination};
+use crate::continuation::{ContinuationOptions, PathPoint, Termination};
 use crate::error::HbError;
-use crate::events::{locate_fold, LocateOptions};
+use crate::events::{BifurcationKind, EventObserver, Fold, LocateOptions, Observer};
 use crate::galerkin::GalerkinJacobian;
 use crate::hopf::{equilibrium, hopf_points, Field, HopfPoint};
 use crate::ihb::{HbOptions, HbResidual, HbSolution};
@@ -112,17 +113,35 @@ where
     let (lo, hi) = (p_from.min(p_to), p_from.max(p_to));
     let (p_start, start) = start_cycle(&family, hb, first, opts.offset * (hi - lo), opts)?;
     let member = |p: f64| Member::new(family(p).ok(), n_dof);
+    // Each fold (a turn in p) is located as the points arrive: the [`Fold`]
+    // detector on the cycle equations ([`CycleSystem`], unknowns {q, ω}).
+    let mut system = CycleSystem::new(&member, hb, p_start)?;
+    let mut observer =
+        EventObserver::without_multipliers(&LocateOptions::fold(), vec![Box::new(Fold)]);
+    let (mut events, mut failure) = (Vec::new(), None);
+    let mut watch = |p: &PathPoint| match observer.on_point(&mut system, p) {
+        Ok(found) => {
+            events.extend(found);
+            true
+        }
+        Err(e) => {
+            failure = Some(e);
+            false
+        }
+    };
     // First away from the Hopf point; if the branch turns back past the
     // start, on to the other end.
     let far = if p_start > first.p { hi } else { lo };
-    let leg = limit_cycle_branch(
+    let steps = opts.stability_steps;
+    let span = (p_start, far);
+    let leg = limit_cycle_leg(
         member,
         hb,
         &start,
-        p_start,
-        far,
+        span,
         &opts.continuation,
-        opts.stability_steps,
+        steps,
+        &mut watch,
     )?;
     out.points = leg.points;
     out.termination = Some(leg.termination);
@@ -130,21 +149,45 @@ where
     if let Some((p_last, cycle)) = back {
         let other = if far == hi { lo } else { hi };
         if (p_last - p_start).abs() < (p_last - far).abs() && p_last != other {
-            let leg = limit_cycle_branch(
+            // The leg's first point is the last one observed.
+            let mut joined = false;
+            let on_point = |p: &PathPoint| !std::mem::replace(&mut joined, true) || watch(p);
+            let span = (p_last, other);
+            let leg = limit_cycle_leg(
                 member,
                 hb,
                 &cycle,
-                p_last,
-                other,
+                span,
                 &opts.continuation,
-                opts.stability_steps,
+                steps,
+                on_point,
             )?;
             out.points.extend(leg.points.into_iter().skip(1));
             out.termination = Some(leg.termination);
         }
     }
-    let mut system = CycleSystem::new(&member, hb, p_start)?;
-    out.folds = locate_folds(&mut system, &out.points);
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    events.extend(observer.finish(&mut system)?);
+    events.sort_by_key(|e| e.index);
+    out.folds = events
+        .into_iter()
+        .filter(|e| e.kind == BifurcationKind::Fold)
+        .filter_map(|e| {
+            let fold = e.location.ok()?;
+            // The fold's unknowns are `[q; ω]`.
+            let (&omega_f, q) = fold.q.split_last()?;
+            let solution = HbSolution {
+                coeffs: q.to_vec(),
+                omega_f,
+                harmonics: hb.harmonics,
+                subharmonic: 1,
+                stats: BroydenStats::default(),
+            };
+            Some((fold.lambda, solution))
+        })
+        .collect();
     out.at = cycles_at(&member, hb, &out.points, &opts.at, opts.stability_steps);
     Ok(out)
 }
@@ -203,40 +246,6 @@ where
     Err(HbError::InvalidInput(
         "no side of the Hopf point has cycles (l₁ = 0 or β does not change sign)".into(),
     ))
-}
-
-/// The folds of the branch `points` (where p turns), each located by
-/// [`locate_fold`] from the turning point; a failed location is left out.
-fn locate_folds<B: Branch>(system: &mut B, points: &[(f64, LimitCycle)]) -> Vec<(f64, HbSolution)> {
-    let mut folds = Vec::new();
-    for w in points.windows(3) {
-        let [(a, _), (b, turning), (c, _)] = w else {
-            continue;
-        };
-        if (b - a) * (c - b) >= 0.0 {
-            continue;
-        }
-        let sol = &turning.solution;
-        let mut u = sol.coeffs.clone();
-        u.push(sol.omega_f);
-        let located = locate_fold(system, &u, *b, &LocateOptions::fold());
-        // The fold's unknowns are `[q; ω]`.
-        if let Some((f, (&omega_f, q))) = located
-            .as_ref()
-            .ok()
-            .and_then(|f| Some((f, f.q.split_last()?)))
-        {
-            let solution = HbSolution {
-                coeffs: q.to_vec(),
-                omega_f,
-                harmonics: sol.harmonics,
-                subharmonic: 1,
-                stats: BroydenStats::default(),
-            };
-            folds.push((f.lambda, solution));
-        }
-    }
-    folds
 }
 
 /// The cycles at each p of `at` where the branch crosses it, by

@@ -7,10 +7,9 @@
 //! between two points), started from the path point nearest the turn.
 
 use crate::aft::Aft;
-use crate::continuation::{turn_estimate, ContinuationOptions, Corrector, Path, Step, Termination};
+use crate::continuation::{ContinuationOptions, Corrector, Termination};
 use crate::events::{
-    locate_fold, BifurcationKind, Detector, Event, EventObserver, Fold, LocateOptions, Observer,
-    Trace,
+    observe, BifurcationKind, Detector, EventObserver, Fold, LocateOptions, Trace,
 };
 use crate::family::{FamilyBranch, Frequency};
 use crate::ihb::{HbError, HbOptions, HbSolution};
@@ -147,12 +146,12 @@ pub fn frequency_response<P: PeriodicProblem>(
     // is the point's (a Newton-corrected point, or every point without the
     // second-order predictor), its ∂g samples serve Hsu's level of the same
     // grid without another evaluation of g; a fold is located once the
-    // point after its start has arrived.
-    let detectors: Vec<Box<dyn Detector<Frequency<'_, P>>>> = vec![Box::new(Fold::position_only())];
+    // point after its start has arrived, or from the last point when the
+    // path ends there.
+    let detectors: Vec<Box<dyn Detector<FamilyBranch<Frequency<'_, P>>>>> = vec![Box::new(Fold)];
     let locate = LocateOptions::fold();
     let mut observer =
         EventObserver::with_detectors(&family, opts.from, opts.stability, &locate, detectors)?;
-    let (mut events, mut turns) = (Vec::new(), Vec::new());
     let mut stepper = family.stepper(
         &x0,
         start.stats.iterations,
@@ -160,62 +159,21 @@ pub fn frequency_response<P: PeriodicProblem>(
         &copts,
         opts.corrector,
     )?;
-    let termination = loop {
-        match stepper.next() {
-            Step::Point(p) => {
-                turns.extend(stepper.fold());
-                events.extend(observer.on_point(stepper.branch(), &p)?);
-            }
-            Step::Stop(t) => break t,
-        }
-    };
-    // A turn at the path's last point has no point after it to start its
-    // locator: it stays unlocated, at the stepper's estimate.
-    for turn in &turns {
-        if !events.iter().any(|e| e.index == turn.index) {
-            events.push(Event {
-                kind: BifurcationKind::Fold,
-                index: turn.index,
-                location: Err(HbError::InvalidInput("the path ended at the turn".into()).into()),
-            });
-        }
-    }
-    events.sort_by_key(|e| e.index);
+    let (path, events) = observe(&mut stepper, &mut observer, |_, _| true)?;
     let trace = Trace {
         points: observer.into_points(),
         events,
-        termination,
+        termination: path.termination,
     };
     // A fold that could not be located keeps the parabola's ω_f through the
     // three points around its turn (the stepper's estimate).
-    let estimate = |index: usize| turns.iter().find(|t| t.index == index).map(|t| t.lambda);
+    let estimate = |index: usize| {
+        path.folds
+            .iter()
+            .find(|t| t.index == index)
+            .map(|t| t.lambda)
+    };
     Frc::assemble(&trace, hb, estimate)
-}
-
-/// Each fold of `path` located by [`locate_fold`] (Newton on the extended
-/// system) from the quadratic through the three path points around the turn
-/// ([`turn_estimate`]): the fold orbit and its λ, or `None` where Newton did
-/// not converge (or the turn has no three points around it). One entry per
-/// `path.folds`, in order; shared by [`frequency_response`] and
-/// [`crate::condense::condensed_response`].
-pub(crate) fn locate_turns<B: crate::branch::Branch>(
-    branch: &mut B,
-    path: &Path,
-) -> Vec<Option<(Vec<f64>, f64)>> {
-    let m = branch.len();
-    path.folds
-        .iter()
-        .map(|turn| {
-            let [a, b, c] = path.points.get(turn.bracket..turn.bracket + 3)? else {
-                return None;
-            };
-            let start = turn_estimate(a, b, c);
-            let (q0, lambda0) = (start.get(..m)?, *start.get(m)?);
-            locate_fold(branch, q0, lambda0, &LocateOptions::fold())
-                .ok()
-                .map(|f| (f.q, f.lambda))
-        })
-        .collect()
 }
 
 impl Frc {

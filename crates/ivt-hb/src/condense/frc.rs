@@ -1,7 +1,8 @@
 //! Frequency-response curves of a condensed structure: the exact-Jacobian
 //! pseudo-arclength continuation (Eq. 68–77, [`NewtonCorrector`]) of
-//! [`CondensedBranch`] in ω_f, each fold located by Newton on the extended
-//! system ([`locate_fold`]) of the condensed Jacobian, any DOF recovered per
+//! [`CondensedBranch`] in ω_f, each fold located as the points arrive by
+//! Newton on the extended system ([`crate::locate_fold`]) of the condensed
+//! Jacobian, any DOF recovered per
 //! point, and per point the estimated errors of the linear solves and of the
 //! harmonic truncation.
 
@@ -15,7 +16,8 @@ use crate::continuation::{
     correct_at_fixed_lambda, ContinuationOptions, NewtonCorrector, Stepper, Termination,
 };
 use crate::error::HbError;
-use crate::frc::{locate_turns, FrcFold};
+use crate::events::{observe, BifurcationKind, EventObserver, Fold, LocateOptions};
+use crate::frc::FrcFold;
 use crate::problem::PeriodicProblem;
 use crate::stability::HsuSteps;
 
@@ -168,66 +170,75 @@ pub fn condensed_response<P: PeriodicProblem>(
     let direction = if opts.to > opts.from { 1.0 } else { -1.0 };
     let mut points = Vec::new();
     let mut failed = None;
-    let path = {
-        let m_len = scaled.len();
-        Stepper::new(
-            &mut scaled,
-            Box::new(NewtonCorrector::new(m_len, &copts)),
-            &x,
-            its,
-            direction,
-            &copts,
-        )?
-        .run(|sc, p| {
-            let (q, omega_f) = sc.physical(p.x.get(..m).unwrap_or_default(), p.lambda());
-            let point = probe.point(
-                sc.branch,
-                &q,
-                omega_f,
-                opts.truncation_estimate,
-                stability.as_mut(),
-            );
-            match point {
-                Ok(point) => {
-                    points.push(point);
-                    true
-                }
-                Err(e) => {
-                    failed = Some(e);
-                    false
-                }
+    // Each fold is located as the points arrive ([`EventObserver`] with the
+    // [`Fold`] detector, Newton on the extended system of the scaled
+    // branch), from the path point nearest the turn.
+    let mut observer =
+        EventObserver::without_multipliers(&LocateOptions::fold(), vec![Box::new(Fold)]);
+    let m_len = scaled.len();
+    let mut stepper = Stepper::new(
+        &mut scaled,
+        Box::new(NewtonCorrector::new(m_len, &copts)),
+        &x,
+        its,
+        direction,
+        &copts,
+    )?;
+    let (path, events) = observe(&mut stepper, &mut observer, |sc, p| {
+        let (q, omega_f) = sc.physical(p.x.get(..m).unwrap_or_default(), p.lambda());
+        let point = probe.point(
+            sc.branch,
+            &q,
+            omega_f,
+            opts.truncation_estimate,
+            stability.as_mut(),
+        );
+        match point {
+            Ok(point) => {
+                points.push(point);
+                true
             }
-        })
-    };
-    let located = locate_turns(&mut scaled, &path);
+            Err(e) => {
+                failed = Some(e);
+                false
+            }
+        }
+    })?;
+    drop(stepper);
     let branch = scaled.branch;
     if let Some(e) = failed.or_else(|| branch.take_failure().filter(|_| points.is_empty())) {
         return Err(e);
     }
-    let mut folds = Vec::with_capacity(path.folds.len());
-    for (turn, located) in path.folds.iter().zip(located) {
-        let fold = match located {
-            Some((q, lambda)) => {
-                let coeffs: Vec<f64> = q.iter().map(|v| v * q_scale).collect();
-                let omega_f = opts.from + lambda * width;
+    let mut folds = Vec::with_capacity(events.len());
+    for event in events.iter().filter(|e| e.kind == BifurcationKind::Fold) {
+        let fold = match &event.location {
+            Ok(located) => {
+                let coeffs: Vec<f64> = located.q.iter().map(|v| v * q_scale).collect();
+                let omega_f = opts.from + located.lambda * width;
                 CondensedFold {
-                    index: turn.index,
+                    index: event.index,
                     omega_f,
                     amplitude: probe.amplitude(branch, &coeffs, omega_f)?,
                     coeffs,
                     located: true,
                 }
             }
-            None => match points.get(turn.index) {
-                Some(near) => CondensedFold {
-                    index: turn.index,
-                    omega_f: opts.from + turn.lambda * width,
-                    amplitude: near.amplitude,
-                    coeffs: near.coeffs.clone(),
-                    located: false,
-                },
-                None => continue,
-            },
+            // Not located: the parabola's ω_f through the three points
+            // around the turn (the stepper's estimate) and the nearest
+            // point's orbit.
+            Err(_) => {
+                let turn = path.folds.iter().find(|t| t.index == event.index);
+                match (points.get(event.index), turn) {
+                    (Some(near), Some(turn)) => CondensedFold {
+                        index: event.index,
+                        omega_f: opts.from + turn.lambda * width,
+                        amplitude: near.amplitude,
+                        coeffs: near.coeffs.clone(),
+                        located: false,
+                    },
+                    _ => continue,
+                }
+            }
         };
         folds.push(fold);
     }

@@ -28,6 +28,6 @@ pub fn follow_residual<F: FnMut(&[f64], &mut [f64])>(
     let m = start.len().saturating_sub(1);
     let mut branch = ResidualBranch::new(m, residual);
     let corrector = Box::new(BroydenCorrector::new(m, &opts.broyden, jac0));
-    let stepper = Stepper::new(&mut branch, corrector, start, 0, direction, opts)?;
+    let mut stepper = Stepper::new(&mut branch, corrector, start, 0, direction, opts)?;
     Ok(stepper.run(|_, p| on_point(p)))
 }

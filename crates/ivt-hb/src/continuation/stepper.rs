@@ -144,7 +144,7 @@ impl<'b, B: Branch> Stepper<'b, B> {
 
     /// Follows the path to its end, `on_point(branch, point)` called with
     /// each point as it arrives (`false` stops the path).
-    pub fn run(mut self, mut on_point: impl FnMut(&mut B, &PathPoint) -> bool) -> Path {
+    pub fn run(&mut self, mut on_point: impl FnMut(&mut B, &PathPoint) -> bool) -> Path {
         let (mut points, mut folds) = (Vec::new(), Vec::new());
         let termination = loop {
             match self.next() {

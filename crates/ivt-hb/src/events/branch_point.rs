@@ -240,7 +240,7 @@ impl BranchPoint {
     }
 }
 
-impl<F: Family> Detector<F> for BranchPoint {
+impl<F: Family> Detector<FamilyBranch<F>> for BranchPoint {
     fn kind(&self) -> BifurcationKind {
         BifurcationKind::BranchPoint
     }
@@ -257,7 +257,7 @@ impl<F: Family> Detector<F> for BranchPoint {
     }
 
     /// From the start point along the secant to the next point.
-    fn locate(&mut self, at: Start<'_, F>) -> Result<Bifurcation, BifurcationError> {
+    fn locate(&mut self, at: Start<'_, FamilyBranch<F>>) -> Result<Bifurcation, BifurcationError> {
         let (q, lambda) = at.point()?;
         let t = at.path.secant(at.index).ok_or_else(|| {
             HbError::InvalidInput(format!("no secant out of path point {}", at.index))

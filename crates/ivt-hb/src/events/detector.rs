@@ -3,8 +3,8 @@
 //! evaluated at each accepted path point and a locator (Newton on a minimally
 //! extended system, Govaerts' bordering) started where the test changes sign.
 
+use crate::branch::Branch;
 use crate::continuation::PathPoint;
-use crate::family::{Family, FamilyBranch};
 use crate::ihb::HbError;
 use crate::stability::StabilityKind;
 use faer::c64;
@@ -176,21 +176,28 @@ pub struct Event {
     pub location: Result<Bifurcation, BifurcationError>,
 }
 
-/// Watches a path as its points arrive (as BifurcationKit's event
-/// detection does): called once per accepted point, in path order, it
-/// returns the events that point completes, already located.
-pub trait Observer<F: Family> {
+/// Watches a path of a [`Branch`] as its points arrive (as BifurcationKit's
+/// event detection does): called once per accepted point, in path order, it
+/// returns the events that point completes, already located; when the path
+/// ends, [`Observer::finish`] locates the events still waiting for a point.
+pub trait Observer<B: Branch> {
     /// Takes the newest accepted `point` of the path followed on `branch`.
     ///
     /// # Errors
     /// A failure that ends the observation (e.g. the point's multipliers);
     /// an event that cannot be located is not one, it carries its error in
     /// [`Event::location`].
-    fn on_point(
-        &mut self,
-        branch: &mut FamilyBranch<F>,
-        point: &PathPoint,
-    ) -> Result<Vec<Event>, HbError>;
+    fn on_point(&mut self, branch: &mut B, point: &PathPoint) -> Result<Vec<Event>, HbError>;
+
+    /// The path has ended: the events bracketed but not yet located (their
+    /// start is the last point, no point after it will come), located from
+    /// the points there are. Default: none.
+    ///
+    /// # Errors
+    /// As [`Observer::on_point`].
+    fn finish(&mut self, _branch: &mut B) -> Result<Vec<Event>, HbError> {
+        Ok(Vec::new())
+    }
 }
 
 /// The path as far as it has arrived, as the detectors see it: each accepted
@@ -242,19 +249,20 @@ impl PathSoFar {
     }
 }
 
-/// One kind of event on a branch of a [`Family`]: a test function evaluated
+/// One kind of event on a [`Branch`]: a test function evaluated
 /// at every accepted point, whose sign change between two consecutive points
 /// brackets the event, and the locator started there. Adding an event is one
 /// file implementing this trait; [`crate::trace`] runs every detector as the
-/// points arrive.
-pub trait Detector<F: Family> {
+/// points arrive. The fold needs the branch alone; the events of the Floquet
+/// multipliers implement it for [`crate::FamilyBranch`] only.
+pub trait Detector<B: Branch> {
     /// The kind located.
     fn kind(&self) -> BifurcationKind;
 
     /// The test function at point `k` of `path` (`k` < `path.len()`; it may
     /// use the points before and, for `k = 0`, the point after). Called once
     /// per point; a zero or NaN never brackets an event.
-    fn test(&mut self, branch: &mut FamilyBranch<F>, path: &PathSoFar, k: usize) -> f64;
+    fn test(&mut self, branch: &mut B, path: &PathSoFar, k: usize) -> f64;
 
     /// The sign changed between the two newest points: the index of the
     /// locator's start, or `None` when this is no event of the kind (yet).
@@ -268,14 +276,15 @@ pub trait Detector<F: Family> {
     /// # Errors
     /// Sizes, a singular extended system or non-convergence of its Newton
     /// iteration (with the residual history); per kind as documented there.
-    fn locate(&mut self, at: Start<'_, F>) -> Result<Bifurcation, BifurcationError>;
+    fn locate(&mut self, at: Start<'_, B>) -> Result<Bifurcation, BifurcationError>;
 }
 
 /// Where a locator starts: the branch, the path so far, the index of the
-/// start point (`index + 1` < `path.len()`) and the options.
-pub struct Start<'a, F: Family> {
+/// start point (`index` < `path.len()`: the point after it, when the path
+/// has one, has arrived) and the options.
+pub struct Start<'a, B: Branch> {
     /// The branch followed.
-    pub branch: &'a mut FamilyBranch<F>,
+    pub branch: &'a mut B,
     /// The path so far.
     pub path: &'a PathSoFar,
     /// The start point.
@@ -284,7 +293,7 @@ pub struct Start<'a, F: Family> {
     pub opts: &'a LocateOptions,
 }
 
-impl<'a, F: Family> Start<'a, F> {
+impl<'a, B: Branch> Start<'a, B> {
     /// The start point `(q, λ)`.
     ///
     /// # Errors

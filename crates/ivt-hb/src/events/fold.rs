@@ -26,6 +26,7 @@ use crate::broyden::SolveError;
 use crate::continuation::turn;
 use crate::family::{Family, FamilyBranch};
 use crate::ihb::HbError;
+use faer::c64;
 use ivt_num::vector::norm2;
 use ivt_num::{newton, BorderedLu, LuWorkspace, NewtonSystem, NewtonWorkspace};
 use std::convert::Infallible;
@@ -222,39 +223,42 @@ impl<B: Branch> NewtonSystem for FoldSystem<'_, B> {
     }
 }
 
-/// The fold event of a traced path: the λ component of the secant into each
-/// point ([`crate::PathPoint::dlambda`]) changes sign; the locator starts from
-/// the point nearest the turn of the parabola through the three points around
-/// it ([`crate::continuation::turn_estimate`]).
-#[derive(Debug, Clone, Copy)]
-pub struct Fold {
-    /// Whether a located fold carries its multipliers.
-    multipliers: bool,
-}
-
-impl Default for Fold {
-    /// [`Fold::new`].
-    fn default() -> Self {
-        Self::new()
-    }
-}
+/// The fold event of a path on any [`Branch`]: the λ component of the secant
+/// into each point ([`crate::PathPoint::dlambda`]) changes sign; the locator
+/// ([`locate_fold`], step tolerance at most 1e-12) starts from the point
+/// nearest the turn of the parabola through the three points around it
+/// ([`crate::continuation::turn_estimate`]). A located fold is its orbit and
+/// λ alone; [`FamilyFold`] adds the multipliers there.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Fold;
 
 impl Fold {
-    /// The detector of [`crate::trace`]: each located fold with its
-    /// multipliers (Hsu, `LocateOptions::stability_steps`).
-    pub fn new() -> Self {
-        Self { multipliers: true }
-    }
-
-    /// The detector of a curve whose points carry their own multipliers
-    /// ([`crate::frequency_response`]): each located fold is its orbit and λ
-    /// alone (no monodromy at the fold).
-    pub fn position_only() -> Self {
-        Self { multipliers: false }
+    /// [`locate_fold`] from the start point of `at`, as a [`Bifurcation`]
+    /// with `multipliers`' of the located orbit.
+    fn locate_with<B: Branch>(
+        at: Start<'_, B>,
+        multipliers: impl FnOnce(&mut B, &[f64], f64, &LocateOptions) -> Result<Vec<c64>, HbError>,
+    ) -> Result<Bifurcation, BifurcationError> {
+        let (q, lambda) = at.point()?;
+        let (branch, opts) = (at.branch, at.opts);
+        let fold_opts = LocateOptions {
+            step_tol: opts.step_tol.min(FOLD_STEP_TOL),
+            ..opts.clone()
+        };
+        let f = locate_fold(branch, q, lambda, &fold_opts)?;
+        let multipliers = multipliers(branch, &f.q, f.lambda, opts)?;
+        Ok(finish(
+            branch,
+            BifurcationKind::Fold,
+            (f.q, f.lambda),
+            multipliers,
+            Vec::new(),
+            f.iterations,
+        ))
     }
 }
 
-impl<F: Family> Detector<F> for Fold {
+impl<B: Branch> Detector<B> for Fold {
     fn kind(&self) -> BifurcationKind {
         BifurcationKind::Fold
     }
@@ -267,34 +271,41 @@ impl<F: Family> Detector<F> for Fold {
         Some(k + turn(a, b, c).1)
     }
 
-    fn test(&mut self, _branch: &mut FamilyBranch<F>, path: &PathSoFar, k: usize) -> f64 {
+    fn test(&mut self, _branch: &mut B, path: &PathSoFar, k: usize) -> f64 {
         path.points.get(k).map_or(f64::NAN, |p| p.dlambda)
     }
 
-    /// [`locate_fold`] with a step tolerance of at most 1e-12,
-    /// then the multipliers there (unless [`Fold::position_only`]).
-    fn locate(&mut self, at: Start<'_, F>) -> Result<Bifurcation, BifurcationError> {
-        let (q, lambda) = at.point()?;
-        let (branch, opts) = (at.branch, at.opts);
-        let fold_opts = LocateOptions {
-            step_tol: opts.step_tol.min(FOLD_STEP_TOL),
-            ..opts.clone()
-        };
-        let f = locate_fold(branch, q, lambda, &fold_opts)?;
-        let multipliers = if self.multipliers {
-            let mut mono = Monodromy::new(branch, f.lambda, opts.stability_steps)?;
-            mono.multipliers(branch, &f.q, f.lambda)
-        } else {
-            Vec::new()
-        };
-        Ok(finish(
-            branch,
-            BifurcationKind::Fold,
-            (f.q, f.lambda),
-            multipliers,
-            Vec::new(),
-            f.iterations,
-        ))
+    /// [`locate_fold`] with a step tolerance of at most 1e-12.
+    fn locate(&mut self, at: Start<'_, B>) -> Result<Bifurcation, BifurcationError> {
+        Self::locate_with(at, |_, _, _, _| Ok(Vec::new()))
+    }
+}
+
+/// The [`Fold`] of a [`Family`] branch with the multipliers of the located
+/// fold (Hsu, `LocateOptions::stability_steps`): the fold detector of
+/// [`crate::trace`].
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FamilyFold;
+
+impl<F: Family> Detector<FamilyBranch<F>> for FamilyFold {
+    fn kind(&self) -> BifurcationKind {
+        BifurcationKind::Fold
+    }
+
+    fn start(&self, path: &PathSoFar) -> Option<usize> {
+        <Fold as Detector<FamilyBranch<F>>>::start(&Fold, path)
+    }
+
+    fn test(&mut self, branch: &mut FamilyBranch<F>, path: &PathSoFar, k: usize) -> f64 {
+        Fold.test(branch, path, k)
+    }
+
+    /// [`Fold`]'s location, then the multipliers there.
+    fn locate(&mut self, at: Start<'_, FamilyBranch<F>>) -> Result<Bifurcation, BifurcationError> {
+        Fold::locate_with(at, |branch, q, lambda, opts| {
+            let mut mono = Monodromy::new(branch, lambda, opts.stability_steps)?;
+            Ok(mono.multipliers(branch, q, lambda))
+        })
     }
 }
 

@@ -35,11 +35,11 @@ pub use detector::{
     Bifurcation, BifurcationError, BifurcationKind, Detector, Event, LocateOptions, Observer,
     PathSoFar, Start, TracedPoint,
 };
-pub use fold::{locate_fold, Fold, FoldLocation};
-pub use multipliers::Multipliers;
+pub use fold::{locate_fold, FamilyFold, Fold, FoldLocation};
+pub use multipliers::{Multipliers, PointMultipliers};
 pub use neimark_sacker::NeimarkSacker;
 pub use period_doubling::PeriodDoubling;
-pub use trace::{trace, EventObserver, Trace, TraceOptions};
+pub use trace::{observe, trace, EventObserver, Trace, TraceOptions};
 
 use crate::family::{Family, FamilyBranch};
 use crate::ihb::HbError;

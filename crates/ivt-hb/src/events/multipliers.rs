@@ -29,19 +29,29 @@ impl Multipliers {
     pub fn new(hsu: AdaptiveHsu) -> Self {
         Self { hsu }
     }
+}
 
-    /// The arrived `point` with its multipliers. Where the branch's last
-    /// Galerkin assembly is the point's, Hsu takes its `∂g` samples
+/// What gives each arriving point of a branch `B` its Floquet multipliers:
+/// the optional part of an [`super::EventObserver`] (a branch without Hsu
+/// multipliers — the STHB string, a condensed structure — runs its detectors
+/// without one).
+pub trait PointMultipliers<B> {
+    /// The arrived `point` with its multipliers.
+    ///
+    /// # Errors
+    /// The monodromy's failure; [`HbError::InvalidInput`] for an empty point.
+    fn at(&mut self, branch: &B, point: &PathPoint) -> Result<TracedPoint, HbError>;
+}
+
+impl<F: Family> PointMultipliers<FamilyBranch<F>> for Multipliers {
+    /// Hsu's monodromy of the point: where the branch's last Galerkin
+    /// assembly is the point's, Hsu takes its `∂g` samples
     /// ([`FamilyBranch::jacobian_samples_at`]).
     ///
     /// # Errors
     /// As [`AdaptiveHsu::floquet_with_samples`]; [`HbError::InvalidInput`]
     /// for an empty point.
-    pub fn at<F: Family>(
-        &mut self,
-        branch: &FamilyBranch<F>,
-        point: &PathPoint,
-    ) -> Result<TracedPoint, HbError> {
+    fn at(&mut self, branch: &FamilyBranch<F>, point: &PathPoint) -> Result<TracedPoint, HbError> {
         let Some((&lambda, q)) = point.x.split_last() else {
             return Err(HbError::InvalidInput("empty path point".into()));
         };

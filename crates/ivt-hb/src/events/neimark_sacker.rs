@@ -79,7 +79,7 @@ pub(crate) fn locate_neimark_sacker<F: Family>(
     Ok(found)
 }
 
-impl<F: Family> Detector<F> for NeimarkSacker {
+impl<F: Family> Detector<FamilyBranch<F>> for NeimarkSacker {
     fn kind(&self) -> BifurcationKind {
         BifurcationKind::NeimarkSacker
     }
@@ -95,7 +95,7 @@ impl<F: Family> Detector<F> for NeimarkSacker {
         pair.iter().any(complex).then_some(k)
     }
 
-    fn locate(&mut self, at: Start<'_, F>) -> Result<Bifurcation, BifurcationError> {
+    fn locate(&mut self, at: Start<'_, FamilyBranch<F>>) -> Result<Bifurcation, BifurcationError> {
         locate_neimark_sacker(at.branch, at.point()?, at.opts)
     }
 }

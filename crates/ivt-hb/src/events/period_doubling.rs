@@ -28,7 +28,7 @@ fn indicator(mu: &[c64]) -> f64 {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct PeriodDoubling;
 
-impl<F: Family> Detector<F> for PeriodDoubling {
+impl<F: Family> Detector<FamilyBranch<F>> for PeriodDoubling {
     fn kind(&self) -> BifurcationKind {
         BifurcationKind::PeriodDoubling
     }
@@ -37,7 +37,7 @@ impl<F: Family> Detector<F> for PeriodDoubling {
         path.multipliers(k).map_or(f64::NAN, indicator)
     }
 
-    fn locate(&mut self, at: Start<'_, F>) -> Result<Bifurcation, BifurcationError> {
+    fn locate(&mut self, at: Start<'_, FamilyBranch<F>>) -> Result<Bifurcation, BifurcationError> {
         let (q, lambda) = at.point()?;
         let kind = (BifurcationKind::PeriodDoubling, shifted_monodromy as _);
         locate_crossing(at.branch, kind, q, lambda, at.opts)

@@ -8,12 +8,12 @@ use super::branch_point::BranchPoint;
 use super::detector::{
     BifurcationError, Detector, Event, LocateOptions, Observer, PathSoFar, Start, TracedPoint,
 };
-use super::fold::Fold;
-use super::multipliers::Multipliers;
+use super::fold::FamilyFold;
+use super::multipliers::{Multipliers, PointMultipliers};
 use super::neimark_sacker::NeimarkSacker;
 use super::period_doubling::PeriodDoubling;
 use crate::branch::Branch;
-use crate::continuation::{ContinuationOptions, Corrector, PathPoint, Step, Termination};
+use crate::continuation::{ContinuationOptions, Corrector, Path, PathPoint, Stepper, Termination};
 use crate::family::{Family, FamilyBranch};
 use crate::ihb::HbError;
 use crate::stability::{AdaptiveHsu, HsuSteps};
@@ -58,11 +58,14 @@ pub struct Trace {
     pub termination: Termination,
 }
 
-/// The observer of [`trace`]: the multipliers of each point, then fold,
-/// period doubling, Neimark–Sacker and branch point as detectors.
-pub struct EventObserver<F: Family> {
-    multipliers: Multipliers,
-    detectors: Vec<Box<dyn Detector<F>>>,
+/// The observer of a path on a branch `B`: the multipliers of each point
+/// (optional: [`EventObserver::new`] and [`EventObserver::with_detectors`]
+/// on a [`Family`] branch), then its detectors — on a [`Family`] branch by
+/// default fold, period doubling, Neimark–Sacker and branch point; on any
+/// [`Branch`] the [`Fold`](super::Fold) ([`EventObserver::without_multipliers`]).
+pub struct EventObserver<B> {
+    multipliers: Option<Box<dyn PointMultipliers<B>>>,
+    detectors: Vec<Box<dyn Detector<B>>>,
     /// Each detector's test at the newest point.
     tests: Vec<f64>,
     /// Brackets waiting for the point after their start: (detector, start).
@@ -73,7 +76,7 @@ pub struct EventObserver<F: Family> {
     opts: LocateOptions,
 }
 
-impl<F: Family> EventObserver<F> {
+impl<F: Family> EventObserver<FamilyBranch<F>> {
     /// The observer of a path of `branch` from `lambda0`: multipliers with
     /// `stability`, every event located with `opts`.
     ///
@@ -85,8 +88,8 @@ impl<F: Family> EventObserver<F> {
         stability: HsuSteps,
         opts: &LocateOptions,
     ) -> Result<Self, HbError> {
-        let detectors: Vec<Box<dyn Detector<F>>> = vec![
-            Box::new(Fold::new()),
+        let detectors: Vec<Box<dyn Detector<FamilyBranch<F>>>> = vec![
+            Box::new(FamilyFold),
             Box::new(PeriodDoubling),
             Box::new(NeimarkSacker),
             Box::new(BranchPoint::new(opts)),
@@ -95,7 +98,7 @@ impl<F: Family> EventObserver<F> {
     }
 
     /// The observer of [`EventObserver::new`] running `detectors` only (e.g.
-    /// the frequency response's [`Fold::position_only`]).
+    /// the frequency response's [`Fold`](super::Fold)).
     ///
     /// # Errors
     /// As [`AdaptiveHsu::new`].
@@ -104,39 +107,69 @@ impl<F: Family> EventObserver<F> {
         lambda0: f64,
         stability: HsuSteps,
         opts: &LocateOptions,
-        detectors: Vec<Box<dyn Detector<F>>>,
+        detectors: Vec<Box<dyn Detector<FamilyBranch<F>>>>,
     ) -> Result<Self, HbError> {
+        let multipliers = Multipliers::new(AdaptiveHsu::new(
+            &branch.family().at(lambda0).0,
+            branch.options().harmonics,
+            stability,
+        )?);
+        let mut observer = Self::without_multipliers(opts, detectors);
+        observer.multipliers = Some(Box::new(multipliers));
+        Ok(observer)
+    }
+}
+
+impl<B: Branch> EventObserver<B> {
+    /// The observer of a path on any branch running `detectors` (e.g. the
+    /// [`Fold`](super::Fold)) without multipliers, every event located with `opts`.
+    pub fn without_multipliers(opts: &LocateOptions, detectors: Vec<Box<dyn Detector<B>>>) -> Self {
         let n = detectors.len();
-        Ok(Self {
-            multipliers: Multipliers::new(AdaptiveHsu::new(
-                &branch.family().at(lambda0).0,
-                branch.options().harmonics,
-                stability,
-            )?),
+        Self {
+            multipliers: None,
             detectors,
             tests: vec![f64::NAN; n],
             pending: Vec::new(),
             last_start: vec![None; n],
             path: PathSoFar::default(),
             opts: opts.clone(),
-        })
+        }
     }
 
-    /// The points observed, with their multipliers.
+    /// The points observed, with their multipliers (none without them).
     pub fn into_points(self) -> Vec<TracedPoint> {
         self.path.traced
     }
+
+    /// Locates the brackets of `which` (detector, start) on the path so far.
+    fn locate(&mut self, branch: &mut B, which: Vec<(usize, usize)>) -> Vec<Event> {
+        let mut events = Vec::with_capacity(which.len());
+        for (d, index) in which {
+            let Some(det) = self.detectors.get_mut(d) else {
+                continue;
+            };
+            let at = Start {
+                branch: &mut *branch,
+                path: &self.path,
+                index,
+                opts: &self.opts,
+            };
+            events.push(Event {
+                kind: det.kind(),
+                index,
+                location: det.locate(at),
+            });
+        }
+        events
+    }
 }
 
-impl<F: Family> Observer<F> for EventObserver<F> {
-    fn on_point(
-        &mut self,
-        branch: &mut FamilyBranch<F>,
-        point: &PathPoint,
-    ) -> Result<Vec<Event>, HbError> {
-        let traced = self.multipliers.at(branch, point)?;
+impl<B: Branch> Observer<B> for EventObserver<B> {
+    fn on_point(&mut self, branch: &mut B, point: &PathPoint) -> Result<Vec<Event>, HbError> {
+        if let Some(multipliers) = self.multipliers.as_mut() {
+            self.path.traced.push(multipliers.at(branch, point)?);
+        }
         self.path.points.push(point.clone());
-        self.path.traced.push(traced);
         let Some(newest) = self.path.len().checked_sub(1).filter(|&k| k > 0) else {
             // The first point's tests may need the second (a secant).
             return Ok(Vec::new());
@@ -169,25 +202,51 @@ impl<F: Family> Observer<F> for EventObserver<F> {
             .into_iter()
             .partition(|(_, start)| start + 1 < len);
         self.pending = waiting;
-        let mut events = Vec::with_capacity(ready.len());
-        for (d, index) in ready {
-            let Some(det) = self.detectors.get_mut(d) else {
-                continue;
-            };
-            let at = Start {
-                branch: &mut *branch,
-                path,
-                index,
-                opts: &self.opts,
-            };
-            events.push(Event {
-                kind: det.kind(),
-                index,
-                location: det.locate(at),
-            });
-        }
-        Ok(events)
+        Ok(self.locate(branch, ready))
     }
+
+    /// The brackets whose start is the path's last point, located from it.
+    fn finish(&mut self, branch: &mut B) -> Result<Vec<Event>, HbError> {
+        let pending = std::mem::take(&mut self.pending);
+        Ok(self.locate(branch, pending))
+    }
+}
+
+/// An observed path: [`Stepper::run`] with each point, after `on_point`
+/// (`false` stops the path), handed to `observer`, whose error ends the path;
+/// when the stepper stops, the observer finishes its pending brackets
+/// ([`Observer::finish`]). Returns the path and its events in path order (by
+/// start point, then kind).
+///
+/// # Errors
+/// The observer's error.
+pub fn observe<B: Branch>(
+    stepper: &mut Stepper<'_, B>,
+    observer: &mut dyn Observer<B>,
+    mut on_point: impl FnMut(&mut B, &PathPoint) -> bool,
+) -> Result<(Path, Vec<Event>), HbError> {
+    let (mut events, mut failure) = (Vec::new(), None);
+    let path = stepper.run(|branch, p| {
+        let go_on = on_point(branch, p);
+        match observer.on_point(branch, p) {
+            Ok(found) => {
+                events.extend(found);
+                go_on
+            }
+            Err(e) => {
+                failure = Some(e);
+                false
+            }
+        }
+    });
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    events.extend(observer.finish(stepper.branch())?);
+    // An event is reported when the point after its start has arrived; a
+    // fold's start may precede a bracket reported before it.
+    events.sort_by_key(|e| (e.index, e.kind));
+    Ok((path, events))
 }
 
 /// Follows `branch` from the orbit `q0` at `lambda0` (corrected first) towards
@@ -217,23 +276,14 @@ pub fn trace<F: Family>(
     copts.lambda_min = lambda0.min(opts.lambda_to);
     copts.lambda_max = lambda0.max(opts.lambda_to);
     let mut observer = EventObserver::new(branch, lambda0, opts.stability, &opts.locate)?;
-    let mut events = Vec::new();
     // The one continuation driver: the observer sees each point as it is
     // reached, and its error ends the path.
     let mut stepper = branch.stepper(&x0, 0, opts.lambda_to - lambda0, &copts, opts.corrector)?;
-    let termination = loop {
-        match stepper.next() {
-            Step::Point(p) => events.extend(observer.on_point(stepper.branch(), &p)?),
-            Step::Stop(t) => break t,
-        }
-    };
-    // An event is reported when the point after its start has arrived; a
-    // fold's start may precede a bracket reported before it.
-    events.sort_by_key(|e| (e.index, e.kind));
+    let (path, events) = observe(&mut stepper, &mut observer, |_, _| true)?;
     Ok(Trace {
         points: observer.into_points(),
         events,
-        termination,
+        termination: path.termination,
     })
 }
 
@@ -286,5 +336,45 @@ mod tests {
             let lambda = e.location.as_ref().unwrap().lambda;
             assert!((lambda - want).abs() < 1e-7, "{lambda} vs {want}");
         }
+    }
+
+    #[test]
+    fn a_turn_at_the_paths_last_point_is_located_from_it() {
+        // Fig. 29 (Duffing, ξ = 0.02, F = 0.1) cut (`max_points`) at the
+        // first point past a turn, for step caps until that point is the
+        // one nearest the turn: the fold's start is then the path's last
+        // point, with no point after it. The observer's `finish` locates it
+        // from there, at the shooting values 1.6548121 and 1.1687244
+        // (tests/frc.rs); on babcee2 it stayed unlocated (`located = false`).
+        let hb = HbOptions::new(20, 64).with_tol(1e-10);
+        let d = Duffing::new(0.02, 1.0, 1.0, 0.1);
+        let mut reached = 0;
+        for k in 0..10 {
+            let mut opts = FrcOptions {
+                corrector: Corrector::Newton,
+                ..FrcOptions::default()
+            };
+            opts.continuation.ds_max = 0.12 - 0.008 * f64::from(k);
+            let full = crate::frequency_response(&d, &hb, &opts).unwrap();
+            let omega: Vec<f64> = full.points.iter().map(|p| p.omega_f).collect();
+            let rising = |j: usize| omega[j] > omega[j - 1];
+            let turns = (2..omega.len()).filter(|&j| rising(j) != rising(j - 1));
+            for (j, want) in turns.zip([1.6548121, 1.1687244]) {
+                // The tangents turn at the highest point `j − 1` or after it.
+                for last in [j - 1, j] {
+                    opts.continuation.max_points = last + 1;
+                    let cut = crate::frequency_response(&d, &hb, &opts).unwrap();
+                    assert_eq!(cut.points.len(), last + 1);
+                    let Some(fold) = cut.folds.last().filter(|f| f.index == last) else {
+                        continue;
+                    };
+                    reached += 1;
+                    assert_eq!(cut.termination, Termination::MaxPoints);
+                    assert!(fold.located, "{fold:?}");
+                    assert!((fold.omega_f - want).abs() < 1e-7, "{fold:?}");
+                }
+            }
+        }
+        assert!(reached > 0, "no step cap put a turn at the last point");
     }
 }

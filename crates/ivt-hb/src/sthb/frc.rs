@@ -22,7 +22,9 @@ use crate::continuation::{
     ContinuationOptions, NewtonCorrector, Path, PathPoint, Stepper, Termination,
 };
 use crate::error::HbError;
-use crate::events::{locate_fold, LocateOptions};
+use crate::events::{
+    observe, BifurcationKind, Detector, Event, EventObserver, Fold, LocateOptions, Observer,
+};
 use crate::frc::{Frc, FrcFold, FrcPoint};
 
 /// Settings of a string curve.
@@ -66,7 +68,8 @@ impl Default for StringFrcOptions {
 /// of the method in `methods`, decreasing modulus, and `multiplier_error` the
 /// Richardson estimate of a [`StabilityMethod::MonodromyRefined`] verdict
 /// (`None` otherwise); each turn of the path is
-/// located by Newton on the bordered fold system ([`locate_fold`], exact `J`),
+/// located as the points arrive by Newton on the bordered fold system
+/// ([`crate::locate_fold`], exact `J`),
 /// `located = false` leaving the parabola through the points around the turn.
 #[derive(Clone, Debug)]
 pub struct StringFrc {
@@ -100,15 +103,18 @@ pub(super) fn coefficients(p: &PathPoint, n: usize) -> Result<&[f64], HbError> {
 
 /// Follows the branch of periodic responses from `omega_from` to `omega_to`
 /// (either direction), starting from rest at `omega_from`, calling `on_point`
-/// with the problem linearized at each point. Returns the path and the Jacobian
-/// count.
+/// with the problem linearized at each point; with `folds`, each fold is
+/// located as the points arrive ([`Fold`] in an [`EventObserver`], on the
+/// reduced branch, its `q` embedded back). Returns the path, its events and
+/// the Jacobian count of the path (the fold locations' own assemblies not
+/// counted).
 fn follow<C>(
     hb: &mut StringHb,
-    omega_from: f64,
-    omega_to: f64,
+    (omega_from, omega_to): (f64, f64),
     opts: &ContinuationOptions,
+    folds: bool,
     on_point: C,
-) -> Result<(Path, usize), HbError>
+) -> Result<(Path, Vec<Event>, usize), HbError>
 where
     C: FnMut(&mut ReducedString<'_>, &PathPoint) -> bool,
 {
@@ -138,18 +144,26 @@ where
     copts.lambda_min = omega_from.min(omega_to);
     copts.lambda_max = omega_from.max(omega_to);
     let direction = if omega_to >= omega_from { 1.0 } else { -1.0 };
-    let mut path = {
-        let m_len = system.len();
-        Stepper::new(
-            &mut system,
-            Box::new(NewtonCorrector::new(m_len, &copts)),
-            &reduced,
-            first.iterations,
-            direction,
-            &copts,
-        )?
-        .run(on_point)
+    let detectors: Vec<Box<dyn Detector<ReducedString<'_>>>> = if folds {
+        vec![Box::new(Fold)]
+    } else {
+        Vec::new()
     };
+    let mut observer = Counted {
+        observer: EventObserver::without_multipliers(&LocateOptions::fold(), detectors),
+        jacobians: 0,
+    };
+    let m_len = system.len();
+    let mut stepper = Stepper::new(
+        &mut system,
+        Box::new(NewtonCorrector::new(m_len, &copts)),
+        &reduced,
+        first.iterations,
+        direction,
+        &copts,
+    )?;
+    let (mut path, mut events) = observe(&mut stepper, &mut observer, on_point)?;
+    drop(stepper);
     if let Termination::StepTooSmall(e) = &path.termination {
         return Err(HbError::Stalled {
             omega: path.points.last().map_or(omega_from, PathPoint::lambda),
@@ -169,8 +183,41 @@ where
         last.fill(omega);
         p.x = full;
     }
+    for located in events.iter_mut().filter_map(|e| e.location.as_mut().ok()) {
+        let mut full = vec![0.0; n];
+        system.sub.embed(&located.q, &mut full);
+        located.q = full;
+    }
     // `solve` assembles once more than it iterates (the converged check).
-    Ok((path, first.iterations + 1 + system.jacobians))
+    let jacobians = first.iterations + 1 + system.jacobians - observer.jacobians;
+    Ok((path, events, jacobians))
+}
+
+/// An observer with the Jacobian assemblies it makes (the fold locations),
+/// so that the path's count leaves them out.
+struct Counted<O> {
+    observer: O,
+    jacobians: usize,
+}
+
+impl<'a, O: Observer<ReducedString<'a>>> Observer<ReducedString<'a>> for Counted<O> {
+    fn on_point(
+        &mut self,
+        branch: &mut ReducedString<'a>,
+        point: &PathPoint,
+    ) -> Result<Vec<Event>, HbError> {
+        let before = branch.jacobians;
+        let found = self.observer.on_point(branch, point);
+        self.jacobians += branch.jacobians - before;
+        found
+    }
+
+    fn finish(&mut self, branch: &mut ReducedString<'a>) -> Result<Vec<Event>, HbError> {
+        let before = branch.jacobians;
+        let found = self.observer.finish(branch);
+        self.jacobians += branch.jacobians - before;
+        found
+    }
 }
 
 /// The path from `omega_from` to `omega_to` without stability (`x` = coefficients
@@ -185,7 +232,7 @@ pub fn trace(
     omega_to: f64,
     opts: &ContinuationOptions,
 ) -> Result<Path, HbError> {
-    Ok(follow(hb, omega_from, omega_to, opts, |_, _| true)?.0)
+    Ok(follow(hb, (omega_from, omega_to), opts, false, |_, _| true)?.0)
 }
 
 /// The curve from `omega_from` to `omega_to` with a stability verdict per point.
@@ -203,7 +250,8 @@ pub fn frequency_response(
     let mut hill_calls = 0;
     let mut failure = None;
     let mut prev_dlambda = if omega_to >= omega_from { 1.0 } else { -1.0 };
-    let (path, jacobians) = follow(hb, omega_from, omega_to, &opts.continuation, |sys, p| {
+    let span = (omega_from, omega_to);
+    let (path, events, jacobians) = follow(hb, span, &opts.continuation, true, |sys, p| {
         let omega = p.lambda();
         let fold = p.dlambda.signum() != f64::signum(prev_dlambda);
         prev_dlambda = p.dlambda;
@@ -251,36 +299,33 @@ pub fn frequency_response(
             })
         })
         .collect::<Result<Vec<_>, HbError>>()?;
-    let mut branch = ReducedString::new(hb);
-    let mut q = vec![0.0; branch.sub.dim()];
-    let folds = path
-        .folds
+    let folds = events
         .iter()
-        .map(|f| {
-            let near = points.get(f.index).ok_or_else(empty_point)?;
-            branch.sub.gather(&near.coeffs, &mut q);
-            Ok(
-                match locate_fold(&mut branch, &q, near.omega_f, &LocateOptions::fold()) {
-                    Ok(loc) => {
-                        let mut coeffs = vec![0.0; n];
-                        branch.sub.embed(&loc.q, &mut coeffs);
-                        FrcFold {
-                            index: f.index,
-                            omega_f: loc.lambda,
-                            amplitude: branch.hb.complex_norm(&coeffs),
-                            coeffs,
-                            located: true,
-                        }
-                    }
-                    Err(_) => FrcFold {
-                        index: f.index,
-                        omega_f: f.lambda,
-                        amplitude: near.amplitude,
-                        coeffs: near.coeffs.clone(),
-                        located: false,
-                    },
+        .filter(|e| e.kind == BifurcationKind::Fold)
+        .map(|e| {
+            let near = points.get(e.index).ok_or_else(empty_point)?;
+            Ok(match &e.location {
+                Ok(loc) => FrcFold {
+                    index: e.index,
+                    omega_f: loc.lambda,
+                    amplitude: hb.complex_norm(&loc.q),
+                    coeffs: loc.q.clone(),
+                    located: true,
                 },
-            )
+                // Not located: the parabola's ω through the points around
+                // the turn (the stepper's estimate).
+                Err(_) => FrcFold {
+                    index: e.index,
+                    omega_f: path
+                        .folds
+                        .iter()
+                        .find(|f| f.index == e.index)
+                        .map_or(near.omega_f, |f| f.lambda),
+                    amplitude: near.amplitude,
+                    coeffs: near.coeffs.clone(),
+                    located: false,
+                },
+            })
         })
         .collect::<Result<_, HbError>>()?;
     Ok(StringFrc {
