@@ -358,7 +358,7 @@ impl Structure {
     }
 
     /// `out += A X` with `A_ij = entry(M_ij, C_ij)`, column by column over
-    /// contiguous slices.
+    /// the stored columns' contiguous slices.
     fn add_mass_damping(
         &self,
         x: MatRef<'_, c64>,
@@ -366,19 +366,21 @@ impl Structure {
         entry: impl Fn(f64, f64) -> c64,
     ) {
         let n = self.n_dof();
-        let mut xs = vec![c64::new(0.0, 0.0); n];
+        let (col_ptr, rows) = (self.pattern.col_ptr(), self.pattern.row_idx());
         let mut acc = vec![c64::new(0.0, 0.0); n];
         for col in 0..x.ncols().min(out.ncols()) {
-            xs.iter_mut()
-                .zip(x.col(col).iter())
-                .for_each(|(a, b)| *a = *b);
             acc.iter_mut()
                 .zip(out.as_ref().col(col).iter())
                 .for_each(|(a, b)| *a = *b);
-            let stored = entries(&self.pattern).zip(self.m.iter().zip(&self.c));
-            for ((i, j), (m, c)) in stored {
-                if let (Some(a), Some(xj)) = (acc.get_mut(i), xs.get(j)) {
-                    *a += entry(*m, *c) * xj;
+            for (xj, bounds) in x.col(col).iter().zip(col_ptr.windows(2)) {
+                let &[start, end] = bounds else { continue };
+                let stored = rows.get(start..end).unwrap_or_default().iter();
+                let m = self.m.get(start..end).unwrap_or_default();
+                let c = self.c.get(start..end).unwrap_or_default();
+                for ((&i, &m), &c) in stored.zip(m).zip(c) {
+                    if let Some(a) = acc.get_mut(i) {
+                        *a += entry(m, c) * xj;
+                    }
                 }
             }
             out.as_mut()
