@@ -89,6 +89,7 @@ impl BandLu {
             }
         }
         let (r, biggest) = best;
+        let singular = || HbError::Singular { omega };
         if biggest == 0.0 || !biggest.is_finite() {
             return Err(HbError::Singular { omega });
         }
@@ -98,24 +99,20 @@ impl BandLu {
         // Row p's band from column p on, and the rows below.
         let start = self.slot(p, p);
         let (head, tail) = self.rows.split_at_mut(start + width - kl);
-        let pivot_row = head
-            .get_mut(start..start + span)
-            .ok_or(HbError::Singular { omega })?;
+        let pivot_row = head.get_mut(start..start + span).ok_or_else(singular)?;
         if r != p {
             let other = (r - p) * width - (r - p);
             let row_r = tail
                 .get_mut(other - (width - kl)..other - (width - kl) + span)
-                .ok_or(HbError::Singular { omega })?;
+                .ok_or_else(singular)?;
             pivot_row.swap_with_slice(row_r);
         }
-        let (pivot, upper) = pivot_row.split_first().ok_or(HbError::Singular { omega })?;
+        let (pivot, upper) = pivot_row.split_first().ok_or_else(singular)?;
         for t in 1..=last_row - p {
             // Row p + t, column p at offset kl − t of its band.
             let at = t * (width - 1) - (width - kl);
-            let row = tail
-                .get_mut(at..at + span)
-                .ok_or(HbError::Singular { omega })?;
-            let (lead, rest) = row.split_first_mut().ok_or(HbError::Singular { omega })?;
+            let row = tail.get_mut(at..at + span).ok_or_else(singular)?;
+            let (lead, rest) = row.split_first_mut().ok_or_else(singular)?;
             let f = *lead / pivot;
             *lead = f;
             if f != c64::new(0.0, 0.0) {

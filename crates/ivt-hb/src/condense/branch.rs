@@ -31,7 +31,11 @@ pub struct CondensedBranch<P: PeriodicProblem> {
     hb: HbOptions,
     res: HbResidual,
     galerkin: GalerkinJacobian,
+    /// The receptances of the last exact evaluation.
     cache: Option<Receptances>,
+    /// Their Taylor model at another ω_f ([`Receptances::taylor`]), serving
+    /// the path callbacks there.
+    model: Option<Receptances>,
     /// The last failure to build receptances (reported by the drivers).
     failure: Option<HbError>,
     scratch: Vec<f64>,
@@ -100,6 +104,7 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
             res,
             galerkin,
             cache: None,
+            model: None,
             failure: None,
             scratch: vec![0.0; m],
         })
@@ -125,7 +130,7 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
         &self.local
     }
 
-    /// The receptances at ω_f (computed once per ω_f, cached).
+    /// The receptances at ω_f, exact (computed once per ω_f, cached).
     ///
     /// # Errors
     /// [`HbError::Singular`] when a dynamic stiffness or `H_SS` is singular.
@@ -134,10 +139,38 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
         self.cached()
     }
 
+    /// The receptances the path callbacks see at ω_f: the exact ones, or
+    /// their Taylor model about the last exact evaluation when its estimated
+    /// error is within [`super::receptance::MODEL_TOLERANCE`] (counted in
+    /// its `solve_error`).
+    fn modelled(&mut self, omega_f: f64) -> Result<&Receptances, HbError> {
+        let at = |r: &Option<Receptances>| r.as_ref().is_some_and(|r| r.omega_f == omega_f);
+        if !at(&self.cache) && !at(&self.model) {
+            self.model = self.cache.as_ref().and_then(|c| c.taylor(omega_f));
+        }
+        if at(&self.model) {
+            return self
+                .model
+                .as_ref()
+                .ok_or_else(|| HbError::InvalidInput("receptance model missing".into()));
+        }
+        self.receptances(omega_f)
+    }
+
+    /// The estimated relative error of the receptances the path used at
+    /// ω_f (exact or modelled).
+    ///
+    /// # Errors
+    /// As [`Self::receptances`].
+    pub fn solve_error(&mut self, omega_f: f64) -> Result<f64, HbError> {
+        Ok(self.modelled(omega_f)?.solve_error)
+    }
+
     /// Computes the receptances at ω_f unless cached.
     fn ensure(&mut self, omega_f: f64) -> Result<(), HbError> {
         let fresh = self.cache.as_ref().is_some_and(|c| c.omega_f == omega_f);
         if !fresh {
+            self.model = None;
             let previous = self.cache.take();
             let r = Receptances::reusing(
                 &self.structure,
@@ -159,12 +192,18 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
     }
 
     /// The relative change of the receptances at ω_f from the rounding of
-    /// the stored `M` and `C` ([`Receptances::data_error`]).
+    /// the stored `M` and `C` ([`Receptances::data_error`]); where the path
+    /// used a Taylor model at ω_f, the change at the model's exact base
+    /// (within the model's radius, where the receptances move by less than
+    /// 1e-5 relative: the same estimate to its first digits).
     ///
     /// # Errors
     /// As [`Self::receptances`].
     pub fn data_error(&mut self, omega_f: f64) -> Result<f64, HbError> {
-        self.ensure(omega_f)?;
+        let modelled = self.model.as_ref().is_some_and(|m| m.omega_f == omega_f);
+        if !modelled {
+            self.ensure(omega_f)?;
+        }
         Ok(self.cached()?.data_error(&self.structure, &self.coupling))
     }
 
@@ -212,6 +251,9 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
         let (s, n) = (self.coupling.dofs.len(), self.hb.harmonics);
         if let Some(&bad) = dofs.iter().find(|&&d| d >= self.structure.n_dof()) {
             return Err(HbError::InvalidInput(format!("DOF {bad} is out of range")));
+        }
+        if dofs.is_empty() {
+            return Ok(Vec::new());
         }
         let l = 2 * n + 1;
         let mut force = std::mem::take(&mut self.scratch);
@@ -340,13 +382,14 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
         out: &mut [f64],
         f: impl FnOnce(&Self, &Receptances, &mut [f64]),
     ) {
-        match self.ensure(omega_f) {
+        match self.modelled(omega_f).map(|_| ()) {
             Ok(()) => {
-                let rc = self.cache.take();
-                if let Some(rc) = rc.as_ref() {
+                let (exact, model) = (self.cache.take(), self.model.take());
+                let at = [model.as_ref(), exact.as_ref()].into_iter().flatten();
+                if let Some(rc) = at.into_iter().find(|r| r.omega_f == omega_f) {
                     f(self, rc, out);
                 }
-                self.cache = rc;
+                (self.cache, self.model) = (exact, model);
             }
             Err(e) => {
                 self.failure = Some(e);

@@ -15,6 +15,7 @@
 //! loses, and the size of the last correction estimates the error left.
 
 use super::band::{BandLu, MAX_HALF_BANDWIDTH};
+use super::double_double::{Dd, Split, SplitDd};
 use crate::error::HbError;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu as SparseLu, SymbolicLu};
@@ -235,7 +236,13 @@ impl Structure {
     /// estimated relative error of the columns (largest over them): the
     /// relative size of the last correction, or infinity if the iteration
     /// diverged or produced non-finite values.
-    pub fn solve_refined(&self, factored: &Factored, mut rhs: MatMut<'_, c64>) -> f64 {
+    pub fn solve_refined(&self, factored: &Factored, rhs: MatMut<'_, c64>) -> f64 {
+        self.refine(factored, rhs).error
+    }
+
+    /// [`Self::solve_refined`], reporting also the relative size of the
+    /// first correction: the plain LU's own error on these columns.
+    pub(crate) fn refine(&self, factored: &Factored, mut rhs: MatMut<'_, c64>) -> Refinement {
         let b = rhs.to_owned();
         factored.lu.solve_in_place(rhs.as_mut());
         let mut r = Mat::<c64>::zeros(b.nrows(), b.ncols());
@@ -244,26 +251,32 @@ impl Structure {
         // successive corrections (ρ ≈ e₀ for the first), so the error after
         // a correction of size d is about ρ·d.
         let mut prev = 1.0;
+        let mut first = None;
+        let done = |error: f64, first: Option<f64>| Refinement {
+            error,
+            plain_error: first.unwrap_or(error),
+        };
         for _ in 0..MAX_REFINEMENTS {
             self.residual(factored, b.as_ref(), rhs.as_ref(), r.as_mut());
             factored.lu.solve_in_place(r.as_mut());
             let size = relative_size(r.as_ref(), rhs.as_ref());
             if !size.is_finite() {
-                return f64::INFINITY;
+                return done(f64::INFINITY, Some(f64::INFINITY));
             }
+            let first = *first.get_or_insert(size);
             if size > 0.5 * prev {
                 // No contraction (rounding level reached, or divergence):
                 // keep the iterate, report the correction as the error.
-                return size.max(f64::EPSILON);
+                return done(size.max(f64::EPSILON), Some(first));
             }
             rhs += &r;
             let left = size * (size / prev);
             prev = size;
             if left <= 2.0 * f64::EPSILON {
-                return left.max(f64::EPSILON);
+                return done(left.max(f64::EPSILON), Some(first));
             }
         }
-        prev
+        done(prev, first)
     }
 
     /// `X = D(w)⁻¹ B` in place by the LU alone (no refinement): what the
@@ -335,12 +348,46 @@ impl Structure {
     /// `out = (−2wM + iC) X`: `∂D/∂w` applied to the columns of `x`.
     pub fn apply_derivative(&self, w: f64, x: MatRef<'_, c64>, mut out: MatMut<'_, c64>) {
         out.fill(c64::new(0.0, 0.0));
+        self.add_mass_damping(x, out, |m, c| c64::new(-2.0 * w * m, c));
+    }
+
+    /// `out += M X`: with [`Self::apply_derivative`], `∂²D/∂w² = −2M` for
+    /// the second ω-derivatives of the receptances.
+    pub(crate) fn add_mass(&self, x: MatRef<'_, c64>, out: MatMut<'_, c64>) {
+        self.add_mass_damping(x, out, |m, _| c64::new(m, 0.0));
+    }
+
+    /// `out += A X` with `A_ij = entry(M_ij, C_ij)`, column by column over
+    /// the stored columns' contiguous slices.
+    fn add_mass_damping(
+        &self,
+        x: MatRef<'_, c64>,
+        mut out: MatMut<'_, c64>,
+        entry: impl Fn(f64, f64) -> c64,
+    ) {
+        let n = self.n_dof();
+        let (col_ptr, rows) = (self.pattern.col_ptr(), self.pattern.row_idx());
+        let mut acc = vec![c64::new(0.0, 0.0); n];
         for col in 0..x.ncols().min(out.ncols()) {
-            let stored = entries(&self.pattern).zip(self.m.iter().zip(&self.c));
-            for ((i, j), (m, c)) in stored {
-                let d = c64::new(-2.0 * w * m, *c);
-                out[(i, col)] += d * x[(j, col)];
+            acc.iter_mut()
+                .zip(out.as_ref().col(col).iter())
+                .for_each(|(a, b)| *a = *b);
+            for (xj, bounds) in x.col(col).iter().zip(col_ptr.windows(2)) {
+                let &[start, end] = bounds else { continue };
+                let stored = rows.get(start..end).unwrap_or_default().iter();
+                let m = self.m.get(start..end).unwrap_or_default();
+                let c = self.c.get(start..end).unwrap_or_default();
+                for ((&i, &m), &c) in stored.zip(m).zip(c) {
+                    if let Some(a) = acc.get_mut(i) {
+                        *a += entry(m, c) * xj;
+                    }
+                }
             }
+            out.as_mut()
+                .col_mut(col)
+                .iter_mut()
+                .zip(&acc)
+                .for_each(|(o, a)| *o = *a);
         }
     }
 
@@ -392,6 +439,16 @@ impl Structure {
             }
         }
     }
+}
+
+/// What [`Structure::refine`] reports.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Refinement {
+    /// Estimated relative error left (as [`Structure::solve_refined`]).
+    pub(crate) error: f64,
+    /// Relative size of the first correction: the error of the plain LU
+    /// solve of the same columns.
+    pub(crate) plain_error: f64,
 }
 
 /// One of the stored matrices of a [`Structure`].
@@ -456,135 +513,4 @@ fn relative_size(d: MatRef<'_, c64>, x: MatRef<'_, c64>) -> f64 {
         worst = worst.max(if rel.is_nan() { f64::INFINITY } else { rel });
     }
     worst
-}
-
-/// The rounding error `a·b − p` of `p = fl(a·b)`, exactly (Dekker's
-/// TwoProduct with Veltkamp's split). Not `f64::mul_add`: without a target
-/// FMA (the baseline x86-64 build) that is a library call, which made the
-/// refinement's residual 40 % of the whole condensed curve (perf, N = 500).
-#[inline(always)]
-fn product_error(a: f64, b: f64, p: f64) -> f64 {
-    let (ah, al) = split(a);
-    let (bh, bl) = split(b);
-    ((ah * bh - p) + ah * bl + al * bh) + al * bl
-}
-
-/// Veltkamp's split of `a` into 26-bit halves `hi + lo = a` (exact for
-/// |a| < 2^996).
-#[inline(always)]
-fn split(a: f64) -> (f64, f64) {
-    const FACTOR: f64 = 134_217_729.0; // 2^27 + 1
-    let t = FACTOR * a;
-    let hi = t - (t - a);
-    (hi, a - hi)
-}
-
-/// A double with its Veltkamp halves (split once, used in many products).
-#[derive(Debug, Clone, Copy)]
-struct Split {
-    v: f64,
-    hi: f64,
-    lo: f64,
-}
-
-impl Split {
-    #[inline(always)]
-    fn of(v: f64) -> Self {
-        let (hi, lo) = split(v);
-        Self { v, hi, lo }
-    }
-
-    /// `a·b − fl(a·b)` exactly, `p = fl(a·b)`.
-    #[inline(always)]
-    fn product_error(self, b: Self, p: f64) -> f64 {
-        ((self.hi * b.hi - p) + self.hi * b.lo + self.lo * b.hi) + self.lo * b.lo
-    }
-}
-
-/// A double-double entry `hi + lo` of `D(w)` with `hi` split.
-#[derive(Debug, Clone, Copy)]
-struct SplitDd {
-    hi: Split,
-    lo: f64,
-}
-
-impl From<Dd> for SplitDd {
-    fn from(d: Dd) -> Self {
-        Self {
-            hi: Split::of(d.hi),
-            lo: d.lo,
-        }
-    }
-}
-
-/// A double-double accumulator `hi + lo` (Dot2: error-free transformations).
-#[derive(Debug, Clone, Copy, Default)]
-struct Dd {
-    hi: f64,
-    lo: f64,
-}
-
-impl From<f64> for Dd {
-    fn from(v: f64) -> Self {
-        Self { hi: v, lo: 0.0 }
-    }
-}
-
-impl Dd {
-    /// `a·b` exactly (as `hi + lo`).
-    fn product(a: f64, b: f64) -> Self {
-        let hi = a * b;
-        Self {
-            hi,
-            lo: product_error(a, b, hi),
-        }
-    }
-
-    /// `self + v` to double-double accuracy.
-    fn add(self, v: f64) -> Self {
-        let s = self.hi + v;
-        let bb = s - self.hi;
-        let e = (self.hi - (s - bb)) + (v - bb);
-        Self {
-            hi: s,
-            lo: self.lo + e,
-        }
-    }
-
-    /// `self·v` to double-double accuracy.
-    fn scale(self, v: f64) -> Self {
-        let mut p = Self::product(self.hi, v);
-        p.lo += self.lo * v;
-        p
-    }
-
-    /// `self += a·b` for a double-double `a` (both split already).
-    #[inline(always)]
-    fn add_split_product(&mut self, a: &SplitDd, b: Split) {
-        let p = a.hi.v * b.v;
-        let ep = a.hi.product_error(b, p);
-        self.add_exact(p, ep + a.lo * b.v);
-    }
-
-    /// `self −= a·b` for a double-double `a` (both split already).
-    #[inline(always)]
-    fn sub_split_product(&mut self, a: &SplitDd, b: Split) {
-        let p = a.hi.v * b.v;
-        let ep = a.hi.product_error(b, p);
-        self.add_exact(-p, -(ep + a.lo * b.v));
-    }
-
-    /// `self += p + e` with `p`'s sum error kept (`e` a small correction).
-    #[inline(always)]
-    fn add_exact(&mut self, p: f64, e: f64) {
-        let s = self.hi + p;
-        let bb = s - self.hi;
-        let es = (self.hi - (s - bb)) + (p - bb);
-        self.hi = s;
-        self.lo += e + es;
-    }
-
-    fn value(self) -> f64 {
-        self.hi + self.lo
-    }
 }

@@ -467,7 +467,7 @@ impl Probe {
     ) -> Result<CondensedPoint, HbError> {
         let amplitude = self.amplitude(branch, q, omega_f)?;
         let recovered = branch.recover(q, omega_f, &self.record)?;
-        let solve_error = branch.receptances(omega_f)?.solve_error;
+        let solve_error = branch.solve_error(omega_f)?;
         let data_error = branch.data_error(omega_f)?;
         let orbit_error = orbit_error(branch, q, omega_f, solve_error + data_error);
         let truncation_error = if truncation {

@@ -24,6 +24,7 @@
 
 mod band;
 mod branch;
+mod double_double;
 pub mod dynamic;
 mod estimate;
 mod frc;
