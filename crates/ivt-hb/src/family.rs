@@ -139,10 +139,9 @@ impl<F: Family> FamilyBranch<F> {
         start_iterations: usize,
         direction: f64,
         opts: &ContinuationOptions,
-        corrector: Corrector,
     ) -> Result<Stepper<'_, Self>, HbError> {
         let m = self.res.len();
-        match corrector {
+        match opts.corrector {
             Corrector::Broyden => {
                 let broyden = Box::new(BroydenCorrector::new(m, &opts.broyden, None));
                 Stepper::new(self, broyden, start, 0, direction, opts)

@@ -7,7 +7,7 @@
 //! between two points), started from the path point nearest the turn.
 
 use crate::aft::Aft;
-use crate::continuation::{turn_estimate, ContinuationOptions, Corrector, Path, Step, Termination};
+use crate::continuation::{turn_estimate, ContinuationOptions, Path, Step, Termination};
 use crate::events::{
     locate_fold, BifurcationKind, Detector, Event, EventObserver, Fold, LocateOptions, Observer,
     Trace,
@@ -26,15 +26,14 @@ pub struct FrcOptions {
     pub from: f64,
     /// End frequency ω_f (may be below `from` for a downward sweep).
     pub to: f64,
-    /// Path-following options (λ bounds are set from `from`/`to`).
+    /// Path-following options (λ bounds are set from `from`/`to`). Its
+    /// corrector: [`crate::Corrector::Broyden`] (the thesis's Eq. 68–77, the
+    /// default) or [`crate::Corrector::Newton`] (exact Galerkin Jacobian; fewer
+    /// residual evaluations per point, for costly `g`).
     pub continuation: ContinuationOptions,
     /// Hsu sub-intervals of each point's multipliers (by default chosen per
     /// point for multipliers to 1e-6, [`HsuSteps::Tolerance`]).
     pub stability: HsuSteps,
-    /// The path's corrector: [`Corrector::Broyden`] (the thesis's Eq. 68–77,
-    /// the default) or [`Corrector::Newton`] (exact Galerkin Jacobian; fewer
-    /// residual evaluations per point, for costly `g`).
-    pub corrector: Corrector,
 }
 
 impl Default for FrcOptions {
@@ -55,7 +54,6 @@ impl Default for FrcOptions {
                 ..ContinuationOptions::default()
             },
             stability: HsuSteps::default(),
-            corrector: Corrector::Broyden,
         }
     }
 }
@@ -153,13 +151,7 @@ pub fn frequency_response<P: PeriodicProblem>(
     let mut observer =
         EventObserver::with_detectors(&family, opts.from, opts.stability, &locate, detectors)?;
     let (mut events, mut turns) = (Vec::new(), Vec::new());
-    let mut stepper = family.stepper(
-        &x0,
-        start.stats.iterations,
-        direction,
-        &copts,
-        opts.corrector,
-    )?;
+    let mut stepper = family.stepper(&x0, start.stats.iterations, direction, &copts)?;
     let termination = loop {
         match stepper.next() {
             Step::Point(p) => {

@@ -26,11 +26,11 @@ fn trace_in_omega<'a, P: PeriodicProblem>(
         .solve(omega_from, None)
         .unwrap();
     let mut branch = FamilyBranch::new(move |w: f64| (problem, w), hb, omega_from).unwrap();
-    let opts = TraceOptions {
+    let mut opts = TraceOptions {
         lambda_to: omega_to,
-        corrector,
         ..TraceOptions::default()
     };
+    opts.continuation.corrector = corrector;
     let tr = trace(&mut branch, &start.coeffs, omega_from, &opts).unwrap();
     (branch, tr)
 }

@@ -15,8 +15,8 @@ fn curve(corrector: Corrector, second_order: bool) -> (Vec<f64>, f64, f64) {
     let p = Counted::chain();
     let defaults = FrcOptions::default();
     let opts = FrcOptions {
-        corrector,
         continuation: ContinuationOptions {
+            corrector,
             second_order_predictor: second_order,
             ..defaults.continuation.clone()
         },

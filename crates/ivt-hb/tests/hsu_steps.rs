@@ -66,10 +66,8 @@ fn every_point_meets_the_multiplier_tolerance_with_fewer_steps_off_resonance() {
     assert!(steps.iter().any(|&s| s >= 168), "{steps:?}");
 
     let chain = cubic_chain();
-    let opts = FrcOptions {
-        corrector: Corrector::Newton,
-        ..FrcOptions::default()
-    };
+    let mut opts = FrcOptions::default();
+    opts.continuation.corrector = Corrector::Newton;
     let frc = frequency_response(&chain, &HbOptions::new(20, 84), &opts).unwrap();
     let (worst, steps) = errors(&chain, &frc, 20);
     eprintln!("chain: worst multiplier error {worst:.1e}");

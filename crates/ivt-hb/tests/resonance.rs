@@ -29,10 +29,9 @@ fn default_frc_finds_the_peak_of_a_lightly_damped_resonance() {
     let zeta: f64 = 0.001;
     let exact = 1.0 / (2.0 * zeta * (1.0 - zeta * zeta).sqrt());
     for corrector in [Corrector::Broyden, Corrector::Newton] {
-        let (top, points, end) = peak(FrcOptions {
-            corrector,
-            ..FrcOptions::default()
-        });
+        let mut opts = FrcOptions::default();
+        opts.continuation.corrector = corrector;
+        let (top, points, end) = peak(opts);
         assert_eq!(
             end,
             Termination::LeftInterval,

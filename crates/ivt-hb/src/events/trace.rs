@@ -13,7 +13,7 @@ use super::multipliers::Multipliers;
 use super::neimark_sacker::NeimarkSacker;
 use super::period_doubling::PeriodDoubling;
 use crate::branch::Branch;
-use crate::continuation::{ContinuationOptions, Corrector, PathPoint, Step, Termination};
+use crate::continuation::{ContinuationOptions, PathPoint, Step, Termination};
 use crate::family::{Family, FamilyBranch};
 use crate::ihb::HbError;
 use crate::stability::{AdaptiveHsu, HsuSteps};
@@ -24,15 +24,14 @@ pub struct TraceOptions {
     /// End of the parameter interval (the path stops once it leaves
     /// `[min(λ₀, lambda_to), max(λ₀, lambda_to)]`).
     pub lambda_to: f64,
-    /// Path following (its λ bounds are set from λ₀ and `lambda_to`).
+    /// Path following (its λ bounds are set from λ₀ and `lambda_to`; its
+    /// corrector [`crate::Corrector::Broyden`] by default).
     pub continuation: ContinuationOptions,
     /// Hsu sub-intervals of the path points' multipliers (by default chosen
     /// per point for multipliers to 1e-6).
     pub stability: HsuSteps,
     /// Options of the located events.
     pub locate: LocateOptions,
-    /// The path's corrector ([`Corrector::Broyden`] by default).
-    pub corrector: Corrector,
 }
 
 impl Default for TraceOptions {
@@ -42,7 +41,6 @@ impl Default for TraceOptions {
             continuation: ContinuationOptions::default(),
             stability: HsuSteps::default(),
             locate: LocateOptions::default(),
-            corrector: Corrector::Broyden,
         }
     }
 }
@@ -220,7 +218,7 @@ pub fn trace<F: Family>(
     let mut events = Vec::new();
     // The one continuation driver: the observer sees each point as it is
     // reached, and its error ends the path.
-    let mut stepper = branch.stepper(&x0, 0, opts.lambda_to - lambda0, &copts, opts.corrector)?;
+    let mut stepper = branch.stepper(&x0, 0, opts.lambda_to - lambda0, &copts)?;
     let termination = loop {
         match stepper.next() {
             Step::Point(p) => events.extend(observer.on_point(stepper.branch(), &p)?),
@@ -243,6 +241,7 @@ mod tests {
     use crate::family::Frequency;
     use crate::frc::FrcOptions;
     use crate::ihb::HbOptions;
+    use crate::Corrector;
     use crate::{BifurcationKind, Duffing, ModifiedIhb};
 
     #[test]
@@ -263,19 +262,17 @@ mod tests {
         let mut observer = EventObserver::new(&branch, 0.2, HsuSteps::default(), &opts).unwrap();
         let mut copts = FrcOptions::default().continuation;
         (copts.lambda_min, copts.lambda_max) = (0.2, 3.0);
+        copts.corrector = Corrector::Newton;
         let mut x0 = start.coeffs.clone();
         x0.push(0.2);
         let mut arrived = Vec::new();
         let mut count = 0;
-        let path = branch
-            .stepper(&x0, 0, 1.0, &copts, Corrector::Newton)
-            .unwrap()
-            .run(|b, p| {
-                let found = observer.on_point(b, p).unwrap();
-                arrived.extend(found.into_iter().map(|e| (count, e)));
-                count += 1;
-                true
-            });
+        let path = branch.stepper(&x0, 0, 1.0, &copts).unwrap().run(|b, p| {
+            let found = observer.on_point(b, p).unwrap();
+            arrived.extend(found.into_iter().map(|e| (count, e)));
+            count += 1;
+            true
+        });
         assert_eq!(path.termination, Termination::LeftInterval);
         let n = path.points.len();
         assert_eq!(arrived.len(), 2, "{arrived:?}");

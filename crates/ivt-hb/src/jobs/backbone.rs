@@ -4,7 +4,7 @@
 
 use super::{finite, Array};
 use crate::backbone::{BackboneOptions, BackbonePoint};
-use crate::continuation::{Corrector, Termination};
+use crate::continuation::{ContinuationOptions, Corrector, Termination};
 use crate::error::HbError;
 use crate::ihb::HbOptions;
 use crate::problem::{GeneralProblem, PeriodicProblem};
@@ -112,12 +112,16 @@ pub fn backbone<P: PeriodicProblem>(
     req: &BackboneRequest,
 ) -> Result<BackboneCurve, HbError> {
     req.validate()?;
+    let defaults = BackboneOptions::default();
     let opts = BackboneOptions {
         dof: req.dof,
         amplitude_from: req.amplitude_from,
         amplitude_to: req.amplitude_to,
-        corrector: req.corrector,
-        ..BackboneOptions::default()
+        continuation: ContinuationOptions {
+            corrector: req.corrector,
+            ..defaults.continuation
+        },
+        ..defaults
     };
     let bb = crate::backbone(problem, hb, req.omega0, &req.mode, &opts)?;
     let col = |f: fn(&BackbonePoint) -> f64| bb.points.iter().map(f).collect();

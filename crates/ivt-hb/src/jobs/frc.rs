@@ -6,7 +6,7 @@
 //! Neimark–Sacker point and branch point as the path passes it.
 
 use super::{check_finite, pairs, Array};
-use crate::continuation::{Corrector, Termination};
+use crate::continuation::{ContinuationOptions, Corrector, Termination};
 use crate::error::HbError;
 use crate::events::{trace, BifurcationError, BifurcationKind, Event, TraceOptions};
 use crate::family::{Family, FamilyBranch, Frequency};
@@ -41,7 +41,7 @@ impl Default for FrcRequest {
             from: o.from,
             to: o.to,
             events: false,
-            corrector: o.corrector,
+            corrector: o.continuation.corrector,
         }
     }
 }
@@ -183,11 +183,15 @@ pub fn frc<P: PeriodicProblem>(
             t0,
         );
     }
+    let defaults = FrcOptions::default();
     let opts = FrcOptions {
         from: req.from,
         to: req.to,
-        corrector: req.corrector,
-        ..FrcOptions::default()
+        continuation: ContinuationOptions {
+            corrector: req.corrector,
+            ..defaults.continuation
+        },
+        ..defaults
     };
     let curve = frequency_response(problem, hb, &opts)?;
     let events = curve.folds.iter().map(|f| fold_event(f, &curve)).collect();
@@ -210,8 +214,10 @@ pub(super) fn traced_curve<F: Family>(
 ) -> Result<FrcCurve<FoldPoint>, HbError> {
     let opts = TraceOptions {
         lambda_to: to,
-        continuation: FrcOptions::default().continuation,
-        corrector,
+        continuation: ContinuationOptions {
+            corrector,
+            ..FrcOptions::default().continuation
+        },
         ..TraceOptions::default()
     };
     let traced = trace(branch, start.0, start.1, &opts).map_err(trace_error)?;
