@@ -83,7 +83,7 @@ fn chain_frc_newton_0p2_to_3(bencher: divan::Bencher) {
     let p = chain();
     let hb = HbOptions::new(20, 84);
     let mut opts = FrcOptions::default();
-    opts.continuation.corrector = Corrector::Newton;
+    opts.path.continuation.corrector = Corrector::Newton;
     bencher.bench_local(|| frequency_response(&p, &hb, &opts).unwrap());
 }
 
@@ -93,7 +93,7 @@ fn duffing_frc_newton_0p2_to_3(bencher: divan::Bencher) {
     let d = Duffing::fig28();
     let hb = HbOptions::new(20, 64);
     let mut opts = FrcOptions::default();
-    opts.continuation.corrector = Corrector::Newton;
+    opts.path.continuation.corrector = Corrector::Newton;
     bencher.bench_local(|| frequency_response(&d, &hb, &opts).unwrap());
 }
 

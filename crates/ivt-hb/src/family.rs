@@ -118,7 +118,7 @@ impl<F: Family> FamilyBranch<F> {
     }
 
     /// The path of the branch from the converged point `start` (`q` then λ) in the
-    /// direction of increasing λ if `direction > 0`, with `corrector`:
+    /// direction of increasing λ if `direction > 0`, with `opts.corrector`:
     /// Broyden on the secant model (Eq. 68–77; `start` is corrected first) or
     /// chord–Newton on the exact Galerkin Jacobian ([`NewtonCorrector`];
     /// `start_iterations` is the start's count).

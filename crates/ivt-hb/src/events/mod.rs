@@ -39,7 +39,7 @@ pub use fold::{locate_fold, Fold, FoldLocation};
 pub use multipliers::Multipliers;
 pub use neimark_sacker::NeimarkSacker;
 pub use period_doubling::PeriodDoubling;
-pub use trace::{trace, EventObserver, Trace, TraceOptions};
+pub use trace::{trace, EventObserver, PathOptions, Trace, TraceOptions};
 
 use crate::family::{Family, FamilyBranch};
 use crate::ihb::HbError;

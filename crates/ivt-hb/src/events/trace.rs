@@ -18,18 +18,27 @@ use crate::family::{Family, FamilyBranch};
 use crate::ihb::HbError;
 use crate::stability::{AdaptiveHsu, HsuSteps};
 
+/// The options of a path whose points get their Floquet multipliers, shared
+/// by the sweep that locates folds only ([`crate::FrcOptions`]) and the one
+/// that locates every event ([`TraceOptions`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PathOptions {
+    /// Path following (its λ bounds are set from the interval; its
+    /// corrector [`crate::Corrector::Broyden`] by default).
+    pub continuation: ContinuationOptions,
+    /// Hsu sub-intervals of the path points' multipliers (by default chosen
+    /// per point for multipliers to 1e-6, [`HsuSteps::Tolerance`]).
+    pub stability: HsuSteps,
+}
+
 /// Options of [`trace`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct TraceOptions {
     /// End of the parameter interval (the path stops once it leaves
     /// `[min(λ₀, lambda_to), max(λ₀, lambda_to)]`).
     pub lambda_to: f64,
-    /// Path following (its λ bounds are set from λ₀ and `lambda_to`; its
-    /// corrector [`crate::Corrector::Broyden`] by default).
-    pub continuation: ContinuationOptions,
-    /// Hsu sub-intervals of the path points' multipliers (by default chosen
-    /// per point for multipliers to 1e-6).
-    pub stability: HsuSteps,
+    /// The path and its multipliers (λ bounds set from λ₀ and `lambda_to`).
+    pub path: PathOptions,
     /// Options of the located events.
     pub locate: LocateOptions,
 }
@@ -38,8 +47,7 @@ impl Default for TraceOptions {
     fn default() -> Self {
         Self {
             lambda_to: 1.0,
-            continuation: ContinuationOptions::default(),
-            stability: HsuSteps::default(),
+            path: PathOptions::default(),
             locate: LocateOptions::default(),
         }
     }
@@ -211,10 +219,10 @@ pub fn trace<F: Family>(
     }
     let mut x0 = q0.to_vec();
     x0.push(lambda0);
-    let mut copts = opts.continuation.clone();
+    let mut copts = opts.path.continuation.clone();
     copts.lambda_min = lambda0.min(opts.lambda_to);
     copts.lambda_max = lambda0.max(opts.lambda_to);
-    let mut observer = EventObserver::new(branch, lambda0, opts.stability, &opts.locate)?;
+    let mut observer = EventObserver::new(branch, lambda0, opts.path.stability, &opts.locate)?;
     let mut events = Vec::new();
     // The one continuation driver: the observer sees each point as it is
     // reached, and its error ends the path.
@@ -260,7 +268,7 @@ mod tests {
         let mut branch = FamilyBranch::new(Frequency(&d), &hb, 0.2).unwrap();
         let opts = LocateOptions::default();
         let mut observer = EventObserver::new(&branch, 0.2, HsuSteps::default(), &opts).unwrap();
-        let mut copts = FrcOptions::default().continuation;
+        let mut copts = FrcOptions::default().path.continuation;
         (copts.lambda_min, copts.lambda_max) = (0.2, 3.0);
         copts.corrector = Corrector::Newton;
         let mut x0 = start.coeffs.clone();
