@@ -101,7 +101,6 @@ fn damped_modes<'py>(py, user, jac;
             corrector: Corrector::Newton,
             ..ContinuationOptions::default()
         },
-        ..BackboneOptions::default()
     };
     let mode = count("mode", mode)?;
     let dm = run_user(py, &problem, |p| ivt_hb::damped_modes(p, &opts, mode, &bopts))?;
