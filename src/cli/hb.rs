@@ -16,7 +16,7 @@ use super::{CliError, Output};
 use clap::{Args, Subcommand};
 use ivt_hb::aft::eval_series;
 use ivt_hb::jobs::{self, CascadeRequest, FrcRequest, Method, OrbitRequest};
-use ivt_hb::{Duffing, HbOptions};
+use ivt_hb::{Duffing, FrcOptions, HbOptions};
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
@@ -224,10 +224,12 @@ fn duffing(a: DuffingArgs) -> Result<Output, CliError> {
 fn duffing_frc(a: FrcArgs) -> Result<Output, CliError> {
     let problem = a.params.problem()?;
     let req = FrcRequest {
-        from: a.from,
-        to: a.to,
+        options: FrcOptions {
+            from: a.from,
+            to: a.to,
+            ..FrcOptions::default()
+        },
         events: a.events,
-        ..FrcRequest::default()
     };
     let frc = jobs::frc(&problem, &a.params.options()?, &req)?.with_fold_omegas();
     if let Some(path) = &a.plot {

@@ -82,10 +82,8 @@ fn chain_frc_0p2_to_3(bencher: divan::Bencher) {
 fn chain_frc_newton_0p2_to_3(bencher: divan::Bencher) {
     let p = chain();
     let hb = HbOptions::new(20, 84);
-    let opts = FrcOptions {
-        corrector: Corrector::Newton,
-        ..FrcOptions::default()
-    };
+    let mut opts = FrcOptions::default();
+    opts.path.continuation.corrector = Corrector::Newton;
     bencher.bench_local(|| frequency_response(&p, &hb, &opts).unwrap());
 }
 
@@ -94,10 +92,8 @@ fn chain_frc_newton_0p2_to_3(bencher: divan::Bencher) {
 fn duffing_frc_newton_0p2_to_3(bencher: divan::Bencher) {
     let d = Duffing::fig28();
     let hb = HbOptions::new(20, 64);
-    let opts = FrcOptions {
-        corrector: Corrector::Newton,
-        ..FrcOptions::default()
-    };
+    let mut opts = FrcOptions::default();
+    opts.path.continuation.corrector = Corrector::Newton;
     bencher.bench_local(|| frequency_response(&d, &hb, &opts).unwrap());
 }
 

@@ -34,12 +34,11 @@ pub struct BackboneOptions {
     pub amplitude_from: f64,
     /// Last amplitude `a₁`.
     pub amplitude_to: f64,
-    /// Path following (λ bounds are set from the amplitudes).
+    /// Path following (λ bounds are set from the amplitudes). Its corrector:
+    /// [`Corrector::Broyden`] on the secant model (the default) or
+    /// [`Corrector::Newton`] on the exact Jacobian of `{q, ω, κ}` (the
+    /// Galerkin Jacobian, so the problem's analytic `∂g` is used).
     pub continuation: ContinuationOptions,
-    /// The path's corrector: [`Corrector::Broyden`] on the secant model (the
-    /// default) or [`Corrector::Newton`] on the exact Jacobian of `{q, ω, κ}`
-    /// (the Galerkin Jacobian, so the problem's analytic `∂g` is used).
-    pub corrector: Corrector,
 }
 
 impl Default for BackboneOptions {
@@ -49,7 +48,6 @@ impl Default for BackboneOptions {
             amplitude_from: 0.01,
             amplitude_to: 1.0,
             continuation: ContinuationOptions::default(),
-            corrector: Corrector::Broyden,
         }
     }
 }
@@ -172,7 +170,7 @@ pub(crate) fn modal_path<P: PeriodicProblem>(
     copts.lambda_min = a_from.min(a_to);
     copts.lambda_max = a_from.max(a_to);
     let direction = a_to - a_from;
-    let path = match opts.corrector {
+    let path = match copts.corrector {
         Corrector::Broyden => {
             let corrector = Box::new(BroydenCorrector::new(m + 2, &copts.broyden, None));
             Stepper::new(&mut system, corrector, &x0, 0, direction, &copts)?.run(|_, _| true)

@@ -68,6 +68,12 @@ pub struct ContinuationOptions {
     /// tangent, gives the next tangent. The price: the last Jacobian assembled
     /// when `on_point` runs is the prediction's, not the point's.
     pub second_order_predictor: bool,
+    /// The corrector, where a path offers both (the frequency response,
+    /// [`crate::trace`], the backbone): [`Corrector::Broyden`] (Eq. 68–77,
+    /// the default) or [`Corrector::Newton`]. Not read by the paths that have
+    /// one: [`follow_residual`] (a residual alone) is Broyden's, the string
+    /// and condensed sweeps (exact Jacobians) are Newton's.
+    pub corrector: Corrector,
 }
 
 impl Default for ContinuationOptions {
@@ -87,6 +93,7 @@ impl Default for ContinuationOptions {
                 ..BroydenOptions::default()
             },
             second_order_predictor: false,
+            corrector: Corrector::Broyden,
         }
     }
 }

@@ -118,7 +118,7 @@ impl<F: Family> FamilyBranch<F> {
     }
 
     /// The path of the branch from the converged point `start` (`q` then λ) in the
-    /// direction of increasing λ if `direction > 0`, with `corrector`:
+    /// direction of increasing λ if `direction > 0`, with `opts.corrector`:
     /// Broyden on the secant model (Eq. 68–77; `start` is corrected first) or
     /// chord–Newton on the exact Galerkin Jacobian ([`NewtonCorrector`];
     /// `start_iterations` is the start's count).
@@ -139,10 +139,9 @@ impl<F: Family> FamilyBranch<F> {
         start_iterations: usize,
         direction: f64,
         opts: &ContinuationOptions,
-        corrector: Corrector,
     ) -> Result<Stepper<'_, Self>, HbError> {
         let m = self.res.len();
-        match corrector {
+        match opts.corrector {
             Corrector::Broyden => {
                 let broyden = Box::new(BroydenCorrector::new(m, &opts.broyden, None));
                 Stepper::new(self, broyden, start, 0, direction, opts)

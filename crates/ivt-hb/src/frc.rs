@@ -9,7 +9,7 @@
 use crate::aft::Aft;
 use crate::continuation::{ContinuationOptions, Corrector, Termination};
 use crate::events::{
-    observe, BifurcationKind, Detector, EventObserver, Fold, LocateOptions, Trace,
+    observe, BifurcationKind, Detector, EventObserver, Fold, LocateOptions, PathOptions, Trace,
 };
 use crate::family::{FamilyBranch, Frequency};
 use crate::ihb::{HbError, HbOptions, HbSolution};
@@ -25,15 +25,12 @@ pub struct FrcOptions {
     pub from: f64,
     /// End frequency ω_f (may be below `from` for a downward sweep).
     pub to: f64,
-    /// Path-following options (λ bounds are set from `from`/`to`).
-    pub continuation: ContinuationOptions,
-    /// Hsu sub-intervals of each point's multipliers (by default chosen per
-    /// point for multipliers to 1e-6, [`HsuSteps::Tolerance`]).
-    pub stability: HsuSteps,
-    /// The path's corrector: [`Corrector::Broyden`] (the thesis's Eq. 68–77,
-    /// the default) or [`Corrector::Newton`] (exact Galerkin Jacobian; fewer
-    /// residual evaluations per point, for costly `g`).
-    pub corrector: Corrector,
+    /// The path (λ bounds are set from `from`/`to`; its corrector
+    /// [`Corrector::Broyden`], the thesis's Eq. 68–77, or
+    /// [`Corrector::Newton`], the exact Galerkin Jacobian: fewer residual
+    /// evaluations per point, for costly `g`) and the Hsu sub-intervals of
+    /// each point's multipliers.
+    pub path: PathOptions,
 }
 
 impl Default for FrcOptions {
@@ -41,21 +38,35 @@ impl Default for FrcOptions {
         Self {
             from: 0.2,
             to: 3.0,
-            // Broyden correctors take 6–12 iterations near the peak; aiming at 16
-            // with Δη ≤ 0.08 gives ~95 points over 0.2–3.0 with folds located to
-            // ~1e-3 in ω_f (aiming at 10 gives 359 points at 4× the cost).
-            continuation: ContinuationOptions {
-                ds: 0.05,
-                ds_max: 0.08,
-                target_iter: 16,
-                // Newton corrector: 3.5 calls of g per point instead of 7.2
-                // on the chain of tests/corrector.rs.
-                second_order_predictor: true,
-                ..ContinuationOptions::default()
+            path: PathOptions {
+                // Broyden correctors take 6–12 iterations near the peak; aiming at 16
+                // with Δη ≤ 0.08 gives ~95 points over 0.2–3.0 with folds located to
+                // ~1e-3 in ω_f (aiming at 10 gives 359 points at 4× the cost).
+                continuation: ContinuationOptions {
+                    ds: 0.05,
+                    ds_max: 0.08,
+                    target_iter: 16,
+                    // Newton corrector: 3.5 calls of g per point instead of 7.2
+                    // on the chain of tests/corrector.rs.
+                    second_order_predictor: true,
+                    ..ContinuationOptions::default()
+                },
+                stability: HsuSteps::default(),
             },
-            stability: HsuSteps::default(),
-            corrector: Corrector::Broyden,
         }
+    }
+}
+
+impl FrcOptions {
+    /// The default sweep from `from` to `to` with `corrector`.
+    pub fn sweep(from: f64, to: f64, corrector: Corrector) -> Self {
+        let mut sweep = Self {
+            from,
+            to,
+            ..Self::default()
+        };
+        sweep.path.continuation.corrector = corrector;
+        sweep
     }
 }
 
@@ -137,7 +148,7 @@ pub fn frequency_response<P: PeriodicProblem>(
     let mut family = FamilyBranch::new(Frequency(problem), hb, opts.from)?;
     let mut x0 = start.coeffs.clone();
     x0.push(opts.from);
-    let mut copts = opts.continuation.clone();
+    let mut copts = opts.path.continuation.clone();
     copts.lambda_min = opts.from.min(opts.to);
     copts.lambda_max = opts.from.max(opts.to);
     let direction = if opts.to > opts.from { 1.0 } else { -1.0 };
@@ -151,14 +162,8 @@ pub fn frequency_response<P: PeriodicProblem>(
     let detectors: Vec<Box<dyn Detector<FamilyBranch<Frequency<'_, P>>>>> = vec![Box::new(Fold)];
     let locate = LocateOptions::fold();
     let mut observer =
-        EventObserver::with_detectors(&family, opts.from, opts.stability, &locate, detectors)?;
-    let mut stepper = family.stepper(
-        &x0,
-        start.stats.iterations,
-        direction,
-        &copts,
-        opts.corrector,
-    )?;
+        EventObserver::with_detectors(&family, opts.from, opts.path.stability, &locate, detectors)?;
+    let mut stepper = family.stepper(&x0, start.stats.iterations, direction, &copts)?;
     let (path, events) = observe(&mut stepper, &mut observer, |_, _| true)?;
     let trace = Trace {
         points: observer.into_points(),

@@ -57,8 +57,8 @@ pub use elements::{Element, ElementProblem, Harmonic, Law};
 pub use error::HbError;
 pub use events::{
     locate_branch_point, locate_fold, locate_multiplier_crossing, trace, Bifurcation,
-    BifurcationError, BifurcationKind, Event, FoldLocation, LocateOptions, Trace, TraceOptions,
-    TracedPoint,
+    BifurcationError, BifurcationKind, Event, FoldLocation, LocateOptions, PathOptions, Trace,
+    TraceOptions, TracedPoint,
 };
 pub use faer::c64;
 pub use family::{Family, FamilyBranch, Frequency};

@@ -6,7 +6,7 @@
 mod common;
 use common::tight_backbone;
 use ivt_hb::aft::eval_series;
-use ivt_hb::{backbone, BackboneOptions, Corrector, Duffing, HbOptions};
+use ivt_hb::{backbone, Corrector, Duffing, HbOptions};
 
 /// Exact frequency of `ẍ + x + αx³ = 0` with `x(0) = A`, `ẋ(0) = 0`:
 /// `T = 4K(k)/√(1 + αA²)`, `k² = αA²/(2(1 + αA²))`, so
@@ -35,10 +35,8 @@ fn closed_form_within(corrector: Corrector) {
     let alpha = 1.0;
     let duffing = Duffing::new(0.0, 1.0, alpha, 0.0);
     let hb = HbOptions::new(15, 64);
-    let opts = BackboneOptions {
-        corrector,
-        ..tight_backbone(0.01, 2.0, 0.02, 0.1)
-    };
+    let mut opts = tight_backbone(0.01, 2.0, 0.02, 0.1);
+    opts.continuation.corrector = corrector;
     let bb = backbone(&duffing, &hb, 1.0, &[1.0], &opts).unwrap();
     assert!(
         bb.points.last().unwrap().amplitude >= 2.0,

@@ -9,7 +9,7 @@ use ivt_hb::ode::{first_order, rk4};
 use ivt_hb::{
     period_doubled_start, switch_branch, trace, BifurcationKind, ContinuationOptions, Corrector,
     Family, FamilyBranch, GeneralProblem, HbOptions, LocateOptions, MathieuDuffing, ModifiedIhb,
-    PeriodicProblem, Trace, TraceOptions,
+    PathOptions, PeriodicProblem, Trace, TraceOptions,
 };
 
 /// The forcing-frequency family `ω_f ↦ (problem, ω_f)` and its trace with the
@@ -26,11 +26,11 @@ fn trace_in_omega<'a, P: PeriodicProblem>(
         .solve(omega_from, None)
         .unwrap();
     let mut branch = FamilyBranch::new(move |w: f64| (problem, w), hb, omega_from).unwrap();
-    let opts = TraceOptions {
+    let mut opts = TraceOptions {
         lambda_to: omega_to,
-        corrector,
         ..TraceOptions::default()
     };
+    opts.path.continuation.corrector = corrector;
     let tr = trace(&mut branch, &start.coeffs, omega_from, &opts).unwrap();
     (branch, tr)
 }
@@ -127,10 +127,13 @@ fn mathieu_duffing_period_doubling_matches_shooting_and_switches_to_period_two()
     let mut branch = FamilyBranch::new(family, &hb, 3.6).unwrap();
     let opts = TraceOptions {
         lambda_to: 5.0,
-        continuation: ContinuationOptions {
-            ds: 0.02,
-            ds_max: 0.05,
-            ..ContinuationOptions::default()
+        path: PathOptions {
+            continuation: ContinuationOptions {
+                ds: 0.02,
+                ds_max: 0.05,
+                ..ContinuationOptions::default()
+            },
+            ..PathOptions::default()
         },
         ..TraceOptions::default()
     };

@@ -7,7 +7,9 @@
 mod common;
 
 use common::counted::Counted;
-use ivt_hb::{frequency_response, ContinuationOptions, Corrector, FrcOptions, HbOptions};
+use ivt_hb::{
+    frequency_response, ContinuationOptions, Corrector, FrcOptions, HbOptions, PathOptions,
+};
 
 /// `(fold ω's, g calls per point, ∂g calls per point)` of the curve 0.2 → 3.0
 /// (`second_order` is [`ContinuationOptions::second_order_predictor`]).
@@ -15,10 +17,13 @@ fn curve(corrector: Corrector, second_order: bool) -> (Vec<f64>, f64, f64) {
     let p = Counted::chain();
     let defaults = FrcOptions::default();
     let opts = FrcOptions {
-        corrector,
-        continuation: ContinuationOptions {
-            second_order_predictor: second_order,
-            ..defaults.continuation.clone()
+        path: PathOptions {
+            continuation: ContinuationOptions {
+                corrector,
+                second_order_predictor: second_order,
+                ..defaults.path.continuation.clone()
+            },
+            ..defaults.path.clone()
         },
         ..defaults
     };

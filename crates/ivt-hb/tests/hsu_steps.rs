@@ -1,5 +1,5 @@
 //! Hsu sub-intervals chosen per point ([`AdaptiveHsu`], the default of
-//! [`FrcOptions::stability`]): every point's multipliers meet the tolerance
+//! [`PathOptions::stability`]): every point's multipliers meet the tolerance
 //! against an independent reference (8192 Magnus-4 steps, whose own error is
 //! below 1e-12: fourth order from 5.6e-7 at 256 steps), on the Duffing curve
 //! (closed-form 2×2 exponential) and the 2-DOF chain (4×4 Taylor).
@@ -74,10 +74,8 @@ fn every_point_meets_the_multiplier_tolerance_with_fewer_steps_off_resonance() {
     assert!(steps.iter().any(|&s| s >= 168), "{steps:?}");
 
     let chain = cubic_chain();
-    let opts = FrcOptions {
-        corrector: Corrector::Newton,
-        ..FrcOptions::default()
-    };
+    let mut opts = FrcOptions::default();
+    opts.path.continuation.corrector = Corrector::Newton;
     let frc = frequency_response(&chain, &HbOptions::new(20, 84), &opts).unwrap();
     checked_steps("chain", &chain, &frc);
 }

@@ -84,10 +84,8 @@ fn rotating_unbalance_folds_match_shooting() {
     assert_folds_match_shooting(&folds);
     // The job with events (the path `ivt.hb.frc` takes) finds the same folds.
     let req = FrcRequest {
-        from: 0.5,
-        to: 2.5,
+        options: FrcOptions::sweep(0.5, 2.5, Corrector::Newton),
         events: true,
-        corrector: Corrector::Newton,
     };
     let curve = jobs::frc(&problem, &hb, &req).unwrap();
     assert!(curve.folds.iter().all(|f| f.located));

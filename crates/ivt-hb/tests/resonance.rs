@@ -29,10 +29,9 @@ fn default_frc_finds_the_peak_of_a_lightly_damped_resonance() {
     let zeta: f64 = 0.001;
     let exact = 1.0 / (2.0 * zeta * (1.0 - zeta * zeta).sqrt());
     for corrector in [Corrector::Broyden, Corrector::Newton] {
-        let (top, points, end) = peak(FrcOptions {
-            corrector,
-            ..FrcOptions::default()
-        });
+        let mut opts = FrcOptions::default();
+        opts.path.continuation.corrector = corrector;
+        let (top, points, end) = peak(opts);
         assert_eq!(
             end,
             Termination::LeftInterval,
@@ -46,7 +45,7 @@ fn default_frc_finds_the_peak_of_a_lightly_damped_resonance() {
     // The test can fail: with the cap absolute (the old step control) the
     // default sweep runs out of points on the way up the circle.
     let mut absolute = FrcOptions::default();
-    absolute.continuation.ds_relative_scale = f64::INFINITY;
+    absolute.path.continuation.ds_relative_scale = f64::INFINITY;
     let (top, points, end) = peak(absolute);
     assert!(
         end == Termination::MaxPoints && top < 0.8 * exact,

@@ -205,10 +205,8 @@ fn frc_event<P: PeriodicProblem>(
     kind: BifurcationKind,
 ) -> (SwitchStart, f64) {
     let req = jobs::FrcRequest {
-        from,
-        to,
+        options: ivt_hb::FrcOptions::sweep(from, to, ivt_hb::Corrector::Newton),
         events: true,
-        corrector: ivt_hb::Corrector::Newton,
     };
     let curve = jobs::frc(p, hb, &req).unwrap();
     let start = event(&curve, kind);

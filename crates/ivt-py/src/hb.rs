@@ -6,7 +6,7 @@
 //! (the keys of the CLI's JSON, [`crate::to_python`]).
 
 use ivt_hb::jobs::{self, CascadeRequest, FrcRequest, LimitCycleRequest, OrbitRequest};
-use ivt_hb::{AtFrequency, Duffing, MathieuDuffing};
+use ivt_hb::{AtFrequency, Duffing, FrcOptions, MathieuDuffing};
 use numpy::PyArrayLike1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -177,10 +177,12 @@ fn duffing_frc<'py>(
     let opts = options(n, samples, 1, 1e-10)?;
     let problem = duffing_problem(xi, alpha, eps, force)?;
     let req = FrcRequest {
-        from: finite("from_", from_)?,
-        to: finite("to", to)?,
+        options: FrcOptions {
+            from: finite("from_", from_)?,
+            to: finite("to", to)?,
+            ..FrcOptions::default()
+        },
         events,
-        ..FrcRequest::default()
     };
     let curve = run(py, || jobs::frc(&problem, &opts, &req))?;
     to_dict(py, &curve.with_fold_omegas())

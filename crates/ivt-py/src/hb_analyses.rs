@@ -7,7 +7,7 @@
 //! (`ivt_hb::jobs::limit_cycle`).
 
 use ivt_hb::jobs::{self, AllSolutionsRequest};
-use ivt_hb::{BackboneOptions, Corrector, DampedModes};
+use ivt_hb::{BackboneOptions, ContinuationOptions, Corrector, DampedModes};
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
@@ -97,8 +97,10 @@ fn damped_modes<'py>(py, user, jac;
         dof: count("dof", dof)?,
         amplitude_from: finite("amplitude_from", amplitude_from)?,
         amplitude_to: finite("amplitude_to", amplitude_to)?,
-        corrector: Corrector::Newton,
-        ..BackboneOptions::default()
+        continuation: ContinuationOptions {
+            corrector: Corrector::Newton,
+            ..ContinuationOptions::default()
+        },
     };
     let mode = count("mode", mode)?;
     let dm = run_user(py, &problem, |p| ivt_hb::damped_modes(p, &opts, mode, &bopts))?;

@@ -5,7 +5,7 @@
 //! extended system) and [`ivt_hb::jobs::backbone`].
 
 use ivt_hb::jobs::{self, BackboneRequest, FrcRequest};
-use ivt_hb::Corrector;
+use ivt_hb::{BackboneOptions, Corrector, FrcOptions};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -58,7 +58,7 @@ fn frc<'py>(py, user, jac;
     }
     // The Newton–chord corrector: one Galerkin Jacobian and ~3 residuals per
     // point, the user's `g` called about a sixth as often as by Broyden.
-    let req = FrcRequest { from, to, events, corrector: Corrector::Newton };
+    let req = FrcRequest { options: FrcOptions::sweep(from, to, Corrector::Newton), events };
     let curve = run_user(py, &problem, |p| jobs::frc(p, &opts, &req))?;
     to_dict(py, &curve)
 }
@@ -92,10 +92,13 @@ fn backbone<'py>(py, user, jac;
     let req = BackboneRequest {
         omega0: finite("omega0", omega0)?,
         mode,
-        dof: crate::args::count("dof", dof)?,
-        amplitude_from: finite("amplitude_from", amplitude_from)?,
-        amplitude_to: finite("amplitude_to", amplitude_to)?,
-        corrector: Corrector::Newton,
+        options: BackboneOptions {
+            dof: crate::args::count("dof", dof)?,
+            amplitude_from: finite("amplitude_from", amplitude_from)?,
+            amplitude_to: finite("amplitude_to", amplitude_to)?,
+            // The request's Newton–chord corrector.
+            ..BackboneRequest::default().options
+        },
     };
     let curve = run_user(py, &problem, |p| jobs::backbone(p, &opts, &req))?;
     to_dict(py, &curve)

@@ -7,7 +7,7 @@
 use super::{to_json, CliError, Output};
 use clap::Args;
 use ivt_hb::jobs::{self, BackboneRequest, LimitCycleRequest, Oscillator};
-use ivt_hb::HbOptions;
+use ivt_hb::{BackboneOptions, HbOptions};
 
 /// Harmonics and samples of the autonomous jobs (Python's defaults and
 /// tolerances: ‖r‖₂ ≤ 1e-9 relative to the force scale).
@@ -111,11 +111,15 @@ pub fn backbone(a: BackboneArgs) -> Result<Output, CliError> {
             a.alpha, a.eps
         )));
     }
+    let defaults = BackboneRequest::default();
     let req = BackboneRequest {
         omega0: a.alpha.sqrt(),
-        amplitude_from: a.from,
-        amplitude_to: a.to,
-        ..BackboneRequest::default()
+        options: BackboneOptions {
+            amplitude_from: a.from,
+            amplitude_to: a.to,
+            ..defaults.options
+        },
+        ..defaults
     };
     let problem = jobs::free_duffing(a.alpha, a.eps);
     let curve = jobs::backbone(&problem, &a.resolution.options()?, &req)?;

@@ -8,7 +8,7 @@ use super::autonomous::Resolution;
 use super::{to_json, CliError, Output};
 use clap::Args;
 use ivt_hb::jobs::{self, FrcRequest, SwitchRequest, SwitchStart};
-use ivt_hb::{BifurcationKind, Corrector, GeneralProblem, PeriodicProblem};
+use ivt_hb::{BifurcationKind, Corrector, FrcOptions, GeneralProblem, PeriodicProblem};
 
 /// `ivt hb switch` (defaults: c = 0.1, F = 0.5, the FRC from ω_f = 3.6 down
 /// to 2.2, the period-2 branch to 2.2).
@@ -77,10 +77,8 @@ pub fn run(a: SwitchArgs) -> Result<Output, CliError> {
     let hb = a.resolution.options()?;
     let req = SwitchRequest {
         start: SwitchStart::Search(FrcRequest {
-            from: a.from,
-            to: a.to,
+            options: FrcOptions::sweep(a.from, a.to, Corrector::Newton),
             events: true,
-            corrector: Corrector::Newton,
         }),
         to: a.branch_to,
         step: a.step,

@@ -9,6 +9,7 @@
 use crate::continuation::Corrector;
 use crate::error::HbError;
 use crate::events::BifurcationKind;
+use crate::frc::FrcOptions;
 use crate::ihb::HbOptions;
 use crate::jobs::{frc, FrcRequest};
 use crate::problem::PeriodicProblem;
@@ -46,10 +47,8 @@ where
 {
     let mut found = Vec::new();
     let req = FrcRequest {
-        from: omega_from,
-        to: omega_to,
+        options: FrcOptions::sweep(omega_from, omega_to, Corrector::Newton),
         events: true,
-        corrector: Corrector::Newton,
     };
     for &p in ps {
         let curve = frc(&family(p)?, hb, &req)?;

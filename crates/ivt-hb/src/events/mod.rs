@@ -39,7 +39,7 @@ pub use fold::{locate_fold, FamilyFold, Fold, FoldLocation};
 pub use multipliers::{Multipliers, PointMultipliers};
 pub use neimark_sacker::NeimarkSacker;
 pub use period_doubling::PeriodDoubling;
-pub use trace::{observe, trace, EventObserver, Trace, TraceOptions};
+pub use trace::{observe, trace, EventObserver, PathOptions, Trace, TraceOptions};
 
 use crate::family::{Family, FamilyBranch};
 use crate::ihb::HbError;

@@ -13,10 +13,23 @@ use super::multipliers::{Multipliers, PointMultipliers};
 use super::neimark_sacker::NeimarkSacker;
 use super::period_doubling::PeriodDoubling;
 use crate::branch::Branch;
-use crate::continuation::{ContinuationOptions, Corrector, Path, PathPoint, Stepper, Termination};
+use crate::continuation::{ContinuationOptions, Path, PathPoint, Stepper, Termination};
 use crate::family::{Family, FamilyBranch};
 use crate::ihb::HbError;
 use crate::stability::{AdaptiveHsu, HsuSteps};
+
+/// The options of a path whose points get their Floquet multipliers, shared
+/// by the sweep that locates folds only ([`crate::FrcOptions`]) and the one
+/// that locates every event ([`TraceOptions`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PathOptions {
+    /// Path following (its λ bounds are set from the interval; its
+    /// corrector [`crate::Corrector::Broyden`] by default).
+    pub continuation: ContinuationOptions,
+    /// Hsu sub-intervals of the path points' multipliers (by default chosen
+    /// per point for multipliers to 1e-6, [`HsuSteps::Tolerance`]).
+    pub stability: HsuSteps,
+}
 
 /// Options of [`trace`].
 #[derive(Debug, Clone, PartialEq)]
@@ -24,25 +37,18 @@ pub struct TraceOptions {
     /// End of the parameter interval (the path stops once it leaves
     /// `[min(λ₀, lambda_to), max(λ₀, lambda_to)]`).
     pub lambda_to: f64,
-    /// Path following (its λ bounds are set from λ₀ and `lambda_to`).
-    pub continuation: ContinuationOptions,
-    /// Hsu sub-intervals of the path points' multipliers (by default chosen
-    /// per point for multipliers to 1e-6).
-    pub stability: HsuSteps,
+    /// The path and its multipliers (λ bounds set from λ₀ and `lambda_to`).
+    pub path: PathOptions,
     /// Options of the located events.
     pub locate: LocateOptions,
-    /// The path's corrector ([`Corrector::Broyden`] by default).
-    pub corrector: Corrector,
 }
 
 impl Default for TraceOptions {
     fn default() -> Self {
         Self {
             lambda_to: 1.0,
-            continuation: ContinuationOptions::default(),
-            stability: HsuSteps::default(),
+            path: PathOptions::default(),
             locate: LocateOptions::default(),
-            corrector: Corrector::Broyden,
         }
     }
 }
@@ -272,13 +278,13 @@ pub fn trace<F: Family>(
     }
     let mut x0 = q0.to_vec();
     x0.push(lambda0);
-    let mut copts = opts.continuation.clone();
+    let mut copts = opts.path.continuation.clone();
     copts.lambda_min = lambda0.min(opts.lambda_to);
     copts.lambda_max = lambda0.max(opts.lambda_to);
-    let mut observer = EventObserver::new(branch, lambda0, opts.stability, &opts.locate)?;
+    let mut observer = EventObserver::new(branch, lambda0, opts.path.stability, &opts.locate)?;
     // The one continuation driver: the observer sees each point as it is
     // reached, and its error ends the path.
-    let mut stepper = branch.stepper(&x0, 0, opts.lambda_to - lambda0, &copts, opts.corrector)?;
+    let mut stepper = branch.stepper(&x0, 0, opts.lambda_to - lambda0, &copts)?;
     let (path, events) = observe(&mut stepper, &mut observer, |_, _| true)?;
     Ok(Trace {
         points: observer.into_points(),
@@ -293,6 +299,7 @@ mod tests {
     use crate::family::Frequency;
     use crate::frc::FrcOptions;
     use crate::ihb::HbOptions;
+    use crate::Corrector;
     use crate::{BifurcationKind, Duffing, ModifiedIhb};
 
     #[test]
@@ -311,21 +318,19 @@ mod tests {
         let mut branch = FamilyBranch::new(Frequency(&d), &hb, 0.2).unwrap();
         let opts = LocateOptions::default();
         let mut observer = EventObserver::new(&branch, 0.2, HsuSteps::default(), &opts).unwrap();
-        let mut copts = FrcOptions::default().continuation;
+        let mut copts = FrcOptions::default().path.continuation;
         (copts.lambda_min, copts.lambda_max) = (0.2, 3.0);
+        copts.corrector = Corrector::Newton;
         let mut x0 = start.coeffs.clone();
         x0.push(0.2);
         let mut arrived = Vec::new();
         let mut count = 0;
-        let path = branch
-            .stepper(&x0, 0, 1.0, &copts, Corrector::Newton)
-            .unwrap()
-            .run(|b, p| {
-                let found = observer.on_point(b, p).unwrap();
-                arrived.extend(found.into_iter().map(|e| (count, e)));
-                count += 1;
-                true
-            });
+        let path = branch.stepper(&x0, 0, 1.0, &copts).unwrap().run(|b, p| {
+            let found = observer.on_point(b, p).unwrap();
+            arrived.extend(found.into_iter().map(|e| (count, e)));
+            count += 1;
+            true
+        });
         assert_eq!(path.termination, Termination::LeftInterval);
         let n = path.points.len();
         assert_eq!(arrived.len(), 2, "{arrived:?}");
@@ -350,11 +355,9 @@ mod tests {
         let d = Duffing::new(0.02, 1.0, 1.0, 0.1);
         let mut reached = 0;
         for k in 0..10 {
-            let mut opts = FrcOptions {
-                corrector: Corrector::Newton,
-                ..FrcOptions::default()
-            };
-            opts.continuation.ds_max = 0.12 - 0.008 * f64::from(k);
+            let mut opts = FrcOptions::default();
+            opts.path.continuation.corrector = Corrector::Newton;
+            opts.path.continuation.ds_max = 0.12 - 0.008 * f64::from(k);
             let full = crate::frequency_response(&d, &hb, &opts).unwrap();
             let omega: Vec<f64> = full.points.iter().map(|p| p.omega_f).collect();
             let rising = |j: usize| omega[j] > omega[j - 1];
@@ -362,7 +365,7 @@ mod tests {
             for (j, want) in turns.zip([1.6548121, 1.1687244]) {
                 // The tangents turn at the highest point `j − 1` or after it.
                 for last in [j - 1, j] {
-                    opts.continuation.max_points = last + 1;
+                    opts.path.continuation.max_points = last + 1;
                     let cut = crate::frequency_response(&d, &hb, &opts).unwrap();
                     assert_eq!(cut.points.len(), last + 1);
                     let Some(fold) = cut.folds.last().filter(|f| f.index == last) else {

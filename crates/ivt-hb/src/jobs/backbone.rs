@@ -30,34 +30,26 @@ pub fn free_duffing(alpha: f64, eps: f64) -> impl PeriodicProblem {
     .with_velocity_dependent(false)
 }
 
-/// The linear mode to start from and the amplitude interval.
+/// The linear mode to start from and the backbone's options.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BackboneRequest {
     /// Linear frequency ω₀ of the mode (K·mode = ω₀² M·mode).
     pub omega0: f64,
     /// Mode shape (n_dof entries).
     pub mode: Vec<f64>,
-    /// DOF whose first cosine coefficient a1 is the amplitude.
-    pub dof: usize,
-    /// First amplitude.
-    pub amplitude_from: f64,
-    /// Last amplitude.
-    pub amplitude_to: f64,
-    /// Corrector of the path.
-    pub corrector: Corrector,
+    /// The reference DOF, the amplitude interval and the path.
+    pub options: BackboneOptions,
 }
 
 impl Default for BackboneRequest {
     /// One DOF of unit frequency, a1 from 0.01 to 1, Newton–chord corrector.
     fn default() -> Self {
-        let o = BackboneOptions::default();
+        let mut options = BackboneOptions::default();
+        options.continuation.corrector = Corrector::Newton;
         Self {
             omega0: 1.0,
             mode: vec![1.0],
-            dof: o.dof,
-            amplitude_from: o.amplitude_from,
-            amplitude_to: o.amplitude_to,
-            corrector: Corrector::Newton,
+            options,
         }
     }
 }
@@ -68,8 +60,8 @@ impl BackboneRequest {
     /// mode and the system are checked by [`crate::backbone()`]).
     pub fn validate(&self) -> Result<(), HbError> {
         finite("omega0", self.omega0)?;
-        finite("amplitude_from", self.amplitude_from)?;
-        finite("amplitude_to", self.amplitude_to)?;
+        finite("amplitude_from", self.options.amplitude_from)?;
+        finite("amplitude_to", self.options.amplitude_to)?;
         Ok(())
     }
 }
@@ -112,14 +104,7 @@ pub fn backbone<P: PeriodicProblem>(
     req: &BackboneRequest,
 ) -> Result<BackboneCurve, HbError> {
     req.validate()?;
-    let opts = BackboneOptions {
-        dof: req.dof,
-        amplitude_from: req.amplitude_from,
-        amplitude_to: req.amplitude_to,
-        corrector: req.corrector,
-        ..BackboneOptions::default()
-    };
-    let bb = crate::backbone(problem, hb, req.omega0, &req.mode, &opts)?;
+    let bb = crate::backbone(problem, hb, req.omega0, &req.mode, &req.options)?;
     let col = |f: fn(&BackbonePoint) -> f64| bb.points.iter().map(f).collect();
     Ok(BackboneCurve {
         amplitude: col(|p| p.amplitude),
@@ -150,10 +135,8 @@ mod tests {
         // a1 = 0.1 the O(a⁴) rest is below 1e-5.
         let d = Duffing::new(0.0, 1.0, 1.0, 0.0);
         let hb = HbOptions::new(10, 32);
-        let req = BackboneRequest {
-            amplitude_to: 0.1,
-            ..BackboneRequest::default()
-        };
+        let mut req = BackboneRequest::default();
+        req.options.amplitude_to = 0.1;
         let bb = backbone(&d, &hb, &req).unwrap();
         assert_eq!(bb.termination, Termination::LeftInterval);
         let last = bb.points.last().unwrap();

@@ -316,10 +316,8 @@ where
             .max_by(|x, y| x.0.total_cmp(&y.0))
     } else {
         let frc = FrcRequest {
-            from,
-            to,
+            options: FrcOptions::sweep(from, to, Corrector::Newton),
             events: true,
-            corrector: Corrector::Newton,
         };
         super::frc(&problem, hb, &frc)?
             .bifurcations

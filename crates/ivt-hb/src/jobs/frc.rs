@@ -6,7 +6,7 @@
 //! Neimark–Sacker point and branch point as the path passes it.
 
 use super::{check_finite, pairs, Array};
-use crate::continuation::{Corrector, Termination};
+use crate::continuation::Termination;
 use crate::error::HbError;
 use crate::events::{trace, BifurcationError, BifurcationKind, Event, TraceOptions};
 use crate::family::{Family, FamilyBranch, Frequency};
@@ -19,31 +19,16 @@ use crate::ModifiedIhb;
 use serde::Serialize;
 use std::time::Instant;
 
-/// The interval, the corrector and whether to locate every event.
-#[derive(Debug, Clone, PartialEq)]
+/// The sweep (its interval: `from`, `to` finite, > 0 and distinct) and
+/// whether to locate every event.
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct FrcRequest {
-    /// Start frequency (finite, > 0).
-    pub from: f64,
-    /// End frequency (finite, > 0, ≠ `from`).
-    pub to: f64,
+    /// The sweep; by default Fig. 29's interval 0.2 → 3.0 and
+    /// [`FrcOptions`]' path.
+    pub options: FrcOptions,
     /// Locate period doublings, Neimark–Sacker and branch points too
-    /// (otherwise folds only).
+    /// (otherwise folds only; the default).
     pub events: bool,
-    /// Corrector of the path.
-    pub corrector: Corrector,
-}
-
-impl Default for FrcRequest {
-    /// Fig. 29's interval 0.2 → 3.0, folds only, [`FrcOptions`]' corrector.
-    fn default() -> Self {
-        let o = FrcOptions::default();
-        Self {
-            from: o.from,
-            to: o.to,
-            events: false,
-            corrector: o.corrector,
-        }
-    }
 }
 
 impl FrcRequest {
@@ -52,8 +37,8 @@ impl FrcRequest {
     /// distinct.
     pub fn validate(&self) -> Result<(), HbError> {
         let (from, to) = (
-            super::finite("from", self.from)?,
-            super::finite("to", self.to)?,
+            super::finite("from", self.options.from)?,
+            super::finite("to", self.options.to)?,
         );
         if !(from > 0.0 && to > 0.0 && from != to) {
             return Err(HbError::InvalidInput(format!(
@@ -171,53 +156,41 @@ pub fn frc<P: PeriodicProblem>(
 ) -> Result<FrcCurve<FoldPoint>, HbError> {
     req.validate()?;
     let t0 = Instant::now();
+    let opts = &req.options;
     if req.events {
-        let at_start = AtFrequency::new(problem, req.from);
-        let start = ModifiedIhb::new(&at_start, hb.clone())?.solve(req.from, None)?;
-        let mut branch = FamilyBranch::new(Frequency(problem), hb, req.from)?;
-        return traced_curve(
-            &mut branch,
-            (&start.coeffs, req.from),
-            req.to,
-            req.corrector,
-            t0,
-        );
+        let at_start = AtFrequency::new(problem, opts.from);
+        let start = ModifiedIhb::new(&at_start, hb.clone())?.solve(opts.from, None)?;
+        let mut branch = FamilyBranch::new(Frequency(problem), hb, opts.from)?;
+        return traced_curve(&mut branch, &start.coeffs, opts, t0);
     }
-    let opts = FrcOptions {
-        from: req.from,
-        to: req.to,
-        corrector: req.corrector,
-        ..FrcOptions::default()
-    };
-    let curve = frequency_response(problem, hb, &opts)?;
+    let curve = frequency_response(problem, hb, opts)?;
     let events = curve.folds.iter().map(|f| fold_event(f, &curve)).collect();
-    assemble(curve, events, t0)
+    assemble(curve, events, opts.path.stability, t0)
 }
 
 /// The curve of `branch` (a frequency family, planned with the options the
 /// points' coefficients have) traced with events by [`crate::trace`] from
-/// the orbit `start = (q, ω_f)` to `to`, as [`frc`] returns it (also the
-/// new branch of [`super::switch()`]); `t0` starts the job's wall time.
+/// the orbit `start` at ω_f = `sweep.from` to `sweep.to` on `sweep.path`, as
+/// [`frc`] returns it (also the new branch of [`super::switch()`]); `t0`
+/// starts the job's wall time.
 ///
 /// # Errors
 /// The trace's ([`trace_error`]) and [`assemble`]'s.
 pub(super) fn traced_curve<F: Family>(
     branch: &mut FamilyBranch<F>,
-    start: (&[f64], f64),
-    to: f64,
-    corrector: Corrector,
+    start: &[f64],
+    sweep: &FrcOptions,
     t0: Instant,
 ) -> Result<FrcCurve<FoldPoint>, HbError> {
     let opts = TraceOptions {
-        lambda_to: to,
-        continuation: FrcOptions::default().continuation,
-        corrector,
+        lambda_to: sweep.to,
+        path: sweep.path.clone(),
         ..TraceOptions::default()
     };
-    let traced = trace(branch, start.0, start.1, &opts).map_err(trace_error)?;
+    let traced = trace(branch, start, sweep.from, &opts).map_err(trace_error)?;
     let curve = Frc::from_trace(&traced, branch.options())?;
     let events = traced.events.iter().map(|e| event(e, &curve)).collect();
-    assemble(curve, events, t0)
+    assemble(curve, events, sweep.path.stability, t0)
 }
 
 /// A bifurcation error as the jobs report it: the [`HbError`] it carries, or
@@ -231,14 +204,15 @@ pub(super) fn trace_error(e: BifurcationError) -> HbError {
 
 /// The job's result from a traced `curve` and its `events`: every point's
 /// multipliers checked finite (a point whose stability is unknown makes the
-/// curve an error, naming the Hsu sub-intervals' cap, not a point reported
-/// unstable).
+/// curve an error, naming the cap of the Hsu sub-intervals `stability`, not
+/// a point reported unstable).
 fn assemble(
     curve: Frc,
     events: Vec<EventRecord>,
+    stability: HsuSteps,
     t0: Instant,
 ) -> Result<FrcCurve<FoldPoint>, HbError> {
-    let hsu_cap = match FrcOptions::default().stability {
+    let hsu_cap = match stability {
         HsuSteps::Tolerance { max, .. } => max,
         HsuSteps::Fixed(steps) => steps,
     };
@@ -351,8 +325,11 @@ mod tests {
     #[test]
     fn bad_interval_is_an_input_error() {
         let req = FrcRequest {
-            from: 1.0,
-            to: 1.0,
+            options: FrcOptions {
+                from: 1.0,
+                to: 1.0,
+                ..FrcOptions::default()
+            },
             ..FrcRequest::default()
         };
         assert_eq!(req.validate().unwrap_err().kind(), "input");

@@ -28,6 +28,7 @@ use crate::error::HbError;
 use crate::events::extended::{border_null_vectors, jacobian_blocks, put_jacobian};
 use crate::events::{dot, Bifurcation, BifurcationKind, LocateOptions};
 use crate::family::{Family, FamilyBranch, Frequency};
+use crate::frc::FrcOptions;
 use crate::ihb::HbOptions;
 use crate::problem::PeriodicProblem;
 use crate::switching::{period_doubled_start, switch_branch};
@@ -73,8 +74,11 @@ impl Default for SwitchRequest {
     fn default() -> Self {
         Self {
             start: SwitchStart::Search(FrcRequest {
-                from: 0.5,
-                to: 3.0,
+                options: FrcOptions {
+                    from: 0.5,
+                    to: 3.0,
+                    ..FrcOptions::default()
+                },
                 ..FrcRequest::default()
             }),
             to: 2.0,
@@ -217,7 +221,8 @@ pub fn switch<P: PeriodicProblem>(
         )));
     }
     let (harmonics, subharmonic) = (branch.options().harmonics, branch.options().subharmonic);
-    let curve = traced_curve(&mut branch, (&q1, w1), req.to, req.corrector, t0)?;
+    let sweep = FrcOptions::sweep(w1, req.to, req.corrector);
+    let curve = traced_curve(&mut branch, &q1, &sweep, t0)?;
     Ok(SwitchedBranch {
         kind,
         start_omega: omega,
@@ -247,7 +252,7 @@ fn first_event<P: PeriodicProblem>(
         .ok_or_else(|| {
             HbError::InvalidInput(format!(
                 "the FRC from ω_f = {} to {} has no located period doubling or branch point",
-                req.from, req.to
+                req.options.from, req.options.to
             ))
         })
 }
