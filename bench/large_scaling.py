@@ -24,16 +24,19 @@ def curve(n_elements, n=7, stability=True):
     f = np.zeros(m.shape[0])
     f[tip] = 0.005
 
-    def g(x, v, t):
-        return 200.0 * x**3
+    # The tip spring as a Rust element on the condensed unknown (its local
+    # index 0): no Python call per sample (a per-sample Python g with its jac
+    # adds about a fifth on the 1000-DOF curve; test_hb_large.py checks that
+    # both give the same curve).
+    spring = ivt.hb.elements.cubic_spring(200.0, dof=0)
 
-    def jac(x, v, t):
-        return np.array([[600.0 * x[0] ** 2]]), np.zeros((1, 1))
-
-    t0 = time.process_time()
-    out = ivt.hb.frc(m, c, k, g, f, 0.7 * W1, 1.3 * W1, jac=jac, nonlinear_dofs=[tip],
-                     n=n, samples=max(32, 4 * n + 4), stability=stability)
-    return time.process_time() - t0, out
+    best = float("inf")
+    for _ in range(2):  # the best of two: the first call also plans the FFTs
+        t0 = time.process_time()
+        out = ivt.hb.frc(m, c, k, spring, f, 0.7 * W1, 1.3 * W1, nonlinear_dofs=[tip],
+                         n=n, samples=max(32, 4 * n + 4), stability=stability)
+        best = min(best, time.process_time() - t0)
+    return best, out
 
 
 def row(label, cpu, out):

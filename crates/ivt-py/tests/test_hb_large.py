@@ -70,6 +70,24 @@ def test_condensed_curve_with_located_folds_and_recovered_dofs():
     assert np.array_equal(out["omega"], [p["omega"] for p in out["points"]])
 
 
+def test_condensed_curve_with_a_rust_element_equals_the_python_g():
+    # The same tip spring as a Rust element on the condensed unknown (its
+    # local index 0) and as the Python g with its Jacobian: the same points
+    # and folds (both correct to 1e-12 of the linear response; the folds are
+    # located on the extended system to 1e-11).
+    m, c, k, tip = ivt.hb.models.cantilever(20)
+    f = np.zeros(m.shape[0])
+    f[tip] = F0
+    args = (0.7 * W1, 1.3 * W1)
+    py = ivt.hb.frc(m, c, k, spring, f, *args, jac=spring_jac, nonlinear_dofs=[tip])
+    el = ivt.hb.frc(m, c, k, ivt.hb.elements.cubic_spring(K3, dof=0), f, *args, nonlinear_dofs=[tip])
+    assert len(el["points"]) == len(py["points"])
+    np.testing.assert_allclose(el["amplitude"], py["amplitude"], rtol=1e-9, atol=0)
+    assert [fd["located"] for fd in el["folds"]] == [True, True]
+    np.testing.assert_allclose([fd["omega"] for fd in el["folds"]],
+                               [fd["omega"] for fd in py["folds"]], rtol=1e-10, atol=0)
+
+
 def test_condensed_solve_equals_the_dense_uncondensed_solve():
     # N = 8: the dense solve (classic Newton on all 16 DOFs) from its own
     # linear guess reaches the same orbit.
