@@ -28,6 +28,7 @@ mod branch;
 pub mod dynamic;
 mod estimate;
 mod frc;
+mod modal_hsu;
 mod receptance;
 mod ritz;
 mod scaled;

@@ -21,6 +21,7 @@
 //! Richardson estimate is added.
 
 use super::branch::CondensedBranch;
+use super::modal_hsu::ModalHsu;
 use super::ritz::{at, row, Reduced, RitzBasis};
 use crate::error::HbError;
 use crate::ihb::HbSolution;
@@ -187,6 +188,17 @@ impl<P: PeriodicProblem> PeriodicProblem for ReducedProblem<'_, P> {
     }
 }
 
+/// One level of the basis: the reduced problem and its monodromies, by
+/// the modal splitting ([`ModalHsu`]) where it applies (proportional
+/// damping, `g` of positions only, a tolerance on Hsu's steps) and meets
+/// the tolerance within the cap, else by Magnus-4.
+#[derive(Debug, Clone)]
+struct Level {
+    reduced: Reduced,
+    modal: Option<ModalHsu>,
+    magnus: AdaptiveHsu,
+}
+
 /// Floquet multipliers of a condensed branch's orbits from a reduced basis
 /// grown per orbit (module docs), with the per-orbit error estimates.
 #[derive(Debug, Clone)]
@@ -196,7 +208,7 @@ pub struct ReducedStability {
     steps: HsuSteps,
     /// The reduced problem and its Hsu of each block count used so far
     /// (index: blocks − 1).
-    levels: Vec<Option<(Reduced, AdaptiveHsu)>>,
+    levels: Vec<Option<Level>>,
     /// The blocks the next orbit starts from.
     start: usize,
 }
@@ -243,7 +255,7 @@ impl ReducedStability {
         self.levels
             .get(self.start.saturating_sub(1))
             .and_then(Option::as_ref)
-            .map_or(0, |(reduced, _)| reduced.size)
+            .map_or(0, |level| level.reduced.size)
     }
 
     /// The multipliers of the condensed orbit `q` at ω_f of `branch`: the
@@ -310,17 +322,33 @@ impl ReducedStability {
             })?;
         if slot.is_none() {
             let reduced = self.basis.reduced(blocks, s, local)?;
+            let modal = ModalHsu::new(&reduced, local, hb.harmonics, self.steps);
             let problem = ReducedProblem {
                 reduced: &reduced,
                 local,
                 s,
             };
-            let hsu = AdaptiveHsu::new(&problem, hb.harmonics, self.steps)?;
-            *slot = Some((reduced, hsu));
+            let magnus = AdaptiveHsu::new(&problem, hb.harmonics, self.steps)?;
+            *slot = Some(Level {
+                reduced,
+                modal,
+                magnus,
+            });
         }
-        let (reduced, hsu) = slot
+        let Level {
+            reduced,
+            modal,
+            magnus: hsu,
+        } = slot
             .as_mut()
             .ok_or_else(|| HbError::InvalidInput("stability level missing".into()))?;
+        if let Some(modal) = modal {
+            let omega = omega_f / hb.subharmonic as f64;
+            if let Some(estimate) = modal.floquet(local, q, omega, hb.subharmonic)? {
+                seen.push((blocks, estimate.clone()));
+                return Ok(estimate);
+            }
+        }
         let l = 2 * hb.harmonics + 1;
         let r = reduced.size;
         let mut coeffs = vec![0.0; r * l];
