@@ -64,6 +64,46 @@ fn beam_curve_n500(bencher: divan::Bencher) {
     });
 }
 
+/// The bladed-disk acceptance curve of issue 28: pyHarm's 72-DOF disk
+/// condensed onto the blade tip (cubic spring 5e10 x³), 1150–1260 rad/s,
+/// n = 5, multipliers at every point.
+#[divan::bench(sample_count = 3)]
+fn disk_curve(bencher: divan::Bencher) {
+    use ivt_hb::condense::{condensed_response, CondensedBranch, CondensedFrcOptions};
+    use ivt_hb::models::bladed_disk;
+    use ivt_hb::{GeneralProblem, HbOptions};
+    let disk = bladed_disk().expect("disk");
+    let s = &disk.model;
+    let structure = Structure::new(s.m.as_ref(), s.c.as_ref(), s.k.as_ref()).expect("structure");
+    let mut load = vec![0.0; s.n_dof()];
+    load[disk.tip] = 1.0;
+    let opts = CondensedFrcOptions {
+        from: 1150.0,
+        to: 1260.0,
+        ..CondensedFrcOptions::default()
+    };
+    bencher.bench_local(|| {
+        let zero = || vec![0.0];
+        let local = GeneralProblem::new(1, zero(), zero(), zero(), tip_spring, unforced)
+            .with_velocity_dependent(false);
+        let mut branch = CondensedBranch::new(
+            structure.clone(),
+            vec![disk.tip],
+            &load,
+            &[],
+            local,
+            &HbOptions::new(5, 32),
+        )
+        .expect("branch");
+        condensed_response(&mut branch, &opts).expect("curve")
+    });
+}
+
+/// The disk's blade-tip cubic spring 5e10 x³.
+fn tip_spring(x: &[f64], _v: &[f64], _t: f64, g: &mut [f64]) {
+    g[0] = 5e10 * x[0].powi(3);
+}
+
 /// The tip's cubic spring 200 x³.
 fn spring(x: &[f64], _v: &[f64], _t: f64, g: &mut [f64]) {
     g[0] = 200.0 * x[0].powi(3);

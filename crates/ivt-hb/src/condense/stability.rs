@@ -4,7 +4,9 @@
 //! `M δẍ + C δẋ + K δx + E_S (G_x(t) E_Sᵀ δx + G_v(t) E_Sᵀ δẋ) = 0`,
 //!
 //! Galerkin-projected onto a reduced basis `V` and analysed by Hsu's method
-//! (Eq. 79–80, [`AdaptiveHsu`]).
+//! (Eq. 79–80): by the modal splitting of [`super::modal_hsu`] where the
+//! reduced damping is proportional and `g` reads positions only, else (or
+//! when the splitting does not meet the tolerance) by [`AdaptiveHsu`].
 //!
 //! The basis: the load-dependent Ritz vectors of `S` ([`super::ritz`]). It
 //! holds the static modes of `S` exactly and converges to the lowest modes
