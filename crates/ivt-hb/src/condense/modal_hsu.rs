@@ -1,6 +1,7 @@
 //! Hsu's monodromy (Eq. 80) of a reduced variational equation whose linear
 //! part is proportionally damped and whose nonlinear term acts on positions
-//! only, by a splitting in the reduced modal coordinates.
+//! only (`G_v = 0` on the orbit, checked per sample), by a splitting in
+//! the reduced modal coordinates.
 //!
 //! With `Φ` the `M_r`-orthonormal eigenvectors of `(K_r, M_r)` and
 //! `Φᵀ C_r Φ` diagonal (checked), the reduced Eq. 78 in τ = ωt reads per mode
@@ -55,21 +56,15 @@ pub(super) struct ModalHsu {
 }
 
 impl ModalHsu {
-    /// The modal form of `reduced` with `local`'s nonlinear term, `None`
-    /// when the splitting does not apply: `local` depends on velocity, the
-    /// damping is not proportional on the reduced basis, `steps` is fixed,
-    /// or the eigenproblem fails.
-    pub(super) fn new<P: PeriodicProblem>(
-        reduced: &Reduced,
-        local: &P,
-        harmonics: usize,
-        steps: HsuSteps,
-    ) -> Option<Self> {
+    /// The modal form of `reduced`, `None`
+    /// when the splitting does not apply: the damping is not proportional
+    /// on the reduced basis, `steps` is fixed, or the eigenproblem fails.
+    pub(super) fn new(reduced: &Reduced, harmonics: usize, steps: HsuSteps) -> Option<Self> {
         let HsuSteps::Tolerance { tol, max } = steps else {
             return None;
         };
         let base = (2 * (harmonics + 1)).max(32);
-        if local.velocity_dependent() || !(tol > 0.0 && tol.is_finite()) || max < 4 * base {
+        if !(tol > 0.0 && tol.is_finite()) || max < 4 * base {
             return None;
         }
         let (r, s) = (reduced.size, reduced.at_dofs.len() / reduced.size.max(1));
@@ -119,7 +114,8 @@ impl ModalHsu {
     /// ω_f/p) with the excitation phase `p·τ`: levels are added until the
     /// Richardson estimate meets the tolerance; `None` if it does not within
     /// the cap (the splitting has not reached its asymptotic order on the
-    /// stiffest coupled modes: the caller falls back to Magnus-4).
+    /// stiffest coupled modes) or `G_v` is not zero on the orbit (the kick
+    /// would not be nilpotent): the caller falls back to Magnus-4.
     ///
     /// # Errors
     /// [`HbError`] if the samples of a level cannot be set up.
@@ -132,8 +128,12 @@ impl ModalHsu {
     ) -> Result<Option<HsuEstimate>, HbError> {
         let dim = 2 * self.r;
         let mut level = self.level.min(self.top.saturating_sub(2));
-        let mut coarse = self.monodromy(local, q, omega, subharmonic, level)?;
-        let mut fine = self.monodromy(local, q, omega, subharmonic, level + 1)?;
+        let Some(mut coarse) = self.monodromy(local, q, omega, subharmonic, level)? else {
+            return Ok(None);
+        };
+        let Some(mut fine) = self.monodromy(local, q, omega, subharmonic, level + 1)? else {
+            return Ok(None);
+        };
         let mut last: Option<Vec<faer::c64>> = None;
         loop {
             let extrapolated: Vec<f64> = fine
@@ -166,7 +166,10 @@ impl ModalHsu {
             last = Some(mu);
             level += 1;
             coarse = fine;
-            fine = self.monodromy(local, q, omega, subharmonic, level + 1)?;
+            let Some(next) = self.monodromy(local, q, omega, subharmonic, level + 1)? else {
+                return Ok(None);
+            };
+            fine = next;
         }
     }
 
@@ -179,11 +182,13 @@ impl ModalHsu {
         omega: f64,
         subharmonic: usize,
         level: usize,
-    ) -> Result<Vec<f64>, HbError> {
+    ) -> Result<Option<Vec<f64>>, HbError> {
         let (r, s) = (self.r, self.s);
         let steps = self.base << level;
         let h = 2.0 * std::f64::consts::PI / steps as f64;
-        let kicks = self.kicks(local, q, omega, subharmonic, steps)?;
+        let Some(kicks) = self.kicks(local, q, omega, subharmonic, steps)? else {
+            return Ok(None);
+        };
         let half = self.flows(0.5 * h, omega);
         let whole = self.flows(h, omega);
         let dim = 2 * r;
@@ -213,11 +218,11 @@ impl ModalHsu {
                 flow(column, if i + 1 < steps { &whole } else { &half });
             }
         }
-        Ok(y)
+        Ok(Some(y))
     }
 
     /// `G_x` (`s×s`, row-major) at the midpoints `(i + ½)h` of the `steps`
-    /// steps.
+    /// steps; `None` if `G_v` is not zero at one of them.
     fn kicks<P: PeriodicProblem>(
         &self,
         local: &P,
@@ -225,7 +230,7 @@ impl ModalHsu {
         omega: f64,
         subharmonic: usize,
         steps: usize,
-    ) -> Result<Vec<f64>, HbError> {
+    ) -> Result<Option<Vec<f64>>, HbError> {
         let s = self.s;
         let mut aft = Aft::new(self.harmonics, steps)?;
         let samples = 2 * steps;
@@ -247,10 +252,17 @@ impl ModalHsu {
             .collect();
         let mut dg = vec![0.0; steps * 2 * s * s];
         local.nonlinear_jacobian_samples(&odd(&xs), &odd(&vs), &phases, &mut dg);
-        Ok(dg
+        if dg
             .chunks_exact(2 * s * s)
-            .flat_map(|d| d.iter().take(s * s).copied())
-            .collect())
+            .any(|d| d.iter().skip(s * s).any(|&gv| gv != 0.0))
+        {
+            return Ok(None);
+        }
+        Ok(Some(
+            dg.chunks_exact(2 * s * s)
+                .flat_map(|d| d.iter().take(s * s).copied())
+                .collect(),
+        ))
     }
 
     /// `exp(hA_j)` (row-major 2×2) of every mode.
@@ -370,7 +382,7 @@ mod tests {
             max: 4096,
         };
         let local = spring();
-        let mut modal = ModalHsu::new(&reduced(damping(0.02)), &local, 3, steps).unwrap();
+        let mut modal = ModalHsu::new(&reduced(damping(0.02)), 3, steps).unwrap();
         let split = modal.floquet(&local, &ORBIT, OMEGA, 1).unwrap().unwrap();
         let chain = cubic(3, M.to_vec(), damping(0.02), K.to_vec());
         let tight = HsuSteps::Tolerance {
@@ -403,14 +415,17 @@ mod tests {
         assert!(moved > 1e3 * estimate, "moved {moved:e}");
     }
 
-    /// Damping that is not proportional on the basis, or a velocity
-    /// dependent `g`, leaves the splitting out.
+    /// Damping that is not proportional on the basis, or a fixed step
+    /// count, leaves the splitting out; so does a `G_v` that is not zero on
+    /// the orbit (the chain's Magnus-4 takes over), while a problem flagged
+    /// velocity dependent whose `G_v` is zero keeps it.
     #[test]
     fn splitting_needs_proportional_damping_and_positions_only() {
         let steps = HsuSteps::default();
         let mut c = damping(0.02);
         c[0] += 0.05;
-        assert!(ModalHsu::new(&reduced(c), &spring(), 3, steps).is_none());
+        assert!(ModalHsu::new(&reduced(c), 3, steps).is_none());
+        assert!(ModalHsu::new(&reduced(damping(0.02)), 3, HsuSteps::Fixed(64)).is_none());
         let viscous = GeneralProblem::new(
             1,
             vec![0.0],
@@ -419,10 +434,19 @@ mod tests {
             |_x: &[f64], v: &[f64], _t: f64, g: &mut [f64]| g[0] = v[0].powi(3),
             |_t: f64, f: &mut [f64]| f[0] = 0.0,
         );
-        assert!(ModalHsu::new(&reduced(damping(0.02)), &viscous, 3, steps).is_none());
-        assert!(ModalHsu::new(&reduced(damping(0.02)), &spring(), 3, steps).is_some());
-        assert!(
-            ModalHsu::new(&reduced(damping(0.02)), &spring(), 3, HsuSteps::Fixed(64)).is_none()
+        let mut modal = ModalHsu::new(&reduced(damping(0.02)), 3, steps).unwrap();
+        assert!(modal.floquet(&viscous, &ORBIT, OMEGA, 1).unwrap().is_none());
+        let flagged = GeneralProblem::new(
+            1,
+            vec![0.0],
+            vec![0.0],
+            vec![0.0],
+            |x: &[f64], _v: &[f64], _t: f64, g: &mut [f64]| g[0] = K3 * x[0].powi(3),
+            |_t: f64, f: &mut [f64]| f[0] = 0.0,
         );
+        assert!(flagged.velocity_dependent());
+        let mut modal = ModalHsu::new(&reduced(damping(0.02)), 3, steps).unwrap();
+        let split = modal.floquet(&flagged, &ORBIT, OMEGA, 1).unwrap();
+        assert!(split.is_some_and(|e| e.error.unwrap() <= 1e-6));
     }
 }

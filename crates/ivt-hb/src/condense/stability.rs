@@ -324,7 +324,7 @@ impl ReducedStability {
             })?;
         if slot.is_none() {
             let reduced = self.basis.reduced(blocks, s, local)?;
-            let modal = ModalHsu::new(&reduced, local, hb.harmonics, self.steps);
+            let modal = ModalHsu::new(&reduced, hb.harmonics, self.steps);
             let problem = ReducedProblem {
                 reduced: &reduced,
                 local,
