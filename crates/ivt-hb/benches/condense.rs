@@ -34,34 +34,70 @@ fn receptances_n7(bencher: divan::Bencher, n_elements: usize) {
 /// point (what `ivt.hb.frc` runs, without Python's callbacks).
 #[divan::bench(sample_count = 3)]
 fn beam_curve_n500(bencher: divan::Bencher) {
-    use ivt_hb::condense::{condensed_response, CondensedBranch, CondensedFrcOptions};
-    use ivt_hb::{GeneralProblem, HbOptions};
     let beam = cantilever(500, &BeamProperties::default()).expect("valid beam");
-    let s = &beam.model;
-    let structure = Structure::new(s.m.as_ref(), s.c.as_ref(), s.k.as_ref()).expect("structure");
-    let mut load = vec![0.0; s.n_dof()];
-    load[beam.tip] = 0.005;
     let w1 = 3.516_015_268_066_119;
-    let opts = CondensedFrcOptions {
-        from: 0.7 * w1,
-        to: 1.3 * w1,
-        ..CondensedFrcOptions::default()
+    let curve = Curve {
+        tip: beam.tip,
+        force: 0.005,
+        band: (0.7 * w1, 1.3 * w1),
+        harmonics: 7,
+        spring,
     };
-    bencher.bench_local(|| {
+    bencher.bench_local(|| curve.run(&beam.model));
+}
+
+/// The bladed-disk acceptance curve of issue 28: pyHarm's 72-DOF disk
+/// condensed onto the blade tip (cubic spring 5e10 x³), 1150–1260 rad/s,
+/// n = 5, multipliers at every point.
+#[divan::bench(sample_count = 3)]
+fn disk_curve(bencher: divan::Bencher) {
+    let disk = ivt_hb::models::bladed_disk().expect("disk");
+    let curve = Curve {
+        tip: disk.tip,
+        force: 1.0,
+        band: (1150.0, 1260.0),
+        harmonics: 5,
+        spring: tip_spring,
+    };
+    bencher.bench_local(|| curve.run(&disk.model));
+}
+
+/// A structure's curve condensed onto one DOF with a spring to ground,
+/// forced there, stability at every point (the defaults).
+struct Curve {
+    tip: usize,
+    force: f64,
+    band: (f64, f64),
+    harmonics: usize,
+    spring: fn(&[f64], &[f64], f64, &mut [f64]),
+}
+
+impl Curve {
+    fn run(&self, s: &ivt_hb::models::SparseModel) -> ivt_hb::condense::CondensedFrc {
+        use ivt_hb::condense::{condensed_response, CondensedBranch, CondensedFrcOptions};
+        use ivt_hb::{GeneralProblem, HbOptions};
+        let structure =
+            Structure::new(s.m.as_ref(), s.c.as_ref(), s.k.as_ref()).expect("structure");
+        let mut load = vec![0.0; s.n_dof()];
+        load[self.tip] = self.force;
+        let opts = CondensedFrcOptions {
+            from: self.band.0,
+            to: self.band.1,
+            ..CondensedFrcOptions::default()
+        };
         let zero = || vec![0.0];
-        let local = GeneralProblem::new(1, zero(), zero(), zero(), spring, unforced)
+        let local = GeneralProblem::new(1, zero(), zero(), zero(), self.spring, unforced)
             .with_velocity_dependent(false);
-        let mut branch = CondensedBranch::new(
-            structure.clone(),
-            vec![beam.tip],
-            &load,
-            &[],
-            local,
-            &HbOptions::new(7, 32),
-        )
-        .expect("branch");
+        let hb = HbOptions::new(self.harmonics, 32);
+        let mut branch = CondensedBranch::new(structure, vec![self.tip], &load, &[], local, &hb)
+            .expect("branch");
         condensed_response(&mut branch, &opts).expect("curve")
-    });
+    }
+}
+
+/// The disk's blade-tip cubic spring 5e10 x³.
+fn tip_spring(x: &[f64], _v: &[f64], _t: f64, g: &mut [f64]) {
+    g[0] = 5e10 * x[0].powi(3);
 }
 
 /// The tip's cubic spring 200 x³.

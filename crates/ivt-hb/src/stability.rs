@@ -497,7 +497,7 @@ fn level_mut<'a, P: PeriodicProblem>(
 /// steps from those of `S/2`, `coarse`: the Hausdorff distance between the two
 /// sets, relative to max(1, |μ|), over 2⁴ − 1 = 15 (fourth order; the pairing
 /// by nearest neighbour needs no common order of the two lists).
-fn richardson_error(fine: &[c64], coarse: &[c64]) -> f64 {
+pub(crate) fn richardson_error(fine: &[c64], coarse: &[c64]) -> f64 {
     let nearest = |z: &c64, set: &[c64]| {
         set.iter()
             .map(|w| (z - w).norm() / z.norm().max(1.0))

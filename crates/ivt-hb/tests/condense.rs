@@ -11,8 +11,10 @@ mod beam;
 mod common;
 #[path = "common/dd.rs"]
 mod dd;
+#[path = "common/disk.rs"]
+mod disk;
 
-use beam::{beam, dense, full_beam, orbit, FORCE, OMEGA1};
+use beam::{beam, full_beam, orbit, FORCE, OMEGA1};
 use common::orbit_defect;
 use faer::{c64, Mat};
 use ivt_hb::condense::{
@@ -20,8 +22,7 @@ use ivt_hb::condense::{
 };
 use ivt_hb::models::{cantilever, BeamProperties};
 use ivt_hb::{
-    locate_fold, ClassicIhb, FamilyBranch, Frequency, GeneralProblem, HbOptions, LocateOptions,
-    PeriodicProblem,
+    locate_fold, ClassicIhb, FamilyBranch, Frequency, HbOptions, LocateOptions, PeriodicProblem,
 };
 
 /// The condensed curve of the `n`-element beam over 0.7–1.3 ω₁ with `hb`.
@@ -254,15 +255,7 @@ fn bladed_disk_curve_solves_the_uncondensed_equations() {
     let structure = Structure::new(s.m.as_ref(), s.c.as_ref(), s.k.as_ref()).unwrap();
     let mut load = vec![0.0; nd];
     load[disk.tip] = 1.0;
-    let local = GeneralProblem::new(
-        1,
-        vec![0.0],
-        vec![0.0],
-        vec![0.0],
-        |x: &[f64], _v: &[f64], _t: f64, g: &mut [f64]| g[0] = 5e10 * x[0].powi(3),
-        |_t: f64, f: &mut [f64]| f[0] = 0.0,
-    )
-    .with_velocity_dependent(false);
+    let local = disk::tip_problem();
     let hb = HbOptions::new(5, 32);
     let mut branch =
         CondensedBranch::new(structure, vec![disk.tip], &load, &[], local, &hb).unwrap();
@@ -279,22 +272,7 @@ fn bladed_disk_curve_solves_the_uncondensed_equations() {
     assert_eq!(frc.termination, ivt_hb::Termination::LeftInterval);
     assert!(frc.points.len() < 400, "{} points", frc.points.len());
     assert!(frc.points.iter().all(|p| p.floquet.is_some()));
-    let tip = disk.tip;
-    let full = GeneralProblem::new(
-        nd,
-        dense(&s.m),
-        dense(&s.c),
-        dense(&s.k),
-        move |x: &[f64], _v: &[f64], _t: f64, g: &mut [f64]| {
-            g.fill(0.0);
-            g[tip] = 5e10 * x[tip].powi(3);
-        },
-        move |theta: f64, f: &mut [f64]| {
-            f.fill(0.0);
-            f[tip] = theta.cos();
-        },
-    )
-    .with_velocity_dependent(false);
+    let full = disk::full_disk();
     let mut residual = ivt_hb::HbResidual::new(&full, &hb).unwrap();
     let mut r = vec![0.0; residual.len()];
     for p in frc.points.iter().step_by(10) {

@@ -310,6 +310,7 @@ fn solve_large<'py>(
             record_dofs,
             truncation_estimate: true,
             stability_blocks: stability.then_some(ivt_hb::condense::DEFAULT_BLOCKS),
+            stability_tol: ivt_hb::condense::DEFAULT_BASIS_TOL,
             continuation: ivt_hb::ContinuationOptions {
                 max_points: 1,
                 ..CondensedFrcOptions::default().continuation

@@ -9,7 +9,9 @@
 use super::branch::CondensedBranch;
 use super::estimate::truncation_error;
 use super::scaled::Scaled;
-use super::stability::{CondensedFloquet, ReducedStability, DEFAULT_BLOCKS};
+use super::stability::{
+    BasisGrowth, CondensedFloquet, ReducedStability, DEFAULT_BASIS_TOL, DEFAULT_BLOCKS,
+};
 use crate::aft::{eval_series, Aft};
 use crate::branch::Branch;
 use crate::continuation::{
@@ -44,10 +46,13 @@ pub struct CondensedFrcOptions {
     /// Estimate the harmonic truncation error per point (one extra
     /// factorization per omitted harmonic, up to 2n per point).
     pub truncation_estimate: bool,
-    /// Floquet multipliers at every point from a reduced basis of this many
-    /// Krylov blocks ([`ReducedStability`]); `None`: none (folds are
-    /// located either way).
+    /// Floquet multipliers at every point from a reduced basis of at most
+    /// this many Krylov blocks ([`ReducedStability`]); `None`: none (folds
+    /// are located either way).
     pub stability_blocks: Option<usize>,
+    /// The basis grows per point until its truncation estimate is at most
+    /// this ([`BasisGrowth::tol`]).
+    pub stability_tol: f64,
 }
 
 impl Default for CondensedFrcOptions {
@@ -71,6 +76,7 @@ impl Default for CondensedFrcOptions {
             record_dofs: Vec::new(),
             truncation_estimate: true,
             stability_blocks: Some(DEFAULT_BLOCKS),
+            stability_tol: DEFAULT_BASIS_TOL,
         }
     }
 }
@@ -150,7 +156,13 @@ pub fn condensed_response<P: PeriodicProblem>(
     let mut probe = Probe::new(branch, amp_dof, &opts.record_dofs)?;
     let mut stability = opts
         .stability_blocks
-        .map(|blocks| ReducedStability::new(branch, blocks, HsuSteps::default()))
+        .map(|max_blocks| {
+            let growth = BasisGrowth {
+                tol: opts.stability_tol,
+                max_blocks,
+            };
+            ReducedStability::new(branch, growth, HsuSteps::default())
+        })
         .transpose()?;
     let q0 = branch.linear_guess(opts.from)?;
     let q_scale = load_scale(branch, opts.from)?;

@@ -19,8 +19,9 @@
 //! - [`condensed_response`]: the frequency-response curve with folds located
 //!   and per point the estimated solve and truncation errors.
 //! - [`ReducedStability`]: Floquet multipliers of the whole structure's
-//!   variational equation on a reduced basis (the Ritz vectors of `S`), with
-//!   the basis truncation's error estimated per orbit.
+//!   variational equation on a reduced basis (the Ritz vectors of `S`,
+//!   load-dependent) grown per orbit until the basis truncation's estimated error
+//!   meets a tolerance.
 
 mod band;
 mod branch;
@@ -28,7 +29,9 @@ mod double_double;
 pub mod dynamic;
 mod estimate;
 mod frc;
+mod modal_hsu;
 mod receptance;
+mod ritz;
 mod scaled;
 mod stability;
 
@@ -40,4 +43,7 @@ pub use frc::{
     CondensedPoint,
 };
 pub use receptance::{Coupling, Receptances};
-pub use stability::{multiplier_distance, CondensedFloquet, ReducedStability, DEFAULT_BLOCKS};
+pub use stability::{
+    multiplier_distance, BasisGrowth, CondensedFloquet, ReducedStability, DEFAULT_BASIS_TOL,
+    DEFAULT_BLOCKS,
+};

@@ -4,36 +4,80 @@
 //! `M δẍ + C δẋ + K δx + E_S (G_x(t) E_Sᵀ δx + G_v(t) E_Sᵀ δẋ) = 0`,
 //!
 //! Galerkin-projected onto a reduced basis `V` and analysed by Hsu's method
-//! (Eq. 79–80, [`AdaptiveHsu`]).
+//! (Eq. 79–80): by the modal splitting of [`super::modal_hsu`] where the
+//! reduced damping is proportional and `g` reads positions only, else (or
+//! when the splitting does not meet the tolerance) by [`AdaptiveHsu`].
 //!
-//! The basis: the load-dependent Ritz vectors of `S` (Wilson, Yuan & Dickens,
-//! *Dynamic analysis by direct superposition of Ritz vectors*, 1982), the
-//! block Krylov space of `K⁻¹M` started from the static modes `K⁻¹E_S`,
-//! M-orthonormal. It holds the static modes of `S` exactly and converges to
-//! the lowest modes as `S` sees them. The time-varying term acts only through
-//! `S`, so for proportional damping the modes `S` does not see (zero at `S`)
-//! stay uncoupled from the orbit: their multipliers are the linear
-//! structure's `exp(λ_j T)` and are not reported. The truncation error is
-//! estimated per orbit as the change of the multipliers (|μ| ≥ 0.01) when
-//! the basis loses its last two blocks (the spaces are nested, so the change
-//! bounds the larger basis's error while the Krylov space converges), plus
-//! Hsu's own Richardson estimate.
+//! The basis: the load-dependent Ritz vectors of `S` ([`super::ritz`]). It
+//! holds the static modes of `S` exactly and converges to the lowest modes
+//! as `S` sees them. The time-varying term acts only through `S`, so for
+//! proportional damping the modes `S` does not see (zero at `S`) stay
+//! uncoupled from the orbit: their multipliers are the linear structure's
+//! `exp(λ_j T)` and are not reported. The truncation error is estimated per
+//! orbit as the change of the multipliers (|μ| ≥ 0.01) when the basis loses
+//! its last block (the spaces are nested, so the change bounds the
+//! larger basis's error while the Krylov space converges); the basis grows
+//! until that change is below a tolerance, or until it closes an invariant
+//! subspace of the linear part (then the estimate is the measured part of
+//! the linear part's image outside it, rounding), or a cap. Hsu's own
+//! Richardson estimate is added.
 
 use super::branch::CondensedBranch;
-use super::dynamic::{Part, Structure};
+use super::modal_hsu::ModalHsu;
+use super::ritz::{at, row, Reduced, RitzBasis};
 use crate::error::HbError;
 use crate::ihb::HbSolution;
 use crate::problem::PeriodicProblem;
-use crate::stability::{AdaptiveHsu, Floquet, HsuSteps};
-use faer::{c64, Mat};
+use crate::stability::{AdaptiveHsu, Floquet, HsuEstimate, HsuSteps};
+use faer::c64;
 use ivt_num::vector::dot;
 
 /// Multipliers of smaller modulus take no part in the truncation estimate:
 /// they are far from deciding stability.
 const COMPARED_MODULUS: f64 = 1e-2;
 
-/// The Krylov blocks of the basis when not chosen ([`ReducedStability::new`]).
-pub const DEFAULT_BLOCKS: usize = 8;
+/// Hsu's Richardson estimate assumes the error ratio 2⁴ of Magnus-4 between
+/// `S/2` and `S` sub-intervals; it is asymptotic (on the bladed disk near its
+/// peak the actual error was 1.025× the estimate), so the reported
+/// [`CondensedFloquet::hsu_error`] is twice it.
+const HSU_SAFETY: f64 = 2.0;
+
+/// The cap on the Krylov blocks of the basis when not chosen
+/// ([`BasisGrowth`]).
+pub const DEFAULT_BLOCKS: usize = 64;
+
+/// The basis truncation estimate the basis grows to when not chosen
+/// ([`BasisGrowth`]). 1e-4 keeps the cantilever's curves on their first 8
+/// blocks, as fast as the fixed basis was (its estimates there are
+/// ≤ 1.4e-5, measured, not asserted); 1e-6, Hsu's default tolerance, grows
+/// the N = 20 beam's basis to 12 vectors (`tests/condense_stability.rs`). A
+/// basis that closes an invariant subspace (the bladed disk's 39 vectors)
+/// is exact either way.
+pub const DEFAULT_BASIS_TOL: f64 = 1e-4;
+
+/// The blocks the first orbit of a path starts from.
+const FIRST_BLOCKS: usize = 8;
+
+/// How far the reduced basis grows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BasisGrowth {
+    /// Target of the truncation estimate (the multipliers' change when the
+    /// basis loses its last block).
+    pub tol: f64,
+    /// At most this many Krylov blocks (at least 3); an orbit that reaches
+    /// the cap keeps its larger estimate.
+    pub max_blocks: usize,
+}
+
+impl Default for BasisGrowth {
+    /// [`DEFAULT_BASIS_TOL`], at most [`DEFAULT_BLOCKS`] blocks.
+    fn default() -> Self {
+        Self {
+            tol: DEFAULT_BASIS_TOL,
+            max_blocks: DEFAULT_BLOCKS,
+        }
+    }
+}
 
 /// The multipliers of one condensed orbit.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,10 +87,12 @@ pub struct CondensedFloquet {
     /// Basis vectors used.
     pub basis: usize,
     /// Estimated error of the multipliers from the basis truncation: the
-    /// Hausdorff distance (|μ| ≥ 0.01) to those of the basis two blocks
-    /// smaller.
+    /// Hausdorff distance (|μ| ≥ 0.01) to those of the basis one block
+    /// smaller, or for a basis spanning an invariant subspace of the linear
+    /// part the relative part of that part's image outside it (at least
+    /// 1e-10, the threshold below which a Krylov vector counts as rounding).
     pub truncation_error: f64,
-    /// Hsu's Richardson estimate of the multipliers' error.
+    /// Twice Hsu's Richardson estimate of the multipliers' error.
     pub hsu_error: f64,
 }
 
@@ -55,22 +101,6 @@ impl CondensedFloquet {
     pub fn error_estimate(&self) -> f64 {
         self.truncation_error + self.hsu_error
     }
-}
-
-/// The structure's linear part on the first `size` basis vectors.
-#[derive(Debug, Clone)]
-struct Reduced {
-    size: usize,
-    /// `VᵀMV`, `VᵀCV`, `VᵀKV` plus the local problem's own matrices
-    /// (`V_Sᵀ M_l V_S`, …), row-major `size×size`.
-    m: Vec<f64>,
-    c: Vec<f64>,
-    k: Vec<f64>,
-    /// `V_S` (rows `S` of `V`), row-major `s×size`.
-    at_dofs: Vec<f64>,
-    /// `V_Sᵀ (V_S V_Sᵀ)⁻¹`, row-major `size×s`: the reduced coordinates of
-    /// least norm with `V_S z = x_S`.
-    lift: Vec<f64>,
 }
 
 /// The reduced variational problem seen by the stability analysis: the
@@ -160,117 +190,189 @@ impl<P: PeriodicProblem> PeriodicProblem for ReducedProblem<'_, P> {
     }
 }
 
+/// One level of the basis: the reduced problem and its monodromies, by
+/// the modal splitting ([`ModalHsu`]) where it applies (proportional
+/// damping, `g` of positions only, a tolerance on Hsu's steps) and meets
+/// the tolerance within the cap, else by Magnus-4.
+#[derive(Debug, Clone)]
+struct Level {
+    reduced: Reduced,
+    modal: Option<ModalHsu>,
+    magnus: AdaptiveHsu,
+}
+
 /// Floquet multipliers of a condensed branch's orbits from a reduced basis
-/// (module docs), with the per-orbit error estimates.
+/// grown per orbit (module docs), with the per-orbit error estimates.
 #[derive(Debug, Clone)]
 pub struct ReducedStability {
-    /// The basis of `blocks` blocks, then the one two blocks smaller.
-    levels: [Reduced; 2],
-    hsu: [AdaptiveHsu; 2],
+    basis: RitzBasis,
+    growth: BasisGrowth,
+    steps: HsuSteps,
+    /// The reduced problem and its Hsu of each block count used so far
+    /// (index: blocks − 1).
+    levels: Vec<Option<Level>>,
+    /// The blocks the next orbit starts from.
+    start: usize,
 }
 
 impl ReducedStability {
-    /// The basis of `blocks` Krylov blocks (at least 3) for the nonlinear DOFs
-    /// of `branch`, Hsu's step counts chosen by `steps`.
+    /// The basis of at most `growth.max_blocks` Krylov blocks for the
+    /// nonlinear DOFs of `branch`, Hsu's step counts chosen by `steps`.
     ///
     /// # Errors
-    /// [`HbError::InvalidInput`] for fewer than 3 blocks, a basis that stops
-    /// growing before its third block or an `M` that is not positive
-    /// definite on it; [`HbError::Singular`] (ω = 0) for a singular `K`.
+    /// [`HbError::InvalidInput`] for a tolerance that is not positive and
+    /// finite, a cap below 3 blocks, or a basis that stops growing before its
+    /// third block without closing an invariant subspace;
+    /// [`HbError::Singular`] (ω = 0) for a singular `K`.
     pub fn new<P: PeriodicProblem>(
         branch: &CondensedBranch<P>,
-        blocks: usize,
+        growth: BasisGrowth,
         steps: HsuSteps,
     ) -> Result<Self, HbError> {
-        if blocks < 3 {
+        if growth.max_blocks < 3 || !(growth.tol > 0.0 && growth.tol.is_finite()) {
             return Err(HbError::InvalidInput(format!(
-                "a stability basis needs at least 3 Krylov blocks, got {blocks}"
+                "a stability basis needs a positive finite tolerance and a cap of at least 3 \
+                 Krylov blocks, got {} and {}",
+                growth.tol, growth.max_blocks
             )));
         }
-        let structure = branch.structure();
-        let dofs = branch.dofs();
-        let (basis, sizes) = krylov_basis(structure, dofs, blocks)?;
-        let small = sizes.get(blocks - 2).copied().unwrap_or(0);
-        if sizes.len() < 3 || small == 0 {
+        let basis = RitzBasis::new(branch.structure(), branch.dofs(), growth.max_blocks)?;
+        if basis.blocks() < 3 && basis.invariant().is_none() {
             return Err(HbError::InvalidInput(
                 "the stability basis stopped growing before its third block".into(),
             ));
         }
-        let local = branch.local();
-        let big = reduce(structure, &basis, dofs, local)?;
-        let small = truncate(&big, small, dofs.len(), local)?;
-        let n = branch.options().harmonics;
-        let hsu_for = |reduced: &Reduced| {
-            let problem = ReducedProblem {
-                reduced,
-                local,
-                s: dofs.len(),
-            };
-            AdaptiveHsu::new(&problem, n, steps)
-        };
-        let hsu = [hsu_for(&big)?, hsu_for(&small)?];
+        let levels = vec![None; basis.blocks()];
         Ok(Self {
-            levels: [big, small],
-            hsu,
+            start: FIRST_BLOCKS.min(basis.blocks()),
+            basis,
+            growth,
+            steps,
+            levels,
         })
     }
 
-    /// Basis vectors of the larger basis.
+    /// Basis vectors of the basis the last orbit ended with.
     pub fn basis_size(&self) -> usize {
-        self.levels[0].size
+        self.levels
+            .get(self.start.saturating_sub(1))
+            .and_then(Option::as_ref)
+            .map_or(0, |level| level.reduced.size)
     }
 
-    /// The multipliers of the condensed orbit `q` at ω_f of `branch`.
+    /// The multipliers of the condensed orbit `q` at ω_f of `branch`: the
+    /// basis grows from the previous orbit's blocks by half (at least two)
+    /// until the truncation estimate meets the tolerance, the basis closes
+    /// an invariant subspace or reaches the cap.
     ///
     /// # Errors
-    /// As [`AdaptiveHsu::floquet`].
+    /// As [`AdaptiveHsu::floquet`]; [`HbError::InvalidInput`] if a level of
+    /// the basis cannot be reduced.
     pub fn floquet<P: PeriodicProblem>(
         &mut self,
         branch: &CondensedBranch<P>,
         q: &[f64],
         omega_f: f64,
     ) -> Result<CondensedFloquet, HbError> {
-        let hb = branch.options();
-        let s = branch.dofs().len();
-        let l = 2 * hb.harmonics + 1;
-        let mut results = Vec::with_capacity(2);
-        for (reduced, hsu) in self.levels.iter().zip(self.hsu.iter_mut()) {
-            let r = reduced.size;
-            let mut coeffs = vec![0.0; r * l];
-            for (i, zi) in coeffs.chunks_exact_mut(l).enumerate() {
-                for a in 0..s {
-                    let w = at(&reduced.lift, i * s + a);
-                    zi.iter_mut()
-                        .zip(row(q, a, l))
-                        .for_each(|(z, x)| *z += w * x);
+        let last = self.basis.blocks();
+        let mut blocks = self.start.min(last);
+        let mut seen: Vec<(usize, HsuEstimate)> = Vec::new();
+        let (big, truncation_error) = loop {
+            let big = self.level_floquet(branch, q, omega_f, blocks, &mut seen)?;
+            if blocks == last {
+                if let Some(part) = self.basis.invariant() {
+                    break (big, part);
                 }
             }
-            let sol = HbSolution {
-                coeffs,
-                omega_f,
-                harmonics: hb.harmonics,
-                subharmonic: hb.subharmonic,
-                stats: Default::default(),
-            };
+            let small = self.level_floquet(branch, q, omega_f, blocks - 1, &mut seen)?;
+            let change = multiplier_distance(&big.floquet.multipliers, &small.floquet.multipliers);
+            if change <= self.growth.tol || blocks == last || !change.is_finite() {
+                break (big, change);
+            }
+            blocks = (blocks + (blocks / 2).max(2)).min(last);
+        };
+        self.start = blocks;
+        Ok(CondensedFloquet {
+            truncation_error,
+            hsu_error: HSU_SAFETY * big.error.unwrap_or(0.0),
+            basis: self.basis_size(),
+            floquet: big.floquet,
+        })
+    }
+
+    /// The multipliers of `q` on the basis of `blocks` blocks (reused from
+    /// `seen` when this orbit had them).
+    fn level_floquet<P: PeriodicProblem>(
+        &mut self,
+        branch: &CondensedBranch<P>,
+        q: &[f64],
+        omega_f: f64,
+        blocks: usize,
+        seen: &mut Vec<(usize, HsuEstimate)>,
+    ) -> Result<HsuEstimate, HbError> {
+        if let Some((_, known)) = seen.iter().find(|(b, _)| *b == blocks) {
+            return Ok(known.clone());
+        }
+        let hb = branch.options();
+        let s = branch.dofs().len();
+        let local = branch.local();
+        let slot = blocks
+            .checked_sub(1)
+            .and_then(|i| self.levels.get_mut(i))
+            .ok_or_else(|| {
+                HbError::InvalidInput(format!("no stability basis of {blocks} blocks"))
+            })?;
+        if slot.is_none() {
+            let reduced = self.basis.reduced(blocks, s, local)?;
+            let modal = ModalHsu::new(&reduced, hb.harmonics, self.steps);
             let problem = ReducedProblem {
-                reduced,
-                local: branch.local(),
+                reduced: &reduced,
+                local,
                 s,
             };
-            results.push(hsu.floquet(&problem, &sol)?);
+            let magnus = AdaptiveHsu::new(&problem, hb.harmonics, self.steps)?;
+            *slot = Some(Level {
+                reduced,
+                modal,
+                magnus,
+            });
         }
-        let [big, small] = results.as_slice() else {
-            return Err(HbError::InvalidInput("two stability bases expected".into()));
+        let Level {
+            reduced,
+            modal,
+            magnus: hsu,
+        } = slot
+            .as_mut()
+            .ok_or_else(|| HbError::InvalidInput("stability level missing".into()))?;
+        if let Some(modal) = modal {
+            let omega = omega_f / hb.subharmonic as f64;
+            if let Some(estimate) = modal.floquet(local, q, omega, hb.subharmonic)? {
+                seen.push((blocks, estimate.clone()));
+                return Ok(estimate);
+            }
+        }
+        let l = 2 * hb.harmonics + 1;
+        let r = reduced.size;
+        let mut coeffs = vec![0.0; r * l];
+        for (i, zi) in coeffs.chunks_exact_mut(l).enumerate() {
+            for a in 0..s {
+                let w = at(&reduced.lift, i * s + a);
+                zi.iter_mut()
+                    .zip(row(q, a, l))
+                    .for_each(|(z, x)| *z += w * x);
+            }
+        }
+        let sol = HbSolution {
+            coeffs,
+            omega_f,
+            harmonics: hb.harmonics,
+            subharmonic: hb.subharmonic,
+            stats: Default::default(),
         };
-        Ok(CondensedFloquet {
-            truncation_error: multiplier_distance(
-                &big.floquet.multipliers,
-                &small.floquet.multipliers,
-            ),
-            hsu_error: big.error.unwrap_or(0.0),
-            basis: self.levels[0].size,
-            floquet: big.floquet.clone(),
-        })
+        let problem = ReducedProblem { reduced, local, s };
+        let estimate = hsu.floquet(&problem, &sol)?;
+        seen.push((blocks, estimate.clone()));
+        Ok(estimate)
     }
 }
 
@@ -289,188 +391,4 @@ pub fn multiplier_distance(a: &[c64], b: &[c64]) -> f64 {
             .fold(0.0f64, f64::max)
     };
     one_way(a, b).max(one_way(b, a))
-}
-
-/// The M-orthonormal block Krylov basis of `K⁻¹M` from `K⁻¹E_S`, `blocks`
-/// blocks (Gram–Schmidt twice per vector; a vector that loses all but 1e-10
-/// of its M-norm is dropped), and the basis size after each block.
-fn krylov_basis(
-    structure: &Structure,
-    dofs: &[usize],
-    blocks: usize,
-) -> Result<(Vec<Vec<f64>>, Vec<usize>), HbError> {
-    let n = structure.n_dof();
-    let k = structure.factor(0.0)?;
-    let solve = |columns: &[Vec<f64>]| -> Result<Vec<Vec<f64>>, HbError> {
-        let mut rhs = Mat::<c64>::from_fn(n, columns.len(), |i, j| {
-            c64::new(columns.get(j).map_or(0.0, |c| at(c, i)), 0.0)
-        });
-        let error = structure.solve_refined(&k, rhs.as_mut());
-        if !error.is_finite() {
-            return Err(HbError::Singular { omega: 0.0 });
-        }
-        Ok((0..columns.len())
-            .map(|j| (0..n).map(|i| rhs[(i, j)].re).collect())
-            .collect())
-    };
-    let units: Vec<Vec<f64>> = dofs
-        .iter()
-        .map(|&d| (0..n).map(|i| if i == d { 1.0 } else { 0.0 }).collect())
-        .collect();
-    let mut block = solve(&units)?;
-    let mut basis: Vec<Vec<f64>> = Vec::new();
-    let mut mass_basis: Vec<Vec<f64>> = Vec::new();
-    let mut sizes = Vec::with_capacity(blocks);
-    let mut mv = vec![0.0; n];
-    for _ in 0..blocks {
-        let start = basis.len();
-        for mut v in block {
-            structure.times(Part::Mass, &v, &mut mv);
-            let before = dot(&v, &mv).sqrt();
-            for _ in 0..2 {
-                for (b, mb) in basis.iter().zip(&mass_basis) {
-                    let c = dot(mb, &v);
-                    v.iter_mut().zip(b).for_each(|(x, y)| *x -= c * y);
-                }
-            }
-            structure.times(Part::Mass, &v, &mut mv);
-            let norm = dot(&v, &mv).sqrt();
-            // NaN (an indefinite M) is dropped too.
-            if norm > 1e-10 * before {
-                v.iter_mut().for_each(|x| *x /= norm);
-                mv.iter_mut().for_each(|x| *x /= norm);
-                basis.push(v);
-                mass_basis.push(mv.clone());
-            }
-        }
-        if basis.len() == start {
-            break;
-        }
-        sizes.push(basis.len());
-        block = solve(mass_basis.get(start..).unwrap_or_default())?;
-    }
-    Ok((basis, sizes))
-}
-
-/// The reduced matrices of the whole basis.
-fn reduce<P: PeriodicProblem>(
-    structure: &Structure,
-    basis: &[Vec<f64>],
-    dofs: &[usize],
-    local: &P,
-) -> Result<Reduced, HbError> {
-    let r = basis.len();
-    let n = structure.n_dof();
-    let mut product = vec![0.0; n];
-    let mut project = |part: Part| {
-        let mut out = vec![0.0; r * r];
-        for (j, v) in basis.iter().enumerate() {
-            structure.times(part, v, &mut product);
-            for (i, u) in basis.iter().enumerate() {
-                if let Some(e) = out.get_mut(i * r + j) {
-                    *e = dot(u, &product);
-                }
-            }
-        }
-        out
-    };
-    let (m, c, k) = (
-        project(Part::Mass),
-        project(Part::Damping),
-        project(Part::Stiffness),
-    );
-    let at_dofs: Vec<f64> = dofs
-        .iter()
-        .flat_map(|&d| basis.iter().map(move |v| at(v, d)))
-        .collect();
-    let full = Reduced {
-        size: r,
-        m,
-        c,
-        k,
-        at_dofs,
-        lift: Vec::new(),
-    };
-    truncate(&full, r, dofs.len(), local)
-}
-
-/// The leading `size` basis vectors of `full` (its matrices' leading
-/// blocks), with the local problem's own matrices added and the lift.
-fn truncate<P: PeriodicProblem>(
-    full: &Reduced,
-    size: usize,
-    s: usize,
-    local: &P,
-) -> Result<Reduced, HbError> {
-    let r = full.size;
-    let lead = |a: &[f64]| -> Vec<f64> {
-        (0..size * size)
-            .map(|e| at(a, (e / size) * r + e % size))
-            .collect()
-    };
-    let at_dofs: Vec<f64> = (0..s * size)
-        .map(|e| at(&full.at_dofs, (e / size) * r + e % size))
-        .collect();
-    let (mut m, mut c, mut k) = (lead(&full.m), lead(&full.c), lead(&full.k));
-    if full.lift.is_empty() {
-        // V_Sᵀ A_l V_S of the local problem's matrices, added once.
-        for (out, a) in [
-            (&mut m, local.mass()),
-            (&mut c, local.damping()),
-            (&mut k, local.stiffness()),
-        ] {
-            for i in 0..size {
-                for j in 0..size {
-                    let mut sum = 0.0;
-                    for x in 0..s {
-                        for y in 0..s {
-                            sum += at(&at_dofs, x * size + i)
-                                * at(a, x * s + y)
-                                * at(&at_dofs, y * size + j);
-                        }
-                    }
-                    if let Some(e) = out.get_mut(i * size + j) {
-                        *e += sum;
-                    }
-                }
-            }
-        }
-    }
-    // (V_S V_Sᵀ)⁻¹: V_S has full row rank, the static modes of S being in
-    // the basis.
-    let gram: Vec<f64> = (0..s * s)
-        .map(|e| {
-            let (a, b) = (e / s, e % s);
-            dot(row(&at_dofs, a, size), row(&at_dofs, b, size))
-        })
-        .collect();
-    let inverse = ivt_num::lu::inverse(&gram, s).ok_or_else(|| {
-        HbError::InvalidInput("the stability basis does not reach the nonlinear DOFs".into())
-    })?;
-    let lift = (0..size * s)
-        .map(|e| {
-            let (i, a) = (e / s, e % s);
-            (0..s)
-                .map(|b| at(&at_dofs, b * size + i) * at(&inverse, b * s + a))
-                .sum()
-        })
-        .collect();
-    Ok(Reduced {
-        size,
-        m,
-        c,
-        k,
-        at_dofs,
-        lift,
-    })
-}
-
-/// `v[i]`, or 0 past the end.
-fn at(v: &[f64], i: usize) -> f64 {
-    v.get(i).copied().unwrap_or(0.0)
-}
-
-/// Row `i` of the row-major `v` with rows of `len` (empty past the end).
-fn row(v: &[f64], i: usize, len: usize) -> &[f64] {
-    v.get(i * len..(i + 1) * len).unwrap_or_default()
 }
