@@ -264,8 +264,11 @@ truncation_error, a relative error). `amplitude_dof=j`: "amplitude" is max |x_j(
 `record_dofs=[...]`: each point carries "dof_coeffs": {j: [a0, a1..an,
 b1..bn]} (any model). Stability (default on; `stability=False` skips it,
 folds are located either way): Floquet multipliers of the whole structure's
-variational equation on the Ritz vectors of the nonlinear DOFs (8 Krylov
-blocks of K⁻¹M from the static modes): "multipliers", "stable",
+variational equation on the Ritz vectors of the nonlinear DOFs (Krylov
+blocks of K⁻¹M from the static modes, grown per point until the multipliers
+move ≤ 1e-4 with the last block or the basis closes an invariant subspace; at
+most 64 blocks; for proportional damping and a position-only g, Hsu by a
+modal splitting): "multipliers", "stable",
 "stability" and "multiplier_error" (basis truncation + Hsu estimates) per
 point.
 """
