@@ -133,17 +133,7 @@ fn condensed_equals_the_refined_uncondensed_harmonic_balance_at_n_20() {
     let n = 20;
     let hb = HbOptions::new(7, 32).with_tolerances(1e-12, 0.0);
     let (frc, mut branch) = curve(n, &hb);
-    let b = cantilever(n, &BeamProperties::default()).unwrap();
-    let full = full_dd::FullBeam {
-        k: beam::dense(&b.model.k),
-        m: beam::dense(&b.model.m),
-        c: beam::dense(&b.model.c),
-        nd: b.model.n_dof(),
-        tip: b.tip,
-        k3: beam::K3,
-        force: FORCE,
-        harmonics: 7,
-    };
+    let full = full_dd::FullBeam::new(n, 7);
     let (mut worst, mut worst_r) = (0.0f64, 0.0f64);
     for p in frc.points.iter().step_by(4) {
         let condensed = all_dofs(&mut branch, &p.coeffs, p.omega_f);

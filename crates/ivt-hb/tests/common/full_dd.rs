@@ -17,27 +17,42 @@
 //! a difference Jacobian in double then converges to the solution of the
 //! same stored equations the condensed solver uses, to about ε of its
 //! coefficients.
-#![allow(clippy::indexing_slicing)]
+#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
+use super::beam::{dense, FORCE, K3};
 use super::dd::Dd;
 use faer::linalg::solvers::Solve;
 use faer::Mat;
+use ivt_hb::models::{cantilever, BeamProperties};
 
-/// The stored dense matrices (row-major `nd × nd`) and the tip spring and force.
+/// The uncondensed cantilever: its stored dense matrices (row-major
+/// `nd × nd`), the tip, the harmonics.
 pub struct FullBeam {
-    pub k: Vec<f64>,
-    pub m: Vec<f64>,
-    pub c: Vec<f64>,
-    pub nd: usize,
-    pub tip: usize,
-    pub k3: f64,
-    pub force: f64,
-    pub harmonics: usize,
+    k: Vec<f64>,
+    m: Vec<f64>,
+    c: Vec<f64>,
+    nd: usize,
+    tip: usize,
+    harmonics: usize,
 }
 
 const SAMPLES: usize = 64;
 
 impl FullBeam {
+    /// The `n_elements` beam of `common/beam.rs` (tip spring `K3`, force
+    /// `FORCE`) with `harmonics` harmonics.
+    pub fn new(n_elements: usize, harmonics: usize) -> Self {
+        let b = cantilever(n_elements, &BeamProperties::default()).unwrap();
+        Self {
+            k: dense(&b.model.k),
+            m: dense(&b.model.m),
+            c: dense(&b.model.c),
+            nd: b.model.n_dof(),
+            tip: b.tip,
+            harmonics,
+        }
+    }
+
     fn len(&self) -> usize {
         self.nd * (2 * self.harmonics + 1)
     }
@@ -54,7 +69,7 @@ impl FullBeam {
                 let (sn, cs) = (h as f64 * tau).sin_cos();
                 xt += q[h] * cs + q[n + h] * sn;
             }
-            let f = self.k3 * xt * xt * xt;
+            let f = K3 * xt * xt * xt;
             g[0] += f / SAMPLES as f64;
             for h in 1..=n {
                 let (sn, cs) = (h as f64 * tau).sin_cos();
@@ -98,7 +113,7 @@ impl FullBeam {
                 if i == self.tip {
                     rc = rc.add(Dd::new(g[h]));
                     if h == 1 {
-                        rc = rc.sub(Dd::new(self.force));
+                        rc = rc.sub(Dd::new(FORCE));
                     }
                     if h > 0 {
                         rs = rs.add(Dd::new(g[n + h]));
@@ -123,7 +138,7 @@ impl FullBeam {
         }
         let r = self.residual(&x, omega);
         let worst = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        (x, worst / self.force)
+        (x, worst / FORCE)
     }
 
     /// Chord Newton from `x` on the Jacobian at `x`.
