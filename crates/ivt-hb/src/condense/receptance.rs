@@ -165,9 +165,11 @@ impl Receptances {
             return None;
         }
         let delta = omega_f - self.omega_f;
+        // Largest |entry|, column by column (no allocation: this runs at
+        // every corrector iterate that asks for the model).
         let size = |m: &Mat<c64>| {
             m.col_iter()
-                .flat_map(|c| c.iter().map(|z| z.norm()).collect::<Vec<_>>())
+                .map(|c| c.iter().fold(0.0f64, |a, z| a.max(z.norm())))
                 .fold(0.0f64, f64::max)
         };
         let mut inverse_radius = 0.0f64;
