@@ -1,7 +1,7 @@
 //! `[controller]` (law, gains, feed-forward) and `[metrics]`.
 
 use super::inputs::{knots, profile_ok, within_r_max};
-use super::keys::{check, fits_f32, Typed, NOT_F32};
+use super::keys::{check_fields, fits_f32, Typed, NOT_F32};
 use super::Invalid;
 use ivt_ctrl::{LawKind, OpenLoopPreset};
 use serde::{Deserialize, Serialize};
@@ -114,11 +114,15 @@ impl Default for ControllerSection {
 
 impl ControllerSection {
     pub(super) fn validate(&self, r_max: f64) -> Result<(), Invalid> {
-        check("controller.omega0_rpm", self.omega0_rpm)?;
-        check("controller.k_mm_per_rad", self.k_mm_per_rad)?;
-        check("controller.k2_mm_per_rad", self.k2_mm_per_rad)?;
-        check("controller.k_prop_deg_per_rpm", self.k_prop_deg_per_rpm)?;
-        check("controller.prop_period_s", self.prop_period_s)?;
+        check_fields!(
+            self,
+            "controller",
+            omega0_rpm,
+            k_mm_per_rad,
+            k2_mm_per_rad,
+            k_prop_deg_per_rpm,
+            prop_period_s
+        )?;
         if self.law == Law::None {
             Invalid::check(!self.r_schedule.is_empty(), "controller.r_schedule", || {
                 "is required when law = \"none\"".into()
@@ -165,8 +169,6 @@ impl Default for MetricsSection {
 
 impl MetricsSection {
     pub(super) fn validate(&self) -> Result<(), Invalid> {
-        check("metrics.from_s", self.from_s)?;
-        check("metrics.band", self.band)?;
-        check("metrics.static_window_s", self.static_window_s)
+        check_fields!(self, "metrics", from_s, band, static_window_s)
     }
 }

@@ -1,7 +1,7 @@
 //! `[integrator]`, `[encoder]`, `[sensors]` and `[stepper]`: how the plant
 //! is integrated and what the controller sees of it.
 
-use super::keys::check;
+use super::keys::check_fields;
 use super::Invalid;
 use ivt_ctrl::SUPPORTED_PPR;
 use serde::Deserialize;
@@ -47,10 +47,7 @@ impl Default for IntegratorSection {
 
 impl IntegratorSection {
     pub(super) fn validate(&self) -> Result<(), Invalid> {
-        check("integrator.rtol", self.rtol)?;
-        check("integrator.atol", self.atol)?;
-        check("integrator.dtheta", self.dtheta)?;
-        check("integrator.omega_handover", self.omega_handover)
+        check_fields!(self, "integrator", rtol, atol, dtheta, omega_handover)
     }
 }
 
@@ -81,8 +78,7 @@ impl EncoderSection {
         Invalid::check(SUPPORTED_PPR.contains(&self.ppr), "encoder.ppr", || {
             format!("must be one of {SUPPORTED_PPR:?}, got {}", self.ppr)
         })?;
-        check("encoder.f_timer_hz", self.f_timer_hz)?;
-        check("encoder.jitter_s", self.jitter_s)
+        check_fields!(self, "encoder", f_timer_hz, jitter_s)
     }
 }
 
@@ -125,11 +121,15 @@ impl SensorsSection {
     }
 
     pub(super) fn validate(&self) -> Result<(), Invalid> {
-        check("sensors.period_s", self.period_s)?;
-        check("sensors.v_m_noise", self.v_m_noise)?;
-        check("sensors.v_m_quantum", self.v_m_quantum)?;
-        check("sensors.t_u_noise", self.t_u_noise)?;
-        check("sensors.t_u_quantum", self.t_u_quantum)
+        check_fields!(
+            self,
+            "sensors",
+            period_s,
+            v_m_noise,
+            v_m_quantum,
+            t_u_noise,
+            t_u_quantum
+        )
     }
 }
 
@@ -160,9 +160,6 @@ impl Default for StepperSection {
 
 impl StepperSection {
     pub(super) fn validate(&self) -> Result<(), Invalid> {
-        check("stepper.steps_per_rev", self.steps_per_rev)?;
-        check("stepper.max_speed", self.max_speed)?;
-        check("stepper.accel", self.accel)?;
-        check("stepper.miss_prob", self.miss_prob)
+        check_fields!(self, "stepper", steps_per_rev, max_speed, accel, miss_prob)
     }
 }

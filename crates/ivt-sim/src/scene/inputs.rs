@@ -43,8 +43,7 @@ pub struct InitialSection {
 
 impl InitialSection {
     pub(super) fn validate(&self, r_max: f64) -> Result<(), Invalid> {
-        keys::check("initial.theta", self.theta)?;
-        keys::check("initial.omega", self.omega)?;
+        keys::check_fields!(self, "initial", theta, omega)?;
         within_r_max(self.r, r_max).map_err(|why| Invalid::new("initial.r", why))
     }
 }

@@ -41,3 +41,26 @@ pub fn check(name: &str, value: f64) -> Result<(), Invalid> {
 pub fn described(name: &str) -> Result<&'static Key, Invalid> {
     find(name).ok_or_else(|| Invalid::new(name, "has no description in ivt_kin::params::KEYS"))
 }
+
+/// Check numbers of one section in order, each `(key, value)`; the first
+/// refusal is the error.
+///
+/// # Errors
+/// [`Invalid`] naming the first key whose value [`check`] refuses.
+pub fn check_all(numbers: &[(&str, f64)]) -> Result<(), Invalid> {
+    numbers
+        .iter()
+        .try_for_each(|&(name, value)| check(name, value))
+}
+
+/// `check_fields!(self, "stepper", accel, miss_prob)`: [`check_all`] of the
+/// named fields of a section, each under its key `section.field`, so the
+/// key a refusal names is the field's own name in the scene file.
+macro_rules! check_fields {
+    ($owner:expr, $section:literal, $($field:ident),+ $(,)?) => {
+        $crate::scene::keys::check_all(&[
+            $((concat!($section, ".", stringify!($field)), $owner.$field)),+
+        ])
+    };
+}
+pub(crate) use check_fields;
