@@ -5,11 +5,12 @@
 // Test code: the crate's panic lints guard shipped code only.
 #![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
+mod common;
+
 use ivt_ctrl::{Config, ControlOutput};
 use ivt_ctrl::{Plan, Selection, SequenceName};
 use ivt_wire::{
-    crc16, ErrorCode, PulseBatch, Reply, Request, StageStart, TelemetryFrame, TelemetrySample,
-    MAX_FRAME,
+    crc16, ErrorCode, PulseBatch, Reply, Request, StageStart, TelemetryFrame, MAX_FRAME,
 };
 
 /// (kind, payload length) of an encoded frame, after checking the layout.
@@ -62,15 +63,7 @@ fn frame_table_kinds_and_payload_lengths() {
         (0x84, 36)
     );
     let tel = |f: TelemetryFrame| kind_and_len(|b| f.encode(b).unwrap());
-    let sample = TelemetrySample {
-        time_ticks: 1,
-        omega: 10.0,
-        omega_a: 10.0,
-        r: 0.005,
-        inputs: Some([8.0, 6.0]),
-        stepper_position: -3,
-        fault: 0,
-    };
+    let sample = common::v2_sample();
     assert_eq!(tel(TelemetryFrame::Sample(sample)), (0x91, 30));
     let mut batch = PulseBatch::new(0);
     for k in 0..60 {

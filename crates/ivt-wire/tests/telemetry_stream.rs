@@ -5,6 +5,8 @@
 // Test code: the crate's panic lints guard shipped code only.
 #![allow(clippy::indexing_slicing, clippy::unwrap_used, clippy::panic)]
 
+mod common;
+
 use ivt_wire::telemetry::{StreamProblem, TelemetryReader};
 use ivt_wire::{TelemetryFrame, TelemetrySample, WireError, MAX_FRAME};
 
@@ -40,15 +42,7 @@ fn committed_v1_bytes_decode_to_the_values_that_wrote_them() {
 #[test]
 fn v1_and_v2_frames_mix_in_one_stream() {
     let mut bytes = V1[..2 * V1_FRAME].to_vec();
-    let v2 = TelemetrySample {
-        time_ticks: 5,
-        omega: 1.0,
-        omega_a: 2.0,
-        r: 3.0,
-        inputs: Some([8.5, 6.25]),
-        stepper_position: 4,
-        fault: 0,
-    };
+    let v2 = common::v2_sample();
     let mut buf = [0u8; MAX_FRAME];
     let n = TelemetryFrame::Sample(v2).encode(&mut buf).unwrap();
     bytes.extend_from_slice(&buf[..n]);
