@@ -4,10 +4,12 @@
 // Test code: the crate's panic lints guard shipped code only.
 #![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 use ivt_design::delay::{delay_stability_about, steady_orbit, DelayOptions, FeedbackGains};
 use ivt_design::gains::stability_map;
-use ivt_design::steady::IhbOptions;
-use ivt_design::sweep::{sweep_serial, Grid};
+use ivt_design::sweep::Grid;
 use ivt_design::OperatingPoint;
 use ivt_kin::plant::PlantParams;
 
@@ -18,13 +20,7 @@ fn main() {
 /// 26 × 16 IHB solves (n = 7), warm starts along rows, one thread.
 #[divan::bench(sample_count = 10)]
 fn ihb_thesis_grid_serial() {
-    let pts = sweep_serial(
-        &PlantParams::printed(),
-        &Grid::thesis(),
-        IhbOptions::default(),
-    )
-    .unwrap();
-    divan::black_box(pts);
+    divan::black_box(common::thesis_grid_serial());
 }
 
 /// One monodromy + eigenvalues at N = 16 about a precomputed steady state.

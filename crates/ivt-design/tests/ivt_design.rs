@@ -3,6 +3,8 @@
 // Test code: the crate's panic lints guard shipped code only.
 #![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
+mod common;
+
 use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
 use ivt_design::gains::grid_stability_map;
 use ivt_design::shooting::{shoot_steady_state, ShootingOptions};
@@ -190,12 +192,7 @@ fn bad_inputs_give_clear_errors() {
 /// The whole thesis grid solves (416 points, none failing).
 #[test]
 fn thesis_grid_solves_everywhere() {
-    let pts = sweep_serial(
-        &PlantParams::printed(),
-        &Grid::thesis(),
-        IhbOptions::default(),
-    )
-    .unwrap();
+    let pts = common::thesis_grid_serial();
     assert_eq!(pts.len(), 416);
     assert!(pts.iter().all(|p| p.result.is_ok()));
 }
