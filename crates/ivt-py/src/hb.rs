@@ -44,6 +44,42 @@ fn duffing_problem(xi: f64, alpha: f64, eps: f64, force: f64) -> PyResult<Duffin
     ))
 }
 
+/// A `#[pyfunction]` on Duffing's equation Eq. 49 returning a dict. Python
+/// parameters: the `head` ones (`name: type [= default]`), then Duffing's
+/// keywords `n=20, samples=64, xi=0.02, alpha=1.0, eps=1.0, force=0.1`
+/// (declared here once for every Duffing function), then the `tail` ones.
+/// The body gets the equation ([`duffing_problem`]) and the two counts under
+/// the names the caller gives.
+macro_rules! duffing_fn {
+    (
+        $(#[$doc:meta])*
+        fn $name:ident<$lt:lifetime>($py:ident, $problem:ident, $n:ident, $samples:ident;
+            head [$( $arg:ident: $ty:ty $(= $default:tt)? ),*];
+            tail [$( $brg:ident: $bty:ty $(= $bdefault:tt)? ),*];
+        ) $body:block
+    ) => {
+        $(#[$doc])*
+        #[pyfunction]
+        #[pyo3(signature = (
+            $($arg $(= $default)?,)* $n = 20, $samples = 64, xi = 0.02, alpha = 1.0, eps = 1.0,
+            force = 0.1 $(, $brg $(= $bdefault)?)*
+        ))]
+        #[allow(clippy::too_many_arguments)]
+        fn $name<$lt>(
+            $py: Python<$lt>,
+            $( $arg: $ty, )*
+            #[pyo3(from_py_with = int64)] $n: i64,
+            #[pyo3(from_py_with = int64)] $samples: i64,
+            xi: f64, alpha: f64, eps: f64, force: f64,
+            $( $brg: $bty, )*
+        ) -> PyResult<Bound<$lt, PyDict>> {
+            let $problem = duffing_problem(xi, alpha, eps, force)?;
+            $body
+        }
+    };
+}
+
+duffing_fn! {
 /// Periodic solution of Duffing's equation Eq. 49,
 /// `u'' + 2ξu' + αu + εu³ = F cos(ω_f t)`, by harmonic balance.
 ///
@@ -56,31 +92,21 @@ fn duffing_problem(xi: f64, alpha: f64, eps: f64, force: f64) -> PyResult<Duffin
 /// steps, as the CLI), stable.
 /// `stability=False` skips the multipliers (floquet = [], stable = None).
 /// The GIL is released while solving.
-#[pyfunction]
-#[pyo3(signature = (
-    n = 20, samples = 64, xi = 0.02, alpha = 1.0, eps = 1.0, force = 0.1, omega_f = 0.4,
-    method = "modified", guess = None, tol = 1e-10, stability = true
-))]
-#[allow(clippy::too_many_arguments)]
-fn duffing<'py>(
-    py: Python<'py>,
-    #[pyo3(from_py_with = int64)] n: i64,
-    #[pyo3(from_py_with = int64)] samples: i64,
-    xi: f64,
-    alpha: f64,
-    eps: f64,
-    force: f64,
-    omega_f: f64,
-    method: &str,
-    guess: Option<&Bound<'py, PyAny>>,
-    tol: f64,
-    stability: bool,
-) -> PyResult<Bound<'py, PyDict>> {
+fn duffing<'py>(py, problem, n, samples;
+    head [];
+    tail [
+        omega_f: f64 = 0.4,
+        method: &str = "modified",
+        guess: Option<&Bound<'py, PyAny>> = None,
+        tol: f64 = 1e-10,
+        stability: bool = true
+    ];
+) {
     let opts = options(n, samples, 1, tol)?;
-    let problem = duffing_problem(xi, alpha, eps, force)?;
     let req = orbit_request(py, omega_f, method, guess, stability)?;
     let orbit = run(py, || jobs::orbit(&problem, &opts, &req))?;
     to_dict(py, &orbit)
+}
 }
 
 /// Periodic solution of the Mathieu–Duffing equation Eq. 81,
@@ -147,6 +173,7 @@ fn mathieu_cascade<'py>(
     to_dict(py, &cascade)
 }
 
+duffing_fn! {
 /// Frequency-response curve of Duffing's equation by pseudo-arclength
 /// continuation in ω_f from `from_` to `to` (Fig. 29), with the Floquet
 /// verdict at every point: the dict of `ivt hb duffing-frc --json`
@@ -156,26 +183,11 @@ fn mathieu_cascade<'py>(
 /// "bifurcations", "termination", "time_s"} and the arrays omega,
 /// amplitude, stable for plotting. `events=True` (`--events`) also locates
 /// period doublings, Neimark–Sacker and branch points. GIL released.
-#[pyfunction]
-#[pyo3(signature = (
-    from_ = 0.2, to = 3.0, n = 20, samples = 64, xi = 0.02, alpha = 1.0, eps = 1.0, force = 0.1,
-    events = false
-))]
-#[allow(clippy::too_many_arguments)]
-fn duffing_frc<'py>(
-    py: Python<'py>,
-    from_: f64,
-    to: f64,
-    #[pyo3(from_py_with = int64)] n: i64,
-    #[pyo3(from_py_with = int64)] samples: i64,
-    xi: f64,
-    alpha: f64,
-    eps: f64,
-    force: f64,
-    events: bool,
-) -> PyResult<Bound<'py, PyDict>> {
+fn duffing_frc<'py>(py, problem, n, samples;
+    head [from_: f64 = 0.2, to: f64 = 3.0];
+    tail [events: bool = false];
+) {
     let opts = options(n, samples, 1, 1e-10)?;
-    let problem = duffing_problem(xi, alpha, eps, force)?;
     let req = FrcRequest {
         options: FrcOptions {
             from: finite("from_", from_)?,
@@ -186,6 +198,7 @@ fn duffing_frc<'py>(
     };
     let curve = run(py, || jobs::frc(&problem, &opts, &req))?;
     to_dict(py, &curve.with_fold_omegas())
+}
 }
 
 user_system_fn! {
