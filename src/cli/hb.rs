@@ -286,6 +286,7 @@ fn mathieu(a: MathieuArgs) -> Result<Output, CliError> {
         omega: a.omega,
         gamma: a.gamma,
         harmonics: a.n,
+        ..CascadeRequest::default()
     };
     let cascade = jobs::cascade(&req)?;
     if let Some(path) = &a.plot {

@@ -19,16 +19,13 @@ fn main() {
     divan::main();
 }
 
+#[path = "../tests/common/string.rs"]
+mod string;
+
+/// The default string (k_d = 10) of `modes` modes and `harmonics` harmonics
+/// solved at `omega`.
 fn solved(modes: usize, harmonics: usize, omega: f64) -> (StringHb, Vec<f64>) {
-    let mut hb = StringHb::new(StringParams {
-        modes,
-        harmonics,
-        ..Default::default()
-    })
-    .unwrap();
-    let mut a = vec![0.0; hb.dim()];
-    hb.solve(omega, &mut a, 1e-10, 50).unwrap();
-    (hb, a)
+    string::solved(modes, harmonics, 10.0, omega, 1e-10)
 }
 
 /// Fig. 34 curve: k_d = 10, N = 5, M = 19, ω ∈ [1, 6], stability at every point.

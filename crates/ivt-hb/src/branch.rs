@@ -13,6 +13,8 @@
 //! [`bilinear_lambda_difference`]); a branch that knows them exactly (the
 //! frequency family, the STHB string) overrides them.
 
+use ivt_num::NewtonOptions;
+
 /// A one-parameter family of square systems `R(q, λ) = 0` with `∂R/∂q`.
 pub trait Branch {
     /// Number of unknowns `m` (λ excluded).
@@ -59,6 +61,20 @@ pub trait Branch {
     /// with step `h`.
     fn bilinear_lambda(&mut self, q: &[f64], lambda: f64, h: f64, w: &[f64], v: &[f64]) -> f64 {
         bilinear_lambda_difference(self, q, lambda, h, w, v)
+    }
+}
+
+/// The options of [`ivt_num::newton()`] for a correction on a branch from a
+/// close start (a converged orbit of another method, a point next to an
+/// event, a step off a bifurcation): every step in full (no halving, no
+/// descent test), at most `max_iter`, converged at `‖R‖ ≤ ftol`.
+pub(crate) fn full_newton_steps(ftol: f64, max_iter: usize) -> NewtonOptions {
+    NewtonOptions {
+        ftol,
+        max_iter,
+        max_halvings: 0,
+        accept_no_descent: true,
+        ..NewtonOptions::default()
     }
 }
 

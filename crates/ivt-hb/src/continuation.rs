@@ -180,16 +180,21 @@ impl serde::Serialize for Termination {
     }
 }
 
-/// A traced path.
+/// A traced curve: its points and folds in path order and why tracing
+/// stopped. The stepper's [`Path`] holds the raw states; [`crate::Frc`] and
+/// [`crate::condense::CondensedFrc`] hold the same curve read as orbits.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Path {
-    /// Converged points in order.
-    pub points: Vec<PathPoint>,
-    /// Detected folds.
-    pub folds: Vec<Fold>,
+pub struct Traced<P, F> {
+    /// Points in path order.
+    pub points: Vec<P>,
+    /// Folds (turning points in λ) in path order.
+    pub folds: Vec<F>,
     /// Why tracing stopped.
     pub termination: Termination,
 }
+
+/// A traced path: the converged states and the folds the stepper detected.
+pub type Path = Traced<PathPoint, Fold>;
 
 impl ContinuationOptions {
     /// The largest step at the point `x`: `ds_max`, relative to `‖x‖₂`

@@ -7,7 +7,7 @@
 //! between two points), started from the path point nearest the turn.
 
 use crate::aft::Aft;
-use crate::continuation::{ContinuationOptions, Corrector, Termination};
+use crate::continuation::{ContinuationOptions, Corrector, Traced};
 use crate::events::{
     observe, BifurcationKind, Detector, EventObserver, Fold, LocateOptions, PathOptions, Trace,
 };
@@ -113,16 +113,8 @@ pub struct FrcFold {
     pub located: bool,
 }
 
-/// A traced frequency-response curve.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Frc {
-    /// Points in path order.
-    pub points: Vec<FrcPoint>,
-    /// Folds (turning points in ω_f) in path order.
-    pub folds: Vec<FrcFold>,
-    /// Why tracing stopped.
-    pub termination: Termination,
-}
+/// A traced frequency-response curve (folds: turning points in ω_f).
+pub type Frc = Traced<FrcPoint, FrcFold>;
 
 /// Traces the frequency-response curve of `problem` from `opts.from` to `opts.to`.
 ///

@@ -48,7 +48,7 @@ pub use classic::ClassicIhb;
 pub use codim2::{fold_curve, neimark_sacker_points, FoldCurve, FoldPoint, NeimarkSackerPoint};
 pub use continuation::{
     BroydenCorrector, ContinuationOptions, Corrector, Fold, NewtonCorrector, Path, PathCorrector,
-    PathPoint, Step, Stepper, Termination,
+    PathPoint, Step, Stepper, Termination, Traced,
 };
 pub use cycle_branch::{cycle_branch, CycleBranch, CycleBranchOptions};
 pub use damped::{damped_modes, linear_mode, DampedModePoint, DampedModes};

@@ -5,7 +5,7 @@
 //! the odd-harmonic null vector of the period-2 Galerkin Jacobian,
 //! [`period_doubled_start`]).
 
-use crate::branch::{residual_lambda_difference, Branch};
+use crate::branch::{full_newton_steps, residual_lambda_difference, Branch};
 use crate::broyden::SolveError;
 use crate::events::extended::{
     check_start, lambda_step, null_vector, put_jacobian, singular_at_start, solve_error,
@@ -53,13 +53,9 @@ pub fn switch_branch<B: Branch>(
     // largest entry of x (at the predictor).
     let scale = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let nopts = NewtonOptions {
-        ftol: 0.0,
         rtol: 0.0,
         atol: opts.step_tol * scale,
-        max_iter: opts.max_iter,
-        max_halvings: 0,
-        accept_no_descent: true,
-        ..NewtonOptions::default()
+        ..full_newton_steps(0.0, opts.max_iter)
     };
     let border = Border {
         rows: direction,

@@ -11,18 +11,9 @@ use ivt_hb::sthb::stability::{
 use ivt_hb::sthb::{StringHb, StringParams};
 use std::time::Instant;
 
-fn solved(modes: usize, harmonics: usize, kd: f64, omega: f64) -> (StringHb, Vec<f64>) {
-    let mut hb = StringHb::new(StringParams {
-        modes,
-        harmonics,
-        kd,
-        ..Default::default()
-    })
-    .unwrap();
-    let mut a = vec![0.0; hb.dim()];
-    hb.solve(omega, &mut a, 1e-12, 50).unwrap();
-    (hb, a)
-}
+#[path = "common/string.rs"]
+mod string;
+use string::solved;
 
 /// Critical multiplier modulus of an RK4 monodromy with `steps` steps.
 fn critical(hb: &StringHb, omega: f64, steps: usize) -> f64 {
@@ -39,7 +30,7 @@ fn refined_monodromy_error_estimate_covers_its_error() {
     // Against RK4 with 8× the default steps (error 4096× below the default's):
     // the Richardson estimate |μ_h − μ_{h/2}| bounds the refined |μ|'s error.
     for (modes, omega) in [(5, 2.0), (5, 3.8), (10, 5.5)] {
-        let (hb, _) = solved(modes, 19, 10.0, omega);
+        let (hb, _) = solved(modes, 19, 10.0, omega, 1e-12);
         let coarse = monodromy(&hb, omega).unwrap();
         let (fine, estimate) = monodromy_refined(&hb, omega, &coarse).unwrap();
         assert_eq!(fine.method, StabilityMethod::MonodromyRefined);
@@ -97,7 +88,7 @@ fn split_monodromy_has_the_full_matrix_multipliers() {
     // The curve's multipliers come from the odd/even-mode blocks; the public
     // monodromy_matrix integrates all modes together.
     for (modes, omega) in [(6, 3.8), (7, 2.0)] {
-        let (hb, _) = solved(modes, 9, 30.0, omega);
+        let (hb, _) = solved(modes, 9, 30.0, omega, 1e-12);
         let split = ivt_hb::sthb::stability::monodromy_multipliers(&hb, omega).unwrap();
         let phi = monodromy_matrix(&hb, omega, default_steps(&hb, omega)).unwrap();
         let mut full: Vec<f64> = phi

@@ -168,6 +168,7 @@ fn mathieu_cascade<'py>(
         omega: finite("omega", omega)?,
         gamma: finite("gamma", gamma)?,
         harmonics: count("n", n)?,
+        ..CascadeRequest::default()
     };
     let cascade = run(py, || jobs::cascade(&req))?;
     to_dict(py, &cascade)

@@ -15,7 +15,7 @@ use super::stability::{
 use crate::aft::{eval_series, Aft};
 use crate::branch::Branch;
 use crate::continuation::{
-    correct_at_fixed_lambda, ContinuationOptions, NewtonCorrector, Stepper, Termination,
+    correct_at_fixed_lambda, ContinuationOptions, NewtonCorrector, Stepper, Traced,
 };
 use crate::error::HbError;
 use crate::events::{observe, BifurcationKind, EventObserver, Fold, LocateOptions};
@@ -116,15 +116,7 @@ pub struct CondensedPoint {
 pub type CondensedFold = FrcFold;
 
 /// A traced condensed curve.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CondensedFrc {
-    /// Points in path order.
-    pub points: Vec<CondensedPoint>,
-    /// Folds in path order.
-    pub folds: Vec<CondensedFold>,
-    /// Why tracing stopped.
-    pub termination: Termination,
-}
+pub type CondensedFrc = Traced<CondensedPoint, CondensedFold>;
 
 /// Traces the frequency response of `branch` from `opts.from` to `opts.to`.
 ///

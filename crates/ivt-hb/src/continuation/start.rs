@@ -1,7 +1,7 @@
 //! The start of an exact-Jacobian path: Newton at fixed λ ([`ivt_num::newton()`]).
 
-use crate::branch::Branch;
-use ivt_num::{newton, NewtonError, NewtonOptions, NewtonSystem, NewtonWorkspace};
+use crate::branch::{full_newton_steps, Branch};
+use ivt_num::{newton, NewtonError, NewtonSystem, NewtonWorkspace};
 use std::convert::Infallible;
 
 use super::{ContinuationOptions, SolveError};
@@ -50,13 +50,7 @@ pub fn correct_at_fixed_lambda<S: Branch>(
         ));
     };
     let mut fixed = FixedLambda { system, lambda };
-    let nopts = NewtonOptions {
-        ftol: opts.broyden.tol,
-        max_iter: opts.broyden.max_iter,
-        max_halvings: 0,
-        accept_no_descent: true,
-        ..NewtonOptions::default()
-    };
+    let nopts = full_newton_steps(opts.broyden.tol, opts.broyden.max_iter);
     match newton(&mut fixed, u, &mut NewtonWorkspace::new(m), &nopts) {
         Ok(stats) => Ok(stats.iterations),
         Err(NewtonError::SingularJacobian { .. }) => Err(HbError::SingularStart { lambda }),

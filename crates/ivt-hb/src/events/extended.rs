@@ -6,7 +6,7 @@
 //! (borders from inverse iteration, the `[R_q, R_λ]` blocks, the result).
 
 use super::detector::{Bifurcation, BifurcationError, BifurcationKind, LocateOptions};
-use crate::branch::{residual_lambda_difference, Branch};
+use crate::branch::{full_newton_steps, residual_lambda_difference, Branch};
 use crate::broyden::SolveError;
 use crate::ihb::HbError;
 use faer::c64;
@@ -194,12 +194,8 @@ impl StepRule {
     /// most `max_iter`, stopped by [`Self::check`] only.
     pub(crate) fn newton_options(max_iter: usize, accept_near_singular: bool) -> NewtonOptions {
         NewtonOptions {
-            ftol: 0.0,
-            max_iter,
-            max_halvings: 0,
-            accept_no_descent: true,
             accept_near_singular,
-            ..NewtonOptions::default()
+            ..full_newton_steps(0.0, max_iter)
         }
     }
 

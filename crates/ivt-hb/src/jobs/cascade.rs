@@ -11,36 +11,15 @@ use std::time::Instant;
 /// β1, β2, β4 as printed in §3.2.5.
 pub const THESIS_BETAS: [f64; 3] = [4.825, 5.194, 5.253];
 
-/// The equation's parameters and the harmonics of the period-1 orbit.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CascadeRequest {
-    /// Damping ratio ξ̂.
-    pub xi: f64,
-    /// Stiffness α̂ (enters as −α̂).
-    pub alpha: f64,
-    /// Parametric excitation frequency Ω (> 0).
-    pub omega: f64,
-    /// Cubic stiffness γ.
-    pub gamma: f64,
-    /// Harmonics of the period-1 solution (period 2^k uses 2^k n).
-    pub harmonics: usize,
-}
+/// The equation's parameters, the harmonics of the period-1 orbit and the
+/// search's settings: the options of [`period_doubling_cascade`] themselves
+/// (the command line and Python set ξ̂, α̂, Ω, γ and n; the rest keeps
+/// §3.2.5's defaults).
+pub type CascadeRequest = CascadeOptions;
 
-impl Default for CascadeRequest {
-    /// §3.2.5: ξ̂ = 0.125, α̂ = 1, Ω = 2, γ = 1, n = 12.
-    fn default() -> Self {
-        let o = CascadeOptions::default();
-        Self {
-            xi: o.xi,
-            alpha: o.alpha,
-            omega: o.omega,
-            gamma: o.gamma,
-            harmonics: o.harmonics,
-        }
-    }
-}
-
-impl CascadeRequest {
+impl CascadeOptions {
+    /// The job's check of its request.
+    ///
     /// # Errors
     /// [`HbError::InvalidInput`] for a non-finite parameter or Ω ≤ 0.
     pub fn validate(&self) -> Result<(), HbError> {
@@ -48,6 +27,7 @@ impl CascadeRequest {
             ("xi", self.xi),
             ("alpha", self.alpha),
             ("gamma", self.gamma),
+            ("beta0", self.beta0),
         ])?;
         positive("omega", self.omega).map(|_| ())
     }
@@ -78,16 +58,8 @@ pub struct Cascade {
 /// [`CascadeRequest::validate`]'s and the continuation's.
 pub fn cascade(req: &CascadeRequest) -> Result<Cascade, HbError> {
     req.validate()?;
-    let opts = CascadeOptions {
-        xi: req.xi,
-        alpha: req.alpha,
-        omega: req.omega,
-        gamma: req.gamma,
-        harmonics: req.harmonics,
-        ..CascadeOptions::default()
-    };
     let t0 = Instant::now();
-    let doublings = period_doubling_cascade(&opts)?;
+    let doublings = period_doubling_cascade(req)?;
     let mu: Vec<_> = doublings.iter().map(|p| p.multiplier).collect();
     Ok(Cascade {
         period_doubling_beta: doublings.iter().map(|p| p.beta).collect(),

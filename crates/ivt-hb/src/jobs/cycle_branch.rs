@@ -3,9 +3,9 @@
 //! point's first Lyapunov coefficient, the cycle branch by HB with ω unknown
 //! and Eq. 68–77, Floquet stability (Hsu) and its folds located).
 
-use super::{all_finite, pairs, stability_steps, Array};
+use super::{all_finite, finite_list, pairs, path_steps, stability_steps, Array};
 use crate::autonomous::LimitCycle;
-use crate::continuation::{ContinuationOptions, Termination};
+use crate::continuation::Termination;
 use crate::cycle_branch::{cycle_branch as trace_cycles, CycleBranchOptions};
 use crate::error::HbError;
 use crate::events::BifurcationKind;
@@ -71,9 +71,7 @@ impl CycleBranchRequest {
                 "`p_from` and `p_to` must differ".into(),
             ));
         }
-        if let Some(p) = self.at.iter().find(|p| !p.is_finite()) {
-            return Err(HbError::InvalidInput(format!("`at` = {p} must be finite")));
-        }
+        finite_list("at", &self.at)?;
         Ok(())
     }
 }
@@ -174,12 +172,7 @@ where
     let opts = CycleBranchOptions {
         samples: req.grid,
         offset: req.offset,
-        continuation: ContinuationOptions {
-            ds: req.ds,
-            ds_max: req.ds_max,
-            max_points: req.max_points,
-            ..ContinuationOptions::default()
-        },
+        continuation: path_steps(req.ds, req.ds_max, req.max_points),
         stability_steps: stability_steps(hb.harmonics),
         at: req.at.clone(),
     };

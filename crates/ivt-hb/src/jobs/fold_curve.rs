@@ -8,9 +8,9 @@
 //! given point, or the point of that kind of largest ω_f located on the FRC
 //! of `family(p_start)` over an interval.
 
-use super::{all_finite, finite, Array, FrcRequest};
+use super::{all_finite, finite, finite_list, path_steps, Array, FrcRequest};
 use crate::codim2::{bifurcation_curve, CurvePoint, CurveStart};
-use crate::continuation::{ContinuationOptions, Corrector, Termination};
+use crate::continuation::{Corrector, Termination};
 use crate::error::HbError;
 use crate::events::BifurcationKind;
 use crate::frc::{frequency_response, FrcOptions};
@@ -116,9 +116,7 @@ impl FoldCurveRequest {
             ("ds", self.ds),
             ("ds_max", self.ds_max),
         ])?;
-        if let Some(p) = self.at.iter().find(|p| !p.is_finite()) {
-            return Err(HbError::InvalidInput(format!("`at` = {p} must be finite")));
-        }
+        finite_list("at", &self.at)?;
         if self.max_points == 0 {
             return Err(HbError::InvalidInput("`max_points` must be ≥ 1".into()));
         }
@@ -218,12 +216,7 @@ where
         FoldStart::Given { omega, coeffs } => (*omega, coeffs.clone()),
         FoldStart::Search { from, to } => search_start(&family, hb, req, *from, *to)?,
     };
-    let copts = ContinuationOptions {
-        ds: req.ds,
-        ds_max: req.ds_max,
-        max_points: req.max_points,
-        ..ContinuationOptions::default()
-    };
+    let copts = path_steps(req.ds, req.ds_max, req.max_points);
     let h = hb.harmonics;
     let (points, at, special, termination) = if req.kind == BifurcationKind::Fold {
         let curve = crate::fold_curve(

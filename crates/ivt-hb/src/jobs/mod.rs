@@ -50,6 +50,7 @@ pub use orbit::{orbit, Method, Orbit, OrbitRequest};
 pub use string::{string, StringCurve, StringPoint, StringRequest};
 pub use switch::{switch, SwitchRequest, SwitchStart, SwitchedBranch};
 
+use crate::continuation::ContinuationOptions;
 use crate::error::HbError;
 
 /// Hsu sub-intervals per period for `harmonics` harmonics: max(8n, 256)
@@ -105,6 +106,22 @@ pub(crate) fn all_finite(values: &[(&str, f64)]) -> Result<(), HbError> {
     values
         .iter()
         .try_for_each(|&(name, v)| finite(name, v).map(|_| ()))
+}
+
+/// [`finite`] of each entry of the list `name`, the first failure returned.
+pub(crate) fn finite_list(name: &str, values: &[f64]) -> Result<(), HbError> {
+    values.iter().try_for_each(|&v| finite(name, v).map(|_| ()))
+}
+
+/// The default path with a request's first and largest arclength steps
+/// and its most points.
+pub(crate) fn path_steps(ds: f64, ds_max: f64, max_points: usize) -> ContinuationOptions {
+    ContinuationOptions {
+        ds,
+        ds_max,
+        max_points,
+        ..ContinuationOptions::default()
+    }
 }
 
 #[cfg(test)]
