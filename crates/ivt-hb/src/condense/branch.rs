@@ -16,7 +16,7 @@
 
 use super::dynamic::Structure;
 use super::receptance::{Coupling, Receptances};
-use crate::branch::Branch;
+use crate::branch::{bilinear_form, Branch};
 use crate::error::HbError;
 use crate::galerkin::GalerkinJacobian;
 use crate::ihb::{HbOptions, HbResidual};
@@ -315,8 +315,10 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
         }
     }
 
-    /// `jac = I_X + H·jac` (row-major `m×m`), `jac` holding `∂G/∂q` on entry.
-    fn condense_jacobian(&self, rc: &Receptances, jac: &mut [f64]) {
+    /// `jac = I_X + H·jac` (row-major `m×m`), `jac` holding `∂G/∂q` on entry;
+    /// without `identity`, `jac = H·jac` (`H` any per-harmonic family: the
+    /// receptances or their ω_f-derivatives).
+    fn condense_jacobian(&self, receptance: &[Mat<c64>], identity: bool, jac: &mut [f64]) {
         let (s, n) = (self.coupling.dofs.len(), self.hb.harmonics);
         let l = 2 * n + 1;
         let m = s * l;
@@ -327,7 +329,7 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
                 dst.copy_from_slice(src);
             }
         };
-        for (h, hm) in rc.receptance.iter().enumerate().take(n + 1) {
+        for (h, hm) in receptance.iter().enumerate().take(n + 1) {
             // The rows of G_h (a then b for each local DOF) before overwriting.
             for b in 0..s {
                 copy(&mut rows, b, jac, b * l + h);
@@ -360,10 +362,10 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
                     }
                 }
                 // X_0 = a0/2: the identity's first entry is ½.
-                let diagonal = if h == 0 {
-                    [(ra, 0.5)].to_vec()
-                } else {
-                    vec![(ra, 1.0), (rb, 1.0)]
+                let diagonal = match (identity, h) {
+                    (false, _) => Vec::new(),
+                    (true, 0) => vec![(ra, 0.5)],
+                    (true, _) => vec![(ra, 1.0), (rb, 1.0)],
                 };
                 for (r, v) in diagonal {
                     if let Some(e) = jac.get_mut(r * m + r) {
@@ -462,7 +464,40 @@ impl<P: PeriodicProblem> Branch for CondensedBranch<P> {
     fn jacobian(&mut self, q: &[f64], lambda: f64, jac: &mut [f64]) {
         self.galerkin
             .assemble(&mut self.res, &self.local, q, lambda, 1.0, jac);
-        self.with_receptances(lambda, jac, |b, rc, j| b.condense_jacobian(rc, j));
+        self.with_receptances(lambda, jac, |b, rc, j| {
+            b.condense_jacobian(&rc.receptance, true, j)
+        });
+    }
+    /// Exact in the receptances: `∂J/∂ω_f = H′ ∂G/∂q + H ∂²G/∂q∂ω_f` at
+    /// the receptances of ω_f (no factorization at ω_f ± h, where the
+    /// default difference of two Jacobians needed two: a sixth of the
+    /// N = 500 beam's curve went to locating its folds). `∂²G/∂q∂ω_f` is the
+    /// central difference of the local Galerkin Jacobian (Eq. 56) with step
+    /// `1e-6·max(|ω_f|, 1)`: exact to rounding for a `g` of positions (the
+    /// local linear part is quadratic in ω, `g`'s part cancels).
+    fn bilinear_lambda(&mut self, q: &[f64], lambda: f64, _h: f64, w: &[f64], v: &[f64]) -> f64 {
+        let m = self.res.len();
+        let h = 1e-6 * lambda.abs().max(1.0);
+        // [∂G/∂q; ∂²G/∂q∂ω_f], each m×m.
+        let mut both = vec![0.0; 2 * m * m];
+        let mut minus = vec![0.0; m * m];
+        let (jg, djg) = both.split_at_mut(m * m);
+        self.galerkin
+            .assemble(&mut self.res, &self.local, q, lambda, 1.0, jg);
+        self.galerkin
+            .assemble(&mut self.res, &self.local, q, lambda + h, 1.0, djg);
+        self.galerkin
+            .assemble(&mut self.res, &self.local, q, lambda - h, 1.0, &mut minus);
+        djg.iter_mut()
+            .zip(&minus)
+            .for_each(|(p, m)| *p = (*p - m) / (2.0 * h));
+        self.with_receptances(lambda, &mut both, |b, rc, both| {
+            let (jg, djg) = both.split_at_mut(m * m);
+            b.condense_jacobian(&rc.d_receptance, false, jg);
+            b.condense_jacobian(&rc.receptance, false, djg);
+        });
+        let (jg, djg) = both.split_at(m * m);
+        bilinear_form(jg, w, v) + bilinear_form(djg, w, v)
     }
     /// Exact: `∂H/∂ω_f G − ∂u/∂ω_f + H ∂G/∂ω_f`.
     fn residual_lambda(&mut self, q: &[f64], lambda: f64, _h: f64, out: &mut [f64]) {
