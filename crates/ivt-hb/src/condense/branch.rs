@@ -511,3 +511,53 @@ impl<P: PeriodicProblem> Branch for CondensedBranch<P> {
         });
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::branch::bilinear_lambda_difference;
+    use crate::models::{cantilever, BeamProperties};
+    use crate::GeneralProblem;
+
+    /// The exact `∂(wᵀJv)/∂ω_f` equals the central difference of two
+    /// Jacobians (each from its own factorizations) at ω_f ± h to its
+    /// O(h²) error, on the N = 50 beam near its first resonance with the
+    /// tip spring well into its nonlinear range.
+    #[test]
+    fn exact_bilinear_lambda_equals_the_difference_of_jacobians() {
+        let beam = cantilever(50, &BeamProperties::default()).unwrap();
+        let s = &beam.model;
+        let structure = Structure::new(s.m.as_ref(), s.c.as_ref(), s.k.as_ref()).unwrap();
+        let mut load = vec![0.0; s.n_dof()];
+        load[beam.tip] = 0.005;
+        let spring = |x: &[f64], _v: &[f64], _t: f64, g: &mut [f64]| g[0] = 200.0 * x[0].powi(3);
+        let unforced = |_t: f64, f: &mut [f64]| f[0] = 0.0;
+        let local = GeneralProblem::new(1, vec![0.0], vec![0.0], vec![0.0], spring, unforced)
+            .with_velocity_dependent(false);
+        let hb = HbOptions::new(7, 32);
+        let mut branch =
+            CondensedBranch::new(structure, vec![beam.tip], &load, &[], local, &hb).unwrap();
+        let omega = 3.6;
+        // Five times the linear response, a second harmonic and a cubic one.
+        let mut q = branch.linear_guess(omega).unwrap();
+        q.iter_mut().for_each(|x| *x *= 5.0);
+        q[3] = 0.004;
+        q[7 + 3] = -0.002;
+        let m = q.len();
+        let w: Vec<f64> = (0..m).map(|i| ((i * 7 % 5) as f64 - 2.0) * 0.3).collect();
+        let v: Vec<f64> = (0..m).map(|i| 1.0 / (1.0 + i as f64)).collect();
+        let exact = Branch::bilinear_lambda(&mut branch, &q, omega, 0.0, &w, &v);
+        let errors: Vec<f64> = [1e-4, 1e-5]
+            .iter()
+            .map(|&h| {
+                let d = bilinear_lambda_difference(&mut branch, &q, omega, h, &w, &v);
+                (d - exact).abs() / exact.abs()
+            })
+            .collect();
+        // O(h²): the error falls by about 100 from h = 1e-4 to 1e-5
+        // (measured 1.7e-6 at h = 1e-4, 1.7e-4 at h = 1e-3).
+        assert!(errors[1] < 1e-7, "{errors:?}");
+        assert!(errors[0] > 30.0 * errors[1], "{errors:?}");
+        assert!(exact.abs() > 1e-3, "{exact}");
+    }
+}
