@@ -115,7 +115,7 @@ pub fn bilinear_lambda_difference<B: Branch + ?Sized>(
 }
 
 /// `wᵀ A v` for a row-major square `A`.
-fn bilinear_form(a: &[f64], w: &[f64], v: &[f64]) -> f64 {
+pub(crate) fn bilinear_form(a: &[f64], w: &[f64], v: &[f64]) -> f64 {
     a.chunks_exact(v.len().max(1))
         .zip(w)
         .map(|(row, wi)| wi * row.iter().zip(v).map(|(x, y)| x * y).sum::<f64>())

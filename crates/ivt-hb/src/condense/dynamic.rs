@@ -198,17 +198,17 @@ impl Structure {
     /// # Errors
     /// [`HbError::Singular`] (with `omega = w`) when the numeric LU fails.
     pub fn factor(&self, w: f64) -> Result<Factored, HbError> {
-        let vals: Vec<c64> = (self.k.iter().zip(&self.m).zip(&self.c))
-            .map(|((k, m), c)| c64::new(k - w * w * m, w * c))
-            .collect();
+        let vals = (self.k.iter().zip(&self.m).zip(&self.c))
+            .map(|((k, m), c)| c64::new(k - w * w * m, w * c));
         let lu = match &self.solver {
             Solver::Band(kl, ku) => {
                 let entries = entries(&self.pattern)
-                    .zip(&vals)
-                    .map(|((i, j), v)| (i, j, *v));
+                    .zip(vals)
+                    .map(|((i, j), v)| (i, j, v));
                 Lu::Band(BandLu::factor(self.n_dof(), (*kl, *ku), entries, w)?)
             }
             Solver::Sparse(symbolic) => {
+                let vals: Vec<c64> = vals.collect();
                 let d = SparseColMatRef::new(self.pattern.as_ref(), &vals);
                 Lu::Sparse(Box::new(
                     SparseLu::try_new_with_symbolic(symbolic.clone(), d)

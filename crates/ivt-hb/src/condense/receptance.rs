@@ -335,15 +335,17 @@ fn harmonic(
             structure.solve_transpose(&factored, wt.as_mut());
             wt
         };
-        let mut du = Mat::<c64>::zeros(n, s + 1);
-        structure.apply_derivative(w, u.as_ref(), du.as_mut());
-        let mut z = du.clone();
-        // Past the load's harmonic the load column is zero.
+        // Past the load's harmonic the load column is zero, and so are its
+        // products.
         let columns = if loaded { s + 1 } else { s };
+        let mut du = Mat::<c64>::zeros(n, s + 1);
+        structure.apply_derivative(w, u.subcols(0, columns), du.subcols_mut(0, columns));
+        let mut z = du.clone();
         structure.solve_plain(&factored, z.subcols_mut(0, columns));
         let mut second = Mat::<c64>::zeros(n, s + 1);
-        structure.apply_derivative(w, z.as_ref(), second.as_mut());
-        structure.add_mass(u.as_ref(), second.as_mut());
+        let (z_used, u_used) = (z.subcols(0, columns), u.subcols(0, columns));
+        structure.apply_derivative(w, z_used, second.subcols_mut(0, columns));
+        structure.add_mass(u_used, second.subcols_mut(0, columns));
         let split = |prod: Mat<c64>, scale: f64| {
             let scaled = Mat::<c64>::from_fn(s, s + 1, |i, j| prod[(i, j)] * scale);
             (

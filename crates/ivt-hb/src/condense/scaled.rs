@@ -102,4 +102,10 @@ impl<P: PeriodicProblem> Branch for Scaled<'_, P> {
         Branch::residual_lambda(self.branch, &self.q, omega_f, h * w, out);
         out.iter_mut().for_each(|v| *v *= w / self.q_scale);
     }
+    /// `∂J̃/∂λ̃ = ω_s ∂J/∂ω_f` (the branch's own, exact in the receptances).
+    fn bilinear_lambda(&mut self, q: &[f64], lambda: f64, h: f64, w: &[f64], v: &[f64]) -> f64 {
+        self.load(q);
+        let (ws, omega_f) = (self.w_scale, self.omega(lambda));
+        ws * Branch::bilinear_lambda(self.branch, &self.q, omega_f, h * ws, w, v)
+    }
 }
