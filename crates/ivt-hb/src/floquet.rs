@@ -12,7 +12,7 @@
 //! [`crate::HbError::NonFiniteMultipliers`].
 
 use faer::c64;
-use ivt_num::small::matmul;
+use ivt_num::small::{matmul, matmul_n};
 
 /// Quadrature rule of one Hsu sub-interval.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -80,6 +80,17 @@ macro_rules! by_size {
         }
     };
 }
+pub(crate) use by_size;
+
+/// `c = a·b` of `dim×dim` matrices with the size `N` known at compile time
+/// ([`matmul_n`]), or read from `dim` for `N = 0` ([`matmul`]).
+fn product<const N: usize>(a: &[f64], b: &[f64], dim: usize, c: &mut [f64]) {
+    if N == 0 {
+        matmul(a, b, dim, c);
+    } else {
+        matmul_n::<N>(a, b, c);
+    }
+}
 
 /// `out = exp(a)` for a small dense row-major `dim×dim` matrix: scaling and
 /// squaring to `‖a/2^s‖₁ ≤ 1/4` and the degree-12 Taylor polynomial evaluated
@@ -126,9 +137,9 @@ fn expm_sized<const N: usize>(a: &[f64], dim: usize, out: &mut [f64], scratch: &
     let (a3, rest) = rest.split_at_mut(d2);
     let (a4, tmp) = rest.split_at_mut(d2);
     a1.iter_mut().zip(a).for_each(|(x, y)| *x = y * scale);
-    matmul(a1, a1, dim, a2);
-    matmul(a2, a1, dim, a3);
-    matmul(a2, a2, dim, a4);
+    product::<N>(a1, a1, dim, a2);
+    product::<N>(a2, a1, dim, a3);
+    product::<N>(a2, a2, dim, a4);
     let [c0, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, c11, c12] = EXPM_TAYLOR;
     // B_i = c[4i] I + c[4i+1] A + c[4i+2] A² + c[4i+3] A³ (B₂ adds c[12] A⁴).
     let block = |[ci, ci1, ci2, ci3]: [f64; 4], a4_coeff: Option<f64>, b: &mut [f64]| {
@@ -143,14 +154,14 @@ fn expm_sized<const N: usize>(a: &[f64], dim: usize, out: &mut [f64], scratch: &
     };
     // out = B₂; tmp = A⁴ B₂ + B₁; out = A⁴ tmp + B₀.
     block([c8, c9, c10, c11], Some(c12), out);
-    matmul(a4, out, dim, tmp);
+    product::<N>(a4, out, dim, tmp);
     block([c4, c5, c6, c7], None, out);
     tmp.iter_mut().zip(out.iter()).for_each(|(t, b)| *t += b);
-    matmul(a4, tmp, dim, out);
+    product::<N>(a4, tmp, dim, out);
     block([c0, c1, c2, c3], None, tmp);
     out.iter_mut().zip(tmp.iter()).for_each(|(o, b)| *o += b);
     for _ in 0..s {
-        matmul(out, out, dim, tmp);
+        product::<N>(out, out, dim, tmp);
         out.copy_from_slice(tmp);
     }
 }
@@ -254,11 +265,13 @@ fn monodromy_sized<const N: usize>(grid: ThetaGrid<'_>, rule: HsuRule, q: &mut [
     let steps = samples / (2 * stride);
     debug_assert!(theta.len() >= samples * d2 && steps * 2 * stride == samples);
     let h = period / steps as f64;
-    let mut omega = vec![0.0; d2];
-    let mut step = vec![0.0; d2];
-    let mut prod = vec![0.0; d2];
-    let mut comm = vec![0.0; dim];
-    let mut scratch = vec![0.0; expm_scratch_len(dim)];
+    // One buffer cut into slices of the exact lengths (known at compile time
+    // for N ≥ 1, so that the loops below unroll).
+    let mut work = vec![0.0; 3 * d2 + dim + expm_scratch_len(dim)];
+    let (omega, rest) = work.split_at_mut(d2);
+    let (step, rest) = rest.split_at_mut(d2);
+    let (prod, rest) = rest.split_at_mut(d2);
+    let (comm, scratch) = rest.split_at_mut(dim);
     let Some(q) = q.get_mut(..d2) else {
         return q.fill(f64::NAN);
     };
@@ -296,13 +309,13 @@ fn monodromy_sized<const N: usize>(grid: ThetaGrid<'_>, rule: HsuRule, q: &mut [
             }
         }
         if dim == 2 {
-            expm2(&omega, &mut step);
+            expm2(omega, step);
         } else {
-            expm_sized::<N>(&omega, dim, &mut step, &mut scratch);
+            expm_sized::<N>(omega, dim, step, scratch);
         }
         // Later sub-intervals multiply from the left.
-        matmul(&step, q, dim, &mut prod);
-        q.copy_from_slice(&prod);
+        product::<N>(step, q, dim, prod);
+        q.copy_from_slice(prod);
     }
 }
 

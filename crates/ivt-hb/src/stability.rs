@@ -194,42 +194,16 @@ impl StabilityAnalyzer {
             self.theta.fill(f64::NAN);
             return &self.theta;
         }
-        // Lower rows [−M⁻¹(K + G_x)/ω² | −M⁻¹(C + G_v)/ω], one entry at a time
-        // from the columns of K + G_x and C + G_v (no allocation per sample).
-        for (dg, th) in self
-            .dg
-            .chunks_exact(2 * n2)
-            .zip(self.theta.chunks_exact_mut(d2))
-        {
-            let (dgx, dgv) = dg.split_at(n2);
-            th.fill(0.0);
-            let (upper, lower) = th.split_at_mut(nd * dim);
-            // Upper rows [0 | I].
-            for (row, one) in upper.chunks_exact_mut(dim).zip(nd..) {
-                if let Some(x) = row.get_mut(one) {
-                    *x = 1.0;
-                }
-            }
-            for (row, minv_row) in lower.chunks_exact_mut(dim).zip(self.minv.chunks_exact(nd)) {
-                let (row_k, row_c) = row.split_at_mut(nd);
-                for (e, (tk, tc)) in row_k.iter_mut().zip(row_c.iter_mut()).enumerate() {
-                    let column = |a: &[f64], b: &[f64]| -> f64 {
-                        minv_row
-                            .iter()
-                            .zip(
-                                a.iter()
-                                    .skip(e)
-                                    .step_by(nd)
-                                    .zip(b.iter().skip(e).step_by(nd)),
-                            )
-                            .map(|(m, (x, y))| m * (x + y))
-                            .sum()
-                    };
-                    *tk = -column(k, dgx) / (omega * omega);
-                    *tc = -column(c, dgv) / omega;
-                }
-            }
-        }
+        let matrices = SystemMatrices {
+            minv: &self.minv,
+            k,
+            c,
+            omega,
+        };
+        crate::floquet::by_size!(
+            nd,
+            theta_from_tangents(nd, matrices, &self.dg, &mut self.theta)
+        );
         &self.theta
     }
 
@@ -491,6 +465,65 @@ fn level_mut<'a, P: PeriodicProblem>(
     levels
         .get_mut(level)
         .ok_or_else(|| HbError::InvalidInput(format!("no Hsu level {level}")))
+}
+
+/// The matrices of Θ's lower rows besides the `∂g` samples: M⁻¹ and K, C
+/// (row-major `n×n`) and ω.
+#[derive(Clone, Copy)]
+struct SystemMatrices<'a> {
+    minv: &'a [f64],
+    k: &'a [f64],
+    c: &'a [f64],
+    omega: f64,
+}
+
+/// Θ's samples (Eq. 80's system matrix, row-major `2n×2n` each) from the
+/// `[∂g/∂x | ∂g/∂v]` samples `dg`: upper rows `[0 | I]`, lower rows
+/// `[−M⁻¹(K + G_x)/ω² | −M⁻¹(C + G_v)/ω]` accumulated row by row, with the
+/// DOF count `N = n` known at compile time (every loop unrolled) or read
+/// from `nd` for `N = 0`. Slices shorter than their sizes give NaN.
+fn theta_from_tangents<const N: usize>(
+    nd: usize,
+    matrices: SystemMatrices<'_>,
+    dg: &[f64],
+    theta: &mut [f64],
+) {
+    let nd = if N == 0 { nd } else { N };
+    let (n2, dim) = (nd * nd, 2 * nd);
+    let SystemMatrices { minv, k, c, omega } = matrices;
+    let (Some(minv), Some(k), Some(c), true) = (minv.get(..n2), k.get(..n2), c.get(..n2), nd > 0)
+    else {
+        return theta.fill(f64::NAN);
+    };
+    for (dg, th) in dg
+        .chunks_exact(2 * n2)
+        .zip(theta.chunks_exact_mut(dim * dim))
+    {
+        let (dgx, dgv) = dg.split_at(n2);
+        th.fill(0.0);
+        let (upper, lower) = th.split_at_mut(nd * dim);
+        for (row, one) in upper.chunks_exact_mut(dim).zip(nd..) {
+            if let Some(x) = row.get_mut(one) {
+                *x = 1.0;
+            }
+        }
+        // Row i: Σ_l (M⁻¹)_il (K + G_x)_l·, the rows l of K and G_x contiguous.
+        for (row, minv_row) in lower.chunks_exact_mut(dim).zip(minv.chunks_exact(nd)) {
+            let (row_k, row_c) = row.split_at_mut(nd);
+            let rows_l = k.chunks_exact(nd).zip(dgx.chunks_exact(nd));
+            let rows_l = rows_l.zip(c.chunks_exact(nd).zip(dgv.chunks_exact(nd)));
+            for (&m, ((k_l, gx_l), (c_l, gv_l))) in minv_row.iter().zip(rows_l) {
+                for (t, (a, b)) in row_k.iter_mut().zip(k_l.iter().zip(gx_l)) {
+                    *t += m * (a + b);
+                }
+                for (t, (a, b)) in row_c.iter_mut().zip(c_l.iter().zip(gv_l)) {
+                    *t += m * (a + b);
+                }
+            }
+            row_k.iter_mut().for_each(|t| *t = -*t / (omega * omega));
+            row_c.iter_mut().for_each(|t| *t = -*t / omega);
+        }
+    }
 }
 
 /// Richardson estimate of the error of the multipliers `fine` of `S` Magnus-4

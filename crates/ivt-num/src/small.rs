@@ -30,14 +30,14 @@ pub fn matmul(a: &[f64], b: &[f64], dim: usize, c: &mut [f64]) {
         return;
     };
     match dim {
-        1 => matmul_fixed::<1>(a, b, c),
-        2 => matmul_fixed::<2>(a, b, c),
-        3 => matmul_fixed::<3>(a, b, c),
-        4 => matmul_fixed::<4>(a, b, c),
-        5 => matmul_fixed::<5>(a, b, c),
-        6 => matmul_fixed::<6>(a, b, c),
-        7 => matmul_fixed::<7>(a, b, c),
-        8 => matmul_fixed::<8>(a, b, c),
+        1 => matmul_n::<1>(a, b, c),
+        2 => matmul_n::<2>(a, b, c),
+        3 => matmul_n::<3>(a, b, c),
+        4 => matmul_n::<4>(a, b, c),
+        5 => matmul_n::<5>(a, b, c),
+        6 => matmul_n::<6>(a, b, c),
+        7 => matmul_n::<7>(a, b, c),
+        8 => matmul_n::<8>(a, b, c),
         _ => {
             let at = DMatrixView::from_slice(a, dim, dim);
             let bt = DMatrixView::from_slice(b, dim, dim);
@@ -46,12 +46,19 @@ pub fn matmul(a: &[f64], b: &[f64], dim: usize, c: &mut [f64]) {
     }
 }
 
-/// [`matmul`] for a compile-time size `N` on slices of `N²` entries.
-fn matmul_fixed<const N: usize>(a: &[f64], b: &[f64], c: &mut [f64]) {
-    // Re-sliced to the compile-time length N², so that the loops below unroll
-    // (`matmul` has checked the lengths; a short slice is left untouched).
-    let (Some(a), Some(b), Some(c)) = (a.get(..N * N), b.get(..N * N), c.get_mut(..N * N)) else {
-        return;
+/// [`matmul`] for a compile-time size `N ≥ 1` on slices of `N²` entries,
+/// for callers that know `N` (the Floquet steps of `2·n_dof ≤ 8` states call
+/// it without [`matmul`]'s dispatch on the size).
+///
+/// # Errors
+/// As [`matmul`]: a slice shorter than `N²` fills `c` with NaN.
+pub fn matmul_n<const N: usize>(a: &[f64], b: &[f64], c: &mut [f64]) {
+    // Re-sliced to the compile-time length N², so that the loops below unroll.
+    let (Some(a), Some(b)) = (a.get(..N * N), b.get(..N * N)) else {
+        return c.fill(f64::NAN);
+    };
+    let Some(c) = c.get_mut(..N * N) else {
+        return c.fill(f64::NAN);
     };
     for (ci, ai) in c.chunks_exact_mut(N).zip(a.chunks_exact(N)) {
         ci.fill(0.0);

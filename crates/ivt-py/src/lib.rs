@@ -24,6 +24,7 @@ mod ctrl_convert;
 mod design;
 mod error_slot;
 mod fields;
+mod flat_floats;
 mod gears;
 mod hb;
 mod hb_analyses;

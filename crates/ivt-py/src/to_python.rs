@@ -4,7 +4,9 @@
 //! [`ivt_hb::jobs::Array`] a numpy array. Floats stay floats (NaN included,
 //! which JSON would turn into null).
 
+use crate::flat_floats::flat_floats;
 use ivt_hb::jobs::ARRAY_NAME;
+use numpy::IntoPyArray;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
@@ -164,13 +166,19 @@ impl<'py> ser::Serializer for Ser<'py> {
     ) -> Res<'py> {
         self.serialize_str(variant)
     }
-    /// An [`ivt_hb::jobs::Array`] becomes `numpy.asarray(list)`; any other
-    /// newtype is its content.
+    /// An [`ivt_hb::jobs::Array`] becomes a numpy array (of `f64` straight
+    /// from its numbers, [`crate::flat_floats`]; otherwise
+    /// `numpy.asarray(list)`); any other newtype is its content.
     fn serialize_newtype_struct<T: Serialize + ?Sized>(
         self,
         name: &'static str,
         v: &T,
     ) -> Res<'py> {
+        if name == ARRAY_NAME {
+            if let Some(floats) = flat_floats(v) {
+                return Ok(floats.into_pyarray(self.py).into_any());
+            }
+        }
         let inner = v.serialize(self)?;
         if name == ARRAY_NAME {
             let np = self.py.import("numpy")?;
