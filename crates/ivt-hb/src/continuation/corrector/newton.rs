@@ -11,12 +11,12 @@ use std::convert::Infallible;
 
 use super::chord::Chord;
 use super::{Corrected, Correction, DirectionError, Found, PathCorrector, Prediction, Retry};
-use crate::branch::{path_lambda_step, Branch};
+use crate::branch::{full_newton_steps, path_lambda_step, Branch};
 use crate::broyden::SolveError;
 use crate::continuation::ContinuationOptions;
 use crate::error::HbError;
 use ivt_num::vector::norm2;
-use ivt_num::{newton, BorderedLu, NewtonOptions, NewtonSystem, NewtonWorkspace, StepCheck};
+use ivt_num::{newton, BorderedLu, NewtonSystem, NewtonWorkspace, StepCheck};
 
 /// Corrector iterations counted as this many chord iterations per full Newton
 /// step (a Newton step assembles and factors the Jacobian).
@@ -138,13 +138,7 @@ impl NewtonCorrector {
         branch: &mut B,
         pred: &Prediction<'_>,
     ) -> Result<usize, SolveError> {
-        let nopts = NewtonOptions {
-            ftol: self.tol,
-            max_iter: self.max_newton,
-            max_halvings: 0,
-            accept_no_descent: true,
-            ..NewtonOptions::default()
-        };
+        let nopts = full_newton_steps(self.tol, self.max_newton);
         let mut corrected = ExactNewton {
             branch,
             jac: &mut self.jac,
