@@ -2,12 +2,14 @@
 //! pseudo-arclength continuation (Eq. 68–77, [`NewtonCorrector`]) of
 //! [`CondensedBranch`] in ω_f, each fold located as the points arrive by
 //! Newton on the extended system ([`crate::locate_fold`]) of the condensed
-//! Jacobian, any DOF recovered per
+//! Jacobian, each amplitude peak located between the points (`peak.rs`),
+//! any DOF recovered per
 //! point, and per point the estimated errors of the linear solves and of the
 //! harmonic truncation.
 
 use super::branch::CondensedBranch;
 use super::estimate::truncation_error;
+use super::peak::{locate_peak, peaks, Sample};
 use super::scaled::Scaled;
 use super::stability::{
     BasisGrowth, CondensedFloquet, ReducedStability, DEFAULT_BASIS_TOL, DEFAULT_BLOCKS,
@@ -37,7 +39,8 @@ pub struct CondensedFrcOptions {
     /// of the nonlinear DOFs' linear response at `from`.
     pub continuation: ContinuationOptions,
     /// Corrector tolerance (on the receptance-form residual, a displacement)
-    /// relative to the linear response ‖u_S‖₂ at the start.
+    /// relative to the larger of the linear response ‖u_S‖₂ at the start and
+    /// the point's own ‖q‖₂ (`condense/scaled.rs`).
     pub rtol: f64,
     /// DOF whose max |x_j(τ)| is the amplitude (default: the first nonlinear DOF).
     pub amplitude_dof: Option<usize>,
@@ -210,6 +213,20 @@ pub fn condensed_response<P: PeriodicProblem>(
         }
     })?;
     drop(stepper);
+    let inserted = if failed.is_none() {
+        let mut peak_probe = PeakProbe {
+            scaled: &mut scaled,
+            copts: &copts,
+            probe: &mut probe,
+            truncation: opts.truncation_estimate,
+            stability: stability.as_mut(),
+        };
+        peak_probe.insert_peaks(&mut points)?
+    } else {
+        Vec::new()
+    };
+    // A path point's index among `points` after the insertions.
+    let shifted = |j: usize| j + inserted.iter().filter(|&&p| p <= j).count();
     let branch = scaled.branch;
     if let Some(e) = failed.or_else(|| branch.take_failure().filter(|_| points.is_empty())) {
         return Err(e);
@@ -221,7 +238,7 @@ pub fn condensed_response<P: PeriodicProblem>(
                 let coeffs: Vec<f64> = located.q.iter().map(|v| v * q_scale).collect();
                 let omega_f = opts.from + located.lambda * width;
                 CondensedFold {
-                    index: event.index,
+                    index: shifted(event.index),
                     omega_f,
                     amplitude: probe.amplitude(branch, &coeffs, omega_f)?,
                     coeffs,
@@ -233,9 +250,10 @@ pub fn condensed_response<P: PeriodicProblem>(
             // point's orbit.
             Err(_) => {
                 let turn = path.folds.iter().find(|t| t.index == event.index);
-                match (points.get(event.index), turn) {
+                let index = shifted(event.index);
+                match (points.get(index), turn) {
                     (Some(near), Some(turn)) => CondensedFold {
-                        index: event.index,
+                        index,
                         omega_f: opts.from + turn.lambda * width,
                         amplitude: near.amplitude,
                         coeffs: near.coeffs.clone(),
@@ -252,6 +270,83 @@ pub fn condensed_response<P: PeriodicProblem>(
         folds,
         termination: path.termination,
     })
+}
+
+/// What locating a peak between the points of a curve needs.
+struct PeakProbe<'s, 'b, P: PeriodicProblem> {
+    scaled: &'s mut Scaled<'b, P>,
+    copts: &'s ContinuationOptions,
+    probe: &'s mut Probe,
+    truncation: bool,
+    stability: Option<&'s mut ReducedStability>,
+}
+
+impl<P: PeriodicProblem> PeakProbe<'_, '_, P> {
+    /// Locates each amplitude peak of `points` ([`peaks`], [`locate_peak`]:
+    /// orbits corrected at fixed ω_f to the curve's tolerance) and inserts
+    /// it as a point of its own between its neighbours; returns the insert
+    /// positions, increasing, in the indices of the points before.
+    ///
+    /// # Errors
+    /// As [`Probe::point`] for a located peak.
+    fn insert_peaks(&mut self, points: &mut Vec<CondensedPoint>) -> Result<Vec<usize>, HbError> {
+        let curve: Vec<(f64, f64)> = points.iter().map(|p| (p.omega_f, p.amplitude)).collect();
+        let mut inserted = Vec::new();
+        for i in peaks(&curve).into_iter().rev() {
+            let sample = |p: &CondensedPoint| Sample {
+                omega_f: p.omega_f,
+                amplitude: p.amplitude,
+                q: p.coeffs.clone(),
+            };
+            let Some(mut bracket) = points
+                .get(i.saturating_sub(1)..=i + 1)
+                .map(|w| w.iter().map(sample).collect::<Vec<_>>())
+            else {
+                continue;
+            };
+            bracket.sort_by(|a, b| a.omega_f.total_cmp(&b.omega_f));
+            let Ok(bracket) = <[Sample; 3]>::try_from(bracket) else {
+                continue;
+            };
+            let Some(peak) = locate_peak(bracket, |guess, w| self.corrected(&guess, w)) else {
+                continue;
+            };
+            let point = self.probe.point(
+                self.scaled.branch,
+                &peak.q,
+                peak.omega_f,
+                self.truncation,
+                self.stability.as_deref_mut(),
+            )?;
+            // After point i when between it and point i + 1 in ω_f.
+            let after = points.get(i..=i + 1).is_some_and(|w| match w {
+                [a, b] => (peak.omega_f - a.omega_f) * (peak.omega_f - b.omega_f) < 0.0,
+                _ => false,
+            });
+            let at = if after { i + 1 } else { i };
+            points.insert(at, point);
+            inserted.push(at);
+        }
+        inserted.reverse();
+        Ok(inserted)
+    }
+
+    /// The orbit at ω_f corrected from `guess` (Newton at fixed ω_f on the
+    /// scaled branch) with its amplitude.
+    fn corrected(&mut self, guess: &[f64], omega_f: f64) -> Result<Sample, HbError> {
+        let mut x = self.scaled.scaled(guess, omega_f);
+        correct_at_fixed_lambda(self.scaled, &mut x, self.copts)?;
+        let Some((&lambda, u)) = x.split_last() else {
+            return Err(HbError::InvalidInput("empty condensed point".into()));
+        };
+        let (q, omega_f) = self.scaled.physical(u, lambda);
+        let amplitude = self.probe.amplitude(self.scaled.branch, &q, omega_f)?;
+        Ok(Sample {
+            omega_f,
+            amplitude,
+            q,
+        })
+    }
 }
 
 /// Corrects the condensed unknowns `q` at fixed ω_f by Newton on the exact

@@ -30,6 +30,7 @@ pub mod dynamic;
 mod estimate;
 mod frc;
 mod modal_hsu;
+mod peak;
 mod receptance;
 mod ritz;
 mod scaled;
