@@ -256,7 +256,8 @@ an array F (F cos θ) or a pair (F_cos, F_sin) of load vectors; with
 the linear DOFs decouple exactly; sparse LU of the dynamic stiffness with
 refinement in double-double residuals) and `g(x, v, theta)` sees x, v of those
 DOFs only. Defaults there: n = 7, samples = 32, rtol = 1e-12 (on the
-receptance-form residual, relative to the linear response). Each point then
+receptance-form residual, relative to the larger of the start's linear
+response and the point's own size). Each point then
 carries "solve_error" (the refined solves'), "orbit_error" (the orbit's error
 from the corrector residual and the refined solves), "data_error" (the first-order effect of storing M and C in
 double precision), "truncation_error" and "error_estimate" (orbit_error +
