@@ -363,11 +363,11 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
                 }
                 // X_0 = a0/2: the identity's first entry is ½.
                 let diagonal = match (identity, h) {
-                    (false, _) => Vec::new(),
-                    (true, 0) => vec![(ra, 0.5)],
-                    (true, _) => vec![(ra, 1.0), (rb, 1.0)],
+                    (false, _) => [None, None],
+                    (true, 0) => [Some((ra, 0.5)), None],
+                    (true, _) => [Some((ra, 1.0)), Some((rb, 1.0))],
                 };
-                for (r, v) in diagonal {
+                for (r, v) in diagonal.into_iter().flatten() {
                     if let Some(e) = jac.get_mut(r * m + r) {
                         *e += v;
                     }

@@ -205,18 +205,18 @@ fn outside_part(
     mass_basis: &[Vec<f64>],
 ) -> Result<f64, HbError> {
     let n = structure.n_dof();
-    let mut product = vec![0.0; n];
+    let mut mw = vec![0.0; n];
     let mut worst = 0.0f64;
     for part in [Part::Mass, Part::Damping] {
         let images: Vec<Vec<f64>> = basis
             .iter()
             .map(|v| {
-                structure.times(part, v, &mut product);
-                product.clone()
+                let mut image = vec![0.0; n];
+                structure.times(part, v, &mut image);
+                image
             })
             .collect();
         for mut w in static_solve(structure, factored, &images)? {
-            let mut mw = vec![0.0; n];
             structure.times(Part::Mass, &w, &mut mw);
             let before = dot(&w, &mw).sqrt();
             orthogonalize(basis, mass_basis, &mut w);
