@@ -171,7 +171,7 @@ fn duffing(ctx: &mut Context) -> Result<(), ReproError> {
                 })
                 .collect();
             let folds: Vec<String> = frc
-                .folds
+                .events
                 .iter()
                 .map(|f| format!("{:.4}", f.omega_f))
                 .collect();

@@ -145,7 +145,7 @@ where
     let copts = bounded(opts, (lo, hi));
     let path = follow_curve(&mut sys, &x0, p_from, &copts)?;
     let cusps = path
-        .folds
+        .events
         .iter()
         .filter_map(|f| locate_cusp(&mut sys, &path, f.bracket, &copts))
         .collect();
@@ -184,7 +184,7 @@ fn locate_cusp<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
         !stop
     })
     .ok()?;
-    let fold = local.folds.first()?;
+    let fold = local.events.first()?;
     let mut x = local.points.get(fold.index)?.x.clone();
     if let Some(last) = x.last_mut() {
         *last = fold.lambda;

@@ -180,15 +180,21 @@ impl serde::Serialize for Termination {
     }
 }
 
-/// A traced curve: its points and folds in path order and why tracing
-/// stopped. The stepper's [`Path`] holds the raw states; [`crate::Frc`] and
-/// [`crate::condense::CondensedFrc`] hold the same curve read as orbits.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Traced<P, F> {
+/// The one result of a traced curve: its points and events in path order
+/// and why tracing stopped. The stepper's [`Path`] holds the raw states;
+/// [`crate::Frc`] and [`crate::condense::CondensedFrc`] hold the same curve
+/// read as orbits; [`crate::Trace`] holds the orbits with their multipliers
+/// and every event detected. Serializes (where its point and event types do)
+/// with [`Termination`] as its snake_case word.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Traced<P, E> {
     /// Points in path order.
     pub points: Vec<P>,
-    /// Folds (turning points in λ) in path order.
-    pub folds: Vec<F>,
+    /// Events in path order: for [`Path`], [`crate::Frc`] and
+    /// [`crate::condense::CondensedFrc`] the folds (turning points in λ),
+    /// the one event their stepper detects; for [`crate::Trace`] every
+    /// event detected, each with its location or why locating it failed.
+    pub events: Vec<E>,
     /// Why tracing stopped.
     pub termination: Termination,
 }

@@ -113,7 +113,8 @@ pub struct FrcFold {
     pub located: bool,
 }
 
-/// A traced frequency-response curve (folds: turning points in ω_f).
+/// A traced frequency-response curve (its events: the folds, turning points
+/// in ω_f).
 pub type Frc = Traced<FrcPoint, FrcFold>;
 
 /// Traces the frequency-response curve of `problem` from `opts.from` to `opts.to`.
@@ -165,7 +166,7 @@ pub fn frequency_response<P: PeriodicProblem>(
     // A fold that could not be located keeps the parabola's ω_f through the
     // three points around its turn (the stepper's estimate).
     let estimate = |index: usize| {
-        path.folds
+        path.events
             .iter()
             .find(|t| t.index == index)
             .map(|t| t.lambda)
@@ -217,7 +218,7 @@ impl Frc {
             .collect();
         Ok(Self {
             points,
-            folds,
+            events: folds,
             termination: trace.termination.clone(),
         })
     }

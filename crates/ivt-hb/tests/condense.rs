@@ -67,8 +67,8 @@ fn all_dofs<P: PeriodicProblem>(
 fn against_uncondensed(n: usize, full_rtol: f64, coeff_tol: f64, residual_tol: f64) {
     let hb = HbOptions::new(7, 32).with_tolerances(1e-12, 0.0);
     let (frc, mut branch) = curve(n, &hb);
-    assert_eq!(frc.folds.len(), 2, "the hardening peak turns twice");
-    assert!(frc.folds.iter().all(|f| f.located));
+    assert_eq!(frc.events.len(), 2, "the hardening peak turns twice");
+    assert!(frc.events.iter().all(|f| f.located));
     let (full, _) = full_beam(n);
     let mut classic = ClassicIhb::new(&full, hb.clone().with_tolerances(full_rtol, 0.0)).unwrap();
     let mut residual = ivt_hb::HbResidual::new(&full, &hb).unwrap();
@@ -97,8 +97,8 @@ fn against_uncondensed(n: usize, full_rtol: f64, coeff_tol: f64, residual_tol: f
         "N = {n}: full residual {worst_r:e}"
     );
     // Each fold located again on the full extended system.
-    let mut family = FamilyBranch::new(Frequency(&full), &hb, frc.folds[0].omega_f).unwrap();
-    for fold in &frc.folds {
+    let mut family = FamilyBranch::new(Frequency(&full), &hb, frc.events[0].omega_f).unwrap();
+    for fold in &frc.events {
         let q = all_dofs(&mut branch, &fold.coeffs, fold.omega_f);
         let located = locate_fold(&mut family, &q, fold.omega_f, &LocateOptions::fold()).unwrap();
         let rel = (located.lambda - fold.omega_f).abs() / fold.omega_f;
@@ -163,7 +163,7 @@ fn condensed_orbits_solve_the_ode_by_rk4_at_n_4() {
     let hb = HbOptions::new(11, 48).with_tolerances(1e-13, 0.0);
     let (frc, mut branch) = curve(4, &hb);
     let (full, _) = full_beam(4);
-    let (first, second) = (frc.folds[0].index, frc.folds[1].index);
+    let (first, second) = (frc.events[0].index, frc.events[1].index);
     let stable = frc
         .points
         .iter()
@@ -304,7 +304,7 @@ fn bladed_disk_curve_solves_the_uncondensed_equations() {
         ..CondensedFrcOptions::default()
     };
     let frc = condensed_response(&mut branch, &opts).unwrap();
-    println!("{} points, {} folds", frc.points.len(), frc.folds.len());
+    println!("{} points, {} folds", frc.points.len(), frc.events.len());
     assert_eq!(frc.termination, ivt_hb::Termination::LeftInterval);
     assert!(frc.points.len() < 400, "{} points", frc.points.len());
     assert!(frc.points.iter().all(|p| p.floquet.is_some()));

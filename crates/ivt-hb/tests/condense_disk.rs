@@ -74,7 +74,7 @@ fn disk_multipliers_equal_the_full_structures_within_their_estimate() {
         (3 * n) / 4,
         n - 1,
     ];
-    for fold in &frc.folds {
+    for fold in &frc.events {
         picks.extend([fold.index.saturating_sub(1), fold.index + 1]);
     }
     picks.sort_unstable();
@@ -148,6 +148,6 @@ fn disk_multipliers_equal_the_full_structures_within_their_estimate() {
     }
     println!(
         "{} folds; worst distance / estimate {worst_ratio}",
-        frc.folds.len()
+        frc.events.len()
     );
 }

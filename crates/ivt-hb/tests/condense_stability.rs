@@ -104,7 +104,7 @@ fn reduced_multipliers_equal_the_full_systems_within_their_estimate() {
         ..defaults
     };
     let frc = condensed_response(&mut branch, &opts).unwrap();
-    let (first, second) = (frc.folds[0].index, frc.folds[1].index);
+    let (first, second) = (frc.events[0].index, frc.events[1].index);
     // Stability changes exactly at the folds: stable before the first and
     // after the second, one multiplier beyond +1 between.
     for (i, p) in frc.points.iter().enumerate() {

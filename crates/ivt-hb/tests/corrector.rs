@@ -28,10 +28,10 @@ fn curve(corrector: Corrector, second_order: bool) -> (Vec<f64>, f64, f64) {
         ..defaults
     };
     let frc = frequency_response(&p, &HbOptions::new(20, 84), &opts).unwrap();
-    assert!(frc.folds.iter().all(|f| f.located), "{corrector:?}");
+    assert!(frc.events.iter().all(|f| f.located), "{corrector:?}");
     let n = frc.points.len() as f64;
     (
-        frc.folds.iter().map(|f| f.omega_f).collect(),
+        frc.events.iter().map(|f| f.omega_f).collect(),
         p.g_calls.get() as f64 / n,
         p.jacobian_calls.get() as f64 / n,
     )

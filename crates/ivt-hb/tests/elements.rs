@@ -22,9 +22,9 @@ fn friction_damper_frc_matches_time_integration() {
     };
     let frc = frequency_response(&p, &hb, &opts).unwrap();
     assert!(
-        frc.points.len() > 10 && frc.folds.is_empty(),
+        frc.points.len() > 10 && frc.events.is_empty(),
         "{:?}",
-        frc.folds
+        frc.events
     );
     // Friction bounds the resonance: the peak amplitude is finite and the
     // damped linear response 0.2/0.01 = 20 is far away.

@@ -29,7 +29,7 @@ fn duffing_fold_curve_through_the_cusp_matches_shooting() {
     let hb = HbOptions::new(15, 64);
     let frc = common::frc_between(&Duffing::new(0.02, 1.0, 1.0, 0.1), &hb, 0.5, 2.5);
     let start = frc
-        .folds
+        .events
         .iter()
         .max_by(|a, b| a.omega_f.total_cmp(&b.omega_f))
         .unwrap();

@@ -119,13 +119,13 @@ fn duffing_folds_located_to_shooting_accuracy_in_both_directions() {
     let hb = HbOptions::new(20, 64);
     let up = frequency_response(&d, &hb, &FrcOptions::default()).unwrap();
     let down = common::frc_between(&d, &hb, 3.0, 0.2);
-    assert_eq!(up.folds.len(), 2, "{:?}", up.folds);
-    assert_eq!(down.folds.len(), 2, "{:?}", down.folds);
+    assert_eq!(up.events.len(), 2, "{:?}", up.events);
+    assert_eq!(down.events.len(), 2, "{:?}", down.events);
     let mut analyzer = StabilityAnalyzer::new(&d, 20, 4096).unwrap();
-    for (k, (want, fold)) in [1.6548121, 1.1687244].iter().zip(&up.folds).enumerate() {
+    for (k, (want, fold)) in [1.6548121, 1.1687244].iter().zip(&up.events).enumerate() {
         assert!(fold.located, "{fold:?}");
         // The same fold from the other direction (it is met in reverse order).
-        let back = &down.folds[1 - k];
+        let back = &down.events[1 - k];
         assert!(back.located, "{back:?}");
         assert!(
             (fold.omega_f - back.omega_f).abs() < 1e-10,
@@ -176,7 +176,7 @@ fn duffing_frc_through_both_folds_with_flags_switching_at_them() {
     eprintln!(
         "{} points, folds {:?}, termination {:?}",
         pts.len(),
-        frc.folds,
+        frc.events,
         frc.termination
     );
     assert!(
@@ -184,9 +184,9 @@ fn duffing_frc_through_both_folds_with_flags_switching_at_them() {
         "reached {}",
         pts.last().unwrap().omega_f
     );
-    assert_eq!(frc.folds.len(), 2, "{:?}", frc.folds);
+    assert_eq!(frc.events.len(), 2, "{:?}", frc.events);
     // Upper fold (peak) first, then the lower (jump-up) fold at smaller ω_f.
-    let (f1, f2) = (&frc.folds[0], &frc.folds[1]);
+    let (f1, f2) = (&frc.events[0], &frc.events[1]);
     assert!(f1.omega_f > f2.omega_f);
     // First-harmonic estimate: the backbone ω² = α + (3/4) ε a² meets the damping
     // limit a = F/(2ξω) at ω ≈ 1.655, a ≈ 1.51.
@@ -226,7 +226,7 @@ fn duffing_frc_through_both_folds_with_flags_switching_at_them() {
     // it lies ahead of the fold along the chord of its two neighbours. Points
     // whose reference multiplier is within MULTIPLIER_TOL of 1 sit on a fold to
     // the accuracy of Hsu's method and are not classified.
-    assert!(f1.located && f2.located, "{:?}", frc.folds);
+    assert!(f1.located && f2.located, "{:?}", frc.events);
     let past = |i: usize, f: &FrcFold| -> bool {
         if i != f.index {
             return i > f.index;
@@ -256,7 +256,7 @@ fn duffing_frc_through_both_folds_with_flags_switching_at_them() {
             "point {i} at ω_f = {}: {:?}, folds {:?}",
             p.omega_f,
             p.multipliers,
-            frc.folds
+            frc.events
                 .iter()
                 .map(|f| (f.index, f.omega_f))
                 .collect::<Vec<_>>()
@@ -304,11 +304,11 @@ fn chain_2dof_folds_are_located_with_a_finite_difference_jacobian() {
     let frc = frequency_response(&chain, &HbOptions::new(15, 64), &opts).unwrap();
     eprintln!(
         "chain folds: {:?}",
-        frc.folds
+        frc.events
             .iter()
             .map(|f| (f.omega_f, f.located))
             .collect::<Vec<_>>()
     );
-    assert_eq!(frc.folds.len(), 2);
-    assert!(frc.folds.iter().all(|f| f.located));
+    assert_eq!(frc.events.len(), 2);
+    assert!(frc.events.iter().all(|f| f.located));
 }

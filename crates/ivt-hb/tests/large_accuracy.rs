@@ -242,10 +242,10 @@ fn curve(n_elements: usize, harmonics: usize) -> CondensedFrc {
 /// truncation, its estimate 1.7e-8).
 fn against_reference(n_elements: usize, harmonics: usize, tol: f64) {
     let frc = curve(n_elements, harmonics);
-    assert_eq!(frc.folds.len(), 2);
+    assert_eq!(frc.events.len(), 2);
     let mut reference = Reference::new(n_elements);
     let len = frc.points.len();
-    let near_fold = |i: usize| frc.folds.iter().any(|f| i.abs_diff(f.index) < 3);
+    let near_fold = |i: usize| frc.events.iter().any(|f| i.abs_diff(f.index) < 3);
     let mut worst = 0.0f64;
     for i in (0..len).step_by(len / 8).filter(|&i| !near_fold(i)) {
         let p = &frc.points[i];
@@ -265,7 +265,7 @@ fn against_reference(n_elements: usize, harmonics: usize, tol: f64) {
         );
         worst = worst.max(err);
     }
-    for fold in &frc.folds {
+    for fold in &frc.events {
         let v0 = to_reference(&fold.coeffs, harmonics);
         let phi0 = v0[REF_HARMONICS + 1].atan2(v0[1]);
         let (omega, amp) = reference.fold(v0, fold.omega_f, phi0);

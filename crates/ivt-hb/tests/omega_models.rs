@@ -75,9 +75,9 @@ fn rotating_unbalance_folds_match_shooting() {
     let mut sweep = FrcOptions::default();
     (sweep.from, sweep.to) = (0.5, 2.5);
     let frc = frequency_response(&problem, &hb, &sweep).unwrap();
-    assert!(frc.folds.iter().all(|f| f.located));
+    assert!(frc.events.iter().all(|f| f.located));
     let folds: Vec<_> = frc
-        .folds
+        .events
         .iter()
         .map(|f| (f.omega_f, f.coeffs.clone()))
         .collect();

@@ -206,9 +206,9 @@ fn kd30_folds_are_located_by_the_bordered_system() {
     let mut hb = StringHb::new(p.clone()).unwrap();
     let frc = frequency_response(&mut hb, 1.0, 6.0, &opts).unwrap();
     let path = trace(&mut hb, 1.0, 6.0, &opts.continuation).unwrap();
-    assert_eq!(frc.frc.folds.len(), 2, "Fig. 35 has two folds");
-    assert_eq!(path.folds.len(), 2);
-    for (f, turn) in frc.frc.folds.iter().zip(&path.folds) {
+    assert_eq!(frc.frc.events.len(), 2, "Fig. 35 has two folds");
+    assert_eq!(path.events.len(), 2);
+    for (f, turn) in frc.frc.events.iter().zip(&path.events) {
         assert!(f.located, "fold near ω = {} not located", turn.lambda);
         // The parabola through the points around the turn is accurate to the step.
         let moved = (f.omega_f - turn.lambda).abs();

@@ -64,7 +64,7 @@ fn regenerate() {
             )
             .unwrap();
         }
-        for f in &frc.frc.folds {
+        for f in &frc.frc.events {
             writeln!(text, "fold {:?} {:?} {}", f.omega_f, f.amplitude, f.located).unwrap();
         }
     }
@@ -143,8 +143,8 @@ fn curves_equal_the_pre_issue_28_solver() {
         }
         assert_eq!(kinds_checked, r.points.len());
         // Folds: the same count, located to 1e-10.
-        assert_eq!(frc.frc.folds.len(), r.folds.len(), "{:?}", r.case);
-        for (f, (omega, norm)) in frc.frc.folds.iter().zip(&r.folds) {
+        assert_eq!(frc.frc.events.len(), r.folds.len(), "{:?}", r.case);
+        for (f, (omega, norm)) in frc.frc.events.iter().zip(&r.folds) {
             assert!(f.located);
             let (dw, dn) = (
                 (f.omega_f - omega).abs() / omega,

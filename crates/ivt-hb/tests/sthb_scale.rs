@@ -78,7 +78,7 @@ fn scaling() {
             "{{\"modes\": {modes}, \"harmonics\": {harmonics}, \"unknowns\": {}, \"points\": {points}, \"jacobians\": {}, \"folds\": {}, \"wall_s\": {wall:.4}, \"cpu_s\": {cpu:.3}}}",
             hb.dim(),
             curve.jacobians,
-            curve.frc.folds.len()
+            curve.frc.events.len()
         );
     }
 }
@@ -128,8 +128,8 @@ fn twenty_modes_thirty_nine_harmonics_whole_curve_with_stability() {
         let norm = r.iter().map(|x| x * x).sum::<f64>().sqrt();
         assert!(norm <= 1.5e-10 * 1.01, "ω = {}: ‖R‖ = {norm:e}", p.omega_f);
     }
-    assert!(!frc.folds.is_empty());
-    for f in &frc.folds {
+    assert!(!frc.events.is_empty());
+    for f in &frc.events {
         assert!(f.located, "fold near ω = {}", f.omega_f);
         hb.residual(&f.coeffs, f.omega_f, &mut r);
         assert!(r.iter().map(|x| x * x).sum::<f64>().sqrt() <= 1e-8);

@@ -63,7 +63,7 @@ fn near_the_folds() {
     let d = Duffing::fig28();
     let hb = HbOptions::new(20, 64);
     let frc = frequency_response(&d, &hb, &FrcOptions::default()).unwrap();
-    for f in &frc.folds {
+    for f in &frc.events {
         let p = &frc.points[f.index];
         let mut solver = ModifiedIhb::new(d.clone(), hb.clone()).unwrap();
         let sol = solver.solve(p.omega_f, Some(&p.coeffs)).unwrap();

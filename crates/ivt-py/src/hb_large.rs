@@ -170,7 +170,7 @@ fn frc_dict<'py>(py: Python<'py>, frc: &CondensedFrc) -> PyResult<Bound<'py, PyD
         points.append(point_dict(py, p)?)?;
     }
     let folds = PyList::empty(py);
-    for f in &frc.folds {
+    for f in &frc.events {
         let e = PyDict::new(py);
         e.set_item("omega", f.omega_f)?;
         e.set_item("amplitude", f.amplitude)?;

@@ -108,7 +108,7 @@ where
     x0.extend([mu, nu_start]);
     let path = follow_curve(&mut sys, &x0, nu_from, &bounded(opts, (lo, hi)))?;
     let cusps = path
-        .folds
+        .events
         .iter()
         .filter_map(|f| {
             let mut point = sys.point(&path.points.get(f.index)?.x)?;

@@ -119,7 +119,7 @@ pub struct CondensedPoint {
 /// the condensed unknowns (harmonics of the nonlinear DOFs).
 pub type CondensedFold = FrcFold;
 
-/// A traced condensed curve.
+/// A traced condensed curve (its events: the folds, turning points in ω_f).
 pub type CondensedFrc = Traced<CondensedPoint, CondensedFold>;
 
 /// Traces the frequency response of `branch` from `opts.from` to `opts.to`.
@@ -249,7 +249,7 @@ pub fn condensed_response<P: PeriodicProblem>(
             // around the turn (the stepper's estimate) and the nearest
             // point's orbit.
             Err(_) => {
-                let turn = path.folds.iter().find(|t| t.index == event.index);
+                let turn = path.events.iter().find(|t| t.index == event.index);
                 let index = shifted(event.index);
                 match (points.get(index), turn) {
                     (Some(near), Some(turn)) => CondensedFold {
@@ -267,7 +267,7 @@ pub fn condensed_response<P: PeriodicProblem>(
     }
     Ok(CondensedFrc {
         points,
-        folds,
+        events: folds,
         termination: path.termination,
     })
 }

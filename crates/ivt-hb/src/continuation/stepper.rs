@@ -161,7 +161,7 @@ impl<'b, B: Branch> Stepper<'b, B> {
         };
         Path {
             points,
-            folds,
+            events: folds,
             termination,
         }
     }

@@ -1,5 +1,6 @@
 //! The stepper on the unit circle `u² + λ² = 1` (folds at λ = ±1) with
-//! both correctors: the folds, and the landing on a bound.
+//! both correctors: the folds, the landing on a bound, and the traced
+//! result's JSON.
 
 use super::*;
 use crate::branch::{Branch, ResidualBranch};
@@ -49,16 +50,16 @@ fn broyden_traces_a_circle_through_both_folds() {
             assert!((p.x[0] * p.x[0] + p.x[1] * p.x[1] - 1.0).abs() < 1e-9);
             n < 150
         });
-    assert!(path.folds.len() >= 2, "{:?}", path.folds);
+    assert!(path.events.len() >= 2, "{:?}", path.events);
     assert!(
-        (path.folds[0].lambda - 1.0).abs() < 1e-3,
+        (path.events[0].lambda - 1.0).abs() < 1e-3,
         "{:?}",
-        path.folds
+        path.events
     );
     assert!(
-        (path.folds[1].lambda + 1.0).abs() < 1e-3,
+        (path.events[1].lambda + 1.0).abs() < 1e-3,
         "{:?}",
-        path.folds
+        path.events
     );
 }
 
@@ -122,12 +123,12 @@ fn newton_traces_a_circle_over_its_fold_onto_the_bound() {
         });
     assert_eq!(path.termination, Termination::LeftInterval);
     assert_eq!(path.points.last().unwrap().lambda(), -0.99);
-    assert_eq!(path.folds.len(), 1, "{:?}", path.folds);
+    assert_eq!(path.events.len(), 1, "{:?}", path.events);
     // The parabola through three points 0.1 apart on the unit circle.
     assert!(
-        (path.folds[0].lambda - 1.0).abs() < 1e-3,
+        (path.events[0].lambda - 1.0).abs() < 1e-3,
         "{:?}",
-        path.folds
+        path.events
     );
 }
 
@@ -157,4 +158,45 @@ fn next_repeats_its_stop_and_the_residual_branch_differences_its_jacobian() {
     let mut jac = [0.0];
     circle_residual().jacobian(&[-0.6], 0.8, &mut jac);
     assert!((jac[0] + 1.2).abs() < 1e-6, "{jac:?}");
+}
+
+/// A traced result serializes as `points`, `events` and `termination` (the
+/// snake_case word, SPEC §6): the circle's path over its fold at λ = 1 onto
+/// the bound λ = −0.99, read as its λ values and its fold's λ.
+#[test]
+fn a_traced_curve_serializes_its_points_events_and_termination_word() {
+    let opts = ContinuationOptions {
+        ds: 0.05,
+        ds_max: 0.1,
+        lambda_min: -0.99,
+        lambda_max: 2.0,
+        ..Default::default()
+    };
+    let corrector = Box::new(NewtonCorrector::new(1, &opts));
+    let path = Stepper::new(&mut Circle, corrector, &[-0.6, 0.8], 0, 1.0, &opts)
+        .unwrap()
+        .run(|_, _| true);
+    let read = Traced {
+        points: path
+            .points
+            .iter()
+            .map(PathPoint::lambda)
+            .collect::<Vec<_>>(),
+        events: path.events.iter().map(|f| f.lambda).collect::<Vec<_>>(),
+        termination: path.termination,
+    };
+    let v = serde_json::to_value(&read).unwrap();
+    let mut keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
+    keys.sort_unstable();
+    assert_eq!(keys, ["events", "points", "termination"]);
+    assert_eq!(v["termination"], "left_interval");
+    assert_eq!(v["points"].as_array().unwrap().len(), read.points.len());
+    assert_eq!(v["points"][0], 0.8);
+    assert_eq!(v["points"][read.points.len() - 1], -0.99);
+    let events = v["events"].as_array().unwrap();
+    assert_eq!(events.len(), 1, "{events:?}");
+    assert!(
+        (events[0].as_f64().unwrap() - 1.0).abs() < 1e-3,
+        "{events:?}"
+    );
 }

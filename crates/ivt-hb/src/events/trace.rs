@@ -13,7 +13,7 @@ use super::multipliers::{Multipliers, PointMultipliers};
 use super::neimark_sacker::NeimarkSacker;
 use super::period_doubling::PeriodDoubling;
 use crate::branch::Branch;
-use crate::continuation::{ContinuationOptions, Path, PathPoint, Stepper, Termination};
+use crate::continuation::{ContinuationOptions, Path, PathPoint, Stepper, Traced};
 use crate::family::{Family, FamilyBranch};
 use crate::ihb::HbError;
 use crate::stability::{AdaptiveHsu, HsuSteps};
@@ -53,16 +53,9 @@ impl Default for TraceOptions {
     }
 }
 
-/// A traced branch.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Trace {
-    /// Points in path order.
-    pub points: Vec<TracedPoint>,
-    /// Events in path order (by start point, then kind).
-    pub events: Vec<Event>,
-    /// Why the path stopped.
-    pub termination: Termination,
-}
+/// A traced branch: its points with their multipliers and every located
+/// event, in path order (by start point, then kind).
+pub type Trace = Traced<TracedPoint, Event>;
 
 /// The observer of a path on a branch `B`: the multipliers of each point
 /// (optional: [`EventObserver::new`] and [`EventObserver::with_detectors`]
@@ -296,6 +289,7 @@ pub fn trace<F: Family>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::continuation::Termination;
     use crate::family::Frequency;
     use crate::frc::FrcOptions;
     use crate::ihb::HbOptions;
@@ -368,7 +362,7 @@ mod tests {
                     opts.path.continuation.max_points = last + 1;
                     let cut = crate::frequency_response(&d, &hb, &opts).unwrap();
                     assert_eq!(cut.points.len(), last + 1);
-                    let Some(fold) = cut.folds.last().filter(|f| f.index == last) else {
+                    let Some(fold) = cut.events.last().filter(|f| f.index == last) else {
                         continue;
                     };
                     reached += 1;

@@ -302,7 +302,7 @@ where
             ..FrcOptions::default()
         };
         frequency_response(&problem, hb, &opts)?
-            .folds
+            .events
             .into_iter()
             .filter(|f| f.located)
             .map(|f| (f.omega_f, f.coeffs))

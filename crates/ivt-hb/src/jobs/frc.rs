@@ -164,7 +164,7 @@ pub fn frc<P: PeriodicProblem>(
         return traced_curve(&mut branch, &start.coeffs, opts, t0);
     }
     let curve = frequency_response(problem, hb, opts)?;
-    let events = curve.folds.iter().map(|f| fold_event(f, &curve)).collect();
+    let events = curve.events.iter().map(|f| fold_event(f, &curve)).collect();
     assemble(curve, events, opts.path.stability, t0)
 }
 
@@ -221,7 +221,7 @@ fn assemble(
     }
     Ok(FrcCurve {
         points: curve.points.iter().map(point).collect(),
-        folds: curve.folds.iter().map(fold).collect(),
+        folds: curve.events.iter().map(fold).collect(),
         bifurcations: events,
         omega: curve.points.iter().map(|p| p.omega_f).collect(),
         amplitude: curve.points.iter().map(|p| p.amplitude).collect(),

@@ -317,7 +317,7 @@ pub fn frequency_response(
                 Err(_) => FrcFold {
                     index: e.index,
                     omega_f: path
-                        .folds
+                        .events
                         .iter()
                         .find(|f| f.index == e.index)
                         .map_or(near.omega_f, |f| f.lambda),
@@ -331,7 +331,7 @@ pub fn frequency_response(
     Ok(StringFrc {
         frc: Frc {
             points,
-            folds,
+            events: folds,
             termination: path.termination,
         },
         methods,
