@@ -102,8 +102,10 @@ fn a_long_step_lands_on_the_bound_and_never_leaves_the_interval() {
     }
 }
 
-#[test]
-fn newton_traces_a_circle_over_its_fold_onto_the_bound() {
+/// The circle by the Newton corrector from (u, λ) = (−0.6, 0.8) upwards:
+/// over the fold at λ = 1 and back down to the bound λ = −0.99, where the
+/// path must end exactly; every point on the circle to 1e-10.
+fn newton_circle_over_its_fold() -> Path {
     let opts = ContinuationOptions {
         ds: 0.05,
         ds_max: 0.1,
@@ -112,15 +114,18 @@ fn newton_traces_a_circle_over_its_fold_onto_the_bound() {
         lambda_max: 2.0,
         ..Default::default()
     };
-    // From (u, λ) = (−0.6, 0.8) upwards: over the fold at λ = 1 and back down
-    // to the bound λ = −0.99, where the path must end exactly.
     let corrector = Box::new(NewtonCorrector::new(1, &opts));
-    let path = Stepper::new(&mut Circle, corrector, &[-0.6, 0.8], 0, 1.0, &opts)
+    Stepper::new(&mut Circle, corrector, &[-0.6, 0.8], 0, 1.0, &opts)
         .unwrap()
         .run(|_, p| {
             assert!((p.x[0] * p.x[0] + p.x[1] * p.x[1] - 1.0).abs() <= 1e-10);
             true
-        });
+        })
+}
+
+#[test]
+fn newton_traces_a_circle_over_its_fold_onto_the_bound() {
+    let path = newton_circle_over_its_fold();
     assert_eq!(path.termination, Termination::LeftInterval);
     assert_eq!(path.points.last().unwrap().lambda(), -0.99);
     assert_eq!(path.events.len(), 1, "{:?}", path.events);
@@ -165,17 +170,7 @@ fn next_repeats_its_stop_and_the_residual_branch_differences_its_jacobian() {
 /// the bound λ = −0.99, read as its λ values and its fold's λ.
 #[test]
 fn a_traced_curve_serializes_its_points_events_and_termination_word() {
-    let opts = ContinuationOptions {
-        ds: 0.05,
-        ds_max: 0.1,
-        lambda_min: -0.99,
-        lambda_max: 2.0,
-        ..Default::default()
-    };
-    let corrector = Box::new(NewtonCorrector::new(1, &opts));
-    let path = Stepper::new(&mut Circle, corrector, &[-0.6, 0.8], 0, 1.0, &opts)
-        .unwrap()
-        .run(|_, _| true);
+    let path = newton_circle_over_its_fold();
     let read = Traced {
         points: path
             .points
