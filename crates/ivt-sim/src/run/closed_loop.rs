@@ -191,7 +191,10 @@ impl<'s> ClosedLoop<'s> {
         self.integ.t
     }
 
-    /// Stage 1: the slow readings, when one is due.
+    /// Stage 1: the slow readings, when one is due. Inlined into the loop
+    /// of [`super::Simulation::run`], its one caller, like
+    /// [`Self::on_pulse`]: a call per pulse is measurable in a scene.
+    #[inline]
     pub(super) fn read_sensors(&mut self, sink: &mut dyn FnMut(Sample)) -> Result<(), SimError> {
         if self.integ.t < self.next_sensor {
             return Ok(());
@@ -342,6 +345,7 @@ impl<'s> ClosedLoop<'s> {
     }
 
     /// Stages 3–5 for the pulse the plant just reached.
+    #[inline]
     pub(super) fn on_pulse(&mut self, sink: &mut dyn FnMut(Sample)) -> Result<(), SimError> {
         let p = self.encoder_pulse();
         let commanded = self.control(&p, sink)?;
