@@ -53,8 +53,9 @@ impl Default for TraceOptions {
     }
 }
 
-/// A traced branch: its points with their multipliers and every located
-/// event, in path order (by start point, then kind).
+/// A traced branch: its points with their multipliers and every detected
+/// event, each with its location or why locating it failed, in path order
+/// (by start point, then kind).
 pub type Trace = Traced<TracedPoint, Event>;
 
 /// The observer of a path on a branch `B`: the multipliers of each point
