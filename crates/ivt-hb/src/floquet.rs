@@ -62,9 +62,9 @@ const EXPM_TAYLOR: [f64; 13] = [
 ];
 
 /// Calls `$f::<N>(args)` with the compile-time size `N = $dim` for sizes
-/// 1–8 (the state sizes `2·n_dof` of systems up to 4 DOF: every loop over
-/// the size is then unrolled and free of bounds checks), `N = 0` (the size
-/// read at run time) beyond.
+/// 1–8 (here the state sizes `2·n_dof` of systems up to 4 DOF, in
+/// `stability.rs` the DOF count: every loop over the size is then unrolled
+/// and free of bounds checks), `N = 0` (the size read at run time) beyond.
 macro_rules! by_size {
     ($dim:expr, $f:ident($($arg:expr),* $(,)?)) => {
         match $dim {

@@ -351,7 +351,8 @@ impl<P: PeriodicProblem> PeakProbe<'_, '_, P> {
 
 /// Corrects the condensed unknowns `q` at fixed ω_f by Newton on the exact
 /// condensed Jacobian until the residual (a displacement) is within `rtol`
-/// of the linear response ‖u_S‖₂ at ω_f; returns the steps taken.
+/// of the larger of the linear response ‖u_S‖₂ at ω_f and ‖q‖₂
+/// (`condense/scaled.rs`); returns the steps taken.
 ///
 /// # Errors
 /// As [`crate::continuation::correct_at_fixed_lambda`]; [`HbError::Singular`]
