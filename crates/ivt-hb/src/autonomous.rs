@@ -15,7 +15,7 @@
 //! Eq. 68–77) on `[R(q, ω; μ); b₁] = 0` with unknowns `{q, ω, μ}`.
 
 use crate::broyden::{BroydenStats, SolveError};
-use crate::continuation::{follow_residual, ContinuationOptions, PathPoint, Termination};
+use crate::continuation::{follow_residual, ContinuationOptions, Fold, PathPoint, Traced};
 use crate::floquet::HsuRule;
 use crate::galerkin::GalerkinJacobian;
 use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
@@ -50,14 +50,11 @@ impl LimitCycle {
     }
 }
 
-/// A limit-cycle branch traced in a parameter.
-#[derive(Debug, Clone, PartialEq)]
-pub struct LimitCycleBranch {
-    /// `(μ, cycle)` in path order.
-    pub points: Vec<(f64, LimitCycle)>,
-    /// Why tracing stopped.
-    pub termination: Termination,
-}
+/// A limit-cycle branch traced in a parameter: `(μ, cycle)` in path order;
+/// its events are the stepper's turning points in μ ([`Fold`]: estimated
+/// from the three points around each, not located; [`crate::cycle_branch()`]
+/// locates them).
+pub type LimitCycleBranch = Traced<(f64, LimitCycle), Fold>;
 
 /// Follows the limit cycle `start` of `family(mu_from)` in μ up to `mu_to`
 /// (pseudo-arclength, `opts`; its λ bounds are set from `mu_from`/`mu_to`),
@@ -67,7 +64,7 @@ pub struct LimitCycleBranch {
 /// # Errors
 /// [`HbError::InvalidInput`] for sizes or bounds, [`HbError::ContinuationStart`]
 /// when the start does not converge; trouble later on ends the branch with a
-/// [`Termination`].
+/// [`crate::continuation::Termination`].
 pub fn limit_cycle_branch<P, F>(
     family: F,
     hb: &HbOptions,
@@ -157,6 +154,7 @@ where
     }
     Ok(LimitCycleBranch {
         points,
+        events: path.events,
         termination: path.termination,
     })
 }

@@ -14,8 +14,8 @@
 
 use crate::branch::Branch;
 use crate::continuation::{
-    correct_at_fixed_lambda, BroydenCorrector, ContinuationOptions, Corrector, NewtonCorrector,
-    Stepper, Termination,
+    correct_at_fixed_lambda, BroydenCorrector, ContinuationOptions, Corrector, Fold,
+    NewtonCorrector, Stepper, Traced,
 };
 use crate::family::{FamilyBranch, Frequency};
 use crate::ihb::{HbError, HbOptions, HbResidual};
@@ -65,14 +65,10 @@ pub struct BackbonePoint {
     pub kappa: f64,
 }
 
-/// A traced backbone curve.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Backbone {
-    /// Points in path order.
-    pub points: Vec<BackbonePoint>,
-    /// Why tracing stopped.
-    pub termination: Termination,
-}
+/// A traced backbone curve; its events are the stepper's turning points in
+/// the amplitude `a₁` ([`Fold`]: estimated from the three points around
+/// each, not located).
+pub type Backbone = Traced<BackbonePoint, Fold>;
 
 /// Traces the backbone of the mode with linear frequency `omega0` and shape
 /// `mode` (`n_dof` entries, `K mode = ω₀² M mode`) from `opts.amplitude_from`
@@ -181,21 +177,25 @@ pub(crate) fn modal_path<P: PeriodicProblem>(
             Stepper::new(&mut system, corrector, &x0, its, direction, &copts)?.run(|_, _| true)
         }
     };
+    // One point per path point, so that the events' indices stay valid.
     let points = path
         .points
         .iter()
-        .filter_map(|p| match p.x.split_at_checked(m) {
-            Some((q, &[omega, kappa, amplitude])) => Some(BackbonePoint {
+        .map(|p| match p.x.split_at_checked(m) {
+            Some((q, &[omega, kappa, amplitude])) => Ok(BackbonePoint {
                 amplitude,
                 omega,
                 coeffs: q.to_vec(),
                 kappa,
             }),
-            _ => None,
+            _ => Err(HbError::InvalidInput(
+                "backbone: point of the wrong size".into(),
+            )),
         })
-        .collect();
+        .collect::<Result<_, _>>()?;
     Ok(Backbone {
         points,
+        events: path.events,
         termination: path.termination,
     })
 }

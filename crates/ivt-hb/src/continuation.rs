@@ -184,15 +184,18 @@ impl serde::Serialize for Termination {
 /// and why tracing stopped. The stepper's [`Path`] holds the raw states;
 /// [`crate::Frc`] and [`crate::condense::CondensedFrc`] hold the same curve
 /// read as orbits; [`crate::Trace`] holds the orbits with their multipliers
-/// and every event detected. Serializes (where its point and event types do)
+/// and every event detected; [`crate::Backbone`] and
+/// [`crate::LimitCycleBranch`] the curves in amplitude and in μ. Serializes
+/// (where its point and event types do)
 /// with [`Termination`] as its snake_case word.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Traced<P, E> {
     /// Points in path order.
     pub points: Vec<P>,
-    /// Events in path order: for [`Path`], [`crate::Frc`] and
-    /// [`crate::condense::CondensedFrc`] the folds (turning points in λ),
-    /// the one event their stepper detects; for [`crate::Trace`] every
+    /// Events in path order: for [`Path`], [`crate::Frc`],
+    /// [`crate::condense::CondensedFrc`], [`crate::Backbone`] and
+    /// [`crate::LimitCycleBranch`] the folds (turning points in λ), the one
+    /// event their stepper detects; for [`crate::Trace`] every
     /// event detected, each with its location or why locating it failed.
     pub events: Vec<E>,
     /// Why tracing stopped.

@@ -43,6 +43,8 @@ fn closed_form_within(corrector: Corrector) {
         "{:?}",
         bb.termination
     );
+    // a₁ is the path parameter and grows along the whole curve: no turn.
+    assert!(bb.events.is_empty(), "{:?}", bb.events);
     let mut worst = 0.0f64;
     for p in &bb.points {
         // x(0) is the turning point (b₁ = 0 and the orbit is even in t).

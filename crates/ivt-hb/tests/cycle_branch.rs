@@ -5,10 +5,11 @@
 //! solves `y(T; x₀, μ) = (x₀, 0)`; a fold of cycles adds
 //! `det ∂(y(T) − y₀)/∂(x₀, T) = 0`; the non-trivial multiplier is
 //! `det ∂y(T)/∂y₀` (the other is 1).
-#![allow(clippy::indexing_slicing)]
+#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 use ivt_hb::{
-    cycle_branch, CycleBranchOptions, GeneralProblem, HbError, HbOptions, PeriodicProblem,
+    cycle_branch, limit_cycle_branch, ContinuationOptions, CycleBranch, CycleBranchOptions,
+    GeneralProblem, HbError, HbOptions, PeriodicProblem, Termination,
 };
 
 mod common;
@@ -58,14 +59,21 @@ fn multiplier(mu: f64, x0: f64, period: f64) -> f64 {
     j[0][0] * j[1][1] - j[0][1] * j[1][0]
 }
 
-#[test]
-fn subcritical_hopf_cycle_branch_and_fold_match_time_integration() {
+/// The cycle branch of `family` over −0.2 ≤ μ ≤ 0.1 (n = 25), with the
+/// cycles at μ = −0.1, and its HB options.
+fn branch_over_the_hopf_point() -> (HbOptions, CycleBranch) {
     let hb = HbOptions::new(25, 128);
     let opts = CycleBranchOptions {
         at: vec![-0.1],
         ..CycleBranchOptions::default()
     };
     let branch = cycle_branch(family, &hb, -0.2, 0.1, &opts).unwrap();
+    (hb, branch)
+}
+
+#[test]
+fn subcritical_hopf_cycle_branch_and_fold_match_time_integration() {
+    let (_, branch) = branch_over_the_hopf_point();
     assert_eq!(branch.hopf.len(), 1);
     let hopf = &branch.hopf[0];
     assert!(
@@ -123,4 +131,49 @@ fn subcritical_hopf_cycle_branch_and_fold_match_time_integration() {
         .filter(|w| w[0].1.stable() != w[1].1.stable())
         .count();
     assert_eq!(changes, 1);
+}
+
+/// `limit_cycle_branch` from the small cycle at μ = −0.1 towards −0.2 turns
+/// at the fold of cycles and comes back on the large cycles: its one event is
+/// that turn, estimated by the stepper from a parabola through the three
+/// points around it. The fold that `cycle_branch` locates (checked against
+/// shooting above) lies beyond those points in μ, and the estimate is nearer
+/// to it than the nearest of them.
+#[test]
+fn limit_cycle_branch_reports_its_turn_at_the_fold_of_cycles() {
+    let (hb, located) = branch_over_the_hopf_point();
+    let mu_fold = located.folds[0].0;
+    let small = located
+        .at
+        .iter()
+        .map(|(_, c)| c)
+        .min_by(|a, b| a.solution.amplitude(0).total_cmp(&b.solution.amplitude(0)))
+        .unwrap();
+    let path = ContinuationOptions {
+        ds: 0.01,
+        ..ContinuationOptions::default()
+    };
+    let family = |mu: f64| family(mu).unwrap();
+    let branch = limit_cycle_branch(family, &hb, small, -0.1, -0.2, &path, 512).unwrap();
+    assert_eq!(branch.termination, Termination::LeftInterval);
+    assert_eq!(branch.events.len(), 1, "{:?}", branch.events);
+    let turn = &branch.events[0];
+    let mus: Vec<f64> = branch.points[turn.bracket..turn.bracket + 3]
+        .iter()
+        .map(|(mu, _)| *mu)
+        .collect();
+    let lo = mus.iter().copied().fold(f64::INFINITY, f64::min);
+    eprintln!(
+        "turn μ = {:.10} (nearest point {lo:.10}), located {mu_fold:.10}, |Δ| {:.1e}",
+        turn.lambda,
+        (turn.lambda - mu_fold).abs()
+    );
+    assert!(mu_fold < lo, "{mus:?} vs {mu_fold}");
+    assert!(
+        (turn.lambda - mu_fold).abs() < lo - mu_fold,
+        "{} vs {mu_fold} ({mus:?})",
+        turn.lambda
+    );
+    // The turn's point is a stability change: small cycles unstable, large stable.
+    assert!(!branch.points[0].1.stable() && branch.points.last().unwrap().1.stable());
 }

@@ -123,6 +123,8 @@ fn van_der_pol_branch_in_mu_matches_shooting_at_every_point() {
     let branch = limit_cycle_branch(van_der_pol, &hb, &start, 0.2, 1.0, &opts, 512).unwrap();
     assert_eq!(branch.termination, Termination::LeftInterval);
     assert!(branch.points.len() >= 5, "{} points", branch.points.len());
+    // μ grows along the whole branch: no turning point.
+    assert!(branch.events.is_empty(), "{:?}", branch.events);
     let mut last_period = 0.0;
     for (mu, lc) in &branch.points {
         let t_ref = shooting_period(*mu, 20_000);
