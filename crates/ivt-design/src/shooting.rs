@@ -18,7 +18,7 @@ use super::{averaged_r, check_plant, IvtError, OperatingPoint};
 use core::f64::consts::PI;
 use ivt_kin::plant::PlantParams;
 use ivt_kin::variant::f_on_segment;
-use ivt_num::{newton, NewtonError, NewtonOptions, NewtonSystem, NewtonWorkspace};
+use ivt_num::{newton, NewtonOptions, NewtonSystem, NewtonWorkspace, SolveError};
 
 /// Accuracy and iteration limits of the shooting route.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -378,7 +378,7 @@ fn solve(
     let mut ws = NewtonWorkspace::new(x.len());
     match newton(map, x, &mut ws, &nopts) {
         Ok(_) => Ok(()),
-        Err(NewtonError::Eval(e)) => Err(e),
+        Err(SolveError::Eval(e)) => Err(e),
         Err(e) => Err(IvtError::NoConvergence {
             method,
             iterations: e.history().len().saturating_sub(1),

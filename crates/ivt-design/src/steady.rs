@@ -13,7 +13,7 @@
 //! The 2n+1 balanced residuals are zeroed in the 2n+1 unknowns `x_p = {r, q_p}`.
 //!
 //! Solver: Broyden's update (Eq. 156–157, [`IhbMethod::Broyden`], default)
-//! through [`ivt_hb::broyden`], seeded on a cold start by the exact Jacobian of
+//! through [`ivt_num::broyden`], seeded on a cold start by the exact Jacobian of
 //! the sampled residual and along a sweep by the previous point's matrix; or
 //! Newton with that exact Jacobian at every step ([`IhbMethod::Newton`], the
 //! classic IHB of §3.2.1). The projection is a direct sum over cos/sin tables
@@ -31,9 +31,9 @@ mod residual;
 use super::{averaged_r, check_plant, IvtError, OperatingPoint, Verdict};
 use core::f64::consts::PI;
 use gauss::gauss_legendre;
-use ivt_hb::broyden::{broyden_solve, BroydenOptions, BroydenWorkspace};
 use ivt_kin::plant::PlantParams;
-use ivt_num::{newton, NewtonError, NewtonOptions, NewtonWorkspace};
+use ivt_num::broyden::{broyden_solve, BroydenOptions, BroydenWorkspace};
+use ivt_num::{newton, NewtonOptions, NewtonWorkspace, SolveError};
 use nalgebra::{DMatrix, DVector};
 use residual::{theta1_of, BalancedResidual};
 
@@ -60,7 +60,7 @@ pub struct IhbOptions {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum IhbMethod {
     /// Broyden's update, Eq. 156–157 (the thesis's modified IHB), via
-    /// [`ivt_hb::broyden::broyden_solve`]: the exact Jacobian seeds it on a cold
+    /// [`ivt_num::broyden_solve`]: the exact Jacobian seeds it on a cold
     /// start, and along a sweep the matrix left by the previous point seeds
     /// the next, so most points need no Jacobian at all.
     #[default]
@@ -308,7 +308,7 @@ impl IhbSolver {
             newton(sys, x, &mut ws, &nopts)
                 .map(|s| (s.iterations, s.residual_norm))
                 .map_err(|e| match e {
-                    NewtonError::SingularJacobian { history, .. } => {
+                    SolveError::SingularJacobian { history, .. } => {
                         ("modified IHB (singular Jacobian)", history)
                     }
                     e => ("modified IHB (Newton)", e.history().to_vec()),

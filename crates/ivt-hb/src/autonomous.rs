@@ -14,7 +14,6 @@
 //! problems by the engine's pseudo-arclength continuation ([`crate::continuation::Stepper`],
 //! Eq. 68–77) on `[R(q, ω; μ); b₁] = 0` with unknowns `{q, ω, μ}`.
 
-use crate::broyden::{BroydenStats, SolveError};
 use crate::continuation::{follow_residual, ContinuationOptions, Fold, PathPoint, Traced};
 use crate::floquet::HsuRule;
 use crate::galerkin::GalerkinJacobian;
@@ -22,6 +21,7 @@ use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
 use crate::stability::{classify, StabilityAnalyzer, StabilityKind};
 use faer::c64;
+use ivt_num::BroydenStats;
 use ivt_num::{newton_bordered, Border, NewtonOptions, NewtonSystem, NewtonWorkspace, StepCheck};
 
 /// A converged limit cycle.
@@ -243,6 +243,7 @@ pub fn limit_cycle<P: PeriodicProblem>(
     let border = Border {
         rows: &phase_row,
         values: &[0.0],
+        origin: &[],
     };
     let nopts = NewtonOptions {
         ftol: 0.0,
@@ -253,7 +254,7 @@ pub fn limit_cycle<P: PeriodicProblem>(
     };
     let mut ws = NewtonWorkspace::bordered(m + 1, 1);
     let stats = newton_bordered(&mut system, border, &mut x, &mut ws, &nopts)
-        .map_err(|e| SolveError::from_newton(e).map_or_else(|e| e, HbError::Solve))?;
+        .map_err(|e| e.infallible().map_or_else(|e| e, HbError::Solve))?;
     let omega = x.pop().unwrap_or(omega_guess);
     let q = x;
     let stats = BroydenStats {

@@ -3,12 +3,12 @@
 //! ([`crate::galerkin`]; plus an LU per iteration) — the baseline the modified IHB is timed
 //! against (thesis: 0.25 s vs 0.003 s).
 
-use crate::broyden::{BroydenStats, SolveError};
 use crate::galerkin::GalerkinJacobian;
 use crate::ihb::{validate_omega, HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
 use ivt_num::vector::matvec;
 use ivt_num::{newton, NewtonOptions, NewtonSystem, NewtonWorkspace};
+use ivt_num::{BroydenStats, SolveError};
 use std::convert::Infallible;
 
 /// Newton–Galerkin solver with reusable buffers.

@@ -8,8 +8,8 @@
 //! cap [`ContinuationOptions::step_cap`], landing on the bounds of λ). A sign
 //! change of the direction's λ component marks a fold (turning point).
 
-use crate::broyden::{BroydenOptions, SolveError};
 use ivt_num::vector::norm2;
+use ivt_num::{BroydenOptions, SolveError};
 
 pub mod corrector;
 mod predictor;

@@ -28,7 +28,11 @@ use crate::stability::{StabilityAnalyzer, StabilityKind};
 use crate::BroydenStats;
 use faer::c64;
 use ivt_num::vector::norm2;
-use ivt_num::LuWorkspace;
+use ivt_num::{
+    deflated_newton, newton, Deflation, LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace,
+    SolveError,
+};
+use std::convert::Infallible;
 
 /// Bounds of the search.
 #[derive(Debug, Clone, PartialEq)]
@@ -186,6 +190,31 @@ struct Deflated<'p, P> {
     omega_f: f64,
     tol: f64,
     opts: SearchOptions,
+    newton: NewtonWorkspace,
+}
+
+/// The HB residual at one frequency with its Galerkin Jacobian (Eq. 56) as
+/// a [`NewtonSystem`].
+struct AtOmega<'a, P> {
+    problem: &'a P,
+    res: &'a mut HbResidual,
+    galerkin: &'a mut GalerkinJacobian,
+    omega_f: f64,
+}
+
+impl<P: PeriodicProblem> NewtonSystem for AtOmega<'_, P> {
+    type Error = Infallible;
+
+    fn residual(&mut self, q: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
+        self.res.eval(self.problem, q, self.omega_f, 1.0, r);
+        Ok(())
+    }
+
+    fn jacobian(&mut self, q: &[f64], jac: &mut [f64]) -> Result<(), Infallible> {
+        self.galerkin
+            .assemble(self.res, self.problem, q, self.omega_f, 1.0, jac);
+        Ok(())
+    }
 }
 
 impl<'p, P: PeriodicProblem> Deflated<'p, P> {
@@ -214,6 +243,7 @@ impl<'p, P: PeriodicProblem> Deflated<'p, P> {
             omega_f,
             tol,
             opts: opts.clone(),
+            newton: NewtonWorkspace::new(m),
         })
     }
 
@@ -278,85 +308,44 @@ impl<'p, P: PeriodicProblem> Deflated<'p, P> {
         norm2(&self.r)
     }
 
-    /// The plain Newton step `−Φ_q⁻¹R(q)` (with `self.r = R(q)`), or `None` if
-    /// Φ_q is singular.
-    fn newton_step(&mut self, q: &[f64]) -> Option<Vec<f64>> {
-        self.galerkin.assemble(
-            &mut self.res,
-            self.problem,
-            q,
-            self.omega_f,
-            1.0,
-            &mut self.jac,
-        );
-        if !self.lu.factor_row_major(&self.jac) {
-            return None;
-        }
-        let mut step: Vec<f64> = self.r.iter().map(|r| -r).collect();
-        self.lu.solve(&mut step);
-        step.iter().all(|s| s.is_finite()).then_some(step)
-    }
-
-    /// `∇ln M(q)` of the deflation by the `known` roots (see the module docs).
-    fn log_gradient(&self, q: &[f64], known: &[Vec<f64>]) -> Vec<f64> {
-        let (p, sigma, s) = (self.opts.power, self.opts.shift, self.opts.max_amplitude);
-        let mut grad = vec![0.0; q.len()];
-        for root in known {
-            let d2: f64 = q.iter().zip(root).map(|(a, b)| ((a - b) / s).powi(2)).sum();
-            let dist = d2.sqrt().max(f64::MIN_POSITIVE);
-            let mp = dist.powf(-p);
-            // ∂/∂q ln(‖d‖⁻ᵖ + σ) = −p‖d‖⁻ᵖ⁻² d/s² / (‖d‖⁻ᵖ + σ).
-            let w = -p * mp / (dist * dist * (mp + sigma) * s * s);
-            for ((g, a), b) in grad.iter_mut().zip(q).zip(root) {
-                *g += w * (a - b);
-            }
-        }
-        grad
-    }
-
-    /// One deflated run from `start`: a new root polished by plain Newton, or
+    /// One deflated run from `start` (at most `max_iter` steps, iterates
+    /// leaving the box abandoned): a new root polished by plain Newton, or
     /// `None` if the run fails within its bounds or only finds a known root.
     fn run(&mut self, start: &[f64], known: &[Vec<f64>]) -> Option<Vec<f64>> {
         let mut q = start.to_vec();
         let box_size = self.opts.max_amplitude;
-        let mut converged = false;
-        for _ in 0..self.opts.max_iter {
-            let norm = self.residual(&q);
-            if !norm.is_finite() {
-                return None;
-            }
-            if norm <= self.tol {
-                converged = true;
-                break;
-            }
-            let step = self.newton_step(&q)?;
-            let grad = self.log_gradient(&q, known);
-            let dot: f64 = grad.iter().zip(&step).map(|(g, s)| g * s).sum();
-            let factor = 1.0 / (1.0 - dot);
-            if !factor.is_finite() {
-                return None;
-            }
-            for (qi, si) in q.iter_mut().zip(&step) {
-                *qi += factor * si;
-            }
-            if q.iter().any(|v| v.abs() > box_size || v.is_nan()) {
-                return None;
-            }
-        }
-        if !converged {
-            return None;
-        }
-        // Polish undeflated: a few plain Newton steps to the root's accuracy.
-        for _ in 0..5 {
-            self.residual(&q);
-            let step = self.newton_step(&q)?;
-            let size = step.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            for (qi, si) in q.iter_mut().zip(&step) {
-                *qi += si;
-            }
-            if size <= 1e-13 * box_size {
-                break;
-            }
+        let mut sys = AtOmega {
+            problem: self.problem,
+            res: &mut self.res,
+            galerkin: &mut self.galerkin,
+            omega_f: self.omega_f,
+        };
+        let deflation = Deflation {
+            roots: known,
+            power: self.opts.power,
+            shift: self.opts.shift,
+            scale: box_size,
+            bound: box_size,
+        };
+        let run = NewtonOptions {
+            ftol: self.tol,
+            max_iter: self.opts.max_iter,
+            ..NewtonOptions::default()
+        };
+        deflated_newton(&mut sys, &mut q, &deflation, &mut self.newton, &run).ok()?;
+        // Polish undeflated: up to five full Newton steps, until a step is
+        // below 1e-13 of the box; the residual is tested after them.
+        let polish = NewtonOptions {
+            ftol: 0.0,
+            atol: 1e-13 * box_size,
+            max_iter: 5,
+            max_halvings: 0,
+            accept_no_descent: true,
+            ..NewtonOptions::default()
+        };
+        match newton(&mut sys, &mut q, &mut self.newton, &polish) {
+            Ok(_) | Err(SolveError::NonConvergence { .. }) => {}
+            Err(_) => return None,
         }
         let norm = self.residual(&q);
         if norm > self.tol || norm.is_nan() {

@@ -2,7 +2,7 @@
 //! ([`SolveError`]) nests in it by `#[from]`, so a failed path or solve keeps its
 //! residual history.
 
-use crate::broyden::SolveError;
+use ivt_num::SolveError;
 use thiserror::Error;
 
 /// Errors of the harmonic-balance engine, its AFT, Hill's method and STHB.

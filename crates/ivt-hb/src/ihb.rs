@@ -13,9 +13,9 @@
 //! NaN output (reported by the solvers as [`HbError::NonFinite`]), not a panic.
 
 use crate::aft::{split_series, split_series_mut, Aft};
-use crate::broyden::{BroydenOptions, BroydenStats};
 pub(crate) use crate::error::HbError;
 use crate::problem::PeriodicProblem;
+use ivt_num::{BroydenOptions, BroydenStats};
 
 /// Options of the IHB solvers.
 ///

@@ -7,7 +7,6 @@ pub mod aft;
 pub mod autonomous;
 pub mod backbone;
 pub mod branch;
-pub mod broyden;
 pub mod classic;
 pub mod codim2;
 pub mod condense;
@@ -41,9 +40,6 @@ pub use aft::Aft;
 pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
 pub use backbone::{backbone, Backbone, BackboneOptions, BackbonePoint};
 pub use branch::{Branch, ResidualBranch};
-pub use broyden::{
-    broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
-};
 pub use classic::ClassicIhb;
 pub use codim2::{fold_curve, neimark_sacker_points, FoldCurve, FoldPoint, NeimarkSackerPoint};
 pub use continuation::{
@@ -68,6 +64,9 @@ pub use galerkin::GalerkinJacobian;
 pub use hill::{fourier_blocks, hill_multipliers, HillResult};
 pub use hopf::{hopf_points, HopfPoint};
 pub use ihb::{HbOptions, HbResidual, HbSolution, HbSolver};
+pub use ivt_num::{
+    broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
+};
 pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;
 pub use problem::{

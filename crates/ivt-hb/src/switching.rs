@@ -6,7 +6,6 @@
 //! [`period_doubled_start`]).
 
 use crate::branch::{full_newton_steps, residual_lambda_difference, Branch};
-use crate::broyden::SolveError;
 use crate::events::extended::{
     check_start, lambda_step, null_vector, put_jacobian, singular_at_start, solve_error,
 };
@@ -14,6 +13,7 @@ use crate::events::{dot, Bifurcation, BifurcationError, BifurcationKind, LocateO
 use crate::family::{Family, FamilyBranch};
 use crate::ihb::{HbError, HbOptions};
 use ivt_num::vector::norm2;
+use ivt_num::SolveError;
 use ivt_num::{newton_bordered, Border, LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace};
 use std::convert::Infallible;
 
@@ -60,6 +60,7 @@ pub fn switch_branch<B: Branch>(
     let border = Border {
         rows: direction,
         values: &[dot(direction, &star) + h],
+        origin: &[],
     };
     newton_bordered(
         &mut system,

@@ -18,12 +18,12 @@
 //! finite differences when the system has none).
 //!
 //! The workspace and its O(m²) kernels are in `broyden/workspace.rs`, the driver
-//! (line search, refresh policy) in `broyden/solve.rs`.
+//! (line search, refresh policy, a [`crate::iteration::Solver`] of the
+//! iteration core) in `broyden/solve.rs`; a failed solve is a
+//! [`crate::SolveError`].
 
-mod error;
 mod solve;
 mod workspace;
-pub use error::SolveError;
 pub use solve::broyden_solve;
 pub use workspace::BroydenWorkspace;
 

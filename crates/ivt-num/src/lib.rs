@@ -26,15 +26,27 @@
 //! - [`bordered`]: the bordered matrix `[[J, B], [Cᵀ, D]]` factored once
 //!   (solve, transposed solve, determinant sign): every extended system of
 //!   the path engine;
+//! - [`iteration`]: the iteration core (argmin's `Solver::next_iter` and
+//!   executor): a [`iteration::Solver`] takes one step, [`iteration::execute`]
+//!   owns the loop, the ‖F‖₂ history and the stopping rule; every solver
+//!   below fails with its one error, [`SolveError`];
 //! - [`newton`](mod@newton): the one damped Newton method (dense Jacobian, optional
 //!   linear border rows, through [`bordered::BorderedLu`], backtracking,
-//!   residual and step tests).
+//!   residual and step tests);
+//! - [`deflation`]: deflated Newton, the roots of `F` other than the known
+//!   ones (the HB solutions at one frequency of `ivt_hb::all_solutions`);
+//! - [`broyden`]: Broyden's quasi-Newton method (the thesis's Eq. 66–67)
+//!   with its line search and Jacobian refreshes, on caller-owned
+//!   `B` and `H = B⁻¹`.
 //!
 //! The rule for linear algebra: faer for dense LU and eigenvalues
 //! (workspace-based, no allocation in loops); nalgebra only for small
 //! fixed-size algebra and `expm`.
 
 pub mod bordered;
+pub mod broyden;
+pub mod deflation;
+pub mod iteration;
 pub mod lu;
 pub mod newton;
 pub mod rk;
@@ -45,10 +57,12 @@ mod test_rng;
 pub mod vector;
 
 pub use bordered::{BorderedError, BorderedLu};
+pub use broyden::{broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, System};
+pub use deflation::{deflated_newton, Deflation};
+pub use iteration::{SolveError, StepCheck};
 pub use lu::LuWorkspace;
 pub use newton::{
-    newton, newton_bordered, Border, NewtonError, NewtonOptions, NewtonStats, NewtonSystem,
-    NewtonWorkspace, StepCheck,
+    newton, newton_bordered, Border, NewtonOptions, NewtonStats, NewtonSystem, NewtonWorkspace,
 };
 pub use rk::{ExplicitRk, Tolerance};
 pub use tableau::{Tableau, DP5, RK4, RK6};

@@ -20,7 +20,7 @@
 //! branch switching, the STHB string and the θ-shooting of ivt-design.
 
 use crate::bordered::{BorderedError, BorderedLu};
-use thiserror::Error;
+use crate::iteration::{execute, Progress, SolveError, Solver, Step, StepCheck, Stopping};
 
 /// A system `F: Rⁿ → Rᵐ` with its Jacobian: square (`m = n`) for
 /// [`newton`], `m = n − k` for [`newton_bordered`] with `k` border rows.
@@ -31,7 +31,7 @@ pub trait NewtonSystem {
     /// (the step is halved): a way to say "outside the domain".
     ///
     /// # Errors
-    /// Any evaluation failure; it ends the iteration ([`NewtonError::Eval`]).
+    /// Any evaluation failure; it ends the iteration ([`SolveError::Eval`]).
     fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), Self::Error>;
     /// `∂F/∂x` at `x`, row-major `m × n`, into `jac`. Called only at the `x`
     /// of the last [`Self::residual`] call, so state computed there may be
@@ -48,7 +48,7 @@ pub trait NewtonSystem {
     ///
     /// # Errors
     /// Any failure of the caller's own (e.g. the iteration collapsed onto a
-    /// trivial solution); it ends the iteration ([`NewtonError::Eval`]).
+    /// trivial solution); it ends the iteration ([`SolveError::Eval`]).
     fn check_step(
         &mut self,
         _x: &[f64],
@@ -57,17 +57,6 @@ pub trait NewtonSystem {
     ) -> Result<StepCheck, Self::Error> {
         Ok(StepCheck::Continue)
     }
-}
-
-/// Verdict of [`NewtonSystem::check_step`] on an accepted step.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StepCheck {
-    /// Iterate on.
-    Continue,
-    /// Stop: the point is the solution.
-    Converged,
-    /// Stop: the iteration diverges ([`NewtonError::NonConvergence`]).
-    Diverged,
 }
 
 /// Options of [`newton`].
@@ -132,79 +121,20 @@ pub struct NewtonStats {
     pub residual_norm: f64,
 }
 
-/// Why [`newton`] failed; the iteration variants carry the `‖F‖₂` history
-/// (first entry: the initial guess; one per accepted step).
-#[derive(Debug, Clone, Error, PartialEq)]
-pub enum NewtonError<E> {
-    /// `max_iter` steps without meeting a stopping test.
-    #[error("no convergence in {iterations} Newton steps")]
-    NonConvergence {
-        /// Steps taken.
-        iterations: usize,
-        /// `‖F‖₂` history.
-        history: Vec<f64>,
-    },
-    /// No step length in the line search reduced `‖F‖₂`.
-    #[error("no descent along the Newton step at step {iteration}")]
-    NoDescent {
-        /// Step at which it happened.
-        iteration: usize,
-        /// `‖F‖₂` history.
-        history: Vec<f64>,
-    },
-    /// The Jacobian is numerically singular (or the step not finite).
-    #[error("singular Jacobian at Newton step {iteration}")]
-    SingularJacobian {
-        /// Step at which it happened.
-        iteration: usize,
-        /// `‖F‖₂` history.
-        history: Vec<f64>,
-    },
-    /// A non-finite start or residual.
-    #[error("non-finite start or residual at Newton step {iteration}")]
-    NonFinite {
-        /// Step at which it happened.
-        iteration: usize,
-        /// `‖F‖₂` history.
-        history: Vec<f64>,
-    },
-    /// The system's evaluation failed.
-    #[error("evaluation failed")]
-    Eval(E),
-    /// The border rows, their right-hand side and the unknowns disagree in
-    /// size (`rows` must be `k × n`, `values` `k`, `k ≤ n`).
-    #[error("border of {rows} entries and {values} values does not fit {unknowns} unknowns")]
-    BorderSize {
-        /// Entries of the border rows.
-        rows: usize,
-        /// Entries of the right-hand side.
-        values: usize,
-        /// Unknowns `n`.
-        unknowns: usize,
-    },
-}
-
-impl<E> NewtonError<E> {
-    /// The `‖F‖₂` history (empty for [`NewtonError::Eval`]).
-    pub fn history(&self) -> &[f64] {
-        match self {
-            Self::NonConvergence { history, .. }
-            | Self::NoDescent { history, .. }
-            | Self::SingularJacobian { history, .. }
-            | Self::NonFinite { history, .. } => history,
-            Self::Eval(_) | Self::BorderSize { .. } => &[],
-        }
-    }
-}
-
-/// `k` linear rows `C x = d` closing an `n − k`-row system (`rows`
-/// row-major `k × n`, `values` `k`).
+/// `k` linear rows `C (x − x₀) = d` closing an `n − k`-row system (`rows`
+/// row-major `k × n`, `values` `k`, `origin` `x₀` of `n` entries or empty
+/// for `C x = d`).
 #[derive(Debug, Clone, Copy)]
 pub struct Border<'a> {
     /// `C`, row-major `k × n`.
     pub rows: &'a [f64],
     /// `d`.
     pub values: &'a [f64],
+    /// `x₀`, or empty. Each row is then evaluated as `Σᵢ cᵢ (xᵢ − x₀ᵢ)`, a
+    /// difference of points, which keeps the last digits that `Cx − Cx₀`
+    /// loses to cancellation when both are large (an arclength constraint
+    /// at large λ).
+    pub origin: &'a [f64],
 }
 
 impl Border<'_> {
@@ -212,6 +142,7 @@ impl Border<'_> {
     pub const NONE: Border<'static> = Border {
         rows: &[],
         values: &[],
+        origin: &[],
     };
 }
 
@@ -220,13 +151,13 @@ impl Border<'_> {
 /// of the same sizes; resized (the only allocation) when they change.
 #[derive(Debug, Clone)]
 pub struct NewtonWorkspace {
-    jac: Vec<f64>,
-    lu: BorderedLu,
-    dx: Vec<f64>,
+    pub(crate) jac: Vec<f64>,
+    pub(crate) lu: BorderedLu,
+    pub(crate) dx: Vec<f64>,
     x_trial: Vec<f64>,
-    r: Vec<f64>,
+    pub(crate) r: Vec<f64>,
     r_trial: Vec<f64>,
-    history: Vec<f64>,
+    pub(crate) history: Vec<f64>,
 }
 
 impl NewtonWorkspace {
@@ -269,6 +200,17 @@ impl NewtonWorkspace {
     pub fn det_sign(&self) -> f64 {
         self.lu.det_sign()
     }
+
+    /// Factors the Jacobian in `jac` bordered by `rows`; `false` when the
+    /// factor is unusable (singular, unless `accept_near_singular` takes a
+    /// factor singular to rounding; or the sizes disagree).
+    pub(crate) fn factor(&mut self, rows: &[f64], accept_near_singular: bool) -> bool {
+        match self.lu.factor_rows(&self.jac, rows) {
+            Ok(()) => true,
+            Err(BorderedError::Singular) => accept_near_singular,
+            Err(BorderedError::Size { .. }) => false,
+        }
+    }
 }
 
 /// `[F(x); C x − d]` into `r`.
@@ -286,7 +228,15 @@ fn bordered_residual<S: NewtonSystem + ?Sized>(
         .zip(border.rows.chunks_exact(x.len()))
         .zip(border.values)
     {
-        *out = crate::vector::dot(row, x) - d;
+        let cx = if border.origin.is_empty() {
+            crate::vector::dot(row, x)
+        } else {
+            row.iter()
+                .zip(x.iter().zip(border.origin))
+                .map(|(c, (a, b))| c * (a - b))
+                .sum()
+        };
+        *out = cx - d;
     }
     Ok(())
 }
@@ -306,25 +256,25 @@ fn line_search<S: NewtonSystem + ?Sized>(
     ws: &mut NewtonWorkspace,
     opts: &NewtonOptions,
     norm: f64,
-    stats: &mut NewtonStats,
-) -> Result<Option<f64>, NewtonError<S::Error>> {
+    residual_evals: &mut usize,
+) -> Result<Option<f64>, SolveError<S::Error>> {
     let mut t = 1.0;
-    let mut trial_at = |t: f64, ws: &mut NewtonWorkspace, stats: &mut NewtonStats| {
+    let mut trial_at = |t: f64, ws: &mut NewtonWorkspace, evals: &mut usize| {
         for ((xt, xi), d) in ws.x_trial.iter_mut().zip(x).zip(&ws.dx) {
             *xt = xi + t * d;
         }
-        stats.residual_evals += 1;
+        *evals += 1;
         bordered_residual(sys, border, &ws.x_trial, &mut ws.r_trial)
-            .map_err(NewtonError::Eval)
+            .map_err(SolveError::Eval)
             .map(|()| norm2(&ws.r_trial))
     };
     for k in 0..=opts.max_halvings {
-        let trial = trial_at(t, ws, stats)?;
+        let trial = trial_at(t, ws, residual_evals)?;
         let descent = trial < norm || trial <= opts.accept_below;
         let last = k == opts.max_halvings;
         if trial.is_finite() && (descent || (last && opts.accept_no_descent)) {
             if !descent && opts.full_step_without_descent && t < 1.0 {
-                trial_at(1.0, ws, stats)?;
+                trial_at(1.0, ws, residual_evals)?;
                 return Ok(Some(1.0));
             }
             return Ok(Some(t));
@@ -338,13 +288,13 @@ fn line_search<S: NewtonSystem + ?Sized>(
 /// (overwritten by the solution).
 ///
 /// # Errors
-/// [`NewtonError`] as described there.
+/// [`SolveError`] as described there.
 pub fn newton<S: NewtonSystem + ?Sized>(
     sys: &mut S,
     x: &mut [f64],
     ws: &mut NewtonWorkspace,
     opts: &NewtonOptions,
-) -> Result<NewtonStats, NewtonError<S::Error>> {
+) -> Result<NewtonStats, SolveError<S::Error>> {
     newton_bordered(sys, Border::NONE, x, ws, opts)
 }
 
@@ -354,7 +304,7 @@ pub fn newton<S: NewtonSystem + ?Sized>(
 /// and its history include the border rows.
 ///
 /// # Errors
-/// [`NewtonError`] as described there; [`NewtonError::BorderSize`] when
+/// [`SolveError`] as described there; [`SolveError::BorderSize`] when
 /// the border does not fit `x`.
 pub fn newton_bordered<S: NewtonSystem + ?Sized>(
     sys: &mut S,
@@ -362,11 +312,11 @@ pub fn newton_bordered<S: NewtonSystem + ?Sized>(
     x: &mut [f64],
     ws: &mut NewtonWorkspace,
     opts: &NewtonOptions,
-) -> Result<NewtonStats, NewtonError<S::Error>> {
+) -> Result<NewtonStats, SolveError<S::Error>> {
     let n = x.len();
     let k = border.values.len();
     if k > n || border.rows.len() != k * n {
-        return Err(NewtonError::BorderSize {
+        return Err(SolveError::BorderSize {
             rows: border.rows.len(),
             values: k,
             unknowns: n,
@@ -375,58 +325,74 @@ pub fn newton_bordered<S: NewtonSystem + ?Sized>(
     if ws.dim() != n || ws.lu.borders() != k {
         *ws = NewtonWorkspace::bordered(n, k);
     }
-    ws.history.clear();
-    let mut stats = NewtonStats {
-        iterations: 0,
+    let mut history = std::mem::take(&mut ws.history);
+    let mut solver = Newton {
+        sys,
+        border,
+        ws,
+        opts,
         residual_evals: 0,
         jacobian_evals: 0,
-        residual_norm: f64::NAN,
+        t: 1.0,
     };
-    let non_finite = |iteration, history: &[f64]| NewtonError::NonFinite {
-        iteration,
-        history: history.to_vec(),
+    let stopping = Stopping {
+        ftol: opts.ftol,
+        max_iter: opts.max_iter,
     };
-    if !x.iter().all(|v| v.is_finite()) {
-        return Err(non_finite(0, &ws.history));
-    }
-    bordered_residual(sys, &border, x, &mut ws.r).map_err(NewtonError::Eval)?;
-    stats.residual_evals += 1;
-    let mut norm = norm2(&ws.r);
-    ws.history.push(norm);
-    if !norm.is_finite() {
-        return Err(non_finite(0, &ws.history));
-    }
-    let mut converged = norm <= opts.ftol;
-    while !converged {
-        if stats.iterations >= opts.max_iter {
-            return Err(NewtonError::NonConvergence {
-                iterations: stats.iterations,
-                history: ws.history.clone(),
+    let result = execute(&mut solver, x, stopping, &mut history);
+    let (residual_evals, jacobian_evals) = (solver.residual_evals, solver.jacobian_evals);
+    let residual_norm = history.last().copied().unwrap_or(f64::NAN);
+    ws.history = history;
+    Ok(NewtonStats {
+        iterations: result?,
+        residual_evals,
+        jacobian_evals,
+        residual_norm,
+    })
+}
+
+/// Damped Newton as a [`Solver`] of the iteration core: the state between
+/// two steps of [`newton_bordered`].
+struct Newton<'a, 'b, S: ?Sized> {
+    sys: &'a mut S,
+    border: Border<'b>,
+    ws: &'a mut NewtonWorkspace,
+    opts: &'a NewtonOptions,
+    residual_evals: usize,
+    jacobian_evals: usize,
+    /// The length of the last accepted step along the Newton direction.
+    t: f64,
+}
+
+impl<S: NewtonSystem + ?Sized> Solver for Newton<'_, '_, S> {
+    type Error = S::Error;
+
+    fn start(&mut self, x: &mut [f64]) -> Result<f64, SolveError<S::Error>> {
+        if !x.iter().all(|v| v.is_finite()) {
+            return Err(SolveError::NonFinite {
+                iteration: 0,
+                history: Vec::new(),
             });
         }
-        stats.iterations += 1;
-        let it = stats.iterations;
-        sys.jacobian(x, &mut ws.jac).map_err(NewtonError::Eval)?;
-        stats.jacobian_evals += 1;
-        let singular = |history: &[f64]| NewtonError::SingularJacobian {
-            iteration: it,
-            history: history.to_vec(),
-        };
-        let factored = match ws.lu.factor_rows(&ws.jac, border.rows) {
-            Ok(()) => true,
-            Err(BorderedError::Singular) => opts.accept_near_singular,
-            Err(BorderedError::Size { .. }) => false,
-        };
-        if !factored {
-            return Err(singular(&ws.history));
+        bordered_residual(self.sys, &self.border, x, &mut self.ws.r).map_err(SolveError::Eval)?;
+        self.residual_evals += 1;
+        Ok(norm2(&self.ws.r))
+    }
+
+    fn next_iter(&mut self, x: &mut [f64], at: Progress<'_>) -> Result<Step, SolveError<S::Error>> {
+        let ws = &mut *self.ws;
+        self.sys
+            .jacobian(x, &mut ws.jac)
+            .map_err(SolveError::Eval)?;
+        self.jacobian_evals += 1;
+        if !ws.factor(self.border.rows, self.opts.accept_near_singular) {
+            return Err(at.singular());
         }
         ws.dx.iter_mut().zip(&ws.r).for_each(|(d, r)| *d = -r);
-        if ws.lu.solve(&mut ws.dx).is_err() {
-            return Err(singular(&ws.history));
+        if ws.lu.solve(&mut ws.dx).is_err() || !ws.dx.iter().all(|v| v.is_finite()) {
+            return Err(at.singular());
         }
-        if !ws.dx.iter().all(|v| v.is_finite()) {
-            return Err(singular(&ws.history));
-        }
+        let opts = self.opts;
         let small = ws
             .dx
             .iter()
@@ -434,52 +400,50 @@ pub fn newton_bordered<S: NewtonSystem + ?Sized>(
             .all(|(d, xi)| d.abs() <= opts.rtol * xi.abs() + opts.atol);
         if small {
             x.iter_mut().zip(&ws.dx).for_each(|(xi, d)| *xi += d);
-            bordered_residual(sys, &border, x, &mut ws.r).map_err(NewtonError::Eval)?;
-            stats.residual_evals += 1;
-            norm = norm2(&ws.r);
-            ws.history.push(norm);
-            if !norm.is_finite() {
-                return Err(non_finite(it, &ws.history));
-            }
-            break;
+            bordered_residual(self.sys, &self.border, x, &mut ws.r).map_err(SolveError::Eval)?;
+            self.residual_evals += 1;
+            return Ok(Step::Moved {
+                norm: norm2(&ws.r),
+                converged: true,
+            });
         }
-        let Some(t) = line_search(sys, &border, x, ws, opts, norm, &mut stats)? else {
+        let searched = line_search(
+            self.sys,
+            &self.border,
+            x,
+            ws,
+            opts,
+            at.norm(),
+            &mut self.residual_evals,
+        )?;
+        let Some(t) = searched else {
             if !norm2(&ws.r_trial).is_finite() {
                 // The shortest trial left the domain of F.
-                return Err(non_finite(it, &ws.history));
+                return Err(at.non_finite());
             }
-            return Err(NewtonError::NoDescent {
-                iteration: it,
-                history: ws.history.clone(),
+            return Err(SolveError::NoDescent {
+                iteration: at.iteration,
+                history: at.history.to_vec(),
             });
         };
         x.copy_from_slice(&ws.x_trial);
         std::mem::swap(&mut ws.r, &mut ws.r_trial);
-        norm = norm2(&ws.r);
-        ws.history.push(norm);
-        if !norm.is_finite() {
-            return Err(non_finite(it, &ws.history));
-        }
-        converged = norm <= opts.ftol;
-        if !converged {
-            ws.dx.iter_mut().for_each(|d| *d *= t);
-            match sys
-                .check_step(x, &ws.dx, &ws.history)
-                .map_err(NewtonError::Eval)?
-            {
-                StepCheck::Continue => {}
-                StepCheck::Converged => converged = true,
-                StepCheck::Diverged => {
-                    return Err(NewtonError::NonConvergence {
-                        iterations: it,
-                        history: ws.history.clone(),
-                    })
-                }
-            }
-        }
+        self.t = t;
+        Ok(Step::Moved {
+            norm: norm2(&ws.r),
+            converged: false,
+        })
     }
-    stats.residual_norm = norm;
-    Ok(stats)
+
+    /// The system's own rule ([`NewtonSystem::check_step`]) on the step
+    /// taken (damping included).
+    fn check(&mut self, x: &[f64], at: Progress<'_>) -> Result<StepCheck, SolveError<S::Error>> {
+        let t = self.t;
+        self.ws.dx.iter_mut().for_each(|d| *d *= t);
+        self.sys
+            .check_step(x, &self.ws.dx, at.history)
+            .map_err(SolveError::Eval)
+    }
 }
 
 #[cfg(test)]

@@ -6,9 +6,9 @@
 
 use super::{IhbSolver, OperatingPoint, Quadrature};
 use core::f64::consts::PI;
-use ivt_hb::broyden::System;
 use ivt_kin::plant::PlantParams;
 use ivt_kin::variant::{f_on_segment, f_on_segment_from_trig, segment_of};
+use ivt_num::broyden::System;
 use ivt_num::NewtonSystem;
 use std::convert::Infallible;
 

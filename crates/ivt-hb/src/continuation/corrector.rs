@@ -8,8 +8,8 @@
 use std::borrow::Cow;
 
 use crate::branch::Branch;
-use crate::broyden::SolveError;
 use crate::error::HbError;
+use ivt_num::SolveError;
 
 mod broyden;
 mod chord;

@@ -1,10 +1,10 @@
 //! The start of an exact-Jacobian path: Newton at fixed λ ([`ivt_num::newton()`]).
 
 use crate::branch::{full_newton_steps, Branch};
-use ivt_num::{newton, NewtonError, NewtonSystem, NewtonWorkspace};
+use ivt_num::{newton, NewtonSystem, NewtonWorkspace, SolveError};
 use std::convert::Infallible;
 
-use super::{ContinuationOptions, SolveError};
+use super::ContinuationOptions;
 use crate::error::HbError;
 
 /// A [`Branch`] at fixed λ as a square [`NewtonSystem`] in `u`.
@@ -53,7 +53,7 @@ pub fn correct_at_fixed_lambda<S: Branch>(
     let nopts = full_newton_steps(opts.broyden.tol, opts.broyden.max_iter);
     match newton(&mut fixed, u, &mut NewtonWorkspace::new(m), &nopts) {
         Ok(stats) => Ok(stats.iterations),
-        Err(NewtonError::SingularJacobian { .. }) => Err(HbError::SingularStart { lambda }),
+        Err(SolveError::SingularJacobian { .. }) => Err(HbError::SingularStart { lambda }),
         Err(e) => Err(HbError::ContinuationStart {
             lambda,
             cause: SolveError::from(e),

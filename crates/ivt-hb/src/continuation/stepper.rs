@@ -9,8 +9,8 @@ use super::predictor::{curvature_between, predict};
 use super::step_control::StepControl;
 use super::{turn, ContinuationOptions, Fold, Path, PathPoint, Termination};
 use crate::branch::Branch;
-use crate::broyden::SolveError;
 use crate::error::HbError;
+use ivt_num::SolveError;
 
 /// What [`Stepper::next`] gives.
 #[derive(Debug, Clone, PartialEq)]

@@ -7,10 +7,10 @@
 
 use super::detector::{Bifurcation, BifurcationError, BifurcationKind, LocateOptions};
 use crate::branch::{full_newton_steps, residual_lambda_difference, Branch};
-use crate::broyden::SolveError;
 use crate::ihb::HbError;
 use faer::c64;
 use ivt_num::vector::norm2;
+use ivt_num::SolveError;
 use ivt_num::{
     newton, BorderedError, LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace, StepCheck,
 };

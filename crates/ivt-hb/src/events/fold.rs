@@ -22,12 +22,12 @@ use super::detector::{
 use super::extended::{check_start, finish, null_vector, singular_at_start, Ruled, StepRule};
 use super::multipliers::Monodromy;
 use crate::branch::Branch;
-use crate::broyden::SolveError;
 use crate::continuation::turn;
 use crate::family::{Family, FamilyBranch};
 use crate::ihb::HbError;
 use faer::c64;
 use ivt_num::vector::norm2;
+use ivt_num::SolveError;
 use ivt_num::{newton, BorderedLu, LuWorkspace, NewtonSystem, NewtonWorkspace};
 use std::convert::Infallible;
 

@@ -17,7 +17,6 @@ use super::stability::{
 };
 use super::StringHb;
 use crate::branch::Branch;
-use crate::broyden::BroydenOptions;
 use crate::continuation::{
     ContinuationOptions, NewtonCorrector, Path, PathPoint, Stepper, Termination,
 };
@@ -26,6 +25,7 @@ use crate::events::{
     observe, BifurcationKind, Detector, Event, EventObserver, Fold, LocateOptions, Observer,
 };
 use crate::frc::{Frc, FrcFold, FrcPoint};
+use ivt_num::BroydenOptions;
 
 /// Settings of a string curve.
 #[derive(Clone, Debug, PartialEq)]

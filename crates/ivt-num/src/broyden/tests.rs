@@ -1,6 +1,7 @@
 //! Unit tests of the Broyden solver and its workspace updates.
 
 use super::*;
+use crate::SolveError;
 
 #[test]
 fn solves_a_small_nonlinear_system_from_identity() {

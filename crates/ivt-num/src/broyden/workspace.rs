@@ -8,10 +8,11 @@
 
 use std::slice::{ChunksExact, ChunksExactMut};
 
-use ivt_num::vector::{axpy, dot, matvec, norm2};
-use ivt_num::LuWorkspace;
+use crate::iteration::{Progress, SolveError};
+use crate::vector::{axpy, dot, matvec, norm2};
+use crate::LuWorkspace;
 
-use super::{BroydenStats, SolveError, System};
+use super::{BroydenStats, System};
 
 /// Caller-owned state of the solver: `B`, `H = B⁻¹` and all scratch vectors.
 ///
@@ -274,9 +275,15 @@ impl BroydenWorkspace {
         norm2(&self.r)
     }
 
-    /// Appends ‖F‖₂ of an accepted iterate to the history.
-    pub(super) fn record(&mut self, norm: f64) {
-        self.history.push(norm);
+    /// The history buffer, for the executor to record the solve in
+    /// ([`Self::restore_history`] gives it back).
+    pub(super) fn take_history(&mut self) -> Vec<f64> {
+        std::mem::take(&mut self.history)
+    }
+
+    /// Keeps the solve's history (read by [`Self::history`]).
+    pub(super) fn restore_history(&mut self, history: Vec<f64>) {
+        self.history = history;
     }
 
     /// The quasi-Newton direction `dx = −H r` (Eq. 66), or the one [`Self::update`]
@@ -318,20 +325,19 @@ impl BroydenWorkspace {
     /// [`Self::refresh`] at `x`, then `H = B⁻¹`, counting the work in `stats`.
     ///
     /// # Errors
-    /// [`SolveError::SingularJacobian`] with the history so far if `B` is singular.
+    /// [`SolveError::SingularJacobian`] with the history so far (`at`) if `B`
+    /// is singular.
     pub(super) fn refresh_inverse<S: System + ?Sized>(
         &mut self,
         sys: &mut S,
         x: &[f64],
         fd_step: f64,
         stats: &mut BroydenStats,
+        at: Progress<'_>,
     ) -> Result<(), SolveError> {
         stats.residual_evals += self.refresh(sys, x, fd_step);
         stats.jacobian_refreshes += 1;
-        self.invert_b().map_err(|_| SolveError::SingularJacobian {
-            iteration: stats.iterations,
-            history: self.history.clone(),
-        })
+        self.invert_b().map_err(|_| at.singular())
     }
 
     /// Refreshes `B` at `x` (whose residual is in `self.r`) from the system's

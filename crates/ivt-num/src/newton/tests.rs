@@ -88,6 +88,7 @@ fn border_rows_close_the_system() {
     let border = Border {
         rows: &[1.0, -1.0],
         values: &[0.0],
+        origin: &[],
     };
     let stats = newton_bordered(&mut Arc, border, &mut x, &mut ws, &opts).unwrap();
     assert_eq!(ws.history.len(), ws_sq.history.len());
@@ -116,6 +117,7 @@ fn border_rows_close_the_system() {
     let border = Border {
         rows: &[0.0, 0.0, 1.0, 1.0, 1.0, 0.0],
         values: &[0.5, 1.0],
+        origin: &[],
     };
     newton_bordered(&mut Parabola, border, &mut x, &mut ws, &opts).unwrap();
     let root = (3f64.sqrt() - 1.0) / 2.0;
@@ -124,13 +126,28 @@ fn border_rows_close_the_system() {
         "{x:?}"
     );
     assert_eq!(x[2], 0.5);
+    // The same rows about an origin: x₂ − 0.1 = 0.4, (x₀ − 0.2) + (x₁ − 0.3)
+    // = 0.5 are the same constraints, so the same root.
+    let mut x = [1.0, 0.0, 0.0];
+    let about = Border {
+        rows: &[0.0, 0.0, 1.0, 1.0, 1.0, 0.0],
+        values: &[0.4, 0.5],
+        origin: &[0.2, 0.3, 0.1],
+    };
+    newton_bordered(&mut Parabola, about, &mut x, &mut ws, &opts).unwrap();
+    assert!(
+        (x[0] - root).abs() < 1e-15 && (x[1] - (1.0 - root)).abs() < 1e-15,
+        "{x:?}"
+    );
+    assert!((x[2] - 0.5).abs() < 1e-15, "{x:?}");
     let bad = Border {
         rows: &[1.0],
         values: &[0.0],
+        origin: &[],
     };
     assert!(matches!(
         newton_bordered(&mut Parabola, bad, &mut x, &mut ws, &opts),
-        Err(NewtonError::BorderSize {
+        Err(SolveError::BorderSize {
             rows: 1,
             values: 1,
             unknowns: 3
@@ -174,7 +191,7 @@ fn no_root_is_an_error_with_history() {
     )
     .unwrap_err();
     assert!(!err.history().is_empty(), "{err:?}");
-    assert!(!matches!(err, NewtonError::Eval(())), "{err:?}");
+    assert!(!matches!(err, SolveError::Eval(())), "{err:?}");
     let mut nan = [f64::NAN];
     let err = newton(
         &mut f,
@@ -184,7 +201,7 @@ fn no_root_is_an_error_with_history() {
     );
     assert!(matches!(
         err,
-        Err(NewtonError::NonFinite { iteration: 0, .. })
+        Err(SolveError::NonFinite { iteration: 0, .. })
     ));
 }
 
@@ -245,7 +262,7 @@ fn check_step_converges_or_diverges_for_the_caller() {
     let mut x = [3.0];
     let err = newton(&mut atan, &mut x, &mut ws, &undamped).unwrap_err();
     assert!(
-        matches!(err, NewtonError::NonConvergence { iterations: 1, ref history } if history.len() == 2),
+        matches!(err, SolveError::NonConvergence { iterations: 1, ref history } if history.len() == 2),
         "{err:?}"
     );
     assert!(x[0].abs() > 3.0, "{x:?}");
@@ -288,7 +305,7 @@ fn no_descent_policies_take_the_step_they_name() {
         let mut x = [0.1];
         let err = newton(&mut f, &mut x, &mut ws, &opts).unwrap_err();
         assert!(
-            matches!(err, NewtonError::NonConvergence { iterations: 1, .. }),
+            matches!(err, SolveError::NonConvergence { iterations: 1, .. }),
             "{err:?}"
         );
         assert!((x[0] - expected).abs() < 1e-14, "{x:?} vs {expected}");
@@ -331,7 +348,7 @@ fn near_singular_factors_are_accepted_on_request() {
     let mut x = [0.0; 3];
     let err = newton(&mut Linear, &mut x, &mut ws, &NewtonOptions::default());
     assert!(
-        matches!(err, Err(NewtonError::SingularJacobian { .. })),
+        matches!(err, Err(SolveError::SingularJacobian { .. })),
         "{err:?}"
     );
     let opts = NewtonOptions {

@@ -9,11 +9,11 @@
 
 use super::{Corrected, Correction, DirectionError, Found, PathCorrector, Prediction, Retry};
 use crate::branch::Branch;
-use crate::broyden::{broyden_solve, BroydenOptions, BroydenWorkspace, SolveError};
 use crate::continuation::predictor::distance;
 use crate::error::HbError;
 use ivt_num::vector::{dot, norm2};
 use ivt_num::LuWorkspace;
+use ivt_num::{broyden_solve, BroydenOptions, BroydenWorkspace, SolveError};
 
 /// `R(x)` of `branch` at `x = (u, λ)` into `r` (NaN for an empty `x`): the
 /// branch as the residual [`broyden_solve`] iterates on.

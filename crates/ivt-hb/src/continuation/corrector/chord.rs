@@ -8,9 +8,9 @@
 
 use super::Prediction;
 use crate::branch::Branch;
-use crate::broyden::SolveError;
 use ivt_num::vector::{dot, norm2};
 use ivt_num::BorderedLu;
+use ivt_num::SolveError;
 
 /// The chord's state: the factored matrix, the iterate and the residual.
 pub(super) struct Chord<'a> {

@@ -12,10 +12,10 @@ use std::convert::Infallible;
 use super::chord::Chord;
 use super::{Corrected, Correction, DirectionError, Found, PathCorrector, Prediction, Retry};
 use crate::branch::{full_newton_steps, path_lambda_step, Branch};
-use crate::broyden::SolveError;
 use crate::continuation::ContinuationOptions;
 use crate::error::HbError;
 use ivt_num::vector::norm2;
+use ivt_num::SolveError;
 use ivt_num::{newton, BorderedLu, NewtonSystem, NewtonWorkspace, StepCheck};
 
 /// Corrector iterations counted as this many chord iterations per full Newton

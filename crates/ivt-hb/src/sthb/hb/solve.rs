@@ -4,7 +4,7 @@
 use super::StringHb;
 use crate::error::HbError;
 use faer::Mat;
-use ivt_num::{newton, NewtonError, NewtonOptions, NewtonSystem, NewtonWorkspace};
+use ivt_num::{newton, NewtonOptions, NewtonSystem, NewtonWorkspace, SolveError};
 use std::convert::Infallible;
 
 /// Newton–Raphson statistics of one converged solve.
@@ -66,18 +66,20 @@ impl StringHb {
                     history,
                 })
             }
-            Err(NewtonError::SingularJacobian { .. } | NewtonError::BorderSize { .. }) => {
-                Err(HbError::Singular { omega })
-            }
-            Err(NewtonError::NonFinite { .. }) => Err(HbError::NonFinite { omega }),
-            Err(NewtonError::NonConvergence { .. } | NewtonError::NoDescent { .. }) => {
+            Err(
+                SolveError::SingularJacobian { .. }
+                | SolveError::BorderSize { .. }
+                | SolveError::Dimension { .. },
+            ) => Err(HbError::Singular { omega }),
+            Err(SolveError::NonFinite { .. }) => Err(HbError::NonFinite { omega }),
+            Err(SolveError::NonConvergence { .. } | SolveError::NoDescent { .. }) => {
                 Err(HbError::NoConvergence {
                     method: "Newton",
                     omega,
                     history,
                 })
             }
-            Err(NewtonError::Eval(never)) => match never {},
+            Err(SolveError::Eval(never)) => match never {},
         }
     }
 }
