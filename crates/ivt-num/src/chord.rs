@@ -1,112 +1,174 @@
-//! The chord corrector: iterations on the factorization `A₀` of the
-//! bordered matrix `[[J, R_λ], [tᵀ]]` the tangent left (no new
-//! factorization), accelerated by Broyden's updates of it (Kelley's `brsol`:
-//! the update of `A₀⁻¹` applied through the stored steps by
-//! Sherman–Morrison), superlinear where the plain chord contracts linearly.
-//! The first attempt of [`super::NewtonCorrector`], whose Newton takes over
-//! where the chord does not contract.
+//! The chord iteration: iterations on a factorization `A₀` of the Jacobian
+//! that the caller already has (no new factorization), accelerated by
+//! Broyden's updates of it (Kelley's `brsol`: the update of `A₀⁻¹` applied
+//! through the stored steps by Sherman–Morrison), superlinear where the
+//! plain chord contracts linearly. It gives up fast, for a Newton iteration
+//! to take over: when the residual does not fall by ½ per iteration (over
+//! two) or grows. A [`Solver`] of the iteration core; the first attempt of
+//! the exact-Jacobian path corrector (ivt-path's `NewtonCorrector`), on the
+//! LU its tangent left.
 
-use super::Prediction;
-use crate::branch::Branch;
-use ivt_num::vector::{dot, norm2};
-use ivt_num::BorderedLu;
-use ivt_num::SolveError;
+use crate::bordered::BorderedLu;
+use crate::broyden::System;
+use crate::iteration::{execute, Progress, SolveError, Solver, Step, StepCheck, Stopping};
+use crate::vector::{dot, norm2};
 
-/// The chord's state: the factored matrix, the iterate and the residual.
-pub(super) struct Chord<'a> {
-    /// The LU of `[[J, R_λ], [rowᵀ]]`.
-    pub(super) aug: &'a mut BorderedLu,
-    /// The iterate (`u` then λ), from the prediction; left at the best
-    /// iterate on failure, for Newton to start from.
-    pub(super) u: &'a mut [f64],
-    /// `[R; constraint]` scratch; on entry with `start_residual_known`, its
-    /// first `m` entries hold `R` at the start.
-    pub(super) rhs: &'a mut [f64],
-    /// Absolute tolerance on `‖[R; constraint]‖₂`.
-    pub(super) tol: f64,
-    /// Up to `3·max_newton` iterations while the chord contracts.
-    pub(super) max_newton: usize,
+/// Chord iterations on `sys` from `x` with the factored `lu` (of size
+/// `x.len()`): at most `max_iter` steps, converged at `‖F‖₂ ≤ tol`. `r` is
+/// the residual scratch (`x.len()` entries); with `residual_known` it holds
+/// `F(x)` on entry. Returns the steps taken; on failure `x` is the best
+/// iterate (the smallest ‖F‖₂), for Newton to start from.
+///
+/// # Errors
+/// [`SolveError::NonConvergence`] (with the history) when the iteration
+/// stops contracting or after `max_iter` steps, [`SolveError::NonFinite`]
+/// for a non-finite residual.
+pub fn chord<S: System + ?Sized>(
+    sys: &mut S,
+    lu: &mut BorderedLu,
+    x: &mut [f64],
+    r: &mut [f64],
+    residual_known: bool,
+    stopping: Stopping,
+) -> Result<usize, SolveError> {
+    let mut solver = Chord {
+        sys,
+        lu,
+        r,
+        residual_known,
+        steps: Vec::new(),
+        best: (f64::INFINITY, x.to_vec()),
+    };
+    let result = execute(&mut solver, x, stopping, &mut Vec::new());
+    if result.is_err() {
+        x.copy_from_slice(&solver.best.1);
+    }
+    result
 }
 
-impl Chord<'_> {
-    /// Chord iterations from `u`: fails fast when the residual does not fall
-    /// by ½ per iteration (over two) or grows. Returns the iteration count.
-    pub(super) fn run<B: Branch>(
-        &mut self,
-        branch: &mut B,
-        pred: &Prediction<'_>,
-        start_residual_known: bool,
-    ) -> Result<usize, SolveError> {
-        let mut history: Vec<f64> = Vec::new();
-        let mut steps: Vec<Vec<f64>> = Vec::new();
-        let mut best = (f64::INFINITY, self.u.to_vec());
-        for it in 0..=3 * self.max_newton {
-            if it > 0 || !start_residual_known {
-                if let (Some((&lambda, u)), Some((_, r))) =
-                    (self.u.split_last(), self.rhs.split_last_mut())
-                {
-                    branch.residual(u, lambda, r);
-                }
-            }
-            let constraint = pred.constraint(self.u);
-            if let Some(c) = self.rhs.last_mut() {
-                *c = constraint;
-            }
-            if let Some(done) = settle(&mut history, norm2(self.rhs), self.tol) {
-                return done;
-            }
-            let now = history.last().copied().unwrap_or(f64::INFINITY);
-            if now < best.0 {
-                best.0 = now;
-                best.1.copy_from_slice(self.u);
-            }
-            let before = |k: usize| {
-                history
-                    .len()
-                    .checked_sub(k + 1)
-                    .and_then(|i| history.get(i))
-            };
-            let grew = before(1).is_some_and(|b| now >= *b);
-            if grew || before(2).is_some_and(|b| now > 0.25 * b) {
-                break;
-            }
-            // z = −A₀⁻¹F, then the updates s_{j+1} s_jᵀ z / ‖s_j‖² in order.
-            let mut z = self.rhs.to_vec();
-            if self.aug.solve(&mut z).is_err() {
-                break;
-            }
-            z.iter_mut().for_each(|v| *v = -*v);
-            for pair in steps.windows(2) {
-                if let [s0, s1] = pair {
-                    let c = dot(s0, &z) / dot(s0, s0);
-                    z.iter_mut().zip(s1).for_each(|(v, s)| *v += c * s);
-                }
-            }
-            if let Some(last) = steps.last() {
-                let denom = 1.0 - dot(last, &z) / dot(last, last);
-                z.iter_mut().for_each(|v| *v /= denom);
-            }
-            for (x, d) in self.u.iter_mut().zip(&z) {
-                *x += d;
-            }
-            steps.push(z);
+/// The chord's state: the factor, the residual, the steps taken (for the
+/// updates) and the best iterate.
+struct Chord<'a, S: ?Sized> {
+    sys: &'a mut S,
+    lu: &'a mut BorderedLu,
+    r: &'a mut [f64],
+    residual_known: bool,
+    steps: Vec<Vec<f64>>,
+    best: (f64, Vec<f64>),
+}
+
+impl<S: ?Sized> Chord<'_, S> {
+    /// Keeps `x` as the best iterate if its ‖F‖₂ (`at.norm()`) is the
+    /// smallest so far.
+    fn keep_best(&mut self, x: &[f64], at: Progress<'_>) {
+        let now = at.norm();
+        if now < self.best.0 {
+            self.best.0 = now;
+            self.best.1.copy_from_slice(x);
         }
-        self.u.copy_from_slice(&best.1);
-        Err(SolveError::NonConvergence {
-            iterations: history.len().saturating_sub(1),
-            history,
+    }
+}
+
+impl<S: System + ?Sized> Solver for Chord<'_, S> {
+    type Error = std::convert::Infallible;
+
+    fn start(&mut self, x: &mut [f64]) -> Result<f64, SolveError> {
+        if !self.residual_known {
+            self.sys.residual(x, self.r);
+        }
+        Ok(norm2(self.r))
+    }
+
+    fn init(&mut self, x: &[f64], at: Progress<'_>) -> Result<(), SolveError> {
+        self.keep_best(x, at);
+        Ok(())
+    }
+
+    fn next_iter(&mut self, x: &mut [f64], at: Progress<'_>) -> Result<Step, SolveError> {
+        // z = −A₀⁻¹F, then the updates s_{j+1} s_jᵀ z / ‖s_j‖² in order.
+        let mut z = self.r.to_vec();
+        if self.lu.solve(&mut z).is_err() {
+            return Err(SolveError::NonConvergence {
+                iterations: at.iteration - 1,
+                history: at.history.to_vec(),
+            });
+        }
+        z.iter_mut().for_each(|v| *v = -*v);
+        for pair in self.steps.windows(2) {
+            if let [s0, s1] = pair {
+                let c = dot(s0, &z) / dot(s0, s0);
+                z.iter_mut().zip(s1).for_each(|(v, s)| *v += c * s);
+            }
+        }
+        if let Some(last) = self.steps.last() {
+            let denom = 1.0 - dot(last, &z) / dot(last, last);
+            z.iter_mut().for_each(|v| *v /= denom);
+        }
+        for (xi, d) in x.iter_mut().zip(&z) {
+            *xi += d;
+        }
+        self.steps.push(z);
+        self.sys.residual(x, self.r);
+        Ok(Step::Moved {
+            norm: norm2(self.r),
+            converged: false,
+        })
+    }
+
+    /// Diverging once ‖F‖ does not fall below the last value, or above a
+    /// quarter of the one two steps back.
+    fn check(&mut self, x: &[f64], at: Progress<'_>) -> Result<StepCheck, SolveError> {
+        self.keep_best(x, at);
+        let now = at.norm();
+        let before = |k: usize| {
+            at.history
+                .len()
+                .checked_sub(k + 1)
+                .and_then(|i| at.history.get(i))
+        };
+        let grew = before(1).is_some_and(|b| now >= *b);
+        Ok(if grew || before(2).is_some_and(|b| now > 0.25 * b) {
+            StepCheck::Diverged
+        } else {
+            StepCheck::Continue
         })
     }
 }
 
-/// Records a corrector's residual norm; `Some` once it is done: converged
-/// (the iteration count) or non-finite (the error with the history).
-fn settle(history: &mut Vec<f64>, norm: f64, tol: f64) -> Option<Result<usize, SolveError>> {
-    let iteration = history.len();
-    history.push(norm);
-    if !norm.is_finite() {
-        let history = std::mem::take(history);
-        return Some(Err(SolveError::NonFinite { iteration, history }));
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `F(x) = (x₀² + x₁² − 4, x₀ − x₁)`, root `(√2, √2)`, from `(1.5, 1.4)`
+    /// on the LU of the exact Jacobian at the start: the chord reaches the
+    /// root to 1e-13 in fewer than 15 steps; on the LU of a Jacobian with the
+    /// wrong sign in a row it stops at once (the residual grows) and leaves
+    /// `x` at the start, its best iterate.
+    #[test]
+    fn converges_on_a_good_factor_and_gives_up_on_a_bad_one() {
+        let mut f = |x: &[f64], r: &mut [f64]| {
+            r[0] = x[0] * x[0] + x[1] * x[1] - 4.0;
+            r[1] = x[0] - x[1];
+        };
+        let start = [1.5, 1.4];
+        let stopping = Stopping {
+            ftol: 1e-13,
+            max_iter: 30,
+        };
+        let mut lu = BorderedLu::new(2, 0);
+        lu.factor(&[3.0, 2.8, 1.0, -1.0], &[], &[], &[]).unwrap();
+        let (mut x, mut r) = (start, [0.0; 2]);
+        let steps = chord(&mut f, &mut lu, &mut x, &mut r, false, stopping).unwrap();
+        let s2 = 2f64.sqrt();
+        assert!(
+            (x[0] - s2).abs() < 1e-13 && (x[1] - s2).abs() < 1e-13,
+            "{x:?}"
+        );
+        assert!(steps < 15, "{steps}");
+        lu.factor(&[-3.0, -2.8, 1.0, -1.0], &[], &[], &[]).unwrap();
+        let mut x = start;
+        let err = chord(&mut f, &mut lu, &mut x, &mut r, false, stopping).unwrap_err();
+        assert!(matches!(err, SolveError::NonConvergence { .. }), "{err:?}");
+        assert_eq!(x, start);
     }
-    (norm <= tol).then_some(Ok(iteration))
 }

@@ -33,6 +33,9 @@
 //! - [`newton`](mod@newton): the one damped Newton method (dense Jacobian, optional
 //!   linear border rows, through [`bordered::BorderedLu`], backtracking,
 //!   residual and step tests);
+//! - [`chord`](mod@chord): the chord iteration on a factorization the
+//!   caller has, with Broyden's updates (Kelley's `brsol`): the first try
+//!   of the exact-Jacobian path corrector;
 //! - [`deflation`]: deflated Newton, the roots of `F` other than the known
 //!   ones (the HB solutions at one frequency of `ivt_hb::all_solutions`);
 //! - [`broyden`]: Broyden's quasi-Newton method (the thesis's Eq. 66–67)
@@ -45,6 +48,7 @@
 
 pub mod bordered;
 pub mod broyden;
+pub mod chord;
 pub mod deflation;
 pub mod iteration;
 pub mod lu;
@@ -58,6 +62,7 @@ pub mod vector;
 
 pub use bordered::{BorderedError, BorderedLu};
 pub use broyden::{broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, System};
+pub use chord::chord;
 pub use deflation::{deflated_newton, Deflation};
 pub use iteration::{SolveError, StepCheck};
 pub use lu::LuWorkspace;

@@ -12,7 +12,6 @@ use crate::error::HbError;
 use ivt_num::SolveError;
 
 mod broyden;
-mod chord;
 mod newton;
 pub use broyden::BroydenCorrector;
 pub use newton::NewtonCorrector;

@@ -9,14 +9,16 @@
 
 use std::convert::Infallible;
 
-use super::chord::Chord;
 use super::{Corrected, Correction, DirectionError, Found, PathCorrector, Prediction, Retry};
 use crate::branch::{full_newton_steps, path_lambda_step, Branch};
 use crate::continuation::ContinuationOptions;
 use crate::error::HbError;
+use ivt_num::iteration::Stopping;
 use ivt_num::vector::norm2;
 use ivt_num::SolveError;
-use ivt_num::{newton, BorderedLu, NewtonSystem, NewtonWorkspace, StepCheck};
+use ivt_num::{
+    chord, newton_bordered, Border, BorderedLu, NewtonSystem, NewtonWorkspace, StepCheck,
+};
 
 /// Corrector iterations counted as this many chord iterations per full Newton
 /// step (a Newton step assembles and factors the Jacobian).
@@ -64,7 +66,7 @@ impl NewtonCorrector {
             rhs: vec![0.0; m + 1],
             u: vec![0.0; m + 1],
             jac_at_u: false,
-            newton: NewtonWorkspace::new(m + 1),
+            newton: NewtonWorkspace::bordered(m + 1, 1),
             tol: opts.broyden.tol,
             max_newton: opts.broyden.max_iter,
             second_order: opts.second_order_predictor,
@@ -143,17 +145,31 @@ impl NewtonCorrector {
             branch,
             jac: &mut self.jac,
             r_lambda: &mut self.r_lambda,
-            pred,
         };
-        let result = newton(&mut corrected, &mut self.u, &mut self.newton, &nopts);
+        // The constraint row about the prediction (`λ = fix` when landing).
+        let row = pred.row();
+        let (values, origin) = match pred.fix {
+            Some(l) => ([l], &[][..]),
+            None => ([0.0], pred.u_pred),
+        };
+        let border = Border {
+            rows: &row,
+            values: &values,
+            origin,
+        };
+        let result = newton_bordered(
+            &mut corrected,
+            border,
+            &mut self.u,
+            &mut self.newton,
+            &nopts,
+        );
         // The last residual evaluation assembled `jac` at `u`.
         self.jac_at_u = result.is_ok();
         if let Some(r) = self.newton.residual().get(..self.m) {
             self.r.copy_from_slice(r);
         }
-        result
-            .map(|stats| stats.iterations)
-            .map_err(SolveError::from)
+        result.map(|stats| stats.iterations)
     }
 }
 
@@ -184,18 +200,29 @@ impl<B: Branch> PathCorrector<B> for NewtonCorrector {
         }
         let chord = if self.chord_ok {
             if fresh {
-                if let Some(r) = self.rhs.get_mut(..self.m) {
+                if let Some((c, r)) = self.rhs.split_last_mut() {
                     r.copy_from_slice(&self.r);
+                    *c = pred.constraint(&self.u);
                 }
             }
-            Chord {
-                aug: &mut self.aug,
-                u: &mut self.u,
-                rhs: &mut self.rhs,
-                tol: self.tol,
-                max_newton: self.max_newton,
-            }
-            .run(branch, pred, fresh)
+            let mut residual = |x: &[f64], r: &mut [f64]| {
+                if let (Some((&lambda, u)), Some((c, r))) = (x.split_last(), r.split_last_mut()) {
+                    branch.residual(u, lambda, r);
+                    *c = pred.constraint(x);
+                }
+            };
+            let stopping = Stopping {
+                ftol: self.tol,
+                max_iter: 3 * self.max_newton,
+            };
+            chord(
+                &mut residual,
+                &mut self.aug,
+                &mut self.u,
+                &mut self.rhs,
+                fresh,
+                stopping,
+            )
         } else {
             Err(SolveError::NonConvergence {
                 iterations: 0,
@@ -255,51 +282,45 @@ impl<B: Branch> PathCorrector<B> for NewtonCorrector {
     }
 }
 
-/// `[R(u, λ); constraint] = 0` in `x = (u, λ)` as a square
-/// [`NewtonSystem`]: each residual assembles `J` with it
-/// ([`Branch::residual_jacobian`]); the Jacobian is `[[J, R_λ], [rowᵀ]]`
+/// `R(u, λ) = 0` in `x = (u, λ)` as the [`NewtonSystem`] that the
+/// constraint row closes ([`newton_bordered`]): each residual assembles `J`
+/// with it ([`Branch::residual_jacobian`]); the Jacobian is `[J, R_λ]`
 /// row-major.
-struct ExactNewton<'a, 'p, B> {
+struct ExactNewton<'a, B> {
     branch: &'a mut B,
     /// `∂R/∂u` of the last residual, row-major `m × m`.
     jac: &'a mut [f64],
     r_lambda: &'a mut [f64],
-    pred: &'a Prediction<'p>,
 }
 
-impl<B: Branch> NewtonSystem for ExactNewton<'_, '_, B> {
+impl<B: Branch> NewtonSystem for ExactNewton<'_, B> {
     type Error = Infallible;
 
     fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
-        let m = self.r_lambda.len();
-        match (x.split_at_checked(m), r.split_at_mut_checked(m)) {
-            (Some((u, &[lambda])), Some((r_u, [r_c]))) => {
-                self.branch.residual_jacobian(u, lambda, r_u, self.jac);
-                *r_c = self.pred.constraint(x);
-            }
-            _ => r.fill(f64::NAN),
+        match x.split_last() {
+            Some((&lambda, u)) => self.branch.residual_jacobian(u, lambda, r, self.jac),
+            None => r.fill(f64::NAN),
         }
         Ok(())
     }
 
     fn jacobian(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), Infallible> {
         let m = self.r_lambda.len();
-        if let Some((u, &[lambda])) = x.split_at_checked(m) {
+        if let Some((&lambda, u)) = x.split_last() {
             let h = path_lambda_step(lambda);
             self.branch.residual_lambda(u, lambda, h, self.r_lambda);
         }
-        let row = self.pred.row();
-        let mut rows = out.chunks_exact_mut(m + 1);
-        // r_lambda first: zip must not pull (and drop) the constraint row.
         let jac_rows = self.jac.chunks_exact(m.max(1));
-        for ((r_l, jac_row), out_row) in self.r_lambda.iter().zip(jac_rows).zip(rows.by_ref()) {
+        for ((r_l, jac_row), out_row) in self
+            .r_lambda
+            .iter()
+            .zip(jac_rows)
+            .zip(out.chunks_exact_mut(m + 1))
+        {
             if let Some((left, last)) = out_row.split_at_mut_checked(m) {
                 left.copy_from_slice(jac_row);
                 last.fill(*r_l);
             }
-        }
-        if let Some(last_row) = rows.next() {
-            last_row.copy_from_slice(&row);
         }
         Ok(())
     }
