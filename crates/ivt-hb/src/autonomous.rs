@@ -11,10 +11,9 @@
 //! +1 (the phase shift); the orbit is classified by the others.
 //!
 //! [`limit_cycle_branch`] follows a limit cycle in a parameter μ of a family of
-//! problems by the engine's pseudo-arclength continuation ([`crate::continuation::Stepper`],
+//! problems by the engine's pseudo-arclength continuation ([`ivt_path::continuation::Stepper`],
 //! Eq. 68–77) on `[R(q, ω; μ); b₁] = 0` with unknowns `{q, ω, μ}`.
 
-use crate::continuation::{follow_residual, ContinuationOptions, Fold, PathPoint, Traced};
 use crate::floquet::HsuRule;
 use crate::galerkin::GalerkinJacobian;
 use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
@@ -23,6 +22,7 @@ use crate::stability::{classify, StabilityAnalyzer, StabilityKind};
 use faer::c64;
 use ivt_num::BroydenStats;
 use ivt_num::{newton_bordered, Border, NewtonOptions, NewtonSystem, NewtonWorkspace, StepCheck};
+use ivt_path::continuation::{follow_residual, ContinuationOptions, PathPoint, Traced, Turn};
 
 /// A converged limit cycle.
 #[derive(Debug, Clone, PartialEq)]
@@ -51,10 +51,10 @@ impl LimitCycle {
 }
 
 /// A limit-cycle branch traced in a parameter: `(μ, cycle)` in path order;
-/// its events are the stepper's turning points in μ ([`Fold`]: estimated
+/// its events are the stepper's turning points in μ ([`Turn`]: estimated
 /// from the three points around each, not located; [`crate::cycle_branch()`]
 /// locates them).
-pub type LimitCycleBranch = Traced<(f64, LimitCycle), Fold>;
+pub type LimitCycleBranch = Traced<(f64, LimitCycle), Turn>;
 
 /// Follows the limit cycle `start` of `family(mu_from)` in μ up to `mu_to`
 /// (pseudo-arclength, `opts`; its λ bounds are set from `mu_from`/`mu_to`),
@@ -62,9 +62,9 @@ pub type LimitCycleBranch = Traced<(f64, LimitCycle), Fold>;
 /// `family(μ)` must build an autonomous problem of the same size for every μ.
 ///
 /// # Errors
-/// [`HbError::InvalidInput`] for sizes or bounds, [`HbError::ContinuationStart`]
+/// [`HbError::InvalidInput`] for sizes or bounds, [`PathError::ContinuationStart`](ivt_path::PathError::ContinuationStart)
 /// when the start does not converge; trouble later on ends the branch with a
-/// [`crate::continuation::Termination`].
+/// [`ivt_path::continuation::Termination`].
 pub fn limit_cycle_branch<P, F>(
     family: F,
     hb: &HbOptions,

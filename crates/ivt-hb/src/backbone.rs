@@ -12,14 +12,14 @@
 //! is the continuation parameter (pseudo-arclength, Eq. 68–77). The problem
 //! must be undamped and unforced (`C = 0`, `f = 0`; checked).
 
-use crate::branch::Branch;
-use crate::continuation::{
-    correct_at_fixed_lambda, BroydenCorrector, ContinuationOptions, Corrector, Fold,
-    NewtonCorrector, Stepper, Traced,
-};
 use crate::family::{FamilyBranch, Frequency};
 use crate::ihb::{HbError, HbOptions, HbResidual};
 use crate::problem::PeriodicProblem;
+use ivt_path::branch::Branch;
+use ivt_path::continuation::{
+    correct_at_fixed_lambda, BroydenCorrector, ContinuationOptions, Corrector, NewtonCorrector,
+    Stepper, Traced, Turn,
+};
 
 mod system;
 use system::BackboneSystem;
@@ -66,9 +66,9 @@ pub struct BackbonePoint {
 }
 
 /// A traced backbone curve; its events are the stepper's turning points in
-/// the amplitude `a₁` ([`Fold`]: estimated from the three points around
+/// the amplitude `a₁` ([`Turn`]: estimated from the three points around
 /// each, not located).
-pub type Backbone = Traced<BackbonePoint, Fold>;
+pub type Backbone = Traced<BackbonePoint, Turn>;
 
 /// Traces the backbone of the mode with linear frequency `omega0` and shape
 /// `mode` (`n_dof` entries, `K mode = ω₀² M mode`) from `opts.amplitude_from`
@@ -77,7 +77,7 @@ pub type Backbone = Traced<BackbonePoint, Fold>;
 ///
 /// # Errors
 /// [`HbError::InvalidInput`] for sizes, a zero reference entry of `mode`, bad
-/// amplitudes, or a problem with damping or excitation; [`HbError::ContinuationStart`] when the start does not converge.
+/// amplitudes, or a problem with damping or excitation; [`PathError::ContinuationStart`](ivt_path::PathError::ContinuationStart) when the start does not converge.
 pub fn backbone<P: PeriodicProblem>(
     problem: &P,
     hb: &HbOptions,

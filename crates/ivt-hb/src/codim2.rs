@@ -12,7 +12,7 @@
 //! (a unit null vector: a fixed normalisation `cᵀv = 1` lets `v` grow without
 //! bound where it turns away from `c`, as it does through a cusp) has the unknowns `{q, v, ω}` and `p`; it is
 //! followed by the engine's pseudo-arclength continuation
-//! ([`crate::continuation::Stepper`], Eq. 68–77) with `p` as the path parameter. A cusp is a
+//! ([`ivt_path::continuation::Stepper`], Eq. 68–77) with `p` as the path parameter. A cusp is a
 //! turning point of this curve in `p` (there the two folds of the FRC merge):
 //! the path's fold detection brackets it and a second, short path with a
 //! hundredth of the step through the bracket locates it (parabola through the
@@ -36,13 +36,13 @@ pub use cycle_fold::{cycle_fold_curve, CycleFoldCurve, CycleFoldPoint};
 pub use multiplier_curve::{bifurcation_curve, BifurcationCurve, CurvePoint, CurveStart};
 pub use ns_points::{neimark_sacker_points, NeimarkSackerPoint};
 
-use crate::continuation::{follow_residual, ContinuationOptions, Path, PathPoint, Termination};
 use crate::error::HbError;
 use crate::ihb::HbOptions;
 use crate::problem::PeriodicProblem;
 use fixed::{solve_crossings, CurveSystem};
 use fold_system::FoldSystem;
 use ivt_num::vector::norm2;
+use ivt_path::continuation::{follow_residual, ContinuationOptions, Path, PathPoint, Termination};
 
 /// One fold on the curve.
 #[derive(Debug, Clone, PartialEq)]
@@ -216,7 +216,14 @@ fn follow_curve<S: CurveSystem>(
     let start = x0.last().copied().unwrap_or(towards);
     let direction = if towards < start { -1.0 } else { 1.0 };
     let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
-    follow_residual(residual, x0, None, direction, opts, |_| true)
+    Ok(follow_residual(
+        residual,
+        x0,
+        None,
+        direction,
+        opts,
+        |_| true,
+    )?)
 }
 
 /// The interval `[lo, hi]` of `p` of a curve of `what` from `(ω, p_start)`.

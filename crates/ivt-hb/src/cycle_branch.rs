@@ -14,8 +14,6 @@
 //! taken at `p_H ± offset·|p_to − p_from|` and refined by [`limit_cycle`].
 
 use crate::autonomous::{limit_cycle, limit_cycle_leg, LimitCycle};
-use crate::branch::Branch;
-use crate::continuation::{ContinuationOptions, PathPoint, Termination};
 use crate::error::HbError;
 use crate::events::{BifurcationKind, EventObserver, Fold, LocateOptions, Observer};
 use crate::galerkin::GalerkinJacobian;
@@ -23,6 +21,8 @@ use crate::hopf::{equilibrium, hopf_points, Field, HopfPoint};
 use crate::ihb::{HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
 use crate::BroydenStats;
+use ivt_path::branch::Branch;
+use ivt_path::continuation::{ContinuationOptions, PathPoint, Termination};
 
 pub(crate) mod member;
 use member::Member;
@@ -116,8 +116,7 @@ where
     // Each fold (a turn in p) is located as the points arrive: the [`Fold`]
     // detector on the cycle equations ([`CycleSystem`], unknowns {q, ω}).
     let mut system = CycleSystem::new(&member, hb, p_start)?;
-    let mut observer =
-        EventObserver::without_multipliers(&LocateOptions::fold(), vec![Box::new(Fold)]);
+    let mut observer = EventObserver::new(&LocateOptions::fold(), vec![Box::new(Fold)]);
     let (mut events, mut failure) = (Vec::new(), None);
     let mut watch = |p: &PathPoint| match observer.on_point(&mut system, p) {
         Ok(found) => {

@@ -14,10 +14,10 @@
 //! increasing frequency.
 
 use crate::backbone::{modal_path, BackboneOptions};
-use crate::continuation::Termination;
 use crate::error::HbError;
 use crate::ihb::HbOptions;
 use crate::problem::PeriodicProblem;
+use ivt_path::continuation::Termination;
 
 /// One point of a damped-mode curve.
 #[derive(Debug, Clone, PartialEq)]

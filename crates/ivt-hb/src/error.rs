@@ -1,8 +1,9 @@
-//! The crate's error type. The outcome of a failed Broyden solve
-//! ([`SolveError`]) nests in it by `#[from]`, so a failed path or solve keeps its
-//! residual history.
+//! The crate's error type. The outcome of a failed solve ([`SolveError`])
+//! and the path engine's errors ([`PathError`]) nest in it by `#[from]`, so
+//! a failed path or solve keeps its residual history.
 
 use ivt_num::SolveError;
+use ivt_path::PathError;
 use thiserror::Error;
 
 /// Errors of the harmonic-balance engine, its AFT, Hill's method and STHB.
@@ -43,20 +44,10 @@ pub enum HbError {
     /// A limit-cycle iteration collapsed onto the equilibrium `x = 0`.
     #[error("the iteration collapsed onto the equilibrium x = 0 (no limit cycle near the guess)")]
     Equilibrium,
-    /// A path's first point did not converge at its fixed parameter.
-    #[error("continuation start at λ = {lambda} does not converge: {cause}")]
-    ContinuationStart {
-        /// Path parameter of the start.
-        lambda: f64,
-        /// The corrector's failure (with its residual history).
-        cause: SolveError,
-    },
-    /// A path has no tangent at its start (singular `∂R/∂q` there).
-    #[error("continuation start at λ = {lambda}: singular Jacobian, no tangent")]
-    SingularStart {
-        /// Path parameter of the start.
-        lambda: f64,
-    },
+    /// A failure of the path engine (a path that cannot start, a locator
+    /// that cannot converge, sizes), with its residual history.
+    #[error(transparent)]
+    Path(#[from] PathError),
     /// A Newton iteration at a fixed frequency did not reach the tolerance.
     #[error("{method} did not converge at omega = {omega}: residual norms {history:?}")]
     NoConvergence {
@@ -140,10 +131,9 @@ impl HbError {
             | Self::Size { .. }
             | Self::AftTooFewSamples { .. }
             | Self::AftTooManySamples { .. } => "input",
+            Self::Path(e) => e.kind(),
             Self::Solve(_)
             | Self::Equilibrium
-            | Self::ContinuationStart { .. }
-            | Self::SingularStart { .. }
             | Self::NoConvergence { .. }
             | Self::Singular { .. }
             | Self::NonFinite { .. }
@@ -159,7 +149,8 @@ impl HbError {
     /// (empty for the other errors).
     pub fn history(&self) -> &[f64] {
         match self {
-            Self::Solve(s) | Self::ContinuationStart { cause: s, .. } => s.history(),
+            Self::Solve(s) => s.history(),
+            Self::Path(e) => e.history(),
             Self::NoConvergence { history, .. } => history,
             _ => &[],
         }

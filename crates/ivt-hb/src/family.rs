@@ -6,15 +6,15 @@
 //! `f(θ)` is projected once (it is part of the planned residual), so it must not
 //! depend on λ; [`FamilyBranch::new`] checks this.
 
-use crate::branch::{bilinear_lambda_difference, residual_lambda_difference, Branch};
-use crate::continuation::{
-    correct_at_fixed_lambda, BroydenCorrector, ContinuationOptions, Corrector, NewtonCorrector,
-    Stepper,
-};
 use crate::galerkin::{GalerkinForm, GalerkinJacobian};
 use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::{AtFrequency, PeriodicProblem};
 use crate::BroydenStats;
+use ivt_path::branch::{bilinear_lambda_difference, residual_lambda_difference, Branch};
+use ivt_path::continuation::{
+    correct_at_fixed_lambda, BroydenCorrector, ContinuationOptions, Corrector, NewtonCorrector,
+    Stepper,
+};
 
 /// A one-parameter family of periodic problems.
 pub trait Family {
@@ -144,13 +144,20 @@ impl<F: Family> FamilyBranch<F> {
         match opts.corrector {
             Corrector::Broyden => {
                 let broyden = Box::new(BroydenCorrector::new(m, &opts.broyden, None));
-                Stepper::new(self, broyden, start, 0, direction, opts)
+                Ok(Stepper::new(self, broyden, start, 0, direction, opts)?)
             }
             Corrector::Newton => {
                 let mut x = start.to_vec();
                 let its = correct_at_fixed_lambda(self, &mut x, opts)?;
                 let newton = Box::new(NewtonCorrector::new(m, opts));
-                Stepper::new(self, newton, &x, start_iterations + its, direction, opts)
+                Ok(Stepper::new(
+                    self,
+                    newton,
+                    &x,
+                    start_iterations + its,
+                    direction,
+                    opts,
+                )?)
             }
         }
     }
@@ -253,8 +260,8 @@ impl<F: Family> Branch for FamilyBranch<F> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::branch::path_lambda_step;
     use crate::problem::{Duffing, MathieuDuffing};
+    use ivt_path::branch::path_lambda_step;
 
     /// `∂R/∂λ` by a central difference of the whole residual, step `h`.
     fn central<F: Family>(

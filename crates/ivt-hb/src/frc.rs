@@ -1,15 +1,15 @@
 //! Frequency-response curves (Fig. 29): the modified-IHB residual followed in ω_f by
-//! pseudo-arclength continuation ([`crate::continuation`], Eq. 68–77), with the
+//! pseudo-arclength continuation ([`ivt_path::continuation`], Eq. 68–77), with the
 //! Floquet multipliers (Hsu, Eq. 80) and stability class at every point. Each
 //! turn of the path is located as the points arrive, through the
-//! [`crate::events::Fold`] detector of an [`EventObserver`]: Newton on the
-//! extended system of [`crate::events::fold`] (the fold itself, not a bracket
-//! between two points), started from the path point nearest the turn.
+//! [`Fold`] detector of an observer ([`crate::events::observer`]): Newton on
+//! the path engine's minimally extended system ([`crate::events::locate_fold`],
+//! the fold itself, not a bracket between two points), started from the path
+//! point nearest the turn.
 
 use crate::aft::Aft;
-use crate::continuation::{ContinuationOptions, Corrector, Traced};
 use crate::events::{
-    observe, BifurcationKind, Detector, EventObserver, Fold, LocateOptions, PathOptions, Trace,
+    observe, observer, BifurcationKind, Detector, Fold, LocateOptions, PathOptions,
 };
 use crate::family::{FamilyBranch, Frequency};
 use crate::ihb::{HbError, HbOptions, HbSolution};
@@ -17,6 +17,8 @@ use crate::modified::ModifiedIhb;
 use crate::problem::{AtFrequency, PeriodicProblem};
 use crate::stability::{HsuSteps, StabilityKind};
 use faer::c64;
+use ivt_path::continuation::{ContinuationOptions, Corrector, Traced};
+use ivt_path::events::{Event, TracedPoint};
 
 /// Options of a frequency sweep.
 #[derive(Debug, Clone, PartialEq)]
@@ -146,19 +148,19 @@ pub fn frequency_response<P: PeriodicProblem>(
     copts.lambda_max = opts.from.max(opts.to);
     let direction = if opts.to > opts.from { 1.0 } else { -1.0 };
     // Each point's multipliers and the fold detector's test as the point
-    // arrives ([`EventObserver`]): where the branch's last Galerkin assembly
+    // arrives (an `EventObserver`): where the branch's last Galerkin assembly
     // is the point's (a Newton-corrected point, or every point without the
     // second-order predictor), its ∂g samples serve Hsu's level of the same
     // grid without another evaluation of g; a fold is located once the
     // point after its start has arrived, or from the last point when the
     // path ends there.
-    let detectors: Vec<Box<dyn Detector<FamilyBranch<Frequency<'_, P>>>>> = vec![Box::new(Fold)];
+    let detectors: Vec<Box<dyn Detector<FamilyBranch<Frequency<'_, P>>, HbError>>> =
+        vec![Box::new(Fold)];
     let locate = LocateOptions::fold();
-    let mut observer =
-        EventObserver::with_detectors(&family, opts.from, opts.path.stability, &locate, detectors)?;
+    let mut observer = observer(&family, opts.from, opts.path.stability, &locate, detectors)?;
     let mut stepper = family.stepper(&x0, start.stats.iterations, direction, &copts)?;
     let (path, events) = observe(&mut stepper, &mut observer, |_, _| true)?;
-    let trace = Trace {
+    let trace = Traced {
         points: observer.into_points(),
         events,
         termination: path.termination,
@@ -171,57 +173,55 @@ pub fn frequency_response<P: PeriodicProblem>(
             .find(|t| t.index == index)
             .map(|t| t.lambda)
     };
-    Frc::assemble(&trace, hb, estimate)
+    assemble(&trace, hb, estimate)
 }
 
-impl Frc {
-    /// The curve of an event trace in ω_f ([`crate::trace`] on a frequency
-    /// family): its points with their amplitudes, and its fold events as
-    /// [`FrcFold`]s (located, or the point before the turn when location failed).
-    ///
-    /// # Errors
-    /// [`HbError`] if `hb`'s AFT sizes are invalid.
-    pub fn from_trace(trace: &Trace, hb: &HbOptions) -> Result<Self, HbError> {
-        Self::assemble(trace, hb, |_| None)
-    }
+/// The curve of an event trace in ω_f ([`crate::trace`] on a frequency
+/// family): its points with their amplitudes, and its fold events as
+/// [`FrcFold`]s (located, or the point before the turn when location failed).
+///
+/// # Errors
+/// [`HbError`] if `hb`'s AFT sizes are invalid.
+pub fn from_trace(trace: &crate::Trace, hb: &HbOptions) -> Result<Frc, HbError> {
+    assemble(trace, hb, |_| None)
+}
 
-    /// [`Frc::from_trace`], an unlocated fold at `estimate(index)` (ω_f), or
-    /// at its point's ω_f where that is `None`.
-    fn assemble(
-        trace: &Trace,
-        hb: &HbOptions,
-        estimate: impl Fn(usize) -> Option<f64>,
-    ) -> Result<Self, HbError> {
-        let mut probe = AmplitudeProbe::new(hb)?;
-        let points: Vec<FrcPoint> = trace
-            .points
-            .iter()
-            .map(|p| FrcPoint {
-                omega_f: p.lambda,
-                amplitude: probe.of(&p.q),
-                kind: p.kind,
-                multipliers: p.multipliers.clone(),
-                multiplier_error: p.multiplier_error,
-                coeffs: p.q.clone(),
-            })
-            .collect();
-        let folds = trace
-            .events
-            .iter()
-            .filter(|e| e.kind == BifurcationKind::Fold)
-            .filter_map(|e| {
-                let near = points.get(e.index)?;
-                let located = e.location.as_ref().ok().map(|b| (b.q.clone(), b.lambda));
-                let omega = estimate(e.index).unwrap_or(near.omega_f);
-                Some(probe.fold(e.index, located, near, omega))
-            })
-            .collect();
-        Ok(Self {
-            points,
-            events: folds,
-            termination: trace.termination.clone(),
+/// [`from_trace`], an unlocated fold at `estimate(index)` (ω_f), or at its
+/// point's ω_f where that is `None`.
+fn assemble<E>(
+    trace: &Traced<TracedPoint, Event<E>>,
+    hb: &HbOptions,
+    estimate: impl Fn(usize) -> Option<f64>,
+) -> Result<Frc, HbError> {
+    let mut probe = AmplitudeProbe::new(hb)?;
+    let points: Vec<FrcPoint> = trace
+        .points
+        .iter()
+        .map(|p| FrcPoint {
+            omega_f: p.lambda,
+            amplitude: probe.of(&p.q),
+            kind: p.kind,
+            multipliers: p.multipliers.clone(),
+            multiplier_error: p.multiplier_error,
+            coeffs: p.q.clone(),
         })
-    }
+        .collect();
+    let folds = trace
+        .events
+        .iter()
+        .filter(|e| e.kind == BifurcationKind::Fold)
+        .filter_map(|e| {
+            let near = points.get(e.index)?;
+            let located = e.location.as_ref().ok().map(|b| (b.q.clone(), b.lambda));
+            let omega = estimate(e.index).unwrap_or(near.omega_f);
+            Some(probe.fold(e.index, located, near, omega))
+        })
+        .collect();
+    Ok(Frc {
+        points,
+        events: folds,
+        termination: trace.termination.clone(),
+    })
 }
 
 /// `max_τ |x_0(τ)|` over the 2N AFT samples of a coefficient vector (DOF 0):

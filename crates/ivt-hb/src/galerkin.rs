@@ -266,12 +266,12 @@ impl GalerkinJacobian {
 mod tests {
     use super::form::{basis_rows, quadrature_basis};
     use super::*;
-    use crate::branch::Branch;
     use crate::elements::{Element, ElementProblem, Harmonic, Law};
     use crate::ihb::HbOptions;
     use crate::problem::{matrix_getters, Duffing, GeneralProblem, MathieuDuffing};
     use crate::FamilyBranch;
     use crate::ModifiedIhb;
+    use ivt_path::branch::Branch;
 
     /// The direct O(2N·n_dof²·(2n+1)²) sum `(2s/2N) Σᵢ C_s(τᵢ)(G_x C_sᵀ + ω G_v C_s'ᵀ)`
     /// on the basis table: the oracle of the FFT assembly (nonlinear part only).

@@ -6,11 +6,9 @@
 pub mod aft;
 pub mod autonomous;
 pub mod backbone;
-pub mod branch;
 pub mod classic;
 pub mod codim2;
 pub mod condense;
-pub mod continuation;
 pub mod cycle_branch;
 pub mod damped;
 pub mod deflation;
@@ -39,13 +37,8 @@ pub mod transient;
 pub use aft::Aft;
 pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
 pub use backbone::{backbone, Backbone, BackboneOptions, BackbonePoint};
-pub use branch::{Branch, ResidualBranch};
 pub use classic::ClassicIhb;
 pub use codim2::{fold_curve, neimark_sacker_points, FoldCurve, FoldPoint, NeimarkSackerPoint};
-pub use continuation::{
-    BroydenCorrector, ContinuationOptions, Corrector, Fold, NewtonCorrector, Path, PathCorrector,
-    PathPoint, Step, Stepper, Termination, Traced,
-};
 pub use cycle_branch::{cycle_branch, CycleBranch, CycleBranchOptions};
 pub use damped::{damped_modes, linear_mode, DampedModePoint, DampedModes};
 pub use deflation::{all_solutions, AllSolutions, FoundSolution, SearchOptions, SearchReport};
@@ -66,6 +59,11 @@ pub use hopf::{hopf_points, HopfPoint};
 pub use ihb::{HbOptions, HbResidual, HbSolution, HbSolver};
 pub use ivt_num::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
+};
+pub use ivt_path::{Branch, PathError, ResidualBranch};
+pub use ivt_path::{
+    BroydenCorrector, ContinuationOptions, Corrector, NewtonCorrector, Path, PathCorrector,
+    PathPoint, Step, Stepper, Termination, Traced, Turn,
 };
 pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;

@@ -15,7 +15,6 @@
 //!    unknowns; `a_1` is then the continuation parameter.
 
 use crate::aft::{embed_subharmonic, resize_harmonics};
-use crate::continuation::{follow_residual, ContinuationOptions};
 use crate::events::{locate_multiplier_crossing, BifurcationError, BifurcationKind, LocateOptions};
 use crate::family::FamilyBranch;
 use crate::floquet::HsuRule;
@@ -25,6 +24,7 @@ use crate::problem::MathieuDuffing;
 use crate::stability::StabilityAnalyzer;
 use faer::c64;
 use ivt_num::{broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace};
+use ivt_path::continuation::{follow_residual, ContinuationOptions};
 
 /// The thesis's period-1 coefficients at β₀ = 3.6, n = 9 (§3.2.5; the printed
 /// "=0.0001" is read as −0.0001).

@@ -4,12 +4,12 @@
 //! Broyden matrix) when the direct iteration fails, and pseudo-arclength in the
 //! stepping parameter when that path folds.
 
-use crate::continuation::{follow_residual, ContinuationOptions};
 use crate::galerkin::GalerkinJacobian;
 use crate::ihb::{validate_omega, HbError, HbOptions, HbResidual, HbSolution, HbSolver};
 use crate::problem::PeriodicProblem;
 use ivt_num::vector::matvec;
 use ivt_num::{broyden_solve, BroydenStats, BroydenWorkspace, System};
+use ivt_path::continuation::{follow_residual, ContinuationOptions};
 
 /// The modified IHB solver for one problem and one size (plans and buffers reused
 /// across solves; nothing is allocated inside the iteration, except the Galerkin

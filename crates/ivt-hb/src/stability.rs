@@ -14,32 +14,7 @@ use crate::hill::{fourier_blocks, hill_multipliers};
 use crate::ihb::HbSolution;
 use crate::problem::PeriodicProblem;
 use faer::c64;
-
-/// What the leading multiplier says.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum StabilityKind {
-    /// All multipliers inside the unit circle.
-    Stable,
-    /// A real multiplier beyond +1 (saddle-node / fold side).
-    Fold,
-    /// A real multiplier beyond −1 (period doubling).
-    PeriodDoubling,
-    /// A complex pair outside the unit circle (Neimark–Sacker / secondary Hopf).
-    NeimarkSacker,
-}
-
-impl StabilityKind {
-    /// Short lowercase name for tables and JSON.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Stable => "stable",
-            Self::Fold => "fold",
-            Self::PeriodDoubling => "period_doubling",
-            Self::NeimarkSacker => "neimark_sacker",
-        }
-    }
-}
+pub use ivt_path::events::{classify, StabilityKind};
 
 /// Floquet multipliers and their verdict.
 #[derive(Debug, Clone, PartialEq)]
@@ -67,24 +42,6 @@ impl Floquet {
     /// All multipliers strictly inside the unit circle.
     pub fn stable(&self) -> bool {
         self.kind == StabilityKind::Stable
-    }
-}
-
-/// Classifies multipliers sorted by decreasing modulus (a multiplier counts as real
-/// when |Im μ| ≤ 1e-7·|μ|).
-pub fn classify(sorted: &[c64]) -> StabilityKind {
-    match sorted.first() {
-        Some(m) if m.norm() >= 1.0 => {
-            if m.im.abs() > 1e-7 * m.norm() {
-                StabilityKind::NeimarkSacker
-            } else if m.re > 0.0 {
-                StabilityKind::Fold
-            } else {
-                StabilityKind::PeriodDoubling
-            }
-        }
-        Some(m) if m.norm().is_nan() => StabilityKind::Fold,
-        _ => StabilityKind::Stable,
     }
 }
 

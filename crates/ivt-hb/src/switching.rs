@@ -5,16 +5,15 @@
 //! the odd-harmonic null vector of the period-2 Galerkin Jacobian,
 //! [`period_doubled_start`]).
 
-use crate::branch::{full_newton_steps, residual_lambda_difference, Branch};
-use crate::events::extended::{
-    check_start, lambda_step, null_vector, put_jacobian, singular_at_start, solve_error,
-};
 use crate::events::{dot, Bifurcation, BifurcationError, BifurcationKind, LocateOptions};
 use crate::family::{Family, FamilyBranch};
 use crate::ihb::{HbError, HbOptions};
 use ivt_num::vector::norm2;
-use ivt_num::SolveError;
 use ivt_num::{newton_bordered, Border, LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace};
+use ivt_path::branch::{full_newton_steps, residual_lambda_difference, Branch};
+use ivt_path::events::extended::{
+    check_start, lambda_step, null_vector, put_jacobian, singular_at_start,
+};
 use std::convert::Infallible;
 
 /// A first point on a new branch: Newton on `[R(q, λ); dᵀ(x − x*) − h] = 0`
@@ -69,7 +68,7 @@ pub fn switch_branch<B: Branch>(
         &mut NewtonWorkspace::bordered(n1, 1),
         &nopts,
     )
-    .map_err(|e| solve_error(SolveError::from(e)))?;
+    .map_err(|e| BifurcationError::from(HbError::Solve(e)))?;
     let lambda = x.pop().unwrap_or(lambda);
     Ok((x, lambda))
 }
@@ -155,7 +154,7 @@ pub fn period_doubled_start<F: Family>(
     let mut lu = LuWorkspace::new(m2);
     lu.factor_row_major(&jac);
     if !null_vector(&mut lu, &mut v, false) {
-        return Err(solve_error(singular_at_start()));
+        return Err(HbError::Solve(singular_at_start()).into());
     }
     let mut d: Vec<f64> = v
         .iter()

@@ -21,7 +21,8 @@ pub struct LuWorkspace {
     mem: MemBuffer,
     /// Scratch of the one-vector [`LuWorkspace::solve`].
     column: Vec<f64>,
-    /// Sign of the determinant of the last factored matrix.
+    /// Sign of the determinant of the last factored matrix (NaN after a
+    /// factorization that met a non-finite pivot).
     pub det_sign: f64,
 }
 
@@ -104,6 +105,7 @@ impl LuWorkspace {
         for i in 0..n {
             let u = self.mat[(i, i)];
             if !u.is_finite() {
+                self.det_sign = f64::NAN;
                 return false;
             }
             sign *= u.signum();

@@ -68,7 +68,7 @@ pub trait Branch {
 /// close start (a converged orbit of another method, a point next to an
 /// event, a step off a bifurcation): every step in full (no halving, no
 /// descent test), at most `max_iter`, converged at `‖R‖ ≤ ftol`.
-pub(crate) fn full_newton_steps(ftol: f64, max_iter: usize) -> NewtonOptions {
+pub fn full_newton_steps(ftol: f64, max_iter: usize) -> NewtonOptions {
     NewtonOptions {
         ftol,
         max_iter,
@@ -115,7 +115,7 @@ pub fn bilinear_lambda_difference<B: Branch + ?Sized>(
 }
 
 /// `wᵀ A v` for a row-major square `A`.
-pub(crate) fn bilinear_form(a: &[f64], w: &[f64], v: &[f64]) -> f64 {
+pub fn bilinear_form(a: &[f64], w: &[f64], v: &[f64]) -> f64 {
     a.chunks_exact(v.len().max(1))
         .zip(w)
         .map(|(row, wi)| wi * row.iter().zip(v).map(|(x, y)| x * y).sum::<f64>())

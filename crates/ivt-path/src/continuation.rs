@@ -6,7 +6,7 @@
 //! and Newton on the exact bordered Jacobian), and adapts the step by one
 //! rule (`step_control.rs`: the corrector's effort, halving on failure, the
 //! cap [`ContinuationOptions::step_cap`], landing on the bounds of λ). A sign
-//! change of the direction's λ component marks a fold (turning point).
+//! change of the direction's λ component marks a turn in λ ([`Turn`]).
 
 use ivt_num::vector::norm2;
 use ivt_num::{BroydenOptions, SolveError};
@@ -68,8 +68,8 @@ pub struct ContinuationOptions {
     /// tangent, gives the next tangent. The price: the last Jacobian assembled
     /// when `on_point` runs is the prediction's, not the point's.
     pub second_order_predictor: bool,
-    /// The corrector, where a path offers both (the frequency response,
-    /// [`crate::trace`], the backbone): [`Corrector::Broyden`] (Eq. 68–77,
+    /// The corrector, where a path offers both (ivt-hb's frequency response,
+    /// its traced events, the backbone): [`Corrector::Broyden`] (Eq. 68–77,
     /// the default) or [`Corrector::Newton`]. Not read by the paths that have
     /// one: [`follow_residual`] (a residual alone) is Broyden's, the string
     /// and condensed sweeps (exact Jacobians) are Newton's.
@@ -136,10 +136,12 @@ impl PathPoint {
     }
 }
 
-/// A fold (turning point in λ): the secant's λ component changed sign between
-/// the points `bracket`, `bracket + 1` and `bracket + 2`.
+/// A turning point in λ as the stepper sees it: the direction's λ component
+/// changed sign between the points `bracket`, `bracket + 1` and
+/// `bracket + 2` (its estimate; the fold itself is located by the
+/// [`crate::events::Fold`] detector).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Fold {
+pub struct Turn {
     /// Index of the point nearest the turn (in arclength along the parabola).
     pub index: usize,
     /// λ at the turn from a parabola through the three points around it.
@@ -181,29 +183,27 @@ impl serde::Serialize for Termination {
 }
 
 /// The one result of a traced curve: its points and events in path order
-/// and why tracing stopped. The stepper's [`Path`] holds the raw states;
-/// [`crate::Frc`] and [`crate::condense::CondensedFrc`] hold the same curve
-/// read as orbits; [`crate::Trace`] holds the orbits with their multipliers
-/// and every event detected; [`crate::Backbone`] and
-/// [`crate::LimitCycleBranch`] the curves in amplitude and in μ. Serializes
-/// (where its point and event types do)
-/// with [`Termination`] as its snake_case word.
+/// and why tracing stopped. The stepper's [`Path`] holds the raw states and
+/// its turns; ivt-hb's `Frc` and ivt-condense's `CondensedFrc` hold the same
+/// curve read as orbits, its `Trace` the orbits with their multipliers and
+/// every event detected, its `Backbone` and `LimitCycleBranch` the curves in
+/// amplitude and in μ. Serializes (where its point and event types do) with
+/// [`Termination`] as its snake_case word.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Traced<P, E> {
     /// Points in path order.
     pub points: Vec<P>,
-    /// Events in path order: for [`Path`], [`crate::Frc`],
-    /// [`crate::condense::CondensedFrc`], [`crate::Backbone`] and
-    /// [`crate::LimitCycleBranch`] the folds (turning points in λ), the one
-    /// event their stepper detects; for [`crate::Trace`] every
-    /// event detected, each with its location or why locating it failed.
+    /// Events in path order: for [`Path`] the turns in λ the stepper
+    /// detects; for the curves read from it the folds located there; for a
+    /// trace every event detected, each with its location or why locating
+    /// it failed.
     pub events: Vec<E>,
     /// Why tracing stopped.
     pub termination: Termination,
 }
 
-/// A traced path: the converged states and the folds the stepper detected.
-pub type Path = Traced<PathPoint, Fold>;
+/// A traced path: the converged states and the turns the stepper detected.
+pub type Path = Traced<PathPoint, Turn>;
 
 impl ContinuationOptions {
     /// The largest step at the point `x`: `ds_max`, relative to `‖x‖₂`
@@ -217,7 +217,7 @@ impl ContinuationOptions {
 /// `c` around a fold: the quadratic through them in chord arclength s,
 /// evaluated where its λ(s) is extremal (`b` itself if λ(s) is straight).
 /// Off the path by O(Δη³) rather than the O(Δη) of the nearest point: the
-/// start for [`crate::locate_fold`].
+/// start for [`crate::events::locate_fold`].
 pub fn turn_estimate(a: &PathPoint, b: &PathPoint, c: &PathPoint) -> Vec<f64> {
     turn(a, b, c).0
 }

@@ -1,8 +1,8 @@
 //! The backbone equations as a [`Branch`] in the prescribed amplitude.
 
-use crate::branch::{path_lambda_step, Branch};
 use crate::family::{FamilyBranch, Frequency};
 use crate::problem::PeriodicProblem;
+use ivt_path::branch::{path_lambda_step, Branch};
 
 /// Adds the Galerkin projection of the unfolding damping `κ M ẋ` (τ = ωt) to
 /// `r`: harmonic h gives `κhω M b_h` to the cosine rows and `−κhω M a_h` to the

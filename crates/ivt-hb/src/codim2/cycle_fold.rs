@@ -15,7 +15,7 @@
 //!
 //! in the path vector `x = [q, ω, v, μ, ν]` has one equation fewer than
 //! unknowns and is followed by the engine's pseudo-arclength continuation
-//! ([`crate::continuation::Stepper`], Eq. 68–77) with ν as the path parameter, μ solved along. A
+//! ([`ivt_path::continuation::Stepper`], Eq. 68–77) with ν as the path parameter, μ solved along. A
 //! cusp of cycle folds (two folds merging) is a turning point of this curve in
 //! ν: it is reported at the path's fold estimate (the vertex of the parabola
 //! through the three points around the turn), not refined further. The fold
@@ -31,15 +31,16 @@ use std::cell::Cell;
 use super::fixed::CurveSystem;
 use super::fold_system::{null_rows, split_fold_residual, split_fold_vector};
 use super::{bounded, fold_curve_of, follow_curve, path_interval, Curve, FoldPoint};
-use crate::branch::Branch;
-use crate::continuation::ContinuationOptions;
 use crate::cycle_branch::member::Member;
 use crate::cycle_branch::CycleSystem;
 use crate::error::HbError;
-use crate::events::extended::unit_null_vector;
 use crate::ihb::{HbOptions, HbSolution};
 use crate::problem::PeriodicProblem;
 use ivt_num::vector::norm2;
+use ivt_path::branch::Branch;
+use ivt_path::continuation::ContinuationOptions;
+use ivt_path::events::extended::unit_null_vector;
+use ivt_path::PathError;
 
 /// One fold of limit cycles on the curve.
 #[derive(Debug, Clone, PartialEq)]
@@ -65,9 +66,9 @@ pub type CycleFoldCurve = Curve<CycleFoldPoint>;
 ///
 /// # Errors
 /// [`HbError::InvalidInput`] for sizes or bounds (`nu_start` must lie in the
-/// interval); `family(mu, nu_start)`'s error; [`HbError::SingularStart`]
+/// interval); `family(mu, nu_start)`'s error; [`PathError::SingularStart`](ivt_path::PathError::SingularStart)
 /// if no null vector is found at the start; the start's failures as
-/// [`follow_residual`](crate::continuation::follow_residual)'s. Later, a (μ, ν) where `family` fails is a failed step,
+/// [`follow_residual`](ivt_path::continuation::follow_residual)'s. Later, a (μ, ν) where `family` fails is a failed step,
 /// and a failed `at` point is left out (the curve is kept).
 pub fn cycle_fold_curve<P, F>(
     family: F,
@@ -152,7 +153,8 @@ impl<'f, 'c, P: PeriodicProblem, F: Fn(f64) -> Member<P>> CycleFoldSystem<'f, 'c
     /// two steps of inverse iteration.
     fn null_vector(&mut self, u: &[f64], mu: f64) -> Result<Vec<f64>, HbError> {
         self.cycle.jacobian(u, mu, &mut self.jac);
-        unit_null_vector(&self.jac, self.m1).ok_or(HbError::SingularStart { lambda: mu })
+        unit_null_vector(&self.jac, self.m1)
+            .ok_or(HbError::Path(PathError::SingularStart { lambda: mu }))
     }
 }
 

@@ -7,8 +7,8 @@
 //! Jacobian from the linear interpolation of the two path points that
 //! bracket the value.
 
-use crate::continuation::PathPoint;
 use ivt_num::{NewtonOptions, NewtonSystem, NewtonWorkspace};
+use ivt_path::continuation::PathPoint;
 
 /// The extended system of a curve: `n − 1` equations in the path vector `x`
 /// of `n` entries (`p` last).

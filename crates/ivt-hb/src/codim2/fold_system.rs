@@ -7,11 +7,12 @@
 use super::fixed::CurveSystem;
 use super::FoldPoint;
 use crate::error::HbError;
-use crate::events::extended::unit_null_vector;
 use crate::galerkin::GalerkinJacobian;
 use crate::ihb::{HbOptions, HbResidual};
 use crate::problem::PeriodicProblem;
 use ivt_num::vector::{dot, matvec};
+use ivt_path::events::extended::unit_null_vector;
+use ivt_path::PathError;
 
 /// The fold system of one family, with the residual planned at the last `p`.
 pub(super) struct FoldSystem<'f, F> {
@@ -65,7 +66,8 @@ impl<'f, P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> FoldSystem<'f, F>
             .ok_or_else(|| HbError::InvalidInput("the family fails at p_start".into()))?;
         self.galerkin
             .assemble(&mut self.res, &problem, q, omega, 1.0, &mut self.jac);
-        unit_null_vector(&self.jac, self.m).ok_or(HbError::SingularStart { lambda: p })
+        unit_null_vector(&self.jac, self.m)
+            .ok_or(HbError::Path(PathError::SingularStart { lambda: p }))
     }
 }
 

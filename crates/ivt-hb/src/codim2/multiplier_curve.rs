@@ -20,7 +20,7 @@
 //!   start's eigenvector); path vector `[q, ω, θ, v_r, v_i, p]`.
 //!
 //! Each system has one equation fewer than unknowns and is followed by the
-//! engine's pseudo-arclength continuation ([`crate::continuation::Stepper`], Eq. 68–77)
+//! engine's pseudo-arclength continuation ([`ivt_path::continuation::Stepper`], Eq. 68–77)
 //! with `p` as the path parameter (Φ's derivatives by the path's finite
 //! differences). The point at each `p` of `at` is solved at that `p` by
 //! Newton (`fixed.rs`). On a Neimark–Sacker curve the strong resonances 1:3
@@ -36,9 +36,7 @@
 
 use super::fixed::{solve_crossings, CurveSystem};
 use super::{bounded, path_interval};
-use crate::continuation::{follow_residual, ContinuationOptions, PathPoint, Termination};
 use crate::error::HbError;
-use crate::events::extended::null_vector;
 use crate::events::{BifurcationKind, LocateOptions};
 use crate::floquet::{eigenvalues, monodromy_uniform, HsuRule};
 use crate::ihb::{HbOptions, HbResidual, HbSolution};
@@ -46,6 +44,9 @@ use crate::problem::PeriodicProblem;
 use crate::stability::StabilityAnalyzer;
 use ivt_num::vector::{dot, norm2};
 use ivt_num::LuWorkspace;
+use ivt_path::continuation::{follow_residual, ContinuationOptions, PathPoint, Termination};
+use ivt_path::events::extended::null_vector;
+use ivt_path::PathError;
 use std::f64::consts::{PI, TAU};
 
 /// A located period doubling or Neimark–Sacker point of the FRC of
@@ -351,7 +352,7 @@ impl<'f, P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>> MultiplierSystem<
         lu.factor_row_major(&a);
         let mut v = vec![1.0 / (n as f64).sqrt(); n];
         if !null_vector(&mut lu, &mut v, false) {
-            return Err(HbError::SingularStart { lambda: p });
+            return Err(HbError::Path(PathError::SingularStart { lambda: p }));
         }
         self.reference = if self.ns { v.clone() } else { Vec::new() };
         let mut x = q.to_vec();

@@ -6,7 +6,6 @@
 //! in p between two samples is not followed, and each sample costs a trace
 //! (the continuation is [`super::bifurcation_curve`]).
 
-use crate::continuation::Corrector;
 use crate::error::HbError;
 use crate::events::BifurcationKind;
 use crate::frc::FrcOptions;
@@ -14,6 +13,7 @@ use crate::ihb::HbOptions;
 use crate::jobs::{frc, FrcRequest};
 use crate::problem::PeriodicProblem;
 use faer::c64;
+use ivt_path::continuation::Corrector;
 
 /// A located Neimark–Sacker point of the FRC at one p.
 #[derive(Debug, Clone, PartialEq)]

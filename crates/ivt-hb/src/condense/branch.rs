@@ -16,12 +16,12 @@
 
 use super::dynamic::Structure;
 use super::receptance::{Coupling, Receptances};
-use crate::branch::{bilinear_form, Branch};
 use crate::error::HbError;
 use crate::galerkin::GalerkinJacobian;
 use crate::ihb::{HbOptions, HbResidual};
 use crate::problem::PeriodicProblem;
 use faer::{c64, Mat};
+use ivt_path::branch::{bilinear_form, Branch};
 
 /// The condensed HB problem of a sparse structure with a local nonlinearity.
 pub struct CondensedBranch<P: PeriodicProblem> {
@@ -517,9 +517,9 @@ impl<P: PeriodicProblem> Branch for CondensedBranch<P> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::branch::bilinear_lambda_difference;
     use crate::models::{cantilever, BeamProperties};
     use crate::GeneralProblem;
+    use ivt_path::branch::bilinear_lambda_difference;
 
     /// The exact `∂(wᵀJv)/∂ω_f` equals the central difference of two
     /// Jacobians (each from its own factorizations) at ω_f ± h to its

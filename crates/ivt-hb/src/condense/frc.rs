@@ -15,15 +15,15 @@ use super::stability::{
     BasisGrowth, CondensedFloquet, ReducedStability, DEFAULT_BASIS_TOL, DEFAULT_BLOCKS,
 };
 use crate::aft::{eval_series, Aft};
-use crate::branch::Branch;
-use crate::continuation::{
-    correct_at_fixed_lambda, ContinuationOptions, NewtonCorrector, Stepper, Traced,
-};
 use crate::error::HbError;
 use crate::events::{observe, BifurcationKind, EventObserver, Fold, LocateOptions};
 use crate::frc::FrcFold;
 use crate::problem::PeriodicProblem;
 use crate::stability::HsuSteps;
+use ivt_path::branch::Branch;
+use ivt_path::continuation::{
+    correct_at_fixed_lambda, ContinuationOptions, NewtonCorrector, Stepper, Traced,
+};
 
 /// Options of a condensed frequency sweep.
 #[derive(Debug, Clone, PartialEq)]
@@ -125,7 +125,7 @@ pub type CondensedFrc = Traced<CondensedPoint, CondensedFold>;
 /// Traces the frequency response of `branch` from `opts.from` to `opts.to`.
 ///
 /// # Errors
-/// [`HbError::InvalidInput`] for bad bounds or DOFs, [`HbError::ContinuationStart`]
+/// [`HbError::InvalidInput`] for bad bounds or DOFs, [`PathError::ContinuationStart`](ivt_path::PathError::ContinuationStart)
 /// when the start does not converge, [`HbError::Singular`] when a dynamic
 /// stiffness is singular at a point.
 pub fn condensed_response<P: PeriodicProblem>(
@@ -178,11 +178,11 @@ pub fn condensed_response<P: PeriodicProblem>(
     let direction = if opts.to > opts.from { 1.0 } else { -1.0 };
     let mut points = Vec::new();
     let mut failed = None;
-    // Each fold is located as the points arrive ([`EventObserver`] with the
+    // Each fold is located as the points arrive (an `EventObserver` with the
     // [`Fold`] detector, Newton on the extended system of the scaled
     // branch), from the path point nearest the turn.
-    let mut observer =
-        EventObserver::without_multipliers(&LocateOptions::fold(), vec![Box::new(Fold)]);
+    let mut observer: EventObserver<_, HbError> =
+        EventObserver::new(&LocateOptions::fold(), vec![Box::new(Fold)]);
     let m_len = scaled.len();
     let mut stepper = Stepper::new(
         &mut scaled,
@@ -355,7 +355,7 @@ impl<P: PeriodicProblem> PeakProbe<'_, '_, P> {
 /// (`condense/scaled.rs`); returns the steps taken.
 ///
 /// # Errors
-/// As [`crate::continuation::correct_at_fixed_lambda`]; [`HbError::Singular`]
+/// As [`ivt_path::continuation::correct_at_fixed_lambda`]; [`HbError::Singular`]
 /// when a dynamic stiffness is singular; [`HbError::InvalidInput`] for a `q`
 /// of the wrong length or a bad ω_f or `rtol`.
 pub fn correct_condensed<P: PeriodicProblem>(

@@ -30,8 +30,8 @@
 //! correctors stop moves.
 
 use super::branch::CondensedBranch;
-use crate::branch::Branch;
 use crate::problem::PeriodicProblem;
+use ivt_path::branch::Branch;
 
 /// [`CondensedBranch`] seen in scaled unknowns (module docs).
 pub(crate) struct Scaled<'a, P: PeriodicProblem> {

@@ -6,19 +6,21 @@
 //! bordering `[[R_q, R_λ, b], [Cᵀ, 0]]` (one [`ivt_num::BorderedLu`]) and an
 //! unfolding `R + μ b = 0` that makes it square and regular.
 
-use super::detector::{
-    dot, Bifurcation, BifurcationError, BifurcationKind, Detector, LocateOptions, PathSoFar, Start,
-};
-use super::extended::{
-    border_null_vectors, check_start, extended_newton, factored, finish, jacobian_blocks,
-    lambda_step, put_jacobian, solve_error,
-};
 use super::multipliers::Monodromy;
-use crate::branch::{residual_lambda_difference, Branch};
+use super::BifurcationError;
 use crate::family::{Family, FamilyBranch};
 use crate::ihb::HbError;
 use ivt_num::vector::norm2;
 use ivt_num::BorderedLu;
+use ivt_path::branch::{residual_lambda_difference, Branch};
+use ivt_path::events::extended::{
+    augmented_null_vectors, check_start, extended_newton, factored, finish, jacobian_blocks,
+    lambda_step,
+};
+use ivt_path::events::{
+    dot, Bifurcation, BifurcationKind, Detector, LocateOptions, PathSoFar, Start,
+};
+use ivt_path::PathError;
 
 /// The two-column bordering of `[R_q, R_λ]` for branch points:
 /// `[[R_q, R_λ, b], [c₁ᵀ, 0], [c₂ᵀ, 0]]`, i.e. `J = R_q` bordered by the
@@ -144,14 +146,11 @@ pub fn locate_branch_point<F: Family>(
     let (jac, r_lambda) = jacobian_blocks(branch, q0, lambda0, opts);
     let mut t1 = tangent.to_vec();
     normalize(&mut t1);
-    let mut aug = vec![0.0; n1 * n1];
-    put_jacobian(&mut aug, n1, &jac, &r_lambda);
-    if let Some(last) = aug.get_mut(m * n1..) {
-        last.copy_from_slice(&t1);
-    }
     let seed: Vec<f64> = (0..n1).map(|i| 1.0 + 0.1 * (i as f64).sin()).collect();
     let (mut right, mut left) = (seed.clone(), seed);
-    border_null_vectors(&aug, &mut right, &mut left).map_err(solve_error)?;
+    let mut aug = BorderedLu::new(m, 1);
+    augmented_null_vectors(&mut aug, (&jac, &r_lambda, &t1), &mut right, &mut left)
+        .map_err(PathError::from)?;
     let along = dot(&right, &t1);
     right.iter_mut().zip(&t1).for_each(|(r, t)| *r -= along * t);
     normalize(&mut right);
@@ -192,8 +191,8 @@ fn orthonormal_pair(mut a: Vec<f64>, b: Vec<f64>) -> Vec<Vec<f64>> {
     vec![a, b]
 }
 
-/// Sign of `det [[R_q, R_λ], [tᵀ]]` (rows scaled to unit max so the
-/// determinant stays in range).
+/// Sign of `det [[R_q, R_λ], [tᵀ]]` (the bordered LU's, [`BorderedLu::det_sign`];
+/// NaN where the matrix is not finite, which brackets no event).
 fn augmented_sign<F: Family>(
     branch: &mut FamilyBranch<F>,
     (q, lambda): (&[f64], f64),
@@ -201,27 +200,16 @@ fn augmented_sign<F: Family>(
     opts: &LocateOptions,
 ) -> f64 {
     let m = q.len();
-    let n1 = m + 1;
     let (jac, r_lambda) = jacobian_blocks(branch, q, lambda, opts);
-    let mut aug = vec![0.0; n1 * n1];
-    put_jacobian(&mut aug, n1, &jac, &r_lambda);
-    if let Some(last) = aug.get_mut(m * n1..) {
-        last.copy_from_slice(t);
+    let Some((corner, row)) = t.split_last() else {
+        return f64::NAN;
+    };
+    let mut aug = BorderedLu::new(m, 1);
+    if factored(aug.factor(&jac, &r_lambda, row, std::slice::from_ref(corner))) {
+        aug.det_sign()
+    } else {
+        f64::NAN
     }
-    let scales: Vec<f64> = aug
-        .chunks_exact(n1)
-        .map(|row| {
-            row.iter()
-                .fold(0.0f64, |a, v| a.max(v.abs()))
-                .max(f64::MIN_POSITIVE)
-        })
-        .collect();
-    let mat = faer::Mat::<f64>::from_fn(n1, n1, |i, j| {
-        aug.get(i * n1 + j)
-            .zip(scales.get(i))
-            .map_or(f64::NAN, |(v, s)| v / s)
-    });
-    mat.determinant().signum()
 }
 
 /// The branch-point event of a traced path: the sign of
@@ -240,7 +228,7 @@ impl BranchPoint {
     }
 }
 
-impl<F: Family> Detector<FamilyBranch<F>> for BranchPoint {
+impl<F: Family> Detector<FamilyBranch<F>, BifurcationError> for BranchPoint {
     fn kind(&self) -> BifurcationKind {
         BifurcationKind::BranchPoint
     }

@@ -1,14 +1,14 @@
-//! Events on a branch `R(q, λ) = 0`: fold, period doubling, Neimark–Sacker and
-//! branch point, each one file implementing one trait ([`Detector`]: a test
-//! function at every accepted path point, and a locator — Newton on a
-//! minimally extended system, Govaerts' bordering on [`ivt_num::BorderedLu`] —
-//! started where the test changes sign), and the Floquet multipliers
-//! ([`Multipliers`], Hsu, Eq. 78–80) as the observer that gives each point its
-//! multipliers. [`trace`] follows a branch and runs them as the points arrive
-//! ([`EventObserver`], an [`Observer`]), as BifurcationKit does, instead of
+//! The events of harmonic-balance branches on the path engine's event
+//! machinery (`ivt_path::events`, re-exported here: the [`Detector`] and
+//! [`Observer`] traits, the [`observe`] driver, the [`Fold`] of any branch):
+//! the Floquet multipliers of each point ([`Multipliers`], Hsu, Eq. 78–80,
+//! a [`PointMultipliers`]), and the events that need them — period
+//! doubling, Neimark–Sacker and branch point on a [`FamilyBranch`], and the
+//! fold with its multipliers ([`FamilyFold`]). [`trace`] follows a branch
+//! and runs them as the points arrive, as BifurcationKit does, instead of
 //! searching the finished path.
 //!
-//! - fold ([`fold`]): the λ component of the secant changes sign;
+//! - fold ([`Fold`], [`FamilyFold`]): the λ component of the secant changes sign;
 //! - period doubling ([`period_doubling`]): `Π(μᵢ + 1)` changes sign (a real μ
 //!   crosses −1);
 //! - Neimark–Sacker ([`neimark_sacker`]): `Πᵢ<ⱼ(μᵢμⱼ − 1)` changes sign with a
@@ -21,8 +21,6 @@
 //! located points is in [`crate::switching`].
 
 pub mod branch_point;
-mod detector;
-pub(crate) mod extended;
 pub mod fold;
 pub mod multipliers;
 pub mod neimark_sacker;
@@ -30,19 +28,47 @@ pub mod period_doubling;
 mod trace;
 
 pub use branch_point::{locate_branch_point, BranchPoint};
-pub(crate) use detector::dot;
-pub use detector::{
-    Bifurcation, BifurcationError, BifurcationKind, Detector, Event, LocateOptions, Observer,
-    PathSoFar, Start, TracedPoint,
+pub use fold::FamilyFold;
+pub use ivt_path::events::{
+    classify, dot, locate_fold, observe, Bifurcation, BifurcationKind, Detector, EventObserver,
+    Fold, FoldLocation, LocateOptions, Observer, PathSoFar, PointMultipliers, StabilityKind, Start,
+    TracedPoint,
 };
-pub use fold::{locate_fold, FamilyFold, Fold, FoldLocation};
-pub use multipliers::{Multipliers, PointMultipliers};
+pub use multipliers::Multipliers;
 pub use neimark_sacker::NeimarkSacker;
 pub use period_doubling::PeriodDoubling;
-pub use trace::{observe, trace, EventObserver, PathOptions, Trace, TraceOptions};
+pub use trace::{observer, trace, PathOptions, Trace, TraceOptions};
 
 use crate::family::{Family, FamilyBranch};
 use crate::ihb::HbError;
+use ivt_path::PathError;
+use thiserror::Error;
+
+/// An event of a harmonic-balance branch, with its location or why it
+/// could not be located.
+pub type Event = ivt_path::events::Event<BifurcationError>;
+
+/// Errors of bifurcation location.
+#[derive(Debug, Clone, Error, PartialEq)]
+pub enum BifurcationError {
+    /// Sizes, solves or Newton failures (with the residual history).
+    #[error(transparent)]
+    Hb(#[from] HbError),
+    /// The Neimark–Sacker test converged to a real pair `μ, 1/μ`.
+    #[error(
+        "neutral saddle at λ = {lambda} (real multipliers μ and 1/μ), not a Neimark–Sacker point"
+    )]
+    NeutralSaddle {
+        /// Where.
+        lambda: f64,
+    },
+}
+
+impl From<PathError> for BifurcationError {
+    fn from(e: PathError) -> Self {
+        Self::Hb(e.into())
+    }
+}
 
 /// Locates the period doubling (multiplier −1) or Neimark–Sacker point (complex
 /// pair on the unit circle) nearest the converged orbit `(q0, λ0)` of `branch`,

@@ -1,22 +1,26 @@
 //! The Floquet multipliers of a branch's orbits (Hsu's method, Eq. 78–80):
-//! [`Multipliers`], the observer that gives each accepted path point its
-//! multipliers as it arrives (the period-doubling and Neimark–Sacker tests
-//! read them), and the monodromy matrix Φ at any `(q, λ)` with the locator of
+//! [`Multipliers`], the [`PointMultipliers`] that gives each accepted path
+//! point its multipliers as it arrives (the period-doubling and
+//! Neimark–Sacker tests read them), and the monodromy matrix Φ at any `(q, λ)` with the locator of
 //! a multiplier crossing: Newton on `R = 0` and the bordered test function of
 //! a matrix built from Φ that turns singular at the crossing (`Φ + I`,
 //! `Φ⊙Φ − I`).
 
-use super::detector::{Bifurcation, BifurcationError, BifurcationKind, LocateOptions, TracedPoint};
-use super::extended::{
-    border_null_vectors, check_start, extended_newton, factored, finish, solve_error,
-};
-use crate::continuation::PathPoint;
+use super::BifurcationError;
 use crate::family::{Family, FamilyBranch};
 use crate::floquet::{eigenvalues, monodromy_uniform, HsuRule};
 use crate::ihb::HbError;
 use crate::stability::{AdaptiveHsu, StabilityAnalyzer};
 use faer::c64;
 use ivt_num::BorderedLu;
+use ivt_path::continuation::PathPoint;
+use ivt_path::events::extended::{
+    border_null_vectors, check_start, extended_newton, factored, finish,
+};
+use ivt_path::events::{
+    Bifurcation, BifurcationKind, LocateOptions, PointMultipliers, TracedPoint,
+};
+use ivt_path::PathError;
 
 /// The observer of the multipliers along a path: Hsu's monodromy of each
 /// accepted point, its steps chosen per point ([`AdaptiveHsu`]).
@@ -31,19 +35,7 @@ impl Multipliers {
     }
 }
 
-/// What gives each arriving point of a branch `B` its Floquet multipliers:
-/// the optional part of an [`super::EventObserver`] (a branch without Hsu
-/// multipliers — the STHB string, a condensed structure — runs its detectors
-/// without one).
-pub trait PointMultipliers<B> {
-    /// The arrived `point` with its multipliers.
-    ///
-    /// # Errors
-    /// The monodromy's failure; [`HbError::InvalidInput`] for an empty point.
-    fn at(&mut self, branch: &B, point: &PathPoint) -> Result<TracedPoint, HbError>;
-}
-
-impl<F: Family> PointMultipliers<FamilyBranch<F>> for Multipliers {
+impl<F: Family, E: From<HbError>> PointMultipliers<FamilyBranch<F>, E> for Multipliers {
     /// Hsu's monodromy of the point: where the branch's last Galerkin
     /// assembly is the point's, Hsu takes its `∂g` samples
     /// ([`FamilyBranch::jacobian_samples_at`]).
@@ -51,9 +43,9 @@ impl<F: Family> PointMultipliers<FamilyBranch<F>> for Multipliers {
     /// # Errors
     /// As [`AdaptiveHsu::floquet_with_samples`]; [`HbError::InvalidInput`]
     /// for an empty point.
-    fn at(&mut self, branch: &FamilyBranch<F>, point: &PathPoint) -> Result<TracedPoint, HbError> {
+    fn at(&mut self, branch: &FamilyBranch<F>, point: &PathPoint) -> Result<TracedPoint, E> {
         let Some((&lambda, q)) = point.x.split_last() else {
-            return Err(HbError::InvalidInput("empty path point".into()));
+            return Err(HbError::InvalidInput("empty path point".into()).into());
         };
         let (problem, sol) = branch.solution(q, lambda);
         let known = branch.jacobian_samples_at(&point.x);
@@ -191,7 +183,7 @@ pub(crate) fn locate_crossing<F: Family>(
         vec![1.0 / (s as f64).sqrt(); s],
         vec![1.0 / (s as f64).sqrt(); s],
     );
-    border_null_vectors(&a, &mut c, &mut b).map_err(solve_error)?;
+    border_null_vectors(&a, &mut c, &mut b).map_err(PathError::from)?;
     let mut bordered = BorderedScalar::new(b, c);
     let (q, lambda, iterations) = extended_newton(
         branch,

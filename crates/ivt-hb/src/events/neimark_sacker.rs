@@ -6,13 +6,13 @@
 //! products `μᵢμⱼ`, `i < j`. A real pair `μ, 1/μ` (neutral saddle) is also a
 //! zero of that test and is reported as [`BifurcationError::NeutralSaddle`].
 
-use super::detector::{
-    Bifurcation, BifurcationError, BifurcationKind, Detector, LocateOptions, PathSoFar, Start,
-    TracedPoint,
-};
 use super::multipliers::locate_crossing;
+use super::BifurcationError;
 use crate::family::{Family, FamilyBranch};
 use faer::c64;
+use ivt_path::events::{
+    Bifurcation, BifurcationKind, Detector, LocateOptions, PathSoFar, Start, TracedPoint,
+};
 
 /// `Φ⊙Φ − I` into `a`: rows and columns are the pairs `i < j`, entries the
 /// 2×2 minors of Φ; returns its size `dim(dim − 1)/2`.
@@ -79,7 +79,7 @@ pub(crate) fn locate_neimark_sacker<F: Family>(
     Ok(found)
 }
 
-impl<F: Family> Detector<FamilyBranch<F>> for NeimarkSacker {
+impl<F: Family> Detector<FamilyBranch<F>, BifurcationError> for NeimarkSacker {
     fn kind(&self) -> BifurcationKind {
         BifurcationKind::NeimarkSacker
     }

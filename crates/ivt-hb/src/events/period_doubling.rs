@@ -3,10 +3,11 @@
 //! sign; the locator solves `R = 0` with the bordered test function of
 //! `Φ + I` (Φ the monodromy matrix), singular exactly at the crossing.
 
-use super::detector::{Bifurcation, BifurcationError, BifurcationKind, Detector, PathSoFar, Start};
 use super::multipliers::locate_crossing;
+use super::BifurcationError;
 use crate::family::{Family, FamilyBranch};
 use faer::c64;
+use ivt_path::events::{Bifurcation, BifurcationKind, Detector, PathSoFar, Start};
 
 /// `Φ + I` into `a`; returns its size `dim`.
 pub(crate) fn shifted_monodromy(phi: &[f64], dim: usize, a: &mut Vec<f64>) -> usize {
@@ -28,7 +29,7 @@ fn indicator(mu: &[c64]) -> f64 {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct PeriodDoubling;
 
-impl<F: Family> Detector<FamilyBranch<F>> for PeriodDoubling {
+impl<F: Family> Detector<FamilyBranch<F>, BifurcationError> for PeriodDoubling {
     fn kind(&self) -> BifurcationKind {
         BifurcationKind::PeriodDoubling
     }

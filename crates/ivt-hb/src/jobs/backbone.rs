@@ -4,10 +4,10 @@
 
 use super::{finite, Array};
 use crate::backbone::{BackboneOptions, BackbonePoint};
-use crate::continuation::{Corrector, Termination};
 use crate::error::HbError;
 use crate::ihb::HbOptions;
 use crate::problem::{GeneralProblem, PeriodicProblem};
+use ivt_path::continuation::{Corrector, Termination};
 use serde::Serialize;
 
 /// The undamped, unforced Duffing oscillator `u'' + αu + εu³ = 0` as the

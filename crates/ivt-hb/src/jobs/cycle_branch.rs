@@ -5,13 +5,13 @@
 
 use super::{all_finite, finite_list, pairs, path_steps, stability_steps, Array};
 use crate::autonomous::LimitCycle;
-use crate::continuation::Termination;
 use crate::cycle_branch::{cycle_branch as trace_cycles, CycleBranchOptions};
 use crate::error::HbError;
 use crate::events::BifurcationKind;
 use crate::ihb::HbOptions;
 use crate::problem::PeriodicProblem;
 use crate::stability::StabilityKind;
+use ivt_path::continuation::Termination;
 use serde::Serialize;
 
 /// The interval of p, the grid of the Hopf search and the path's steps.

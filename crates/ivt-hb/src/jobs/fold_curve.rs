@@ -10,12 +10,12 @@
 
 use super::{all_finite, finite, finite_list, path_steps, Array, FrcRequest};
 use crate::codim2::{bifurcation_curve, CurvePoint, CurveStart};
-use crate::continuation::{Corrector, Termination};
 use crate::error::HbError;
 use crate::events::BifurcationKind;
 use crate::frc::{frequency_response, FrcOptions};
 use crate::ihb::{HbOptions, HbSolution};
 use crate::problem::PeriodicProblem;
+use ivt_path::continuation::{Corrector, Termination};
 use serde::Serialize;
 use std::time::Instant;
 

@@ -6,7 +6,6 @@
 //! Neimark–Sacker point and branch point as the path passes it.
 
 use super::{check_finite, pairs, Array};
-use crate::continuation::Termination;
 use crate::error::HbError;
 use crate::events::{trace, BifurcationError, BifurcationKind, Event, TraceOptions};
 use crate::family::{Family, FamilyBranch, Frequency};
@@ -16,6 +15,7 @@ use crate::problem::{AtFrequency, PeriodicProblem};
 use crate::stability::HsuSteps;
 use crate::stability::StabilityKind;
 use crate::ModifiedIhb;
+use ivt_path::continuation::Termination;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -188,7 +188,7 @@ pub(super) fn traced_curve<F: Family>(
         ..TraceOptions::default()
     };
     let traced = trace(branch, start, sweep.from, &opts).map_err(trace_error)?;
-    let curve = Frc::from_trace(&traced, branch.options())?;
+    let curve = crate::frc::from_trace(&traced, branch.options())?;
     let events = traced.events.iter().map(|e| event(e, &curve)).collect();
     assemble(curve, events, sweep.path.stability, t0)
 }

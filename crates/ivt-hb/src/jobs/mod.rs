@@ -50,8 +50,8 @@ pub use orbit::{orbit, Method, Orbit, OrbitRequest};
 pub use string::{string, StringCurve, StringPoint, StringRequest};
 pub use switch::{switch, SwitchRequest, SwitchStart, SwitchedBranch};
 
-use crate::continuation::ContinuationOptions;
 use crate::error::HbError;
+use ivt_path::continuation::ContinuationOptions;
 
 /// Hsu sub-intervals per period for `harmonics` harmonics: max(8n, 256)
 /// (Eq. 78; 256 resolve the stability flags of the thesis's examples, 8n

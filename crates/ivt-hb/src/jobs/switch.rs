@@ -22,10 +22,7 @@
 
 use super::frc::{trace_error, traced_curve};
 use super::{finite, FoldPoint, FrcCurve, FrcRequest};
-use crate::branch::Branch;
-use crate::continuation::Corrector;
 use crate::error::HbError;
-use crate::events::extended::{border_null_vectors, jacobian_blocks, put_jacobian};
 use crate::events::{dot, Bifurcation, BifurcationKind, LocateOptions};
 use crate::family::{Family, FamilyBranch, Frequency};
 use crate::frc::FrcOptions;
@@ -33,6 +30,10 @@ use crate::ihb::HbOptions;
 use crate::problem::PeriodicProblem;
 use crate::switching::{period_doubled_start, switch_branch};
 use ivt_num::vector::norm2;
+use ivt_num::BorderedLu;
+use ivt_path::branch::Branch;
+use ivt_path::continuation::Corrector;
+use ivt_path::events::extended::{augmented_null_vectors, jacobian_blocks};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -278,24 +279,17 @@ fn new_direction<F: Family>(
     // [[R_q, R_λ], [uᵀ]] is singular with the null vector in null(A) ⊥ u and
     // the left one (ψ, 0): u = e_λ gives v₁ (at constant λ) and ψ, u = v₁
     // gives v₂.
-    let mut aug = vec![0.0; n1 * n1];
-    put_jacobian(&mut aug, n1, &jac, &r_lambda);
+    let mut aug = BorderedLu::new(m, 1);
     let seed: Vec<f64> = (0..n1).map(|i| 1.0 + 0.1 * (i as f64).sin()).collect();
-    let last_row = |aug: &mut Vec<f64>, u: &[f64]| {
-        aug.truncate(m * n1);
-        aug.extend_from_slice(u);
-    };
     let mut e_lambda = vec![0.0; n1];
     if let Some(l) = e_lambda.last_mut() {
         *l = 1.0;
     }
-    last_row(&mut aug, &e_lambda);
     let (mut v1, mut left) = (seed.clone(), seed.clone());
-    border_null_vectors(&aug, &mut v1, &mut left)?;
+    augmented_null_vectors(&mut aug, (&jac, &r_lambda, &e_lambda), &mut v1, &mut left)?;
     unit(&mut v1)?;
-    last_row(&mut aug, &v1);
     let (mut v2, mut unused) = (seed.clone(), seed);
-    border_null_vectors(&aug, &mut v2, &mut unused)?;
+    augmented_null_vectors(&mut aug, (&jac, &r_lambda, &v1), &mut v2, &mut unused)?;
     let along = dot(&v2, &v1);
     v2.iter_mut().zip(&v1).for_each(|(a, b)| *a -= along * b);
     unit(&mut v2)?;

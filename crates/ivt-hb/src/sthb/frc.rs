@@ -16,16 +16,17 @@ use super::stability::{
     hill, hill_dim, monodromy, monodromy_refined, Stability, StabilityMethod, HILL_MAX_DIM,
 };
 use super::StringHb;
-use crate::branch::Branch;
-use crate::continuation::{
-    ContinuationOptions, NewtonCorrector, Path, PathPoint, Stepper, Termination,
-};
 use crate::error::HbError;
 use crate::events::{
-    observe, BifurcationKind, Detector, Event, EventObserver, Fold, LocateOptions, Observer,
+    observe, BifurcationKind, Detector, EventObserver, Fold, LocateOptions, Observer,
 };
 use crate::frc::{Frc, FrcFold, FrcPoint};
 use ivt_num::BroydenOptions;
+use ivt_path::branch::Branch;
+use ivt_path::continuation::{
+    ContinuationOptions, NewtonCorrector, Path, PathPoint, Stepper, Termination,
+};
+use ivt_path::events::Event;
 
 /// Settings of a string curve.
 #[derive(Clone, Debug, PartialEq)]
@@ -114,7 +115,7 @@ fn follow<C>(
     opts: &ContinuationOptions,
     folds: bool,
     on_point: C,
-) -> Result<(Path, Vec<Event>, usize), HbError>
+) -> Result<(Path, Vec<Event<HbError>>, usize), HbError>
 where
     C: FnMut(&mut ReducedString<'_>, &PathPoint) -> bool,
 {
@@ -144,13 +145,13 @@ where
     copts.lambda_min = omega_from.min(omega_to);
     copts.lambda_max = omega_from.max(omega_to);
     let direction = if omega_to >= omega_from { 1.0 } else { -1.0 };
-    let detectors: Vec<Box<dyn Detector<ReducedString<'_>>>> = if folds {
+    let detectors: Vec<Box<dyn Detector<ReducedString<'_>, HbError>>> = if folds {
         vec![Box::new(Fold)]
     } else {
         Vec::new()
     };
     let mut observer = Counted {
-        observer: EventObserver::without_multipliers(&LocateOptions::fold(), detectors),
+        observer: EventObserver::new(&LocateOptions::fold(), detectors),
         jacobians: 0,
     };
     let m_len = system.len();
@@ -201,18 +202,20 @@ struct Counted<O> {
 }
 
 impl<'a, O: Observer<ReducedString<'a>>> Observer<ReducedString<'a>> for Counted<O> {
+    type Error = O::Error;
+
     fn on_point(
         &mut self,
         branch: &mut ReducedString<'a>,
         point: &PathPoint,
-    ) -> Result<Vec<Event>, HbError> {
+    ) -> Result<Vec<Event<O::Error>>, O::Error> {
         let before = branch.jacobians;
         let found = self.observer.on_point(branch, point);
         self.jacobians += branch.jacobians - before;
         found
     }
 
-    fn finish(&mut self, branch: &mut ReducedString<'a>) -> Result<Vec<Event>, HbError> {
+    fn finish(&mut self, branch: &mut ReducedString<'a>) -> Result<Vec<Event<O::Error>>, O::Error> {
         let before = branch.jacobians;
         let found = self.observer.finish(branch);
         self.jacobians += branch.jacobians - before;

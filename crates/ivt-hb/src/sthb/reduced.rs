@@ -22,7 +22,7 @@ use ivt_num::vector::dot;
 
 use super::toeplitz::add_real_toeplitz_odd;
 use super::{Boundary, StringHb};
-use crate::branch::Branch;
+use ivt_path::branch::Branch;
 
 /// Marks a full index outside the subspace.
 const OUTSIDE: usize = usize::MAX;
@@ -256,8 +256,8 @@ impl Branch for ReducedString<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::branch::fd_jacobian_gradient;
     use crate::sthb::StringParams;
+    use ivt_path::branch::fd_jacobian_gradient;
 
     /// A response on the branch from rest at `omega` (in the subspace).
     fn solved(params: StringParams, omega: f64) -> (StringHb, Vec<f64>) {
@@ -352,7 +352,7 @@ mod tests {
             // ∂(wᵀJv)/∂ω against the central difference of wᵀJv in ω.
             let h = 1e-4;
             let exact_w = sys.bilinear_lambda(&q, 3.8, h, &w, &v);
-            let fd_w = crate::branch::bilinear_lambda_difference(&mut sys, &q, 3.8, h, &w, &v);
+            let fd_w = ivt_path::branch::bilinear_lambda_difference(&mut sys, &q, 3.8, h, &w, &v);
             assert!((exact_w - fd_w).abs() <= 1e-6 * exact_w.abs().max(1.0));
         }
     }

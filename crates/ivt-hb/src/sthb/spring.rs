@@ -3,14 +3,14 @@
 //!
 //! The residual is [`StringHb`] with [`super::Boundary::Spring`] (Tau rows
 //! Eq. 134–136); the path follower is the engine's
-//! [`crate::continuation::Stepper`] with [`crate::continuation::BroydenCorrector`]: Broyden's
+//! [`ivt_path::continuation::Stepper`] with [`ivt_path::continuation::BroydenCorrector`]: Broyden's
 //! method (Eq. 66–67) with the exact augmenting row. It is seeded once with the
 //! exact STHB Jacobian `[J | ∂R/∂ω]` at the start point; afterwards only
 //! rank-one updates (and the engine's Jacobian refresh if Broyden stalls).
 
 use faer::Mat;
 
-use crate::continuation::{follow_residual, ContinuationOptions, Termination};
+use ivt_path::continuation::{follow_residual, ContinuationOptions, Termination};
 
 use super::{StringHb, StringParams};
 use crate::error::HbError;

@@ -8,7 +8,7 @@
 use std::borrow::Cow;
 
 use crate::branch::Branch;
-use crate::error::HbError;
+use crate::error::PathError;
 use ivt_num::SolveError;
 
 mod broyden;
@@ -110,9 +110,9 @@ pub trait PathCorrector<B: Branch> {
     /// direction there into `dir`, whose λ component gives its sign on entry.
     ///
     /// # Errors
-    /// [`HbError::ContinuationStart`] if the start cannot be converged,
-    /// [`HbError::SingularStart`] if it has no tangent.
-    fn start(&mut self, branch: &mut B, x: &mut [f64], dir: &mut [f64]) -> Result<(), HbError>;
+    /// [`PathError::ContinuationStart`] if the start cannot be converged,
+    /// [`PathError::SingularStart`] if it has no tangent.
+    fn start(&mut self, branch: &mut B, x: &mut [f64], dir: &mut [f64]) -> Result<(), PathError>;
 
     /// Corrects the prediction `pred` into `x` (`u` then λ).
     ///

@@ -5,7 +5,7 @@
 
 use super::{BroydenCorrector, ContinuationOptions, Path, PathPoint, Stepper};
 use crate::branch::ResidualBranch;
-use crate::error::HbError;
+use crate::error::PathError;
 
 /// Follows `residual(x, r)` (`x = (u, λ)`, `start.len() = m + 1` entries,
 /// `r` of `m`) from `start` in the direction of increasing λ if
@@ -24,7 +24,7 @@ pub fn follow_residual<F: FnMut(&[f64], &mut [f64])>(
     direction: f64,
     opts: &ContinuationOptions,
     mut on_point: impl FnMut(&PathPoint) -> bool,
-) -> Result<Path, HbError> {
+) -> Result<Path, PathError> {
     let m = start.len().saturating_sub(1);
     let mut branch = ResidualBranch::new(m, residual);
     let corrector = Box::new(BroydenCorrector::new(m, &opts.broyden, jac0));

@@ -5,7 +5,7 @@ use ivt_num::{newton, NewtonSystem, NewtonWorkspace, SolveError};
 use std::convert::Infallible;
 
 use super::ContinuationOptions;
-use crate::error::HbError;
+use crate::error::PathError;
 
 /// A [`Branch`] at fixed λ as a square [`NewtonSystem`] in `u`.
 struct FixedLambda<'a, S> {
@@ -35,17 +35,17 @@ impl<S: Branch> NewtonSystem for FixedLambda<'_, S> {
 /// converged orbit of another method, already close). Returns the steps taken.
 ///
 /// # Errors
-/// [`HbError::ContinuationStart`] with the residual history when Newton does
-/// not converge; [`HbError::SingularStart`] for a singular Jacobian;
-/// [`HbError::InvalidInput`] when `x` has not `m + 1` entries.
+/// [`PathError::ContinuationStart`] with the residual history when Newton does
+/// not converge; [`PathError::SingularStart`] for a singular Jacobian;
+/// [`PathError::InvalidInput`] when `x` has not `m + 1` entries.
 pub fn correct_at_fixed_lambda<S: Branch>(
     system: &mut S,
     x: &mut [f64],
     opts: &ContinuationOptions,
-) -> Result<usize, HbError> {
+) -> Result<usize, PathError> {
     let m = system.len();
     let Some((&mut lambda, u)) = x.split_last_mut().filter(|(_, u)| u.len() == m) else {
-        return Err(HbError::InvalidInput(
+        return Err(PathError::InvalidInput(
             "continuation start must hold m unknowns and λ".into(),
         ));
     };
@@ -53,8 +53,8 @@ pub fn correct_at_fixed_lambda<S: Branch>(
     let nopts = full_newton_steps(opts.broyden.tol, opts.broyden.max_iter);
     match newton(&mut fixed, u, &mut NewtonWorkspace::new(m), &nopts) {
         Ok(stats) => Ok(stats.iterations),
-        Err(SolveError::SingularJacobian { .. }) => Err(HbError::SingularStart { lambda }),
-        Err(e) => Err(HbError::ContinuationStart {
+        Err(SolveError::SingularJacobian { .. }) => Err(PathError::SingularStart { lambda }),
+        Err(e) => Err(PathError::ContinuationStart {
             lambda,
             cause: SolveError::from(e),
         }),

@@ -7,9 +7,9 @@
 use super::corrector::{DirectionError, PathCorrector, Prediction, Retry};
 use super::predictor::{curvature_between, predict};
 use super::step_control::StepControl;
-use super::{turn, ContinuationOptions, Fold, Path, PathPoint, Termination};
+use super::{turn, ContinuationOptions, Path, PathPoint, Termination, Turn};
 use crate::branch::Branch;
-use crate::error::HbError;
+use crate::error::PathError;
 use ivt_num::SolveError;
 
 /// What [`Stepper::next`] gives.
@@ -43,7 +43,7 @@ pub struct Stepper<'b, B: Branch> {
     pending: Option<PathPoint>,
     count: usize,
     landed: bool,
-    fold: Option<Fold>,
+    turn: Option<Turn>,
     done: Option<Termination>,
 }
 
@@ -54,7 +54,7 @@ impl<'b, B: Branch> Stepper<'b, B> {
     /// direction here.
     ///
     /// # Errors
-    /// [`HbError::InvalidInput`] for a start of the wrong size or non-finite
+    /// [`PathError::InvalidInput`] for a start of the wrong size or non-finite
     /// entries or steps; the corrector's start errors
     /// ([`PathCorrector::start`]).
     pub fn new(
@@ -64,15 +64,15 @@ impl<'b, B: Branch> Stepper<'b, B> {
         start_iterations: usize,
         direction: f64,
         opts: &ContinuationOptions,
-    ) -> Result<Self, HbError> {
+    ) -> Result<Self, PathError> {
         let m = branch.len();
         if m == 0 || start.len() != m + 1 {
-            return Err(HbError::InvalidInput(
+            return Err(PathError::InvalidInput(
                 "continuation: start must hold m ≥ 1 unknowns and λ".into(),
             ));
         }
         if !(start.iter().all(|v| v.is_finite()) && opts.ds > 0.0 && opts.ds_min > 0.0) {
-            return Err(HbError::InvalidInput(
+            return Err(PathError::InvalidInput(
                 "continuation: non-finite start or step".into(),
             ));
         }
@@ -104,7 +104,7 @@ impl<'b, B: Branch> Stepper<'b, B> {
             pending: Some(first),
             count: 0,
             landed: false,
-            fold: None,
+            turn: None,
             done: None,
         })
     }
@@ -114,10 +114,10 @@ impl<'b, B: Branch> Stepper<'b, B> {
         self.branch
     }
 
-    /// The fold (a sign change of the direction's λ component) between the
+    /// The turn (a sign change of the direction's λ component) between the
     /// last three points, found as the last point was handed out.
-    pub fn fold(&self) -> Option<Fold> {
-        self.fold
+    pub fn turn(&self) -> Option<Turn> {
+        self.turn
     }
 
     /// The next point of the path, or why it ended.
@@ -145,11 +145,11 @@ impl<'b, B: Branch> Stepper<'b, B> {
     /// Follows the path to its end, `on_point(branch, point)` called with
     /// each point as it arrives (`false` stops the path).
     pub fn run(&mut self, mut on_point: impl FnMut(&mut B, &PathPoint) -> bool) -> Path {
-        let (mut points, mut folds) = (Vec::new(), Vec::new());
+        let (mut points, mut turns) = (Vec::new(), Vec::new());
         let termination = loop {
             match self.next() {
                 Step::Point(p) => {
-                    folds.extend(self.fold);
+                    turns.extend(self.turn);
                     let go_on = on_point(self.branch, &p);
                     points.push(p);
                     if !go_on {
@@ -161,7 +161,7 @@ impl<'b, B: Branch> Stepper<'b, B> {
         };
         Path {
             points,
-            events: folds,
+            events: turns,
             termination,
         }
     }
@@ -171,12 +171,12 @@ impl<'b, B: Branch> Stepper<'b, B> {
         Step::Stop(termination)
     }
 
-    /// Records `point` as the last (a fold if its direction turned in λ).
+    /// Records `point` as the last (a turn if its direction turned in λ).
     fn hand_out(&mut self, point: PathPoint) -> PathPoint {
-        self.fold = match (&self.before_last, &self.last) {
+        self.turn = match (&self.before_last, &self.last) {
             (Some(a), Some(b)) if b.dlambda * point.dlambda < 0.0 => {
                 let (turned, nearest) = turn(a, b, &point);
-                Some(Fold {
+                Some(Turn {
                     index: self.count - 2 + nearest,
                     lambda: turned.last().copied().unwrap_or(f64::NAN),
                     bracket: self.count - 2,

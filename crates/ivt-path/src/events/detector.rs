@@ -5,19 +5,61 @@
 
 use crate::branch::Branch;
 use crate::continuation::PathPoint;
-use crate::ihb::HbError;
-use crate::stability::StabilityKind;
+use crate::error::PathError;
 use faer::c64;
 use ivt_num::vector::norm2;
-use thiserror::Error;
 
-/// The kind of a located bifurcation (in the order [`crate::trace`] reports
-/// events found between the same two points).
+/// What the leading Floquet multiplier of a periodic orbit says.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StabilityKind {
+    /// All multipliers inside the unit circle.
+    Stable,
+    /// A real multiplier beyond +1 (saddle-node / fold side).
+    Fold,
+    /// A real multiplier beyond −1 (period doubling).
+    PeriodDoubling,
+    /// A complex pair outside the unit circle (Neimark–Sacker / secondary Hopf).
+    NeimarkSacker,
+}
+
+impl StabilityKind {
+    /// Short lowercase name for tables and JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Stable => "stable",
+            Self::Fold => "fold",
+            Self::PeriodDoubling => "period_doubling",
+            Self::NeimarkSacker => "neimark_sacker",
+        }
+    }
+}
+
+/// Classifies multipliers sorted by decreasing modulus (a multiplier counts as real
+/// when |Im μ| ≤ 1e-7·|μ|; a NaN one as a fold).
+pub fn classify(sorted: &[c64]) -> StabilityKind {
+    match sorted.first() {
+        Some(m) if m.norm() >= 1.0 => {
+            if m.im.abs() > 1e-7 * m.norm() {
+                StabilityKind::NeimarkSacker
+            } else if m.re > 0.0 {
+                StabilityKind::Fold
+            } else {
+                StabilityKind::PeriodDoubling
+            }
+        }
+        Some(m) if m.norm().is_nan() => StabilityKind::Fold,
+        _ => StabilityKind::Stable,
+    }
+}
+
+/// The kind of a located bifurcation (in the order the [`Observer`]s
+/// report events found between the same two points).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum BifurcationKind {
     /// A turning point in λ (a real multiplier through +1), located by
-    /// [`crate::locate_fold`].
+    /// [`crate::events::locate_fold`].
     Fold,
     /// A real Floquet multiplier through −1.
     PeriodDoubling,
@@ -76,7 +118,7 @@ impl Default for LocateOptions {
 }
 
 impl LocateOptions {
-    /// The options of a fold located on its own ([`crate::locate_fold`]):
+    /// The options of a fold located on its own ([`crate::events::locate_fold`]):
     /// step tolerance 1e-12, 25 Newton steps.
     pub fn fold() -> Self {
         Self {
@@ -96,7 +138,7 @@ pub struct TracedPoint {
     pub lambda: f64,
     /// Floquet multipliers (Hsu), decreasing modulus.
     pub multipliers: Vec<c64>,
-    /// Error estimate of their monodromy ([`crate::HsuEstimate::error`]):
+    /// Error estimate of their monodromy (ivt-hb's `HsuEstimate::error`):
     /// `None` for fixed Hsu steps.
     pub multiplier_error: Option<f64>,
     /// Stability class.
@@ -145,35 +187,20 @@ impl Bifurcation {
 }
 
 /// `aᵀb`.
-pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-/// Errors of bifurcation location.
-#[derive(Debug, Clone, Error, PartialEq)]
-pub enum BifurcationError {
-    /// Sizes, solves or Newton failures (with the residual history).
-    #[error(transparent)]
-    Hb(#[from] HbError),
-    /// The Neimark–Sacker test converged to a real pair `μ, 1/μ`.
-    #[error(
-        "neutral saddle at λ = {lambda} (real multipliers μ and 1/μ), not a Neimark–Sacker point"
-    )]
-    NeutralSaddle {
-        /// Where.
-        lambda: f64,
-    },
-}
-
-/// An event between points `index` and `index + 1` of a traced path.
+/// An event between points `index` and `index + 1` of a traced path; `E`
+/// is the detector's location error.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Event {
+pub struct Event<E> {
     /// What changed.
     pub kind: BifurcationKind,
     /// The point before the change (the Newton start).
     pub index: usize,
     /// The located bifurcation, or why it could not be located.
-    pub location: Result<Bifurcation, BifurcationError>,
+    pub location: Result<Bifurcation, E>,
 }
 
 /// Watches a path of a [`Branch`] as its points arrive (as BifurcationKit's
@@ -181,13 +208,21 @@ pub struct Event {
 /// returns the events that point completes, already located; when the path
 /// ends, [`Observer::finish`] locates the events still waiting for a point.
 pub trait Observer<B: Branch> {
+    /// The failure that ends the observation, and the location error its
+    /// events carry.
+    type Error;
+
     /// Takes the newest accepted `point` of the path followed on `branch`.
     ///
     /// # Errors
     /// A failure that ends the observation (e.g. the point's multipliers);
     /// an event that cannot be located is not one, it carries its error in
     /// [`Event::location`].
-    fn on_point(&mut self, branch: &mut B, point: &PathPoint) -> Result<Vec<Event>, HbError>;
+    fn on_point(
+        &mut self,
+        branch: &mut B,
+        point: &PathPoint,
+    ) -> Result<Vec<Event<Self::Error>>, Self::Error>;
 
     /// The path has ended: the events bracketed but not yet located (their
     /// start is the last point, no point after it will come), located from
@@ -195,14 +230,15 @@ pub trait Observer<B: Branch> {
     ///
     /// # Errors
     /// As [`Observer::on_point`].
-    fn finish(&mut self, _branch: &mut B) -> Result<Vec<Event>, HbError> {
+    fn finish(&mut self, _branch: &mut B) -> Result<Vec<Event<Self::Error>>, Self::Error> {
         Ok(Vec::new())
     }
 }
 
 /// The path as far as it has arrived, as the detectors see it: each accepted
 /// point (from the continuation driver) with its multipliers (from the
-/// Floquet observer, [`crate::events::Multipliers`]), in path order.
+/// [`PointMultipliers`](crate::events::PointMultipliers) of the observer,
+/// if it has one), in path order.
 #[derive(Debug, Clone, Default)]
 pub struct PathSoFar {
     /// The driver's points `{q, λ}` with their secant λ component and
@@ -251,11 +287,12 @@ impl PathSoFar {
 
 /// One kind of event on a [`Branch`]: a test function evaluated
 /// at every accepted point, whose sign change between two consecutive points
-/// brackets the event, and the locator started there. Adding an event is one
-/// file implementing this trait; [`crate::trace`] runs every detector as the
-/// points arrive. The fold needs the branch alone; the events of the Floquet
-/// multipliers implement it for [`crate::FamilyBranch`] only.
-pub trait Detector<B: Branch> {
+/// brackets the event, and the locator started there; `E` is its location
+/// error. Adding an event is one file implementing this trait; an
+/// [`EventObserver`](crate::events::EventObserver) runs every detector as
+/// the points arrive. The fold needs the branch alone; ivt-hb's events of
+/// the Floquet multipliers implement it for its `FamilyBranch` only.
+pub trait Detector<B: Branch, E> {
     /// The kind located.
     fn kind(&self) -> BifurcationKind;
 
@@ -276,7 +313,7 @@ pub trait Detector<B: Branch> {
     /// # Errors
     /// Sizes, a singular extended system or non-convergence of its Newton
     /// iteration (with the residual history); per kind as documented there.
-    fn locate(&mut self, at: Start<'_, B>) -> Result<Bifurcation, BifurcationError>;
+    fn locate(&mut self, at: Start<'_, B>) -> Result<Bifurcation, E>;
 }
 
 /// Where a locator starts: the branch, the path so far, the index of the
@@ -297,10 +334,10 @@ impl<'a, B: Branch> Start<'a, B> {
     /// The start point `(q, λ)`.
     ///
     /// # Errors
-    /// [`HbError::InvalidInput`] if `index` is past the path.
-    pub fn point(&self) -> Result<(&'a [f64], f64), HbError> {
+    /// [`PathError::InvalidInput`] if `index` is past the path.
+    pub fn point(&self) -> Result<(&'a [f64], f64), PathError> {
         let path: &'a PathSoFar = self.path;
         path.q_lambda(self.index)
-            .ok_or_else(|| HbError::InvalidInput(format!("no path point {}", self.index)))
+            .ok_or_else(|| PathError::InvalidInput(format!("no path point {}", self.index)))
     }
 }

@@ -5,24 +5,20 @@
 //! stopped by one [`StepRule`], with the small pieces the locators share
 //! (borders from inverse iteration, the `[R_q, R_λ]` blocks, the result).
 
-use super::detector::{Bifurcation, BifurcationError, BifurcationKind, LocateOptions};
+use super::detector::{Bifurcation, BifurcationKind, LocateOptions};
 use crate::branch::{full_newton_steps, residual_lambda_difference, Branch};
-use crate::ihb::HbError;
+use crate::error::PathError;
 use faer::c64;
 use ivt_num::vector::norm2;
 use ivt_num::SolveError;
 use ivt_num::{
-    newton, BorderedError, LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace, StepCheck,
+    newton, BorderedError, BorderedLu, LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace,
+    StepCheck,
 };
 use std::convert::Infallible;
 
-/// A Newton failure of a locator as a [`BifurcationError`].
-pub(crate) fn solve_error(e: SolveError) -> BifurcationError {
-    BifurcationError::Hb(HbError::Solve(e))
-}
-
 /// The error of a singular matrix before the first Newton step.
-pub(crate) fn singular_at_start() -> SolveError {
+pub fn singular_at_start() -> SolveError {
     SolveError::SingularJacobian {
         iteration: 0,
         history: Vec::new(),
@@ -33,17 +29,17 @@ pub(crate) fn singular_at_start() -> SolveError {
 /// finite.
 ///
 /// # Errors
-/// [`HbError::InvalidInput`] for sizes, [`SolveError::NonFinite`] for NaN or ∞.
-pub(crate) fn check_start<B: Branch>(branch: &B, q0: &[f64], lambda0: f64) -> Result<(), HbError> {
+/// [`PathError::InvalidInput`] for sizes, [`SolveError::NonFinite`] for NaN or ∞.
+pub fn check_start<B: Branch>(branch: &B, q0: &[f64], lambda0: f64) -> Result<(), PathError> {
     if q0.len() != branch.len() || q0.is_empty() {
-        return Err(HbError::InvalidInput(format!(
+        return Err(PathError::InvalidInput(format!(
             "start must have {} entries (at least one), got {}",
             branch.len(),
             q0.len()
         )));
     }
     if !(lambda0.is_finite() && q0.iter().all(|v| v.is_finite())) {
-        return Err(HbError::Solve(SolveError::NonFinite {
+        return Err(PathError::Solve(SolveError::NonFinite {
             iteration: 0,
             history: Vec::new(),
         }));
@@ -52,7 +48,7 @@ pub(crate) fn check_start<B: Branch>(branch: &B, q0: &[f64], lambda0: f64) -> Re
 }
 
 /// The located bifurcation with its residual norm ‖R(q, λ)‖₂.
-pub(crate) fn finish<B: Branch>(
+pub fn finish<B: Branch>(
     branch: &mut B,
     kind: BifurcationKind,
     (q, lambda): (Vec<f64>, f64),
@@ -75,12 +71,24 @@ pub(crate) fn finish<B: Branch>(
 
 /// Two steps of inverse iteration with the factored `J` (or `Jᵀ`) from `v`,
 /// normalised; `false` if the iterate vanishes or is not finite.
-pub(crate) fn null_vector(lu: &mut LuWorkspace, v: &mut [f64], transpose: bool) -> bool {
-    for _ in 0..2 {
+pub fn null_vector(lu: &mut LuWorkspace, v: &mut [f64], transpose: bool) -> bool {
+    inverse_iteration(v, |v| {
         if transpose {
             lu.solve_transpose(v);
         } else {
             lu.solve(v);
+        }
+        true
+    })
+}
+
+/// Two steps of inverse iteration from `v` with `solve` (`v ← A⁻¹v`,
+/// `false` if the solve is refused), normalised each time; `false` if the
+/// iterate vanishes or is not finite.
+fn inverse_iteration(v: &mut [f64], mut solve: impl FnMut(&mut [f64]) -> bool) -> bool {
+    for _ in 0..2 {
+        if !solve(v) {
+            return false;
         }
         let n = norm2(v);
         if n == 0.0 || !n.is_finite() {
@@ -95,7 +103,7 @@ pub(crate) fn null_vector(lu: &mut LuWorkspace, v: &mut [f64], transpose: bool) 
 /// steps of inverse iteration ([`null_vector`]) from the uniform seed; `None`
 /// if they break down. A factor singular to rounding still serves (the solve
 /// is checked instead).
-pub(crate) fn unit_null_vector(jac: &[f64], m: usize) -> Option<Vec<f64>> {
+pub fn unit_null_vector(jac: &[f64], m: usize) -> Option<Vec<f64>> {
     let mut lu = LuWorkspace::new(m);
     let mut v = vec![1.0 / (m as f64).sqrt(); m];
     lu.factor_row_major(jac);
@@ -107,7 +115,7 @@ pub(crate) fn unit_null_vector(jac: &[f64], m: usize) -> Option<Vec<f64>> {
 ///
 /// # Errors
 /// [`SolveError::SingularJacobian`] when inverse iteration breaks down.
-pub(crate) fn border_null_vectors(
+pub fn border_null_vectors(
     a: &[f64],
     right: &mut [f64],
     left: &mut [f64],
@@ -121,16 +129,44 @@ pub(crate) fn border_null_vectors(
     Ok(())
 }
 
+/// Right and left near-null vectors of the bordered matrix `[[J, b], [cᵀ, d]]`
+/// (`b = r_lambda`, `[cᵀ, d] = row`: the augmented Jacobian
+/// `[[R_q, R_λ], [uᵀ]]` of a branch point), factored once by `lu`
+/// ([`BorderedLu`], `m` and one border) and refined in place from their
+/// seeds by inverse iteration; only a non-finite factor is refused.
+///
+/// # Errors
+/// [`SolveError::SingularJacobian`] when inverse iteration breaks down.
+pub fn augmented_null_vectors(
+    lu: &mut BorderedLu,
+    (jac, r_lambda, row): (&[f64], &[f64], &[f64]),
+    right: &mut [f64],
+    left: &mut [f64],
+) -> Result<(), SolveError> {
+    let Some((corner, c)) = row.split_last() else {
+        return Err(singular_at_start());
+    };
+    // Near-singular at the event: only sizes that do not fit are refused.
+    let usable = factored(lu.factor(jac, r_lambda, c, std::slice::from_ref(corner)));
+    if !usable
+        || !inverse_iteration(right, |v| lu.solve(v).is_ok())
+        || !inverse_iteration(left, |v| lu.solve_transpose(v).is_ok())
+    {
+        return Err(singular_at_start());
+    }
+    Ok(())
+}
+
 /// A factorization usable for solves: regular, or singular to rounding
 /// (inverse iteration and test functions at a bifurcation accept it and
 /// check the solution); not one refused for its sizes.
-pub(crate) fn factored(result: Result<(), BorderedError>) -> bool {
+pub fn factored(result: Result<(), BorderedError>) -> bool {
     matches!(result, Ok(()) | Err(BorderedError::Singular))
 }
 
 /// Writes `[J | R_λ]` (`m` rows) into the first `m + 1` columns of the row-major
 /// matrix `dst` with row stride `stride` (> `m`).
-pub(crate) fn put_jacobian(dst: &mut [f64], stride: usize, jac: &[f64], r_lambda: &[f64]) {
+pub fn put_jacobian(dst: &mut [f64], stride: usize, jac: &[f64], r_lambda: &[f64]) {
     let m = r_lambda.len();
     if m == 0 || stride <= m {
         return;
@@ -151,13 +187,13 @@ pub(crate) fn put_jacobian(dst: &mut [f64], stride: usize, jac: &[f64], r_lambda
 
 /// The central-difference step in λ of the locators' `∂R/∂λ` and test
 /// functions: `fd_step·max(|λ|, 1e-3)`.
-pub(crate) fn lambda_step(opts: &LocateOptions, lambda: f64) -> f64 {
+pub fn lambda_step(opts: &LocateOptions, lambda: f64) -> f64 {
     opts.fd_step * lambda.abs().max(1e-3)
 }
 
 /// The blocks `R_q` (row-major `m×m`) and `R_λ` of `[R_q, R_λ]` at `(q, λ)`,
 /// `R_λ` by a central difference with [`lambda_step`].
-pub(crate) fn jacobian_blocks<B: Branch>(
+pub fn jacobian_blocks<B: Branch>(
     branch: &mut B,
     q: &[f64],
     lambda: f64,
@@ -178,21 +214,21 @@ pub(crate) fn jacobian_blocks<B: Branch>(
 /// differences in their Jacobians (a user `g` without an analytic
 /// Jacobian). Full Newton steps, no residual test.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct StepRule {
+pub struct StepRule {
     /// Unknowns `q` (the entries before λ).
-    pub(crate) m: usize,
+    pub m: usize,
     /// See [`LocateOptions::step_tol`].
-    pub(crate) step_tol: f64,
+    pub step_tol: f64,
     /// See [`LocateOptions::noise_tol`].
-    pub(crate) noise_tol: f64,
+    pub noise_tol: f64,
     /// Smallest |λ| the λ step is taken relative to.
-    pub(crate) lambda_floor: f64,
+    pub lambda_floor: f64,
 }
 
 impl StepRule {
     /// The options of [`ivt_num::newton()`] under this rule: full steps, at
     /// most `max_iter`, stopped by [`Self::check`] only.
-    pub(crate) fn newton_options(max_iter: usize, accept_near_singular: bool) -> NewtonOptions {
+    pub fn newton_options(max_iter: usize, accept_near_singular: bool) -> NewtonOptions {
         NewtonOptions {
             accept_near_singular,
             ..full_newton_steps(0.0, max_iter)
@@ -201,7 +237,7 @@ impl StepRule {
 
     /// The verdict after a step: `x` is `(q, λ, …)` after the step with `q`
     /// of `m` entries, `history` the ‖F‖ history up to the point after it.
-    pub(crate) fn check(&self, x: &[f64], step: &[f64], history: &[f64]) -> StepCheck {
+    pub fn check(&self, x: &[f64], step: &[f64], history: &[f64]) -> StepCheck {
         let m = self.m;
         let (Some(q), Some(dq), Some(lambda), Some(d_lambda)) =
             (x.get(..m), step.get(..m), x.get(m), step.get(m))
@@ -232,9 +268,11 @@ impl StepRule {
 
 /// An extended system stopped by its [`StepRule`]: the one
 /// [`NewtonSystem::check_step`] of the locators.
-pub(crate) struct Ruled<S> {
-    pub(crate) system: S,
-    pub(crate) rule: StepRule,
+pub struct Ruled<S> {
+    /// The extended system.
+    pub system: S,
+    /// Its stopping rule.
+    pub rule: StepRule,
 }
 
 impl<S: NewtonSystem> NewtonSystem for Ruled<S> {
@@ -254,22 +292,22 @@ impl<S: NewtonSystem> NewtonSystem for Ruled<S> {
 }
 
 /// Result of [`extended_newton`]: `(q, λ, iterations)`.
-pub(crate) type Converged = (Vec<f64>, f64, usize);
+pub type Converged = (Vec<f64>, f64, usize);
 
 /// Newton ([`ivt_num::newton()`]) on `[R(q, λ) + Σⱼ μⱼ bⱼ; ψ(q, λ)] = 0`,
 /// unknowns `{q, λ, μ}` with `k = unfold.len() + 1` test functions `ψ` (the
 /// unfoldings `μ` make it square). Full steps; stops by [`StepRule`].
 ///
 /// # Errors
-/// [`BifurcationError::Hb`] with the ‖F‖ history for a singular extended
+/// [`PathError::Solve`] with the ‖F‖ history for a singular extended
 /// matrix, non-finite values or no convergence within `max_iter` steps.
-pub(crate) fn extended_newton<B, T>(
+pub fn extended_newton<B, T>(
     branch: &mut B,
     (q0, lambda0): (&[f64], f64),
     unfold: &[Vec<f64>],
     tests: T,
     opts: &LocateOptions,
-) -> Result<Converged, BifurcationError>
+) -> Result<Converged, PathError>
 where
     B: Branch,
     T: FnMut(&mut B, &[f64], f64, &mut [f64]),
@@ -304,8 +342,7 @@ where
         &mut x,
         &mut NewtonWorkspace::new(m + k),
         &nopts,
-    )
-    .map_err(|e| solve_error(SolveError::from(e)))?;
+    )?;
     let lambda = x.get(m).copied().unwrap_or(lambda0);
     x.truncate(m);
     Ok((x, lambda, stats.iterations))

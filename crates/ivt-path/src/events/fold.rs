@@ -16,18 +16,14 @@
 //! the path turns in λ, and the locator starts from the point nearest the turn.
 
 use super::detector::{
-    Bifurcation, BifurcationError, BifurcationKind, Detector, LocateOptions, PathSoFar, Start,
-    FOLD_STEP_TOL,
+    Bifurcation, BifurcationKind, Detector, LocateOptions, PathSoFar, Start, FOLD_STEP_TOL,
 };
 use super::extended::{check_start, finish, null_vector, singular_at_start, Ruled, StepRule};
-use super::multipliers::Monodromy;
 use crate::branch::Branch;
 use crate::continuation::turn;
-use crate::family::{Family, FamilyBranch};
-use crate::ihb::HbError;
+use crate::error::PathError;
 use faer::c64;
 use ivt_num::vector::norm2;
-use ivt_num::SolveError;
 use ivt_num::{newton, BorderedLu, LuWorkspace, NewtonSystem, NewtonWorkspace};
 use std::convert::Infallible;
 
@@ -107,17 +103,18 @@ impl Bordered {
 /// (`opts.stability_steps` unused: no multipliers).
 ///
 /// # Errors
-/// [`HbError::InvalidInput`] for sizes; [`HbError::Solve`]:
-/// [`SolveError::SingularJacobian`] if the bordered or extended matrix is
+/// [`PathError::InvalidInput`] for sizes; [`PathError::Solve`]:
+/// [`ivt_num::SolveError::SingularJacobian`] if the bordered or extended matrix is
 /// singular (e.g. a branch point rather than a fold),
-/// [`SolveError::NonConvergence`] (with the ‖(R, g)‖ history) when Newton does
-/// not settle within `max_iter` steps, [`SolveError::NonFinite`] for NaN.
+/// [`ivt_num::SolveError::NonConvergence`] (with the ‖(R, g)‖ history) when
+/// Newton does not settle within `max_iter` steps,
+/// [`ivt_num::SolveError::NonFinite`] for NaN.
 pub fn locate_fold<B: Branch>(
     branch: &mut B,
     q0: &[f64],
     lambda0: f64,
     opts: &LocateOptions,
-) -> Result<FoldLocation, HbError> {
+) -> Result<FoldLocation, PathError> {
     check_start(branch, q0, lambda0)?;
     let m = branch.len();
     let n1 = m + 1;
@@ -134,7 +131,7 @@ pub fn locate_fold<B: Branch>(
     // J is near-singular at a fold: only a non-finite factor is refused.
     lu.factor_row_major(&bd.jac);
     if !null_vector(&mut lu, &mut bd.c, false) || !null_vector(&mut lu, &mut bd.b, true) {
-        return Err(HbError::Solve(singular_at_start()));
+        return Err(PathError::Solve(singular_at_start()));
     }
     let mut x = q0.to_vec();
     x.push(lambda0);
@@ -158,7 +155,7 @@ pub fn locate_fold<B: Branch>(
     };
     let nopts = StepRule::newton_options(opts.max_iter, false);
     let mut ws = NewtonWorkspace::new(n1);
-    let stats = newton(&mut system, &mut x, &mut ws, &nopts).map_err(SolveError::from)?;
+    let stats = newton(&mut system, &mut x, &mut ws, &nopts)?;
     let residual_norm = norm2(ws.residual().get(..m).unwrap_or_default());
     let lambda = x.pop().unwrap_or(lambda0);
     Ok(FoldLocation {
@@ -228,17 +225,22 @@ impl<B: Branch> NewtonSystem for FoldSystem<'_, B> {
 /// ([`locate_fold`], step tolerance at most 1e-12) starts from the point
 /// nearest the turn of the parabola through the three points around it
 /// ([`crate::continuation::turn_estimate`]). A located fold is its orbit and
-/// λ alone; [`FamilyFold`] adds the multipliers there.
+/// λ alone; [`Fold::locate_with`] adds the multipliers there (ivt-hb's
+/// `FamilyFold`).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Fold;
 
 impl Fold {
-    /// [`locate_fold`] from the start point of `at`, as a [`Bifurcation`]
-    /// with `multipliers`' of the located orbit.
-    fn locate_with<B: Branch>(
+    /// [`locate_fold`] from the start point of `at` (step tolerance at most
+    /// 1e-12), as a [`Bifurcation`] with `multipliers`' of the located
+    /// orbit.
+    ///
+    /// # Errors
+    /// As [`locate_fold`]; the error of `multipliers`.
+    pub fn locate_with<B: Branch, E: From<PathError>>(
         at: Start<'_, B>,
-        multipliers: impl FnOnce(&mut B, &[f64], f64, &LocateOptions) -> Result<Vec<c64>, HbError>,
-    ) -> Result<Bifurcation, BifurcationError> {
+        multipliers: impl FnOnce(&mut B, &[f64], f64, &LocateOptions) -> Result<Vec<c64>, E>,
+    ) -> Result<Bifurcation, E> {
         let (q, lambda) = at.point()?;
         let (branch, opts) = (at.branch, at.opts);
         let fold_opts = LocateOptions {
@@ -256,14 +258,10 @@ impl Fold {
             f.iterations,
         ))
     }
-}
 
-impl<B: Branch> Detector<B> for Fold {
-    fn kind(&self) -> BifurcationKind {
-        BifurcationKind::Fold
-    }
-
-    fn start(&self, path: &PathSoFar) -> Option<usize> {
+    /// The start of the locator: the point nearest the turn of the parabola
+    /// through the three newest points, once their secants turned.
+    pub fn start(path: &PathSoFar) -> Option<usize> {
         let k = path.len().checked_sub(3)?;
         let [a, b, c] = path.points.get(k..)? else {
             return None;
@@ -271,41 +269,29 @@ impl<B: Branch> Detector<B> for Fold {
         Some(k + turn(a, b, c).1)
     }
 
-    fn test(&mut self, _branch: &mut B, path: &PathSoFar, k: usize) -> f64 {
+    /// The test function at point `k`: the λ component of the secant into
+    /// it.
+    pub fn test(path: &PathSoFar, k: usize) -> f64 {
         path.points.get(k).map_or(f64::NAN, |p| p.dlambda)
-    }
-
-    /// [`locate_fold`] with a step tolerance of at most 1e-12.
-    fn locate(&mut self, at: Start<'_, B>) -> Result<Bifurcation, BifurcationError> {
-        Self::locate_with(at, |_, _, _, _| Ok(Vec::new()))
     }
 }
 
-/// The [`Fold`] of a [`Family`] branch with the multipliers of the located
-/// fold (Hsu, `LocateOptions::stability_steps`): the fold detector of
-/// [`crate::trace`].
-#[derive(Debug, Clone, Copy, Default)]
-pub struct FamilyFold;
-
-impl<F: Family> Detector<FamilyBranch<F>> for FamilyFold {
+impl<B: Branch, E: From<PathError>> Detector<B, E> for Fold {
     fn kind(&self) -> BifurcationKind {
         BifurcationKind::Fold
     }
 
     fn start(&self, path: &PathSoFar) -> Option<usize> {
-        <Fold as Detector<FamilyBranch<F>>>::start(&Fold, path)
+        Fold::start(path)
     }
 
-    fn test(&mut self, branch: &mut FamilyBranch<F>, path: &PathSoFar, k: usize) -> f64 {
-        Fold.test(branch, path, k)
+    fn test(&mut self, _branch: &mut B, path: &PathSoFar, k: usize) -> f64 {
+        Fold::test(path, k)
     }
 
-    /// [`Fold`]'s location, then the multipliers there.
-    fn locate(&mut self, at: Start<'_, FamilyBranch<F>>) -> Result<Bifurcation, BifurcationError> {
-        Fold::locate_with(at, |branch, q, lambda, opts| {
-            let mut mono = Monodromy::new(branch, lambda, opts.stability_steps)?;
-            Ok(mono.multipliers(branch, q, lambda))
-        })
+    /// [`locate_fold`] with a step tolerance of at most 1e-12.
+    fn locate(&mut self, at: Start<'_, B>) -> Result<Bifurcation, E> {
+        Self::locate_with(at, |_, _, _, _| Ok(Vec::new()))
     }
 }
 

@@ -10,7 +10,7 @@
 use super::{Corrected, Correction, DirectionError, Found, PathCorrector, Prediction, Retry};
 use crate::branch::Branch;
 use crate::continuation::predictor::distance;
-use crate::error::HbError;
+use crate::error::PathError;
 use ivt_num::vector::{dot, norm2};
 use ivt_num::LuWorkspace;
 use ivt_num::{broyden_solve, BroydenOptions, BroydenWorkspace, SolveError};
@@ -104,14 +104,14 @@ impl BroydenCorrector {
 }
 
 impl<B: Branch> PathCorrector<B> for BroydenCorrector {
-    fn start(&mut self, branch: &mut B, x: &mut [f64], dir: &mut [f64]) -> Result<(), HbError> {
+    fn start(&mut self, branch: &mut B, x: &mut [f64], dir: &mut [f64]) -> Result<(), PathError> {
         let sign = dir.last().copied().unwrap_or(1.0);
         let direction = dir;
         let (m, n1) = (self.m, self.m + 1);
         match self.jac0.take() {
             Some(j) if j.len() == m * n1 => self.jac.copy_from_slice(&j),
             Some(_) => {
-                return Err(HbError::InvalidInput(
+                return Err(PathError::InvalidInput(
                     "continuation: jac0 must be m×(m+1)".into(),
                 ))
             }
@@ -119,7 +119,7 @@ impl<B: Branch> PathCorrector<B> for BroydenCorrector {
         }
         // Correct the start at fixed λ.
         let Some((lam0, q)) = x.split_last_mut() else {
-            return Err(HbError::InvalidInput("continuation: empty start".into()));
+            return Err(PathError::InvalidInput("continuation: empty start".into()));
         };
         let lam0 = *lam0;
         let mut wsq = BroydenWorkspace::new(m);
@@ -133,7 +133,7 @@ impl<B: Branch> PathCorrector<B> for BroydenCorrector {
         }
         let mut fixed = |qv: &[f64], r: &mut [f64]| branch.residual(qv, lam0, r);
         broyden_solve(&mut fixed, q, &mut wsq, &self.opts).map_err(|cause| {
-            HbError::ContinuationStart {
+            PathError::ContinuationStart {
                 lambda: lam0,
                 cause,
             }
@@ -156,7 +156,7 @@ impl<B: Branch> PathCorrector<B> for BroydenCorrector {
             .collect();
         lu.solve(&mut z);
         if !z.iter().all(|v| v.is_finite()) {
-            return Err(HbError::SingularStart { lambda: lam0 });
+            return Err(PathError::SingularStart { lambda: lam0 });
         }
         let mut xd: Vec<f64> = z.iter().map(|v| -v).chain(std::iter::once(1.0)).collect();
         let nt = norm2(&xd);

@@ -12,7 +12,7 @@ use std::convert::Infallible;
 use super::{Corrected, Correction, DirectionError, Found, PathCorrector, Prediction, Retry};
 use crate::branch::{full_newton_steps, path_lambda_step, Branch};
 use crate::continuation::ContinuationOptions;
-use crate::error::HbError;
+use crate::error::PathError;
 use ivt_num::iteration::Stopping;
 use ivt_num::vector::norm2;
 use ivt_num::SolveError;
@@ -175,7 +175,7 @@ impl NewtonCorrector {
 
 impl<B: Branch> PathCorrector<B> for NewtonCorrector {
     /// The start must be converged ([`super::super::correct_at_fixed_lambda`]).
-    fn start(&mut self, branch: &mut B, x: &mut [f64], dir: &mut [f64]) -> Result<(), HbError> {
+    fn start(&mut self, branch: &mut B, x: &mut [f64], dir: &mut [f64]) -> Result<(), PathError> {
         let sign = dir.last().copied().unwrap_or(1.0);
         let direction = dir;
         direction.fill(0.0);
@@ -185,7 +185,7 @@ impl<B: Branch> PathCorrector<B> for NewtonCorrector {
         if self.tangent(branch, x, direction) {
             Ok(())
         } else {
-            Err(HbError::SingularStart {
+            Err(PathError::SingularStart {
                 lambda: x.last().copied().unwrap_or(f64::NAN),
             })
         }

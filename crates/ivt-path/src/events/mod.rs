@@ -1,0 +1,29 @@
+//! Events on a branch `R(u, λ) = 0`, each one [`Detector`]: a test function
+//! at every accepted path point and a locator — Newton on a minimally
+//! extended system (Govaerts' bordering on [`ivt_num::BorderedLu`],
+//! [`extended`]) — started where the test changes sign. The [`observe`]
+//! driver hands each point of a [`Stepper`](crate::Stepper) to an
+//! [`Observer`] as it arrives, as BifurcationKit does, instead of searching
+//! the finished path; the [`EventObserver`] runs detectors and, through a
+//! [`PointMultipliers`], gives each point its Floquet multipliers.
+//!
+//! Here: the [`Fold`] of any branch ([`fold`]: the λ component of the secant
+//! changes sign; located by [`locate_fold`]). The events of the Floquet
+//! multipliers (period doubling, Neimark–Sacker) and the branch point need
+//! the monodromy of the orbits; they are ivt-hb's (`ivt_hb::events`).
+//!
+//! The location error of an event is the detector's `E` (a branch whose
+//! locators fail in its own terms, as ivt-hb's, reports its own error type;
+//! the path engine's failures convert into it, `E: From<PathError>`).
+
+mod detector;
+pub mod extended;
+pub mod fold;
+mod observe;
+
+pub use detector::{
+    classify, dot, Bifurcation, BifurcationKind, Detector, Event, LocateOptions, Observer,
+    PathSoFar, StabilityKind, Start, TracedPoint,
+};
+pub use fold::{locate_fold, Fold, FoldLocation};
+pub use observe::{observe, EventObserver, PointMultipliers};
