@@ -140,7 +140,8 @@ pub fn trace<F: Family>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::continuation::Termination;
+    use ivt_path::continuation::Termination;
+    use ivt_path::events::Observer;
     use crate::family::Frequency;
     use crate::frc::FrcOptions;
     use crate::ihb::HbOptions;
