@@ -69,7 +69,7 @@ pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;
 pub use problem::{
     central_difference_samples, AtFrequency, Duffing, Excitation, FrequencyExcitation,
-    GeneralProblem, MathieuDuffing, Nonlinearity, PeriodicProblem, WithJacobian,
+    GeneralProblem, MathieuDuffing, Nonlinearity, Oscillator, PeriodicProblem, WithJacobian,
 };
 pub use stability::{
     classify, AdaptiveHsu, Floquet, HsuEstimate, HsuSteps, StabilityAnalyzer, StabilityKind,

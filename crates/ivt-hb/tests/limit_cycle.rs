@@ -4,8 +4,8 @@
 #![allow(clippy::indexing_slicing, clippy::panic)]
 
 use ivt_hb::aft::eval_series;
-use ivt_hb::jobs::Oscillator;
 use ivt_hb::ode::rk4;
+use ivt_hb::Oscillator;
 use ivt_hb::{
     limit_cycle, limit_cycle_branch, ContinuationOptions, HbError, HbOptions, PeriodicProblem,
     StabilityKind, Termination,

@@ -6,7 +6,8 @@
 
 use super::{to_json, CliError, Output};
 use clap::Args;
-use ivt_hb::jobs::{self, BackboneRequest, LimitCycleRequest, Oscillator};
+use ivt_hb::jobs::{self, BackboneRequest, LimitCycleRequest};
+use ivt_hb::Oscillator;
 use ivt_hb::{BackboneOptions, HbOptions};
 
 /// Harmonics and samples of the autonomous jobs (Python's defaults and

@@ -140,13 +140,13 @@ pub fn trace<F: Family>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ivt_path::continuation::Termination;
-    use ivt_path::events::Observer;
     use crate::family::Frequency;
     use crate::frc::FrcOptions;
     use crate::ihb::HbOptions;
     use crate::Corrector;
     use crate::{BifurcationKind, Duffing, ModifiedIhb};
+    use ivt_path::continuation::Termination;
+    use ivt_path::events::Observer;
 
     #[test]
     fn folds_are_located_as_the_points_arrive_not_after_the_path() {

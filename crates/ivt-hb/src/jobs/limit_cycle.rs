@@ -5,57 +5,9 @@
 use super::{finite, finite_pairs, stability_steps, Array};
 use crate::error::HbError;
 use crate::ihb::HbOptions;
-use crate::problem::{GeneralProblem, PeriodicProblem};
+use crate::problem::PeriodicProblem;
 use crate::stability::StabilityKind;
 use serde::Serialize;
-
-/// A self-excited oscillator of one DOF, `ẍ + x = μ h(x, ẋ)`, written as
-/// `M = 1`, `C = −μ`, `K = 1` and the rest in `g` (the CLI's `ivt hb
-/// limit-cycle --model`; Python builds the same system from `m, c, k, g`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Oscillator {
-    /// Van der Pol `ẍ − μ(1 − x²)ẋ + x = 0`: `g = μ x² ẋ`.
-    VanDerPol,
-    /// Rayleigh `ẍ − μ(ẋ − ẋ³/3) + x = 0`: `g = μ ẋ³/3`.
-    Rayleigh,
-}
-
-impl std::str::FromStr for Oscillator {
-    type Err = HbError;
-
-    /// `"van-der-pol"` or `"rayleigh"`.
-    fn from_str(s: &str) -> Result<Self, HbError> {
-        super::one_of(
-            "model",
-            s,
-            [
-                ("van-der-pol", Self::VanDerPol),
-                ("rayleigh", Self::Rayleigh),
-            ],
-        )
-    }
-}
-
-impl Oscillator {
-    /// The oscillator with parameter `mu` as a periodic problem (unforced).
-    pub fn problem(self, mu: f64) -> impl PeriodicProblem {
-        GeneralProblem::new(
-            1,
-            vec![1.0],
-            vec![-mu],
-            vec![1.0],
-            move |x: &[f64], v: &[f64], _theta: f64, out: &mut [f64]| {
-                if let (Some(g), Some(&x), Some(&v)) = (out.first_mut(), x.first(), v.first()) {
-                    *g = match self {
-                        Self::VanDerPol => mu * x * x * v,
-                        Self::Rayleigh => mu * v * v * v / 3.0,
-                    };
-                }
-            },
-            |_theta: f64, out: &mut [f64]| out.fill(0.0),
-        )
-    }
-}
 
 /// Where the iteration starts.
 #[derive(Debug, Clone, PartialEq)]
@@ -180,6 +132,7 @@ pub fn limit_cycle<P: PeriodicProblem>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::problem::Oscillator;
 
     #[test]
     fn weak_van_der_pol_has_amplitude_two_and_is_stable() {

@@ -1,7 +1,10 @@
 //! The one-DOF oscillators of the thesis as [`PeriodicProblem`]s: Duffing's
-//! equation (Eq. 49) and the Mathieu–Duffing equation (Eq. 81).
+//! equation (Eq. 49) and the Mathieu–Duffing equation (Eq. 81); and the
+//! self-excited oscillators of the limit-cycle examples (Van der Pol,
+//! Rayleigh).
 
-use super::{displacement_jacobian, matrix_getters, PeriodicProblem};
+use super::{displacement_jacobian, matrix_getters, GeneralProblem, PeriodicProblem};
+use crate::error::HbError;
 
 /// `out[0] = law(x[0])` of a one-DOF force; NaN in `out` if `x` is empty.
 #[inline]
@@ -123,4 +126,51 @@ impl PeriodicProblem for MathieuDuffing {
     displacement_jacobian!(|s, x, theta, dg_dx| {
         one_dof(x, dg_dx, |u| -s.beta * theta.sin() + 3.0 * s.gamma * u * u)
     });
+}
+
+/// A self-excited oscillator of one DOF, `ẍ + x = μ h(x, ẋ)`, written as
+/// `M = 1`, `C = −μ`, `K = 1` and the rest in `g` (the CLI's `ivt hb
+/// limit-cycle --model`; Python builds the same system from `m, c, k, g`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Oscillator {
+    /// Van der Pol `ẍ − μ(1 − x²)ẋ + x = 0`: `g = μ x² ẋ`.
+    VanDerPol,
+    /// Rayleigh `ẍ − μ(ẋ − ẋ³/3) + x = 0`: `g = μ ẋ³/3`.
+    Rayleigh,
+}
+
+impl std::str::FromStr for Oscillator {
+    type Err = HbError;
+
+    /// `"van-der-pol"` or `"rayleigh"`.
+    fn from_str(s: &str) -> Result<Self, HbError> {
+        match s {
+            "van-der-pol" => Ok(Self::VanDerPol),
+            "rayleigh" => Ok(Self::Rayleigh),
+            other => Err(HbError::InvalidInput(format!(
+                "`model` = {other:?} must be 'van-der-pol' or 'rayleigh'"
+            ))),
+        }
+    }
+}
+
+impl Oscillator {
+    /// The oscillator with parameter `mu` as a periodic problem (unforced).
+    pub fn problem(self, mu: f64) -> impl PeriodicProblem {
+        GeneralProblem::new(
+            1,
+            vec![1.0],
+            vec![-mu],
+            vec![1.0],
+            move |x: &[f64], v: &[f64], _theta: f64, out: &mut [f64]| {
+                if let (Some(g), Some(&x), Some(&v)) = (out.first_mut(), x.first(), v.first()) {
+                    *g = match self {
+                        Self::VanDerPol => mu * x * x * v,
+                        Self::Rayleigh => mu * v * v * v / 3.0,
+                    };
+                }
+            },
+            |_theta: f64, out: &mut [f64]| out.fill(0.0),
+        )
+    }
 }
