@@ -27,13 +27,17 @@ pub mod cli;
 #[doc(hidden)]
 pub mod reproduce;
 
+pub use ivt_condense as condense;
 pub use ivt_ctrl as ctrl;
 pub use ivt_design as design;
 pub use ivt_hb as hb;
+pub use ivt_jobs as jobs;
 pub use ivt_kin as kin;
 pub use ivt_num as num;
+pub use ivt_path as path;
 pub use ivt_plot as plot;
 pub use ivt_sim as sim;
+pub use ivt_sthb as sthb;
 pub use ivt_wire as wire;
 
 /// The guide's chapters (docs/guide/src) as doctests: every ```rust block of

@@ -16,9 +16,9 @@
 use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
 use ivt_design::OperatingPoint;
 use ivt_hb::problem::Duffing;
-use ivt_hb::sthb::{StringHb, StringParams};
 use ivt_hb::{c64, HbOptions, HsuRule, ModifiedIhb, StabilityAnalyzer};
 use ivt_kin::plant::PlantParams;
+use ivt_sthb::{StringHb, StringParams};
 use std::f64::consts::PI;
 
 /// Floquet multipliers of the default Duffing orbit (Fig. 28 parameters,

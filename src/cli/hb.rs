@@ -2,7 +2,7 @@
 //! with Floquet stability, the Duffing frequency-response curve, and the
 //! Mathieu–Duffing period-doubling cascade, the fold curve in (ω, F), limit
 //! cycles and the Duffing backbone. `--plot FILE.png` draws the curves.
-//! Each command parses its arguments, runs an `ivt_hb::jobs` job and prints
+//! Each command parses its arguments, runs an `ivt_jobs` job and prints
 //! its serialized result (the keys of `ivt.hb`'s dicts).
 
 mod all_solutions;
@@ -15,8 +15,8 @@ mod torus;
 use super::{CliError, Output};
 use clap::{Args, Subcommand};
 use ivt_hb::aft::eval_series;
-use ivt_hb::jobs::{self, CascadeRequest, FrcRequest, Method, OrbitRequest};
 use ivt_hb::{Duffing, FrcOptions, HbOptions};
+use ivt_jobs::{self as jobs, CascadeRequest, FrcRequest, Method, OrbitRequest};
 use std::f64::consts::PI;
 use std::path::PathBuf;
 

@@ -3,9 +3,9 @@
 
 use super::{CliError, Output};
 use clap::{Args, ValueEnum};
-use ivt_hb::jobs::{self, StringRequest};
-use ivt_hb::sthb::{Boundary, StringParams};
 use ivt_hb::FrcPoint;
+use ivt_jobs::{self as jobs, StringRequest};
+use ivt_sthb::{Boundary, StringParams};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -63,7 +63,7 @@ pub struct StringArgs {
     plot: Option<PathBuf>,
 }
 
-/// Trace the curve (the job [`ivt_hb::jobs::string()`]) and report
+/// Trace the curve (the job [`ivt_jobs::string()`]) and report
 /// `{"points": [{"omega", "norm", "stable", "kind", "max_multiplier",
 /// "method"}...], "jacobians", "hill_calls", "stop", "solve_time_s"}` (and
 /// `boundary_note` for a spring of k0 > 1).

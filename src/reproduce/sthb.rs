@@ -3,9 +3,9 @@
 
 use super::{series, Context, Points, ReproError, SeriesSpec, Verdict};
 use ivt_hb::frc::Frc;
-use ivt_hb::sthb::frc::{frequency_response, trace, StringFrcOptions};
-use ivt_hb::sthb::{Boundary, StringHb, StringParams};
 use ivt_plot::{Figure, Style};
+use ivt_sthb::frc::{frequency_response, trace, StringFrcOptions};
+use ivt_sthb::{Boundary, StringHb, StringParams};
 
 /// Frequency window of the sweeps (around the first resonance, ω₁ = π for
 /// the linear string; the thesis does not print its axis range in the text).

@@ -5,8 +5,8 @@
 #![allow(clippy::expect_used, clippy::indexing_slicing)]
 
 use faer::c64;
-use ivt_hb::condense::{Coupling, Receptances, Structure};
-use ivt_hb::models::{cantilever, BeamProperties};
+use ivt_condense::models::{cantilever, BeamProperties};
+use ivt_condense::{Coupling, Receptances, Structure};
 
 fn main() {
     divan::main();
@@ -51,7 +51,7 @@ fn beam_curve_n500(bencher: divan::Bencher) {
 /// n = 5, multipliers at every point.
 #[divan::bench(sample_count = 3)]
 fn disk_curve(bencher: divan::Bencher) {
-    let disk = ivt_hb::models::bladed_disk().expect("disk");
+    let disk = ivt_condense::models::bladed_disk().expect("disk");
     let curve = Curve {
         tip: disk.tip,
         force: 1.0,
@@ -73,8 +73,8 @@ struct Curve {
 }
 
 impl Curve {
-    fn run(&self, s: &ivt_hb::models::SparseModel) -> ivt_hb::condense::CondensedFrc {
-        use ivt_hb::condense::{condensed_response, CondensedBranch, CondensedFrcOptions};
+    fn run(&self, s: &ivt_condense::models::SparseModel) -> ivt_condense::CondensedFrc {
+        use ivt_condense::{condensed_response, CondensedBranch, CondensedFrcOptions};
         use ivt_hb::{GeneralProblem, HbOptions};
         let structure =
             Structure::new(s.m.as_ref(), s.c.as_ref(), s.k.as_ref()).expect("structure");

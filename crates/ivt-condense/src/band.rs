@@ -5,8 +5,8 @@
 //! `O(n·kl·(kl + ku))` with no symbolic analysis, no allocation per column
 //! and contiguous rows. Pivoting widens `U`'s upper band to `kl + ku`.
 
-use crate::error::HbError;
 use faer::{c64, MatMut};
+use ivt_hb::HbError;
 
 /// Largest half-bandwidth (`max(kl, ku)`) the band factorization is chosen
 /// for ([`super::Structure::new`]); wider patterns go to the sparse LU.

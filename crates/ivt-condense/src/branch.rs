@@ -3,7 +3,7 @@
 //! and the fold locator see it in scaled unknowns, `scaled.rs`).
 //!
 //! Unknowns `q`: the harmonics of the nonlinear DOFs `S` only, in the layout of
-//! [`crate::HbResidual`] (`s` blocks `[a0, a1..an, b1..bn]`). The residual is
+//! [`ivt_hb::HbResidual`] (`s` blocks `[a0, a1..an, b1..bn]`). The residual is
 //!
 //! `R_h(q, ω_f) = X_h − u_h(ω) + H_h(ω) G_h(q, ω_f)` per harmonic h
 //!
@@ -16,11 +16,11 @@
 
 use super::dynamic::Structure;
 use super::receptance::{Coupling, Receptances};
-use crate::error::HbError;
-use crate::galerkin::GalerkinJacobian;
-use crate::ihb::{HbOptions, HbResidual};
-use crate::problem::PeriodicProblem;
 use faer::{c64, Mat};
+use ivt_hb::galerkin::GalerkinJacobian;
+use ivt_hb::ihb::{HbOptions, HbResidual};
+use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::HbError;
 use ivt_path::branch::{bilinear_form, Branch};
 
 /// The condensed HB problem of a sparse structure with a local nonlinearity.
@@ -518,7 +518,7 @@ impl<P: PeriodicProblem> Branch for CondensedBranch<P> {
 mod tests {
     use super::*;
     use crate::models::{cantilever, BeamProperties};
-    use crate::GeneralProblem;
+    use ivt_hb::GeneralProblem;
     use ivt_path::branch::bilinear_lambda_difference;
 
     /// The exact `∂(wᵀJv)/∂ω_f` equals the central difference of two

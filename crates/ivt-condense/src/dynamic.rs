@@ -16,11 +16,11 @@
 
 use super::band::{BandLu, MAX_HALF_BANDWIDTH};
 use super::double_double::{Dd, Split, SplitDd};
-use crate::error::HbError;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu as SparseLu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{c64, Mat, MatMut, MatRef};
+use ivt_hb::HbError;
 
 /// Units of rounding (ε) per stored entry of `M` and `C` in
 /// [`Structure::data_error`]: an assembled entry is a sum of element

@@ -10,17 +10,17 @@
 //! of these harmonics come from the plain LU (an estimate needs no more).
 
 use super::branch::CondensedBranch;
-use crate::aft::Aft;
-use crate::error::HbError;
-use crate::problem::PeriodicProblem;
 use faer::{c64, Mat};
+use ivt_hb::aft::Aft;
+use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::HbError;
 
 /// Estimated relative truncation error of the orbit `q` at ω_f, or 0 when
 /// the AFT grid resolves no harmonic above `n` (then nothing can be said:
 /// choose `N > 3n`).
 ///
 /// # Errors
-/// As [`crate::condense::Structure::factor`] for the omitted harmonics.
+/// As [`crate::Structure::factor`] for the omitted harmonics.
 pub fn truncation_error<P: PeriodicProblem>(
     branch: &CondensedBranch<P>,
     q: &[f64],

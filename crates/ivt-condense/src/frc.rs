@@ -1,7 +1,7 @@
 //! Frequency-response curves of a condensed structure: the exact-Jacobian
 //! pseudo-arclength continuation (Eq. 68–77, [`NewtonCorrector`]) of
 //! [`CondensedBranch`] in ω_f, each fold located as the points arrive by
-//! Newton on the extended system ([`crate::locate_fold`]) of the condensed
+//! Newton on the extended system ([`ivt_hb::locate_fold`]) of the condensed
 //! Jacobian, each amplitude peak located between the points (`peak.rs`),
 //! any DOF recovered per
 //! point, and per point the estimated errors of the linear solves and of the
@@ -14,12 +14,12 @@ use super::scaled::Scaled;
 use super::stability::{
     BasisGrowth, CondensedFloquet, ReducedStability, DEFAULT_BASIS_TOL, DEFAULT_BLOCKS,
 };
-use crate::aft::{eval_series, Aft};
-use crate::error::HbError;
-use crate::events::{observe, BifurcationKind, EventObserver, Fold, LocateOptions};
-use crate::frc::FrcFold;
-use crate::problem::PeriodicProblem;
-use crate::stability::HsuSteps;
+use ivt_hb::aft::{eval_series, Aft};
+use ivt_hb::events::{observe, BifurcationKind, EventObserver, Fold, LocateOptions};
+use ivt_hb::frc::FrcFold;
+use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::stability::HsuSteps;
+use ivt_hb::HbError;
 use ivt_path::branch::Branch;
 use ivt_path::continuation::{
     correct_at_fixed_lambda, ContinuationOptions, NewtonCorrector, Stepper, Traced,
@@ -100,7 +100,7 @@ pub struct CondensedPoint {
     /// Estimated relative error of the receptances (the refined solves).
     pub solve_error: f64,
     /// Relative change of the receptances from the rounding of the stored
-    /// `M` and `C` ([`crate::condense::Structure::data_error`]).
+    /// `M` and `C` ([`crate::Structure::data_error`]).
     pub data_error: f64,
     /// Estimated relative error of the orbit (and of the amplitude when it
     /// is a nonlinear DOF's) at this ω_f from the corrector's residual and

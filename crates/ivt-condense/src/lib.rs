@@ -1,3 +1,4 @@
+#![doc = include_str!("../README.md")]
 //! Large structures with local nonlinearity (issue 28): harmonic balance
 //! condensed onto the nonlinear DOFs.
 //!
@@ -14,7 +15,7 @@
 //!   refinement in double-double residuals so the fine mesh's κ ~ N⁴ costs no
 //!   accuracy ([`dynamic`]).
 //! - [`Receptances`]: `D̃_h`, the condensed load and their ω-derivatives.
-//! - [`CondensedBranch`]: the condensed residual as a [`crate::Branch`];
+//! - [`CondensedBranch`]: the condensed residual as a [`ivt_hb::Branch`];
 //!   any DOF recovered on request.
 //! - [`condensed_response`]: the frequency-response curve with folds located
 //!   and per point the estimated solve and truncation errors.
@@ -30,6 +31,7 @@ pub mod dynamic;
 mod estimate;
 mod frc;
 mod modal_hsu;
+pub mod models;
 mod peak;
 mod receptance;
 mod ritz;

@@ -17,12 +17,12 @@
 //! monodromy instead of the `O(r³)` exponential of a Magnus step.
 
 use super::ritz::{at, Reduced};
-use crate::aft::Aft;
-use crate::error::HbError;
-use crate::floquet::{eigenvalues, expm2};
-use crate::problem::PeriodicProblem;
-use crate::stability::{richardson_error, Floquet, HsuEstimate, HsuSteps};
 use faer::{Mat, Side};
+use ivt_hb::aft::Aft;
+use ivt_hb::floquet::{eigenvalues, expm2};
+use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::stability::{richardson_error, Floquet, HsuEstimate, HsuSteps};
+use ivt_hb::HbError;
 
 /// The Richardson estimate of [`richardson_error`] divides the change of
 /// the multipliers by 2⁴ − 1, the ratio of a fourth-order method's errors;
@@ -316,9 +316,9 @@ mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
 
     use super::*;
-    use crate::ihb::HbSolution;
-    use crate::problem::GeneralProblem;
-    use crate::stability::AdaptiveHsu;
+    use ivt_hb::ihb::HbSolution;
+    use ivt_hb::problem::GeneralProblem;
+    use ivt_hb::stability::AdaptiveHsu;
 
     /// A 3-DOF chain with a non-diagonal mass, `C = 0.02 M + 0.01 K`.
     const M: [f64; 9] = [2.0, 0.5, 0.0, 0.5, 1.0, 0.0, 0.0, 0.0, 1.0];

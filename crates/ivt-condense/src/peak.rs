@@ -10,7 +10,7 @@
 //! successive parabolic interpolation (Brent's inverse-parabolic step,
 //! bracketed) on the corrected orbits.
 
-use crate::error::HbError;
+use ivt_hb::HbError;
 
 /// One corrected orbit: its ω_f, amplitude and condensed unknowns.
 #[derive(Debug, Clone)]

@@ -14,8 +14,8 @@
 //! from `∂H/∂ω = −H D′ H` with transposed solves (no second factorization).
 
 use super::dynamic::Structure;
-use crate::error::HbError;
 use faer::{c64, Mat};
+use ivt_hb::HbError;
 
 /// `H_SS`, `u_S`, their ω_f-derivatives and the responses `U_h` for
 /// `h = 0..=n` at one ω_f.

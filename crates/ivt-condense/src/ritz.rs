@@ -13,9 +13,9 @@
 //! the basis truncation costs nothing but that measured part.
 
 use super::dynamic::{Factored, Part, Structure};
-use crate::error::HbError;
-use crate::problem::PeriodicProblem;
 use faer::{c64, Mat};
+use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::HbError;
 use ivt_num::vector::dot;
 
 /// A new vector that keeps at most this part of its M-norm after

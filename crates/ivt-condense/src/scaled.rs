@@ -30,7 +30,7 @@
 //! correctors stop moves.
 
 use super::branch::CondensedBranch;
-use crate::problem::PeriodicProblem;
+use ivt_hb::problem::PeriodicProblem;
 use ivt_path::branch::Branch;
 
 /// [`CondensedBranch`] seen in scaled unknowns (module docs).

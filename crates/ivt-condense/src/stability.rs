@@ -25,11 +25,11 @@
 use super::branch::CondensedBranch;
 use super::modal_hsu::ModalHsu;
 use super::ritz::{at, row, Reduced, RitzBasis};
-use crate::error::HbError;
-use crate::ihb::HbSolution;
-use crate::problem::PeriodicProblem;
-use crate::stability::{AdaptiveHsu, Floquet, HsuEstimate, HsuSteps};
 use faer::c64;
+use ivt_hb::ihb::HbSolution;
+use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::stability::{AdaptiveHsu, Floquet, HsuEstimate, HsuSteps};
+use ivt_hb::HbError;
 use ivt_num::vector::dot;
 
 /// Multipliers of smaller modulus take no part in the truncation estimate:

@@ -8,6 +8,7 @@
 
 #[path = "common/beam.rs"]
 mod beam;
+#[path = "../../ivt-hb/tests/common/mod.rs"]
 mod common;
 #[path = "common/dd.rs"]
 mod dd;
@@ -19,10 +20,10 @@ mod full_dd;
 use beam::{beam, full_beam, orbit, FORCE, OMEGA1};
 use common::orbit_defect;
 use faer::{c64, Mat};
-use ivt_hb::condense::{
+use ivt_condense::models::{cantilever, BeamProperties};
+use ivt_condense::{
     condensed_response, correct_condensed, CondensedFrc, CondensedFrcOptions, Structure,
 };
-use ivt_hb::models::{cantilever, BeamProperties};
 use ivt_hb::{
     locate_fold, ClassicIhb, FamilyBranch, Frequency, HbOptions, LocateOptions, PeriodicProblem,
 };
@@ -33,7 +34,7 @@ fn curve(
     hb: &HbOptions,
 ) -> (
     CondensedFrc,
-    ivt_hb::condense::CondensedBranch<impl PeriodicProblem>,
+    ivt_condense::CondensedBranch<impl PeriodicProblem>,
 ) {
     let mut branch = beam(n, FORCE, hb);
     let opts = CondensedFrcOptions {
@@ -48,7 +49,7 @@ fn curve(
 /// All DOFs' coefficients of a condensed orbit, DOF-major (the layout of
 /// the uncondensed unknowns).
 fn all_dofs<P: PeriodicProblem>(
-    branch: &mut ivt_hb::condense::CondensedBranch<P>,
+    branch: &mut ivt_condense::CondensedBranch<P>,
     q: &[f64],
     omega_f: f64,
 ) -> Vec<f64> {
@@ -283,8 +284,8 @@ fn bladed_disk_curve_solves_the_uncondensed_equations() {
     // sector 0's blade tip, F = 1 there, from ω = 1150 rad/s: every tenth
     // point's recovered 72-DOF orbit has a full HB residual (dense, Eq. 61)
     // below 1e-9 of the force.
-    use ivt_hb::condense::CondensedBranch;
-    use ivt_hb::models::bladed_disk;
+    use ivt_condense::models::bladed_disk;
+    use ivt_condense::CondensedBranch;
     let disk = bladed_disk().unwrap();
     let s = &disk.model;
     let nd = s.n_dof();

@@ -12,10 +12,10 @@ mod disk;
 use beam::orbit;
 use disk::{full_disk, tip_problem};
 use faer::c64;
-use ivt_hb::condense::{
+use ivt_condense::models::bladed_disk;
+use ivt_condense::{
     condensed_response, CondensedBranch, CondensedFrc, CondensedFrcOptions, Structure,
 };
-use ivt_hb::models::bladed_disk;
 use ivt_hb::{AdaptiveHsu, HbOptions, HsuSteps, PeriodicProblem};
 
 /// The disk condensed onto the tip, `F = 1` there, and its curve over

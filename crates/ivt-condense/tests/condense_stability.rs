@@ -9,8 +9,8 @@ mod beam;
 
 use beam::{beam, dense, full_beam, orbit, FORCE, K3, OMEGA1};
 use faer::{Mat, Side};
-use ivt_hb::condense::{condensed_response, multiplier_distance, CondensedFrcOptions};
-use ivt_hb::models::{cantilever, BeamProperties};
+use ivt_condense::models::{cantilever, BeamProperties};
+use ivt_condense::{condensed_response, multiplier_distance, CondensedFrcOptions};
 use ivt_hb::{
     AdaptiveHsu, ContinuationOptions, GeneralProblem, HbOptions, HsuSteps, PeriodicProblem,
 };

@@ -9,7 +9,7 @@
 //! form, at `ω = √(1 − 2ζ²)`), about 375 times the response at the start.
 #![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
-use ivt_hb::condense::{
+use ivt_condense::{
     condensed_response, CondensedBranch, CondensedFrc, CondensedFrcOptions, Structure,
 };
 use ivt_hb::{GeneralProblem, HbOptions, Termination};

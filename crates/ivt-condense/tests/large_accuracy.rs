@@ -21,7 +21,7 @@ mod dd;
 use beam::{beam, FORCE, K3, OMEGA1};
 use faer::c64;
 use faer::linalg::solvers::Solve;
-use ivt_hb::condense::{condensed_response, CondensedFrc, CondensedFrcOptions};
+use ivt_condense::{condensed_response, CondensedFrc, CondensedFrcOptions};
 use ivt_hb::HbOptions;
 use std::collections::HashMap;
 

@@ -28,20 +28,20 @@ pub struct Aft {
 
 /// Forward and inverse real FFT plans of one length with one scratch, the
 /// spectrum (`len/2 + 1` bins) and a sample buffer: the transforms of [`Aft`] and of
-/// the string's time axis ([`crate::sthb::StringHb`]). They allocate nothing.
-pub(crate) struct RealFftPair {
+/// the string's time axis (ivt-sthb's `StringHb`). They allocate nothing.
+pub struct RealFftPair {
     fwd: Arc<dyn RealToComplex<f64>>,
     inv: Arc<dyn ComplexToReal<f64>>,
     scratch: Vec<Complex<f64>>,
     samples: Vec<f64>,
     /// The spectrum: input of [`Self::inverse_into`] (overwritten), output of
     /// [`Self::forward_from`].
-    pub(crate) spectrum: Vec<Complex<f64>>,
+    pub spectrum: Vec<Complex<f64>>,
 }
 
 impl RealFftPair {
     /// Plans for `len` real samples.
-    pub(crate) fn new(len: usize) -> Self {
+    pub fn new(len: usize) -> Self {
         let mut planner = RealFftPlanner::<f64>::new();
         let fwd = planner.plan_fft_forward(len);
         let inv = planner.plan_fft_inverse(len);
@@ -57,7 +57,7 @@ impl RealFftPair {
 
     /// Unnormalised DFT of `samples` (`len`) into [`Self::spectrum`] (NaN if
     /// `samples` is not `len` long).
-    pub(crate) fn forward_from(&mut self, samples: &[f64]) {
+    pub fn forward_from(&mut self, samples: &[f64]) {
         debug_assert_eq!(samples.len(), self.samples.len());
         if samples.len() != self.samples.len() {
             self.spectrum.fill(Complex::new(f64::NAN, f64::NAN));
@@ -77,7 +77,7 @@ impl RealFftPair {
 
     /// `x_i = Σ_K X_K e^{+jKτ_i}` over the Hermitian extension of
     /// [`Self::spectrum`] into `samples` (`len`; NaN if it is not `len` long).
-    pub(crate) fn inverse_into(&mut self, samples: &mut [f64]) {
+    pub fn inverse_into(&mut self, samples: &mut [f64]) {
         debug_assert_eq!(samples.len(), self.samples.len());
         match self
             .inv

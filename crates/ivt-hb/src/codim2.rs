@@ -31,10 +31,8 @@ pub mod cycle_fold;
 mod fixed;
 mod fold_system;
 pub mod multiplier_curve;
-mod ns_points;
 pub use cycle_fold::{cycle_fold_curve, CycleFoldCurve, CycleFoldPoint};
 pub use multiplier_curve::{bifurcation_curve, BifurcationCurve, CurvePoint, CurveStart};
-pub use ns_points::{neimark_sacker_points, NeimarkSackerPoint};
 
 use crate::error::HbError;
 use crate::ihb::HbOptions;

@@ -169,7 +169,7 @@ fn expm_sized<const N: usize>(a: &[f64], dim: usize, out: &mut [f64], scratch: &
 /// Closed-form exponential of a 2×2 matrix: with `μ = tr/2` and `δ² = μ² − det`,
 /// `exp(A) = e^μ [cosh δ · I + (sinh δ/δ)(A − μI)]` (δ imaginary → cos/sin).
 /// `out` is NaN if `a` has fewer than 4 entries.
-pub(crate) fn expm2(a: &[f64], out: &mut [f64]) {
+pub fn expm2(a: &[f64], out: &mut [f64]) {
     let Some(out) = out.first_chunk_mut::<4>() else {
         return out.fill(f64::NAN);
     };

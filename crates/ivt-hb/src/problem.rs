@@ -79,7 +79,9 @@ use forward_matrices;
 
 /// `velocity_dependent() = false` and a `nonlinear_jacobian` that writes `∂g/∂x`
 /// by `$body` (`$s` stands for `self`) and zeroes `∂g/∂v`: the trait items of a
-/// force that depends on displacement and phase only.
+/// force that depends on displacement and phase only (exported for the
+/// problems of the crates built on this one, e.g. ivt-sthb's modal string).
+#[macro_export]
 macro_rules! displacement_jacobian {
     (|$s:ident, $x:ident, $theta:ident, $dg_dx:ident| $body:expr) => {
         fn velocity_dependent(&self) -> bool {
@@ -93,7 +95,7 @@ macro_rules! displacement_jacobian {
         }
     };
 }
-pub(crate) use displacement_jacobian;
+pub use displacement_jacobian;
 
 /// A periodically forced second-order system (see the module docs).
 pub trait PeriodicProblem {

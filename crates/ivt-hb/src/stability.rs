@@ -487,7 +487,7 @@ fn theta_from_tangents<const N: usize>(
 /// steps from those of `S/2`, `coarse`: the Hausdorff distance between the two
 /// sets, relative to max(1, |μ|), over 2⁴ − 1 = 15 (fourth order; the pairing
 /// by nearest neighbour needs no common order of the two lists).
-pub(crate) fn richardson_error(fine: &[c64], coarse: &[c64]) -> f64 {
+pub fn richardson_error(fine: &[c64], coarse: &[c64]) -> f64 {
     let nearest = |z: &c64, set: &[c64]| {
         set.iter()
             .map(|w| (z - w).norm() / z.norm().max(1.0))

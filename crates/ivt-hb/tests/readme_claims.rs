@@ -1,8 +1,7 @@
-//! The defaults the guide quotes (docs/guide/src/model/orbit.md and
-//! string.md; crates/ivt-hb/README.md points there): Broyden, HB options, Hsu
-//! rule, the STHB string of §3.3.4.
+//! The defaults the guide quotes (docs/guide/src/model/orbit.md;
+//! crates/ivt-hb/README.md points there): Broyden, HB options, Hsu rule.
+//! (The STHB string's: ivt-sthb's tests/readme_claims.rs.)
 
-use ivt_hb::sthb::{Boundary, StringParams};
 use ivt_hb::{BroydenOptions, HbOptions, HsuRule};
 
 /// `BroydenOptions`: tol 1e-10, max_iter 100, max_backtracks 8.
@@ -24,15 +23,4 @@ fn hb_defaults_are_the_readme_values() {
     );
     assert_eq!(o.subharmonic, 1);
     assert_eq!(HsuRule::default(), HsuRule::Magnus4);
-}
-
-/// `StringParams::default()` = §3.3.4, whose text prints "c_d = 0.8,
-/// y_0 = 0.5, M = 19, N_s = 64 and M_s = 128", k_d = 10 for the weak case and
-/// N = 5 (Fig. 34); fixed ends.
-#[test]
-fn string_defaults_are_section_3_3_4() {
-    let p = StringParams::default();
-    assert_eq!((p.kd, p.cd, p.y0), (10.0, 0.8, 0.5));
-    assert_eq!((p.modes, p.harmonics, p.ns, p.ms), (5, 19, 64, 128));
-    assert!(matches!(p.boundary, Boundary::Fixed));
 }

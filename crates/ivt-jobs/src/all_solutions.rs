@@ -1,13 +1,13 @@
 //! Every periodic solution at one excitation frequency that deflated Newton
-//! finds within bounded starts ([`crate::all_solutions()`]), each with its
+//! finds within bounded starts ([`ivt_hb::all_solutions()`]), each with its
 //! Floquet multipliers (Hsu, Eq. 78) and verdict, and the search's bounds.
 
 use super::{finite, pairs, stability_steps, Array};
-use crate::deflation::{all_solutions as deflated, SearchOptions};
-use crate::error::HbError;
-use crate::ihb::HbOptions;
-use crate::problem::PeriodicProblem;
-use crate::stability::StabilityKind;
+use ivt_hb::deflation::{all_solutions as deflated, SearchOptions};
+use ivt_hb::ihb::HbOptions;
+use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::stability::StabilityKind;
+use ivt_hb::HbError;
 use serde::Serialize;
 
 /// The frequency and the search's bounds.
@@ -81,7 +81,7 @@ pub struct AllSolutionsResult {
 ///
 /// # Errors
 /// [`HbError::InvalidInput`] for a non-finite frequency or box;
-/// [`crate::all_solutions()`]'s.
+/// [`ivt_hb::all_solutions()`]'s.
 pub fn all_solutions<P: PeriodicProblem>(
     problem: &P,
     hb: &HbOptions,

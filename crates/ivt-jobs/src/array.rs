@@ -1,11 +1,11 @@
 //! Numbers the results carry as columns: JSON lists, numpy arrays in Python.
 
-use crate::{c64, HbError};
+use ivt_hb::{c64, HbError};
 use serde::{Serialize, Serializer};
 
 /// The newtype-struct name by which a serializer recognizes an [`Array`]
 /// (ivt-py turns it into a numpy array; JSON sees the plain list).
-pub const ARRAY_NAME: &str = "ivt_hb::jobs::Array";
+pub const ARRAY_NAME: &str = "ivt_jobs::Array";
 
 /// A column of numbers (coefficients, a curve's ω or amplitudes): a list in
 /// JSON, a numpy array in Python.

@@ -1,12 +1,12 @@
 //! Backbone curve (nonlinear normal mode) of an undamped, unforced system,
 //! followed in amplitude from a linear mode with ω unknown (phase condition
-//! b1 = 0, a fictitious damping κ unfolding the family: [`crate::backbone()`]).
+//! b1 = 0, a fictitious damping κ unfolding the family: [`ivt_hb::backbone()`]).
 
 use super::{finite, Array};
-use crate::backbone::{BackboneOptions, BackbonePoint};
-use crate::error::HbError;
-use crate::ihb::HbOptions;
-use crate::problem::{GeneralProblem, PeriodicProblem};
+use ivt_hb::backbone::{BackboneOptions, BackbonePoint};
+use ivt_hb::ihb::HbOptions;
+use ivt_hb::problem::{GeneralProblem, PeriodicProblem};
+use ivt_hb::HbError;
 use ivt_path::continuation::{Corrector, Termination};
 use serde::Serialize;
 
@@ -57,7 +57,7 @@ impl Default for BackboneRequest {
 impl BackboneRequest {
     /// # Errors
     /// [`HbError::InvalidInput`] for a non-finite frequency or amplitude (the
-    /// mode and the system are checked by [`crate::backbone()`]).
+    /// mode and the system are checked by [`ivt_hb::backbone()`]).
     pub fn validate(&self) -> Result<(), HbError> {
         finite("omega0", self.omega0)?;
         finite("amplitude_from", self.options.amplitude_from)?;
@@ -97,14 +97,14 @@ pub struct BackboneCurve {
 /// The backbone of `problem` from `req`'s mode.
 ///
 /// # Errors
-/// [`BackboneRequest::validate`]'s and [`crate::backbone()`]'s.
+/// [`BackboneRequest::validate`]'s and [`ivt_hb::backbone()`]'s.
 pub fn backbone<P: PeriodicProblem>(
     problem: &P,
     hb: &HbOptions,
     req: &BackboneRequest,
 ) -> Result<BackboneCurve, HbError> {
     req.validate()?;
-    let bb = crate::backbone(problem, hb, req.omega0, &req.mode, &req.options)?;
+    let bb = ivt_hb::backbone(problem, hb, req.omega0, &req.mode, &req.options)?;
     let col = |f: fn(&BackbonePoint) -> f64| bb.points.iter().map(f).collect();
     Ok(BackboneCurve {
         amplitude: col(|p| p.amplitude),
@@ -127,7 +127,7 @@ pub fn backbone<P: PeriodicProblem>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Duffing;
+    use ivt_hb::Duffing;
 
     #[test]
     fn duffing_backbone_follows_the_first_order_frequency_law() {

@@ -3,8 +3,8 @@
 //! Floquet multiplier crosses −1 along the branch in β.
 
 use super::{all_finite, pairs, positive};
-use crate::error::HbError;
-use crate::mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
+use ivt_hb::mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
+use ivt_hb::HbError;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -17,20 +17,18 @@ pub const THESIS_BETAS: [f64; 3] = [4.825, 5.194, 5.253];
 /// §3.2.5's defaults).
 pub type CascadeRequest = CascadeOptions;
 
-impl CascadeOptions {
-    /// The job's check of its request.
-    ///
-    /// # Errors
-    /// [`HbError::InvalidInput`] for a non-finite parameter or Ω ≤ 0.
-    pub fn validate(&self) -> Result<(), HbError> {
-        all_finite(&[
-            ("xi", self.xi),
-            ("alpha", self.alpha),
-            ("gamma", self.gamma),
-            ("beta0", self.beta0),
-        ])?;
-        positive("omega", self.omega).map(|_| ())
-    }
+/// The job's check of its request.
+///
+/// # Errors
+/// [`HbError::InvalidInput`] for a non-finite parameter or Ω ≤ 0.
+pub fn validate(req: &CascadeRequest) -> Result<(), HbError> {
+    all_finite(&[
+        ("xi", req.xi),
+        ("alpha", req.alpha),
+        ("gamma", req.gamma),
+        ("beta0", req.beta0),
+    ])?;
+    positive("omega", req.omega).map(|_| ())
 }
 
 /// The cascade: the keys of `ivt hb mathieu-duffing --json` and
@@ -55,9 +53,9 @@ pub struct Cascade {
 /// Follow the cascade of `req`.
 ///
 /// # Errors
-/// [`CascadeRequest::validate`]'s and the continuation's.
+/// [`validate`]'s and the continuation's.
 pub fn cascade(req: &CascadeRequest) -> Result<Cascade, HbError> {
-    req.validate()?;
+    validate(req)?;
     let t0 = Instant::now();
     let doublings = period_doubling_cascade(req)?;
     let mu: Vec<_> = doublings.iter().map(|p| p.multiplier).collect();

@@ -1,16 +1,16 @@
 //! Hopf points of an autonomous family and the limit-cycle branch born at
-//! the first ([`crate::cycle_branch()`]: equilibria followed in p, the Hopf
+//! the first ([`ivt_hb::cycle_branch()`]: equilibria followed in p, the Hopf
 //! point's first Lyapunov coefficient, the cycle branch by HB with ω unknown
 //! and Eq. 68–77, Floquet stability (Hsu) and its folds located).
 
 use super::{all_finite, finite_list, pairs, path_steps, stability_steps, Array};
-use crate::autonomous::LimitCycle;
-use crate::cycle_branch::{cycle_branch as trace_cycles, CycleBranchOptions};
-use crate::error::HbError;
-use crate::events::BifurcationKind;
-use crate::ihb::HbOptions;
-use crate::problem::PeriodicProblem;
-use crate::stability::StabilityKind;
+use ivt_hb::autonomous::LimitCycle;
+use ivt_hb::cycle_branch::{cycle_branch as trace_cycles, CycleBranchOptions};
+use ivt_hb::events::BifurcationKind;
+use ivt_hb::ihb::HbOptions;
+use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::stability::StabilityKind;
+use ivt_hb::HbError;
 use ivt_path::continuation::Termination;
 use serde::Serialize;
 
@@ -57,7 +57,7 @@ impl Default for CycleBranchRequest {
 impl CycleBranchRequest {
     /// # Errors
     /// [`HbError::InvalidInput`] for a non-finite number or equal ends (the
-    /// grid, the steps and the offset are checked by [`crate::cycle_branch()`]).
+    /// grid, the steps and the offset are checked by [`ivt_hb::cycle_branch()`]).
     pub fn validate(&self) -> Result<(), HbError> {
         all_finite(&[
             ("p_from", self.p_from),
@@ -158,7 +158,7 @@ pub struct CycleBranchResult {
 /// The Hopf points of `family(p)` and the cycle branch of the first.
 ///
 /// # Errors
-/// [`CycleBranchRequest::validate`]'s and [`crate::cycle_branch()`]'s.
+/// [`CycleBranchRequest::validate`]'s and [`ivt_hb::cycle_branch()`]'s.
 pub fn cycle_branch<P, F>(
     family: F,
     hb: &HbOptions,

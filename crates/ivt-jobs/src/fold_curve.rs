@@ -1,20 +1,20 @@
 //! Bifurcation curves (codimension 2) of a model family `family(p)` in
 //! (ω, p): a fold of the frequency response followed through its cusps
-//! ([`crate::fold_curve`]: the extended system `R = 0`, `Φ_q v = 0`,
+//! ([`ivt_hb::fold_curve`]: the extended system `R = 0`, `Φ_q v = 0`,
 //! `|v| = 1` of Eq. 56/61 continued by Eq. 68–77 in `p`), or a period
 //! doubling or Neimark–Sacker point to the ends of its curve with the strong
-//! resonances on it ([`crate::codim2::bifurcation_curve`]: `R = 0` with the
+//! resonances on it ([`ivt_hb::codim2::bifurcation_curve`]: `R = 0` with the
 //! critical eigenvector of the monodromy matrix, Eq. 80). The start is a
 //! given point, or the point of that kind of largest ω_f located on the FRC
 //! of `family(p_start)` over an interval.
 
 use super::{all_finite, finite, finite_list, path_steps, Array, FrcRequest};
-use crate::codim2::{bifurcation_curve, CurvePoint, CurveStart};
-use crate::error::HbError;
-use crate::events::BifurcationKind;
-use crate::frc::{frequency_response, FrcOptions};
-use crate::ihb::{HbOptions, HbSolution};
-use crate::problem::PeriodicProblem;
+use ivt_hb::codim2::{bifurcation_curve, CurvePoint, CurveStart};
+use ivt_hb::events::BifurcationKind;
+use ivt_hb::frc::{frequency_response, FrcOptions};
+use ivt_hb::ihb::{HbOptions, HbSolution};
+use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::HbError;
 use ivt_path::continuation::{Corrector, Termination};
 use serde::Serialize;
 use std::time::Instant;
@@ -88,7 +88,7 @@ impl FoldCurveRequest {
     /// # Errors
     /// [`HbError::InvalidInput`] for a non-finite number or no path point
     /// (the interval and the start fold are checked by
-    /// [`crate::fold_curve`]).
+    /// [`ivt_hb::fold_curve`]).
     pub fn validate(&self) -> Result<(), HbError> {
         if self.kind == BifurcationKind::BranchPoint {
             return Err(HbError::InvalidInput(
@@ -199,8 +199,8 @@ pub struct FoldCurveResult {
 /// # Errors
 /// [`FoldCurveRequest::validate`]'s; `family(p_start)`'s; with
 /// [`FoldStart::Search`], the FRC's and [`HbError::InvalidInput`] when it has
-/// no located point of the kind; [`crate::fold_curve`]'s or
-/// [`crate::codim2::bifurcation_curve`]'s.
+/// no located point of the kind; [`ivt_hb::fold_curve`]'s or
+/// [`ivt_hb::codim2::bifurcation_curve`]'s.
 pub fn fold_curve<P, F>(
     family: F,
     hb: &HbOptions,
@@ -219,7 +219,7 @@ where
     let copts = path_steps(req.ds, req.ds_max, req.max_points);
     let h = hb.harmonics;
     let (points, at, special, termination) = if req.kind == BifurcationKind::Fold {
-        let curve = crate::fold_curve(
+        let curve = ivt_hb::fold_curve(
             family,
             hb,
             &coeffs,
@@ -230,7 +230,7 @@ where
             &req.at,
             &copts,
         )?;
-        let fold = |f: &crate::FoldPoint| sample(f.omega, f.p, &f.coeffs, None, h);
+        let fold = |f: &ivt_hb::FoldPoint| sample(f.omega, f.p, &f.coeffs, None, h);
         let cusps = curve.cusps.iter().map(|c| SpecialPoint {
             kind: SpecialKind::Cusp,
             point: fold(c),
@@ -355,7 +355,7 @@ fn sample(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Duffing;
+    use ivt_hb::Duffing;
 
     #[test]
     fn duffing_folds_through_the_cusp_are_the_shooting_folds() {
@@ -386,7 +386,7 @@ mod tests {
         // F = 0.2: by shooting (tests/ns_curve.rs) the NS point at F = 0.3 is
         // at ω_f = 0.8980504973 and the 1:1 end at F = 0.1924005859.
         let family = |f: f64| {
-            Ok(crate::GeneralProblem::new(
+            Ok(ivt_hb::GeneralProblem::new(
                 1,
                 vec![1.0],
                 vec![-0.2],

@@ -1,20 +1,20 @@
 //! Frequency-response curve (FRC) in ω_f by pseudo-arclength continuation
 //! (Eq. 68–77) with Floquet multipliers (Hsu, Eq. 78) at every point. Without
-//! events [`crate::frequency_response`] traces it and locates the folds on
+//! events [`ivt_hb::frequency_response`] traces it and locates the folds on
 //! their extended system; with events the start is solved by the modified
-//! IHB and [`crate::trace`] locates every fold, period doubling,
+//! IHB and [`ivt_hb::trace`] locates every fold, period doubling,
 //! Neimark–Sacker point and branch point as the path passes it.
 
 use super::{check_finite, pairs, Array};
-use crate::error::HbError;
-use crate::events::{trace, BifurcationError, BifurcationKind, Event, TraceOptions};
-use crate::family::{Family, FamilyBranch, Frequency};
-use crate::frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
-use crate::ihb::HbOptions;
-use crate::problem::{AtFrequency, PeriodicProblem};
-use crate::stability::HsuSteps;
-use crate::stability::StabilityKind;
-use crate::ModifiedIhb;
+use ivt_hb::events::{trace, BifurcationError, BifurcationKind, Event, TraceOptions};
+use ivt_hb::family::{Family, FamilyBranch, Frequency};
+use ivt_hb::frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
+use ivt_hb::ihb::HbOptions;
+use ivt_hb::problem::{AtFrequency, PeriodicProblem};
+use ivt_hb::stability::HsuSteps;
+use ivt_hb::stability::StabilityKind;
+use ivt_hb::HbError;
+use ivt_hb::ModifiedIhb;
 use ivt_path::continuation::Termination;
 use serde::Serialize;
 use std::time::Instant;
@@ -169,7 +169,7 @@ pub fn frc<P: PeriodicProblem>(
 }
 
 /// The curve of `branch` (a frequency family, planned with the options the
-/// points' coefficients have) traced with events by [`crate::trace`] from
+/// points' coefficients have) traced with events by [`ivt_hb::trace`] from
 /// the orbit `start` at ω_f = `sweep.from` to `sweep.to` on `sweep.path`, as
 /// [`frc`] returns it (also the new branch of [`super::switch()`]); `t0`
 /// starts the job's wall time.
@@ -188,7 +188,7 @@ pub(super) fn traced_curve<F: Family>(
         ..TraceOptions::default()
     };
     let traced = trace(branch, start, sweep.from, &opts).map_err(trace_error)?;
-    let curve = crate::frc::from_trace(&traced, branch.options())?;
+    let curve = ivt_hb::frc::from_trace(&traced, branch.options())?;
     let events = traced.events.iter().map(|e| event(e, &curve)).collect();
     assemble(curve, events, sweep.path.stability, t0)
 }
@@ -296,7 +296,7 @@ fn fold_event(f: &FrcFold, curve: &Frc) -> EventRecord {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Duffing;
+    use ivt_hb::Duffing;
 
     #[test]
     fn duffing_folds_with_and_without_events_are_the_shooting_folds() {

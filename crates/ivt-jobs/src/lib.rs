@@ -1,9 +1,10 @@
+#![doc = include_str!("../README.md")]
 //! The harmonic-balance jobs run by the command line (`ivt hb ...`) and by
 //! Python (`ivt.hb.*`): each takes a typed request (with `Default` and
 //! `validate`) and returns a [`serde::Serialize`] result whose field names
 //! are the JSON keys of SPEC §6 and the keys of the Python dicts. Neither
 //! front end assembles a job or classifies its errors
-//! ([`crate::HbError::kind`]); they parse arguments and serialize results.
+//! ([`ivt_hb::HbError::kind`]); they parse arguments and serialize results.
 //!
 //! | job | request | result | CLI | Python |
 //! |---|---|---|---|---|
@@ -27,6 +28,7 @@ pub mod cycle_branch;
 pub mod fold_curve;
 pub mod frc;
 pub mod limit_cycle;
+pub mod ns_points;
 pub mod orbit;
 pub mod string;
 pub mod switch;
@@ -46,11 +48,12 @@ pub use fold_curve::{
 };
 pub use frc::{frc, CurvePoint, EventRecord, FoldPoint, FrcCurve, FrcRequest};
 pub use limit_cycle::{limit_cycle, Cycle, LimitCycleRequest};
+pub use ns_points::{neimark_sacker_points, NeimarkSackerPoint};
 pub use orbit::{orbit, Method, Orbit, OrbitRequest};
 pub use string::{string, StringCurve, StringPoint, StringRequest};
 pub use switch::{switch, SwitchRequest, SwitchStart, SwitchedBranch};
 
-use crate::error::HbError;
+use ivt_hb::HbError;
 use ivt_path::continuation::ContinuationOptions;
 
 /// Hsu sub-intervals per period for `harmonics` harmonics: max(8n, 256)

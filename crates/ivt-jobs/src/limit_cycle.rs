@@ -3,10 +3,10 @@
 //! Newton with the Galerkin Jacobian), its multipliers by Hsu (Eq. 78).
 
 use super::{finite, finite_pairs, stability_steps, Array};
-use crate::error::HbError;
-use crate::ihb::HbOptions;
-use crate::problem::PeriodicProblem;
-use crate::stability::StabilityKind;
+use ivt_hb::ihb::HbOptions;
+use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::stability::StabilityKind;
+use ivt_hb::HbError;
 use serde::Serialize;
 
 /// Where the iteration starts.
@@ -19,7 +19,7 @@ pub struct LimitCycleRequest {
     pub guess: Option<Vec<f64>>,
     /// Start state `[x..., v...]` (2·n_dof entries) of the transient that
     /// settles onto the attractor before HB refines it
-    /// ([`crate::limit_cycle_from_state`]); None: x = (`amplitude`, 0, …),
+    /// ([`ivt_hb::limit_cycle_from_state`]); None: x = (`amplitude`, 0, …),
     /// v = 0. Not used with a `guess`.
     pub x0: Option<Vec<f64>>,
     /// x of DOF 0 in the default start state.
@@ -85,9 +85,9 @@ pub struct Cycle {
 /// The limit cycle of `problem` near `req`'s start.
 ///
 /// # Errors
-/// [`LimitCycleRequest::validate`]'s, those of [`crate::limit_cycle`]
+/// [`LimitCycleRequest::validate`]'s, those of [`ivt_hb::limit_cycle`]
 /// (non-convergence, collapse onto the equilibrium) and, without a guess,
-/// those of [`crate::limit_cycle_from_state`] (a transient that comes to rest).
+/// those of [`ivt_hb::limit_cycle_from_state`] (a transient that comes to rest).
 pub fn limit_cycle<P: PeriodicProblem>(
     problem: &P,
     hb: &HbOptions,
@@ -96,7 +96,7 @@ pub fn limit_cycle<P: PeriodicProblem>(
     req.validate()?;
     let steps = stability_steps(hb.harmonics);
     let lc = match &req.guess {
-        Some(start) => crate::limit_cycle(problem, hb, req.omega_guess, start, steps)?,
+        Some(start) => ivt_hb::limit_cycle(problem, hb, req.omega_guess, start, steps)?,
         None => {
             let state = match &req.x0 {
                 Some(x0) => x0.clone(),
@@ -108,11 +108,11 @@ pub fn limit_cycle<P: PeriodicProblem>(
                     s
                 }
             };
-            crate::limit_cycle_from_state(
+            ivt_hb::limit_cycle_from_state(
                 problem,
                 hb,
                 &state,
-                &crate::TransientOptions::default(),
+                &ivt_hb::TransientOptions::default(),
                 steps,
             )?
         }
@@ -132,7 +132,7 @@ pub fn limit_cycle<P: PeriodicProblem>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::problem::Oscillator;
+    use ivt_hb::problem::Oscillator;
 
     #[test]
     fn weak_van_der_pol_has_amplitude_two_and_is_stable() {

@@ -5,12 +5,12 @@
 //! Magnus-4 steps.
 
 use super::{finite_pairs, positive, stability_steps, Array};
-use crate::error::HbError;
-use crate::floquet::HsuRule;
-use crate::ihb::{HbOptions, HbSolution, HbSolver};
-use crate::problem::PeriodicProblem;
-use crate::stability::{StabilityAnalyzer, StabilityKind};
-use crate::{ClassicIhb, ModifiedIhb};
+use ivt_hb::floquet::HsuRule;
+use ivt_hb::ihb::{HbOptions, HbSolution, HbSolver};
+use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::stability::{StabilityAnalyzer, StabilityKind};
+use ivt_hb::HbError;
+use ivt_hb::{ClassicIhb, ModifiedIhb};
 use serde::Serialize;
 use std::str::FromStr;
 use std::time::Instant;
@@ -169,7 +169,7 @@ pub fn orbit<P: PeriodicProblem>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Duffing;
+    use ivt_hb::Duffing;
 
     #[test]
     fn methods_parse_by_name_and_refuse_others() {

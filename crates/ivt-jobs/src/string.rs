@@ -3,13 +3,13 @@
 //! the exact (Tau) Jacobian for both boundaries, stability by monodromy,
 //! confirmed by Hill's method near |μ| = 1 (Eq. 130–131).
 
-use crate::error::HbError;
-use crate::frc::Frc;
-use crate::stability::StabilityKind;
-use crate::sthb::frc::{frequency_response, StringFrcOptions};
-use crate::sthb::stability::StabilityMethod;
-use crate::sthb::{Boundary, StringHb, StringParams};
+use ivt_hb::frc::Frc;
+use ivt_hb::stability::StabilityKind;
+use ivt_hb::HbError;
 use ivt_path::continuation::Termination;
+use ivt_sthb::frc::{frequency_response, StringFrcOptions};
+use ivt_sthb::stability::StabilityMethod;
+use ivt_sthb::{Boundary, StringHb, StringParams};
 use serde::Serialize;
 use std::time::Instant;
 

@@ -4,7 +4,7 @@
 //!
 //! - **Period doubling**: the orbit is re-expressed with period 2T and the
 //!   odd-harmonic null vector of the period-2 Galerkin Jacobian (Eq. 56) is the
-//!   new direction ([`crate::period_doubled_start`]); the new branch's
+//!   new direction ([`ivt_hb::period_doubled_start`]); the new branch's
 //!   coefficients have `2n` harmonics of the response frequency ω_f/2.
 //! - **Branch point**: the new direction is a root of the algebraic
 //!   bifurcation equation `ψᵀ R''[d, d] = 0` on the null space
@@ -16,19 +16,19 @@
 //!   carries no tangent of the traced branch, so at a transcritical point,
 //!   where both branches cross ω_f, this may be the traced one.
 //!
-//! [`crate::switch_branch`] corrects the first point at a distance
+//! [`ivt_hb::switch_branch`] corrects the first point at a distance
 //! `step · ‖q‖₂` from the bifurcation; the path then runs towards `to`, which
 //! must lie on the side where the new branch leaves.
 
 use super::frc::{trace_error, traced_curve};
 use super::{finite, FoldPoint, FrcCurve, FrcRequest};
-use crate::error::HbError;
-use crate::events::{dot, Bifurcation, BifurcationKind, LocateOptions};
-use crate::family::{Family, FamilyBranch, Frequency};
-use crate::frc::FrcOptions;
-use crate::ihb::HbOptions;
-use crate::problem::PeriodicProblem;
-use crate::switching::{period_doubled_start, switch_branch};
+use ivt_hb::events::{dot, Bifurcation, BifurcationKind, LocateOptions};
+use ivt_hb::family::{Family, FamilyBranch, Frequency};
+use ivt_hb::frc::FrcOptions;
+use ivt_hb::ihb::HbOptions;
+use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::switching::{period_doubled_start, switch_branch};
+use ivt_hb::HbError;
 use ivt_num::vector::norm2;
 use ivt_num::BorderedLu;
 use ivt_path::branch::Branch;

@@ -8,10 +8,12 @@
 
 use ivt_hb::codim2::{bifurcation_curve, CurveStart};
 use ivt_hb::{
-    neimark_sacker_points, BifurcationKind, ContinuationOptions, GeneralProblem, HbError,
-    HbOptions, PeriodicProblem, Termination,
+    BifurcationKind, ContinuationOptions, GeneralProblem, HbError, HbOptions, PeriodicProblem,
+    Termination,
 };
+use ivt_jobs::neimark_sacker_points;
 
+#[path = "../../ivt-hb/tests/common/mod.rs"]
 mod common;
 use common::shooting::{
     assert_omega_matches_shooting, central_jacobian, flow, newton3, orbit_state,

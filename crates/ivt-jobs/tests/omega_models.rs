@@ -6,12 +6,13 @@
 //! ω being `0.03 ω²`.
 #![allow(clippy::indexing_slicing)]
 
-use ivt_hb::jobs::{self, FrcRequest};
 use ivt_hb::{
     frequency_response, Corrector, Duffing, FrcOptions, FrequencyExcitation, GeneralProblem,
     HbOptions, ModifiedIhb, PeriodicProblem,
 };
+use ivt_jobs::{self as jobs, FrcRequest};
 
+#[path = "../../ivt-hb/tests/common/mod.rs"]
 mod common;
 use common::shooting::{newton3, orbit_state, period_map, period_map_jacobian};
 

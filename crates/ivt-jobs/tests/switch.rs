@@ -1,4 +1,4 @@
-//! Branch switching ([`ivt_hb::jobs::switch`]) checked by shooting (RK4 with
+//! Branch switching ([`ivt_jobs::switch`]) checked by shooting (RK4 with
 //! Newton on the period map, sharing no code with the HB path): the period-2
 //! branch of a forced Duffing oscillator in a well, born at a period doubling,
 //! and the symmetry-breaking branch of a symmetric 2-DOF chain at a pitchfork.
@@ -10,9 +10,9 @@
 )]
 
 use ivt_hb::aft::eval_series;
-use ivt_hb::jobs::{self, SwitchRequest, SwitchStart, SwitchedBranch};
 use ivt_hb::ode::{first_order, rk4};
 use ivt_hb::{BifurcationKind, GeneralProblem, HbOptions, PeriodicProblem};
+use ivt_jobs::{self as jobs, SwitchRequest, SwitchStart, SwitchedBranch};
 use std::f64::consts::PI;
 
 /// The twin-well Duffing ü + 0.1u̇ − u + u³ = 0.5 cos ω_f t about its well

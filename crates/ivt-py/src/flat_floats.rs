@@ -1,6 +1,6 @@
 //! The numbers of a flat sequence of floats, collected by serde without
 //! Python objects: the fast path of [`crate::to_python`] for an
-//! [`ivt_hb::jobs::Array`] of `f64` (one numpy array from a `Vec`, instead of a
+//! [`ivt_jobs::Array`] of `f64` (one numpy array from a `Vec`, instead of a
 //! Python list of floats handed to `numpy.asarray`). Anything else (nested
 //! sequences, bools, strings) is refused with [`NotFlat`], and the caller
 //! takes the general path.

@@ -2,11 +2,11 @@
 //! cycles, Floquet stability by Hsu's method, frequency-response curves with
 //! located folds) for Duffing, Mathieu–Duffing and user systems
 //! `M x'' + C x' + K x + g(x, x', θ) = f(θ)`. Each function parses its
-//! arguments, runs an `ivt_hb::jobs` job and returns its result as a dict
+//! arguments, runs an `ivt_jobs` job and returns its result as a dict
 //! (the keys of the CLI's JSON, [`crate::to_python`]).
 
-use ivt_hb::jobs::{self, CascadeRequest, FrcRequest, LimitCycleRequest, OrbitRequest};
 use ivt_hb::{AtFrequency, Duffing, FrcOptions, MathieuDuffing};
+use ivt_jobs::{self as jobs, CascadeRequest, FrcRequest, LimitCycleRequest, OrbitRequest};
 use numpy::PyArrayLike1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -178,7 +178,7 @@ duffing_fn! {
 /// Frequency-response curve of Duffing's equation by pseudo-arclength
 /// continuation in ω_f from `from_` to `to` (Fig. 29), with the Floquet
 /// verdict at every point: the dict of `ivt hb duffing-frc --json`
-/// ([`ivt_hb::jobs::FrcCurve`]): {"points": [{"omega", "amplitude",
+/// ([`ivt_jobs::FrcCurve`]): {"points": [{"omega", "amplitude",
 /// "stable", "stability", "kind", "coeffs", "multipliers",
 /// "multiplier_error"}...], "folds": [ω_f at each turning point],
 /// "bifurcations", "termination", "time_s"} and the arrays omega,

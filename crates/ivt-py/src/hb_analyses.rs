@@ -1,13 +1,13 @@
 //! `ivt.hb.all_solutions` and `ivt.hb.damped_modes` (issue 27): every periodic
 //! solution at one frequency by deflated Newton (the job
-//! [`ivt_hb::jobs::all_solutions()`] of `ivt hb all-solutions`),
+//! [`ivt_jobs::all_solutions()`] of `ivt hb all-solutions`),
 //! and damped nonlinear modes by the extended periodic motion concept
 //! ([`ivt_hb::damped_modes`]), on a user system. Fold curves are in
 //! `hb_folds.rs`. The limit cycle from a state is `limit_cycle(..., x0=)`
-//! (`ivt_hb::jobs::limit_cycle`).
+//! (`ivt_jobs::limit_cycle`).
 
-use ivt_hb::jobs::{self, AllSolutionsRequest};
 use ivt_hb::{BackboneOptions, ContinuationOptions, Corrector, DampedModes};
+use ivt_jobs::{self as jobs, AllSolutionsRequest};
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};

@@ -1,10 +1,10 @@
 //! `ivt.hb.cycle_branch` (issue 27, item 2): the Hopf points of an
 //! autonomous user family and the limit-cycle branch born at the first
-//! (the job [`ivt_hb::jobs::cycle_branch()`] of `ivt hb cycle-branch`);
+//! (the job [`ivt_jobs::cycle_branch()`] of `ivt hb cycle-branch`);
 //! `ivt.hb.neimark_sacker_points`, the sampled Neimark–Sacker boundary of a forced family
-//! ([`ivt_hb::neimark_sacker_points`]), on a Python `family(p)` ([`PyFamily`]).
+//! ([`ivt_jobs::neimark_sacker_points`]), on a Python `family(p)` ([`PyFamily`]).
 
-use ivt_hb::jobs::{self, pairs, CycleBranchRequest};
+use ivt_jobs::{self as jobs, pairs, CycleBranchRequest};
 use numpy::IntoPyArray;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -81,7 +81,7 @@ fn cycle_branch<'py>(
 }
 
 /// The Neimark–Sacker boundary of the forced family `family(p)` → (m, c, k,
-/// g, f) in (omega, p), sampled (ivt_hb::neimark_sacker_points): at each p of
+/// g, f) in (omega, p), sampled (ivt_jobs::neimark_sacker_points): at each p of
 /// `ps` the frequency response from `omega_from` to `omega_to` is traced
 /// with its events, and each Neimark–Sacker point located on its extended
 /// system. Not a continuation: a turn of the boundary in p between samples is
@@ -120,7 +120,7 @@ fn neimark_sacker_points<'py>(
     let fam = PyFamily::new(family, keys);
     let first = fam.first(py, finite("ps[0]", p0)?)?;
     let points = fam.run(py, first, |hb| {
-        ivt_hb::neimark_sacker_points(|p| fam.build(p), hb, from, to, &ps)
+        ivt_jobs::neimark_sacker_points(|p| fam.build(p), hb, from, to, &ps)
     })?;
     let list = PyList::empty(py);
     for pt in points {

@@ -1,10 +1,10 @@
 //! `ivt.hb.continue_bifurcation` and `ivt.hb.duffing_folds`: a fold of the
 //! frequency response followed in a second parameter p through its cusps, the
-//! job [`ivt_hb::jobs::fold_curve`] (the CLI's `ivt hb duffing-folds`), on a
+//! job [`ivt_jobs::fold_curve`] (the CLI's `ivt hb duffing-folds`), on a
 //! user family `family(p) -> (m, c, k, g, f)` or on Duffing's equation in F.
 
-use ivt_hb::jobs::{self, FoldCurveRequest, FoldStart};
 use ivt_hb::{BifurcationKind, Duffing};
+use ivt_jobs::{self as jobs, FoldCurveRequest, FoldStart};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -36,7 +36,7 @@ fn given_start(start: &Bound<'_, PyDict>) -> PyResult<(BifurcationKind, FoldStar
 family_fn! {
 /// Two-parameter continuation of a fold, period doubling or Neimark–Sacker
 /// point of the frequency response of `family(p)` → (m, c, k, g, f) in
-/// (omega, p), the job [`ivt_hb::jobs::fold_curve`]. `start` is an entry of
+/// (omega, p), the job [`ivt_jobs::fold_curve`]. `start` is an entry of
 /// `frc(..., events=True)["bifurcations"]` (or of `frc(...)["folds"]`)
 /// computed at p = `p_start`, with the same `n` and `samples`; its "kind"
 /// says what is followed. Folds (ivt_hb::fold_curve: R = 0, Φ_q v = 0,
@@ -51,7 +51,7 @@ family_fn! {
 /// solved exactly (each crossing). An exception in `family` is re-raised;
 /// one in the `g` or `f` it returns for p ≠ p_start makes that point fail
 /// (the curve stops there). Returns the job's
-/// [`ivt_hb::jobs::FoldCurveResult`]: {"kind", "start_omega", "points":
+/// [`ivt_jobs::FoldCurveResult`]: {"kind", "start_omega", "points":
 /// [{"omega", "p", "amplitude", "coeffs", "angle" (not on folds)}...],
 /// "at": [...], "special": [{"kind": "cusp" | "resonance_1_1" | ...,
 /// "omega", "p", "amplitude", "coeffs"}...], "termination", "time_s"}.

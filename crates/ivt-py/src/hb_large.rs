@@ -1,17 +1,17 @@
 //! Large structures for `ivt.hb` (issue 28): the frequency response and the
 //! single orbit of a sparse `M, C, K` with `g` on a few DOFs, condensed onto
-//! those DOFs ([`ivt_hb::condense`]), any DOF recovered per point, and the
+//! those DOFs ([`ivt_condense`]), any DOF recovered per point, and the
 //! cantilever model. The public wrappers in `ivt/hb.py` convert
 //! `scipy.sparse`/dense matrices to COO triplets and `f` to load vectors.
 
 use crate::hb_shared::{finite, run_user};
 use crate::user_problem::{user_problem, PyProblem};
-use ivt_hb::condense::{
+use ivt_condense::{
     condensed_response, CondensedBranch, CondensedFrc, CondensedFrcOptions, CondensedPoint,
     Structure,
 };
-use ivt_hb::jobs::pairs;
 use ivt_hb::{HbError, HbOptions};
+use ivt_jobs::pairs;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -236,7 +236,7 @@ fn frc_large<'py>(
         amplitude_dof,
         record_dofs,
         truncation_estimate,
-        stability_blocks: stability.then_some(ivt_hb::condense::DEFAULT_BLOCKS),
+        stability_blocks: stability.then_some(ivt_condense::DEFAULT_BLOCKS),
         ..CondensedFrcOptions::default()
     };
     let steps = [
@@ -309,8 +309,8 @@ fn solve_large<'py>(
             amplitude_dof,
             record_dofs,
             truncation_estimate: true,
-            stability_blocks: stability.then_some(ivt_hb::condense::DEFAULT_BLOCKS),
-            stability_tol: ivt_hb::condense::DEFAULT_BASIS_TOL,
+            stability_blocks: stability.then_some(ivt_condense::DEFAULT_BLOCKS),
+            stability_tol: ivt_condense::DEFAULT_BASIS_TOL,
             continuation: ivt_hb::ContinuationOptions {
                 max_points: 1,
                 ..CondensedFrcOptions::default().continuation
@@ -339,14 +339,14 @@ fn cantilever_coo<'py>(
     alpha: f64,
     beta: f64,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let props = ivt_hb::models::BeamProperties {
+    let props = ivt_condense::models::BeamProperties {
         length,
         ei,
         rho_a,
         alpha,
         beta,
     };
-    let beam = ivt_hb::models::cantilever(n_elements, &props)
+    let beam = ivt_condense::models::cantilever(n_elements, &props)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     let mats = beam.model.triplets().map(|t| {
         let rows: Vec<usize> = t.iter().map(|e| e.0).collect();

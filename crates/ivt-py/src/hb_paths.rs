@@ -1,11 +1,11 @@
 //! `ivt.hb.frc` and `ivt.hb.backbone`: branches of periodic orbits of a user
 //! system followed by pseudo-arclength continuation (Eq. 68–77), the jobs
-//! [`ivt_hb::jobs::frc`] (Floquet multipliers at every point; folds, period
+//! [`ivt_jobs::frc`] (Floquet multipliers at every point; folds, period
 //! doublings, Neimark–Sacker points and branch points each located on its
-//! extended system) and [`ivt_hb::jobs::backbone`].
+//! extended system) and [`ivt_jobs::backbone`].
 
-use ivt_hb::jobs::{self, BackboneRequest, FrcRequest};
 use ivt_hb::{BackboneOptions, Corrector, FrcOptions};
+use ivt_jobs::{self as jobs, BackboneRequest, FrcRequest};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -27,7 +27,7 @@ user_system_fn! {
 /// `f(theta, omega)`: a rotating unbalance, a frequency-dependent load) gets
 /// ω_f as that keyword, and the path's ∂R/∂ω_f includes its ω-dependence
 /// (`jac` must then be None).
-/// Returns the job's [`ivt_hb::jobs::FrcCurve`]: {"points": [{"omega",
+/// Returns the job's [`ivt_jobs::FrcCurve`]: {"points": [{"omega",
 /// "coeffs", "amplitude", "multipliers", "multiplier_error", "stable",
 /// "stability", "kind"}...], "folds": [{"omega",
 /// "amplitude", "coeffs", "located", "index" (path point before the

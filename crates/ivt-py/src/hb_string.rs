@@ -1,9 +1,9 @@
 //! `ivt.hb.string`: the frequency-response curve of the nonlinear string by
 //! space–time harmonic balance (STHB, thesis §3.3, Eq. 103; Figs. 34–36), the
-//! job [`ivt_hb::jobs::string`] of `ivt hb string --json`.
+//! job [`ivt_jobs::string`] of `ivt hb string --json`.
 
-use ivt_hb::jobs::{self, StringRequest};
-use ivt_hb::sthb::{Boundary, StringParams};
+use ivt_jobs::{self as jobs, StringRequest};
+use ivt_sthb::{Boundary, StringParams};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -21,10 +21,10 @@ use crate::to_python::to_dict;
 /// "spring" (k0 w(1) = w_x(1), Eq. 132, Tau method).
 /// Returns the dict of `ivt hb string --json`: points [{"omega", "norm" (‖a‖,
 /// Eq. 114), "stable", "kind", "max_multiplier", "method"}...], jacobians,
-/// hill_calls, stop, solve_time_s ([`ivt_hb::jobs::StringCurve`]; a spring
+/// hill_calls, stop, solve_time_s ([`ivt_jobs::StringCurve`]; a spring
 /// of k0 > 1 adds boundary_note). A trace that fails numerically raises
 /// `ConvergenceError`. |kd| is limited to 1e9
-/// ([`ivt_hb::jobs::string::MAX_KD`]: larger values only make the trace slow
+/// ([`ivt_jobs::string::MAX_KD`]: larger values only make the trace slow
 /// before it fails). GIL released.
 #[pyfunction]
 #[pyo3(signature = (

@@ -1,9 +1,9 @@
 //! `ivt.hb.switch_branch` (issue 27 item 2): from a period doubling or a
 //! branch point of `frc(..., events=True)` onto the new branch, continued in
-//! ω_f — the job [`ivt_hb::jobs::switch()`] (the CLI's `ivt hb switch`).
+//! ω_f — the job [`ivt_jobs::switch()`] (the CLI's `ivt hb switch`).
 
-use ivt_hb::jobs::{self, SwitchRequest, SwitchStart};
 use ivt_hb::{BifurcationKind, Corrector};
+use ivt_jobs::{self as jobs, SwitchRequest, SwitchStart};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -54,7 +54,7 @@ user_system_fn! {
 /// the two through it (the symmetry-breaking branch of a pitchfork). Its
 /// first point is `step`·‖coeffs‖ away; it is then continued to `to` (on the
 /// side where it leaves, else a ValueError) with its own events, as `frc`.
-/// Returns the job's [`ivt_hb::jobs::SwitchedBranch`]: the keys of `frc`
+/// Returns the job's [`ivt_jobs::SwitchedBranch`]: the keys of `frc`
 /// ("points", "folds", "bifurcations", "termination", "omega", "amplitude",
 /// "stable", "time_s") and "kind" (of `at`), "start_omega", "harmonics",
 /// "subharmonic" (2 after a period doubling). GIL released between callbacks.

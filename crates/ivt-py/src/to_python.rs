@@ -1,11 +1,11 @@
-//! The results of `ivt_hb::jobs` as Python objects, by serde: a struct or map
+//! The results of `ivt_jobs` as Python objects, by serde: a struct or map
 //! becomes a dict (its field names are the JSON keys of the CLI), a sequence
 //! a list, a unit enum variant its snake_case name, `None` None, and an
-//! [`ivt_hb::jobs::Array`] a numpy array. Floats stay floats (NaN included,
+//! [`ivt_jobs::Array`] a numpy array. Floats stay floats (NaN included,
 //! which JSON would turn into null).
 
 use crate::flat_floats::flat_floats;
-use ivt_hb::jobs::ARRAY_NAME;
+use ivt_jobs::ARRAY_NAME;
 use numpy::IntoPyArray;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -166,7 +166,7 @@ impl<'py> ser::Serializer for Ser<'py> {
     ) -> Res<'py> {
         self.serialize_str(variant)
     }
-    /// An [`ivt_hb::jobs::Array`] becomes a numpy array (of `f64` straight
+    /// An [`ivt_jobs::Array`] becomes a numpy array (of `f64` straight
     /// from its numbers, [`crate::flat_floats`]; otherwise
     /// `numpy.asarray(list)`); any other newtype is its content.
     fn serialize_newtype_struct<T: Serialize + ?Sized>(

@@ -9,11 +9,11 @@ use divan::Bencher;
 use faer::linalg::solvers::Solve;
 use faer::Mat;
 use ivt_hb::frc::{frequency_response as engine_frc, FrcOptions};
-use ivt_hb::sthb::frc::{frequency_response, trace, StringFrcOptions};
-use ivt_hb::sthb::modal::ModalString;
-use ivt_hb::sthb::stability::{hill, monodromy};
-use ivt_hb::sthb::{StringHb, StringParams};
 use ivt_hb::{HbOptions, ModifiedIhb};
+use ivt_sthb::frc::{frequency_response, trace, StringFrcOptions};
+use ivt_sthb::modal::ModalString;
+use ivt_sthb::stability::{hill, monodromy};
+use ivt_sthb::{StringHb, StringParams};
 
 fn main() {
     divan::main();

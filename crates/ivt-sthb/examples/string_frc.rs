@@ -1,8 +1,8 @@
 //! Frequency–response curve of the nonlinear string (Figs. 34–35):
 //! `cargo run --release -p ivt-hb --example string_frc -- KD N FROM TO`.
 #![allow(clippy::expect_used, clippy::indexing_slicing)]
-use ivt_hb::sthb::frc::{frequency_response, trace, StringFrcOptions};
-use ivt_hb::sthb::{StringHb, StringParams};
+use ivt_sthb::frc::{frequency_response, trace, StringFrcOptions};
+use ivt_sthb::{StringHb, StringParams};
 
 fn main() {
     let args: Vec<f64> = std::env::args()

@@ -16,11 +16,11 @@ use super::stability::{
     hill, hill_dim, monodromy, monodromy_refined, Stability, StabilityMethod, HILL_MAX_DIM,
 };
 use super::StringHb;
-use crate::error::HbError;
-use crate::events::{
+use ivt_hb::events::{
     observe, BifurcationKind, Detector, EventObserver, Fold, LocateOptions, Observer,
 };
-use crate::frc::{Frc, FrcFold, FrcPoint};
+use ivt_hb::frc::{Frc, FrcFold, FrcPoint};
+use ivt_hb::HbError;
 use ivt_num::BroydenOptions;
 use ivt_path::branch::Branch;
 use ivt_path::continuation::{
@@ -70,7 +70,7 @@ impl Default for StringFrcOptions {
 /// Richardson estimate of a [`StabilityMethod::MonodromyRefined`] verdict
 /// (`None` otherwise); each turn of the path is
 /// located as the points arrive by Newton on the bordered fold system
-/// ([`crate::locate_fold`], exact `J`),
+/// ([`ivt_hb::locate_fold`], exact `J`),
 /// `located = false` leaving the parabola through the points around the turn.
 #[derive(Clone, Debug)]
 pub struct StringFrc {

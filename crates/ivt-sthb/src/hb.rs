@@ -13,8 +13,8 @@ use rustdct::DctPlanner;
 use super::spatial::{Spatial, DIRECT_MAX_MODES};
 use super::toeplitz::{add_real_toeplitz, BlockLayout, PeriodicSpectrum};
 use super::{Boundary, StringParams};
-use crate::aft::RealFftPair;
-use crate::error::HbError;
+use ivt_hb::aft::RealFftPair;
+use ivt_hb::HbError;
 use ivt_num::NewtonWorkspace;
 
 mod solve;

@@ -1,3 +1,4 @@
+#![doc = include_str!("../README.md")]
 //! Spatial and temporal harmonic balance (STHB, thesis §3.3) for the string
 //! with geometric nonlinearity, Eq. 103:
 //!
@@ -15,7 +16,7 @@
 //!   same linearization, with the classification stable / fold / period
 //!   doubling / Neimark–Sacker.
 //! * [`frc`] — curves ‖a‖(ω) (Figs. 34–36) traced by the engine's
-//!   exact-Jacobian pseudo-arclength, as the engine's [`crate::Frc`], in the
+//!   exact-Jacobian pseudo-arclength, as the engine's [`ivt_hb::Frc`], in the
 //!   branch's invariant subspace (`reduced`: odd harmonics × odd modes, the
 //!   Jacobian's block structure in modes × harmonics).
 //! * [`modal`] — the "traditional route": the Galerkin modal ODEs derived in
@@ -41,7 +42,7 @@ pub mod toeplitz;
 
 pub use hb::StringHb;
 
-use crate::error::HbError;
+use ivt_hb::HbError;
 
 /// Boundary condition at `x = 1` (`w(0, t) = 0` always).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -103,16 +104,16 @@ impl StringParams {
         if self.modes == 0 || self.harmonics == 0 {
             return bad("modes and harmonics must be at least 1".into());
         }
-        if let Some(why) = crate::limits::unknowns_error(self.modes, self.harmonics) {
+        if let Some(why) = ivt_hb::limits::unknowns_error(self.modes, self.harmonics) {
             return bad(why);
         }
         // The space–time grid holds ns·ms samples.
-        if self.ns.saturating_mul(self.ms) > crate::limits::MAX_SAMPLES {
+        if self.ns.saturating_mul(self.ms) > ivt_hb::limits::MAX_SAMPLES {
             return bad(format!(
                 "ns·ms = {}·{} exceeds the limit of {} space–time samples",
                 self.ns,
                 self.ms,
-                crate::limits::MAX_SAMPLES
+                ivt_hb::limits::MAX_SAMPLES
             ));
         }
         if self.ns <= 2 * self.modes + 1 {

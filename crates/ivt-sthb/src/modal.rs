@@ -13,7 +13,7 @@ use ivt_num::{ExplicitRk, RK4};
 use std::f64::consts::PI;
 
 use super::StringParams;
-use crate::problem::{displacement_jacobian, PeriodicProblem};
+use ivt_hb::problem::{displacement_jacobian, PeriodicProblem};
 
 /// The cubic Galerkin model of the fixed–fixed string with `N` sine modes.
 #[derive(Clone, Debug)]

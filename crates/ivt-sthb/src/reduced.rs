@@ -256,7 +256,7 @@ impl Branch for ReducedString<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sthb::StringParams;
+    use crate::StringParams;
     use ivt_path::branch::fd_jacobian_gradient;
 
     /// A response on the branch from rest at `omega` (in the subspace).

@@ -13,7 +13,7 @@ use faer::Mat;
 use ivt_path::continuation::{follow_residual, ContinuationOptions, Termination};
 
 use super::{StringHb, StringParams};
-use crate::error::HbError;
+use ivt_hb::HbError;
 
 /// One point `(ω, ‖a‖)` of a spring-boundary curve, with the solution.
 #[derive(Clone, Debug, PartialEq)]

@@ -22,12 +22,12 @@ use realfft::RealFftPlanner;
 
 use super::toeplitz::{add_real_toeplitz, BlockLayout, PeriodicSpectrum};
 use super::StringHb;
-use crate::error::HbError;
+use ivt_hb::HbError;
 
-/// The stability classes of the engine ([`crate::stability::classify`]): the
+/// The stability classes of the engine ([`ivt_hb::stability::classify`]): the
 /// unstable kinds name the multiplier that left the unit circle (fold +1,
 /// period doubling −1, Neimark–Sacker complex pair).
-pub use crate::stability::StabilityKind;
+pub use ivt_hb::stability::StabilityKind;
 
 /// Which method produced a verdict.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -80,7 +80,7 @@ impl Stability {
             return Err(HbError::Eigen("no Floquet multiplier".into()));
         };
         Ok(Self {
-            kind: crate::stability::classify(critical),
+            kind: ivt_hb::stability::classify(critical),
             multipliers,
             method,
         })

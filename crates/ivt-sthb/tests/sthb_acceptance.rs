@@ -2,16 +2,14 @@
 //! against monodromy, Figs. 34–36 behaviour, stress.
 #![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
-use ivt_hb::sthb::frc::{frequency_response, trace, StringFrcOptions};
-use ivt_hb::sthb::modal::ModalString;
-use ivt_hb::sthb::spring::spring_frequency_response;
-use ivt_hb::sthb::stability::{
-    hill, hill_exponents, monodromy, monodromy_multipliers, StabilityKind,
-};
-use ivt_hb::sthb::{Boundary, StringHb, StringParams};
 use ivt_hb::Frc;
 use ivt_hb::HbError;
 use ivt_num::{ExplicitRk, RK4};
+use ivt_sthb::frc::{frequency_response, trace, StringFrcOptions};
+use ivt_sthb::modal::ModalString;
+use ivt_sthb::spring::spring_frequency_response;
+use ivt_sthb::stability::{hill, hill_exponents, monodromy, monodromy_multipliers, StabilityKind};
+use ivt_sthb::{Boundary, StringHb, StringParams};
 use realfft::num_complex::Complex;
 use std::f64::consts::PI;
 

@@ -3,7 +3,7 @@
 #![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 use faer::Mat;
-use ivt_hb::sthb::{Boundary, StringHb, StringParams};
+use ivt_sthb::{Boundary, StringHb, StringParams};
 use std::f64::consts::PI;
 
 /// Deterministic pseudo-random coefficients (xorshift) decaying with harmonic.
@@ -197,7 +197,7 @@ fn kd30_folds_are_located_by_the_bordered_system() {
     // ω − ω* ∝ (s − s*)², so σ_min/σ_max ≤ 1e-12 (measured ~4e-18) puts the
     // located ω far within 1e-8 of the turn (relative to the conditioning at the nearest path point,
     // ~0.02 of arclength away: measured 3e-6–1e-5).
-    use ivt_hb::sthb::frc::{frequency_response, trace, StringFrcOptions};
+    use ivt_sthb::frc::{frequency_response, trace, StringFrcOptions};
     let p = StringParams {
         kd: 30.0,
         ..Default::default()

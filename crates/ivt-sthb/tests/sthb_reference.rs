@@ -12,9 +12,9 @@
 //! each reference ω from the nearest point of the new curve.
 #![allow(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used)]
 
-use ivt_hb::sthb::frc::{frequency_response, StringFrc, StringFrcOptions};
-use ivt_hb::sthb::stability::StabilityMethod;
-use ivt_hb::sthb::{StringHb, StringParams};
+use ivt_sthb::frc::{frequency_response, StringFrc, StringFrcOptions};
+use ivt_sthb::stability::StabilityMethod;
+use ivt_sthb::{StringHb, StringParams};
 use std::fmt::Write as _;
 
 /// The cases: (k_d, N, M).
@@ -132,8 +132,8 @@ fn curves_equal_the_pre_issue_28_solver() {
             // The same stability function at the re-solved point: the same verdict
             // and |μ| to 1e-8 (RK4 of a solution 1e-10 away, different rounding).
             let s = match method.as_str() {
-                "Hill" => ivt_hb::sthb::stability::hill(&hb, *omega),
-                _ => ivt_hb::sthb::stability::monodromy(&hb, *omega),
+                "Hill" => ivt_sthb::stability::hill(&hb, *omega),
+                _ => ivt_sthb::stability::monodromy(&hb, *omega),
             }
             .unwrap();
             assert_eq!(s.kind.name(), kind, "{:?} ω = {omega}", r.case);

@@ -4,11 +4,11 @@
 #![allow(clippy::unwrap_used)]
 
 use faer::Mat;
-use ivt_hb::sthb::frc::{frequency_response, StringFrcOptions};
-use ivt_hb::sthb::stability::{
+use ivt_sthb::frc::{frequency_response, StringFrcOptions};
+use ivt_sthb::stability::{
     default_steps, monodromy, monodromy_matrix, monodromy_refined, StabilityMethod,
 };
-use ivt_hb::sthb::{StringHb, StringParams};
+use ivt_sthb::{StringHb, StringParams};
 use std::time::Instant;
 
 #[path = "common/string.rs"]
@@ -89,7 +89,7 @@ fn split_monodromy_has_the_full_matrix_multipliers() {
     // monodromy_matrix integrates all modes together.
     for (modes, omega) in [(6, 3.8), (7, 2.0)] {
         let (hb, _) = solved(modes, 9, 30.0, omega, 1e-12);
-        let split = ivt_hb::sthb::stability::monodromy_multipliers(&hb, omega).unwrap();
+        let split = ivt_sthb::stability::monodromy_multipliers(&hb, omega).unwrap();
         let phi = monodromy_matrix(&hb, omega, default_steps(&hb, omega)).unwrap();
         let mut full: Vec<f64> = phi
             .eigenvalues()
@@ -117,7 +117,7 @@ fn twenty_modes_thirty_nine_harmonics_whole_curve_with_stability() {
         ..Default::default()
     })
     .unwrap();
-    assert_eq!(ivt_hb::sthb::stability::HILL_MAX_DIM, 800);
+    assert_eq!(ivt_sthb::stability::HILL_MAX_DIM, 800);
     let curve = frequency_response(&mut hb, 1.0, 6.0, &StringFrcOptions::default()).unwrap();
     let frc = &curve.frc;
     assert!((frc.points.last().unwrap().omega_f - 6.0).abs() < 1e-12);

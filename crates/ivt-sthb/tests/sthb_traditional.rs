@@ -5,10 +5,10 @@
 #![allow(clippy::unwrap_used)]
 
 use ivt_hb::frc::{frequency_response as engine_frc, FrcOptions};
-use ivt_hb::sthb::frc::{trace, StringFrcOptions};
-use ivt_hb::sthb::modal::ModalString;
-use ivt_hb::sthb::{StringHb, StringParams};
 use ivt_hb::{HbOptions, HbResidual, ModifiedIhb, Path};
+use ivt_sthb::frc::{trace, StringFrcOptions};
+use ivt_sthb::modal::ModalString;
+use ivt_sthb::{StringHb, StringParams};
 use std::time::Instant;
 
 /// The engine's options matching the STHB grid: M = 19 harmonics, 2·64 = M_s samples.

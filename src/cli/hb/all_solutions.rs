@@ -1,12 +1,12 @@
 //! `ivt hb all-solutions`: every period-one orbit of Duffing's equation
 //! (Eq. 49, the thesis's ξ = 0.02, α = ε = 1, F = 0.1) at one ω_f by
 //! deflated Newton, with stability, by the job
-//! [`ivt_hb::jobs::all_solutions()`] that `ivt.hb.all_solutions` runs.
+//! [`ivt_jobs::all_solutions()`] that `ivt.hb.all_solutions` runs.
 
 use super::{to_json, CliError, DuffingParams, Output};
 use clap::Args;
-use ivt_hb::jobs::{self, AllSolutionsRequest};
 use ivt_hb::{GeneralProblem, PeriodicProblem};
+use ivt_jobs::{self as jobs, AllSolutionsRequest};
 
 /// `ivt hb all-solutions` (defaults: the thesis Duffing at ω_f = 1.4).
 #[derive(Args)]

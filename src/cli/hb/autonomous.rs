@@ -1,14 +1,14 @@
 //! `ivt hb limit-cycle` and `ivt hb duffing-backbone`: periodic orbits with
 //! the frequency an unknown (§3.2.4) — the limit cycle of a self-excited
 //! oscillator and the backbone of the free Duffing oscillator — through the
-//! jobs [`ivt_hb::jobs::limit_cycle`] and [`ivt_hb::jobs::backbone`] that
+//! jobs [`ivt_jobs::limit_cycle`] and [`ivt_jobs::backbone`] that
 //! `ivt.hb.limit_cycle` and `ivt.hb.backbone` run.
 
 use super::{to_json, CliError, Output};
 use clap::Args;
-use ivt_hb::jobs::{self, BackboneRequest, LimitCycleRequest};
 use ivt_hb::Oscillator;
 use ivt_hb::{BackboneOptions, HbOptions};
+use ivt_jobs::{self as jobs, BackboneRequest, LimitCycleRequest};
 
 /// Harmonics and samples of the autonomous jobs (Python's defaults and
 /// tolerances: ‖r‖₂ ≤ 1e-9 relative to the force scale).

@@ -1,13 +1,13 @@
 //! `ivt hb cycle-branch`: the Hopf point of ẍ − (μ + x² − x⁴)ẋ + x = 0
 //! (issue 27: subcritical at μ = 0) and the limit-cycle branch born there,
 //! with its stability and its fold, by the job
-//! [`ivt_hb::jobs::cycle_branch()`] that `ivt.hb.cycle_branch` runs.
+//! [`ivt_jobs::cycle_branch()`] that `ivt.hb.cycle_branch` runs.
 
 use super::autonomous::Resolution;
 use super::{to_json, CliError, Output};
 use clap::Args;
-use ivt_hb::jobs::{self, CycleBranchRequest};
 use ivt_hb::{GeneralProblem, HbError, PeriodicProblem};
+use ivt_jobs::{self as jobs, CycleBranchRequest};
 
 /// `ivt hb cycle-branch` (defaults: μ from −0.2 to 0.1, the cycles at μ = −0.1).
 #[derive(Args)]

@@ -1,11 +1,11 @@
 //! `ivt hb duffing-folds`: how the folds of Duffing's frequency response
 //! (Eq. 49) move with the force F — the fold curve in (ω, F) through the cusp
-//! where the jump disappears, by the job [`ivt_hb::jobs::fold_curve`] that
+//! where the jump disappears, by the job [`ivt_jobs::fold_curve`] that
 //! `ivt.hb.duffing_folds` and `ivt.hb.continue_bifurcation` run.
 
 use super::{to_json, CliError, DuffingParams, Output};
 use clap::Args;
-use ivt_hb::jobs::{self, FoldCurveRequest, FoldStart};
+use ivt_jobs::{self as jobs, FoldCurveRequest, FoldStart};
 
 /// `ivt hb duffing-folds` (defaults: the thesis Duffing, from the F = 0.1 fold).
 #[derive(Args)]

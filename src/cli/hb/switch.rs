@@ -1,14 +1,14 @@
 //! `ivt hb switch`: branch switching at the first period doubling of the
 //! twin-well Duffing oscillator about its well (ẍ + cẋ + 2x + 3x² + x³ =
 //! F cos ω_f t, x = u − 1 of ü + cu̇ − u + u³ = F cos ω_f t) onto its
-//! period-2 branch, by the job [`ivt_hb::jobs::switch()`] that
+//! period-2 branch, by the job [`ivt_jobs::switch()`] that
 //! `ivt.hb.switch_branch` runs.
 
 use super::autonomous::Resolution;
 use super::{to_json, CliError, Output};
 use clap::Args;
-use ivt_hb::jobs::{self, FrcRequest, SwitchRequest, SwitchStart};
 use ivt_hb::{BifurcationKind, Corrector, FrcOptions, GeneralProblem, PeriodicProblem};
+use ivt_jobs::{self as jobs, FrcRequest, SwitchRequest, SwitchStart};
 
 /// `ivt hb switch` (defaults: c = 0.1, F = 0.5, the FRC from ω_f = 3.6 down
 /// to 2.2, the period-2 branch to 2.2).

@@ -2,13 +2,13 @@
 //! oscillator `ẍ − μ(1 − x²)ẋ + x = F cos ω_f t` gives way to a torus — its
 //! Neimark–Sacker curve in (ω_f, F) from the NS point of the FRC at `--force`
 //! to its 1:1 end on the fold curve and up to `--force-to`, by the job
-//! [`ivt_hb::jobs::fold_curve`] that `ivt.hb.continue_bifurcation` runs.
+//! [`ivt_jobs::fold_curve`] that `ivt.hb.continue_bifurcation` runs.
 
 use super::autonomous::Resolution;
 use super::{to_json, CliError, Output};
 use clap::Args;
-use ivt_hb::jobs::{self, FoldCurveRequest, FoldStart};
 use ivt_hb::{BifurcationKind, GeneralProblem, HbError, PeriodicProblem};
+use ivt_jobs::{self as jobs, FoldCurveRequest, FoldStart};
 
 /// `ivt hb vdp-torus` (defaults: μ = 0.2 from the point
 /// (0.94525643, 0.2)).

@@ -3,7 +3,7 @@
 //! coupled cyclically.
 
 use super::{from_triplets, SparseModel};
-use crate::error::HbError;
+use ivt_hb::HbError;
 
 /// The bladed disk and the DOF its force and cubic spring act on.
 #[derive(Debug, Clone)]

@@ -2,7 +2,7 @@
 //! x = 0, of N equal Hermite-cubic elements with consistent mass.
 
 use super::{from_triplets, SparseModel};
-use crate::error::HbError;
+use ivt_hb::HbError;
 
 /// The cantilever and the index of its tip displacement.
 #[derive(Debug, Clone)]
@@ -57,7 +57,7 @@ pub fn element_dofs(e: usize) -> [Option<usize>; 4] {
 /// `K_e` is formed from `1/h = N/L`: with L = EI = 1 its entries are
 /// integers, stored exactly for every N ≤ 2^17 (the fine mesh's
 /// ill-conditioning then comes from the dynamic stiffness alone, see
-/// [`crate::condense`]).
+/// [`crate`]).
 ///
 /// # Errors
 /// [`HbError::InvalidInput`] for no elements or non-positive / non-finite

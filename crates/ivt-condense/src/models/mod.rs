@@ -2,7 +2,7 @@
 //! Euler–Bernoulli cantilever of Hermite-cubic elements and pyHarm's lumped
 //! bladed disk. Each is a [`SparseModel`]: sparse `M`, `C`, `K`, the DOF the
 //! nonlinear element and the force act on. The tests and the benches of
-//! [`crate::condense`] use them; Python exposes the cantilever as
+//! [`crate`] use them; Python exposes the cantilever as
 //! `ivt.hb.models.cantilever`.
 
 mod bladed_disk;
@@ -11,8 +11,8 @@ mod cantilever;
 pub use bladed_disk::{bladed_disk, BladedDisk};
 pub use cantilever::{cantilever, element_dofs, BeamProperties, Cantilever};
 
-use crate::error::HbError;
 use faer::sparse::{SparseColMat, Triplet};
+use ivt_hb::HbError;
 
 /// Sparse mass, damping and stiffness of a linear structure (`n_dof × n_dof`,
 /// column-compressed; duplicates of the assembly summed).

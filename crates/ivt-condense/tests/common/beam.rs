@@ -4,8 +4,8 @@
 #![allow(dead_code)] // each test binary uses its own subset
 #![allow(clippy::expect_used, clippy::indexing_slicing, clippy::unwrap_used)]
 
-use ivt_hb::condense::{CondensedBranch, Structure};
-use ivt_hb::models::{cantilever, BeamProperties};
+use ivt_condense::models::{cantilever, BeamProperties};
+use ivt_condense::{CondensedBranch, Structure};
 use ivt_hb::{GeneralProblem, HbOptions, PeriodicProblem};
 
 /// Cubic spring constant at the tip (issue 28).

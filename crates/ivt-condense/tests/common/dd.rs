@@ -207,7 +207,7 @@ pub fn exact_cantilever_entry(n_elements: usize, i: usize, j: usize) -> [Dd; 3] 
     let beta = d(2.0).div(d(10000.0));
     let (mut k, mut m) = (Dd::default(), Dd::default());
     for e in 0..n_elements {
-        let dofs = ivt_hb::models::element_dofs(e);
+        let dofs = ivt_condense::models::element_dofs(e);
         for a in 0..4 {
             for b in 0..4 {
                 if dofs[a] == Some(i) && dofs[b] == Some(j) {

@@ -1,4 +1,4 @@
-//! pyHarm's 72-DOF bladed disk (tutorial 006, `ivt_hb::models::bladed_disk`)
+//! pyHarm's 72-DOF bladed disk (tutorial 006, `ivt_condense::models::bladed_disk`)
 //! with the cubic spring 5e10 x³ from sector 0's blade tip to ground: the
 //! local problem of the condensed disk and the uncondensed disk the tests
 //! compare with (`#[path]`-included by the condense tests).
@@ -6,7 +6,7 @@
 #![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 use super::beam::dense;
-use ivt_hb::models::bladed_disk;
+use ivt_condense::models::bladed_disk;
 use ivt_hb::{GeneralProblem, PeriodicProblem};
 
 /// Cubic spring constant at the blade tip.

@@ -23,7 +23,7 @@ use super::beam::{dense, FORCE, K3};
 use super::dd::Dd;
 use faer::linalg::solvers::Solve;
 use faer::Mat;
-use ivt_hb::models::{cantilever, BeamProperties};
+use ivt_condense::models::{cantilever, BeamProperties};
 
 /// The uncondensed cantilever: its stored dense matrices (row-major
 /// `nd × nd`), the tip, the harmonics.

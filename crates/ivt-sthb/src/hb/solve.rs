@@ -2,8 +2,8 @@
 //! [`ivt_num::newton()`] on the STHB residual and exact Jacobian).
 
 use super::StringHb;
-use crate::error::HbError;
 use faer::Mat;
+use ivt_hb::HbError;
 use ivt_num::{newton, NewtonOptions, NewtonSystem, NewtonWorkspace, SolveError};
 use std::convert::Infallible;
 

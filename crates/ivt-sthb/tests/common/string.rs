@@ -2,7 +2,7 @@
 //! and benches (`#[path]`-included there).
 #![allow(clippy::unwrap_used)]
 
-use ivt_hb::sthb::{StringHb, StringParams};
+use ivt_sthb::{StringHb, StringParams};
 
 /// The string with `modes` sine modes, `harmonics` harmonics and the spring
 /// `kd` (the other parameters the default's), solved by Newton from rest at
