@@ -7,7 +7,7 @@
 #![allow(clippy::indexing_slicing)]
 
 use core::f64::consts::PI;
-use ivt_hb::mathieu::THESIS_A0;
+use ivt_hb::branches::mathieu::THESIS_A0;
 use ivt_hb::{ClassicIhb, HbOptions, MathieuDuffing, ModifiedIhb};
 
 /// A0's b3 (printed 0.0471, ours 0.04718): a slip in one parameter of

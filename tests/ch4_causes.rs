@@ -18,7 +18,7 @@ use ivt_design::delay::{steady_orbit, system_matrix, DelayOptions, FeedbackGains
 use ivt_design::shooting::{omega_at_angles, periodic_at_r, shoot_steady_state, ShootingOptions};
 use ivt_design::steady::{solve_steady_state, IhbOptions, Quadrature};
 use ivt_design::OperatingPoint;
-use ivt_hb::floquet::{monodromy_hsu, HsuRule};
+use ivt_hb::stability::floquet::{monodromy_hsu, HsuRule};
 use ivt_kin::plant::{GravityModel, PlantParams, PlantPreset};
 
 /// §4.3 computes the transformation matrix by Hsu's method [57], Eq. 80: a

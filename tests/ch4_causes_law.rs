@@ -17,7 +17,7 @@ use ivt_design::delay::{
 };
 use ivt_design::shooting::{omega_at_angles, periodic_at_r, ShootingOptions};
 use ivt_design::OperatingPoint;
-use ivt_hb::floquet::{expm, expm_scratch_len, monodromy_uniform, HsuRule};
+use ivt_hb::stability::floquet::{expm, expm_scratch_len, monodromy_uniform, HsuRule};
 use ivt_kin::plant::PlantParams;
 
 /// Why 0.4871 cannot come out with the printed gain ratio k2 = 2k: with

@@ -14,7 +14,7 @@ mod torus;
 
 use super::{CliError, Output};
 use clap::{Args, Subcommand};
-use ivt_hb::aft::eval_series;
+use ivt_hb::orbit::aft::eval_series;
 use ivt_hb::{Duffing, FrcOptions, HbOptions};
 use ivt_jobs::{self as jobs, CascadeRequest, FrcRequest, Method, OrbitRequest};
 use std::f64::consts::PI;

@@ -2,9 +2,9 @@
 //! §3.2.3) and Mathieu–Duffing (A0 and β1/β2/β4 of §3.2.5, Figs. 30–33).
 
 use super::{fmt_sig, series, Cause, Context, ReproError, Verdict};
-use ivt_hb::aft::eval_series;
-use ivt_hb::mathieu::THESIS_A0;
-use ivt_hb::ode::{first_order, rk4};
+use ivt_hb::branches::mathieu::THESIS_A0;
+use ivt_hb::orbit::aft::eval_series;
+use ivt_hb::problem::ode::{first_order, rk4};
 use ivt_hb::{
     frequency_response, period_doubling_cascade, CascadeOptions, ClassicIhb, Duffing, FrcOptions,
     HbOptions, MathieuDuffing, ModifiedIhb,

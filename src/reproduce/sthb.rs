@@ -2,7 +2,7 @@
 //! (Figs. 34–36; c_d = 0.8, y0 = 0.5, M = 19, N_s = 64, M_s = 128).
 
 use super::{series, Context, Points, ReproError, SeriesSpec, Verdict};
-use ivt_hb::frc::Frc;
+use ivt_hb::branches::frc::Frc;
 use ivt_plot::{Figure, Style};
 use ivt_sthb::frc::{frequency_response, trace, StringFrcOptions};
 use ivt_sthb::{Boundary, StringHb, StringParams};

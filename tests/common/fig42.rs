@@ -8,7 +8,7 @@
 use ivt_design::delay::{delay_stability_about, steady_orbit, DelayOptions, FeedbackGains};
 use ivt_design::shooting::PeriodicOrbit;
 use ivt_design::OperatingPoint;
-use ivt_hb::floquet::eigenvalues;
+use ivt_hb::stability::floquet::eigenvalues;
 use ivt_kin::plant::{PlantParams, PlantPreset};
 
 /// Fig. 42's two printed cases at (7 V, 2 N·m): gains in mm·rad⁻¹ and the

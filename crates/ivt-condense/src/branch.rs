@@ -17,8 +17,8 @@
 use super::dynamic::Structure;
 use super::receptance::{Coupling, Receptances};
 use faer::{c64, Mat};
-use ivt_hb::galerkin::GalerkinJacobian;
-use ivt_hb::ihb::{HbOptions, HbResidual};
+use ivt_hb::orbit::galerkin::GalerkinJacobian;
+use ivt_hb::orbit::ihb::{HbOptions, HbResidual};
 use ivt_hb::problem::PeriodicProblem;
 use ivt_hb::HbError;
 use ivt_path::branch::{bilinear_form, Branch};

@@ -11,7 +11,7 @@
 
 use super::branch::CondensedBranch;
 use faer::{c64, Mat};
-use ivt_hb::aft::Aft;
+use ivt_hb::orbit::aft::Aft;
 use ivt_hb::problem::PeriodicProblem;
 use ivt_hb::HbError;
 

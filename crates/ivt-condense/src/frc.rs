@@ -14,9 +14,9 @@ use super::scaled::Scaled;
 use super::stability::{
     BasisGrowth, CondensedFloquet, ReducedStability, DEFAULT_BASIS_TOL, DEFAULT_BLOCKS,
 };
-use ivt_hb::aft::{eval_series, Aft};
-use ivt_hb::events::{observe, BifurcationKind, EventObserver, Fold, LocateOptions};
-use ivt_hb::frc::FrcFold;
+use ivt_hb::branches::events::{observe, BifurcationKind, EventObserver, Fold, LocateOptions};
+use ivt_hb::branches::frc::FrcFold;
+use ivt_hb::orbit::aft::{eval_series, Aft};
 use ivt_hb::problem::PeriodicProblem;
 use ivt_hb::stability::HsuSteps;
 use ivt_hb::HbError;

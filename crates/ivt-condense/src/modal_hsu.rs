@@ -18,9 +18,9 @@
 
 use super::ritz::{at, Reduced};
 use faer::{Mat, Side};
-use ivt_hb::aft::Aft;
-use ivt_hb::floquet::{eigenvalues, expm2};
+use ivt_hb::orbit::aft::Aft;
 use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::stability::floquet::{eigenvalues, expm2};
 use ivt_hb::stability::{richardson_error, Floquet, HsuEstimate, HsuSteps};
 use ivt_hb::HbError;
 
@@ -316,7 +316,7 @@ mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
 
     use super::*;
-    use ivt_hb::ihb::HbSolution;
+    use ivt_hb::orbit::ihb::HbSolution;
     use ivt_hb::problem::GeneralProblem;
     use ivt_hb::stability::AdaptiveHsu;
 

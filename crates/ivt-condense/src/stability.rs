@@ -26,7 +26,7 @@ use super::branch::CondensedBranch;
 use super::modal_hsu::ModalHsu;
 use super::ritz::{at, row, Reduced, RitzBasis};
 use faer::c64;
-use ivt_hb::ihb::HbSolution;
+use ivt_hb::orbit::ihb::HbSolution;
 use ivt_hb::problem::PeriodicProblem;
 use ivt_hb::stability::{AdaptiveHsu, Floquet, HsuEstimate, HsuSteps};
 use ivt_hb::HbError;

@@ -251,9 +251,9 @@ fn truncation_estimate_covers_the_change_to_more_harmonics() {
     let mut fine = beam(20, FORCE, &high);
     let mut worst_ratio = 0.0f64;
     for p in frc.points.iter().step_by(3) {
-        let mut x = ivt_hb::aft::resize_harmonics(&p.coeffs, high.harmonics);
+        let mut x = ivt_hb::orbit::aft::resize_harmonics(&p.coeffs, high.harmonics);
         correct_condensed(&mut fine, &mut x, p.omega_f, 1e-14).unwrap();
-        let coarse = ivt_hb::aft::resize_harmonics(&p.coeffs, high.harmonics);
+        let coarse = ivt_hb::orbit::aft::resize_harmonics(&p.coeffs, high.harmonics);
         let scale = x
             .iter()
             .take(coarse.len())

@@ -166,7 +166,7 @@ fn appendix_b(p: &PlantTerms, r: f64, w: f64) -> (f64, f64, f64, f64) {
 /// on the orbit at r = `r`; N = `opts.chebyshev_order`. The monodromy of
 /// [`monodromy`] applies the same matrix without forming it; this dense form
 /// is for other transformation-matrix rules, e.g. Hsu's product of matrix
-/// exponentials (Eq. 80, `ivt_hb::floquet::monodromy_hsu`) that §4.3 cites.
+/// exponentials (Eq. 80, `ivt_hb::stability::floquet::monodromy_hsu`) that §4.3 cites.
 ///
 /// # Errors
 /// Bad inputs, an odd or zero N, non-finite gains or ω̄ ≤ 0.

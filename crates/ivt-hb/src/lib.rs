@@ -3,57 +3,34 @@
 // chains would hide the matrix structure the equations are written in.
 #![allow(clippy::needless_range_loop)]
 
-pub mod aft;
-pub mod autonomous;
-pub mod backbone;
-pub mod classic;
-pub mod codim2;
-pub mod cycle_branch;
-pub mod damped;
-pub mod deflation;
-pub mod elements;
+pub mod analyses;
+pub mod branches;
 mod error;
-pub mod events;
-pub mod family;
-pub mod floquet;
-pub mod frc;
-pub mod galerkin;
-pub mod hill;
-pub mod hopf;
-mod hysteresis;
-pub mod ihb;
 pub mod limits;
-pub mod mathieu;
-pub mod modified;
-pub mod ode;
+pub mod orbit;
 pub mod problem;
 pub mod stability;
-pub mod switching;
-pub mod transient;
 
-pub use aft::Aft;
-pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
-pub use backbone::{backbone, Backbone, BackboneOptions, BackbonePoint};
-pub use classic::ClassicIhb;
-pub use codim2::{fold_curve, FoldCurve, FoldPoint};
-pub use cycle_branch::{cycle_branch, CycleBranch, CycleBranchOptions};
-pub use damped::{damped_modes, linear_mode, DampedModePoint, DampedModes};
-pub use deflation::{all_solutions, AllSolutions, FoundSolution, SearchOptions, SearchReport};
-pub use elements::{Element, ElementProblem, Harmonic, Law};
-pub use error::HbError;
-pub use events::{
+pub use analyses::deflation::{
+    all_solutions, AllSolutions, FoundSolution, SearchOptions, SearchReport,
+};
+pub use analyses::transient::{limit_cycle_from_state, settle, Settled, TransientOptions};
+pub use branches::autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBranch};
+pub use branches::backbone::{backbone, Backbone, BackboneOptions, BackbonePoint};
+pub use branches::codim2::{fold_curve, FoldCurve, FoldPoint};
+pub use branches::cycle_branch::{cycle_branch, CycleBranch, CycleBranchOptions};
+pub use branches::damped::{damped_modes, linear_mode, DampedModePoint, DampedModes};
+pub use branches::events::{
     locate_branch_point, locate_fold, locate_multiplier_crossing, trace, Bifurcation,
     BifurcationError, BifurcationKind, Event, FoldLocation, LocateOptions, PathOptions, Trace,
     TraceOptions, TracedPoint,
 };
+pub use branches::family::{Family, FamilyBranch, Frequency};
+pub use branches::frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
+pub use branches::mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
+pub use branches::switching::{period_doubled_start, switch_branch};
+pub use error::HbError;
 pub use faer::c64;
-pub use family::{Family, FamilyBranch, Frequency};
-pub use floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
-pub use frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
-pub use galerkin::GalerkinJacobian;
-pub use hill::{fourier_blocks, hill_multipliers, HillResult};
-pub use hopf::{hopf_points, HopfPoint};
-pub use ihb::{HbOptions, HbResidual, HbSolution, HbSolver};
 pub use ivt_num::{
     broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
 };
@@ -62,14 +39,19 @@ pub use ivt_path::{
     BroydenCorrector, ContinuationOptions, Corrector, NewtonCorrector, Path, PathCorrector,
     PathPoint, Step, Stepper, Termination, Traced, Turn,
 };
-pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
-pub use modified::ModifiedIhb;
+pub use orbit::aft::Aft;
+pub use orbit::classic::ClassicIhb;
+pub use orbit::galerkin::GalerkinJacobian;
+pub use orbit::ihb::{HbOptions, HbResidual, HbSolution, HbSolver};
+pub use orbit::modified::ModifiedIhb;
+pub use problem::elements::{Element, ElementProblem, Harmonic, Law};
 pub use problem::{
     central_difference_samples, AtFrequency, Duffing, Excitation, FrequencyExcitation,
     GeneralProblem, MathieuDuffing, Nonlinearity, Oscillator, PeriodicProblem, WithJacobian,
 };
+pub use stability::floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
+pub use stability::hill::{fourier_blocks, hill_multipliers, HillResult};
+pub use stability::hopf::{hopf_points, HopfPoint};
 pub use stability::{
     classify, AdaptiveHsu, Floquet, HsuEstimate, HsuSteps, StabilityAnalyzer, StabilityKind,
 };
-pub use switching::{period_doubled_start, switch_branch};
-pub use transient::{limit_cycle_from_state, settle, Settled, TransientOptions};

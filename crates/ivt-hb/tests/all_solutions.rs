@@ -3,7 +3,7 @@
 //! The reference is shooting on an RK4 integration from a grid of initial
 //! states (no HB): its distinct fixed points and their stability.
 
-use ivt_hb::aft::eval_series;
+use ivt_hb::orbit::aft::eval_series;
 use ivt_hb::{all_solutions, Duffing, HbError, HbOptions, SearchOptions, StabilityKind};
 
 mod common;

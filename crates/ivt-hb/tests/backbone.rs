@@ -5,7 +5,7 @@
 
 mod common;
 use common::tight_backbone;
-use ivt_hb::aft::eval_series;
+use ivt_hb::orbit::aft::eval_series;
 use ivt_hb::{backbone, Corrector, Duffing, HbOptions};
 
 /// Exact frequency of `ẍ + x + αx³ = 0` with `x(0) = A`, `ẋ(0) = 0`:

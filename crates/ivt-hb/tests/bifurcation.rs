@@ -3,9 +3,9 @@
 //! equations, sharing no code with the HB path) and time integration.
 #![allow(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used)]
 
-use ivt_hb::aft::{eval_series, resize_harmonics};
-use ivt_hb::mathieu::THESIS_A0;
-use ivt_hb::ode::{first_order, rk4};
+use ivt_hb::branches::mathieu::THESIS_A0;
+use ivt_hb::orbit::aft::{eval_series, resize_harmonics};
+use ivt_hb::problem::ode::{first_order, rk4};
 use ivt_hb::{
     period_doubled_start, switch_branch, trace, BifurcationKind, ContinuationOptions, Corrector,
     Family, FamilyBranch, GeneralProblem, HbOptions, LocateOptions, MathieuDuffing, ModifiedIhb,

@@ -8,7 +8,7 @@
 //! the curve's shape).
 #![allow(clippy::indexing_slicing)]
 
-use ivt_hb::codim2::cycle_fold_curve;
+use ivt_hb::branches::codim2::cycle_fold_curve;
 use ivt_hb::{cycle_branch, GeneralProblem, HbError, HbOptions, PeriodicProblem};
 
 mod common;
@@ -74,8 +74,9 @@ fn cycle_fold_curve_matches_shooting_in_nu() {
         &opts,
     )
     .unwrap();
-    let nus =
-        |c: &ivt_hb::codim2::CycleFoldCurve| c.at.iter().map(|p| p.fold.p).collect::<Vec<_>>();
+    let nus = |c: &ivt_hb::branches::codim2::CycleFoldCurve| {
+        c.at.iter().map(|p| p.fold.p).collect::<Vec<_>>()
+    };
     assert_eq!(
         nus(&down),
         [0.35, 0.5, 0.7, 0.9, 1.0],

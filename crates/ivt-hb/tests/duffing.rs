@@ -4,8 +4,8 @@
 mod common;
 
 use common::{max_abs_diff, orbit_defect, solve_classic, solve_modified};
-use ivt_hb::aft::{eval_series, resize_harmonics};
-use ivt_hb::ode::{first_order, rk4};
+use ivt_hb::orbit::aft::{eval_series, resize_harmonics};
+use ivt_hb::problem::ode::{first_order, rk4};
 use ivt_hb::{ClassicIhb, Duffing, HbOptions, HsuRule, ModifiedIhb, StabilityAnalyzer};
 use std::f64::consts::PI;
 

@@ -1,8 +1,8 @@
 //! The element library in use: the friction-damper FRC of
 //! `examples/friction_damper.rs` against time integration.
 
-use ivt_hb::aft::eval_series;
-use ivt_hb::ode::{first_order, rk4};
+use ivt_hb::orbit::aft::eval_series;
+use ivt_hb::problem::ode::{first_order, rk4};
 use ivt_hb::{frequency_response, FrcOptions, HbOptions, HbSolution, ModifiedIhb};
 
 // The example's model, shared so that the test checks exactly what it shows.

@@ -2,8 +2,8 @@
 //! ε = 1, F = 0.1, n = 20, N = 64) through both folds of the hardening peak.
 #![allow(clippy::indexing_slicing, clippy::panic)]
 
-use ivt_hb::aft::eval_series;
-use ivt_hb::ode::rk4;
+use ivt_hb::orbit::aft::eval_series;
+use ivt_hb::problem::ode::rk4;
 use ivt_hb::{
     c64, frequency_response, BroydenStats, Duffing, FrcFold, FrcOptions, HbOptions, HbSolution,
     HsuRule, StabilityAnalyzer, StabilityKind,

@@ -3,7 +3,7 @@
 //! time integration of the hysteretic ODE, with the order of convergence in n.
 #![allow(clippy::unwrap_used)]
 
-use ivt_hb::aft::eval_series;
+use ivt_hb::orbit::aft::eval_series;
 use ivt_hb::{Element, ElementProblem, Harmonic, HbOptions, HbResidual, Law, ModifiedIhb};
 use std::f64::consts::PI;
 

@@ -3,8 +3,8 @@
 //! an unknown, against shooting on the time integration.
 #![allow(clippy::indexing_slicing, clippy::panic)]
 
-use ivt_hb::aft::eval_series;
-use ivt_hb::ode::rk4;
+use ivt_hb::orbit::aft::eval_series;
+use ivt_hb::problem::ode::rk4;
 use ivt_hb::Oscillator;
 use ivt_hb::{
     limit_cycle, limit_cycle_branch, ContinuationOptions, HbError, HbOptions, PeriodicProblem,

@@ -1,7 +1,7 @@
 //! §3.2.5: the Mathieu–Duffing period-doubling cascade (ξ̂ = 0.125, α̂ = 1, Ω = 2,
 //! γ = 1); thesis: β1 = 4.825, β2 = 5.194, β4 = 5.253.
 
-use ivt_hb::ode::{first_order, rk4};
+use ivt_hb::problem::ode::{first_order, rk4};
 use ivt_hb::{period_doubling_cascade, CascadeOptions, MathieuDuffing};
 use std::f64::consts::PI;
 
@@ -70,8 +70,8 @@ fn rk_confirms_first_period_doubling() {
     .unwrap();
     let b1 = pds[0].beta;
     let sol = &pds[0].solution;
-    let x0 = ivt_hb::aft::eval_series(sol.dof(0), 0.0, 0);
-    let v0 = 2.0 * ivt_hb::aft::eval_series(sol.dof(0), 0.0, 1);
+    let x0 = ivt_hb::orbit::aft::eval_series(sol.dof(0), 0.0, 0);
+    let v0 = 2.0 * ivt_hb::orbit::aft::eval_series(sol.dof(0), 0.0, 1);
     let below = period1_defect(b1 - BRACKET, x0, v0);
     let above = period1_defect(b1 + BRACKET, x0 + 1e-3, v0);
     eprintln!("RK: period-1 defect at β1 − {BRACKET}: {below:.2e}; at β1 + {BRACKET}: {above:.2e}");

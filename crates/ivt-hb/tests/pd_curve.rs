@@ -4,7 +4,7 @@
 //! shooting on RK4 (no HB): a fixed point of the period map whose Jacobian
 //! has the multiplier −1, det(∂P/∂y + I) = 0.
 
-use ivt_hb::codim2::{bifurcation_curve, CurveStart};
+use ivt_hb::branches::codim2::{bifurcation_curve, CurveStart};
 use ivt_hb::{
     period_doubling_cascade, BifurcationKind, CascadeOptions, HbError, HbOptions, MathieuDuffing,
     Termination,

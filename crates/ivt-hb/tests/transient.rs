@@ -4,7 +4,7 @@
 //! on an RK4 integration that shares no code with the transient or HB.
 #![allow(clippy::expect_used, clippy::indexing_slicing)]
 
-use ivt_hb::ode::rk4;
+use ivt_hb::problem::ode::rk4;
 use ivt_hb::Oscillator;
 use ivt_hb::{
     limit_cycle_from_state, settle, GeneralProblem, HbError, HbOptions, PeriodicProblem,

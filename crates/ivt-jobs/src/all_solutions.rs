@@ -3,8 +3,8 @@
 //! Floquet multipliers (Hsu, Eq. 78) and verdict, and the search's bounds.
 
 use super::{finite, pairs, stability_steps, Array};
-use ivt_hb::deflation::{all_solutions as deflated, SearchOptions};
-use ivt_hb::ihb::HbOptions;
+use ivt_hb::analyses::deflation::{all_solutions as deflated, SearchOptions};
+use ivt_hb::orbit::ihb::HbOptions;
 use ivt_hb::problem::PeriodicProblem;
 use ivt_hb::stability::StabilityKind;
 use ivt_hb::HbError;

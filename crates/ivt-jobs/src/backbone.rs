@@ -3,8 +3,8 @@
 //! b1 = 0, a fictitious damping κ unfolding the family: [`ivt_hb::backbone()`]).
 
 use super::{finite, Array};
-use ivt_hb::backbone::{BackboneOptions, BackbonePoint};
-use ivt_hb::ihb::HbOptions;
+use ivt_hb::branches::backbone::{BackboneOptions, BackbonePoint};
+use ivt_hb::orbit::ihb::HbOptions;
 use ivt_hb::problem::{GeneralProblem, PeriodicProblem};
 use ivt_hb::HbError;
 use ivt_path::continuation::{Corrector, Termination};

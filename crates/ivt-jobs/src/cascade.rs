@@ -3,7 +3,7 @@
 //! Floquet multiplier crosses −1 along the branch in β.
 
 use super::{all_finite, pairs, positive};
-use ivt_hb::mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
+use ivt_hb::branches::mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 use ivt_hb::HbError;
 use serde::Serialize;
 use std::time::Instant;

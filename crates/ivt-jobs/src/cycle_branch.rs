@@ -4,10 +4,10 @@
 //! and Eq. 68–77, Floquet stability (Hsu) and its folds located).
 
 use super::{all_finite, finite_list, pairs, path_steps, stability_steps, Array};
-use ivt_hb::autonomous::LimitCycle;
-use ivt_hb::cycle_branch::{cycle_branch as trace_cycles, CycleBranchOptions};
-use ivt_hb::events::BifurcationKind;
-use ivt_hb::ihb::HbOptions;
+use ivt_hb::branches::autonomous::LimitCycle;
+use ivt_hb::branches::cycle_branch::{cycle_branch as trace_cycles, CycleBranchOptions};
+use ivt_hb::branches::events::BifurcationKind;
+use ivt_hb::orbit::ihb::HbOptions;
 use ivt_hb::problem::PeriodicProblem;
 use ivt_hb::stability::StabilityKind;
 use ivt_hb::HbError;

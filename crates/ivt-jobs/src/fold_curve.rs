@@ -3,16 +3,16 @@
 //! ([`ivt_hb::fold_curve`]: the extended system `R = 0`, `Φ_q v = 0`,
 //! `|v| = 1` of Eq. 56/61 continued by Eq. 68–77 in `p`), or a period
 //! doubling or Neimark–Sacker point to the ends of its curve with the strong
-//! resonances on it ([`ivt_hb::codim2::bifurcation_curve`]: `R = 0` with the
+//! resonances on it ([`ivt_hb::branches::codim2::bifurcation_curve`]: `R = 0` with the
 //! critical eigenvector of the monodromy matrix, Eq. 80). The start is a
 //! given point, or the point of that kind of largest ω_f located on the FRC
 //! of `family(p_start)` over an interval.
 
 use super::{all_finite, finite, finite_list, path_steps, Array, FrcRequest};
-use ivt_hb::codim2::{bifurcation_curve, CurvePoint, CurveStart};
-use ivt_hb::events::BifurcationKind;
-use ivt_hb::frc::{frequency_response, FrcOptions};
-use ivt_hb::ihb::{HbOptions, HbSolution};
+use ivt_hb::branches::codim2::{bifurcation_curve, CurvePoint, CurveStart};
+use ivt_hb::branches::events::BifurcationKind;
+use ivt_hb::branches::frc::{frequency_response, FrcOptions};
+use ivt_hb::orbit::ihb::{HbOptions, HbSolution};
 use ivt_hb::problem::PeriodicProblem;
 use ivt_hb::HbError;
 use ivt_path::continuation::{Corrector, Termination};
@@ -200,7 +200,7 @@ pub struct FoldCurveResult {
 /// [`FoldCurveRequest::validate`]'s; `family(p_start)`'s; with
 /// [`FoldStart::Search`], the FRC's and [`HbError::InvalidInput`] when it has
 /// no located point of the kind; [`ivt_hb::fold_curve`]'s or
-/// [`ivt_hb::codim2::bifurcation_curve`]'s.
+/// [`ivt_hb::branches::codim2::bifurcation_curve`]'s.
 pub fn fold_curve<P, F>(
     family: F,
     hb: &HbOptions,

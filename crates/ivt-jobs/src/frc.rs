@@ -6,10 +6,10 @@
 //! Neimark–Sacker point and branch point as the path passes it.
 
 use super::{check_finite, pairs, Array};
-use ivt_hb::events::{trace, BifurcationError, BifurcationKind, Event, TraceOptions};
-use ivt_hb::family::{Family, FamilyBranch, Frequency};
-use ivt_hb::frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
-use ivt_hb::ihb::HbOptions;
+use ivt_hb::branches::events::{trace, BifurcationError, BifurcationKind, Event, TraceOptions};
+use ivt_hb::branches::family::{Family, FamilyBranch, Frequency};
+use ivt_hb::branches::frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
+use ivt_hb::orbit::ihb::HbOptions;
 use ivt_hb::problem::{AtFrequency, PeriodicProblem};
 use ivt_hb::stability::HsuSteps;
 use ivt_hb::stability::StabilityKind;
@@ -188,7 +188,7 @@ pub(super) fn traced_curve<F: Family>(
         ..TraceOptions::default()
     };
     let traced = trace(branch, start, sweep.from, &opts).map_err(trace_error)?;
-    let curve = ivt_hb::frc::from_trace(&traced, branch.options())?;
+    let curve = ivt_hb::branches::frc::from_trace(&traced, branch.options())?;
     let events = traced.events.iter().map(|e| event(e, &curve)).collect();
     assemble(curve, events, sweep.path.stability, t0)
 }

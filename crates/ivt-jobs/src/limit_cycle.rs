@@ -3,7 +3,7 @@
 //! Newton with the Galerkin Jacobian), its multipliers by Hsu (Eq. 78).
 
 use super::{finite, finite_pairs, stability_steps, Array};
-use ivt_hb::ihb::HbOptions;
+use ivt_hb::orbit::ihb::HbOptions;
 use ivt_hb::problem::PeriodicProblem;
 use ivt_hb::stability::StabilityKind;
 use ivt_hb::HbError;

@@ -1,16 +1,16 @@
 //! The Neimark–Sacker boundary of a forced family in (ω, p), sampled: at each
 //! requested p the frequency-response curve of `family(p)` is traced with
 //! its events ([`crate::frc`]) and each of its Neimark–Sacker points
-//! is located on the engine's extended system ([`ivt_hb::events`]: a
+//! is located on the engine's extended system ([`ivt_hb::branches::events`]: a
 //! pair of Floquet multipliers on the unit circle). Not a continuation of the curve: a turn of the boundary
 //! in p between two samples is not followed, and each sample costs a trace
-//! (the continuation is [`ivt_hb::codim2::bifurcation_curve`]).
+//! (the continuation is [`ivt_hb::branches::codim2::bifurcation_curve`]).
 
 use crate::{frc, FrcRequest};
 use faer::c64;
-use ivt_hb::events::BifurcationKind;
-use ivt_hb::frc::FrcOptions;
-use ivt_hb::ihb::HbOptions;
+use ivt_hb::branches::events::BifurcationKind;
+use ivt_hb::branches::frc::FrcOptions;
+use ivt_hb::orbit::ihb::HbOptions;
 use ivt_hb::problem::PeriodicProblem;
 use ivt_hb::HbError;
 use ivt_path::continuation::Corrector;

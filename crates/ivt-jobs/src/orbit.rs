@@ -5,9 +5,9 @@
 //! Magnus-4 steps.
 
 use super::{finite_pairs, positive, stability_steps, Array};
-use ivt_hb::floquet::HsuRule;
-use ivt_hb::ihb::{HbOptions, HbSolution, HbSolver};
+use ivt_hb::orbit::ihb::{HbOptions, HbSolution, HbSolver};
 use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::stability::floquet::HsuRule;
 use ivt_hb::stability::{StabilityAnalyzer, StabilityKind};
 use ivt_hb::HbError;
 use ivt_hb::{ClassicIhb, ModifiedIhb};

@@ -3,7 +3,7 @@
 //! the exact (Tau) Jacobian for both boundaries, stability by monodromy,
 //! confirmed by Hill's method near |μ| = 1 (Eq. 130–131).
 
-use ivt_hb::frc::Frc;
+use ivt_hb::branches::frc::Frc;
 use ivt_hb::stability::StabilityKind;
 use ivt_hb::HbError;
 use ivt_path::continuation::Termination;

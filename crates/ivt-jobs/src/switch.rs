@@ -22,12 +22,12 @@
 
 use super::frc::{trace_error, traced_curve};
 use super::{finite, FoldPoint, FrcCurve, FrcRequest};
-use ivt_hb::events::{dot, Bifurcation, BifurcationKind, LocateOptions};
-use ivt_hb::family::{Family, FamilyBranch, Frequency};
-use ivt_hb::frc::FrcOptions;
-use ivt_hb::ihb::HbOptions;
+use ivt_hb::branches::events::{dot, Bifurcation, BifurcationKind, LocateOptions};
+use ivt_hb::branches::family::{Family, FamilyBranch, Frequency};
+use ivt_hb::branches::frc::FrcOptions;
+use ivt_hb::branches::switching::{period_doubled_start, switch_branch};
+use ivt_hb::orbit::ihb::HbOptions;
 use ivt_hb::problem::PeriodicProblem;
-use ivt_hb::switching::{period_doubled_start, switch_branch};
 use ivt_hb::HbError;
 use ivt_num::vector::norm2;
 use ivt_num::BorderedLu;

@@ -6,7 +6,7 @@
 //! a complex pair on the unit circle) and half trace cos θ.
 #![allow(clippy::indexing_slicing)]
 
-use ivt_hb::codim2::{bifurcation_curve, CurveStart};
+use ivt_hb::branches::codim2::{bifurcation_curve, CurveStart};
 use ivt_hb::{
     BifurcationKind, ContinuationOptions, GeneralProblem, HbError, HbOptions, PeriodicProblem,
     Termination,

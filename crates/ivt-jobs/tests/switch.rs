@@ -9,8 +9,8 @@
     clippy::unwrap_used
 )]
 
-use ivt_hb::aft::eval_series;
-use ivt_hb::ode::{first_order, rk4};
+use ivt_hb::orbit::aft::eval_series;
+use ivt_hb::problem::ode::{first_order, rk4};
 use ivt_hb::{BifurcationKind, GeneralProblem, HbOptions, PeriodicProblem};
 use ivt_jobs::{self as jobs, SwitchRequest, SwitchStart, SwitchedBranch};
 use std::f64::consts::PI;

@@ -314,14 +314,14 @@ fn eval_series<'py>(
     }
     if n_dof == 1 {
         return crate::vectorize::map1(py, [("tau", tau)], |[t]| {
-            ivt_hb::aft::eval_series(&q, t, order)
+            ivt_hb::orbit::aft::eval_series(&q, t, order)
         });
     }
     let per_dof = q
         .chunks_exact(q.len() / n_dof)
         .map(|block| {
             crate::vectorize::map1(py, [("tau", tau)], |[t]| {
-                ivt_hb::aft::eval_series(block, t, order)
+                ivt_hb::orbit::aft::eval_series(block, t, order)
             })
         })
         .collect::<PyResult<Vec<_>>>()?;

@@ -17,7 +17,7 @@ use crate::to_python::to_dict;
 
 /// Hopf points and the limit-cycle branch of the autonomous family
 /// `family(p)` → (m, c, k, g, f) (f None) for p in [p_from, p_to]
-/// (ivt_hb::cycle_branch): the equilibria (from x = 0) are followed on
+/// (ivt_hb::branches::cycle_branch): the equilibria (from x = 0) are followed on
 /// `grid` intervals of p, a Hopf point is where two complex eigenvalues
 /// cross the imaginary axis (bisection), with its first Lyapunov coefficient
 /// ("lyapunov" > 0: subcritical, the cycles born there are unstable). The

@@ -1,9 +1,9 @@
 //! `ivt.hb.cycle_fold_curve` (issue 27, item 1): a fold of limit cycles of an
 //! autonomous user family `family(mu, nu)` followed in ν
-//! ([`ivt_hb::codim2::cycle_fold_curve`]), started from the first fold of the
-//! cycle branch in μ at ν = `nu_from` ([`ivt_hb::cycle_branch`]).
+//! ([`ivt_hb::branches::codim2::cycle_fold_curve`]), started from the first fold of the
+//! cycle branch in μ at ν = `nu_from` ([`ivt_hb::branches::cycle_branch`]).
 
-use ivt_hb::codim2::{cycle_fold_curve as follow, CycleFoldPoint};
+use ivt_hb::branches::codim2::{cycle_fold_curve as follow, CycleFoldPoint};
 use ivt_hb::{cycle_branch, ContinuationOptions, CycleBranchOptions, HbError, HbSolution};
 use numpy::IntoPyArray;
 use pyo3::exceptions::PyValueError;
@@ -57,7 +57,7 @@ fn point_dict<'py>(py: Python<'py>, pt: &CycleFoldPoint, n: usize) -> PyResult<B
 family_fn! {
 /// The fold of limit cycles of the autonomous family `family(mu, nu)` →
 /// (m, c, k, g, None) followed in ν from `nu_from` towards `nu_to`
-/// (ivt_hb::codim2::cycle_fold_curve: the cycle equations with ω unknown and
+/// (ivt_hb::branches::codim2::cycle_fold_curve: the cycle equations with ω unknown and
 /// the phase condition, plus a unit null vector of their Jacobian in (q, ω),
 /// pseudo-arclength in ν, μ solved along). The start is the first fold of
 /// the cycle branch of `family(mu, nu_from)` for mu in [mu_from, mu_to]

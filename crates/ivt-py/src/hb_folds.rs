@@ -43,7 +43,7 @@ family_fn! {
 /// |v| = 1 followed in p, first towards `p_from`, until p leaves
 /// [p_from, p_to]): cusps (where two folds merge and the jump disappears)
 /// are located as turning points of the curve in p. Period doublings and
-/// Neimark–Sacker points (ivt_hb::codim2::bifurcation_curve: R = 0 with the
+/// Neimark–Sacker points (ivt_hb::branches::codim2::bifurcation_curve: R = 0 with the
 /// critical eigenvector of the monodromy matrix, followed both ways from the
 /// start): each point carries the angle θ of its critical multipliers
 /// e^{±iθ}, and on an NS curve the resonances 1:1 and 1:2 (its ends on a fold

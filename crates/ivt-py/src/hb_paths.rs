@@ -71,7 +71,7 @@ user_system_fn! {
 ///
 /// The frequency ω is an unknown, with the phase condition b1 = 0 on DOF `dof`
 /// and its first cosine coefficient a1 prescribed: `amplitude` is a1 of DOF
-/// `dof`, traced from `amplitude_from` to `amplitude_to` (ivt_hb::backbone, a
+/// `dof`, traced from `amplitude_from` to `amplitude_to` (ivt_hb::branches::backbone, a
 /// fictitious damping κ unfolds the family and is ~0 on the result).
 /// g, velocity_dependent, vectorized and jac as in `solve`: the curve is
 /// followed with the Newton–chord corrector on the exact Jacobian of

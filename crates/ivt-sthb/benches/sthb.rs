@@ -8,7 +8,7 @@
 use divan::Bencher;
 use faer::linalg::solvers::Solve;
 use faer::Mat;
-use ivt_hb::frc::{frequency_response as engine_frc, FrcOptions};
+use ivt_hb::branches::frc::{frequency_response as engine_frc, FrcOptions};
 use ivt_hb::{HbOptions, ModifiedIhb};
 use ivt_sthb::frc::{frequency_response, trace, StringFrcOptions};
 use ivt_sthb::modal::ModalString;

@@ -16,10 +16,10 @@ use super::stability::{
     hill, hill_dim, monodromy, monodromy_refined, Stability, StabilityMethod, HILL_MAX_DIM,
 };
 use super::StringHb;
-use ivt_hb::events::{
+use ivt_hb::branches::events::{
     observe, BifurcationKind, Detector, EventObserver, Fold, LocateOptions, Observer,
 };
-use ivt_hb::frc::{Frc, FrcFold, FrcPoint};
+use ivt_hb::branches::frc::{Frc, FrcFold, FrcPoint};
 use ivt_hb::HbError;
 use ivt_num::BroydenOptions;
 use ivt_path::branch::Branch;

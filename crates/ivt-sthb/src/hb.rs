@@ -13,7 +13,7 @@ use rustdct::DctPlanner;
 use super::spatial::{Spatial, DIRECT_MAX_MODES};
 use super::toeplitz::{add_real_toeplitz, BlockLayout, PeriodicSpectrum};
 use super::{Boundary, StringParams};
-use ivt_hb::aft::RealFftPair;
+use ivt_hb::orbit::aft::RealFftPair;
 use ivt_hb::HbError;
 use ivt_num::NewtonWorkspace;
 

@@ -4,7 +4,7 @@
 //! the STHB route on the same curve (N = 5, k_d = 10, c_d = 0.8, y0 = 0.5, M = 19).
 #![allow(clippy::unwrap_used)]
 
-use ivt_hb::frc::{frequency_response as engine_frc, FrcOptions};
+use ivt_hb::branches::frc::{frequency_response as engine_frc, FrcOptions};
 use ivt_hb::{HbOptions, HbResidual, ModifiedIhb, Path};
 use ivt_sthb::frc::{trace, StringFrcOptions};
 use ivt_sthb::modal::ModalString;

@@ -20,10 +20,10 @@
 //! start's last run found nothing new within these bounds, not a proof.
 
 use crate::error::HbError;
-use crate::floquet::HsuRule;
-use crate::galerkin::GalerkinJacobian;
-use crate::ihb::{HbOptions, HbResidual, HbSolution};
+use crate::orbit::galerkin::GalerkinJacobian;
+use crate::orbit::ihb::{HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
+use crate::stability::floquet::HsuRule;
 use crate::stability::{StabilityAnalyzer, StabilityKind};
 use crate::BroydenStats;
 use faer::c64;
@@ -117,7 +117,7 @@ pub fn all_solutions<P: PeriodicProblem>(
     omega_f: f64,
     opts: &SearchOptions,
 ) -> Result<AllSolutions, HbError> {
-    crate::ihb::validate_omega(omega_f)?;
+    crate::orbit::ihb::validate_omega(omega_f)?;
     if !(opts.max_amplitude.is_finite()
         && opts.max_amplitude > 0.0
         && opts.amplitudes > 0
@@ -293,7 +293,10 @@ impl<'p, P: PeriodicProblem> Deflated<'p, P> {
                 // shape; for a forced problem a different orbit).
                 let mut q: Vec<f64> = shape.iter().map(|v| amp * v).collect();
                 for block in q.chunks_exact_mut(l) {
-                    crate::aft::shift_time(block, quarter as f64 * std::f64::consts::FRAC_PI_2);
+                    crate::orbit::aft::shift_time(
+                        block,
+                        quarter as f64 * std::f64::consts::FRAC_PI_2,
+                    );
                 }
                 starts.push(q);
             }

@@ -12,10 +12,10 @@
 //! equilibrium ends with [`HbError::Equilibrium`], one that never settles with
 //! [`HbError::Transient`]; no start needs Fourier coefficients or a frequency.
 
-use crate::autonomous::{limit_cycle, LimitCycle};
+use crate::branches::autonomous::{limit_cycle, LimitCycle};
 use crate::error::HbError;
-use crate::ihb::HbOptions;
-use crate::ode::first_order;
+use crate::orbit::ihb::HbOptions;
+use crate::problem::ode::first_order;
 use crate::problem::PeriodicProblem;
 use crate::Aft;
 use ivt_num::rk::step_factor;
@@ -206,7 +206,7 @@ pub fn fourier_start<P: PeriodicProblem>(
     if let (Some(&a1), Some(&b1)) = (guess.get(1), guess.get(n + 1)) {
         let phi = b1.atan2(a1);
         for block in guess.chunks_exact_mut(l) {
-            crate::aft::shift_time(block, phi);
+            crate::orbit::aft::shift_time(block, phi);
         }
     }
     Ok(guess)

@@ -14,10 +14,10 @@
 //! problems by the engine's pseudo-arclength continuation ([`ivt_path::continuation::Stepper`],
 //! Eq. 68–77) on `[R(q, ω; μ); b₁] = 0` with unknowns `{q, ω, μ}`.
 
-use crate::floquet::HsuRule;
-use crate::galerkin::GalerkinJacobian;
-use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
+use crate::orbit::galerkin::GalerkinJacobian;
+use crate::orbit::ihb::{HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
+use crate::stability::floquet::HsuRule;
 use crate::stability::{classify, StabilityAnalyzer, StabilityKind};
 use faer::c64;
 use ivt_num::BroydenStats;
@@ -84,7 +84,7 @@ where
 
 /// [`limit_cycle_branch`] handing each path point `{q, ω, μ}` to
 /// `on_point` as it arrives (`false` stops the path): the hook of an
-/// observer ([`crate::cycle_branch`]'s fold events).
+/// observer ([`crate::branches::cycle_branch`]'s fold events).
 pub(crate) fn limit_cycle_leg<P, F>(
     family: F,
     hb: &HbOptions,
@@ -210,7 +210,7 @@ pub fn limit_cycle<P: PeriodicProblem>(
             "a limit cycle has no excitation: subharmonic order must be 1".into(),
         ));
     }
-    crate::ihb::validate_omega(omega_guess)?;
+    crate::orbit::ihb::validate_omega(omega_guess)?;
     let res = HbResidual::new(problem, hb)?;
     let m = res.len();
     let n = hb.harmonics;

@@ -7,13 +7,13 @@
 //! mass-proportional damping `κ M ẋ` is added with κ an unknown; on a periodic
 //! orbit of a conservative system the damping work forces κ = 0, and the
 //! system becomes square and regular. With the frequency ω unknown, the phase
-//! condition `b₁ = 0` on the reference DOF (as [`crate::autonomous`]) and the
+//! condition `b₁ = 0` on the reference DOF (as [`crate::branches::autonomous`]) and the
 //! amplitude `a₁` of that DOF prescribed, the unknowns are `{q, ω, κ}` and `a₁`
 //! is the continuation parameter (pseudo-arclength, Eq. 68–77). The problem
 //! must be undamped and unforced (`C = 0`, `f = 0`; checked).
 
-use crate::family::{FamilyBranch, Frequency};
-use crate::ihb::{HbError, HbOptions, HbResidual};
+use crate::branches::family::{FamilyBranch, Frequency};
+use crate::orbit::ihb::{HbError, HbOptions, HbResidual};
 use crate::problem::PeriodicProblem;
 use ivt_path::branch::Branch;
 use ivt_path::continuation::{
@@ -95,7 +95,7 @@ pub fn backbone<P: PeriodicProblem>(
 
 /// The path of [`backbone`] without its check `C = 0`: with damping, the
 /// unfolding `κ M ẋ` is the extended periodic motion concept's negative modal
-/// damping (Krack 2015), and [`crate::damped`] reads `ζ = −κ/(2ω)` off it.
+/// damping (Krack 2015), and [`crate::branches::damped`] reads `ζ = −κ/(2ω)` off it.
 /// Arguments (`linear` = `(omega0, mode)`) and errors as [`backbone`] (all
 /// checked here except `C = 0`).
 pub(crate) fn modal_path<P: PeriodicProblem>(

@@ -35,7 +35,7 @@ pub use cycle_fold::{cycle_fold_curve, CycleFoldCurve, CycleFoldPoint};
 pub use multiplier_curve::{bifurcation_curve, BifurcationCurve, CurvePoint, CurveStart};
 
 use crate::error::HbError;
-use crate::ihb::HbOptions;
+use crate::orbit::ihb::HbOptions;
 use crate::problem::PeriodicProblem;
 use fixed::{solve_crossings, CurveSystem};
 use fold_system::FoldSystem;

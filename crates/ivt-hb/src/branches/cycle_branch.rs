@@ -1,6 +1,6 @@
 //! The limit cycles born at a Hopf point, followed in the parameter
 //! (issue 27, item 2): [`cycle_branch`] finds the Hopf points of the
-//! equilibria of an autonomous family ([`crate::hopf`]), starts the cycle
+//! equilibria of an autonomous family ([`crate::stability::hopf`]), starts the cycle
 //! branch from the first one by its normal form, and follows it with
 //! [`crate::limit_cycle_branch`] (HB with ω unknown and the phase condition
 //! b₁ = 0, Eq. 61, pseudo-arclength Eq. 68–77) with Floquet stability at every
@@ -13,13 +13,13 @@
 //! `y(t) ≈ y* + 2 Re(z e^{iωt} q)`, on the side of p where `−β/l₁ > 0`; it is
 //! taken at `p_H ± offset·|p_to − p_from|` and refined by [`limit_cycle`].
 
-use crate::autonomous::{limit_cycle, limit_cycle_leg, LimitCycle};
+use crate::branches::autonomous::{limit_cycle, limit_cycle_leg, LimitCycle};
+use crate::branches::events::{BifurcationKind, EventObserver, Fold, LocateOptions, Observer};
 use crate::error::HbError;
-use crate::events::{BifurcationKind, EventObserver, Fold, LocateOptions, Observer};
-use crate::galerkin::GalerkinJacobian;
-use crate::hopf::{equilibrium, hopf_points, Field, HopfPoint};
-use crate::ihb::{HbOptions, HbResidual, HbSolution};
+use crate::orbit::galerkin::GalerkinJacobian;
+use crate::orbit::ihb::{HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
+use crate::stability::hopf::{equilibrium, hopf_points, Field, HopfPoint};
 use crate::BroydenStats;
 use ivt_path::branch::Branch;
 use ivt_path::continuation::{ContinuationOptions, PathPoint, Termination};
@@ -212,16 +212,17 @@ where
         let mut x = hopf.equilibrium.clone();
         equilibrium(&problem, &mut x)?;
         let d = 2 * x.len();
-        let beta = crate::floquet::eigenvalues(&Field::new(&problem)?.linearisation(&x), d)
-            .iter()
-            .filter(|e| e.im > 0.0)
-            .min_by(|a, b| {
-                (a.im - hopf.omega)
-                    .abs()
-                    .total_cmp(&(b.im - hopf.omega).abs())
-            })
-            .map(|e| e.re)
-            .unwrap_or(f64::NAN);
+        let beta =
+            crate::stability::floquet::eigenvalues(&Field::new(&problem)?.linearisation(&x), d)
+                .iter()
+                .filter(|e| e.im > 0.0)
+                .min_by(|a, b| {
+                    (a.im - hopf.omega)
+                        .abs()
+                        .total_cmp(&(b.im - hopf.omega).abs())
+                })
+                .map(|e| e.re)
+                .unwrap_or(f64::NAN);
         let radius2 = -beta / (hopf.omega * hopf.lyapunov);
         if !(radius2 > 0.0 && radius2.is_finite()) {
             continue;

@@ -13,9 +13,9 @@
 //! The linear mode (the start) is the `mode`-th eigenpair of `M⁻¹K` by
 //! increasing frequency.
 
-use crate::backbone::{modal_path, BackboneOptions};
+use crate::branches::backbone::{modal_path, BackboneOptions};
 use crate::error::HbError;
-use crate::ihb::HbOptions;
+use crate::orbit::ihb::HbOptions;
 use crate::problem::PeriodicProblem;
 use ivt_path::continuation::Termination;
 

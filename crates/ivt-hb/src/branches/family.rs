@@ -6,8 +6,8 @@
 //! `f(θ)` is projected once (it is part of the planned residual), so it must not
 //! depend on λ; [`FamilyBranch::new`] checks this.
 
-use crate::galerkin::{GalerkinForm, GalerkinJacobian};
-use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
+use crate::orbit::galerkin::{GalerkinForm, GalerkinJacobian};
+use crate::orbit::ihb::{HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::{AtFrequency, PeriodicProblem};
 use crate::BroydenStats;
 use ivt_path::branch::{bilinear_lambda_difference, residual_lambda_difference, Branch};

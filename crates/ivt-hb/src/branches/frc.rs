@@ -2,18 +2,18 @@
 //! pseudo-arclength continuation ([`ivt_path::continuation`], Eq. 68–77), with the
 //! Floquet multipliers (Hsu, Eq. 80) and stability class at every point. Each
 //! turn of the path is located as the points arrive, through the
-//! [`Fold`] detector of an observer ([`crate::events::observer`]): Newton on
-//! the path engine's minimally extended system ([`crate::events::locate_fold`],
+//! [`Fold`] detector of an observer ([`crate::branches::events::observer`]): Newton on
+//! the path engine's minimally extended system ([`crate::branches::events::locate_fold`],
 //! the fold itself, not a bracket between two points), started from the path
 //! point nearest the turn.
 
-use crate::aft::Aft;
-use crate::events::{
+use crate::branches::events::{
     observe, observer, BifurcationKind, Detector, Fold, LocateOptions, PathOptions,
 };
-use crate::family::{FamilyBranch, Frequency};
-use crate::ihb::{HbError, HbOptions, HbSolution};
-use crate::modified::ModifiedIhb;
+use crate::branches::family::{FamilyBranch, Frequency};
+use crate::orbit::aft::Aft;
+use crate::orbit::ihb::{HbError, HbOptions, HbSolution};
+use crate::orbit::modified::ModifiedIhb;
 use crate::problem::{AtFrequency, PeriodicProblem};
 use crate::stability::{HsuSteps, StabilityKind};
 use faer::c64;

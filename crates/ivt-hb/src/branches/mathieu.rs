@@ -6,7 +6,7 @@
 //!    coefficients (n = 9) and followed in β by pseudo-arclength continuation
 //!    with Hsu multipliers at every point.
 //! 2. The crossing μ = −1, bracketed by two path points, is located by Newton
-//!    on the extended system of [`crate::events`] (the branch in β with
+//!    on the extended system of [`crate::branches::events`] (the branch in β with
 //!    the bordered test function of Φ + I), as every event of [`crate::trace`].
 //! 3. The period-2p branch is entered with the controlled-amplitude scheme of
 //!    Eq. 84–85: the solution is embedded with harmonic k → 2k
@@ -14,13 +14,15 @@
 //!    prescribed (non-zero forces the new branch) and β takes its slot among the
 //!    unknowns; `a_1` is then the continuation parameter.
 
-use crate::aft::{embed_subharmonic, resize_harmonics};
-use crate::events::{locate_multiplier_crossing, BifurcationError, BifurcationKind, LocateOptions};
-use crate::family::FamilyBranch;
-use crate::floquet::HsuRule;
-use crate::ihb::{HbError, HbOptions, HbResidual, HbSolution};
-use crate::modified::ModifiedIhb;
+use crate::branches::events::{
+    locate_multiplier_crossing, BifurcationError, BifurcationKind, LocateOptions,
+};
+use crate::branches::family::FamilyBranch;
+use crate::orbit::aft::{embed_subharmonic, resize_harmonics};
+use crate::orbit::ihb::{HbError, HbOptions, HbResidual, HbSolution};
+use crate::orbit::modified::ModifiedIhb;
 use crate::problem::MathieuDuffing;
+use crate::stability::floquet::HsuRule;
 use crate::stability::StabilityAnalyzer;
 use faer::c64;
 use ivt_num::{broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace};

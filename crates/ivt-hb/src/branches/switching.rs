@@ -1,13 +1,13 @@
-//! Branch switching at a located bifurcation ([`crate::events`]):
+//! Branch switching at a located bifurcation ([`crate::branches::events`]):
 //! [`switch_branch`] steps from the bifurcation along a direction transversal to
 //! the known branch and corrects onto the new one (the second null vector at a
 //! branch point, [`crate::Bifurcation::second_direction`]; at a period doubling
 //! the odd-harmonic null vector of the period-2 Galerkin Jacobian,
 //! [`period_doubled_start`]).
 
-use crate::events::{dot, Bifurcation, BifurcationError, BifurcationKind, LocateOptions};
-use crate::family::{Family, FamilyBranch};
-use crate::ihb::{HbError, HbOptions};
+use crate::branches::events::{dot, Bifurcation, BifurcationError, BifurcationKind, LocateOptions};
+use crate::branches::family::{Family, FamilyBranch};
+use crate::orbit::ihb::{HbError, HbOptions};
 use ivt_num::vector::norm2;
 use ivt_num::{newton_bordered, Border, LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace};
 use ivt_path::branch::{full_newton_steps, residual_lambda_difference, Branch};
@@ -138,7 +138,7 @@ pub fn period_doubled_start<F: Family>(
     let l2 = 4 * n + 1;
     let q2: Vec<f64> =
         pd.q.chunks_exact(l)
-            .flat_map(|c| crate::aft::embed_subharmonic(c, 2, 2 * n))
+            .flat_map(|c| crate::orbit::aft::embed_subharmonic(c, 2, 2 * n))
             .collect();
     let m2 = q2.len();
     let mut jac = vec![0.0; m2 * m2];

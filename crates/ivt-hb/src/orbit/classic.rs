@@ -1,10 +1,10 @@
 //! Classic IHB (§3.2.1, Eq. 53–57): damped Newton with the exact Galerkin
 //! Jacobian Φ_q, the nonlinear part summed on the 2N grid by FFT
-//! ([`crate::galerkin`]; plus an LU per iteration) — the baseline the modified IHB is timed
+//! ([`crate::orbit::galerkin`]; plus an LU per iteration) — the baseline the modified IHB is timed
 //! against (thesis: 0.25 s vs 0.003 s).
 
-use crate::galerkin::GalerkinJacobian;
-use crate::ihb::{validate_omega, HbError, HbOptions, HbResidual, HbSolution};
+use crate::orbit::galerkin::GalerkinJacobian;
+use crate::orbit::ihb::{validate_omega, HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
 use ivt_num::vector::matvec;
 use ivt_num::{newton, NewtonOptions, NewtonSystem, NewtonWorkspace};
@@ -132,7 +132,7 @@ impl<P: PeriodicProblem> ClassicIhb<P> {
     }
 }
 
-impl<P: PeriodicProblem> crate::ihb::HbSolver for ClassicIhb<P> {
+impl<P: PeriodicProblem> crate::orbit::ihb::HbSolver for ClassicIhb<P> {
     fn solve(&mut self, omega_f: f64, guess: Option<&[f64]>) -> Result<HbSolution, HbError> {
         ClassicIhb::solve(self, omega_f, guess)
     }

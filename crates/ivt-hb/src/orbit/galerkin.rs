@@ -23,8 +23,8 @@ mod form;
 
 pub(crate) use form::GalerkinForm;
 
-use crate::aft::Aft;
-use crate::ihb::HbResidual;
+use crate::orbit::aft::Aft;
+use crate::orbit::ihb::HbResidual;
 use crate::problem::PeriodicProblem;
 use realfft::num_complex::Complex;
 
@@ -266,8 +266,8 @@ impl GalerkinJacobian {
 mod tests {
     use super::form::{basis_rows, quadrature_basis};
     use super::*;
-    use crate::elements::{Element, ElementProblem, Harmonic, Law};
-    use crate::ihb::HbOptions;
+    use crate::orbit::ihb::HbOptions;
+    use crate::problem::elements::{Element, ElementProblem, Harmonic, Law};
     use crate::problem::{matrix_getters, Duffing, GeneralProblem, MathieuDuffing};
     use crate::FamilyBranch;
     use crate::ModifiedIhb;

@@ -12,8 +12,8 @@
 //! Slice lengths are the callers' contract: a vector of the wrong length gives a
 //! NaN output (reported by the solvers as [`HbError::NonFinite`]), not a panic.
 
-use crate::aft::{split_series, split_series_mut, Aft};
 pub(crate) use crate::error::HbError;
+use crate::orbit::aft::{split_series, split_series_mut, Aft};
 use crate::problem::PeriodicProblem;
 use ivt_num::{BroydenOptions, BroydenStats};
 
@@ -136,7 +136,7 @@ impl HbSolution {
     }
     /// `x_d` at physical time `t` (NaN if there is no DOF `d`).
     pub fn x_at(&self, d: usize, t: f64) -> f64 {
-        crate::aft::eval_series(self.dof(d), self.omega() * t, 0)
+        crate::orbit::aft::eval_series(self.dof(d), self.omega() * t, 0)
     }
     /// Amplitude `max_τ |x_d|` sampled at 512 points (NaN if there is no DOF `d`).
     pub fn amplitude(&self, d: usize) -> f64 {
@@ -145,7 +145,7 @@ impl HbSolution {
         }
         (0..512)
             .map(|i| {
-                crate::aft::eval_series(
+                crate::orbit::aft::eval_series(
                     self.dof(d),
                     2.0 * std::f64::consts::PI * i as f64 / 512.0,
                     0,

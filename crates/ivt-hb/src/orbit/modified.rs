@@ -4,8 +4,8 @@
 //! Broyden matrix) when the direct iteration fails, and pseudo-arclength in the
 //! stepping parameter when that path folds.
 
-use crate::galerkin::GalerkinJacobian;
-use crate::ihb::{validate_omega, HbError, HbOptions, HbResidual, HbSolution, HbSolver};
+use crate::orbit::galerkin::GalerkinJacobian;
+use crate::orbit::ihb::{validate_omega, HbError, HbOptions, HbResidual, HbSolution, HbSolver};
 use crate::problem::PeriodicProblem;
 use ivt_num::vector::matvec;
 use ivt_num::{broyden_solve, BroydenStats, BroydenWorkspace, System};

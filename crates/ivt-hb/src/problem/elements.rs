@@ -6,7 +6,7 @@
 //! force `F(δ, δ̇)` is added to `g_a` and subtracted from `g_b`.
 //!
 //! The hysteretic [`Law::Jenkins`] depends on the history of δ: its force is
-//! computed period by period over the AFT samples (`crate::hysteresis`) by
+//! computed period by period over the AFT samples (`crate::problem::hysteresis`) by
 //! [`PeriodicProblem::nonlinear_samples`] and
 //! [`PeriodicProblem::nonlinear_jacobian_samples`]; a one-sample call
 //! ([`PeriodicProblem::nonlinear`]) has no history and gives its virgin loading
@@ -292,7 +292,7 @@ impl ElementProblem {
         mut dg: Option<&mut [f64]>,
     ) {
         let n = self.n;
-        let ranges = crate::hysteresis::period_ranges(theta);
+        let ranges = crate::problem::hysteresis::period_ranges(theta);
         let mut delta = vec![0.0; theta.len()];
         let (mut force, mut tangent) = (vec![0.0; theta.len()], vec![0.0; theta.len()]);
         // n ≥ 1 (checked in `new`); x holds n values per sample.
@@ -316,7 +316,7 @@ impl ElementProblem {
                     force.fill(f64::NAN);
                     continue;
                 };
-                crate::hysteresis::jenkins_period(k, slip_force, d, f, t);
+                crate::problem::hysteresis::jenkins_period(k, slip_force, d, f, t);
             }
             if let Some(out) = out.as_deref_mut() {
                 for (o, f) in out.chunks_exact_mut(n).zip(&force) {

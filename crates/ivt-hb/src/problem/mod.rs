@@ -12,7 +12,10 @@
 //! default methods and helpers here is not a panic: the output is NaN, which the
 //! solvers report as [`crate::HbError::NonFinite`].
 
+pub mod elements;
 mod general;
+mod hysteresis;
+pub mod ode;
 mod omega;
 mod oscillators;
 pub use general::{GeneralProblem, Nonlinearity, WithJacobian};

@@ -130,7 +130,7 @@ pub fn hill_multipliers(dim: usize, theta_hat: &[c64], h: usize) -> Result<HillR
         .iter()
         .map(|l| c64::from_polar((l.re * tp).exp(), l.im * tp))
         .collect();
-    crate::floquet::sort_by_modulus(&mut multipliers);
+    crate::stability::floquet::sort_by_modulus(&mut multipliers);
     Ok(HillResult {
         exponents,
         multipliers,
@@ -140,7 +140,7 @@ pub fn hill_multipliers(dim: usize, theta_hat: &[c64], h: usize) -> Result<HillR
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::floquet::{eigenvalues, monodromy_hsu, HsuRule};
+    use crate::stability::floquet::{eigenvalues, monodromy_hsu, HsuRule};
 
     #[test]
     fn damped_mathieu_hill_agrees_with_hsu() {

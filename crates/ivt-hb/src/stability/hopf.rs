@@ -22,8 +22,8 @@
 //! supercritical.
 
 use crate::error::HbError;
-use crate::floquet::eigenvalues;
 use crate::problem::PeriodicProblem;
+use crate::stability::floquet::eigenvalues;
 use ivt_num::{LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace};
 
 /// A Hopf point of the equilibria.

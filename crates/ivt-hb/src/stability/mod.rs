@@ -7,14 +7,18 @@
 //! Classification: stable (all |μ| < 1), fold (a real μ > 1), period doubling (a
 //! real μ < −1), Neimark–Sacker (a complex pair outside the unit circle).
 
-use crate::aft::Aft;
 use crate::error::HbError;
-use crate::floquet::{eigenvalues, monodromy_strided, monodromy_uniform, HsuRule};
-use crate::hill::{fourier_blocks, hill_multipliers};
-use crate::ihb::HbSolution;
+use crate::orbit::aft::Aft;
+use crate::orbit::ihb::HbSolution;
 use crate::problem::PeriodicProblem;
+use crate::stability::floquet::{eigenvalues, monodromy_strided, monodromy_uniform, HsuRule};
+use crate::stability::hill::{fourier_blocks, hill_multipliers};
 use faer::c64;
 pub use ivt_path::events::{classify, StabilityKind};
+
+pub mod floquet;
+pub mod hill;
+pub mod hopf;
 
 /// Floquet multipliers and their verdict.
 #[derive(Debug, Clone, PartialEq)]
@@ -28,7 +32,7 @@ pub struct Floquet {
 impl Floquet {
     /// From multipliers (sorted here).
     pub fn new(mut multipliers: Vec<c64>) -> Self {
-        crate::floquet::sort_by_modulus(&mut multipliers);
+        crate::stability::floquet::sort_by_modulus(&mut multipliers);
         let kind = classify(&multipliers);
         Self { multipliers, kind }
     }
@@ -157,7 +161,7 @@ impl StabilityAnalyzer {
             c,
             omega,
         };
-        crate::floquet::by_size!(
+        crate::stability::floquet::by_size!(
             nd,
             theta_from_tangents(nd, matrices, &self.dg, &mut self.theta)
         );

@@ -8,8 +8,8 @@ pub mod chain;
 pub mod counted;
 pub mod shooting;
 
-use ivt_hb::aft::eval_series;
-use ivt_hb::ode::{first_order, rk4};
+use ivt_hb::orbit::aft::eval_series;
+use ivt_hb::problem::ode::{first_order, rk4};
 use ivt_hb::{
     c64, frequency_response, BackboneOptions, BroydenOptions, ClassicIhb, ContinuationOptions, Frc,
     FrcOptions, HbOptions, HbSolution, LimitCycle, ModifiedIhb, PeriodicProblem,

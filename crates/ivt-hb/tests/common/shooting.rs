@@ -3,8 +3,8 @@
 //! (Eq. 49) for the fold-curve and all-solutions tests.
 #![allow(clippy::indexing_slicing)]
 
-use ivt_hb::aft::eval_series;
-use ivt_hb::ode::{first_order, rk4};
+use ivt_hb::orbit::aft::eval_series;
+use ivt_hb::problem::ode::{first_order, rk4};
 use ivt_hb::Duffing;
 use std::f64::consts::PI;
 

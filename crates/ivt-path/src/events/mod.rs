@@ -10,7 +10,7 @@
 //! Here: the [`Fold`] of any branch ([`fold`]: the λ component of the secant
 //! changes sign; located by [`locate_fold`]). The events of the Floquet
 //! multipliers (period doubling, Neimark–Sacker) and the branch point need
-//! the monodromy of the orbits; they are ivt-hb's (`ivt_hb::events`).
+//! the monodromy of the orbits; they are ivt-hb's (`ivt_hb::branches::events`).
 //!
 //! The location error of an event is the detector's `E` (a branch whose
 //! locators fail in its own terms, as ivt-hb's, reports its own error type;

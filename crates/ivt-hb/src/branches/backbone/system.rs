@@ -1,6 +1,6 @@
 //! The backbone equations as a [`Branch`] in the prescribed amplitude.
 
-use crate::family::{FamilyBranch, Frequency};
+use crate::branches::family::{FamilyBranch, Frequency};
 use crate::problem::PeriodicProblem;
 use ivt_path::branch::{path_lambda_step, Branch};
 

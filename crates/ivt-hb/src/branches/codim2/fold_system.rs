@@ -7,8 +7,8 @@
 use super::fixed::CurveSystem;
 use super::FoldPoint;
 use crate::error::HbError;
-use crate::galerkin::GalerkinJacobian;
-use crate::ihb::{HbOptions, HbResidual};
+use crate::orbit::galerkin::GalerkinJacobian;
+use crate::orbit::ihb::{HbOptions, HbResidual};
 use crate::problem::PeriodicProblem;
 use ivt_num::vector::{dot, matvec};
 use ivt_path::events::extended::unit_null_vector;

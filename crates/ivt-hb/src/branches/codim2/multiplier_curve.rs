@@ -36,11 +36,11 @@
 
 use super::fixed::{solve_crossings, CurveSystem};
 use super::{bounded, path_interval};
+use crate::branches::events::{BifurcationKind, LocateOptions};
 use crate::error::HbError;
-use crate::events::{BifurcationKind, LocateOptions};
-use crate::floquet::{eigenvalues, monodromy_uniform, HsuRule};
-use crate::ihb::{HbOptions, HbResidual, HbSolution};
+use crate::orbit::ihb::{HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
+use crate::stability::floquet::{eigenvalues, monodromy_uniform, HsuRule};
 use crate::stability::StabilityAnalyzer;
 use ivt_num::vector::{dot, norm2};
 use ivt_num::LuWorkspace;

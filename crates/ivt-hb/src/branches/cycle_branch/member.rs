@@ -1,7 +1,7 @@
 //! A member of a family that may fail: the problem at p, or where the family
 //! fails a problem of the same size that is NaN everywhere, so that the path
 //! follower rejects the step (as the fold curve's NaN residual,
-//! [`crate::codim2`]).
+//! [`crate::branches::codim2`]).
 
 use crate::problem::PeriodicProblem;
 

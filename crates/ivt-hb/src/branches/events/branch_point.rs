@@ -8,8 +8,8 @@
 
 use super::multipliers::Monodromy;
 use super::BifurcationError;
-use crate::family::{Family, FamilyBranch};
-use crate::ihb::HbError;
+use crate::branches::family::{Family, FamilyBranch};
+use crate::orbit::ihb::HbError;
 use ivt_num::vector::norm2;
 use ivt_num::BorderedLu;
 use ivt_path::branch::{residual_lambda_difference, Branch};

@@ -4,8 +4,8 @@
 //! [`ivt_path::events::locate_fold`]), then Hsu's monodromy there.
 
 use super::multipliers::Monodromy;
-use crate::family::{Family, FamilyBranch};
-use crate::ihb::HbError;
+use crate::branches::family::{Family, FamilyBranch};
+use crate::orbit::ihb::HbError;
 use ivt_path::events::{Bifurcation, BifurcationKind, Detector, Fold, PathSoFar, Start};
 use ivt_path::PathError;
 

@@ -18,7 +18,7 @@
 //!
 //! `∂R/∂q` is the exact Galerkin Jacobian (Eq. 56); `∂R/∂λ` and the derivatives
 //! of the test functions are central differences. Branch switching at the
-//! located points is in [`crate::switching`].
+//! located points is in [`crate::branches::switching`].
 
 pub mod branch_point;
 pub mod fold;
@@ -39,8 +39,8 @@ pub use neimark_sacker::NeimarkSacker;
 pub use period_doubling::PeriodDoubling;
 pub use trace::{observer, trace, PathOptions, Trace, TraceOptions};
 
-use crate::family::{Family, FamilyBranch};
-use crate::ihb::HbError;
+use crate::branches::family::{Family, FamilyBranch};
+use crate::orbit::ihb::HbError;
 use ivt_path::PathError;
 use thiserror::Error;
 

@@ -7,9 +7,9 @@
 //! `Φ⊙Φ − I`).
 
 use super::BifurcationError;
-use crate::family::{Family, FamilyBranch};
-use crate::floquet::{eigenvalues, monodromy_uniform, HsuRule};
-use crate::ihb::HbError;
+use crate::branches::family::{Family, FamilyBranch};
+use crate::orbit::ihb::HbError;
+use crate::stability::floquet::{eigenvalues, monodromy_uniform, HsuRule};
 use crate::stability::{AdaptiveHsu, StabilityAnalyzer};
 use faer::c64;
 use ivt_num::BorderedLu;

@@ -5,7 +5,7 @@
 
 use super::multipliers::locate_crossing;
 use super::BifurcationError;
-use crate::family::{Family, FamilyBranch};
+use crate::branches::family::{Family, FamilyBranch};
 use faer::c64;
 use ivt_path::events::{Bifurcation, BifurcationKind, Detector, PathSoFar, Start};
 

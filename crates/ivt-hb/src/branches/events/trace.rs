@@ -10,8 +10,8 @@ use super::multipliers::Multipliers;
 use super::neimark_sacker::NeimarkSacker;
 use super::period_doubling::PeriodDoubling;
 use super::{BifurcationError, Event};
-use crate::family::{Family, FamilyBranch};
-use crate::ihb::HbError;
+use crate::branches::family::{Family, FamilyBranch};
+use crate::orbit::ihb::HbError;
 use crate::stability::{AdaptiveHsu, HsuSteps};
 use ivt_path::continuation::{ContinuationOptions, Traced};
 use ivt_path::events::{observe, Detector, EventObserver, LocateOptions, TracedPoint};
@@ -140,9 +140,9 @@ pub fn trace<F: Family>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::family::Frequency;
-    use crate::frc::FrcOptions;
-    use crate::ihb::HbOptions;
+    use crate::branches::family::Frequency;
+    use crate::branches::frc::FrcOptions;
+    use crate::orbit::ihb::HbOptions;
     use crate::Corrector;
     use crate::{BifurcationKind, Duffing, ModifiedIhb};
     use ivt_path::continuation::Termination;

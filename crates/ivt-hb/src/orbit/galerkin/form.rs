@@ -6,7 +6,7 @@
 //! panic: the value (and gradient) is NaN, which the solvers report as
 //! [`crate::HbError::NonFinite`].
 
-use crate::ihb::HbResidual;
+use crate::orbit::ihb::HbResidual;
 use crate::problem::PeriodicProblem;
 
 /// The nonlinear part of `wᵀΦ_q v` without assembling `Φ_q` (the fold test of

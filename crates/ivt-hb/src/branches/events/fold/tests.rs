@@ -1,7 +1,7 @@
 //! The fold test function's gradient of a family branch against
 //! differences of the assembled Jacobian.
 
-use crate::ihb::HbOptions;
+use crate::orbit::ihb::HbOptions;
 use crate::problem::PeriodicProblem;
 use ivt_path::branch::fd_jacobian_gradient;
 use ivt_path::Branch;
