@@ -7,6 +7,7 @@ pub mod branch;
 pub mod continuation;
 mod error;
 pub mod events;
+pub mod multipliers;
 
 pub use branch::{Branch, ResidualBranch};
 pub use continuation::{
@@ -15,7 +16,7 @@ pub use continuation::{
 };
 pub use error::PathError;
 pub use events::{
-    classify, locate_fold, observe, Bifurcation, BifurcationKind, Detector, Event, EventObserver,
-    Fold, FoldLocation, LocateOptions, Observer, PathSoFar, PointMultipliers, StabilityKind, Start,
-    TracedPoint,
+    locate_fold, observe, Bifurcation, BifurcationKind, Detector, Event, EventObserver, Fold,
+    FoldLocation, LocateOptions, Observer, PathSoFar, PointMultipliers, Start, TracedPoint,
 };
+pub use multipliers::{classify, StabilityKind};

@@ -14,7 +14,7 @@ use crate::problem::PeriodicProblem;
 use crate::stability::floquet::{eigenvalues, monodromy_strided, monodromy_uniform, HsuRule};
 use crate::stability::hill::{fourier_blocks, hill_multipliers};
 use faer::c64;
-pub use ivt_path::events::{classify, StabilityKind};
+pub use ivt_path::multipliers::{classify, StabilityKind};
 
 pub mod floquet;
 pub mod hill;

@@ -22,8 +22,8 @@ pub mod fold;
 mod observe;
 
 pub use detector::{
-    classify, dot, Bifurcation, BifurcationKind, Detector, Event, LocateOptions, Observer,
-    PathSoFar, StabilityKind, Start, TracedPoint,
+    dot, Bifurcation, BifurcationKind, Detector, Event, LocateOptions, Observer, PathSoFar, Start,
+    TracedPoint,
 };
 pub use fold::{locate_fold, Fold, FoldLocation};
 pub use observe::{observe, EventObserver, PointMultipliers};

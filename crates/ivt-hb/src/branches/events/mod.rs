@@ -30,9 +30,8 @@ mod trace;
 pub use branch_point::{locate_branch_point, BranchPoint};
 pub use fold::FamilyFold;
 pub use ivt_path::events::{
-    classify, dot, locate_fold, observe, Bifurcation, BifurcationKind, Detector, EventObserver,
-    Fold, FoldLocation, LocateOptions, Observer, PathSoFar, PointMultipliers, StabilityKind, Start,
-    TracedPoint,
+    dot, locate_fold, observe, Bifurcation, BifurcationKind, Detector, EventObserver, Fold,
+    FoldLocation, LocateOptions, Observer, PathSoFar, PointMultipliers, Start, TracedPoint,
 };
 pub use multipliers::Multipliers;
 pub use neimark_sacker::NeimarkSacker;
