@@ -14,7 +14,7 @@ use super::scaled::Scaled;
 use super::stability::{
     BasisGrowth, CondensedFloquet, ReducedStability, DEFAULT_BASIS_TOL, DEFAULT_BLOCKS,
 };
-use crate::aft::{eval_series, Aft};
+use crate::aft::Aft;
 use crate::branch::Branch;
 use crate::continuation::{
     correct_at_fixed_lambda, ContinuationOptions, NewtonCorrector, Stepper, Traced,
@@ -22,6 +22,7 @@ use crate::continuation::{
 use crate::error::HbError;
 use crate::events::{observe, BifurcationKind, EventObserver, Fold, LocateOptions};
 use crate::frc::FrcFold;
+use crate::ihb::refine_peak;
 use crate::problem::PeriodicProblem;
 use crate::stability::HsuSteps;
 
@@ -515,31 +516,12 @@ impl Probe {
         })
     }
 
-    /// max_τ |x(τ)| of the series `coeffs`: the largest of the 2N samples,
-    /// refined by Newton on `x′(τ) = 0` (the sampled maximum alone is low by
-    /// up to ~(π/2N)²/2 relative).
+    /// max_τ |x(τ)| of the series `coeffs`: its 2N samples refined by
+    /// Newton on `x′(τ) = 0` ([`crate::ihb::refine_peak`]; the sampled
+    /// maximum alone is low by up to ~(π/2N)²/2 relative).
     fn max_abs(&mut self, coeffs: &[f64]) -> f64 {
         self.aft.synthesize(coeffs, &mut self.samples);
-        let (mut best, mut at) = (0.0f64, 0usize);
-        for (i, v) in self.samples.iter().enumerate() {
-            if v.abs() > best {
-                (best, at) = (v.abs(), i);
-            }
-        }
-        let mut tau = self.aft.tau(at);
-        let step = std::f64::consts::PI / self.samples.len() as f64;
-        for _ in 0..8 {
-            let (d1, d2) = (eval_series(coeffs, tau, 1), eval_series(coeffs, tau, 2));
-            if d2 == 0.0 {
-                break;
-            }
-            let delta = (d1 / d2).clamp(-step, step);
-            tau -= delta;
-            if delta.abs() <= 1e-15 * (1.0 + tau.abs()) {
-                break;
-            }
-        }
-        best.max(eval_series(coeffs, tau, 0).abs())
+        refine_peak(coeffs, &self.samples)
     }
 
     fn amplitude<P: PeriodicProblem>(
