@@ -138,31 +138,31 @@ impl HbSolution {
     pub fn x_at(&self, d: usize, t: f64) -> f64 {
         crate::aft::eval_series(self.dof(d), self.omega() * t, 0)
     }
-    /// Amplitude `max_τ |x_d(τ)|` of DOF `d` by [`series_peak`] (NaN if there
-    /// is no DOF `d`).
+    /// Amplitude `max_τ |x_d(τ)|` of DOF `d` (NaN if there is no DOF `d`),
+    /// with x_d = a0/2 + Σ a_k cos kτ + b_k sin kτ: the largest of `M = 4(n+1)`
+    /// equally spaced samples (four per period of the n-th harmonic), refined by
+    /// up to 8 Newton steps on `x′(τ) = 0` from that sample. Cost: `M·n` complex
+    /// multiply-adds (Horner's rule in `z = e^{jτ}`, no sine per harmonic) and
+    /// O(n) per Newton step: ≈ 3.3·10⁴ instructions at n = 20 (measured, not
+    /// asserted), where 512 direct evaluations took 1.6·10⁶.
+    ///
+    /// Accuracy: the value reported is `|x(τ̂)|` at a τ̂ the search visited, the
+    /// largest such value, so it never exceeds the true maximum and never falls
+    /// below the largest sample: `0 ≤ max|x| − A ≤ ½(π/M)²·Σ k²·hypot(a_k, b_k)`.
+    /// When the largest sample lies in the basin of the global maximum, A is that
+    /// maximum to rounding: within 1e-14 relative of a brute-force search (10⁵
+    /// points, then 2·10⁴ around the best) for Fig. 28's orbit and for random
+    /// series up to n = 40 (the `series_peak_*` tests). The 512 samples used before
+    /// were low by 8.2e-6 relative on Fig. 28's orbit. NaN for non-finite
+    /// coefficients.
     pub fn amplitude(&self, d: usize) -> f64 {
         series_peak(self.dof(d))
     }
 }
 
-/// `max_τ |x(τ)|` of the series `coeffs = [a0, a1..an, b1..bn]`
-/// (x = a0/2 + Σ a_k cos kτ + b_k sin kτ): the largest of `M = 4(n+1)`
-/// equally spaced samples (four per period of the n-th harmonic), refined by
-/// up to 8 Newton steps on `x′(τ) = 0` from that sample. Cost: `M·n` complex
-/// multiply-adds (Horner's rule in `z = e^{jτ}`, no sine per harmonic) and
-/// O(n) per Newton step: ≈ 1.2·10⁴ instructions at n = 20 (measured, not
-/// asserted), where 512 direct evaluations took 1.6·10⁶.
-///
-/// Accuracy: the value reported is `|x(τ̂)|` at a τ̂ the search visited, the
-/// largest such value, so it never exceeds the true maximum and never falls
-/// below the largest sample: `0 ≤ max|x| − A ≤ ½(π/M)²·Σ k²·hypot(a_k, b_k)`.
-/// When the largest sample lies in the basin of the global maximum, A is that
-/// maximum to rounding: within 1e-14 relative of a brute-force search (10⁵
-/// points, then 2·10⁴ around the best) for Fig. 28's orbit and for random
-/// series up to n = 40 (`tests::series_peak_*`). The 512 samples used before
-/// were low by 8.2e-6 relative on Fig. 28's orbit.
-/// NaN for an empty series or non-finite coefficients.
-pub fn series_peak(coeffs: &[f64]) -> f64 {
+/// `max_τ |x(τ)|` of the series `coeffs = [a0, a1..an, b1..bn]` as
+/// [`HbSolution::amplitude`] finds it.
+pub(crate) fn series_peak(coeffs: &[f64]) -> f64 {
     let Some((a0, cos, sin)) = split_series(coeffs) else {
         return f64::NAN;
     };
