@@ -142,9 +142,11 @@ fn point_dict<'py>(py: Python<'py>, p: &CondensedPoint) -> PyResult<Bound<'py, P
     d.set_item("data_error", p.data_error)?;
     d.set_item("orbit_error", p.orbit_error)?;
     d.set_item("truncation_error", p.truncation_error)?;
+    // Without the truncation estimate there is no whole estimate: None, not
+    // the orbit error alone.
     d.set_item(
         "error_estimate",
-        p.orbit_error + p.truncation_error.unwrap_or(0.0),
+        p.truncation_error.map(|t| p.orbit_error + t),
     )?;
     match &p.floquet {
         Some(f) => {

@@ -70,6 +70,26 @@ def test_condensed_curve_with_located_folds_and_recovered_dofs():
     assert np.array_equal(out["omega"], [p["omega"] for p in out["points"]])
 
 
+def test_a_curve_without_the_truncation_estimate_has_the_same_points_and_no_estimate():
+    # truncation_estimate=False skips only the estimate: the same path, the
+    # same orbits, truncation_error and error_estimate None (not the orbit
+    # error alone); with it both are numbers and error_estimate is their sum.
+    m, c, k, tip = ivt.hb.models.cantilever(8)
+    f = np.zeros(m.shape[0])
+    f[tip] = F0
+    args = (m, c, k, ivt.hb.elements.cubic_spring(K3, dof=0), f, 0.9 * W1, 1.1 * W1)
+    kw = dict(n=5, samples=16, nonlinear_dofs=[tip], stability=False)
+    full = ivt.hb.frc(*args, **kw)
+    bare = ivt.hb.frc(*args, truncation_estimate=False, **kw)
+    assert len(bare["points"]) == len(full["points"]) > 10
+    np.testing.assert_array_equal(bare["omega"], full["omega"])
+    np.testing.assert_array_equal(bare["amplitude"], full["amplitude"])
+    for p, q in zip(bare["points"], full["points"]):
+        assert p["truncation_error"] is None and p["error_estimate"] is None
+        assert p["orbit_error"] == q["orbit_error"]
+        assert q["error_estimate"] == q["orbit_error"] + q["truncation_error"]
+
+
 def test_condensed_curve_with_a_rust_element_equals_the_python_g():
     # The same tip spring as a Rust element on the condensed unknown (its
     # local index 0) and as the Python g with its Jacobian: the same points

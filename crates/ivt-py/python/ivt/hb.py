@@ -212,6 +212,7 @@ def _large_call(native_name, sig, args, kwargs, extra):
         for key in ("ds", "ds_min", "ds_max"):
             if given.get(key) is not None:
                 kw[key] = float(given[key])
+        kw["truncation_estimate"] = bool(given.get("truncation_estimate", True))
         return _ivt.hb.frc_large(n, m, c, k, a.g, f, a.omega_from, a.omega_to, dofs, **kw)
     return _ivt.hb.solve_large(n, m, c, k, a.g, f, a.omega_f, dofs, **kw)
 
@@ -261,7 +262,9 @@ response and the point's own size). Each point then
 carries "solve_error" (the refined solves'), "orbit_error" (the orbit's error
 from the corrector residual and the refined solves), "data_error" (the first-order effect of storing M and C in
 double precision), "truncation_error" and "error_estimate" (orbit_error +
-truncation_error, a relative error). `amplitude_dof=j`: "amplitude" is max |x_j(τ)|;
+truncation_error, a relative error; a curve's `truncation_estimate=False`
+skips the truncation estimate, most of a curve's cost without stability,
+and leaves both None). `amplitude_dof=j`: "amplitude" is max |x_j(τ)|;
 `record_dofs=[...]`: each point carries "dof_coeffs": {j: [a0, a1..an,
 b1..bn]} (any model). Stability (default on; `stability=False` skips it,
 folds are located either way): Floquet multipliers of the whole structure's
