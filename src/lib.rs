@@ -47,6 +47,8 @@ mod guide {
     mod api {}
     #[doc = include_str!("../docs/guide/src/architecture.md")]
     mod architecture {}
+    #[doc = include_str!("../docs/guide/src/contributing.md")]
+    mod contributing {}
     #[doc = include_str!("../docs/guide/src/getting-started.md")]
     mod getting_started {}
     #[doc = include_str!("../docs/guide/src/limits.md")]

@@ -34,6 +34,9 @@ GUIDE = REPO / "docs" / "guide" / "src"
 NOT_RUN: Dict[str, str] = {
     "./scripts/test": "the check that runs this test",
     "./scripts/py-test": "the check that runs this test",
+    "scripts/bench-gate": "the benchmark gate: its own step of scripts/test (valgrind, a minute)",
+    "python bench/gate/gate.py": "the gate on another build (valgrind, a minute)",
+    ".venv/bin/python bench/gate/gate.py": "the gate against another baseline (valgrind, a minute)",
     "cargo install": "installs a tool into the user's ~/.cargo",
     "pip install": "installs into the user's environment (tests/test_wheel.py installs the wheel)",
     "python -m venv": "creates the user's environment",
