@@ -10,7 +10,7 @@ import time
 import numpy as np
 
 import ivt
-from periodic_common import ALPHA, EPS, FORCE, PYHARM_SOLVERS, XI, hb_samples, pyharm_to_ivt, timed
+from periodic_common import ALPHA, EPS, FORCE, PYHARM_SOLVERS, XI, hb_samples, pyharm_input, pyharm_to_ivt, timed
 
 
 def pyharm_curve(m, c, k, cubic, n, omega_from, omega_to, ds_max, solver="scipyroot"):
