@@ -207,6 +207,7 @@ fn sweep_row(
         return Vec::new(); // checked by the caller
     };
     let mut warm: Option<(f64, Vec<f64>)> = None;
+    let token = ivt_num::cancel::Token::now();
     grid.v_m
         .iter()
         .map(|&v_m| {
@@ -215,6 +216,12 @@ fn sweep_row(
                 t_u,
                 omega0: grid.omega0,
             };
+            if token.cancelled() {
+                return SweepPoint {
+                    op,
+                    result: Err(ivt_num::cancel::CANCELLED.to_string()),
+                };
+            }
             let seed = warm.as_ref().map(|(r, q)| (*r, q.as_slice()));
             let mut res = solver.solve(plant, &op, seed);
             if res.is_err() && seed.is_some() {
