@@ -161,10 +161,12 @@ pub fn sweep<P: Fn() + Sync>(
     check_plant(plant)?;
     grid.validate()?;
     IhbSolver::new(opts)?;
+    // one token for the whole sweep: a row started after a cancellation stops too
+    let token = ivt_num::cancel::Token::now();
     let rows: Vec<Vec<SweepPoint>> = grid
         .t_u
         .par_iter()
-        .map(|&t_u| sweep_row(plant, grid, t_u, opts, &progress))
+        .map(|&t_u| sweep_row(plant, grid, (t_u, token), opts, &progress))
         .collect();
     Ok(rows.into_iter().flatten().collect())
 }
@@ -181,10 +183,11 @@ pub fn sweep_serial(
     check_plant(plant)?;
     grid.validate()?;
     IhbSolver::new(opts)?;
+    let token = ivt_num::cancel::Token::now();
     Ok(grid
         .t_u
         .iter()
-        .flat_map(|&t_u| sweep_row(plant, grid, t_u, opts, &|| ()))
+        .flat_map(|&t_u| sweep_row(plant, grid, (t_u, token), opts, &|| ()))
         .collect())
 }
 
@@ -199,7 +202,7 @@ pub fn require_some_solved(points: &[SweepPoint]) -> Result<(), IvtError> {
 fn sweep_row(
     plant: &PlantParams,
     grid: &Grid,
-    t_u: f64,
+    (t_u, token): (f64, ivt_num::cancel::Token),
     opts: IhbOptions,
     progress: &(impl Fn() + Sync),
 ) -> Vec<SweepPoint> {
@@ -207,7 +210,6 @@ fn sweep_row(
         return Vec::new(); // checked by the caller
     };
     let mut warm: Option<(f64, Vec<f64>)> = None;
-    let token = ivt_num::cancel::Token::now();
     grid.v_m
         .iter()
         .map(|&v_m| {
