@@ -71,7 +71,10 @@ fn assert_inside(name: &str, v: &Value, p: &PlantParams) {
         let ci = &v["ci95"][key];
         let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
         eprintln!("{name} {key}: {want:.5e} in [{lo:.5e}, {hi:.5e}]");
-        assert!(lo <= want && want <= hi, "{name} {key}: {want} outside [{lo}, {hi}]");
+        assert!(
+            lo <= want && want <= hi,
+            "{name} {key}: {want} outside [{lo}, {hi}]"
+        );
     }
 }
 
@@ -102,7 +105,10 @@ fn every_preset_is_identified_inside_its_intervals_or_refused_with_the_reason() 
                 assert_eq!(code, 2, "{name}: {v}");
                 assert_eq!(v["kind"], "unidentifiable", "{name}: {v}");
                 let e = v["error"].as_str().unwrap();
-                assert!(e.contains("is not identifiable") || e.contains("not consistent"), "{e}");
+                assert!(
+                    e.contains("is not identifiable") || e.contains("not consistent"),
+                    "{e}"
+                );
             }
         }
         match name.as_str() {
@@ -112,13 +118,19 @@ fn every_preset_is_identified_inside_its_intervals_or_refused_with_the_reason() 
             }
             "l_a = 1 mH" => {
                 assert_eq!(code, 0, "{v}");
-                assert!(v["model"].as_str().unwrap().starts_with("Eq. 137 with L_a = 0.001 H"));
+                assert!(v["model"]
+                    .as_str()
+                    .unwrap()
+                    .starts_with("Eq. 137 with L_a = 0.001 H"));
                 assert_eq!(v["l_a"], 1e-3);
             }
             "thesis-ch4" => {
                 assert_eq!(code, 2, "{v}");
                 let e = v["error"].as_str().unwrap();
-                assert!(e.contains("j_a is not identifiable") && e.contains("includes 0"), "{e}");
+                assert!(
+                    e.contains("j_a is not identifiable") && e.contains("includes 0"),
+                    "{e}"
+                );
             }
             _ => {}
         }
@@ -167,7 +179,10 @@ fn stuck_sensors_are_refused_and_named() {
     let (code, clean, _) = identify(&rec);
     assert_eq!(code, 0, "{clean}");
     let ratio = clean["residual_rms"].as_f64().unwrap() / clean["noise_rms"].as_f64().unwrap();
-    assert!((0.8..1.5).contains(&ratio), "clean run: residual/noise = {ratio}");
+    assert!(
+        (0.8..1.5).contains(&ratio),
+        "clean run: residual/noise = {ratio}"
+    );
     assert_eq!(clean["warnings"].as_array().unwrap().len(), 0, "{clean}");
 
     let data = std::fs::read(&rec).unwrap();
@@ -223,7 +238,10 @@ fn a_rig_with_inductance_identified_as_l_a_0_is_refused_naming_j_d() {
     assert_eq!(code, 2, "{v}");
     assert_eq!(v["kind"], "unidentifiable");
     let e = v["error"].as_str().unwrap();
-    assert!(e.contains("j_d is not identifiable") && e.contains("lies below 0"), "{e}");
+    assert!(
+        e.contains("j_d is not identifiable") && e.contains("lies below 0"),
+        "{e}"
+    );
     assert!(e.contains("L_a"), "{e}");
 }
 
@@ -285,7 +303,10 @@ fn metadata_values_outside_their_range_are_refused_by_name() {
     // (window ends on a pulse may round to the next one: a fraction of the
     // interval, measured 0.03 of its half-width for J_a)
     for (key, _) in required(&PlantParams::printed()) {
-        let (a, b) = (v["summary"][key].as_f64().unwrap(), clean["summary"][key].as_f64().unwrap());
+        let (a, b) = (
+            v["summary"][key].as_f64().unwrap(),
+            clean["summary"][key].as_f64().unwrap(),
+        );
         let ci = &clean["ci95"][key];
         let half = 0.5 * (ci[1].as_f64().unwrap() - ci[0].as_f64().unwrap());
         assert!((a - b).abs() < 0.25 * half, "{key}: {a} vs {b} (±{half})");

@@ -259,9 +259,9 @@ const META_RANGES: [(&str, f64, f64, &str); 5] = [
 /// `value` of metadata `key` inside its [`META_RANGES`] row.
 fn in_range(key: &str, text: &str, value: f64) -> Result<f64, String> {
     match META_RANGES.iter().find(|r| r.0 == key) {
-        Some(&(_, lo, hi, range)) if !(lo..=hi).contains(&value) => Err(format!(
-            "metadata `{key}` = {text} is outside {range}"
-        )),
+        Some(&(_, lo, hi, range)) if !(lo..=hi).contains(&value) => {
+            Err(format!("metadata `{key}` = {text} is outside {range}"))
+        }
         _ => Ok(value),
     }
 }

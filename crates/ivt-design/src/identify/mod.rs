@@ -518,7 +518,8 @@ pub fn identify(rec: &Recording, nominal: &PlantParams) -> Result<Identification
 /// model error or a sensor's error is common to both), so the RMS of the
 /// difference over √2 is the noise of one.
 fn noise_rms(pairs: &[(windows::Row, windows::Row)], p: &[f64], g: f64) -> f64 {
-    let residual = |r: &windows::Row| g * r.gravity - r.x.iter().zip(p).map(|(x, p)| x * p).sum::<f64>();
+    let residual =
+        |r: &windows::Row| g * r.gravity - r.x.iter().zip(p).map(|(x, p)| x * p).sum::<f64>();
     let sum: f64 = pairs
         .iter()
         .map(|(x, z)| (residual(x) - residual(z)).powi(2))
@@ -597,13 +598,20 @@ impl Checks {
 
     /// Each coefficient of [`REQUIRED`] with a 95 % interval above 0;
     /// J_b, J_c whose interval includes 0 are warned about.
-    fn excited(&self, estimates: &[Estimate; 7], warnings: &mut Vec<String>) -> Result<(), IdentifyError> {
+    fn excited(
+        &self,
+        estimates: &[Estimate; 7],
+        warnings: &mut Vec<String>,
+    ) -> Result<(), IdentifyError> {
         for (name, e) in NAMES.iter().zip(estimates) {
             let [lo, hi] = e.ci95;
             if lo > 0.0 {
                 continue;
             }
-            let interval = format!("{} = {:.4e}, 95 % interval [{lo:.4e}, {hi:.4e}]", name, e.value);
+            let interval = format!(
+                "{} = {:.4e}, 95 % interval [{lo:.4e}, {hi:.4e}]",
+                name, e.value
+            );
             if REQUIRED.contains(name) {
                 let why = if hi < 0.0 {
                     let hint = if *name == "j_d" {

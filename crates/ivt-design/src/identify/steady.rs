@@ -101,7 +101,10 @@ pub struct Motor {
 ///
 /// # Errors
 /// A sweep with fewer than 4 usable holds, or all at one angle.
-pub fn sweep_analysis(rec: &Recording, motor: Motor) -> Result<Option<SweepAnalysis>, IdentifyError> {
+pub fn sweep_analysis(
+    rec: &Recording,
+    motor: Motor,
+) -> Result<Option<SweepAnalysis>, IdentifyError> {
     let holds: Vec<HoldPoint> = stages_named(rec, "sweep")
         .filter_map(|(s, end)| hold_point(rec, s, end, motor))
         .collect();

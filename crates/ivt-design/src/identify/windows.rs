@@ -132,7 +132,13 @@ pub fn rows(rec: &Recording, lag_s: f64) -> Vec<Row> {
 
 /// The row of the window from pulse `a` to pulse `b` (None: r changes in
 /// it, an input is missing, or a point speed cannot be fitted).
-fn window_row(rec: &Recording, (a, b): (usize, usize), m: usize, lag_s: f64, key: i64) -> Option<Row> {
+fn window_row(
+    rec: &Recording,
+    (a, b): (usize, usize),
+    m: usize,
+    lag_s: f64,
+    key: i64,
+) -> Option<Row> {
     let t = &rec.pulse_t;
     let dtheta = rec.dtheta();
     let (ta, tb) = (*t.get(a)?, *t.get(b)?);
@@ -319,7 +325,12 @@ mod tests {
                 sum += 0.5 * (s + next) * h;
                 s = next;
             }
-            assert!((mean[i] - sum / dt).abs() < 1e-8, "{} vs {}", mean[i], sum / dt);
+            assert!(
+                (mean[i] - sum / dt).abs() < 1e-8,
+                "{} vs {}",
+                mean[i],
+                sum / dt
+            );
             assert!((lag.state.unwrap()[i] - s).abs() < 1e-12);
         }
         let mut none = Lag {
