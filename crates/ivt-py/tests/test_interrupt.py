@@ -89,20 +89,20 @@ def test_sigint_stops_a_long_call_within_a_second(name: str) -> None:
         if child.poll() is None:
             child.kill()
             child.wait()
+    print(f"{name}: KeyboardInterrupt {waited:.3f} s after SIGINT")
     assert "PanicException" not in err, err
     assert out.strip() == "interrupted", (out, err)
     assert child.returncode == 0, err
     assert waited < 1.0, f"{name}: KeyboardInterrupt {waited:.2f} s after SIGINT"
 
 
-def test_an_uninterrupted_call_returns_its_result_unchanged() -> None:
-    # the worker thread and the waiting main thread give the same numbers
-    first = hb.duffing(n=20, samples=64, omega_f=1.2)
-    second = hb.duffing(n=20, samples=64, omega_f=1.2)
-    assert np.array_equal(first["coeffs"], second["coeffs"])
-    out = hb.frc(1.0, 0.04, 1.0, hb.elements.cubic_spring(1.0), lambda th: 0.1 * np.cos(th),
-                 0.5, 2.5, n=9)
-    assert out["termination"] == "left_interval"
+def test_an_uninterrupted_call_returns_the_cli_result(cli: Any) -> None:
+    # the same job on the worker thread (Python) and on the CLI's main thread
+    ref = cli("hb", "duffing-frc", "--from", "0.2", "--to", "3.0")
+    got = hb.duffing_frc(from_=0.2, to=3.0)
+    assert len(got["points"]) == len(ref["points"]) == 98
+    for a, b in zip(got["points"], ref["points"]):
+        assert a["omega"] == b["omega"] and a["amplitude"] == b["amplitude"]
 
 
 # -- counts bounded before allocation -------------------------------------------------
