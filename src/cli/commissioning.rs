@@ -240,6 +240,32 @@ fn message(topic: &str, v: &Value, c: &mut Collected) -> Option<()> {
     Some(())
 }
 
+/// The range of every numeric metadata value (key, lowest, highest, the
+/// range as printed): a value outside is refused by name, never clamped or
+/// wrapped.
+const META_RANGES: [(&str, f64, f64, &str); 5] = [
+    ("frame_version", 0.0, 65_535.0, "[0, 65535]"),
+    ("ppr", 1.0, 1e6, "[1, 1e6] pulses"),
+    ("f_timer_hz", 1e3, 1e10, "[1e3, 1e10] Hz"),
+    ("steps_per_rev", 1.0, 1e7, "[1, 1e7] steps"),
+    (
+        "theta0",
+        ivt_design::identify::THETA0_RANGE[0],
+        ivt_design::identify::THETA0_RANGE[1],
+        "[−2π, 2π] rad",
+    ),
+];
+
+/// `value` of metadata `key` inside its [`META_RANGES`] row.
+fn in_range(key: &str, text: &str, value: f64) -> Result<f64, String> {
+    match META_RANGES.iter().find(|r| r.0 == key) {
+        Some(&(_, lo, hi, range)) if !(lo..=hi).contains(&value) => {
+            Err(format!("metadata `{key}` = {text} is outside {range}"))
+        }
+        _ => Ok(value),
+    }
+}
+
 /// The arrays from the collected channels and metadata.
 fn assemble(c: Collected) -> Result<Commissioning, String> {
     let meta = c
@@ -251,14 +277,15 @@ fn assemble(c: Collected) -> Result<Commissioning, String> {
             .map(|s| {
                 s.parse::<f64>()
                     .map_err(|e| format!("metadata `{k}` = {s:?}: {e}"))
+                    .and_then(|v| in_range(k, &s, v))
             })
             .transpose()
     };
     let ppr = number("ppr")?.ok_or("metadata `ppr` is missing")?;
-    if !((1.0..=1e6).contains(&ppr) && ppr.fract() == 0.0) {
+    if ppr.fract() != 0.0 {
         return Err(format!("metadata `ppr` = {ppr} is not a pulse count"));
     }
-    let f_timer_hz = number("f_timer_hz")?.filter(|f| f.is_finite() && *f > 0.0);
+    let f_timer_hz = number("f_timer_hz")?;
     let nominal = match field("plant") {
         None => PlantSection::default(),
         Some(p) if p.starts_with('{') => plant_from_json(&p)?,
@@ -284,9 +311,7 @@ fn assemble(c: Collected) -> Result<Commissioning, String> {
         None => steps_per_rev_from_stages(&c.stages, &c.stepper)
             .ok_or("metadata `steps_per_rev` is missing and /sequence gives no stage at θ_CT > 0 to infer it")?,
     };
-    if !(steps_per_rev.is_finite() && steps_per_rev > 0.0) {
-        return Err(format!("steps per revolution {steps_per_rev} must be > 0"));
-    }
+    let steps_per_rev = in_range("steps_per_rev", &steps_per_rev.to_string(), steps_per_rev)?;
     let pulse_t = match f_timer_hz {
         Some(f) if c.pulse_ticks.len() == c.pulse_t.len() => {
             edge_times(&c.pulse_t, &c.pulse_ticks, f)

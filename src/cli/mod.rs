@@ -46,16 +46,23 @@ pub enum CliError {
     /// Reading or writing a file or stream failed; the message names the path.
     #[error("{0}")]
     Io(String),
+    /// A recording that does not determine the plant (`ivt rig identify`:
+    /// a coefficient not excited, a residual far above the noise, a plant
+    /// that is not physical); the message names the check and its numbers.
+    #[error("{0}")]
+    Unidentifiable(String),
 }
 
 impl CliError {
-    /// The `kind` of the JSON error object: `input`, `failed` or `io`
-    /// (`usage` is used for argument-parse errors, before any command runs).
+    /// The `kind` of the JSON error object: `input`, `failed`, `io` or
+    /// `unidentifiable` (`usage` is used for argument-parse errors, before
+    /// any command runs).
     pub fn kind(&self) -> &'static str {
         match self {
             CliError::Input(_) => "input",
             CliError::Failed(_) => "failed",
             CliError::Io(_) => "io",
+            CliError::Unidentifiable(_) => "unidentifiable",
         }
     }
 

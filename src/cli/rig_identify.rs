@@ -40,15 +40,14 @@ pub fn run(a: &IdentifyArgs) -> Result<Output, CliError> {
         other => CliError::Input(other.to_string()),
     })?;
     let nominal = commissioning::nominal_params(&rec).map_err(CliError::Input)?;
-    let id = identify::identify(&rec.recording, &nominal)
-        .map_err(|e| CliError::Failed(format!("{}: {e}", a.recording.display())))?;
-    let plant = id.plant(&nominal);
-    plant.validate().map_err(|e| {
-        CliError::Failed(format!(
-            "{}: the identified plant is not physical: {e}",
-            a.recording.display()
-        ))
+    let id = identify::identify(&rec.recording, &nominal).map_err(|e| {
+        let text = format!("{}: {e}", a.recording.display());
+        match e {
+            identify::IdentifyError::Recording { .. } => CliError::Input(text),
+            _ => CliError::Unidentifiable(text),
+        }
     })?;
+    let plant = id.plant(&nominal);
     let section = PlantSection::from_params(rec.nominal.preset, &plant);
     if let Some(out) = &a.out {
         let text = format!(
@@ -94,7 +93,7 @@ fn report(
     }
     summary.insert("r_max".into(), json!(plant.r_max));
     let sweep = id.sweep.as_ref().map(|s| sweep_json(s, plant));
-    let mut human = String::from("identified (95 % interval):\n");
+    let mut human = format!("model: {}\nidentified (95 % interval):\n", model(id, plant));
     for (name, e) in NAMES.iter().zip(&id.estimates) {
         human.push_str(&format!(
             "  {name:<14} {:>12.6e}  [{:.6e}, {:.6e}]\n",
@@ -117,6 +116,9 @@ fn report(
     if let Some(out) = &a.out {
         human.push_str(&format!("plant file → {}\n", out.display()));
     }
+    for w in &id.warnings {
+        human.push_str(&format!("warning: {w}\n"));
+    }
     Output {
         json: json!({
             "summary": summary,
@@ -125,11 +127,28 @@ fn report(
             "plant": section.to_toml(),
             "figures": figures.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
             "residual_rms": id.residual_rms,
+            "noise_rms": id.noise_rms,
+            "gravity_rms": id.gravity_rms,
+            "model": model(id, plant),
+            "l_a": plant.l_a,
+            "warnings": id.warnings,
             "windows": id.windows,
             "inverse_condition": id.inverse_condition,
             "sweep": sweep,
         }),
         human,
+    }
+}
+
+/// The model fitted, with its assumption on L_a stated.
+fn model(id: &Identification, plant: &PlantParams) -> String {
+    if id.lag_s > 0.0 {
+        format!(
+            "Eq. 137 with L_a = {} H from the nominal plant (τ_e = L_a/R_a = {:.3e} s; L_a is not identifiable from the motion)",
+            plant.l_a, id.lag_s
+        )
+    } else {
+        "Eq. 151, L_a = 0 as the nominal plant (Eq. 138; a rig with L_a > 0 needs it in the plant metadata)".into()
     }
 }
 

@@ -159,6 +159,8 @@ pub enum Termination {
     Stopped,
     /// The step fell below `ds_min`; carries the last corrector error.
     StepTooSmall(SolveError),
+    /// The caller cancelled the path ([`ivt_num::cancel`], Ctrl-C in Python).
+    Interrupted,
 }
 
 impl Termination {
@@ -169,6 +171,7 @@ impl Termination {
             Self::MaxPoints => "max_points",
             Self::Stopped => "stopped",
             Self::StepTooSmall(_) => "step_too_small",
+            Self::Interrupted => "interrupted",
         }
     }
 }

@@ -125,6 +125,9 @@ pub enum HbError {
         /// Hsu sub-intervals of the period (the cap, for adaptive Hsu).
         steps: usize,
     },
+    /// The caller cancelled the computation ([`ivt_num::cancel`]).
+    #[error("{}", ivt_num::cancel::CANCELLED)]
+    Interrupted,
 }
 
 impl HbError {
@@ -151,7 +154,8 @@ impl HbError {
             | Self::ColdStart { .. }
             | Self::Eigen(_)
             | Self::Transient { .. }
-            | Self::NonFiniteMultipliers { .. } => "failed",
+            | Self::NonFiniteMultipliers { .. }
+            | Self::Interrupted => "failed",
         }
     }
 

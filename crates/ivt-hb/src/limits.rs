@@ -14,6 +14,18 @@ pub const MAX_UNKNOWNS: usize = 4096;
 /// Most AFT samples `2N` per DOF (32 MiB per f64 buffer).
 pub const MAX_SAMPLES: usize = 1 << 22;
 
+/// Most points of one continuation path (`max_points`): each holds its
+/// state, so 10⁵ points of 4096 unknowns are 3.3 GB; a path that needs more
+/// is better cut into pieces.
+pub const MAX_PATH_POINTS: usize = 100_000;
+
+/// `None` when `max_points` fits [`MAX_PATH_POINTS`], otherwise the reason.
+pub fn path_points_error(max_points: usize) -> Option<String> {
+    (max_points > MAX_PATH_POINTS).then(|| {
+        format!("max_points = {max_points} exceeds the limit of {MAX_PATH_POINTS} points per path")
+    })
+}
+
 /// `None` when `n_dof·(2·harmonics + 1)` unknowns fit [`MAX_UNKNOWNS`],
 /// otherwise the reason (overflow-safe for any `usize`).
 pub fn unknowns_error(n_dof: usize, harmonics: usize) -> Option<String> {
@@ -57,5 +69,7 @@ mod tests {
         assert!(samples_error(1 << 21).is_none());
         assert!(samples_error((1 << 21) + 1).is_some());
         assert!(samples_error(usize::MAX).is_some());
+        assert!(path_points_error(100_000).is_none());
+        assert!(path_points_error(100_001).is_some());
     }
 }

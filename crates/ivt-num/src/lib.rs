@@ -35,6 +35,7 @@
 //! fixed-size algebra and `expm`.
 
 pub mod bordered;
+pub mod cancel;
 pub mod lu;
 pub mod newton;
 pub mod rk;

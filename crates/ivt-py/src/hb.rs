@@ -277,7 +277,13 @@ fn limit_cycle<'py>(py, user, jac;
     tol: f64 = 0.0,
     x0: Option<Vec<f64>> = None,
 ) {
+    if !(omega_guess.is_finite() && omega_guess > 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "argument `omega_guess` = {omega_guess} must be finite and > 0 (a cycle's frequency)"
+        )));
+    }
     let (problem, opts) = user.setup(None, 1, tol)?;
+    crate::hb_shared::without_omega(&problem, "limit_cycle")?;
     let req = LimitCycleRequest {
         omega_guess,
         guess: guess_vec(guess)?,

@@ -93,6 +93,7 @@ fn damped_modes<'py>(py, user, jac;
     tol: f64 = 0.0,
 ) {
     let (problem, opts) = user.setup(None, 1, tol)?;
+    crate::hb_shared::without_omega(&problem, "damped_modes")?;
     let bopts = BackboneOptions {
         dof: count("dof", dof)?,
         amplitude_from: finite("amplitude_from", amplitude_from)?,

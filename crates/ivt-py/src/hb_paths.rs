@@ -89,6 +89,7 @@ fn backbone<'py>(py, user, jac;
     tol: f64 = 0.0,
 ) {
     let (problem, opts) = user.setup(None, 1, tol)?;
+    crate::hb_shared::without_omega(&problem, "backbone")?;
     let req = BackboneRequest {
         omega0: finite("omega0", omega0)?,
         mode,
