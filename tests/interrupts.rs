@@ -1,7 +1,8 @@
 //! SIGINT during a run that writes files (moved from `tests/hardening.rs`,
 //! which it made longer than 600 lines): under `--json` the one JSON error and
-//! exit 2 (issue 30), and nothing the run created is left behind — neither its
-//! staged files nor the output directory it made.
+//! exit 130 (issue 43: 128 + SIGINT with or without `--json`), and nothing the
+//! run created is left behind — neither its staged files nor the output
+//! directory it made.
 // A test may unwrap (the package's panic lints guard library code).
 #![allow(clippy::unwrap_used)]
 
@@ -42,9 +43,9 @@ fn interrupt_once_staged(args: &[&str], out: &Path) -> (Option<i32>, Vec<String>
     (res.status.code(), left)
 }
 
-/// Ctrl-C during a simulation under `--json`: exit 2 (issue 30: one JSON
-/// error and exit 2, as every failure) and no output (the partial MCAP and
-/// the output directory this run created are removed).
+/// Ctrl-C during a simulation under `--json`: exit 130 (one JSON error of
+/// kind `interrupted`) and no output (the partial MCAP and the output
+/// directory this run created are removed).
 #[test]
 fn interrupted_sim_leaves_nothing() {
     let dir = scratch_dir("interrupts-sim");
@@ -58,7 +59,7 @@ fn interrupted_sim_leaves_nothing() {
     std::fs::write(&scene, drive).unwrap();
     let (scene, out_arg) = (scene.to_str().unwrap(), out.to_str().unwrap());
     let (code, left) = interrupt_once_staged(&["--json", "sim", scene, "--out", out_arg], &out);
-    assert_eq!(code, Some(2));
+    assert_eq!(code, Some(130));
     assert!(left.is_empty(), "left behind: {left:?}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -73,7 +74,7 @@ fn interrupted_reproduce_leaves_nothing() {
     let out_arg = out.to_str().unwrap();
     let (code, left) =
         interrupt_once_staged(&["--json", "reproduce", "--quick", "--out", out_arg], &out);
-    assert_eq!(code, Some(2));
+    assert_eq!(code, Some(130));
     assert!(left.is_empty(), "left behind: {left:?}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

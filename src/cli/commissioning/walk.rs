@@ -289,9 +289,12 @@ fn chunk(body: &[u8], c: &mut Collected) -> Result<(), String> {
             .and_then(|n| (at + 9).checked_add(n))
             .and_then(|end| records.get(at + 9..end))
             .ok_or_else(|| {
-                format!("record 0x{opcode:02x} at {at} in the chunk claims {len} bytes, more than the chunk holds")
+                format!(
+                    "in its chunk, record 0x{opcode:02x} at {at} claims {len} bytes, more than the chunk holds ({})",
+                    records.len()
+                )
             })?;
-        record(opcode, body, c, true).map_err(|e| format!("in the chunk, record at {at}: {e}"))?;
+        record(opcode, body, c, true).map_err(|e| format!("in its chunk, record at {at}: {e}"))?;
         at += 9 + body.len();
     }
     Ok(())
