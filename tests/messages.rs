@@ -38,15 +38,17 @@ fn number_options() -> Vec<(Vec<String>, String)> {
 
 /// The arguments a subcommand needs besides the option under test (a
 /// number-taking subcommand missing here fails the test).
-fn base(path: &[String], log: &str, scene: &str) -> Option<Vec<String>> {
+/// Outputs go to `out` (a scratch directory).
+fn base(path: &[String], log: &str, scene: &str, out: &str) -> Option<Vec<String>> {
     let path: Vec<&str> = path.iter().map(String::as_str).collect();
+    let mcap = format!("{out}/unused.mcap");
     let extra: &[&str] = match path.as_slice() {
         ["kin", _] | ["hb", _] | ["ol", "table" | "fit"] | ["stability-map"] => &[],
         ["ol", "solve"] | ["stability"] => &["--vm", "8", "--tu", "4"],
         ["ctrl", "replay"] => &[log],
-        ["sim"] => &[scene, "--out", "unused-out"],
-        ["rig", "record"] => &["--port", "/dev/null", "--out", "unused.mcap"],
-        ["rig", "commission"] => &["--sim", "--sequence", "hold", "--out", "unused.mcap"],
+        ["sim"] => &[scene, "--out", out],
+        ["rig", "record"] => &["--port", "/dev/null", "--out", &mcap],
+        ["rig", "commission"] => &["--sim", "--sequence", "hold", "--out", &mcap],
         ["bench", "work-precision"] => &[],
         _ => return None,
     };
@@ -102,7 +104,7 @@ fn every_number_option_takes_a_negative_value() {
     assert!(options.len() > 80, "{} options", options.len());
     for (path, opt) in &options {
         let mut argv = vec!["ivt".to_string()];
-        let head = base(path, "log.csv", "s.toml").unwrap_or_else(|| path.clone());
+        let head = base(path, "log.csv", "s.toml", "out").unwrap_or_else(|| path.clone());
         argv.extend(with_option(head, path, opt, "-0.5"));
         let parsed = ivt::cli::command().try_get_matches_from(&argv);
         assert!(parsed.is_ok(), "{argv:?}: {}", parsed.unwrap_err());
@@ -118,7 +120,7 @@ fn refusals_print_numbers_in_their_shortest_form() {
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/drive.toml");
     let _serial = serial();
     for (path, opt) in number_options() {
-        let argv = base(&path, &log, scene)
+        let argv = base(&path, &log, scene, dir.to_str().unwrap())
             .unwrap_or_else(|| panic!("{path:?} {opt}: no base arguments in tests/messages.rs"));
         for v in ["1e300", "-1e300", "1e-300"] {
             let last = path.last().map_or("", String::as_str);

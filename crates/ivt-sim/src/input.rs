@@ -144,14 +144,18 @@ pub fn open(path: &Path, limit: u64) -> std::io::Result<Input> {
 
 /// The path under which this process read the file that `target` names (the
 /// same device and inode), if it did; None for a target that does not exist.
+/// An input whose path no longer names that file (deleted or replaced since)
+/// does not count: its inode may have been reused by an unrelated file.
 #[must_use]
 pub fn read_as(target: &Path) -> Option<PathBuf> {
     let meta = std::fs::metadata(target).ok()?;
+    let id = (meta.dev(), meta.ino());
     let read = READ
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner);
     read.iter()
-        .find(|(d, i, _)| (*d, *i) == (meta.dev(), meta.ino()))
+        .filter(|(d, i, _)| (*d, *i) == id)
+        .find(|(_, _, p)| std::fs::metadata(p).is_ok_and(|m| (m.dev(), m.ino()) == id))
         .map(|(_, _, p)| p.clone())
 }
 
@@ -282,6 +286,9 @@ mod tests {
         assert_eq!(read_as(&d.join("other.toml")), Some(f.clone()));
         assert_eq!(read_as(&d.join(".").join("plant.toml")), Some(f.clone()));
         assert_eq!(read_as(&d.join("new.toml")), None);
+        // once the input's path is gone, its inode is no longer its own
+        std::fs::remove_file(&f).unwrap();
+        assert_eq!(read_as(&d.join("other.toml")), None);
         std::fs::remove_dir_all(&d).unwrap();
     }
 
