@@ -6,7 +6,12 @@
 //! checking that it ends with it. A status or kind documented without a
 //! command here, or a command whose ending differs, fails.
 // A test may index and unwrap (the package's panic lints guard library code).
-#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
+#![allow(
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic,
+    clippy::unwrap_used
+)]
 
 use ivt_sim::testing::{listing, scratch_dir};
 use serde_json::Value;

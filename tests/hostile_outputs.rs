@@ -6,7 +6,12 @@
 //! recording's path in the plant file's comment; a file that cannot be
 //! written is kind `io`.
 // A test may index and unwrap (the package's panic lints guard library code).
-#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
+#![allow(
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic,
+    clippy::unwrap_used
+)]
 
 #[path = "common/rig.rs"]
 mod rig;

@@ -8,7 +8,12 @@
 //! read (they blocked, or were read up to the budget). Plant files hold the
 //! `[plant]` table alone.
 // A test may index and unwrap (the package's panic lints guard library code).
-#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
+#![allow(
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic,
+    clippy::unwrap_used
+)]
 
 #[path = "common/mcap_forge.rs"]
 mod forge;

@@ -6,7 +6,12 @@
 //! 1e300` named an internal generated file, `--pil` showed the build
 //! machine's path, `ctrl replay --omega0-rpm 1e-30` was accepted.
 // A test may index and unwrap (the package's panic lints guard library code).
-#![allow(clippy::indexing_slicing, clippy::unwrap_used)]
+#![allow(
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic,
+    clippy::unwrap_used
+)]
 
 #[path = "common/contract.rs"]
 mod contract;
