@@ -13,11 +13,14 @@
     clippy::unwrap_used
 )]
 
-use ivt_sim::testing::{listing, scratch_dir};
+#[path = "common/interrupt.rs"]
+mod interrupt;
+
+use interrupt::interrupt_once_staged;
+use ivt_sim::testing::scratch_dir;
 use serde_json::Value;
 use std::collections::BTreeSet;
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
 
 const IVT: &str = env!("CARGO_BIN_EXE_ivt");
 const LIMITS: &str = include_str!("../docs/guide/src/limits.md");
@@ -70,27 +73,19 @@ fn interrupted(signal: &str) -> (i32, Value) {
     let path = dir.join("long.toml");
     std::fs::write(&path, scene).unwrap();
     let out = dir.join("out");
-    let child = Command::new(IVT)
-        .args(["--json", "sim", path.to_str().unwrap(), "--out"])
-        .arg(&out)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let t0 = Instant::now();
-    while !out.exists() || listing(&out).is_empty() {
-        assert!(t0.elapsed() < Duration::from_secs(60), "no staged output");
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    let sent = Command::new("kill")
-        .args([&format!("-{signal}"), &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(sent.success());
-    let res = child.wait_with_output().unwrap();
-    let v = serde_json::from_slice(&res.stdout).unwrap_or(Value::Null);
+    let args = [
+        "--json",
+        "sim",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let (code, stdout, _) = interrupt_once_staged(&args, &out, signal);
     std::fs::remove_dir_all(&dir).unwrap();
-    (res.status.code().unwrap_or(-1), v)
+    (
+        code.unwrap_or(-1),
+        serde_json::from_str(&stdout).unwrap_or(Value::Null),
+    )
 }
 
 #[test]

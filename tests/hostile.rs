@@ -11,54 +11,21 @@
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
 
-const IVT: &str = env!("CARGO_BIN_EXE_ivt");
-/// The bounds for one hostile input.
-const TIME_LIMIT: Duration = Duration::from_secs(20);
+use std::time::Duration;
+
+#[path = "common/limited.rs"]
+mod limited;
+
+/// The memory bound for one hostile input: 1.5 GB.
 const MEMORY_LIMIT_KB: u64 = 1536 * 1024;
 
-/// `ivt ARGS` under `ulimit -v` (a run that would grow past 1.5 GB aborts
-/// instead) and coreutils' `timeout` (a run past the time limit is killed and
-/// exits 124), with `shell_tail` appended to the command (e.g. `>&-`); the
-/// exit code, stdout, stderr and the wall time.
 fn run_limited(args: &[&str], shell_tail: &str) -> (Option<i32>, String, String, Duration) {
-    let secs = TIME_LIMIT.as_secs();
-    let script = format!(
-        "ulimit -v {MEMORY_LIMIT_KB}; exec timeout -s KILL {secs} \"$0\" \"$@\" {shell_tail}"
-    );
-    let t0 = Instant::now();
-    let out = Command::new("sh")
-        .args(["-c", &script, IVT])
-        .args(args)
-        .stdin(Stdio::null())
-        .output()
-        .unwrap();
-    let took = t0.elapsed();
-    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
-    (
-        out.status.code(),
-        text(&out.stdout),
-        text(&out.stderr),
-        took,
-    )
+    limited::run_limited(args, shell_tail, MEMORY_LIMIT_KB)
 }
 
-/// `ivt --json ARGS` must refuse: exit 2, one JSON object with a string
-/// `error` and `kind`, nothing else on stdout, no panic; returns the error.
 fn refused(args: &[&str], kind: &str) -> String {
-    let mut argv = vec!["--json"];
-    argv.extend(args);
-    let (code, out, err, took) = run_limited(&argv, "");
-    assert!(!err.contains("panicked"), "{argv:?}: {err}");
-    assert_eq!(code, Some(2), "{argv:?}: stdout {out:?} stderr {err:?}");
-    let lines: Vec<&str> = out.lines().filter(|l| !l.trim().is_empty()).collect();
-    assert_eq!(lines.len(), 1, "{argv:?}: {out:?}");
-    let v: Value = serde_json::from_str(lines[0]).unwrap();
-    assert_eq!(v["kind"], kind, "{argv:?}: {v}");
-    assert!(took < TIME_LIMIT, "{argv:?}: {took:?}");
-    v["error"].as_str().unwrap().to_string()
+    limited::refused(args, kind, MEMORY_LIMIT_KB)
 }
 
 fn scratch(name: &str) -> PathBuf {

@@ -18,52 +18,19 @@
 #[path = "common/mcap_forge.rs"]
 mod forge;
 
-use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
 
-const IVT: &str = env!("CARGO_BIN_EXE_ivt");
-/// One hostile input's bounds: 20 s and 1 GiB of address space (the issue's
+#[path = "common/limited.rs"]
+mod limited;
+
+/// One hostile input's memory bound: 1 GiB of address space (the issue's
 /// 100 MB recording reached 2 GB; the budgets of the reader keep it near
-/// 100 MB).
-const TIME_LIMIT: Duration = Duration::from_secs(20);
+/// 100 MB). The time bound is `limited::TIME_LIMIT`, 20 s.
 const MEMORY_LIMIT_KB: u64 = 1024 * 1024;
 
-/// `ivt --json ARGS` under `ulimit -v` and `timeout`: exit code, stdout,
-/// stderr, wall time.
-fn run_limited(args: &[&str]) -> (Option<i32>, String, String, Duration) {
-    let secs = TIME_LIMIT.as_secs();
-    let script =
-        format!("ulimit -v {MEMORY_LIMIT_KB}; exec timeout -s KILL {secs} \"$0\" --json \"$@\"");
-    let t0 = Instant::now();
-    let out = Command::new("sh")
-        .args(["-c", &script, IVT])
-        .args(args)
-        .stdin(Stdio::null())
-        .output()
-        .unwrap();
-    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
-    (
-        out.status.code(),
-        text(&out.stdout),
-        text(&out.stderr),
-        t0.elapsed(),
-    )
-}
-
-/// `ivt --json ARGS` must refuse with `kind`: exit 2, one JSON object, no
-/// panic, within the time limit; returns the error.
 fn refused(args: &[&str], kind: &str) -> String {
-    let (code, out, err, took) = run_limited(args);
-    assert!(!err.contains("panicked"), "{args:?}: {err}");
-    assert_eq!(code, Some(2), "{args:?}: stdout {out:?} stderr {err:?}");
-    let lines: Vec<&str> = out.lines().filter(|l| !l.trim().is_empty()).collect();
-    assert_eq!(lines.len(), 1, "{args:?}: {out:?}");
-    let v: Value = serde_json::from_str(lines[0]).unwrap();
-    assert_eq!(v["kind"], kind, "{args:?}: {v}");
-    assert!(took < TIME_LIMIT, "{args:?}: {took:?}");
-    v["error"].as_str().unwrap().to_string()
+    limited::refused(args, kind, MEMORY_LIMIT_KB)
 }
 
 fn scratch(name: &str) -> PathBuf {

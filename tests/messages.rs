@@ -180,42 +180,27 @@ fn the_issues_message_examples() {
     assert!(v["error"].as_str().unwrap().contains("`kd` = 1e300"), "{v}");
     // named by the option the user typed, not the generated scene
     let out = dir.join("k.mcap");
-    let (code, v) = run(&[
-        "--json",
-        "rig",
-        "commission",
-        "--sim",
-        "--k-prop",
-        "1e300",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!((code, v["kind"].as_str()), (2, Some("input")), "{v}");
-    assert!(
-        v["error"]
-            .as_str()
-            .unwrap()
-            .starts_with("--k-prop = 1e300 deg/rpm does not fit the controller's f32"),
-        "{v}"
-    );
-    let (code, v) = run(&[
-        "--json",
-        "rig",
-        "commission",
-        "--sim",
-        "--k-prop",
-        "-5",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 2, "{v}");
-    assert!(
-        v["error"]
-            .as_str()
-            .unwrap()
-            .starts_with("--k-prop = -5 deg/rpm must be > 0"),
-        "{v}"
-    );
+    for (value, refusal) in [
+        (
+            "1e300",
+            "--k-prop = 1e300 deg/rpm does not fit the controller's f32",
+        ),
+        ("-5", "--k-prop = -5 deg/rpm must be > 0"),
+    ] {
+        let o = out.to_str().unwrap();
+        let (code, v) = run(&[
+            "--json",
+            "rig",
+            "commission",
+            "--sim",
+            "--k-prop",
+            value,
+            "--out",
+            o,
+        ]);
+        assert_eq!((code, v["kind"].as_str()), (2, Some("input")), "{v}");
+        assert!(v["error"].as_str().unwrap().starts_with(refusal), "{v}");
+    }
     // a negative damping ratio is a value, and a valid problem
     let (code, v) = run(&["--json", "hb", "duffing", "--xi", "-0.5"]);
     assert_eq!(code, 0, "{v}");
