@@ -17,6 +17,7 @@ use clap::{Args, Subcommand};
 use ivt_hb::aft::eval_series;
 use ivt_hb::jobs::{self, CascadeRequest, FrcRequest, Method, OrbitRequest};
 use ivt_hb::{Duffing, FrcOptions, HbOptions};
+use ivt_kin::params::Typed;
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
@@ -87,7 +88,7 @@ impl DuffingParams {
         if !(self.tol.is_finite() && self.tol > 0.0) {
             return Err(CliError::Input(format!(
                 "--tol must be finite and > 0, got {}",
-                self.tol
+                Typed(self.tol)
             )));
         }
         Ok(HbOptions::new(self.n, self.samples).with_tol(self.tol))

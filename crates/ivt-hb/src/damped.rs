@@ -90,7 +90,7 @@ pub fn linear_mode<P: PeriodicProblem>(
     let lambda = s[col];
     if !(lambda.re > 0.0 && lambda.im.abs() <= 1e-10 * lambda.re) {
         return Err(HbError::InvalidInput(format!(
-            "mode {mode} has ω₀² = {lambda}, not real and positive"
+            "mode {mode} has ω₀² = {lambda:?}, not real and positive"
         )));
     }
     // The eigenvector up to a complex factor: divide by its largest entry.

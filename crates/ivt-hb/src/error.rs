@@ -44,7 +44,7 @@ pub enum HbError {
     #[error("the iteration collapsed onto the equilibrium x = 0 (no limit cycle near the guess)")]
     Equilibrium,
     /// A path's first point did not converge at its fixed parameter.
-    #[error("continuation start at λ = {lambda} does not converge: {cause}")]
+    #[error("continuation start at λ = {lambda:?} does not converge: {cause}")]
     ContinuationStart {
         /// Path parameter of the start.
         lambda: f64,
@@ -52,7 +52,7 @@ pub enum HbError {
         cause: SolveError,
     },
     /// A path has no tangent at its start (singular `∂R/∂q` there).
-    #[error("continuation start at λ = {lambda}: singular Jacobian, no tangent")]
+    #[error("continuation start at λ = {lambda:?}: singular Jacobian, no tangent")]
     SingularStart {
         /// Path parameter of the start.
         lambda: f64,
@@ -68,13 +68,13 @@ pub enum HbError {
         history: Vec<f64>,
     },
     /// The Jacobian at a fixed frequency is singular.
-    #[error("singular Jacobian at omega = {omega}")]
+    #[error("singular Jacobian at omega = {omega:?}")]
     Singular {
         /// Excitation frequency.
         omega: f64,
     },
     /// The residual at a fixed frequency became NaN or infinite.
-    #[error("non-finite residual at omega = {omega}")]
+    #[error("non-finite residual at omega = {omega:?}")]
     NonFinite {
         /// Excitation frequency.
         omega: f64,
@@ -91,7 +91,7 @@ pub enum HbError {
     },
     /// A curve's first point, solved from rest (a = 0), did not converge: near a
     /// resonance the start lies outside Newton's basin.
-    #[error("the curve starts from rest at omega = {omega} and that solve failed ({cause}); start below the resonance (e.g. at half its frequency) and continue through it")]
+    #[error("the curve starts from rest at omega = {omega:?} and that solve failed ({cause}); start below the resonance (e.g. at half its frequency) and continue through it")]
     ColdStart {
         /// Start frequency.
         omega: f64,
@@ -101,7 +101,7 @@ pub enum HbError {
     /// A transient integration (limit cycle from a state) ended without
     /// settling onto a periodic attractor.
     #[error(
-        "the transient from the given state did not reach a limit cycle (t = {time}): {reason}"
+        "the transient from the given state did not reach a limit cycle (t = {time:?}): {reason}"
     )]
     Transient {
         /// Time integrated.
@@ -116,7 +116,7 @@ pub enum HbError {
     /// so its stability is unknown (e.g. ω_f so small that one period spans
     /// far more time than the steps resolve).
     #[error(
-        "the Floquet multipliers at ω_f = {omega} are not finite (Hsu's method over at most \
+        "the Floquet multipliers at ω_f = {omega:?} are not finite (Hsu's method over at most \
          {steps} steps of one period 2π/ω_f); the stability of this solution is unknown"
     )]
     NonFiniteMultipliers {

@@ -288,7 +288,7 @@ pub(crate) fn validate<P: PeriodicProblem>(problem: &P, opts: &HbOptions) -> Res
     let (atol, rtol) = (opts.broyden.tol, opts.rtol);
     if !(atol.is_finite() && rtol.is_finite() && atol >= 0.0 && rtol >= 0.0 && atol + rtol > 0.0) {
         return Err(HbError::InvalidInput(format!(
-            "tolerances must be finite, ≥ 0 and not both 0, got rtol = {rtol}, atol = {atol}"
+            "tolerances must be finite, ≥ 0 and not both 0, got rtol = {rtol:?}, atol = {atol:?}"
         )));
     }
     if opts.broyden.max_iter == 0 {
@@ -300,7 +300,7 @@ pub(crate) fn validate<P: PeriodicProblem>(problem: &P, opts: &HbOptions) -> Res
 pub(crate) fn validate_omega(omega_f: f64) -> Result<(), HbError> {
     if !omega_f.is_finite() || omega_f <= 0.0 {
         return Err(HbError::InvalidInput(format!(
-            "excitation frequency must be positive and finite, got {omega_f}"
+            "excitation frequency must be positive and finite, got {omega_f:?}"
         )));
     }
     Ok(())

@@ -12,6 +12,7 @@ use ivt_hb::condense::{
 };
 use ivt_hb::jobs::pairs;
 use ivt_hb::{HbError, HbOptions};
+use ivt_kin::params::Typed;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -260,7 +261,8 @@ fn positive(name: &str, v: f64) -> PyResult<f64> {
         Ok(v)
     } else {
         Err(PyValueError::new_err(format!(
-            "argument `{name}` must be > 0, got {v}"
+            "argument `{name}` must be > 0, got {}",
+            Typed(v)
         )))
     }
 }

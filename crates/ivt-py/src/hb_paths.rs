@@ -6,6 +6,7 @@
 
 use ivt_hb::jobs::{self, BackboneRequest, FrcRequest};
 use ivt_hb::{BackboneOptions, Corrector, FrcOptions};
+use ivt_kin::params::Typed;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -53,7 +54,9 @@ fn frc<'py>(py, user, jac;
     let (from, to) = (finite("omega_from", omega_from)?, finite("omega_to", omega_to)?);
     if !(from > 0.0 && to > 0.0 && from != to) {
         return Err(PyValueError::new_err(format!(
-            "arguments `omega_from` = {from}, `omega_to` = {to} must be > 0 and distinct"
+            "arguments `omega_from` = {}, `omega_to` = {} must be > 0 and distinct",
+            Typed(from),
+            Typed(to)
         )));
     }
     // The Newton–chord corrector: one Galerkin Jacobian and ~3 residuals per

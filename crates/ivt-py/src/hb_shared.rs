@@ -9,6 +9,7 @@
 //! `hb_keywords_fn!` (the keywords both share).
 
 use ivt_hb::{HbError, HbOptions};
+use ivt_kin::params::Typed;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -101,7 +102,8 @@ pub(crate) fn options(n: i64, samples: i64, subharmonic: i64, tol: f64) -> PyRes
     }
     if !(tol.is_finite() && tol > 0.0) {
         return Err(PyValueError::new_err(format!(
-            "argument `tol` = {tol} must be finite and > 0"
+            "argument `tol` = {} must be finite and > 0",
+            Typed(tol)
         )));
     }
     Ok(HbOptions::new(n, samples)
@@ -115,7 +117,8 @@ pub(crate) fn finite(name: &str, v: f64) -> PyResult<f64> {
         Ok(v)
     } else {
         Err(PyValueError::new_err(format!(
-            "argument `{name}` = {v} must be finite"
+            "argument `{name}` = {} must be finite",
+            Typed(v)
         )))
     }
 }

@@ -8,6 +8,7 @@ use super::{to_json, CliError, Output};
 use clap::Args;
 use ivt_hb::jobs::{self, BackboneRequest, LimitCycleRequest, Oscillator};
 use ivt_hb::{BackboneOptions, HbOptions};
+use ivt_kin::params::Typed;
 
 /// Harmonics and samples of the autonomous jobs (Python's defaults and
 /// tolerances: ‖r‖₂ ≤ 1e-9 relative to the force scale).
@@ -76,7 +77,10 @@ pub struct BackboneArgs {
 /// transient comes to rest or Newton does not converge.
 pub fn limit_cycle(a: LimitCycleArgs) -> Result<Output, CliError> {
     if !a.mu.is_finite() {
-        return Err(CliError::Input(format!("--mu = {} must be finite", a.mu)));
+        return Err(CliError::Input(format!(
+            "--mu = {} must be finite",
+            Typed(a.mu)
+        )));
     }
     let req = LimitCycleRequest {
         amplitude: a.amplitude,
@@ -108,7 +112,8 @@ pub fn backbone(a: BackboneArgs) -> Result<Output, CliError> {
     if !(a.alpha.is_finite() && a.alpha > 0.0 && a.eps.is_finite()) {
         return Err(CliError::Input(format!(
             "--alpha = {} must be finite and > 0, --eps = {} finite",
-            a.alpha, a.eps
+            Typed(a.alpha),
+            Typed(a.eps)
         )));
     }
     let defaults = BackboneRequest::default();

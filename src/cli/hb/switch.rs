@@ -9,6 +9,7 @@ use super::{to_json, CliError, Output};
 use clap::Args;
 use ivt_hb::jobs::{self, FrcRequest, SwitchRequest, SwitchStart};
 use ivt_hb::{BifurcationKind, Corrector, FrcOptions, GeneralProblem, PeriodicProblem};
+use ivt_kin::params::Typed;
 
 /// `ivt hb switch` (defaults: c = 0.1, F = 0.5, the FRC from ω_f = 3.6 down
 /// to 2.2, the period-2 branch to 2.2).
@@ -71,7 +72,8 @@ pub fn run(a: SwitchArgs) -> Result<Output, CliError> {
     if !(a.damping.is_finite() && a.force.is_finite()) {
         return Err(CliError::Input(format!(
             "--damping = {} and --force = {} must be finite",
-            a.damping, a.force
+            Typed(a.damping),
+            Typed(a.force)
         )));
     }
     let hb = a.resolution.options()?;

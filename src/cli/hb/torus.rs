@@ -9,6 +9,7 @@ use super::{to_json, CliError, Output};
 use clap::Args;
 use ivt_hb::jobs::{self, FoldCurveRequest, FoldStart};
 use ivt_hb::{BifurcationKind, GeneralProblem, HbError, PeriodicProblem};
+use ivt_kin::params::Typed;
 
 /// `ivt hb vdp-torus` (defaults: μ = 0.2 from the point
 /// (0.94525643, 0.2)).
@@ -65,7 +66,7 @@ pub fn run(a: TorusArgs) -> Result<Output, CliError> {
     if !a.mu.is_finite() {
         return Err(CliError::Input(format!(
             "--mu must be finite, got {}",
-            a.mu
+            Typed(a.mu)
         )));
     }
     let req = FoldCurveRequest {

@@ -157,7 +157,7 @@ pub enum BifurcationError {
     Hb(#[from] HbError),
     /// The Neimark–Sacker test converged to a real pair `μ, 1/μ`.
     #[error(
-        "neutral saddle at λ = {lambda} (real multipliers μ and 1/μ), not a Neimark–Sacker point"
+        "neutral saddle at λ = {lambda:?} (real multipliers μ and 1/μ), not a Neimark–Sacker point"
     )]
     NeutralSaddle {
         /// Where.

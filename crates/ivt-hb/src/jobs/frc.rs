@@ -42,7 +42,7 @@ impl FrcRequest {
         );
         if !(from > 0.0 && to > 0.0 && from != to) {
             return Err(HbError::InvalidInput(format!(
-                "`from` = {from}, `to` = {to} must be > 0 and distinct"
+                "`from` = {from:?}, `to` = {to:?} must be > 0 and distinct"
             )));
         }
         Ok(())

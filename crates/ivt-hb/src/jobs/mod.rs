@@ -84,7 +84,7 @@ pub(crate) fn finite(name: &str, v: f64) -> Result<f64, HbError> {
         Ok(v)
     } else {
         Err(HbError::InvalidInput(format!(
-            "`{name}` = {v} must be finite"
+            "`{name}` = {v:?} must be finite"
         )))
     }
 }
@@ -96,7 +96,7 @@ pub(crate) fn positive(name: &str, v: f64) -> Result<f64, HbError> {
         Ok(v)
     } else {
         Err(HbError::InvalidInput(format!(
-            "`{name}` = {v} must be finite and > 0"
+            "`{name}` = {v:?} must be finite and > 0"
         )))
     }
 }

@@ -51,14 +51,14 @@ impl StringRequest {
         let kd = self.params.kd;
         if !(kd.is_finite() && kd.abs() <= MAX_KD) {
             return Err(HbError::InvalidInput(format!(
-                "`kd` = {kd} must be finite with |kd| <= {MAX_KD:e}"
+                "`kd` = {kd:?} must be finite with |kd| <= {MAX_KD:e}"
             )));
         }
         self.params.validate()?;
         let (from, to, ds) = (self.from, self.to, self.step_max);
         if !(from > 0.0 && to > from && to.is_finite() && ds > 0.0 && ds.is_finite()) {
             return Err(HbError::InvalidInput(format!(
-                "need 0 < `from` < `to` (finite) and `step_max` > 0, got {from} .. {to}, {ds}"
+                "need 0 < `from` < `to` (finite) and `step_max` > 0, got {from:?} .. {to:?}, {ds:?}"
             )));
         }
         Ok(())
