@@ -177,7 +177,11 @@ fn reduced_curve_equals_the_exact_condensed_harmonic_balance() {
     assert_eq!(frc.events.len(), 2, "{:?}", frc.events);
     assert!(frc.events.iter().all(|e| e.located));
     let mut exact = CondensedBranch::new(full, vec![p.tip], &f, &[], spring(k3), &hb).unwrap();
-    // Orbits: every fourth point corrected at its ω_f on the whole plate.
+    // Orbits: every fourth point corrected at its ω_f on the whole plate
+    // (Newton on the exact condensed equations from the reduced orbit; it
+    // takes no step where the reduced orbit already solves them to the
+    // relative residual 1e-12, as it does at every point: measured 0 to
+    // 1.4e-16).
     for point in frc.points.iter().step_by(4) {
         let mut q = point.coeffs.clone();
         correct_condensed(&mut exact, &mut q, point.omega_f, 1e-12).unwrap();

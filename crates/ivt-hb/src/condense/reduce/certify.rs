@@ -20,7 +20,7 @@ use faer::{c64, Mat, Side};
 pub struct Sample {
     /// The frequency `w = h·ω_f/p` of the check, rad/s.
     pub omega: f64,
-    /// Its harmonic `h` and excitation frequency ω_f.
+    /// Its harmonic `h`.
     pub harmonic: usize,
     /// The excitation frequency ω_f it belongs to.
     pub omega_f: f64,

@@ -128,4 +128,6 @@ pub struct Reduction {
     pub nested_change: f64,
     /// The exact checks, in the order made.
     pub sampled: Vec<Sample>,
+    /// Wall time of the reduction in seconds (measured, for benchmarks).
+    pub seconds: f64,
 }

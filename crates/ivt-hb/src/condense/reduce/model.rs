@@ -52,6 +52,7 @@ impl ReducedModel {
         load_sin: &[f64],
         opts: &ReductionOptions,
     ) -> Result<Self, HbError> {
+        let clock = std::time::Instant::now();
         let n = ops.k.nrows();
         let (lo, hi) = (opts.band.0.min(opts.band.1), opts.band.0.max(opts.band.1));
         let valid = lo > 0.0 && hi.is_finite() && opts.tol > 0.0 && opts.tol.is_finite();
@@ -105,15 +106,15 @@ impl ReducedModel {
             previous = theta;
             let past = previous.last().is_some_and(|&t| t > cutoff * cutoff);
             let change = if past {
-                nested_change(&basis, &fine, dofs, &loads, &points)?
+                nested_change(&basis, &fine, dofs, &loads, &points, opts)?
             } else {
-                (f64::INFINITY, None)
+                (f64::INFINITY, Vec::new())
             };
             if (past && change.0 <= target) || basis.size() >= opts.max_basis {
                 break change;
             }
             if basis.grow() == 0 {
-                break nested_change(&basis, &fine, dofs, &loads, &points)?;
+                break nested_change(&basis, &fine, dofs, &loads, &points, opts)?;
             }
         };
         // The certificate: exact solves at the top of the highest harmonic
@@ -130,7 +131,7 @@ impl ReducedModel {
             omega_f: hi,
             loaded: opts.harmonics == opts.subharmonic,
         };
-        let chosen = choose_samples(top, &nested.1, &points, opts.samples);
+        let chosen = choose_samples(top, &nested.1, opts.samples);
         let mut checks: Vec<(Point, Mat<c64>, f64)> = Vec::with_capacity(chosen.len());
         for point in chosen {
             let (reference, solve_error, full) =
@@ -154,7 +155,7 @@ impl ReducedModel {
         }
         let fine = modal(&basis, None, dofs, &loads)?;
         if checks.iter().any(|(p, ..)| p.omega > 0.0) {
-            nested = nested_change(&basis, &fine, dofs, &loads, &points)?;
+            nested = nested_change(&basis, &fine, dofs, &loads, &points, opts)?;
         }
         let sampled: Vec<Sample> = checks
             .iter()
@@ -185,10 +186,15 @@ impl ReducedModel {
             error_estimate: worst_sample.max(nested.0),
             nested_change: nested.0,
             sampled,
+            seconds: 0.0,
         };
         let all: Vec<usize> = (0..basis.size()).collect();
         let (fine_form, shapes) = craig_bampton(&basis, &all, dofs, &loads)?;
         let (coarse_form, _) = craig_bampton(&basis, &basis.without_last_block(), dofs, &loads)?;
+        let report = Reduction {
+            seconds: clock.elapsed().as_secs_f64(),
+            ..report
+        };
         Ok(Self {
             structure: fine_form.structure,
             coarse: coarse_form.structure,
@@ -270,28 +276,52 @@ fn modal(
     )
 }
 
-/// The largest change of the receptances on the grid from the nested basis
-/// (one Krylov block fewer) and per grid point the changes.
+/// The change of the receptances from the nested basis (one Krylov block
+/// fewer) at each grid point and at each resonance of the reduced model
+/// inside a harmonic band (`√θ_j = h·ω_f/p`, where the quality factor
+/// amplifies any error), with the largest.
 fn nested_change(
     basis: &KrylovBasis<'_>,
     fine: &Modal,
     dofs: &[usize],
     loads: &Mat<f64>,
-    points: &[Point],
-) -> Result<(f64, Option<Vec<f64>>), HbError> {
+    grid_points: &[Point],
+    opts: &ReductionOptions,
+) -> Result<(f64, Vec<(Point, f64)>), HbError> {
     let coarse = modal(basis, Some(&basis.without_last_block()), dofs, loads)?;
-    let changes: Vec<f64> = points
+    let (lo, hi) = (opts.band.0.min(opts.band.1), opts.band.0.max(opts.band.1));
+    let p = opts.subharmonic as f64;
+    let resonances = fine
+        .ritz_values()
         .iter()
-        .map(|p| {
-            distance(
-                &coarse.receptances(p.omega),
-                &fine.receptances(p.omega),
-                p.loaded,
-            )
+        .filter(|t| **t > 0.0)
+        .flat_map(|t| {
+            let w = t.sqrt();
+            (1..=opts.harmonics).filter_map(move |h| {
+                let omega_f = w * p / h as f64;
+                (omega_f >= lo && omega_f <= hi).then_some(Point {
+                    omega: w,
+                    harmonic: h,
+                    omega_f,
+                    loaded: h == opts.subharmonic,
+                })
+            })
+        });
+    let changes: Vec<(Point, f64)> = grid_points
+        .iter()
+        .copied()
+        .chain(resonances)
+        .map(|pt| {
+            let change = distance(
+                &coarse.receptances(pt.omega),
+                &fine.receptances(pt.omega),
+                pt.loaded,
+            );
+            (pt, change)
         })
         .collect();
-    let worst = changes.iter().copied().fold(0.0f64, f64::max);
-    Ok((worst, Some(changes)))
+    let worst = changes.iter().map(|(_, c)| *c).fold(0.0f64, f64::max);
+    Ok((worst, changes))
 }
 
 /// Ritz values below `limit` that moved by at most [`CONVERGED`] since
@@ -305,38 +335,24 @@ fn converged(theta: &[f64], previous: &[f64], limit: f64) -> usize {
         .count()
 }
 
-/// The samples: `top`, then the grid points of largest nested change at
-/// least 2 % apart from those chosen.
-fn choose_samples(
-    top: Point,
-    changes: &Option<Vec<f64>>,
-    points: &[Point],
-    count: usize,
-) -> Vec<Point> {
+/// The samples: `top`, then the points of largest nested change at least
+/// 2 % apart from those chosen.
+fn choose_samples(top: Point, changes: &[(Point, f64)], count: usize) -> Vec<Point> {
     if count == 0 {
         return Vec::new();
     }
+    let mut order: Vec<&(Point, f64)> = changes.iter().collect();
+    order.sort_by(|a, b| b.1.total_cmp(&a.1));
     let mut chosen = vec![top];
-    let mut order: Vec<usize> = (0..points.len()).collect();
-    if let Some(c) = changes {
-        order.sort_by(|&a, &b| {
-            let (x, y) = (
-                c.get(a).copied().unwrap_or(0.0),
-                c.get(b).copied().unwrap_or(0.0),
-            );
-            y.total_cmp(&x)
-        });
-    }
-    for i in order {
+    for (p, _) in order {
         if chosen.len() >= count {
             break;
         }
-        let Some(&p) = points.get(i) else { continue };
         if chosen
             .iter()
             .all(|q| (q.omega - p.omega).abs() > 0.02 * q.omega.max(p.omega))
         {
-            chosen.push(p);
+            chosen.push(*p);
         }
     }
     chosen
