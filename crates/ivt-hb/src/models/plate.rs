@@ -215,7 +215,11 @@ fn gradients(p: &[[f64; 3]; 4]) -> Option<([[f64; 3]; 4], f64)> {
     let g1 = cross(b, c).map(|v| v / det);
     let g2 = cross(c, a).map(|v| v / det);
     let g3 = cross(a, b).map(|v| v / det);
-    let g0 = [0, 1, 2].map(|i| -(g1[i] + g2[i] + g3[i]));
+    let g0 = [
+        -(g1[0] + g2[0] + g3[0]),
+        -(g1[1] + g2[1] + g3[1]),
+        -(g1[2] + g2[2] + g3[2]),
+    ];
     Some(([g0, g1, g2, g3], det.abs() / 6.0))
 }
 
