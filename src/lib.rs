@@ -80,6 +80,8 @@ mod guide {
         mod backbones {}
         #[doc = include_str!("../docs/guide/src/model/elements.md")]
         mod elements {}
+        #[doc = include_str!("../docs/guide/src/model/fe-models.md")]
+        mod fe_models {}
         #[doc = include_str!("../docs/guide/src/model/frc.md")]
         mod frc {}
         #[doc = include_str!("../docs/guide/src/model/large-models.md")]

@@ -357,6 +357,7 @@ pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     crate::hb_bifurcation::register(&m)?;
     crate::hb_cycle_fold::register(&m)?;
     crate::hb_large::register(&m)?;
+    crate::hb_reduced::register(&m)?;
     crate::hb_string::register(&m)?;
     crate::hb_switch::register(&m)?;
     crate::hb_elements::register(&m)?;

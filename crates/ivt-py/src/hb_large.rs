@@ -89,17 +89,8 @@ impl<'py> Large<'py> {
             &triplets("k", &self.k)?,
         )
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
-        let zeros = PyArray2::<f64>::zeros(py, [s, s], false).into_any();
-        let local = user_problem(
-            &zeros,
-            &zeros,
-            &zeros,
-            &self.g,
-            None,
-            self.jac.as_ref(),
-            self.velocity_dependent,
-            self.vectorized,
-        )?;
+        let flags = [self.velocity_dependent, self.vectorized];
+        let local = local_problem(py, s, &self.g, self.jac.as_ref(), flags)?;
         Ok((structure, local))
     }
 
@@ -119,8 +110,30 @@ impl<'py> Large<'py> {
     }
 }
 
+/// The local problem of `s` nonlinear DOFs: zero matrices, `g` (with its
+/// optional Jacobian `jac`), no `f`; `[velocity_dependent, vectorized]`.
+pub(crate) fn local_problem<'py>(
+    py: Python<'py>,
+    s: usize,
+    g: &Bound<'py, PyAny>,
+    jac: Option<&Bound<'py, PyAny>>,
+    [velocity_dependent, vectorized]: [bool; 2],
+) -> PyResult<PyProblem> {
+    let zeros = PyArray2::<f64>::zeros(py, [s, s], false).into_any();
+    user_problem(
+        &zeros,
+        &zeros,
+        &zeros,
+        g,
+        None,
+        jac,
+        velocity_dependent,
+        vectorized,
+    )
+}
+
 /// `n` harmonics, `samples` = N, relative tolerance `rtol`.
-fn hb_options(n: usize, samples: usize) -> PyResult<HbOptions> {
+pub(crate) fn hb_options(n: usize, samples: usize) -> PyResult<HbOptions> {
     if n == 0 || samples <= n {
         return Err(PyValueError::new_err(format!(
             "need n ≥ 1 harmonics and samples > n, got n = {n}, samples = {samples}"
@@ -129,7 +142,7 @@ fn hb_options(n: usize, samples: usize) -> PyResult<HbOptions> {
     Ok(HbOptions::new(n, samples))
 }
 
-fn point_dict<'py>(py: Python<'py>, p: &CondensedPoint) -> PyResult<Bound<'py, PyDict>> {
+pub(crate) fn point_dict<'py>(py: Python<'py>, p: &CondensedPoint) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("omega", p.omega_f)?;
     d.set_item("amplitude", p.amplitude)?;
@@ -166,7 +179,7 @@ fn point_dict<'py>(py: Python<'py>, p: &CondensedPoint) -> PyResult<Bound<'py, P
     Ok(d)
 }
 
-fn frc_dict<'py>(py: Python<'py>, frc: &CondensedFrc) -> PyResult<Bound<'py, PyDict>> {
+pub(crate) fn frc_dict<'py>(py: Python<'py>, frc: &CondensedFrc) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let points = PyList::empty(py);
     for p in &frc.points {
@@ -232,6 +245,25 @@ fn frc_large<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let (hb, flags) = (hb_options(n, samples)?, [velocity_dependent, vectorized]);
     let large = Large::new(n_dof, (m, c, k), (g, jac), f, nonlinear_dofs, hb, flags);
+    let opts = frc_options(
+        (omega_from, omega_to, rtol),
+        (amplitude_dof, record_dofs),
+        [truncation_estimate, stability],
+        [ds, ds_min, ds_max],
+    )?;
+    let frc = large.run(py, move |branch| condensed_response(branch, &opts))?;
+    frc_dict(py, &frc)
+}
+
+/// The condensed sweep's options from the keywords of `frc`: `(from, to,
+/// rtol)`, `(amplitude_dof, record_dofs)`, `[truncation_estimate,
+/// stability]`, `[ds, ds_min, ds_max]`.
+pub(crate) fn frc_options(
+    (omega_from, omega_to, rtol): (f64, f64, f64),
+    (amplitude_dof, record_dofs): (Option<usize>, Vec<usize>),
+    [truncation_estimate, stability]: [bool; 2],
+    steps: [Option<f64>; 3],
+) -> PyResult<CondensedFrcOptions> {
     let mut opts = CondensedFrcOptions {
         from: finite("omega_from", omega_from)?,
         to: finite("omega_to", omega_to)?,
@@ -242,21 +274,21 @@ fn frc_large<'py>(
         stability_blocks: stability.then_some(ivt_hb::condense::DEFAULT_BLOCKS),
         ..CondensedFrcOptions::default()
     };
-    let steps = [
+    let [ds, ds_min, ds_max] = steps;
+    let slots = [
         ("ds", ds, &mut opts.continuation.ds),
         ("ds_min", ds_min, &mut opts.continuation.ds_min),
         ("ds_max", ds_max, &mut opts.continuation.ds_max),
     ];
-    for (name, given, slot) in steps {
+    for (name, given, slot) in slots {
         if let Some(v) = given {
             *slot = positive(name, v)?;
         }
     }
-    let frc = large.run(py, move |branch| condensed_response(branch, &opts))?;
-    frc_dict(py, &frc)
+    Ok(opts)
 }
 
-fn positive(name: &str, v: f64) -> PyResult<f64> {
+pub(crate) fn positive(name: &str, v: f64) -> PyResult<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {

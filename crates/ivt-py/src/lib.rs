@@ -35,6 +35,7 @@ mod hb_family;
 mod hb_folds;
 mod hb_large;
 mod hb_paths;
+mod hb_reduced;
 mod hb_shared;
 mod hb_string;
 mod hb_switch;

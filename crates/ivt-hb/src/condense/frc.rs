@@ -489,6 +489,14 @@ fn orbit_error<P: PeriodicProblem>(
     }
 }
 
+/// max_τ |x(τ)| of the series `coeffs`: the largest of the 2N samples of
+/// `aft` (`samples`: its scratch), refined by Newton on `x′(τ) = 0` (the
+/// sampled maximum alone is low by up to ~(π/2N)²/2 relative).
+pub(crate) fn series_max(aft: &mut Aft, samples: &mut [f64], coeffs: &[f64]) -> f64 {
+    aft.synthesize(coeffs, samples);
+    refine_peak(coeffs, samples)
+}
+
 /// The per-point quantities: amplitude, recorded DOFs, error estimates.
 struct Probe {
     aft: Aft,
@@ -516,12 +524,9 @@ impl Probe {
         })
     }
 
-    /// max_τ |x(τ)| of the series `coeffs`: its 2N samples refined by
-    /// Newton on `x′(τ) = 0` ([`crate::ihb::refine_peak`]; the sampled
-    /// maximum alone is low by up to ~(π/2N)²/2 relative).
+    /// [`series_max`] of `coeffs`.
     fn max_abs(&mut self, coeffs: &[f64]) -> f64 {
-        self.aft.synthesize(coeffs, &mut self.samples);
-        refine_peak(coeffs, &self.samples)
+        series_max(&mut self.aft, &mut self.samples, coeffs)
     }
 
     fn amplitude<P: PeriodicProblem>(

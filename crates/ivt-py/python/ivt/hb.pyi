@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from typing import Any, Callable, Dict, List, Literal, Optional, Sequence, Tuple, Union, overload
 
+import os
+
 import numpy as np
 import numpy.typing as npt
 
@@ -67,8 +69,9 @@ class ConvergenceError(RuntimeError):
 
     history: List[float]
 
-# A model's matrix: dense (``Matrix``) or, for large models, scipy.sparse.
-Operator = Union[Matrix, SparseMatrix]
+# A model's matrix: dense (``Matrix``) or, for large models, scipy.sparse or
+# the path of a Matrix Market (.mtx) file.
+Operator = Union[Matrix, SparseMatrix, str, "os.PathLike[str]"]
 # ``g``: a Python callback (per sample or vectorized) or a sum of Rust elements.
 Nonlinearity = Union[Callback, VectorizedCallback, Elements]
 # ``family(p) -> (m, c, k, g, f)``: the system at parameter value p.
@@ -76,6 +79,9 @@ Family = Callable[[float], Sequence[Any]]
 # Large models, keyword only: DOF indices (``nonlinear_dofs``: where ``g``
 # acts; ``record_dofs``: whose coefficients the result holds).
 Dofs = Optional[Sequence[int]]
+# Large models: the exact condensed path, the reduced one, or the choice by
+# size and bandwidth (``None`` = "auto").
+Reduction = Literal["auto", "exact", "krylov"]
 
 # The signatures below are the runtime's, parameter for parameter
 # (tests/test_stubs.py pins each name, kind, order and default), so the options
@@ -117,6 +123,8 @@ def solve(
     jac: Optional[Jacobian] = None,
     *,
     nonlinear_dofs: Dofs = None, amplitude_dof: Optional[int] = None, record_dofs: Dofs = None,
+    reduction: Optional[Reduction] = None, reduction_tol: Optional[float] = None,
+    reduction_samples: Optional[int] = None,
 ) -> Dict[str, Any]: ...
 def frc(
     m: Operator, c: Operator, k: Operator, g: Nonlinearity,
@@ -126,6 +134,8 @@ def frc(
     jac: Optional[Jacobian] = None,
     *,
     nonlinear_dofs: Dofs = None, amplitude_dof: Optional[int] = None, record_dofs: Dofs = None,
+    reduction: Optional[Reduction] = None, reduction_tol: Optional[float] = None,
+    reduction_samples: Optional[int] = None,
 ) -> Dict[str, Any]: ...
 def continue_bifurcation(
     family: Family, start: Dict[str, Any],
@@ -206,6 +216,24 @@ class models:
         alpha: float = 0.07,
         beta: float = 2e-4,
     ) -> Tuple[SparseMatrix, SparseMatrix, SparseMatrix, int]: ...
+    @staticmethod
+    def solid(
+        mesh: Any,
+        clamped: Callable[[FloatArray], Any],
+        young: float = 210e9,
+        poisson: float = 0.3,
+        density: float = 7800.0,
+    ) -> Tuple[SparseMatrix, SparseMatrix, FloatArray, Callable[[int, int], int]]: ...
+    @staticmethod
+    def plate(
+        nx: int,
+        ny: Optional[int] = None,
+        nz: int = 2,
+        size: Tuple[float, float, float] = (1.0, 0.2, 0.02),
+        young: float = 210e9,
+        poisson: float = 0.3,
+        density: float = 7800.0,
+    ) -> Tuple[SparseMatrix, SparseMatrix, int]: ...
 
 # Branch switching (issue 27 item 2, crates/ivt-py/src/hb_switch.rs).
 def switch_branch(
