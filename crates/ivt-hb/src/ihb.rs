@@ -138,21 +138,10 @@ impl HbSolution {
     pub fn x_at(&self, d: usize, t: f64) -> f64 {
         crate::aft::eval_series(self.dof(d), self.omega() * t, 0)
     }
-    /// Amplitude `max_τ |x_d|` sampled at 512 points (NaN if there is no DOF `d`).
+    /// Amplitude `max_τ |x_d|` sampled at 512 points ([`crate::aft::peak`];
+    /// NaN if there is no DOF `d`).
     pub fn amplitude(&self, d: usize) -> f64 {
-        if self.dof(d).is_empty() {
-            return f64::NAN;
-        }
-        (0..512)
-            .map(|i| {
-                crate::aft::eval_series(
-                    self.dof(d),
-                    2.0 * std::f64::consts::PI * i as f64 / 512.0,
-                    0,
-                )
-                .abs()
-            })
-            .fold(0.0, f64::max)
+        crate::aft::peak(self.dof(d))
     }
 }
 
