@@ -2,7 +2,7 @@
 //! with Floquet stability, the Duffing frequency-response curve, and the
 //! Mathieu–Duffing period-doubling cascade, the fold curve in (ω, F), limit
 //! cycles and the Duffing backbone. `--plot FILE.png` draws the result
-//! ([`figure`]: the pictures of `ivt.plot`).
+//! (`figure.rs`: the pictures of `ivt.plot`).
 //! Each command parses its arguments, runs an `ivt_hb::jobs` job and prints
 //! its serialized result (the keys of `ivt.hb`'s dicts).
 

@@ -173,7 +173,8 @@ def _stable(p: Mapping[str, Any]) -> bool:
 
 
 def _size_key(points: Sequence[Mapping[str, Any]]) -> str:
-    """"amplitude" (max |x|) or, for the STHB string, "norm" (‖a‖)."""
+    """The key of the ordinate: ``amplitude`` (max |x|), or ``norm`` (‖a‖)
+    for the STHB string."""
     return "norm" if points and "norm" in points[0] and "amplitude" not in points[0] else "amplitude"
 
 
@@ -204,6 +205,8 @@ def _curve_events(result: Result, points: Sequence[Mapping[str, Any]], key: str)
         if size is None and e.get("index") is not None and 0 <= int(e["index"]) < len(points):
             size = points[int(e["index"])][key]
         if size is None:
+            if not points:
+                continue
             size = _turn_amplitude(points, float(omega), key)
         out.append((EVENT_LABELS.get(str(e.get("kind", "fold")), str(e.get("kind"))), float(omega), float(size)))
     return out
