@@ -16,13 +16,16 @@ use ivt_plot::Style;
 use std::f64::consts::PI;
 use std::path::Path;
 
+/// The (x, y) points of a series; a NaN point breaks the curve.
+type Points = Vec<(f64, f64)>;
+
 /// A figure with owned data: title, axis labels and the series in drawing
 /// order.
 pub(crate) struct Picture {
     title: String,
     x_label: &'static str,
     y_label: &'static str,
-    series: Vec<(String, Vec<(f64, f64)>, Style)>,
+    series: Vec<(String, Points, Style)>,
 }
 
 impl Picture {
@@ -98,7 +101,7 @@ impl Picture {
 /// segment to the neighbouring unstable point on either side, so that the
 /// curve stays connected (the change of stability lies on that segment, at
 /// the event marked there).
-pub(super) fn stability_runs(points: &[(f64, f64, bool)]) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
+pub(super) fn stability_runs(points: &[(f64, f64, bool)]) -> (Points, Points) {
     let gap = (f64::NAN, f64::NAN);
     let (mut solid, mut dashed) = (Vec::new(), Vec::new());
     let mut previous: Option<(f64, f64, bool)> = None;
