@@ -117,6 +117,33 @@ def test_events_of_a_forced_van_der_pol_curve_are_labelled_by_kind() -> None:
     assert dashed(ax) == runs(vdp["points"])
 
 
+def test_frc_of_a_switched_branch_and_of_a_large_model() -> None:
+    # switch_branch: the keys of frc; the period-2 branch of the well.
+    well_g = lambda x, v, th: x * x * (3.0 + x)  # noqa: E731
+    well_f = lambda th: 0.5 * math.cos(th)  # noqa: E731
+    curve = hb.frc(1.0, 0.1, 2.0, well_g, well_f, 3.6, 2.2, n=6, samples=24,
+                   velocity_dependent=False, vectorized=True)
+    pd = next(e for e in curve["bifurcations"] if e["kind"] == "period_doubling")
+    two = hb.switch_branch(1.0, 0.1, 2.0, well_g, well_f, at=pd, to=2.2, n=6, samples=24,
+                           velocity_dependent=False, vectorized=True)
+    ax = plot.frc(two).axes[0]
+    assert dashed(ax) == runs(two["points"])
+    assert events(ax) == [(plot.EVENT_LABELS[b["kind"]], (b["omega"], b["amplitude"]))
+                          for b in two["bifurcations"]]
+    # a condensed model: its folds are dicts of the tip's amplitude, no bifurcations
+    m, c, k, tip = hb.models.cantilever(4)
+    f = np.zeros(m.shape[0])
+    f[tip] = 0.005
+    w1 = 1.8751041**2
+    big = hb.frc(m, c, k, lambda x, v, th: 200.0 * x**3, f, 0.7 * w1, 1.3 * w1,
+                 nonlinear_dofs=[tip], stability=False)
+    ax = plot.frc(big).axes[0]
+    assert "bifurcations" not in big and len(big["folds"]) == 2
+    assert events(ax) == [("fold", (fd["omega"], fd["amplitude"])) for fd in big["folds"]]
+    assert dashed(ax) == []  # stability=False: no verdict, drawn solid
+
+
+
 def test_amplitude_dof_moves_the_events_with_the_points() -> None:
     m, c, k = np.eye(2), 0.02 * np.eye(2), np.array([[2.0, -1.0], [-1.0, 2.0]])
 
