@@ -1,23 +1,27 @@
 //! `ivt hb ...`: harmonic balance (thesis §3.2) — Duffing by modified/classic IHB
 //! with Floquet stability, the Duffing frequency-response curve, and the
 //! Mathieu–Duffing period-doubling cascade, the fold curve in (ω, F), limit
-//! cycles and the Duffing backbone. `--plot FILE.png` draws the curves.
+//! cycles and the Duffing backbone. `--plot FILE.png` draws the result
+//! (`figure.rs`: the pictures of `ivt.plot`).
 //! Each command parses its arguments, runs an `ivt_hb::jobs` job and prints
 //! its serialized result (the keys of `ivt.hb`'s dicts).
 
 mod all_solutions;
 mod autonomous;
 mod cycle_branch;
+pub(super) mod figure;
 mod folds;
 mod switch;
 mod torus;
 
 use super::{CliError, Output};
 use clap::{Args, Subcommand};
+use figure::Picture;
 use ivt_hb::aft::eval_series;
 use ivt_hb::jobs::{self, CascadeRequest, FrcRequest, Method, OrbitRequest};
 use ivt_hb::{Duffing, FrcOptions, HbOptions};
 use ivt_kin::params::Typed;
+use ivt_plot::Style;
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
@@ -127,7 +131,8 @@ pub struct FrcArgs {
     /// start by the modified IHB, every event on its extended system).
     #[arg(long)]
     events: bool,
-    /// Write a PNG of amplitude vs ω_f (stable solid, unstable red).
+    /// Write a PNG of amplitude vs ω_f: stable solid, unstable dashed, the
+    /// events marked and labelled (fold, PD, NS, BP).
     #[arg(long)]
     plot: Option<PathBuf>,
 }
@@ -194,17 +199,13 @@ fn duffing(a: DuffingArgs) -> Result<Output, CliError> {
         let period = 2.0 * PI / sol.omega();
         let pts: Vec<(f64, f64)> = (0..=400)
             .map(|i| {
-                let t = period * i as f64 / 400.0;
+                let t = period * f64::from(i) / 400.0;
                 (t, sol.x_at(0, t))
             })
             .collect();
-        draw(
-            path,
-            &format!("Duffing, ω_f = {}", a.omega_f),
-            "t",
-            "x",
-            &[("HB", pts)],
-        )?;
+        Picture::new(format!("Duffing, ω_f = {}", a.omega_f), "t", "x")
+            .with("HB", pts, Style::Line)
+            .draw(path)?;
     }
     let human = format!(
         "Duffing ω_f = {}: {} iterations, ‖r‖ = {:.2e}, {:.1} µs, amplitude {:.6}, {} (|μ|max = {:.6})\n",
@@ -234,36 +235,7 @@ fn duffing_frc(a: FrcArgs) -> Result<Output, CliError> {
     };
     let frc = jobs::frc(&problem, &a.params.options()?, &req)?.with_fold_omegas();
     if let Some(path) = &a.plot {
-        // One curve per stability; a NaN point breaks a curve where the other
-        // takes over, and each run shares its end point with the next.
-        let gap = (f64::NAN, f64::NAN);
-        let (mut stable, mut unstable) = (Vec::new(), Vec::new());
-        let mut prev: Option<((f64, f64), bool)> = None;
-        for p in &frc.points {
-            let (pt, s) = ((p.omega, p.amplitude), p.stable);
-            if let Some((last, _)) = prev.filter(|&(_, was)| was != s) {
-                let (into, other) = if s {
-                    (&mut stable, &mut unstable)
-                } else {
-                    (&mut unstable, &mut stable)
-                };
-                into.push(last);
-                other.push(gap);
-            }
-            if s {
-                stable.push(pt)
-            } else {
-                unstable.push(pt)
-            }
-            prev = Some((pt, s));
-        }
-        draw(
-            path,
-            "Duffing frequency response",
-            "ω_f",
-            "max |x|",
-            &[("stable", stable), ("unstable", unstable)],
-        )?;
+        figure::frc("Duffing frequency response", &frc).draw(path)?;
     }
     let human = format!(
         "{} points from ω_f = {} to {}, folds at {:?}, {} events, {:.1} ms\n",
@@ -292,30 +264,24 @@ fn mathieu(a: MathieuArgs) -> Result<Output, CliError> {
     let cascade = jobs::cascade(&req)?;
     if let Some(path) = &a.plot {
         let names = ["period 1 at β1", "period 2 at β2", "period 4 at β4"];
-        let series: Vec<_> = cascade
-            .doublings
-            .iter()
-            .zip(names)
-            .map(|(p, name)| {
-                let pts = (0..=800)
-                    .map(|j| {
-                        let tau = 2.0 * PI * j as f64 / 800.0;
-                        (
-                            eval_series(p.solution.dof(0), tau, 0),
-                            eval_series(p.solution.dof(0), tau, 1) * p.solution.omega(),
-                        )
-                    })
-                    .collect();
-                (name, pts)
-            })
-            .collect();
-        draw(
-            path,
-            "Mathieu–Duffing critical orbits",
-            "x",
-            "dx/dt",
-            &series,
-        )?;
+        let portraits = cascade.doublings.iter().zip(names).map(|(p, name)| {
+            let pts = (0..=800)
+                .map(|j| {
+                    let tau = 2.0 * PI * f64::from(j) / 800.0;
+                    (
+                        eval_series(p.solution.dof(0), tau, 0),
+                        eval_series(p.solution.dof(0), tau, 1) * p.solution.omega(),
+                    )
+                })
+                .collect();
+            (name, pts)
+        });
+        portraits
+            .fold(
+                Picture::new("Mathieu–Duffing critical orbits", "x", "dx/dt"),
+                |fig, (name, pts)| fig.with(name, pts, Style::Line),
+            )
+            .draw(path)?;
     }
     let human = format!(
         "period doubling at β = {:?} (thesis 4.825, 5.194, 5.253), {:.1} ms\n",
@@ -326,29 +292,4 @@ fn mathieu(a: MathieuArgs) -> Result<Output, CliError> {
         json: to_json(&cascade)?,
         human,
     })
-}
-
-/// Draw curves with the shared figure crate (embedded font, NaN breaks).
-fn draw(
-    path: &std::path::Path,
-    title: &str,
-    x_label: &str,
-    y_label: &str,
-    curves: &[(&str, Vec<(f64, f64)>)],
-) -> Result<(), CliError> {
-    let series = curves
-        .iter()
-        .map(|(label, points)| ivt_plot::Series {
-            label,
-            points,
-            style: ivt_plot::Style::Line,
-        })
-        .collect();
-    let figure = ivt_plot::Figure {
-        title,
-        x_label,
-        y_label,
-        series,
-    };
-    super::write_figure(path, |tmp| ivt_plot::line_plot(tmp, &figure))
 }

@@ -349,6 +349,18 @@ pub fn eval_series(coeffs: &[f64], tau: f64, order: u32) -> f64 {
     s
 }
 
+/// `max_τ |x(τ)|` of the series `[a0, a.., b..]`, sampled at 512 points of
+/// one period (NaN for an empty `coeffs`): the amplitude of a solution's DOF
+/// ([`crate::HbSolution::amplitude`]) and the `peak` of a backbone's points.
+pub fn peak(coeffs: &[f64]) -> f64 {
+    if coeffs.is_empty() {
+        return f64::NAN;
+    }
+    (0..512)
+        .map(|i| eval_series(coeffs, 2.0 * std::f64::consts::PI * f64::from(i) / 512.0, 0).abs())
+        .fold(0.0, f64::max)
+}
+
 /// The series `[a0, a1..an, b1..bn]` with `n_to` harmonics (truncated or
 /// zero-padded), e.g. to seed a solve at another n from a converged solution.
 /// An empty `coeffs` is the zero series.

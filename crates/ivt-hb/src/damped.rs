@@ -28,6 +28,8 @@ pub struct DampedModePoint {
     pub omega: f64,
     /// Modal damping ratio `ζ = −κ/(2ω)`.
     pub damping_ratio: f64,
+    /// `max_τ |x(τ)|` of the reference DOF (as [`crate::BackbonePoint::peak`]).
+    pub peak: f64,
     /// Fourier coefficients (layout of [`crate::HbSolution::coeffs`]).
     pub coeffs: Vec<f64>,
 }
@@ -135,6 +137,7 @@ pub fn damped_modes<P: PeriodicProblem>(
             amplitude: p.amplitude,
             omega: p.omega,
             damping_ratio: -p.kappa / (2.0 * p.omega),
+            peak: p.peak,
             coeffs: p.coeffs,
         })
         .collect();

@@ -81,7 +81,8 @@ user_system_fn! {
 /// {q, ω, κ} (the Galerkin Jacobian, with ∂g from `jac`, the elements, or
 /// differences of `g`).
 /// Returns {"amplitude", "omega", "kappa" (arrays), "points": [{"amplitude",
-/// "omega", "kappa", "coeffs"}...], "termination"}. GIL released between
+/// "omega", "kappa", "peak" (max |x| of DOF `dof`), "coeffs"}...],
+/// "termination"}. GIL released between
 /// callbacks.
 fn backbone<'py>(py, user, jac;
     omega0: f64,

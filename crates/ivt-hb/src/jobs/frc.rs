@@ -10,7 +10,7 @@ use crate::continuation::Termination;
 use crate::error::HbError;
 use crate::events::{trace, BifurcationError, BifurcationKind, Event, TraceOptions};
 use crate::family::{Family, FamilyBranch, Frequency};
-use crate::frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
+use crate::frc::{frequency_response, AmplitudeProbe, Frc, FrcFold, FrcOptions, FrcPoint};
 use crate::ihb::HbOptions;
 use crate::problem::{AtFrequency, PeriodicProblem};
 use crate::stability::HsuSteps;
@@ -95,6 +95,9 @@ pub struct EventRecord {
     pub index: usize,
     /// ω_f (located, else that of the point before).
     pub omega: Option<f64>,
+    /// max |x_0| of its orbit over the AFT samples, the measure of the
+    /// points' `amplitude` (located, else that of the point before).
+    pub amplitude: Option<f64>,
     /// Converged on its extended system.
     pub located: bool,
     /// Multipliers there `[[re, im], ...]`.
@@ -189,7 +192,12 @@ pub(super) fn traced_curve<F: Family>(
     };
     let traced = trace(branch, start, sweep.from, &opts).map_err(trace_error)?;
     let curve = Frc::from_trace(&traced, branch.options())?;
-    let events = traced.events.iter().map(|e| event(e, &curve)).collect();
+    let mut probe = AmplitudeProbe::new(branch.options())?;
+    let events = traced
+        .events
+        .iter()
+        .map(|e| event(e, &curve, &mut probe))
+        .collect();
     assemble(curve, events, sweep.path.stability, t0)
 }
 
@@ -254,14 +262,16 @@ fn fold(f: &FrcFold) -> FoldPoint {
     }
 }
 
-/// An event of the trace; a failed location takes the point before it.
-fn event(e: &Event, curve: &Frc) -> EventRecord {
+/// An event of the trace (its amplitude by `probe`); a failed location
+/// takes the point before it.
+fn event(e: &Event, curve: &Frc, probe: &mut AmplitudeProbe) -> EventRecord {
     let near = curve.points.get(e.index);
     match &e.location {
         Ok(b) => EventRecord {
             kind: e.kind,
             index: e.index,
             omega: Some(b.lambda),
+            amplitude: Some(probe.of(&b.q)),
             located: true,
             multipliers: Some(pairs(&b.multipliers)),
             coeffs: Some(Array(b.q.clone())),
@@ -271,6 +281,7 @@ fn event(e: &Event, curve: &Frc) -> EventRecord {
             kind: e.kind,
             index: e.index,
             omega: near.map(|p| p.omega_f),
+            amplitude: near.map(|p| p.amplitude),
             located: false,
             multipliers: near.map(|p| pairs(&p.multipliers)),
             coeffs: near.map(|p| Array(p.coeffs.clone())),
@@ -286,6 +297,7 @@ fn fold_event(f: &FrcFold, curve: &Frc) -> EventRecord {
         kind: BifurcationKind::Fold,
         index: f.index,
         omega: Some(f.omega_f),
+        amplitude: Some(f.amplitude),
         located: f.located,
         multipliers: curve.points.get(f.index).map(|p| pairs(&p.multipliers)),
         coeffs: Some(Array(f.coeffs.clone())),

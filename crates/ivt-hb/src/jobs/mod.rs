@@ -47,7 +47,7 @@ pub use fold_curve::{
 pub use frc::{frc, CurvePoint, EventRecord, FoldPoint, FrcCurve, FrcRequest};
 pub use limit_cycle::{limit_cycle, Cycle, LimitCycleRequest, Oscillator};
 pub use orbit::{orbit, Method, Orbit, OrbitRequest};
-pub use string::{string, StringCurve, StringPoint, StringRequest};
+pub use string::{string, StringCurve, StringFold, StringPoint, StringRequest};
 pub use switch::{switch, SwitchRequest, SwitchStart, SwitchedBranch};
 
 use crate::continuation::ContinuationOptions;

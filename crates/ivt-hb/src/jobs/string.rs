@@ -82,11 +82,26 @@ pub struct StringPoint {
     pub method: StabilityMethod,
 }
 
+/// A fold of the string's curve.
+#[derive(Debug, Clone, Serialize)]
+pub struct StringFold {
+    /// ω at the turn.
+    pub omega: f64,
+    /// ‖a‖ there.
+    pub norm: f64,
+    /// Converged on the extended system (else the path's turning point).
+    pub located: bool,
+    /// Path point before the turn.
+    pub index: usize,
+}
+
 /// The curve: the keys of `ivt hb string --json` and `ivt.hb.string`.
 #[derive(Debug, Clone, Serialize)]
 pub struct StringCurve {
     /// Points in path order.
     pub points: Vec<StringPoint>,
+    /// Folds in path order.
+    pub folds: Vec<StringFold>,
     /// Exact Jacobians assembled.
     pub jacobians: usize,
     /// Hill's method calls.
@@ -144,8 +159,20 @@ pub fn string(req: &StringRequest) -> Result<StringCurve, HbError> {
         )),
         _ => None,
     };
+    let folds = curve
+        .frc
+        .events
+        .iter()
+        .map(|f| StringFold {
+            omega: f.omega_f,
+            norm: f.amplitude,
+            located: f.located,
+            index: f.index,
+        })
+        .collect();
     Ok(StringCurve {
         points,
+        folds,
         jacobians: curve.jacobians,
         hill_calls: curve.hill_calls,
         stop: curve.frc.termination.clone(),

@@ -309,6 +309,11 @@ def _with_large(native):
                 _dense_dofs(e, n_dof, amplitude_dof, record_dofs)
             if "points" in out and amplitude_dof is not None:
                 out["amplitude"] = _np.array([e["amplitude"] for e in entries])
+                # the folds and events are measured as the points are
+                for e in [*out.get("folds", []), *out.get("bifurcations", [])]:
+                    if isinstance(e, dict) and e.get("coeffs") is not None:
+                        blocks = _np.asarray(e["coeffs"]).reshape(n_dof, -1)
+                        e["amplitude"] = _series_max(blocks[_index("amplitude_dof", amplitude_dof)])
         return out
 
     params = list(sig.parameters.values()) + [
@@ -338,7 +343,8 @@ truncation_error, a relative error; a curve's `truncation_estimate=False`
 skips the truncation estimate, most of a curve's cost without stability,
 and leaves both None). `amplitude_dof=j`: "amplitude" is max |x_j(τ)|;
 `record_dofs=[...]`: each point carries "dof_coeffs": {j: [a0, a1..an,
-b1..bn]} (any model). Stability (default on; `stability=False` skips it,
+b1..bn]} (any model). With `amplitude_dof` the folds' and events'
+"amplitude" is that DOF's too. Stability (default on; `stability=False` skips it,
 folds are located either way): Floquet multipliers of the whole structure's
 variational equation on the Ritz vectors of the nonlinear DOFs (Krylov
 blocks of K⁻¹M from the static modes, grown per point until the multipliers
