@@ -35,6 +35,7 @@ pub mod ode;
 pub mod problem;
 pub mod stability;
 pub mod switching;
+pub mod torus;
 pub mod transient;
 
 pub use aft::Aft;

@@ -17,6 +17,7 @@
 //! | Hopf points and the cycle branch (issue 27) | [`CycleBranchRequest`] | [`CycleBranchResult`] | `hb cycle-branch` | `cycle_branch` |
 //! | every solution at one ω_f by deflation (issue 27) | [`AllSolutionsRequest`] | [`AllSolutionsResult`] | `hb all-solutions` | `all_solutions` |
 //! | branch switching at a period doubling or branch point (Eq. 56, 61, 68–77) | [`SwitchRequest`] | [`SwitchedBranch`] | `hb switch` | `switch_branch` |
+//! | the torus branch from a Neimark–Sacker point (issue 45) | [`TorusRequest`] | [`TorusCurve`] | `hb torus` | `torus_branch` |
 //!
 
 pub mod all_solutions;
@@ -30,6 +31,7 @@ pub mod limit_cycle;
 pub mod orbit;
 pub mod string;
 pub mod switch;
+pub mod torus;
 
 pub use all_solutions::{
     all_solutions, AllSolutionsRequest, AllSolutionsResult, FoundOrbit, SearchBounds,
@@ -49,6 +51,7 @@ pub use limit_cycle::{limit_cycle, Cycle, LimitCycleRequest, Oscillator};
 pub use orbit::{orbit, Method, Orbit, OrbitRequest};
 pub use string::{string, StringCurve, StringPoint, StringRequest};
 pub use switch::{switch, SwitchRequest, SwitchStart, SwitchedBranch};
+pub use torus::{torus, Section, TorusCurve, TorusPoint, TorusRequest};
 
 use crate::continuation::ContinuationOptions;
 use crate::error::HbError;

@@ -6,6 +6,7 @@
 
 pub mod chain;
 pub mod counted;
+pub mod quasi;
 pub mod shooting;
 
 use ivt_hb::aft::eval_series;
