@@ -33,6 +33,7 @@ pub mod models;
 pub mod modified;
 pub mod ode;
 pub mod problem;
+pub mod sensitivity;
 pub mod stability;
 pub mod switching;
 pub mod torus;

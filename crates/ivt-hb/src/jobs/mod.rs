@@ -18,6 +18,7 @@
 //! | every solution at one ω_f by deflation (issue 27) | [`AllSolutionsRequest`] | [`AllSolutionsResult`] | `hb all-solutions` | `all_solutions` |
 //! | branch switching at a period doubling or branch point (Eq. 56, 61, 68–77) | [`SwitchRequest`] | [`SwitchedBranch`] | `hb switch` | `switch_branch` |
 //! | the torus branch from a Neimark–Sacker point (issue 45) | [`TorusRequest`] | [`TorusCurve`] | `hb torus` | `torus_branch` |
+//! | `dω/dp`, `dA/dp` of a located feature by its adjoint (issue 45) | [`SensitivityRequest`] | [`SensitivityResult`] | — | `event_sensitivity` |
 //!
 
 pub mod all_solutions;
@@ -29,6 +30,7 @@ pub mod fold_curve;
 pub mod frc;
 pub mod limit_cycle;
 pub mod orbit;
+pub mod sensitivity;
 pub mod string;
 pub mod switch;
 pub mod torus;
@@ -49,6 +51,7 @@ pub use fold_curve::{
 pub use frc::{frc, CurvePoint, EventRecord, FoldPoint, FrcCurve, FrcRequest};
 pub use limit_cycle::{limit_cycle, Cycle, LimitCycleRequest, Oscillator};
 pub use orbit::{orbit, Method, Orbit, OrbitRequest};
+pub use sensitivity::{event_sensitivity, SensitivityRequest, SensitivityResult};
 pub use string::{string, StringCurve, StringPoint, StringRequest};
 pub use switch::{switch, SwitchRequest, SwitchStart, SwitchedBranch};
 pub use torus::{torus, Section, TorusCurve, TorusPoint, TorusRequest};
