@@ -231,7 +231,7 @@ fn assemble(
     })
 }
 
-fn point(p: &FrcPoint) -> CurvePoint {
+pub(super) fn point(p: &FrcPoint) -> CurvePoint {
     CurvePoint {
         omega: p.omega_f,
         amplitude: p.amplitude,
@@ -255,7 +255,7 @@ fn fold(f: &FrcFold) -> FoldPoint {
 }
 
 /// An event of the trace; a failed location takes the point before it.
-fn event(e: &Event, curve: &Frc) -> EventRecord {
+pub(super) fn event(e: &Event, curve: &Frc) -> EventRecord {
     let near = curve.points.get(e.index);
     match &e.location {
         Ok(b) => EventRecord {

@@ -19,6 +19,7 @@
 //! | branch switching at a period doubling or branch point (Eq. 56, 61, 68–77) | [`SwitchRequest`] | [`SwitchedBranch`] | `hb switch` | `switch_branch` |
 //! | the torus branch from a Neimark–Sacker point (issue 45) | [`TorusRequest`] | [`TorusCurve`] | `hb torus` | `torus_branch` |
 //! | `dω/dp`, `dA/dp` of a located feature by its adjoint (issue 45) | [`SensitivityRequest`] | [`SensitivityResult`] | — | `event_sensitivity` |
+//! | the automatic bifurcation diagram (issue 45) | [`DiagramRequest`] | [`Diagram`] | `hb diagram` | `diagram` |
 //!
 
 pub mod all_solutions;
@@ -26,6 +27,7 @@ mod array;
 pub mod backbone;
 pub mod cascade;
 pub mod cycle_branch;
+pub mod diagram;
 pub mod fold_curve;
 pub mod frc;
 pub mod limit_cycle;
@@ -43,6 +45,10 @@ pub use backbone::{backbone, free_duffing, BackboneCurve, BackboneRequest, Backb
 pub use cascade::{cascade, Cascade, CascadeRequest, THESIS_BETAS};
 pub use cycle_branch::{
     cycle_branch, CycleBranchRequest, CycleBranchResult, CycleFold, CycleRecord, HopfRecord,
+};
+pub use diagram::{
+    diagram, BranchKind, Diagram, DiagramBranch, DiagramPoint, DiagramRequest, DiagramSearch,
+    Origin,
 };
 pub use fold_curve::{
     fold_curve, CurveFoldPoint, FoldCurveRequest, FoldCurveResult, FoldStart, SpecialKind,
