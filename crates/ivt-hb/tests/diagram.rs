@@ -324,3 +324,88 @@ fn twin_well_period_doublings_lead_to_the_period_two_orbits() {
         assert_eq!(stable, shot.stable, "{:?}", shot.state);
     }
 }
+
+#[test]
+fn an_isola_is_found_by_following_the_folds_in_the_force() {
+    // x″ + 0.02x′ + x + x³ − 0.002x′³ = 0.02 cos ω_f t: the negative cubic
+    // damping lets a detached resonance curve (an isola) stand beside the
+    // primary curve. With deflation off, the primary's folds followed in
+    // the forcing scale cross s = 1 on the isola's folds: the isola is
+    // traced from there and closes on itself. Shooting at ω_f = 1.95 finds
+    // the primary's small orbit and orbits of the isola: each is in the
+    // diagram.
+    let problem = GeneralProblem::new(
+        1,
+        vec![1.0],
+        vec![0.02],
+        vec![1.0],
+        |x: &[f64], v: &[f64], _t: f64, g: &mut [f64]| g[0] = x[0].powi(3) - 0.002 * v[0].powi(3),
+        |t: f64, f: &mut [f64]| f[0] = 0.02 * t.cos(),
+    )
+    .with_jacobian(|x: &[f64], v: &[f64], _t: f64, dg: &mut [f64]| {
+        dg[0] = 3.0 * x[0] * x[0];
+        dg[1] = -0.006 * v[0] * v[0];
+    });
+    let hb = HbOptions::new(15, 64);
+    let omega = 1.95;
+    let req = DiagramRequest {
+        from: 0.3,
+        to: 3.0,
+        samples: 0,
+        at: vec![omega],
+        ..DiagramRequest::default()
+    };
+    let d = jobs::diagram(&problem, &hb, &req).unwrap();
+    let isola = d
+        .branches
+        .iter()
+        .find(|b| b.kind == jobs::BranchKind::FoldCurve)
+        .expect("the isola from a fold curve");
+    assert_eq!(
+        isola.termination,
+        ivt_hb::Termination::Stopped,
+        "the isola closes"
+    );
+    assert_eq!(isola.parent, Some(0));
+    let mut states = Vec::new();
+    for b in &d.branches {
+        for p in b.points.iter().filter(|p| p.at) {
+            let x = eval_series(&p.coeffs.0, 0.0, 0);
+            states.push((
+                vec![x, omega * eval_series(&p.coeffs.0, 0.0, 1)],
+                p.stable.unwrap(),
+            ));
+        }
+    }
+    let shots = all_orbits(&problem, omega, 3.0, 60, 1);
+    eprintln!(
+        "ω = {omega}: shooting {} orbits, diagram {}",
+        shots.len(),
+        states.len()
+    );
+    assert!(
+        shots.iter().any(|s| s.state[0].abs() > 1.0),
+        "no orbit of the isola: {shots:?}"
+    );
+    for shot in &shots {
+        let (distance, stable) = states
+            .iter()
+            .map(|(y, st)| {
+                (
+                    y.iter()
+                        .zip(&shot.state)
+                        .map(|(a, b)| (a - b).abs())
+                        .fold(0.0, f64::max),
+                    *st,
+                )
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .unwrap();
+        assert!(
+            distance < 1e-6,
+            "{:?} is not in the diagram ({distance:e})",
+            shot.state
+        );
+        assert_eq!(stable, shot.stable, "{:?}", shot.state);
+    }
+}

@@ -342,6 +342,10 @@ impl<P: PeriodicProblem> PeriodicProblem for ForcingScale<'_, P> {
     }
 }
 
+/// The largest step of a fold curve in the forcing scale (its crossings of
+/// `s = 1` are solved there exactly; a Python `g` pays per residual).
+const FOLD_CURVE_DS_MAX: f64 = 0.2;
+
 /// A periodic branch found but not yet traced: its HB options, first point
 /// `[q, ω_f]`, direction in ω_f, and what it is.
 struct Pending {
@@ -870,7 +874,9 @@ impl<'a, P: PeriodicProblem> Search<'a, P> {
         let family = |scale: f64| -> Result<ForcingScale<'_, P>, HbError> {
             Ok(ForcingScale { problem, scale })
         };
-        let copts = super::path_steps(self.req.ds, self.req.ds_max, self.req.max_points);
+        // Only the crossings of s = 1 are kept (each solved at s = 1 by
+        // Newton): the curves are followed with long steps.
+        let copts = super::path_steps(0.05, FOLD_CURVE_DS_MAX, self.req.max_points);
         let folds: Vec<(usize, Bifurcation)> = self
             .located
             .iter()
