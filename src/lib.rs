@@ -92,6 +92,8 @@ mod guide {
         mod orbit {}
         #[doc = include_str!("../docs/guide/src/model/string.md")]
         mod string {}
+        #[doc = include_str!("../docs/guide/src/model/tori-diagrams.md")]
+        mod tori_diagrams {}
         #[doc = include_str!("../docs/guide/src/model/two-parameter.md")]
         mod two_parameter {}
     }

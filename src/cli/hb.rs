@@ -9,10 +9,12 @@
 mod all_solutions;
 mod autonomous;
 mod cycle_branch;
+mod diagram;
 pub(super) mod figure;
 mod folds;
 mod switch;
 mod torus;
+mod torus_branch;
 
 use super::{CliError, Output};
 use clap::{Args, Subcommand};
@@ -36,6 +38,10 @@ pub enum HbCommand {
     DuffingFolds(folds::FoldsArgs),
     /// The Neimark–Sacker curve of the forced Van der Pol oscillator in (ω_f, F), to its 1:1 end.
     VdpTorus(torus::TorusArgs),
+    /// The quasi-periodic torus of the forced Van der Pol oscillator from its Neimark–Sacker point.
+    Torus(torus_branch::TorusBranchArgs),
+    /// The automatic bifurcation diagram of the 2-DOF cubic chain.
+    Diagram(diagram::DiagramArgs),
     /// Limit cycle of Van der Pol's or Rayleigh's oscillator (ω unknown, §3.2.4) with its multipliers.
     LimitCycle(autonomous::LimitCycleArgs),
     /// Backbone curve (nonlinear normal mode) of the free Duffing oscillator u'' + αu + εu³ = 0.
@@ -171,6 +177,8 @@ pub fn run(cmd: HbCommand) -> Result<Output, CliError> {
         HbCommand::DuffingFrc(a) => duffing_frc(a),
         HbCommand::DuffingFolds(a) => folds::run(a),
         HbCommand::VdpTorus(a) => torus::run(a),
+        HbCommand::Torus(a) => torus_branch::run(a),
+        HbCommand::Diagram(a) => diagram::run(a),
         HbCommand::LimitCycle(a) => autonomous::limit_cycle(a),
         HbCommand::DuffingBackbone(a) => autonomous::backbone(a),
         HbCommand::CycleBranch(a) => cycle_branch::run(a),

@@ -377,6 +377,9 @@ impl PeriodicProblem for ElementProblem {
     fn velocity_dependent(&self) -> bool {
         self.elements.iter().any(|e| e.law.velocity_dependent())
     }
+    fn hysteretic(&self) -> bool {
+        self.has_hysteresis()
+    }
     fn nonlinear_jacobian(&self, x: &[f64], v: &[f64], _theta: f64, dg: &mut [f64]) {
         self.tangents(x, v, dg, |_| true);
     }

@@ -33,8 +33,10 @@ pub mod models;
 pub mod modified;
 pub mod ode;
 pub mod problem;
+pub mod sensitivity;
 pub mod stability;
 pub mod switching;
+pub mod torus;
 pub mod transient;
 
 pub use aft::Aft;

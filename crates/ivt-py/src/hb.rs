@@ -360,6 +360,8 @@ pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     crate::hb_reduced::register(&m)?;
     crate::hb_string::register(&m)?;
     crate::hb_switch::register(&m)?;
+    crate::hb_torus::register(&m)?;
+    crate::hb_sensitivity::register(&m)?;
     crate::hb_elements::register(&m)?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     parent.add_submodule(&m)

@@ -45,7 +45,7 @@ pub struct TorusArgs {
 }
 
 /// The forced Van der Pol oscillator at F.
-fn van_der_pol(mu: f64, force: f64) -> impl PeriodicProblem {
+pub(super) fn van_der_pol(mu: f64, force: f64) -> impl PeriodicProblem {
     GeneralProblem::new(
         1,
         vec![1.0],

@@ -239,7 +239,7 @@ fn assemble(
     })
 }
 
-fn point(p: &FrcPoint) -> CurvePoint {
+pub(super) fn point(p: &FrcPoint) -> CurvePoint {
     CurvePoint {
         omega: p.omega_f,
         amplitude: p.amplitude,
@@ -264,7 +264,7 @@ fn fold(f: &FrcFold) -> FoldPoint {
 
 /// An event of the trace (its amplitude by `probe`); a failed location
 /// takes the point before it.
-fn event(e: &Event, curve: &Frc, probe: &mut AmplitudeProbe) -> EventRecord {
+pub(super) fn event(e: &Event, curve: &Frc, probe: &mut AmplitudeProbe) -> EventRecord {
     let near = curve.points.get(e.index);
     match &e.location {
         Ok(b) => EventRecord {

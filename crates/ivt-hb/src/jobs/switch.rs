@@ -260,7 +260,7 @@ fn first_event<P: PeriodicProblem>(
 /// The direction of the new branch at the branch point `(q, λ)` (`m + 1`
 /// entries, unit): the root nearer λ = const of the bifurcation equation
 /// `ψᵀ R''[d, d] = 0`, `d = cos φ v₁ + sin φ v₂` (see the module docs).
-fn new_direction<F: Family>(
+pub(super) fn new_direction<F: Family>(
     branch: &mut FamilyBranch<F>,
     q: &[f64],
     lambda: f64,

@@ -1,6 +1,9 @@
 """Harmonic balance (``ivt-hb``): periodic solutions, Floquet stability,
 frequency-response curves with located folds, period doublings,
-Neimark–Sacker and branch points (:func:`frc`), and limit cycles, for Duffing,
+Neimark–Sacker and branch points (:func:`frc`), the quasi-periodic torus born
+at a Neimark–Sacker point (:func:`torus_branch`), automatic bifurcation
+diagrams (:func:`diagram`), sensitivities of located features to a model
+parameter (:func:`event_sensitivity`), and limit cycles, for Duffing,
 Mathieu–Duffing, the STHB string (:func:`string`) and user systems; backbone
 curves (:func:`backbone`) of conservative ones. ``g`` may be a Python callable
 or a sum of Rust elements from :mod:`ivt.hb.elements` (e.g.
@@ -33,10 +36,12 @@ __all__ = [
     "cycle_branch",
     "cycle_fold_curve",
     "damped_modes",
+    "diagram",
     "duffing",
     "duffing_folds",
     "duffing_frc",
     "eval_series",
+    "event_sensitivity",
     "frc",
     "limit_cycle",
     "mathieu_cascade",
@@ -45,6 +50,7 @@ __all__ = [
     "solve",
     "string",
     "switch_branch",
+    "torus_branch",
 ]
 
 _NATIVE = [name for name in __all__ if name not in ("AllSolutions", "all_solutions")]

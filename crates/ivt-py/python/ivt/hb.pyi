@@ -236,6 +236,35 @@ class models:
     ) -> Tuple[SparseMatrix, SparseMatrix, int]: ...
 
 # Branch switching (issue 27 item 2, crates/ivt-py/src/hb_switch.rs).
+def torus_branch(
+    m: Matrix, c: Matrix, k: Matrix, g: Nonlinearity,
+    f: Optional[Forcing], start: Dict[str, Any], omega_to: float, at: Sequence[float] = ...,
+    n: int = 20, samples: int = 64,
+    truncation: Optional[Union[int, Tuple[int, int]]] = None, step: float = 0.02,
+    ds: float = 0.01, ds_max: float = 0.05, max_points: int = 400,
+    estimate_tol: float = 1e-7, max_unknowns: int = 3000, amplitude_dof: int = 0,
+    estimate_points: bool = False, section_points: int = 200, tol: float = 0.0,
+    velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
+    jac: Optional[Jacobian] = None,
+) -> Dict[str, Any]: ...
+def diagram(
+    m: Matrix, c: Matrix, k: Matrix, g: Nonlinearity,
+    f: Optional[Forcing], omega_from: float, omega_to: float, at: Sequence[float] = ...,
+    n: int = 20, samples: int = 64,
+    depth: int = 2, max_branches: int = 24,
+    tori: bool = True, torus: Optional[Union[int, Tuple[int, int]]] = None, torus_points: int = 60,
+    fold_scale: Optional[Tuple[float, float]] = ...,
+    deflation_omegas: int = 6, max_amplitude: float = 10.0, amplitudes: int = 6,
+    ds: float = 0.02, ds_max: float = 0.05, max_points: int = 2000, step: float = 0.05, tol: float = 0.0,
+    velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
+    jac: Optional[Jacobian] = None,
+) -> Dict[str, Any]: ...
+def event_sensitivity(
+    family: Family, event: Dict[str, Any], p: float, amplitude_dof: int = 0,
+    n: int = 20, samples: int = 64,
+    velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
+    ds: float = 0.02, ds_max: float = 0.05, max_points: int = 2000,
+) -> Dict[str, Any]: ...
 def switch_branch(
     m: Matrix,
     c: Matrix,
