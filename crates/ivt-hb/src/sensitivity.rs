@@ -382,13 +382,16 @@ fn fold<F: Family>(
     adjoint_features(&mut lu, m, grad_a, &fp)
 }
 
+/// A scalar test `ψ(branch, q, ω)` of a located feature.
+type ScalarTest<'a, F> = dyn FnMut(&mut FamilyBranch<F>, &[f64], f64) -> f64 + 'a;
+
 /// The adjoint of a scalar test `ψ` at a located `(q, ω)` of `t.at`: the
 /// Newton matrix `[[J, R_ω], [ψ_q, ψ_ω]]` by [`extended_matrix`],
 /// `F_p = [R_p; ψ_p]` by central differences (`psi_p` the test's own).
 fn scalar_adjoint<F: Family>(
     t: &mut Triple<F>,
     (q, omega): (&[f64], f64),
-    test: &mut dyn FnMut(&mut FamilyBranch<F>, &[f64], f64) -> f64,
+    test: &mut ScalarTest<'_, F>,
     psi_p: f64,
     grad_a: &[f64],
     opts: &LocateOptions,

@@ -667,6 +667,7 @@ mod tests {
 
     /// A forced Van der Pol oscillator with a cubic spring (velocity and
     /// displacement nonlinearity, two DOFs coupled).
+    #[allow(clippy::type_complexity)] // a test fixture: the two closures of a GeneralProblem
     fn chain() -> GeneralProblem<impl Fn(&[f64], &[f64], f64, &mut [f64]), impl Fn(f64, &mut [f64])>
     {
         GeneralProblem::new(

@@ -111,7 +111,8 @@ fn duffing_fold_frequencies_move_with_the_force_as_shooting_says() {
         let frc = jobs::frc(&d, &hb, &req).unwrap();
         assert_eq!(frc.folds.len(), 2);
         for fold in &frc.folds {
-            (g.set(0), jac.set(0));
+            g.set(0);
+            jac.set(0);
             let s = sensitivity(
                 family,
                 &hb,
@@ -135,7 +136,8 @@ fn duffing_fold_frequencies_move_with_the_force_as_shooting_says() {
             // One fold location, as the curve does it: from its point
             // nearest the turn.
             let near = &frc.points[fold.index];
-            (g.set(0), jac.set(0));
+            g.set(0);
+            jac.set(0);
             let counted = family(force).unwrap();
             let mut branch = FamilyBranch::new(Frequency(&counted), &hb, near.omega).unwrap();
             let located = locate_fold(

@@ -497,7 +497,8 @@ impl<'a, P: PeriodicProblem> Search<'a, P> {
                     let [a, b] = w else { return false };
                     let la = a.last().copied().unwrap_or(f64::NAN);
                     let lb = b.last().copied().unwrap_or(f64::NAN);
-                    if !((la - omega) * (lb - omega) <= 0.0) || la == lb {
+                    let product = (la - omega) * (lb - omega);
+                    if product.is_nan() || product > 0.0 || la == lb {
                         return false;
                     }
                     let t = (omega - la) / (lb - la);
@@ -832,7 +833,7 @@ impl<'a, P: PeriodicProblem> Search<'a, P> {
 
     /// Both halves of the branch through the fold `(q, ω_f)` with null vector
     /// `v` (stepped `±h` along it), unless known.
-    fn from_fold(
+    fn branches_from_fold(
         &mut self,
         q: &[f64],
         omega: f64,
@@ -935,7 +936,7 @@ impl<'a, P: PeriodicProblem> Search<'a, P> {
                         omega: crossing.omega,
                         event: None,
                     };
-                    if let Err(why) = self.from_fold(
+                    if let Err(why) = self.branches_from_fold(
                         &crossing.coeffs,
                         crossing.omega,
                         &crossing.null_vector,

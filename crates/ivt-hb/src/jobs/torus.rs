@@ -110,7 +110,7 @@ impl TorusRequest {
         }
         positive("ds", self.ds)?;
         positive("ds_max", self.ds_max)?;
-        if !(self.tol >= 0.0) {
+        if self.tol.is_nan() || self.tol < 0.0 {
             return Err(HbError::InvalidInput(format!(
                 "`tol` = {} must be ≥ 0",
                 self.tol
