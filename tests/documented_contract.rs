@@ -15,6 +15,8 @@
 
 #[path = "common/interrupt.rs"]
 mod interrupt;
+#[path = "common/rig.rs"]
+mod rig;
 
 use interrupt::interrupt_once_staged;
 use ivt_sim::testing::scratch_dir;
@@ -141,6 +143,29 @@ fn the_documented_statuses_and_kinds_are_what_the_commands_end_with() {
         seen_statuses.insert(code);
         seen_kinds.insert(kind.to_string());
     }
+    // unidentifiable: the thesis-ch4 preset's commissioning run under the
+    // default plan does not determine J_a (docs/guide/src/rig/identification.md)
+    let plant = dir.join("ch4_plant.toml");
+    std::fs::write(&plant, "[plant]\npreset = \"thesis-ch4\"\n").unwrap();
+    let rec = dir.join("ch4.mcap");
+    let (code, v) = rig::commission_sim(&plant, &rec, &[]);
+    assert_eq!(code, 0, "{v}");
+    let identified = dir.join("ch4_identified.toml");
+    let args = [
+        "rig",
+        "identify",
+        rec.to_str().unwrap(),
+        "--out",
+        identified.to_str().unwrap(),
+    ];
+    let (code, v) = run(&args);
+    assert_eq!(
+        (code, v["kind"].as_str()),
+        (2, Some("unidentifiable")),
+        "{v}"
+    );
+    seen_statuses.insert(code);
+    seen_kinds.insert("unidentifiable".to_string());
     for signal in ["INT", "TERM"] {
         let (code, v) = interrupted(signal);
         assert_eq!(

@@ -152,7 +152,8 @@ impl From<ivt_design::IvtError> for CliError {
     version,
     about = "IVT toolkit: kinematics, harmonic balance, controller and simulator (Wang 2017)",
     after_help = "Exit status: 0 success; 2 failure, under --json with one {\"error\", \"kind\"} \
-                  object on stdout, kind \"usage\" | \"input\" | \"failed\" | \"io\"; 130 stopped \
+                  object on stdout, kind \"usage\" | \"input\" | \"failed\" | \"io\" | \"unidentifiable\"; 130 \
+                  stopped \
                   by SIGINT/SIGTERM (kind \"interrupted\"). Inputs are read from regular files only; \
                   no output replaces an input of the run. See the guide's Limits and errors."
 )]

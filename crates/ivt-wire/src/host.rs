@@ -124,7 +124,11 @@ fn missing_image(elf: &Path) -> String {
              run firmware/run-qemu.sh build there, or set $IVT_FW_ELF to an image"
         )
     } else {
-        format!("firmware image {} not found", elf.display())
+        format!(
+            "firmware image {} not found: set $IVT_FW_ELF to an image, or build the \
+             source tree's with firmware/run-qemu.sh build",
+            elf.display()
+        )
     }
 }
 

@@ -8,6 +8,7 @@ use super::{to_json, CliError, Output};
 use clap::Args;
 use ivt_hb::jobs::{self, DiagramRequest};
 use ivt_hb::{GeneralProblem, PeriodicProblem};
+use ivt_kin::params::Typed;
 
 /// `ivt hb diagram` (defaults: F = 0.1 on DOF 1, ω_f from 0.5 to 2.5).
 #[derive(Args)]
@@ -65,7 +66,7 @@ pub fn run(a: DiagramArgs) -> Result<Output, CliError> {
     if !a.force.is_finite() {
         return Err(CliError::Input(format!(
             "--force = {} must be finite",
-            a.force
+            Typed(a.force)
         )));
     }
     let req = DiagramRequest {

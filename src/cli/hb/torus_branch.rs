@@ -11,13 +11,17 @@ use clap::Args;
 use ivt_hb::jobs::{self, FrcRequest, TorusRequest};
 use ivt_hb::torus::{TorusOptions, Truncation};
 use ivt_hb::{c64, BifurcationKind, FrcOptions};
+use ivt_kin::params::Typed;
+
+/// The smallest μ `ivt hb torus` takes.
+const MU_MIN: f64 = 1e-3;
 
 /// `ivt hb torus` (defaults: μ = F = 0.2, the issue's tori at 0.93 and 0.90).
 #[derive(Args)]
 pub struct TorusBranchArgs {
     #[command(flatten)]
     resolution: Resolution,
-    /// The damping parameter μ.
+    /// The damping parameter μ (≥ 1e-3).
     #[arg(long, default_value_t = 0.2)]
     mu: f64,
     /// Forcing amplitude F.
@@ -56,7 +60,18 @@ pub fn run(a: TorusBranchArgs) -> Result<Output, CliError> {
     if !(a.mu.is_finite() && a.force.is_finite()) {
         return Err(CliError::Input(format!(
             "--mu = {} and --force = {} must be finite",
-            a.mu, a.force
+            Typed(a.mu),
+            Typed(a.force)
+        )));
+    }
+    // The FRC's resonance amplitude grows as (4F/μ)^{1/3} (the only damping
+    // at large x is μx²ẋ): at μ = 1e-3, F = 0.2 the job took 25 s under load
+    // (measured, not asserted); at μ = 1e-300 the path climbs towards 1e100.
+    if a.mu < MU_MIN {
+        return Err(CliError::Input(format!(
+            "--mu = {} must be ≥ {MU_MIN:?}: the forced response's resonance amplitude grows as \
+             (4F/μ)^(1/3), and its frequency response would be followed up to it",
+            Typed(a.mu)
         )));
     }
     let problem = van_der_pol(a.mu, a.force);
@@ -79,7 +94,8 @@ pub fn run(a: TorusBranchArgs) -> Result<Output, CliError> {
         .ok_or_else(|| {
             CliError::Input(format!(
                 "the FRC from ω_f = {} to {} has no located Neimark–Sacker point",
-                a.from, a.to
+                Typed(a.from),
+                Typed(a.to)
             ))
         })?;
     let (Some(omega), Some(coeffs), Some(multipliers)) = (ns.omega, &ns.coeffs, &ns.multipliers)

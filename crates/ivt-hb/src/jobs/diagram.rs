@@ -132,13 +132,13 @@ impl DiagramRequest {
         let (from, to) = (finite("from", self.from)?, finite("to", self.to)?);
         if !(from > 0.0 && to > 0.0 && from != to) {
             return Err(HbError::InvalidInput(format!(
-                "`from` = {from}, `to` = {to} must be > 0 and distinct"
+                "`from` = {from:?}, `to` = {to:?} must be > 0 and distinct"
             )));
         }
         if let Some((lo, hi)) = self.fold_scale {
             if !(lo.is_finite() && hi.is_finite() && lo < 1.0 && hi > 1.0) {
                 return Err(HbError::InvalidInput(format!(
-                    "`fold_scale` = ({lo}, {hi}) must be finite with lo < 1 < hi"
+                    "`fold_scale` = ({lo:?}, {hi:?}) must be finite with lo < 1 < hi"
                 )));
             }
         }
@@ -149,7 +149,7 @@ impl DiagramRequest {
         let step = finite("step", self.step)?;
         if !(step > 0.0 && step <= 1.0) {
             return Err(HbError::InvalidInput(format!(
-                "`step` = {step} must be in (0, 1]"
+                "`step` = {step:?} must be in (0, 1]"
             )));
         }
         Ok(())

@@ -94,7 +94,7 @@ impl TorusRequest {
         all_finite(&[("omega", self.omega), ("omega_to", self.omega_to)])?;
         if !(self.omega > 0.0 && self.omega_to > 0.0 && self.omega != self.omega_to) {
             return Err(HbError::InvalidInput(format!(
-                "the start's ω_f = {} and `omega_to` = {} must be > 0 and distinct",
+                "the start's ω_f = {:?} and `omega_to` = {:?} must be > 0 and distinct",
                 self.omega, self.omega_to
             )));
         }
@@ -105,14 +105,14 @@ impl TorusRequest {
         let step = finite("step", self.step)?;
         if !(step > 0.0 && step <= 1.0) {
             return Err(HbError::InvalidInput(format!(
-                "`step` = {step} must be in (0, 1]"
+                "`step` = {step:?} must be in (0, 1]"
             )));
         }
         positive("ds", self.ds)?;
         positive("ds_max", self.ds_max)?;
         if self.tol.is_nan() || self.tol < 0.0 {
             return Err(HbError::InvalidInput(format!(
-                "`tol` = {} must be ≥ 0",
+                "`tol` = {:?} must be ≥ 0",
                 self.tol
             )));
         }
@@ -219,8 +219,8 @@ pub fn torus<P: PeriodicProblem>(
     let lambda1 = first.last().copied().unwrap_or(f64::NAN);
     if (lambda1 - req.omega) * (req.omega_to - req.omega) < 0.0 {
         return Err(HbError::InvalidInput(format!(
-            "the torus leaves the Neimark–Sacker point at ω_f = {} towards ω_f = {lambda1}: \
-             `omega_to` = {} must lie on that side",
+            "the torus leaves the Neimark–Sacker point at ω_f = {:?} towards ω_f = {lambda1:?}: \
+             `omega_to` = {:?} must lie on that side",
             req.omega, req.omega_to
         )));
     }
