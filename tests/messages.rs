@@ -48,6 +48,22 @@ fn base(path: &[String], log: &str, scene: &str, out: &str) -> Option<Vec<String
     let path: Vec<&str> = path.iter().map(String::as_str).collect();
     let mcap = format!("{out}/unused.mcap");
     let extra: &[&str] = match path.as_slice() {
+        // the torus and the diagram at a low resolution (4 s and 2 s, not 30 s)
+        ["hb", "torus"] => &[
+            "--n",
+            "8",
+            "--samples",
+            "24",
+            "--h1",
+            "3",
+            "--h2",
+            "6",
+            "--at",
+            "0.93",
+            "--omega-to",
+            "0.92",
+        ],
+        ["hb", "diagram"] => &["--n", "5", "--samples", "16", "--depth", "0"],
         ["kin", _] | ["hb", _] | ["ol", "table" | "fit"] | ["stability-map"] => &[],
         ["ol", "solve"] | ["stability"] => &["--vm", "8", "--tu", "4"],
         ["ctrl", "replay"] => &[log],
@@ -99,6 +115,9 @@ const SLOW: &[(&str, &str, &str)] = &[
     ("switch", "--branch-to", "-1e300"),
     ("switch", "--branch-to", "1e-300"),
     ("switch", "--damping", "1e-300"),
+    ("torus", "--omega-to", "1e-300"),
+    ("diagram", "--from", "1e-300"),
+    ("diagram", "--to", "1e300"),
 ];
 
 /// `-0.5` is a value for every number option (clap read it as the flag
