@@ -472,3 +472,20 @@ def _bladed_disk(blade_stiffness=None):
 
 models = _Namespace(cantilever=_cantilever, solid=_solid, plate=_plate, bladed_disk=_bladed_disk)
 
+
+# --- pickling of element sums (dask ships models to worker processes) --------
+
+import copyreg as _copyreg
+
+
+def _elements_from_state(state):
+    """The sum of elements that ``Elements._state()`` lists, rebuilt by the
+    constructors (the inverse of the pickling below)."""
+    out = None
+    for name, params, dof, to in state:
+        e = getattr(elements, name)(*params, dof=dof, to=to)
+        out = e if out is None else out + e
+    return out
+
+
+_copyreg.pickle(Elements, lambda e: (_elements_from_state, (e._state(),)))
