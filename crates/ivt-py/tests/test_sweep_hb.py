@@ -206,3 +206,16 @@ def test_dask_process_cluster_equals_the_local_sweep() -> None:
     assert_identical(remote[3], hb.frc(m, c, k, g, f, **DISK))
     peaks = [float(np.max(r["amplitude"])) for r in remote]
     assert len(set(peaks)) == 6
+
+
+def test_the_mistuned_disk_example_runs(tmp_path: Any) -> None:
+    import pathlib
+    import subprocess
+    import sys
+
+    example = pathlib.Path(__file__).resolve().parents[1] / "examples" / "mistuned_disks.py"
+    png = tmp_path / "amplification.png"
+    out = subprocess.run([sys.executable, str(example), "--disks", "3", "--workers", "0", "--plot", str(png)],
+                         check=True, capture_output=True, text=True, timeout=300).stdout
+    assert "3 of 3 disks crossed the band" in out and "peak amplification" in out, out
+    assert png.stat().st_size > 0
