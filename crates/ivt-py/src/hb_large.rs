@@ -384,7 +384,34 @@ fn cantilever_coo<'py>(
     };
     let beam = ivt_hb::models::cantilever(n_elements, &props)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    let mats = beam.model.triplets().map(|t| {
+    model_coo(py, &beam.model, beam.tip)
+}
+
+/// pyHarm's 24-sector bladed disk of issue 28 as COO triplets, `(n_dof,
+/// (m, c, k), tip)` as [`cantilever_coo`]; `blade_stiffness` (24 factors, one
+/// per sector's blade springs; None: the tuned disk) mistunes it (private:
+/// `ivt.hb.models.bladed_disk`).
+#[pyfunction]
+#[pyo3(signature = (blade_stiffness = None))]
+fn bladed_disk_coo<'py>(
+    py: Python<'py>,
+    blade_stiffness: Option<Vec<f64>>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let disk = match blade_stiffness {
+        Some(factors) => ivt_hb::models::bladed_disk_mistuned(&factors),
+        None => ivt_hb::models::bladed_disk(),
+    }
+    .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    model_coo(py, &disk.model, disk.tip)
+}
+
+/// `(n_dof, (m, c, k), dof)` with each matrix `(rows, cols, values)` arrays.
+fn model_coo<'py>(
+    py: Python<'py>,
+    model: &ivt_hb::models::SparseModel,
+    dof: usize,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let mats = model.triplets().map(|t| {
         let rows: Vec<usize> = t.iter().map(|e| e.0).collect();
         let cols: Vec<usize> = t.iter().map(|e| e.1).collect();
         let vals: Vec<f64> = t.iter().map(|e| e.2).collect();
@@ -394,7 +421,7 @@ fn cantilever_coo<'py>(
             vals.into_pyarray(py),
         )
     });
-    (beam.model.n_dof(), mats, beam.tip).into_pyobject(py)
+    (model.n_dof(), mats, dof).into_pyobject(py)
 }
 
 /// Register the large-structure functions on `ivt._ivt.hb`.
@@ -402,5 +429,6 @@ pub fn register(hb: &Bound<'_, PyModule>) -> PyResult<()> {
     hb.add_function(wrap_pyfunction!(frc_large, hb)?)?;
     hb.add_function(wrap_pyfunction!(solve_large, hb)?)?;
     hb.add_function(wrap_pyfunction!(cantilever_coo, hb)?)?;
+    hb.add_function(wrap_pyfunction!(bladed_disk_coo, hb)?)?;
     Ok(())
 }

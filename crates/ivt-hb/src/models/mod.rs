@@ -9,7 +9,7 @@ mod bladed_disk;
 mod cantilever;
 mod plate;
 
-pub use bladed_disk::{bladed_disk, BladedDisk};
+pub use bladed_disk::{bladed_disk, bladed_disk_mistuned, BladedDisk, SECTORS};
 pub use cantilever::{cantilever, element_dofs, BeamProperties, Cantilever};
 pub use plate::{plate, Plate, SolidProperties};
 

@@ -453,4 +453,39 @@ def _plate(nx, ny=None, nz=2, size=(1.0, 0.2, 0.02), young=210e9, poisson=0.3, d
     return m, k, dof(corner, 2)
 
 
-models = _Namespace(cantilever=_cantilever, solid=_solid, plate=_plate)
+def _bladed_disk(blade_stiffness=None):
+    """pyHarm's 24-sector lumped bladed disk of issue 28 (tutorial 006):
+    sectors of three DOFs [disk, blade root, blade tip], M = diag(1.2, 0.35,
+    0.25), disk-to-ground 6e5, disk-root 1e6, root-tip 2e6, neighbouring
+    disks joined by 5e7 (cyclically), C = 2e-6 K. ``blade_stiffness``: 24
+    factors scaling each sector's blade springs (stiffness mistuning; None or
+    all ones: the tuned disk). Returns (m, c, k, tip) with scipy.sparse CSR
+    matrices and the index of sector 0's blade tip (DOF 2), where the
+    tutorial's force and cubic spring 5e10·x³ act."""
+    import scipy.sparse as sp
+
+    factors = None if blade_stiffness is None else [float(v) for v in _np.ravel(blade_stiffness)]
+    n, mats, tip = _ivt.hb.bladed_disk_coo(factors)
+    m, c, k = (sp.csr_matrix((v, (r, cc)), shape=(n, n)) for r, cc, v in mats)
+    return m, c, k, tip
+
+
+models = _Namespace(cantilever=_cantilever, solid=_solid, plate=_plate, bladed_disk=_bladed_disk)
+
+
+# --- pickling of element sums (dask ships models to worker processes) --------
+
+import copyreg as _copyreg
+
+
+def _elements_from_state(state):
+    """The sum of elements that ``Elements._state()`` lists, rebuilt by the
+    constructors (the inverse of the pickling below)."""
+    out = None
+    for name, params, dof, to in state:
+        e = getattr(elements, name)(*params, dof=dof, to=to)
+        out = e if out is None else out + e
+    return out
+
+
+_copyreg.pickle(Elements, lambda e: (_elements_from_state, (e._state(),)))

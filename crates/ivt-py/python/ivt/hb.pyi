@@ -234,6 +234,10 @@ class models:
         poisson: float = 0.3,
         density: float = 7800.0,
     ) -> Tuple[SparseMatrix, SparseMatrix, int]: ...
+    @staticmethod
+    def bladed_disk(
+        blade_stiffness: Optional[npt.ArrayLike] = None,
+    ) -> Tuple[SparseMatrix, SparseMatrix, SparseMatrix, int]: ...
 
 # Branch switching (issue 27 item 2, crates/ivt-py/src/hb_switch.rs).
 def torus_branch(
