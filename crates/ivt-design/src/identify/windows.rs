@@ -215,8 +215,9 @@ impl Lag {
     }
 }
 
-/// ∫ f dθ and ∫ f² dθ over [θ0, θ1] exactly (Eq. 43: f = A cos(θ − kπ/2)
-/// on segment k), split at a corner π/4 + kπ/2 inside (f has a kink there).
+/// ∫ f dθ, ∫ f² dθ and ∫ f·(θ − θ_m) dθ (θ_m the middle) over [θ0, θ1]
+/// exactly (Eq. 43: f = A cos(θ − kπ/2) on segment k), split at a corner
+/// π/4 + kπ/2 inside (f has a kink there).
 ///
 /// A midpoint rule here biased J_d by +1 %: the motor's work per window
 /// (≈ 10 J) is three orders above the gravity work that fixes the scale
@@ -225,16 +226,26 @@ impl Lag {
 /// f's kink) are of the size of the equation noise, and they are correlated
 /// with the J_d column (the windows across a corner are those from
 /// kπ/2 + π/8 to kπ/2 + 3π/8).
-pub fn f_integrals(theta0: f64, theta1: f64) -> [f64; 2] {
+pub fn f_integrals(theta0: f64, theta1: f64) -> [f64; 3] {
+    let middle = 0.5 * (theta0 + theta1);
     let on = |a: f64, b: f64, k: i64| {
-        // θ − kπ/2 at the ends; sums and differences of sines in product
-        // form (no cancellation over a pulse interval).
+        // c = θ − kπ/2 at the ends as mid ± half: every sine from the two
+        // pairs (sums and differences in product form, no cancellation
+        // over a pulse interval).
         let (c0, c1) = (a - k as f64 * FRAC_PI_2, b - k as f64 * FRAC_PI_2);
-        let (mid, half) = (0.5 * (c0 + c1), 0.5 * (c1 - c0));
+        let (s_m, c_m) = (0.5 * (c0 + c1)).sin_cos();
+        let (s_h, c_h) = (0.5 * (c1 - c0)).sin_cos();
+        let half = 0.5 * (c1 - c0);
+        let (sin_c0, sin_c1) = (s_m * c_h - c_m * s_h, s_m * c_h + c_m * s_h);
         let amp = ivt_kin::NCG_AMPLITUDE;
+        // cos 2·mid · sin 2·half
+        let cos2m_sin2h = (1.0 - 2.0 * s_m * s_m) * 2.0 * s_h * c_h;
+        // the primitive of A cos c·(θ − θ_m) is A((θ − θ_m) sin c + cos c)
+        let moment = (b - middle) * sin_c1 - (a - middle) * sin_c0 - 2.0 * s_m * s_h;
         [
-            2.0 * amp * mid.cos() * half.sin(),
-            amp * amp * (half + 0.5 * (2.0 * mid).cos() * (2.0 * half).sin()),
+            2.0 * amp * c_m * s_h,
+            amp * amp * (half + 0.5 * cos2m_sin2h),
+            amp * moment,
         ]
     };
     let (k0, k1) = (variant::segment_of(theta0), variant::segment_of(theta1));
@@ -242,8 +253,8 @@ pub fn f_integrals(theta0: f64, theta1: f64) -> [f64; 2] {
         return on(theta0, theta1, k0);
     }
     let corner = variant::segment_end(k0);
-    let ([a1, a2], [b1, b2]) = (on(theta0, corner, k0), on(corner, theta1, k1));
-    [a1 + b1, a2 + b2]
+    let ([a1, a2, a3], [b1, b2, b3]) = (on(theta0, corner, k0), on(corner, theta1, k1));
+    [a1 + b1, a2 + b2, a3 + b3]
 }
 
 /// The motor's inputs over pulse interval k (Eq. 137's armature voltage and
@@ -251,16 +262,16 @@ pub fn f_integrals(theta0: f64, theta1: f64) -> [f64; 2] {
 /// ∫ f dθ / Δt exactly; with ∫ f dθ, ∫ f² dθ ([`f_integrals`]), T_U and the
 /// duration Δt. None: a non-increasing pulse time or an input outside the
 /// sensor record.
-fn interval(rec: &Recording, k: usize) -> Option<([f64; 2], [f64; 2], f64, f64)> {
+fn interval(rec: &Recording, k: usize) -> Option<([f64; 2], [f64; 3], f64, f64)> {
     let t = &rec.pulse_t;
     let (t0, t1) = (*t.get(k)?, *t.get(k + 1)?);
     let dt = t1 - t0;
     if dt.is_nan() || dt <= 0.0 {
         return None;
     }
-    let [f1, f2] = f_integrals(rec.theta_of(k), rec.theta_of(k + 1));
+    let f = f_integrals(rec.theta_of(k), rec.theta_of(k + 1));
     let (v_m, t_u) = rec.inputs_at(0.5 * (t0 + t1))?;
-    Some(([v_m, f1 / dt], [f1, f2], t_u, dt))
+    Some(([v_m, f[0] / dt], f, t_u, dt))
 }
 
 /// [`Integrals`] from pulse `a` to pulse `b` at eccentricity `r` with the
@@ -300,13 +311,17 @@ pub fn integrals(rec: &Recording, a: usize, b: usize, r: f64, lag_s: f64) -> Opt
     }
     for k in a..b {
         let (th0, th1) = (rec.theta_of(k), rec.theta_of(k + 1));
-        let (u, [f1, f2], t_u, dt) = interval(rec, k)?;
+        let (u, [f1, f2, f1_moment], t_u, dt) = interval(rec, k)?;
         let [v_m, f_omega] = lag.step(u, dt);
         // ∫ f (f ω)_lag dθ: with τ = 0 the speed is the interval's mean
-        // dθ/dt against the exact ∫ f² dθ; with τ > 0 the lagged speed
-        // (smooth over τ) against the exact ∫ f dθ.
+        // dθ/dt against the exact ∫ f² dθ; with τ > 0 the lagged speed x
+        // as a line in θ over the interval, its mean and its slope
+        // dx/dθ = (u − x)/(τ ω) from the lag's own equation, against the
+        // exact ∫ f and ∫ f·(θ − θ_m) (the slope term matters on the
+        // interval that holds a corner of f).
         s.damp += if lag_s > 0.0 {
-            f1 * f_omega
+            let slope = (u[1] - f_omega) * dt / (lag_s * dtheta);
+            f1 * f_omega + slope * f1_moment
         } else {
             f2 * dtheta / dt
         };
@@ -380,17 +395,24 @@ mod tests {
         assert_eq!(none.step(u, dt), u);
     }
 
-    /// ∫ f and ∫ f² over intervals inside a segment and across a corner
+    /// ∫ f, ∫ f² and ∫ f·(θ − θ_m) over intervals inside a segment and across a corner
     /// equal a composite Simpson rule on each side of the corner (10⁴
     /// panels each, error ~1e-17), to 1e-14; the midpoint rule they
     /// replace is off by ~h²/24 relative inside and by ~A h²/(8√2) at
     /// a corner.
     #[test]
     fn f_integrals_are_exact_across_a_corner() {
-        let simpson = |a: f64, b: f64, p: i32| {
+        let simpson = |a: f64, b: f64, p: i32, m: f64| {
             let n = 10_000;
             let h = (b - a) / n as f64;
-            let g = |x: f64| variant::f(x).powi(p);
+            // p = 3: f·(θ − m)
+            let g = |x: f64| {
+                if p == 3 {
+                    variant::f(x) * (x - m)
+                } else {
+                    variant::f(x).powi(p)
+                }
+            };
             let odd: f64 = (0..n / 2).map(|i| g(a + (2 * i + 1) as f64 * h)).sum();
             let even: f64 = (1..n / 2).map(|i| g(a + (2 * i) as f64 * h)).sum();
             h / 3.0 * (g(a) + g(b) + 4.0 * odd + 2.0 * even)
@@ -406,10 +428,12 @@ mod tests {
             let got = f_integrals(a, b);
             let (k0, k1) = (variant::segment_of(a), variant::segment_of(b));
             let mid = if k1 > k0 { variant::segment_end(k0) } else { b };
-            for p in [1, 2] {
-                let want = simpson(a, mid, p) + if k1 > k0 { simpson(mid, b, p) } else { 0.0 };
+            let m = 0.5 * (a + b);
+            for p in [1, 2, 3] {
+                let want =
+                    simpson(a, mid, p, m) + if k1 > k0 { simpson(mid, b, p, m) } else { 0.0 };
                 let e = got[p as usize - 1] - want;
-                assert!(e.abs() < 1e-14, "[{a}, {b}] f^{p}: {e:e}");
+                assert!(e.abs() < 1e-14, "[{a}, {b}] integral {p}: {e:e}");
             }
         }
     }
