@@ -232,7 +232,7 @@ fn rewrite(
 /// The case: V_m and T_U stuck at their first readings while the
 /// sequences run. Before: exit 0 with k_t = 0.113 against 0.76 and
 /// intervals excluding the truth. Now: refused, the residual 87× the noise
-/// the two halves imply (the limit is 3×; clean runs measure 0.9–1.04), both
+/// the two halves imply (the limit is 3×; clean runs measure 0.86–1.10), both
 /// sensors named.
 #[test]
 fn stuck_sensors_are_refused_and_named() {
