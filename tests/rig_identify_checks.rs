@@ -24,14 +24,20 @@ fn scratch(name: &str) -> PathBuf {
     d
 }
 
-/// `ivt rig commission --sim` with realistic sensors on the plant whose
-/// `[plant]` body is `body`: the recording's path and the true parameters.
+/// `ivt rig commission --sim` with realistic sensors (seed 1) on the plant
+/// whose `[plant]` body is `body`: the recording's path and the true parameters.
 fn commission(dir: &Path, body: &str) -> (PathBuf, PlantParams) {
+    commission_with(dir, body, "realistic", 1)
+}
+
+/// [`commission`] with the sensor model `sensors` and the noise seed `seed`.
+fn commission_with(dir: &Path, body: &str, sensors: &str, seed: u64) -> (PathBuf, PlantParams) {
     let plant = dir.join("rig_plant.toml");
     let text = format!("[plant]\n{body}\n");
     std::fs::write(&plant, &text).unwrap();
     let out = dir.join("run.mcap");
-    let (code, v) = commission_sim(&plant, &out, &["--sensors", "realistic", "--seed", "1"]);
+    let seed = seed.to_string();
+    let (code, v) = commission_sim(&plant, &out, &["--sensors", sensors, "--seed", &seed]);
     assert_eq!(code, 0, "{v}");
     let truth = PlantSection::parse_file(&text, "rig_plant.toml")
         .unwrap()
@@ -65,28 +71,63 @@ fn required(p: &PlantParams) -> [(&'static str, f64); 5] {
     ]
 }
 
-/// The truth of every required coefficient inside its reported 95 % interval.
-fn assert_inside(name: &str, v: &Value, p: &PlantParams) {
-    for (key, want) in required(p) {
-        let ci = &v["ci95"][key];
-        let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
-        eprintln!("{name} {key}: {want:.5e} in [{lo:.5e}, {hi:.5e}]");
-        assert!(
-            lo <= want && want <= hi,
-            "{name} {key}: {want} outside [{lo}, {hi}]"
-        );
-    }
+/// Every coefficient of Eq. 151 with its true value (J_b and J_c too: an
+/// interval that includes 0 says "not determined", it must still hold the truth).
+fn coefficients(p: &PlantParams) -> [(&'static str, f64); 7] {
+    let [a, d, damping, gain, load] = required(p);
+    [
+        a,
+        ("j_b", p.j_b()),
+        ("j_c", p.j_c()),
+        d,
+        damping,
+        gain,
+        load,
+    ]
 }
 
-/// Every preset and a plant with L_a = 1 mH: identified with the truth
-/// inside the intervals, or refused as `unidentifiable` naming the
-/// coefficient. Pinned: `printed` and L_a = 1 mH (Eq. 137 with the nominal
-/// L_a) are identified, the model string stating the L_a used; `thesis-ch4`
-/// is refused: under the default plan its motor runs at up to 960 rpm, where
-/// the gravity work that fixes the scale of Eq. 151 (2.1e-2 J RMS per window)
-/// is below the equation's residual (2.5e-2 J), and J_a's interval includes
-/// 0 (before: exit 0 was never reached either, "k_t = −0.00046 is not
-/// physical", a failure that named no cause).
+/// The coefficients whose reported 95 % interval misses the truth (each
+/// printed with its interval).
+fn misses(name: &str, v: &Value, p: &PlantParams) -> Vec<&'static str> {
+    let mut out = Vec::new();
+    for (key, want) in coefficients(p) {
+        let ci = &v["ci95"][key];
+        let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
+        let inside = lo <= want && want <= hi;
+        eprintln!("{name} {key}: {want:.5e} in [{lo:.5e}, {hi:.5e}]: {inside}");
+        if !inside {
+            out.push(key);
+        }
+    }
+    out
+}
+
+/// Noise seeds of the realistic sensors per plant.
+const SEEDS: u64 = 10;
+
+/// A 95 % interval misses the truth in 5 % of the runs: of [`SEEDS`]
+/// independent runs, 3 or more misses of one coefficient happen with
+/// probability 1.2 % (binomial), so more than this many is a lie.
+const MISSES_ALLOWED: usize = 2;
+
+/// Every preset and a plant with L_a = 1 mH, each commissioned with ideal
+/// sensors and with realistic ones under [`SEEDS`] noise seeds: identified,
+/// or refused as `unidentifiable` naming the coefficient. Identified, the
+/// ideal run has the truth of all seven coefficients inside their 95 %
+/// intervals, and of the realistic runs at most [`MISSES_ALLOWED`] miss it
+/// for any one coefficient (measured: `printed` none, L_a = 1 mH one run,
+/// seed 2, whose scale — J_a, the motor's two, the load gain together — is
+/// 1.1 half-widths off). Pinned: `printed` and L_a = 1 mH (Eq. 137 with the
+/// nominal L_a) are identified, the model string stating the L_a used;
+/// `thesis-ch4` is refused: under the default plan its motor runs at up to
+/// 960 rpm, where the gravity work that fixes the scale of Eq. 151 (2.1e-2 J
+/// RMS per window) is not above the equation's residual (2.1e-2 J with ideal
+/// sensors: the timer's 1 µs tick on edges ~50 µs apart), and J_a's interval
+/// includes 0.
+///
+/// Before the θ-integrals of f and f² were exact (a midpoint rule over each
+/// pulse interval), `printed` with ideal sensors gave J_d = 0.002364 with
+/// the interval [0.002353, 0.002375] against the true 0.002347.
 #[test]
 fn every_preset_is_identified_inside_its_intervals_or_refused_with_the_reason() {
     let mut cases: Vec<(String, String)> = PlantPreset::ALL
@@ -94,45 +135,66 @@ fn every_preset_is_identified_inside_its_intervals_or_refused_with_the_reason() 
         .map(|p| (p.name().to_string(), format!("preset = \"{}\"", p.name())))
         .collect();
     cases.push(("l_a = 1 mH".into(), "l_a = 1e-3".into()));
-    for (name, body) in cases {
-        let dir = scratch(&name.replace(' ', "_"));
-        let (rec, truth) = commission(&dir, &body);
-        let (code, v, secs) = identify(&rec);
-        eprintln!("{name}: exit {code} in {secs:.1} s");
-        match code {
-            0 => assert_inside(&name, &v, &truth),
-            _ => {
-                assert_eq!(code, 2, "{name}: {v}");
-                assert_eq!(v["kind"], "unidentifiable", "{name}: {v}");
-                let e = v["error"].as_str().unwrap();
-                assert!(
-                    e.contains("is not identifiable") || e.contains("not consistent"),
-                    "{e}"
-                );
+    let runs = std::iter::once(("ideal", 1)).chain((1..=SEEDS).map(|s| ("realistic", s)));
+    for (case, body) in cases {
+        let mut missed: BTreeMap<&str, Vec<u64>> = BTreeMap::new();
+        for (sensors, seed) in runs.clone() {
+            let dir = scratch(&format!("{}-{sensors}-{seed}", case.replace(' ', "_")));
+            let (rec, truth) = commission_with(&dir, &body, sensors, seed);
+            let (code, v, secs) = identify(&rec);
+            let name = format!("{case} ({sensors} sensors, seed {seed})");
+            eprintln!("{name}: exit {code} in {secs:.1} s");
+            match code {
+                0 => {
+                    let out = misses(&name, &v, &truth);
+                    if sensors == "ideal" {
+                        assert!(out.is_empty(), "{name}: the truth outside {out:?}");
+                    }
+                    for key in out {
+                        missed.entry(key).or_default().push(seed);
+                    }
+                }
+                _ => {
+                    assert_eq!(code, 2, "{name}: {v}");
+                    assert_eq!(v["kind"], "unidentifiable", "{name}: {v}");
+                    let e = v["error"].as_str().unwrap();
+                    assert!(
+                        e.contains("is not identifiable") || e.contains("not consistent"),
+                        "{e}"
+                    );
+                }
+            }
+            match case.as_str() {
+                "printed" => {
+                    assert_eq!(code, 0, "{v}");
+                    assert!(v["model"].as_str().unwrap().contains("L_a = 0"), "{v}");
+                }
+                "l_a = 1 mH" => {
+                    assert_eq!(code, 0, "{v}");
+                    assert!(v["model"]
+                        .as_str()
+                        .unwrap()
+                        .starts_with("Eq. 137 with L_a = 0.001 H"));
+                    assert_eq!(v["l_a"], 1e-3);
+                }
+                "thesis-ch4" => {
+                    assert_eq!(code, 2, "{v}");
+                    let e = v["error"].as_str().unwrap();
+                    assert!(
+                        e.contains("j_a is not identifiable") && e.contains("includes 0"),
+                        "{e}"
+                    );
+                }
+                _ => {}
             }
         }
-        match name.as_str() {
-            "printed" => {
-                assert_eq!(code, 0, "{v}");
-                assert!(v["model"].as_str().unwrap().contains("L_a = 0"), "{v}");
-            }
-            "l_a = 1 mH" => {
-                assert_eq!(code, 0, "{v}");
-                assert!(v["model"]
-                    .as_str()
-                    .unwrap()
-                    .starts_with("Eq. 137 with L_a = 0.001 H"));
-                assert_eq!(v["l_a"], 1e-3);
-            }
-            "thesis-ch4" => {
-                assert_eq!(code, 2, "{v}");
-                let e = v["error"].as_str().unwrap();
-                assert!(
-                    e.contains("j_a is not identifiable") && e.contains("includes 0"),
-                    "{e}"
-                );
-            }
-            _ => {}
+        eprintln!("{case}: seeds whose interval misses the truth {missed:?}");
+        for (key, seeds) in &missed {
+            assert!(
+                seeds.len() <= MISSES_ALLOWED,
+                "{case} {key}: the truth outside the 95 % interval in {} of {SEEDS} runs (seeds {seeds:?})",
+                seeds.len()
+            );
         }
     }
 }
@@ -170,7 +232,7 @@ fn rewrite(
 /// The issue's case: V_m and T_U stuck at their first readings while the
 /// sequences run. Before: exit 0 with k_t = 0.113 against 0.76 and
 /// intervals excluding the truth. Now: refused, the residual 87× the noise
-/// the two halves imply (the limit is 3×; clean runs measure 0.9–1.04), both
+/// the two halves imply (the limit is 3×; clean runs measure 0.86–1.10), both
 /// sensors named.
 #[test]
 fn stuck_sensors_are_refused_and_named() {
@@ -183,7 +245,16 @@ fn stuck_sensors_are_refused_and_named() {
         (0.8..1.5).contains(&ratio),
         "clean run: residual/noise = {ratio}"
     );
-    assert_eq!(clean["warnings"].as_array().unwrap().len(), 0, "{clean}");
+    // Its only possible warnings: J_b or J_c not determined (seed 1's J_c
+    // interval is [−0.005, 1.63], truth 0.339), never a stuck sensor or a
+    // residual beyond the noise.
+    for w in clean["warnings"].as_array().unwrap() {
+        let w = w.as_str().unwrap();
+        assert!(
+            (w.starts_with("j_b = ") || w.starts_with("j_c = ")) && w.contains("not determined"),
+            "{w}"
+        );
+    }
 
     let data = std::fs::read(&rec).unwrap();
     let first = mcap::MessageStream::new(&data)
