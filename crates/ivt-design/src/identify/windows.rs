@@ -276,7 +276,7 @@ fn interval(rec: &Recording, k: usize) -> Option<([f64; 2], [f64; 3], f64, f64)>
 
 /// [`Integrals`] from pulse `a` to pulse `b` at eccentricity `r` with the
 /// motor lag `lag_s` = L_a/R_a (its state settled over the
-/// [`LAG_WARMUP`] time constants of pulses before `a`, as far as they are
+/// 12 (`LAG_WARMUP`) time constants of pulses before `a`, as far as they are
 /// recorded without a gap). None: a non-increasing pulse time or an input
 /// outside the sensor record.
 pub fn integrals(rec: &Recording, a: usize, b: usize, r: f64, lag_s: f64) -> Option<Integrals> {
