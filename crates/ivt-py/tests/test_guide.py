@@ -3,6 +3,7 @@ run them, chapter by chapter:
 
 - each chapter runs in a fresh temporary directory (its cwd) that holds what
   a checkout holds and the chapters read: ``scenes/`` (the shipped scenes),
+  ``examples/`` (the example models),
   and the manifests ``Cargo.toml``, ``crates/`` and ``firmware/`` (symlinks
   into the repository, read only);
 - its ```python blocks run top to bottom in ONE fresh namespace, so a later
@@ -76,7 +77,7 @@ def book_dir() -> pathlib.Path:
 
 
 # What a chapter's directory holds of a checkout (symlinks, read only).
-CHECKOUT = ("scenes", "Cargo.toml", "crates", "firmware")
+CHECKOUT = ("scenes", "examples", "Cargo.toml", "crates", "firmware")
 
 
 def checkout(work: pathlib.Path) -> None:

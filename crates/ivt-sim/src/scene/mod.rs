@@ -12,7 +12,7 @@ mod controller;
 mod hardware;
 mod inputs;
 pub mod keys;
-mod locate;
+pub mod locate;
 mod outputs;
 mod plant;
 
