@@ -5,6 +5,7 @@
 //! Python call in the loop.
 
 use ivt_hb::{Element, Law};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::args::{count, int64};
@@ -35,6 +36,48 @@ impl Elements {
 
     fn __len__(&self) -> usize {
         self.list.len()
+    }
+
+    /// The model DOFs the elements act on (each `dof` and `to`), sorted and
+    /// without repeats: the nonlinear DOFs a large model is condensed onto.
+    #[getter]
+    fn dofs(&self) -> Vec<usize> {
+        let mut dofs: Vec<usize> = self
+            .list
+            .iter()
+            .flat_map(|e| [Some(e.a), e.b])
+            .flatten()
+            .collect();
+        dofs.sort_unstable();
+        dofs.dedup();
+        dofs
+    }
+
+    /// The same elements on the sub-vector `x[dofs]` of the model's DOFs:
+    /// each DOF replaced by its position in `dofs` (how the condensed path
+    /// sees them). ValueError naming the element whose DOF `dofs` lacks.
+    fn restricted(&self, dofs: Vec<usize>) -> PyResult<Elements> {
+        let local = |i: usize, e: &Element, d: usize| {
+            dofs.iter().position(|&x| x == d).ok_or_else(|| {
+                PyValueError::new_err(format!(
+                    "element {i} ({}) acts on model DOF {d}, which is not among the nonlinear DOFs {dofs:?}",
+                    call_text(e)
+                ))
+            })
+        };
+        let list = self
+            .list
+            .iter()
+            .enumerate()
+            .map(|(i, e)| {
+                Ok(Element {
+                    a: local(i, e, e.a)?,
+                    b: e.b.map(|b| local(i, e, b)).transpose()?,
+                    law: e.law,
+                })
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        Ok(Elements { list })
     }
 
     fn __repr__(&self) -> String {
