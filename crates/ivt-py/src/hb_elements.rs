@@ -4,7 +4,7 @@
 //! `limit_cycle` or `backbone`: the forces are evaluated in Rust, with no
 //! Python call in the loop.
 
-use ivt_hb::{Element, Law};
+use ivt_hb::{element_dofs, restrict_elements, Element, Law};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -39,45 +39,26 @@ impl Elements {
     }
 
     /// The model DOFs the elements act on (each `dof` and `to`), sorted and
-    /// without repeats: the nonlinear DOFs a large model is condensed onto.
+    /// without repeats: the nonlinear DOFs a large model is condensed onto
+    /// ([`ivt_hb::element_dofs`]).
     #[getter]
     fn dofs(&self) -> Vec<usize> {
-        let mut dofs: Vec<usize> = self
-            .list
-            .iter()
-            .flat_map(|e| [Some(e.a), e.b])
-            .flatten()
-            .collect();
-        dofs.sort_unstable();
-        dofs.dedup();
-        dofs
+        element_dofs(&self.list)
     }
 
     /// The same elements on the sub-vector `x[dofs]` of the model's DOFs:
     /// each DOF replaced by its position in `dofs` (how the condensed path
-    /// sees them). ValueError naming the element whose DOF `dofs` lacks.
+    /// sees them, [`ivt_hb::restrict_elements`]). ValueError naming the
+    /// element whose DOF `dofs` lacks.
     fn restricted(&self, dofs: Vec<usize>) -> PyResult<Elements> {
-        let local = |i: usize, e: &Element, d: usize| {
-            dofs.iter().position(|&x| x == d).ok_or_else(|| {
+        restrict_elements(&self.list, &dofs)
+            .map(|list| Elements { list })
+            .map_err(|(i, d)| {
+                let text = self.list.get(i).map(call_text).unwrap_or_default();
                 PyValueError::new_err(format!(
-                    "element {i} ({}) acts on model DOF {d}, which is not among the nonlinear DOFs {dofs:?}",
-                    call_text(e)
+                    "element {i} ({text}) acts on model DOF {d}, which is not among the nonlinear DOFs {dofs:?}"
                 ))
             })
-        };
-        let list = self
-            .list
-            .iter()
-            .enumerate()
-            .map(|(i, e)| {
-                Ok(Element {
-                    a: local(i, e, e.a)?,
-                    b: e.b.map(|b| local(i, e, b)).transpose()?,
-                    law: e.law,
-                })
-            })
-            .collect::<PyResult<Vec<_>>>()?;
-        Ok(Elements { list })
     }
 
     fn __repr__(&self) -> String {
