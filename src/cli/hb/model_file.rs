@@ -191,28 +191,16 @@ pub fn load(path: &Path) -> Result<Model, CliError> {
         .map_err(|e| CliError::io(path, e))?;
     let origin = path.display().to_string();
     let doc = Doc::new(&src);
-    let at = |span: Option<std::ops::Range<usize>>| match span {
-        Some(s) => {
-            let (line, col) = doc.line_col(s.start);
-            format!("{origin}:{line}:{col}")
-        }
-        None => origin.clone(),
-    };
+    let at = |span: Option<std::ops::Range<usize>>| doc.at(&origin, span);
     let file: ModelFile = toml::from_str(&src).map_err(|e| {
-        let key = e
-            .span()
-            .and_then(|s| doc.path_at(s.start))
-            .map(|k| format!("`{k}`: "))
-            .unwrap_or_default();
-        let msg = e.message().replace('\n', " ");
         // The value as written, unless the message shows it already.
         let got = e
             .span()
             .and_then(|s| src.get(s))
-            .filter(|v| !msg.contains(v.trim()))
+            .filter(|v| !e.message().contains(v.trim()))
             .map(|v| format!(" (got {})", ivt_sim::input::excerpt(v.trim())))
             .unwrap_or_default();
-        CliError::Input(format!("{}: {key}{}{got}", at(e.span()), msg.trim()))
+        CliError::Input(format!("{}{got}", doc.serde_error(&origin, &e)))
     })?;
     let base = path.parent().unwrap_or(Path::new("."));
     let [m, c, k] = [

@@ -43,6 +43,31 @@ impl<'s> Doc<'s> {
         }
     }
 
+    /// `origin:line:col` of the start of `span`, or `origin` without one.
+    #[must_use]
+    pub fn at(&self, origin: &str, span: Option<Range<usize>>) -> String {
+        match span {
+            Some(s) => {
+                let (line, col) = self.line_col(s.start);
+                format!("{origin}:{line}:{col}")
+            }
+            None => origin.to_string(),
+        }
+    }
+
+    /// A deserialization error of this document as one line: its position,
+    /// the key path there and toml's message.
+    #[must_use]
+    pub fn serde_error(&self, origin: &str, e: &toml::de::Error) -> String {
+        let key = e
+            .span()
+            .and_then(|s| self.path_at(s.start))
+            .map(|k| format!("`{k}`: "))
+            .unwrap_or_default();
+        let msg = e.message().replace('\n', " ");
+        format!("{}: {key}{}", self.at(origin, e.span()), msg.trim())
+    }
+
     /// 1-based (line, column) of byte `offset`.
     pub fn line_col(&self, offset: usize) -> (usize, usize) {
         let before = &self.src[..floor_char_boundary(self.src, offset)];
