@@ -199,6 +199,20 @@ pub fn run(cmd: HbCommand) -> Result<Output, CliError> {
     }
 }
 
+/// One line on an orbit: iterations, residual, solve time, amplitude and
+/// the Floquet verdict.
+fn orbit_summary(orbit: &jobs::Orbit) -> String {
+    format!(
+        "{} iterations, ‖r‖ = {:.2e}, {:.1} µs, amplitude {:.6}, {} (|μ|max = {:.6})\n",
+        orbit.iterations,
+        orbit.residual_norm,
+        orbit.solve_time_s * 1e6,
+        orbit.amplitude,
+        orbit.stability.map_or("unknown", |k| k.name()),
+        orbit.max_modulus()
+    )
+}
+
 /// The JSON object of a job's result.
 fn to_json<T: serde::Serialize>(result: &T) -> Result<serde_json::Value, CliError> {
     serde_json::to_value(result).map_err(|e| CliError::Failed(e.to_string()))
@@ -225,16 +239,7 @@ fn duffing(a: DuffingArgs) -> Result<Output, CliError> {
             .with("HB", pts, Style::Line)
             .draw(path)?;
     }
-    let human = format!(
-        "Duffing ω_f = {}: {} iterations, ‖r‖ = {:.2e}, {:.1} µs, amplitude {:.6}, {} (|μ|max = {:.6})\n",
-        a.omega_f,
-        orbit.iterations,
-        orbit.residual_norm,
-        orbit.solve_time_s * 1e6,
-        orbit.amplitude,
-        orbit.stability.map_or("unknown", |k| k.name()),
-        orbit.max_modulus()
-    );
+    let human = format!("Duffing ω_f = {}: {}", a.omega_f, orbit_summary(&orbit));
     Ok(Output {
         json: to_json(&orbit)?,
         human,

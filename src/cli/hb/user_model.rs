@@ -4,7 +4,7 @@
 //! `jobs::orbit` at ω_f); the JSON is their dicts, key for key.
 
 use super::model_file::{self, Model};
-use super::to_json;
+use super::{orbit_summary, to_json};
 use crate::cli::{CliError, Output};
 use clap::Args;
 use ivt_hb::jobs::{self, FrcRequest, OrbitRequest};
@@ -110,15 +110,7 @@ pub fn solve(a: SolveArgs) -> Result<Output, CliError> {
         &model.options,
         &req,
     )?;
-    let human = format!(
-        "ω_f = {}: {} iterations, ‖r‖ = {:.2e}, amplitude {:.6}, {} (|μ|max = {:.6})\n",
-        a.omega,
-        orbit.iterations,
-        orbit.residual_norm,
-        orbit.amplitude,
-        orbit.stability.map_or("unknown", |k| k.name()),
-        orbit.max_modulus()
-    );
+    let human = format!("ω_f = {}: {}", a.omega, orbit_summary(&orbit));
     Ok(Output {
         json: to_json(&orbit)?,
         human,
