@@ -37,7 +37,7 @@ def condensed_beam():
     f = np.zeros(m.shape[0])
     f[tip] = 0.005
     w1 = 3.516015268066119
-    return hb.frc(m, c, k, hb.elements.cubic_spring(200.0, dof=0), f, 1.05 * w1, 1.2 * w1, n=5, samples=16,
+    return hb.frc(m, c, k, hb.elements.cubic_spring(200.0, dof=tip), f, 1.05 * w1, 1.2 * w1, n=5, samples=16,
                   nonlinear_dofs=[tip])
 
 

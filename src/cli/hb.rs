@@ -1,7 +1,7 @@
 //! `ivt hb ...`: harmonic balance (thesis §3.2) — Duffing by modified/classic IHB
 //! with Floquet stability, the Duffing frequency-response curve, and the
 //! Mathieu–Duffing period-doubling cascade, the fold curve in (ω, F), limit
-//! cycles and the Duffing backbone. `--plot FILE.png` draws the result
+//! cycles and the Duffing backbone; `frc` and `solve` on a user's model file. `--plot FILE.png` draws the result
 //! (`figure.rs`: the pictures of `ivt.plot`).
 //! Each command parses its arguments, runs an `ivt_hb::jobs` job and prints
 //! its serialized result (the keys of `ivt.hb`'s dicts).
@@ -12,9 +12,12 @@ mod cycle_branch;
 mod diagram;
 pub(super) mod figure;
 mod folds;
+mod matrix_market;
+mod model_file;
 mod switch;
 mod torus;
 mod torus_branch;
+mod user_model;
 
 use super::{CliError, Output};
 use clap::{Args, Subcommand};
@@ -30,6 +33,11 @@ use std::path::PathBuf;
 /// Harmonic-balance subcommands.
 #[derive(Subcommand)]
 pub enum HbCommand {
+    /// Frequency-response curve of a user's model file (M, C, K, elements,
+    /// forcing; the JSON of `ivt.hb.frc`).
+    Frc(user_model::FrcArgs),
+    /// Periodic solution of a user's model file at one ω_f (the JSON of `ivt.hb.solve`).
+    Solve(user_model::SolveArgs),
     /// Periodic solution of Duffing's equation Eq. 49 (Fig. 28) with Floquet multipliers.
     Duffing(DuffingArgs),
     /// Frequency-response curve of Duffing's equation with stability (Fig. 29).
@@ -173,6 +181,8 @@ pub struct MathieuArgs {
 /// does not converge (the message carries the residual history summary).
 pub fn run(cmd: HbCommand) -> Result<Output, CliError> {
     match cmd {
+        HbCommand::Frc(a) => user_model::frc(a),
+        HbCommand::Solve(a) => user_model::solve(a),
         HbCommand::Duffing(a) => duffing(a),
         HbCommand::DuffingFrc(a) => duffing_frc(a),
         HbCommand::DuffingFolds(a) => folds::run(a),
@@ -187,6 +197,20 @@ pub fn run(cmd: HbCommand) -> Result<Output, CliError> {
         HbCommand::MathieuDuffing(a) => mathieu(a),
         HbCommand::String(a) => super::string::run(a),
     }
+}
+
+/// One line on an orbit: iterations, residual, solve time, amplitude and
+/// the Floquet verdict.
+fn orbit_summary(orbit: &jobs::Orbit) -> String {
+    format!(
+        "{} iterations, ‖r‖ = {:.2e}, {:.1} µs, amplitude {:.6}, {} (|μ|max = {:.6})\n",
+        orbit.iterations,
+        orbit.residual_norm,
+        orbit.solve_time_s * 1e6,
+        orbit.amplitude,
+        orbit.stability.map_or("unknown", |k| k.name()),
+        orbit.max_modulus()
+    )
 }
 
 /// The JSON object of a job's result.
@@ -215,16 +239,7 @@ fn duffing(a: DuffingArgs) -> Result<Output, CliError> {
             .with("HB", pts, Style::Line)
             .draw(path)?;
     }
-    let human = format!(
-        "Duffing ω_f = {}: {} iterations, ‖r‖ = {:.2e}, {:.1} µs, amplitude {:.6}, {} (|μ|max = {:.6})\n",
-        a.omega_f,
-        orbit.iterations,
-        orbit.residual_norm,
-        orbit.solve_time_s * 1e6,
-        orbit.amplitude,
-        orbit.stability.map_or("unknown", |k| k.name()),
-        orbit.max_modulus()
-    );
+    let human = format!("Duffing ω_f = {}: {}", a.omega_f, orbit_summary(&orbit));
     Ok(Output {
         json: to_json(&orbit)?,
         human,

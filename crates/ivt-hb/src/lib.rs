@@ -55,7 +55,7 @@ pub use continuation::{
 pub use cycle_branch::{cycle_branch, CycleBranch, CycleBranchOptions};
 pub use damped::{damped_modes, linear_mode, DampedModePoint, DampedModes};
 pub use deflation::{all_solutions, AllSolutions, FoundSolution, SearchOptions, SearchReport};
-pub use elements::{Element, ElementProblem, Harmonic, Law};
+pub use elements::{element_dofs, restrict_elements, Element, ElementProblem, Harmonic, Law};
 pub use error::HbError;
 pub use events::{
     locate_branch_point, locate_fold, locate_multiplier_crossing, trace, Bifurcation,

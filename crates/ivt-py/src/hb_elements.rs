@@ -4,7 +4,8 @@
 //! `limit_cycle` or `backbone`: the forces are evaluated in Rust, with no
 //! Python call in the loop.
 
-use ivt_hb::{Element, Law};
+use ivt_hb::{element_dofs, restrict_elements, Element, Law};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::args::{count, int64};
@@ -35,6 +36,29 @@ impl Elements {
 
     fn __len__(&self) -> usize {
         self.list.len()
+    }
+
+    /// The model DOFs the elements act on (each `dof` and `to`), sorted and
+    /// without repeats: the nonlinear DOFs a large model is condensed onto
+    /// ([`ivt_hb::element_dofs`]).
+    #[getter]
+    fn dofs(&self) -> Vec<usize> {
+        element_dofs(&self.list)
+    }
+
+    /// The same elements on the sub-vector `x[dofs]` of the model's DOFs:
+    /// each DOF replaced by its position in `dofs` (how the condensed path
+    /// sees them, [`ivt_hb::restrict_elements`]). ValueError naming the
+    /// element whose DOF `dofs` lacks.
+    fn restricted(&self, dofs: Vec<usize>) -> PyResult<Elements> {
+        restrict_elements(&self.list, &dofs)
+            .map(|list| Elements { list })
+            .map_err(|(i, d)| {
+                let text = self.list.get(i).map(call_text).unwrap_or_default();
+                PyValueError::new_err(format!(
+                    "element {i} ({text}) acts on model DOF {d}, which is not among the nonlinear DOFs {dofs:?}"
+                ))
+            })
     }
 
     fn __repr__(&self) -> String {

@@ -3,8 +3,9 @@ run them, chapter by chapter:
 
 - each chapter runs in a fresh temporary directory (its cwd) that holds what
   a checkout holds and the chapters read: ``scenes/`` (the shipped scenes),
-  the manifests ``Cargo.toml``, ``crates/`` and ``firmware/``, and ``bench/``
-  (the benchmark gate's baseline; symlinks into the repository, read only);
+  ``examples/`` (the example models), the manifests ``Cargo.toml``,
+  ``crates/`` and ``firmware/``, and ``bench/`` (the benchmark gate's
+  baseline; symlinks into the repository, read only);
 - its ```python blocks run top to bottom in ONE fresh namespace, so a later
   block uses what an earlier one defined; their assertions are the checks;
 - its ```console blocks run in the same directory, in document order with the
@@ -76,7 +77,7 @@ def book_dir() -> pathlib.Path:
 
 
 # What a chapter's directory holds of a checkout (symlinks, read only).
-CHECKOUT = ("scenes", "Cargo.toml", "crates", "firmware", "bench")
+CHECKOUT = ("scenes", "examples", "Cargo.toml", "crates", "firmware", "bench")
 
 
 def checkout(work: pathlib.Path) -> None:

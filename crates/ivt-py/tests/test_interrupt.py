@@ -34,7 +34,7 @@ LONG_CALLS: Dict[str, str] = {
     "frc_condensed": """
         m, c, k, tip = hb.models.cantilever(1500)
         f = np.zeros(m.shape[0]); f[tip] = 1e-3
-        hb.frc(m, c, k, hb.elements.cubic_spring(1e3), f, 0.5, 200.0, nonlinear_dofs=[tip],
+        hb.frc(m, c, k, hb.elements.cubic_spring(1e3, dof=tip), f, 0.5, 200.0, nonlinear_dofs=[tip],
                n=9)
     """,
     "stability_map": """

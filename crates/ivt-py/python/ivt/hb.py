@@ -233,10 +233,19 @@ def _large_call(native_name, sig, args, kwargs, extra):
     bound.apply_defaults()
     a = _Namespace(**bound.arguments)
     dofs = extra.get("nonlinear_dofs")
-    if dofs is None:
+    g = a.g
+    if isinstance(g, Elements):
+        # An element's dof/to name model DOFs on every path (issue 46): the
+        # condensed path takes its nonlinear DOFs from the elements and sees
+        # them at their positions in that list.
+        if dofs is None:
+            dofs = g.dofs
+        g = g.restricted([_index("nonlinear_dofs", j) for j in dofs])
+    elif dofs is None:
         raise ValueError(
-            "a large model (sparse m/c/k or load-vector f) needs nonlinear_dofs=[...]: "
-            "the DOFs g acts on (g then sees x, v of those DOFs only)"
+            "a large model (sparse m/c/k or load-vector f) with a Python g needs nonlinear_dofs=[...]: "
+            "the DOFs g acts on (g then sees x, v of those DOFs only); ivt.hb.elements name "
+            "their model DOFs themselves"
         )
     n, m = _coo_arrays("m", a.m)
     nc, c = _coo_arrays("c", a.c)
@@ -281,13 +290,13 @@ def _large_call(native_name, sig, args, kwargs, extra):
         kw["reduction_samples"] = (
             _index("reduction_samples", samples) if samples is not None else (3 if n < _FEWER_CHECKS else 2)
         )
-        return _ivt.hb.frc_reduced(n, m, c, k, a.g, f, a.omega_from, a.omega_to, dofs, **kw)
+        return _ivt.hb.frc_reduced(n, m, c, k, g, f, a.omega_from, a.omega_to, dofs, **kw)
     m, c, k = ((r.tolist(), cc.tolist(), v.tolist()) for r, cc, v in (m, c, k))
     if native_name == "frc":
         kw["truncation_estimate"] = bool(given.get("truncation_estimate", True))
-        out = _ivt.hb.frc_large(n, m, c, k, a.g, f, a.omega_from, a.omega_to, dofs, **kw)
+        out = _ivt.hb.frc_large(n, m, c, k, g, f, a.omega_from, a.omega_to, dofs, **kw)
     else:
-        out = _ivt.hb.solve_large(n, m, c, k, a.g, f, a.omega_f, dofs, **kw)
+        out = _ivt.hb.solve_large(n, m, c, k, g, f, a.omega_f, dofs, **kw)
     out["method"] = "exact"
     out["reduction"] = None
     return out
@@ -338,8 +347,10 @@ Large models (issue 28): `m`, `c`, `k` may be scipy.sparse matrices and `f`
 an array F (F cos θ) or a pair (F_cos, F_sin) of load vectors; with
 `nonlinear_dofs=[...]` the problem is condensed onto those DOFs (per harmonic
 the linear DOFs decouple exactly; sparse LU of the dynamic stiffness with
-refinement in double-double residuals) and `g(x, v, theta)` sees x, v of those
-DOFs only. Defaults there: n = 7, samples = 32, rtol = 1e-12 (on the
+refinement in double-double residuals) and a Python `g(x, v, theta)` sees x, v
+of those DOFs only. With `ivt.hb.elements` as `g`, each element's `dof`/`to`
+names a model DOF, as on a dense model, and the nonlinear DOFs are the
+elements' own (`g.dofs`); `nonlinear_dofs`, if given, must hold them all. Defaults there: n = 7, samples = 32, rtol = 1e-12 (on the
 receptance-form residual, relative to the larger of the start's linear
 response and the point's own size). Each point then
 carries "solve_error" (the refined solves'), "orbit_error" (the orbit's error

@@ -44,6 +44,9 @@ class Elements:
 
     def __add__(self, other: Elements) -> Elements: ...
     def __len__(self) -> int: ...
+    @property
+    def dofs(self) -> List[int]: ...
+    def restricted(self, dofs: Sequence[int]) -> Elements: ...
 
 class elements:
     """``ivt.hb.elements``: element constructors; ``+`` composes them. Each acts on
@@ -74,7 +77,7 @@ class ConvergenceError(RuntimeError):
 Operator = Union[Matrix, SparseMatrix, str, "os.PathLike[str]"]
 # ``g``: a Python callback (per sample or vectorized) or a sum of Rust elements.
 Nonlinearity = Union[Callback, VectorizedCallback, Elements]
-# ``family(p) -> (m, c, k, g, f)``: the system at parameter value p.
+# ``family(p) -> (m, c, k, g, f)`` or, unforced, ``(m, c, k, g)``: the system at p.
 Family = Callable[[float], Sequence[Any]]
 # Large models, keyword only: DOF indices (``nonlinear_dofs``: where ``g``
 # acts; ``record_dofs``: whose coefficients the result holds).

@@ -12,7 +12,7 @@ mod controller;
 mod hardware;
 mod inputs;
 pub mod keys;
-mod locate;
+pub mod locate;
 mod outputs;
 mod plant;
 
@@ -177,22 +177,9 @@ impl Scene {
     /// file's own position for an error inside it).
     pub fn parse_in(src: &str, origin: &str, base: &std::path::Path) -> Result<Self, SceneError> {
         let doc = locate::Doc::new(src);
-        let at = |span: Option<std::ops::Range<usize>>| match span {
-            Some(s) => {
-                let (line, col) = doc.line_col(s.start);
-                format!("{origin}:{line}:{col}")
-            }
-            None => origin.to_string(),
-        };
-        let mut scene: Scene = toml::from_str(src).map_err(|e| {
-            let msg = e.message().replace('\n', " ");
-            let key = e
-                .span()
-                .and_then(|s| doc.path_at(s.start))
-                .map(|k| format!("`{k}`: "))
-                .unwrap_or_default();
-            SceneError::invalid(format!("{}: {key}{}", at(e.span()), msg.trim()))
-        })?;
+        let at = |span: Option<std::ops::Range<usize>>| doc.at(origin, span);
+        let mut scene: Scene =
+            toml::from_str(src).map_err(|e| SceneError::invalid(doc.serde_error(origin, &e)))?;
         if scene.plant.file.is_some() {
             for key in ["plant.preset", "plant.gravity"] {
                 if let Some(span) = doc.span_of(key) {

@@ -169,22 +169,9 @@ impl PlantSection {
     /// As [`Self::from_file`].
     pub fn parse_file(src: &str, origin: &str) -> Result<Self, SceneError> {
         let doc = Doc::new(src);
-        let at = |span: Option<std::ops::Range<usize>>| match span {
-            Some(s) => {
-                let (line, col) = doc.line_col(s.start);
-                format!("{origin}:{line}:{col}")
-            }
-            None => origin.to_string(),
-        };
-        let file: PlantFile = toml::from_str(src).map_err(|e| {
-            let key = e
-                .span()
-                .and_then(|s| doc.path_at(s.start))
-                .map(|k| format!("`{k}`: "))
-                .unwrap_or_default();
-            let msg = e.message().replace('\n', " ");
-            SceneError::invalid(format!("{}: {key}{}", at(e.span()), msg.trim()))
-        })?;
+        let at = |span: Option<std::ops::Range<usize>>| doc.at(origin, span);
+        let file: PlantFile =
+            toml::from_str(src).map_err(|e| SceneError::invalid(doc.serde_error(origin, &e)))?;
         let plant = file.plant;
         let check = || {
             Invalid::check(plant.file.is_none(), "plant.file", || {
