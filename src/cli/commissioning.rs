@@ -62,7 +62,7 @@ pub enum ReadError {
 
 /// Largest commissioning recording read \[bytes\]: 512 MiB (23 MB for a
 /// full simulated plan). The file is walked record by record within the
-/// budgets of [`walk`], never read whole.
+/// budgets of its walk (`walk`), never read whole.
 pub const MAX_RECORDING_BYTES: u64 = 512 << 20;
 
 /// Read a commissioning recording.

@@ -240,7 +240,7 @@ pub fn fuzz_args(args: &[std::ffi::OsString]) -> Result<(), String> {
     }
 }
 
-/// The command line: [`Cli`] with every option that takes a value accepting
+/// The command line (`Cli`) with every option that takes a value accepting
 /// a negative number (`--xi -0.5`, `--vm -8`), which clap otherwise reads as
 /// a flag (`-0`); the command checks the value's range.
 pub fn command() -> clap::Command {

@@ -18,7 +18,7 @@
 //! bordered solves ([`crate::Branch::jacobian_gradient`]); for the
 //! multiplier events and the peak it is a central difference, as the
 //! locators' ([`crate::events`]; the multiplier events' with a wider step,
-//! [`CROSSING_FD_STEP`]).
+//! `CROSSING_FD_STEP`).
 //!
 //! A branch point of a forced curve persists in `p` only through a symmetry
 //! (a pitchfork): with `v`, `w` the right and left null vectors of

@@ -4,7 +4,7 @@
 //! ([`crate::events`]), then recursively, to `depth` levels,
 //!
 //! - at each branch point both halves of the crossing branch (the root of
-//!   the bifurcation equation nearer ω_f = const, [`super::switch`]) stepped
+//!   the bifurcation equation nearer ω_f = const, [`super::switch()`]) stepped
 //!   `±h` from it;
 //! - at each period doubling the period-2 branch
 //!   ([`crate::period_doubled_start`]);

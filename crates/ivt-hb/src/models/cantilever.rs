@@ -64,7 +64,7 @@ pub const MAX_ELEMENTS: usize = 100_000;
 /// [`crate::condense`]).
 ///
 /// # Errors
-/// [`HbError::InvalidInput`] for no elements or more than [`MAX_ELEMENTS`],
+/// [`HbError::InvalidInput`] for no elements or more than `MAX_ELEMENTS` (100 000),
 /// non-positive / non-finite parameters.
 pub fn cantilever(n_elements: usize, beam: &BeamProperties) -> Result<Cantilever, HbError> {
     if n_elements > MAX_ELEMENTS {
