@@ -86,7 +86,8 @@ def test_fresh_venv_runs_every_chapter_as_a_user_copies_it(tmp_path: Path) -> No
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
     py = venv / "bin" / "python"
     pip = [str(py), "-m", "pip", "install", "-q", "--disable-pip-version-check"]
-    subprocess.run([*pip, f"{WHEEL}[plot]", "numpy", "scipy"], check=True, cwd=tmp_path)
+    # the extras the chapters name: figures, finite-element models, Dask sweeps
+    subprocess.run([*pip, f"{WHEEL}[plot,fe,dask]", "numpy", "scipy"], check=True, cwd=tmp_path)
     exe = ivt_bin()
     ran = 0
     for chapter in sorted(GUIDE.rglob("*.md")):

@@ -408,15 +408,28 @@ def _cantilever(n_elements, length=1.0, ei=1.0, rho_a=1.0, alpha=0.07, beta=2e-4
     return m, c, k, tip
 
 
+def _scikit_fem():
+    """The scikit-fem module, or an ImportError saying how to install it."""
+    try:
+        import skfem
+    except ImportError as e:
+        raise ImportError(
+            "ivt.hb.models.plate and solid assemble with scikit-fem, an optional extra: "
+            "pip install 'ivt[fe]' (or pip install scikit-fem)"
+        ) from e
+    return skfem
+
+
 def _solid(mesh, clamped, young=210e9, poisson=0.3, density=7800.0):
     """Linear elasticity with the consistent mass on a scikit-fem tetrahedral
     (or any 3-D) mesh, P1 vector elements, SI units: returns (m, k, xyz, dof)
     with scipy.sparse CSR m and k of the free DOFs (those not at the nodes
     where ``clamped(x)`` holds, x of shape (3, N)), xyz (n_dof, 3) the node
     coordinates of each free DOF and dof(node, direction) its index (-1 if
-    clamped). Needs scikit-fem (``pip install scikit-fem``)."""
+    clamped). Needs scikit-fem (``pip install 'ivt[fe]'``)."""
     import numpy as np
-    import skfem
+
+    skfem = _scikit_fem()
     from skfem.helpers import dot
     from skfem.models.elasticity import lame_parameters, linear_elasticity
 
@@ -450,9 +463,10 @@ def _plate(nx, ny=None, nz=2, size=(1.0, 0.2, 0.02), young=210e9, poisson=0.3, d
     ν = 0.3, ρ = 7800 kg/m³) of nx × ny × nz hexahedra split into six
     tetrahedra each (scikit-fem's ``MeshTet.init_tensor``), clamped at x = 0:
     returns (m, k, tip), tip the vertical DOF of the corner (L, W, H).
-    ny defaults to nx // 5. Needs scikit-fem."""
+    ny defaults to nx // 5. Needs scikit-fem (``pip install 'ivt[fe]'``)."""
     import numpy as np
-    import skfem
+
+    skfem = _scikit_fem()
 
     ny = max(1, nx // 5) if ny is None else ny
     lx, ly, lz = size
