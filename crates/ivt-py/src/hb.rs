@@ -88,9 +88,12 @@ duffing_fn! {
 /// Jacobian, §3.2.1). Returns the dict of `ivt hb duffing --json`: coeffs
 /// [a0, a1..an, b1..bn] (u = a0/2 + Σ a_k cos kτ + b_k sin kτ, τ = ω_f t),
 /// iterations, residual_norm, solve_time_s (the solve alone), floquet
-/// multipliers [[re, im], ...] by Hsu's method (max(8n, 256) Magnus-4
-/// steps, as the CLI), stable.
-/// `stability=False` skips the multipliers (floquet = [], stable = None).
+/// multipliers [[re, im], ...] by Hsu's method (Magnus-4 steps doubled from
+/// max(2(n + 1), 32) until their Richardson estimate multiplier_error, relative
+/// to max(1, |μ|), is at most 1e-6, at most 4096; as the CLI and the FRC
+/// points), stable.
+/// `stability=False` skips the multipliers (floquet = [], stable = None,
+/// multiplier_error = None).
 /// The GIL is released while solving.
 fn duffing<'py>(py, problem, n, samples;
     head [];
