@@ -20,6 +20,9 @@ use contract::{contract, replay_log, serial, tmp};
 use std::any::TypeId;
 use std::time::Duration;
 
+/// The example model file of `ivt hb frc MODEL` and `ivt hb solve MODEL`.
+const MODEL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/models/two-mass.toml");
+
 /// Every `(subcommand path, --option)` whose value is an `f64`.
 fn number_options() -> Vec<(Vec<String>, String)> {
     fn walk(cmd: &clap::Command, path: &mut Vec<String>, out: &mut Vec<(Vec<String>, String)>) {
@@ -64,6 +67,9 @@ fn base(path: &[String], log: &str, scene: &str, out: &str) -> Option<Vec<String
             "0.92",
         ],
         ["hb", "diagram"] => &["--n", "5", "--samples", "16", "--depth", "0"],
+        // a user's model file (the guide's example)
+        ["hb", "frc"] => &[MODEL],
+        ["hb", "solve"] => &[MODEL, "--omega", "1.1"],
         ["kin", _] | ["hb", _] | ["ol", "table" | "fit"] | ["stability-map"] => &[],
         ["ol", "solve"] | ["stability"] => &["--vm", "8", "--tu", "4"],
         ["ctrl", "replay"] => &[log],

@@ -319,7 +319,7 @@ fn build(file: ModelFile, mats: Vec<(usize, Vec<f64>)>) -> Result<Model, Invalid
     for (key, v) in [("range.from", range.0), ("range.to", range.1)] {
         if let Some(v) = v {
             if !(v.is_finite() && v > 0.0) {
-                return Err(invalid(key, format!(" = {v}: must be finite and > 0")));
+                return Err(invalid(key, format!(" = {v:?}: must be finite and > 0")));
             }
         }
     }
@@ -396,7 +396,7 @@ fn element(i: usize, e: &ElementEntry, n: usize) -> Result<Element, Invalid> {
                 ))
             }
             (true, Some(v)) if !v.is_finite() => {
-                return Err(invalid(key(name), format!(" = {v}: must be finite")))
+                return Err(invalid(key(name), format!(" = {v:?}: must be finite")))
             }
             _ => {}
         }
@@ -436,7 +436,7 @@ fn element(i: usize, e: &ElementEntry, n: usize) -> Result<Element, Invalid> {
         _ => Vec::new(),
     };
     if let Some((name, v, _, rule)) = rules.into_iter().find(|r| !r.2) {
-        return Err(invalid(key(name), format!(" = {v}: must be {rule}")));
+        return Err(invalid(key(name), format!(" = {v:?}: must be {rule}")));
     }
     Ok(Element {
         a: e.dof,
@@ -481,7 +481,7 @@ fn harmonics(f: &Forcing, n: usize) -> Result<Vec<Harmonic>, Invalid> {
                 if !v.is_finite() {
                     return Err(invalid(
                         format!("{key}[{dof}]"),
-                        format!(" = {v}: must be finite"),
+                        format!(" = {v:?}: must be finite"),
                     ));
                 }
             }
@@ -520,7 +520,7 @@ fn options(o: &Options) -> Result<HbOptions, Invalid> {
     }
     for (key, v) in [("options.tol", o.tol), ("options.rtol", o.rtol)] {
         if !(v.is_finite() && v >= 0.0) {
-            return Err(invalid(key, format!(" = {v}: must be finite and >= 0")));
+            return Err(invalid(key, format!(" = {v:?}: must be finite and >= 0")));
         }
     }
     if o.tol + o.rtol <= 0.0 {

@@ -41,7 +41,7 @@ fn frequency(what: &str, v: f64) -> Result<f64, CliError> {
         Ok(v)
     } else {
         Err(CliError::Input(format!(
-            "{what} = {v}: must be finite and > 0"
+            "{what} = {v:?}: must be finite and > 0"
         )))
     }
 }
