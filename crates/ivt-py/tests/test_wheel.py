@@ -108,8 +108,13 @@ def test_fresh_venv_runs_every_chapter_as_a_user_copies_it(tmp_path: Path) -> No
         work.mkdir()
         checkout(work)
         (work / "example.py").write_text("".join(parts))
+        # Run as `python -c`, as pasted into an interpreter or a notebook: a
+        # process cluster's workers then do not re-run the chapter (a script
+        # needs `if __name__ == "__main__":` around them, as large-models.md
+        # says).
         run = subprocess.run(
-            [str(py), "example.py"], cwd=work, capture_output=True, text=True,
+            [str(py), "-c", (work / "example.py").read_text()], cwd=work, capture_output=True,
+            text=True,
             env={"PATH": f"{exe.parent}{os.pathsep}{os.environ.get('PATH', '')}", "HOME": str(tmp_path)},
         )
         assert run.returncode == 0, f"{chapter.name}:\n{run.stdout[-2000:]}\n{run.stderr[-3000:]}"
