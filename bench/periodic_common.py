@@ -36,12 +36,23 @@ def hb_samples(n):
 # x = c0 + Σ c_k cos kωt + s_k sin kωt (its own DFT operator), ω last.
 
 
-def pyharm_input(m, c, k, cubic, force, n, nti, omega_from, omega_to, xtol, frc_options=None):
+# pyHarm's nonlinear solvers (its `solver` keyword) and the options that set
+# each one's tolerance to `tol`.
+PYHARM_SOLVERS = {
+    "scipyroot": lambda tol: {"root": {"options": {"xtol": tol}}},
+    "NewtonRaphson": lambda tol: {"tol_residual": tol, "tol_delta_x": tol},
+    "MoorePenrose": lambda tol: {"tol_residual": tol, "tol_delta_x": tol},
+}
+
+
+def pyharm_input(m, c, k, cubic, force, n, nti, omega_from, omega_to, xtol, frc_options=None,
+                 solver="scipyroot"):
     """Maestro input: one linear substructure (M, C, K), a cubic spring on DOF 0 to
     ground, a cosine force on DOF 0; an 'frf' analysis (arc-length continuation,
-    scipy root/hybr corrector with xtol)."""
+    tangent predictor) whose corrector iterations use `solver` at tolerance xtol
+    (default scipy root/hybr)."""
     analysis = {"study": "frf", "puls_inf": omega_from, "puls_sup": omega_to, "verbose": False,
-                "solver_options": {"root": {"options": {"xtol": xtol}}}}
+                "solver": solver, "solver_options": PYHARM_SOLVERS[solver](xtol)}
     analysis.update(frc_options or {})
     return {
         "system": {"type": "Base", "nh": n, "nti": nti},

@@ -10,18 +10,18 @@ import time
 import numpy as np
 
 import ivt
-from periodic_common import ALPHA, EPS, FORCE, XI, hb_samples, pyharm_input, pyharm_to_ivt, timed
+from periodic_common import ALPHA, EPS, FORCE, PYHARM_SOLVERS, XI, hb_samples, pyharm_input, pyharm_to_ivt, timed
 
 
-def pyharm_curve(m, c, k, cubic, n, omega_from, omega_to, ds_max):
-    """pyHarm FRC by its arc-length continuation (tangent predictor, root/hybr
-    corrector at xtol 1e-10), ds0 = ds_max / 5. Returns time, accepted points
-    as (ω, unknowns) and the number of ω turns (folds)."""
+def pyharm_curve(m, c, k, cubic, n, omega_from, omega_to, ds_max, solver="scipyroot"):
+    """pyHarm FRC by its arc-length continuation (tangent predictor; corrector
+    iterations by `solver` at tolerance 1e-10, default root/hybr), ds0 = ds_max / 5.
+    Returns time, accepted points as (ω, unknowns) and the number of ω turns (folds)."""
     from pyHarm.Maestro import Maestro
 
     n_dof = np.atleast_2d(m).shape[0]
     mae = Maestro(pyharm_input(m, c, k, cubic, FORCE, n, 2 * hb_samples(n), omega_from, omega_to, 1e-10,
-                               dict(ds_max=ds_max, ds0=ds_max / 5)))
+                               dict(ds_max=ds_max, ds0=ds_max / 5), solver=solver))
     frf = mae.nls["frf"]
     t0 = time.perf_counter()
     frf.Solve()
@@ -44,15 +44,31 @@ def fold_omegas(folds):
 
 def duffing_frc_rows(n, ds_max):
     """Thesis Duffing 0.2–3.0: ivt.hb.duffing_frc (its own step control, Hsu
-    stability at every point) against pyHarm's continuation (no stability)."""
-    out, t_ivt = timed(lambda: ivt.hb.duffing_frc(from_=0.2, to=3.0, n=n, samples=hb_samples(n), xi=XI,
-                                                  alpha=ALPHA, eps=EPS, force=FORCE), budget=1.0)
-    ph = pyharm_curve(1.0, 2 * XI, ALPHA, EPS, n, 0.2, 3.0, ds_max)
+    stability at every point) against pyHarm's continuation (no stability) with
+    each of its nonlinear solvers; `pyharm` is the default (scipy root/hybr),
+    `pyharm_solvers` every solver, timed right after an ivt run of its own."""
+    def ivt_curve():
+        return timed(lambda: ivt.hb.duffing_frc(from_=0.2, to=3.0, n=n, samples=hb_samples(n), xi=XI,
+                                                alpha=ALPHA, eps=EPS, force=FORCE), budget=1.0)
+
+    out, t_ivt = ivt_curve()
+    solvers = {}
+    for solver in PYHARM_SOLVERS:
+        _, t_mine = ivt_curve()
+        try:
+            ph = pyharm_curve(1.0, 2 * XI, ALPHA, EPS, n, 0.2, 3.0, ds_max, solver=solver)
+        except Exception as e:  # a solver that fails on this curve: say so, time the others
+            solvers[solver] = dict(error=f"{type(e).__name__}: {e}")
+            continue
+        solvers[solver] = dict(time=ph["time"], points=ph["points"], folds=ph["folds"], peak=ph["peak"],
+                               ivt_time=t_mine, ratio=ph["time"] / t_mine)
+    ph = solvers["scipyroot"]
     return dict(problem="Duffing FRC 0.2–3.0", n=n, samples=hb_samples(n),
                 ivt=dict(time=t_ivt, points=len(out["points"]), folds=fold_omegas(out["folds"]),
                          peak=max(p["amplitude"] for p in out["points"]), stability=True),
-                pyharm=dict(time=ph["time"], points=ph["points"], folds=ph["folds"], peak=ph["peak"],
-                            ds_max=ds_max, stability=False))
+                pyharm=dict(time=ph.get("time"), points=ph.get("points"), folds=ph.get("folds"),
+                            peak=ph.get("peak"), ds_max=ds_max, stability=False),
+                pyharm_solvers=solvers)
 
 
 CHAIN_M = np.eye(2)

@@ -328,6 +328,13 @@ def print_report(refs, rows, frcs, pyharm_error):
             ph_pp = row["pyharm"]["time"] / max(row["pyharm"]["points"], 1)
             print(f"\nratio pyHarm / ivt: whole curve {row['pyharm']['time'] / row['ivt']['time']:.0f}×, "
                   f"per point {ph_pp / ivt_pp:.0f}×")
+        for solver, d in row.get("pyharm_solvers", {}).items():
+            if "error" in d:
+                print(f"pyHarm solver {solver}: failed ({d['error']})")
+                continue
+            print(f"pyHarm solver {solver}: {d['time']:.3g} s, {d['points']} points, folds "
+                  f"{', '.join(f'{f:.5f}' for f in d['folds']) or '—'}; ivt run beside it {1e3 * d['ivt_time']:.2f} ms: "
+                  f"whole curve {d['ratio']:.0f}×")
             if row["ivt"].get("max_coeff_diff_vs_pyharm") is not None:
                 print(f"ivt orbits agreeing with pyHarm's to 1e-6: {row['ivt']['agree_1e6']} of "
                       f"{row['pyharm']['points']} (max coefficient difference "

@@ -13,12 +13,8 @@
 //! identify run.mcap --out plant.toml`, then `ivt ol fit --plant-file
 //! plant.toml --emit-rust FILE`.
 
-/// The reader of `ivt rig identify` (the binary's module, not a copy; the
-/// example uses its arrays only, hence the allowance).
-#[allow(dead_code)]
-#[path = "../src/cli/commissioning.rs"]
-mod commissioning;
-
+/// The reader of `ivt rig identify` (the command layer's module).
+use ivt::cli::commissioning;
 use ivt_design::identify::{identify, NAMES};
 use ivt_design::open_loop::fit_law;
 use ivt_design::steady::IhbOptions;
@@ -42,7 +38,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     std::fs::write(&rig_file, format!("[plant]\n{body}"))?;
     let run = out.join("run.mcap");
     let opts = ivt_sim::commission::CommissionOptions {
-        plant: ivt_sim::commission::load_plant_file(&rig_file)?,
+        plant: PlantSection::from_file(&rig_file)?,
         sensors: ivt_sim::commission::SensorModel::Realistic,
         ..Default::default()
     };

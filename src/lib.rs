@@ -51,6 +51,8 @@ mod guide {
     mod api {}
     #[doc = include_str!("../docs/guide/src/architecture.md")]
     mod architecture {}
+    #[doc = include_str!("../docs/guide/src/contributing.md")]
+    mod contributing {}
     #[doc = include_str!("../docs/guide/src/getting-started.md")]
     mod getting_started {}
     #[doc = include_str!("../docs/guide/src/limits.md")]
@@ -82,6 +84,8 @@ mod guide {
         mod backbones {}
         #[doc = include_str!("../docs/guide/src/model/elements.md")]
         mod elements {}
+        #[doc = include_str!("../docs/guide/src/model/fe-models.md")]
+        mod fe_models {}
         #[doc = include_str!("../docs/guide/src/model/frc.md")]
         mod frc {}
         #[doc = include_str!("../docs/guide/src/model/large-models.md")]
@@ -92,6 +96,8 @@ mod guide {
         mod orbit {}
         #[doc = include_str!("../docs/guide/src/model/string.md")]
         mod string {}
+        #[doc = include_str!("../docs/guide/src/model/tori-diagrams.md")]
+        mod tori_diagrams {}
         #[doc = include_str!("../docs/guide/src/model/two-parameter.md")]
         mod two_parameter {}
     }

@@ -141,7 +141,36 @@ fn commands(flag: &str, key: &str, log: &str, scene: &str) -> Vec<Vec<String>> {
             vec![with(&["stability", "--si"], &point)]
         }
         ("--k" | "--k2", _) => vec![with(&["stability"], &point), replay],
-        ("--k-prop" | "--prop-period" | "--f-timer" | "--stall-timeout", _) => vec![replay],
+        ("--k-prop", _) => vec![
+            replay,
+            with(&["rig", "commission", "--sim", "--out", "unused.mcap"], &[]),
+        ],
+        ("--prop-period" | "--f-timer" | "--stall-timeout", _) => vec![replay],
+        // checked before the port is opened
+        ("--f-timer-hz", _) => vec![
+            with(
+                &[
+                    "rig",
+                    "record",
+                    "--port",
+                    "/dev/null",
+                    "--out",
+                    "unused.mcap",
+                ],
+                &[],
+            ),
+            with(
+                &[
+                    "rig",
+                    "commission",
+                    "--port",
+                    "/dev/null",
+                    "--out",
+                    "unused.mcap",
+                ],
+                &[],
+            ),
+        ],
         ("--max-events", _) => vec![with(&["sim", scene], &[])],
         _ => vec![],
     }

@@ -240,3 +240,69 @@ fn vdp_torus_curve_ends_at_the_one_to_one_resonance() {
         );
     }
 }
+
+/// Every `ivt hb` job that returns a curve, a branch or orbits draws it with
+/// `--plot` (small resolutions, to stay quick): a PNG of ivt-plot's size,
+/// written through the staged writer (nothing else left in the directory),
+/// and the same JSON as without `--plot`.
+#[test]
+fn every_curve_job_draws_its_picture_with_plot() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_hb_plots");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let jobs = [
+        ("duffing", "hb duffing --n 8 --samples 32"),
+        ("duffing-frc", "hb duffing-frc --n 8 --samples 32 --events"),
+        (
+            "duffing-folds",
+            "hb duffing-folds --n 8 --samples 32 --at 0.2",
+        ),
+        ("cycle-branch", "hb cycle-branch --n 10 --samples 48"),
+        ("duffing-backbone", "hb duffing-backbone --n 8 --samples 32"),
+        ("all-solutions", "hb all-solutions --n 8 --samples 32"),
+        ("limit-cycle", "hb limit-cycle --n 12 --samples 48"),
+        (
+            "string",
+            "hb string --modes 3 --harmonics 5 --ns 32 --ms 32 --from 3 --to 4",
+        ),
+        ("switch", "hb switch --n 6 --samples 24"),
+        (
+            "vdp-torus",
+            "hb vdp-torus --n 7 --samples 24 --force-to 0.25 --at 0.25",
+        ),
+        ("mathieu-duffing", "hb mathieu-duffing --n 8"),
+    ];
+    for (name, cmd) in jobs {
+        let png = dir.join(format!("{name}.png"));
+        let mut args: Vec<&str> = cmd.split_whitespace().collect();
+        args.insert(0, "--json");
+        let (code, plain) = run_args(&args);
+        assert_eq!(code, 0, "{name}: {plain}");
+        args.extend(["--plot", png.to_str().unwrap()]);
+        let (code, drawn) = run_args(&args);
+        assert_eq!(code, 0, "{name}: {drawn}");
+        let strip = |mut v: serde_json::Value| {
+            for key in ["time_s", "solve_time_s"] {
+                v.as_object_mut().map(|o| o.remove(key));
+            }
+            v
+        };
+        assert_eq!(
+            strip(plain),
+            strip(drawn),
+            "{name}: --plot changed the answer"
+        );
+        let bytes = std::fs::read(&png).unwrap_or_else(|e| panic!("{name}: no PNG: {e}"));
+        assert!(bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "{name}: not a PNG");
+        assert_eq!(u32::from_be_bytes(bytes[16..20].try_into().unwrap()), 1000);
+        assert_eq!(u32::from_be_bytes(bytes[20..24].try_into().unwrap()), 640);
+    }
+    let mut left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    left.sort();
+    let mut want: Vec<_> = jobs.iter().map(|(n, _)| format!("{n}.png")).collect();
+    want.sort();
+    assert_eq!(left, want, "only the PNGs, no staged temporary");
+}

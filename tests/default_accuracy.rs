@@ -1,10 +1,12 @@
-//! The accuracy of two defaults of the command line, each against a
-//! converged reference computed the same way with a much finer setting
-//! (the guide's Limits and errors, docs/guide/src/limits.md, "Accuracy of the
-//! defaults"):
+//! The accuracy of defaults, each against a converged reference computed
+//! the same way with a much finer setting (the guide's Limits and errors,
+//! docs/guide/src/limits.md, "Accuracy of the defaults"; the error-controlled
+//! Floquet multipliers of `hb duffing` are checked against their estimate in
+//! crates/ivt-hb/tests/hsu_steps.rs):
 //!
-//! - `hb duffing` Floquet multipliers: Hsu's method with Magnus-4 over
-//!   max(8n, 256) sub-intervals (256 at the default n = 20) against 8192;
+//! - Floquet multipliers of the default Duffing orbit by Hsu's method with
+//!   Magnus-4 over 256 fixed sub-intervals (the guide's Rust example of
+//!   `StabilityAnalyzer`) against 8192;
 //! - `hb string` STHB truncation: N = 5 sine modes and M = 19 harmonics
 //!   against M = 39 (harmonic truncation) and N = 15 (modal truncation),
 //!   compared on the mid-span displacement w(½, t) over one period;
@@ -53,7 +55,7 @@ fn multiplier_distance(a: &[c64], b: &[c64]) -> f64 {
 }
 
 #[test]
-fn default_floquet_steps_are_accurate_to_1e_9() {
+fn floquet_multipliers_of_256_hsu_steps_are_accurate_to_1e_9() {
     // ω_f = 0.4 (the default), 1.2 (upper branch near the resonance peak),
     // 2.0 (above it). Measured 4.7e-11, 4.0e-10, 3.0e-13.
     for omega_f in [0.4, 1.2, 2.0] {

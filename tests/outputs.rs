@@ -190,8 +190,9 @@ fn concurrent_runs_into_one_directory_all_succeed() {
 }
 
 /// SIGINT during `ivt --json sim`: one `{"error", "kind": "interrupted"}`
-/// object on stdout, exit 2 (issue 30; 130 without --json), and the output directory the run
-/// created is gone with its staged files.
+/// object on stdout, exit 130 (the shell's 128 + SIGINT, as without
+/// `--json`; issue 43), and the output directory the run created is gone
+/// with its staged files.
 #[cfg(unix)]
 #[test]
 fn interrupted_json_sim_prints_one_error_and_removes_its_directory() {
@@ -220,7 +221,7 @@ fn interrupted_json_sim_prints_one_error_and_removes_its_directory() {
         .unwrap();
     assert!(status.success());
     let (code, v, _) = parse(&child.wait_with_output().unwrap());
-    assert_eq!(code, Some(2), "{v}");
+    assert_eq!(code, Some(130), "{v}");
     assert_eq!(v["kind"], "interrupted", "{v}");
     assert!(v["error"].as_str().unwrap().contains("interrupted"), "{v}");
     assert_eq!(

@@ -2,6 +2,7 @@
 
 use super::{CliError, Output};
 use clap::Subcommand;
+use ivt_kin::params::Typed;
 use serde_json::json;
 
 /// Benchmark subcommands.
@@ -25,7 +26,8 @@ pub fn run(cmd: BenchCommand) -> Result<Output, CliError> {
         BenchCommand::WorkPrecision { budget } => {
             if !(budget.is_finite() && budget > 0.0 && budget <= 60.0) {
                 return Err(CliError::Input(format!(
-                    "--budget must be in (0, 60] s, got {budget}"
+                    "--budget must be in (0, 60] s, got {}",
+                    Typed(budget)
                 )));
             }
             let s = ivt_sim::work_precision::study(budget);

@@ -7,20 +7,19 @@
 //! optional `steps_per_rev`, `theta0`). Other channels (`/control`) are
 //! skipped.
 //!
-//! The file is walked record by record so that a truncated or corrupt one
-//! fails with the byte offset of the record at fault — never a partial
-//! estimate: a recording without its footer and closing magic is refused.
+//! The file is walked record by record (`walk.rs`, within its budgets) so
+//! that a truncated or corrupt one fails with the byte offset of the record
+//! at fault — never a partial estimate: a recording without its footer and
+//! closing magic is refused.
+
+mod walk;
 
 use ivt_design::identify::{Recording, Stage};
 use ivt_kin::plant::PlantParams;
 use ivt_sim::scene::PlantSection;
-use mcap::records::Record;
 use serde_json::Value;
-use std::collections::BTreeMap;
 use std::path::Path;
-
-/// The MCAP magic, at both ends of a file.
-const MAGIC: &[u8; 8] = b"\x89MCAP0\r\n";
+use walk::Collected;
 
 /// A recording as read, with its metadata.
 #[derive(Debug)]
@@ -61,183 +60,78 @@ pub enum ReadError {
     },
 }
 
-/// The channels and metadata collected while walking the file.
-#[derive(Default)]
-struct Collected {
-    topics: BTreeMap<u16, String>,
-    pulse_t: Vec<f64>,
-    pulse_ticks: Vec<u64>,
-    sensors: Vec<[f64; 3]>,
-    stepper: Vec<(f64, i64)>,
-    stages: Vec<Stage>,
-    meta: Option<BTreeMap<String, String>>,
-}
-
-/// Largest commissioning recording read \[bytes\]: 512 MiB, a third of the
-/// 1.5 GB a hostile input may cost (the recording is read whole).
-const MAX_RECORDING_BYTES: u64 = 512 << 20;
+/// Largest commissioning recording read \[bytes\]: 512 MiB (23 MB for a
+/// full simulated plan). The file is walked record by record within the
+/// budgets of its walk (`walk`), never read whole.
+pub const MAX_RECORDING_BYTES: u64 = 512 << 20;
 
 /// Read a commissioning recording.
 ///
 /// # Errors
 /// [`ReadError::Corrupt`] (truncated, bad magic, bad record or chunk CRC,
-/// unparsable message: each with its byte offset), [`ReadError::Content`]
-/// (missing channel or metadata), [`ReadError::Io`].
+/// unparsable message, a length beyond its budget: each with its byte
+/// offset), [`ReadError::Content`] (missing channel or metadata),
+/// [`ReadError::Io`] (the file cannot be opened or read: missing, not a
+/// regular file, over [`MAX_RECORDING_BYTES`]).
 pub fn read(path: &Path) -> Result<Commissioning, ReadError> {
-    let bytes = ivt_sim::input::read_bounded(path, MAX_RECORDING_BYTES)
-        .map_err(|e| ReadError::Io(format!("{}: {e}", path.display())))?;
-    let name = path.display().to_string();
-    let corrupt = |why: String| ReadError::Corrupt {
-        path: name.clone(),
-        why,
-    };
-    let content = |why: String| ReadError::Content {
-        path: name.clone(),
-        why,
-    };
+    let io = |e: std::io::Error| ReadError::Io(format!("{}: {e}", path.display()));
+    let mut input = ivt_sim::input::open(path, MAX_RECORDING_BYTES).map_err(io)?;
+    let len = input.len();
+    read_from(&mut input, len, &path.display().to_string()).map_err(|e| match e {
+        ReadError::Io(m) => ReadError::Io(format!("{}: {m}", path.display())),
+        other => other,
+    })
+}
+
+/// A commissioning recording from `src` (`len` bytes), named `name` in
+/// errors: what [`read`] does after opening the file (and the fuzz target
+/// of the reader, `fuzz/fuzz_targets/recording_mcap.rs`).
+///
+/// # Errors
+/// As [`read`]; [`ReadError::Io`] carries the read error alone.
+pub fn read_from(
+    src: &mut impl std::io::Read,
+    len: u64,
+    name: &str,
+) -> Result<Commissioning, ReadError> {
     let mut c = Collected::default();
-    walk(&bytes, &mut c).map_err(corrupt)?;
-    assemble(c).map_err(content)
+    walk::walk(src, len, &mut c).map_err(|e| match e {
+        walk::WalkError::Io(e) => ReadError::Io(e.to_string()),
+        walk::WalkError::Corrupt(why) => ReadError::Corrupt {
+            path: name.to_string(),
+            why,
+        },
+    })?;
+    assemble(c).map_err(|why| ReadError::Content {
+        path: name.to_string(),
+        why,
+    })
 }
 
-/// Every record from the leading magic to the footer and closing magic.
-fn walk(bytes: &[u8], c: &mut Collected) -> Result<(), String> {
-    let len = bytes.len();
-    if bytes.get(..8) != Some(MAGIC.as_slice()) {
-        return Err("not an MCAP file: no magic at byte offset 0".into());
-    }
-    let mut at = 8usize;
-    loop {
-        let Some(head) = bytes.get(at..at + 9) else {
-            return Err(format!(
-                "truncated at byte offset {at}: the file ends ({len} bytes) before the footer"
-            ));
-        };
-        let (op, body_len) = match head.split_first() {
-            Some((&op, len)) => (op, <[u8; 8]>::try_from(len).map(u64::from_le_bytes)),
-            None => (0, Ok(u64::MAX)),
-        };
-        let body_len = body_len.unwrap_or(u64::MAX);
-        let end = usize::try_from(body_len)
-            .ok()
-            .and_then(|b| (at + 9).checked_add(b))
-            .filter(|&e| e <= len)
-            .ok_or_else(|| {
-                format!(
-                    "truncated at byte offset {at}: record 0x{op:02x} of {body_len} bytes runs past the end of the file ({len} bytes)"
-                )
-            })?;
-        let body = bytes.get(at + 9..end).unwrap_or_default();
-        let record = mcap::read::parse_record(op, body)
-            .map_err(|e| format!("corrupt record 0x{op:02x} at byte offset {at}: {e}"))?;
-        match record {
-            Record::DataEnd(d) => {
-                // The data section's CRC covers every byte before this record
-                // (messages, chunks and their indexes alike).
-                let crc = crc32fast::hash(bytes.get(..at).unwrap_or_default());
-                if d.data_section_crc != 0 && d.data_section_crc != crc {
-                    return Err(format!(
-                        "corrupt data section (bytes 0 to {at}): its CRC 0x{crc:08x} is not the recorded 0x{:08x} (data end record at byte offset {at})",
-                        d.data_section_crc
-                    ));
-                }
-            }
-            Record::Footer(f) => {
-                let start = usize::try_from(f.summary_start).unwrap_or(usize::MAX);
-                // The summary CRC covers the summary section up to the footer's summary_crc field.
-                let covered = bytes.get(start..at + 9 + 16);
-                if f.summary_start != 0 && f.summary_crc != 0 {
-                    match covered.map(crc32fast::hash) {
-                        Some(crc) if crc == f.summary_crc => {}
-                        _ => {
-                            return Err(format!(
-                                "corrupt summary section (from byte offset {start}): CRC mismatch (footer at byte offset {at})"
-                            ))
-                        }
-                    }
-                }
-                return if bytes.get(end..) == Some(MAGIC.as_slice()) {
-                    Ok(())
-                } else {
-                    Err(format!(
-                        "corrupt or truncated at byte offset {end}: no closing magic after the footer"
-                    ))
-                };
-            }
-            Record::Chunk { header, data } => {
-                let records = mcap::read::ChunkReader::new(header, &data)
-                    .map_err(|e| format!("corrupt chunk at byte offset {at}: {e}"))?;
-                for r in records {
-                    let r = r.map_err(|e| format!("corrupt chunk at byte offset {at}: {e}"))?;
-                    take(r, c).map_err(|e| format!("in the chunk at byte offset {at}: {e}"))?;
-                }
-            }
-            other => take(other, c).map_err(|e| format!("at byte offset {at}: {e}"))?,
-        }
-        at = end;
-    }
-}
+/// The range of every numeric metadata value (key, lowest, highest, the
+/// range as printed): a value outside is refused by name, never clamped or
+/// wrapped.
+const META_RANGES: [(&str, f64, f64, &str); 5] = [
+    ("frame_version", 0.0, 65_535.0, "[0, 65535]"),
+    ("ppr", 1.0, 1e6, "[1, 1e6] pulses"),
+    ("f_timer_hz", 1e3, 1e10, "[1e3, 1e10] Hz"),
+    ("steps_per_rev", 1.0, 1e7, "[1, 1e7] steps"),
+    (
+        "theta0",
+        ivt_design::identify::THETA0_RANGE[0],
+        ivt_design::identify::THETA0_RANGE[1],
+        "[−2π, 2π] rad",
+    ),
+];
 
-/// File one record's content away.
-fn take(r: Record<'_>, c: &mut Collected) -> Result<(), String> {
-    match r {
-        Record::Channel(ch) => {
-            c.topics.insert(ch.id, ch.topic);
+/// `value` of metadata `key` inside its [`META_RANGES`] row.
+fn in_range(key: &str, text: &str, value: f64) -> Result<f64, String> {
+    match META_RANGES.iter().find(|r| r.0 == key) {
+        Some(&(_, lo, hi, range)) if !(lo..=hi).contains(&value) => {
+            Err(format!("metadata `{key}` = {text} is outside {range}"))
         }
-        Record::Metadata(m) if m.name == "ivt" => c.meta = Some(m.metadata),
-        Record::Message { header, data } => {
-            let topic = c
-                .topics
-                .get(&header.channel_id)
-                .cloned()
-                .unwrap_or_default();
-            if !matches!(
-                topic.as_str(),
-                "/pulses" | "/sensors" | "/stepper" | "/sequence"
-            ) {
-                return Ok(());
-            }
-            let v: Value = serde_json::from_slice(&data)
-                .map_err(|e| format!("message {} on {topic} is not JSON: {e}", header.sequence))?;
-            message(&topic, &v, c).ok_or_else(|| {
-                format!("message {} on {topic} lacks a field: {v}", header.sequence)
-            })?;
-        }
-        _ => {}
+        _ => Ok(value),
     }
-    Ok(())
-}
-
-/// One JSON message of a known channel (None: a field is missing or of the wrong type).
-fn message(topic: &str, v: &Value, c: &mut Collected) -> Option<()> {
-    let num = |k: &str| v.get(k).and_then(Value::as_f64);
-    match topic {
-        "/pulses" => {
-            let t = v.get("t")?.as_array()?;
-            let ticks = v.get("ticks").and_then(Value::as_array);
-            if ticks.is_some_and(|k| k.len() != t.len()) {
-                return None;
-            }
-            for x in t {
-                c.pulse_t.push(x.as_f64()?);
-            }
-            for x in ticks.into_iter().flatten() {
-                c.pulse_ticks.push(x.as_u64()?);
-            }
-        }
-        "/sensors" => c.sensors.push([num("t")?, num("v_m")?, num("t_u")?]),
-        "/stepper" => c.stepper.push((num("t")?, v.get("position")?.as_i64()?)),
-        _ => c.stages.push(Stage {
-            t: num("t")?,
-            name: v.get("name")?.as_str()?.to_string(),
-            // null while the law runs (the drive cycle, the step test's law stages).
-            theta_ct_deg: match v.get("theta_ct_deg")? {
-                Value::Null => f64::NAN,
-                x => x.as_f64()?,
-            },
-        }),
-    }
-    Some(())
 }
 
 /// The arrays from the collected channels and metadata.
@@ -251,24 +145,32 @@ fn assemble(c: Collected) -> Result<Commissioning, String> {
             .map(|s| {
                 s.parse::<f64>()
                     .map_err(|e| format!("metadata `{k}` = {s:?}: {e}"))
+                    .and_then(|v| in_range(k, &s, v))
             })
             .transpose()
     };
     let ppr = number("ppr")?.ok_or("metadata `ppr` is missing")?;
-    if !((1.0..=1e6).contains(&ppr) && ppr.fract() == 0.0) {
+    if ppr.fract() != 0.0 {
         return Err(format!("metadata `ppr` = {ppr} is not a pulse count"));
     }
-    let f_timer_hz = number("f_timer_hz")?.filter(|f| f.is_finite() && *f > 0.0);
+    let f_timer_hz = number("f_timer_hz")?;
     let nominal = match field("plant") {
         None => PlantSection::default(),
         Some(p) if p.starts_with('{') => plant_from_json(&p)?,
         Some(p) if p.contains('[') => {
-            PlantSection::parse_file(&p, "metadata `plant`").map_err(|e| e.0)?
+            PlantSection::parse_file(&p, "metadata `plant`").map_err(|e| e.message)?
         }
-        Some(p) => {
-            let text = format!("[plant]\npreset = \"{p}\"\n");
-            PlantSection::parse_file(&text, "metadata `plant`").map_err(|e| e.0)?
-        }
+        Some(p) => PlantSection {
+            preset: ivt_kin::plant::PlantPreset::from_name(&p)
+                .ok_or_else(|| {
+                    format!(
+                        "metadata `plant` = {}: not a preset (printed, thesis-ch4), a JSON object or a `[plant]` table",
+                        ivt_sim::input::excerpt(&p)
+                    )
+                })?
+                .into(),
+            ..PlantSection::default()
+        },
     };
     if c.pulse_t.len() < 2 {
         return Err("channel /pulses is missing or holds fewer than 2 edges".into());
@@ -284,9 +186,7 @@ fn assemble(c: Collected) -> Result<Commissioning, String> {
         None => steps_per_rev_from_stages(&c.stages, &c.stepper)
             .ok_or("metadata `steps_per_rev` is missing and /sequence gives no stage at θ_CT > 0 to infer it")?,
     };
-    if !(steps_per_rev.is_finite() && steps_per_rev > 0.0) {
-        return Err(format!("steps per revolution {steps_per_rev} must be > 0"));
-    }
+    let steps_per_rev = in_range("steps_per_rev", &steps_per_rev.to_string(), steps_per_rev)?;
     let pulse_t = match f_timer_hz {
         Some(f) if c.pulse_ticks.len() == c.pulse_t.len() => {
             edge_times(&c.pulse_t, &c.pulse_ticks, f)
@@ -319,18 +219,31 @@ fn assemble(c: Collected) -> Result<Commissioning, String> {
 /// A simulated rig's metadata `plant`: a flat JSON object of `[plant]` keys
 /// (`ivt_sim::commission`), read by the scene's `[plant]` parser.
 fn plant_from_json(text: &str) -> Result<PlantSection, String> {
-    let bad = |why: String| format!("metadata `plant` = {text}: {why}");
+    let bad = |why: String| {
+        format!(
+            "metadata `plant` = {}: {why}",
+            ivt_sim::input::excerpt(text)
+        )
+    };
     let obj: serde_json::Map<String, Value> =
         serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
     let mut toml = String::from("[plant]\n");
     for (k, v) in &obj {
+        // Keys go into the TOML text as they are: only a parameter's name
+        // (letters, digits, `_`), so that a key cannot write other lines.
+        if k.is_empty() || !k.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_') {
+            return Err(bad(format!(
+                "{} is not a plant parameter",
+                ivt_sim::input::excerpt(k)
+            )));
+        }
         match v {
             Value::Number(n) => toml.push_str(&format!("{k} = {n}\n")),
             Value::String(s) => toml.push_str(&format!("{k} = {s:?}\n")),
             _ => return Err(bad(format!("`{k}` is neither a number nor a string"))),
         }
     }
-    PlantSection::parse_file(&toml, "metadata `plant`").map_err(|e| bad(e.0))
+    PlantSection::parse_file(&toml, "metadata `plant`").map_err(|e| bad(e.message))
 }
 
 /// Eq. 185 in SI: e \[m\] per degree of θ_CT, 7π/51840 inch.

@@ -1,28 +1,43 @@
 //! `ivt hb ...`: harmonic balance (thesis §3.2) — Duffing by modified/classic IHB
 //! with Floquet stability, the Duffing frequency-response curve, and the
 //! Mathieu–Duffing period-doubling cascade, the fold curve in (ω, F), limit
-//! cycles and the Duffing backbone. `--plot FILE.png` draws the curves.
+//! cycles and the Duffing backbone; `frc` and `solve` on a user's model file. `--plot FILE.png` draws the result
+//! (`figure.rs`: the pictures of `ivt.plot`).
 //! Each command parses its arguments, runs an `ivt_jobs` job and prints
 //! its serialized result (the keys of `ivt.hb`'s dicts).
 
 mod all_solutions;
 mod autonomous;
 mod cycle_branch;
+mod diagram;
+pub(super) mod figure;
 mod folds;
+mod matrix_market;
+mod model_file;
 mod switch;
 mod torus;
+mod torus_branch;
+mod user_model;
 
 use super::{CliError, Output};
 use clap::{Args, Subcommand};
+use figure::Picture;
 use ivt_hb::orbit::aft::eval_series;
 use ivt_hb::{Duffing, FrcOptions, HbOptions};
 use ivt_jobs::{self as jobs, CascadeRequest, FrcRequest, Method, OrbitRequest};
+use ivt_kin::params::Typed;
+use ivt_plot::Style;
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
 /// Harmonic-balance subcommands.
 #[derive(Subcommand)]
 pub enum HbCommand {
+    /// Frequency-response curve of a user's model file (M, C, K, elements,
+    /// forcing; the JSON of `ivt.hb.frc`).
+    Frc(user_model::FrcArgs),
+    /// Periodic solution of a user's model file at one ω_f (the JSON of `ivt.hb.solve`).
+    Solve(user_model::SolveArgs),
     /// Periodic solution of Duffing's equation Eq. 49 (Fig. 28) with Floquet multipliers.
     Duffing(DuffingArgs),
     /// Frequency-response curve of Duffing's equation with stability (Fig. 29).
@@ -31,6 +46,10 @@ pub enum HbCommand {
     DuffingFolds(folds::FoldsArgs),
     /// The Neimark–Sacker curve of the forced Van der Pol oscillator in (ω_f, F), to its 1:1 end.
     VdpTorus(torus::TorusArgs),
+    /// The quasi-periodic torus of the forced Van der Pol oscillator from its Neimark–Sacker point.
+    Torus(torus_branch::TorusBranchArgs),
+    /// The automatic bifurcation diagram of the 2-DOF cubic chain.
+    Diagram(diagram::DiagramArgs),
     /// Limit cycle of Van der Pol's or Rayleigh's oscillator (ω unknown, §3.2.4) with its multipliers.
     LimitCycle(autonomous::LimitCycleArgs),
     /// Backbone curve (nonlinear normal mode) of the free Duffing oscillator u'' + αu + εu³ = 0.
@@ -87,7 +106,7 @@ impl DuffingParams {
         if !(self.tol.is_finite() && self.tol > 0.0) {
             return Err(CliError::Input(format!(
                 "--tol must be finite and > 0, got {}",
-                self.tol
+                Typed(self.tol)
             )));
         }
         Ok(HbOptions::new(self.n, self.samples).with_tol(self.tol))
@@ -126,7 +145,8 @@ pub struct FrcArgs {
     /// start by the modified IHB, every event on its extended system).
     #[arg(long)]
     events: bool,
-    /// Write a PNG of amplitude vs ω_f (stable solid, unstable red).
+    /// Write a PNG of amplitude vs ω_f: stable solid, unstable dashed, the
+    /// events marked and labelled (fold, PD, NS, BP).
     #[arg(long)]
     plot: Option<PathBuf>,
 }
@@ -161,10 +181,14 @@ pub struct MathieuArgs {
 /// does not converge (the message carries the residual history summary).
 pub fn run(cmd: HbCommand) -> Result<Output, CliError> {
     match cmd {
+        HbCommand::Frc(a) => user_model::frc(a),
+        HbCommand::Solve(a) => user_model::solve(a),
         HbCommand::Duffing(a) => duffing(a),
         HbCommand::DuffingFrc(a) => duffing_frc(a),
         HbCommand::DuffingFolds(a) => folds::run(a),
         HbCommand::VdpTorus(a) => torus::run(a),
+        HbCommand::Torus(a) => torus_branch::run(a),
+        HbCommand::Diagram(a) => diagram::run(a),
         HbCommand::LimitCycle(a) => autonomous::limit_cycle(a),
         HbCommand::DuffingBackbone(a) => autonomous::backbone(a),
         HbCommand::CycleBranch(a) => cycle_branch::run(a),
@@ -173,6 +197,20 @@ pub fn run(cmd: HbCommand) -> Result<Output, CliError> {
         HbCommand::MathieuDuffing(a) => mathieu(a),
         HbCommand::String(a) => super::string::run(a),
     }
+}
+
+/// One line on an orbit: iterations, residual, solve time, amplitude and
+/// the Floquet verdict.
+fn orbit_summary(orbit: &jobs::Orbit) -> String {
+    format!(
+        "{} iterations, ‖r‖ = {:.2e}, {:.1} µs, amplitude {:.6}, {} (|μ|max = {:.6})\n",
+        orbit.iterations,
+        orbit.residual_norm,
+        orbit.solve_time_s * 1e6,
+        orbit.amplitude,
+        orbit.stability.map_or("unknown", |k| k.name()),
+        orbit.max_modulus()
+    )
 }
 
 /// The JSON object of a job's result.
@@ -193,28 +231,15 @@ fn duffing(a: DuffingArgs) -> Result<Output, CliError> {
         let period = 2.0 * PI / sol.omega();
         let pts: Vec<(f64, f64)> = (0..=400)
             .map(|i| {
-                let t = period * i as f64 / 400.0;
+                let t = period * f64::from(i) / 400.0;
                 (t, sol.x_at(0, t))
             })
             .collect();
-        draw(
-            path,
-            &format!("Duffing, ω_f = {}", a.omega_f),
-            "t",
-            "x",
-            &[("HB", pts)],
-        )?;
+        Picture::new(format!("Duffing, ω_f = {}", a.omega_f), "t", "x")
+            .with("HB", pts, Style::Line)
+            .draw(path)?;
     }
-    let human = format!(
-        "Duffing ω_f = {}: {} iterations, ‖r‖ = {:.2e}, {:.1} µs, amplitude {:.6}, {} (|μ|max = {:.6})\n",
-        a.omega_f,
-        orbit.iterations,
-        orbit.residual_norm,
-        orbit.solve_time_s * 1e6,
-        orbit.amplitude,
-        orbit.stability.map_or("unknown", |k| k.name()),
-        orbit.max_modulus()
-    );
+    let human = format!("Duffing ω_f = {}: {}", a.omega_f, orbit_summary(&orbit));
     Ok(Output {
         json: to_json(&orbit)?,
         human,
@@ -233,36 +258,7 @@ fn duffing_frc(a: FrcArgs) -> Result<Output, CliError> {
     };
     let frc = jobs::frc(&problem, &a.params.options()?, &req)?.with_fold_omegas();
     if let Some(path) = &a.plot {
-        // One curve per stability; a NaN point breaks a curve where the other
-        // takes over, and each run shares its end point with the next.
-        let gap = (f64::NAN, f64::NAN);
-        let (mut stable, mut unstable) = (Vec::new(), Vec::new());
-        let mut prev: Option<((f64, f64), bool)> = None;
-        for p in &frc.points {
-            let (pt, s) = ((p.omega, p.amplitude), p.stable);
-            if let Some((last, _)) = prev.filter(|&(_, was)| was != s) {
-                let (into, other) = if s {
-                    (&mut stable, &mut unstable)
-                } else {
-                    (&mut unstable, &mut stable)
-                };
-                into.push(last);
-                other.push(gap);
-            }
-            if s {
-                stable.push(pt)
-            } else {
-                unstable.push(pt)
-            }
-            prev = Some((pt, s));
-        }
-        draw(
-            path,
-            "Duffing frequency response",
-            "ω_f",
-            "max |x|",
-            &[("stable", stable), ("unstable", unstable)],
-        )?;
+        figure::frc("Duffing frequency response", &frc).draw(path)?;
     }
     let human = format!(
         "{} points from ω_f = {} to {}, folds at {:?}, {} events, {:.1} ms\n",
@@ -291,30 +287,24 @@ fn mathieu(a: MathieuArgs) -> Result<Output, CliError> {
     let cascade = jobs::cascade(&req)?;
     if let Some(path) = &a.plot {
         let names = ["period 1 at β1", "period 2 at β2", "period 4 at β4"];
-        let series: Vec<_> = cascade
-            .doublings
-            .iter()
-            .zip(names)
-            .map(|(p, name)| {
-                let pts = (0..=800)
-                    .map(|j| {
-                        let tau = 2.0 * PI * j as f64 / 800.0;
-                        (
-                            eval_series(p.solution.dof(0), tau, 0),
-                            eval_series(p.solution.dof(0), tau, 1) * p.solution.omega(),
-                        )
-                    })
-                    .collect();
-                (name, pts)
-            })
-            .collect();
-        draw(
-            path,
-            "Mathieu–Duffing critical orbits",
-            "x",
-            "dx/dt",
-            &series,
-        )?;
+        let portraits = cascade.doublings.iter().zip(names).map(|(p, name)| {
+            let pts = (0..=800)
+                .map(|j| {
+                    let tau = 2.0 * PI * f64::from(j) / 800.0;
+                    (
+                        eval_series(p.solution.dof(0), tau, 0),
+                        eval_series(p.solution.dof(0), tau, 1) * p.solution.omega(),
+                    )
+                })
+                .collect();
+            (name, pts)
+        });
+        portraits
+            .fold(
+                Picture::new("Mathieu–Duffing critical orbits", "x", "dx/dt"),
+                |fig, (name, pts)| fig.with(name, pts, Style::Line),
+            )
+            .draw(path)?;
     }
     let human = format!(
         "period doubling at β = {:?} (thesis 4.825, 5.194, 5.253), {:.1} ms\n",
@@ -325,29 +315,4 @@ fn mathieu(a: MathieuArgs) -> Result<Output, CliError> {
         json: to_json(&cascade)?,
         human,
     })
-}
-
-/// Draw curves with the shared figure crate (embedded font, NaN breaks).
-fn draw(
-    path: &std::path::Path,
-    title: &str,
-    x_label: &str,
-    y_label: &str,
-    curves: &[(&str, Vec<(f64, f64)>)],
-) -> Result<(), CliError> {
-    let series = curves
-        .iter()
-        .map(|(label, points)| ivt_plot::Series {
-            label,
-            points,
-            style: ivt_plot::Style::Line,
-        })
-        .collect();
-    let figure = ivt_plot::Figure {
-        title,
-        x_label,
-        y_label,
-        series,
-    };
-    super::write_figure(path, |tmp| ivt_plot::line_plot(tmp, &figure))
 }

@@ -46,16 +46,23 @@ pub enum CliError {
     /// Reading or writing a file or stream failed; the message names the path.
     #[error("{0}")]
     Io(String),
+    /// A recording that does not determine the plant (`ivt rig identify`:
+    /// a coefficient not excited, a residual far above the noise, a plant
+    /// that is not physical); the message names the check and its numbers.
+    #[error("{0}")]
+    Unidentifiable(String),
 }
 
 impl CliError {
-    /// The `kind` of the JSON error object: `input`, `failed` or `io`
-    /// (`usage` is used for argument-parse errors, before any command runs).
+    /// The `kind` of the JSON error object: `input`, `failed`, `io` or
+    /// `unidentifiable` (`usage` is used for argument-parse errors, before
+    /// any command runs).
     pub fn kind(&self) -> &'static str {
         match self {
             CliError::Input(_) => "input",
             CliError::Failed(_) => "failed",
             CliError::Io(_) => "io",
+            CliError::Unidentifiable(_) => "unidentifiable",
         }
     }
 
@@ -74,6 +81,43 @@ impl CliError {
 pub fn check_flag(flag: &'static str, key: &str, value: f64) -> Result<(), CliError> {
     ivt_kin::params::check_as(ivt_kin::params::Boundary::Cli, flag, key, value)
         .map_err(|refused| CliError::Input(format!("{flag} {refused}")))
+}
+
+/// A scene or plant file error: `io` when the file could not be read
+/// (missing, not a regular file, over its size budget), else `input`.
+impl From<ivt_sim::scene::SceneError> for CliError {
+    fn from(e: ivt_sim::scene::SceneError) -> Self {
+        if e.unreadable {
+            CliError::Io(e.message)
+        } else {
+            CliError::Input(e.message)
+        }
+    }
+}
+
+/// A simulator error: a work budget exceeded or a scene refused is the
+/// user's input, a file that could not be written or read (an output, the
+/// telemetry stream) `io`, the rest a failed run.
+impl From<ivt_sim::SimError> for CliError {
+    fn from(e: ivt_sim::SimError) -> Self {
+        use ivt_sim::SimError as E;
+        match e {
+            E::Budget(_) | E::Scene(_) => CliError::Input(e.to_string()),
+            E::Io { .. } | E::Mcap { .. } | E::TelemetryRead(_) => CliError::Io(e.to_string()),
+            _ => CliError::Failed(e.to_string()),
+        }
+    }
+}
+
+/// The reproduction's error: a file it could not write is `io`, the rest
+/// failed.
+impl From<crate::reproduce::ReproError> for CliError {
+    fn from(e: crate::reproduce::ReproError) -> Self {
+        match e {
+            crate::reproduce::ReproError::Io { .. } => CliError::Io(e.to_string()),
+            _ => CliError::Failed(e.to_string()),
+        }
+    }
 }
 
 /// A harmonic-balance error: `input` or `failed` as
@@ -106,7 +150,12 @@ impl From<ivt_design::IvtError> for CliError {
 #[command(
     name = "ivt",
     version,
-    about = "IVT toolkit: kinematics, harmonic balance, controller and simulator (Wang 2017)"
+    about = "IVT toolkit: kinematics, harmonic balance, controller and simulator (Wang 2017)",
+    after_help = "Exit status: 0 success; 2 failure, under --json with one {\"error\", \"kind\"} \
+                  object on stdout, kind \"usage\" | \"input\" | \"failed\" | \"io\" | \"unidentifiable\"; 130 \
+                  stopped \
+                  by SIGINT/SIGTERM (kind \"interrupted\"). Inputs are read from regular files only; \
+                  no output replaces an input of the run. See the guide's Limits and errors."
 )]
 struct Cli {
     /// Print exactly one JSON object on stdout instead of text.
@@ -184,21 +233,54 @@ pub fn write_figure(
 /// The parse or command failure, one line.
 #[doc(hidden)]
 pub fn fuzz_args(args: &[std::ffi::OsString]) -> Result<(), String> {
-    let cli = Cli::try_parse_from(args).map_err(|e| e.kind().to_string())?;
+    let cli = parse(args).map_err(|e| e.kind().to_string())?;
     match cli.command {
         Some(Command::Kin(cmd)) => kin::run(cmd).map(|_| ()).map_err(|e| e.to_string()),
         _ => Ok(()),
     }
 }
 
+/// The command line (`Cli`) with every option that takes a value accepting
+/// a negative number (`--xi -0.5`, `--vm -8`), which clap otherwise reads as
+/// a flag (`-0`); the command checks the value's range.
+pub fn command() -> clap::Command {
+    fn negative_numbers(cmd: clap::Command) -> clap::Command {
+        cmd.mut_args(|a| {
+            if a.get_action().takes_values() {
+                a.allow_negative_numbers(true)
+            } else {
+                a
+            }
+        })
+        .mut_subcommands(negative_numbers)
+    }
+    negative_numbers(<Cli as clap::CommandFactory>::command())
+}
+
+/// `args` (program name first) parsed by [`command`].
+fn parse<I, T>(args: I) -> Result<Cli, clap::Error>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let matches = command().try_get_matches_from(args)?;
+    <Cli as clap::FromArgMatches>::from_arg_matches(&matches)
+}
+
 /// Exit status of every failure (argument, input, numerical, I/O).
 const EXIT_FAILURE: u8 = 2;
 
 /// Parse the process arguments, run, print, and map errors to exit codes:
-/// 0 on success (and for `--help`/`--version`), 2 for every failure. Under
-/// `--json` a failure prints exactly one `{"error", "kind"}` object on stdout,
-/// argument-parse errors included. A closed stdout (EPIPE) ends quietly with
-/// status 2; any other write error (ENOSPC, ...) is reported on stderr.
+/// 0 on success (and for `--help`/`--version`), 2 for every failure, 130
+/// when SIGINT/SIGTERM stopped the run. Under `--json` a failure prints
+/// exactly one `{"error", "kind"}` object on stdout, argument-parse errors
+/// included. A reader that closed the pipe (EPIPE) ends the command quietly
+/// with status 2; any other write error (ENOSPC, ...) is reported on stderr.
+/// A stdout on `/dev/null` (`subprocess.DEVNULL`, `>/dev/null`) is written
+/// to like any other: the command runs and writes its files. (A stdout
+/// closed with `>&-` cannot be told from it: the Rust runtime reopens a
+/// closed descriptor 1 on `/dev/null` read-write before `main`, as Python
+/// opens `DEVNULL`.)
 pub fn main() -> ExitCode {
     // Looked up in the raw arguments: the interrupt handler and a parse
     // failure need it before (or without) a parsed command line.
@@ -207,17 +289,12 @@ pub fn main() -> ExitCode {
         .any(|a| a == "--json");
     JSON.store(json, Ordering::SeqCst);
     install_interrupt_handler();
-    let cli = match Cli::try_parse() {
+    let cli = match parse(std::env::args_os()) {
         Ok(cli) => cli,
         Err(e) => return parse_failure(&e, json),
     };
     let json = cli.json;
     JSON.store(json, Ordering::SeqCst);
-    if json && stdout_closed_at_start() {
-        // Nothing to print the answer on: refuse before any work is done.
-        note("error: stdout is closed (`>&-`): the JSON answer would be lost");
-        return ExitCode::from(EXIT_FAILURE);
-    }
     let result = match cli.command {
         Some(Command::Kin(cmd)) => kin::run(cmd),
         Some(Command::Sim(args)) => sim::run_file(&args, json),
@@ -238,30 +315,11 @@ pub fn main() -> ExitCode {
     }
 }
 
-/// Exit status after SIGINT/SIGTERM without `--json` (128 + SIGINT, the
-/// shell's convention); under `--json` an interruption is a failure like any
-/// other: its one JSON error and [`EXIT_FAILURE`] (SPEC §6, issue 30).
-const EXIT_INTERRUPTED: i32 = 130;
-
-/// Whether stdout was closed when the process started (`ivt --json ... >&-`).
-/// The Rust runtime reopens a closed fd 1 on `/dev/null` read-write
-/// (`sanitize_standard_fds`) and writes to it then succeed, so the closed
-/// descriptor shows only as fd 1 → `/dev/null` with access mode O_RDWR in
-/// `/proc/self/fdinfo/1` — a shell's `>/dev/null` and Rust's `Stdio::null()`
-/// open it write-only. A caller that hands a read-write `/dev/null` (Python's
-/// `subprocess.DEVNULL`) is taken for a closed stdout under `--json`; outside
-/// Linux (no /proc) nothing is detected.
-fn stdout_closed_at_start() -> bool {
-    let devnull = std::fs::read_link("/proc/self/fd/1")
-        .is_ok_and(|target| target == std::path::Path::new("/dev/null"));
-    devnull
-        && std::fs::read_to_string("/proc/self/fdinfo/1").is_ok_and(|info| {
-            info.lines()
-                .find_map(|l| l.strip_prefix("flags:"))
-                .and_then(|f| u32::from_str_radix(f.trim(), 8).ok())
-                .is_some_and(|flags| flags & 0o3 == 0o2)
-        })
-}
+/// Exit status after SIGINT/SIGTERM, with or without `--json`: 128 +
+/// SIGINT, the shell's convention for a run stopped by the user (an
+/// interruption is not an error of the input or of the computation; under
+/// `--json` its one `{"error", "kind": "interrupted"}` object says so).
+const EXIT_INTERRUPTED: u8 = 130;
 
 /// `--json` is on the command line.
 static JSON: AtomicBool = AtomicBool::new(false);
@@ -271,9 +329,10 @@ static STDOUT_DONE: Mutex<bool> = Mutex::new(false);
 
 /// On SIGINT/SIGTERM, delete every staged (incomplete) output file and every
 /// directory the run created, print the one `{"error", "kind":
-/// "interrupted"}` object and exit 2 under `--json` (130 without) — or, while the rig
-/// recorder is running, let it stop reading and close its MCAP with a valid
-/// footer ([`ivt_sim::atomic::on_interrupt`]).
+/// "interrupted"}` object under `--json`, and exit with
+/// [`EXIT_INTERRUPTED`] — or, while the rig recorder is running, let it stop
+/// reading and close its MCAP with a valid footer
+/// ([`ivt_sim::atomic::on_interrupt`]).
 fn install_interrupt_handler() {
     let installed = ctrlc::set_handler(|| {
         if ivt_sim::atomic::on_interrupt() {
@@ -291,11 +350,7 @@ fn install_interrupt_handler() {
         *done = true;
         note(&format!("error: {message}"));
         // exits with the lock held: nothing else reaches stdout
-        std::process::exit(if json {
-            i32::from(EXIT_FAILURE)
-        } else {
-            EXIT_INTERRUPTED
-        });
+        std::process::exit(i32::from(EXIT_INTERRUPTED));
     });
     if let Err(e) = installed {
         note(&format!("warning: no interrupt handler: {e}"));

@@ -30,17 +30,14 @@ impl PlantArg {
     /// The plant's parameters: the preset, or the plant file's table.
     ///
     /// # Errors
-    /// An unreadable or invalid plant file ([`CliError::Input`], naming the
-    /// file, line and key).
+    /// An unreadable plant file ([`CliError::Io`]) or an invalid one
+    /// ([`CliError::Input`], naming the file, line and key).
     pub fn params(&self) -> Result<PlantParams, CliError> {
         match &self.file {
             None => Ok(self.preset.params()),
-            Some(path) => ivt_sim::scene::PlantSection::from_file(path)
-                .and_then(|s| {
-                    s.params()
-                        .map_err(|e| ivt_sim::scene::SceneError(format!("{}: {e}", path.display())))
-                })
-                .map_err(|e| CliError::Input(e.0)),
+            Some(path) => ivt_sim::scene::PlantSection::from_file(path)?
+                .params()
+                .map_err(|e| CliError::Input(format!("{}: {e}", path.display()))),
         }
     }
 

@@ -29,8 +29,7 @@ pub fn run(args: ReproduceArgs, json: bool) -> Result<Output, CliError> {
             quick: args.quick,
             progress: !json,
         },
-    )
-    .map_err(|e| CliError::Failed(e.to_string()))?;
+    )?;
     let count = |v: Verdict| report.rows.iter().filter(|r| r.verdict == v).count();
     let mut human = String::new();
     let _ = writeln!(

@@ -61,6 +61,7 @@ pub fn run(cmd: RigCommand) -> Result<Output, CliError> {
 const MAX_IDLE_TIMEOUT: Duration = Duration::from_secs(86_400);
 
 fn record_cmd(a: &RecordArgs) -> Result<Output, CliError> {
+    super::check_flag("--f-timer-hz", "encoder.f_timer_hz", a.f_timer_hz)?;
     let idle_timeout = Duration::try_from_secs_f64(a.idle_timeout_s)
         .ok()
         .filter(|d| !d.is_zero() && *d <= MAX_IDLE_TIMEOUT)

@@ -7,7 +7,9 @@
 use super::{CliError, Output};
 use clap::{Args, ValueEnum};
 use ivt_ctrl::commission::{Plan, Selection, SequenceName};
-use ivt_sim::commission::{load_plant_file, run_sil, CommissionOptions, SensorModel};
+use ivt_kin::params::Typed;
+use ivt_sim::commission::{run_sil, CommissionOptions, SensorModel};
+use ivt_sim::scene::PlantSection;
 use serde_json::json;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -98,14 +100,15 @@ pub fn commission_cmd(a: &CommissionArgs) -> Result<Output, CliError> {
     if let Some(port) = &a.port {
         return on_rig(a, port, selection, &plan);
     }
-    if !(a.k_prop.is_finite() && a.k_prop > 0.0) {
+    super::check_flag("--k-prop", "controller.k_prop_deg_per_rpm", a.k_prop)?;
+    if a.k_prop <= 0.0 {
         return Err(CliError::Input(format!(
-            "--k-prop must be finite and > 0, got {}",
-            a.k_prop
+            "--k-prop = {} deg/rpm must be > 0 (the proportional law drives the stepper against the speed error)",
+            Typed(a.k_prop)
         )));
     }
     let plant = match &a.plant_file {
-        Some(p) => load_plant_file(p).map_err(|e| CliError::Input(e.to_string()))?,
+        Some(p) => PlantSection::from_file(p)?,
         None => Default::default(),
     };
     let opts = CommissionOptions {
@@ -124,8 +127,7 @@ pub fn commission_cmd(a: &CommissionArgs) -> Result<Output, CliError> {
         ivt_sim::pil::run_pil_commission(&opts, &a.out)
     } else {
         run_sil(&opts, &a.out)
-    }
-    .map_err(|e| CliError::Failed(e.to_string()))?;
+    }?;
     let human = format!(
         "{} stages, {} pulses over {:.2} s ({}) → {}\n",
         s.stages,
@@ -157,6 +159,7 @@ fn on_rig(
     selection: Selection,
     plan: &Plan,
 ) -> Result<Output, CliError> {
+    super::check_flag("--f-timer-hz", "encoder.f_timer_hz", a.f_timer_hz)?;
     let mut dev = super::rig_port::open_port(port, a.baud)?;
     let mut frame = [0u8; ivt_wire::MAX_FRAME];
     let n = ivt_wire::Request::Commission {
@@ -166,7 +169,7 @@ fn on_rig(
     .encode(&mut frame)
     .map_err(|e| CliError::Failed(e.to_string()))?;
     std::io::Write::write_all(&mut dev, frame.get(..n).unwrap_or(&[]))
-        .map_err(|e| CliError::Failed(format!("{port}: {e}")))?;
+        .map_err(|e| CliError::Io(format!("{port}: {e}")))?;
     super::note(&format!("commissioning started on {port}"));
     let total = plan.duration_s(selection, ivt_ctrl::Config::default().open_loop.r_max);
     // The rig sends a sample every 10 ms: the plan and one second more.

@@ -11,6 +11,7 @@ use ivt_design::identify::{self, Identification, SweepAnalysis, NAMES};
 use ivt_kin::plant::PlantParams;
 use ivt_kin::sgivt::R_AVG_SLOPE_PRINTED_PER_DEG;
 use ivt_plot::{Figure, Series, Style};
+use ivt_sim::atomic::Staged;
 use ivt_sim::scene::PlantSection;
 use serde_json::{json, Map, Value};
 use std::f64::consts::{PI, SQRT_2};
@@ -40,32 +41,38 @@ pub fn run(a: &IdentifyArgs) -> Result<Output, CliError> {
         other => CliError::Input(other.to_string()),
     })?;
     let nominal = commissioning::nominal_params(&rec).map_err(CliError::Input)?;
-    let id = identify::identify(&rec.recording, &nominal)
-        .map_err(|e| CliError::Failed(format!("{}: {e}", a.recording.display())))?;
-    let plant = id.plant(&nominal);
-    plant.validate().map_err(|e| {
-        CliError::Failed(format!(
-            "{}: the identified plant is not physical: {e}",
-            a.recording.display()
-        ))
+    let id = identify::identify(&rec.recording, &nominal).map_err(|e| {
+        let text = format!("{}: {e}", a.recording.display());
+        match e {
+            identify::IdentifyError::Recording { .. } => CliError::Input(text),
+            _ => CliError::Unidentifiable(text),
+        }
     })?;
+    let plant = id.plant(&nominal);
     let section = PlantSection::from_params(rec.nominal.preset, &plant);
-    if let Some(out) = &a.out {
-        let text = format!(
-            "# Identified by `ivt rig identify {}` (equation error on Eq. 151, {} windows).\n{}",
-            a.recording.display(),
-            id.windows,
-            section.to_toml()
-        );
-        super::write_atomic(out, text.as_bytes())?;
-    }
     let dir = a.figures.clone().unwrap_or_else(|| {
         let beside = a.out.as_deref().unwrap_or(&a.recording);
         beside
             .parent()
             .map_or_else(|| PathBuf::from("."), Path::to_path_buf)
     });
-    let figures = draw_figures(&dir, &id, &plant)?;
+    // The plant file and the figures are one set: all of them or none.
+    let mut staged = Staged::in_dir(&dir).map_err(|e| CliError::io(&dir, e))?;
+    if let Some(out) = &a.out {
+        // The recording's path as a quoted, escaped string: a newline in it
+        // cannot start a line of the plant file.
+        let text = format!(
+            "# Identified by `ivt rig identify {:?}` (equation error on Eq. 151, {} windows).\n{}",
+            a.recording.display().to_string(),
+            id.windows,
+            section.to_toml()
+        );
+        staged
+            .write(out, text.as_bytes())
+            .map_err(|e| CliError::io(out, e))?;
+    }
+    let figures = draw_figures(&mut staged, &dir, &id, &plant)?;
+    staged.commit().map_err(|e| CliError::io(&dir, e))?;
     let mut out = report(a, &id, &plant, &section, &figures);
     if let Some(obj) = out.json.as_object_mut() {
         obj.insert(
@@ -94,7 +101,7 @@ fn report(
     }
     summary.insert("r_max".into(), json!(plant.r_max));
     let sweep = id.sweep.as_ref().map(|s| sweep_json(s, plant));
-    let mut human = String::from("identified (95 % interval):\n");
+    let mut human = format!("model: {}\nidentified (95 % interval):\n", model(id, plant));
     for (name, e) in NAMES.iter().zip(&id.estimates) {
         human.push_str(&format!(
             "  {name:<14} {:>12.6e}  [{:.6e}, {:.6e}]\n",
@@ -117,6 +124,9 @@ fn report(
     if let Some(out) = &a.out {
         human.push_str(&format!("plant file → {}\n", out.display()));
     }
+    for w in &id.warnings {
+        human.push_str(&format!("warning: {w}\n"));
+    }
     Output {
         json: json!({
             "summary": summary,
@@ -125,11 +135,28 @@ fn report(
             "plant": section.to_toml(),
             "figures": figures.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
             "residual_rms": id.residual_rms,
+            "noise_rms": id.noise_rms,
+            "gravity_rms": id.gravity_rms,
+            "model": model(id, plant),
+            "l_a": plant.l_a,
+            "warnings": id.warnings,
             "windows": id.windows,
             "inverse_condition": id.inverse_condition,
             "sweep": sweep,
         }),
         human,
+    }
+}
+
+/// The model fitted, with its assumption on L_a stated.
+fn model(id: &Identification, plant: &PlantParams) -> String {
+    if id.lag_s > 0.0 {
+        format!(
+            "Eq. 137 with L_a = {} H from the nominal plant (τ_e = L_a/R_a = {:.3e} s; L_a is not identifiable from the motion)",
+            plant.l_a, id.lag_s
+        )
+    } else {
+        "Eq. 151, L_a = 0 as the nominal plant (Eq. 138; a rig with L_a > 0 needs it in the plant metadata)".into()
     }
 }
 
@@ -164,14 +191,15 @@ fn sweep_json(s: &SweepAnalysis, plant: &PlantParams) -> Value {
     })
 }
 
-/// Fig. 47, 48 and 50 from the data, as far as the recording has them.
+/// Fig. 47, 48 and 50 from the data, as far as the recording has them,
+/// staged in `staged`.
 fn draw_figures(
+    staged: &mut Staged,
     dir: &Path,
     id: &Identification,
     plant: &PlantParams,
 ) -> Result<Vec<PathBuf>, CliError> {
     let mut out = Vec::new();
-    std::fs::create_dir_all(dir).map_err(|e| CliError::io(dir, e))?;
     if let Some(s) = &id.sweep {
         let measured: Vec<(f64, f64)> = s
             .holds
@@ -189,6 +217,7 @@ fn draw_figures(
         let eq185 = line(0.0, eq185_slope(plant));
         let printed = line(0.0, R_AVG_SLOPE_PRINTED_PER_DEG);
         out.push(plot(
+            staged,
             dir,
             "fig47_average_ratio.png",
             &Figure {
@@ -234,6 +263,7 @@ fn draw_figures(
             s.k2_t_out, s.k
         );
         out.push(plot(
+            staged,
             dir,
             "fig50_motor_speed.png",
             &Figure {
@@ -257,6 +287,7 @@ fn draw_figures(
     }
     if let Some(p) = &id.phase_average {
         out.push(plot(
+            staged,
             dir,
             "fig48_speed_over_theta_in.png",
             &Figure {
@@ -274,11 +305,15 @@ fn draw_figures(
     Ok(out)
 }
 
-/// Draw one figure under a temporary name and rename it into place.
-fn plot(dir: &Path, name: &str, fig: &Figure<'_>) -> Result<PathBuf, CliError> {
+/// Draw one figure into its staged temporary file.
+fn plot(
+    staged: &mut Staged,
+    dir: &Path,
+    name: &str,
+    fig: &Figure<'_>,
+) -> Result<PathBuf, CliError> {
     let path = dir.join(name);
-    let tmp = dir.join(format!(".{}.tmp.{name}", std::process::id()));
-    ivt_plot::line_plot(&tmp, fig).map_err(|e| CliError::io(&path, e))?;
-    std::fs::rename(&tmp, &path).map_err(|e| CliError::io(&path, e))?;
+    let tmp = staged.path(&path).map_err(|e| CliError::io(&path, e))?;
+    ivt_plot::line_plot(&tmp, fig).map_err(|e| CliError::Failed(e.for_path(&path).to_string()))?;
     Ok(path)
 }

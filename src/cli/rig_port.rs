@@ -17,7 +17,7 @@ pub(super) fn open_port(
     serialport::new(port, baud)
         .timeout(Duration::from_millis(100))
         .open()
-        .map_err(|e| CliError::Failed(format!("{port}: {e}")))
+        .map_err(|e| CliError::Io(format!("{port}: {e}")))
 }
 
 /// Records a live port's telemetry into `out`: the firmware's PPR in the
@@ -36,5 +36,5 @@ pub(super) fn record_live<R: Read>(
         ppr: FIRMWARE_PPR,
         strict: false,
     };
-    record(src, out, &opts).map_err(|e| CliError::Failed(e.to_string()))
+    Ok(record(src, out, &opts)?)
 }

@@ -7,7 +7,6 @@ use ivt_sim::progress::Progress;
 use ivt_sim::run::Simulation;
 use ivt_sim::scene::Scene;
 use ivt_sim::steady::{Route, SceneRun};
-use ivt_sim::SimError;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -60,9 +59,10 @@ impl From<RouteArg> for Route {
 /// Run a scene file.
 ///
 /// # Errors
-/// Scene errors as [`CliError::Input`], run/output failures as [`CliError::Failed`].
+/// Scene errors as [`CliError::Input`], unreadable scenes and unwritable
+/// outputs as [`CliError::Io`], failed runs as [`CliError::Failed`].
 pub fn run_file(args: &SimArgs, json: bool) -> Result<Output, CliError> {
-    let scene = Scene::load(&args.scene).map_err(|e| CliError::Input(e.to_string()))?;
+    let scene = Scene::load(&args.scene)?;
     let route = if args.pil {
         if matches!(args.route, Some(RouteArg::IhbSteadyState)) {
             return Err(CliError::Input(
@@ -82,19 +82,9 @@ pub fn run_file(args: &SimArgs, json: bool) -> Result<Output, CliError> {
 /// # Errors
 /// As [`run_file`].
 pub fn run_default(json: bool) -> Result<Output, CliError> {
-    let scene = Scene::parse(DEFAULT_SCENE, "scenes/drive.toml")
-        .map_err(|e| CliError::Input(e.to_string()))?;
+    let scene = Scene::parse(DEFAULT_SCENE, "scenes/drive.toml")?;
     let max_events = ivt_sim::scene::DEFAULT_MAX_EVENTS;
     run_scene(&scene, Path::new("out"), json, false, None, max_events)
-}
-
-/// A simulator failure: a work budget exceeded or a scene refused is the
-/// user's input, the rest a failed run.
-fn sim_error(e: SimError) -> CliError {
-    match e {
-        SimError::Budget(_) | SimError::Scene(_) => CliError::Input(e.to_string()),
-        _ => CliError::Failed(e.to_string()),
-    }
 }
 
 fn run_scene(
@@ -108,11 +98,11 @@ fn run_scene(
     let mut bar = Progress::new(!json && scene.duration_s >= 5.0, &scene.name);
     let (answered, paths) = if pil {
         scene.check_events(max_events).map_err(CliError::Input)?;
-        let r = ivt_sim::pil::run_pil(scene, &mut |f| bar.update(f)).map_err(sim_error)?;
+        let r = ivt_sim::pil::run_pil(scene, &mut |f| bar.update(f))?;
         bar.finish();
         let mut answered = SceneRun::time_integration(scene, r);
         answered.route_reason = "processor in the loop".into();
-        let paths = write_outputs(out, scene, &answered).map_err(sim_error)?;
+        let paths = write_outputs(out, scene, &answered)?;
         (answered, paths)
     } else if !scene.outputs.steady_state && route != Some(Route::IhbSteadyState) {
         // A transient is asked for: the MCAP log is written by a thread while
@@ -127,17 +117,15 @@ fn run_scene(
                 .answer_by_time_integration();
             bar.finish();
             r
-        })
-        .map_err(sim_error)?
+        })?
     } else {
         let answered = Simulation::new(scene)
             .route(route)
             .max_events(max_events)
             .progress(&mut |f| bar.update(f))
-            .answer()
-            .map_err(sim_error)?;
+            .answer()?;
         bar.finish();
-        let paths = write_outputs(out, scene, &answered).map_err(sim_error)?;
+        let paths = write_outputs(out, scene, &answered)?;
         (answered, paths)
     };
     let summary = answered.summary_json(scene);

@@ -10,6 +10,7 @@ use ivt_design::delay::{delay_stability, DelayOptions, FeedbackGains};
 use ivt_design::gains::grid_stability_map;
 use ivt_design::sweep::{axis, Grid};
 use ivt_design::{rpm_to_rad_s, OperatingPoint};
+use ivt_kin::params::Typed;
 use serde_json::json;
 
 /// Arguments of `ivt stability`.
@@ -245,7 +246,8 @@ fn design_box(b: &[f64], steps: usize) -> Result<(f64, f64), CliError> {
     for (name, v) in [("K_MAX", k_max), ("K2_MAX", k2_max)] {
         if !(v.is_finite() && v > 0.0) {
             return Err(CliError::Input(format!(
-                "--design {name} must be finite and > 0, got {v}"
+                "--design {name} must be finite and > 0, got {}",
+                Typed(v)
             )));
         }
     }

@@ -3,11 +3,10 @@
 
 use super::{CliError, Output};
 use clap::{Args, ValueEnum};
-use ivt_hb::FrcPoint;
 use ivt_jobs::{self as jobs, StringRequest};
 use ivt_sthb::{Boundary, StringParams};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Boundary at `x = 1`.
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -58,14 +57,16 @@ pub struct StringArgs {
     /// Largest arclength step.
     #[arg(long, default_value_t = 0.05)]
     step_max: f64,
-    /// Draw ‖a‖ against ω into this PNG (stable solid, unstable dashed).
+    /// Draw ‖a‖ against ω into this PNG (stable solid, unstable dashed,
+    /// folds marked).
     #[arg(long)]
     plot: Option<PathBuf>,
 }
 
 /// Trace the curve (the job [`ivt_jobs::string()`]) and report
 /// `{"points": [{"omega", "norm", "stable", "kind", "max_multiplier",
-/// "method"}...], "jacobians", "hill_calls", "stop", "solve_time_s"}` (and
+/// "method"}...], "folds": [{"omega", "norm", "located", "index"}...],
+/// "jacobians", "hill_calls", "stop", "solve_time_s"}` (and
 /// `boundary_note` for a spring of k0 > 1).
 ///
 /// # Errors
@@ -113,7 +114,17 @@ pub fn run(args: StringArgs) -> Result<Output, CliError> {
             args.harmonics,
             boundary_name(boundary)
         );
-        plot(path, &title, &curve.frc.points)?;
+        let points: Vec<_> = curve
+            .points
+            .iter()
+            .map(|p| (p.omega, p.norm, p.stable))
+            .collect();
+        let folds: Vec<_> = curve
+            .folds
+            .iter()
+            .map(|f| ("fold".to_owned(), (f.omega, f.norm)))
+            .collect();
+        super::hb::figure::response(title, "||a|| (Eq. 114)", &points, &folds).draw(path)?;
         let _ = writeln!(human, "# plot: {}", path.display());
     }
     let json = serde_json::to_value(&curve).map_err(|e| CliError::Failed(e.to_string()))?;
@@ -126,48 +137,4 @@ fn boundary_name(boundary: Boundary) -> String {
         Boundary::Fixed => "fixed–fixed".to_string(),
         Boundary::Spring { k0 } => format!("spring k0 = {k0}"),
     }
-}
-
-/// ‖a‖(ω) with the stable stretches solid and the unstable ones dashed; each
-/// change of verdict repeats the boundary point in both series so the curve
-/// stays connected (NaN breaks the other series there).
-fn plot(path: &Path, title: &str, points: &[FrcPoint]) -> Result<(), CliError> {
-    let stable = FrcPoint::stable;
-    let (mut solid, mut dashed) = (Vec::new(), Vec::new());
-    let mut previous: Option<&FrcPoint> = None;
-    for p in points {
-        let xy = (p.omega_f, p.amplitude);
-        let gap = (f64::NAN, f64::NAN);
-        let (own, other) = if stable(p) {
-            (&mut solid, &mut dashed)
-        } else {
-            (&mut dashed, &mut solid)
-        };
-        own.push(xy);
-        if previous.is_some_and(|q| stable(q) != stable(p)) {
-            // Close the other style's stretch at this point, then break it.
-            other.push(xy);
-        }
-        other.push(gap);
-        previous = Some(p);
-    }
-    let mut series = vec![ivt_plot::Series {
-        label: "stable",
-        points: &solid,
-        style: ivt_plot::Style::Line,
-    }];
-    if dashed.iter().any(|p| p.0.is_finite()) {
-        series.push(ivt_plot::Series {
-            label: "unstable",
-            points: &dashed,
-            style: ivt_plot::Style::Dashed,
-        });
-    }
-    let figure = ivt_plot::Figure {
-        title,
-        x_label: "ω (normalized excitation frequency)",
-        y_label: "||a|| (Eq. 114)",
-        series,
-    };
-    super::write_figure(path, |tmp| ivt_plot::line_plot(tmp, &figure))
 }

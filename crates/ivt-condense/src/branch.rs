@@ -39,6 +39,10 @@ pub struct CondensedBranch<P: PeriodicProblem> {
     /// The last failure to build receptances (reported by the drivers).
     failure: Option<HbError>,
     scratch: Vec<f64>,
+    /// The structure's own relative receptance error (a reduced model's
+    /// certified estimate; 0 for the whole structure), added to
+    /// [`Self::data_error`].
+    model_error: f64,
 }
 
 impl<P: PeriodicProblem> CondensedBranch<P> {
@@ -107,7 +111,17 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
             model: None,
             failure: None,
             scratch: vec![0.0; m],
+            model_error: 0.0,
         })
+    }
+
+    /// The branch of a structure whose receptances are off by `error`
+    /// (relative) from the true structure's: a reduced model
+    /// ([`super::reduce::ReducedModel`]). [`Self::data_error`] and so every
+    /// point's `orbit_error` carry it.
+    pub fn with_model_error(mut self, error: f64) -> Self {
+        self.model_error = error.max(0.0);
+        self
     }
 
     /// The HB options.
@@ -195,7 +209,8 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
     /// the stored `M` and `C` ([`Receptances::data_error`]); where the path
     /// used a Taylor model at ω_f, the change at the model's exact base
     /// (within the model's radius, where the receptances move by less than
-    /// 1e-5 relative: the same estimate to its first digits).
+    /// 1e-5 relative: the same estimate to its first digits); plus the
+    /// model's own error ([`Self::with_model_error`]).
     ///
     /// # Errors
     /// As [`Self::receptances`].
@@ -204,7 +219,8 @@ impl<P: PeriodicProblem> CondensedBranch<P> {
         if !modelled {
             self.ensure(omega_f)?;
         }
-        Ok(self.cached()?.data_error(&self.structure, &self.coupling))
+        let rounding = self.cached()?.data_error(&self.structure, &self.coupling);
+        Ok(rounding + self.model_error)
     }
 
     /// Takes the last receptance failure seen by the path callbacks (which

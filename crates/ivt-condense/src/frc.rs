@@ -16,7 +16,8 @@ use super::stability::{
 };
 use ivt_hb::branches::events::{observe, BifurcationKind, EventObserver, Fold, LocateOptions};
 use ivt_hb::branches::frc::FrcFold;
-use ivt_hb::orbit::aft::{eval_series, Aft};
+use ivt_hb::orbit::aft::Aft;
+use ivt_hb::orbit::ihb::refine_peak;
 use ivt_hb::problem::PeriodicProblem;
 use ivt_hb::stability::HsuSteps;
 use ivt_hb::HbError;
@@ -488,6 +489,14 @@ fn orbit_error<P: PeriodicProblem>(
     }
 }
 
+/// max_τ |x(τ)| of the series `coeffs`: the largest of the 2N samples of
+/// `aft` (`samples`: its scratch), refined by Newton on `x′(τ) = 0` (the
+/// sampled maximum alone is low by up to ~(π/2N)²/2 relative).
+pub(crate) fn series_max(aft: &mut Aft, samples: &mut [f64], coeffs: &[f64]) -> f64 {
+    aft.synthesize(coeffs, samples);
+    refine_peak(coeffs, samples)
+}
+
 /// The per-point quantities: amplitude, recorded DOFs, error estimates.
 struct Probe {
     aft: Aft,
@@ -515,31 +524,9 @@ impl Probe {
         })
     }
 
-    /// max_τ |x(τ)| of the series `coeffs`: the largest of the 2N samples,
-    /// refined by Newton on `x′(τ) = 0` (the sampled maximum alone is low by
-    /// up to ~(π/2N)²/2 relative).
+    /// [`series_max`] of `coeffs`.
     fn max_abs(&mut self, coeffs: &[f64]) -> f64 {
-        self.aft.synthesize(coeffs, &mut self.samples);
-        let (mut best, mut at) = (0.0f64, 0usize);
-        for (i, v) in self.samples.iter().enumerate() {
-            if v.abs() > best {
-                (best, at) = (v.abs(), i);
-            }
-        }
-        let mut tau = self.aft.tau(at);
-        let step = std::f64::consts::PI / self.samples.len() as f64;
-        for _ in 0..8 {
-            let (d1, d2) = (eval_series(coeffs, tau, 1), eval_series(coeffs, tau, 2));
-            if d2 == 0.0 {
-                break;
-            }
-            let delta = (d1 / d2).clamp(-step, step);
-            tau -= delta;
-            if delta.abs() <= 1e-15 * (1.0 + tau.abs()) {
-                break;
-            }
-        }
-        best.max(eval_series(coeffs, tau, 0).abs())
+        series_max(&mut self.aft, &mut self.samples, coeffs)
     }
 
     fn amplitude<P: PeriodicProblem>(

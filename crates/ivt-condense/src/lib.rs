@@ -23,6 +23,8 @@
 //!   variational equation on a reduced basis (the Ritz vectors of `S`,
 //!   load-dependent) grown per orbit until the basis truncation's estimated error
 //!   meets a tolerance.
+//! - [`reduce`]: a large solid projected once onto a certified basis
+//!   (issue 42), the condensed path then run on the small reduced model.
 
 mod band;
 mod branch;
@@ -34,6 +36,7 @@ mod modal_hsu;
 pub mod models;
 mod peak;
 mod receptance;
+pub mod reduce;
 mod ritz;
 mod scaled;
 mod stability;

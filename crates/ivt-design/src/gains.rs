@@ -98,9 +98,13 @@ pub fn stability_map(
     if points.is_empty() {
         return Err(IvtError::EmptyGrid("no operating points"));
     }
+    let token = ivt_num::cancel::Token::now();
     Ok(points
         .par_iter()
         .map(|op| {
+            if token.cancelled() {
+                return (*op, Err(ivt_num::cancel::CANCELLED.to_string()));
+            }
             let r = super::delay::delay_stability(plant, op, gains, opts)
                 .map(|s| s.max_abs_multiplier)
                 .map_err(|e| e.to_string());

@@ -149,7 +149,7 @@ pub enum IvtError {
     EmptyGrid(&'static str),
     /// The speed reached zero or became non-finite: the torque cannot keep the
     /// IVT turning at this r (Eq. 162 needs ω > 0, Prop. 2).
-    #[error("stall: ω = {omega} rad/s at θ = {theta} rad with r = {r} m")]
+    #[error("stall: ω = {omega:?} rad/s at θ = {theta:?} rad with r = {r:?} m")]
     Stall {
         /// Angle where it happened.
         theta: f64,

@@ -161,10 +161,12 @@ pub fn sweep<P: Fn() + Sync>(
     check_plant(plant)?;
     grid.validate()?;
     IhbSolver::new(opts)?;
+    // one token for the whole sweep: a row started after a cancellation stops too
+    let token = ivt_num::cancel::Token::now();
     let rows: Vec<Vec<SweepPoint>> = grid
         .t_u
         .par_iter()
-        .map(|&t_u| sweep_row(plant, grid, t_u, opts, &progress))
+        .map(|&t_u| sweep_row(plant, grid, (t_u, token), opts, &progress))
         .collect();
     Ok(rows.into_iter().flatten().collect())
 }
@@ -181,10 +183,11 @@ pub fn sweep_serial(
     check_plant(plant)?;
     grid.validate()?;
     IhbSolver::new(opts)?;
+    let token = ivt_num::cancel::Token::now();
     Ok(grid
         .t_u
         .iter()
-        .flat_map(|&t_u| sweep_row(plant, grid, t_u, opts, &|| ()))
+        .flat_map(|&t_u| sweep_row(plant, grid, (t_u, token), opts, &|| ()))
         .collect())
 }
 
@@ -199,7 +202,7 @@ pub fn require_some_solved(points: &[SweepPoint]) -> Result<(), IvtError> {
 fn sweep_row(
     plant: &PlantParams,
     grid: &Grid,
-    t_u: f64,
+    (t_u, token): (f64, ivt_num::cancel::Token),
     opts: IhbOptions,
     progress: &(impl Fn() + Sync),
 ) -> Vec<SweepPoint> {
@@ -215,6 +218,12 @@ fn sweep_row(
                 t_u,
                 omega0: grid.omega0,
             };
+            if token.cancelled() {
+                return SweepPoint {
+                    op,
+                    result: Err(ivt_num::cancel::CANCELLED.to_string()),
+                };
+            }
             let seed = warm.as_ref().map(|(r, q)| (*r, q.as_slice()));
             let mut res = solver.solve(plant, &op, seed);
             if res.is_err() && seed.is_some() {

@@ -59,13 +59,13 @@ pub enum HbError {
         history: Vec<f64>,
     },
     /// The Jacobian at a fixed frequency is singular.
-    #[error("singular Jacobian at omega = {omega}")]
+    #[error("singular Jacobian at omega = {omega:?}")]
     Singular {
         /// Excitation frequency.
         omega: f64,
     },
     /// The residual at a fixed frequency became NaN or infinite.
-    #[error("non-finite residual at omega = {omega}")]
+    #[error("non-finite residual at omega = {omega:?}")]
     NonFinite {
         /// Excitation frequency.
         omega: f64,
@@ -82,7 +82,7 @@ pub enum HbError {
     },
     /// A curve's first point, solved from rest (a = 0), did not converge: near a
     /// resonance the start lies outside Newton's basin.
-    #[error("the curve starts from rest at omega = {omega} and that solve failed ({cause}); start below the resonance (e.g. at half its frequency) and continue through it")]
+    #[error("the curve starts from rest at omega = {omega:?} and that solve failed ({cause}); start below the resonance (e.g. at half its frequency) and continue through it")]
     ColdStart {
         /// Start frequency.
         omega: f64,
@@ -92,7 +92,7 @@ pub enum HbError {
     /// A transient integration (limit cycle from a state) ended without
     /// settling onto a periodic attractor.
     #[error(
-        "the transient from the given state did not reach a limit cycle (t = {time}): {reason}"
+        "the transient from the given state did not reach a limit cycle (t = {time:?}): {reason}"
     )]
     Transient {
         /// Time integrated.
@@ -107,7 +107,7 @@ pub enum HbError {
     /// so its stability is unknown (e.g. ω_f so small that one period spans
     /// far more time than the steps resolve).
     #[error(
-        "the Floquet multipliers at ω_f = {omega} are not finite (Hsu's method over at most \
+        "the Floquet multipliers at ω_f = {omega:?} are not finite (Hsu's method over at most \
          {steps} steps of one period 2π/ω_f); the stability of this solution is unknown"
     )]
     NonFiniteMultipliers {
@@ -116,6 +116,9 @@ pub enum HbError {
         /// Hsu sub-intervals of the period (the cap, for adaptive Hsu).
         steps: usize,
     },
+    /// The caller cancelled the computation ([`ivt_num::cancel`]).
+    #[error("{}", ivt_num::cancel::CANCELLED)]
+    Interrupted,
 }
 
 impl HbError {
@@ -141,7 +144,8 @@ impl HbError {
             | Self::ColdStart { .. }
             | Self::Eigen(_)
             | Self::Transient { .. }
-            | Self::NonFiniteMultipliers { .. } => "failed",
+            | Self::NonFiniteMultipliers { .. }
+            | Self::Interrupted => "failed",
         }
     }
 

@@ -44,7 +44,9 @@ pub use orbit::classic::ClassicIhb;
 pub use orbit::galerkin::GalerkinJacobian;
 pub use orbit::ihb::{HbOptions, HbResidual, HbSolution, HbSolver};
 pub use orbit::modified::ModifiedIhb;
-pub use problem::elements::{Element, ElementProblem, Harmonic, Law};
+pub use problem::elements::{
+    element_dofs, restrict_elements, Element, ElementProblem, Harmonic, Law,
+};
 pub use problem::{
     central_difference_samples, AtFrequency, Duffing, Excitation, FrequencyExcitation,
     GeneralProblem, MathieuDuffing, Nonlinearity, Oscillator, PeriodicProblem, WithJacobian,

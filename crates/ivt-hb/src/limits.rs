@@ -14,6 +14,9 @@ pub const MAX_UNKNOWNS: usize = 4096;
 /// Most AFT samples `2N` per DOF (32 MiB per f64 buffer).
 pub const MAX_SAMPLES: usize = 1 << 22;
 
+/// The path engine's limit on the points of one path (`max_points`).
+pub use ivt_path::limits::{path_points_error, MAX_PATH_POINTS};
+
 /// `None` when `n_dof·(2·harmonics + 1)` unknowns fit [`MAX_UNKNOWNS`],
 /// otherwise the reason (overflow-safe for any `usize`).
 pub fn unknowns_error(n_dof: usize, harmonics: usize) -> Option<String> {
@@ -57,5 +60,7 @@ mod tests {
         assert!(samples_error(1 << 21).is_none());
         assert!(samples_error((1 << 21) + 1).is_some());
         assert!(samples_error(usize::MAX).is_some());
+        assert!(path_points_error(100_000).is_none());
+        assert!(path_points_error(100_001).is_some());
     }
 }

@@ -75,6 +75,9 @@ pub struct BackboneSample {
     pub omega: f64,
     /// Fictitious damping κ (~0 on the result).
     pub kappa: f64,
+    /// max |x| of the amplitude DOF over one period (the ordinate of a
+    /// response curve's `amplitude`).
+    pub peak: f64,
     /// Coefficients.
     pub coeffs: Array<f64>,
 }
@@ -117,6 +120,7 @@ pub fn backbone<P: PeriodicProblem>(
                 amplitude: p.amplitude,
                 omega: p.omega,
                 kappa: p.kappa,
+                peak: p.peak,
                 coeffs: Array(p.coeffs.clone()),
             })
             .collect(),

@@ -321,7 +321,7 @@ where
     };
     best.ok_or_else(|| {
         HbError::InvalidInput(format!(
-            "the FRC from ω_f = {from} to {to} at p = {} has no located {} to start from",
+            "the FRC from ω_f = {from:?} to {to:?} at p = {:?} has no located {} to start from",
             req.p_start,
             req.kind.words()
         ))

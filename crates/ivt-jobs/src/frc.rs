@@ -8,7 +8,9 @@
 use super::{check_finite, pairs, Array};
 use ivt_hb::branches::events::{trace, BifurcationError, BifurcationKind, Event, TraceOptions};
 use ivt_hb::branches::family::{Family, FamilyBranch, Frequency};
-use ivt_hb::branches::frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
+use ivt_hb::branches::frc::{
+    frequency_response, AmplitudeProbe, Frc, FrcFold, FrcOptions, FrcPoint,
+};
 use ivt_hb::orbit::ihb::HbOptions;
 use ivt_hb::problem::{AtFrequency, PeriodicProblem};
 use ivt_hb::stability::HsuSteps;
@@ -42,7 +44,7 @@ impl FrcRequest {
         );
         if !(from > 0.0 && to > 0.0 && from != to) {
             return Err(HbError::InvalidInput(format!(
-                "`from` = {from}, `to` = {to} must be > 0 and distinct"
+                "`from` = {from:?}, `to` = {to:?} must be > 0 and distinct"
             )));
         }
         Ok(())
@@ -95,6 +97,9 @@ pub struct EventRecord {
     pub index: usize,
     /// ω_f (located, else that of the point before).
     pub omega: Option<f64>,
+    /// max |x_0| of its orbit over the AFT samples, the measure of the
+    /// points' `amplitude` (located, else that of the point before).
+    pub amplitude: Option<f64>,
     /// Converged on its extended system.
     pub located: bool,
     /// Multipliers there `[[re, im], ...]`.
@@ -189,7 +194,12 @@ pub(super) fn traced_curve<F: Family>(
     };
     let traced = trace(branch, start, sweep.from, &opts).map_err(trace_error)?;
     let curve = ivt_hb::branches::frc::from_trace(&traced, branch.options())?;
-    let events = traced.events.iter().map(|e| event(e, &curve)).collect();
+    let mut probe = AmplitudeProbe::new(branch.options())?;
+    let events = traced
+        .events
+        .iter()
+        .map(|e| event(e, &curve, &mut probe))
+        .collect();
     assemble(curve, events, sweep.path.stability, t0)
 }
 
@@ -231,7 +241,7 @@ fn assemble(
     })
 }
 
-fn point(p: &FrcPoint) -> CurvePoint {
+pub(super) fn point(p: &FrcPoint) -> CurvePoint {
     CurvePoint {
         omega: p.omega_f,
         amplitude: p.amplitude,
@@ -254,14 +264,16 @@ fn fold(f: &FrcFold) -> FoldPoint {
     }
 }
 
-/// An event of the trace; a failed location takes the point before it.
-fn event(e: &Event, curve: &Frc) -> EventRecord {
+/// An event of the trace (its amplitude by `probe`); a failed location
+/// takes the point before it.
+pub(super) fn event(e: &Event, curve: &Frc, probe: &mut AmplitudeProbe) -> EventRecord {
     let near = curve.points.get(e.index);
     match &e.location {
         Ok(b) => EventRecord {
             kind: e.kind,
             index: e.index,
             omega: Some(b.lambda),
+            amplitude: Some(probe.of(&b.q)),
             located: true,
             multipliers: Some(pairs(&b.multipliers)),
             coeffs: Some(Array(b.q.clone())),
@@ -271,6 +283,7 @@ fn event(e: &Event, curve: &Frc) -> EventRecord {
             kind: e.kind,
             index: e.index,
             omega: near.map(|p| p.omega_f),
+            amplitude: near.map(|p| p.amplitude),
             located: false,
             multipliers: near.map(|p| pairs(&p.multipliers)),
             coeffs: near.map(|p| Array(p.coeffs.clone())),
@@ -286,6 +299,7 @@ fn fold_event(f: &FrcFold, curve: &Frc) -> EventRecord {
         kind: BifurcationKind::Fold,
         index: f.index,
         omega: Some(f.omega_f),
+        amplitude: Some(f.amplitude),
         located: f.located,
         multipliers: curve.points.get(f.index).map(|p| pairs(&p.multipliers)),
         coeffs: Some(Array(f.coeffs.clone())),

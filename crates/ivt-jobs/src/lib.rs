@@ -18,6 +18,9 @@
 //! | Hopf points and the cycle branch (issue 27) | [`CycleBranchRequest`] | [`CycleBranchResult`] | `hb cycle-branch` | `cycle_branch` |
 //! | every solution at one ω_f by deflation (issue 27) | [`AllSolutionsRequest`] | [`AllSolutionsResult`] | `hb all-solutions` | `all_solutions` |
 //! | branch switching at a period doubling or branch point (Eq. 56, 61, 68–77) | [`SwitchRequest`] | [`SwitchedBranch`] | `hb switch` | `switch_branch` |
+//! | the torus branch from a Neimark–Sacker point (issue 45) | [`TorusRequest`] | [`TorusCurve`] | `hb torus` | `torus_branch` |
+//! | `dω/dp`, `dA/dp` of a located feature by its adjoint (issue 45) | [`SensitivityRequest`] | [`SensitivityResult`] | — | `event_sensitivity` |
+//! | the automatic bifurcation diagram (issue 45) | [`DiagramRequest`] | [`Diagram`] | `hb diagram` | `diagram` |
 //!
 
 pub mod all_solutions;
@@ -25,13 +28,16 @@ mod array;
 pub mod backbone;
 pub mod cascade;
 pub mod cycle_branch;
+pub mod diagram;
 pub mod fold_curve;
 pub mod frc;
 pub mod limit_cycle;
 pub mod ns_points;
 pub mod orbit;
+pub mod sensitivity;
 pub mod string;
 pub mod switch;
+pub mod torus;
 
 pub use all_solutions::{
     all_solutions, AllSolutionsRequest, AllSolutionsResult, FoundOrbit, SearchBounds,
@@ -42,6 +48,10 @@ pub use cascade::{cascade, Cascade, CascadeRequest, THESIS_BETAS};
 pub use cycle_branch::{
     cycle_branch, CycleBranchRequest, CycleBranchResult, CycleFold, CycleRecord, HopfRecord,
 };
+pub use diagram::{
+    diagram, BranchKind, Diagram, DiagramBranch, DiagramPoint, DiagramRequest, DiagramSearch,
+    Origin,
+};
 pub use fold_curve::{
     fold_curve, CurveFoldPoint, FoldCurveRequest, FoldCurveResult, FoldStart, SpecialKind,
     SpecialPoint,
@@ -50,8 +60,10 @@ pub use frc::{frc, CurvePoint, EventRecord, FoldPoint, FrcCurve, FrcRequest};
 pub use limit_cycle::{limit_cycle, Cycle, LimitCycleRequest};
 pub use ns_points::{neimark_sacker_points, NeimarkSackerPoint};
 pub use orbit::{orbit, Method, Orbit, OrbitRequest};
-pub use string::{string, StringCurve, StringPoint, StringRequest};
+pub use sensitivity::{event_sensitivity, SensitivityRequest, SensitivityResult};
+pub use string::{string, StringCurve, StringFold, StringPoint, StringRequest};
 pub use switch::{switch, SwitchRequest, SwitchStart, SwitchedBranch};
+pub use torus::{torus, Section, TorusCurve, TorusPoint, TorusRequest};
 
 use ivt_hb::HbError;
 use ivt_path::continuation::ContinuationOptions;
@@ -87,7 +99,7 @@ pub(crate) fn finite(name: &str, v: f64) -> Result<f64, HbError> {
         Ok(v)
     } else {
         Err(HbError::InvalidInput(format!(
-            "`{name}` = {v} must be finite"
+            "`{name}` = {v:?} must be finite"
         )))
     }
 }
@@ -99,7 +111,7 @@ pub(crate) fn positive(name: &str, v: f64) -> Result<f64, HbError> {
         Ok(v)
     } else {
         Err(HbError::InvalidInput(format!(
-            "`{name}` = {v} must be finite and > 0"
+            "`{name}` = {v:?} must be finite and > 0"
         )))
     }
 }

@@ -1,6 +1,6 @@
 //! The Neimark–Sacker boundary of a forced family in (ω, p), sampled: at each
 //! requested p the frequency-response curve of `family(p)` is traced with
-//! its events ([`crate::frc`]) and each of its Neimark–Sacker points
+//! its events ([`ivt_hb::branches::frc`]) and each of its Neimark–Sacker points
 //! is located on the engine's extended system ([`ivt_hb::branches::events`]: a
 //! pair of Floquet multipliers on the unit circle). Not a continuation of the curve: a turn of the boundary
 //! in p between two samples is not followed, and each sample costs a trace

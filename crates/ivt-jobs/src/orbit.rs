@@ -1,14 +1,14 @@
 //! Orbit + stability: one periodic solution at a fixed ω_f by the modified
 //! IHB (§3.2.2, AFT residual Eq. 62 + Broyden Eq. 63–67) or the classic IHB
 //! (§3.2.1, Newton with the Galerkin Jacobian Eq. 56–61), then its Floquet
-//! multipliers by Hsu's method (Eq. 78) over [`super::stability_steps`]
-//! Magnus-4 steps.
+//! multipliers by Hsu's method (Eq. 78) with Magnus-4 steps, as many as
+//! reach 1e-6 by their Richardson estimate ([`AdaptiveHsu`] with
+//! [`HsuSteps::default`], the rule of the FRC points).
 
-use super::{finite_pairs, positive, stability_steps, Array};
+use super::{finite_pairs, positive, Array};
 use ivt_hb::orbit::ihb::{HbOptions, HbSolution, HbSolver};
 use ivt_hb::problem::PeriodicProblem;
-use ivt_hb::stability::floquet::HsuRule;
-use ivt_hb::stability::{StabilityAnalyzer, StabilityKind};
+use ivt_hb::stability::{AdaptiveHsu, HsuSteps, StabilityKind};
 use ivt_hb::HbError;
 use ivt_hb::{ClassicIhb, ModifiedIhb};
 use serde::Serialize;
@@ -96,6 +96,10 @@ pub struct Orbit {
     /// Floquet multipliers `[[re, im], ...]`, decreasing modulus (empty
     /// without stability).
     pub floquet: Vec<[f64; 2]>,
+    /// Richardson estimate of the multipliers' error, relative to
+    /// max(1, |μ|) (at most 1e-6 unless 4096 sub-intervals did not reach
+    /// it; None without stability).
+    pub multiplier_error: Option<f64>,
     /// All multipliers inside the unit circle (None without stability).
     pub stable: Option<bool>,
     /// The leading multiplier's class (None without stability).
@@ -134,20 +138,18 @@ pub fn orbit<P: PeriodicProblem>(
     };
     let sol = solver.solve(req.omega_f, req.guess.as_deref())?;
     let solve_time_s = t0.elapsed().as_secs_f64();
-    let (floquet, stable, stability) = if req.stability {
-        let steps = stability_steps(hb.harmonics);
-        let f = StabilityAnalyzer::new(problem, hb.harmonics, steps)?.hsu(
-            problem,
-            &sol,
-            HsuRule::Magnus4,
-        );
+    let (floquet, multiplier_error, stable, stability) = if req.stability {
+        let est =
+            AdaptiveHsu::new(problem, hb.harmonics, HsuSteps::default())?.floquet(problem, &sol)?;
+        let f = est.floquet;
         (
-            finite_pairs(&f.multipliers, req.omega_f, steps)?,
+            finite_pairs(&f.multipliers, req.omega_f, est.steps)?,
+            est.error,
             Some(f.stable()),
             Some(f.kind),
         )
     } else {
-        (Vec::new(), None, None)
+        (Vec::new(), None, None, None)
     };
     Ok(Orbit {
         coeffs: Array(sol.coeffs.clone()),
@@ -160,6 +162,7 @@ pub fn orbit<P: PeriodicProblem>(
         subharmonic: sol.subharmonic,
         amplitude: sol.amplitude(0),
         floquet,
+        multiplier_error,
         stable,
         stability,
         solution: sol,

@@ -51,14 +51,14 @@ impl StringRequest {
         let kd = self.params.kd;
         if !(kd.is_finite() && kd.abs() <= MAX_KD) {
             return Err(HbError::InvalidInput(format!(
-                "`kd` = {kd} must be finite with |kd| <= {MAX_KD:e}"
+                "`kd` = {kd:?} must be finite with |kd| <= {MAX_KD:e}"
             )));
         }
         self.params.validate()?;
         let (from, to, ds) = (self.from, self.to, self.step_max);
         if !(from > 0.0 && to > from && to.is_finite() && ds > 0.0 && ds.is_finite()) {
             return Err(HbError::InvalidInput(format!(
-                "need 0 < `from` < `to` (finite) and `step_max` > 0, got {from} .. {to}, {ds}"
+                "need 0 < `from` < `to` (finite) and `step_max` > 0, got {from:?} .. {to:?}, {ds:?}"
             )));
         }
         Ok(())
@@ -82,11 +82,26 @@ pub struct StringPoint {
     pub method: StabilityMethod,
 }
 
+/// A fold of the string's curve.
+#[derive(Debug, Clone, Serialize)]
+pub struct StringFold {
+    /// ω at the turn.
+    pub omega: f64,
+    /// ‖a‖ there.
+    pub norm: f64,
+    /// Converged on the extended system (else the path's turning point).
+    pub located: bool,
+    /// Path point before the turn.
+    pub index: usize,
+}
+
 /// The curve: the keys of `ivt hb string --json` and `ivt.hb.string`.
 #[derive(Debug, Clone, Serialize)]
 pub struct StringCurve {
     /// Points in path order.
     pub points: Vec<StringPoint>,
+    /// Folds in path order.
+    pub folds: Vec<StringFold>,
     /// Exact Jacobians assembled.
     pub jacobians: usize,
     /// Hill's method calls.
@@ -144,8 +159,20 @@ pub fn string(req: &StringRequest) -> Result<StringCurve, HbError> {
         )),
         _ => None,
     };
+    let folds = curve
+        .frc
+        .events
+        .iter()
+        .map(|f| StringFold {
+            omega: f.omega_f,
+            norm: f.amplitude,
+            located: f.located,
+            index: f.index,
+        })
+        .collect();
     Ok(StringCurve {
         points,
+        folds,
         jacobians: curve.jacobians,
         hill_calls: curve.hill_calls,
         stop: curve.frc.termination.clone(),

@@ -99,7 +99,7 @@ impl SwitchRequest {
         let step = finite("step", self.step)?;
         if !(step > 0.0 && step <= 1.0) {
             return Err(HbError::InvalidInput(format!(
-                "`step` = {step} must be in (0, 1]"
+                "`step` = {step:?} must be in (0, 1]"
             )));
         }
         match &self.start {
@@ -112,7 +112,7 @@ impl SwitchRequest {
                 let omega = finite("omega", *omega)?;
                 if !(omega > 0.0 && to > 0.0 && omega != to) {
                     return Err(HbError::InvalidInput(format!(
-                        "the event's ω_f = {omega} and `to` = {to} must be > 0 and distinct"
+                        "the event's ω_f = {omega:?} and `to` = {to:?} must be > 0 and distinct"
                     )));
                 }
                 if coeffs.iter().any(|c| !c.is_finite()) {
@@ -215,8 +215,8 @@ pub fn switch<P: PeriodicProblem>(
     };
     if (w1 - omega) * (req.to - omega) < 0.0 {
         return Err(HbError::InvalidInput(format!(
-            "the new branch leaves the {} at ω_f = {omega} towards ω_f = {w1}: \
-             `to` = {} must lie on that side",
+            "the new branch leaves the {} at ω_f = {omega:?} towards ω_f = {w1:?}: \
+             `to` = {:?} must lie on that side",
             kind.words(),
             req.to
         )));
@@ -252,7 +252,7 @@ fn first_event<P: PeriodicProblem>(
         .find_map(|e| Some((e.kind, e.omega?, e.coeffs?.0)))
         .ok_or_else(|| {
             HbError::InvalidInput(format!(
-                "the FRC from ω_f = {} to {} has no located period doubling or branch point",
+                "the FRC from ω_f = {:?} to {:?} has no located period doubling or branch point",
                 req.options.from, req.options.to
             ))
         })
@@ -261,7 +261,7 @@ fn first_event<P: PeriodicProblem>(
 /// The direction of the new branch at the branch point `(q, λ)` (`m + 1`
 /// entries, unit): the root nearer λ = const of the bifurcation equation
 /// `ψᵀ R''[d, d] = 0`, `d = cos φ v₁ + sin φ v₂` (see the module docs).
-fn new_direction<F: Family>(
+pub(super) fn new_direction<F: Family>(
     branch: &mut FamilyBranch<F>,
     q: &[f64],
     lambda: f64,
@@ -318,7 +318,7 @@ fn new_direction<F: Family>(
     let two_roots = radius.is_finite() && a.abs() < radius;
     if !two_roots {
         return Err(HbError::InvalidInput(format!(
-            "not a simple branch point at ω_f = {lambda}: its bifurcation equation has no two real roots"
+            "not a simple branch point at ω_f = {lambda:?}: its bifurcation equation has no two real roots"
         )));
     }
     let spread = (-a / radius).acos();

@@ -129,7 +129,10 @@ pub const KEYS: &[Key] = &[
     scene("stepper.max_speed", "steps/s", Open(0.0), Closed(1e7), true),
     scene("stepper.accel", "steps/s²", Open(0.0), Closed(1e9), true),
     scene("stepper.miss_prob", "", Closed(0.0), Closed(1.0), false),
-    scene("controller.omega0_rpm", "rpm", Open(0.0), Open(1e4), true),
+    // ω0: the thesis's 100 rpm widened by three orders of magnitude below;
+    // slower, a pulse of the coarsest encoder takes longer than any stall
+    // timeout a rig would run with, and 1e-30 rpm is no set speed at all.
+    scene("controller.omega0_rpm", "rpm", Closed(0.1), Open(1e4), true),
     scene("controller.k_mm_per_rad", "mm/rad", Closed(-1e6), Closed(1e6), true),
     scene("controller.k2_mm_per_rad", "mm/rad", Closed(-1e6), Closed(1e6), true),
     scene("controller.k_prop_deg_per_rpm", "deg/rpm", Closed(-1e6), Closed(1e6), true),
@@ -139,25 +142,27 @@ pub const KEYS: &[Key] = &[
     scene("metrics.band", "", Open(0.0), Open(1.0), false),
     scene("metrics.static_window_s", "s", Open(0.0), Closed(T_MAX), false),
     scene("outputs.max_bytes", "bytes", Open(0.0), Closed(1e15), false),
-    // Table 1 (PlantParams): positive where a zero divides or is no machine,
-    // non-negative where 0 neglects the term.
-    plant("plant.r_a", "Ω", Open(0.0), 1e3),
-    plant("plant.k_e", "V·s/rad", Open(0.0), 1e3),
-    plant("plant.k_t", "N·m/A", Open(0.0), 1e3),
+    // Table 1 (PlantParams): non-negative where 0 neglects the term; where a
+    // zero divides or is no machine, at least Table 1's value / 1e4 (the
+    // ceilings are ~1e4× it), so that 1e-300 Ω is refused by name instead of
+    // failing later as a NaN.
+    plant("plant.r_a", "Ω", Closed(1e-4), 1e3),
+    plant("plant.k_e", "V·s/rad", Closed(1e-5), 1e3),
+    plant("plant.k_t", "N·m/A", Closed(1e-5), 1e3),
     plant("plant.l_a", "H", Closed(0.0), 1e3),
-    plant("plant.j_n1", "kg·m²", Open(0.0), J_MAX),
-    plant("plant.j_n2", "kg·m²", Open(0.0), J_MAX),
+    plant("plant.j_n1", "kg·m²", Closed(1e-7), J_MAX),
+    plant("plant.j_n2", "kg·m²", Closed(1e-7), J_MAX),
     plant("plant.j_inshaft", "kg·m²", Closed(0.0), J_MAX),
     plant("plant.j_carrier", "kg·m²", Closed(0.0), J_MAX),
     plant("plant.j_ring", "kg·m²", Closed(0.0), J_MAX),
-    plant("plant.j_crk", "kg·m²", Open(0.0), J_MAX),
+    plant("plant.j_crk", "kg·m²", Closed(1e-7), J_MAX),
     plant("plant.m_r", "kg", Closed(0.0), J_MAX),
     plant("plant.m_dr", "kg", Closed(0.0), J_MAX),
     plant("plant.j_u", "kg·m²", Closed(0.0), J_MAX),
-    plant("plant.r_u", "m", Open(0.0), 1e2),
+    plant("plant.r_u", "m", Closed(1e-5), 1e2),
     plant("plant.g", "m/s²", Closed(0.0), 1e3),
-    plant("plant.sun_to_planet", "", Open(0.0), 1e3),
-    plant("plant.r_max", "m", Open(0.0), 1e2),
+    plant("plant.sun_to_planet", "", Closed(1e-3), 1e3),
+    plant("plant.r_max", "m", Closed(1e-6), 1e2),
     // Set by the CLI and Python only.
     other("kin.theta_ct_deg", "deg", (Closed(0.0), Closed(3600.0)), false),
     other("kin.givt_r_mm", "mm", (Closed(0.0), Closed(1e3)), false),
@@ -167,7 +172,7 @@ pub const KEYS: &[Key] = &[
     other("kin.arc_corner_deg", "deg", (Open(0.0), Closed(90.0)), false),
     other("kin.r_sun", "", (Open(0.0), Closed(1e6)), false),
     other("kin.r_planet", "", (Open(0.0), Closed(1e6)), false),
-    other("controller.omega0", "rad/s", (Open(0.0), Open(1e3)), true),
+    other("controller.omega0", "rad/s", (Closed(0.01), Open(1e3)), true),
     other("controller.k_si", "m·s/rad²", (Closed(-1e3), Closed(1e3)), true),
     other("controller.k2_si", "m·s/rad²", (Closed(-1e3), Closed(1e3)), true),
     other("controller.k_prop_si", "m·s/rad", (Closed(-1e3), Closed(1e3)), true),
@@ -213,7 +218,8 @@ const fn py(name: &'static str, key: &'static str) -> Alias {
 
 /// The CLI flags and Python arguments of [`KEYS`]' quantities: `ivt kin`
 /// (θ_CT, the GIVT's lengths in mm, the arc fit, the direction module),
-/// `ivt ol`, `ivt stability(-map)`, `ivt ctrl replay`, `ivt sim`;
+/// `ivt ol`, `ivt stability(-map)`, `ivt ctrl replay`, `ivt sim`, `ivt rig
+/// commission` and `ivt rig record`;
 /// `ivt.kin.Plant`, `ivt.kin.direction`, `ivt.design`, `ivt.ctrl.Controller`. (A scene passed to
 /// `ivt sim` or `ivt.sim.run` is checked under its scene keys; a plant file
 /// under `plant.<field>`.) Gains under `--si`/`si=True` and the controller's
@@ -242,6 +248,7 @@ pub const ALIASES: &[Alias] = &[
     cli("--k-prop", "controller.k_prop_deg_per_rpm"),
     cli("--prop-period", "controller.prop_period_s"),
     cli("--f-timer", "encoder.f_timer_hz"),
+    cli("--f-timer-hz", "encoder.f_timer_hz"),
     cli("--stall-timeout", "controller.stall_timeout_s"),
     cli("--max-events", "budget.max_events"),
     py("r_sun", "kin.r_sun"),

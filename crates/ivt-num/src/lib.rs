@@ -48,6 +48,7 @@
 
 pub mod bordered;
 pub mod broyden;
+pub mod cancel;
 pub mod chord;
 pub mod deflation;
 pub mod iteration;

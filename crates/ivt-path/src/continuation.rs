@@ -161,6 +161,8 @@ pub enum Termination {
     Stopped,
     /// The step fell below `ds_min`; carries the last corrector error.
     StepTooSmall(SolveError),
+    /// The caller cancelled the path ([`ivt_num::cancel`], Ctrl-C in Python).
+    Interrupted,
 }
 
 impl Termination {
@@ -171,6 +173,7 @@ impl Termination {
             Self::MaxPoints => "max_points",
             Self::Stopped => "stopped",
             Self::StepTooSmall(_) => "step_too_small",
+            Self::Interrupted => "interrupted",
         }
     }
 }

@@ -17,7 +17,7 @@ pub enum PathError {
     #[error("the iteration did not converge: {0}; ‖r‖ history {history:?}", history = .0.history())]
     Solve(#[from] SolveError),
     /// A path's first point did not converge at its fixed parameter.
-    #[error("continuation start at λ = {lambda} does not converge: {cause}")]
+    #[error("continuation start at λ = {lambda:?} does not converge: {cause}")]
     ContinuationStart {
         /// Path parameter of the start.
         lambda: f64,
@@ -25,7 +25,7 @@ pub enum PathError {
         cause: SolveError,
     },
     /// A path has no tangent at its start (singular `∂R/∂u` there).
-    #[error("continuation start at λ = {lambda}: singular Jacobian, no tangent")]
+    #[error("continuation start at λ = {lambda:?}: singular Jacobian, no tangent")]
     SingularStart {
         /// Path parameter of the start.
         lambda: f64,

@@ -7,6 +7,7 @@ pub mod branch;
 pub mod continuation;
 mod error;
 pub mod events;
+pub mod limits;
 pub mod multipliers;
 
 pub use branch::{Branch, ResidualBranch};

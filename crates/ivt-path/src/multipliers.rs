@@ -49,4 +49,3 @@ pub fn classify(sorted: &[c64]) -> StabilityKind {
         _ => StabilityKind::Stable,
     }
 }
-

@@ -2,6 +2,7 @@
 
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::{register_font, FontStyle};
 use std::path::{Path, PathBuf};
@@ -52,6 +53,10 @@ pub enum Style {
     Dashed,
     /// A small filled circle at each point.
     Markers,
+    /// A triangle at each point with the series' label written beside it:
+    /// the events of a curve (folds, bifurcations, special points), one
+    /// marker each. The label is on the plot, not in the legend.
+    Events,
 }
 
 /// One curve of a [`Figure`].
@@ -100,7 +105,16 @@ fn finite_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     if !lo.is_finite() {
         return (0.0, 1.0);
     }
-    let pad = ((hi - lo) * 0.05).max(1e-9 * hi.abs().max(1.0));
+    // One value (or a span below round-off of it): ±5 % of it, so that the
+    // axis still shows where it is.
+    let scale = hi.abs().max(lo.abs());
+    let pad = if hi - lo > 1e-9 * scale {
+        (hi - lo) * 0.05
+    } else if scale > 0.0 {
+        0.05 * scale
+    } else {
+        0.05
+    };
     (lo - pad, hi + pad)
 }
 
@@ -198,12 +212,31 @@ pub fn line_plot(path: &Path, figure: &Figure<'_>) -> Result<(), PlotError> {
                 Style::Markers => {
                     chart.draw_series(piece.iter().map(|&p| Circle::new(p, 3, color.filled())))
                 }
+                Style::Events => chart.draw_series(piece.iter().map(|&p| {
+                    EmptyElement::at(p)
+                        + TriangleMarker::new((0, 0), 7, color.filled())
+                        + Text::new(
+                            series.label.to_owned(),
+                            (9, -20),
+                            ("sans-serif", 16).into_font().color(&color),
+                        )
+                })),
             }
             .map_err(|e| err(&e))?;
-            if first && !series.label.is_empty() {
-                anno.label(series.label).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                });
+            if first && !series.label.is_empty() && series.style != Style::Events {
+                // The legend's sample: a short solid or dashed line, or the marker.
+                let anno = anno.label(series.label);
+                let line = move |x: i32, y: i32| vec![(x, y), (x + 20, y)];
+                match series.style {
+                    Style::Dashed => anno.legend(move |(x, y)| {
+                        DashedPathElement::new(line(x, y), 6, 4, color.stroke_width(2))
+                    }),
+                    Style::Markers => {
+                        anno.legend(move |(x, y)| Circle::new((x + 10, y), 3, color.filled()))
+                    }
+                    Style::Line | Style::Events => anno
+                        .legend(move |(x, y)| PathElement::new(line(x, y), color.stroke_width(2))),
+                };
                 legend = true;
             }
             first = false;
@@ -320,6 +353,20 @@ mod tests {
         assert_eq!(half_widths(&[5.0]), [0.5]);
     }
 
+    /// 5 % margins; one value alone gets ±5 % of itself (±0.05 for zero).
+    #[test]
+    fn axis_ranges_have_margins_even_for_one_value() {
+        let close =
+            |a: (f64, f64), b: (f64, f64)| (a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12;
+        assert!(close(finite_range([0.0, 10.0].into_iter()), (-0.5, 10.5)));
+        assert!(close(
+            finite_range([1.4, 1.4, f64::NAN].into_iter()),
+            (1.33, 1.47)
+        ));
+        assert!(close(finite_range([0.0].into_iter()), (-0.05, 0.05)));
+        assert_eq!(finite_range([f64::NAN].into_iter()), (0.0, 1.0));
+    }
+
     fn png_ok(path: &Path) -> bool {
         let bytes = std::fs::read(path).unwrap_or_default();
         bytes.len() > 1000 && bytes.starts_with(&[0x89, b'P', b'N', b'G'])
@@ -358,6 +405,11 @@ mod tests {
                     label: "",
                     points: &b,
                     style: Style::Markers,
+                },
+                Series {
+                    label: "fold",
+                    points: &b[..2],
+                    style: Style::Events,
                 },
             ],
         };

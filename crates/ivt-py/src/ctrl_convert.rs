@@ -5,6 +5,7 @@
 
 use ivt_ctrl::open_loop::{POLY_T_TERMS, POLY_V_TERMS};
 use ivt_ctrl::{ControlOutput, Fault, LawKind, OlRegion, OpenLoopCoeffs, OpenLoopPreset};
+use ivt_kin::params::Typed;
 use numpy::{PyArray1, PyArrayDescrMethods, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -228,7 +229,8 @@ pub(crate) fn whole_ticks(ob: &Bound<'_, PyAny>) -> PyResult<Vec<u32>> {
                 Ok(t as u32)
             } else {
                 Err(PyValueError::new_err(format!(
-                    "argument `ticks`[{i}] = {t} is not a whole timer count in [0, 2^32)"
+                    "argument `ticks`[{i}] = {} is not a whole timer count in [0, 2^32)",
+                    Typed(t)
                 )))
             }
         })

@@ -248,9 +248,10 @@ fn ol_table<'py>(
     plant: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (params, plant_name, opts, grid) = grid_job(plant, harmonics, v_m, t_u, omega0_rpm)?;
-    let pts = py
-        .detach(|| sweep::sweep(&params, &grid, opts, || ()))
-        .map_err(design_err)?;
+    let pts = crate::interrupt::detach_interruptible_threaded(py, || {
+        sweep::sweep(&params, &grid, opts, || ())
+    })?
+    .map_err(design_err)?;
     let points = PyList::empty(py);
     let mut r = Array2::<f64>::from_elem((grid.t_u.len(), grid.v_m.len()), f64::NAN);
     for (i, p) in pts.iter().enumerate() {
@@ -313,9 +314,10 @@ fn ol_fit<'py>(
     } else {
         PolyForm::Eq158
     };
-    let rep = py
-        .detach(|| fit_law(&params, &grid, form, opts, || ()))
-        .map_err(design_err)?;
+    let rep = crate::interrupt::detach_interruptible_threaded(py, || {
+        fit_law(&params, &grid, form, opts, || ())
+    })?
+    .map_err(design_err)?;
     let error_dict = |e: &LawError| -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
         d.set_item("max_abs", e.max_abs_rpm)?;
@@ -419,9 +421,10 @@ fn stability_map<'py>(
     let grid = grid_of(v_m, t_u, omega0_rpm)?;
     let (params, plant_name, gains, opts) = delay_loop(plant, k, k2, si, n)?;
     let t0 = Instant::now();
-    let map = py
-        .detach(|| grid_stability_map(&params, &grid, feasible_only, gains, &opts))
-        .map_err(design_err)?;
+    let map = crate::interrupt::detach_interruptible_threaded(py, || {
+        grid_stability_map(&params, &grid, feasible_only, gains, &opts)
+    })?
+    .map_err(design_err)?;
     let dt = t0.elapsed().as_secs_f64();
     let points = PyList::empty(py);
     for (op, r) in &map.entries {

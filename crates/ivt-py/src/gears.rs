@@ -6,6 +6,7 @@ use crate::fields::{self, Field};
 use crate::vectorize::{map, map1, map2};
 use ivt_kin::givt::{DirectionMode, DirectionModule, GivtGeometry};
 use ivt_kin::ncg::{self, GearRatio, GivtNcg, PitchPoint, SgivtNcg, SmoothNcg};
+use ivt_kin::params::Typed;
 use ivt_kin::sgivt::{self, SgivtGeometry};
 use ivt_kin::{units, KinError};
 use numpy::ndarray::Array1;
@@ -157,7 +158,8 @@ fn sgivt_positive(geometry: &SgivtGeometry) -> PyResult<()> {
         let v = get(geometry);
         if !(v.is_finite() && v > 0.0) {
             return Err(PyValueError::new_err(format!(
-                "SGIVT parameter `{name}` = {v} must be finite and > 0"
+                "SGIVT parameter `{name}` = {} must be finite and > 0",
+                Typed(v)
             )));
         }
     }

@@ -88,9 +88,12 @@ duffing_fn! {
 /// Jacobian, §3.2.1). Returns the dict of `ivt hb duffing --json`: coeffs
 /// [a0, a1..an, b1..bn] (u = a0/2 + Σ a_k cos kτ + b_k sin kτ, τ = ω_f t),
 /// iterations, residual_norm, solve_time_s (the solve alone), floquet
-/// multipliers [[re, im], ...] by Hsu's method (max(8n, 256) Magnus-4
-/// steps, as the CLI), stable.
-/// `stability=False` skips the multipliers (floquet = [], stable = None).
+/// multipliers [[re, im], ...] by Hsu's method (Magnus-4 steps doubled from
+/// max(2(n + 1), 32) until their Richardson estimate multiplier_error, relative
+/// to max(1, |μ|), is at most 1e-6, at most 4096; as the CLI and the FRC
+/// points), stable.
+/// `stability=False` skips the multipliers (floquet = [], stable = None,
+/// multiplier_error = None).
 /// The GIL is released while solving.
 fn duffing<'py>(py, problem, n, samples;
     head [];
@@ -277,7 +280,13 @@ fn limit_cycle<'py>(py, user, jac;
     tol: f64 = 0.0,
     x0: Option<Vec<f64>> = None,
 ) {
+    if !(omega_guess.is_finite() && omega_guess > 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "argument `omega_guess` = {omega_guess} must be finite and > 0 (a cycle's frequency)"
+        )));
+    }
     let (problem, opts) = user.setup(None, 1, tol)?;
+    crate::hb_shared::without_omega(&problem, "limit_cycle")?;
     let req = LimitCycleRequest {
         omega_guess,
         guess: guess_vec(guess)?,
@@ -351,8 +360,11 @@ pub fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     crate::hb_bifurcation::register(&m)?;
     crate::hb_cycle_fold::register(&m)?;
     crate::hb_large::register(&m)?;
+    crate::hb_reduced::register(&m)?;
     crate::hb_string::register(&m)?;
     crate::hb_switch::register(&m)?;
+    crate::hb_torus::register(&m)?;
+    crate::hb_sensitivity::register(&m)?;
     crate::hb_elements::register(&m)?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     parent.add_submodule(&m)

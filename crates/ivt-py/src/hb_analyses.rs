@@ -54,7 +54,7 @@ fn _all_solutions<'py>(py, user, jac;
 }
 
 /// The damped modes as `{"points": [{"amplitude", "omega", "damping_ratio",
-/// "coeffs"}...], "linear_omega", "linear_mode", "termination"}`.
+/// "peak", "coeffs"}...], "linear_omega", "linear_mode", "termination"}`.
 fn damped_dict<'py>(py: Python<'py>, dm: &DampedModes) -> PyResult<Bound<'py, PyDict>> {
     let points = PyList::empty(py);
     for p in &dm.points {
@@ -62,6 +62,7 @@ fn damped_dict<'py>(py: Python<'py>, dm: &DampedModes) -> PyResult<Bound<'py, Py
         e.set_item("amplitude", p.amplitude)?;
         e.set_item("omega", p.omega)?;
         e.set_item("damping_ratio", p.damping_ratio)?;
+        e.set_item("peak", p.peak)?;
         e.set_item("coeffs", p.coeffs.clone().into_pyarray(py))?;
         points.append(e)?;
     }
@@ -83,7 +84,8 @@ user_system_fn! {
 /// (Newton–chord on the exact Jacobian). At vanishing amplitude the point is
 /// the linear mode (ω₀ and, for proportional damping, its ζ); for C = 0 the
 /// curve is `backbone`'s.
-/// Returns {"points": [{"amplitude", "omega", "damping_ratio", "coeffs"}...],
+/// Returns {"points": [{"amplitude", "omega", "damping_ratio", "peak" (max |x|
+/// of DOF `dof`), "coeffs"}...],
 /// "linear_omega", "linear_mode", "termination"}.
 fn damped_modes<'py>(py, user, jac;
     amplitude_from: f64,
@@ -93,6 +95,7 @@ fn damped_modes<'py>(py, user, jac;
     tol: f64 = 0.0,
 ) {
     let (problem, opts) = user.setup(None, 1, tol)?;
+    crate::hb_shared::without_omega(&problem, "damped_modes")?;
     let bopts = BackboneOptions {
         dof: count("dof", dof)?,
         amplitude_from: finite("amplitude_from", amplitude_from)?,

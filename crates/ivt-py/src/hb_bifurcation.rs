@@ -74,6 +74,7 @@ fn cycle_branch<'py>(
     let keys = HbKeys::new(n, samples, velocity_dependent, vectorized, rtol, max_iter)?;
     let fam = PyFamily::new(family, keys);
     let first = fam.first(py, p_from)?;
+    crate::hb_shared::without_omega(&first.0, "cycle_branch")?;
     let branch = fam.run(py, first, |hb| {
         jobs::cycle_branch(|p| fam.build(p), hb, &req)
     })?;

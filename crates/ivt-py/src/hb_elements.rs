@@ -4,7 +4,8 @@
 //! `limit_cycle` or `backbone`: the forces are evaluated in Rust, with no
 //! Python call in the loop.
 
-use ivt_hb::{Element, Law};
+use ivt_hb::{element_dofs, restrict_elements, Element, Law};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::args::{count, int64};
@@ -37,26 +38,69 @@ impl Elements {
         self.list.len()
     }
 
+    /// The model DOFs the elements act on (each `dof` and `to`), sorted and
+    /// without repeats: the nonlinear DOFs a large model is condensed onto
+    /// ([`ivt_hb::element_dofs`]).
+    #[getter]
+    fn dofs(&self) -> Vec<usize> {
+        element_dofs(&self.list)
+    }
+
+    /// The same elements on the sub-vector `x[dofs]` of the model's DOFs:
+    /// each DOF replaced by its position in `dofs` (how the condensed path
+    /// sees them, [`ivt_hb::restrict_elements`]). ValueError naming the
+    /// element whose DOF `dofs` lacks.
+    fn restricted(&self, dofs: Vec<usize>) -> PyResult<Elements> {
+        restrict_elements(&self.list, &dofs)
+            .map(|list| Elements { list })
+            .map_err(|(i, d)| {
+                let text = self.list.get(i).map(call_text).unwrap_or_default();
+                PyValueError::new_err(format!(
+                    "element {i} ({text}) acts on model DOF {d}, which is not among the nonlinear DOFs {dofs:?}"
+                ))
+            })
+    }
+
     fn __repr__(&self) -> String {
         let parts: Vec<String> = self.list.iter().map(call_text).collect();
         format!("Elements([{}])", parts.join(", "))
+    }
+
+    /// The elements as constructor calls, `[(name, params, dof, to), ...]`
+    /// (`ivt.hb` pickles an `Elements` as these calls; the floats round-trip
+    /// exactly).
+    #[allow(clippy::type_complexity)]
+    fn _state(&self) -> Vec<(&'static str, Vec<f64>, usize, Option<usize>)> {
+        self.list
+            .iter()
+            .map(|e| {
+                let (name, params) = law_call(&e.law);
+                (name, params.iter().map(|p| p.1).collect(), e.a, e.b)
+            })
+            .collect()
     }
 }
 
 /// The element as the Python call that builds it, e.g.
 /// `cubic_spring(k3=0.5, dof=0, to=None)` (not the Debug text of [`Law`]).
 fn call_text(e: &Element) -> String {
-    let law = match e.law {
-        Law::CubicSpring { k3 } => format!("cubic_spring(k3={k3}"),
-        Law::QuadraticDamper { c2 } => format!("quadratic_damper(c2={c2}"),
-        Law::CubicDamper { c3 } => format!("cubic_damper(c3={c3}"),
-        Law::Coulomb { force, v_reg } => format!("coulomb(force={force}, v_reg={v_reg}"),
-        Law::Clearance { gap, k } => format!("clearance(gap={gap}, k={k}"),
-        Law::Unilateral { gap, k } => format!("unilateral(gap={gap}, k={k}"),
-        Law::Jenkins { k, slip_force } => format!("jenkins(k={k}, slip_force={slip_force}"),
-    };
+    let (name, params) = law_call(&e.law);
+    let params: Vec<String> = params.iter().map(|(p, v)| format!("{p}={v}")).collect();
     let to = e.b.map_or_else(|| "None".to_string(), |b| b.to_string());
-    format!("{law}, dof={}, to={to})", e.a)
+    format!("{name}({}, dof={}, to={to})", params.join(", "), e.a)
+}
+
+/// The constructor of `law` and its parameters in the constructor's order.
+fn law_call(law: &Law) -> (&'static str, Vec<(&'static str, f64)>) {
+    match *law {
+        Law::CubicSpring { k3 } => ("cubic_spring", vec![("k3", k3)]),
+        Law::QuadraticDamper { c2 } => ("quadratic_damper", vec![("c2", c2)]),
+        Law::CubicDamper { c3 } => ("cubic_damper", vec![("c3", c3)]),
+        Law::Coulomb { force, v_reg } => ("coulomb", vec![("force", force), ("v_reg", v_reg)]),
+        Law::Clearance { gap, k } => ("clearance", vec![("gap", gap), ("k", k)]),
+        Law::Unilateral { gap, k } => ("unilateral", vec![("gap", gap), ("k", k)]),
+        Law::Jenkins { k, slip_force } => ("jenkins", vec![("k", k), ("slip_force", slip_force)]),
+    }
 }
 
 /// One element of law `law` between DOF `dof` and DOF `to` (None: ground).

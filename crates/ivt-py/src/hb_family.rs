@@ -1,4 +1,4 @@
-//! A Python `family(p)` → (m, c, k, g, f) as the fallible Rust family of
+//! A Python `family(p)` → (m, c, k, g, f) (or (m, c, k, g), unforced) as the fallible Rust family of
 //! ivt-hb's two-parameter functions ([`PyFamily`]), and the `family_fn!`
 //! signature of the continuation functions on such a family (the keywords
 //! they share reach the body as one [`FamilyArgs`]).
@@ -11,13 +11,21 @@ use std::sync::Mutex;
 use crate::hb_shared::{run_user, HbKeys, UserArgs};
 use crate::user_problem::{user_problem, PyProblem};
 
-/// The user system `family(p)` returns: a tuple (m, c, k, g, f).
+/// The user system `family(p)` returns: a tuple (m, c, k, g, f), or
+/// (m, c, k, g) for an unforced (autonomous) system (f None).
 pub(crate) fn family_system<'py>(
     family: &Bound<'py, PyAny>,
     p: f64,
 ) -> PyResult<[Bound<'py, PyAny>; 5]> {
-    let wrong = || PyTypeError::new_err("argument `family` must return a tuple (m, c, k, g, f)");
-    let parts: Vec<Bound<'py, PyAny>> = family.call1((p,))?.extract().map_err(|_| wrong())?;
+    let wrong = || {
+        PyTypeError::new_err(
+            "argument `family` must return a tuple (m, c, k, g, f) or, unforced, (m, c, k, g)",
+        )
+    };
+    let mut parts: Vec<Bound<'py, PyAny>> = family.call1((p,))?.extract().map_err(|_| wrong())?;
+    if parts.len() == 4 {
+        parts.push(family.py().None().into_bound(family.py()));
+    }
     parts.try_into().map_err(|_| wrong())
 }
 

@@ -80,6 +80,7 @@ fn continue_bifurcation<'py>(py, args) [
     };
     let fam = &args.family;
     let first = fam.first(py, p_start)?;
+    crate::hb_shared::without_omega(&first.0, "continue_bifurcation")?;
     let curve = fam.run(py, first, |hb| jobs::fold_curve(|p| fam.build(p), hb, &req))?;
     to_dict(py, &curve)
 }

@@ -12,6 +12,7 @@ use ivt_condense::{
 };
 use ivt_hb::{HbError, HbOptions};
 use ivt_jobs::pairs;
+use ivt_kin::params::Typed;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -88,17 +89,8 @@ impl<'py> Large<'py> {
             &triplets("k", &self.k)?,
         )
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
-        let zeros = PyArray2::<f64>::zeros(py, [s, s], false).into_any();
-        let local = user_problem(
-            &zeros,
-            &zeros,
-            &zeros,
-            &self.g,
-            None,
-            self.jac.as_ref(),
-            self.velocity_dependent,
-            self.vectorized,
-        )?;
+        let flags = [self.velocity_dependent, self.vectorized];
+        let local = local_problem(py, s, &self.g, self.jac.as_ref(), flags)?;
         Ok((structure, local))
     }
 
@@ -118,8 +110,30 @@ impl<'py> Large<'py> {
     }
 }
 
+/// The local problem of `s` nonlinear DOFs: zero matrices, `g` (with its
+/// optional Jacobian `jac`), no `f`; `[velocity_dependent, vectorized]`.
+pub(crate) fn local_problem<'py>(
+    py: Python<'py>,
+    s: usize,
+    g: &Bound<'py, PyAny>,
+    jac: Option<&Bound<'py, PyAny>>,
+    [velocity_dependent, vectorized]: [bool; 2],
+) -> PyResult<PyProblem> {
+    let zeros = PyArray2::<f64>::zeros(py, [s, s], false).into_any();
+    user_problem(
+        &zeros,
+        &zeros,
+        &zeros,
+        g,
+        None,
+        jac,
+        velocity_dependent,
+        vectorized,
+    )
+}
+
 /// `n` harmonics, `samples` = N, relative tolerance `rtol`.
-fn hb_options(n: usize, samples: usize) -> PyResult<HbOptions> {
+pub(crate) fn hb_options(n: usize, samples: usize) -> PyResult<HbOptions> {
     if n == 0 || samples <= n {
         return Err(PyValueError::new_err(format!(
             "need n ≥ 1 harmonics and samples > n, got n = {n}, samples = {samples}"
@@ -128,7 +142,7 @@ fn hb_options(n: usize, samples: usize) -> PyResult<HbOptions> {
     Ok(HbOptions::new(n, samples))
 }
 
-fn point_dict<'py>(py: Python<'py>, p: &CondensedPoint) -> PyResult<Bound<'py, PyDict>> {
+pub(crate) fn point_dict<'py>(py: Python<'py>, p: &CondensedPoint) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("omega", p.omega_f)?;
     d.set_item("amplitude", p.amplitude)?;
@@ -142,9 +156,11 @@ fn point_dict<'py>(py: Python<'py>, p: &CondensedPoint) -> PyResult<Bound<'py, P
     d.set_item("data_error", p.data_error)?;
     d.set_item("orbit_error", p.orbit_error)?;
     d.set_item("truncation_error", p.truncation_error)?;
+    // Without the truncation estimate there is no whole estimate: None, not
+    // the orbit error alone.
     d.set_item(
         "error_estimate",
-        p.orbit_error + p.truncation_error.unwrap_or(0.0),
+        p.truncation_error.map(|t| p.orbit_error + t),
     )?;
     match &p.floquet {
         Some(f) => {
@@ -163,7 +179,7 @@ fn point_dict<'py>(py: Python<'py>, p: &CondensedPoint) -> PyResult<Bound<'py, P
     Ok(d)
 }
 
-fn frc_dict<'py>(py: Python<'py>, frc: &CondensedFrc) -> PyResult<Bound<'py, PyDict>> {
+pub(crate) fn frc_dict<'py>(py: Python<'py>, frc: &CondensedFrc) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let points = PyList::empty(py);
     for p in &frc.points {
@@ -229,6 +245,25 @@ fn frc_large<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let (hb, flags) = (hb_options(n, samples)?, [velocity_dependent, vectorized]);
     let large = Large::new(n_dof, (m, c, k), (g, jac), f, nonlinear_dofs, hb, flags);
+    let opts = frc_options(
+        (omega_from, omega_to, rtol),
+        (amplitude_dof, record_dofs),
+        [truncation_estimate, stability],
+        [ds, ds_min, ds_max],
+    )?;
+    let frc = large.run(py, move |branch| condensed_response(branch, &opts))?;
+    frc_dict(py, &frc)
+}
+
+/// The condensed sweep's options from the keywords of `frc`: `(from, to,
+/// rtol)`, `(amplitude_dof, record_dofs)`, `[truncation_estimate,
+/// stability]`, `[ds, ds_min, ds_max]`.
+pub(crate) fn frc_options(
+    (omega_from, omega_to, rtol): (f64, f64, f64),
+    (amplitude_dof, record_dofs): (Option<usize>, Vec<usize>),
+    [truncation_estimate, stability]: [bool; 2],
+    steps: [Option<f64>; 3],
+) -> PyResult<CondensedFrcOptions> {
     let mut opts = CondensedFrcOptions {
         from: finite("omega_from", omega_from)?,
         to: finite("omega_to", omega_to)?,
@@ -239,26 +274,27 @@ fn frc_large<'py>(
         stability_blocks: stability.then_some(ivt_condense::DEFAULT_BLOCKS),
         ..CondensedFrcOptions::default()
     };
-    let steps = [
+    let [ds, ds_min, ds_max] = steps;
+    let slots = [
         ("ds", ds, &mut opts.continuation.ds),
         ("ds_min", ds_min, &mut opts.continuation.ds_min),
         ("ds_max", ds_max, &mut opts.continuation.ds_max),
     ];
-    for (name, given, slot) in steps {
+    for (name, given, slot) in slots {
         if let Some(v) = given {
             *slot = positive(name, v)?;
         }
     }
-    let frc = large.run(py, move |branch| condensed_response(branch, &opts))?;
-    frc_dict(py, &frc)
+    Ok(opts)
 }
 
-fn positive(name: &str, v: f64) -> PyResult<f64> {
+pub(crate) fn positive(name: &str, v: f64) -> PyResult<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
         Err(PyValueError::new_err(format!(
-            "argument `{name}` must be > 0, got {v}"
+            "argument `{name}` must be > 0, got {}",
+            Typed(v)
         )))
     }
 }
@@ -348,7 +384,34 @@ fn cantilever_coo<'py>(
     };
     let beam = ivt_condense::models::cantilever(n_elements, &props)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    let mats = beam.model.triplets().map(|t| {
+    model_coo(py, &beam.model, beam.tip)
+}
+
+/// pyHarm's 24-sector bladed disk of issue 28 as COO triplets, `(n_dof,
+/// (m, c, k), tip)` as [`cantilever_coo`]; `blade_stiffness` (24 factors, one
+/// per sector's blade springs; None: the tuned disk) mistunes it (private:
+/// `ivt.hb.models.bladed_disk`).
+#[pyfunction]
+#[pyo3(signature = (blade_stiffness = None))]
+fn bladed_disk_coo<'py>(
+    py: Python<'py>,
+    blade_stiffness: Option<Vec<f64>>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let disk = match blade_stiffness {
+        Some(factors) => ivt_condense::models::bladed_disk_mistuned(&factors),
+        None => ivt_condense::models::bladed_disk(),
+    }
+    .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    model_coo(py, &disk.model, disk.tip)
+}
+
+/// `(n_dof, (m, c, k), dof)` with each matrix `(rows, cols, values)` arrays.
+fn model_coo<'py>(
+    py: Python<'py>,
+    model: &ivt_condense::models::SparseModel,
+    dof: usize,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let mats = model.triplets().map(|t| {
         let rows: Vec<usize> = t.iter().map(|e| e.0).collect();
         let cols: Vec<usize> = t.iter().map(|e| e.1).collect();
         let vals: Vec<f64> = t.iter().map(|e| e.2).collect();
@@ -358,7 +421,7 @@ fn cantilever_coo<'py>(
             vals.into_pyarray(py),
         )
     });
-    (beam.model.n_dof(), mats, beam.tip).into_pyobject(py)
+    (model.n_dof(), mats, dof).into_pyobject(py)
 }
 
 /// Register the large-structure functions on `ivt._ivt.hb`.
@@ -366,5 +429,6 @@ pub fn register(hb: &Bound<'_, PyModule>) -> PyResult<()> {
     hb.add_function(wrap_pyfunction!(frc_large, hb)?)?;
     hb.add_function(wrap_pyfunction!(solve_large, hb)?)?;
     hb.add_function(wrap_pyfunction!(cantilever_coo, hb)?)?;
+    hb.add_function(wrap_pyfunction!(bladed_disk_coo, hb)?)?;
     Ok(())
 }

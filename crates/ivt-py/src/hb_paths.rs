@@ -6,6 +6,7 @@
 
 use ivt_hb::{BackboneOptions, Corrector, FrcOptions};
 use ivt_jobs::{self as jobs, BackboneRequest, FrcRequest};
+use ivt_kin::params::Typed;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -53,7 +54,9 @@ fn frc<'py>(py, user, jac;
     let (from, to) = (finite("omega_from", omega_from)?, finite("omega_to", omega_to)?);
     if !(from > 0.0 && to > 0.0 && from != to) {
         return Err(PyValueError::new_err(format!(
-            "arguments `omega_from` = {from}, `omega_to` = {to} must be > 0 and distinct"
+            "arguments `omega_from` = {}, `omega_to` = {} must be > 0 and distinct",
+            Typed(from),
+            Typed(to)
         )));
     }
     // The Newton–chord corrector: one Galerkin Jacobian and ~3 residuals per
@@ -78,7 +81,8 @@ user_system_fn! {
 /// {q, ω, κ} (the Galerkin Jacobian, with ∂g from `jac`, the elements, or
 /// differences of `g`).
 /// Returns {"amplitude", "omega", "kappa" (arrays), "points": [{"amplitude",
-/// "omega", "kappa", "coeffs"}...], "termination"}. GIL released between
+/// "omega", "kappa", "peak" (max |x| of DOF `dof`), "coeffs"}...],
+/// "termination"}. GIL released between
 /// callbacks.
 fn backbone<'py>(py, user, jac;
     omega0: f64,
@@ -89,6 +93,7 @@ fn backbone<'py>(py, user, jac;
     tol: f64 = 0.0,
 ) {
     let (problem, opts) = user.setup(None, 1, tol)?;
+    crate::hb_shared::without_omega(&problem, "backbone")?;
     let req = BackboneRequest {
         omega0: finite("omega0", omega0)?,
         mode,

@@ -9,12 +9,14 @@
 //! `hb_keywords_fn!` (the keywords both share).
 
 use ivt_hb::{HbError, HbOptions};
+use ivt_kin::params::Typed;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::args::count;
+use crate::interrupt::detach_interruptible;
 use crate::user_problem::{callback_error, user_problem, with_tolerances, PyProblem};
 
 create_exception!(
@@ -38,28 +40,42 @@ pub(crate) fn hb_err(py: Python<'_>, e: HbError) -> PyErr {
     err
 }
 
-/// Run `solve` with the GIL released; its error mapped by [`hb_err`].
+/// Run `solve` with the GIL released, interruptible by Ctrl-C
+/// ([`detach_interruptible`]); its error mapped by [`hb_err`].
 pub(crate) fn run<T: Send>(
     py: Python<'_>,
     solve: impl FnOnce() -> Result<T, HbError> + Send,
 ) -> PyResult<T> {
-    py.detach(solve).map_err(|e| hb_err(py, e))
+    detach_interruptible(py, solve)?.map_err(|e| hb_err(py, e))
 }
 
 /// Run `solve` on a user system with the GIL released (its callbacks take it
-/// back), then re-raise the first exception a callback raised (it aborted the
+/// back), interruptible by Ctrl-C ([`detach_interruptible`]), then re-raise the first exception a callback raised (it aborted the
 /// run) or map the ivt-hb error with [`hb_err`].
 pub(crate) fn run_user<T: Send>(
     py: Python<'_>,
     problem: &PyProblem,
     solve: impl FnOnce(&PyProblem) -> Result<T, HbError> + Send,
 ) -> PyResult<T> {
-    let result = py.detach(|| solve(problem));
+    let result = detach_interruptible(py, || solve(problem))?;
     // The callback's exception, not the failure it caused, is the error.
     if let Some(e) = callback_error(problem) {
         return Err(e);
     }
     result.map_err(|e| hb_err(py, e))
+}
+
+/// ValueError when the user system's `g` or `f` reads `omega`: `what` has no
+/// excitation frequency to give it, its ω is an unknown of the orbit (only
+/// `frc` and `solve` pass ω).
+pub(crate) fn without_omega(problem: &PyProblem, what: &str) -> PyResult<()> {
+    if ivt_hb::PeriodicProblem::frequency_dependent(problem) {
+        return Err(PyValueError::new_err(format!(
+            "`g` or `f` reads `omega`, but {what} has no excitation frequency to pass: its ω \
+             is an unknown of the orbit (only `frc` and `solve` pass omega)"
+        )));
+    }
+    Ok(())
 }
 
 /// Options from the Python keywords: n harmonics, `samples` = N (2N AFT samples).
@@ -86,7 +102,8 @@ pub(crate) fn options(n: i64, samples: i64, subharmonic: i64, tol: f64) -> PyRes
     }
     if !(tol.is_finite() && tol > 0.0) {
         return Err(PyValueError::new_err(format!(
-            "argument `tol` = {tol} must be finite and > 0"
+            "argument `tol` = {} must be finite and > 0",
+            Typed(tol)
         )));
     }
     Ok(HbOptions::new(n, samples)
@@ -100,7 +117,8 @@ pub(crate) fn finite(name: &str, v: f64) -> PyResult<f64> {
         Ok(v)
     } else {
         Err(PyValueError::new_err(format!(
-            "argument `{name}` = {v} must be finite"
+            "argument `{name}` = {} must be finite",
+            Typed(v)
         )))
     }
 }

@@ -20,8 +20,9 @@ use crate::to_python::to_dict;
 /// confirmed by Hill's method near |μ| = 1. `boundary` "fixed" (Eq. 104) or
 /// "spring" (k0 w(1) = w_x(1), Eq. 132, Tau method).
 /// Returns the dict of `ivt hb string --json`: points [{"omega", "norm" (‖a‖,
-/// Eq. 114), "stable", "kind", "max_multiplier", "method"}...], jacobians,
-/// hill_calls, stop, solve_time_s ([`ivt_jobs::StringCurve`]; a spring
+/// Eq. 114), "stable", "kind", "max_multiplier", "method"}...], folds
+/// [{"omega", "norm", "located", "index"}...], jacobians, hill_calls, stop,
+/// solve_time_s ([`ivt_jobs::StringCurve`]; a spring
 /// of k0 > 1 adds boundary_note). A trace that fails numerically raises
 /// `ConvergenceError`. |kd| is limited to 1e9
 /// ([`ivt_jobs::string::MAX_KD`]: larger values only make the trace slow

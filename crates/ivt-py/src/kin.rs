@@ -155,17 +155,19 @@ fn apply_overrides(
 /// one parser.
 ///
 /// # Errors
-/// `FileNotFoundError` for a missing file, `ValueError` (one line: file,
-/// line, column, key) for an invalid one.
+/// `FileNotFoundError` for a missing file; `ValueError` for a path that is
+/// not a regular file (saying what it is: a FIFO, a device, a directory),
+/// one over the size budget, or an invalid file (one line: file, line,
+/// column, key). The file is opened by ivt-sim's one input opener
+/// ([`ivt_sim::input`]).
 pub fn plant_from_file(path: &std::path::Path) -> PyResult<PlantParams> {
-    if !path.is_file() {
-        return Err(PyFileNotFoundError::new_err(format!(
-            "plant file {} does not exist",
-            path.display()
-        )));
-    }
-    let section =
-        ivt_sim::scene::PlantSection::from_file(path).map_err(|e| PyValueError::new_err(e.0))?;
+    let section = ivt_sim::scene::PlantSection::from_file(path).map_err(|e| {
+        if e.unreadable && !path.try_exists().unwrap_or(true) {
+            PyFileNotFoundError::new_err(format!("plant file {}", e.message))
+        } else {
+            PyValueError::new_err(e.message)
+        }
+    })?;
     section
         .params()
         .map_err(|e| PyValueError::new_err(format!("{}: {e}", path.display())))

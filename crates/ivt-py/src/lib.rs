@@ -35,9 +35,13 @@ mod hb_family;
 mod hb_folds;
 mod hb_large;
 mod hb_paths;
+mod hb_reduced;
+mod hb_sensitivity;
 mod hb_shared;
 mod hb_string;
 mod hb_switch;
+mod hb_torus;
+mod interrupt;
 mod kin;
 mod sim;
 mod to_python;
@@ -49,6 +53,10 @@ mod vectorize;
 #[pymodule]
 fn _ivt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    // The NumPy C API now, at import: looked up lazily, a first array made
+    // while a KeyboardInterrupt is pending (Ctrl-C during a call) fails the
+    // lookup, which the numpy crate turns into a panic.
+    numpy::PyArray1::<f64>::zeros(m.py(), 0, false);
     kin::register(m)?;
     ctrl::register(m)?;
     hb::register(m)?;

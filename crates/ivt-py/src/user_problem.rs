@@ -131,6 +131,9 @@ impl Nonlinearity for UserG {
     fn frequency_dependent(&self) -> bool {
         matches!(&self.law, UserLaw::Python(g, _) if g.omega)
     }
+    fn hysteretic(&self) -> bool {
+        matches!(&self.law, UserLaw::Elements(e) if e.hysteretic())
+    }
     fn eval_samples_at(&self, x: &[f64], v: &[f64], theta: &[f64], w: f64, out: &mut [f64]) {
         match &self.law {
             UserLaw::Python(g, _) => g.eval_with(x, v, theta, Some(w), out),

@@ -1,8 +1,11 @@
 """The guide's (docs/guide) Python and command-line blocks run as a reader would
 run them, chapter by chapter:
 
-- each chapter runs in a fresh temporary directory (its cwd) that holds
-  ``scenes/``, the repository's shipped scenes, as a checkout does;
+- each chapter runs in a fresh temporary directory (its cwd) that holds what
+  a checkout holds and the chapters read: ``scenes/`` (the shipped scenes),
+  ``examples/`` (the example models), the manifests ``Cargo.toml``,
+  ``crates/`` and ``firmware/``, and ``bench/`` (the benchmark gate's
+  baseline; symlinks into the repository, read only);
 - its ```python blocks run top to bottom in ONE fresh namespace, so a later
   block uses what an earlier one defined; their assertions are the checks;
 - its ```console blocks run in the same directory, in document order with the
@@ -12,7 +15,15 @@ run them, chapter by chapter:
   program and runs as ``ivt [ARGS]``. The only ``$`` lines not run are those in
   ``NOT_RUN`` (the check itself, or a machine this is not), each named there;
   any other ``$`` line fails the test;
-- lines without ``$`` in a console block, and ```text blocks, are output shown.
+- lines without ``$`` in a console block, and ```text blocks, are output shown;
+- its figures: every image the chapter shows (``![alt](path.png)``, the path
+  relative to the chapter) is a file its blocks wrote at that path in its
+  directory — a Python block with :mod:`ivt.plot` or matplotlib, or an
+  ``ivt ... --plot`` line — and is copied into the rendered book beside the
+  chapter's page (``target/guide``, or ``$IVT_GUIDE_BOOK``), where
+  scripts/check-book-browser opens it. A figure is therefore drawn by the
+  code the chapter shows each time this test runs: it cannot go stale, and
+  none is committed. Every chapter shows at least one.
 
 ```rust blocks are doctests (src/lib.rs includes every chapter); tests/guide.rs
 refuses any other fence language.
@@ -22,6 +33,7 @@ import os
 import pathlib
 import re
 import shlex
+import shutil
 import subprocess
 from typing import Dict, List, Tuple
 
@@ -34,6 +46,9 @@ GUIDE = REPO / "docs" / "guide" / "src"
 NOT_RUN: Dict[str, str] = {
     "./scripts/test": "the check that runs this test",
     "./scripts/py-test": "the check that runs this test",
+    "scripts/bench-gate": "the benchmark gate: its own step of scripts/test (valgrind, a minute)",
+    "python bench/gate/gate.py": "the gate on another build (valgrind, a minute)",
+    ".venv/bin/python bench/gate/gate.py": "the gate against another baseline (valgrind, a minute)",
     "cargo install": "installs a tool into the user's ~/.cargo",
     "pip install": "installs into the user's environment (tests/test_wheel.py installs the wheel)",
     "python -m venv": "creates the user's environment",
@@ -51,6 +66,24 @@ NOT_RUN: Dict[str, str] = {
 }
 
 FENCE = re.compile(r"^(\s*)(`{3,}|~{3,})\s*([^\s`]*)")
+# A Markdown image: ![alt](path).
+IMAGE = re.compile(r"!\[[^\]]*\]\(([^)\s]+)\)")
+
+
+def book_dir() -> pathlib.Path:
+    """The rendered book the chapters' figures are copied into."""
+    env = os.environ.get("IVT_GUIDE_BOOK")
+    return pathlib.Path(env) if env else REPO / "target" / "guide"
+
+
+# What a chapter's directory holds of a checkout (symlinks, read only).
+CHECKOUT = ("scenes", "examples", "Cargo.toml", "crates", "firmware", "bench")
+
+
+def checkout(work: pathlib.Path) -> None:
+    """Link the parts of the repository a chapter reads into `work`."""
+    for name in CHECKOUT:
+        (work / name).symlink_to(REPO / name, target_is_directory=(REPO / name).is_dir())
 
 
 def ivt_bin() -> pathlib.Path:
@@ -87,6 +120,23 @@ def blocks(text: str) -> List[Tuple[str, int, str]]:
     return out
 
 
+def prose(text: str) -> str:
+    """The chapter without its fenced blocks (what is rendered as text)."""
+    lines = text.splitlines()
+    keep = [True] * len(lines)
+    for _, start, body in blocks(text):
+        # the opening fence is line start - 1 (1-based), the closing one after the body
+        first = start - 2
+        for i in range(first, min(len(lines), first + body.count("\n") + 2)):
+            keep[i] = False
+    return "\n".join(line for line, k in zip(lines, keep) if k)
+
+
+def figures(text: str) -> List[str]:
+    """The image paths a chapter shows, relative to the chapter, in order."""
+    return IMAGE.findall(prose(text))
+
+
 def commands(body: str) -> List[str]:
     """The ``$`` lines of a console block, continuation lines joined."""
     out: List[str] = []
@@ -121,6 +171,30 @@ def chapters() -> List[str]:
     )
 
 
+def test_every_chapter_shows_a_figure_of_its_own() -> None:
+    """Each chapter shows at least one figure; each figure path is relative,
+    stays in the chapter's directory of the book, is a PNG, and names no
+    file of the guide's sources nor another chapter's figure."""
+    seen: Dict[str, str] = {}
+    for chapter in chapters():
+        shown = figures((GUIDE / chapter).read_text())
+        assert shown, f"{chapter} shows no figure"
+        for path in shown:
+            rel = pathlib.PurePosixPath(path)
+            assert not rel.is_absolute() and ".." not in rel.parts and rel.suffix == ".png", (
+                f"{chapter}: figure {path} must be a relative .png inside the chapter's directory"
+            )
+            book_path = (pathlib.PurePosixPath(chapter).parent / rel).as_posix()
+            assert not (GUIDE / book_path).exists(), f"{chapter}: {path} is a source file"
+            assert book_path not in seen, f"{chapter} and {seen.get(book_path)} both show {book_path}"
+            seen[book_path] = chapter
+
+
+def test_figure_reader() -> None:
+    text = "![a](x.png)\n```python\n# ![b](not-a-figure.png)\n```\ntext ![c](out/y.png) end\n"
+    assert figures(text) == ["x.png", "out/y.png"]
+
+
 def test_block_reader() -> None:
     text = "x\n```python\na = 1\n```\n- item\n  ```console\n  $ ivt kin \\\n  plant\n  out\n  ```\n"
     got = blocks(text)
@@ -133,7 +207,7 @@ def test_block_reader() -> None:
 @pytest.mark.parametrize("chapter", chapters())
 def test_chapter_runs(chapter: str, tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch) -> None:
     path = GUIDE / chapter
-    (tmp_path / "scenes").symlink_to(REPO / "scenes", target_is_directory=True)
+    checkout(tmp_path)
     monkeypatch.chdir(tmp_path)
     exe = ivt_bin()
     monkeypatch.setenv("PATH", f"{exe.parent}{os.pathsep}{os.environ.get('PATH', '')}")
@@ -163,3 +237,11 @@ def test_chapter_runs(chapter: str, tmp_path: pathlib.Path, monkeypatch: pytest.
                     f"{where}: `$ {cmd}` exited {run.returncode}\n"
                     f"stdout: {run.stdout[-2000:]}\nstderr: {run.stderr[-2000:]}"
                 )
+    # The chapter's figures, drawn just now by its blocks, into the book.
+    target = book_dir() / pathlib.PurePosixPath(chapter).parent
+    for figure in figures(path.read_text()):
+        drawn = tmp_path / figure
+        assert drawn.is_file(), f"{chapter}: figure {figure} was not drawn by the chapter's code"
+        assert drawn.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", f"{chapter}: {figure} is not a PNG"
+        (target / figure).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(drawn, target / figure)

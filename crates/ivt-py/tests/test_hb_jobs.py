@@ -1,4 +1,4 @@
-"""Every `ivt_hb::jobs` job that has a command line gives Python the CLI's
+"""Every `ivt_jobs` job that has a command line gives Python the CLI's
 result: the dict of `ivt.hb.X(...)` and the object of `ivt hb X --json` on
 the same input hold the same keys and the same values (wall times aside).
 Both serialize one Rust result type, so any difference is a front end that
@@ -153,3 +153,141 @@ def test_elements_repr_is_the_python_call_not_debug_text() -> None:
     el = hb.elements.cubic_spring(0.5) + hb.elements.coulomb(0.02, 0.05, dof=0, to=1)
     assert repr(el) == ("Elements([cubic_spring(k3=0.5, dof=0, to=None), "
                         "coulomb(force=0.02, v_reg=0.05, dof=0, to=1)])")
+
+
+# --- user models from the command line (issue 46): `ivt hb frc|solve MODEL.toml`
+
+#: Two masses in a chain (m = 1, k = 2/-1, light proportional damping) with
+#: a hardening spring from DOF 0 to the ground and a cubic damper between the
+#: masses, driven at DOF 0. K comes from a Matrix Market file written by
+#: scipy (an independent writer of the format).
+_M = [[1.0, 0.0], [0.0, 1.0]]
+_C = [[0.04, -0.02], [-0.02, 0.04]]
+_K = [[2.0, -1.0], [-1.0, 2.0]]
+_MODEL = """
+[model]
+m = [[1.0, 0.0], [0.0, 1.0]]
+c = [[0.04, -0.02], [-0.02, 0.04]]
+k = "k.mtx"
+
+[[element]]
+law = "cubic_spring"
+k3 = 0.5
+dof = 0
+
+[[element]]
+law = "cubic_damper"
+c3 = 0.01
+dof = 1
+to = 0
+
+[forcing]
+amplitude = [0.1, 0.0]
+
+[range]
+from = 0.5
+to = 2.5
+
+[options]
+n = 12
+samples = 32
+"""
+
+
+def _model_files(tmp_path: Any) -> Any:
+    import scipy.io
+    import scipy.sparse
+
+    scipy.io.mmwrite(str(tmp_path / "k.mtx"), scipy.sparse.coo_matrix(np.array(_K)))
+    path = tmp_path / "model.toml"
+    path.write_text(_MODEL)
+    return path
+
+
+def _g() -> Any:
+    return hb.elements.cubic_spring(0.5, dof=0) + hb.elements.cubic_damper(0.01, dof=1, to=0)
+
+
+def _f(theta: float) -> list:  # type: ignore[type-arg]
+    return [0.1 * math.cos(theta), 0.0]
+
+
+def test_model_file_frc_equals_python_frc(cli: Callable[..., Dict[str, Any]], tmp_path: Any) -> None:
+    path = _model_files(tmp_path)
+    ref = cli("hb", "frc", str(path))
+    got = hb.frc(np.array(_M), np.array(_C), np.array(_K), _g(), _f, 0.5, 2.5, n=12, samples=32)
+    same(got, ref)
+    # A curve with its folds (the hardening peak near the first mode, ω ≈ 1)
+    # and a point count that a wrong model would not reproduce.
+    assert len(ref["folds"]) == 2 and len(ref["points"]) > 50
+    assert all(0.9 < f["omega"] < 2.0 for f in ref["folds"])
+    # --from/--to override [range].
+    part = cli("hb", "frc", str(path), "--from", "2.5", "--to", "1.5")
+    same(hb.frc(_M, _C, _K, _g(), _f, 2.5, 1.5, n=12, samples=32), part)
+
+
+def test_model_file_solve_equals_python_solve(cli: Callable[..., Dict[str, Any]], tmp_path: Any) -> None:
+    path = _model_files(tmp_path)
+    ref = cli("hb", "solve", str(path), "--omega", "1.3")
+    same(hb.solve(_M, _C, _K, _g(), 1.3, _f, n=12, samples=32), ref)
+    # The orbit balances the equations: the first harmonic of DOF 0 is far
+    # from the linear response alone would give at this ω (cubic spring on).
+    assert ref["residual_norm"] < 1e-9 and ref["stability"] in ("stable", "unstable")
+
+
+def _cli_error(tmp_path: Any, text: str, *args: str) -> Dict[str, Any]:
+    """The one JSON error object of `ivt --json hb frc BAD.toml` (exit 2)."""
+    import json
+    import subprocess
+
+    from conftest import _ivt_bin
+
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text)
+    out = subprocess.run(
+        [str(_ivt_bin()), "--json", "hb", *(args or ("frc",)), str(bad)],
+        capture_output=True,
+        text=True,
+    )
+    assert out.returncode == 2, (out.returncode, out.stdout, out.stderr)
+    lines = out.stdout.strip().splitlines()
+    assert len(lines) == 1, out.stdout
+    obj: Dict[str, Any] = json.loads(lines[0])
+    assert set(obj) == {"error", "kind"}, obj
+    return obj
+
+
+_BASE = "[model]\nm = 1.0\nc = 0.1\nk = 1.0\n[range]\nfrom = 0.5\nto = 2.0\n"
+
+
+def test_bad_model_files_give_one_error_naming_the_key(tmp_path: Any) -> None:
+    cases = [
+        (_BASE + "[options]\nharmonics = 3\n", "input", ["options.harmonics"]),
+        (_BASE + "[options]\nn = 0\n", "input", ["options.n", "0"]),
+        (_BASE + "[options]\nn = 10\nsamples = 8\n", "input", ["options.samples", "8"]),
+        (_BASE + "[[element]]\nlaw = 'cubic'\nk3 = 1.0\ndof = 0\n", "input", ["element[0].law", "cubic"]),
+        (_BASE + "[[element]]\nlaw = 'cubic_spring'\nk3 = 1.0\ndof = 1\n", "input", ["element[0].dof", "1"]),
+        (_BASE + "[[element]]\nlaw = 'cubic_spring'\ndof = 0\n", "input", ["element[0]", "k3"]),
+        (_BASE + "[[element]]\nlaw = 'cubic_spring'\nk3 = 1.0\ngap = 0.1\ndof = 0\n", "input",
+         ["element[0].gap", "0.1"]),
+        (_BASE + "[[element]]\nlaw = 'coulomb'\nforce = 1.0\nv_reg = -1.0\ndof = 0\n", "input",
+         ["element[0].v_reg", "-1"]),
+        (_BASE + "[forcing]\namplitude = [1.0, 2.0]\n", "input", ["forcing.amplitude", "2 entries"]),
+        (_BASE + "[forcing]\namplitude = [nan]\n", "input", ["forcing.amplitude[0]", "NaN"]),
+        ("[model]\nm = [[1.0, 0.0], [0.0]]\nc = 0.1\nk = 1.0\n", "input", ["model.m", "row 1"]),
+        ("[model]\nm = true\nc = 0.1\nk = 1.0\n", "input", ["model.m", "true"]),
+        ("[model]\nm = 1.0\nc = 0.1\n", "input", ["model", "k"]),
+        ("[model]\nm = 'missing.mtx'\nc = 0.1\nk = 1.0\n", "io", ["model.m", "missing.mtx"]),
+        (_BASE.replace("from = 0.5", "from = -0.5"), "input", ["range.from", "-0.5"]),
+        ("[model]\nm = 1.0\nc = 0.1\nk = 1.0\n", "input", ["range.from", "--from"]),
+    ]
+    for text, kind, words in cases:
+        err = _cli_error(tmp_path, text)
+        assert err["kind"] == kind, (text, err)
+        for w in words:
+            assert w in err["error"], (text, w, err)
+    (tmp_path / "c.mtx").write_text("%%MatrixMarket matrix coordinate complex general\n1 1 1\n1 1 1.0 0.5\n")
+    err = _cli_error(tmp_path, "[model]\nm = 1.0\nc = 'c.mtx'\nk = 1.0\n")
+    assert err["kind"] == "input" and "model.c" in err["error"] and "complex" in err["error"], err
+    err = _cli_error(tmp_path, _BASE, "solve", "--omega", "0")
+    assert err["kind"] == "input" and "--omega" in err["error"], err

@@ -156,3 +156,24 @@ def test_all_solutions_equals_cli(cli: Callable[..., Dict[str, Any]]) -> None:
     same(list(got), ref["solutions"], "solutions")
     same(got.search, ref["search"], "search")
     assert [s["stable"] for s in got] == [True, False, True]
+
+
+def test_an_autonomous_family_may_return_four_items() -> None:
+    """Issue 46: (m, c, k, g) is an unforced family, the same as (m, c, k, g, None)."""
+    def g(x: Any, v: Any, th: float) -> Any:
+        return (x * x * (x * x) - x * x) * v
+
+    def timeless(d: Any) -> Any:
+        if isinstance(d, dict):
+            return {k: timeless(v) for k, v in d.items() if k not in ("time_s", "solve_time_s")}
+        if isinstance(d, (list, tuple)):
+            return [timeless(v) for v in d]
+        return d
+
+    five = hb.cycle_branch(lambda mu: (1.0, -mu, 1.0, g, None), -0.2, 0.1, at=[-0.1])
+    four = hb.cycle_branch(lambda mu: (1.0, -mu, 1.0, g), -0.2, 0.1, at=[-0.1])
+    # The same problem: bit for bit.
+    np.testing.assert_equal(timeless(four), timeless(five))
+    assert len(four["hopf"]) == 1 and len(four["at"]) == 2
+    with pytest.raises(TypeError, match=r"\(m, c, k, g\)"):
+        hb.cycle_branch(lambda mu: (1.0, -mu, 1.0), -0.2, 0.1)

@@ -42,6 +42,13 @@ def test_fresh_venv_runs_a_shipped_scene(tmp_path: Path) -> None:
     script = (
         "import json, ivt\n"
         "assert 'drive' in ivt.scenes.names(), ivt.scenes.names()\n"
+        # no matplotlib here: ivt works, ivt.plot says which extra it needs
+        "try:\n"
+        "    ivt.plot\n"
+        "except ImportError as e:\n"
+        "    assert \"pip install 'ivt[plot]'\" in str(e), e\n"
+        "else:\n"
+        "    raise AssertionError('ivt.plot imported without matplotlib')\n"
         "p = ivt.scenes.path('drive')\n"
         "r = ivt.sim.run(p)\n"
         "print(json.dumps({'path': str(p), 'scene': r['summary']['scene'],"
@@ -66,20 +73,22 @@ def test_fresh_venv_runs_a_shipped_scene(tmp_path: Path) -> None:
 @needs_wheel
 def test_fresh_venv_runs_every_chapter_as_a_user_copies_it(tmp_path: Path) -> None:
     """Issue 31: each chapter's example, copied into a fresh venv as a user
-    would (the wheel + numpy + scipy, nothing of the repository importable),
-    runs as shown: each chapter becomes one script, its Python blocks in
-    order and its `$ ivt ...` lines as shell commands between them (the same
-    lines test_guide.py runs, the same NOT_RUN list), run by the fresh venv's
-    Python in an empty directory holding `scenes/` as a checkout does."""
-    from test_guide import GUIDE, NOT_RUN, as_ivt, blocks, commands, ivt_bin
+    would (the wheel with its `plot` extra (matplotlib) + scipy, nothing of
+    the repository importable), runs as shown: each chapter becomes one
+    script, its Python blocks in order and its `$ ivt ...` lines as shell
+    commands between them (the same lines test_guide.py runs, the same
+    NOT_RUN list), run by the fresh venv's Python in an empty directory
+    holding what a checkout holds (test_guide.checkout), and draws the
+    figures the chapter shows."""
+    from test_guide import GUIDE, NOT_RUN, as_ivt, blocks, checkout, commands, figures, ivt_bin
 
     venv = tmp_path / "venv"
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
     py = venv / "bin" / "python"
     pip = [str(py), "-m", "pip", "install", "-q", "--disable-pip-version-check"]
-    subprocess.run([*pip, str(WHEEL), "numpy", "scipy"], check=True, cwd=tmp_path)
+    # the extras the chapters name: figures, finite-element models, Dask sweeps
+    subprocess.run([*pip, f"{WHEEL}[plot,fe,dask]", "numpy", "scipy"], check=True, cwd=tmp_path)
     exe = ivt_bin()
-    repo = Path(__file__).resolve().parents[3]
     ran = 0
     for chapter in sorted(GUIDE.rglob("*.md")):
         parts = []
@@ -97,12 +106,19 @@ def test_fresh_venv_runs_every_chapter_as_a_user_copies_it(tmp_path: Path) -> No
             continue
         work = tmp_path / chapter.relative_to(GUIDE).with_suffix("").as_posix().replace("/", "-")
         work.mkdir()
-        (work / "scenes").symlink_to(repo / "scenes", target_is_directory=True)
+        checkout(work)
         (work / "example.py").write_text("".join(parts))
+        # Run as `python -c`, as pasted into an interpreter or a notebook: a
+        # process cluster's workers then do not re-run the chapter (a script
+        # needs `if __name__ == "__main__":` around them, as large-models.md
+        # says).
         run = subprocess.run(
-            [str(py), "example.py"], cwd=work, capture_output=True, text=True,
+            [str(py), "-c", (work / "example.py").read_text()], cwd=work, capture_output=True,
+            text=True,
             env={"PATH": f"{exe.parent}{os.pathsep}{os.environ.get('PATH', '')}", "HOME": str(tmp_path)},
         )
         assert run.returncode == 0, f"{chapter.name}:\n{run.stdout[-2000:]}\n{run.stderr[-3000:]}"
+        for figure in figures(chapter.read_text()):
+            assert (work / figure).is_file(), f"{chapter.name}: {figure} not drawn"
         ran += 1
     assert ran >= 10, ran

@@ -6,9 +6,10 @@
 //!   `.tmp-<pid>-<counter>-<random>-<name>` (the extension kept), created
 //!   exclusively (`O_CREAT | O_EXCL`: never through a symlink, never shared
 //!   by two calls, threads or processes).
-//! - A target must be absent or a regular file: a symlink, a directory or a
-//!   device (`/dev/full`) is refused with an error before anything is
-//!   written, and checked again at the commit.
+//! - A target must be absent or a regular file that is not an input of the
+//!   run: a symlink, a directory, a device (`/dev/full`) or a file the process
+//!   has read ([`crate::input`], by device and inode) is refused with an error
+//!   before anything is written, and checked again at the commit.
 //! - [`Staged::commit`] renames the whole set into place, all or none: the
 //!   targets that existed are kept under a backup link until every rename
 //!   succeeded, and put back if one fails. Dropping a set without committing
@@ -62,14 +63,26 @@ pub struct Staged {
 }
 
 /// Refuses to replace anything but a regular file (or nothing): a symlink
-/// is never written through, a device or directory never replaced.
+/// is never written through, a device or directory never replaced, and a
+/// file this process has read ([`crate::input::read_as`]: compared by
+/// device and inode, so a hard link or another path to an input is one too)
+/// is never replaced by an output.
 ///
 /// # Errors
 /// [`ErrorKind::InvalidInput`] saying what the target is, or the error of
 /// reading its metadata.
 pub fn check_target(target: &Path) -> std::io::Result<()> {
     match std::fs::symlink_metadata(target) {
-        Ok(m) if m.file_type().is_file() => Ok(()),
+        Ok(m) if m.file_type().is_file() => match crate::input::read_as(target) {
+            None => Ok(()),
+            Some(read) => Err(Error::new(
+                ErrorKind::InvalidInput,
+                format!(
+                    "is an input of this run (read as {}); refusing to replace it",
+                    read.display()
+                ),
+            )),
+        },
         Ok(m) => {
             let what = if m.file_type().is_symlink() {
                 "a symbolic link (never written through)"
@@ -145,12 +158,21 @@ impl Staged {
     /// directories it created are removed again (when empty).
     ///
     /// # Errors
-    /// The directory cannot be created (or a parent is not a directory).
+    /// The directory cannot be created, or it or a parent exists and is not
+    /// a directory (kind `NotADirectory`).
     pub fn in_dir(dir: &Path) -> std::io::Result<Self> {
         let mut missing = vec![];
         let mut d = Some(dir);
         while let Some(p) = d.filter(|p| !p.as_os_str().is_empty()) {
             if std::fs::symlink_metadata(p).is_ok() {
+                if !std::fs::metadata(p).is_ok_and(|m| m.is_dir()) {
+                    let what = if p == dir {
+                        "is not a directory".to_string()
+                    } else {
+                        format!("{} (a parent) is not a directory", p.display())
+                    };
+                    return Err(Error::new(ErrorKind::NotADirectory, what));
+                }
                 break;
             }
             missing.push(p.to_path_buf());

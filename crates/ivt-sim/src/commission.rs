@@ -66,20 +66,6 @@ impl Default for CommissionOptions {
     }
 }
 
-/// Reads the `[plant]` table of a plant file with the scene's parser
-/// ([`PlantSection::from_file`]) and checks its parameters.
-///
-/// # Errors
-/// [`SimError::Scene`] naming the file: I/O, TOML, an unknown key or an
-/// invalid parameter.
-pub fn load_plant_file(path: &Path) -> Result<PlantSection, SimError> {
-    let plant = PlantSection::from_file(path).map_err(|e| SimError::Scene(e.to_string()))?;
-    plant
-        .params()
-        .map_err(|e| SimError::Scene(format!("{}: {e}", path.display())))?;
-    Ok(plant)
-}
-
 /// The simulated rig for `opts`: a scene whose inputs follow the plan.
 ///
 /// # Errors
@@ -174,7 +160,8 @@ every = 1
         rpm = opts.omega0_rpm,
         k = opts.k_prop_deg_per_rpm,
     );
-    let mut scene = Scene::parse(&src, "commissioning scene").map_err(|e| SimError::Scene(e.0))?;
+    let mut scene =
+        Scene::parse(&src, "commissioning scene").map_err(|e| SimError::Scene(e.message))?;
     scene.plant = opts.plant.clone();
     Ok(scene)
 }

@@ -14,7 +14,9 @@ pub enum SimError {
     #[error("scene: {0}")]
     Scene(String),
     /// The adaptive step fell below the resolution of x.
-    #[error("step size underflow at t = {t} s, θ = {theta} rad, ω = {omega} rad/s (h = {h:e})")]
+    #[error(
+        "step size underflow at t = {t:?} s, θ = {theta:?} rad, ω = {omega:?} rad/s (h = {h:e})"
+    )]
     StepUnderflow {
         /// Time.
         t: f64,
@@ -28,7 +30,7 @@ pub enum SimError {
     /// An advance of the plant needed more steps than
     /// [`crate::integrate::MAX_STEPS_PER_ADVANCE`] (a very stiff plant, e.g. a
     /// tiny L_a, or an absurd tolerance).
-    #[error("no progress: {steps} steps without reaching the next event at t = {t} s, θ = {theta} rad, ω = {omega} rad/s (stiff plant or tolerance too tight?)")]
+    #[error("no progress: {steps} steps without reaching the next event at t = {t:?} s, θ = {theta:?} rad, ω = {omega:?} rad/s (stiff plant or tolerance too tight?)")]
     TooManySteps {
         /// Time.
         t: f64,
@@ -40,7 +42,7 @@ pub enum SimError {
         steps: u64,
     },
     /// The plant state became NaN or infinite.
-    #[error("state not finite at t = {t} s: {state:?}")]
+    #[error("state not finite at t = {t:?} s: {state:?}")]
     NotFinite {
         /// Time.
         t: f64,
@@ -95,7 +97,7 @@ pub enum SimError {
     #[error("work budget: {0}")]
     Budget(String),
     /// The telemetry timer rate is not a positive finite number.
-    #[error("f_timer_hz must be positive and finite, got {0}")]
+    #[error("f_timer_hz must be positive and finite, got {0:?}")]
     BadTimer(f64),
 }
 

@@ -157,13 +157,13 @@ fn unknown_names_are_refused_with_the_table() {
         "s.toml",
     )
     .unwrap_err()
-    .0;
+    .message;
     assert!(e.contains("plnat") && e.contains("outputs.channels"), "{e}");
     for c in Channel::ALL {
         assert!(e.contains(c.name()), "{e}");
     }
     let e = Scene::parse(&format!("{base}[outputs]\nplots = [\"w\"]\n"), "s.toml")
         .unwrap_err()
-        .0;
+        .message;
     assert!(e.contains("\"w\"") && e.contains("outputs.plots"), "{e}");
 }

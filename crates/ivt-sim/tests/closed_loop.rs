@@ -366,6 +366,6 @@ fn noisy_sensors_jitter_and_missed_steps() {
 fn tiny_inductance_is_refused() {
     let src =
         "duration_s = 1.0\n[plant]\nl_a = 1e-9\n[inputs]\nv_m = [[0.0, 8.0]]\nt_u = [[0.0, 4.0]]\n";
-    let e = Scene::parse(src, "s.toml").unwrap_err().0;
+    let e = Scene::parse(src, "s.toml").unwrap_err().message;
     assert!(e.contains("plant.l_a") && e.contains("s.toml:3"), "{e}");
 }

@@ -10,7 +10,8 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use ivt_ctrl::commission::{Plan, Selection, SequenceName};
-use ivt_sim::commission::{load_plant_file, run_sil, CommissionOptions, SensorModel};
+use ivt_sim::commission::{run_sil, CommissionOptions, SensorModel};
+use ivt_sim::scene::PlantSection;
 use serde_json::Value;
 
 /// Eq. 185 in SI, from the thesis's constants (not the crate's): metres of
@@ -207,7 +208,7 @@ fn realistic_sensors_quantize_the_readings_and_keep_the_schedule() {
     let opts = CommissionOptions {
         plan,
         selection,
-        plant: load_plant_file(&dir_plant).unwrap(),
+        plant: PlantSection::from_file(&dir_plant).unwrap(),
         sensors: SensorModel::Realistic,
         ..CommissionOptions::default()
     };
@@ -234,7 +235,7 @@ fn realistic_sensors_quantize_the_readings_and_keep_the_schedule() {
 
     // An unknown key in a plant file is refused with the file's name.
     std::fs::write(&dir_plant, "[plant]\nk_tt = 0.5\n").unwrap();
-    let err = load_plant_file(&dir_plant).unwrap_err().to_string();
+    let err = PlantSection::from_file(&dir_plant).unwrap_err().to_string();
     assert!(
         err.contains("perturbed.toml") && err.contains("k_tt"),
         "{err}"

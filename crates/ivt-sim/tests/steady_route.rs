@@ -162,14 +162,14 @@ fn scenes_that_need_a_transient_take_the_time_route() {
         "route = \"auto\"",
         "route = \"ihb_steady_state\"\nmcap = true",
     );
-    let e = Scene::parse(&src, "s.toml").unwrap_err().0;
+    let e = Scene::parse(&src, "s.toml").unwrap_err().message;
     assert!(e.contains("outputs.route") && e.contains("MCAP"), "{e}");
     let e = Scene::parse(
         &src.replace("route = \"ihb_steady_state\"", "route = \"fast\""),
         "s.toml",
     )
     .unwrap_err()
-    .0;
+    .message;
     assert!(e.contains("outputs.route"), "{e}");
 }
 

@@ -121,7 +121,7 @@ where
 {
     if !(omega_from.is_finite() && omega_to.is_finite() && omega_from > 0.0 && omega_to > 0.0) {
         return Err(HbError::InvalidInput(format!(
-            "frequencies must be positive: {omega_from} .. {omega_to}"
+            "frequencies must be positive: {omega_from:?} .. {omega_to:?}"
         )));
     }
     let tol = opts.broyden.tol;

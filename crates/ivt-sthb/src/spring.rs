@@ -39,7 +39,7 @@ pub fn spring_frequency_response(
 ) -> Result<Vec<SpringPoint>, HbError> {
     if !(omega_from > 0.0 && omega_to > omega_from && omega_to.is_finite()) {
         return Err(HbError::InvalidInput(format!(
-            "need 0 < from < to, got {omega_from} .. {omega_to}"
+            "need 0 < from < to, got {omega_from:?} .. {omega_to:?}"
         )));
     }
     let mut hb = StringHb::new(params)?;

@@ -25,8 +25,10 @@ use crate::msg::{Reply, Request, VERSION};
 /// firmware printed.
 #[derive(Debug, thiserror::Error)]
 pub enum PilError {
-    /// The firmware image is not there (build it with `firmware/run-qemu.sh build`).
-    #[error("firmware image {0} not found: build it with firmware/run-qemu.sh build")]
+    /// The firmware image is not there: a path the user gave (`$IVT_FW_ELF`)
+    /// is shown, the default image of the source tree is named relative to
+    /// the tree (never by the build machine's absolute path).
+    #[error("{}", missing_image(.0))]
     MissingImage(PathBuf),
     /// QEMU could not be started.
     #[error("cannot start {program}: {source}")]
@@ -104,10 +106,30 @@ impl QemuOptions {
     }
 }
 
+/// The default firmware image, relative to the source tree.
+const DEFAULT_ELF: &str = "firmware/target/thumbv7em-none-eabihf/release/ivt-fw-qemu";
+
 /// `firmware/target/thumbv7em-none-eabihf/release/ivt-fw-qemu` of this repository.
 pub fn default_elf() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../firmware/target/thumbv7em-none-eabihf/release/ivt-fw-qemu")
+        .join("../..")
+        .join(DEFAULT_ELF)
+}
+
+/// The message of [`PilError::MissingImage`] for the image `elf`.
+fn missing_image(elf: &Path) -> String {
+    if elf == default_elf() {
+        format!(
+            "the QEMU firmware image is not built ({DEFAULT_ELF} of the source tree): \
+             run firmware/run-qemu.sh build there, or set $IVT_FW_ELF to an image"
+        )
+    } else {
+        format!(
+            "firmware image {} not found: set $IVT_FW_ELF to an image, or build the \
+             source tree's with firmware/run-qemu.sh build",
+            elf.display()
+        )
+    }
 }
 
 /// What the firmware reported when the session ended (semihosting

@@ -7,6 +7,7 @@ use super::{to_json, CliError, DuffingParams, Output};
 use clap::Args;
 use ivt_hb::{GeneralProblem, PeriodicProblem};
 use ivt_jobs::{self as jobs, AllSolutionsRequest};
+use std::path::PathBuf;
 
 /// `ivt hb all-solutions` (defaults: the thesis Duffing at ω_f = 1.4).
 #[derive(Args)]
@@ -20,6 +21,9 @@ pub struct AllSolutionsArgs {
     /// The search box: max |coefficient|.
     #[arg(long, default_value_t = 10.0)]
     max_amplitude: f64,
+    /// Write a PNG of the orbits' amplitudes at ω_f, stable and unstable apart.
+    #[arg(long)]
+    plot: Option<PathBuf>,
 }
 
 /// Duffing as a user system: M = 1, C = 2ξ, K = α, g = ε x³, f = F cos θ
@@ -60,6 +64,10 @@ pub fn run(a: AllSolutionsArgs) -> Result<Output, CliError> {
     };
     let problem = duffing(p.xi, p.alpha, p.eps, p.force);
     let all = jobs::all_solutions(&problem, &p.options()?, &req)?;
+    if let Some(path) = &a.plot {
+        let title = format!("Period-one orbits of Duffing at ω_f = {}", a.omega);
+        super::figure::solutions(title, a.omega, &all).draw(path)?;
+    }
     let mut human = format!(
         "{} orbit(s) at ω_f = {} ({} starts, {} runs, {})\n",
         all.solutions.len(),

@@ -9,6 +9,8 @@ use clap::Args;
 use ivt_hb::Oscillator;
 use ivt_hb::{BackboneOptions, HbOptions};
 use ivt_jobs::{self as jobs, BackboneRequest, LimitCycleRequest};
+use ivt_kin::params::Typed;
+use std::path::PathBuf;
 
 /// Harmonics and samples of the autonomous jobs (Python's defaults and
 /// tolerances: ‖r‖₂ ≤ 1e-9 relative to the force scale).
@@ -49,6 +51,9 @@ pub struct LimitCycleArgs {
     /// x of the start state (x, 0) of the transient that settles onto the cycle.
     #[arg(long, default_value_t = 1.0)]
     amplitude: f64,
+    /// Write a PNG of the cycle's phase portrait (x, dx/dt).
+    #[arg(long)]
+    plot: Option<PathBuf>,
 }
 
 /// `ivt hb duffing-backbone` (defaults: the thesis α = ε = 1).
@@ -68,6 +73,9 @@ pub struct BackboneArgs {
     /// Last amplitude a1.
     #[arg(long, default_value_t = 1.0)]
     to: f64,
+    /// Write a PNG of the backbone: ω against max |x|.
+    #[arg(long)]
+    plot: Option<PathBuf>,
 }
 
 /// Run `ivt hb limit-cycle`.
@@ -77,14 +85,26 @@ pub struct BackboneArgs {
 /// transient comes to rest or Newton does not converge.
 pub fn limit_cycle(a: LimitCycleArgs) -> Result<Output, CliError> {
     if !a.mu.is_finite() {
-        return Err(CliError::Input(format!("--mu = {} must be finite", a.mu)));
+        return Err(CliError::Input(format!(
+            "--mu = {} must be finite",
+            Typed(a.mu)
+        )));
     }
     let req = LimitCycleRequest {
         amplitude: a.amplitude,
         ..LimitCycleRequest::default()
     };
     let problem = a.model.problem(a.mu);
-    let cycle = jobs::limit_cycle(&problem, &a.resolution.options()?, &req)?;
+    let hb = a.resolution.options()?;
+    let cycle = jobs::limit_cycle(&problem, &hb, &req)?;
+    if let Some(path) = &a.plot {
+        let name = match a.model {
+            Oscillator::VanDerPol => "Van der Pol",
+            Oscillator::Rayleigh => "Rayleigh",
+        };
+        let title = format!("Limit cycle of the {name} oscillator, μ = {}", a.mu);
+        super::figure::phase_portrait(title, &cycle, hb.harmonics).draw(path)?;
+    }
     let human = format!(
         "limit cycle, μ = {}: ω = {:.10}, period {:.10}, {} ({} Newton steps, ‖r‖ = {:.1e})\n",
         a.mu,
@@ -109,7 +129,8 @@ pub fn backbone(a: BackboneArgs) -> Result<Output, CliError> {
     if !(a.alpha.is_finite() && a.alpha > 0.0 && a.eps.is_finite()) {
         return Err(CliError::Input(format!(
             "--alpha = {} must be finite and > 0, --eps = {} finite",
-            a.alpha, a.eps
+            Typed(a.alpha),
+            Typed(a.eps)
         )));
     }
     let defaults = BackboneRequest::default();
@@ -124,6 +145,10 @@ pub fn backbone(a: BackboneArgs) -> Result<Output, CliError> {
     };
     let problem = jobs::free_duffing(a.alpha, a.eps);
     let curve = jobs::backbone(&problem, &a.resolution.options()?, &req)?;
+    if let Some(path) = &a.plot {
+        let title = format!("Backbone of u'' + {}u + {}u³ = 0", a.alpha, a.eps);
+        super::figure::backbone(title, &curve).draw(path)?;
+    }
     let last = curve.points.last();
     let human = format!(
         "Duffing backbone: {} points, a1 {} → {:?}, ω {:?}, {}\n",

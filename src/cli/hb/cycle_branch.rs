@@ -8,6 +8,7 @@ use super::{to_json, CliError, Output};
 use clap::Args;
 use ivt_hb::{GeneralProblem, HbError, PeriodicProblem};
 use ivt_jobs::{self as jobs, CycleBranchRequest};
+use std::path::PathBuf;
 
 /// `ivt hb cycle-branch` (defaults: μ from −0.2 to 0.1, the cycles at μ = −0.1).
 #[derive(Args)]
@@ -23,6 +24,9 @@ pub struct CycleBranchArgs {
     /// μ at which the cycles are solved exactly (comma-separated).
     #[arg(long, value_delimiter = ',', default_values_t = [-0.1], allow_negative_numbers = true)]
     at: Vec<f64>,
+    /// Write a PNG of the cycles' amplitude against μ: unstable dashed, Hopf points and folds marked.
+    #[arg(long)]
+    plot: Option<PathBuf>,
 }
 
 /// The model at μ: M = 1, C = −μ, K = 1, g = (x⁴ − x²) ẋ (the arithmetic of
@@ -58,6 +62,14 @@ pub fn run(a: CycleBranchArgs) -> Result<Output, CliError> {
         ..CycleBranchRequest::default()
     };
     let branch = jobs::cycle_branch(model, &a.resolution.options()?, &req)?;
+    if let Some(path) = &a.plot {
+        super::figure::cycles(
+            "Limit cycles of x'' − (μ + x² − x^4)x' + x = 0",
+            "μ",
+            &branch,
+        )
+        .draw(path)?;
+    }
     let mut human = format!(
         "{} Hopf point(s), {} cycles, {}\n",
         branch.hopf.len(),

@@ -6,6 +6,7 @@
 use super::{to_json, CliError, DuffingParams, Output};
 use clap::Args;
 use ivt_jobs::{self as jobs, FoldCurveRequest, FoldStart};
+use std::path::PathBuf;
 
 /// `ivt hb duffing-folds` (defaults: the thesis Duffing, from the F = 0.1 fold).
 #[derive(Args)]
@@ -28,6 +29,9 @@ pub struct FoldsArgs {
     /// Forces at which the folds are located exactly (comma-separated).
     #[arg(long, value_delimiter = ',', default_values_t = [0.1, 0.2, 0.3])]
     at: Vec<f64>,
+    /// Write a PNG of the curve in (ω_f, F) with its cusps and the folds at `--at`.
+    #[arg(long)]
+    plot: Option<PathBuf>,
 }
 
 /// Run `ivt hb duffing-folds`: the JSON holds the fold curve with the second
@@ -58,6 +62,9 @@ pub fn run(a: FoldsArgs) -> Result<Output, CliError> {
             .map_err(|e| ivt_hb::HbError::InvalidInput(e.to_string()))
     };
     let curve = jobs::fold_curve(family, &hb, &req)?;
+    if let Some(path) = &a.plot {
+        super::figure::curve2("Folds of Duffing's response in (ω_f, F)", "F", &curve).draw(path)?;
+    }
     let termination = curve.termination.as_str();
     let mut human = format!(
         "fold curve of Duffing from F = {} (ω_f = {:.8}): {} points, {termination}\n",

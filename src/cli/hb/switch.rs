@@ -9,6 +9,8 @@ use super::{to_json, CliError, Output};
 use clap::Args;
 use ivt_hb::{BifurcationKind, Corrector, FrcOptions, GeneralProblem, PeriodicProblem};
 use ivt_jobs::{self as jobs, FrcRequest, SwitchRequest, SwitchStart};
+use ivt_kin::params::Typed;
+use std::path::PathBuf;
 
 /// `ivt hb switch` (defaults: c = 0.1, F = 0.5, the FRC from ω_f = 3.6 down
 /// to 2.2, the period-2 branch to 2.2).
@@ -36,6 +38,9 @@ pub struct SwitchArgs {
     /// orbit's ‖coefficients‖₂.
     #[arg(long, default_value_t = 0.05)]
     step: f64,
+    /// Write a PNG of the new branch: unstable dashed, its events marked.
+    #[arg(long)]
+    plot: Option<PathBuf>,
 }
 
 /// The well model: M = 1, C = `c`, K = 2, g = x²(3 + x), f = F cos θ (the
@@ -71,7 +76,8 @@ pub fn run(a: SwitchArgs) -> Result<Output, CliError> {
     if !(a.damping.is_finite() && a.force.is_finite()) {
         return Err(CliError::Input(format!(
             "--damping = {} and --force = {} must be finite",
-            a.damping, a.force
+            Typed(a.damping),
+            Typed(a.force)
         )));
     }
     let hb = a.resolution.options()?;
@@ -86,6 +92,14 @@ pub fn run(a: SwitchArgs) -> Result<Output, CliError> {
     };
     let branch = jobs::switch(&well(a.damping, a.force), &hb, &req)?;
     let curve = &branch.curve;
+    if let Some(path) = &a.plot {
+        let title = format!(
+            "Branch switched at the {} at ω_f = {:.6}",
+            word(branch.kind).replace('_', " "),
+            branch.start_omega
+        );
+        super::figure::frc(title, curve).draw(path)?;
+    }
     let mut human = format!(
         "switched at the {} at ω_f = {:.10}: {} points (subharmonic {}) to ω_f = {}, {}\n",
         word(branch.kind),

@@ -9,6 +9,8 @@ use super::{to_json, CliError, Output};
 use clap::Args;
 use ivt_hb::{BifurcationKind, GeneralProblem, HbError, PeriodicProblem};
 use ivt_jobs::{self as jobs, FoldCurveRequest, FoldStart};
+use ivt_kin::params::Typed;
+use std::path::PathBuf;
 
 /// `ivt hb vdp-torus` (defaults: μ = 0.2 from the point
 /// (0.94525643, 0.2)).
@@ -37,10 +39,13 @@ pub struct TorusArgs {
     /// Forces at which the NS points are located exactly (comma-separated).
     #[arg(long, value_delimiter = ',', default_values_t = [0.2, 0.3, 0.4])]
     at: Vec<f64>,
+    /// Write a PNG of the curve in (ω_f, F) with its resonances and the points at `--at`.
+    #[arg(long)]
+    plot: Option<PathBuf>,
 }
 
 /// The forced Van der Pol oscillator at F.
-fn van_der_pol(mu: f64, force: f64) -> impl PeriodicProblem {
+pub(super) fn van_der_pol(mu: f64, force: f64) -> impl PeriodicProblem {
     GeneralProblem::new(
         1,
         vec![1.0],
@@ -65,7 +70,7 @@ pub fn run(a: TorusArgs) -> Result<Output, CliError> {
     if !a.mu.is_finite() {
         return Err(CliError::Input(format!(
             "--mu must be finite, got {}",
-            a.mu
+            Typed(a.mu)
         )));
     }
     let req = FoldCurveRequest {
@@ -85,6 +90,10 @@ pub fn run(a: TorusArgs) -> Result<Output, CliError> {
     let mu = a.mu;
     let family = |f: f64| Ok::<_, HbError>(van_der_pol(mu, f));
     let curve = jobs::fold_curve(family, &hb, &req)?;
+    if let Some(path) = &a.plot {
+        let title = format!("Neimark–Sacker curve of the forced Van der Pol oscillator, μ = {mu}");
+        super::figure::curve2(title, "F", &curve).draw(path)?;
+    }
     let termination = curve.termination.as_str();
     let mut human = format!(
         "Neimark–Sacker curve of the forced Van der Pol oscillator (μ = {mu}) from F = {} (ω_f = {:.8}): {} points, {termination}\n",

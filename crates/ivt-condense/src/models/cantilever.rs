@@ -48,6 +48,10 @@ pub fn element_dofs(e: usize) -> [Option<usize>; 4] {
     [left, left.map(|d| d + 1), Some(2 * e), Some(2 * e + 1)]
 }
 
+/// Most elements of [`cantilever`]: 2·10⁵ DOF, a few MB of triplets (a
+/// count such as 10⁹ is refused before anything is allocated).
+pub const MAX_ELEMENTS: usize = 100_000;
+
 /// The cantilever of `n_elements` Hermite-cubic elements with the
 /// properties `beam`, clamped at x = 0.
 ///
@@ -60,9 +64,14 @@ pub fn element_dofs(e: usize) -> [Option<usize>; 4] {
 /// [`crate`]).
 ///
 /// # Errors
-/// [`HbError::InvalidInput`] for no elements or non-positive / non-finite
-/// parameters.
+/// [`HbError::InvalidInput`] for no elements or more than `MAX_ELEMENTS` (100 000),
+/// non-positive / non-finite parameters.
 pub fn cantilever(n_elements: usize, beam: &BeamProperties) -> Result<Cantilever, HbError> {
+    if n_elements > MAX_ELEMENTS {
+        return Err(HbError::InvalidInput(format!(
+            "cantilever: n_elements = {n_elements} exceeds the limit of {MAX_ELEMENTS} elements"
+        )));
+    }
     let BeamProperties {
         length,
         ei,

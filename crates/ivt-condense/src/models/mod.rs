@@ -1,15 +1,17 @@
 //! Structural test models with local nonlinearity (issue 28): an
-//! Euler–Bernoulli cantilever of Hermite-cubic elements and pyHarm's lumped
-//! bladed disk. Each is a [`SparseModel`]: sparse `M`, `C`, `K`, the DOF the
+//! Euler–Bernoulli cantilever of Hermite-cubic elements, pyHarm's lumped
+//! bladed disk and (issue 42) a solid plate of linear tetrahedra. Each is a [`SparseModel`]: sparse `M`, `C`, `K`, the DOF the
 //! nonlinear element and the force act on. The tests and the benches of
 //! [`crate`] use them; Python exposes the cantilever as
 //! `ivt.hb.models.cantilever`.
 
 mod bladed_disk;
 mod cantilever;
+mod plate;
 
-pub use bladed_disk::{bladed_disk, BladedDisk};
+pub use bladed_disk::{bladed_disk, bladed_disk_mistuned, BladedDisk, SECTORS};
 pub use cantilever::{cantilever, element_dofs, BeamProperties, Cantilever};
+pub use plate::{plate, Plate, SolidProperties};
 
 use faer::sparse::{SparseColMat, Triplet};
 use ivt_hb::HbError;

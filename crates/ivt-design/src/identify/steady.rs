@@ -51,7 +51,7 @@ pub struct SweepAnalysis {
 
 /// The steady state at the end of `stage` (its last half, whole
 /// revolutions at one r): None if the stage holds less than one revolution.
-fn hold_point(rec: &Recording, stage: &Stage, end_t: f64, gains: (f64, f64)) -> Option<HoldPoint> {
+fn hold_point(rec: &Recording, stage: &Stage, end_t: f64, motor: Motor) -> Option<HoldPoint> {
     let t = &rec.pulse_t;
     let from = stage.t + 0.5 * (end_t - stage.t);
     let last = t.partition_point(|&x| x <= end_t).checked_sub(1)?;
@@ -66,11 +66,10 @@ fn hold_point(rec: &Recording, stage: &Stage, end_t: f64, gains: (f64, f64)) -> 
     if rec.eccentricity_changes_in(t0, t1) {
         return None;
     }
-    let i = integrals(rec, first, last, r)?;
+    let i = integrals(rec, first, last, r, motor.lag_s)?;
     let span = TAU * revs as f64;
-    let (motor_gain, motor_damping) = gains;
     let t_u = i.torque / span;
-    let t_in = (motor_gain * i.volt - motor_damping * i.damp) / span;
+    let t_in = (motor.gain * i.volt - motor.damping * i.damp) / span;
     let mut v_sum = 0.0;
     for k in first..last {
         v_sum += rec.inputs_at(0.5 * (t.get(k)? + t.get(k + 1)?))?.0;
@@ -86,19 +85,28 @@ fn hold_point(rec: &Recording, stage: &Stage, end_t: f64, gains: (f64, f64)) -> 
     })
 }
 
+/// The motor as identified: what the input torque T_in of a hold needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Motor {
+    /// k_t/R_a \[N·m/V\].
+    pub gain: f64,
+    /// k_t k_e/R_a \[N·m·s/rad\].
+    pub damping: f64,
+    /// Electrical time constant L_a/R_a \[s\] (Eq. 137; 0: Eq. 138).
+    pub lag_s: f64,
+}
+
 /// Fig. 47 and Fig. 50 from the stages named `sweep`, with the identified
-/// motor gain k_t/R_a and damping k_t k_e/R_a. None if the recording has
-/// no sweep.
+/// motor. None if the recording has no sweep.
 ///
 /// # Errors
 /// A sweep with fewer than 4 usable holds, or all at one angle.
 pub fn sweep_analysis(
     rec: &Recording,
-    motor_gain: f64,
-    motor_damping: f64,
+    motor: Motor,
 ) -> Result<Option<SweepAnalysis>, IdentifyError> {
     let holds: Vec<HoldPoint> = stages_named(rec, "sweep")
-        .filter_map(|(s, end)| hold_point(rec, s, end, (motor_gain, motor_damping)))
+        .filter_map(|(s, end)| hold_point(rec, s, end, motor))
         .collect();
     if holds.is_empty() {
         return Ok(None);

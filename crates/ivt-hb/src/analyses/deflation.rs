@@ -105,12 +105,17 @@ pub struct AllSolutions {
 /// unforced conservative problem).
 const MAX_SOLUTIONS: usize = 64;
 
+/// Most start amplitudes per harmonic (`SearchOptions::amplitudes`): the
+/// starts are listed before the search, each is one deflated Newton run.
+pub const MAX_AMPLITUDES: usize = 1000;
+
 /// All periodic solutions of `problem` at `omega_f` that deflated Newton finds
 /// within `opts` (see the module docs).
 ///
 /// # Errors
-/// [`HbError::InvalidInput`] for a bad frequency or bounds, the AFT's size
-/// errors.
+/// [`HbError::InvalidInput`] for a bad frequency or bounds (`amplitudes`
+/// above [`MAX_AMPLITUDES`]), the AFT's size errors; [`HbError::Interrupted`]
+/// when cancelled ([`ivt_num::cancel`]).
 pub fn all_solutions<P: PeriodicProblem>(
     problem: &P,
     hb: &HbOptions,
@@ -118,6 +123,12 @@ pub fn all_solutions<P: PeriodicProblem>(
     opts: &SearchOptions,
 ) -> Result<AllSolutions, HbError> {
     crate::orbit::ihb::validate_omega(omega_f)?;
+    if opts.amplitudes > MAX_AMPLITUDES {
+        return Err(HbError::InvalidInput(format!(
+            "amplitudes = {} exceeds the limit of {MAX_AMPLITUDES} start amplitudes",
+            opts.amplitudes
+        )));
+    }
     if !(opts.max_amplitude.is_finite()
         && opts.max_amplitude > 0.0
         && opts.amplitudes > 0
@@ -134,8 +145,12 @@ pub fn all_solutions<P: PeriodicProblem>(
     let mut known: Vec<Vec<f64>> = Vec::new();
     let mut runs = 0;
     let mut exhausted = true;
+    let token = ivt_num::cancel::Token::now();
     'starts: for start in &starts {
         loop {
+            if token.cancelled() {
+                return Err(HbError::Interrupted);
+            }
             if known.len() >= MAX_SOLUTIONS {
                 exhausted = false;
                 break 'starts;

@@ -63,6 +63,10 @@ pub struct BackbonePoint {
     pub coeffs: Vec<f64>,
     /// The unfolding damping κ (zero up to the tolerance for a conservative system).
     pub kappa: f64,
+    /// `max_τ |x(τ)|` of the reference DOF ([`crate::orbit::aft::peak`]): the
+    /// measure of a response curve's amplitude, so that the backbone can be
+    /// drawn over one.
+    pub peak: f64,
 }
 
 /// A traced backbone curve; its events are the stepper's turning points in
@@ -187,6 +191,9 @@ pub(crate) fn modal_path<P: PeriodicProblem>(
                 omega,
                 coeffs: q.to_vec(),
                 kappa,
+                peak: crate::orbit::aft::peak(
+                    q.get(opts.dof * l..(opts.dof + 1) * l).unwrap_or_default(),
+                ),
             }),
             _ => Err(HbError::InvalidInput(
                 "backbone: point of the wrong size".into(),

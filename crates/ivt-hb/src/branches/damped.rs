@@ -28,6 +28,8 @@ pub struct DampedModePoint {
     pub omega: f64,
     /// Modal damping ratio `ζ = −κ/(2ω)`.
     pub damping_ratio: f64,
+    /// `max_τ |x(τ)|` of the reference DOF (as [`crate::BackbonePoint::peak`]).
+    pub peak: f64,
     /// Fourier coefficients (layout of [`crate::HbSolution::coeffs`]).
     pub coeffs: Vec<f64>,
 }
@@ -90,7 +92,7 @@ pub fn linear_mode<P: PeriodicProblem>(
     let lambda = s[col];
     if !(lambda.re > 0.0 && lambda.im.abs() <= 1e-10 * lambda.re) {
         return Err(HbError::InvalidInput(format!(
-            "mode {mode} has ω₀² = {lambda}, not real and positive"
+            "mode {mode} has ω₀² = {lambda:?}, not real and positive"
         )));
     }
     // The eigenvector up to a complex factor: divide by its largest entry.
@@ -135,6 +137,7 @@ pub fn damped_modes<P: PeriodicProblem>(
             amplitude: p.amplitude,
             omega: p.omega,
             damping_ratio: -p.kappa / (2.0 * p.omega),
+            peak: p.peak,
             coeffs: p.coeffs,
         })
         .collect();

@@ -225,14 +225,18 @@ fn assemble<E>(
 }
 
 /// `max_τ |x_0(τ)|` over the 2N AFT samples of a coefficient vector (DOF 0):
-/// the `amplitude` of [`FrcPoint`] and [`FrcFold`].
-struct AmplitudeProbe {
+/// the `amplitude` of [`FrcPoint`] and [`FrcFold`] (and of the jobs' events).
+pub struct AmplitudeProbe {
     aft: Aft,
     samples: Vec<f64>,
 }
 
 impl AmplitudeProbe {
-    fn new(hb: &HbOptions) -> Result<Self, HbError> {
+    /// A probe for the coefficient vectors of `hb`'s harmonics.
+    ///
+    /// # Errors
+    /// [`HbError`] if `hb`'s AFT sizes are invalid.
+    pub fn new(hb: &HbOptions) -> Result<Self, HbError> {
         let aft = Aft::new(hb.harmonics, hb.n_half)?;
         Ok(Self {
             samples: vec![0.0; aft.n_samples()],
@@ -240,7 +244,8 @@ impl AmplitudeProbe {
         })
     }
 
-    fn of(&mut self, q: &[f64]) -> f64 {
+    /// `max |x_0|` over the AFT samples of `q`.
+    pub fn of(&mut self, q: &[f64]) -> f64 {
         let l = self.aft.coeff_len();
         self.aft
             .synthesize(q.get(..l).unwrap_or_default(), &mut self.samples);

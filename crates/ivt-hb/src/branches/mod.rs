@@ -5,7 +5,8 @@
 //! branch from a Hopf point ([`cycle_branch`]), backbones and damped modes
 //! ([`backbone`], [`damped`]), curves of folds, period doublings and
 //! Neimark–Sacker points in two parameters ([`codim2`]), the Mathieu–Duffing
-//! cascade ([`mathieu`]), branch switching ([`switching`]), and the events of
+//! cascade ([`mathieu`]), branch switching ([`switching`]), quasi-periodic tori
+//! bifurcating from a Neimark–Sacker point ([`torus`]), and the events of
 //! a family branch with their Floquet multipliers ([`events`]). It uses the
 //! problem, orbit and stability layers and the path engine.
 
@@ -19,3 +20,4 @@ pub mod family;
 pub mod frc;
 pub mod mathieu;
 pub mod switching;
+pub mod torus;

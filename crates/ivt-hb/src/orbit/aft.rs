@@ -26,6 +26,12 @@ pub struct Aft {
     fft: RealFftPair,
 }
 
+thread_local! {
+    /// The plans of [`RealFftPair::new`] on this thread.
+    static PLANNER: std::cell::RefCell<RealFftPlanner<f64>> =
+        std::cell::RefCell::new(RealFftPlanner::new());
+}
+
 /// Forward and inverse real FFT plans of one length with one scratch, the
 /// spectrum (`len/2 + 1` bins) and a sample buffer: the transforms of [`Aft`] and of
 /// the string's time axis (ivt-sthb's `StringHb`). They allocate nothing.
@@ -40,11 +46,18 @@ pub struct RealFftPair {
 }
 
 impl RealFftPair {
-    /// Plans for `len` real samples.
+    /// Plans for `len` real samples, from this thread's planner: it keeps
+    /// every plan it made, so the solves after the first of a length reuse
+    /// its twiddles (planning the 128-point pair of Fig. 28 costs ~1.2·10⁵
+    /// instructions, more than half the solve; measured, not asserted).
     pub fn new(len: usize) -> Self {
-        let mut planner = RealFftPlanner::<f64>::new();
-        let fwd = planner.plan_fft_forward(len);
-        let inv = planner.plan_fft_inverse(len);
+        let plan = |planner: &mut RealFftPlanner<f64>| {
+            (planner.plan_fft_forward(len), planner.plan_fft_inverse(len))
+        };
+        let (fwd, inv) = PLANNER.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut planner) => plan(&mut planner),
+            Err(_) => plan(&mut RealFftPlanner::new()),
+        });
         let scratch_len = fwd.get_scratch_len().max(inv.get_scratch_len());
         Self {
             scratch: vec![Complex::new(0.0, 0.0); scratch_len],
@@ -334,6 +347,18 @@ pub fn eval_series(coeffs: &[f64], tau: f64, order: u32) -> f64 {
         s += a * cs + b * sn;
     }
     s
+}
+
+/// `max_τ |x(τ)|` of the series `[a0, a.., b..]`, sampled at 512 points of
+/// one period (NaN for an empty `coeffs`): the amplitude of a solution's DOF
+/// ([`crate::HbSolution::amplitude`]) and the `peak` of a backbone's points.
+pub fn peak(coeffs: &[f64]) -> f64 {
+    if coeffs.is_empty() {
+        return f64::NAN;
+    }
+    (0..512)
+        .map(|i| eval_series(coeffs, 2.0 * std::f64::consts::PI * f64::from(i) / 512.0, 0).abs())
+        .fold(0.0, f64::max)
 }
 
 /// The series `[a0, a1..an, b1..bn]` with `n_to` harmonics (truncated or

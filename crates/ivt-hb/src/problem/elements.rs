@@ -135,6 +135,46 @@ pub struct Element {
     pub law: Law,
 }
 
+/// The model DOFs `elements` act on (each `a` and `b`), sorted and without
+/// repeats: the nonlinear DOFs a large model is condensed onto
+/// ([`crate::condense`]), so that an element's DOFs name model DOFs on the
+/// condensed path as on a dense [`ElementProblem`].
+#[must_use]
+pub fn element_dofs(elements: &[Element]) -> Vec<usize> {
+    let mut dofs: Vec<usize> = elements
+        .iter()
+        .flat_map(|e| [Some(e.a), e.b])
+        .flatten()
+        .collect();
+    dofs.sort_unstable();
+    dofs.dedup();
+    dofs
+}
+
+/// `elements` on the sub-vector `x[dofs]` of the model's DOFs: each DOF
+/// replaced by its position in `dofs` (how the condensed path's `g` sees
+/// them).
+///
+/// # Errors
+/// `(i, d)`: element `i` acts on model DOF `d`, which `dofs` lacks.
+pub fn restrict_elements(
+    elements: &[Element],
+    dofs: &[usize],
+) -> Result<Vec<Element>, (usize, usize)> {
+    elements
+        .iter()
+        .enumerate()
+        .map(|(i, e)| {
+            let local = |d: usize| dofs.iter().position(|&x| x == d).ok_or((i, d));
+            Ok(Element {
+                a: local(e.a)?,
+                b: e.b.map(local).transpose()?,
+                law: e.law,
+            })
+        })
+        .collect()
+}
+
 /// Harmonic forcing `amplitude·cos(θ + phase)` on one DOF.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Harmonic {
@@ -377,6 +417,9 @@ impl PeriodicProblem for ElementProblem {
     fn velocity_dependent(&self) -> bool {
         self.elements.iter().any(|e| e.law.velocity_dependent())
     }
+    fn hysteretic(&self) -> bool {
+        self.has_hysteresis()
+    }
     fn nonlinear_jacobian(&self, x: &[f64], v: &[f64], _theta: f64, dg: &mut [f64]) {
         self.tangents(x, v, dg, |_| true);
     }
@@ -388,6 +431,27 @@ impl PeriodicProblem for ElementProblem {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn elements_restricted_to_their_dofs_keep_their_order_and_laws() {
+        let law = Law::CubicSpring { k3: 2.0 };
+        let model = [
+            Element { a: 7, b: None, law },
+            Element {
+                a: 3,
+                b: Some(7),
+                law,
+            },
+        ];
+        let dofs = element_dofs(&model);
+        assert_eq!(dofs, vec![3, 7]);
+        let local = restrict_elements(&model, &dofs).unwrap();
+        assert_eq!((local[0].a, local[0].b), (1, None));
+        assert_eq!((local[1].a, local[1].b), (0, Some(1)));
+        assert_eq!(local[1].law, law);
+        // A DOF outside the list names the element and the model DOF.
+        assert_eq!(restrict_elements(&model, &[7]), Err((1, 3)));
+    }
 
     #[test]
     fn jacobian_matches_central_differences_for_every_law() {

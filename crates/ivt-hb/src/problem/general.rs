@@ -44,6 +44,11 @@ pub trait Nonlinearity {
     fn eval_samples_at(&self, x: &[f64], v: &[f64], theta: &[f64], _w: f64, out: &mut [f64]) {
         self.eval_samples(x, v, theta, out)
     }
+    /// Whether `g` has a memory ([`PeriodicProblem::hysteretic`]). Default:
+    /// `false`.
+    fn hysteretic(&self) -> bool {
+        false
+    }
 }
 
 /// A [`Nonlinearity`] `g` with its analytic Jacobian `jacobian(x, v, θ, dg)`
@@ -76,6 +81,9 @@ where
     }
     fn eval_samples_at(&self, x: &[f64], v: &[f64], theta: &[f64], w: f64, out: &mut [f64]) {
         self.g.eval_samples_at(x, v, theta, w, out)
+    }
+    fn hysteretic(&self) -> bool {
+        self.g.hysteretic()
     }
 }
 
@@ -190,6 +198,9 @@ where
     }
     fn velocity_dependent(&self) -> bool {
         self.velocity_dependent
+    }
+    fn hysteretic(&self) -> bool {
+        self.g.hysteretic()
     }
     fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
         if !self.g.jacobian_samples(x, v, theta, dg) {

@@ -76,6 +76,10 @@ macro_rules! forward_matrices {
             let $s = self;
             $inner.velocity_dependent()
         }
+        fn hysteretic(&self) -> bool {
+            let $s = self;
+            $inner.hysteretic()
+        }
     };
 }
 use forward_matrices;
@@ -129,6 +133,12 @@ pub trait PeriodicProblem {
     /// Whether `g` depends on `v` (saves one inverse FFT per DOF when not).
     fn velocity_dependent(&self) -> bool {
         true
+    }
+    /// Whether `g` has a memory along the trajectory (the Jenkins element,
+    /// whose samples are taken period by period): a quasi-periodic torus
+    /// ([`crate::branches::torus`]) refuses such a `g`. Default: `false`.
+    fn hysteretic(&self) -> bool {
+        false
     }
     /// `∂g/∂x` and `∂g/∂v` at one sample into `dg` as the row-major blocks
     /// `[∂g/∂x | ∂g/∂v]` (`2·n_dof²`, one sample of

@@ -306,7 +306,7 @@ impl AdaptiveHsu {
                 let base = (2 * (harmonics + 1)).max(32);
                 if !(tol > 0.0 && tol.is_finite()) || max < base {
                     return Err(HbError::InvalidInput(format!(
-                        "Hsu tolerance {tol} must be positive and finite and the cap {max} at \
+                        "Hsu tolerance {tol:?} must be positive and finite and the cap {max} at \
                          least {base} sub-intervals (2(n + 1), at least 32)"
                     )));
                 }

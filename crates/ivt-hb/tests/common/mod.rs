@@ -4,8 +4,10 @@
 #![allow(dead_code)] // each test binary uses its own subset
 #![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
+pub mod brute;
 pub mod chain;
 pub mod counted;
+pub mod quasi;
 pub mod shooting;
 
 use ivt_hb::orbit::aft::eval_series;

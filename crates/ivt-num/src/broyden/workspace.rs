@@ -44,8 +44,11 @@ pub struct BroydenWorkspace {
     u: Vec<f64>,
     hu: Vec<f64>,
     sth: Vec<f64>,
-    /// Factor of `B` or `H` when one is inverted from the other.
-    lu: LuWorkspace,
+    /// Factor of `B` or `H` when one is inverted from the other; built on the
+    /// first inversion (a solve seeded with `H₀` by
+    /// [`Self::set_inverse_jacobian`] usually never inverts, and the `m×m`
+    /// zero-filled factor was a fifth of the set-up's allocations).
+    lu: Option<LuWorkspace>,
     history: Vec<f64>,
 }
 
@@ -70,7 +73,7 @@ impl BroydenWorkspace {
             u: vec![0.0; m],
             hu: vec![0.0; m],
             sth: vec![0.0; m],
-            lu: LuWorkspace::new(m),
+            lu: None,
             history: Vec::with_capacity(256),
         }
     }
@@ -214,7 +217,7 @@ impl BroydenWorkspace {
         if self.b_current {
             return;
         }
-        if !invert(&mut self.lu, &self.h, &mut self.b) {
+        if !invert(&mut self.lu, self.m, &self.h, &mut self.b) {
             self.b.fill(f64::NAN);
         }
         self.b_current = true;
@@ -248,7 +251,7 @@ impl BroydenWorkspace {
     fn invert_b(&mut self) -> Result<(), SolveError> {
         self.b_current = true;
         self.dx_next_ready = false;
-        self.has_jacobian = invert(&mut self.lu, &self.b, &mut self.h);
+        self.has_jacobian = invert(&mut self.lu, self.m, &self.b, &mut self.h);
         if self.has_jacobian {
             Ok(())
         } else {
@@ -445,12 +448,14 @@ fn overwrite<'a>(entries: impl Iterator<Item = &'a mut f64>, new: &[f64], change
     }
 }
 
-/// `out = a⁻¹` (row-major) through `lu`; `false` only if the inverse is not
+/// `out = a⁻¹` (row-major, `m×m`) through `lu` (built for `m` on first use);
+/// `false` only if the inverse is not
 /// finite (an exactly zero pivot or a poisoned matrix). A badly conditioned
 /// `B` is inverted all the same: Broyden's approximations are often poorly
 /// conditioned in strongly nonlinear solves, and their quasi-Newton steps stay
 /// useful there (the line search and the refresh policy judge them).
-fn invert(lu: &mut LuWorkspace, a: &[f64], out: &mut [f64]) -> bool {
+fn invert(lu: &mut Option<LuWorkspace>, m: usize, a: &[f64], out: &mut [f64]) -> bool {
+    let lu = lu.get_or_insert_with(|| LuWorkspace::new(m));
     // The factor's own verdict (pivots above n·ε of the largest) is stricter
     // than this solver needs; only a non-finite inverse is refused.
     let _well_conditioned = lu.factor_row_major(a);

@@ -45,6 +45,8 @@ pub struct Stepper<'b, B: Branch> {
     landed: bool,
     turn: Option<Turn>,
     done: Option<Termination>,
+    /// Cancellation (checked before each step).
+    token: ivt_num::cancel::Token,
 }
 
 impl<'b, B: Branch> Stepper<'b, B> {
@@ -55,7 +57,8 @@ impl<'b, B: Branch> Stepper<'b, B> {
     ///
     /// # Errors
     /// [`PathError::InvalidInput`] for a start of the wrong size or non-finite
-    /// entries or steps; the corrector's start errors
+    /// entries or steps, or `max_points` above [`crate::limits::MAX_PATH_POINTS`];
+    /// the corrector's start errors
     /// ([`PathCorrector::start`]).
     pub fn new(
         branch: &'b mut B,
@@ -75,6 +78,9 @@ impl<'b, B: Branch> Stepper<'b, B> {
             return Err(PathError::InvalidInput(
                 "continuation: non-finite start or step".into(),
             ));
+        }
+        if let Some(why) = crate::limits::path_points_error(opts.max_points) {
+            return Err(PathError::InvalidInput(why));
         }
         let mut x = start.to_vec();
         let mut dir = vec![0.0; m + 1];
@@ -106,6 +112,7 @@ impl<'b, B: Branch> Stepper<'b, B> {
             landed: false,
             turn: None,
             done: None,
+            token: ivt_num::cancel::Token::now(),
         })
     }
 
@@ -135,6 +142,9 @@ impl<'b, B: Branch> Stepper<'b, B> {
         }
         if self.count >= self.opts.max_points {
             return self.finish(Termination::MaxPoints);
+        }
+        if self.token.cancelled() {
+            return self.finish(Termination::Interrupted);
         }
         match self.step() {
             Ok(point) => Step::Point(self.hand_out(point)),

@@ -348,6 +348,43 @@ where
     Ok((x, lambda, stats.iterations))
 }
 
+/// The Newton matrix of [`extended_newton`]'s system at `(q, λ)` with the
+/// unfoldings `μ = 0` (row-major, `m + k` square, `k = unfold.len() + 1`):
+/// `[[J, R_λ, b], [ψ_q, ψ_λ, 0]]`, the test rows by the same central
+/// differences. The matrix whose transpose gives the adjoint of a located
+/// event (ivt-hb's `analyses::sensitivity`).
+pub fn extended_matrix<B, T>(
+    branch: &mut B,
+    (q, lambda): (&[f64], f64),
+    unfold: &[Vec<f64>],
+    tests: T,
+    opts: &LocateOptions,
+) -> Vec<f64>
+where
+    B: Branch,
+    T: FnMut(&mut B, &[f64], f64, &mut [f64]),
+{
+    let m = branch.len();
+    let k = unfold.len() + 1;
+    let mut x = q.to_vec();
+    x.push(lambda);
+    x.resize(m + k, 0.0);
+    let mut system = Extended {
+        branch,
+        unfold,
+        tests,
+        opts,
+        m,
+        jac: vec![0.0; m * m],
+        r_lambda: vec![0.0; m],
+        psi: (vec![0.0; k], vec![0.0; k]),
+        qt: vec![0.0; m],
+    };
+    let mut out = vec![0.0; (m + k) * (m + k)];
+    let Ok(()) = system.jacobian(&x, &mut out);
+    out
+}
+
 /// The extended system of [`extended_newton`] as a [`NewtonSystem`]:
 /// `[J, R_λ, b]` analytic in `q` with `R_λ` by [`lambda_step`], the
 /// test-function rows by central differences in `q` and λ.

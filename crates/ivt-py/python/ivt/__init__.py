@@ -11,13 +11,18 @@ same names and dict keys as its ``--json`` output, SPEC §6):
 - :mod:`ivt.sim`   scenes of the simulator → numpy arrays and the summary
 - :mod:`ivt.scenes` the shipped scenes: ``names()``, ``path(name)``
 - :mod:`ivt.sweep` grid / Monte-Carlo sweeps of scenes on threads or dask
+- :mod:`ivt.plot`  figures of harmonic-balance results (matplotlib, the
+  optional extra ``pip install 'ivt[plot]'``; imported on first use, so
+  ``import ivt`` works without it)
 - :func:`ivt.foxglove_layout` the Foxglove layout for a run's or a rig's MCAP
 
 The numerics are the Rust crates of the workspace, reached through the private
 native module ``ivt._ivt``; long calls release the GIL.
 """
 
+import importlib
 import pathlib
+from typing import Any
 
 from . import ctrl, design, hb, kin, scenes, sim, sweep
 from ._ivt import __version__
@@ -33,3 +38,10 @@ def foxglove_layout() -> pathlib.Path:
     the stepper position, and the controller's fault state over time.
     """
     return pathlib.Path(__file__).resolve().with_name("foxglove") / "ivt-layout.json"
+
+
+def __getattr__(name: str) -> Any:
+    """``ivt.plot`` on first use (it needs matplotlib, an optional extra)."""
+    if name == "plot":
+        return importlib.import_module(".plot", __name__)
+    raise AttributeError(f"module 'ivt' has no attribute {name!r}")

@@ -1,6 +1,9 @@
 """Harmonic balance (``ivt-hb``): periodic solutions, Floquet stability,
 frequency-response curves with located folds, period doublings,
-Neimark–Sacker and branch points (:func:`frc`), and limit cycles, for Duffing,
+Neimark–Sacker and branch points (:func:`frc`), the quasi-periodic torus born
+at a Neimark–Sacker point (:func:`torus_branch`), automatic bifurcation
+diagrams (:func:`diagram`), sensitivities of located features to a model
+parameter (:func:`event_sensitivity`), and limit cycles, for Duffing,
 Mathieu–Duffing, the STHB string (:func:`string`) and user systems; backbone
 curves (:func:`backbone`) of conservative ones. ``g`` may be a Python callable
 or a sum of Rust elements from :mod:`ivt.hb.elements` (e.g.
@@ -33,10 +36,12 @@ __all__ = [
     "cycle_branch",
     "cycle_fold_curve",
     "damped_modes",
+    "diagram",
     "duffing",
     "duffing_folds",
     "duffing_frc",
     "eval_series",
+    "event_sensitivity",
     "frc",
     "limit_cycle",
     "mathieu_cascade",
@@ -45,6 +50,7 @@ __all__ = [
     "solve",
     "string",
     "switch_branch",
+    "torus_branch",
 ]
 
 _NATIVE = [name for name in __all__ if name not in ("AllSolutions", "all_solutions")]
@@ -84,6 +90,7 @@ def all_solutions(
 
 import inspect as _inspect
 import operator as _operator
+import os as _os
 from types import SimpleNamespace as _Namespace
 
 import numpy as _np
@@ -103,25 +110,68 @@ def _index(name, value):
         raise ValueError(f"argument `{name}` must be >= 0, got {index}")
     return index
 
-_LARGE_KEYS = ("nonlinear_dofs", "amplitude_dof", "record_dofs")
+_LARGE_KEYS = ("nonlinear_dofs", "amplitude_dof", "record_dofs", "reduction", "reduction_tol",
+               "reduction_samples")
+
+# The exact condensed path keeps narrow-banded structures (half-bandwidth at most
+# this: the beams) and small ones (below _REDUCE_FROM DOFs); "auto" reduces the rest.
+_BAND = 16
+_REDUCE_FROM = 1000
+# From this many DOFs on, "krylov" checks at 2 sampled frequencies, not 3.
+_FEWER_CHECKS = 50_000
 
 
-def _coo(name, a):
-    """COO triplets (rows, cols, values) of a scipy.sparse or dense matrix."""
+def _matrix(name, a):
+    """`a`, or the matrix in the Matrix Market file `a` names (str or path)."""
+    if isinstance(a, (str, _os.PathLike)):
+        import scipy.io
+
+        try:
+            return scipy.io.mmread(_os.fspath(a))
+        except (OSError, ValueError) as e:
+            raise ValueError(f"argument `{name}`: cannot read Matrix Market file {a!r}: {e}") from None
+    return a
+
+
+def _coo_arrays(name, a):
+    """n and the COO arrays (rows, cols, values: int64, int64, float64) of a
+    scipy.sparse or dense matrix or a Matrix Market file; complex entries
+    (structural damping K(1 + iη)) are refused."""
+    a = _matrix(name, a)
     if hasattr(a, "tocoo"):
         c = a.tocoo()
         rows, cols, vals = c.row, c.col, c.data
-        n = c.shape[0]
-        if c.shape[0] != c.shape[1]:
-            raise ValueError(f"argument `{name}` must be square, got shape {c.shape}")
+        shape = c.shape
     else:
-        arr = _np.atleast_2d(_np.asarray(a, dtype=float))
-        if arr.ndim != 2 or arr.shape[0] != arr.shape[1]:
-            raise ValueError(f"argument `{name}` must be square, got shape {arr.shape}")
+        arr = _np.atleast_2d(_np.asarray(a))
+        shape = arr.shape
+        if arr.ndim != 2:
+            raise ValueError(f"argument `{name}` must be square, got shape {shape}")
         rows, cols = _np.nonzero(arr)
         vals = arr[rows, cols]
-        n = arr.shape[0]
-    return n, ([int(i) for i in rows], [int(j) for j in cols], [float(v) for v in vals])
+    if len(shape) != 2 or shape[0] != shape[1]:
+        raise ValueError(f"argument `{name}` must be square, got shape {shape}")
+    if _np.iscomplexobj(vals):
+        raise ValueError(
+            f"argument `{name}` is complex: structural damping K(1 + iη) is not supported; "
+            "give a real damping matrix c (e.g. Rayleigh c = α·m + β·k)"
+        )
+    return shape[0], (
+        _np.ascontiguousarray(rows, dtype=_np.int64),
+        _np.ascontiguousarray(cols, dtype=_np.int64),
+        _np.ascontiguousarray(vals, dtype=_np.float64),
+    )
+
+
+def _coo(name, a):
+    """COO triplets (rows, cols, values) as lists, for the exact path."""
+    n, (rows, cols, vals) = _coo_arrays(name, a)
+    return n, (rows.tolist(), cols.tolist(), vals.tolist())
+
+
+def _half_bandwidth(coo):
+    rows, cols, _ = coo
+    return int(_np.max(_np.abs(rows - cols))) if len(rows) else 0
 
 
 def _loads(f, n):
@@ -138,7 +188,8 @@ def _loads(f, n):
 
 def _is_large(m, f, extra):
     loads = f is not None and not callable(f)
-    return hasattr(m, "tocoo") or loads or extra.get("nonlinear_dofs") is not None
+    files = isinstance(m, (str, _os.PathLike))
+    return hasattr(m, "tocoo") or files or loads or extra.get("nonlinear_dofs") is not None
 
 
 def _series_max(coeffs):
@@ -182,16 +233,34 @@ def _large_call(native_name, sig, args, kwargs, extra):
     bound.apply_defaults()
     a = _Namespace(**bound.arguments)
     dofs = extra.get("nonlinear_dofs")
-    if dofs is None:
+    g = a.g
+    if isinstance(g, Elements):
+        # An element's dof/to name model DOFs on every path (issue 46): the
+        # condensed path takes its nonlinear DOFs from the elements and sees
+        # them at their positions in that list.
+        if dofs is None:
+            dofs = g.dofs
+        g = g.restricted([_index("nonlinear_dofs", j) for j in dofs])
+    elif dofs is None:
         raise ValueError(
-            "a large model (sparse m/c/k or load-vector f) needs nonlinear_dofs=[...]: "
-            "the DOFs g acts on (g then sees x, v of those DOFs only)"
+            "a large model (sparse m/c/k or load-vector f) with a Python g needs nonlinear_dofs=[...]: "
+            "the DOFs g acts on (g then sees x, v of those DOFs only); ivt.hb.elements name "
+            "their model DOFs themselves"
         )
-    n, m = _coo("m", a.m)
-    nc, c = _coo("c", a.c)
-    nk, k = _coo("k", a.k)
+    n, m = _coo_arrays("m", a.m)
+    nc, c = _coo_arrays("c", a.c)
+    nk, k = _coo_arrays("k", a.k)
     if not n == nc == nk:
         raise ValueError(f"`m`, `c`, `k` must have one size, got {n}, {nc}, {nk}")
+    reduction = extra.get("reduction") or "auto"
+    if reduction not in ("auto", "exact", "krylov"):
+        raise ValueError(f"argument `reduction` must be 'auto', 'exact' or 'krylov', got {reduction!r}")
+    if reduction == "auto":
+        banded = _half_bandwidth(k) <= _BAND
+        reduce = native_name == "frc" and not banded and n >= _REDUCE_FROM
+        reduction = "krylov" if reduce else "exact"
+    if reduction == "krylov" and native_name != "frc":
+        raise ValueError("reduction='krylov' is available for frc; solve runs the exact condensed path")
     kw = dict(
         amplitude_dof=(
             None if extra.get("amplitude_dof") is None else _index("amplitude_dof", extra["amplitude_dof"])
@@ -212,8 +281,25 @@ def _large_call(native_name, sig, args, kwargs, extra):
         for key in ("ds", "ds_min", "ds_max"):
             if given.get(key) is not None:
                 kw[key] = float(given[key])
-        return _ivt.hb.frc_large(n, m, c, k, a.g, f, a.omega_from, a.omega_to, dofs, **kw)
-    return _ivt.hb.solve_large(n, m, c, k, a.g, f, a.omega_f, dofs, **kw)
+    if reduction == "krylov":
+        if extra.get("reduction_tol") is not None:
+            kw["reduction_tol"] = float(extra["reduction_tol"])
+        samples = extra.get("reduction_samples")
+        # An exact check is a complex sparse LU of the whole structure: about
+        # 9 s CPU at 100 k DOFs, three quarters of the reduction there.
+        kw["reduction_samples"] = (
+            _index("reduction_samples", samples) if samples is not None else (3 if n < _FEWER_CHECKS else 2)
+        )
+        return _ivt.hb.frc_reduced(n, m, c, k, g, f, a.omega_from, a.omega_to, dofs, **kw)
+    m, c, k = ((r.tolist(), cc.tolist(), v.tolist()) for r, cc, v in (m, c, k))
+    if native_name == "frc":
+        kw["truncation_estimate"] = bool(given.get("truncation_estimate", True))
+        out = _ivt.hb.frc_large(n, m, c, k, g, f, a.omega_from, a.omega_to, dofs, **kw)
+    else:
+        out = _ivt.hb.solve_large(n, m, c, k, g, f, a.omega_f, dofs, **kw)
+    out["method"] = "exact"
+    out["reduction"] = None
+    return out
 
 
 def _with_large(native):
@@ -222,8 +308,10 @@ def _with_large(native):
     load-vector `f` route to the condensed solver."""
     sig = _inspect.signature(native)
 
-    def call(*args, nonlinear_dofs=None, amplitude_dof=None, record_dofs=None, **kwargs):
-        extra = dict(nonlinear_dofs=nonlinear_dofs, amplitude_dof=amplitude_dof, record_dofs=record_dofs)
+    def call(*args, nonlinear_dofs=None, amplitude_dof=None, record_dofs=None, reduction=None,
+             reduction_tol=None, reduction_samples=None, **kwargs):
+        extra = dict(nonlinear_dofs=nonlinear_dofs, amplitude_dof=amplitude_dof, record_dofs=record_dofs,
+                     reduction=reduction, reduction_tol=reduction_tol, reduction_samples=reduction_samples)
         bound = sig.bind_partial(*args, **{k: v for k, v in kwargs.items() if k in sig.parameters})
         m, f = bound.arguments.get("m"), bound.arguments.get("f")
         if _is_large(m, f, extra):
@@ -236,6 +324,11 @@ def _with_large(native):
                 _dense_dofs(e, n_dof, amplitude_dof, record_dofs)
             if "points" in out and amplitude_dof is not None:
                 out["amplitude"] = _np.array([e["amplitude"] for e in entries])
+                # the folds and events are measured as the points are
+                for e in [*out.get("folds", []), *out.get("bifurcations", [])]:
+                    if isinstance(e, dict) and e.get("coeffs") is not None:
+                        blocks = _np.asarray(e["coeffs"]).reshape(n_dof, -1)
+                        e["amplitude"] = _series_max(blocks[_index("amplitude_dof", amplitude_dof)])
         return out
 
     params = list(sig.parameters.values()) + [
@@ -254,16 +347,21 @@ Large models (issue 28): `m`, `c`, `k` may be scipy.sparse matrices and `f`
 an array F (F cos θ) or a pair (F_cos, F_sin) of load vectors; with
 `nonlinear_dofs=[...]` the problem is condensed onto those DOFs (per harmonic
 the linear DOFs decouple exactly; sparse LU of the dynamic stiffness with
-refinement in double-double residuals) and `g(x, v, theta)` sees x, v of those
-DOFs only. Defaults there: n = 7, samples = 32, rtol = 1e-12 (on the
+refinement in double-double residuals) and a Python `g(x, v, theta)` sees x, v
+of those DOFs only. With `ivt.hb.elements` as `g`, each element's `dof`/`to`
+names a model DOF, as on a dense model, and the nonlinear DOFs are the
+elements' own (`g.dofs`); `nonlinear_dofs`, if given, must hold them all. Defaults there: n = 7, samples = 32, rtol = 1e-12 (on the
 receptance-form residual, relative to the larger of the start's linear
 response and the point's own size). Each point then
 carries "solve_error" (the refined solves'), "orbit_error" (the orbit's error
 from the corrector residual and the refined solves), "data_error" (the first-order effect of storing M and C in
 double precision), "truncation_error" and "error_estimate" (orbit_error +
-truncation_error, a relative error). `amplitude_dof=j`: "amplitude" is max |x_j(τ)|;
+truncation_error, a relative error; a curve's `truncation_estimate=False`
+skips the truncation estimate, most of a curve's cost without stability,
+and leaves both None). `amplitude_dof=j`: "amplitude" is max |x_j(τ)|;
 `record_dofs=[...]`: each point carries "dof_coeffs": {j: [a0, a1..an,
-b1..bn]} (any model). Stability (default on; `stability=False` skips it,
+b1..bn]} (any model). With `amplitude_dof` the folds' and events'
+"amplitude" is that DOF's too. Stability (default on; `stability=False` skips it,
 folds are located either way): Floquet multipliers of the whole structure's
 variational equation on the Ritz vectors of the nonlinear DOFs (Krylov
 blocks of K⁻¹M from the static modes, grown per point until the multipliers
@@ -272,6 +370,26 @@ most 64 blocks; for proportional damping and a position-only g, Hsu by a
 modal splitting): "multipliers", "stable",
 "stability" and "multiplier_error" (basis truncation + Hsu estimates) per
 point.
+
+Large solids (issue 42): m, c, k may also be Matrix Market files (paths), as
+FE codes export them (real entries; complex structural damping is refused).
+`reduction="auto"` (the default) keeps the exact condensed path for
+narrow-banded structures (half-bandwidth ≤ 16, e.g. beams), for models below
+1000 DOFs and for `solve`, and otherwise reduces once (`"krylov"`): block
+Lanczos in shift-invert mode at σ = 0 (one sparse Cholesky factorization of
+K, which must be positive definite: a clamped structure) from the static modes
+of the nonlinear DOFs and the load, grown until its Ritz values pass
+1.5·n·ω_max and the receptances at the nonlinear DOFs change by less than
+`reduction_tol`/10 (default tol 1e-8) from one block fewer over every harmonic
+band, then checked by exact sparse solves at `reduction_samples` frequencies
+(default 3, or 2 from 50 000 DOFs on); the curve runs on the reduced model. The result carries "method"
+("exact" or "reduced") and "reduction" (None, or {"method", "n_dof", "basis",
+"blocks", "modes", "cutoff", "first_frequency", "error_estimate",
+"nested_change", "sampled": [{"omega", "harmonic", "omega_f", "error",
+"solve_error"}]}); each point's "error_estimate" includes the reduction's
+receptance error, "multiplier_error" its effect on max |μ|
+("reduction_multiplier_error"), and "stability" is "uncertain" (and "stable"
+None) where max |μ| lies within "multiplier_error" of 1.
 """
 
 frc = _with_large(_ivt.hb.frc)
@@ -290,4 +408,109 @@ def _cantilever(n_elements, length=1.0, ei=1.0, rho_a=1.0, alpha=0.07, beta=2e-4
     return m, c, k, tip
 
 
-models = _Namespace(cantilever=_cantilever)
+def _scikit_fem():
+    """The scikit-fem module, or an ImportError saying how to install it."""
+    try:
+        import skfem
+    except ImportError as e:
+        raise ImportError(
+            "ivt.hb.models.plate and solid assemble with scikit-fem, an optional extra: "
+            "pip install 'ivt[fe]' (or pip install scikit-fem)"
+        ) from e
+    return skfem
+
+
+def _solid(mesh, clamped, young=210e9, poisson=0.3, density=7800.0):
+    """Linear elasticity with the consistent mass on a scikit-fem tetrahedral
+    (or any 3-D) mesh, P1 vector elements, SI units: returns (m, k, xyz, dof)
+    with scipy.sparse CSR m and k of the free DOFs (those not at the nodes
+    where ``clamped(x)`` holds, x of shape (3, N)), xyz (n_dof, 3) the node
+    coordinates of each free DOF and dof(node, direction) its index (-1 if
+    clamped). Needs scikit-fem (``pip install 'ivt[fe]'``)."""
+    import numpy as np
+
+    skfem = _scikit_fem()
+    from skfem.helpers import dot
+    from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+    element = {4: skfem.ElementTetP1, 8: skfem.ElementHex1}.get(mesh.t.shape[0], skfem.ElementTetP1)
+    basis = skfem.Basis(mesh, skfem.ElementVector(element()))
+    k = linear_elasticity(*lame_parameters(young, poisson)).assemble(basis)
+
+    @skfem.BilinearForm
+    def mass(u, v, w):
+        return density * dot(u, v)
+
+    m = mass.assemble(basis)
+    fixed = basis.get_dofs(clamped).all()
+    free = np.setdiff1d(np.arange(basis.N), fixed)
+    index = -np.ones(basis.N, dtype=np.int64)
+    index[free] = np.arange(free.size)
+    nodal = basis.nodal_dofs  # (3, n_nodes)
+    xyz = np.zeros((basis.N, 3))
+    for d in range(3):
+        xyz[nodal[d]] = mesh.p.T
+    m, k = (a.tocsr()[free][:, free].tocsr() for a in (m, k))
+
+    def dof(node, direction):
+        return int(index[nodal[direction, node]])
+
+    return m, k, xyz[free], dof
+
+
+def _plate(nx, ny=None, nz=2, size=(1.0, 0.2, 0.02), young=210e9, poisson=0.3, density=7800.0):
+    """Issue 42's steel cantilever plate (1 × 0.2 × 0.02 m, E = 210 GPa,
+    ν = 0.3, ρ = 7800 kg/m³) of nx × ny × nz hexahedra split into six
+    tetrahedra each (scikit-fem's ``MeshTet.init_tensor``), clamped at x = 0:
+    returns (m, k, tip), tip the vertical DOF of the corner (L, W, H).
+    ny defaults to nx // 5. Needs scikit-fem (``pip install 'ivt[fe]'``)."""
+    import numpy as np
+
+    skfem = _scikit_fem()
+
+    ny = max(1, nx // 5) if ny is None else ny
+    lx, ly, lz = size
+    mesh = skfem.MeshTet.init_tensor(
+        np.linspace(0.0, lx, nx + 1), np.linspace(0.0, ly, ny + 1), np.linspace(0.0, lz, nz + 1)
+    )
+    m, k, _, dof = _solid(mesh, lambda x: np.isclose(x[0], 0.0), young, poisson, density)
+    corner = int(np.argmin(np.sum((mesh.p.T - np.array([lx, ly, lz])) ** 2, axis=1)))
+    return m, k, dof(corner, 2)
+
+
+def _bladed_disk(blade_stiffness=None):
+    """pyHarm's 24-sector lumped bladed disk of issue 28 (tutorial 006):
+    sectors of three DOFs [disk, blade root, blade tip], M = diag(1.2, 0.35,
+    0.25), disk-to-ground 6e5, disk-root 1e6, root-tip 2e6, neighbouring
+    disks joined by 5e7 (cyclically), C = 2e-6 K. ``blade_stiffness``: 24
+    factors scaling each sector's blade springs (stiffness mistuning; None or
+    all ones: the tuned disk). Returns (m, c, k, tip) with scipy.sparse CSR
+    matrices and the index of sector 0's blade tip (DOF 2), where the
+    tutorial's force and cubic spring 5e10·x³ act."""
+    import scipy.sparse as sp
+
+    factors = None if blade_stiffness is None else [float(v) for v in _np.ravel(blade_stiffness)]
+    n, mats, tip = _ivt.hb.bladed_disk_coo(factors)
+    m, c, k = (sp.csr_matrix((v, (r, cc)), shape=(n, n)) for r, cc, v in mats)
+    return m, c, k, tip
+
+
+models = _Namespace(cantilever=_cantilever, solid=_solid, plate=_plate, bladed_disk=_bladed_disk)
+
+
+# --- pickling of element sums (dask ships models to worker processes) --------
+
+import copyreg as _copyreg
+
+
+def _elements_from_state(state):
+    """The sum of elements that ``Elements._state()`` lists, rebuilt by the
+    constructors (the inverse of the pickling below)."""
+    out = None
+    for name, params, dof, to in state:
+        e = getattr(elements, name)(*params, dof=dof, to=to)
+        out = e if out is None else out + e
+    return out
+
+
+_copyreg.pickle(Elements, lambda e: (_elements_from_state, (e._state(),)))

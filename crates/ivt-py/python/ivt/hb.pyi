@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from typing import Any, Callable, Dict, List, Literal, Optional, Sequence, Tuple, Union, overload
 
+import os
+
 import numpy as np
 import numpy.typing as npt
 
@@ -42,6 +44,9 @@ class Elements:
 
     def __add__(self, other: Elements) -> Elements: ...
     def __len__(self) -> int: ...
+    @property
+    def dofs(self) -> List[int]: ...
+    def restricted(self, dofs: Sequence[int]) -> Elements: ...
 
 class elements:
     """``ivt.hb.elements``: element constructors; ``+`` composes them. Each acts on
@@ -67,15 +72,19 @@ class ConvergenceError(RuntimeError):
 
     history: List[float]
 
-# A model's matrix: dense (``Matrix``) or, for large models, scipy.sparse.
-Operator = Union[Matrix, SparseMatrix]
+# A model's matrix: dense (``Matrix``) or, for large models, scipy.sparse or
+# the path of a Matrix Market (.mtx) file.
+Operator = Union[Matrix, SparseMatrix, str, "os.PathLike[str]"]
 # ``g``: a Python callback (per sample or vectorized) or a sum of Rust elements.
 Nonlinearity = Union[Callback, VectorizedCallback, Elements]
-# ``family(p) -> (m, c, k, g, f)``: the system at parameter value p.
+# ``family(p) -> (m, c, k, g, f)`` or, unforced, ``(m, c, k, g)``: the system at p.
 Family = Callable[[float], Sequence[Any]]
 # Large models, keyword only: DOF indices (``nonlinear_dofs``: where ``g``
 # acts; ``record_dofs``: whose coefficients the result holds).
 Dofs = Optional[Sequence[int]]
+# Large models: the exact condensed path, the reduced one, or the choice by
+# size and bandwidth (``None`` = "auto").
+Reduction = Literal["auto", "exact", "krylov"]
 
 # The signatures below are the runtime's, parameter for parameter
 # (tests/test_stubs.py pins each name, kind, order and default), so the options
@@ -117,6 +126,8 @@ def solve(
     jac: Optional[Jacobian] = None,
     *,
     nonlinear_dofs: Dofs = None, amplitude_dof: Optional[int] = None, record_dofs: Dofs = None,
+    reduction: Optional[Reduction] = None, reduction_tol: Optional[float] = None,
+    reduction_samples: Optional[int] = None,
 ) -> Dict[str, Any]: ...
 def frc(
     m: Operator, c: Operator, k: Operator, g: Nonlinearity,
@@ -126,6 +137,8 @@ def frc(
     jac: Optional[Jacobian] = None,
     *,
     nonlinear_dofs: Dofs = None, amplitude_dof: Optional[int] = None, record_dofs: Dofs = None,
+    reduction: Optional[Reduction] = None, reduction_tol: Optional[float] = None,
+    reduction_samples: Optional[int] = None,
 ) -> Dict[str, Any]: ...
 def continue_bifurcation(
     family: Family, start: Dict[str, Any],
@@ -206,8 +219,59 @@ class models:
         alpha: float = 0.07,
         beta: float = 2e-4,
     ) -> Tuple[SparseMatrix, SparseMatrix, SparseMatrix, int]: ...
+    @staticmethod
+    def solid(
+        mesh: Any,
+        clamped: Callable[[FloatArray], Any],
+        young: float = 210e9,
+        poisson: float = 0.3,
+        density: float = 7800.0,
+    ) -> Tuple[SparseMatrix, SparseMatrix, FloatArray, Callable[[int, int], int]]: ...
+    @staticmethod
+    def plate(
+        nx: int,
+        ny: Optional[int] = None,
+        nz: int = 2,
+        size: Tuple[float, float, float] = (1.0, 0.2, 0.02),
+        young: float = 210e9,
+        poisson: float = 0.3,
+        density: float = 7800.0,
+    ) -> Tuple[SparseMatrix, SparseMatrix, int]: ...
+    @staticmethod
+    def bladed_disk(
+        blade_stiffness: Optional[npt.ArrayLike] = None,
+    ) -> Tuple[SparseMatrix, SparseMatrix, SparseMatrix, int]: ...
 
 # Branch switching (issue 27 item 2, crates/ivt-py/src/hb_switch.rs).
+def torus_branch(
+    m: Matrix, c: Matrix, k: Matrix, g: Nonlinearity,
+    f: Optional[Forcing], start: Dict[str, Any], omega_to: float, at: Sequence[float] = ...,
+    n: int = 20, samples: int = 64,
+    truncation: Optional[Union[int, Tuple[int, int]]] = None, step: float = 0.02,
+    ds: float = 0.01, ds_max: float = 0.05, max_points: int = 400,
+    estimate_tol: float = 1e-7, max_unknowns: int = 3000, amplitude_dof: int = 0,
+    estimate_points: bool = False, section_points: int = 200, tol: float = 0.0,
+    velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
+    jac: Optional[Jacobian] = None,
+) -> Dict[str, Any]: ...
+def diagram(
+    m: Matrix, c: Matrix, k: Matrix, g: Nonlinearity,
+    f: Optional[Forcing], omega_from: float, omega_to: float, at: Sequence[float] = ...,
+    n: int = 20, samples: int = 64,
+    depth: int = 2, max_branches: int = 24,
+    tori: bool = True, torus: Optional[Union[int, Tuple[int, int]]] = None, torus_points: int = 60,
+    fold_scale: Optional[Tuple[float, float]] = ...,
+    deflation_omegas: int = 6, max_amplitude: float = 10.0, amplitudes: int = 6,
+    ds: float = 0.02, ds_max: float = 0.05, max_points: int = 2000, step: float = 0.05, tol: float = 0.0,
+    velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
+    jac: Optional[Jacobian] = None,
+) -> Dict[str, Any]: ...
+def event_sensitivity(
+    family: Family, event: Dict[str, Any], p: float, amplitude_dof: int = 0,
+    n: int = 20, samples: int = 64,
+    velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
+    ds: float = 0.02, ds_max: float = 0.05, max_points: int = 2000,
+) -> Dict[str, Any]: ...
 def switch_branch(
     m: Matrix,
     c: Matrix,

@@ -1,4 +1,5 @@
-//! Positions in the scene source, from toml's own spans: the line and column
+//! Positions in a TOML source (scenes, plant files; the CLI's harmonic-balance
+//! model files), from toml's own spans: the line and column
 //! of a key path (`controller.law`, `outputs.channels[1].name`) and the key
 //! path at a byte offset (for serde errors, which carry only a span).
 
@@ -7,7 +8,7 @@ use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
 /// The parsed document with its spans (None if the text is not TOML).
-pub(super) struct Doc<'s> {
+pub struct Doc<'s> {
     src: &'s str,
     root: Option<Spanned<DeTable<'s>>>,
 }
@@ -33,15 +34,42 @@ fn segments(path: &str) -> Vec<Seg<'_>> {
 }
 
 impl<'s> Doc<'s> {
-    pub(super) fn new(src: &'s str) -> Self {
+    /// The document of `src` (without spans if `src` is not TOML).
+    #[must_use]
+    pub fn new(src: &'s str) -> Self {
         Self {
             src,
             root: DeTable::parse(src).ok(),
         }
     }
 
+    /// `origin:line:col` of the start of `span`, or `origin` without one.
+    #[must_use]
+    pub fn at(&self, origin: &str, span: Option<Range<usize>>) -> String {
+        match span {
+            Some(s) => {
+                let (line, col) = self.line_col(s.start);
+                format!("{origin}:{line}:{col}")
+            }
+            None => origin.to_string(),
+        }
+    }
+
+    /// A deserialization error of this document as one line: its position,
+    /// the key path there and toml's message.
+    #[must_use]
+    pub fn serde_error(&self, origin: &str, e: &toml::de::Error) -> String {
+        let key = e
+            .span()
+            .and_then(|s| self.path_at(s.start))
+            .map(|k| format!("`{k}`: "))
+            .unwrap_or_default();
+        let msg = e.message().replace('\n', " ");
+        format!("{}: {key}{}", self.at(origin, e.span()), msg.trim())
+    }
+
     /// 1-based (line, column) of byte `offset`.
-    pub(super) fn line_col(&self, offset: usize) -> (usize, usize) {
+    pub fn line_col(&self, offset: usize) -> (usize, usize) {
         let before = &self.src[..floor_char_boundary(self.src, offset)];
         let line = before.matches('\n').count() + 1;
         let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
@@ -50,7 +78,7 @@ impl<'s> Doc<'s> {
 
     /// Span of the key that names `path` (its value's span for array
     /// elements); None when the key is not in the source (a default).
-    pub(super) fn span_of(&self, path: &str) -> Option<Range<usize>> {
+    pub fn span_of(&self, path: &str) -> Option<Range<usize>> {
         let root = self.root.as_ref()?;
         let mut table = root.get_ref();
         let mut value: Option<&Spanned<DeValue<'_>>> = None;
@@ -83,7 +111,7 @@ impl<'s> Doc<'s> {
 
     /// The dotted key path whose key or value holds byte `offset`
     /// (innermost), e.g. `controller.law`; None outside every key.
-    pub(super) fn path_at(&self, offset: usize) -> Option<String> {
+    pub fn path_at(&self, offset: usize) -> Option<String> {
         path_in(self.root.as_ref()?.get_ref(), offset)
     }
 }

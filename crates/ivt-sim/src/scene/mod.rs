@@ -12,7 +12,7 @@ mod controller;
 mod hardware;
 mod inputs;
 pub mod keys;
-mod locate;
+pub mod locate;
 mod outputs;
 mod plant;
 
@@ -36,8 +36,45 @@ const BYTES_PER_FIELD: f64 = 24.0;
 
 /// A scene error: one line, naming the position and the key.
 #[derive(Debug, thiserror::Error, Clone, PartialEq, Eq)]
-#[error("{0}")]
-pub struct SceneError(pub String);
+#[error("{message}")]
+pub struct SceneError {
+    /// The line.
+    pub message: String,
+    /// A file could not be read (missing, not a regular file, over its size
+    /// budget: [`crate::input::open`]) — the CLI's kind `io`; otherwise the
+    /// text is not a valid scene or plant file.
+    pub unreadable: bool,
+}
+
+impl SceneError {
+    /// Invalid text (TOML, a key, a value).
+    #[must_use]
+    pub fn invalid(message: String) -> Self {
+        Self {
+            message,
+            unreadable: false,
+        }
+    }
+
+    /// `path` could not be read ([`crate::input`]); not UTF-8 text is
+    /// invalid text instead.
+    #[must_use]
+    pub fn reading(path: &std::path::Path, e: &std::io::Error) -> Self {
+        Self {
+            message: format!("{}: {e}", path.display()),
+            unreadable: e.kind() != std::io::ErrorKind::InvalidData,
+        }
+    }
+
+    /// The same error with `prefix` in front of its message.
+    #[must_use]
+    pub fn within(self, prefix: &str) -> Self {
+        Self {
+            message: format!("{prefix}{}", self.message),
+            ..self
+        }
+    }
+}
 
 /// A validation failure: the dotted key path (`controller.law`,
 /// `outputs.channels[1].name`) and what is wrong with its value.
@@ -140,42 +177,28 @@ impl Scene {
     /// file's own position for an error inside it).
     pub fn parse_in(src: &str, origin: &str, base: &std::path::Path) -> Result<Self, SceneError> {
         let doc = locate::Doc::new(src);
-        let at = |span: Option<std::ops::Range<usize>>| match span {
-            Some(s) => {
-                let (line, col) = doc.line_col(s.start);
-                format!("{origin}:{line}:{col}")
-            }
-            None => origin.to_string(),
-        };
-        let mut scene: Scene = toml::from_str(src).map_err(|e| {
-            let msg = e.message().replace('\n', " ");
-            let key = e
-                .span()
-                .and_then(|s| doc.path_at(s.start))
-                .map(|k| format!("`{k}`: "))
-                .unwrap_or_default();
-            SceneError(format!("{}: {key}{}", at(e.span()), msg.trim()))
-        })?;
+        let at = |span: Option<std::ops::Range<usize>>| doc.at(origin, span);
+        let mut scene: Scene =
+            toml::from_str(src).map_err(|e| SceneError::invalid(doc.serde_error(origin, &e)))?;
         if scene.plant.file.is_some() {
             for key in ["plant.preset", "plant.gravity"] {
                 if let Some(span) = doc.span_of(key) {
-                    return Err(SceneError(format!(
+                    return Err(SceneError::invalid(format!(
                         "{}: `{key}` comes from `plant.file`; give it there, not beside it",
                         at(Some(span))
                     )));
                 }
             }
             scene.plant = scene.plant.resolve(base).map_err(|e| {
-                SceneError(format!(
-                    "{}: `plant.file`: {}",
-                    at(doc.span_of("plant.file")),
-                    e.0
+                e.within(&format!(
+                    "{}: `plant.file`: ",
+                    at(doc.span_of("plant.file"))
                 ))
             })?;
         }
         scene
             .validate()
-            .map_err(|e| SceneError(format!("{}: {e}", at(doc.span_of(&e.key)))))?;
+            .map_err(|e| SceneError::invalid(format!("{}: {e}", at(doc.span_of(&e.key)))))?;
         Ok(scene)
     }
 
@@ -185,7 +208,7 @@ impl Scene {
     /// I/O or scene errors, one line.
     pub fn load(path: &std::path::Path) -> Result<Self, SceneError> {
         let src = crate::input::read_text_bounded(path, crate::input::MAX_SCENE_BYTES)
-            .map_err(|e| SceneError(format!("{}: {e}", path.display())))?;
+            .map_err(|e| SceneError::reading(path, &e))?;
         let base = path.parent().unwrap_or(std::path::Path::new("."));
         Self::parse_in(&src, &path.display().to_string(), base)
     }

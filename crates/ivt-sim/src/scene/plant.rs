@@ -94,9 +94,10 @@ pub struct PlantSection {
     pub r_max: Option<f64>,
 }
 
-/// A plant file: its `[plant]` table; other top-level tables are ignored, so
-/// that a scene serves as a plant file too.
+/// A plant file: its `[plant]` table and nothing else (a key above the table
+/// or another table is refused by name, as an unknown key inside it is).
 #[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct PlantFile {
     plant: PlantSection,
 }
@@ -158,7 +159,7 @@ impl PlantSection {
     pub fn from_file(path: &Path) -> Result<Self, SceneError> {
         let origin = path.display().to_string();
         let src = crate::input::read_text_bounded(path, crate::input::MAX_SCENE_BYTES)
-            .map_err(|e| SceneError(format!("{origin}: {e}")))?;
+            .map_err(|e| SceneError::reading(path, &e))?;
         Self::parse_file(&src, &origin)
     }
 
@@ -168,22 +169,9 @@ impl PlantSection {
     /// As [`Self::from_file`].
     pub fn parse_file(src: &str, origin: &str) -> Result<Self, SceneError> {
         let doc = Doc::new(src);
-        let at = |span: Option<std::ops::Range<usize>>| match span {
-            Some(s) => {
-                let (line, col) = doc.line_col(s.start);
-                format!("{origin}:{line}:{col}")
-            }
-            None => origin.to_string(),
-        };
-        let file: PlantFile = toml::from_str(src).map_err(|e| {
-            let key = e
-                .span()
-                .and_then(|s| doc.path_at(s.start))
-                .map(|k| format!("`{k}`: "))
-                .unwrap_or_default();
-            let msg = e.message().replace('\n', " ");
-            SceneError(format!("{}: {key}{}", at(e.span()), msg.trim()))
-        })?;
+        let at = |span: Option<std::ops::Range<usize>>| doc.at(origin, span);
+        let file: PlantFile =
+            toml::from_str(src).map_err(|e| SceneError::invalid(doc.serde_error(origin, &e)))?;
         let plant = file.plant;
         let check = || {
             Invalid::check(plant.file.is_none(), "plant.file", || {
@@ -191,7 +179,7 @@ impl PlantSection {
             })?;
             plant.params().map(|_| ())
         };
-        check().map_err(|e| SceneError(format!("{}: {e}", at(doc.span_of(&e.key)))))?;
+        check().map_err(|e| SceneError::invalid(format!("{}: {e}", at(doc.span_of(&e.key)))))?;
         Ok(plant)
     }
 

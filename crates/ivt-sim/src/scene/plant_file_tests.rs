@@ -56,17 +56,17 @@ fn plant_file_errors_name_file_line_and_key() {
     let dir = scratch("errors");
     let bad = dir.join("bad.toml");
     std::fs::write(&bad, "[plant]\npreset = \"printed\"\nk_t = -1.0\n").unwrap();
-    let e = PlantSection::from_file(&bad).unwrap_err().0;
+    let e = PlantSection::from_file(&bad).unwrap_err().message;
     assert!(e.contains("bad.toml:3:1: `plant.k_t`"), "{e}");
     std::fs::write(&bad, "[plant]\nk_tt = 1.0\n").unwrap();
-    let e = PlantSection::from_file(&bad).unwrap_err().0;
+    let e = PlantSection::from_file(&bad).unwrap_err().message;
     assert!(e.contains("bad.toml:2:1") && e.contains("k_tt"), "{e}");
     std::fs::write(&bad, "[plant]\nfile = \"other.toml\"\n").unwrap();
-    let e = PlantSection::from_file(&bad).unwrap_err().0;
+    let e = PlantSection::from_file(&bad).unwrap_err().message;
     assert!(e.contains("`plant.file`") && e.contains("chains"), "{e}");
     let e = PlantSection::from_file(&dir.join("missing.toml"))
         .unwrap_err()
-        .0;
+        .message;
     assert!(e.contains("missing.toml"), "{e}");
     let head = "duration_s = 1.0\n[inputs]\nv_m = [[0.0, 8.0]]\nt_u = [[0.0, 4.0]]\n";
     let e = Scene::parse_in(
@@ -75,7 +75,7 @@ fn plant_file_errors_name_file_line_and_key() {
         &dir,
     )
     .unwrap_err()
-    .0;
+    .message;
     assert!(e.starts_with("s.toml:7:1: `plant.preset`"), "{e}");
     std::fs::write(dir.join("neg.toml"), "[plant]\nr_a = 0.0\n").unwrap();
     let e = Scene::parse_in(
@@ -84,9 +84,36 @@ fn plant_file_errors_name_file_line_and_key() {
         &dir,
     )
     .unwrap_err()
-    .0;
+    .message;
     assert!(
         e.starts_with("s.toml:6:1: `plant.file`") && e.contains("neg.toml:2:1: `plant.r_a`"),
         "{e}"
     );
+}
+
+/// Nothing outside `[plant]`: a key above the table and another table are
+/// refused by name, as an unknown key inside it is (they were ignored).
+#[test]
+fn a_plant_file_holds_the_plant_table_alone() {
+    for (text, name) in [
+        ("k_t = 0.1\n[plant]\npreset = \"printed\"\n", "k_t"),
+        (
+            "[plant]\npreset = \"printed\"\n[controller]\nk_prop_deg_per_rpm = 5.0\n",
+            "controller",
+        ),
+        ("[plant]\n[plant.extra]\nx = 1\n", "extra"),
+    ] {
+        let e = PlantSection::parse_file(text, "p.toml").unwrap_err();
+        assert!(!e.unreadable, "{e}");
+        assert!(
+            e.message.starts_with("p.toml:") && e.message.contains(name),
+            "{text:?}: {e}"
+        );
+    }
+    // a missing file is unreadable (the CLI's kind `io`), a bad value is not
+    let dir = scratch("kinds");
+    let e = PlantSection::from_file(&dir.join("missing.toml")).unwrap_err();
+    assert!(e.unreadable, "{e}");
+    let e = PlantSection::from_file(&dir).unwrap_err();
+    assert!(e.unreadable && e.message.contains("a directory"), "{e}");
 }

@@ -8,7 +8,7 @@ t_u = [[0.0, 4.0]]
 "#;
 
 fn err(src: &str) -> String {
-    let e = Scene::parse(src, "s.toml").unwrap_err().0;
+    let e = Scene::parse(src, "s.toml").unwrap_err().message;
     assert!(!e.contains('\n'), "multi-line error: {e}");
     e
 }

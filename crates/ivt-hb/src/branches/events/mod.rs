@@ -36,7 +36,7 @@ pub use ivt_path::events::{
 pub use multipliers::Multipliers;
 pub use neimark_sacker::NeimarkSacker;
 pub use period_doubling::PeriodDoubling;
-pub use trace::{observer, trace, PathOptions, Trace, TraceOptions};
+pub use trace::{every_event, observer, trace, PathOptions, Trace, TraceOptions};
 
 use crate::branches::family::{Family, FamilyBranch};
 use crate::orbit::ihb::HbError;
@@ -55,7 +55,7 @@ pub enum BifurcationError {
     Hb(#[from] HbError),
     /// The Neimark–Sacker test converged to a real pair `μ, 1/μ`.
     #[error(
-        "neutral saddle at λ = {lambda} (real multipliers μ and 1/μ), not a Neimark–Sacker point"
+        "neutral saddle at λ = {lambda:?} (real multipliers μ and 1/μ), not a Neimark–Sacker point"
     )]
     NeutralSaddle {
         /// Where.

@@ -64,7 +64,7 @@ impl<F: Family, E: From<HbError>> PointMultipliers<FamilyBranch<F>, E> for Multi
 pub(crate) struct Monodromy {
     analyzer: StabilityAnalyzer,
     steps: usize,
-    dim: usize,
+    pub(crate) dim: usize,
     phi: Vec<f64>,
 }
 
@@ -90,7 +90,12 @@ impl Monodromy {
     }
 
     /// Φ (row-major `dim × dim`) of the orbit `q` at λ.
-    fn eval<F: Family>(&mut self, branch: &FamilyBranch<F>, q: &[f64], lambda: f64) -> &[f64] {
+    pub(crate) fn eval<F: Family>(
+        &mut self,
+        branch: &FamilyBranch<F>,
+        q: &[f64],
+        lambda: f64,
+    ) -> &[f64] {
         let (problem, sol) = branch.solution(q, lambda);
         let theta = self.analyzer.theta_samples(&problem, &sol);
         let period = 2.0 * std::f64::consts::PI;
@@ -124,7 +129,7 @@ pub(crate) type TestMatrix = fn(phi: &[f64], dim: usize, a: &mut Vec<f64>) -> us
 /// `g` of `[[A, b], [cᵀ, 0]] [v; g] = [0; 1]` for fixed borders `b`, `c`: the
 /// bordered LU and the right-hand side are kept across the calls of the
 /// finite-difference loop of [`extended_newton`].
-struct BorderedScalar {
+pub(crate) struct BorderedScalar {
     b: Vec<f64>,
     c: Vec<f64>,
     lu: BorderedLu,
@@ -132,7 +137,7 @@ struct BorderedScalar {
 }
 
 impl BorderedScalar {
-    fn new(b: Vec<f64>, c: Vec<f64>) -> Self {
+    pub(crate) fn new(b: Vec<f64>, c: Vec<f64>) -> Self {
         let s = b.len();
         Self {
             b,
@@ -143,7 +148,7 @@ impl BorderedScalar {
     }
 
     /// `g` for the `s×s` row-major `a` (NaN if singular).
-    fn eval(&mut self, a: &[f64]) -> f64 {
+    pub(crate) fn eval(&mut self, a: &[f64]) -> f64 {
         // Near-singular pivots are accepted (the solve is checked instead).
         if !factored(self.lu.factor(a, &self.b, &self.c, &[0.0])) {
             return f64::NAN;

@@ -82,7 +82,7 @@ pub fn observer<F: Family, E: From<HbError> + 'static>(
 
 /// The four events of a [`Family`] branch: fold (with its multipliers),
 /// period doubling, Neimark–Sacker and branch point.
-fn every_event<F: Family>(
+pub fn every_event<F: Family>(
     opts: &LocateOptions,
 ) -> Vec<Box<dyn Detector<FamilyBranch<F>, BifurcationError>>> {
     vec![

@@ -1,0 +1,1105 @@
+//! The automatic bifurcation diagram of a forced system over an interval of
+//! ω_f (issue 45 item 2; BifurcationKit's `bifurcationdiagram` for periodic
+//! responses): the primary response curve traced with its events
+//! ([`ivt_hb::branches::events`]), then recursively, to `depth` levels,
+//!
+//! - at each branch point both halves of the crossing branch (the root of
+//!   the bifurcation equation nearer ω_f = const, [`super::switch()`]) stepped
+//!   `±h` from it;
+//! - at each period doubling the period-2 branch
+//!   ([`ivt_hb::period_doubled_start`]);
+//! - at each Neimark–Sacker point the torus branch ([`ivt_hb::branches::torus`]; not
+//!   searched further);
+//!
+//! and, for branches no event leads to (isolas),
+//!
+//! - the folds of every branch followed in the forcing scale `s`
+//!   (`f → s·f`, [`ivt_hb::fold_curve`]) over `fold_scale`: a fold curve that
+//!   crosses `s = 1` again off the known branches is a fold of another
+//!   branch, traced from there;
+//! - every solution that deflated Newton ([`ivt_hb::all_solutions()`]) finds
+//!   at `samples` frequencies spread over the interval, off the known
+//!   branches, traced both ways.
+//!
+//! Every branch is traced within `[from, to]` (bounds, not ends: a branch
+//! may leave and re-enter the interval only by a path inside it) and stops
+//! where it closes on its own start (a loop through two branch points). A
+//! branch that starts on a known branch is not traced again. The result
+//! lists the branches (each with its parent, how it began, its points with
+//! stability and its events) and what bounded the search.
+
+use super::frc::{event, trace_error, EventRecord};
+use super::switch::new_direction;
+use super::{finite, finite_list, pairs, positive, Array};
+use ivt_hb::analyses::deflation::{all_solutions, SearchOptions};
+use ivt_hb::branches::codim2::fold_curve;
+use ivt_hb::branches::events::{
+    every_event, observe, observer, BifurcationKind, Event, LocateOptions, Multipliers,
+    PointMultipliers, Trace, TracedPoint,
+};
+use ivt_hb::branches::family::{Family, FamilyBranch, Frequency};
+use ivt_hb::branches::frc::{from_trace, AmplitudeProbe, FrcPoint};
+use ivt_hb::branches::switching::{period_doubled_start, switch_branch};
+use ivt_hb::branches::torus::{torus_start, NeimarkSackerStart, TorusOptions, Truncation};
+use ivt_hb::orbit::ihb::HbOptions;
+use ivt_hb::problem::{AtFrequency, PeriodicProblem};
+use ivt_hb::stability::{AdaptiveHsu, HsuSteps, StabilityKind};
+use ivt_hb::HbError;
+use ivt_hb::{Bifurcation, Corrector, ModifiedIhb};
+use ivt_num::vector::norm2;
+use ivt_path::continuation::{
+    correct_at_fixed_lambda, ContinuationOptions, PathPoint, Termination,
+};
+use serde::Serialize;
+use std::time::Instant;
+
+/// The interval, the recursion and the isola search.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DiagramRequest {
+    /// Start of the interval of ω_f (the primary curve starts here).
+    pub from: f64,
+    /// End of the interval.
+    pub to: f64,
+    /// Levels of switching: the primary curve is level 0, a branch switched
+    /// at an event of level `k` is level `k + 1`; events of level `depth`
+    /// are not switched at.
+    pub depth: usize,
+    /// Most branches (tori included).
+    pub max_branches: usize,
+    /// Start the torus branch at each Neimark–Sacker point.
+    pub tori: bool,
+    /// Harmonics and grid of the tori.
+    pub torus: TorusOptions,
+    /// Most points of a torus branch.
+    pub torus_points: usize,
+    /// The interval of the forcing scale over which folds are followed
+    /// (`None`: no fold curves).
+    pub fold_scale: Option<(f64, f64)>,
+    /// Frequencies of the deflation search, spread evenly inside the
+    /// interval (0: none).
+    pub samples: usize,
+    /// The deflation search's box `‖q‖∞ ≤ max_amplitude`.
+    pub max_amplitude: f64,
+    /// Its start amplitudes per phase.
+    pub amplitudes: usize,
+    /// ω_f at which every branch is solved exactly (inserted into its
+    /// points, marked `at`).
+    pub at: Vec<f64>,
+    /// First arclength step.
+    pub ds: f64,
+    /// Largest arclength step.
+    pub ds_max: f64,
+    /// Most points per branch.
+    pub max_points: usize,
+    /// Distance of a switched branch's first point from its event, relative
+    /// to the orbit's ‖coefficients‖₂.
+    pub step: f64,
+}
+
+impl Default for DiagramRequest {
+    /// ω_f ∈ [0.5, 2.5], depth 2, at most 24 branches, tori (the box
+    /// |k₁| ≤ 5, |k₂| ≤ 10, 60 points), folds followed in the forcing scale
+    /// over [0.25, 4], deflation at 6 frequencies.
+    fn default() -> Self {
+        Self {
+            from: 0.5,
+            to: 2.5,
+            depth: 2,
+            max_branches: 24,
+            tori: true,
+            torus: TorusOptions {
+                truncation: Truncation::Box { h1: 5, h2: 10 },
+                ..TorusOptions::default()
+            },
+            torus_points: 60,
+            fold_scale: Some((0.25, 4.0)),
+            samples: 6,
+            max_amplitude: 10.0,
+            amplitudes: 6,
+            at: Vec::new(),
+            ds: 0.02,
+            ds_max: 0.05,
+            max_points: 2000,
+            step: 0.05,
+        }
+    }
+}
+
+impl DiagramRequest {
+    /// # Errors
+    /// [`HbError::InvalidInput`] for an interval that is not finite, positive
+    /// and non-empty, a fold scale interval not around 1, non-finite `at`,
+    /// non-positive steps or box, a `step` outside (0, 1].
+    pub fn validate(&self) -> Result<(), HbError> {
+        let (from, to) = (finite("from", self.from)?, finite("to", self.to)?);
+        if !(from > 0.0 && to > 0.0 && from != to) {
+            return Err(HbError::InvalidInput(format!(
+                "`from` = {from:?}, `to` = {to:?} must be > 0 and distinct"
+            )));
+        }
+        if let Some((lo, hi)) = self.fold_scale {
+            if !(lo.is_finite() && hi.is_finite() && lo < 1.0 && hi > 1.0) {
+                return Err(HbError::InvalidInput(format!(
+                    "`fold_scale` = ({lo:?}, {hi:?}) must be finite with lo < 1 < hi"
+                )));
+            }
+        }
+        finite_list("at", &self.at)?;
+        positive("ds", self.ds)?;
+        positive("ds_max", self.ds_max)?;
+        positive("max_amplitude", self.max_amplitude)?;
+        let step = finite("step", self.step)?;
+        if !(step > 0.0 && step <= 1.0) {
+            return Err(HbError::InvalidInput(format!(
+                "`step` = {step:?} must be in (0, 1]"
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// How a branch began.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BranchKind {
+    /// The curve from `from`.
+    Primary,
+    /// Switched at a branch point of its parent.
+    BranchPoint,
+    /// The period-2 branch of a period doubling of its parent.
+    PeriodDoubling,
+    /// The torus branch of a Neimark–Sacker point of its parent.
+    Torus,
+    /// Found by following a fold of its parent in the forcing scale.
+    FoldCurve,
+    /// Found by deflated Newton at one ω_f.
+    Deflation,
+}
+
+/// One point of a branch.
+#[derive(Debug, Clone, Serialize)]
+pub struct DiagramPoint {
+    /// ω_f.
+    pub omega: f64,
+    /// max |x₀| (a torus: its maximum of |x₀| over the torus).
+    pub amplitude: f64,
+    /// The orbit's coefficients (a torus: the torus's, see its branch's
+    /// `harmonics`).
+    pub coeffs: Array<f64>,
+    /// Stable (a torus: its normal exponent < 0 for one DOF, else `None`).
+    pub stable: Option<bool>,
+    /// The leading multiplier's class (periodic branches).
+    pub stability: Option<StabilityKind>,
+    /// Floquet multipliers `[[re, im], ...]` (periodic branches).
+    pub multipliers: Option<Vec<[f64; 2]>>,
+    /// Rotation number (tori).
+    pub rotation_number: Option<f64>,
+    /// Solved at an ω_f of `at`.
+    pub at: bool,
+}
+
+/// Where a branch began on its parent.
+#[derive(Debug, Clone, Serialize)]
+pub struct Origin {
+    /// The event (or `fold` for a fold curve's crossing).
+    pub kind: BifurcationKind,
+    /// Its ω_f.
+    pub omega: f64,
+    /// Its index in the parent's `events` (`None` for a fold curve's
+    /// crossing of `s = 1`).
+    pub event: Option<usize>,
+}
+
+/// One branch of the diagram.
+#[derive(Debug, Clone, Serialize)]
+pub struct DiagramBranch {
+    /// How it began.
+    pub kind: BranchKind,
+    /// The branch it came from (index into `branches`).
+    pub parent: Option<usize>,
+    /// Where on the parent.
+    pub origin: Option<Origin>,
+    /// Its level (primary 0).
+    pub level: usize,
+    /// Harmonics of its coefficients (a torus: the number of harmonics
+    /// kept).
+    pub harmonics: usize,
+    /// Response period over excitation period (2 after a period doubling).
+    pub subharmonic: usize,
+    /// `[k₁, k₂]` of a torus's coefficient pairs (empty otherwise).
+    pub torus_harmonics: Vec<[i64; 2]>,
+    /// Points in path order.
+    pub points: Vec<DiagramPoint>,
+    /// Events in path order (none on tori).
+    pub events: Vec<EventRecord>,
+    /// Why tracing stopped (`stopped`: it closed on its start).
+    pub termination: Termination,
+}
+
+/// What bounded the search.
+#[derive(Debug, Clone, Serialize)]
+pub struct DiagramSearch {
+    /// The interval.
+    pub interval: [f64; 2],
+    /// The depth bound.
+    pub depth: usize,
+    /// The deepest level reached.
+    pub deepest: usize,
+    /// Events not switched at because they lie at the depth bound.
+    pub events_beyond_depth: usize,
+    /// The branch bound and whether it was reached.
+    pub max_branches: usize,
+    /// Whether new branches were left out at `max_branches`.
+    pub branch_limit_reached: bool,
+    /// Starts that lay on a known branch (not traced again).
+    pub duplicates: usize,
+    /// Switches and starts that failed, with their reasons.
+    pub failures: Vec<String>,
+    /// Folds followed in the forcing scale, and the scale's interval.
+    pub fold_curves: usize,
+    /// The forcing scale's interval.
+    pub fold_scale: Option<[f64; 2]>,
+    /// The deflation search's frequencies.
+    pub deflation_omegas: Vec<f64>,
+    /// Solutions it found (known ones included).
+    pub deflation_solutions: usize,
+    /// Whether every deflated run ended without a new solution.
+    pub deflation_exhausted: bool,
+    /// Branches that reached `max_points`.
+    pub truncated_branches: usize,
+}
+
+/// The keys of `ivt hb diagram --json` and `ivt.hb.diagram`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Diagram {
+    /// The branches, the primary first.
+    pub branches: Vec<DiagramBranch>,
+    /// What bounded the search.
+    pub search: DiagramSearch,
+    /// Wall time.
+    pub time_s: f64,
+}
+
+/// `problem` with its excitation scaled by `scale` (the isola search's
+/// second parameter).
+struct ForcingScale<'a, P> {
+    problem: &'a P,
+    scale: f64,
+}
+
+impl<P: PeriodicProblem> PeriodicProblem for ForcingScale<'_, P> {
+    fn n_dof(&self) -> usize {
+        self.problem.n_dof()
+    }
+    fn mass(&self) -> &[f64] {
+        self.problem.mass()
+    }
+    fn damping(&self) -> &[f64] {
+        self.problem.damping()
+    }
+    fn stiffness(&self) -> &[f64] {
+        self.problem.stiffness()
+    }
+    fn velocity_dependent(&self) -> bool {
+        self.problem.velocity_dependent()
+    }
+    fn hysteretic(&self) -> bool {
+        self.problem.hysteretic()
+    }
+    fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
+        self.problem.nonlinear(x, v, theta, out)
+    }
+    fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+        self.problem.nonlinear_samples(x, v, theta, out)
+    }
+    fn excitation(&self, theta: f64, out: &mut [f64]) {
+        self.problem.excitation(theta, out);
+        out.iter_mut().for_each(|f| *f *= self.scale);
+    }
+    fn nonlinear_jacobian(&self, x: &[f64], v: &[f64], theta: f64, dg: &mut [f64]) {
+        self.problem.nonlinear_jacobian(x, v, theta, dg)
+    }
+    fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
+        self.problem.nonlinear_jacobian_samples(x, v, theta, dg)
+    }
+    fn frequency_dependent(&self) -> bool {
+        self.problem.frequency_dependent()
+    }
+    fn nonlinear_samples_at(&self, x: &[f64], v: &[f64], th: &[f64], w: f64, out: &mut [f64]) {
+        self.problem.nonlinear_samples_at(x, v, th, w, out)
+    }
+    fn nonlinear_jacobian_samples_at(
+        &self,
+        x: &[f64],
+        v: &[f64],
+        th: &[f64],
+        w: f64,
+        dg: &mut [f64],
+    ) {
+        self.problem.nonlinear_jacobian_samples_at(x, v, th, w, dg)
+    }
+    fn excitation_at(&self, theta: f64, omega_f: f64, out: &mut [f64]) {
+        self.problem.excitation_at(theta, omega_f, out);
+        out.iter_mut().for_each(|f| *f *= self.scale);
+    }
+}
+
+/// The largest step of a fold curve in the forcing scale (its crossings of
+/// `s = 1` are solved there exactly; a Python `g` pays per residual).
+const FOLD_CURVE_DS_MAX: f64 = 0.2;
+
+/// A periodic branch found but not yet traced: its HB options, first point
+/// `[q, ω_f]`, direction in ω_f, and what it is.
+struct Pending {
+    hb: HbOptions,
+    x0: Vec<f64>,
+    direction: f64,
+    kind: BranchKind,
+    parent: Option<usize>,
+    origin: Option<Origin>,
+    level: usize,
+}
+
+/// The search's state: the request, the branches so far and the report.
+struct Search<'a, P> {
+    problem: &'a P,
+    hb: HbOptions,
+    req: &'a DiagramRequest,
+    /// Each branch's states `[q, ω_f]` with its HB options (tori: `None`).
+    states: Vec<Option<(HbOptions, Vec<Vec<f64>>)>>,
+    /// Each branch's located events (tori: none).
+    located: Vec<Vec<Event>>,
+    branches: Vec<DiagramBranch>,
+    search: DiagramSearch,
+}
+
+/// The distance from `x` to the segment `[a, b]`.
+fn segment_distance(x: &[f64], a: &[f64], b: &[f64]) -> f64 {
+    let ab: Vec<f64> = b.iter().zip(a).map(|(p, q)| p - q).collect();
+    let ax: Vec<f64> = x.iter().zip(a).map(|(p, q)| p - q).collect();
+    let len2: f64 = ab.iter().map(|v| v * v).sum();
+    let t = if len2 > 0.0 {
+        (ax.iter().zip(&ab).map(|(p, q)| p * q).sum::<f64>() / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    ax.iter()
+        .zip(&ab)
+        .map(|(p, q)| (p - t * q).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// The point of a periodic branch.
+fn periodic_point(p: &FrcPoint, at: bool) -> DiagramPoint {
+    DiagramPoint {
+        omega: p.omega_f,
+        amplitude: p.amplitude,
+        coeffs: Array(p.coeffs.clone()),
+        stable: Some(p.stable()),
+        stability: Some(p.kind),
+        multipliers: Some(pairs(&p.multipliers)),
+        rotation_number: None,
+        at,
+    }
+}
+
+/// `+1` or `−1` by the sign of `d` (`+1` for 0).
+fn sign(d: f64) -> f64 {
+    if d < 0.0 {
+        -1.0
+    } else {
+        1.0
+    }
+}
+
+/// Follows `branch` from `x0` (`[q, λ]`) in the direction of `direction`
+/// within the bounds of `copts`, with multipliers and events
+/// ([`EventObserver`] on the one stepper); with `close`, stops where the
+/// path returns to its start after leaving it (termination `stopped`).
+fn trace_within<F: Family>(
+    branch: &mut FamilyBranch<F>,
+    x0: &[f64],
+    direction: f64,
+    copts: &ContinuationOptions,
+    close: bool,
+) -> Result<Trace, HbError> {
+    let lambda0 = x0.last().copied().unwrap_or(f64::NAN);
+    let locate = LocateOptions::default();
+    let mut observer = observer(
+        branch,
+        lambda0,
+        HsuSteps::default(),
+        &locate,
+        every_event(&locate),
+    )?;
+    let mut stepper = branch.stepper(x0, 0, direction, copts)?;
+    let tol = 0.5 * copts.ds;
+    let (mut prev, mut far, mut closed): (Option<Vec<f64>>, bool, bool) = (None, false, false);
+    let (path, events) = observe(&mut stepper, &mut observer, |_, p: &PathPoint| {
+        if close {
+            if let Some(a) = &prev {
+                closed = far && segment_distance(x0, a, &p.x) < tol;
+            }
+            let gone =
+                p.x.iter()
+                    .zip(x0)
+                    .map(|(a, b)| (a - b).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+            far = far || gone > 4.0 * tol;
+            prev = Some(p.x.clone());
+        }
+        !closed
+    })
+    .map_err(trace_error)?;
+    Ok(Trace {
+        points: observer.into_points(),
+        events,
+        termination: if closed {
+            Termination::Stopped
+        } else {
+            path.termination
+        },
+    })
+}
+
+impl<'a, P: PeriodicProblem> Search<'a, P> {
+    /// The continuation options of every branch, within the interval.
+    fn path_options(&self) -> ContinuationOptions {
+        let mut c = super::path_steps(self.req.ds, self.req.ds_max, self.req.max_points);
+        c.corrector = Corrector::Newton;
+        c.lambda_min = self.req.from.min(self.req.to);
+        c.lambda_max = self.req.from.max(self.req.to);
+        c
+    }
+
+    /// Whether `x = [q, ω_f]` lies within `tol` of a traced branch with the
+    /// options `hb`.
+    fn known(&self, hb: &HbOptions, x: &[f64], tol: f64) -> bool {
+        self.states.iter().flatten().any(|(h, states)| {
+            h.harmonics == hb.harmonics
+                && h.subharmonic == hb.subharmonic
+                && states
+                    .windows(2)
+                    .any(|w| matches!(w, [a, b] if a.len() == x.len() && segment_distance(x, a, b) < tol))
+        })
+    }
+
+    /// Whether the period-one orbit `q` at ω_f lies on a traced branch: each
+    /// crossing of ω_f by a branch corrected there at fixed ω_f by Newton,
+    /// within `1e-6·max(‖q‖, 1)` of `q`.
+    fn on_branch_at(&self, q: &[f64], omega: f64) -> bool {
+        let copts = self.path_options();
+        let Ok(mut branch) = FamilyBranch::new(Frequency(self.problem), &self.hb, omega) else {
+            return false;
+        };
+        let tol = 1e-6 * norm2(q).max(1.0);
+        self.states.iter().flatten().any(|(h, states)| {
+            h.harmonics == self.hb.harmonics
+                && h.subharmonic == self.hb.subharmonic
+                && states.windows(2).any(|w| {
+                    let [a, b] = w else { return false };
+                    let la = a.last().copied().unwrap_or(f64::NAN);
+                    let lb = b.last().copied().unwrap_or(f64::NAN);
+                    let product = (la - omega) * (lb - omega);
+                    if product.is_nan() || product > 0.0 || la == lb {
+                        return false;
+                    }
+                    let t = (omega - la) / (lb - la);
+                    let mut x: Vec<f64> = a.iter().zip(b).map(|(u, v)| u + t * (v - u)).collect();
+                    if let Some(l) = x.last_mut() {
+                        *l = omega;
+                    }
+                    correct_at_fixed_lambda(&mut branch, &mut x, &copts).is_ok()
+                        && x.iter()
+                            .zip(q)
+                            .map(|(u, v)| (u - v).powi(2))
+                            .sum::<f64>()
+                            .sqrt()
+                            < tol
+                })
+        })
+    }
+
+    /// Room for one more branch; records the bound otherwise.
+    fn room(&mut self) -> bool {
+        let room = self.branches.len() < self.req.max_branches;
+        if !room {
+            self.search.branch_limit_reached = true;
+        }
+        room
+    }
+
+    /// Traces a pending branch and records it; its index, or `None` at the
+    /// branch bound.
+    fn trace(&mut self, pending: Pending) -> Result<Option<usize>, HbError> {
+        if !self.room() {
+            return Ok(None);
+        }
+        let lambda0 = pending.x0.last().copied().unwrap_or(f64::NAN);
+        let mut branch = FamilyBranch::new(Frequency(self.problem), &pending.hb, lambda0)?;
+        let copts = self.path_options();
+        let close = pending.kind != BranchKind::Primary;
+        let trace = trace_within(&mut branch, &pending.x0, pending.direction, &copts, close)?;
+        if trace.termination == Termination::MaxPoints {
+            self.search.truncated_branches += 1;
+        }
+        let states: Vec<Vec<f64>> = trace
+            .points
+            .iter()
+            .map(|p| p.q.iter().copied().chain([p.lambda]).collect())
+            .collect();
+        let curve = from_trace(&trace, &pending.hb)?;
+        let mut probe = AmplitudeProbe::new(&pending.hb)?;
+        let events: Vec<EventRecord> = trace
+            .events
+            .iter()
+            .map(|e| event(e, &curve, &mut probe))
+            .collect();
+        let mut points: Vec<(usize, DiagramPoint)> = curve
+            .points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (2 * i, periodic_point(p, false)))
+            .collect();
+        points.extend(self.solve_at(&mut branch, &pending.hb, &states)?);
+        points.sort_by_key(|(slot, _)| *slot);
+        let index = self.branches.len();
+        self.branches.push(DiagramBranch {
+            kind: pending.kind,
+            parent: pending.parent,
+            origin: pending.origin,
+            level: pending.level,
+            harmonics: pending.hb.harmonics,
+            subharmonic: pending.hb.subharmonic,
+            torus_harmonics: Vec::new(),
+            points: points.into_iter().map(|(_, p)| p).collect(),
+            events,
+            termination: trace.termination,
+        });
+        self.search.deepest = self.search.deepest.max(pending.level);
+        self.states.push(Some((pending.hb, states)));
+        self.located.push(trace.events);
+        Ok(Some(index))
+    }
+
+    /// The orbit at each ω_f of `at` where the path `states` crosses it,
+    /// corrected there by Newton, with its multipliers: `(slot, point)`,
+    /// the slot between those of its two path points.
+    fn solve_at<F: Family>(
+        &self,
+        branch: &mut FamilyBranch<F>,
+        hb: &HbOptions,
+        states: &[Vec<f64>],
+    ) -> Result<Vec<(usize, DiagramPoint)>, HbError> {
+        let copts = self.path_options();
+        let mut out = Vec::new();
+        for &target in &self.req.at {
+            for (k, w) in states.windows(2).enumerate() {
+                let [a, b] = w else { continue };
+                let la = a.last().copied().unwrap_or(f64::NAN);
+                let lb = b.last().copied().unwrap_or(f64::NAN);
+                if !((la - target) * (lb - target) < 0.0 || lb == target) {
+                    continue;
+                }
+                let t = (target - la) / (lb - la);
+                let mut x: Vec<f64> = a.iter().zip(b).map(|(u, v)| u + t * (v - u)).collect();
+                if let Some(l) = x.last_mut() {
+                    *l = target;
+                }
+                correct_at_fixed_lambda(branch, &mut x, &copts)?;
+                let problem = branch.family().at(target).0;
+                let mut mult = Multipliers::new(AdaptiveHsu::new(
+                    &problem,
+                    hb.harmonics,
+                    HsuSteps::default(),
+                )?);
+                let point = PathPoint {
+                    x,
+                    iterations: 0,
+                    dlambda: 0.0,
+                    bordered_sign: None,
+                };
+                let traced: TracedPoint =
+                    PointMultipliers::<_, HbError>::at(&mut mult, branch, &point)?;
+                let single = Trace {
+                    points: vec![traced],
+                    events: Vec::new(),
+                    termination: Termination::LeftInterval,
+                };
+                let curve = from_trace(&single, hb)?;
+                out.extend(
+                    curve
+                        .points
+                        .first()
+                        .map(|p| (2 * k + 1, periodic_point(p, true))),
+                );
+            }
+        }
+        Ok(out)
+    }
+
+    /// Switches at every located event of branch `b` (below the depth
+    /// bound); a failed switch is recorded, not an error.
+    fn switch_at_events(&mut self, b: usize) -> Result<(), HbError> {
+        let (Some(Some((hb, _))), Some(events), Some(parent)) = (
+            self.states.get(b).cloned(),
+            self.located.get(b).cloned(),
+            self.branches.get(b),
+        ) else {
+            return Ok(());
+        };
+        let level = parent.level;
+        for (i, e) in events.iter().enumerate() {
+            let Ok(bif) = &e.location else { continue };
+            if e.kind == BifurcationKind::Fold
+                || (e.kind == BifurcationKind::NeimarkSacker && !self.req.tori)
+            {
+                continue;
+            }
+            if level >= self.req.depth {
+                self.search.events_beyond_depth += 1;
+                continue;
+            }
+            let origin = Origin {
+                kind: e.kind,
+                omega: bif.lambda,
+                event: Some(i),
+            };
+            let done = match e.kind {
+                BifurcationKind::BranchPoint => {
+                    self.switch_branch_point(b, &hb, bif, origin, level + 1)
+                }
+                BifurcationKind::PeriodDoubling => {
+                    self.switch_period_doubling(b, &hb, bif, origin, level + 1)
+                }
+                _ => self.torus_at(b, &hb, bif, origin, level + 1),
+            };
+            if let Err(why) = done {
+                self.search.failures.push(format!(
+                    "{} at ω_f = {} on branch {b}: {why}",
+                    e.kind.words(),
+                    bif.lambda
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Both halves of the branch crossing at the branch point `bif`.
+    fn switch_branch_point(
+        &mut self,
+        b: usize,
+        hb: &HbOptions,
+        bif: &Bifurcation,
+        origin: Origin,
+        level: usize,
+    ) -> Result<(), HbError> {
+        let opts = LocateOptions::default();
+        let mut branch = FamilyBranch::new(Frequency(self.problem), hb, bif.lambda)?;
+        let d = new_direction(&mut branch, &bif.q, bif.lambda, &opts)?;
+        let h = self.req.step * norm2(&bif.q).max(f64::MIN_POSITIVE);
+        for side in [1.0, -1.0] {
+            let (q1, w1) = switch_branch(&mut branch, &bif.q, bif.lambda, &d, side * h, &opts)
+                .map_err(trace_error)?;
+            let mut x0 = q1;
+            x0.push(w1);
+            if self.known(hb, &x0, 0.25 * h) {
+                self.search.duplicates += 1;
+                continue;
+            }
+            self.trace(Pending {
+                hb: hb.clone(),
+                x0,
+                direction: sign(w1 - bif.lambda),
+                kind: BranchKind::BranchPoint,
+                parent: Some(b),
+                origin: Some(origin.clone()),
+                level,
+            })?;
+        }
+        Ok(())
+    }
+
+    /// The period-2 branch of the period doubling `bif`.
+    fn switch_period_doubling(
+        &mut self,
+        b: usize,
+        hb: &HbOptions,
+        bif: &Bifurcation,
+        origin: Origin,
+        level: usize,
+    ) -> Result<(), HbError> {
+        let opts = LocateOptions::default();
+        let h = self.req.step * norm2(&bif.q).max(f64::MIN_POSITIVE);
+        let (branch, q1, w1) = period_doubled_start(Frequency(self.problem), hb, bif, h, &opts)
+            .map_err(trace_error)?;
+        let hb2 = branch.options().clone();
+        let mut x0 = q1;
+        x0.push(w1);
+        if self.known(&hb2, &x0, 0.25 * h) {
+            self.search.duplicates += 1;
+            return Ok(());
+        }
+        self.trace(Pending {
+            hb: hb2,
+            x0,
+            direction: sign(w1 - bif.lambda),
+            kind: BranchKind::PeriodDoubling,
+            parent: Some(b),
+            origin: Some(origin),
+            level,
+        })?;
+        Ok(())
+    }
+
+    /// The torus branch of the Neimark–Sacker point `bif` (its points read
+    /// without error estimates).
+    fn torus_at(
+        &mut self,
+        b: usize,
+        hb: &HbOptions,
+        bif: &Bifurcation,
+        origin: Origin,
+        level: usize,
+    ) -> Result<(), HbError> {
+        if !self.room() {
+            return Ok(());
+        }
+        let ns = NeimarkSackerStart {
+            coeffs: &bif.q,
+            harmonics: hb.harmonics,
+            lambda: bif.lambda,
+            multipliers: &bif.multipliers,
+        };
+        let options = TorusOptions {
+            subharmonic: hb.subharmonic,
+            ..self.req.torus
+        };
+        let start = torus_start(
+            Frequency(self.problem),
+            &ns,
+            &options,
+            0.5 * self.req.step,
+            &LocateOptions::default(),
+        )?;
+        let mut branch = start.branch;
+        let lambda1 = start.first.last().copied().unwrap_or(f64::NAN);
+        let mut copts = self.path_options();
+        copts.max_points = self.req.torus_points;
+        let (path, termination) = super::torus::follow(
+            &mut branch,
+            &start.first,
+            sign(lambda1 - bif.lambda),
+            &copts,
+        )?;
+        let mut points = Vec::with_capacity(path.len());
+        for x in &path {
+            let Some((&lambda, q)) = x.split_last() else {
+                continue;
+            };
+            let m = branch.measures(q, lambda, 0)?;
+            let exponent = branch.normal_exponent(q, lambda);
+            points.push(DiagramPoint {
+                omega: lambda,
+                amplitude: m.amplitude_max,
+                coeffs: Array(
+                    q.get(..q.len().saturating_sub(1))
+                        .unwrap_or_default()
+                        .to_vec(),
+                ),
+                stable: exponent.map(|e| e < 0.0),
+                stability: None,
+                multipliers: None,
+                rotation_number: Some(m.rotation_number),
+                at: false,
+            });
+        }
+        if termination == Termination::MaxPoints {
+            self.search.truncated_branches += 1;
+        }
+        self.branches.push(DiagramBranch {
+            kind: BranchKind::Torus,
+            parent: Some(b),
+            origin: Some(origin),
+            level,
+            harmonics: branch.harmonics().len(),
+            subharmonic: hb.subharmonic,
+            torus_harmonics: branch.harmonics().iter().map(|(a, k)| [a, k]).collect(),
+            points,
+            events: Vec::new(),
+            termination,
+        });
+        self.search.deepest = self.search.deepest.max(level);
+        self.states.push(None);
+        self.located.push(Vec::new());
+        Ok(())
+    }
+
+    /// Both halves of the branch through the fold `(q, ω_f)` with null vector
+    /// `v` (stepped `±h` along it), unless known.
+    fn branches_from_fold(
+        &mut self,
+        q: &[f64],
+        omega: f64,
+        v: &[f64],
+        origin: (Option<usize>, Origin),
+    ) -> Result<(), HbError> {
+        let opts = LocateOptions::default();
+        let hb = self.hb.clone();
+        let mut branch = FamilyBranch::new(Frequency(self.problem), &hb, omega)?;
+        let mut d = v.to_vec();
+        d.push(0.0);
+        let h = self.req.step * norm2(q).max(f64::MIN_POSITIVE);
+        for side in [1.0, -1.0] {
+            let (q1, w1) =
+                switch_branch(&mut branch, q, omega, &d, side * h, &opts).map_err(trace_error)?;
+            let mut x0 = q1;
+            x0.push(w1);
+            if self.known(&hb, &x0, 0.25 * h) {
+                self.search.duplicates += 1;
+                continue;
+            }
+            self.trace(Pending {
+                hb: hb.clone(),
+                x0,
+                direction: sign(w1 - omega),
+                kind: BranchKind::FoldCurve,
+                parent: origin.0,
+                origin: Some(origin.1.clone()),
+                level: 0,
+            })?;
+        }
+        Ok(())
+    }
+
+    /// The folds of every period-one branch followed in the forcing scale
+    /// both ways from 1 over `fold_scale`; a crossing of `s = 1` off the
+    /// known branches starts a branch there.
+    fn fold_curves(&mut self) -> Result<(), HbError> {
+        let Some((lo, hi)) = self.req.fold_scale else {
+            return Ok(());
+        };
+        self.search.fold_scale = Some([lo, hi]);
+        let problem = self.problem;
+        let family = |scale: f64| -> Result<ForcingScale<'_, P>, HbError> {
+            Ok(ForcingScale { problem, scale })
+        };
+        // Only the crossings of s = 1 are kept (each solved at s = 1 by
+        // Newton): the curves are followed with long steps.
+        let copts = super::path_steps(0.05, FOLD_CURVE_DS_MAX, self.req.max_points);
+        let folds: Vec<(usize, Bifurcation)> = self
+            .located
+            .iter()
+            .enumerate()
+            .filter(|(b, _)| matches!(self.states.get(*b), Some(Some((h, _))) if h.subharmonic == self.hb.subharmonic && h.harmonics == self.hb.harmonics))
+            .flat_map(|(b, events)| {
+                events
+                    .iter()
+                    .filter(|e| e.kind == BifurcationKind::Fold)
+                    .filter_map(move |e| e.location.as_ref().ok().map(|l| (b, l.clone())))
+            })
+            .collect();
+        for (b, fold) in folds {
+            for (from, to) in [(lo, hi), (hi, lo)] {
+                self.search.fold_curves += 1;
+                let curve = match fold_curve(
+                    family,
+                    &self.hb,
+                    &fold.q,
+                    fold.lambda,
+                    1.0,
+                    from,
+                    to,
+                    &[1.0],
+                    &copts,
+                ) {
+                    Ok(c) => c,
+                    Err(why) => {
+                        self.search.failures.push(format!(
+                            "fold curve from ω_f = {} on branch {b}: {why}",
+                            fold.lambda
+                        ));
+                        continue;
+                    }
+                };
+                for crossing in curve
+                    .at
+                    .iter()
+                    .filter(|c| (c.omega - fold.lambda).abs() > 1e-6 * fold.lambda)
+                {
+                    let inside = (self.req.from.min(self.req.to)..=self.req.from.max(self.req.to))
+                        .contains(&crossing.omega);
+                    let mut x = crossing.coeffs.clone();
+                    x.push(crossing.omega);
+                    let h = self.req.step * norm2(&crossing.coeffs);
+                    if !inside || self.known(&self.hb, &x, 0.25 * h) {
+                        continue;
+                    }
+                    let origin = Origin {
+                        kind: BifurcationKind::Fold,
+                        omega: crossing.omega,
+                        event: None,
+                    };
+                    if let Err(why) = self.branches_from_fold(
+                        &crossing.coeffs,
+                        crossing.omega,
+                        &crossing.null_vector,
+                        (Some(b), origin),
+                    ) {
+                        self.search
+                            .failures
+                            .push(format!("the fold at ω_f = {}: {why}", crossing.omega));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Deflated Newton at `samples` frequencies; each solution off the known
+    /// branches is traced both ways.
+    fn deflation(&mut self) -> Result<(), HbError> {
+        let n = self.req.samples;
+        if n == 0 {
+            return Ok(());
+        }
+        let (a, b) = (self.req.from, self.req.to);
+        let omegas: Vec<f64> = (0..n)
+            .map(|i| a + (b - a) * (i as f64 + 0.5) / n as f64)
+            .collect();
+        self.search.deflation_omegas = omegas.clone();
+        self.search.deflation_exhausted = true;
+        let opts = SearchOptions {
+            max_amplitude: self.req.max_amplitude,
+            amplitudes: self.req.amplitudes,
+            stability_steps: super::stability_steps(self.hb.harmonics),
+            ..SearchOptions::default()
+        };
+        for omega in omegas {
+            let found = match all_solutions(self.problem, &self.hb, omega, &opts) {
+                Ok(f) => f,
+                Err(why) => {
+                    self.search
+                        .failures
+                        .push(format!("deflation at ω_f = {omega}: {why}"));
+                    continue;
+                }
+            };
+            self.search.deflation_solutions += found.solutions.len();
+            self.search.deflation_exhausted &= found.report.exhausted;
+            for s in found.solutions {
+                let q = s.solution.coeffs;
+                if self.on_branch_at(&q, omega) {
+                    continue;
+                }
+                let mut x0 = q;
+                x0.push(omega);
+                let mut first: Option<usize> = None;
+                for direction in [1.0, -1.0] {
+                    if let Some(i) = first {
+                        // The first half closed on itself: it is the whole branch.
+                        if self
+                            .branches
+                            .get(i)
+                            .is_some_and(|br| br.termination == Termination::Stopped)
+                        {
+                            break;
+                        }
+                    }
+                    let traced = self.trace(Pending {
+                        hb: self.hb.clone(),
+                        x0: x0.clone(),
+                        direction,
+                        kind: BranchKind::Deflation,
+                        parent: first,
+                        origin: None,
+                        level: 0,
+                    });
+                    match traced {
+                        Ok(i) => first = first.or(i),
+                        Err(why) => self
+                            .search
+                            .failures
+                            .push(format!("the orbit found at ω_f = {omega}: {why}")),
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The automatic bifurcation diagram of `problem` over `[req.from, req.to]`
+/// (see the module docs).
+///
+/// # Errors
+/// [`DiagramRequest::validate`]'s; the primary curve's start and path (a
+/// failure on a later branch is recorded in `search.failures`).
+pub fn diagram<P: PeriodicProblem>(
+    problem: &P,
+    hb: &HbOptions,
+    req: &DiagramRequest,
+) -> Result<Diagram, HbError> {
+    req.validate()?;
+    let t0 = Instant::now();
+    let mut s = Search {
+        problem,
+        hb: hb.clone(),
+        req,
+        states: Vec::new(),
+        located: Vec::new(),
+        branches: Vec::new(),
+        search: DiagramSearch {
+            interval: [req.from, req.to],
+            depth: req.depth,
+            deepest: 0,
+            events_beyond_depth: 0,
+            max_branches: req.max_branches,
+            branch_limit_reached: false,
+            duplicates: 0,
+            failures: Vec::new(),
+            fold_curves: 0,
+            fold_scale: None,
+            deflation_omegas: Vec::new(),
+            deflation_solutions: 0,
+            deflation_exhausted: false,
+            truncated_branches: 0,
+        },
+    };
+    let at_start = AtFrequency::new(problem, req.from);
+    let start = ModifiedIhb::new(&at_start, hb.clone())?.solve(req.from, None)?;
+    let mut x0 = start.coeffs;
+    x0.push(req.from);
+    s.trace(Pending {
+        hb: hb.clone(),
+        x0,
+        direction: req.to - req.from,
+        kind: BranchKind::Primary,
+        parent: None,
+        origin: None,
+        level: 0,
+    })?;
+    // Breadth first: every branch's events, then the isola searches, then
+    // the events of what they found.
+    let mut next = 0;
+    let mut searched = false;
+    loop {
+        while next < s.branches.len() {
+            s.switch_at_events(next)?;
+            next += 1;
+        }
+        if searched {
+            break;
+        }
+        s.fold_curves()?;
+        s.deflation()?;
+        searched = true;
+    }
+    Ok(Diagram {
+        branches: s.branches,
+        search: s.search,
+        time_s: t0.elapsed().as_secs_f64(),
+    })
+}
