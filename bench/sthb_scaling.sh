@@ -8,7 +8,7 @@
 #   bench/sthb_scaling.sh --baseline PATH      also the `ivt` CLI at PATH (the tree
 #                                              before issue 28), each size cut at
 #                                              $BASELINE_TIMEOUT s (default 300)
-# The timings come from the ignored test `scaling` of crates/ivt-hb/tests/sthb_scale.rs
+# The timings come from the ignored test `scaling` of crates/ivt-sthb/tests/sthb_scale.rs
 # (CPU seconds from /proc, so a loaded machine inflates wall time, not the CPU column).
 # Needs python3 with numpy and matplotlib (the repository's .venv if present).
 set -euo pipefail
@@ -19,7 +19,7 @@ py=python3
 [ -x .venv/bin/python ] && py=.venv/bin/python
 tmp=$(mktemp)
 cut_s=${BASELINE_TIMEOUT:-300}
-SIZES="$sizes" CARGO_BUILD_JOBS=${CARGO_BUILD_JOBS:-2} cargo test --release -q -p ivt-hb \
+SIZES="$sizes" CARGO_BUILD_JOBS=${CARGO_BUILD_JOBS:-2} cargo test --release -q -p ivt-sthb \
   --test sthb_scale -- --ignored --exact scaling --nocapture 2>/dev/null |
   grep '^{' | sed 's/^{/{"solver": "sthb", /' >"$tmp"
 if [ "${1:-}" = "--baseline" ]; then
