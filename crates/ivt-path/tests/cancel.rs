@@ -4,7 +4,9 @@
 // A test may index and unwrap (the crate's panic lints guard library code).
 #![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
-use ivt_hb::{Branch, ContinuationOptions, HbError, NewtonCorrector, Step, Stepper, Termination};
+use ivt_path::{
+    Branch, ContinuationOptions, NewtonCorrector, PathError, Step, Stepper, Termination,
+};
 
 /// x² + λ² = 1.
 struct Circle;
@@ -21,7 +23,7 @@ impl Branch for Circle {
     }
 }
 
-fn start<'b>(c: &'b mut Circle, o: &ContinuationOptions) -> Result<Stepper<'b, Circle>, HbError> {
+fn start<'b>(c: &'b mut Circle, o: &ContinuationOptions) -> Result<Stepper<'b, Circle>, PathError> {
     Stepper::new(
         c,
         Box::new(NewtonCorrector::new(1, o)),
@@ -50,7 +52,7 @@ fn a_cancelled_path_stops_before_its_next_step() {
     let mut after = start(&mut fresh, &opts).unwrap();
     assert!(matches!(after.next(), Step::Point(_)));
     assert!(matches!(after.next(), Step::Point(_)));
-    opts.max_points = ivt_hb::limits::MAX_PATH_POINTS + 1;
+    opts.max_points = ivt_path::limits::MAX_PATH_POINTS + 1;
     let refused = start(&mut fresh, &opts).err().unwrap().to_string();
     assert!(
         refused.contains("max_points = 100001 exceeds the limit of 100000"),
