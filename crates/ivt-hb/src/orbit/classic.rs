@@ -7,8 +7,8 @@ use crate::orbit::galerkin::GalerkinJacobian;
 use crate::orbit::ihb::{validate_omega, HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
 use ivt_num::vector::matvec;
+use ivt_num::BroydenStats;
 use ivt_num::{newton, NewtonOptions, NewtonSystem, NewtonWorkspace};
-use ivt_num::{BroydenStats, SolveError};
 use std::convert::Infallible;
 
 /// Newton–Galerkin solver with reusable buffers.
@@ -116,7 +116,7 @@ impl<P: PeriodicProblem> ClassicIhb<P> {
             galerkin: &mut self.galerkin,
             omega_f,
         };
-        let stats = newton(&mut sys, &mut q, &mut self.newton, &opts).map_err(SolveError::from)?;
+        let stats = newton(&mut sys, &mut q, &mut self.newton, &opts)?;
         Ok(HbSolution {
             coeffs: q,
             omega_f,

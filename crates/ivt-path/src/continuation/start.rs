@@ -54,9 +54,6 @@ pub fn correct_at_fixed_lambda<S: Branch>(
     match newton(&mut fixed, u, &mut NewtonWorkspace::new(m), &nopts) {
         Ok(stats) => Ok(stats.iterations),
         Err(SolveError::SingularJacobian { .. }) => Err(PathError::SingularStart { lambda }),
-        Err(e) => Err(PathError::ContinuationStart {
-            lambda,
-            cause: SolveError::from(e),
-        }),
+        Err(e) => Err(PathError::ContinuationStart { lambda, cause: e }),
     }
 }

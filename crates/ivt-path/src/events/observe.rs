@@ -148,6 +148,8 @@ impl<B: Branch, E> Observer<B> for EventObserver<B, E> {
 ///
 /// # Errors
 /// The observer's error.
+// The pair (path, events) is the result's shape, read at once by every caller.
+#[allow(clippy::type_complexity)]
 pub fn observe<B: Branch, O: Observer<B> + ?Sized>(
     stepper: &mut Stepper<'_, B>,
     observer: &mut O,
