@@ -8,7 +8,7 @@
 //!
 //! Its solvers: damped Newton ([`crate::newton()`], [`crate::newton_bordered`]),
 //! Broyden ([`crate::broyden_solve`]), the chord iteration on a given
-//! factorization ([`crate::chord`]) and deflated Newton
+//! factorization ([`crate::chord()`]) and deflated Newton
 //! ([`crate::deflated_newton`]). Stopping is not failing: a converged solve
 //! returns its iteration count, a verdict of the solver's own (a step test,
 //! a divergence rule) is a [`StepCheck`].

@@ -137,7 +137,7 @@ pub struct Element {
 
 /// The model DOFs `elements` act on (each `a` and `b`), sorted and without
 /// repeats: the nonlinear DOFs a large model is condensed onto
-/// ([`crate::condense`]), so that an element's DOFs name model DOFs on the
+/// (ivt-condense), so that an element's DOFs name model DOFs on the
 /// condensed path as on a dense [`ElementProblem`].
 #[must_use]
 pub fn element_dofs(elements: &[Element]) -> Vec<usize> {

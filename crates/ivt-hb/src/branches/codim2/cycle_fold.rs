@@ -66,7 +66,7 @@ pub type CycleFoldCurve = Curve<CycleFoldPoint>;
 ///
 /// # Errors
 /// [`HbError::InvalidInput`] for sizes or bounds (`nu_start` must lie in the
-/// interval); `family(mu, nu_start)`'s error; [`PathError::SingularStart`](ivt_path::PathError::SingularStart)
+/// interval); `family(mu, nu_start)`'s error; [`PathError::SingularStart`]
 /// if no null vector is found at the start; the start's failures as
 /// [`follow_residual`](ivt_path::continuation::follow_residual)'s. Later, a (μ, ν) where `family` fails is a failed step,
 /// and a failed `at` point is left out (the curve is kept).
