@@ -44,7 +44,8 @@ pub use autonomous::{limit_cycle, limit_cycle_branch, LimitCycle, LimitCycleBran
 pub use backbone::{backbone, Backbone, BackboneOptions, BackbonePoint};
 pub use branch::{Branch, ResidualBranch};
 pub use broyden::{
-    broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
+    broyden_solve, BlockDiagonal, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError,
+    System,
 };
 pub use classic::ClassicIhb;
 pub use codim2::{fold_curve, neimark_sacker_points, FoldCurve, FoldPoint, NeimarkSackerPoint};
