@@ -400,14 +400,13 @@ impl BroydenWorkspace {
         if ss == 0.0 || !ss.is_finite() {
             return false;
         }
-        // u = y − B s, masked on the exact rows; untracked, B s = −t r (B = H⁻¹).
+        // u = y − B s, masked on the exact rows, with B s = −t r: the step is
+        // s = −t H r and B = H⁻¹ (tracked or not, every change of one is made
+        // to the other), so no product with B is needed.
         let y = self.r_trial.iter().zip(&self.r);
-        for (i, ((u, (rt, r)), brow)) in self.u.iter_mut().zip(y).zip(rows(&self.b, m)).enumerate()
-        {
+        for (i, (u, (rt, r))) in self.u.iter_mut().zip(y).enumerate() {
             *u = if self.exact_rows.contains(&i) {
                 0.0
-            } else if self.track_jacobian {
-                (rt - r) - dot(brow, &self.dx)
             } else {
                 rt - (1.0 - t) * r
             };
