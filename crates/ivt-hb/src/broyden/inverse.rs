@@ -11,9 +11,12 @@ use ivt_num::vector::{axpy, dot, matvec};
 
 use super::BlockDiagonal;
 
-/// Stored updates before they are folded into the dense matrix (a fold costs
-/// `rank` rank-one passes, the same as updating densely all along).
-const MAX_RANK: usize = 16;
+/// Most stored updates on a block-diagonal base (then folded into the dense
+/// matrix): each product with `H` costs 2·rank·m beyond the base, against the
+/// m² of a dense one.
+fn max_rank(m: usize) -> usize {
+    (m / 4).clamp(2, 16)
+}
 
 /// `H` as base plus factor pairs (see the module doc).
 #[derive(Debug, Clone)]
@@ -102,14 +105,19 @@ impl InverseJacobian {
         }
     }
 
-    /// `H ← H + p qᵀ`, stored as a pair (folded into the dense matrix once
-    /// [`MAX_RANK`] pairs are stored).
+    /// `H ← H + p qᵀ`: stored as a pair while the base is block-diagonal and
+    /// fewer than [`max_rank`] pairs are stored, else applied to the dense
+    /// matrix (with a dense base, pairs would make every product dearer).
     pub(super) fn add_rank_one(&mut self, p: impl Iterator<Item = f64>, q: &[f64]) {
-        if self.low_rank.len() >= 2 * MAX_RANK * self.m {
-            self.dense();
+        let m = self.m;
+        if self.blocks_active && self.low_rank.len() < 2 * max_rank(m) * m {
+            self.low_rank.extend(p.take(m));
+            self.low_rank.extend_from_slice(q);
+            return;
         }
-        self.low_rank.extend(p.take(self.m));
-        self.low_rank.extend_from_slice(q);
+        for (pi, hrow) in p.zip(rows_mut(self.dense(), m)) {
+            axpy(pi, q, hrow);
+        }
     }
 }
 

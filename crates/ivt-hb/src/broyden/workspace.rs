@@ -400,35 +400,33 @@ impl BroydenWorkspace {
         if ss == 0.0 || !ss.is_finite() {
             return false;
         }
-        // u = y − B s, masked on the exact rows, with B s = −t r: the step is
-        // s = −t H r and B = H⁻¹ (tracked or not, every change of one is made
-        // to the other), so no product with B is needed.
+        // u = y − B s, masked on the exact rows; untracked, B s = −t r (B = H⁻¹).
         let y = self.r_trial.iter().zip(&self.r);
-        for (i, (u, (rt, r))) in self.u.iter_mut().zip(y).enumerate() {
+        for (i, ((u, (rt, r)), brow)) in self.u.iter_mut().zip(y).zip(rows(&self.b, m)).enumerate()
+        {
             *u = if self.exact_rows.contains(&i) {
                 0.0
+            } else if self.track_jacobian {
+                (rt - r) - dot(brow, &self.dx)
             } else {
                 rt - (1.0 - t) * r
             };
         }
-        // B ← B + u sᵀ/ss;  H ← H − (H u)(sᵀ H)/(ss + sᵀ H u): densely when B
-        // is tracked, else stored as the pair (−H u/denom, Hᵀ s).
+        // B ← B + u sᵀ/ss;  H ← H − (H u)(sᵀ H)/(ss + sᵀ H u) (kept as the pair
+        // (−H u/denom, Hᵀ s) on a block-diagonal H₀).
         self.h.mul(&self.u, &mut self.hu);
         self.h.mul_transpose(&self.dx, &mut self.sth);
         let denom = ss + dot(&self.dx, &self.hu);
         if denom.abs() <= 1e-14 * ss || !denom.is_finite() {
             return false;
         }
+        self.h
+            .add_rank_one(self.hu.iter().map(|hu| -hu / denom), &self.sth);
         if self.track_jacobian {
-            for (hui, hrow) in self.hu.iter().zip(rows_mut(self.h.dense(), m)) {
-                axpy(-hui / denom, &self.sth, hrow);
-            }
             for (ui, brow) in self.u.iter().zip(rows_mut(&mut self.b, m)) {
                 axpy(ui / ss, &self.dx, brow);
             }
         } else {
-            self.h
-                .add_rank_one(self.hu.iter().map(|hu| -hu / denom), &self.sth);
             self.b_current = false;
         }
         // A full untracked step with no masked row has u = r_trial, so the next
