@@ -30,7 +30,7 @@ FloatArray = npt.NDArray[np.float64]
 # at most 2 % of the band: the peaks are sharp (ζ ≈ 0.12 %), and a hardening
 # peak next to its fold is left as sampled; at the default 15 % every curve
 # still reaches its peak (the stepper rejects a step that jumps across one),
-# within 3.5e-3 on 40 disks (tests/test_sweep_hb.py, measured).
+# within 2.3e-3 on 40 disks (tests/test_sweep_hb.py, measured).
 OPTIONS: Dict[str, Any] = dict(
     omega_from=1150.0, omega_to=1260.0, vectorized=True, stability=False, ds_max=0.02
 )
