@@ -76,14 +76,14 @@ impl StepControl {
     /// step of length `step`, lies too far from it
     /// ([`ContinuationOptions::max_correction`]).
     pub(crate) fn too_far(correction: f64, step: f64, opts: &ContinuationOptions) -> bool {
-        !(correction <= opts.max_correction * step)
+        correction.is_nan() || correction > opts.max_correction * step
     }
 
     /// Whether the direction turned by more than
     /// [`ContinuationOptions::max_turn`] over a step: `cos_turn` is the
     /// cosine of the angle between the two unit directions.
     pub(crate) fn turned(cos_turn: f64, opts: &ContinuationOptions) -> bool {
-        !(cos_turn >= opts.max_turn.min(std::f64::consts::PI).cos())
+        cos_turn.is_nan() || cos_turn < opts.max_turn.min(std::f64::consts::PI).cos()
     }
 
     /// A converged point rejected after a step of length `step` (too far from
