@@ -129,10 +129,12 @@ fn unforced_undamped_orbits_are_reported_once_each_not_per_phase() {
         .collect();
     assert_eq!(amplitudes.len(), 3, "{amplitudes:?}");
     assert!(amplitudes[0] < 1e-12);
-    for (a, h) in amplitudes[1..].iter().zip([1.0, 3.0]) {
+    // The second keeps only its harmonics 3, 9, 15 of 1.4 at n = 20 (three
+    // of its own): its truncation error is larger (measured 7e-5).
+    for ((a, h), tol) in amplitudes[1..].iter().zip([1.0, 3.0]).zip([1e-8, 2e-4]) {
         let w = free_frequency(*a);
         assert!(
-            (w - h * omega).abs() < 1e-8 * w,
+            (w - h * omega).abs() < tol * w,
             "A = {a}: ω(A) = {w}, not {}",
             h * omega
         );
