@@ -69,7 +69,7 @@ pub use floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
 pub use frc::{frequency_response, Frc, FrcFold, FrcOptions, FrcPoint};
 pub use galerkin::GalerkinJacobian;
 pub use hill::{fourier_blocks, hill_multipliers, HillResult};
-pub use hopf::{hopf_points, HopfPoint};
+pub use hopf::{hopf_points, HopfPoint, HopfSearch, Undecided};
 pub use ihb::{HbOptions, HbResidual, HbSolution, HbSolver};
 pub use mathieu::{period_doubling_cascade, CascadeOptions, PeriodDoubling};
 pub use modified::ModifiedIhb;

@@ -55,7 +55,9 @@ pub use fold_curve::{
     SpecialPoint,
 };
 pub use frc::{frc, CurvePoint, EventRecord, FoldPoint, FrcCurve, FrcRequest};
-pub use limit_cycle::{limit_cycle, Cycle, LimitCycleRequest, Oscillator};
+pub use limit_cycle::{
+    limit_cycle, Cycle, LimitCycleRequest, Oscillator, DEFAULT_TOL, MAX_HARMONICS,
+};
 pub use orbit::{orbit, Method, Orbit, OrbitRequest};
 pub use sensitivity::{event_sensitivity, SensitivityRequest, SensitivityResult};
 pub use string::{string, StringCurve, StringFold, StringPoint, StringRequest};
