@@ -32,7 +32,8 @@ pub use branches::switching::{period_doubled_start, switch_branch};
 pub use error::HbError;
 pub use faer::c64;
 pub use ivt_num::{
-    broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError, System,
+    broyden_solve, BlockDiagonal, BroydenOptions, BroydenStats, BroydenWorkspace, SolveError,
+    System,
 };
 pub use ivt_path::{Branch, PathError, ResidualBranch};
 pub use ivt_path::{
@@ -53,7 +54,7 @@ pub use problem::{
 };
 pub use stability::floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
 pub use stability::hill::{fourier_blocks, hill_multipliers, HillResult};
-pub use stability::hopf::{hopf_points, HopfPoint};
+pub use stability::hopf::{hopf_points, HopfPoint, HopfSearch, Undecided};
 pub use stability::{
     classify, AdaptiveHsu, Floquet, HsuEstimate, HsuSteps, StabilityAnalyzer, StabilityKind,
 };

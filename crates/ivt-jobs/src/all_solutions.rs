@@ -65,6 +65,12 @@ pub struct SearchBounds {
     pub newton_steps: usize,
     /// Every start's last run found nothing new within the bounds.
     pub exhausted: bool,
+    /// Failed runs that end the search from one start.
+    pub failures_per_start: usize,
+    /// Orbits dropped as time-shifted copies of another (autonomous problems).
+    pub copies_merged: usize,
+    /// The bound `exhausted` refers to, in words.
+    pub bound: String,
 }
 
 /// The keys of `ivt hb all-solutions --json` (`ivt.hb.all_solutions`: the
@@ -113,6 +119,9 @@ pub fn all_solutions<P: PeriodicProblem>(
             max_amplitude: all.report.max_amplitude,
             newton_steps: all.report.max_iter,
             exhausted: all.report.exhausted,
+            failures_per_start: all.report.failures_per_start,
+            copies_merged: all.report.copies_merged,
+            bound: all.report.bound.clone(),
         },
     })
 }

@@ -89,6 +89,19 @@ pub struct HopfRecord {
     pub subcritical: bool,
 }
 
+/// A stretch of p where the Hopf search could not decide
+/// ([`crate::hopf_points`]): no equilibrium there, or a crossing that is
+/// neither a simple Hopf point nor a real eigenvalue through zero.
+#[derive(Debug, Clone, Serialize)]
+pub struct UndecidedRecord {
+    /// One end (the side of `p_from`).
+    pub p_from: f64,
+    /// The other end.
+    pub p_to: f64,
+    /// Why.
+    pub reason: String,
+}
+
 /// A limit cycle of the branch.
 #[derive(Debug, Clone, Serialize)]
 pub struct CycleRecord {
@@ -143,8 +156,12 @@ pub struct CycleFold {
 /// The keys of `ivt.hb.cycle_branch` and `ivt hb cycle-branch --json`.
 #[derive(Debug, Clone, Serialize)]
 pub struct CycleBranchResult {
-    /// Hopf points in order of p from `p_from`.
+    /// Hopf points in order of p from `p_from`: each place where a complex
+    /// pair of the equilibria's eigenvalues crosses the imaginary axis.
     pub hopf: Vec<HopfRecord>,
+    /// Where the search could not decide (empty: every Hopf point on the
+    /// grid's resolution found).
+    pub hopf_undecided: Vec<UndecidedRecord>,
     /// The branch from the first Hopf point, in path order.
     pub points: Vec<CycleRecord>,
     /// Its folds.
@@ -191,6 +208,15 @@ where
                 omega: h.omega,
                 lyapunov: h.lyapunov,
                 subcritical: h.subcritical(),
+            })
+            .collect(),
+        hopf_undecided: branch
+            .undecided
+            .iter()
+            .map(|u| UndecidedRecord {
+                p_from: u.p_from,
+                p_to: u.p_to,
+                reason: u.reason.clone(),
             })
             .collect(),
         points: cycles(&branch.points),

@@ -57,7 +57,7 @@ pub use fold_curve::{
     SpecialPoint,
 };
 pub use frc::{frc, CurvePoint, EventRecord, FoldPoint, FrcCurve, FrcRequest};
-pub use limit_cycle::{limit_cycle, Cycle, LimitCycleRequest};
+pub use limit_cycle::{limit_cycle, Cycle, LimitCycleRequest, DEFAULT_TOL, MAX_HARMONICS};
 pub use ns_points::{neimark_sacker_points, NeimarkSackerPoint};
 pub use orbit::{orbit, Method, Orbit, OrbitRequest};
 pub use sensitivity::{event_sensitivity, SensitivityRequest, SensitivityResult};

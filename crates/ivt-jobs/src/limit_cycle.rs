@@ -24,19 +24,43 @@ pub struct LimitCycleRequest {
     pub x0: Option<Vec<f64>>,
     /// x of DOF 0 in the default start state.
     pub amplitude: f64,
+    /// The relative accuracy asked of ω and the coefficients
+    /// ([`DEFAULT_TOL`]); 0: the harmonics stay as given (the estimate is
+    /// still reported).
+    pub tol: f64,
 }
 
 impl Default for LimitCycleRequest {
-    /// ω ≈ 1, start x_0 = cos τ.
+    /// ω ≈ 1, start x_0 = cos τ, `tol` [`DEFAULT_TOL`].
     fn default() -> Self {
         Self {
             omega_guess: 1.0,
             guess: None,
             x0: None,
             amplitude: 1.0,
+            tol: DEFAULT_TOL,
         }
     }
 }
+
+/// The default relative accuracy of a limit cycle's ω and coefficients.
+pub const DEFAULT_TOL: f64 = 1e-8;
+
+/// Most harmonics the accuracy loop grows n to; beyond, the result says
+/// `accuracy: "not met"` with its estimate.
+pub const MAX_HARMONICS: usize = 160;
+
+/// The estimate is this multiple of the change from n to the next n: the
+/// error of n is at most the change plus the error of the next n, which is
+/// at most half that of n where the harmonics converge (each step adds
+/// half the harmonics).
+const ESTIMATE_FACTOR: f64 = 2.0;
+
+/// The estimate's floor: the accuracy of the Newton solves themselves (their
+/// last step is below 1e-10 relative and Newton converges quadratically) and
+/// of double-precision sums over the harmonics; below it a change between n
+/// and the next n is rounding.
+const ESTIMATE_FLOOR: f64 = 1e-11;
 
 impl LimitCycleRequest {
     /// # Errors
@@ -56,6 +80,12 @@ impl LimitCycleRequest {
                     "give either `guess` (coefficients) or `x0` (a state), not both".into(),
                 ));
             }
+        }
+        if !(self.tol.is_finite() && self.tol >= 0.0) {
+            return Err(HbError::InvalidInput(format!(
+                "tol = {} must be finite and ≥ 0 (0: the harmonics as given)",
+                self.tol
+            )));
         }
         Ok(())
     }
@@ -80,9 +110,28 @@ pub struct Cycle {
     pub iterations: usize,
     /// ‖r‖₂ at the result.
     pub residual_norm: f64,
+    /// Harmonics n of the result.
+    pub harmonics: usize,
+    /// Half the AFT samples N of the result.
+    pub samples: usize,
+    /// Relative error estimate of ω and of the coefficients (relative to
+    /// their largest): twice the largest change of either from this n to
+    /// the next, 1.5·n, and at least 1e-11 (the solves' floor); None if the
+    /// next n did not converge.
+    pub error_estimate: Option<f64>,
+    /// The relative accuracy asked (0: none, n as given).
+    pub tol: f64,
+    /// `"met"` (the estimate is at most `tol`), `"not met"` (n reached
+    /// [`MAX_HARMONICS`], or the next n failed, first), or `"not asked"`
+    /// (`tol` = 0).
+    pub accuracy: &'static str,
 }
 
-/// The limit cycle of `problem` near `req`'s start.
+/// The limit cycle of `problem` near `req`'s start, with its error
+/// estimate; with `req.tol` > 0 the harmonics grow (n → 1.5·n, samples in
+/// proportion) until the estimate meets it, up to [`MAX_HARMONICS`]
+/// ([`Cycle::accuracy`]). Samples N ≤ n are raised to the default
+/// proportion 64 per 20 harmonics.
 ///
 /// # Errors
 /// [`LimitCycleRequest::validate`]'s, those of [`ivt_hb::limit_cycle`]
@@ -94,6 +143,14 @@ pub fn limit_cycle<P: PeriodicProblem>(
     req: &LimitCycleRequest,
 ) -> Result<Cycle, HbError> {
     req.validate()?;
+    ivt_hb::branches::autonomous::require_autonomous(problem, "a limit cycle")?;
+    // Too few samples for n (e.g. n = 80 with the default 64): the default
+    // proportion, 64 per 20 harmonics.
+    let mut hb = hb.clone();
+    if hb.n_half <= hb.harmonics {
+        hb.n_half = samples_for(hb.harmonics, 20, 64);
+    }
+    let hb = &hb;
     let steps = stability_steps(hb.harmonics);
     let lc = match &req.guess {
         Some(start) => ivt_hb::limit_cycle(problem, hb, req.omega_guess, start, steps)?,
@@ -117,6 +174,91 @@ pub fn limit_cycle<P: PeriodicProblem>(
             )?
         }
     };
+    certified(problem, hb, req.tol, lc)
+}
+
+/// The next n of the accuracy loop: half as many harmonics more.
+fn next_harmonics(n: usize) -> usize {
+    n + n.div_ceil(2).max(2)
+}
+
+/// Half the AFT samples for `n` harmonics, in the proportion `samples/from`
+/// of the caller's options (so aliasing does not grow with n).
+fn samples_for(n: usize, from: usize, samples: usize) -> usize {
+    (samples * n).div_ceil(from.max(1)).max(n + 1)
+}
+
+/// `coeffs` (`2n + 1` per DOF) with `to` harmonics (zeros added).
+fn padded(coeffs: &[f64], n: usize, to: usize) -> Vec<f64> {
+    coeffs
+        .chunks_exact(2 * n + 1)
+        .flat_map(|block| ivt_hb::orbit::aft::embed_subharmonic(block, 1, to))
+        .collect()
+}
+
+/// max(|Δω|/ω, max|Δq|/max|q|) between the cycle `coarse` (n harmonics) and
+/// `fine` (more).
+fn change(coarse: &ivt_hb::HbSolution, fine: &ivt_hb::HbSolution) -> f64 {
+    let q = padded(&coarse.coeffs, coarse.harmonics, fine.harmonics);
+    let size = fine.coeffs.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let dq = q
+        .iter()
+        .zip(&fine.coeffs)
+        .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+    let dw = (coarse.omega_f - fine.omega_f).abs() / fine.omega_f.abs();
+    dw.max(dq / size)
+}
+
+/// The cycle `lc` (at `hb`) with its error estimate, n grown until the
+/// estimate meets `tol` (issue 41): at each n the cycle is solved again at
+/// 1.5·n (samples in proportion) from its own coefficients, and the
+/// estimate is [`ESTIMATE_FACTOR`] times the change. The reported cycle is
+/// the last n whose estimate is known (its multipliers by Hsu at that n).
+fn certified<P: PeriodicProblem>(
+    problem: &P,
+    hb: &HbOptions,
+    tol: f64,
+    lc: ivt_hb::LimitCycle,
+) -> Result<Cycle, HbError> {
+    let (n0, s0) = (hb.harmonics, hb.n_half);
+    let mut current = lc.solution.clone();
+    let mut estimate = None;
+    let mut met = false;
+    loop {
+        let n = current.harmonics;
+        let next = next_harmonics(n);
+        let mut fine_hb = hb.clone();
+        fine_hb.harmonics = next;
+        fine_hb.n_half = samples_for(next, n0, s0);
+        let guess = padded(&current.coeffs, n, next);
+        let Ok(fine) = ivt_hb::branches::autonomous::limit_cycle_orbit(
+            problem,
+            &fine_hb,
+            current.omega_f,
+            &guess,
+        ) else {
+            break;
+        };
+        let e = (ESTIMATE_FACTOR * change(&current, &fine)).max(ESTIMATE_FLOOR);
+        estimate = Some(e);
+        if e <= tol {
+            met = true;
+            break;
+        }
+        if tol == 0.0 || next > MAX_HARMONICS {
+            break;
+        }
+        current = fine;
+        estimate = None;
+    }
+    let n = current.harmonics;
+    let samples = if n == n0 { s0 } else { samples_for(n, n0, s0) };
+    let steps = stability_steps(n);
+    let lc = if n == n0 {
+        lc
+    } else {
+        ivt_hb::branches::autonomous::classify_cycle(problem, current, steps)?
+    };
     Ok(Cycle {
         omega: lc.omega(),
         period: lc.period(),
@@ -126,6 +268,15 @@ pub fn limit_cycle<P: PeriodicProblem>(
         stability: lc.kind,
         iterations: lc.solution.stats.iterations,
         residual_norm: lc.solution.stats.residual_norm,
+        harmonics: n,
+        samples,
+        error_estimate: estimate,
+        tol,
+        accuracy: match (met, tol == 0.0) {
+            (_, true) => "not asked",
+            (true, false) => "met",
+            (false, false) => "not met",
+        },
     })
 }
 

@@ -53,7 +53,7 @@ impl Deflation<'_> {
 /// Deflated Newton on `sys` from `x` (overwritten by the last iterate):
 /// full deflated steps (no line search), converged at `‖F‖₂ ≤ opts.ftol`,
 /// at most `opts.max_iter` steps; the Jacobian's factorization as in
-/// [`crate::newton()`] (`accept_near_singular` honoured, the other
+/// [`crate::newton()`] (`accept_near_singular` and `scale_rows` honoured, the other
 /// line-search and step-test options unused).
 ///
 /// # Errors
@@ -78,7 +78,7 @@ pub fn deflated_newton<S: NewtonSystem + ?Sized>(
         sys,
         deflation,
         ws,
-        accept_near_singular: opts.accept_near_singular,
+        opts,
         grad: vec![0.0; n],
         residual_evals: 0,
         jacobian_evals: 0,
@@ -105,7 +105,8 @@ struct Deflated<'a, 'r, S: ?Sized> {
     sys: &'a mut S,
     deflation: &'a Deflation<'r>,
     ws: &'a mut NewtonWorkspace,
-    accept_near_singular: bool,
+    /// `accept_near_singular` and `scale_rows` apply to the factorization.
+    opts: &'a NewtonOptions,
     /// `∇ln M` at the iterate.
     grad: Vec<f64>,
     residual_evals: usize,
@@ -129,11 +130,7 @@ impl<S: NewtonSystem + ?Sized> Solver for Deflated<'_, '_, S> {
             .jacobian(x, &mut ws.jac)
             .map_err(SolveError::Eval)?;
         self.jacobian_evals += 1;
-        if !ws.factor(&[], self.accept_near_singular) {
-            return Err(at.singular());
-        }
-        ws.dx.iter_mut().zip(&ws.r).for_each(|(d, r)| *d = -r);
-        if ws.lu.solve(&mut ws.dx).is_err() || !ws.dx.iter().all(|v| v.is_finite()) {
+        if !ws.newton_step(&[], self.opts) {
             return Err(at.singular());
         }
         self.deflation.log_gradient(x, &mut self.grad);

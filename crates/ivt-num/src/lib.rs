@@ -62,7 +62,9 @@ mod test_rng;
 pub mod vector;
 
 pub use bordered::{BorderedError, BorderedLu};
-pub use broyden::{broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace, System};
+pub use broyden::{
+    broyden_solve, BlockDiagonal, BroydenOptions, BroydenStats, BroydenWorkspace, System,
+};
 pub use chord::chord;
 pub use deflation::{deflated_newton, Deflation};
 pub use iteration::{SolveError, StepCheck};

@@ -90,6 +90,12 @@ pub struct NewtonOptions {
     /// extended systems at a bifurcation are regular in exact arithmetic but
     /// may be badly scaled. Default `false`.
     pub accept_near_singular: bool,
+    /// Factor the Jacobian with each row (and the residual entry on it)
+    /// scaled to unit ∞-norm: the step is the same in exact arithmetic, but
+    /// the singularity test then sees how separated the rows are, not how
+    /// their sizes differ (harmonic h of a harmonic-balance Jacobian grows
+    /// as h²ω²). Border rows are not scaled. Default `false`.
+    pub scale_rows: bool,
 }
 
 impl Default for NewtonOptions {
@@ -104,6 +110,7 @@ impl Default for NewtonOptions {
             full_step_without_descent: false,
             accept_below: 0.0,
             accept_near_singular: false,
+            scale_rows: false,
         }
     }
 }
@@ -158,6 +165,8 @@ pub struct NewtonWorkspace {
     pub(crate) r: Vec<f64>,
     r_trial: Vec<f64>,
     pub(crate) history: Vec<f64>,
+    /// The ∞-norms the Jacobian's rows were divided by (`scale_rows`).
+    row_sizes: Vec<f64>,
 }
 
 impl NewtonWorkspace {
@@ -177,6 +186,7 @@ impl NewtonWorkspace {
             r: vec![0.0; n],
             r_trial: vec![0.0; n],
             history: Vec::with_capacity(64),
+            row_sizes: Vec::new(),
         }
     }
 
@@ -201,15 +211,38 @@ impl NewtonWorkspace {
         self.lu.det_sign()
     }
 
-    /// Factors the Jacobian in `jac` bordered by `rows`; `false` when the
-    /// factor is unusable (singular, unless `accept_near_singular` takes a
-    /// factor singular to rounding; or the sizes disagree).
-    pub(crate) fn factor(&mut self, rows: &[f64], accept_near_singular: bool) -> bool {
-        match self.lu.factor_rows(&self.jac, rows) {
-            Ok(()) => true,
-            Err(BorderedError::Singular) => accept_near_singular,
-            Err(BorderedError::Size { .. }) => false,
+    /// Factors the Jacobian in `jac` bordered by `rows` (its rows scaled
+    /// under `opts.scale_rows`) and solves for the Newton step
+    /// `dx = −J⁻¹ r`; `false` when the factor is unusable (singular, unless
+    /// `accept_near_singular` takes a factor singular to rounding; or the
+    /// sizes disagree) or the step is not finite.
+    pub(crate) fn newton_step(&mut self, rows: &[f64], opts: &NewtonOptions) -> bool {
+        self.row_sizes.clear();
+        if opts.scale_rows {
+            let n = self.dx.len().max(1);
+            for row in self.jac.chunks_exact_mut(n) {
+                let size = row.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                if size > 0.0 && size.is_finite() {
+                    row.iter_mut().for_each(|v| *v /= size);
+                    self.row_sizes.push(size);
+                } else {
+                    self.row_sizes.push(1.0);
+                }
+            }
         }
+        let factored = match self.lu.factor_rows(&self.jac, rows) {
+            Ok(()) => true,
+            Err(BorderedError::Singular) => opts.accept_near_singular,
+            Err(BorderedError::Size { .. }) => false,
+        };
+        if !factored {
+            return false;
+        }
+        self.dx.iter_mut().zip(&self.r).for_each(|(d, r)| *d = -r);
+        for (d, size) in self.dx.iter_mut().zip(&self.row_sizes) {
+            *d /= size;
+        }
+        self.lu.solve(&mut self.dx).is_ok() && self.dx.iter().all(|v| v.is_finite())
     }
 }
 
@@ -385,11 +418,7 @@ impl<S: NewtonSystem + ?Sized> Solver for Newton<'_, '_, S> {
             .jacobian(x, &mut ws.jac)
             .map_err(SolveError::Eval)?;
         self.jacobian_evals += 1;
-        if !ws.factor(self.border.rows, self.opts.accept_near_singular) {
-            return Err(at.singular());
-        }
-        ws.dx.iter_mut().zip(&ws.r).for_each(|(d, r)| *d = -r);
-        if ws.lu.solve(&mut ws.dx).is_err() || !ws.dx.iter().all(|v| v.is_finite()) {
+        if !ws.newton_step(self.border.rows, self.opts) {
             return Err(at.singular());
         }
         let opts = self.opts;

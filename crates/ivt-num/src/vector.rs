@@ -9,6 +9,7 @@ const LANES: usize = 8;
 
 /// Dot product over the common length, summed in `LANES` interleaved partial sums
 /// (a different, not less accurate, rounding order than a left-to-right sum).
+#[inline]
 pub fn dot(x: &[f64], y: &[f64]) -> f64 {
     let n = x.len().min(y.len());
     let (x, y) = (x.get(..n).unwrap_or(x), y.get(..n).unwrap_or(y));
@@ -24,11 +25,13 @@ pub fn dot(x: &[f64], y: &[f64]) -> f64 {
 }
 
 /// Euclidean norm.
+#[inline]
 pub fn norm2(x: &[f64]) -> f64 {
     dot(x, x).sqrt()
 }
 
 /// `y ← y + alpha·x` over the common length.
+#[inline]
 pub fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
     for (yi, xi) in y.iter_mut().zip(x) {
         *yi += alpha * xi;
@@ -37,6 +40,7 @@ pub fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
 
 /// `y = A x` for row-major `A` (`rows×cols`), over the first `rows` entries
 /// of `y` and the whole rows `A` has (`cols = 0`: empty sums, `y = 0`).
+#[inline]
 pub fn matvec(a: &[f64], rows: usize, cols: usize, x: &[f64], y: &mut [f64]) {
     if cols == 0 {
         y.iter_mut().take(rows).for_each(|v| *v = 0.0);

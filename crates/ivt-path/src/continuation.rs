@@ -4,8 +4,11 @@
 //! `predictor.rs`), corrects with a [`PathCorrector`] (`corrector/`: Broyden
 //! on the secant model with the exact constraint row, Eq. 72–77, or chord
 //! and Newton on the exact bordered Jacobian), and adapts the step by one
-//! rule (`step_control.rs`: the corrector's effort, halving on failure, the
-//! cap [`ContinuationOptions::step_cap`], landing on the bounds of λ). A sign
+//! rule (`step_control.rs`: the corrector's effort, halving on failure and on
+//! a rejected point — one whose direction turned by more than
+//! [`ContinuationOptions::max_turn`] or that lies farther than
+//! [`ContinuationOptions::max_correction`]`·Δη` from its prediction — the cap
+//! [`ContinuationOptions::step_cap`], landing on the bounds of λ). A sign
 //! change of the direction's λ component marks a turn in λ ([`Turn`]).
 
 use ivt_num::vector::norm2;
@@ -56,6 +59,20 @@ pub struct ContinuationOptions {
     pub target_iter: usize,
     /// Step growth factor after an easy corrector.
     pub growth: f64,
+    /// The largest angle (radians) between the directions at two consecutive
+    /// points: a step whose direction turned by more is rejected and redone
+    /// at half the length (COCO's `al_max`, the angle between consecutive
+    /// tangents of its 1-d atlas). Without it a step longer than a sharp
+    /// resonance is wide lands on the far side of the peak, and the curve
+    /// misses it; a tight bound spends points on every bend.
+    /// Default 1 (about 57°); `π` switches the check off.
+    pub max_turn: f64,
+    /// The largest distance of the corrected point from the prediction,
+    /// relative to the step Δη: farther, the corrector converged onto
+    /// another part of the branch, and the step is rejected and redone at
+    /// half the length (the corrector-distance test of HomCont and MatCont).
+    /// Default 0.5; `f64::INFINITY` switches the check off.
+    pub max_correction: f64,
     /// Corrector options (tolerance, iteration limit, refresh policy).
     pub broyden: BroydenOptions,
     /// [`NewtonCorrector`] only: predict along the tangent and the
@@ -88,6 +105,8 @@ impl Default for ContinuationOptions {
             lambda_max: f64::INFINITY,
             target_iter: 10,
             growth: 1.5,
+            max_turn: 1.0,
+            max_correction: 0.5,
             broyden: BroydenOptions {
                 max_iter: 25,
                 ..BroydenOptions::default()

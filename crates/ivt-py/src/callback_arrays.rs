@@ -72,6 +72,39 @@ impl SampleArrays {
     }
 }
 
+/// ValueError naming `what` when `ob` holds complex numbers: a Python or
+/// numpy complex scalar, a complex numpy array, or a list or tuple with a
+/// complex entry. Converting them to floats would drop the imaginary part
+/// silently (numpy only warns), so every complex input is refused.
+pub(crate) fn refuse_complex(what: &str, ob: &Bound<'_, PyAny>) -> PyResult<()> {
+    if holds_complex(ob, 2) {
+        return Err(PyValueError::new_err(format!(
+            "{what} is complex: its imaginary part would be dropped. Complex inputs are refused \
+             (structural damping K(1 + iη) included: give a real damping matrix c, e.g. \
+             c = η·k/ω at one frequency ω, or Rayleigh c = α·m + β·k)"
+        )));
+    }
+    Ok(())
+}
+
+/// Whether `ob` is complex ([`refuse_complex`]), looking `depth` levels
+/// into lists and tuples.
+fn holds_complex(ob: &Bound<'_, PyAny>, depth: usize) -> bool {
+    use numpy::{PyArrayDescrMethods, PyUntypedArray};
+    use pyo3::types::{PyComplex, PyList, PyTuple};
+    if ob.is_instance_of::<PyComplex>() {
+        return true;
+    }
+    if let Ok(a) = ob.cast::<PyUntypedArray>() {
+        return a.dtype().kind() == b'c';
+    }
+    depth > 0
+        && (ob.is_instance_of::<PyList>() || ob.is_instance_of::<PyTuple>())
+        && ob
+            .try_iter()
+            .is_ok_and(|it| it.flatten().any(|e| holds_complex(&e, depth - 1)))
+}
+
 /// A callback's array result as its shape and its values in row-major order,
 /// or `None` if it is not an array of floats. A C-contiguous float64 array is
 /// copied directly; anything else is converted by numpy first.

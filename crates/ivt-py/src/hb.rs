@@ -270,14 +270,23 @@ user_system_fn! {
 /// a transient that comes to rest raises ivt.hb.ConvergenceError naming the equilibrium).
 /// g(x, v, theta): theta is the phase ω t (an autonomous g ignores it);
 /// `vectorized` and `jac` as in `solve`.
+/// Accuracy (issue 41): `tol` (default 1e-8) is the relative accuracy asked
+/// of ω and the coefficients. The cycle is solved again at 1.5·n (samples in
+/// proportion) from its own coefficients; "error_estimate" is twice the
+/// largest relative change of ω or a coefficient (at least 1e-11, the solves'
+/// floor); while it exceeds `tol`, n
+/// grows by half (up to 160) and "accuracy" says "met" or "not met" (with
+/// the estimate); `tol=0` keeps n as given ("not asked", the estimate still
+/// reported). `n` is the first n; `samples` ≤ n is raised to 3.2·n.
 /// Returns {"omega", "period", "coeffs", "multipliers" ([[re, im], ...],
 /// the trivial +1 included), "stable" (all others inside the unit circle),
-/// "stability", "iterations", "residual_norm"}.
+/// "stability", "iterations", "residual_norm", "harmonics", "samples",
+/// "error_estimate", "tol", "accuracy"}.
 fn limit_cycle<'py>(py, user, jac;
     omega_guess: f64,
     amplitude: f64 = 1.0,
     guess: Option<&Bound<'py, PyAny>> = None;
-    tol: f64 = 0.0,
+    tol: f64 = 1e-8,
     x0: Option<Vec<f64>> = None,
 ) {
     if !(omega_guess.is_finite() && omega_guess > 0.0) {
@@ -285,13 +294,19 @@ fn limit_cycle<'py>(py, user, jac;
             "argument `omega_guess` = {omega_guess} must be finite and > 0 (a cycle's frequency)"
         )));
     }
-    let (problem, opts) = user.setup(None, 1, tol)?;
+    let mut user = user;
+    // `samples` ≤ n: the default proportion, 64 per 20 harmonics (as the job).
+    if user.keys.n > 0 && user.keys.samples <= user.keys.n {
+        user.keys.samples = (16 * user.keys.n + 4) / 5;
+    }
+    let (problem, opts) = user.setup(None, 1, 0.0)?;
     crate::hb_shared::without_omega(&problem, "limit_cycle")?;
     let req = LimitCycleRequest {
         omega_guess,
         guess: guess_vec(guess)?,
         x0,
         amplitude: finite("amplitude", amplitude)?,
+        tol,
     };
     let cycle = run_user(py, &problem, |p| jobs::limit_cycle(p, &opts, &req))?;
     to_dict(py, &cycle)

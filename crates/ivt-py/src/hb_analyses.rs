@@ -29,8 +29,12 @@ user_system_fn! {
 /// `ivt.hb.AllSolutions`: a list of {"coeffs", "amplitude" (max |x|
 /// of DOF 0), "multipliers" ([[re, im], ...], Hsu), "stable", "stability"}
 /// by increasing size, whose `search` attribute is {"starts", "runs",
-/// "max_amplitude", "newton_steps", "exhausted"} ("exhausted": every start's
-/// last run found nothing new within the bounds). g, f, jac as in `solve`.
+/// "max_amplitude", "newton_steps", "exhausted", "failures_per_start",
+/// "copies_merged", "bound"} ("exhausted": every start's last run found
+/// nothing new within the bounds, stated in "bound"). Time-shifted copies of
+/// an autonomous problem's orbits are merged; an undamped linear resonance
+/// where nothing is found raises ValueError naming the harmonic. g, f, jac
+/// as in `solve`.
 fn _all_solutions<'py>(py, user, jac;
     f: Option<&Bound<'py, PyAny>>,
     omega: f64;

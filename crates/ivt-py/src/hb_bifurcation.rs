@@ -25,7 +25,12 @@ use crate::to_python::to_dict;
 /// `offset`·|p_to − p_from| and is followed (HB with ω unknown,
 /// pseudo-arclength) with Floquet stability at every point; its folds are
 /// located on the fold system; the cycles at each p of `at` are solved
-/// exactly. Returns {"hopf": [{"p", "omega", "lyapunov", "subcritical"}...],
+/// exactly. A Hopf point is only where a complex pair crosses (a pair turning
+/// real is none); stretches the search could not decide are in
+/// "hopf_undecided" ([{"p_from", "p_to", "reason"}]). A forced family (f
+/// not zero, or g depending on θ) raises ValueError, as does a member that
+/// fails along the branch (the family's exception, another size, g NaN).
+/// Returns {"hopf": [{"p", "omega", "lyapunov", "subcritical"}...], "hopf_undecided",
 /// "points": [{"p", "omega", "period", "amplitude", "stable", "stability",
 /// "multipliers", "coeffs"}...], "bifurcations": [{"kind": "fold", "p",
 /// "omega", "amplitude", "coeffs"}...], "at": [cycles as in points],

@@ -48,6 +48,7 @@ impl PyExcitation {
         };
         let omega = self.omega.then_some(omega_f);
         call_into(
+            "the value of `f`",
             &self.error,
             f,
             |py| pyo3::types::PyTuple::new(py, [theta]),
@@ -162,6 +163,7 @@ pub(crate) struct PyNonlinearity {
 /// Calls `func(*args)` (with `omega=ω_f`, see [`OmegaArg`]) and writes its `out.len()` floats into `out` (NaN and the
 /// exception recorded on error).
 fn call_into(
+    what: &str,
     slot: &ErrorSlot,
     func: &Py<PyAny>,
     args: impl FnOnce(Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyTuple>>,
@@ -177,6 +179,9 @@ fn call_into(
         let res = func
             .bind(py)
             .call(args(py)?, omega_kwargs(py, omega)?.as_ref())?;
+        if !res.is_exact_instance_of::<pyo3::types::PyFloat>() {
+            crate::callback_arrays::refuse_complex(what, &res)?;
+        }
         let v: Vec<f64> = if let Ok(x) = res.extract::<f64>() {
             vec![x]
         } else {
@@ -216,6 +221,7 @@ impl PyNonlinearity {
             let [xs, vs, ths] = self.arrays.args(py, n, x, v, theta)?;
             let kw = omega_kwargs(py, omega)?;
             let res = self.g.bind(py).call((xs, vs, ths), kw.as_ref())?;
+            crate::callback_arrays::refuse_complex("the value of vectorized `g`", &res)?;
             let (shape, values) = float_array(&res).ok_or_else(|| {
                 PyTypeError::new_err("vectorized `g` must return an array of floats")
             })?;
@@ -258,6 +264,7 @@ impl PyNonlinearity {
     /// One call of a per-sample `g`.
     fn call_one(&self, x: &[f64], v: &[f64], theta: f64, omega: OmegaArg, out: &mut [f64]) {
         call_into(
+            "the value of `g`",
             &self.error,
             &self.g,
             |py| {
@@ -287,6 +294,7 @@ impl Nonlinearity for PyNonlinearity {
 
 /// An n×n float64 matrix (array-like) as row-major data.
 fn matrix(name: &str, ob: &Bound<'_, PyAny>) -> PyResult<(usize, Vec<f64>)> {
+    crate::callback_arrays::refuse_complex(&format!("argument `{name}`"), ob)?;
     // A scalar is a 1×1 matrix (single DOF).
     let (n, data) = if let Ok(x) = ob.extract::<f64>() {
         (1, vec![x])

@@ -19,20 +19,28 @@ pub struct Resolution {
     /// Harmonics n.
     #[arg(long, default_value_t = 20)]
     n: usize,
-    /// Half the number of AFT samples N (2N samples, N > n).
-    #[arg(long, default_value_t = 64)]
-    samples: usize,
+    /// Half the number of AFT samples N (2N samples, N > n) [default: 64,
+    /// or 3.2·n from n = 20 on, so that --n alone suffices]
+    #[arg(long)]
+    samples: Option<usize>,
 }
 
 impl Resolution {
     pub(super) fn options(&self) -> Result<HbOptions, CliError> {
-        if self.n == 0 || self.samples <= self.n {
+        let samples = self.samples.unwrap_or_else(|| {
+            if self.n < 20 {
+                64
+            } else {
+                (16 * self.n).div_ceil(5)
+            }
+        });
+        if self.n == 0 || samples <= self.n {
             return Err(CliError::Input(format!(
-                "--n must be ≥ 1 and --samples > --n, got n = {}, samples = {}",
-                self.n, self.samples
+                "--n must be ≥ 1 and --samples > --n, got n = {}, samples = {samples}",
+                self.n
             )));
         }
-        Ok(HbOptions::new(self.n, self.samples))
+        Ok(HbOptions::new(self.n, samples))
     }
 }
 
@@ -51,6 +59,10 @@ pub struct LimitCycleArgs {
     /// x of the start state (x, 0) of the transient that settles onto the cycle.
     #[arg(long, default_value_t = 1.0)]
     amplitude: f64,
+    /// Relative accuracy of ω and the coefficients: n grows by half from
+    /// --n until the error estimate meets it (up to 160); 0: n as given.
+    #[arg(long, default_value_t = jobs::DEFAULT_TOL)]
+    tol: f64,
     /// Write a PNG of the cycle's phase portrait (x, dx/dt).
     #[arg(long)]
     plot: Option<PathBuf>,
@@ -92,6 +104,7 @@ pub fn limit_cycle(a: LimitCycleArgs) -> Result<Output, CliError> {
     }
     let req = LimitCycleRequest {
         amplitude: a.amplitude,
+        tol: a.tol,
         ..LimitCycleRequest::default()
     };
     let problem = a.model.problem(a.mu);
@@ -103,16 +116,23 @@ pub fn limit_cycle(a: LimitCycleArgs) -> Result<Output, CliError> {
             Oscillator::Rayleigh => "Rayleigh",
         };
         let title = format!("Limit cycle of the {name} oscillator, μ = {}", a.mu);
-        super::figure::phase_portrait(title, &cycle, hb.harmonics).draw(path)?;
+        super::figure::phase_portrait(title, &cycle, cycle.harmonics).draw(path)?;
     }
     let human = format!(
-        "limit cycle, μ = {}: ω = {:.10}, period {:.10}, {} ({} Newton steps, ‖r‖ = {:.1e})\n",
+        "limit cycle, μ = {}: ω = {:.10}, period {:.10}, {} ({} Newton steps, ‖r‖ = {:.1e}); \
+         n = {}, error estimate {}, accuracy {} (tol {:e})\n",
         a.mu,
         cycle.omega,
         cycle.period,
         cycle.stability.name(),
         cycle.iterations,
-        cycle.residual_norm
+        cycle.residual_norm,
+        cycle.harmonics,
+        cycle
+            .error_estimate
+            .map_or_else(|| "unknown".to_string(), |e| format!("{e:.1e}")),
+        cycle.accuracy,
+        cycle.tol
     );
     Ok(Output {
         json: to_json(&cycle)?,

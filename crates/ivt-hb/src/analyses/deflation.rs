@@ -15,9 +15,23 @@
 //! The search is bounded, and the result says how: a fixed set of starts (the
 //! linear solution, Eq. 59, and its shape scaled to amplitudes spread
 //! geometrically up to `max_amplitude` at four phases), from each start deflated
-//! runs until one fails, at most `max_iter` Newton steps per run, and iterates
-//! leaving the box `‖q‖∞ ≤ max_amplitude` abandoned. "Exhausted" means every
-//! start's last run found nothing new within these bounds, not a proof.
+//! runs until one fails (k = 1 consecutive failure per start), at most
+//! `max_iter` Newton steps per run, and iterates leaving the box
+//! `‖q‖∞ ≤ max_amplitude` abandoned. "Exhausted" means every start's last run
+//! found nothing new within these bounds, not a proof; the report states the
+//! bound ([`SearchReport::bound`]).
+//!
+//! Each Newton matrix is factored with its rows scaled to unit ∞-norm
+//! (harmonic h of the linear part grows as h²ω², so at large ω_f the
+//! unscaled matrix looks singular to the pivot test while its rows are
+//! well separated). When the linear part itself is singular at a harmonic
+//! (an undamped resonance, h·ω_f a natural frequency) and nothing is found,
+//! the search says so ([`HbError::InvalidInput`] naming the harmonic): there
+//! is no isolated orbit — none if the load excites that harmonic, a continuum
+//! if it does not. For an autonomous problem (no excitation, `g` independent
+//! of θ) every time shift of an orbit is an orbit: copies that differ by a
+//! shift (and the symmetric copies that are half-period shifts) are merged
+//! into one ([`SearchReport::copies_merged`]).
 
 use crate::error::HbError;
 use crate::orbit::galerkin::GalerkinJacobian;
@@ -90,6 +104,14 @@ pub struct SearchReport {
     /// Whether every start's last run failed to find a new solution (the search
     /// found nothing more within its bounds).
     pub exhausted: bool,
+    /// Failed runs that end the search from one start (k = 1).
+    pub failures_per_start: usize,
+    /// Orbits dropped as time-shifted copies of another (autonomous
+    /// problems only).
+    pub copies_merged: usize,
+    /// The bound `exhausted` refers to, in words: the start set, the
+    /// failures per start, the Newton steps per run and the box.
+    pub bound: String,
 }
 
 /// Every solution found, by increasing `‖q‖₂`, and the search's bounds.
@@ -162,6 +184,18 @@ pub fn all_solutions<P: PeriodicProblem>(
             }
         }
     }
+    if known.is_empty() {
+        if let Some(why) = newton.singular_linear_part() {
+            return Err(HbError::InvalidInput(why));
+        }
+    }
+    let found = known.len();
+    let known = if crate::branches::autonomous::require_autonomous(problem, "").is_ok() {
+        merge_time_shifts(known, hb.harmonics)
+    } else {
+        known
+    };
+    let copies_merged = found - known.len();
     let mut analyzer = StabilityAnalyzer::new(problem, hb.harmonics, opts.stability_steps)?;
     let mut solutions: Vec<FoundSolution> = known
         .into_iter()
@@ -190,7 +224,85 @@ pub fn all_solutions<P: PeriodicProblem>(
             max_amplitude: opts.max_amplitude,
             max_iter: opts.max_iter,
             exhausted,
+            failures_per_start: 1,
+            copies_merged,
+            bound: format!(
+                "deflated Newton from {} starts (the linear solution if it lies in the box, \
+                 then its shape at {} amplitudes from {} to {} at 4 phases each) until 1 \
+                 failed run per start; at most {} Newton steps per run; the box max \
+                 |coefficient| ≤ {}",
+                starts.len(),
+                opts.amplitudes,
+                opts.max_amplitude / 100.0,
+                opts.max_amplitude / 2.0,
+                opts.max_iter,
+                opts.max_amplitude
+            ),
         },
+    })
+}
+
+/// `known` without the orbits that are time shifts of an earlier one
+/// (`n_dof` blocks of `2n + 1` coefficients each; the shift is found from
+/// the largest harmonic of the earlier orbit and checked on every
+/// coefficient, relative 1e-6).
+fn merge_time_shifts(known: Vec<Vec<f64>>, n: usize) -> Vec<Vec<f64>> {
+    let l = 2 * n + 1;
+    let mut kept: Vec<Vec<f64>> = Vec::new();
+    for q in known {
+        if !kept.iter().any(|k| is_time_shift(k, &q, n, l)) {
+            kept.push(q);
+        }
+    }
+    kept
+}
+
+/// Whether `q` is `p` shifted in time (module docs).
+fn is_time_shift(p: &[f64], q: &[f64], n: usize, l: usize) -> bool {
+    if p.len() != q.len() || l == 0 {
+        return false;
+    }
+    let scale = p.iter().chain(q).fold(0.0f64, |a, v| a.max(v.abs()));
+    let close = |a: &[f64]| {
+        a.iter()
+            .zip(q)
+            .all(|(x, y)| (x - y).abs() <= 1e-6 * scale.max(f64::MIN_POSITIVE))
+    };
+    // The harmonic (DOF, h) of p with the largest amplitude fixes the shift
+    // up to multiples of 2π/h.
+    let amp = |c: &[f64], d: usize, h: usize| {
+        let (a, b) = (
+            c.get(d * l + h).copied().unwrap_or(0.0),
+            c.get(d * l + n + h).copied().unwrap_or(0.0),
+        );
+        (a, b)
+    };
+    let Some((d, h)) = (0..p.len() / l)
+        .flat_map(|d| (1..=n).map(move |h| (d, h)))
+        .max_by(|&(d1, h1), &(d2, h2)| {
+            let (a1, b1) = amp(p, d1, h1);
+            let (a2, b2) = amp(p, d2, h2);
+            a1.hypot(b1).total_cmp(&a2.hypot(b2))
+        })
+    else {
+        return close(p);
+    };
+    let (pa, pb) = amp(p, d, h);
+    let (qa, qb) = amp(q, d, h);
+    if pa.hypot(pb) == 0.0 {
+        return close(p);
+    }
+    // u(τ + φ): (a, b) of harmonic h turns by −hφ in the (a, b) plane
+    // ([`crate::orbit::aft::shift_time`]), i.e. arg(a + ib) decreases by hφ.
+    let turn = pb.atan2(pa) - qb.atan2(qa);
+    let hf = h as f64;
+    (0..h).any(|k| {
+        let phi = (turn + 2.0 * std::f64::consts::PI * k as f64) / hf;
+        let mut shifted = p.to_vec();
+        for block in shifted.chunks_exact_mut(l) {
+            crate::orbit::aft::shift_time(block, phi);
+        }
+        close(&shifted)
     })
 }
 
@@ -274,7 +386,7 @@ impl<'p, P: PeriodicProblem> Deflated<'p, P> {
             &mut self.jac,
         );
         let mut linear = self.res.excitation().to_vec();
-        let solvable = self.lu.factor_row_major(&self.jac);
+        let solvable = self.factor_scaled(&mut linear);
         if solvable {
             self.lu.solve(&mut linear);
         }
@@ -319,6 +431,67 @@ impl<'p, P: PeriodicProblem> Deflated<'p, P> {
         Ok(starts)
     }
 
+    /// Factor `self.jac` with each row (and the entry of `rhs` on it) scaled
+    /// to unit ∞-norm (module docs); false if it is singular even so.
+    fn factor_scaled(&mut self, rhs: &mut [f64]) -> bool {
+        let m = self.res.len();
+        for (row, b) in self.jac.chunks_exact_mut(m.max(1)).zip(rhs.iter_mut()) {
+            let size = row.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            if size > 0.0 && size.is_finite() {
+                row.iter_mut().for_each(|v| *v /= size);
+                *b /= size;
+            }
+        }
+        self.lu.factor_row_major(&self.jac)
+    }
+
+    /// Why the linear part `L(ω_f)` (Eq. 59) has no unique solution: the
+    /// first harmonic h whose block is singular (module docs); `None` if
+    /// every block is regular.
+    fn singular_linear_part(&mut self) -> Option<String> {
+        let m = self.res.len();
+        let n = self.res.harmonics();
+        let l = 2 * n + 1;
+        let omega = self.omega_f / self.res.subharmonic() as f64;
+        self.res.linear_matrix(self.problem, omega, &mut self.jac);
+        let n_dof = m / l;
+        for h in 0..=n {
+            let rows: Vec<usize> = (0..n_dof)
+                .flat_map(|d| {
+                    let cos = d * l + h;
+                    if h == 0 {
+                        vec![cos]
+                    } else {
+                        vec![cos, cos + n]
+                    }
+                })
+                .collect();
+            let k = rows.len();
+            let mut block: Vec<f64> = rows
+                .iter()
+                .flat_map(|&i| rows.iter().map(move |&j| (i, j)))
+                .map(|(i, j)| self.jac.get(i * m + j).copied().unwrap_or(f64::NAN))
+                .collect();
+            for row in block.chunks_exact_mut(k.max(1)) {
+                let size = row.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                if size > 0.0 && size.is_finite() {
+                    row.iter_mut().for_each(|v| *v /= size);
+                }
+            }
+            if !LuWorkspace::new(k).factor_row_major(&block) {
+                return Some(format!(
+                    "no isolated periodic orbit at ω_f = {}: the linear part is singular at \
+                     harmonic {h} (h·ω = {} is an undamped natural frequency, or K is \
+                     singular at h = 0): none exists if the load excites it, a continuum if \
+                     not; add damping or move ω_f",
+                    self.omega_f,
+                    h as f64 * omega
+                ));
+            }
+        }
+        None
+    }
+
     /// ‖R(q)‖₂ into `self.r`.
     fn residual(&mut self, q: &[f64]) -> f64 {
         self.res
@@ -348,6 +521,7 @@ impl<'p, P: PeriodicProblem> Deflated<'p, P> {
         let run = NewtonOptions {
             ftol: self.tol,
             max_iter: self.opts.max_iter,
+            scale_rows: true,
             ..NewtonOptions::default()
         };
         deflated_newton(&mut sys, &mut q, &deflation, &mut self.newton, &run).ok()?;
@@ -359,6 +533,7 @@ impl<'p, P: PeriodicProblem> Deflated<'p, P> {
             max_iter: 5,
             max_halvings: 0,
             accept_no_descent: true,
+            scale_rows: true,
             ..NewtonOptions::default()
         };
         match newton(&mut sys, &mut q, &mut self.newton, &polish) {

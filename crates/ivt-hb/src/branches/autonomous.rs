@@ -159,8 +159,13 @@ where
     })
 }
 
-/// Multipliers of an autonomous orbit and its class by the non-trivial ones.
-fn classify_cycle<P: PeriodicProblem>(
+/// Multipliers of an autonomous orbit and its class by the non-trivial ones
+/// (Hsu with `stability_steps` sub-intervals, Eq. 78).
+///
+/// # Errors
+/// Those of [`StabilityAnalyzer::new`] (`stability_steps` ≤ the orbit's
+/// harmonics, a problem without DOFs).
+pub fn classify_cycle<P: PeriodicProblem>(
     problem: &P,
     solution: HbSolution,
     stability_steps: usize,
@@ -187,6 +192,51 @@ fn classify_cycle<P: PeriodicProblem>(
     })
 }
 
+/// Refuses a forced `problem` for an autonomous analysis (`what`): an
+/// excitation `f(θ)` that is not zero, or a `g` whose value depends on θ
+/// (both sampled at four θ; the state for `g` is a fixed non-zero one). Its
+/// forcing would be ignored: the cycle's θ is its own phase, not a forcing.
+/// A hysteretic `g` (history-dependent, no pointwise value) is checked by
+/// its excitation only.
+///
+/// # Errors
+/// [`HbError::InvalidInput`] naming the forcing.
+pub fn require_autonomous<P: PeriodicProblem>(problem: &P, what: &str) -> Result<(), HbError> {
+    let n = problem.n_dof();
+    let thetas = [0.0, 1.0, 2.5, 4.0];
+    let mut out = vec![0.0; n];
+    for &theta in &thetas {
+        problem.excitation(theta, &mut out);
+        if out.iter().any(|f| *f != 0.0) {
+            return Err(HbError::InvalidInput(format!(
+                "{what} needs an autonomous system, but the excitation f(θ) is not zero (at θ = \
+                 {theta}): a forced system has no limit cycles of its own; use frc or solve"
+            )));
+        }
+    }
+    if problem.hysteretic() {
+        return Ok(());
+    }
+    let x: Vec<f64> = (0..n).map(|i| 0.37 + 0.11 * i as f64).collect();
+    let v: Vec<f64> = (0..n).map(|i| -0.23 + 0.07 * i as f64).collect();
+    let mut first = vec![0.0; n];
+    problem.nonlinear(&x, &v, 0.0, &mut first);
+    for &theta in &thetas[1..] {
+        problem.nonlinear(&x, &v, theta, &mut out);
+        let moved = out.iter().zip(&first).any(|(a, b)| {
+            let scale = a.abs().max(b.abs()).max(f64::MIN_POSITIVE);
+            (a - b).abs() > 1e-12 * scale
+        });
+        if moved {
+            return Err(HbError::InvalidInput(format!(
+                "{what} needs an autonomous system, but g(x, v, θ) depends on θ (a parametric \
+                 or forced term): its forcing would be ignored; use frc or solve"
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Finds the limit cycle of the autonomous `problem` near the orbit `guess`
 /// (coefficients, `n_dof·(2n+1)`, not all zero) at frequency `omega_guess`.
 /// Convergence: ‖[R; b₁]‖₂ ≤ `atol + rtol·S` ([`HbOptions`], S = ‖L(ω)q₀‖₂ of the
@@ -205,12 +255,28 @@ pub fn limit_cycle<P: PeriodicProblem>(
     guess: &[f64],
     stability_steps: usize,
 ) -> Result<LimitCycle, HbError> {
+    let solution = limit_cycle_orbit(problem, hb, omega_guess, guess)?;
+    classify_cycle(problem, solution, stability_steps)
+}
+
+/// The orbit of [`limit_cycle`] without its multipliers (a refinement
+/// whose stability is not reported).
+///
+/// # Errors
+/// Those of [`limit_cycle`].
+pub fn limit_cycle_orbit<P: PeriodicProblem>(
+    problem: &P,
+    hb: &HbOptions,
+    omega_guess: f64,
+    guess: &[f64],
+) -> Result<HbSolution, HbError> {
     if hb.subharmonic != 1 {
         return Err(HbError::InvalidInput(
             "a limit cycle has no excitation: subharmonic order must be 1".into(),
         ));
     }
     crate::orbit::ihb::validate_omega(omega_guess)?;
+    require_autonomous(problem, "a limit cycle")?;
     let res = HbResidual::new(problem, hb)?;
     let m = res.len();
     let n = hb.harmonics;
@@ -263,14 +329,13 @@ pub fn limit_cycle<P: PeriodicProblem>(
         jacobian_refreshes: stats.jacobian_evals,
         residual_norm: stats.residual_norm,
     };
-    let solution = HbSolution {
+    Ok(HbSolution {
         coeffs: q,
         omega_f: omega,
         harmonics: n,
         subharmonic: 1,
         stats,
-    };
-    classify_cycle(problem, solution, stability_steps)
+    })
 }
 
 /// `R(q, ω) = 0` of an autonomous problem in `x = (q, ω)` for

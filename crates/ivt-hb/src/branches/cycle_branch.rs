@@ -19,13 +19,13 @@ use crate::error::HbError;
 use crate::orbit::galerkin::GalerkinJacobian;
 use crate::orbit::ihb::{HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
-use crate::stability::hopf::{equilibrium, hopf_points, Field, HopfPoint};
+use crate::stability::hopf::{equilibrium, hopf_points, Field, HopfPoint, Undecided};
 use crate::BroydenStats;
 use ivt_path::branch::Branch;
 use ivt_path::continuation::{ContinuationOptions, PathPoint, Termination};
 
 pub(crate) mod member;
-use member::Member;
+use member::{Failures, Member};
 
 /// Options of [`cycle_branch`].
 #[derive(Debug, Clone, PartialEq)]
@@ -66,6 +66,9 @@ pub struct CycleBranch {
     /// Hopf points of the equilibria in `[p_from, p_to]`, in order of p
     /// from `p_from`.
     pub hopf: Vec<HopfPoint>,
+    /// Stretches of p where the Hopf search could not decide
+    /// ([`hopf_points`]).
+    pub undecided: Vec<Undecided>,
     /// `(p, cycle)` of the branch from the first Hopf point, in path order.
     pub points: Vec<(f64, LimitCycle)>,
     /// Folds of the branch: `(p, orbit)` located on the fold system.
@@ -81,9 +84,12 @@ pub struct CycleBranch {
 /// branch of the first, with its folds (module docs).
 ///
 /// # Errors
-/// [`HbError::InvalidInput`] for bounds, options or sizes; `family(p_from)`'s
-/// error; the start cycle's failure ([`limit_cycle`]). Later, a `p` where
-/// `family` fails is a failed step of the path.
+/// [`HbError::InvalidInput`] for bounds, options or sizes, a forced family
+/// ([`crate::branches::autonomous::require_autonomous`]); `family(p_from)`'s error;
+/// the start cycle's failure ([`limit_cycle`]). Later, a `p` where `family`
+/// fails is a failed step of the path; when the path stalls on such steps
+/// (the family's error, a member of another size, a `g` that is NaN or ±∞
+/// at a finite state) that cause is the error, not a `step_too_small` end.
 pub fn cycle_branch<P, F>(
     family: F,
     hb: &HbOptions,
@@ -98,10 +104,13 @@ where
     if !(opts.offset > 0.0 && opts.offset < 1.0) {
         return Err(HbError::InvalidInput("offset must lie in (0, 1)".into()));
     }
-    let n_dof = family(p_from)?.n_dof();
-    let hopf = hopf_points(&family, &vec![0.0; n_dof], p_from, p_to, opts.samples)?;
+    let first_member = family(p_from)?;
+    crate::branches::autonomous::require_autonomous(&first_member, "cycle_branch")?;
+    let n_dof = first_member.n_dof();
+    let search = hopf_points(&family, &vec![0.0; n_dof], p_from, p_to, opts.samples)?;
     let mut out = CycleBranch {
-        hopf,
+        hopf: search.points,
+        undecided: search.undecided,
         points: Vec::new(),
         folds: Vec::new(),
         at: Vec::new(),
@@ -112,7 +121,8 @@ where
     };
     let (lo, hi) = (p_from.min(p_to), p_from.max(p_to));
     let (p_start, start) = start_cycle(&family, hb, first, opts.offset * (hi - lo), opts)?;
-    let member = |p: f64| Member::new(family(p).ok(), n_dof);
+    let failures = Failures::default();
+    let member = |p: f64| Member::new(family(p), n_dof, p, Some(&failures));
     // Each fold (a turn in p) is located as the points arrive: the [`Fold`]
     // detector on the cycle equations ([`CycleSystem`], unknowns {q, ω}).
     let mut system = CycleSystem::new(&member, hb, p_start)?;
@@ -120,6 +130,7 @@ where
     let (mut events, mut failure) = (Vec::new(), None);
     let mut watch = |p: &PathPoint| match observer.on_point(&mut system, p) {
         Ok(found) => {
+            failures.clear();
             events.extend(found);
             true
         }
@@ -142,6 +153,7 @@ where
         steps,
         &mut watch,
     )?;
+    stalled_by(&leg.termination, &failures)?;
     out.points = leg.points;
     out.termination = Some(leg.termination);
     let back = out.points.last().map(|(p, c)| (*p, c.clone()));
@@ -161,6 +173,7 @@ where
                 steps,
                 on_point,
             )?;
+            stalled_by(&leg.termination, &failures)?;
             out.points.extend(leg.points.into_iter().skip(1));
             out.termination = Some(leg.termination);
         }
@@ -191,6 +204,15 @@ where
     Ok(out)
 }
 
+/// The kept cause of failed members when a leg ended by stalling on them
+/// (module [`member`]).
+fn stalled_by(termination: &Termination, failures: &Failures) -> Result<(), HbError> {
+    match (termination, failures.take()) {
+        (Termination::StepTooSmall(_), Some(cause)) => Err(cause),
+        _ => Ok(()),
+    }
+}
+
 /// The cycle near the Hopf point `hopf` at `p_H ± distance` by its normal
 /// form, refined by [`limit_cycle`]: `(p, cycle)`.
 fn start_cycle<P, F>(
@@ -207,22 +229,9 @@ where
     let n = hb.harmonics;
     let l = 2 * n + 1;
     for side in [-1.0, 1.0] {
-        let p = hopf.p + side * distance;
-        let problem = family(p)?;
-        let mut x = hopf.equilibrium.clone();
-        equilibrium(&problem, &mut x)?;
-        let d = 2 * x.len();
-        let beta =
-            crate::stability::floquet::eigenvalues(&Field::new(&problem)?.linearisation(&x), d)
-                .iter()
-                .filter(|e| e.im > 0.0)
-                .min_by(|a, b| {
-                    (a.im - hopf.omega)
-                        .abs()
-                        .total_cmp(&(b.im - hopf.omega).abs())
-                })
-                .map(|e| e.re)
-                .unwrap_or(f64::NAN);
+        let Some((p, x, beta)) = near_pair(family, hopf, side, distance)? else {
+            continue;
+        };
         let radius2 = -beta / (hopf.omega * hopf.lyapunov);
         if !(radius2 > 0.0 && radius2.is_finite()) {
             continue;
@@ -240,12 +249,57 @@ where
                 }
             }
         }
-        let cycle = limit_cycle(&problem, hb, hopf.omega, &guess, opts.stability_steps)?;
+        let cycle = limit_cycle(&family(p)?, hb, hopf.omega, &guess, opts.stability_steps)?;
         return Ok((p, cycle));
     }
     Err(HbError::InvalidInput(
         "no side of the Hopf point has cycles (l₁ = 0 or β does not change sign)".into(),
     ))
+}
+
+/// Most halvings of the start's distance from the Hopf point.
+const MAX_HALVINGS: usize = 60;
+
+/// The equilibrium and `β = Re λ` of the crossing pair at `p_H + side·d`,
+/// with `d` halved from `distance` until the pair is complex there and
+/// `|β| ≤ ω/20` (the normal form's range: on a wide interval `offset`·|p_to
+/// − p_from| can reach where the pair has turned real): `(p, x, β)`, or
+/// `None` if no such `d`.
+fn near_pair<P, F>(
+    family: &F,
+    hopf: &HopfPoint,
+    side: f64,
+    distance: f64,
+) -> Result<Option<(f64, Vec<f64>, f64)>, HbError>
+where
+    P: PeriodicProblem,
+    F: Fn(f64) -> Result<P, HbError>,
+{
+    let mut d = distance;
+    for _ in 0..MAX_HALVINGS {
+        let p = hopf.p + side * d;
+        d *= 0.5;
+        let problem = family(p)?;
+        let mut x = hopf.equilibrium.clone();
+        if equilibrium(&problem, &mut x).is_err() {
+            continue;
+        }
+        let dim = 2 * x.len();
+        let beta =
+            crate::stability::floquet::eigenvalues(&Field::new(&problem)?.linearisation(&x), dim)
+                .iter()
+                .filter(|e| e.im > 0.0)
+                .min_by(|a, b| {
+                    (a.im - hopf.omega)
+                        .abs()
+                        .total_cmp(&(b.im - hopf.omega).abs())
+                })
+                .map(|e| e.re);
+        if let Some(beta) = beta.filter(|b| b.abs() <= hopf.omega / 20.0) {
+            return Ok(Some((p, x, beta)));
+        }
+    }
+    Ok(None)
 }
 
 /// The cycles at each p of `at` where the branch crosses it, by

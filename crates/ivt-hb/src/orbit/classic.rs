@@ -6,9 +6,7 @@
 use crate::orbit::galerkin::GalerkinJacobian;
 use crate::orbit::ihb::{validate_omega, HbError, HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
-use ivt_num::vector::matvec;
-use ivt_num::BroydenStats;
-use ivt_num::{newton, NewtonOptions, NewtonSystem, NewtonWorkspace};
+use ivt_num::{newton, BlockDiagonal, BroydenStats, NewtonOptions, NewtonSystem, NewtonWorkspace};
 use std::convert::Infallible;
 
 /// Newton–Galerkin solver with reusable buffers.
@@ -18,8 +16,8 @@ pub struct ClassicIhb<P> {
     opts: HbOptions,
     res: HbResidual,
     galerkin: GalerkinJacobian,
-    b0: Vec<f64>,
-    h0: Vec<f64>,
+    /// `H₀`, the inverse of the linear Jacobian Eq. 60, by blocks.
+    h0: BlockDiagonal,
     /// Scratch for the force scale of the tolerance.
     scratch: Vec<f64>,
     newton: NewtonWorkspace,
@@ -62,8 +60,7 @@ impl<P: PeriodicProblem> ClassicIhb<P> {
             opts,
             res,
             galerkin,
-            b0: vec![0.0; m * m],
-            h0: vec![0.0; m * m],
+            h0: BlockDiagonal::default(),
             scratch: vec![0.0; m],
             newton: NewtonWorkspace::new(m),
         })
@@ -92,11 +89,8 @@ impl<P: PeriodicProblem> ClassicIhb<P> {
                 )))
             }
             None => {
-                if self
-                    .res
-                    .linear_jacobian(&self.problem, omega, &mut self.b0, &mut self.h0)
-                {
-                    matvec(&self.h0, m, m, self.res.excitation(), &mut q);
+                if self.res.linear_inverse(&self.problem, omega, &mut self.h0) {
+                    self.h0.mul(self.res.excitation(), &mut q);
                 }
             }
         }

@@ -15,7 +15,7 @@
 pub(crate) use crate::error::HbError;
 use crate::orbit::aft::{split_series, split_series_mut, Aft};
 use crate::problem::PeriodicProblem;
-use ivt_num::{BroydenOptions, BroydenStats};
+use ivt_num::{BlockDiagonal, BroydenOptions, BroydenStats};
 
 /// Options of the IHB solvers.
 ///
@@ -141,10 +141,8 @@ impl HbSolution {
     /// Amplitude `max_τ |x_d(τ)|` of DOF `d` (NaN if there is no DOF `d`),
     /// with x_d = a0/2 + Σ a_k cos kτ + b_k sin kτ: the largest of `M = 4(n+1)`
     /// equally spaced samples (four per period of the n-th harmonic), refined by
-    /// up to 8 Newton steps on `x′(τ) = 0` from that sample. Cost: `M·n` complex
-    /// multiply-adds (Horner's rule in `z = e^{jτ}`, no sine per harmonic) and
-    /// O(n) per Newton step: ≈ 3.3·10⁴ instructions at n = 20 (measured, not
-    /// asserted), where 512 direct evaluations took 1.6·10⁶.
+    /// up to 8 Newton steps on `x′(τ) = 0` from that sample. Cost: one inverse
+    /// real FFT of length M (the samples) and O(n) per Newton step.
     ///
     /// Accuracy: the value reported is `|x(τ̂)|` at a τ̂ the search visited, the
     /// largest such value, so it never exceeds the true maximum and never falls
@@ -163,35 +161,19 @@ impl HbSolution {
 /// `max_τ |x(τ)|` of the series `coeffs = [a0, a1..an, b1..bn]` as
 /// [`HbSolution::amplitude`] finds it.
 pub(crate) fn series_peak(coeffs: &[f64]) -> f64 {
-    let Some((a0, cos, sin)) = split_series(coeffs) else {
+    let Some((_, cos, sin)) = split_series(coeffs) else {
         return f64::NAN;
     };
-    if !coeffs.iter().all(|c| c.is_finite()) {
+    if cos.len() != sin.len() || !coeffs.iter().all(|c| c.is_finite()) {
         return f64::NAN;
     }
-    let m = 4 * (cos.len() + 1);
-    // Sample i at z_i = e^{jτ_i}, τ_i = 2πi/M: x_i = a0/2 + Re Σ_k c_k z_i^k with
-    // c_k = a_k − j b_k, by Horner over k for all samples at once.
-    let (sn, cs) = (std::f64::consts::TAU / m as f64).sin_cos();
-    let mut z = Vec::with_capacity(m);
-    let (mut zr, mut zi) = (1.0f64, 0.0f64);
-    for _ in 0..m {
-        z.push((zr, zi));
-        (zr, zi) = (zr * cs - zi * sn, zr * sn + zi * cs);
-    }
-    let mut p = vec![(0.0f64, 0.0f64); m];
-    for (&a, &b) in cos.iter().zip(sin).rev() {
-        for (pk, &(zr, zi)) in p.iter_mut().zip(&z) {
-            let (pr, pi) = *pk;
-            *pk = (pr * zr - pi * zi + a, pr * zi + pi * zr - b);
-        }
-    }
-    // p = Σ_k c_k z^{k−1}; one more factor z gives Σ c_k z^k.
-    let samples: Vec<f64> = p
-        .iter()
-        .zip(&z)
-        .map(|(&(pr, pi), &(zr, zi))| 0.5 * a0 + pr * zr - pi * zi)
-        .collect();
+    // M = 4(n + 1) samples by one inverse real FFT (the thread's cached plan).
+    let n = cos.len();
+    let Ok(mut aft) = Aft::new(n, 2 * (n + 1)) else {
+        return f64::NAN;
+    };
+    let mut samples = vec![0.0; aft.n_samples()];
+    aft.synthesize(coeffs, &mut samples);
     refine_peak(coeffs, &samples)
 }
 
@@ -519,95 +501,108 @@ impl HbResidual {
     /// Allocation-free (the classic Newton loop and the Broyden refresh call it).
     /// NaN if `b0` or the problem's matrices have the wrong size.
     pub fn linear_matrix<P: PeriodicProblem>(&self, problem: &P, omega: f64, b0: &mut [f64]) {
-        let (nd, n) = (self.n_dof, self.n);
-        let l = 2 * n + 1;
-        let len = nd * l;
-        let (m, c, k) = (problem.mass(), problem.damping(), problem.stiffness());
-        let sizes_ok = b0.len() == len * len && [m, c, k].iter().all(|a| a.len() == nd * nd);
+        let len = self.n_dof * (2 * self.n + 1);
+        let sizes_ok = b0.len() == len * len;
         debug_assert!(sizes_ok, "linear_matrix: sizes do not match the residual");
         if !sizes_ok {
             return b0.fill(f64::NAN);
         }
         b0.fill(0.0);
-        // Every index below is < len² (checked above).
-        let mut set = |row: usize, col: usize, v: f64| {
-            if let Some(x) = b0.get_mut(row * len + col) {
-                *x = v;
-            }
-        };
-        let entries = k.iter().zip(m).zip(c).enumerate();
-        for (de, ((&kde, &mde), &cde)) in entries {
-            let (d, e) = (de / nd, de % nd);
-            set(d * l, e * l, 0.5 * kde);
-            for h in 1..=n {
-                let kw = h as f64 * omega;
-                let stiff = kde - kw * kw * mde;
-                let damp = kw * cde;
-                let (ra, rb) = (d * l + h, d * l + n + h);
-                let (ca, cb) = (e * l + h, e * l + n + h);
-                set(ra, ca, stiff);
-                set(ra, cb, damp);
-                set(rb, ca, -damp);
-                set(rb, cb, stiff);
+        for h in 0..=self.n {
+            let set = |row: usize, col: usize, v: f64| {
+                let (i, j) = (self.harmonic_unknown(h, row), self.harmonic_unknown(h, col));
+                if let Some(x) = b0.get_mut(i * len + j) {
+                    *x = v;
+                }
+            };
+            if !self.harmonic_block(problem, omega, h, set) {
+                return b0.fill(f64::NAN);
             }
         }
     }
 
-    /// [`Self::linear_matrix`] and its inverse `h0`, inverted block by block (one
-    /// `2·n_dof` block per harmonic). Returns `false` (and leaves `h0` incomplete) if
-    /// a block is singular, e.g. at a linear resonance, or `b0`, `h0` have the
-    /// wrong size.
-    pub fn linear_jacobian<P: PeriodicProblem>(
+    /// The inverse of [`Self::linear_matrix`] as its blocks, one per harmonic
+    /// (inverted one by one): the Broyden solver's `H₀`. Returns `false` (and
+    /// leaves `h0` incomplete) if a block is singular, e.g. at a linear
+    /// resonance, or the problem's matrices have the wrong size.
+    pub fn linear_inverse<P: PeriodicProblem>(
         &self,
         problem: &P,
         omega: f64,
-        b0: &mut [f64],
-        h0: &mut [f64],
+        h0: &mut BlockDiagonal,
     ) -> bool {
-        self.linear_matrix(problem, omega, b0);
-        let (nd, n) = (self.n_dof, self.n);
-        let l = 2 * n + 1;
-        let len = nd * l;
-        h0.fill(0.0);
-        if b0.len() != len * len || h0.len() != len * len {
-            return false;
-        }
+        let nd = self.n_dof;
+        h0.clear(nd * (2 * self.n + 1));
         let bs = 2 * nd;
         let mut blk = vec![0.0; bs * bs];
         let mut inv = vec![0.0; bs * bs];
-        let mut idx = vec![0usize; bs];
+        let mut idx = Vec::with_capacity(bs);
         let mut ok = true;
-        for h in 0..=n {
-            // Index list of the block: h = 0 → {a0 of each dof}; h ≥ 1 → {a_h…, b_h…}.
+        for h in 0..=self.n {
             let size = if h == 0 { nd } else { bs };
-            let (cos_idx, sin_idx) = idx.split_at_mut(nd);
-            for (d, (ia, ib)) in cos_idx.iter_mut().zip(sin_idx.iter_mut()).enumerate() {
-                (*ia, *ib) = (d * l + h, d * l + n + h);
-            }
             let (Some(blk), Some(inv)) = (blk.get_mut(..size * size), inv.get_mut(..size * size))
             else {
                 return false;
             };
-            let block = idx.iter().take(size);
-            // Every index is < len² (checked above); NaN would mark a slip.
-            for (row, &i) in blk.chunks_exact_mut(size).zip(block.clone()) {
-                for (x, &j) in row.iter_mut().zip(block.clone()) {
-                    *x = b0.get(i * len + j).copied().unwrap_or(f64::NAN);
+            let set = |row: usize, col: usize, v: f64| {
+                if let Some(x) = blk.get_mut(row * size + col) {
+                    *x = v;
                 }
+            };
+            if !self.harmonic_block(problem, omega, h, set) {
+                return false;
             }
-            if ivt_num::small::inverse(blk, size, inv) {
-                for (row, &i) in inv.chunks_exact(size).zip(block.clone()) {
-                    for (&x, &j) in row.iter().zip(block.clone()) {
-                        if let Some(y) = h0.get_mut(i * len + j) {
-                            *y = x;
-                        }
-                    }
-                }
-            } else {
-                ok = false;
-            }
+            idx.clear();
+            idx.extend((0..size).map(|r| self.harmonic_unknown(h, r)));
+            ok &= ivt_num::small::inverse(blk, size, inv) && h0.push_block(&idx, inv);
         }
         ok
+    }
+
+    /// Index in the coefficient vector of row `r` of harmonic `h`'s block of
+    /// Eq. 60: `a_h` of DOF `r` for `r < n_dof`, else `b_h` of DOF `r − n_dof`
+    /// (harmonic 0: the `a_0` of each DOF).
+    fn harmonic_unknown(&self, h: usize, r: usize) -> usize {
+        let (nd, n) = (self.n_dof, self.n);
+        let l = 2 * n + 1;
+        if r < nd {
+            r * l + h
+        } else {
+            (r - nd) * l + n + h
+        }
+    }
+
+    /// The entries of harmonic `h`'s block of Eq. 60, passed to `set(row, col,
+    /// value)` in the order of [`Self::harmonic_unknown`]: `½K` for h = 0, else
+    /// `[[K − (hω)²M, hωC], [−hωC, K − (hω)²M]]`. Every entry of the block is set.
+    /// `false` (nothing set) if the problem's matrices are not `n_dof×n_dof`.
+    fn harmonic_block<P: PeriodicProblem>(
+        &self,
+        problem: &P,
+        omega: f64,
+        h: usize,
+        mut set: impl FnMut(usize, usize, f64),
+    ) -> bool {
+        let nd = self.n_dof;
+        let (m, c, k) = (problem.mass(), problem.damping(), problem.stiffness());
+        if [m, c, k].iter().any(|a| a.len() != nd * nd) {
+            return false;
+        }
+        let kw = h as f64 * omega;
+        for (de, ((&kde, &mde), &cde)) in k.iter().zip(m).zip(c).enumerate() {
+            let (d, e) = (de / nd, de % nd);
+            if h == 0 {
+                set(d, e, 0.5 * kde);
+                continue;
+            }
+            let stiff = kde - kw * kw * mde;
+            let damp = kw * cde;
+            set(d, e, stiff);
+            set(d, nd + e, damp);
+            set(nd + d, e, -damp);
+            set(nd + d, nd + e, stiff);
+        }
+        true
     }
 
     /// `∂g/∂x`, `∂g/∂v` of the orbit `q` at all samples, from one

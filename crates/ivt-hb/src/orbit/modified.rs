@@ -7,8 +7,7 @@
 use crate::orbit::galerkin::GalerkinJacobian;
 use crate::orbit::ihb::{validate_omega, HbError, HbOptions, HbResidual, HbSolution, HbSolver};
 use crate::problem::PeriodicProblem;
-use ivt_num::vector::matvec;
-use ivt_num::{broyden_solve, BroydenStats, BroydenWorkspace, System};
+use ivt_num::{broyden_solve, BlockDiagonal, BroydenStats, BroydenWorkspace, System};
 use ivt_path::continuation::{follow_residual, ContinuationOptions};
 
 /// The modified IHB solver for one problem and one size (plans and buffers reused
@@ -22,8 +21,10 @@ pub struct ModifiedIhb<P> {
     /// Built on the first Broyden refresh (most solves never need it).
     galerkin: Option<GalerkinJacobian>,
     ws: BroydenWorkspace,
-    b0: Vec<f64>,
-    h0: Vec<f64>,
+    /// `H₀`, the inverse of the linear Jacobian Eq. 60, by blocks.
+    h0: BlockDiagonal,
+    /// Scratch of `m` entries (the forcing scale).
+    scratch: Vec<f64>,
     q: Vec<f64>,
 }
 
@@ -47,8 +48,8 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
                 ws.track_jacobian = false;
                 ws
             },
-            b0: vec![0.0; m * m],
-            h0: vec![0.0; m * m],
+            h0: BlockDiagonal::default(),
+            scratch: vec![0.0; m],
             q: vec![0.0; m],
         })
     }
@@ -126,12 +127,10 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
             q.copy_from_slice(g);
         }
         let omega = omega_f / self.opts.subharmonic as f64;
-        let invertible = self
-            .res
-            .linear_jacobian(&self.problem, omega, &mut self.b0, &mut self.h0);
-        let seed = |ws: &mut BroydenWorkspace, h0: &[f64]| {
+        let invertible = self.res.linear_inverse(&self.problem, omega, &mut self.h0);
+        let seed = |ws: &mut BroydenWorkspace, h0: &BlockDiagonal| {
             if invertible {
-                ws.set_inverse_jacobian(h0)
+                ws.set_inverse_jacobian_blocks(h0)
             } else {
                 ws.clear_jacobian();
                 Ok(())
@@ -139,18 +138,15 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
         };
         if !use_guess {
             if invertible {
-                matvec(&self.h0, m, m, self.res.excitation(), q);
+                self.h0.mul(self.res.excitation(), q);
             } else {
                 q.fill(0.0);
             }
         }
         // Tolerance atol + rtol·S (HbOptions), S from the forcing or the start.
-        let Some(scratch) = self.b0.get_mut(..m) else {
-            return Err(HbError::InvalidInput(format!(
-                "linear Jacobian buffer holds fewer than {m} entries"
-            )));
-        };
-        let scale = self.res.force_scale(&self.problem, q, omega, scratch);
+        let scale = self
+            .res
+            .force_scale(&self.problem, q, omega, &mut self.scratch);
         let broyden = crate::BroydenOptions {
             tol: self.opts.residual_tol(scale),
             ..self.opts.broyden.clone()
@@ -182,7 +178,7 @@ impl<P: PeriodicProblem> ModifiedIhb<P> {
             let mut s = vec![0.0; m];
             match guess {
                 Some(g) => s.copy_from_slice(g),
-                None if invertible => matvec(&self.h0, m, m, sys.res.excitation(), &mut s),
+                None if invertible => self.h0.mul(sys.res.excitation(), &mut s),
                 None => {}
             }
             s

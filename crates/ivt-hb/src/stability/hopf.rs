@@ -239,13 +239,12 @@ fn axpy(y: &[f64], s: f64, u: &[f64]) -> Vec<f64> {
     y.iter().zip(u).map(|(a, b)| a + s * b).collect()
 }
 
-/// The number of eigenvalues of `a` (`dim×dim`) with positive real part and
-/// non-zero imaginary part.
-pub(crate) fn unstable_oscillatory(a: &[f64], dim: usize) -> usize {
-    eigenvalues(a, dim)
-        .iter()
-        .filter(|l| l.re > 0.0 && l.im != 0.0)
-        .count()
+/// The number of eigenvalues of `a` (`dim×dim`) with positive real part,
+/// real or complex: it changes by two where a complex pair crosses the
+/// imaginary axis (a Hopf point), by one where a real eigenvalue crosses
+/// zero, and not where a pair in the right half-plane turns real.
+pub(crate) fn unstable(a: &[f64], dim: usize) -> usize {
+    eigenvalues(a, dim).iter().filter(|l| l.re > 0.0).count()
 }
 
 /// The first Lyapunov coefficient and eigenvector at a Hopf point with
@@ -409,20 +408,63 @@ fn complex_null_vector(a: &[f64], d: usize, omega: f64) -> Result<[Vec<f64>; 2],
 /// equilibrium solve and an eigenvalue problem).
 pub const MAX_SAMPLES: usize = 100_000;
 
+/// A stretch of p where [`hopf_points`] could not decide whether a Hopf
+/// point lies there, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Undecided {
+    /// One end of the stretch (the side of `p_from`).
+    pub p_from: f64,
+    /// The other end.
+    pub p_to: f64,
+    /// Why: no equilibrium, or an eigenvalue crossing that is neither a
+    /// complex pair nor a real eigenvalue, or no Lyapunov coefficient.
+    pub reason: String,
+}
+
+/// The Hopf points of a range of p and the stretches left undecided.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct HopfSearch {
+    /// Hopf points in order of p from `p_from`.
+    pub points: Vec<HopfPoint>,
+    /// Stretches where the search could not decide (module docs of
+    /// [`hopf_points`]).
+    pub undecided: Vec<Undecided>,
+}
+
+/// |Im λ| below this fraction of max(1, |λ|) counts as a real eigenvalue at
+/// a located crossing: a crossing pair there is not a Hopf point.
+const REAL_AT_CROSSING: f64 = 1e-6;
+
 /// The equilibria of `family(p)` from `x0` at `samples + 1` values of p
-/// from `p_from` to `p_to`, and the Hopf points between them (module docs).
+/// from `p_from` to `p_to`, and the Hopf points between them.
+///
+/// At each grid value the eigenvalues of `A` with positive real part are
+/// counted (complex or real); where the count changes between neighbours,
+/// bisection locates the change to the rounding of p, and the search goes
+/// on from there to the interval's end (several crossings in one interval
+/// are all located). A located change is a Hopf point when the eigenvalue
+/// nearest the imaginary axis there is a complex pair ±iω (|ω| above
+/// 1e-6·max(1, |λ|)) and the count changed by two; a real eigenvalue
+/// through zero (a fold or branch point of the equilibria) is not
+/// reported; a pair that turns real inside the right half-plane changes no
+/// count and is not reported. What the grid cannot see is a pair that
+/// crosses and crosses back within one interval (the count is equal at
+/// both ends): a finer grid decides it. Grid values where Newton finds no
+/// equilibrium, and crossings whose class or Lyapunov coefficient cannot
+/// be computed, are returned in [`HopfSearch::undecided`] with the
+/// reason instead of ending the search.
 ///
 /// # Errors
 /// [`HbError::InvalidInput`] for bounds, sizes, a singular mass matrix, or
-/// an equilibrium Newton does not find; [`HbError::Size`] for a matrix that
-/// is not `n_dof×n_dof`; `family`'s error.
+/// no equilibrium at `p_from`; [`HbError::Size`] for a matrix that is not
+/// `n_dof×n_dof`; `family`'s error.
 pub fn hopf_points<P, F>(
     family: &F,
     x0: &[f64],
     p_from: f64,
     p_to: f64,
     samples: usize,
-) -> Result<Vec<HopfPoint>, HbError>
+) -> Result<HopfSearch, HbError>
 where
     P: PeriodicProblem,
     F: Fn(f64) -> Result<P, HbError>,
@@ -438,70 +480,157 @@ where
     }
     let state = |p: f64, x: &mut Vec<f64>| -> Result<usize, HbError> {
         let problem = family(p)?;
+        if problem.n_dof() != x.len() {
+            return Err(HbError::InvalidInput(format!(
+                "the family changes size: at p = {p} it has {} DOFs, at p_from {}",
+                problem.n_dof(),
+                x.len()
+            )));
+        }
         equilibrium(&problem, x)?;
         let field = Field::new(&problem)?;
-        Ok(unstable_oscillatory(&field.linearisation(x), 2 * x.len()))
+        Ok(unstable(&field.linearisation(x), 2 * x.len()))
     };
     let mut x = x0.to_vec();
     let mut count = state(p_from, &mut x)?;
-    let mut found = Vec::new();
+    let mut search = HopfSearch::default();
+    // `prev`: the last grid value with an equilibrium; across a gap the
+    // next interval spans it (a crossing there is still bisected).
     let mut prev = p_from;
     for i in 1..=samples {
         let p = p_from + (p_to - p_from) * i as f64 / samples as f64;
         let mut xi = x.clone();
-        let ci = state(p, &mut xi)?;
+        let ci = match state(p, &mut xi) {
+            Ok(c) => c,
+            Err(HbError::InvalidInput(why)) if why.starts_with("no equilibrium") => {
+                match search.undecided.last_mut() {
+                    Some(u) if u.p_from == prev => u.p_to = p,
+                    _ => search.undecided.push(Undecided {
+                        p_from: prev,
+                        p_to: p,
+                        reason: why,
+                    }),
+                }
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
         if ci != count {
-            found.push(locate(family, &x, prev, p, count, &state)?);
+            crossings(family, &x, (prev, count), (p, ci), &state, &mut search)?;
         }
         (x, count, prev) = (xi, ci, p);
     }
-    Ok(found)
+    Ok(search)
 }
 
-/// The Hopf point between `a` (where `count_a` eigenvalues are unstable
-/// and oscillatory) and `b`, by bisection from the equilibrium `x` at `a`.
-fn locate<P, F>(
+/// Every change of the unstable count between `(a, count_a)` (equilibrium
+/// `x` there) and `(b, count_b)`: each located by bisection and classified
+/// ([`hopf_points`]).
+fn crossings<P, F>(
     family: &F,
     x: &[f64],
-    mut a: f64,
-    mut b: f64,
-    count_a: usize,
+    (mut a, mut count_a): (f64, usize),
+    (b, count_b): (f64, usize),
     state: &impl Fn(f64, &mut Vec<f64>) -> Result<usize, HbError>,
-) -> Result<HopfPoint, HbError>
+    search: &mut HopfSearch,
+) -> Result<(), HbError>
 where
     P: PeriodicProblem,
     F: Fn(f64) -> Result<P, HbError>,
 {
-    let mut xm = x.to_vec();
-    while (b - a).abs() > 4.0 * f64::EPSILON * a.abs().max(b.abs()).max(1.0) {
-        let mid = 0.5 * (a + b);
-        let mut xt = xm.clone();
-        if state(mid, &mut xt)? == count_a {
-            a = mid;
-        } else {
-            b = mid;
+    let mut xa = x.to_vec();
+    // Each pass locates one change and moves `a` past it; a change needs at
+    // least one bisection step, so this ends.
+    while count_a != count_b {
+        let (mut lo, mut hi) = (a, b);
+        let mut count_hi = count_b;
+        let mut xm = xa.clone();
+        while (hi - lo).abs() > 4.0 * f64::EPSILON * lo.abs().max(hi.abs()).max(1.0) {
+            let mid = 0.5 * (lo + hi);
+            let mut xt = xm.clone();
+            let c = match state(mid, &mut xt) {
+                Ok(c) => c,
+                Err(HbError::InvalidInput(why)) => {
+                    search.undecided.push(Undecided {
+                        p_from: a,
+                        p_to: b,
+                        reason: format!("the unstable eigenvalue count changes here, but {why}"),
+                    });
+                    return Ok(());
+                }
+                Err(e) => return Err(e),
+            };
+            if c == count_a {
+                lo = mid;
+            } else {
+                (hi, count_hi) = (mid, c);
+            }
+            xm = xt;
         }
-        xm = xt;
+        match classify(family, &xm, lo, hi, count_a.abs_diff(count_hi)) {
+            Ok(Some(point)) => search.points.push(point),
+            Ok(None) => {}
+            Err(why) => search.undecided.push(Undecided {
+                p_from: lo,
+                p_to: hi,
+                reason: why,
+            }),
+        }
+        (a, count_a) = (hi, count_hi);
+        let mut xh = xm;
+        state(hi, &mut xh)?;
+        xa = xh;
     }
-    let p = 0.5 * (a + b);
-    let problem = family(p)?;
-    equilibrium(&problem, &mut xm)?;
-    let field = Field::new(&problem)?;
+    Ok(())
+}
+
+/// The located change of the unstable count by `change` between `lo` and
+/// `hi` (adjacent in floating point, equilibrium near `x`): a Hopf point, or
+/// `None` for a real eigenvalue through zero, or why it is undecided.
+fn classify<P, F>(
+    family: &F,
+    x: &[f64],
+    lo: f64,
+    hi: f64,
+    change: usize,
+) -> Result<Option<HopfPoint>, String>
+where
+    P: PeriodicProblem,
+    F: Fn(f64) -> Result<P, HbError>,
+{
+    let p = 0.5 * (lo + hi);
+    let mut xm = x.to_vec();
+    let problem = family(p).map_err(|e| e.to_string())?;
+    equilibrium(&problem, &mut xm).map_err(|e| e.to_string())?;
+    let field = Field::new(&problem).map_err(|e| e.to_string())?;
     let d = 2 * xm.len();
-    let omega = eigenvalues(&field.linearisation(&xm), d)
-        .iter()
-        .filter(|l| l.im > 0.0)
-        .min_by(|l, m| l.re.abs().total_cmp(&m.re.abs()))
-        .map(|l| l.im)
-        .ok_or_else(|| HbError::InvalidInput("no oscillatory eigenvalue at the crossing".into()))?;
-    let (lyapunov, eigenvector) = lyapunov(&field, &xm, omega)?;
-    Ok(HopfPoint {
+    let eigs = eigenvalues(&field.linearisation(&xm), d);
+    let Some(nearest) = eigs.iter().min_by(|l, m| l.re.abs().total_cmp(&m.re.abs())) else {
+        return Err("no eigenvalues at the crossing".into());
+    };
+    let complex = nearest.im.abs() > REAL_AT_CROSSING * nearest.norm().max(1.0);
+    match (complex, change) {
+        (false, 1) => return Ok(None),
+        (true, 2) => {}
+        _ => {
+            return Err(format!(
+                "{change} eigenvalue(s) cross at once, the nearest to the axis {} ± {}i: \
+                 not a simple Hopf point or fold",
+                nearest.re,
+                nearest.im.abs()
+            ))
+        }
+    }
+    let omega = nearest.im.abs();
+    let (lyapunov, eigenvector) =
+        lyapunov(&field, &xm, omega).map_err(|e| format!("a complex pair crosses, but {e}"))?;
+    Ok(Some(HopfPoint {
         p,
         omega,
         lyapunov,
         equilibrium: xm,
         eigenvector,
-    })
+    }))
 }
 
 #[cfg(test)]
@@ -529,7 +658,7 @@ mod tests {
         // ẍ + x = x²ẋ + …: averaging gives ṙ = r(μ/2 + r²/8), i.e. in the
         // normal form with ⟨q, q⟩ = 1 (r = √2|z|) Re c₁ = 1/4, ω = 1:
         // l₁ = 1/4 (the x⁴ẋ term is of fifth order and does not enter).
-        let hopf = hopf_points(&family, &[0.0], -0.2, 0.1, 30).unwrap();
+        let hopf = hopf_points(&family, &[0.0], -0.2, 0.1, 30).unwrap().points;
         assert_eq!(hopf.len(), 1);
         let h = &hopf[0];
         assert!(h.p.abs() < 1e-14, "{}", h.p);

@@ -6,13 +6,12 @@
 //! is computed in the loops; the only indexed accesses (one row or column chosen
 //! by the caller) are checked, a wrong index or length a [`SolveError::Dimension`].
 
-use std::slice::{ChunksExact, ChunksExactMut};
-
 use crate::iteration::{Progress, SolveError};
 use crate::vector::{axpy, dot, matvec, norm2};
 use crate::LuWorkspace;
 
-use super::{BroydenStats, System};
+use super::inverse::{rows, rows_mut, InverseJacobian};
+use super::{BlockDiagonal, BroydenStats, System};
 
 /// Caller-owned state of the solver: `B`, `H = B⁻¹` and all scratch vectors.
 ///
@@ -23,7 +22,7 @@ use super::{BroydenStats, System};
 pub struct BroydenWorkspace {
     m: usize,
     b: Vec<f64>,
-    h: Vec<f64>,
+    h: InverseJacobian,
     has_jacobian: bool,
     /// `b` holds the current `B` (false after untracked updates: rebuilt from `H`).
     b_current: bool,
@@ -59,7 +58,7 @@ impl BroydenWorkspace {
         Self {
             m,
             b: vec![0.0; m * m],
-            h: vec![0.0; m * m],
+            h: InverseJacobian::new(m),
             has_jacobian: false,
             b_current: true,
             track_jacobian: true,
@@ -106,11 +105,35 @@ impl BroydenWorkspace {
     /// # Errors
     /// [`SolveError::Dimension`] on size mismatch.
     pub fn set_inverse_jacobian(&mut self, h0: &[f64]) -> Result<(), SolveError> {
-        copy_square(h0, &mut self.h)?;
+        copy_square(h0, self.h.overwrite())?;
+        self.seeded_with_inverse();
+        Ok(())
+    }
+
+    /// Sets `H₀` as a [`BlockDiagonal`] matrix, e.g. the inverse of the linear
+    /// Jacobian Eq. 60: like [`Self::set_inverse_jacobian`], and while `B` is not
+    /// tracked the iteration keeps `H` as `H₀` plus its rank-one updates, so no
+    /// step costs O(m²).
+    ///
+    /// # Errors
+    /// [`SolveError::Dimension`] unless `h0` is `m×m`.
+    pub fn set_inverse_jacobian_blocks(&mut self, h0: &BlockDiagonal) -> Result<(), SolveError> {
+        if h0.len() != self.m {
+            return Err(SolveError::Dimension {
+                expected: self.m,
+                got: h0.len(),
+            });
+        }
+        self.h.set_blocks(h0);
+        self.seeded_with_inverse();
+        Ok(())
+    }
+
+    /// State after `H` was set directly: `B` stale, a Jacobian present.
+    fn seeded_with_inverse(&mut self) {
         self.b_current = false;
         self.has_jacobian = true;
         self.dx_next_ready = false;
-        Ok(())
     }
 
     /// Gives mutable access to `B` for the caller to edit (e.g. to replace one
@@ -143,13 +166,11 @@ impl BroydenWorkspace {
         self.materialize_b();
         let b_i = rows_mut(&mut self.b, m).nth(i).into_iter().flatten();
         overwrite(b_i, row, &mut self.u);
-        for (hu, hrow) in self.hu.iter_mut().zip(rows(&self.h, m)) {
+        let h = self.h.dense();
+        for (hu, hrow) in self.hu.iter_mut().zip(rows(h, m)) {
             *hu = hrow.get(i).copied().unwrap_or(f64::NAN);
         }
-        self.sth.fill(0.0);
-        for (uk, hrow) in self.u.iter().zip(rows(&self.h, m)) {
-            axpy(*uk, hrow, &mut self.sth);
-        }
+        self.h.mul_transpose(&self.u, &mut self.sth);
         self.sherman_morrison(1.0 + self.sth.get(i).copied().unwrap_or(f64::NAN))
     }
 
@@ -166,11 +187,12 @@ impl BroydenWorkspace {
         self.materialize_b();
         let b_j = rows_mut(&mut self.b, m).filter_map(|brow| brow.get_mut(j));
         overwrite(b_j, col, &mut self.u);
-        matvec(&self.h, m, m, &self.u, &mut self.hu);
+        let h = self.h.dense();
+        matvec(h, m, m, &self.u, &mut self.hu);
         for (s, h) in self
             .sth
             .iter_mut()
-            .zip(rows(&self.h, m).nth(j).into_iter().flatten())
+            .zip(rows(h, m).nth(j).into_iter().flatten())
         {
             *s = *h;
         }
@@ -198,7 +220,7 @@ impl BroydenWorkspace {
         if !self.has_jacobian || denom.abs() < 1e-8 || !denom.is_finite() {
             return self.invert_b();
         }
-        for (hui, hrow) in self.hu.iter().zip(rows_mut(&mut self.h, self.m)) {
+        for (hui, hrow) in self.hu.iter().zip(rows_mut(self.h.dense(), self.m)) {
             axpy(-(hui / denom), &self.sth, hrow);
         }
         Ok(())
@@ -217,15 +239,16 @@ impl BroydenWorkspace {
         if self.b_current {
             return;
         }
-        if !invert(&mut self.lu, self.m, &self.h, &mut self.b) {
+        if !invert(&mut self.lu, self.m, self.h.dense(), &mut self.b) {
             self.b.fill(f64::NAN);
         }
         self.b_current = true;
     }
 
-    /// Current approximate inverse Jacobian `H = B⁻¹` (row-major).
-    pub fn inverse_jacobian(&self) -> &[f64] {
-        &self.h
+    /// Current approximate inverse Jacobian `H = B⁻¹` (row-major; formed from
+    /// its factors if the solve kept it factored).
+    pub fn inverse_jacobian(&mut self) -> &[f64] {
+        self.h.dense()
     }
 
     /// Whether a Jacobian is set (otherwise the next solve refreshes first).
@@ -251,7 +274,7 @@ impl BroydenWorkspace {
     fn invert_b(&mut self) -> Result<(), SolveError> {
         self.b_current = true;
         self.dx_next_ready = false;
-        self.has_jacobian = invert(&mut self.lu, self.m, &self.b, &mut self.h);
+        self.has_jacobian = invert(&mut self.lu, self.m, &self.b, self.h.overwrite());
         if self.has_jacobian {
             Ok(())
         } else {
@@ -296,7 +319,7 @@ impl BroydenWorkspace {
             std::mem::swap(&mut self.dx, &mut self.dx_next);
             self.dx_next_ready = false;
         } else {
-            matvec(&self.h, self.m, self.m, &self.r, &mut self.dx);
+            self.h.mul(&self.r, &mut self.dx);
             self.dx.iter_mut().for_each(|d| *d = -*d);
         }
     }
@@ -395,19 +418,16 @@ impl BroydenWorkspace {
                 rt - (1.0 - t) * r
             };
         }
-        // B ← B + u sᵀ/ss;  H ← H − (H u)(sᵀ H)/(ss + sᵀ H u).
-        matvec(&self.h, m, m, &self.u, &mut self.hu);
-        self.sth.fill(0.0);
-        for (si, hrow) in self.dx.iter().zip(rows(&self.h, m)) {
-            axpy(*si, hrow, &mut self.sth);
-        }
+        // B ← B + u sᵀ/ss;  H ← H − (H u)(sᵀ H)/(ss + sᵀ H u) (kept as the pair
+        // (−H u/denom, Hᵀ s) on a block-diagonal H₀).
+        self.h.mul(&self.u, &mut self.hu);
+        self.h.mul_transpose(&self.dx, &mut self.sth);
         let denom = ss + dot(&self.dx, &self.hu);
         if denom.abs() <= 1e-14 * ss || !denom.is_finite() {
             return false;
         }
-        for (hui, hrow) in self.hu.iter().zip(rows_mut(&mut self.h, m)) {
-            axpy(-hui / denom, &self.sth, hrow);
-        }
+        self.h
+            .add_rank_one(self.hu.iter().map(|hu| -hu / denom), &self.sth);
         if self.track_jacobian {
             for (ui, brow) in self.u.iter().zip(rows_mut(&mut self.b, m)) {
                 axpy(ui / ss, &self.dx, brow);
@@ -426,17 +446,6 @@ impl BroydenWorkspace {
         }
         true
     }
-}
-
-/// The rows of the row-major `m×m` matrix `a` (none when `m = 0`, where
-/// `chunks_exact` would refuse the size).
-fn rows(a: &[f64], m: usize) -> ChunksExact<'_, f64> {
-    a.chunks_exact(m.max(1))
-}
-
-/// Mutable [`rows`].
-fn rows_mut(a: &mut [f64], m: usize) -> ChunksExactMut<'_, f64> {
-    a.chunks_exact_mut(m.max(1))
 }
 
 /// Writes `new` over `entries` (one row or column of `B`) and leaves the change

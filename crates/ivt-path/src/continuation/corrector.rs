@@ -96,9 +96,14 @@ pub enum DirectionError {
 pub enum Retry {
     /// The corrector failed: the step is halved.
     Failed,
-    /// The point was rejected (outside the interval, or backwards): the step
-    /// is redone without the corrector's state of the rejected attempt.
+    /// The point was rejected (outside the interval, backwards, or too far
+    /// from the prediction): the step is redone without the corrector's
+    /// state of the rejected attempt.
     Rejected,
+    /// The direction at the point turned too much
+    /// ([`super::ContinuationOptions::max_turn`]): as [`Retry::Rejected`],
+    /// after [`PathCorrector::direction`] ran at the rejected point.
+    Turned,
 }
 
 /// A corrector of the continuation stepper ([`super::Stepper`]): the start's

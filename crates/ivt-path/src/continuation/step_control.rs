@@ -1,7 +1,10 @@
 //! The one step rule of the continuation stepper (§3.2.3): the arclength
-//! step Δη adapted to the corrector's effort, halved on a failed corrector,
-//! capped by [`ContinuationOptions::step_cap`], and shortened to land on a
-//! bound of `[lambda_min, lambda_max]` instead of stepping past it.
+//! step Δη adapted to the corrector's effort, halved on a failed corrector
+//! and on a rejected point (its direction turned by more than
+//! [`ContinuationOptions::max_turn`], or it lies farther than
+//! [`ContinuationOptions::max_correction`]`·Δη` from the prediction), capped
+//! by [`ContinuationOptions::step_cap`], and shortened to land on a bound of
+//! `[lambda_min, lambda_max]` instead of stepping past it.
 
 use super::ContinuationOptions;
 
@@ -61,10 +64,40 @@ impl StepControl {
         self.force_landing = true;
     }
 
-    /// A failed corrector: halves Δη; `false` once it is below `ds_min`.
+    /// A failed corrector: halves Δη (and drops a forced landing, whose step
+    /// the halving would not shorten); `false` once it is below `ds_min`.
     pub(crate) fn failed(&mut self, opts: &ContinuationOptions) -> bool {
         self.ds *= 0.5;
+        self.force_landing = false;
         self.ds >= opts.ds_min
+    }
+
+    /// Whether a converged point `correction` away from its prediction, on a
+    /// step of length `step`, lies too far from it
+    /// ([`ContinuationOptions::max_correction`]).
+    pub(crate) fn too_far(correction: f64, step: f64, opts: &ContinuationOptions) -> bool {
+        correction.is_nan() || correction > opts.max_correction * step
+    }
+
+    /// Whether the direction turned by more than
+    /// [`ContinuationOptions::max_turn`] over a step: `cos_turn` is the
+    /// cosine of the angle between the two unit directions.
+    pub(crate) fn turned(cos_turn: f64, opts: &ContinuationOptions) -> bool {
+        cos_turn.is_nan() || cos_turn < opts.max_turn.min(std::f64::consts::PI).cos()
+    }
+
+    /// A converged point rejected after a step of length `step` (too far from
+    /// its prediction, or its direction turned too much): the step is redone
+    /// at half that length and `true` returned, unless that is below
+    /// `ds_min` (`false`: the point is kept, the step cannot shrink).
+    pub(crate) fn rejected(&mut self, step: f64, opts: &ContinuationOptions) -> bool {
+        let half = 0.5 * step.min(self.ds);
+        if half < opts.ds_min {
+            return false;
+        }
+        self.ds = half;
+        self.force_landing = false;
+        true
     }
 
     /// An accepted point `x` whose corrector spent `effort` (iterations, a
@@ -130,5 +163,49 @@ mod tests {
         assert!((c.ds - 0.084).abs() < 1e-15);
         assert!(c.failed(&opts)); // 0.042
         assert!(!c.failed(&opts)); // 0.021 < ds_min
+    }
+
+    #[test]
+    fn a_far_or_turned_point_is_rejected_at_half_its_step_unless_below_ds_min() {
+        let opts = ContinuationOptions {
+            ds: 0.1,
+            ds_min: 0.03,
+            ..Default::default()
+        };
+        // Half a step from its prediction is still accepted; more is not.
+        assert!(!StepControl::too_far(0.05, 0.1, &opts));
+        assert!(StepControl::too_far(0.0501, 0.1, &opts));
+        assert!(StepControl::too_far(f64::NAN, 0.1, &opts));
+        // One radian of turn is accepted, more is not.
+        assert!(!StepControl::turned(1.0f64.cos(), &opts));
+        assert!(StepControl::turned(1.01f64.cos(), &opts));
+        let off = ContinuationOptions {
+            max_turn: std::f64::consts::PI,
+            ..opts.clone()
+        };
+        assert!(!StepControl::turned(-1.0, &off));
+        // A landing step of 0.08 is redone at 0.04 (not from ds = 0.1), then
+        // 0.02 < ds_min: the point is kept.
+        let mut c = StepControl::new(&opts);
+        c.force_landing();
+        assert!(c.rejected(0.08, &opts));
+        assert_eq!((c.ds, c.force_landing), (0.04, false));
+        assert!(!c.rejected(0.04, &opts));
+        assert_eq!(c.ds, 0.04);
+    }
+
+    #[test]
+    fn a_failed_forced_landing_is_not_repeated_at_the_same_length() {
+        let mut opts = ContinuationOptions::default();
+        (opts.ds, opts.lambda_min, opts.lambda_max) = (0.1, 0.0, 1.0);
+        let mut c = StepControl::new(&opts);
+        c.force_landing();
+        // Forced: the whole way to the bound, 100 steps of ds along d_λ = 0.01.
+        let forced = c.plan(0.9, 0.01, &opts).unwrap();
+        assert_eq!(forced.landing, Some(1.0));
+        assert!((forced.step - 10.0).abs() < 1e-9, "{forced:?}");
+        assert!(c.failed(&opts));
+        let plan = c.plan(0.9, 0.01, &opts).unwrap();
+        assert_eq!((plan.step, plan.landing), (0.05, None));
     }
 }

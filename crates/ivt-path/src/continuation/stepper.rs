@@ -5,11 +5,12 @@
 //! [`Stepper::run`] collects the whole [`Path`].
 
 use super::corrector::{DirectionError, PathCorrector, Prediction, Retry};
-use super::predictor::{curvature_between, predict};
+use super::predictor::{curvature_between, distance, predict};
 use super::step_control::StepControl;
 use super::{turn, ContinuationOptions, Path, PathPoint, Termination, Turn};
 use crate::branch::Branch;
 use crate::error::PathError;
+use ivt_num::vector::dot;
 use ivt_num::SolveError;
 
 /// What [`Stepper::next`] gives.
@@ -200,7 +201,8 @@ impl<'b, B: Branch> Stepper<'b, B> {
     }
 
     /// Predicts and corrects until a point is accepted (halving the step on
-    /// failures) or the path ends.
+    /// failures and on rejected points, [`StepControl::rejected`]) or the
+    /// path ends.
     fn step(&mut self) -> Result<PathPoint, Termination> {
         let opts = &self.opts;
         let curved = self.corrector.second_order()
@@ -243,6 +245,15 @@ impl<'b, B: Branch> Stepper<'b, B> {
                     if let (Some(bound), Some(l)) = (plan.landing, self.x_new.last_mut()) {
                         *l = bound;
                     }
+                    // Converged far from the prediction: onto another part
+                    // of the branch (across a sharp peak, say).
+                    let correction = distance(&self.x_new, &self.u_pred);
+                    if StepControl::too_far(correction, plan.step, opts)
+                        && self.control.rejected(plan.step, opts)
+                    {
+                        self.corrector.retry(self.branch, &self.x, Retry::Rejected);
+                        continue;
+                    }
                     let l = self.x_new.last().copied().unwrap_or(f64::NAN);
                     if plan.landing.is_none() && (l < opts.lambda_min || l > opts.lambda_max) {
                         // Corrected past a bound: redo the step onto it.
@@ -257,6 +268,16 @@ impl<'b, B: Branch> Stepper<'b, B> {
                         &self.x_new,
                         &mut self.direction,
                     ) {
+                        Ok(())
+                            if StepControl::turned(
+                                dot(&self.prev_direction, &self.direction),
+                                opts,
+                            ) && self.control.rejected(plan.step, opts) =>
+                        {
+                            self.direction.copy_from_slice(&self.prev_direction);
+                            self.corrector.retry(self.branch, &self.x, Retry::Turned);
+                            continue;
+                        }
                         Ok(()) => {
                             let shrink_at = self.corrector.shrink_at(opts.target_iter);
                             self.control

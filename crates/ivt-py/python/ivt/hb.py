@@ -62,7 +62,9 @@ Elements = _ivt.hb.elements.Elements
 class AllSolutions(list):  # type: ignore[type-arg]
     """The orbits found by :func:`all_solutions` (a list of dicts), with the
     search's bounds and outcome in ``search``: {"starts", "runs",
-    "max_amplitude", "newton_steps", "exhausted"}."""
+    "max_amplitude", "newton_steps", "exhausted", "failures_per_start",
+    "copies_merged", "bound"} ("bound" states in words what "exhausted"
+    refers to)."""
 
     def __init__(self, solutions: list, search: dict) -> None:  # type: ignore[type-arg]
         super().__init__(solutions)
@@ -78,7 +80,10 @@ def all_solutions(
     within bounded starts (see ``ivt._ivt.hb._all_solutions``): a list of
     {"coeffs", "amplitude", "multipliers", "stable", "stability"} by
     increasing size, with ``.search`` = {"starts", "runs", "max_amplitude",
-    "newton_steps", "exhausted"}."""
+    "newton_steps", "exhausted", "failures_per_start", "copies_merged",
+    "bound"}. Time-shifted copies of an autonomous problem's orbits are
+    merged; an undamped linear resonance with nothing found raises
+    ValueError naming the harmonic."""
     found = _ivt.hb._all_solutions(
         m, c, k, g, f, omega, n=n, samples=samples, max_amplitude=max_amplitude,
         amplitudes=amplitudes, newton_steps=newton_steps, tol=tol,
@@ -153,8 +158,9 @@ def _coo_arrays(name, a):
         raise ValueError(f"argument `{name}` must be square, got shape {shape}")
     if _np.iscomplexobj(vals):
         raise ValueError(
-            f"argument `{name}` is complex: structural damping K(1 + iη) is not supported; "
-            "give a real damping matrix c (e.g. Rayleigh c = α·m + β·k)"
+            f"argument `{name}` is complex: its imaginary part would be dropped. Complex inputs are "
+            "refused (structural damping K(1 + iη) included: give a real damping matrix c, e.g. "
+            "c = η·k/ω at one frequency ω, or Rayleigh c = α·m + β·k)"
         )
     return shape[0], (
         _np.ascontiguousarray(rows, dtype=_np.int64),
@@ -176,6 +182,10 @@ def _half_bandwidth(coo):
 
 def _loads(f, n):
     """(F_cos, F_sin) from an array F (F cos θ) or a pair (F_cos, F_sin)."""
+    parts = f if isinstance(f, (tuple, list)) and len(f) == 2 and _np.ndim(f[0]) == 1 else (f,)
+    if any(_np.iscomplexobj(v) for v in parts):
+        raise ValueError("argument `f` is complex: its imaginary part would be dropped; give real load vectors "
+                         "(F_cos, F_sin) for a phase")
     if isinstance(f, (tuple, list)) and len(f) == 2 and _np.ndim(f[0]) == 1:
         fc, fs = (_np.asarray(v, dtype=float).ravel() for v in f)
     else:
@@ -221,6 +231,32 @@ def _dense_dofs(entry, n_dof, amplitude_dof, record_dofs):
         entry["amplitude"] = _series_max(blocks[amplitude_dof])
 
 
+# The keywords the condensed (large-model) path reads; any other keyword is
+# refused there, not ignored (issue 41).
+_LARGE_PATH_KEYS = {
+    "solve": {"m", "c", "k", "g", "omega_f", "f", "n", "samples", "velocity_dependent", "vectorized",
+              "jac", "stability", "rtol"},
+    "frc": {"m", "c", "k", "g", "f", "omega_from", "omega_to", "n", "samples", "velocity_dependent",
+            "vectorized", "jac", "stability", "rtol", "ds", "ds_min", "ds_max", "truncation_estimate"},
+}
+
+
+def _refuse_keys(native_name, given, sig):
+    """TypeError for a keyword neither function knows (a misspelling), ValueError
+    for one of the dense path's that the large-model path does not read."""
+    allowed = _LARGE_PATH_KEYS[native_name]
+    unknown = sorted(k for k in given if k not in allowed and k not in sig.parameters)
+    if unknown:
+        raise TypeError(f"{native_name}() got unexpected keyword argument(s) {', '.join(map(repr, unknown))}")
+    inapplicable = sorted(k for k in given if k not in allowed)
+    if inapplicable:
+        raise ValueError(
+            f"{native_name}: {', '.join(map(repr, inapplicable))} do(es) not apply to a large model "
+            f"(sparse m/c/k, load-vector f or nonlinear_dofs: the condensed path); it reads "
+            f"{', '.join(sorted(allowed - {'m', 'c', 'k', 'g', 'f'}))}"
+        )
+
+
 def _large_call(native_name, sig, args, kwargs, extra):
     known = {k: v for k, v in kwargs.items() if k in sig.parameters}
     try:
@@ -230,6 +266,7 @@ def _large_call(native_name, sig, args, kwargs, extra):
     # What the caller gave (the condensed path's own defaults apply to the
     # rest), including the path keywords the native signature lacks.
     given = {**bound.arguments, **{k: v for k, v in kwargs.items() if k not in known}}
+    _refuse_keys(native_name, given, sig)
     bound.apply_defaults()
     a = _Namespace(**bound.arguments)
     dofs = extra.get("nonlinear_dofs")
@@ -370,6 +407,11 @@ most 64 blocks; for proportional damping and a position-only g, Hsu by a
 modal splitting): "multipliers", "stable",
 "stability" and "multiplier_error" (basis truncation + Hsu estimates) per
 point.
+
+Keywords of the dense path that the condensed path does not read
+(`subharmonic`, `guess`, `method`, `tol`, `max_iter`, `events`) raise
+ValueError there, unknown ones TypeError; complex m, c, k or loads raise
+ValueError.
 
 Large solids (issue 42): m, c, k may also be Matrix Market files (paths), as
 FE codes export them (real entries; complex structural damping is refused).

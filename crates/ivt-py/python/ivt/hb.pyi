@@ -163,7 +163,7 @@ def neimark_sacker_points(
 def limit_cycle(
     m: Matrix, c: Matrix, k: Matrix, g: Nonlinearity,
     omega_guess: float, amplitude: float = 1.0, guess: Optional[ArrayLike] = None,
-    n: int = 20, samples: int = 64, tol: float = 0.0, x0: Optional[Sequence[float]] = None,
+    n: int = 20, samples: int = 64, tol: float = 1e-8, x0: Optional[Sequence[float]] = None,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
     jac: Optional[Jacobian] = None,
 ) -> Dict[str, Any]: ...

@@ -92,7 +92,7 @@ where
     }
     let n_dof = family(mu, nu_start)?.n_dof();
     let nu = Cell::new(nu_start);
-    let member = |m: f64| Member::new(family(m, nu.get()).ok(), n_dof);
+    let member = |m: f64| Member::new(family(m, nu.get()), n_dof, m, None);
     let mut sys = CycleFoldSystem::new(CycleSystem::new(&member, hb, mu)?, &nu);
     let m1 = sys.m1;
     if start.coeffs.len() + 1 != m1 {
@@ -138,7 +138,7 @@ struct CycleFoldSystem<'f, 'c, F> {
     m1: usize,
 }
 
-impl<'f, 'c, P: PeriodicProblem, F: Fn(f64) -> Member<P>> CycleFoldSystem<'f, 'c, F> {
+impl<'f, 'c, P: PeriodicProblem, F: Fn(f64) -> Member<'static, P>> CycleFoldSystem<'f, 'c, F> {
     fn new(cycle: CycleSystem<'f, F>, nu: &'c Cell<f64>) -> Self {
         let m1 = cycle.len();
         Self {
@@ -158,7 +158,9 @@ impl<'f, 'c, P: PeriodicProblem, F: Fn(f64) -> Member<P>> CycleFoldSystem<'f, 'c
     }
 }
 
-impl<P: PeriodicProblem, F: Fn(f64) -> Member<P>> CurveSystem for CycleFoldSystem<'_, '_, F> {
+impl<P: PeriodicProblem, F: Fn(f64) -> Member<'static, P>> CurveSystem
+    for CycleFoldSystem<'_, '_, F>
+{
     type Point = CycleFoldPoint;
 
     /// `[R; b₁; J v; (vᵀv − 1)/2]` at `x = [u, v, μ, ν]`; `None` if the

@@ -264,8 +264,14 @@ impl<B: Branch> PathCorrector<B> for NewtonCorrector {
         found.then_some(()).ok_or(DirectionError::Singular)
     }
 
-    /// The chord stays off for the rest of the step once it failed.
-    fn retry(&mut self, _branch: &mut B, _x_prev: &[f64], _why: Retry) {}
+    /// The chord stays off for the rest of the step once it failed, and
+    /// after [`Retry::Turned`] unless it factors afresh at each prediction
+    /// (the tangent's LU is the rejected point's).
+    fn retry(&mut self, _branch: &mut B, _x_prev: &[f64], why: Retry) {
+        if why == Retry::Turned && !self.second_order {
+            self.chord_ok = false;
+        }
+    }
 
     fn bordered_sign(&self) -> Option<f64> {
         Some(self.aug.det_sign())
