@@ -363,3 +363,42 @@ fn near_singular_factors_are_accepted_on_request() {
         "{x:?} {stats:?}"
     );
 }
+
+/// `F = (10²⁰(x₀ + x₁ − 3), x₀ − x₁ + 1)`, root (1, 2): the unscaled
+/// Jacobian's second pivot (−2) is below `n·ε` of the first (10²⁰), a
+/// singular factor; with `scale_rows` the rows are `(1, 1)` and `(1, −1)`
+/// and one Newton step lands on the root (the system is linear).
+#[test]
+fn scaled_rows_factor_a_jacobian_whose_rows_differ_in_size() {
+    struct Lopsided;
+    impl NewtonSystem for Lopsided {
+        type Error = ();
+        fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), ()> {
+            r[0] = 1e20 * (x[0] + x[1] - 3.0);
+            r[1] = x[0] - x[1] + 1.0;
+            Ok(())
+        }
+        fn jacobian(&mut self, _x: &[f64], jac: &mut [f64]) -> Result<(), ()> {
+            jac.copy_from_slice(&[1e20, 1e20, 1.0, -1.0]);
+            Ok(())
+        }
+    }
+    let mut ws = NewtonWorkspace::new(2);
+    let mut x = [0.0; 2];
+    let err = newton(&mut Lopsided, &mut x, &mut ws, &NewtonOptions::default());
+    assert!(
+        matches!(err, Err(SolveError::SingularJacobian { .. })),
+        "{err:?}"
+    );
+    let opts = NewtonOptions {
+        scale_rows: true,
+        ..Default::default()
+    };
+    let mut x = [0.0; 2];
+    let stats = newton(&mut Lopsided, &mut x, &mut ws, &opts).unwrap();
+    assert_eq!(stats.iterations, 1, "{stats:?}");
+    assert!(
+        (x[0] - 1.0).abs() < 1e-15 && (x[1] - 2.0).abs() < 1e-15,
+        "{x:?}"
+    );
+}
