@@ -90,7 +90,7 @@ pub struct HopfRecord {
 }
 
 /// A stretch of p where the Hopf search could not decide
-/// ([`crate::hopf_points`]): no equilibrium there, or a crossing that is
+/// ([`ivt_hb::hopf_points`]): no equilibrium there, or a crossing that is
 /// neither a simple Hopf point nor a real eigenvalue through zero.
 #[derive(Debug, Clone, Serialize)]
 pub struct UndecidedRecord {
