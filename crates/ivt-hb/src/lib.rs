@@ -32,6 +32,7 @@ pub mod mathieu;
 pub mod models;
 pub mod modified;
 pub mod ode;
+mod peak;
 pub mod problem;
 pub mod sensitivity;
 pub mod stability;

@@ -22,7 +22,7 @@ use crate::continuation::{
 use crate::error::HbError;
 use crate::events::{observe, BifurcationKind, EventObserver, Fold, LocateOptions};
 use crate::frc::FrcFold;
-use crate::ihb::refine_peak;
+use crate::peak::refine_peak;
 use crate::problem::PeriodicProblem;
 use crate::stability::HsuSteps;
 
