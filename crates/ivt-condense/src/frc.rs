@@ -17,7 +17,7 @@ use super::stability::{
 use ivt_hb::branches::events::{observe, BifurcationKind, EventObserver, Fold, LocateOptions};
 use ivt_hb::branches::frc::FrcFold;
 use ivt_hb::orbit::aft::Aft;
-use ivt_hb::orbit::ihb::refine_peak;
+use ivt_hb::orbit::peak::refine_peak;
 use ivt_hb::problem::PeriodicProblem;
 use ivt_hb::stability::HsuSteps;
 use ivt_hb::HbError;

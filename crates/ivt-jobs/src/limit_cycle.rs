@@ -83,7 +83,7 @@ impl LimitCycleRequest {
         }
         if !(self.tol.is_finite() && self.tol >= 0.0) {
             return Err(HbError::InvalidInput(format!(
-                "tol = {} must be finite and ≥ 0 (0: the harmonics as given)",
+                "tol = {:?} must be finite and ≥ 0 (0: the harmonics as given)",
                 self.tol
             )));
         }

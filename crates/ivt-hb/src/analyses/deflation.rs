@@ -480,8 +480,8 @@ impl<'p, P: PeriodicProblem> Deflated<'p, P> {
             }
             if !LuWorkspace::new(k).factor_row_major(&block) {
                 return Some(format!(
-                    "no isolated periodic orbit at ω_f = {}: the linear part is singular at \
-                     harmonic {h} (h·ω = {} is an undamped natural frequency, or K is \
+                    "no isolated periodic orbit at ω_f = {:?}: the linear part is singular at \
+                     harmonic {h} (h·ω = {:?} is an undamped natural frequency, or K is \
                      singular at h = 0): none exists if the load excites it, a continuum if \
                      not; add damping or move ω_f",
                     self.omega_f,

@@ -15,3 +15,4 @@ pub mod classic;
 pub mod galerkin;
 pub mod ihb;
 pub mod modified;
+pub mod peak;
