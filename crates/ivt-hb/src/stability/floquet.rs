@@ -539,6 +539,32 @@ mod tests {
     }
 
     #[test]
+    fn closed_form_2x2_matches_the_rotation_and_boost() {
+        // [[0, w], [−w, 0]] is a rotation by w (d2 = −w²), [[0, w], [w, 0]] a
+        // boost (d2 = w²): exp is [[cos w, sin w], [−sin w, cos w]] and
+        // [[cosh w, sinh w], [sinh w, cosh w]]; w = 1e-9 takes the series
+        // branch (|d2| < 1e-8), the others cos/sin and cosh/sinh.
+        for w in [1e-9f64, 1e-4, 0.1, 0.5, 0.9, 0.999_999, 1.0, 1.01, 3.0] {
+            let (c, s) = (w.cos(), w.sin());
+            let mut out = [0.0; 4];
+            expm2(&[0.0, w, -w, 0.0], &mut out);
+            for (got, want) in out.iter().zip([c, s, -s, c]) {
+                assert!(
+                    (got - want).abs() <= 4e-16 * want.abs().max(1e-300),
+                    "rotation {w}: {out:?}"
+                );
+            }
+            expm2(&[0.0, w, w, 0.0], &mut out);
+            for (got, want) in out.iter().zip([w.cosh(), w.sinh(), w.sinh(), w.cosh()]) {
+                assert!(
+                    (got - want).abs() <= 4e-16 * want.abs(),
+                    "boost {w}: {out:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn mathieu_free_oscillator_multipliers() {
         // Θ constant [[0,1],[−ω0², −2ζω0]]: multipliers exp(2π λ), λ the eigenvalues.
         let (w0, z) = (1.3f64, 0.05);

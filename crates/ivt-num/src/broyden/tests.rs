@@ -92,6 +92,54 @@ fn untracked_mode_matches_tracked_and_rebuilds_b_on_demand() {
 }
 
 #[test]
+fn untracked_mode_keeps_the_tracked_column_and_exact_rows_of_b() {
+    // The continuation corrector's set-up: the last row exact (a linear
+    // equation), B not tracked except its last column. After a dozen
+    // untracked updates and a row and a column replacement, the entries read
+    // without rebuilding B (`jacobian_entry`) equal those of H⁻¹ (rebuilt by
+    // inversion) to 1e-9 relative, and the exact row is the one set.
+    let m = 6;
+    let mut f = |x: &[f64], r: &mut [f64]| {
+        cubic_system(&x[..m - 1], &mut r[..m - 1]);
+        r[m - 1] = x.iter().sum::<f64>() - m as f64;
+    };
+    let mut ws = BroydenWorkspace::new(m);
+    ws.track_jacobian = false;
+    ws.exact_rows = m - 1..m;
+    ws.tracked_column = Some(m - 1);
+    let b0: Vec<f64> = (0..m * m)
+        .map(|k| match (k / m, k % m) {
+            (i, _) if i == m - 1 => 1.0,
+            (i, j) if i == j => 5.0,
+            _ => 0.0,
+        })
+        .collect();
+    ws.set_jacobian(&b0).unwrap();
+    let mut x = [4.0, -2.0, 2.5, 4.0, -1.1, 0.0];
+    let opts = BroydenOptions::default().with_tol(1e-13);
+    let stats = broyden_solve(&mut f, &mut x, &mut ws, &opts).unwrap();
+    assert!(stats.iterations >= 6, "too easy: {stats:?}");
+    let col: Vec<f64> = (0..m).map(|i| 0.5 + i as f64).collect();
+    let row: Vec<f64> = (0..m).map(|j| 1.0 + 0.1 * j as f64).collect();
+    ws.replace_col(m - 1, &col).unwrap();
+    ws.replace_row(m - 1, &row).unwrap();
+    let mut known: Vec<f64> = (0..m)
+        .map(|i| ws.jacobian_entry(i, m - 1).unwrap())
+        .collect();
+    known.extend((0..m).map(|j| ws.jacobian_entry(m - 1, j).unwrap()));
+    assert_eq!(&known[m..], &row[..]);
+    let b = ws.jacobian().to_vec();
+    let scale = b.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+    let rebuilt = (0..m)
+        .map(|i| b[i * m + m - 1])
+        .chain((0..m).map(|j| b[(m - 1) * m + j]));
+    for (k, (a, w)) in known.iter().zip(rebuilt).enumerate() {
+        assert!((a - w).abs() <= 1e-9 * scale, "entry {k}: {a} vs {w}");
+    }
+    assert_eq!(ws.jacobian_entry(m, 0), None);
+}
+
+#[test]
 fn non_convergence_carries_history() {
     // x² + 1 = 0 has no real root.
     let mut f = |x: &[f64], r: &mut [f64]| r[0] = x[0] * x[0] + 1.0;

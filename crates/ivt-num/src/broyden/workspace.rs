@@ -30,6 +30,14 @@ pub struct BroydenWorkspace {
     /// `B` is not read between solves: each iteration then saves two of its five
     /// O(m²) passes, and [`Self::jacobian`] rebuilds `B` from `H` on demand.
     pub track_jacobian: bool,
+    /// While `B` is not tracked, keep this one column of `B` current anyway
+    /// (O(m) per update), so [`Self::replace_col`] of it and
+    /// [`Self::replace_row`] of an exact row need no inversion: the
+    /// continuation corrector's `B_λ` column and arc-length row (Eq. 72).
+    pub tracked_column: Option<usize>,
+    /// `b`'s exact rows and its tracked column are current (while `b` is stale
+    /// as a whole); false once `H` was set directly.
+    b_lines_current: bool,
     /// The next quasi-Newton direction is already in `dx_next` (see [`Self::update`]).
     dx_next_ready: bool,
     /// Rows of `B` that the Broyden update leaves untouched (their equations are
@@ -62,6 +70,8 @@ impl BroydenWorkspace {
             has_jacobian: false,
             b_current: true,
             track_jacobian: true,
+            tracked_column: None,
+            b_lines_current: true,
             dx_next_ready: false,
             exact_rows: 0..0,
             r: vec![0.0; m],
@@ -132,6 +142,7 @@ impl BroydenWorkspace {
     /// State after `H` was set directly: `B` stale, a Jacobian present.
     fn seeded_with_inverse(&mut self) {
         self.b_current = false;
+        self.b_lines_current = false;
         self.has_jacobian = true;
         self.dx_next_ready = false;
     }
@@ -163,7 +174,9 @@ impl BroydenWorkspace {
         self.check_line(i, row)?;
         let m = self.m;
         // B' = B + e_i dᵀ, d = row − B_i;  H' = H − (H e_i)(dᵀ H)/(1 + dᵀ H e_i).
-        self.materialize_b();
+        if !(self.b_lines_current && self.exact_rows.contains(&i)) {
+            self.materialize_b();
+        }
         let b_i = rows_mut(&mut self.b, m).nth(i).into_iter().flatten();
         overwrite(b_i, row, &mut self.u);
         let h = self.h.dense();
@@ -184,7 +197,9 @@ impl BroydenWorkspace {
         self.check_line(j, col)?;
         let m = self.m;
         // B' = B + c e_jᵀ, c = col − B_:j;  H' = H − (H c)(e_jᵀ H)/(1 + e_jᵀ H c).
-        self.materialize_b();
+        if !(self.b_lines_current && self.tracked_column == Some(j)) {
+            self.materialize_b();
+        }
         let b_j = rows_mut(&mut self.b, m).filter_map(|brow| brow.get_mut(j));
         overwrite(b_j, col, &mut self.u);
         let h = self.h.dense();
@@ -226,6 +241,20 @@ impl BroydenWorkspace {
         Ok(())
     }
 
+    /// Entry `(i, j)` of the current `B`, without rebuilding `B` when the entry
+    /// is on an exact row or the tracked column; `None` out of range.
+    pub fn jacobian_entry(&mut self, i: usize, j: usize) -> Option<f64> {
+        let known = self.b_lines_current
+            && (self.exact_rows.contains(&i) || self.tracked_column == Some(j));
+        if !known {
+            self.materialize_b();
+        }
+        if i >= self.m || j >= self.m {
+            return None;
+        }
+        self.b.get(i * self.m + j).copied()
+    }
+
     /// Current approximate Jacobian `B` (row-major); rebuilt from `H` when
     /// [`Self::track_jacobian`] was off (NaN-filled if `H` is singular, which an `H`
     /// built by the solver is not unless it overflowed).
@@ -243,6 +272,7 @@ impl BroydenWorkspace {
             self.b.fill(f64::NAN);
         }
         self.b_current = true;
+        self.b_lines_current = true;
     }
 
     /// Current approximate inverse Jacobian `H = B⁻¹` (row-major; formed from
@@ -273,6 +303,7 @@ impl BroydenWorkspace {
 
     fn invert_b(&mut self) -> Result<(), SolveError> {
         self.b_current = true;
+        self.b_lines_current = true;
         self.dx_next_ready = false;
         self.has_jacobian = invert(&mut self.lu, self.m, &self.b, self.h.overwrite());
         if self.has_jacobian {
@@ -434,14 +465,28 @@ impl BroydenWorkspace {
             }
         } else {
             self.b_current = false;
+            if let Some(j) = self.tracked_column {
+                let f = self.dx.get(j).copied().unwrap_or(f64::NAN) / ss;
+                for (ui, brow) in self.u.iter().zip(rows_mut(&mut self.b, m)) {
+                    if let Some(bij) = brow.get_mut(j) {
+                        *bij += ui * f;
+                    }
+                }
+            }
         }
-        // A full untracked step with no masked row has u = r_trial, so the next
-        // direction −H' r_trial = −(ss/denom)·H u needs no further product.
-        self.dx_next_ready = !self.track_jacobian && t == 1.0 && self.exact_rows.is_empty();
+        // A full untracked step has u = r_trial off the exact rows, so the next
+        // direction −H' r_trial = −(ss/denom)·H u − Σ_exact r_trial,i·H'e_i needs
+        // no further O(m²) product (the columns H'e_i are read when H is dense).
+        self.dx_next_ready =
+            !self.track_jacobian && t == 1.0 && (self.exact_rows.is_empty() || self.h.is_dense());
         if self.dx_next_ready {
             let f = -ss / denom;
             for (d, hu) in self.dx_next.iter_mut().zip(&self.hu) {
                 *d = f * hu;
+            }
+            for i in self.exact_rows.clone() {
+                let rt = self.r_trial.get(i).copied().unwrap_or(f64::NAN);
+                self.h.axpy_column(i, -rt, &mut self.dx_next);
             }
         }
         true

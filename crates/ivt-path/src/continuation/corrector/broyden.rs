@@ -55,6 +55,12 @@ impl BroydenCorrector {
         let n1 = m + 1;
         let mut ws = BroydenWorkspace::new(n1);
         ws.exact_rows = m..n1;
+        // Only H = B_x⁻¹ is updated in the iterations (three O(m²) passes
+        // each, not six); the λ column and the arc-length row that change
+        // between points stay known, and B_x is rebuilt from H only when a
+        // rejected point needs B_q.
+        ws.track_jacobian = false;
+        ws.tracked_column = Some(m);
         let mut e_lambda = vec![0.0; n1];
         if let Some(last) = e_lambda.last_mut() {
             *last = 1.0;
@@ -203,7 +209,7 @@ impl<B: Branch> PathCorrector<B> for BroydenCorrector {
             }
             self.ws.set_jacobian(&self.b)
         } else {
-            let corner = self.ws.jacobian().get(m * n1 + m).copied();
+            let corner = self.ws.jacobian_entry(m, m);
             let col: Vec<f64> = self
                 .jac
                 .chunks_exact(n1)
@@ -249,13 +255,10 @@ impl<B: Branch> PathCorrector<B> for BroydenCorrector {
         }
     }
 
-    /// The secant from `x_prev` (Eq. 71), after carrying `B_q` forward; a
-    /// secant against the previous one is a corrector that went backwards.
+    /// The secant from `x_prev` (Eq. 71); a secant against the previous one
+    /// is a corrector that went backwards.
     fn direction(&mut self, _branch: &mut B, x_prev: &[f64], x: &[f64], dir: &mut [f64]) -> Found {
         let direction = dir;
-        let n1 = self.m + 1;
-        let rows = self.ws.jacobian().to_vec();
-        self.carry_bq(&rows, n1);
         let mut new_xd: Vec<f64> = x.iter().zip(x_prev).map(|(a, b)| a - b).collect();
         let nn = norm2(&new_xd);
         new_xd.iter_mut().for_each(|v| *v /= nn);
@@ -270,10 +273,14 @@ impl<B: Branch> PathCorrector<B> for BroydenCorrector {
     }
 
     /// A failed corrector restarts from forward differences at `x_prev`; a
-    /// rejected point only from a fresh factorization.
+    /// rejected point only from a fresh factorization of the current `B_q`.
     fn retry(&mut self, branch: &mut B, x_prev: &[f64], why: Retry) {
         if why == Retry::Failed {
             self.difference_jacobian(branch, x_prev);
+        } else {
+            let n1 = self.m + 1;
+            let rows = self.ws.jacobian().to_vec();
+            self.carry_bq(&rows, n1);
         }
         self.fresh = true;
     }
