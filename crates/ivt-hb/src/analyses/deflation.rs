@@ -34,6 +34,7 @@
 //! into one ([`SearchReport::copies_merged`]).
 
 use crate::error::HbError;
+use crate::orbit::classic::Galerkin;
 use crate::orbit::galerkin::GalerkinJacobian;
 use crate::orbit::ihb::{HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
@@ -43,10 +44,8 @@ use crate::BroydenStats;
 use faer::c64;
 use ivt_num::vector::norm2;
 use ivt_num::{
-    deflated_newton, newton, Deflation, LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace,
-    SolveError,
+    deflated_newton, newton, Deflation, LuWorkspace, NewtonOptions, NewtonWorkspace, SolveError,
 };
-use std::convert::Infallible;
 
 /// Bounds of the search.
 #[derive(Debug, Clone, PartialEq)]
@@ -320,30 +319,6 @@ struct Deflated<'p, P> {
     newton: NewtonWorkspace,
 }
 
-/// The HB residual at one frequency with its Galerkin Jacobian (Eq. 56) as
-/// a [`NewtonSystem`].
-struct AtOmega<'a, P> {
-    problem: &'a P,
-    res: &'a mut HbResidual,
-    galerkin: &'a mut GalerkinJacobian,
-    omega_f: f64,
-}
-
-impl<P: PeriodicProblem> NewtonSystem for AtOmega<'_, P> {
-    type Error = Infallible;
-
-    fn residual(&mut self, q: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
-        self.res.eval(self.problem, q, self.omega_f, 1.0, r);
-        Ok(())
-    }
-
-    fn jacobian(&mut self, q: &[f64], jac: &mut [f64]) -> Result<(), Infallible> {
-        self.galerkin
-            .assemble(self.res, self.problem, q, self.omega_f, 1.0, jac);
-        Ok(())
-    }
-}
-
 impl<'p, P: PeriodicProblem> Deflated<'p, P> {
     fn new(
         problem: &'p P,
@@ -505,7 +480,7 @@ impl<'p, P: PeriodicProblem> Deflated<'p, P> {
     fn run(&mut self, start: &[f64], known: &[Vec<f64>]) -> Option<Vec<f64>> {
         let mut q = start.to_vec();
         let box_size = self.opts.max_amplitude;
-        let mut sys = AtOmega {
+        let mut sys = Galerkin {
             problem: self.problem,
             res: &mut self.res,
             galerkin: &mut self.galerkin,

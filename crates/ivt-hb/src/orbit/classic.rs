@@ -24,12 +24,12 @@ pub struct ClassicIhb<P> {
 }
 
 /// The HB residual (Eq. 61) at fixed ω_f with its Galerkin Jacobian Φ_q
-/// (Eq. 56) as a Newton system.
-struct Galerkin<'a, P> {
-    problem: &'a P,
-    res: &'a mut HbResidual,
-    galerkin: &'a mut GalerkinJacobian,
-    omega_f: f64,
+/// (Eq. 56) as a Newton system (also the deflated search's, analyses/deflation.rs).
+pub(crate) struct Galerkin<'a, P> {
+    pub(crate) problem: &'a P,
+    pub(crate) res: &'a mut HbResidual,
+    pub(crate) galerkin: &'a mut GalerkinJacobian,
+    pub(crate) omega_f: f64,
 }
 
 impl<P: PeriodicProblem> NewtonSystem for Galerkin<'_, P> {
