@@ -10,7 +10,7 @@
 #![allow(clippy::expect_used, clippy::indexing_slicing, clippy::panic)]
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 /// The layout file, parsed.
@@ -67,11 +67,8 @@ fn read_mcap(path: &Path) -> BTreeMap<String, ChannelData> {
 }
 
 /// A fresh scratch directory.
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ivt-foxglove-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("scratch dir");
-    d
+fn scratch(name: &str) -> ivt_sim::testing::Scratch {
+    ivt_sim::testing::scratch_dir(&format!("foxglove-{name}"))
 }
 
 fn run_ivt(dir: &Path, args: &[&str]) {

@@ -10,7 +10,7 @@
 #![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
 use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use std::time::Duration;
 
@@ -28,7 +28,7 @@ fn refused(args: &[&str], kind: &str) -> String {
     limited::refused(args, kind, MEMORY_LIMIT_KB)
 }
 
-fn scratch(name: &str) -> PathBuf {
+fn scratch(name: &str) -> ivt_sim::testing::Scratch {
     ivt_sim::testing::scratch_dir(&format!("hostile-{name}"))
 }
 

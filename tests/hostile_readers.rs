@@ -18,7 +18,7 @@
 #[path = "common/mcap_forge.rs"]
 mod forge;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 #[path = "common/limited.rs"]
@@ -33,7 +33,7 @@ fn refused(args: &[&str], kind: &str) -> String {
     limited::refused(args, kind, MEMORY_LIMIT_KB)
 }
 
-fn scratch(name: &str) -> PathBuf {
+fn scratch(name: &str) -> ivt_sim::testing::Scratch {
     ivt_sim::testing::scratch_dir(&format!("hostile-readers-{name}"))
 }
 

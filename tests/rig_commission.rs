@@ -10,8 +10,7 @@ use rig::{commission_sim, ivt};
 
 #[test]
 fn sim_commissioning_writes_the_recording_and_refuses_bad_input() {
-    let dir = std::env::temp_dir().join(format!("ivt-rig-commission-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = ivt_sim::testing::scratch_dir("rig-commission");
     let out = dir.join("hold.mcap");
     let o = out.to_str().unwrap();
     let (code, v) = ivt(&[

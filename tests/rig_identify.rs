@@ -10,16 +10,14 @@ use ivt_kin::plant::PlantParams;
 use ivt_sim::scene::{PlantSection, PresetName};
 use ivt_sim::sensors::Rng;
 use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 #[path = "common/rig.rs"]
 mod rig;
 use rig::{commission_sim, ivt};
 
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ivt-rig-identify-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn scratch(name: &str) -> ivt_sim::testing::Scratch {
+    ivt_sim::testing::scratch_dir(&format!("rig-identify-{name}"))
 }
 
 /// Table 1 with k_t, k_e, R_a, the inertias and the brake gain (through
@@ -218,7 +216,11 @@ fn truncated_or_corrupt_recording_names_the_byte_offset() {
 /// seed `run`) and identified into `dir/plant.toml`: the truth, the scratch
 /// directory, the JSON of `ivt rig identify` and the plant read back from the
 /// file it names.
-fn identified_rig(seed: u64, name: &str, run: u64) -> (PlantParams, PathBuf, Value, PlantParams) {
+fn identified_rig(
+    seed: u64,
+    name: &str,
+    run: u64,
+) -> (PlantParams, ivt_sim::testing::Scratch, Value, PlantParams) {
     let p = perturbed(seed);
     let dir = scratch(name);
     let v = identify(&dir, &commission(&dir, &plant_body(&p), "ideal", run));

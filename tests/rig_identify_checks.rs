@@ -18,10 +18,8 @@ use std::time::Instant;
 mod rig;
 use rig::{commission_sim, ivt};
 
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ivt-id-checks-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn scratch(name: &str) -> ivt_sim::testing::Scratch {
+    ivt_sim::testing::scratch_dir(&format!("id-checks-{name}"))
 }
 
 /// `ivt rig commission --sim` with realistic sensors (seed 1) on the plant

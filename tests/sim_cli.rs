@@ -17,7 +17,7 @@ fn ivt(args: &[&str]) -> (i32, String, String) {
     )
 }
 
-fn tmp(name: &str) -> std::path::PathBuf {
+fn tmp(name: &str) -> ivt_sim::testing::Scratch {
     ivt_sim::testing::scratch_dir(&format!("sim-cli-{name}"))
 }
 

@@ -9,7 +9,7 @@
 use ivt_sim::testing::scratch_dir;
 use serde_json::Value;
 use std::io::Read as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -89,7 +89,7 @@ pub fn contract(args: &[&str], limit: Duration) -> Result<(i32, Value), String> 
 }
 
 /// A fresh scratch directory for one test of this file.
-pub fn tmp(name: &str) -> PathBuf {
+pub fn tmp(name: &str) -> ivt_sim::testing::Scratch {
     scratch_dir(&format!("hardening-{name}"))
 }
 

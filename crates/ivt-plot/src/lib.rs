@@ -417,6 +417,7 @@ mod tests {
         line_plot(&path, &fig).unwrap();
         assert!(png_ok(&path));
         assert_eq!(pieces(&b).count(), 2);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
@@ -443,5 +444,6 @@ mod tests {
             ..map
         };
         assert!(heat_map(&dir.join("bad.png"), &bad).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -207,14 +207,12 @@ pub fn excerpt(line: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testing::scratch::Scratch;
 
     /// Not crate::testing::scratch_dir: testing reads scenes, which read
     /// input (a module cycle).
-    fn scratch(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("ivt-input-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        d
+    fn scratch(name: &str) -> Scratch {
+        Scratch::new(&format!("input-{name}"))
     }
 
     #[test]

@@ -7,7 +7,7 @@
 #![allow(clippy::unwrap_used)]
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use ivt_ctrl::commission::{Plan, Selection, SequenceName};
 use ivt_sim::commission::{run_sil, CommissionOptions, SensorModel};
@@ -18,10 +18,9 @@ use serde_json::Value;
 /// eccentricity per degree of stepper angle.
 const M_PER_DEG: f64 = 7.0 * std::f64::consts::PI / 51840.0 * 0.0254;
 
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ivt-commission-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+/// A scratch directory for one test, removed when the test ends.
+fn tmp(name: &str) -> ivt_sim::testing::Scratch {
+    ivt_sim::testing::scratch_dir(&format!("commission-{name}"))
 }
 
 /// Messages per topic and the `ivt` metadata of a recording.
@@ -51,7 +50,8 @@ fn f(v: &Value, k: &str) -> f64 {
 
 #[test]
 fn sil_recording_follows_the_plan() {
-    let out = tmp("sil.mcap");
+    let dir = tmp("sil");
+    let out = dir.join("sil.mcap");
     let s = run_sil(&CommissionOptions::default(), &out).unwrap();
     let (ch, meta) = read(&out);
     assert_eq!(meta["ppr"], "1200");
@@ -199,7 +199,8 @@ fn short_plan() -> (Plan, Selection) {
 #[test]
 fn realistic_sensors_quantize_the_readings_and_keep_the_schedule() {
     let (plan, selection) = short_plan();
-    let dir_plant = tmp("perturbed.toml");
+    let dir = tmp("noisy");
+    let dir_plant = dir.join("perturbed.toml");
     std::fs::write(
         &dir_plant,
         "[plant]\npreset = \"printed\"\nk_t = 0.55\nj_u = 0.2\n",
@@ -212,7 +213,7 @@ fn realistic_sensors_quantize_the_readings_and_keep_the_schedule() {
         sensors: SensorModel::Realistic,
         ..CommissionOptions::default()
     };
-    let out = tmp("noisy.mcap");
+    let out = dir.join("noisy.mcap");
     run_sil(&opts, &out).unwrap();
     let (ch, meta) = read(&out);
     let plant: Value = serde_json::from_str(&meta["plant"]).unwrap();
@@ -253,7 +254,8 @@ fn pil_commissioning_recording_equals_sil_byte_for_byte() {
         sensors: SensorModel::Realistic,
         ..CommissionOptions::default()
     };
-    let (sil, pil) = (tmp("cmp-sil.mcap"), tmp("cmp-pil.mcap"));
+    let dir = tmp("cmp");
+    let (sil, pil) = (dir.join("cmp-sil.mcap"), dir.join("cmp-pil.mcap"));
     let s = run_sil(&opts, &sil).unwrap();
     let p = ivt_sim::pil::run_pil_commission(&opts, &pil).unwrap();
     assert_eq!(s.channels, p.channels);

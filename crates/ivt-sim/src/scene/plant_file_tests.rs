@@ -2,12 +2,11 @@
 
 use super::*;
 use crate::scene::Scene;
+use crate::testing::scratch::Scratch;
 
 /// A scratch directory unique to this test process and `name`.
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ivt-plant-file-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn scratch(name: &str) -> Scratch {
+    Scratch::new(&format!("plant-file-{name}"))
 }
 
 /// Every parameter changed from the preset survives `from_params` →

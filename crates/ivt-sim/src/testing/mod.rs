@@ -9,19 +9,20 @@
 //! share, and no library path calls it.
 #![allow(clippy::expect_used)]
 
+pub(crate) mod scratch;
+
 use crate::scene::Scene;
-use std::path::{Path, PathBuf};
+pub use scratch::Scratch;
+use std::path::Path;
 
 /// A fresh, empty directory `ivt-{name}-{pid}` under the system temporary
-/// directory (removed first if a previous run left it).
+/// directory (removed first if a previous run left it), deleted again when
+/// the returned guard is dropped.
 ///
 /// # Panics
 /// If the directory cannot be created.
-pub fn scratch_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ivt-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("create scratch directory");
-    d
+pub fn scratch_dir(name: &str) -> Scratch {
+    Scratch::new(name)
 }
 
 /// The file names in `dir`, sorted.
