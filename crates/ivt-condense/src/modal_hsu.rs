@@ -24,12 +24,11 @@ use ivt_hb::stability::floquet::{eigenvalues, expm2};
 use ivt_hb::stability::{richardson_error, Floquet, HsuEstimate, HsuSteps};
 use ivt_hb::HbError;
 
-/// The Richardson estimate of [`richardson_error`] divides the change of
-/// the multipliers by 2⁴ − 1, the ratio of a fourth-order method's errors;
-/// the extrapolated splitting reaches that ratio only once `h` resolves the
-/// stiffest coupled mode, so the change is divided by 2² − 1 = 3 instead
-/// (the splitting's own second order): this factor on that estimate.
-const SECOND_ORDER: f64 = 5.0;
+/// The order of the Richardson estimate ([`richardson_error`]): the
+/// extrapolated splitting is fourth order only once `h` resolves the
+/// stiffest coupled mode, so the change of the multipliers is divided by
+/// 2² − 1 = 3 (the splitting's own second order), not 2⁴ − 1.
+const SECOND_ORDER: u32 = 2;
 
 /// `Φᵀ C_r Φ` counts as diagonal when every off-diagonal entry is at most
 /// this part of its largest diagonal entry (rounding of the projections).
@@ -144,7 +143,7 @@ impl ModalHsu {
             // Y is column-major: its transpose has the same eigenvalues.
             let mu = eigenvalues(&extrapolated, dim);
             if let Some(previous) = last.take() {
-                let error = SECOND_ORDER * richardson_error(&mu, &previous);
+                let error = richardson_error(&mu, &previous, SECOND_ORDER);
                 let finest = level + 1;
                 if error <= self.tol {
                     self.level = if error * 32.0 <= self.tol {
@@ -318,6 +317,7 @@ mod tests {
     use super::*;
     use ivt_hb::orbit::ihb::HbSolution;
     use ivt_hb::problem::GeneralProblem;
+    use ivt_hb::stability::multiplier_distance;
     use ivt_hb::stability::AdaptiveHsu;
 
     /// A 3-DOF chain with a non-diagonal mass, `C = 0.02 M + 0.01 K`.
@@ -370,7 +370,7 @@ mod tests {
     /// Hausdorff distance of two multiplier sets relative to max(1, |μ|),
     /// the measure of the Richardson estimates.
     fn distance(a: &[faer::c64], b: &[faer::c64]) -> f64 {
-        15.0 * richardson_error(a, b)
+        multiplier_distance(a, b)
     }
 
     /// The split multipliers equal Magnus-4 Hsu of the whole chain (tight

@@ -10,7 +10,7 @@ mod common;
 
 use common::chain::cubic_chain;
 use common::counted::Counted;
-use common::max_distance;
+use ivt_hb::stability::multiplier_distance;
 use ivt_hb::{
     frequency_response, AdaptiveHsu, Branch, BroydenStats, Corrector, Duffing, FamilyBranch, Frc,
     FrcOptions, Frequency, HbError, HbOptions, HbSolution, HsuRule, HsuSteps, ModifiedIhb,
@@ -34,7 +34,8 @@ fn errors<P: PeriodicProblem>(problem: &P, frc: &Frc, harmonics: usize) -> (f64,
             stats: BroydenStats::default(),
         };
         let want = reference.hsu(problem, &sol, HsuRule::Magnus4).multipliers;
-        let err = max_distance(&p.multipliers, &want);
+        // Relative to max(1, |μ|), the measure of the estimate.
+        let err = multiplier_distance(&p.multipliers, &want);
         let estimate = p.multiplier_error.expect("an estimate at every point");
         // The estimate meets the tolerance at every point (no point reached
         // the 4096 cap), and it is the error: the true one is within 2× of it
