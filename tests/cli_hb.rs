@@ -136,9 +136,10 @@ fn string_cold_start_on_the_peak_flank_says_how_to_start() {
 }
 
 /// `ivt hb duffing-folds`: the fold curve of the thesis Duffing in (ω, F)
-/// through the cusp. References by shooting in crates/ivt-hb/tests/fold_curve.rs:
-/// folds at F = 0.2 and 0.3 at ω = 1.2589591460 and 1.3297591465, the cusp at
-/// F = 0.0120510724.
+/// through the cusp, and both folds at each F of `--at`. References by
+/// shooting in crates/ivt-hb/tests/fold_curve.rs: folds at F = 0.2 at
+/// ω = 1.2589591460 and 2.2115927040, at F = 0.3 at 1.3297591465 and
+/// 2.6572119678, the cusp at F = 0.0120510724.
 #[test]
 fn duffing_folds_reach_the_cusp() {
     let (code, v) = run("--json hb duffing-folds --n 15 --at 0.2,0.3");
@@ -150,17 +151,24 @@ fn duffing_folds_reach_the_cusp() {
     assert_eq!(special[0]["kind"], "cusp");
     let f = special[0]["p"].as_f64().unwrap();
     assert!((f / 0.0120510724 - 1.0).abs() < 1e-6, "{f}");
-    let at: Vec<(f64, f64)> = v["at"]
+    let mut at: Vec<(f64, f64)> = v["at"]
         .as_array()
         .unwrap()
         .iter()
         .map(|a| (a["p"].as_f64().unwrap(), a["omega"].as_f64().unwrap()))
         .collect();
-    assert_eq!(at.len(), 2, "{at:?}");
-    for ((force, omega), want) in at.iter().zip([1.2589591460, 1.3297591465]) {
+    at.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    assert_eq!(at.len(), 4, "{at:?}");
+    let want = [
+        (0.2, 1.2589591460),
+        (0.2, 2.2115927040),
+        (0.3, 1.3297591465),
+        (0.3, 2.6572119678),
+    ];
+    for ((force, omega), (f, w)) in at.iter().zip(want) {
         assert!(
-            (omega - want).abs() < 1e-7,
-            "F = {force}: {omega} vs {want}"
+            *force == f && (omega - w).abs() < 1e-7,
+            "F = {force}: {omega} vs {w}"
         );
     }
 }

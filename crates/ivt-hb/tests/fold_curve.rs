@@ -1,6 +1,7 @@
 //! Two-parameter fold continuation (issue 27, item 1): the thesis Duffing
 //! (Eq. 49, ξ = 0.02, α = ε = 1) in (ω, F) from the F = 0.1 fold down to the
-//! cusp and up the other fold to F = 0.3. References by shooting on RK4 (no
+//! cusp and up the other fold to F = 0.3, then from the start up its own fold
+//! to F = 0.3. References by shooting on RK4 (no
 //! HB): a fold is a fixed point of the period map with det(∂P/∂y − I) = 0;
 //! the cusp is the extremum of F along the curve of such points.
 
@@ -42,20 +43,27 @@ fn duffing_fold_curve_through_the_cusp_matches_shooting() {
         0.1,
         0.0,
         0.3,
-        &[0.1, 0.2, 0.3],
+        &[0.03, 0.1, 0.2, 0.3],
         &opts,
     )
     .unwrap();
     assert_eq!(curve.termination, Termination::LeftInterval);
     assert_eq!(curve.cusps.len(), 1, "{:?}", curve.cusps);
-    // Each of F = 0.1, 0.2, 0.3 is crossed on both sides of the cusp, except
-    // 0.2 and 0.3 on the start's side (the path went down from 0.1 there).
-    assert_eq!(
-        curve.at.len(),
-        4,
-        "{:?}",
-        curve.at.iter().map(|a| (a.p, a.omega)).collect::<Vec<_>>()
-    );
+    // Each F above the cusp's is crossed twice, once on each fold (both
+    // folds of the FRC at that F): the first leg goes down from the start
+    // through the cusp and up the lower fold, the second up the start's own.
+    let found: Vec<(f64, f64)> = curve.at.iter().map(|a| (a.p, a.omega)).collect();
+    assert_eq!(found.len(), 8, "{found:?}");
+    for f in [0.03, 0.1, 0.2, 0.3] {
+        let omegas: Vec<f64> = (found.iter())
+            .filter(|(p, _)| *p == f)
+            .map(|&(_, w)| w)
+            .collect();
+        assert!(
+            omegas.len() == 2 && (omegas[0] - omegas[1]).abs() > 0.05,
+            "F = {f}: {omegas:?}"
+        );
+    }
     for fp in &curve.at {
         let y = state(&fp.coeffs, fp.omega);
         let u = newton3(

@@ -52,7 +52,8 @@ pub struct FoldCurveRequest {
     pub start: FoldStart,
     /// `p` of the start.
     pub p_start: f64,
-    /// The curve goes first towards this `p` …
+    /// The curve goes first towards this `p`, then from the start the other
+    /// way …
     pub p_from: f64,
     /// … and ends where `p` leaves `[p_from, p_to]`.
     pub p_to: f64,
@@ -360,9 +361,10 @@ mod tests {
     #[test]
     fn duffing_folds_through_the_cusp_are_the_shooting_folds() {
         // The thesis Duffing in F from the F = 0.1 upper fold down to the
-        // cusp and up the lower fold: by shooting (tests/fold_curve.rs) the
-        // folds at F = 0.2 and 0.3 are at ω = 1.2589591460 and 1.3297591465,
-        // the cusp at F = 0.0120510724.
+        // cusp and up the lower fold, then up the upper fold: by shooting
+        // (tests/fold_curve.rs) the folds at F = 0.2 are at ω = 1.2589591460
+        // and 2.2115927040, at F = 0.3 at 1.3297591465 and 2.6572119678, the
+        // cusp at F = 0.0120510724.
         let family = |f: f64| Ok(Duffing::new(0.02, 1.0, 1.0, f));
         let hb = HbOptions::new(15, 64).with_tol(1e-10);
         let req = FoldCurveRequest {
@@ -371,10 +373,20 @@ mod tests {
         };
         let c = fold_curve(family, &hb, &req).unwrap();
         assert_eq!(c.termination, Termination::LeftInterval);
-        let omegas: Vec<f64> = c.at.iter().map(|p| p.omega).collect();
-        assert_eq!(omegas.len(), 2, "{omegas:?}");
-        for (got, want) in omegas.iter().zip([1.2589591460, 1.3297591465]) {
-            assert!((got - want).abs() < 1e-7, "{got} vs {want}");
+        let mut found: Vec<(f64, f64)> = c.at.iter().map(|p| (p.p, p.omega)).collect();
+        found.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        assert_eq!(found.len(), 4, "{found:?}");
+        let want = [
+            (0.2, 1.2589591460),
+            (0.2, 2.2115927040),
+            (0.3, 1.3297591465),
+            (0.3, 2.6572119678),
+        ];
+        for (got, want) in found.iter().zip(want) {
+            assert!(
+                got.0 == want.0 && (got.1 - want.1).abs() < 1e-7,
+                "{got:?} vs {want:?}"
+            );
         }
         assert_eq!(c.special.len(), 1);
         assert!((c.special[0].point.p / 0.0120510724 - 1.0).abs() < 1e-6);

@@ -40,8 +40,8 @@ family_fn! {
 /// `frc(..., events=True)["bifurcations"]` (or of `frc(...)["folds"]`)
 /// computed at p = `p_start`, with the same `n` and `samples`; its "kind"
 /// says what is followed. Folds (ivt_hb::fold_curve: R = 0, Φ_q v = 0,
-/// |v| = 1 followed in p, first towards `p_from`, until p leaves
-/// [p_from, p_to]): cusps (where two folds merge and the jump disappears)
+/// |v| = 1 followed in p from the start first towards `p_from`, then the
+/// other way, each until p leaves [p_from, p_to]): cusps (where two folds merge and the jump disappears)
 /// are located as turning points of the curve in p. Period doublings and
 /// Neimark–Sacker points (ivt_hb::branches::codim2::bifurcation_curve: R = 0 with the
 /// critical eigenvector of the monodromy matrix, followed both ways from the
@@ -90,9 +90,10 @@ fn continue_bifurcation<'py>(py, args) [
 /// 0.02, α = ε = 1) followed in the force F (p = F) through the cusp where
 /// the jump disappears: the dict of `ivt hb duffing-folds --json` (the same
 /// job, defaults and tolerance 1e-10). The start is the fold of largest ω_f
-/// on the FRC from `from_` to `to` at `force`; the curve goes first towards
-/// `force_from` and ends where F leaves [force_from, force_to]; the folds at
-/// each F of `at` are located exactly. GIL released.
+/// on the FRC from `from_` to `to` at `force`; the curve goes from it first
+/// towards `force_from`, then from it towards `force_to`, each leg until F
+/// leaves [force_from, force_to]; the folds at each F of `at` are located
+/// exactly, on every fold the curve crosses there. GIL released.
 #[pyfunction]
 #[pyo3(signature = (
     force = 0.1, force_from = 0.0, force_to = 0.3, at = vec![0.1, 0.2, 0.3], from_ = 0.5,

@@ -141,9 +141,10 @@ def test_jenkins_parameters_are_checked():
 
 def test_continue_bifurcation_duffing_fold_curve_to_the_cusp():
     # The thesis Duffing family in F: from the F = 0.1 fold at the higher ω,
-    # down to the cusp and up the other fold to F = 0.3. Fold frequencies by
-    # shooting (tests/fold_curve.rs, 5e-14 there): 1.6548121230 and
-    # 1.1687243884 at F = 0.1, 1.2589591460 at 0.2, 1.3297591465 at 0.3;
+    # down to the cusp and up the other fold to F = 0.3, then up its own fold
+    # to F = 0.3. Fold frequencies by shooting (tests/fold_curve.rs, 3e-13
+    # there): 1.6548121230 and 1.1687243884 at F = 0.1, 1.2589591460 and
+    # 2.2115927040 at 0.2, 1.3297591465 and 2.6572119678 at 0.3;
     # the cusp at F = 0.0120510724 (the extremum of F along the shooting curve).
     family = lambda F: (1.0, 0.04, 1.0, hb.elements.cubic_spring(1.0),
                         lambda th: F * np.cos(th))
@@ -154,8 +155,9 @@ def test_continue_bifurcation_duffing_fold_curve_to_the_cusp():
                                     p_start=0.1, n=15)
     assert curve["kind"] == "fold" and curve["termination"] == "left_interval"
     got = sorted((round(a["p"], 12), a["omega"]) for a in curve["at"])
-    want = [(0.1, 1.1687243884), (0.1, 1.6548121230), (0.2, 1.2589591460), (0.3, 1.3297591465)]
-    assert len(got) == 4
+    want = [(0.1, 1.1687243884), (0.1, 1.6548121230), (0.2, 1.2589591460),
+            (0.2, 2.2115927040), (0.3, 1.3297591465), (0.3, 2.6572119678)]
+    assert len(got) == 6
     for (p, w), (pw, ww) in zip(got, want):
         assert p == pw and abs(w - ww) < 1e-7
     (cusp,) = curve["special"]

@@ -112,7 +112,10 @@ def test_fold_curve_equals_cli(cli: Callable[..., Dict[str, Any]]) -> None:
     # type, so not to the last bit).
     family = lambda F: (1.0, 0.04, 1.0, hb.elements.cubic_spring(1.0),
                         lambda th: F * np.cos(th))
-    start = {"kind": "fold", "omega": got["start_omega"], "coeffs": got["points"][0]["coeffs"]}
+    # The points run from the far end of the first leg (towards F = 0, through
+    # the cusp, up to 0.3) to that of the second: the start is inside.
+    (first,) = [p for p in got["points"] if p["omega"] == got["start_omega"]]
+    start = {"kind": "fold", "omega": got["start_omega"], "coeffs": first["coeffs"]}
     user = hb.continue_bifurcation(family, start, 0.0, 0.3, at=[0.2, 0.3], p_start=0.1, n=15,
                                    max_points=5000)
     assert set(user) == set(got)

@@ -20,7 +20,8 @@ pub struct FoldsArgs {
     /// … to this one; the fold of largest ω_f starts the curve.
     #[arg(long, default_value_t = 2.5)]
     to: f64,
-    /// The curve goes first towards this force (down to the cusp) …
+    /// The curve goes first towards this force (down to the cusp), then from
+    /// the start the other way …
     #[arg(long, default_value_t = 0.0)]
     force_from: f64,
     /// … and ends where F leaves [force_from, force_to].

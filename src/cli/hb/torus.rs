@@ -30,7 +30,8 @@ pub struct TorusArgs {
     /// … to this one; the NS point of largest ω_f starts the curve.
     #[arg(long, default_value_t = 1.6)]
     to: f64,
-    /// The curve goes first towards this force …
+    /// The curve goes first towards this force, then from the start the
+    /// other way …
     #[arg(long, default_value_t = 0.0)]
     force_from: f64,
     /// … and ends where F leaves [force_from, force_to].

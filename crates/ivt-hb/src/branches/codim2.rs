@@ -40,7 +40,9 @@ use crate::problem::PeriodicProblem;
 use fixed::{solve_crossings, CurveSystem};
 use fold_system::FoldSystem;
 use ivt_num::vector::norm2;
-use ivt_path::continuation::{follow_residual, ContinuationOptions, Path, PathPoint, Termination};
+use ivt_path::continuation::{
+    follow_residual, ContinuationOptions, Path, PathPoint, Termination, Turn,
+};
 
 /// One fold on the curve.
 #[derive(Debug, Clone, PartialEq)]
@@ -73,38 +75,101 @@ pub struct Curve<T> {
 /// A fold curve in (ω, p).
 pub type FoldCurve = Curve<FoldPoint>;
 
-/// The curve of `sys` along `path` with the given `cusps`: each path point
-/// mapped to its point and the points at each value of `at` of the path
-/// parameter (the last component) solved at fixed value.
+/// The curve of `sys` along `path` (joined [`Legs`]) with the given `cusps`:
+/// each path point mapped to its point and the points at each value of `at`
+/// of the path parameter (the last component) solved at fixed value.
 fn fold_curve_of<S: CurveSystem>(
     sys: &mut S,
-    path: Path,
+    (path, termination): (Vec<PathPoint>, Termination),
     at: &[f64],
     cusps: Vec<S::Point>,
     scale: f64,
 ) -> Curve<S::Point> {
-    let p_index = path
-        .points
-        .first()
-        .map_or(0, |pt| pt.x.len().saturating_sub(1));
-    let located = solve_crossings(sys, &path.points, at, p_index, scale);
-    let points = path
-        .points
-        .iter()
-        .filter_map(|pt| sys.point(&pt.x))
-        .collect();
+    let p_index = path.first().map_or(0, |pt| pt.x.len().saturating_sub(1));
+    let located = solve_crossings(sys, &path, at, p_index, scale);
+    let points = path.iter().filter_map(|pt| sys.point(&pt.x)).collect();
     Curve {
         points,
         at: located,
         cusps,
-        termination: path.termination,
+        termination,
+    }
+}
+
+/// The two legs of a curve through its start: the path from the start
+/// towards one end of the interval, and — unless the start is the other end,
+/// or the first leg was cut short (interrupted, or at `max_points`, e.g.
+/// round a closed curve) — the path from the start the other way. A leg that
+/// turns (a cusp) runs back on the other branch and leaves the interval at
+/// the far end without passing the start's own branch there, so both legs
+/// are followed.
+pub(crate) struct Legs {
+    /// From the start towards the first end.
+    pub first: Path,
+    /// From the start the other way.
+    pub second: Option<Path>,
+}
+
+impl Legs {
+    /// `trace(direction)` (the path from the start with that sign of the
+    /// path parameter's initial change) for the direction from `p_start`
+    /// towards `p_from`, then for the other.
+    ///
+    /// # Errors
+    /// `trace`'s.
+    pub(crate) fn follow<E>(
+        (p_start, p_from, p_to): (f64, f64, f64),
+        mut trace: impl FnMut(f64) -> Result<Path, E>,
+    ) -> Result<Self, E> {
+        let direction = if p_from < p_start { -1.0 } else { 1.0 };
+        let first = trace(direction)?;
+        let cut = matches!(
+            first.termination,
+            Termination::Interrupted | Termination::MaxPoints
+        );
+        let second = if cut || p_start == p_to {
+            None
+        } else {
+            Some(trace(-direction)?)
+        };
+        Ok(Self { first, second })
+    }
+
+    /// `locate(path, turn)` for each turn of each leg (a cusp) that it
+    /// locates, in the order of [`Self::joined`].
+    pub(crate) fn cusps<T>(&self, mut locate: impl FnMut(&Path, &Turn) -> Option<T>) -> Vec<T> {
+        let mut found: Vec<T> = (self.first.events.iter())
+            .filter_map(|turn| locate(&self.first, turn))
+            .collect();
+        if let Some(path) = &self.second {
+            found.reverse();
+            found.extend(path.events.iter().filter_map(|turn| locate(path, turn)));
+        }
+        found
+    }
+
+    /// One path: with two legs in order from the first leg's end (its points
+    /// reversed, then the second leg's after the shared start), with one the
+    /// first leg from the start; the last leg's termination.
+    pub(crate) fn joined(self) -> (Vec<PathPoint>, Termination) {
+        match self.second {
+            Some(second) => {
+                let mut points: Vec<PathPoint> = self.first.points.into_iter().rev().collect();
+                points.extend(second.points.into_iter().skip(1));
+                (points, second.termination)
+            }
+            None => (self.first.points, self.first.termination),
+        }
     }
 }
 
 /// Follows the fold of the FRC of `family(p_start)` at `(start, omega)` (a
-/// located fold: coefficients and ω_f) in `p`, first towards `p_from`, until `p`
-/// leaves `[min(p_from, p_to), max(p_from, p_to)]`; the folds at each `p` of
-/// `at` and the cusps are located (see the module docs).
+/// located fold: coefficients and ω_f) in `p`, first towards `p_from` until `p`
+/// leaves `[min(p_from, p_to), max(p_from, p_to)]`, then from the start towards
+/// `p_to` ([`Legs`]); points in path order from the first leg's end (from the
+/// start when `p_to` is the start); the folds
+/// at each `p` of `at` (every crossing of either leg) and the cusps are
+/// located (see the module docs).
 ///
 /// # Errors
 /// [`HbError::InvalidInput`] for sizes or bounds (`p_start` must lie in the
@@ -141,13 +206,17 @@ where
     x0.extend_from_slice(&v0);
     x0.extend([omega, p_start]);
     let copts = bounded(opts, (lo, hi));
-    let path = follow_curve(&mut sys, &x0, p_from, &copts)?;
-    let cusps = path
-        .events
-        .iter()
-        .filter_map(|f| locate_cusp(&mut sys, &path, f.bracket, &copts))
-        .collect();
-    Ok(fold_curve_of(&mut sys, path, at, cusps, norm2(start)))
+    let legs = Legs::follow((p_start, p_from, p_to), |direction| {
+        follow_curve(&mut sys, &x0, direction, &copts)
+    })?;
+    let cusps = legs.cusps(|path, turn| locate_cusp(&mut sys, path, turn.bracket, &copts));
+    Ok(fold_curve_of(
+        &mut sys,
+        legs.joined(),
+        at,
+        cusps,
+        norm2(start),
+    ))
 }
 
 /// The turning point in `p` near `path.points[bracket..bracket + 3]`: a
@@ -200,19 +269,18 @@ fn bounded(opts: &ContinuationOptions, (lo, hi): (f64, f64)) -> ContinuationOpti
     copts
 }
 
-/// The path of the curve of `sys` from `x0` (the path parameter last), first
-/// towards the path parameter `towards`, to its end or the bounds of `opts`.
+/// The path of the curve of `sys` from `x0` (the path parameter last) with
+/// the sign `direction` of the path parameter's first change, to its end or
+/// the bounds of `opts`.
 ///
 /// # Errors
 /// The start's failures as [`follow_residual`]'s.
 fn follow_curve<S: CurveSystem>(
     sys: &mut S,
     x0: &[f64],
-    towards: f64,
+    direction: f64,
     opts: &ContinuationOptions,
 ) -> Result<Path, HbError> {
-    let start = x0.last().copied().unwrap_or(towards);
-    let direction = if towards < start { -1.0 } else { 1.0 };
     let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
     Ok(follow_residual(
         residual,

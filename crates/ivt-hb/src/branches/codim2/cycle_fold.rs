@@ -30,7 +30,7 @@ use std::cell::Cell;
 
 use super::fixed::CurveSystem;
 use super::fold_system::{null_rows, split_fold_residual, split_fold_vector};
-use super::{bounded, fold_curve_of, follow_curve, path_interval, Curve, FoldPoint};
+use super::{bounded, fold_curve_of, follow_curve, path_interval, Curve, FoldPoint, Legs};
 use crate::branches::cycle_branch::member::Member;
 use crate::branches::cycle_branch::CycleSystem;
 use crate::error::HbError;
@@ -60,9 +60,10 @@ pub type CycleFoldCurve = Curve<CycleFoldPoint>;
 /// Follows the fold of limit cycles of `family(μ, ν)` (autonomous: no
 /// excitation) at `start` (a located fold of [`crate::cycle_branch()`] at
 /// `(mu, nu_start)`: its coefficients with phase `b₁ = 0` and ω) in ν,
-/// first towards `nu_from` of `(nu_from, nu_to)`, until ν leaves the
-/// interval between them; the folds at each ν of `at` are solved exactly and
-/// the cusps reported (module docs).
+/// first towards `nu_from` of `(nu_from, nu_to)` until ν leaves the
+/// interval between them, then from the start towards `nu_to` ([`Legs`]);
+/// the folds at each ν of `at` are solved exactly and the cusps reported
+/// (module docs).
 ///
 /// # Errors
 /// [`HbError::InvalidInput`] for sizes or bounds (`nu_start` must lie in the
@@ -107,19 +108,18 @@ where
     let mut x0 = u0;
     x0.extend_from_slice(&v0);
     x0.extend([mu, nu_start]);
-    let path = follow_curve(&mut sys, &x0, nu_from, &bounded(opts, (lo, hi)))?;
-    let cusps = path
-        .events
-        .iter()
-        .filter_map(|f| {
-            let mut point = sys.point(&path.points.get(f.index)?.x)?;
-            point.fold.p = f.lambda;
-            Some(point)
-        })
-        .collect();
+    let copts = bounded(opts, (lo, hi));
+    let legs = Legs::follow((nu_start, nu_from, nu_to), |direction| {
+        follow_curve(&mut sys, &x0, direction, &copts)
+    })?;
+    let cusps = legs.cusps(|path, turn| {
+        let mut point = sys.point(&path.points.get(turn.index)?.x)?;
+        point.fold.p = turn.lambda;
+        Some(point)
+    });
     Ok(fold_curve_of(
         &mut sys,
-        path,
+        legs.joined(),
         at,
         cusps,
         norm2(&start.coeffs),

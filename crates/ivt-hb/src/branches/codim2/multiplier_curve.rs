@@ -35,7 +35,7 @@
 //! θ_e ± 2h.
 
 use super::fixed::{solve_crossings, CurveSystem};
-use super::{bounded, path_interval};
+use super::{bounded, path_interval, Legs};
 use crate::branches::events::{BifurcationKind, LocateOptions};
 use crate::error::HbError;
 use crate::orbit::ihb::{HbOptions, HbResidual, HbSolution};
@@ -99,9 +99,9 @@ pub struct BifurcationCurve {
 /// Follows the period doubling or Neimark–Sacker point `start` of the FRC of
 /// `family(start.p)` in `p`, first towards `p_from` until `p` leaves
 /// `[min(p_from, p_to), max(p_from, p_to)]` or the curve ends (a 1:1 or 1:2
-/// resonance); unless that path turned back and left at `p_to`, then from
-/// the start towards `p_to`. Points are in path order from the
-/// `p_from` end; `termination` is that of the last path. The point at each `p` of `at`
+/// resonance), then from the start towards `p_to` ([`Legs`]). Points are in
+/// path order from the first leg's end (from the start when `p_to` is the
+/// start); `termination` is that of the last path. The point at each `p` of `at`
 /// and the strong resonances are located (module docs). `hb` must be the
 /// options `start` was computed with.
 ///
@@ -141,32 +141,16 @@ pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
     }
     let x0 = sys.start_vector(&start.coeffs, start.omega, p_start)?;
     let copts = bounded(opts, (lo, hi));
-    let towards_from = if p_from < p_start { -1.0 } else { 1.0 };
     let theta_index = m + 1;
     // A Neimark–Sacker path through θ = 0 or π (1:1, 1:2) continues on the
     // conjugate pair back along the same curve: it stops at the point past.
-    let trace = |sys: &mut MultiplierSystem<'_, F>, direction: f64| {
+    let legs = Legs::follow((p_start, p_from, p_to), |direction| {
         let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
         follow_residual(residual, &x0, None, direction, &copts, |pt| {
             !ns || pt.x.get(theta_index).is_none_or(|t| t.sin() > 0.0)
         })
-    };
-    let first = trace(&mut sys, towards_from)?;
-    // Unless the first path turned and left the interval at `p_to`, the
-    // curve is followed from the start towards `p_to` too.
-    let at_p_to = first.termination == Termination::LeftInterval
-        && first
-            .points
-            .last()
-            .is_some_and(|pt| (pt.lambda() - p_to).abs() < (pt.lambda() - p_from).abs());
-    let (mut path, termination) = if !at_p_to {
-        let second = trace(&mut sys, -towards_from)?;
-        let mut joined: Vec<PathPoint> = first.points.into_iter().rev().collect();
-        joined.extend(second.points.into_iter().skip(1));
-        (joined, second.termination)
-    } else {
-        (first.points, first.termination)
-    };
+    })?;
+    let (mut path, termination) = legs.joined();
     let scale = norm2(&start.coeffs);
     let p_index = x0.len() - 1;
     let mut solve = |path: &[PathPoint], index: usize, values: &[f64]| {
