@@ -15,6 +15,7 @@ usage: budgets.py OUT_DIR [--json]
 import json
 import os
 import re
+import shutil
 import statistics
 import subprocess
 import sys
@@ -50,7 +51,11 @@ def bench(elf):
              "-display", "none", "-monitor", "none", "-serial", "null", "-serial", "null",
              "-semihosting-config", "enable=on,target=native",
              "-singlestep", "-d", "exec,nochain", "-D", log, "-kernel", elf],
-            check=True, capture_output=True, text=True, timeout=600)
+            capture_output=True, text=True, timeout=600)
+        if run.returncode != 0:
+            # The execution log is ~140 MB: say how much room there was.
+            free = shutil.disk_usage(d).free / 1e9
+            raise SystemExit(f"QEMU exited {run.returncode} ({free:.1f} GB free in {d}):\n{run.stderr[-3000:]}")
         report = dict(l.split("=", 1) for l in run.stdout.split() if "=" in l)
         counts, prev_pc, ret, n = [], None, None, 0
         pat = re.compile(r"\[[0-9a-f]+/([0-9a-f]+)/")

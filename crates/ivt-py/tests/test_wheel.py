@@ -5,10 +5,12 @@ repository, it runs a shipped scene, and its native extension is small.
 """
 
 import os
+import shutil
 import subprocess
 import sys
 import zipfile
 from pathlib import Path
+from typing import List
 
 import pytest
 
@@ -17,6 +19,17 @@ needs_wheel = pytest.mark.skipif(not WHEEL, reason="IVT_WHEEL not set (scripts/p
 
 #: Acceptance of the packaging: the installed extension stays under 15 MB.
 MAX_EXTENSION_BYTES = 15_000_000
+
+
+def pip_install(pip: List[str], *packages: str, cwd: Path) -> None:
+    """`pip install packages`, failing with pip's own message and the free
+    disk space (the CI once failed here without a message, on a disk that
+    leftover test directories had filled)."""
+    proc = subprocess.run([*pip, *packages], cwd=cwd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        free = shutil.disk_usage(cwd).free / 1e9
+        pytest.fail(f"pip install {' '.join(packages)}: exit {proc.returncode}, {free:.1f} GB free\n"
+                    f"{proc.stdout[-2000:]}\n{proc.stderr[-4000:]}")
 
 
 @needs_wheel
@@ -38,7 +51,7 @@ def test_fresh_venv_runs_a_shipped_scene(tmp_path: Path) -> None:
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
     py = venv / "bin" / "python"
     pip = [str(py), "-m", "pip", "install", "-q", "--disable-pip-version-check"]
-    subprocess.run([*pip, str(WHEEL)], check=True, cwd=tmp_path)
+    pip_install(pip, str(WHEEL), cwd=tmp_path)
     script = (
         "import json, ivt\n"
         "assert 'drive' in ivt.scenes.names(), ivt.scenes.names()\n"
@@ -87,7 +100,7 @@ def test_fresh_venv_runs_every_chapter_as_a_user_copies_it(tmp_path: Path) -> No
     py = venv / "bin" / "python"
     pip = [str(py), "-m", "pip", "install", "-q", "--disable-pip-version-check"]
     # the extras the chapters name: figures, finite-element models, Dask sweeps
-    subprocess.run([*pip, f"{WHEEL}[plot,fe,dask]", "numpy", "scipy"], check=True, cwd=tmp_path)
+    pip_install(pip, f"{WHEEL}[plot,fe,dask]", "numpy", "scipy", cwd=tmp_path)
     exe = ivt_bin()
     ran = 0
     for chapter in sorted(GUIDE.rglob("*.md")):
