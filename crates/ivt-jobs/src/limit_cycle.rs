@@ -165,13 +165,7 @@ pub fn limit_cycle<P: PeriodicProblem>(
                     s
                 }
             };
-            ivt_hb::limit_cycle_from_state(
-                problem,
-                hb,
-                &state,
-                &START_TRANSIENT,
-                steps,
-            )?
+            ivt_hb::limit_cycle_from_state(problem, hb, &state, &START_TRANSIENT, steps)?
         }
     };
     certified(problem, hb, req.tol, lc)
