@@ -11,8 +11,8 @@
 //! iteration core; the Newton system and workspace are those of
 //! [`crate::newton()`].
 
-use crate::iteration::{execute, Progress, SolveError, Solver, Step, Stopping};
-use crate::newton::{NewtonOptions, NewtonStats, NewtonSystem, NewtonWorkspace};
+use crate::iteration::{Progress, SolveError, Solver, Step};
+use crate::newton::{run_newton, NewtonOptions, NewtonStats, NewtonSystem, NewtonWorkspace};
 use crate::vector::norm2;
 
 /// The deflation operator `M` of the known roots and the region searched.
@@ -83,20 +83,11 @@ pub fn deflated_newton<S: NewtonSystem + ?Sized>(
         residual_evals: 0,
         jacobian_evals: 0,
     };
-    let stopping = Stopping {
-        ftol: opts.ftol,
-        max_iter: opts.max_iter,
-    };
-    let result = execute(&mut solver, x, stopping, &mut history);
-    let (residual_evals, jacobian_evals) = (solver.residual_evals, solver.jacobian_evals);
-    let residual_norm = history.last().copied().unwrap_or(f64::NAN);
+    let stats = run_newton(&mut solver, x, opts, &mut history, |s| {
+        (s.residual_evals, s.jacobian_evals)
+    });
     ws.history = history;
-    Ok(NewtonStats {
-        iterations: result?,
-        residual_evals,
-        jacobian_evals,
-        residual_norm,
-    })
+    stats
 }
 
 /// Deflated Newton as a [`Solver`]: the state between two steps of

@@ -368,19 +368,37 @@ pub fn newton_bordered<S: NewtonSystem + ?Sized>(
         jacobian_evals: 0,
         t: 1.0,
     };
+    let stats = run_newton(&mut solver, x, opts, &mut history, |s| {
+        (s.residual_evals, s.jacobian_evals)
+    });
+    ws.history = history;
+    stats
+}
+
+/// The tail of the damped and the deflated Newton drivers: `solver` run by
+/// [`execute`] from `x` under `opts`' stopping rule, recording ‖F‖₂ in
+/// `history`; its statistics, the evaluation counts read by `evals`.
+///
+/// # Errors
+/// [`execute`]'s.
+pub(crate) fn run_newton<S: Solver>(
+    solver: &mut S,
+    x: &mut [f64],
+    opts: &NewtonOptions,
+    history: &mut Vec<f64>,
+    evals: fn(&S) -> (usize, usize),
+) -> Result<NewtonStats, SolveError<S::Error>> {
     let stopping = Stopping {
         ftol: opts.ftol,
         max_iter: opts.max_iter,
     };
-    let result = execute(&mut solver, x, stopping, &mut history);
-    let (residual_evals, jacobian_evals) = (solver.residual_evals, solver.jacobian_evals);
-    let residual_norm = history.last().copied().unwrap_or(f64::NAN);
-    ws.history = history;
+    let result = execute(solver, x, stopping, history);
+    let (residual_evals, jacobian_evals) = evals(solver);
     Ok(NewtonStats {
         iterations: result?,
         residual_evals,
         jacobian_evals,
-        residual_norm,
+        residual_norm: history.last().copied().unwrap_or(f64::NAN),
     })
 }
 
