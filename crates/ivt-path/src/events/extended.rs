@@ -312,23 +312,10 @@ where
     B: Branch,
     T: FnMut(&mut B, &[f64], f64, &mut [f64]),
 {
-    let m = branch.len();
-    let k = unfold.len() + 1;
-    let mut x = q0.to_vec();
-    x.push(lambda0);
-    x.resize(m + k, 0.0);
+    let (extended, mut x) = Extended::at(branch, (q0, lambda0), unfold, tests, opts);
+    let (m, n) = (extended.m, x.len());
     let mut system = Ruled {
-        system: Extended {
-            branch,
-            unfold,
-            tests,
-            opts,
-            m,
-            jac: vec![0.0; m * m],
-            r_lambda: vec![0.0; m],
-            psi: (vec![0.0; k], vec![0.0; k]),
-            qt: vec![0.0; m],
-        },
+        system: extended,
         rule: StepRule {
             m,
             step_tol: opts.step_tol,
@@ -337,12 +324,7 @@ where
         },
     };
     let nopts = StepRule::newton_options(opts.max_iter, true);
-    let stats = newton(
-        &mut system,
-        &mut x,
-        &mut NewtonWorkspace::new(m + k),
-        &nopts,
-    )?;
+    let stats = newton(&mut system, &mut x, &mut NewtonWorkspace::new(n), &nopts)?;
     let lambda = x.get(m).copied().unwrap_or(lambda0);
     x.truncate(m);
     Ok((x, lambda, stats.iterations))
@@ -364,23 +346,8 @@ where
     B: Branch,
     T: FnMut(&mut B, &[f64], f64, &mut [f64]),
 {
-    let m = branch.len();
-    let k = unfold.len() + 1;
-    let mut x = q.to_vec();
-    x.push(lambda);
-    x.resize(m + k, 0.0);
-    let mut system = Extended {
-        branch,
-        unfold,
-        tests,
-        opts,
-        m,
-        jac: vec![0.0; m * m],
-        r_lambda: vec![0.0; m],
-        psi: (vec![0.0; k], vec![0.0; k]),
-        qt: vec![0.0; m],
-    };
-    let mut out = vec![0.0; (m + k) * (m + k)];
+    let (mut system, x) = Extended::at(branch, (q, lambda), unfold, tests, opts);
+    let mut out = vec![0.0; x.len() * x.len()];
     let Ok(()) = system.jacobian(&x, &mut out);
     out
 }
@@ -398,6 +365,36 @@ struct Extended<'a, B, T> {
     r_lambda: Vec<f64>,
     psi: (Vec<f64>, Vec<f64>),
     qt: Vec<f64>,
+}
+
+impl<'a, B: Branch, T> Extended<'a, B, T> {
+    /// The system of `branch` with `unfold` and `tests`, and its unknowns at
+    /// `(q, λ)` with the unfoldings `μ = 0`: `[q, λ, 0, …]`.
+    fn at(
+        branch: &'a mut B,
+        (q, lambda): (&[f64], f64),
+        unfold: &'a [Vec<f64>],
+        tests: T,
+        opts: &'a LocateOptions,
+    ) -> (Self, Vec<f64>) {
+        let m = branch.len();
+        let k = unfold.len() + 1;
+        let mut x = q.to_vec();
+        x.push(lambda);
+        x.resize(m + k, 0.0);
+        let system = Self {
+            branch,
+            unfold,
+            tests,
+            opts,
+            m,
+            jac: vec![0.0; m * m],
+            r_lambda: vec![0.0; m],
+            psi: (vec![0.0; k], vec![0.0; k]),
+            qt: vec![0.0; m],
+        };
+        (system, x)
+    }
 }
 
 impl<B, T> NewtonSystem for Extended<'_, B, T>
