@@ -61,13 +61,28 @@ impl<P: PeriodicProblem> Search<'_, P> {
         origin: Origin,
         level: usize,
     ) -> Result<(), HbError> {
-        let opts = LocateOptions::default();
         let mut branch = FamilyBranch::new(Frequency(self.problem), hb, bif.lambda)?;
-        let d = new_direction(&mut branch, &bif.q, bif.lambda, &opts)?;
-        let h = self.req.step * norm2(&bif.q).max(f64::MIN_POSITIVE);
+        let d = new_direction(&mut branch, &bif.q, bif.lambda, &LocateOptions::default())?;
+        let start = (bif.q.as_slice(), bif.lambda, d.as_slice());
+        let from = (BranchKind::BranchPoint, Some(b), origin, level);
+        self.both_halves(&mut branch, hb, start, from)
+    }
+
+    /// Both halves of the branch through `(q, ω_f)` stepped `±h` along the
+    /// direction `d` (`h` the request's step relative to ‖q‖), each traced as
+    /// `kind` from `parent` and `origin` at `level` unless already known.
+    fn both_halves(
+        &mut self,
+        branch: &mut FamilyBranch<Frequency<'_, P>>,
+        hb: &HbOptions,
+        (q, omega, d): (&[f64], f64, &[f64]),
+        (kind, parent, origin, level): (BranchKind, Option<usize>, Origin, usize),
+    ) -> Result<(), HbError> {
+        let opts = LocateOptions::default();
+        let h = self.req.step * norm2(q).max(f64::MIN_POSITIVE);
         for side in [1.0, -1.0] {
-            let (q1, w1) = switch_branch(&mut branch, &bif.q, bif.lambda, &d, side * h, &opts)
-                .map_err(trace_error)?;
+            let (q1, w1) =
+                switch_branch(branch, q, omega, d, side * h, &opts).map_err(trace_error)?;
             let mut x0 = q1;
             x0.push(w1);
             if self.known(hb, &x0, 0.25 * h) {
@@ -77,9 +92,9 @@ impl<P: PeriodicProblem> Search<'_, P> {
             self.trace(Pending {
                 hb: hb.clone(),
                 x0,
-                direction: sign(w1 - bif.lambda),
-                kind: BranchKind::BranchPoint,
-                parent: Some(b),
+                direction: sign(w1 - omega),
+                kind,
+                parent,
                 origin: Some(origin.clone()),
                 level,
             })?;
@@ -211,31 +226,11 @@ impl<P: PeriodicProblem> Search<'_, P> {
         v: &[f64],
         origin: (Option<usize>, Origin),
     ) -> Result<(), HbError> {
-        let opts = LocateOptions::default();
         let hb = self.hb.clone();
         let mut branch = FamilyBranch::new(Frequency(self.problem), &hb, omega)?;
         let mut d = v.to_vec();
         d.push(0.0);
-        let h = self.req.step * norm2(q).max(f64::MIN_POSITIVE);
-        for side in [1.0, -1.0] {
-            let (q1, w1) =
-                switch_branch(&mut branch, q, omega, &d, side * h, &opts).map_err(trace_error)?;
-            let mut x0 = q1;
-            x0.push(w1);
-            if self.known(&hb, &x0, 0.25 * h) {
-                self.search.duplicates += 1;
-                continue;
-            }
-            self.trace(Pending {
-                hb: hb.clone(),
-                x0,
-                direction: sign(w1 - omega),
-                kind: BranchKind::FoldCurve,
-                parent: origin.0,
-                origin: Some(origin.1.clone()),
-                level: 0,
-            })?;
-        }
-        Ok(())
+        let from = (BranchKind::FoldCurve, origin.0, origin.1, 0);
+        self.both_halves(&mut branch, &hb, (q, omega, &d), from)
     }
 }
