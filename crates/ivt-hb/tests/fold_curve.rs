@@ -24,16 +24,20 @@ fn fold_residual(force: f64, omega: f64, y: [f64; 2]) -> [f64; 3] {
     ]
 }
 
-#[test]
-fn duffing_fold_curve_through_the_cusp_matches_shooting() {
+/// From either fold of the FRC at F = 0.1 (the upper at ω = 1.6548, the
+/// lower at 1.1687): the curve on [0, 0.3] with the folds at F = 0.03, 0.1,
+/// 0.2 and 0.3, each checked by shooting; the one cusp.
+fn curve_from(upper: bool) -> ivt_hb::FoldCurve {
     let family = |f: f64| -> Result<Duffing, HbError> { Ok(Duffing::new(0.02, 1.0, 1.0, f)) };
     let hb = HbOptions::new(15, 64);
     let frc = common::frc_between(&Duffing::new(0.02, 1.0, 1.0, 0.1), &hb, 0.5, 2.5);
-    let start = frc
-        .events
-        .iter()
-        .max_by(|a, b| a.omega_f.total_cmp(&b.omega_f))
-        .unwrap();
+    let by_omega = |a: &&ivt_hb::FrcFold, b: &&ivt_hb::FrcFold| a.omega_f.total_cmp(&b.omega_f);
+    let start = if upper {
+        frc.events.iter().max_by(by_omega)
+    } else {
+        frc.events.iter().min_by(by_omega)
+    }
+    .unwrap();
     let opts = common::curve_steps(2000);
     let curve = fold_curve(
         family,
@@ -51,7 +55,7 @@ fn duffing_fold_curve_through_the_cusp_matches_shooting() {
     assert_eq!(curve.cusps.len(), 1, "{:?}", curve.cusps);
     // Each F above the cusp's is crossed twice, once on each fold (both
     // folds of the FRC at that F): the first leg goes down from the start
-    // through the cusp and up the lower fold, the second up the start's own.
+    // through the cusp and up the other fold, the second up the start's own.
     let found: Vec<(f64, f64)> = curve.at.iter().map(|a| (a.p, a.omega)).collect();
     assert_eq!(found.len(), 8, "{found:?}");
     for f in [0.03, 0.1, 0.2, 0.3] {
@@ -72,6 +76,17 @@ fn duffing_fold_curve_through_the_cusp_matches_shooting() {
         );
         assert_omega_matches_shooting("fold", fp.p, fp.omega, u[2]);
     }
+    curve
+}
+
+#[test]
+fn the_fold_curve_from_the_lower_fold_finds_the_same_folds() {
+    curve_from(false);
+}
+
+#[test]
+fn duffing_fold_curve_through_the_cusp_matches_shooting() {
+    let curve = curve_from(true);
     // The cusp: F is extremal along the fold curve; by shooting, minimise F over
     // the curve parametrised by x(0) (golden section on [x_c ± 0.01]).
     let cusp = &curve.cusps[0];

@@ -142,7 +142,7 @@ def test_jenkins_parameters_are_checked():
 def test_continue_bifurcation_duffing_fold_curve_to_the_cusp():
     # The thesis Duffing family in F: from the F = 0.1 fold at the higher ω,
     # down to the cusp and up the other fold to F = 0.3, then up its own fold
-    # to F = 0.3. Fold frequencies by shooting (tests/fold_curve.rs, 3e-13
+    # to F = 0.3. Fold frequencies by shooting (tests/fold_curve.rs, 3.5e-13
     # there): 1.6548121230 and 1.1687243884 at F = 0.1, 1.2589591460 and
     # 2.2115927040 at 0.2, 1.3297591465 and 2.6572119678 at 0.3;
     # the cusp at F = 0.0120510724 (the extremum of F along the shooting curve).
