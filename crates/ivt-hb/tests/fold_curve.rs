@@ -5,6 +5,8 @@
 //! HB): a fold is a fixed point of the period map with det(∂P/∂y − I) = 0;
 //! the cusp is the extremum of F along the curve of such points.
 
+#![allow(clippy::unwrap_used, clippy::indexing_slicing)]
+
 use ivt_hb::{fold_curve, Duffing, HbError, HbOptions, Termination};
 
 mod common;

@@ -94,6 +94,18 @@ pub fn opt_int(ob: &Bound<'_, PyAny>) -> PyResult<Option<i128>> {
     }
 }
 
+/// [`int64`] for an optional argument (None stays None).
+///
+/// # Errors
+/// As [`int64`].
+pub fn opt_int64(ob: &Bound<'_, PyAny>) -> PyResult<Option<i64>> {
+    if ob.is_none() {
+        Ok(None)
+    } else {
+        int64(ob).map(Some)
+    }
+}
+
 /// [`int`] limited to the 64-bit range, for arguments converted later with
 /// [`count`].
 ///

@@ -46,7 +46,7 @@ fn duffing_problem(xi: f64, alpha: f64, eps: f64, force: f64) -> PyResult<Duffin
 
 /// A `#[pyfunction]` on Duffing's equation Eq. 49 returning a dict. Python
 /// parameters: the `head` ones (`name: type [= default]`), then Duffing's
-/// keywords `n=20, samples=64, xi=0.02, alpha=1.0, eps=1.0, force=0.1`
+/// keywords `n=20, samples=None, xi=0.02, alpha=1.0, eps=1.0, force=0.1`
 /// (declared here once for every Duffing function), then the `tail` ones.
 /// The body gets the equation ([`duffing_problem`]) and the two counts under
 /// the names the caller gives.
@@ -61,7 +61,7 @@ macro_rules! duffing_fn {
         $(#[$doc])*
         #[pyfunction]
         #[pyo3(signature = (
-            $($arg $(= $default)?,)* $n = 20, $samples = 64, xi = 0.02, alpha = 1.0, eps = 1.0,
+            $($arg $(= $default)?,)* $n = 20, $samples = None, xi = 0.02, alpha = 1.0, eps = 1.0,
             force = 0.1 $(, $brg $(= $bdefault)?)*
         ))]
         #[allow(clippy::too_many_arguments)]
@@ -69,7 +69,7 @@ macro_rules! duffing_fn {
             $py: Python<$lt>,
             $( $arg: $ty, )*
             #[pyo3(from_py_with = int64)] $n: i64,
-            #[pyo3(from_py_with = int64)] $samples: i64,
+            #[pyo3(from_py_with = crate::args::opt_int64)] $samples: Option<i64>,
             xi: f64, alpha: f64, eps: f64, force: f64,
             $( $brg: $bty, )*
         ) -> PyResult<Bound<$lt, PyDict>> {
@@ -119,7 +119,7 @@ fn duffing<'py>(py, problem, n, samples;
 /// `duffing`.
 #[pyfunction]
 #[pyo3(signature = (
-    beta, n = 20, samples = 64, xi = 0.125, alpha = 1.0, gamma = 1.0, omega = 2.0,
+    beta, n = 20, samples = None, xi = 0.125, alpha = 1.0, gamma = 1.0, omega = 2.0,
     subharmonic = 1, guess = None, tol = 1e-10, stability = true
 ))]
 #[allow(clippy::too_many_arguments)]
@@ -127,7 +127,7 @@ fn mathieu_duffing<'py>(
     py: Python<'py>,
     beta: f64,
     #[pyo3(from_py_with = int64)] n: i64,
-    #[pyo3(from_py_with = int64)] samples: i64,
+    #[pyo3(from_py_with = crate::args::opt_int64)] samples: Option<i64>,
     xi: f64,
     alpha: f64,
     gamma: f64,
@@ -277,7 +277,7 @@ user_system_fn! {
 /// floor); while it exceeds `tol`, n
 /// grows by half (up to 160) and "accuracy" says "met" or "not met" (with
 /// the estimate); `tol=0` keeps n as given ("not asked", the estimate still
-/// reported). `n` is the first n; `samples` ≤ n is raised to 3.2·n.
+/// reported). `n` is the first n; `samples` ≤ n is raised to the default.
 /// Returns {"omega", "period", "coeffs", "multipliers" ([[re, im], ...],
 /// the trivial +1 included), "stable" (all others inside the unit circle),
 /// "stability", "iterations", "residual_norm", "harmonics", "samples",
@@ -295,9 +295,9 @@ fn limit_cycle<'py>(py, user, jac;
         )));
     }
     let mut user = user;
-    // `samples` ≤ n: the default proportion, 64 per 20 harmonics (as the job).
-    if user.keys.n > 0 && user.keys.samples <= user.keys.n {
-        user.keys.samples = (16 * user.keys.n + 4) / 5;
+    // `samples` ≤ n: the default (as the job).
+    if user.keys.samples.is_some_and(|s| s <= user.keys.n) {
+        user.keys.samples = None;
     }
     let (problem, opts) = user.setup(None, 1, 0.0)?;
     crate::hb_shared::without_omega(&problem, "limit_cycle")?;

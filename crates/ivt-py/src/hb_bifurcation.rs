@@ -37,7 +37,7 @@ use crate::to_python::to_dict;
 /// "termination" (None when there is no Hopf point)}.
 #[pyfunction]
 #[pyo3(signature = (
-    family, p_from, p_to, at = Vec::new(), n = 20, samples = 64,
+    family, p_from, p_to, at = Vec::new(), n = 20, samples = None,
     velocity_dependent = true, vectorized = false, grid = 100, rtol = 1e-9, max_iter = 100,
     ds = 0.02, ds_max = 0.05, max_points = 2000, offset = 1e-2
 ))]
@@ -49,7 +49,7 @@ fn cycle_branch<'py>(
     p_to: f64,
     at: Vec<f64>,
     #[pyo3(from_py_with = crate::args::int64)] n: i64,
-    #[pyo3(from_py_with = crate::args::int64)] samples: i64,
+    #[pyo3(from_py_with = crate::args::opt_int64)] samples: Option<i64>,
     velocity_dependent: bool,
     vectorized: bool,
     #[pyo3(from_py_with = crate::args::int64)] grid: i64,
@@ -95,7 +95,7 @@ fn cycle_branch<'py>(
 /// order of `ps`.
 #[pyfunction]
 #[pyo3(signature = (
-    family, ps, omega_from, omega_to, n = 20, samples = 64, rtol = 1e-9, max_iter = 100,
+    family, ps, omega_from, omega_to, n = 20, samples = None, rtol = 1e-9, max_iter = 100,
     velocity_dependent = true, vectorized = false
 ))]
 #[allow(clippy::too_many_arguments)]
@@ -106,7 +106,7 @@ fn neimark_sacker_points<'py>(
     omega_from: f64,
     omega_to: f64,
     #[pyo3(from_py_with = crate::args::int64)] n: i64,
-    #[pyo3(from_py_with = crate::args::int64)] samples: i64,
+    #[pyo3(from_py_with = crate::args::opt_int64)] samples: Option<i64>,
     rtol: f64,
     #[pyo3(from_py_with = crate::args::int64)] max_iter: i64,
     velocity_dependent: bool,

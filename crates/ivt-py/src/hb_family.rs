@@ -137,7 +137,7 @@ pub(crate) struct FamilyArgs {
 /// A `#[pyfunction]` continuing a solution of a Python family, returning a
 /// dict: `fn name<'py>(py, args) [own parameters] { body }`. Python
 /// parameters: `family`, the function's own (`name: type [= default]`, in
-/// brackets), then `n=20, samples=64, velocity_dependent=True,
+/// brackets), then `n=20, samples=None, velocity_dependent=True,
 /// vectorized=False, rtol=1e-9, max_iter=100, ds=0.02, ds_max=0.05,
 /// max_points=2000`; those reach the body as the [`FamilyArgs`] named by the
 /// caller.

@@ -97,7 +97,7 @@ fn continue_bifurcation<'py>(py, args) [
 #[pyfunction]
 #[pyo3(signature = (
     force = 0.1, force_from = 0.0, force_to = 0.3, at = vec![0.1, 0.2, 0.3], from_ = 0.5,
-    to = 2.5, n = 20, samples = 64
+    to = 2.5, n = 20, samples = None
 ))]
 #[allow(clippy::too_many_arguments)]
 fn duffing_folds<'py>(
@@ -109,7 +109,7 @@ fn duffing_folds<'py>(
     from_: f64,
     to: f64,
     #[pyo3(from_py_with = int64)] n: i64,
-    #[pyo3(from_py_with = int64)] samples: i64,
+    #[pyo3(from_py_with = crate::args::opt_int64)] samples: Option<i64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let opts = options(n, samples, 1, 1e-10)?;
     let req = FoldCurveRequest {

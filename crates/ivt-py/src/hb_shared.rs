@@ -78,9 +78,26 @@ pub(crate) fn without_omega(problem: &PyProblem, what: &str) -> PyResult<()> {
     Ok(())
 }
 
-/// Options from the Python keywords: n harmonics, `samples` = N (2N AFT samples).
-pub(crate) fn options(n: i64, samples: i64, subharmonic: i64, tol: f64) -> PyResult<HbOptions> {
-    let (n, samples): (usize, usize) = (count("n", n)?, count("samples", samples)?);
+/// `samples` = N (2N AFT samples) when the caller gives none: 64, the
+/// default for n ≤ 20 (Fig. 28's 2N = 128), and the same proportion, 3.2·n
+/// rounded up, above (`n = 80` → 256), so that every n works without it.
+pub(crate) fn default_samples(n: usize) -> usize {
+    (16 * n).div_ceil(5).max(64)
+}
+
+/// Options from the Python keywords: n harmonics, `samples` = N (2N AFT
+/// samples; None: [`default_samples`]).
+pub(crate) fn options(
+    n: i64,
+    samples: Option<i64>,
+    subharmonic: i64,
+    tol: f64,
+) -> PyResult<HbOptions> {
+    let n: usize = count("n", n)?;
+    let samples: usize = match samples {
+        Some(s) => count("samples", s)?,
+        None => default_samples(n),
+    };
     let subharmonic: usize = count("subharmonic", subharmonic)?;
     if n == 0 {
         return Err(PyValueError::new_err(
@@ -165,7 +182,7 @@ pub(crate) fn given_point(dict: &Bound<'_, PyDict>, arg: &str) -> PyResult<(f64,
 #[derive(Clone, Copy)]
 pub(crate) struct HbKeys {
     pub(crate) n: i64,
-    pub(crate) samples: i64,
+    pub(crate) samples: Option<i64>,
     pub(crate) velocity_dependent: bool,
     pub(crate) vectorized: bool,
     pub(crate) rtol: f64,
@@ -176,7 +193,7 @@ impl HbKeys {
     /// The keywords as given; `max_iter` must be ≥ 0.
     pub(crate) fn new(
         n: i64,
-        samples: i64,
+        samples: Option<i64>,
         velocity_dependent: bool,
         vectorized: bool,
         rtol: f64,
@@ -196,7 +213,7 @@ impl HbKeys {
 /// The `#[pyfunction]` behind [`user_system_fn!`] and
 /// `hb_family::family_fn!`, returning a dict. Python parameters: the
 /// `head` ones, the function's own (`name: type [= default]`), `n=20,
-/// samples=64`, its own again (`mid`), `velocity_dependent=True,
+/// samples=None`, its own again (`mid`), `velocity_dependent=True,
 /// vectorized=False, rtol=1e-9, max_iter=100`, then the `tail` ones. Those
 /// six reach the body as the [`HbKeys`] named `$keys`; the head and tail
 /// parameters are named (for the body) by the calling macro. A default is
@@ -215,7 +232,7 @@ macro_rules! hb_keywords_fn {
         $(#[$doc])*
         #[pyfunction]
         #[pyo3(signature = (
-            $($head_sig)* $($arg $(= $default)?,)* n = 20, samples = 64, $($brg $(= $bdefault)?,)*
+            $($head_sig)* $($arg $(= $default)?,)* n = 20, samples = None, $($brg $(= $bdefault)?,)*
             velocity_dependent = true, vectorized = false, rtol = 1e-9, max_iter = 100
             $($tail_sig)*
         ))]
@@ -225,7 +242,7 @@ macro_rules! hb_keywords_fn {
             $($head_param)*
             $( $(#[$pa($($pa_args)*)])* $arg: $ty, )*
             #[pyo3(from_py_with = crate::args::int64)] n: i64,
-            #[pyo3(from_py_with = crate::args::int64)] samples: i64,
+            #[pyo3(from_py_with = crate::args::opt_int64)] samples: Option<i64>,
             $( $(#[$pb($($pb_args)*)])* $brg: $bty, )*
             velocity_dependent: bool, vectorized: bool, rtol: f64,
             #[pyo3(from_py_with = crate::args::int64)] max_iter: i64,
@@ -242,7 +259,7 @@ pub(crate) use hb_keywords_fn;
 
 /// A `#[pyfunction]` on a user system `M x'' + C x' + K x + g(x, v, θ) =
 /// f(θ)` returning a dict. Python parameters: `m, c, k, g`, the function's
-/// own (`name: type [= default]`), `n=20, samples=64`, its own again, then
+/// own (`name: type [= default]`), `n=20, samples=None`, its own again, then
 /// `velocity_dependent=True, vectorized=False, rtol=1e-9, max_iter=100`, and
 /// `jac=None` when the caller names it after the `UserArgs` binding (a
 /// function whose solver assembles the Galerkin Jacobian). The

@@ -9,7 +9,8 @@
 //! when crossing `i` returns to crossing `i − k` within `settle` relative, for the
 //! smallest `k ≤ max_returns` (an orbit may cross the section `k` times per
 //! period). The period is then `t_i − t_{i−k}`. A start in the basin of the
-//! equilibrium ends with [`HbError::Equilibrium`], one that never settles with
+//! equilibrium (a crossing below max(100·tol, 1e-8) of the largest) ends with
+//! [`HbError::Equilibrium`], one that never settles with
 //! [`HbError::Transient`]; no start needs Fourier coefficients or a frequency.
 
 use crate::branches::autonomous::{limit_cycle, LimitCycle};
@@ -133,7 +134,10 @@ pub fn settle<P: PeriodicProblem>(
             .iter()
             .map(|c| norm_inf(&c.1))
             .fold(size, f64::max);
-        if size <= 1e-8 * largest {
+        // At rest below the integration's own noise: an error-controlled
+        // solution that decays to the absolute tolerance (tol × the start's
+        // size) stays there, so the ratio is at least 100·tol.
+        if size <= (100.0 * opts.tol).max(1e-8) * largest {
             return Err(HbError::Equilibrium);
         }
         for (k, (tk, sk)) in crossings.iter().rev().take(opts.max_returns).enumerate() {

@@ -72,7 +72,7 @@ class AllSolutions(list):  # type: ignore[type-arg]
 
 
 def all_solutions(
-    m, c, k, g, f, omega, n=20, samples=64, max_amplitude=10.0, amplitudes=6,
+    m, c, k, g, f, omega, n=20, samples=None, max_amplitude=10.0, amplitudes=6,
     newton_steps=60, tol=0.0, velocity_dependent=True, vectorized=False,
     rtol=1e-9, max_iter=100, jac=None,
 ):  # type: ignore[no-untyped-def]
@@ -257,6 +257,17 @@ def _refuse_keys(native_name, given, sig):
         )
 
 
+def _large_samples(given):  # type: ignore[no-untyped-def]
+    """The large-model path's N: as given, or 32 (its default for n ≤ 7)
+    and the same proportion, 32/7·n rounded up, above, so that every n works
+    without ``samples``."""
+    samples = given.get("samples")
+    if samples is not None:
+        return _index("samples", samples)
+    n = _index("n", given.get("n", 7))
+    return max(32, -(-32 * n // 7))
+
+
 def _large_call(native_name, sig, args, kwargs, extra):
     known = {k: v for k, v in kwargs.items() if k in sig.parameters}
     try:
@@ -304,7 +315,7 @@ def _large_call(native_name, sig, args, kwargs, extra):
         ),
         record_dofs=[_index("record_dofs", j) for j in (extra.get("record_dofs") or ())],
         n=_index("n", given.get("n", 7)),
-        samples=_index("samples", given.get("samples", 32)),
+        samples=_large_samples(given),
         velocity_dependent=bool(given.get("velocity_dependent", True)),
         vectorized=bool(given.get("vectorized", False)),
         jac=given.get("jac"),

@@ -93,13 +93,13 @@ Reduction = Literal["auto", "exact", "krylov"]
 # the Newton options (``tol``, ``velocity_dependent``, ``vectorized``, ``rtol``,
 # ``max_iter``, ``jac``).
 def duffing(
-    n: int = 20, samples: int = 64,
+    n: int = 20, samples: Optional[int] = None,
     xi: float = 0.02, alpha: float = 1.0, eps: float = 1.0, force: float = 0.1, omega_f: float = 0.4,
     method: Method = "modified", guess: Optional[ArrayLike] = None, tol: float = 1e-10, stability: bool = True,
 ) -> Dict[str, Any]: ...
 def mathieu_duffing(
     beta: float,
-    n: int = 20, samples: int = 64,
+    n: int = 20, samples: Optional[int] = None,
     xi: float = 0.125, alpha: float = 1.0, gamma: float = 1.0, omega: float = 2.0, subharmonic: int = 1,
     guess: Optional[ArrayLike] = None, tol: float = 1e-10, stability: bool = True,
 ) -> Dict[str, Any]: ...
@@ -108,19 +108,19 @@ def mathieu_cascade(
 ) -> Dict[str, Any]: ...
 def duffing_frc(
     from_: float = 0.2, to: float = 3.0,
-    n: int = 20, samples: int = 64,
+    n: int = 20, samples: Optional[int] = None,
     xi: float = 0.02, alpha: float = 1.0, eps: float = 1.0, force: float = 0.1,
     events: bool = False,
 ) -> Dict[str, Any]: ...
 def duffing_folds(
     force: float = 0.1, force_from: float = 0.0, force_to: float = 0.3, at: Sequence[float] = ...,
     from_: float = 0.5, to: float = 2.5,
-    n: int = 20, samples: int = 64,
+    n: int = 20, samples: Optional[int] = None,
 ) -> Dict[str, Any]: ...
 def solve(
     m: Operator, c: Operator, k: Operator, g: Nonlinearity,
     omega_f: float, f: Optional[Union[Forcing, Loads]] = None,
-    n: int = 20, samples: int = 64, subharmonic: int = 1,
+    n: int = 20, samples: Optional[int] = None, subharmonic: int = 1,
     method: Method = "modified", guess: Optional[ArrayLike] = None, tol: float = 0.0, stability: bool = True,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
     jac: Optional[Jacobian] = None,
@@ -132,7 +132,7 @@ def solve(
 def frc(
     m: Operator, c: Operator, k: Operator, g: Nonlinearity,
     f: Optional[Union[Forcing, Loads]], omega_from: float, omega_to: float,
-    n: int = 20, samples: int = 64, tol: float = 0.0, events: bool = True,
+    n: int = 20, samples: Optional[int] = None, tol: float = 0.0, events: bool = True,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
     jac: Optional[Jacobian] = None,
     *,
@@ -143,34 +143,34 @@ def frc(
 def continue_bifurcation(
     family: Family, start: Dict[str, Any],
     p_from: float, p_to: float, at: Sequence[float] = ..., p_start: Optional[float] = None,
-    n: int = 20, samples: int = 64,
+    n: int = 20, samples: Optional[int] = None,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
     ds: float = 0.02, ds_max: float = 0.05, max_points: int = 2000,
 ) -> Dict[str, Any]: ...
 def cycle_branch(
     family: Family,
     p_from: float, p_to: float, at: Sequence[float] = ...,
-    n: int = 20, samples: int = 64,
+    n: int = 20, samples: Optional[int] = None,
     velocity_dependent: bool = True, vectorized: bool = False, grid: int = 100, rtol: float = 1e-9, max_iter: int = 100,
     ds: float = 0.02, ds_max: float = 0.05, max_points: int = 2000, offset: float = 1e-2,
 ) -> Dict[str, Any]: ...
 def neimark_sacker_points(
     family: Family, ps: Sequence[float],
     omega_from: float, omega_to: float,
-    n: int = 20, samples: int = 64, rtol: float = 1e-9, max_iter: int = 100,
+    n: int = 20, samples: Optional[int] = None, rtol: float = 1e-9, max_iter: int = 100,
     velocity_dependent: bool = True, vectorized: bool = False,
 ) -> List[Dict[str, Any]]: ...
 def limit_cycle(
     m: Matrix, c: Matrix, k: Matrix, g: Nonlinearity,
     omega_guess: float, amplitude: float = 1.0, guess: Optional[ArrayLike] = None,
-    n: int = 20, samples: int = 64, tol: float = 1e-8, x0: Optional[Sequence[float]] = None,
+    n: int = 20, samples: Optional[int] = None, tol: float = 1e-8, x0: Optional[Sequence[float]] = None,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
     jac: Optional[Jacobian] = None,
 ) -> Dict[str, Any]: ...
 def backbone(
     m: Matrix, c: Matrix, k: Matrix, g: Nonlinearity,
     omega0: float, mode: Sequence[float], amplitude_from: float = 0.01, amplitude_to: float = 1.0,
-    n: int = 20, samples: int = 64, dof: int = 0, tol: float = 0.0,
+    n: int = 20, samples: Optional[int] = None, dof: int = 0, tol: float = 0.0,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
     jac: Optional[Jacobian] = None,
 ) -> Dict[str, Any]: ...
@@ -184,7 +184,7 @@ class AllSolutions(List[Dict[str, Any]]):
 def all_solutions(
     m: Matrix, c: Matrix, k: Matrix, g: Nonlinearity,
     f: Optional[Forcing], omega: float,
-    n: int = 20, samples: int = 64, max_amplitude: float = 10.0, amplitudes: int = 6, newton_steps: int = 60,
+    n: int = 20, samples: Optional[int] = None, max_amplitude: float = 10.0, amplitudes: int = 6, newton_steps: int = 60,
     tol: float = 0.0,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
     jac: Optional[Jacobian] = None,
@@ -192,7 +192,7 @@ def all_solutions(
 def damped_modes(
     m: Matrix, c: Matrix, k: Matrix, g: Nonlinearity,
     amplitude_from: float, amplitude_to: float,
-    n: int = 20, samples: int = 64, mode: int = 0, dof: int = 0, tol: float = 0.0,
+    n: int = 20, samples: Optional[int] = None, mode: int = 0, dof: int = 0, tol: float = 0.0,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
     jac: Optional[Jacobian] = None,
 ) -> Dict[str, Any]: ...
@@ -246,7 +246,7 @@ class models:
 def torus_branch(
     m: Matrix, c: Matrix, k: Matrix, g: Nonlinearity,
     f: Optional[Forcing], start: Dict[str, Any], omega_to: float, at: Sequence[float] = ...,
-    n: int = 20, samples: int = 64,
+    n: int = 20, samples: Optional[int] = None,
     truncation: Optional[Union[int, Tuple[int, int]]] = None, step: float = 0.02,
     ds: float = 0.01, ds_max: float = 0.05, max_points: int = 400,
     estimate_tol: float = 1e-7, max_unknowns: int = 3000, amplitude_dof: int = 0,
@@ -257,7 +257,7 @@ def torus_branch(
 def diagram(
     m: Matrix, c: Matrix, k: Matrix, g: Nonlinearity,
     f: Optional[Forcing], omega_from: float, omega_to: float, at: Sequence[float] = ...,
-    n: int = 20, samples: int = 64,
+    n: int = 20, samples: Optional[int] = None,
     depth: int = 2, max_branches: int = 24,
     tori: bool = True, torus: Optional[Union[int, Tuple[int, int]]] = None, torus_points: int = 60,
     fold_scale: Optional[Tuple[float, float]] = ...,
@@ -268,7 +268,7 @@ def diagram(
 ) -> Dict[str, Any]: ...
 def event_sensitivity(
     family: Family, event: Dict[str, Any], p: float, amplitude_dof: int = 0,
-    n: int = 20, samples: int = 64,
+    n: int = 20, samples: Optional[int] = None,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
     ds: float = 0.02, ds_max: float = 0.05, max_points: int = 2000,
 ) -> Dict[str, Any]: ...
@@ -281,7 +281,7 @@ def switch_branch(
     at: Dict[str, Any],
     to: float,
     n: int = 20,
-    samples: int = 64,
+    samples: Optional[int] = None,
     step: float = 0.05,
     tol: float = 0.0,
     velocity_dependent: bool = True,
@@ -295,7 +295,7 @@ def switch_branch(
 def cycle_fold_curve(
     family: Callable[[float, float], Any],
     nu_from: float, nu_to: float, mu_from: float, mu_to: float, at: Sequence[float] = ...,
-    n: int = 20, samples: int = 64,
+    n: int = 20, samples: Optional[int] = None,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
     ds: float = 0.02, ds_max: float = 0.05, max_points: int = 2000,
 ) -> Dict[str, Any]: ...
