@@ -125,3 +125,45 @@ fn duffing_fold_curve_through_the_cusp_matches_shooting() {
     );
     assert!((cusp.p - f_cusp).abs() < 1e-6 * f_cusp);
 }
+
+/// A first leg that fails (the family has no model below F = 0.09, so the
+/// path towards F = 0 stalls there) is reported as `step_too_small`, not
+/// hidden by the second leg's normal end; the second leg still runs (the
+/// upper fold at F = 0.2, by shooting 2.2115927040).
+#[test]
+fn a_failed_first_leg_is_not_hidden_by_the_second() {
+    let family = |f: f64| -> Result<Duffing, HbError> {
+        if f < 0.09 {
+            Err(HbError::InvalidInput("no model below F = 0.09".into()))
+        } else {
+            Ok(Duffing::new(0.02, 1.0, 1.0, f))
+        }
+    };
+    let hb = HbOptions::new(15, 64);
+    let frc = common::frc_between(&Duffing::new(0.02, 1.0, 1.0, 0.1), &hb, 0.5, 2.5);
+    let start = (frc.events.iter())
+        .max_by(|a, b| a.omega_f.total_cmp(&b.omega_f))
+        .unwrap();
+    let curve = fold_curve(
+        family,
+        &hb,
+        &start.coeffs,
+        start.omega_f,
+        0.1,
+        0.0,
+        0.3,
+        &[0.2],
+        &common::curve_steps(2000),
+    )
+    .unwrap();
+    assert!(
+        matches!(curve.termination, Termination::StepTooSmall(_)),
+        "{:?}",
+        curve.termination
+    );
+    let upper: Vec<f64> = curve.at.iter().map(|a| a.omega).collect();
+    assert!(
+        upper.iter().any(|w| (w - 2.2115927040).abs() < 1e-7),
+        "{upper:?}"
+    );
+}

@@ -150,15 +150,22 @@ impl Legs {
 
     /// One path: with two legs in order from the first leg's end (its points
     /// reversed, then the second leg's after the shared start), with one the
-    /// first leg from the start; the last leg's termination.
+    /// first leg from the start. The termination is the last leg's, unless
+    /// the first failed (`step_too_small`): a failure is not hidden by the
+    /// other leg's normal end.
     pub(crate) fn joined(self) -> (Vec<PathPoint>, Termination) {
-        match self.second {
+        let Self { first, second } = self;
+        match second {
             Some(second) => {
-                let mut points: Vec<PathPoint> = self.first.points.into_iter().rev().collect();
+                let mut points: Vec<PathPoint> = first.points.into_iter().rev().collect();
                 points.extend(second.points.into_iter().skip(1));
-                (points, second.termination)
+                let termination = match first.termination {
+                    failed @ Termination::StepTooSmall(_) => failed,
+                    _ => second.termination,
+                };
+                (points, termination)
             }
-            None => (self.first.points, self.first.termination),
+            None => (first.points, first.termination),
         }
     }
 }
