@@ -117,7 +117,7 @@ fn with_option(argv: Vec<String>, path: &[String], opt: &str, value: &str) -> Ve
 const SLOW: &[(&str, &str, &str)] = &[
     ("string", "--to", "1e300"),
     ("string", "--cd", "1e-300"),
-    ("string", "--step-max", "1e-300"),
+    ("string", "--ds-max", "1e-300"),
     ("switch", "--branch-to", "-1e300"),
     ("switch", "--branch-to", "1e-300"),
     ("switch", "--damping", "1e-300"),

@@ -54,9 +54,9 @@ pub struct StringArgs {
     /// Spring stiffness k0 (with --boundary spring).
     #[arg(long, default_value_t = 10.0)]
     k0: f64,
-    /// Largest arclength step.
-    #[arg(long, default_value_t = 0.05)]
-    step_max: f64,
+    /// Largest arclength step (default 0.05; `--step-max` is its old name).
+    #[arg(long, alias = "step-max")]
+    ds_max: Option<f64>,
     /// Draw ‖a‖ against ω into this PNG (stable solid, unstable dashed,
     /// folds marked).
     #[arg(long)]
@@ -90,7 +90,10 @@ pub fn run(args: StringArgs) -> Result<Output, CliError> {
         },
         from: args.from,
         to: args.to,
-        step_max: args.step_max,
+        steps: ivt_jobs::Steps {
+            ds_max: args.ds_max,
+            ..ivt_jobs::Steps::default()
+        },
     };
     let curve = jobs::string(&req)?;
     let mut human = format!(

@@ -3,7 +3,7 @@
 //! point's first Lyapunov coefficient, the cycle branch by HB with ω unknown
 //! and Eq. 68–77, Floquet stability (Hsu) and its folds located).
 
-use super::{all_finite, finite_list, pairs, path_steps, stability_steps, Array};
+use super::{all_finite, finite_list, pairs, path_steps, stability_steps, Array, Steps};
 use ivt_hb::branches::autonomous::LimitCycle;
 use ivt_hb::branches::cycle_branch::{cycle_branch as trace_cycles, CycleBranchOptions};
 use ivt_hb::branches::events::BifurcationKind;
@@ -25,16 +25,16 @@ pub struct CycleBranchRequest {
     pub at: Vec<f64>,
     /// Intervals of the equilibria's grid in p.
     pub grid: usize,
-    /// First arclength step of the cycle branch.
-    pub ds: f64,
-    /// Largest arclength step.
-    pub ds_max: f64,
-    /// Most path points.
-    pub max_points: usize,
+    /// The cycle branch's steps and most points (by default Δη from 0.02 up
+    /// to 0.05, 2000 points: [`CYCLE_BRANCH_STEPS`]).
+    pub steps: Steps,
     /// The first cycle's distance from the Hopf point, relative to
     /// `|p_to − p_from|`.
     pub offset: f64,
 }
+
+/// The cycle branch's own first step, largest step and most points.
+pub const CYCLE_BRANCH_STEPS: (f64, f64, usize) = (0.02, 0.05, 2000);
 
 impl Default for CycleBranchRequest {
     /// The example's interval μ ∈ [−0.2, 0.1], a grid of 100, steps
@@ -46,9 +46,7 @@ impl Default for CycleBranchRequest {
             p_to: 0.1,
             at: Vec::new(),
             grid: 100,
-            ds: 0.02,
-            ds_max: 0.05,
-            max_points: 2000,
+            steps: Steps::default(),
             offset: 1e-2,
         }
     }
@@ -62,8 +60,6 @@ impl CycleBranchRequest {
         all_finite(&[
             ("p_from", self.p_from),
             ("p_to", self.p_to),
-            ("ds", self.ds),
-            ("ds_max", self.ds_max),
             ("offset", self.offset),
         ])?;
         if self.p_from == self.p_to {
@@ -72,7 +68,8 @@ impl CycleBranchRequest {
             ));
         }
         finite_list("at", &self.at)?;
-        Ok(())
+        let (ds, ds_max, max_points) = CYCLE_BRANCH_STEPS;
+        path_steps(&self.steps, ds, ds_max, max_points).map(|_| ())
     }
 }
 
@@ -189,7 +186,10 @@ where
     let opts = CycleBranchOptions {
         samples: req.grid,
         offset: req.offset,
-        continuation: path_steps(req.ds, req.ds_max, req.max_points),
+        continuation: {
+            let (ds, ds_max, max_points) = CYCLE_BRANCH_STEPS;
+            path_steps(&req.steps, ds, ds_max, max_points)?
+        },
         stability_steps: stability_steps(hb.harmonics),
         at: req.at.clone(),
     };

@@ -36,7 +36,7 @@ use follow::{periodic_point, segment_distance, sign, trace_within};
 
 use super::frc::{event, trace_error, EventRecord};
 use super::switch::new_direction;
-use super::{finite, finite_list, pairs, positive, Array};
+use super::{finite, finite_list, pairs, positive, Array, Steps};
 use ivt_hb::analyses::deflation::{all_solutions, SearchOptions};
 use ivt_hb::branches::codim2::fold_curve;
 use ivt_hb::branches::events::{
@@ -91,16 +91,16 @@ pub struct DiagramRequest {
     /// ω_f at which every branch is solved exactly (inserted into its
     /// points, marked `at`).
     pub at: Vec<f64>,
-    /// First arclength step.
-    pub ds: f64,
-    /// Largest arclength step.
-    pub ds_max: f64,
-    /// Most points per branch.
-    pub max_points: usize,
+    /// Every branch's steps and most points (by default Δη from 0.02 up to
+    /// 0.05, 2000 points: [`DIAGRAM_STEPS`]).
+    pub steps: Steps,
     /// Distance of a switched branch's first point from its event, relative
     /// to the orbit's ‖coefficients‖₂.
     pub step: f64,
 }
+
+/// Every branch's own first step, largest step and most points.
+pub const DIAGRAM_STEPS: (f64, f64, usize) = (0.02, 0.05, 2000);
 
 impl Default for DiagramRequest {
     /// ω_f ∈ [0.5, 2.5], depth 2, at most 24 branches, tori (the box
@@ -123,15 +123,27 @@ impl Default for DiagramRequest {
             max_amplitude: 10.0,
             amplitudes: 6,
             at: Vec::new(),
-            ds: 0.02,
-            ds_max: 0.05,
-            max_points: 2000,
+            steps: Steps::default(),
             step: 0.05,
         }
     }
 }
 
 impl DiagramRequest {
+    /// The continuation options of every branch: [`DIAGRAM_STEPS`] with the
+    /// request's `steps`, the Newton–chord corrector, within the interval.
+    ///
+    /// # Errors
+    /// [`HbError::InvalidInput`] for steps [`Steps::on`] refuses.
+    pub fn path(&self) -> Result<ContinuationOptions, HbError> {
+        let (ds, ds_max, max_points) = DIAGRAM_STEPS;
+        let mut c = super::path_steps(&self.steps, ds, ds_max, max_points)?;
+        c.corrector = Corrector::Newton;
+        c.lambda_min = self.from.min(self.to);
+        c.lambda_max = self.from.max(self.to);
+        Ok(c)
+    }
+
     /// # Errors
     /// [`HbError::InvalidInput`] for an interval that is not finite, positive
     /// and non-empty, a fold scale interval not around 1, non-finite `at`,
@@ -151,8 +163,7 @@ impl DiagramRequest {
             }
         }
         finite_list("at", &self.at)?;
-        positive("ds", self.ds)?;
-        positive("ds_max", self.ds_max)?;
+        self.path()?;
         positive("max_amplitude", self.max_amplitude)?;
         let step = finite("step", self.step)?;
         if !(step > 0.0 && step <= 1.0) {
@@ -303,6 +314,8 @@ struct Search<'a, P> {
     problem: &'a P,
     hb: HbOptions,
     req: &'a DiagramRequest,
+    /// The continuation options of every branch, within the interval.
+    path: ContinuationOptions,
     /// Each branch's states `[q, ω_f]` with its HB options (tori: `None`).
     states: Vec<Option<(HbOptions, Vec<Vec<f64>>)>>,
     /// Each branch's located events (tori: none).
@@ -312,15 +325,6 @@ struct Search<'a, P> {
 }
 
 impl<'a, P: PeriodicProblem> Search<'a, P> {
-    /// The continuation options of every branch, within the interval.
-    fn path_options(&self) -> ContinuationOptions {
-        let mut c = super::path_steps(self.req.ds, self.req.ds_max, self.req.max_points);
-        c.corrector = Corrector::Newton;
-        c.lambda_min = self.req.from.min(self.req.to);
-        c.lambda_max = self.req.from.max(self.req.to);
-        c
-    }
-
     /// Whether `x = [q, ω_f]` lies within `tol` of a traced branch with the
     /// options `hb`.
     fn known(&self, hb: &HbOptions, x: &[f64], tol: f64) -> bool {
@@ -337,7 +341,7 @@ impl<'a, P: PeriodicProblem> Search<'a, P> {
     /// crossing of ω_f by a branch corrected there at fixed ω_f by Newton,
     /// within `1e-6·max(‖q‖, 1)` of `q`.
     fn on_branch_at(&self, q: &[f64], omega: f64) -> bool {
-        let copts = self.path_options();
+        let copts = self.path.clone();
         let Ok(mut branch) = FamilyBranch::new(Frequency(self.problem), &self.hb, omega) else {
             return false;
         };
@@ -386,7 +390,7 @@ impl<'a, P: PeriodicProblem> Search<'a, P> {
         }
         let lambda0 = pending.x0.last().copied().unwrap_or(f64::NAN);
         let mut branch = FamilyBranch::new(Frequency(self.problem), &pending.hb, lambda0)?;
-        let copts = self.path_options();
+        let copts = self.path.clone();
         let close = pending.kind != BranchKind::Primary;
         let trace = trace_within(&mut branch, &pending.x0, pending.direction, &copts, close)?;
         if trace.termination == Termination::MaxPoints {
@@ -440,7 +444,7 @@ impl<'a, P: PeriodicProblem> Search<'a, P> {
         hb: &HbOptions,
         states: &[Vec<f64>],
     ) -> Result<Vec<(usize, DiagramPoint)>, HbError> {
-        let copts = self.path_options();
+        let copts = self.path.clone();
         let mut out = Vec::new();
         for &target in &self.req.at {
             for (k, w) in states.windows(2).enumerate() {
@@ -505,6 +509,7 @@ pub fn diagram<P: PeriodicProblem>(
         problem,
         hb: hb.clone(),
         req,
+        path: req.path()?,
         states: Vec::new(),
         located: Vec::new(),
         branches: Vec::new(),

@@ -8,14 +8,14 @@
 //! given point, or the point of that kind of largest ω_f located on the FRC
 //! of `family(p_start)` over an interval.
 
-use super::{all_finite, finite, finite_list, path_steps, Array, FrcRequest};
+use super::{all_finite, finite, finite_list, path_steps, Array, FrcRequest, Steps};
 use ivt_hb::branches::codim2::{bifurcation_curve, CurvePoint, CurveStart};
 use ivt_hb::branches::events::BifurcationKind;
 use ivt_hb::branches::frc::{frequency_response, FrcOptions};
 use ivt_hb::orbit::ihb::{HbOptions, HbSolution};
 use ivt_hb::problem::PeriodicProblem;
 use ivt_hb::HbError;
-use ivt_path::continuation::{Corrector, Termination};
+use ivt_path::continuation::{ContinuationOptions, Corrector, Termination};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -59,13 +59,13 @@ pub struct FoldCurveRequest {
     pub p_to: f64,
     /// `p` at which the folds are located exactly (each crossing).
     pub at: Vec<f64>,
-    /// First arclength step.
-    pub ds: f64,
-    /// Largest arclength step.
-    pub ds_max: f64,
-    /// Most path points.
-    pub max_points: usize,
+    /// The path's steps and most points (by default Δη from 0.02 up to
+    /// 0.05, 5000 points: [`FOLD_CURVE_STEPS`]).
+    pub steps: Steps,
 }
+
+/// The curve's own first step, largest step and most points.
+pub const FOLD_CURVE_STEPS: (f64, f64, usize) = (0.02, 0.05, 5000);
 
 impl Default for FoldCurveRequest {
     /// The thesis Duffing's upper fold searched on ω_f ∈ [0.5, 2.5] at
@@ -78,9 +78,7 @@ impl Default for FoldCurveRequest {
             p_from: 0.0,
             p_to: 0.3,
             at: Vec::new(),
-            ds: 0.02,
-            ds_max: 0.05,
-            max_points: 5000,
+            steps: Steps::default(),
         }
     }
 }
@@ -114,14 +112,18 @@ impl FoldCurveRequest {
             ("p_start", self.p_start),
             ("p_from", self.p_from),
             ("p_to", self.p_to),
-            ("ds", self.ds),
-            ("ds_max", self.ds_max),
         ])?;
         finite_list("at", &self.at)?;
-        if self.max_points == 0 {
-            return Err(HbError::InvalidInput("`max_points` must be ≥ 1".into()));
-        }
-        Ok(())
+        self.path().map(|_| ())
+    }
+
+    /// [`FOLD_CURVE_STEPS`] with the request's `steps`.
+    ///
+    /// # Errors
+    /// [`HbError::InvalidInput`] for steps [`Steps::on`] refuses.
+    pub fn path(&self) -> Result<ContinuationOptions, HbError> {
+        let (ds, ds_max, max_points) = FOLD_CURVE_STEPS;
+        path_steps(&self.steps, ds, ds_max, max_points)
     }
 }
 
@@ -217,7 +219,7 @@ where
         FoldStart::Given { omega, coeffs } => (*omega, coeffs.clone()),
         FoldStart::Search { from, to } => search_start(&family, hb, req, *from, *to)?,
     };
-    let copts = path_steps(req.ds, req.ds_max, req.max_points);
+    let copts = req.path()?;
     let h = hb.harmonics;
     let (points, at, special, termination) = if req.kind == BifurcationKind::Fold {
         let curve = ivt_hb::fold_curve(
@@ -414,9 +416,12 @@ mod tests {
             p_from: 0.0,
             p_to: 0.3,
             at: vec![0.3],
-            ds: 0.01,
-            ds_max: 0.02,
-            max_points: 400,
+            steps: Steps {
+                ds: Some(0.01),
+                ds_max: Some(0.02),
+                max_points: Some(400),
+                ds_min: None,
+            },
         };
         let c = fold_curve(family, &HbOptions::new(9, 32), &req).unwrap();
         assert_eq!(c.kind, BifurcationKind::NeimarkSacker);

@@ -67,6 +67,7 @@ pub use torus::{torus, Section, TorusCurve, TorusPoint, TorusRequest};
 
 use ivt_hb::HbError;
 use ivt_path::continuation::ContinuationOptions;
+pub use ivt_path::continuation::Steps;
 
 /// Hsu sub-intervals per period for `harmonics` harmonics: max(8n, 256)
 /// (Eq. 78; 256 resolve the stability flags of the thesis's examples, 8n
@@ -128,15 +129,24 @@ pub(crate) fn finite_list(name: &str, values: &[f64]) -> Result<(), HbError> {
     values.iter().try_for_each(|&v| finite(name, v).map(|_| ()))
 }
 
-/// The default path with a request's first and largest arclength steps
-/// and its most points.
-pub(crate) fn path_steps(ds: f64, ds_max: f64, max_points: usize) -> ContinuationOptions {
-    ContinuationOptions {
+/// The default path with a job's own first and largest arclength steps and
+/// most points, overridden by the request's `steps`.
+///
+/// # Errors
+/// [`HbError::InvalidInput`] for steps [`Steps::on`] refuses.
+pub(crate) fn path_steps(
+    steps: &Steps,
+    ds: f64,
+    ds_max: f64,
+    max_points: usize,
+) -> Result<ContinuationOptions, HbError> {
+    let own = ContinuationOptions {
         ds,
         ds_max,
         max_points,
         ..ContinuationOptions::default()
-    }
+    };
+    steps.on(own).map_err(HbError::InvalidInput)
 }
 
 #[cfg(test)]

@@ -13,7 +13,6 @@ use ivt_hb::branches::frc::FrcOptions;
 use ivt_hb::orbit::ihb::HbOptions;
 use ivt_hb::problem::PeriodicProblem;
 use ivt_hb::HbError;
-use ivt_path::continuation::Corrector;
 
 /// A located Neimark–Sacker point of the FRC at one p.
 #[derive(Debug, Clone, PartialEq)]
@@ -28,8 +27,8 @@ pub struct NeimarkSackerPoint {
     pub multipliers: Vec<c64>,
 }
 
-/// The located Neimark–Sacker points of the FRC of `family(p)` from
-/// `omega_from` to `omega_to`, for each p of `ps`, in order (module docs).
+/// The located Neimark–Sacker points of the FRC `sweep` (its interval and
+/// path) of `family(p)`, for each p of `ps`, in order (module docs).
 /// A point whose location failed is left out.
 ///
 /// # Errors
@@ -37,8 +36,7 @@ pub struct NeimarkSackerPoint {
 pub fn neimark_sacker_points<P, F>(
     family: F,
     hb: &HbOptions,
-    omega_from: f64,
-    omega_to: f64,
+    sweep: &FrcOptions,
     ps: &[f64],
 ) -> Result<Vec<NeimarkSackerPoint>, HbError>
 where
@@ -47,7 +45,7 @@ where
 {
     let mut found = Vec::new();
     let req = FrcRequest {
-        options: FrcOptions::sweep(omega_from, omega_to, Corrector::Newton),
+        options: sweep.clone(),
         events: true,
     };
     for &p in ps {

@@ -6,7 +6,7 @@
 use ivt_hb::branches::frc::Frc;
 use ivt_hb::stability::StabilityKind;
 use ivt_hb::HbError;
-use ivt_path::continuation::Termination;
+use ivt_path::continuation::{Steps, Termination};
 use ivt_sthb::frc::{frequency_response, StringFrcOptions};
 use ivt_sthb::stability::StabilityMethod;
 use ivt_sthb::{Boundary, StringHb, StringParams};
@@ -18,7 +18,7 @@ use std::time::Instant;
 /// not asserted; the thesis uses 10 and 30).
 pub const MAX_KD: f64 = 1e9;
 
-/// The string, the interval in ω and the largest arclength step.
+/// The string, the interval in ω and the path's steps.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StringRequest {
     /// The model and its discretization.
@@ -27,8 +27,9 @@ pub struct StringRequest {
     pub from: f64,
     /// End frequency (> `from`, finite).
     pub to: f64,
-    /// Largest arclength step (> 0, finite).
-    pub step_max: f64,
+    /// The path's steps and most points (by default those of
+    /// [`StringFrcOptions`]: Δη from 0.02 up to 0.05, 2000 points).
+    pub steps: Steps,
 }
 
 impl Default for StringRequest {
@@ -38,7 +39,7 @@ impl Default for StringRequest {
             params: StringParams::default(),
             from: 1.0,
             to: 6.0,
-            step_max: StringFrcOptions::default().continuation.ds_max,
+            steps: Steps::default(),
         }
     }
 }
@@ -46,7 +47,8 @@ impl Default for StringRequest {
 impl StringRequest {
     /// # Errors
     /// [`HbError::InvalidInput`] for |k_d| > [`MAX_KD`], invalid
-    /// [`StringParams`], or unless 0 < from < to (finite) and step_max > 0.
+    /// [`StringParams`], unless 0 < from < to (finite), or for steps
+    /// [`Steps::on`] refuses.
     pub fn validate(&self) -> Result<(), HbError> {
         let kd = self.params.kd;
         if !(kd.is_finite() && kd.abs() <= MAX_KD) {
@@ -55,13 +57,26 @@ impl StringRequest {
             )));
         }
         self.params.validate()?;
-        let (from, to, ds) = (self.from, self.to, self.step_max);
-        if !(from > 0.0 && to > from && to.is_finite() && ds > 0.0 && ds.is_finite()) {
+        let (from, to) = (self.from, self.to);
+        if !(from > 0.0 && to > from && to.is_finite()) {
             return Err(HbError::InvalidInput(format!(
-                "need 0 < `from` < `to` (finite) and `step_max` > 0, got {from:?} .. {to:?}, {ds:?}"
+                "need 0 < `from` < `to` (finite), got {from:?} .. {to:?}"
             )));
         }
-        Ok(())
+        self.options().map(|_| ())
+    }
+
+    /// The default [`StringFrcOptions`] with the request's steps.
+    ///
+    /// # Errors
+    /// [`HbError::InvalidInput`] for steps [`Steps::on`] refuses.
+    pub fn options(&self) -> Result<StringFrcOptions, HbError> {
+        let mut opts = StringFrcOptions::default();
+        opts.continuation = self
+            .steps
+            .on(opts.continuation)
+            .map_err(HbError::InvalidInput)?;
+        Ok(opts)
     }
 }
 
@@ -126,8 +141,7 @@ pub struct StringCurve {
 /// Hill's method) are numerical failures.
 pub fn string(req: &StringRequest) -> Result<StringCurve, HbError> {
     req.validate()?;
-    let mut opts = StringFrcOptions::default();
-    opts.continuation.ds_max = req.step_max;
+    let opts = req.options()?;
     let t0 = Instant::now();
     // Newton arclength with the exact (Tau) Jacobian for both boundaries: the
     // engine's Broyden continuation (`spring_frequency_response`, §3.3.5)

@@ -32,7 +32,7 @@ use ivt_hb::HbError;
 use ivt_num::vector::norm2;
 use ivt_num::BorderedLu;
 use ivt_path::branch::Branch;
-use ivt_path::continuation::Corrector;
+use ivt_path::continuation::{Corrector, Steps};
 use ivt_path::events::extended::{augmented_null_vectors, jacobian_blocks};
 use serde::Serialize;
 use std::time::Instant;
@@ -67,6 +67,9 @@ pub struct SwitchRequest {
     pub step: f64,
     /// Corrector of the path.
     pub corrector: Corrector,
+    /// The new branch's steps and most points (by default the FRC's:
+    /// [`FrcOptions::default`]).
+    pub steps: Steps,
 }
 
 impl Default for SwitchRequest {
@@ -85,6 +88,7 @@ impl Default for SwitchRequest {
             to: 2.0,
             step: 0.05,
             corrector: Corrector::Newton,
+            steps: Steps::default(),
         }
     }
 }
@@ -222,7 +226,11 @@ pub fn switch<P: PeriodicProblem>(
         )));
     }
     let (harmonics, subharmonic) = (branch.options().harmonics, branch.options().subharmonic);
-    let sweep = FrcOptions::sweep(w1, req.to, req.corrector);
+    let mut sweep = FrcOptions::sweep(w1, req.to, req.corrector);
+    sweep.path.continuation = req
+        .steps
+        .on(sweep.path.continuation)
+        .map_err(HbError::InvalidInput)?;
     let curve = traced_curve(&mut branch, &q1, &sweep, t0)?;
     Ok(SwitchedBranch {
         kind,

@@ -5,7 +5,7 @@
 //! normal exponent of a one-DOF torus) and the torus solved exactly at each
 //! ω_f of `at` (with its Poincaré section).
 
-use super::{all_finite, finite, finite_list, path_steps, positive, Array};
+use super::{all_finite, finite, finite_list, path_steps, Array, Steps};
 use ivt_hb::branches::events::LocateOptions;
 use ivt_hb::branches::family::{Family, Frequency};
 use ivt_hb::branches::torus::measure::{section, WIDER};
@@ -42,12 +42,9 @@ pub struct TorusRequest {
     /// The first torus's distance from the orbit along the critical
     /// direction, relative to the orbit's ‖coefficients‖₂.
     pub step: f64,
-    /// First arclength step.
-    pub ds: f64,
-    /// Largest arclength step.
-    pub ds_max: f64,
-    /// Most points.
-    pub max_points: usize,
+    /// The path's steps and most points (by default Δη from 0.01 up to 0.05,
+    /// 400 points: [`TORUS_STEPS`]).
+    pub steps: Steps,
     /// The DOF whose `|x|` is measured.
     pub amplitude_dof: usize,
     /// Estimate the errors of every path point too (one Newton step in a
@@ -62,6 +59,9 @@ pub struct TorusRequest {
     pub section_points: usize,
 }
 
+/// The torus path's own first step, largest step and most points.
+pub const TORUS_STEPS: (f64, f64, usize) = (0.01, 0.05, 400);
+
 impl Default for TorusRequest {
     /// No start (`coeffs` empty): a request is completed by the caller.
     fn default() -> Self {
@@ -73,9 +73,7 @@ impl Default for TorusRequest {
             at: Vec::new(),
             torus: TorusOptions::default(),
             step: 0.02,
-            ds: 0.01,
-            ds_max: 0.05,
-            max_points: 400,
+            steps: Steps::default(),
             amplitude_dof: 0,
             estimate_points: false,
             tol: 1e-7,
@@ -108,8 +106,8 @@ impl TorusRequest {
                 "`step` = {step:?} must be in (0, 1]"
             )));
         }
-        positive("ds", self.ds)?;
-        positive("ds_max", self.ds_max)?;
+        let (ds, ds_max, max_points) = TORUS_STEPS;
+        path_steps(&self.steps, ds, ds_max, max_points)?;
         if self.tol.is_nan() || self.tol < 0.0 {
             return Err(HbError::InvalidInput(format!(
                 "`tol` = {:?} must be ≥ 0",
@@ -224,7 +222,8 @@ pub fn torus<P: PeriodicProblem>(
             req.omega, req.omega_to
         )));
     }
-    let mut copts = path_steps(req.ds, req.ds_max, req.max_points);
+    let (ds, ds_max, max_points) = TORUS_STEPS;
+    let mut copts = path_steps(&req.steps, ds, ds_max, max_points)?;
     copts.corrector = Corrector::Newton;
     copts.lambda_min = lambda1.min(req.omega_to);
     copts.lambda_max = lambda1.max(req.omega_to);

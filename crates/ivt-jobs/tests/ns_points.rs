@@ -8,8 +8,8 @@
 
 use ivt_hb::branches::codim2::{bifurcation_curve, CurveStart};
 use ivt_hb::{
-    BifurcationKind, ContinuationOptions, GeneralProblem, HbError, HbOptions, PeriodicProblem,
-    Termination,
+    BifurcationKind, ContinuationOptions, Corrector, FrcOptions, GeneralProblem, HbError,
+    HbOptions, PeriodicProblem, Termination,
 };
 use ivt_jobs::neimark_sacker_points;
 
@@ -18,6 +18,11 @@ mod common;
 use common::shooting::{
     assert_omega_matches_shooting, central_jacobian, flow, newton3, orbit_state,
 };
+
+/// The FRC over ω_f ∈ [0.5, 1.6] with the Newton–chord corrector.
+fn newton_sweep() -> FrcOptions {
+    FrcOptions::sweep(0.5, 1.6, Corrector::Newton)
+}
 
 /// The family in F.
 fn van_der_pol(force: f64) -> Result<impl PeriodicProblem, HbError> {
@@ -56,8 +61,13 @@ fn ns_residual(force: f64, u: [f64; 3]) -> [f64; 3] {
 #[test]
 fn neimark_sacker_boundary_points_match_shooting() {
     let forces = [0.2, 0.25, 0.3];
-    let points =
-        neimark_sacker_points(van_der_pol, &HbOptions::new(9, 32), 0.5, 1.6, &forces).unwrap();
+    let points = neimark_sacker_points(
+        van_der_pol,
+        &HbOptions::new(9, 32),
+        &newton_sweep(),
+        &forces,
+    )
+    .unwrap();
     eprintln!(
         "{:?}",
         points.iter().map(|p| (p.p, p.omega)).collect::<Vec<_>>()
@@ -92,7 +102,7 @@ fn shoot(force: f64, coeffs: &[f64], omega: f64) -> ([f64; 3], f64) {
 #[test]
 fn van_der_pol_neimark_sacker_curve_matches_shooting() {
     let hb = HbOptions::new(9, 32);
-    let ns = neimark_sacker_points(van_der_pol, &hb, 0.5, 1.6, &[0.2]).unwrap();
+    let ns = neimark_sacker_points(van_der_pol, &hb, &newton_sweep(), &[0.2]).unwrap();
     let first = ns
         .iter()
         .find(|p| (p.omega - 0.94525643).abs() < 1e-6)

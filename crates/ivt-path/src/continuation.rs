@@ -20,12 +20,14 @@ mod residual_path;
 mod start;
 mod step_control;
 mod stepper;
+mod steps;
 #[cfg(test)]
 mod tests;
 pub use corrector::{BroydenCorrector, NewtonCorrector, PathCorrector};
 pub use residual_path::follow_residual;
 pub use start::correct_at_fixed_lambda;
 pub use stepper::{Step, Stepper};
+pub use steps::Steps;
 
 #[cfg(doc)]
 use crate::branch::Branch;

@@ -5,7 +5,7 @@
 //! arguments, runs an `ivt_jobs` job and returns its result as a dict
 //! (the keys of the CLI's JSON, [`crate::to_python`]).
 
-use ivt_hb::{AtFrequency, Duffing, FrcOptions, MathieuDuffing};
+use ivt_hb::{AtFrequency, Duffing, MathieuDuffing};
 use ivt_jobs::{self as jobs, CascadeRequest, FrcRequest, LimitCycleRequest, OrbitRequest};
 use numpy::PyArrayLike1;
 use pyo3::exceptions::PyValueError;
@@ -55,7 +55,7 @@ macro_rules! duffing_fn {
         $(#[$doc:meta])*
         fn $name:ident<$lt:lifetime>($py:ident, $problem:ident, $n:ident, $samples:ident;
             head [$( $arg:ident: $ty:ty $(= $default:tt)? ),*];
-            tail [$( $brg:ident: $bty:ty $(= $bdefault:tt)? ),*];
+            tail [$( $(#[$pb:ident($($pb_args:tt)*)])* $brg:ident: $bty:ty $(= $bdefault:tt)? ),*];
         ) $body:block
     ) => {
         $(#[$doc])*
@@ -71,7 +71,7 @@ macro_rules! duffing_fn {
             #[pyo3(from_py_with = int64)] $n: i64,
             #[pyo3(from_py_with = crate::args::opt_int64)] $samples: Option<i64>,
             xi: f64, alpha: f64, eps: f64, force: f64,
-            $( $brg: $bty, )*
+            $( $(#[$pb($($pb_args)*)])* $brg: $bty, )*
         ) -> PyResult<Bound<$lt, PyDict>> {
             let $problem = duffing_problem(xi, alpha, eps, force)?;
             $body
@@ -186,18 +186,23 @@ duffing_fn! {
 /// "multiplier_error"}...], "folds": [ω_f at each turning point],
 /// "bifurcations", "termination", "time_s"} and the arrays omega,
 /// amplitude, stable for plotting. `events=True` (`--events`) also locates
-/// period doublings, Neimark–Sacker and branch points. GIL released.
+/// period doublings, Neimark–Sacker and branch points. `ds`, `ds_min`,
+/// `ds_max`, `max_points`: the path's steps (None: Δη from 0.05 up to 0.08,
+/// 5000 points). GIL released.
 fn duffing_frc<'py>(py, problem, n, samples;
     head [from_: f64 = 0.2, to: f64 = 3.0];
-    tail [events: bool = false];
+    tail [
+        events: bool = false,
+        ds: Option<f64> = None,
+        ds_min: Option<f64> = None,
+        ds_max: Option<f64> = None,
+        #[pyo3(from_py_with = crate::args::opt_int64)] max_points: Option<i64> = None
+    ];
 ) {
     let opts = options(n, samples, 1, 1e-10)?;
+    let steps = crate::steps::steps(ds, ds_min, ds_max, max_points)?;
     let req = FrcRequest {
-        options: FrcOptions {
-            from: finite("from_", from_)?,
-            to: finite("to", to)?,
-            ..FrcOptions::default()
-        },
+        options: crate::steps::sweep(finite("from_", from_)?, finite("to", to)?, &steps)?,
         events,
     };
     let curve = run(py, || jobs::frc(&problem, &opts, &req))?;

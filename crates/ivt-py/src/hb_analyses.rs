@@ -90,24 +90,34 @@ user_system_fn! {
 /// curve is `backbone`'s.
 /// Returns {"points": [{"amplitude", "omega", "damping_ratio", "peak" (max |x|
 /// of DOF `dof`), "coeffs"}...],
-/// "linear_omega", "linear_mode", "termination"}.
+/// "linear_omega", "linear_mode", "termination"}. `ds`, `ds_min`, `ds_max`,
+/// `max_points`: the path's steps (None: Δη from 0.02 up to 0.2, 5000
+/// points).
 fn damped_modes<'py>(py, user, jac;
     amplitude_from: f64,
     amplitude_to: f64;
     #[pyo3(from_py_with = crate::args::int64)] mode: i64 = 0,
     #[pyo3(from_py_with = crate::args::int64)] dof: i64 = 0,
     tol: f64 = 0.0,
+    ds: Option<f64> = None,
+    ds_min: Option<f64> = None,
+    ds_max: Option<f64> = None,
+    #[pyo3(from_py_with = crate::args::opt_int64)] max_points: Option<i64> = None,
 ) {
     let (problem, opts) = user.setup(None, 1, tol)?;
     crate::hb_shared::without_omega(&problem, "damped_modes")?;
+    let steps = crate::steps::steps(ds, ds_min, ds_max, max_points)?;
     let bopts = BackboneOptions {
         dof: count("dof", dof)?,
         amplitude_from: finite("amplitude_from", amplitude_from)?,
         amplitude_to: finite("amplitude_to", amplitude_to)?,
-        continuation: ContinuationOptions {
-            corrector: Corrector::Newton,
-            ..ContinuationOptions::default()
-        },
+        continuation: crate::steps::on(
+            &steps,
+            ContinuationOptions {
+                corrector: Corrector::Newton,
+                ..ContinuationOptions::default()
+            },
+        )?,
     };
     let mode = count("mode", mode)?;
     let dm = run_user(py, &problem, |p| ivt_hb::damped_modes(p, &opts, mode, &bopts))?;

@@ -39,7 +39,7 @@ use crate::to_python::to_dict;
 #[pyo3(signature = (
     family, p_from, p_to, at = Vec::new(), n = 20, samples = None,
     velocity_dependent = true, vectorized = false, grid = 100, rtol = 1e-9, max_iter = 100,
-    ds = 0.02, ds_max = 0.05, max_points = 2000, offset = 1e-2
+    ds = None, ds_min = None, ds_max = None, max_points = None, offset = 1e-2
 ))]
 #[allow(clippy::too_many_arguments)]
 fn cycle_branch<'py>(
@@ -55,9 +55,10 @@ fn cycle_branch<'py>(
     #[pyo3(from_py_with = crate::args::int64)] grid: i64,
     rtol: f64,
     #[pyo3(from_py_with = crate::args::int64)] max_iter: i64,
-    ds: f64,
-    ds_max: f64,
-    #[pyo3(from_py_with = crate::args::int64)] max_points: i64,
+    ds: Option<f64>,
+    ds_min: Option<f64>,
+    ds_max: Option<f64>,
+    #[pyo3(from_py_with = crate::args::opt_int64)] max_points: Option<i64>,
     offset: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (p_from, p_to) = (finite("p_from", p_from)?, finite("p_to", p_to)?);
@@ -71,9 +72,7 @@ fn cycle_branch<'py>(
         p_to,
         at,
         grid: count("grid", grid)?,
-        ds,
-        ds_max,
-        max_points: count("max_points", max_points)?,
+        steps: crate::steps::steps(ds, ds_min, ds_max, max_points)?,
         offset,
     };
     let keys = HbKeys::new(n, samples, velocity_dependent, vectorized, rtol, max_iter)?;
@@ -91,12 +90,14 @@ fn cycle_branch<'py>(
 /// `ps` the frequency response from `omega_from` to `omega_to` is traced
 /// with its events, and each Neimark–Sacker point located on its extended
 /// system. Not a continuation: a turn of the boundary in p between samples is
-/// not followed. Returns [{"p", "omega", "coeffs", "multipliers"}...] in
-/// order of `ps`.
+/// not followed. `ds`, `ds_min`, `ds_max`, `max_points`: each response's
+/// steps (None: those of `frc`). Returns [{"p", "omega", "coeffs",
+/// "multipliers"}...] in order of `ps`.
 #[pyfunction]
 #[pyo3(signature = (
     family, ps, omega_from, omega_to, n = 20, samples = None, rtol = 1e-9, max_iter = 100,
-    velocity_dependent = true, vectorized = false
+    velocity_dependent = true, vectorized = false, ds = None, ds_min = None, ds_max = None,
+    max_points = None
 ))]
 #[allow(clippy::too_many_arguments)]
 fn neimark_sacker_points<'py>(
@@ -111,6 +112,10 @@ fn neimark_sacker_points<'py>(
     #[pyo3(from_py_with = crate::args::int64)] max_iter: i64,
     velocity_dependent: bool,
     vectorized: bool,
+    ds: Option<f64>,
+    ds_min: Option<f64>,
+    ds_max: Option<f64>,
+    #[pyo3(from_py_with = crate::args::opt_int64)] max_points: Option<i64>,
 ) -> PyResult<Bound<'py, PyList>> {
     let (from, to) = (
         finite("omega_from", omega_from)?,
@@ -122,11 +127,13 @@ fn neimark_sacker_points<'py>(
             "arguments `omega_from`, `omega_to` must be > 0 and distinct, `ps` not empty",
         ));
     };
+    let steps = crate::steps::steps(ds, ds_min, ds_max, max_points)?;
+    let sweep = crate::steps::sweep(from, to, &steps)?;
     let keys = HbKeys::new(n, samples, velocity_dependent, vectorized, rtol, max_iter)?;
     let fam = PyFamily::new(family, keys);
     let first = fam.first(py, finite("ps[0]", p0)?)?;
     let points = fam.run(py, first, |hb| {
-        ivt_jobs::neimark_sacker_points(|p| fam.build(p), hb, from, to, &ps)
+        ivt_jobs::neimark_sacker_points(|p| fam.build(p), hb, &sweep, &ps)
     })?;
     let list = PyList::empty(py);
     for pt in points {

@@ -86,12 +86,14 @@ fn cycle_fold_curve<'py>(py, args) [
     // The user system at (mu_from, nu_from) sets the HB options.
     let first = fam.at_mu(py, mu_from)?.first(py, nu_from)?;
     let harmonics = first.1.harmonics;
-    let continuation = ContinuationOptions {
-        ds: args.ds,
-        ds_max: args.ds_max,
-        max_points: args.max_points,
+    // Its own steps: Δη from 0.02 up to 0.05, 2000 points.
+    let own = ContinuationOptions {
+        ds: 0.02,
+        ds_max: 0.05,
+        max_points: 2000,
         ..ContinuationOptions::default()
     };
+    let continuation = crate::steps::on(&args.steps, own)?;
     let curve = fam.family.run(py, first, |hb| {
         let family = |mu: f64, nu: f64| fam.build(mu, nu);
         let branch = cycle_branch(

@@ -4,6 +4,7 @@
 //! they share reach the body as one [`FamilyArgs`]).
 
 use ivt_hb::{HbError, HbOptions};
+use ivt_jobs::Steps;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use std::sync::Mutex;
@@ -121,26 +122,22 @@ impl PyFamily {
 }
 
 /// What a [`family_fn!`] function's shared keywords give its body: the
-/// family with its HB keywords, and the continuation steps.
+/// family with its HB keywords, and the continuation keywords.
 pub(crate) struct FamilyArgs {
     /// `family` with `n`, `samples`, `velocity_dependent`, `vectorized`,
     /// `rtol`, `max_iter`.
     pub family: PyFamily,
-    /// First arclength step.
-    pub ds: f64,
-    /// Largest arclength step.
-    pub ds_max: f64,
-    /// Most points of the path.
-    pub max_points: usize,
+    /// `ds`, `ds_min`, `ds_max`, `max_points` (None: the path's own).
+    pub steps: Steps,
 }
 
 /// A `#[pyfunction]` continuing a solution of a Python family, returning a
 /// dict: `fn name<'py>(py, args) [own parameters] { body }`. Python
 /// parameters: `family`, the function's own (`name: type [= default]`, in
 /// brackets), then `n=20, samples=None, velocity_dependent=True,
-/// vectorized=False, rtol=1e-9, max_iter=100, ds=0.02, ds_max=0.05,
-/// max_points=2000`; those reach the body as the [`FamilyArgs`] named by the
-/// caller.
+/// vectorized=False, rtol=1e-9, max_iter=100, ds=None, ds_min=None,
+/// ds_max=None, max_points=None`; those reach the body as the [`FamilyArgs`]
+/// named by the caller.
 macro_rules! family_fn {
     ($(#[$doc:meta])* fn $name:ident<$lt:lifetime>($py:ident, $args:ident) $own:tt $body:block) => {
         $crate::hb_shared::hb_keywords_fn! {
@@ -149,16 +146,14 @@ macro_rules! family_fn {
             head [family,] [family: &Bound<$lt, PyAny>,];
             own $own;
             mid [];
-            tail [, ds = 0.02, ds_max = 0.05, max_points = 2000] [
-                ds: f64, ds_max: f64,
-                #[pyo3(from_py_with = crate::args::int64)] max_points: i64,
+            tail [, ds = None, ds_min = None, ds_max = None, max_points = None] [
+                ds: Option<f64>, ds_min: Option<f64>, ds_max: Option<f64>,
+                #[pyo3(from_py_with = crate::args::opt_int64)] max_points: Option<i64>,
             ];
             {
                 let $args = $crate::hb_family::FamilyArgs {
                     family: $crate::hb_family::PyFamily::new(family, keys),
-                    ds,
-                    ds_max,
-                    max_points: crate::args::count("max_points", max_points)?,
+                    steps: crate::steps::steps(ds, ds_min, ds_max, max_points)?,
                 };
                 $body
             }

@@ -74,9 +74,7 @@ fn continue_bifurcation<'py>(py, args) [
         p_from,
         p_to,
         at,
-        ds: args.ds,
-        ds_max: args.ds_max,
-        max_points: args.max_points,
+        steps: args.steps,
     };
     let fam = &args.family;
     let first = fam.first(py, p_start)?;
@@ -97,7 +95,7 @@ fn continue_bifurcation<'py>(py, args) [
 #[pyfunction]
 #[pyo3(signature = (
     force = 0.1, force_from = 0.0, force_to = 0.3, at = vec![0.1, 0.2, 0.3], from_ = 0.5,
-    to = 2.5, n = 20, samples = None
+    to = 2.5, n = 20, samples = None, ds = None, ds_min = None, ds_max = None, max_points = None
 ))]
 #[allow(clippy::too_many_arguments)]
 fn duffing_folds<'py>(
@@ -110,9 +108,14 @@ fn duffing_folds<'py>(
     to: f64,
     #[pyo3(from_py_with = int64)] n: i64,
     #[pyo3(from_py_with = crate::args::opt_int64)] samples: Option<i64>,
+    ds: Option<f64>,
+    ds_min: Option<f64>,
+    ds_max: Option<f64>,
+    #[pyo3(from_py_with = crate::args::opt_int64)] max_points: Option<i64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let opts = options(n, samples, 1, 1e-10)?;
     let req = FoldCurveRequest {
+        steps: crate::steps::steps(ds, ds_min, ds_max, max_points)?,
         start: FoldStart::Search { from: from_, to },
         p_start: finite("force", force)?,
         p_from: force_from,

@@ -11,7 +11,7 @@ use ivt_condense::{
     Structure,
 };
 use ivt_hb::{HbError, HbOptions};
-use ivt_jobs::pairs;
+use ivt_jobs::{pairs, Steps};
 use ivt_kin::params::Typed;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::exceptions::PyValueError;
@@ -215,7 +215,7 @@ pub(crate) fn frc_dict<'py>(py: Python<'py>, frc: &CondensedFrc) -> PyResult<Bou
     n_dof, m, c, k, g, f, omega_from, omega_to, nonlinear_dofs, amplitude_dof = None,
     record_dofs = Vec::new(), n = 7, samples = 32, velocity_dependent = true,
     vectorized = false, rtol = 1e-12, jac = None, ds = None, ds_min = None, ds_max = None,
-    truncation_estimate = true, stability = true
+    max_points = None, truncation_estimate = true, stability = true
 ))]
 #[allow(clippy::too_many_arguments)]
 fn frc_large<'py>(
@@ -240,6 +240,7 @@ fn frc_large<'py>(
     ds: Option<f64>,
     ds_min: Option<f64>,
     ds_max: Option<f64>,
+    max_points: Option<usize>,
     truncation_estimate: bool,
     stability: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -249,7 +250,12 @@ fn frc_large<'py>(
         (omega_from, omega_to, rtol),
         (amplitude_dof, record_dofs),
         [truncation_estimate, stability],
-        [ds, ds_min, ds_max],
+        &Steps {
+            ds,
+            ds_min,
+            ds_max,
+            max_points,
+        },
     )?;
     let frc = large.run(py, move |branch| condensed_response(branch, &opts))?;
     frc_dict(py, &frc)
@@ -257,12 +263,12 @@ fn frc_large<'py>(
 
 /// The condensed sweep's options from the keywords of `frc`: `(from, to,
 /// rtol)`, `(amplitude_dof, record_dofs)`, `[truncation_estimate,
-/// stability]`, `[ds, ds_min, ds_max]`.
+/// stability]` and the continuation keywords.
 pub(crate) fn frc_options(
     (omega_from, omega_to, rtol): (f64, f64, f64),
     (amplitude_dof, record_dofs): (Option<usize>, Vec<usize>),
     [truncation_estimate, stability]: [bool; 2],
-    steps: [Option<f64>; 3],
+    steps: &Steps,
 ) -> PyResult<CondensedFrcOptions> {
     let mut opts = CondensedFrcOptions {
         from: finite("omega_from", omega_from)?,
@@ -274,17 +280,7 @@ pub(crate) fn frc_options(
         stability_blocks: stability.then_some(ivt_condense::DEFAULT_BLOCKS),
         ..CondensedFrcOptions::default()
     };
-    let [ds, ds_min, ds_max] = steps;
-    let slots = [
-        ("ds", ds, &mut opts.continuation.ds),
-        ("ds_min", ds_min, &mut opts.continuation.ds_min),
-        ("ds_max", ds_max, &mut opts.continuation.ds_max),
-    ];
-    for (name, given, slot) in slots {
-        if let Some(v) = given {
-            *slot = positive(name, v)?;
-        }
-    }
+    opts.continuation = crate::steps::on(steps, opts.continuation)?;
     Ok(opts)
 }
 

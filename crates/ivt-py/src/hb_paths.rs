@@ -4,7 +4,7 @@
 //! doublings, Neimark–Sacker points and branch points each located on its
 //! extended system) and [`ivt_jobs::backbone`].
 
-use ivt_hb::{BackboneOptions, Corrector, FrcOptions};
+use ivt_hb::BackboneOptions;
 use ivt_jobs::{self as jobs, BackboneRequest, FrcRequest};
 use ivt_kin::params::Typed;
 use pyo3::exceptions::PyValueError;
@@ -42,13 +42,20 @@ user_system_fn! {
 /// multipliers come from 2048 fixed steps. `events=False` locates the folds
 /// only by `ivt_hb::frequency_response` (no period-doubling,
 /// Neimark–Sacker or branch-point test per point: cheaper per
-/// point, see docs/guide/src/accuracy-speed.md). GIL released between callbacks.
+/// point, see docs/guide/src/accuracy-speed.md). `ds`, `ds_min`, `ds_max`,
+/// `max_points`: the path's steps in (coefficients, ω_f) and most points
+/// (None: Δη from 0.05 up to 0.08, ds_min 1e-7, 5000 points; on the
+/// condensed path, in its scaled unknowns). GIL released between callbacks.
 fn frc<'py>(py, user, jac;
     f: Option<&Bound<'py, PyAny>>,
     omega_from: f64,
     omega_to: f64;
     tol: f64 = 0.0,
     events: bool = true,
+    ds: Option<f64> = None,
+    ds_min: Option<f64> = None,
+    ds_max: Option<f64> = None,
+    #[pyo3(from_py_with = crate::args::opt_int64)] max_points: Option<i64> = None,
 ) {
     let (problem, opts) = user.setup(f, 1, tol)?;
     let (from, to) = (finite("omega_from", omega_from)?, finite("omega_to", omega_to)?);
@@ -61,7 +68,8 @@ fn frc<'py>(py, user, jac;
     }
     // The Newton–chord corrector: one Galerkin Jacobian and ~3 residuals per
     // point, the user's `g` called about a sixth as often as by Broyden.
-    let req = FrcRequest { options: FrcOptions::sweep(from, to, Corrector::Newton), events };
+    let steps = crate::steps::steps(ds, ds_min, ds_max, max_points)?;
+    let req = FrcRequest { options: crate::steps::sweep(from, to, &steps)?, events };
     let curve = run_user(py, &problem, |p| jobs::frc(p, &opts, &req))?;
     to_dict(py, &curve)
 }
@@ -82,7 +90,8 @@ user_system_fn! {
 /// differences of `g`).
 /// Returns {"amplitude", "omega", "kappa" (arrays), "points": [{"amplitude",
 /// "omega", "kappa", "peak" (max |x| of DOF `dof`), "coeffs"}...],
-/// "termination"}. GIL released between
+/// "termination"}. `ds`, `ds_min`, `ds_max`, `max_points`: the path's
+/// steps (None: Δη from 0.02 up to 0.2, 5000 points). GIL released between
 /// callbacks.
 fn backbone<'py>(py, user, jac;
     omega0: f64,
@@ -91,9 +100,16 @@ fn backbone<'py>(py, user, jac;
     amplitude_to: f64 = 1.0;
     #[pyo3(from_py_with = crate::args::int64)] dof: i64 = 0,
     tol: f64 = 0.0,
+    ds: Option<f64> = None,
+    ds_min: Option<f64> = None,
+    ds_max: Option<f64> = None,
+    #[pyo3(from_py_with = crate::args::opt_int64)] max_points: Option<i64> = None,
 ) {
     let (problem, opts) = user.setup(None, 1, tol)?;
     crate::hb_shared::without_omega(&problem, "backbone")?;
+    // The request's Newton–chord corrector, with the keywords' steps.
+    let own = BackboneRequest::default().options.continuation;
+    let steps = crate::steps::steps(ds, ds_min, ds_max, max_points)?;
     let req = BackboneRequest {
         omega0: finite("omega0", omega0)?,
         mode,
@@ -101,8 +117,7 @@ fn backbone<'py>(py, user, jac;
             dof: crate::args::count("dof", dof)?,
             amplitude_from: finite("amplitude_from", amplitude_from)?,
             amplitude_to: finite("amplitude_to", amplitude_to)?,
-            // The request's Newton–chord corrector.
-            ..BackboneRequest::default().options
+            continuation: crate::steps::on(&steps, own)?,
         },
     };
     let curve = run_user(py, &problem, |p| jobs::backbone(p, &opts, &req))?;

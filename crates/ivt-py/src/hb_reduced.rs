@@ -60,7 +60,8 @@ fn sparse(name: &str, n: usize, coo: &CooArrays<'_>) -> PyResult<SparseColMat<us
     n_dof, m, c, k, g, f, omega_from, omega_to, nonlinear_dofs, amplitude_dof = None,
     record_dofs = Vec::new(), n = 7, samples = 32, velocity_dependent = true,
     vectorized = false, rtol = 1e-12, jac = None, ds = None, ds_min = None, ds_max = None,
-    truncation_estimate = true, stability = true, reduction_tol = 1e-8, reduction_samples = 3
+    max_points = None, truncation_estimate = true, stability = true, reduction_tol = 1e-8,
+    reduction_samples = 3
 ))]
 #[allow(clippy::too_many_arguments)]
 fn frc_reduced<'py>(
@@ -85,6 +86,7 @@ fn frc_reduced<'py>(
     ds: Option<f64>,
     ds_min: Option<f64>,
     ds_max: Option<f64>,
+    max_points: Option<usize>,
     truncation_estimate: bool,
     stability: bool,
     reduction_tol: f64,
@@ -95,7 +97,12 @@ fn frc_reduced<'py>(
         (omega_from, omega_to, rtol),
         (amplitude_dof, record_dofs),
         [truncation_estimate, stability],
-        [ds, ds_min, ds_max],
+        &ivt_jobs::Steps {
+            ds,
+            ds_min,
+            ds_max,
+            max_points,
+        },
     )?;
     let matrices = (
         sparse("m", n_dof, &m)?,

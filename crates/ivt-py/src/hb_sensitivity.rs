@@ -10,11 +10,12 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::args::count;
-use crate::hb_family::family_fn;
+use crate::hb_family::PyFamily;
+use crate::hb_shared::hb_keywords_fn;
 use crate::hb_shared::{finite, given_point};
 use crate::to_python::to_dict;
 
-family_fn! {
+hb_keywords_fn! {
 /// dω_f/dp and dA/dp (A = max |x_d| of the orbit, d = `amplitude_dof`) of a
 /// located feature of the frequency response of `family(p)` → (m, c, k, g,
 /// f), by the adjoint of the feature's extended system: one transposed
@@ -28,11 +29,17 @@ family_fn! {
 /// `p` from it. Returns {"kind", "p", "omega", "amplitude", "d_omega_dp",
 /// "d_amplitude_dp", "coeffs", "iterations", "time_s"}. An exception in
 /// `family` is re-raised. GIL released between callbacks.
-fn event_sensitivity<'py>(py, args) [
+/// (Not a path: no continuation keywords.)
+fn event_sensitivity<'py>(py, keys);
+head [family,] [family: &Bound<'py, PyAny>,];
+own [
     event: &Bound<'py, PyDict>,
     p: f64,
     #[pyo3(from_py_with = crate::args::int64)] amplitude_dof: i64 = 0
-] {
+];
+mid [];
+tail [] [];
+{
     let p = finite("p", p)?;
     let kind: Option<String> = event.get_item("kind")?.map(|k| k.extract()).transpose()?;
     let feature = Feature::from_name(kind.as_deref().unwrap_or("fold"))
@@ -49,7 +56,7 @@ fn event_sensitivity<'py>(py, args) [
         p,
         amplitude_dof: count("amplitude_dof", amplitude_dof)?,
     };
-    let fam = &args.family;
+    let fam = &PyFamily::new(family, keys);
     let first = fam.first(py, p)?;
     let s = fam.run(py, first, |hb| jobs::event_sensitivity(|x| fam.build(x), hb, &req))?;
     to_dict(py, &s)

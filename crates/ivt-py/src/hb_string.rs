@@ -16,7 +16,9 @@ use crate::to_python::to_dict;
 /// `ω² w_tt + ω c_d w_t − w_xx − k_d w_x² w_xx − y0 sin(πx) cos t = 0`
 /// (Eq. 103, t the phase), by STHB: `modes` sine trial functions N,
 /// `harmonics` M, grids `ns` × `ms`, traced in ω from `from_` to `to` by
-/// Newton arclength with steps up to `step_max`; stability by monodromy,
+/// Newton arclength (`ds`, `ds_min`, `ds_max`, `max_points`: its steps and
+/// most points, None: Δη from 0.02 up to 0.05, ds_min 1e-6, 2000 points);
+/// stability by monodromy,
 /// confirmed by Hill's method near |μ| = 1. `boundary` "fixed" (Eq. 104) or
 /// "spring" (k0 w(1) = w_x(1), Eq. 132, Tau method).
 /// Returns the dict of `ivt hb string --json`: points [{"omega", "norm" (‖a‖,
@@ -30,7 +32,8 @@ use crate::to_python::to_dict;
 #[pyfunction]
 #[pyo3(signature = (
     kd = 10.0, modes = 5, harmonics = 19, from_ = 1.0, to = 6.0, cd = 0.8, y0 = 0.5, ns = 64,
-    ms = 128, boundary = "fixed", k0 = 10.0, step_max = 0.05
+    ms = 128, boundary = "fixed", k0 = 10.0, ds = None, ds_min = None, ds_max = None,
+    max_points = None
 ))]
 #[allow(clippy::too_many_arguments)]
 fn string<'py>(
@@ -46,7 +49,10 @@ fn string<'py>(
     #[pyo3(from_py_with = int64)] ms: i64,
     boundary: &str,
     k0: f64,
-    step_max: f64,
+    ds: Option<f64>,
+    ds_min: Option<f64>,
+    ds_max: Option<f64>,
+    #[pyo3(from_py_with = crate::args::opt_int64)] max_points: Option<i64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let boundary = match boundary {
         "fixed" => Boundary::Fixed,
@@ -67,16 +73,16 @@ fn string<'py>(
         ms: count("ms", ms)?,
         boundary,
     };
-    if !(from_ > 0.0 && to > from_ && to.is_finite() && step_max > 0.0 && step_max.is_finite()) {
+    if !(from_ > 0.0 && to > from_ && to.is_finite()) {
         return Err(PyValueError::new_err(format!(
-            "need 0 < `from_` < `to` (finite) and `step_max` > 0, got {from_} .. {to}, {step_max}"
+            "need 0 < `from_` < `to` (finite), got {from_} .. {to}"
         )));
     }
     let req = StringRequest {
         params,
         from: from_,
         to,
-        step_max,
+        steps: crate::steps::steps(ds, ds_min, ds_max, max_points)?,
     };
     let curve = run(py, || jobs::string(&req))?;
     to_dict(py, &curve)

@@ -57,12 +57,18 @@ user_system_fn! {
 /// Returns the job's [`ivt_jobs::SwitchedBranch`]: the keys of `frc`
 /// ("points", "folds", "bifurcations", "termination", "omega", "amplitude",
 /// "stable", "time_s") and "kind" (of `at`), "start_omega", "harmonics",
-/// "subharmonic" (2 after a period doubling). GIL released between callbacks.
+/// "subharmonic" (2 after a period doubling). `ds`, `ds_min`, `ds_max`,
+/// `max_points`: the new branch's steps (None: those of `frc`, Δη from 0.05
+/// up to 0.08, 5000 points). GIL released between callbacks.
 fn switch_branch<'py>(py, user, jac;
     f: Option<&Bound<'py, PyAny>>,
     at: &Bound<'py, PyDict>,
     to: f64;
     step: f64 = 0.05,
+    ds: Option<f64> = None,
+    ds_min: Option<f64> = None,
+    ds_max: Option<f64> = None,
+    #[pyo3(from_py_with = crate::args::opt_int64)] max_points: Option<i64> = None,
     tol: f64 = 0.0,
 ) {
     let (problem, opts) = user.setup(f, 1, tol)?;
@@ -71,6 +77,7 @@ fn switch_branch<'py>(py, user, jac;
         to,
         step,
         corrector: Corrector::Newton,
+        steps: crate::steps::steps(ds, ds_min, ds_max, max_points)?,
     };
     let branch = run_user(py, &problem, |p| jobs::switch(p, &opts, &req))?;
     to_dict(py, &branch)

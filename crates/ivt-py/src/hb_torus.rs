@@ -85,7 +85,9 @@ user_system_fn! {
 /// would exceed `max_unknowns`), with its Poincaré section θ₁ = 0
 /// ("section": {"x", "v"}) and its "harmonics" [[k₁, k₂], ...]. Returns
 /// {"start_omega", "angle", "start_second_frequency", "truncation",
-/// "harmonics", "samples", "points", "at", "termination", "time_s"}. A
+/// "harmonics", "samples", "points", "at", "termination", "time_s"}.
+/// `ds`, `ds_min`, `ds_max`, `max_points`: the path's steps (None: Δη from
+/// 0.01 up to 0.05, 400 points). A
 /// hysteretic element (Jenkins) is a ValueError. GIL released between
 /// callbacks.
 fn torus_branch<'py>(py, user, jac;
@@ -95,9 +97,10 @@ fn torus_branch<'py>(py, user, jac;
     at: Vec<f64> = (Vec::new());
     truncation: Option<&Bound<'py, PyAny>> = None,
     step: f64 = 0.02,
-    ds: f64 = 0.01,
-    ds_max: f64 = 0.05,
-    #[pyo3(from_py_with = crate::args::int64)] max_points: i64 = 400,
+    ds: Option<f64> = None,
+    ds_min: Option<f64> = None,
+    ds_max: Option<f64> = None,
+    #[pyo3(from_py_with = crate::args::opt_int64)] max_points: Option<i64> = None,
     estimate_tol: f64 = 1e-7,
     #[pyo3(from_py_with = crate::args::int64)] max_unknowns: i64 = 3000,
     #[pyo3(from_py_with = crate::args::int64)] amplitude_dof: i64 = 0,
@@ -122,9 +125,7 @@ fn torus_branch<'py>(py, user, jac;
         at,
         torus,
         step,
-        ds,
-        ds_max,
-        max_points: count("max_points", max_points)?,
+        steps: crate::steps::steps(ds, ds_min, ds_max, max_points)?,
         amplitude_dof: count("amplitude_dof", amplitude_dof)?,
         estimate_points,
         tol: estimate_tol,
@@ -158,7 +159,9 @@ user_system_fn! {
 /// "deepest", "events_beyond_depth", "max_branches", "branch_limit_reached",
 /// "duplicates", "failures", "fold_curves", "fold_scale",
 /// "deflation_omegas", "deflation_solutions", "deflation_exhausted",
-/// "truncated_branches"}, "time_s"}. GIL released between callbacks.
+/// "truncated_branches"}, "time_s"}. `ds`, `ds_min`, `ds_max`, `max_points`:
+/// every branch's steps (None: Δη from 0.02 up to 0.05, 2000 points).
+/// GIL released between callbacks.
 fn diagram<'py>(py, user, jac;
     f: Option<&Bound<'py, PyAny>>,
     omega_from: f64,
@@ -173,9 +176,10 @@ fn diagram<'py>(py, user, jac;
     #[pyo3(from_py_with = crate::args::int64)] deflation_omegas: i64 = 6,
     max_amplitude: f64 = 10.0,
     #[pyo3(from_py_with = crate::args::int64)] amplitudes: i64 = 6,
-    ds: f64 = 0.02,
-    ds_max: f64 = 0.05,
-    #[pyo3(from_py_with = crate::args::int64)] max_points: i64 = 2000,
+    ds: Option<f64> = None,
+    ds_min: Option<f64> = None,
+    ds_max: Option<f64> = None,
+    #[pyo3(from_py_with = crate::args::opt_int64)] max_points: Option<i64> = None,
     step: f64 = 0.05,
     tol: f64 = 0.0,
 ) {
@@ -200,9 +204,7 @@ fn diagram<'py>(py, user, jac;
         max_amplitude,
         amplitudes: count("amplitudes", amplitudes)?,
         at,
-        ds,
-        ds_max,
-        max_points: count("max_points", max_points)?,
+        steps: crate::steps::steps(ds, ds_min, ds_max, max_points)?,
         step,
     };
     let d = run_user(py, &problem, |p| jobs::diagram(p, &opts, &req))?;

@@ -44,6 +44,7 @@ mod hb_torus;
 mod interrupt;
 mod kin;
 mod sim;
+mod steps;
 mod to_python;
 mod user_jacobian;
 mod user_problem;

@@ -48,7 +48,7 @@ LONG_CALLS: Dict[str, str] = {
     """,
     # 1129 points in 4.7 s
     "string": """
-        hb.string(kd=30.0, to=12.0, step_max=0.01)
+        hb.string(kd=30.0, to=12.0, ds_max=0.01)
     """,
     # 75 651 grid points in 42 s
     "ol_table": """

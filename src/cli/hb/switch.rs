@@ -89,6 +89,7 @@ pub fn run(a: SwitchArgs) -> Result<Output, CliError> {
         to: a.branch_to,
         step: a.step,
         corrector: Corrector::Newton,
+        steps: ivt_jobs::Steps::default(),
     };
     let branch = jobs::switch(&well(a.damping, a.force), &hb, &req)?;
     let curve = &branch.curve;

@@ -84,9 +84,11 @@ pub fn run(a: TorusArgs) -> Result<Output, CliError> {
         p_from: a.force_from,
         p_to: a.force_to,
         at: a.at.clone(),
-        ds: 0.01,
-        ds_max: 0.02,
-        ..FoldCurveRequest::default()
+        steps: ivt_jobs::Steps {
+            ds: Some(0.01),
+            ds_max: Some(0.02),
+            ..ivt_jobs::Steps::default()
+        },
     };
     let mu = a.mu;
     let family = |f: f64| Ok::<_, HbError>(van_der_pol(mu, f));

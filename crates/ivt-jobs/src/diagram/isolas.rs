@@ -87,7 +87,12 @@ impl<P: PeriodicProblem> Search<'_, P> {
         };
         // Only the crossings of s = 1 are kept (each solved at s = 1 by
         // Newton): the curves are followed with long steps.
-        let copts = crate::path_steps(0.05, FOLD_CURVE_DS_MAX, self.req.max_points);
+        let copts = ContinuationOptions {
+            ds: 0.05,
+            ds_max: FOLD_CURVE_DS_MAX,
+            max_points: self.path.max_points,
+            ..ContinuationOptions::default()
+        };
         let folds: Vec<(usize, Bifurcation)> = self
             .located
             .iter()

@@ -166,7 +166,7 @@ impl<P: PeriodicProblem> Search<'_, P> {
         )?;
         let mut branch = start.branch;
         let lambda1 = start.first.last().copied().unwrap_or(f64::NAN);
-        let mut copts = self.path_options();
+        let mut copts = self.path.clone();
         copts.max_points = self.req.torus_points;
         let (path, termination) = crate::torus::follow(
             &mut branch,

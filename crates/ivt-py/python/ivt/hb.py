@@ -237,7 +237,7 @@ _LARGE_PATH_KEYS = {
     "solve": {"m", "c", "k", "g", "omega_f", "f", "n", "samples", "velocity_dependent", "vectorized",
               "jac", "stability", "rtol"},
     "frc": {"m", "c", "k", "g", "f", "omega_from", "omega_to", "n", "samples", "velocity_dependent",
-            "vectorized", "jac", "stability", "rtol", "ds", "ds_min", "ds_max", "truncation_estimate"},
+            "vectorized", "jac", "stability", "rtol", "ds", "ds_min", "ds_max", "max_points", "truncation_estimate"},
 }
 
 
@@ -329,6 +329,8 @@ def _large_call(native_name, sig, args, kwargs, extra):
         for key in ("ds", "ds_min", "ds_max"):
             if given.get(key) is not None:
                 kw[key] = float(given[key])
+        if given.get("max_points") is not None:
+            kw["max_points"] = _index("max_points", given["max_points"])
     if reduction == "krylov":
         if extra.get("reduction_tol") is not None:
             kw["reduction_tol"] = float(extra["reduction_tol"])

@@ -111,11 +111,13 @@ def duffing_frc(
     n: int = 20, samples: Optional[int] = None,
     xi: float = 0.02, alpha: float = 1.0, eps: float = 1.0, force: float = 0.1,
     events: bool = False,
+    ds: Optional[float] = None, ds_min: Optional[float] = None, ds_max: Optional[float] = None, max_points: Optional[int] = None,
 ) -> Dict[str, Any]: ...
 def duffing_folds(
     force: float = 0.1, force_from: float = 0.0, force_to: float = 0.3, at: Sequence[float] = ...,
     from_: float = 0.5, to: float = 2.5,
     n: int = 20, samples: Optional[int] = None,
+    ds: Optional[float] = None, ds_min: Optional[float] = None, ds_max: Optional[float] = None, max_points: Optional[int] = None,
 ) -> Dict[str, Any]: ...
 def solve(
     m: Operator, c: Operator, k: Operator, g: Nonlinearity,
@@ -133,6 +135,7 @@ def frc(
     m: Operator, c: Operator, k: Operator, g: Nonlinearity,
     f: Optional[Union[Forcing, Loads]], omega_from: float, omega_to: float,
     n: int = 20, samples: Optional[int] = None, tol: float = 0.0, events: bool = True,
+    ds: Optional[float] = None, ds_min: Optional[float] = None, ds_max: Optional[float] = None, max_points: Optional[int] = None,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
     jac: Optional[Jacobian] = None,
     *,
@@ -145,20 +148,21 @@ def continue_bifurcation(
     p_from: float, p_to: float, at: Sequence[float] = ..., p_start: Optional[float] = None,
     n: int = 20, samples: Optional[int] = None,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
-    ds: float = 0.02, ds_max: float = 0.05, max_points: int = 2000,
+    ds: Optional[float] = None, ds_min: Optional[float] = None, ds_max: Optional[float] = None, max_points: Optional[int] = None,
 ) -> Dict[str, Any]: ...
 def cycle_branch(
     family: Family,
     p_from: float, p_to: float, at: Sequence[float] = ...,
     n: int = 20, samples: Optional[int] = None,
     velocity_dependent: bool = True, vectorized: bool = False, grid: int = 100, rtol: float = 1e-9, max_iter: int = 100,
-    ds: float = 0.02, ds_max: float = 0.05, max_points: int = 2000, offset: float = 1e-2,
+    ds: Optional[float] = None, ds_min: Optional[float] = None, ds_max: Optional[float] = None, max_points: Optional[int] = None, offset: float = 1e-2,
 ) -> Dict[str, Any]: ...
 def neimark_sacker_points(
     family: Family, ps: Sequence[float],
     omega_from: float, omega_to: float,
     n: int = 20, samples: Optional[int] = None, rtol: float = 1e-9, max_iter: int = 100,
     velocity_dependent: bool = True, vectorized: bool = False,
+    ds: Optional[float] = None, ds_min: Optional[float] = None, ds_max: Optional[float] = None, max_points: Optional[int] = None,
 ) -> List[Dict[str, Any]]: ...
 def limit_cycle(
     m: Matrix, c: Matrix, k: Matrix, g: Nonlinearity,
@@ -171,6 +175,7 @@ def backbone(
     m: Matrix, c: Matrix, k: Matrix, g: Nonlinearity,
     omega0: float, mode: Sequence[float], amplitude_from: float = 0.01, amplitude_to: float = 1.0,
     n: int = 20, samples: Optional[int] = None, dof: int = 0, tol: float = 0.0,
+    ds: Optional[float] = None, ds_min: Optional[float] = None, ds_max: Optional[float] = None, max_points: Optional[int] = None,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
     jac: Optional[Jacobian] = None,
 ) -> Dict[str, Any]: ...
@@ -193,6 +198,7 @@ def damped_modes(
     m: Matrix, c: Matrix, k: Matrix, g: Nonlinearity,
     amplitude_from: float, amplitude_to: float,
     n: int = 20, samples: Optional[int] = None, mode: int = 0, dof: int = 0, tol: float = 0.0,
+    ds: Optional[float] = None, ds_min: Optional[float] = None, ds_max: Optional[float] = None, max_points: Optional[int] = None,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
     jac: Optional[Jacobian] = None,
 ) -> Dict[str, Any]: ...
@@ -200,7 +206,8 @@ def string(
     kd: float = 10.0, modes: int = 5, harmonics: int = 19,
     from_: float = 1.0, to: float = 6.0,
     cd: float = 0.8, y0: float = 0.5, ns: int = 64, ms: int = 128,
-    boundary: Literal["fixed", "spring"] = "fixed", k0: float = 10.0, step_max: float = 0.05,
+    boundary: Literal["fixed", "spring"] = "fixed", k0: float = 10.0,
+    ds: Optional[float] = None, ds_min: Optional[float] = None, ds_max: Optional[float] = None, max_points: Optional[int] = None,
 ) -> Dict[str, Any]: ...
 @overload
 def eval_series(coeffs: ArrayLike, tau: float, order: int = 0, n_dof: Literal[1] = 1) -> float: ...
@@ -248,7 +255,7 @@ def torus_branch(
     f: Optional[Forcing], start: Dict[str, Any], omega_to: float, at: Sequence[float] = ...,
     n: int = 20, samples: Optional[int] = None,
     truncation: Optional[Union[int, Tuple[int, int]]] = None, step: float = 0.02,
-    ds: float = 0.01, ds_max: float = 0.05, max_points: int = 400,
+    ds: Optional[float] = None, ds_min: Optional[float] = None, ds_max: Optional[float] = None, max_points: Optional[int] = None,
     estimate_tol: float = 1e-7, max_unknowns: int = 3000, amplitude_dof: int = 0,
     estimate_points: bool = False, section_points: int = 200, tol: float = 0.0,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
@@ -262,7 +269,8 @@ def diagram(
     tori: bool = True, torus: Optional[Union[int, Tuple[int, int]]] = None, torus_points: int = 60,
     fold_scale: Optional[Tuple[float, float]] = ...,
     deflation_omegas: int = 6, max_amplitude: float = 10.0, amplitudes: int = 6,
-    ds: float = 0.02, ds_max: float = 0.05, max_points: int = 2000, step: float = 0.05, tol: float = 0.0,
+    ds: Optional[float] = None, ds_min: Optional[float] = None, ds_max: Optional[float] = None, max_points: Optional[int] = None,
+    step: float = 0.05, tol: float = 0.0,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
     jac: Optional[Jacobian] = None,
 ) -> Dict[str, Any]: ...
@@ -270,7 +278,6 @@ def event_sensitivity(
     family: Family, event: Dict[str, Any], p: float, amplitude_dof: int = 0,
     n: int = 20, samples: Optional[int] = None,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
-    ds: float = 0.02, ds_max: float = 0.05, max_points: int = 2000,
 ) -> Dict[str, Any]: ...
 def switch_branch(
     m: Matrix,
@@ -283,6 +290,10 @@ def switch_branch(
     n: int = 20,
     samples: Optional[int] = None,
     step: float = 0.05,
+    ds: Optional[float] = None,
+    ds_min: Optional[float] = None,
+    ds_max: Optional[float] = None,
+    max_points: Optional[int] = None,
     tol: float = 0.0,
     velocity_dependent: bool = True,
     vectorized: bool = False,
@@ -297,5 +308,5 @@ def cycle_fold_curve(
     nu_from: float, nu_to: float, mu_from: float, mu_to: float, at: Sequence[float] = ...,
     n: int = 20, samples: Optional[int] = None,
     velocity_dependent: bool = True, vectorized: bool = False, rtol: float = 1e-9, max_iter: int = 100,
-    ds: float = 0.02, ds_max: float = 0.05, max_points: int = 2000,
+    ds: Optional[float] = None, ds_min: Optional[float] = None, ds_max: Optional[float] = None, max_points: Optional[int] = None,
 ) -> Dict[str, Any]: ...
