@@ -65,8 +65,8 @@ def test_event_sensitivity_is_no_path_and_takes_no_steps():
     assert not set(STEPS) & set(params)
 
 
-# Each path with a few points' budget: (call, budget of points). Two-leg
-# curves (the codim-2 ones) spend it per leg.
+# Each path with a few points' budget. Curves of two legs (the codim-2 ones,
+# and the cycle branch when it turns back past its start) spend it per leg.
 CUT = {
     "frc": lambda k: hb.frc(*DUFFING, 0.2, 3.0, n=8, max_points=k),
     "frc (condensed)": lambda k: hb.frc(*_chain(), lambda x, v, th: 0.5 * x**3,
@@ -93,7 +93,7 @@ def test_max_points_cuts_every_path_short(name):
     end = out["branches"][0]["termination"] if name == "diagram" else out.get(
         "termination", out.get("stop"))
     assert end == "max_points", (name, end)
-    legs = 2 if name in ("duffing_folds", "continue_bifurcation") else 1
+    legs = 2 if name in ("duffing_folds", "continue_bifurcation", "cycle_branch") else 1
     assert 2 <= len(points) <= 6 * legs, (name, len(points))
 
 
