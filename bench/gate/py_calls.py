@@ -2,10 +2,12 @@
 user types, at a size that keeps the gate's step short. Run by gate.py under
 callgrind as `python py_calls.py REGION_SO NAME...`; each named call is made
 once as a warm-up (one-time costs: numpy's C API import, pyo3's interned
-names) and once inside `ivt_bench_measure` (bench/gate/region.c), whose dump
-holds that call's instructions alone. Without valgrind it just runs them."""
+names) and once inside `ivt_bench_measure` (bench/gate/region.c), after a
+full garbage collection, whose dump holds that call's instructions alone
+(gate.py names one call per process). Without valgrind it just runs them."""
 
 import ctypes
+import gc
 import math
 import sys
 
@@ -75,6 +77,12 @@ def main(region_so, names):
     region.ivt_bench_start()
     for name in names:
         call = CALLS[name]
+        # A full collection first: the cyclic collector's counters start at
+        # zero, so whether a collection falls inside the call depends on the
+        # call's own allocations, not on what the import or the previous call
+        # left (without it `py duffing`, 260 k instructions, moved by 8 % when
+        # a line was added to hb.py).
+        gc.collect()
         # a ctypes callback must return its declared int; the result is dropped
         # inside the region, as a user's `ivt.hb.duffing()` statement drops it
         region.ivt_bench_measure(callback(lambda: call() and 0), name.encode())
