@@ -173,7 +173,7 @@ impl Legs {
 /// Follows the fold of the FRC of `family(p_start)` at `(start, omega)` (a
 /// located fold: coefficients and ω_f) in `p`, first towards `p_from` until `p`
 /// leaves `[min(p_from, p_to), max(p_from, p_to)]`, then from the start towards
-/// `p_to` ([`Legs`]); points in path order from the first leg's end (from the
+/// `p_to` (`Legs`); points in path order from the first leg's end (from the
 /// start when `p_to` is the start); the folds
 /// at each `p` of `at` (every crossing of either leg) and the cusps are
 /// located (see the module docs).

@@ -61,7 +61,7 @@ pub type CycleFoldCurve = Curve<CycleFoldPoint>;
 /// excitation) at `start` (a located fold of [`crate::cycle_branch()`] at
 /// `(mu, nu_start)`: its coefficients with phase `b₁ = 0` and ω) in ν,
 /// first towards `nu_from` of `(nu_from, nu_to)` until ν leaves the
-/// interval between them, then from the start towards `nu_to` ([`Legs`]);
+/// interval between them, then from the start towards `nu_to` (`Legs`);
 /// the folds at each ν of `at` are solved exactly and the cusps reported
 /// (module docs).
 ///

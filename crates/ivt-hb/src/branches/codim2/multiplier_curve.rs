@@ -99,7 +99,7 @@ pub struct BifurcationCurve {
 /// Follows the period doubling or Neimark–Sacker point `start` of the FRC of
 /// `family(start.p)` in `p`, first towards `p_from` until `p` leaves
 /// `[min(p_from, p_to), max(p_from, p_to)]` or the curve ends (a 1:1 or 1:2
-/// resonance), then from the start towards `p_to` ([`Legs`]). Points are in
+/// resonance), then from the start towards `p_to` (`Legs`). Points are in
 /// path order from the first leg's end (from the start when `p_to` is the
 /// start); `termination` is that of the last path. The point at each `p` of `at`
 /// and the strong resonances are located (module docs). `hb` must be the
