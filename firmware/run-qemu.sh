@@ -20,11 +20,14 @@ build() {
   $CARGO build --release --features rig --bins
 }
 
+# --workspace (not -p ivt-sim): the workspace's feature set, so the test
+# binaries `cargo test --workspace` built are reused instead of rebuilding
+# every crate under ivt-sim with the narrower features of one package.
 pil() {
   (cd .. && export IVT_FW_ELF="$here/$out/ivt-fw-qemu" &&
-    cargo test -p ivt-sim --release --test pil -- --include-ignored &&
-    cargo test -p ivt-sim --release --test commission -- --include-ignored &&
-    cargo test --release --test rig_record -- --include-ignored)
+    cargo test --workspace --release --test pil -- --include-ignored &&
+    cargo test --workspace --release --test commission -- --include-ignored &&
+    cargo test --workspace --release --test rig_record -- --include-ignored)
 }
 
 # Checks are chained with && (not left to `set -e`): `test` calls them in a

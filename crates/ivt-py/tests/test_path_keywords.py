@@ -99,13 +99,16 @@ def test_max_points_cuts_every_path_short(name):
 
 def test_max_points_reaches_the_curves_of_ns_points_switching_tori_and_cycle_folds():
     # The forced Van der Pol's Neimark–Sacker point lies at ω_f ≈ 0.945: five
-    # points from 0.5 do not reach it.
-    assert len(hb.neimark_sacker_points(_forced_vdp, [0.2], 0.5, 1.6, n=9, samples=32)) == 1
-    assert hb.neimark_sacker_points(_forced_vdp, [0.2], 0.5, 1.6, n=9, samples=32,
-                                    max_points=5) == []
-    frc = hb.frc(*_forced_vdp(0.2), 0.6, 1.6, n=12, samples=32, events=True)
+    # points from 0.5 do not reach it. (g takes arrays: a scalar g costs the
+    # multipliers of every point ~30 k Python calls, 35 s here, and the
+    # keywords under test do not depend on it.)
+    keys = dict(n=9, samples=32, vectorized=True)
+    assert len(hb.neimark_sacker_points(_forced_vdp, [0.2], 0.5, 1.6, **keys)) == 1
+    assert hb.neimark_sacker_points(_forced_vdp, [0.2], 0.5, 1.6, max_points=5, **keys) == []
+    keys = dict(n=12, samples=32, vectorized=True)
+    frc = hb.frc(*_forced_vdp(0.2), 0.6, 1.6, events=True, **keys)
     [ns] = [b for b in frc["bifurcations"] if b["kind"] == "neimark_sacker"]
-    tor = hb.torus_branch(*_forced_vdp(0.2), ns, 0.89, n=12, samples=32, max_points=4)
+    tor = hb.torus_branch(*_forced_vdp(0.2), ns, 0.89, max_points=4, **keys)
     assert tor["termination"] == "max_points" and len(tor["points"]) <= 4
     curve = hb.cycle_fold_curve(_cycle_family, 1.0, 0.45, -0.2, 0.1, n=25, samples=128,
                                 vectorized=True, max_points=3)
