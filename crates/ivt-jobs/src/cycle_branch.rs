@@ -11,7 +11,7 @@ use ivt_hb::orbit::ihb::HbOptions;
 use ivt_hb::problem::PeriodicProblem;
 use ivt_hb::stability::StabilityKind;
 use ivt_hb::HbError;
-use ivt_path::continuation::Termination;
+use ivt_path::continuation::{ContinuationOptions, Termination};
 use serde::Serialize;
 
 /// The interval of p, the grid of the Hopf search and the path's steps.
@@ -68,8 +68,15 @@ impl CycleBranchRequest {
             ));
         }
         finite_list("at", &self.at)?;
-        let (ds, ds_max, max_points) = CYCLE_BRANCH_STEPS;
-        path_steps(&self.steps, ds, ds_max, max_points).map(|_| ())
+        self.path().map(|_| ())
+    }
+
+    /// [`CYCLE_BRANCH_STEPS`] with the request's `steps`.
+    ///
+    /// # Errors
+    /// [`HbError::InvalidInput`] for steps [`Steps::on`] refuses.
+    pub fn path(&self) -> Result<ContinuationOptions, HbError> {
+        path_steps(&self.steps, CYCLE_BRANCH_STEPS)
     }
 }
 
@@ -186,10 +193,7 @@ where
     let opts = CycleBranchOptions {
         samples: req.grid,
         offset: req.offset,
-        continuation: {
-            let (ds, ds_max, max_points) = CYCLE_BRANCH_STEPS;
-            path_steps(&req.steps, ds, ds_max, max_points)?
-        },
+        continuation: req.path()?,
         stability_steps: stability_steps(hb.harmonics),
         at: req.at.clone(),
     };

@@ -136,8 +136,7 @@ impl DiagramRequest {
     /// # Errors
     /// [`HbError::InvalidInput`] for steps [`Steps::on`] refuses.
     pub fn path(&self) -> Result<ContinuationOptions, HbError> {
-        let (ds, ds_max, max_points) = DIAGRAM_STEPS;
-        let mut c = super::path_steps(&self.steps, ds, ds_max, max_points)?;
+        let mut c = super::path_steps(&self.steps, DIAGRAM_STEPS)?;
         c.corrector = Corrector::Newton;
         c.lambda_min = self.from.min(self.to);
         c.lambda_max = self.from.max(self.to);

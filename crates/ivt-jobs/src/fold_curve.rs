@@ -122,8 +122,7 @@ impl FoldCurveRequest {
     /// # Errors
     /// [`HbError::InvalidInput`] for steps [`Steps::on`] refuses.
     pub fn path(&self) -> Result<ContinuationOptions, HbError> {
-        let (ds, ds_max, max_points) = FOLD_CURVE_STEPS;
-        path_steps(&self.steps, ds, ds_max, max_points)
+        path_steps(&self.steps, FOLD_CURVE_STEPS)
     }
 }
 

@@ -28,6 +28,7 @@ mod array;
 pub mod backbone;
 pub mod cascade;
 pub mod cycle_branch;
+pub mod cycle_fold;
 pub mod diagram;
 pub mod fold_curve;
 pub mod frc;
@@ -48,6 +49,7 @@ pub use cascade::{cascade, Cascade, CascadeRequest, THESIS_BETAS};
 pub use cycle_branch::{
     cycle_branch, CycleBranchRequest, CycleBranchResult, CycleFold, CycleRecord, HopfRecord,
 };
+pub use cycle_fold::{cycle_fold_curve, CycleFoldRequest, CYCLE_FOLD_STEPS};
 pub use diagram::{
     diagram, BranchKind, Diagram, DiagramBranch, DiagramPoint, DiagramRequest, DiagramSearch,
     Origin,
@@ -129,16 +131,14 @@ pub(crate) fn finite_list(name: &str, values: &[f64]) -> Result<(), HbError> {
     values.iter().try_for_each(|&v| finite(name, v).map(|_| ()))
 }
 
-/// The default path with a job's own first and largest arclength steps and
-/// most points, overridden by the request's `steps`.
+/// The default path with a job's own `(ds, ds_max, max_points)` (its
+/// `*_STEPS` constant), overridden by the request's `steps`.
 ///
 /// # Errors
 /// [`HbError::InvalidInput`] for steps [`Steps::on`] refuses.
 pub(crate) fn path_steps(
     steps: &Steps,
-    ds: f64,
-    ds_max: f64,
-    max_points: usize,
+    (ds, ds_max, max_points): (f64, f64, usize),
 ) -> Result<ContinuationOptions, HbError> {
     let own = ContinuationOptions {
         ds,

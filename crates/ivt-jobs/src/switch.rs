@@ -226,10 +226,7 @@ pub fn switch<P: PeriodicProblem>(
         )));
     }
     let (harmonics, subharmonic) = (branch.options().harmonics, branch.options().subharmonic);
-    let mut sweep = FrcOptions::sweep(w1, req.to, req.corrector);
-    sweep.path.continuation = req
-        .steps
-        .on(sweep.path.continuation)
+    let sweep = FrcOptions::stepped_sweep(w1, req.to, req.corrector, &req.steps)
         .map_err(HbError::InvalidInput)?;
     let curve = traced_curve(&mut branch, &q1, &sweep, t0)?;
     Ok(SwitchedBranch {

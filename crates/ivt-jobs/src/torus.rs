@@ -106,8 +106,7 @@ impl TorusRequest {
                 "`step` = {step:?} must be in (0, 1]"
             )));
         }
-        let (ds, ds_max, max_points) = TORUS_STEPS;
-        path_steps(&self.steps, ds, ds_max, max_points)?;
+        self.path()?;
         if self.tol.is_nan() || self.tol < 0.0 {
             return Err(HbError::InvalidInput(format!(
                 "`tol` = {:?} must be ≥ 0",
@@ -115,6 +114,14 @@ impl TorusRequest {
             )));
         }
         Ok(())
+    }
+
+    /// [`TORUS_STEPS`] with the request's `steps`.
+    ///
+    /// # Errors
+    /// [`HbError::InvalidInput`] for steps [`Steps::on`] refuses.
+    pub fn path(&self) -> Result<ContinuationOptions, HbError> {
+        path_steps(&self.steps, TORUS_STEPS)
     }
 }
 
@@ -222,8 +229,7 @@ pub fn torus<P: PeriodicProblem>(
             req.omega, req.omega_to
         )));
     }
-    let (ds, ds_max, max_points) = TORUS_STEPS;
-    let mut copts = path_steps(&req.steps, ds, ds_max, max_points)?;
+    let mut copts = req.path()?;
     copts.corrector = Corrector::Newton;
     copts.lambda_min = lambda1.min(req.omega_to);
     copts.lambda_max = lambda1.max(req.omega_to);

@@ -1,17 +1,17 @@
 //! `ivt.hb.cycle_fold_curve` (issue 27, item 1): a fold of limit cycles of an
-//! autonomous user family `family(mu, nu)` followed in ν
-//! ([`ivt_hb::branches::codim2::cycle_fold_curve`]), started from the first fold of the
-//! cycle branch in μ at ν = `nu_from` ([`ivt_hb::branches::cycle_branch`]).
+//! autonomous user family `family(mu, nu)` followed in ν, started from the
+//! first fold of the cycle branch in μ at ν = `nu_from`: the job
+//! [`ivt_jobs::cycle_fold_curve`] on the Python family.
 
-use ivt_hb::branches::codim2::{cycle_fold_curve as follow, CycleFoldPoint};
-use ivt_hb::{cycle_branch, ContinuationOptions, CycleBranchOptions, HbError, HbSolution};
+use ivt_hb::branches::codim2::CycleFoldPoint;
+use ivt_hb::{HbError, HbSolution};
+use ivt_jobs::CycleFoldRequest;
 use numpy::IntoPyArray;
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::hb_family::{family_fn, PyFamily};
-use crate::hb_shared::finite;
+use crate::hb_shared::hb_err;
 
 /// `family(mu, nu)` as the one-parameter [`PyFamily`] `partial(family, mu)`
 /// of ν; the first exception it raised is kept in the slot of `family`.
@@ -72,13 +72,15 @@ fn cycle_fold_curve<'py>(py, args) [
     mu_to: f64,
     at: Vec<f64> = (Vec::new())
 ] {
-    let (nu_from, nu_to) = (finite("nu_from", nu_from)?, finite("nu_to", nu_to)?);
-    let (mu_from, mu_to) = (finite("mu_from", mu_from)?, finite("mu_to", mu_to)?);
-    if nu_from == nu_to || mu_from == mu_to {
-        return Err(PyValueError::new_err(
-            "arguments `nu_from`, `nu_to` must differ, and `mu_from`, `mu_to`",
-        ));
-    }
+    let req = CycleFoldRequest {
+        nu_from,
+        nu_to,
+        mu_from,
+        mu_to,
+        at,
+        steps: args.steps,
+    };
+    req.validate().map_err(|e| hb_err(py, e))?;
     let fam = PyFamily2 {
         family: &args.family,
         partial: py.import("functools")?.getattr("partial")?.unbind(),
@@ -86,38 +88,8 @@ fn cycle_fold_curve<'py>(py, args) [
     // The user system at (mu_from, nu_from) sets the HB options.
     let first = fam.at_mu(py, mu_from)?.first(py, nu_from)?;
     let harmonics = first.1.harmonics;
-    // Its own steps: Δη from 0.02 up to 0.05, 2000 points.
-    let own = ContinuationOptions {
-        ds: 0.02,
-        ds_max: 0.05,
-        max_points: 2000,
-        ..ContinuationOptions::default()
-    };
-    let continuation = crate::steps::on(&args.steps, own)?;
     let curve = fam.family.run(py, first, |hb| {
-        let family = |mu: f64, nu: f64| fam.build(mu, nu);
-        let branch = cycle_branch(
-            |mu| family(mu, nu_from),
-            hb,
-            mu_from,
-            mu_to,
-            &CycleBranchOptions::default(),
-        )?;
-        let Some((mu, start)) = branch.folds.first() else {
-            return Err(HbError::InvalidInput(
-                "the cycle branch at nu_from has no fold in [mu_from, mu_to]".into(),
-            ));
-        };
-        // The path goes first towards the first of the pair: nu_to.
-        follow(
-            family,
-            hb,
-            start,
-            (*mu, nu_from),
-            (nu_to, nu_from),
-            &at,
-            &continuation,
-        )
+        ivt_jobs::cycle_fold_curve(|mu: f64, nu: f64| fam.build(mu, nu), hb, &req)
     })?;
     let list = |pts: &[CycleFoldPoint]| -> PyResult<Bound<'py, PyList>> {
         let list = PyList::empty(py);

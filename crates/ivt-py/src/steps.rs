@@ -34,18 +34,19 @@ pub(crate) fn steps(
 /// # Errors
 /// `ValueError` with [`Steps::on`]'s reason, as "argument ...".
 pub(crate) fn on(steps: &Steps, base: ContinuationOptions) -> PyResult<ContinuationOptions> {
-    steps
-        .on(base)
-        .map_err(|why| PyValueError::new_err(format!("argument {why}")))
+    steps.on(base).map_err(refused)
+}
+
+/// [`Steps::on`]'s reason as the ValueError "argument ...".
+fn refused(why: String) -> PyErr {
+    PyValueError::new_err(format!("argument {why}"))
 }
 
 /// The default frequency sweep from `from` to `to` (the Newton–chord
-/// corrector, [`FrcOptions::sweep`]) with the keywords' steps.
+/// corrector, [`FrcOptions::stepped_sweep`]) with the keywords' steps.
 ///
 /// # Errors
 /// As [`on`].
 pub(crate) fn sweep(from: f64, to: f64, steps: &Steps) -> PyResult<FrcOptions> {
-    let mut sweep = FrcOptions::sweep(from, to, Corrector::Newton);
-    sweep.path.continuation = on(steps, sweep.path.continuation)?;
-    Ok(sweep)
+    FrcOptions::stepped_sweep(from, to, Corrector::Newton, steps).map_err(refused)
 }

@@ -17,7 +17,7 @@ use crate::orbit::modified::ModifiedIhb;
 use crate::problem::{AtFrequency, PeriodicProblem};
 use crate::stability::{HsuSteps, StabilityKind};
 use faer::c64;
-use ivt_path::continuation::{ContinuationOptions, Corrector, Traced};
+use ivt_path::continuation::{ContinuationOptions, Corrector, Steps, Traced};
 use ivt_path::events::{Event, TracedPoint};
 
 /// Options of a frequency sweep.
@@ -73,6 +73,22 @@ impl FrcOptions {
         };
         sweep.path.continuation.corrector = corrector;
         sweep
+    }
+
+    /// [`sweep`](Self::sweep) with `steps` overriding its continuation
+    /// steps ([`Steps::on`]).
+    ///
+    /// # Errors
+    /// The reason [`Steps::on`] gives for steps it refuses.
+    pub fn stepped_sweep(
+        from: f64,
+        to: f64,
+        corrector: Corrector,
+        steps: &Steps,
+    ) -> Result<Self, String> {
+        let mut sweep = Self::sweep(from, to, corrector);
+        sweep.path.continuation = steps.on(sweep.path.continuation)?;
+        Ok(sweep)
     }
 }
 
