@@ -7,24 +7,18 @@
 //! `det ∂y(T)/∂y₀` (the other is 1).
 #![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
+use ivt_hb::problem::bautin;
 use ivt_hb::{
     cycle_branch, limit_cycle_branch, ContinuationOptions, CycleBranch, CycleBranchOptions,
-    GeneralProblem, HbError, HbOptions, PeriodicProblem, Termination,
+    HbError, HbOptions, PeriodicProblem, Termination,
 };
 
 mod common;
 use common::shooting::{central_jacobian, flow, newton3, newton_step, turning_state};
 
-/// The family as `M = 1`, `C = −μ`, `K = 1`, `g = −(x² − x⁴)ẋ`.
+/// The family `ẍ − (μ + x² − x⁴)ẋ + x = 0` (`bautin` at ν = 1).
 fn family(mu: f64) -> Result<impl PeriodicProblem, HbError> {
-    Ok(GeneralProblem::new(
-        1,
-        vec![1.0],
-        vec![-mu],
-        vec![1.0],
-        |x: &[f64], v: &[f64], _th: f64, g: &mut [f64]| g[0] = -(x[0] * x[0] - x[0].powi(4)) * v[0],
-        |_: f64, f: &mut [f64]| f.fill(0.0),
-    ))
+    Ok(bautin(mu, 1.0))
 }
 
 /// `y(T)` from `y₀` at μ (RK4, 4000 steps).

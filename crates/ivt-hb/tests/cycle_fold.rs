@@ -9,23 +9,15 @@
 #![allow(clippy::indexing_slicing)]
 
 use ivt_hb::branches::codim2::cycle_fold_curve;
-use ivt_hb::{cycle_branch, GeneralProblem, HbError, HbOptions, PeriodicProblem};
+use ivt_hb::problem::bautin;
+use ivt_hb::{cycle_branch, HbError, HbOptions, PeriodicProblem};
 
 mod common;
 use common::shooting::{central_jacobian, flow, newton3, turning_state};
 
-/// The family as `M = 1`, `C = −μ`, `K = 1`, `g = −(νx² − x⁴)ẋ`.
+/// The family `ẍ − (μ + νx² − x⁴)ẋ + x = 0` (`bautin`).
 fn family(mu: f64, nu: f64) -> Result<impl PeriodicProblem, HbError> {
-    Ok(GeneralProblem::new(
-        1,
-        vec![1.0],
-        vec![-mu],
-        vec![1.0],
-        move |x: &[f64], v: &[f64], _th: f64, g: &mut [f64]| {
-            g[0] = -(nu * x[0] * x[0] - x[0].powi(4)) * v[0]
-        },
-        |_: f64, f: &mut [f64]| f.fill(0.0),
-    ))
+    Ok(bautin(mu, nu))
 }
 
 /// `y(T; (x₀, 0)) − (x₀, 0)` at (μ, ν) (RK4, 4000 steps).

@@ -107,21 +107,11 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ivt_hb::GeneralProblem;
 
     /// `ẍ − (μ + νx² − x⁴)ẋ + x = 0` (ivt-hb's tests/cycle_fold.rs checks
-    /// the curve against shooting).
+    /// its curve against shooting).
     fn family(mu: f64, nu: f64) -> Result<impl PeriodicProblem, HbError> {
-        Ok(GeneralProblem::new(
-            1,
-            vec![1.0],
-            vec![-mu],
-            vec![1.0],
-            move |x: &[f64], v: &[f64], _th: f64, g: &mut [f64]| {
-                g[0] = -(nu * x[0] * x[0] - x[0].powi(4)) * v[0];
-            },
-            |_: f64, f: &mut [f64]| f.fill(0.0),
-        ))
+        Ok(ivt_hb::problem::bautin(mu, nu))
     }
 
     fn request() -> CycleFoldRequest {

@@ -20,7 +20,7 @@ mod omega;
 mod oscillators;
 pub use general::{GeneralProblem, Nonlinearity, WithJacobian};
 pub use omega::{AtFrequency, Excitation, FrequencyExcitation, REFERENCE_FREQUENCY};
-pub use oscillators::{Duffing, MathieuDuffing, Oscillator};
+pub use oscillators::{bautin, Duffing, MathieuDuffing, Oscillator};
 
 /// `n_dof` (the field `n`, or a literal), `mass`, `damping`, `stiffness` of a
 /// problem that stores the row-major matrices `m`, `c`, `k` as fields.

@@ -174,3 +174,23 @@ impl Oscillator {
         )
     }
 }
+
+/// `ẍ − (μ + νx² − x⁴)ẋ + x = 0` as `M = 1`, `C = −μ`, `K = 1`,
+/// `g = −(νx² − x⁴)ẋ`: the one-DOF oscillator with a Hopf point at μ = 0
+/// (subcritical for ν > 0: averaging gives `ṙ = r(μ/2 + νr²/8 − r⁴/16)`)
+/// and a fold of limit cycles near μ = −ν²/8, meeting at the Bautin point
+/// μ = ν = 0 — the family of the cycle-fold and Hopf examples.
+pub fn bautin(mu: f64, nu: f64) -> impl PeriodicProblem {
+    GeneralProblem::new(
+        1,
+        vec![1.0],
+        vec![-mu],
+        vec![1.0],
+        move |x: &[f64], v: &[f64], _theta: f64, out: &mut [f64]| {
+            if let (Some(g), Some(&x), Some(&v)) = (out.first_mut(), x.first(), v.first()) {
+                *g = -(nu * x * x - x.powi(4)) * v;
+            }
+        },
+        |_theta: f64, out: &mut [f64]| out.fill(0.0),
+    )
+}

@@ -411,20 +411,10 @@ fn complex_null_vector(a: &[f64], d: usize, omega: f64) -> Result<[Vec<f64>; 2],
 mod tests {
     use super::*;
     use crate::problem::matrix_getters;
-    use crate::GeneralProblem;
 
-    /// `ẍ − (μ + x² − x⁴)ẋ + x = 0` as `C = −μ`, `g = −(x² − x⁴)v`.
+    /// `ẍ − (μ + x² − x⁴)ẋ + x = 0` ([`crate::problem::bautin`] at ν = 1).
     fn family(mu: f64) -> Result<impl PeriodicProblem, HbError> {
-        Ok(GeneralProblem::new(
-            1,
-            vec![1.0],
-            vec![-mu],
-            vec![1.0],
-            |x: &[f64], v: &[f64], _th: f64, g: &mut [f64]| {
-                g[0] = -(x[0] * x[0] - x[0].powi(4)) * v[0]
-            },
-            |_: f64, f: &mut [f64]| f.fill(0.0),
-        ))
+        Ok(crate::problem::bautin(mu, 1.0))
     }
 
     #[test]
