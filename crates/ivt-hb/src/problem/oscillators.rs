@@ -157,21 +157,10 @@ impl std::str::FromStr for Oscillator {
 impl Oscillator {
     /// The oscillator with parameter `mu` as a periodic problem (unforced).
     pub fn problem(self, mu: f64) -> impl PeriodicProblem {
-        GeneralProblem::new(
-            1,
-            vec![1.0],
-            vec![-mu],
-            vec![1.0],
-            move |x: &[f64], v: &[f64], _theta: f64, out: &mut [f64]| {
-                if let (Some(g), Some(&x), Some(&v)) = (out.first_mut(), x.first(), v.first()) {
-                    *g = match self {
-                        Self::VanDerPol => mu * x * x * v,
-                        Self::Rayleigh => mu * v * v * v / 3.0,
-                    };
-                }
-            },
-            |_theta: f64, out: &mut [f64]| out.fill(0.0),
-        )
+        self_excited(mu, move |x, v| match self {
+            Self::VanDerPol => mu * x * x * v,
+            Self::Rayleigh => mu * v * v * v / 3.0,
+        })
     }
 }
 
@@ -181,14 +170,19 @@ impl Oscillator {
 /// and a fold of limit cycles near μ = −ν²/8, meeting at the Bautin point
 /// μ = ν = 0 — the family of the cycle-fold and Hopf examples.
 pub fn bautin(mu: f64, nu: f64) -> impl PeriodicProblem {
+    self_excited(mu, move |x, v| -(nu * x * x - x.powi(4)) * v)
+}
+
+/// `ẍ − μẋ + x + g(x, ẋ) = 0` unforced, as `M = 1`, `C = −μ`, `K = 1`.
+fn self_excited(mu: f64, g: impl Fn(f64, f64) -> f64) -> impl PeriodicProblem {
     GeneralProblem::new(
         1,
         vec![1.0],
         vec![-mu],
         vec![1.0],
         move |x: &[f64], v: &[f64], _theta: f64, out: &mut [f64]| {
-            if let (Some(g), Some(&x), Some(&v)) = (out.first_mut(), x.first(), v.first()) {
-                *g = -(nu * x * x - x.powi(4)) * v;
+            if let (Some(out), Some(&x), Some(&v)) = (out.first_mut(), x.first(), v.first()) {
+                *out = g(x, v);
             }
         },
         |_theta: f64, out: &mut [f64]| out.fill(0.0),
