@@ -20,7 +20,8 @@ pub type CascadeRequest = CascadeOptions;
 /// The job's check of its request.
 ///
 /// # Errors
-/// [`HbError::InvalidInput`] for a non-finite parameter or Ω ≤ 0.
+/// [`HbError::InvalidInput`] for a non-finite parameter, Ω ≤ 0, samples
+/// that do not exceed n, or steps the period-1 leg refuses.
 pub fn validate(req: &CascadeRequest) -> Result<(), HbError> {
     all_finite(&[
         ("xi", req.xi),
@@ -28,7 +29,9 @@ pub fn validate(req: &CascadeRequest) -> Result<(), HbError> {
         ("gamma", req.gamma),
         ("beta0", req.beta0),
     ])?;
-    positive("omega", req.omega).map(|_| ())
+    positive("omega", req.omega)?;
+    req.period_one_samples()?;
+    req.period_one_path().map(|_| ())
 }
 
 /// The cascade: the keys of `ivt hb mathieu-duffing --json` and
@@ -82,5 +85,41 @@ mod tests {
         let e = cascade(&req).unwrap_err();
         assert_eq!(e.kind(), "input");
         assert!(e.to_string().contains("`omega`"), "{e}");
+    }
+
+    #[test]
+    fn samples_and_steps_are_checked_before_solving() {
+        let refused = |req: CascadeRequest| cascade(&req).unwrap_err().to_string();
+        let few = refused(CascadeRequest {
+            samples: Some(12),
+            ..CascadeRequest::default()
+        });
+        assert!(few.contains("`samples` = 12 must exceed `n` = 12"), "{few}");
+        let ds = refused(CascadeRequest {
+            steps: ivt_path::continuation::Steps {
+                ds_min: Some(0.5),
+                ..Default::default()
+            },
+            ..CascadeRequest::default()
+        });
+        assert!(ds.contains("`ds_min` = 0.5"), "{ds}");
+    }
+
+    #[test]
+    fn a_leg_cut_short_says_how_it_ended() {
+        let short = CascadeRequest {
+            steps: ivt_path::continuation::Steps {
+                max_points: Some(4),
+                ..Default::default()
+            },
+            ..CascadeRequest::default()
+        };
+        let e = cascade(&short).unwrap_err().to_string();
+        assert!(
+            e.contains(
+                "period-1 branch never reached μ = −1: it ended with `max_points` after 4 points"
+            ),
+            "{e}"
+        );
     }
 }

@@ -151,12 +151,19 @@ fn mathieu_duffing<'py>(
 
 /// The period-doubling cascade of the Mathieu–Duffing equation Eq. 81
 /// (§3.2.5): β at the first three period doublings, located by Floquet
-/// multipliers crossing −1 along the branch, with `n` harmonics per period.
+/// multipliers crossing −1 along the branch, with `n` harmonics per period
+/// and `samples` = N (2N AFT samples; None: 4n) on the period-1 orbit, both
+/// doubled with each period. `ds`, `ds_min`, `ds_max`, `max_points`: the
+/// steps of every leg (None: the period-1 branch in β from Δη = 0.02 up to
+/// 0.05, each period-2^k branch in its amplitude a₁ from 0.01·A up to 0.02·A,
+/// A the largest coefficient of the orbit that doubled; 4000 points per leg).
 /// Returns the dict of `ivt hb mathieu-duffing --json`:
 /// period_doubling_beta, periods, multipliers ([[re, im]...] at each
 /// doubling), thesis ([4.825, 5.194, 5.253]), time_s. GIL released.
 #[pyfunction]
-#[pyo3(signature = (xi = 0.125, alpha = 1.0, omega = 2.0, gamma = 1.0, n = 12))]
+#[pyo3(signature = (xi = 0.125, alpha = 1.0, omega = 2.0, gamma = 1.0, n = 12, samples = None,
+                    ds = None, ds_min = None, ds_max = None, max_points = None))]
+#[allow(clippy::too_many_arguments)]
 fn mathieu_cascade<'py>(
     py: Python<'py>,
     xi: f64,
@@ -164,6 +171,11 @@ fn mathieu_cascade<'py>(
     omega: f64,
     gamma: f64,
     #[pyo3(from_py_with = int64)] n: i64,
+    #[pyo3(from_py_with = crate::args::opt_int64)] samples: Option<i64>,
+    ds: Option<f64>,
+    ds_min: Option<f64>,
+    ds_max: Option<f64>,
+    #[pyo3(from_py_with = crate::args::opt_int64)] max_points: Option<i64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let req = CascadeRequest {
         xi: finite("xi", xi)?,
@@ -171,6 +183,8 @@ fn mathieu_cascade<'py>(
         omega: finite("omega", omega)?,
         gamma: finite("gamma", gamma)?,
         harmonics: count("n", n)?,
+        samples: samples.map(|s| count("samples", s)).transpose()?,
+        steps: crate::steps::steps(ds, ds_min, ds_max, max_points)?,
         ..CascadeRequest::default()
     };
     let cascade = run(py, || jobs::cascade(&req))?;

@@ -18,7 +18,7 @@ from ivt import hb
 STEPS = ("ds", "ds_min", "ds_max", "max_points")
 PATHS = ["frc", "duffing_frc", "duffing_folds", "continue_bifurcation", "cycle_branch",
          "cycle_fold_curve", "neimark_sacker_points", "backbone", "damped_modes",
-         "torus_branch", "diagram", "switch_branch", "string"]
+         "torus_branch", "diagram", "switch_branch", "string", "mathieu_cascade"]
 
 DUFFING = (1.0, 0.04, 1.0, hb.elements.cubic_spring(1.0), lambda th: 0.1 * np.cos(th))
 UNDAMPED = (1.0, 0.0, 1.0, hb.elements.cubic_spring(1.0))
@@ -57,7 +57,9 @@ def test_every_path_function_has_the_same_continuation_and_accuracy_keywords(nam
         assert key in params and params[key].default is None, (name, key)
     assert "step_max" not in params
     if name != "string":
-        assert params["n"].default == 20 and params["samples"].default is None, name
+        # The cascade keeps §3.2.5's n = 12 (its orbits double it with each period).
+        n = 12 if name == "mathieu_cascade" else 20
+        assert params["n"].default == n and params["samples"].default is None, name
 
 
 def test_event_sensitivity_is_no_path_and_takes_no_steps():
@@ -113,6 +115,26 @@ def test_max_points_reaches_the_curves_of_ns_points_switching_tori_and_cycle_fol
     curve = hb.cycle_fold_curve(_cycle_family, 1.0, 0.45, -0.2, 0.1, n=25, samples=128,
                                 vectorized=True, max_points=3)
     assert curve["termination"] == "max_points" and len(curve["points"]) <= 6
+
+
+def test_the_cascade_takes_samples_and_steps_per_leg():
+    # A leg cut short cannot reach its doubling: the error says how it ended.
+    with pytest.raises(ValueError, match="period-1 branch never reached μ = −1: it ended "
+                                         "with `max_points` after 4 points"):
+        hb.mathieu_cascade(max_points=4)
+    with pytest.raises(ValueError, match="`samples` = 12 must exceed `n` = 12"):
+        hb.mathieu_cascade(samples=12)
+    with pytest.raises(ValueError, match="`ds` = -1.0 must be finite and > 0"):
+        hb.mathieu_cascade(ds=-1.0)
+    # Twice the default samples and smaller steps: the same doublings (each
+    # located on its extended system), §3.2.5's β to its printed digits.
+    base = hb.mathieu_cascade()
+    fine = hb.mathieu_cascade(samples=96, ds_max=0.02)
+    assert np.allclose(base["period_doubling_beta"], fine["period_doubling_beta"], atol=1e-7)
+    assert np.allclose(fine["period_doubling_beta"], [4.825, 5.194, 5.253], atol=6e-3)
+    # N = n + 1 aliases the cubic term (exact from N = 2n): the samples reach the AFT.
+    aliased = hb.mathieu_cascade(samples=13)["period_doubling_beta"]
+    assert 1e-9 < abs(aliased[0] - base["period_doubling_beta"][0]) < 1e-6, aliased
 
 
 def test_max_points_reaches_the_switched_branch():

@@ -26,7 +26,7 @@ use crate::stability::floquet::HsuRule;
 use crate::stability::StabilityAnalyzer;
 use faer::c64;
 use ivt_num::{broyden_solve, BroydenOptions, BroydenStats, BroydenWorkspace};
-use ivt_path::continuation::{follow_residual, ContinuationOptions};
+use ivt_path::continuation::{follow_residual, ContinuationOptions, Path, Steps};
 
 /// The thesis's period-1 coefficients at β₀ = 3.6, n = 9 (§3.2.5; the printed
 /// "=0.0001" is read as −0.0001).
@@ -54,6 +54,12 @@ pub struct CascadeOptions {
     pub doublings: usize,
     /// Hsu sub-intervals per harmonic of the solution (total = this × n).
     pub hsu_steps_per_harmonic: usize,
+    /// AFT samples N (2N per period) of the period-1 orbit; `None`: 4n.
+    /// The period-2^k branch uses 2^k times as many, as it does harmonics.
+    pub samples: Option<usize>,
+    /// Overrides of every leg's steps ([`CascadeOptions::period_one_path`],
+    /// [`CascadeOptions::doubled_path`]); `max_points` counts per leg.
+    pub steps: Steps,
 }
 
 impl Default for CascadeOptions {
@@ -67,7 +73,70 @@ impl Default for CascadeOptions {
             harmonics: 12,
             doublings: 3,
             hsu_steps_per_harmonic: 24,
+            samples: None,
+            steps: Steps::default(),
         }
+    }
+}
+
+impl CascadeOptions {
+    /// The AFT samples N of the period-1 orbit (`samples`, or 4n).
+    ///
+    /// # Errors
+    /// [`HbError::InvalidInput`] when N ≤ n or the period-2^k branch's
+    /// samples exceed [`crate::limits::samples_error`]'s bound.
+    pub fn period_one_samples(&self) -> Result<usize, HbError> {
+        let n_half = self.samples.unwrap_or(4 * self.harmonics);
+        if n_half <= self.harmonics {
+            return Err(HbError::InvalidInput(format!(
+                "`samples` = {n_half} must exceed `n` = {} (2N > 2n AFT samples)",
+                self.harmonics
+            )));
+        }
+        let last = 1usize << self.doublings.saturating_sub(1).min(30);
+        if let Some(why) = crate::limits::samples_error(n_half.saturating_mul(last)) {
+            return Err(HbError::InvalidInput(format!(
+                "`samples` = {n_half} on the period-{last} branch: {why}"
+            )));
+        }
+        Ok(n_half)
+    }
+
+    /// The period-1 branch in β: Δη from 0.02 up to 0.05, 4000 points, β ≤ 20,
+    /// with [`steps`](Self::steps).
+    ///
+    /// # Errors
+    /// [`HbError::InvalidInput`] for steps [`Steps::on`] refuses.
+    pub fn period_one_path(&self) -> Result<ContinuationOptions, HbError> {
+        self.stepped(ContinuationOptions {
+            ds: 0.02,
+            ds_max: 0.05,
+            lambda_max: 20.0,
+            max_points: 4000,
+            ..ContinuationOptions::default()
+        })
+    }
+
+    /// A period-2^k branch in its controlled amplitude a₁ (Eq. 84–85), scaled
+    /// to `amp`, the largest coefficient of the orbit that doubled: Δη from
+    /// 0.01·amp up to 0.02·amp, a₁ in [0, 10·amp], 4000 points, with
+    /// [`steps`](Self::steps).
+    ///
+    /// # Errors
+    /// [`HbError::InvalidInput`] for steps [`Steps::on`] refuses.
+    pub fn doubled_path(&self, amp: f64) -> Result<ContinuationOptions, HbError> {
+        self.stepped(ContinuationOptions {
+            ds: 0.01 * amp,
+            ds_max: 0.02 * amp,
+            lambda_min: 0.0,
+            lambda_max: 10.0 * amp,
+            max_points: 4000,
+            ..ContinuationOptions::default()
+        })
+    }
+
+    fn stepped(&self, own: ContinuationOptions) -> Result<ContinuationOptions, HbError> {
+        self.steps.on(own).map_err(HbError::InvalidInput)
     }
 }
 
@@ -241,6 +310,16 @@ fn locate_period_doubling(
     })
 }
 
+/// The period-`period` branch ended (`path`'s termination, after its
+/// points) without a multiplier reaching −1.
+fn never_doubled(period: usize, path: &Path) -> HbError {
+    HbError::InvalidInput(format!(
+        "period-{period} branch never reached μ = −1: it ended with `{}` after {} points",
+        path.termination.as_str(),
+        path.points.len()
+    ))
+}
+
 /// Runs the cascade and returns the critical points β1, β2, β4, … in order.
 ///
 /// # Errors
@@ -253,7 +332,9 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
     }
     // --- period 1: continuation in β.
     let n1 = opts.harmonics;
-    let hb1 = HbOptions::new(n1, 4 * n1);
+    let n_half1 = opts.period_one_samples()?;
+    let copts = opts.period_one_path()?;
+    let hb1 = HbOptions::new(n1, n_half1);
     let problem = MathieuDuffing::new(opts.xi, opts.alpha, opts.beta0, opts.gamma);
     let guess = resize_harmonics(&THESIS_A0, n1);
     let start = ModifiedIhb::new(problem.clone(), hb1.clone())?.solve(opts.omega, Some(&guess))?;
@@ -261,13 +342,6 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
     let mut x0 = start.coeffs.clone();
     x0.push(opts.beta0);
     let mut an = StabilityAnalyzer::new(&problem, n1, opts.hsu_steps_per_harmonic * n1)?;
-    let copts = ContinuationOptions {
-        ds: 0.02,
-        ds_max: 0.05,
-        lambda_max: 20.0,
-        max_points: 4000,
-        ..ContinuationOptions::default()
-    };
     let mut bracket = PdBracket::default();
     let mut p = problem.clone();
     let stab = |an: &mut StabilityAnalyzer,
@@ -291,15 +365,13 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
         pp.beta = beta;
         res.eval(&pp, q, opts.omega, 1.0, r)
     };
-    follow_residual(residual, &x0, None, 1.0, &copts, |pt| {
+    let path = follow_residual(residual, &x0, None, 1.0, &copts, |pt| {
         p.beta = pt.lambda();
         let (g, _) = stab(&mut an, &p, split_param(&pt.x).0, n1, 1);
         bracket.push(&pt.x, g)
     })
     .map_err(|e| HbError::InvalidInput(format!("period-1 continuation: {e}")))?;
-    let ((xa, ga), (xb, gb)) = bracket
-        .found
-        .ok_or_else(|| HbError::InvalidInput("period-1 branch never reached μ = −1".into()))?;
+    let ((xa, ga), (xb, gb)) = bracket.found.ok_or_else(|| never_doubled(1, &path))?;
     let (q, beta) = nearer(&xa, ga, &xb, gb, |x| {
         let (q, beta) = split_param(x);
         (q.to_vec(), beta)
@@ -311,7 +383,7 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
     let mut n = n1;
     while out.len() < opts.doublings {
         let (new_period, new_n) = (2 * period, 2 * n);
-        let hb = HbOptions::new(new_n, 4 * new_n).with_subharmonic(new_period);
+        let hb = HbOptions::new(new_n, new_period * n_half1).with_subharmonic(new_period);
         let mut y = embed_subharmonic(&crit.solution.coeffs, 2, new_n);
         let c = 1; // a_1 of the new lowest harmonic
         set(&mut y, c, crit.beta);
@@ -346,21 +418,14 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
         )?;
         let mut x0 = y.clone();
         x0.push(a_start);
-        let copts = ContinuationOptions {
-            ds: 0.01 * amp,
-            ds_max: 0.02 * amp,
-            lambda_min: 0.0,
-            lambda_max: 10.0 * amp,
-            max_points: 4000,
-            ..ContinuationOptions::default()
-        };
+        let copts = opts.doubled_path(amp)?;
         let mut bracket = PdBracket::default();
         // Skip the start region where the new branch's multiplier is still ≈ +1.
         let residual = |x: &[f64], r: &mut [f64]| {
             let (y, a) = split_param(x);
             ctl.eval(y, a, r)
         };
-        follow_residual(residual, &x0, None, 1.0, &copts, |pt| {
+        let path = follow_residual(residual, &x0, None, 1.0, &copts, |pt| {
             let (y, a) = split_param(&pt.x);
             pp.beta = y.get(c).copied().unwrap_or(f64::NAN);
             let mut q = y.to_vec();
@@ -368,9 +433,9 @@ pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubli
             let (g, _) = stab(&mut an2, &pp, &q, new_n, new_period);
             bracket.push(&pt.x, g)
         })?;
-        let ((xa, ga), (xb, gb)) = bracket.found.ok_or_else(|| {
-            HbError::InvalidInput(format!("period-{new_period} branch never reached μ = −1"))
-        })?;
+        let ((xa, ga), (xb, gb)) = bracket
+            .found
+            .ok_or_else(|| never_doubled(new_period, &path))?;
         // The bracketing points as orbits of the period-2p branch in β.
         let (q, beta) = nearer(&xa, ga, &xb, gb, |x| {
             let (y, a) = split_param(x);

@@ -104,7 +104,9 @@ def mathieu_duffing(
     guess: Optional[ArrayLike] = None, tol: float = 1e-10, stability: bool = True,
 ) -> Dict[str, Any]: ...
 def mathieu_cascade(
-    xi: float = 0.125, alpha: float = 1.0, omega: float = 2.0, gamma: float = 1.0, n: int = 12
+    xi: float = 0.125, alpha: float = 1.0, omega: float = 2.0, gamma: float = 1.0, n: int = 12,
+    samples: Optional[int] = None,
+    ds: Optional[float] = None, ds_min: Optional[float] = None, ds_max: Optional[float] = None, max_points: Optional[int] = None,
 ) -> Dict[str, Any]: ...
 def duffing_frc(
     from_: float = 0.2, to: float = 3.0,
