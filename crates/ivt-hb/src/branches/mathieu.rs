@@ -83,10 +83,18 @@ impl CascadeOptions {
     /// The AFT samples N of the period-1 orbit (`samples`, or 4n).
     ///
     /// # Errors
-    /// [`HbError::InvalidInput`] when N ≤ n or the period-2^k branch's
-    /// samples exceed [`crate::limits::samples_error`]'s bound.
+    /// [`HbError::InvalidInput`] when the period-4 branch's 4n harmonics
+    /// exceed [`crate::limits::unknowns_error`]'s bound, when N ≤ n, or when
+    /// the period-2^k branch's samples exceed
+    /// [`crate::limits::samples_error`]'s.
     pub fn period_one_samples(&self) -> Result<usize, HbError> {
-        let n_half = self.samples.unwrap_or(4 * self.harmonics);
+        // Refused before any allocation (the period-4 branch carries 4n harmonics).
+        if let Some(why) = crate::limits::unknowns_error(1, self.harmonics.saturating_mul(4)) {
+            return Err(HbError::InvalidInput(why));
+        }
+        let n_half = self
+            .samples
+            .unwrap_or_else(|| self.harmonics.saturating_mul(4));
         if n_half <= self.harmonics {
             return Err(HbError::InvalidInput(format!(
                 "`samples` = {n_half} must exceed `n` = {} (2N > 2n AFT samples)",
@@ -326,10 +334,6 @@ fn never_doubled(period: usize, path: &Path) -> HbError {
 /// [`HbError`] if a solve or a branch switch fails.
 pub fn period_doubling_cascade(opts: &CascadeOptions) -> Result<Vec<PeriodDoubling>, HbError> {
     let mut out = Vec::new();
-    // The period-4 branch carries 4n harmonics: refuse before any allocation.
-    if let Some(why) = crate::limits::unknowns_error(1, opts.harmonics.saturating_mul(4)) {
-        return Err(HbError::InvalidInput(why));
-    }
     // --- period 1: continuation in β.
     let n1 = opts.harmonics;
     let n_half1 = opts.period_one_samples()?;
