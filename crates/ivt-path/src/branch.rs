@@ -44,12 +44,13 @@ pub trait Branch {
     }
     /// `∂/∂q (wᵀ J(q, λ) v)` into `out` (`m`): the gradient of the fold test
     /// function is `−` this at the bordered solutions `v`, `w`. Default:
-    /// [`fd_jacobian_gradient`] (2m Jacobians); override with a cheaper form.
+    /// [`directional_jacobian_gradient`] (2 Jacobians); override with an
+    /// exact form.
     fn jacobian_gradient(&mut self, q: &[f64], lambda: f64, w: &[f64], v: &[f64], out: &mut [f64])
     where
         Self: Sized,
     {
-        fd_jacobian_gradient(self, q, lambda, w, v, 1e-6, out);
+        directional_jacobian_gradient(self, q, lambda, w, v, 1e-6, out);
     }
     /// `∂R/∂λ` at `(q, λ)` into `out` (`m`): the λ column of the tangent, of
     /// the correctors' bordered matrix (Eq. 72) and of the fold system.
@@ -122,8 +123,47 @@ pub fn bilinear_form(a: &[f64], w: &[f64], v: &[f64]) -> f64 {
         .sum()
 }
 
+/// `∂/∂q (wᵀ J v)` as the derivative of `J(q + εv)ᵀ w` in ε (the second
+/// derivatives of `R` are symmetric: `∂_k Σᵢⱼ wᵢ ∂ⱼRᵢ vⱼ = Σᵢ wᵢ ∂_ε ∂_kRᵢ(q + εv)`),
+/// by the central difference of two [`Branch::jacobian`]s with
+/// `ε = fd_step·max(‖q‖∞, ‖v‖∞)/‖v‖∞`: the cost of two Jacobians where
+/// [`fd_jacobian_gradient`] takes `2m`. Zero for `v = 0`.
+pub fn directional_jacobian_gradient<B: Branch>(
+    branch: &mut B,
+    q: &[f64],
+    lambda: f64,
+    w: &[f64],
+    v: &[f64],
+    fd_step: f64,
+    out: &mut [f64],
+) {
+    let m = q.len();
+    let inf = |x: &[f64]| x.iter().fold(0.0f64, |a, e| a.max(e.abs()));
+    let v_scale = inf(v);
+    out.fill(0.0);
+    if v_scale == 0.0 || !v_scale.is_finite() {
+        return;
+    }
+    let eps = fd_step * inf(q).max(v_scale) / v_scale;
+    let mut jac = vec![0.0; m * m];
+    let mut qt: Vec<f64> = q.to_vec();
+    for (sign, weight) in [(1.0, 0.5 / eps), (-1.0, -0.5 / eps)] {
+        for ((t, &qk), &vk) in qt.iter_mut().zip(q).zip(v) {
+            *t = qk + sign * eps * vk;
+        }
+        branch.jacobian(&qt, lambda, &mut jac);
+        // out += weight · Jᵀ w.
+        for (row, &wi) in jac.chunks_exact(m.max(1)).zip(w) {
+            for (o, &a) in out.iter_mut().zip(row) {
+                *o += weight * wi * a;
+            }
+        }
+    }
+}
+
 /// `∂/∂q (wᵀ J v)` by central differences of [`Branch::jacobian`], steps
-/// `fd_step·max(|q_k|, ‖q‖∞)`.
+/// `fd_step·max(|q_k|, ‖q‖∞)`: `2m` Jacobians, the reference the exact and
+/// the directional forms are checked against.
 pub fn fd_jacobian_gradient<B: Branch>(
     branch: &mut B,
     q: &[f64],
@@ -215,5 +255,71 @@ impl<F: FnMut(&[f64], &mut [f64])> Branch for ResidualBranch<F> {
                 set_entry(row, j, (a - b) / h);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `R = (q₀²q₁ − λ, sin q₁ + q₀q₂, q₂³ + λq₀)` with its Jacobian.
+    struct Cubic;
+
+    impl Branch for Cubic {
+        fn len(&self) -> usize {
+            3
+        }
+        fn residual(&mut self, q: &[f64], lambda: f64, r: &mut [f64]) {
+            r.copy_from_slice(&[
+                q[0] * q[0] * q[1] - lambda,
+                q[1].sin() + q[0] * q[2],
+                q[2].powi(3) + lambda * q[0],
+            ]);
+        }
+        fn jacobian(&mut self, q: &[f64], lambda: f64, jac: &mut [f64]) {
+            jac.copy_from_slice(&[
+                2.0 * q[0] * q[1],
+                q[0] * q[0],
+                0.0,
+                q[2],
+                q[1].cos(),
+                q[0],
+                lambda,
+                0.0,
+                3.0 * q[2] * q[2],
+            ]);
+        }
+    }
+
+    #[test]
+    fn the_directional_gradient_of_the_bilinear_form_is_the_exact_one() {
+        let (q, lambda): ([f64; 3], f64) = ([0.7, -1.3, 0.4], 0.9);
+        let (w, v) = ([0.3, -0.8, 0.5], [1.1, 0.2, -0.6]);
+        // ∂/∂q (wᵀ J v) by hand from the Jacobian above.
+        let exact = [
+            w[0] * (2.0 * q[1] * v[0] + 2.0 * q[0] * v[1]) + w[1] * v[2],
+            w[0] * 2.0 * q[0] * v[0] - w[1] * q[1].sin() * v[1],
+            w[1] * v[0] + w[2] * 6.0 * q[2] * v[2],
+        ];
+        let (mut directional, mut reference) = ([0.0; 3], [0.0; 3]);
+        directional_jacobian_gradient(&mut Cubic, &q, lambda, &w, &v, 1e-5, &mut directional);
+        fd_jacobian_gradient(&mut Cubic, &q, lambda, &w, &v, 1e-5, &mut reference);
+        for ((d, r), e) in directional.iter().zip(&reference).zip(&exact) {
+            assert!(
+                (d - e).abs() < 1e-8 && (r - e).abs() < 1e-8,
+                "{directional:?} {reference:?} {exact:?}"
+            );
+        }
+        // v = 0: zero, not NaN.
+        directional_jacobian_gradient(
+            &mut Cubic,
+            &q,
+            lambda,
+            &w,
+            &[0.0; 3],
+            1e-5,
+            &mut directional,
+        );
+        assert_eq!(directional, [0.0; 3]);
     }
 }

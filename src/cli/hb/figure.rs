@@ -136,6 +136,7 @@ fn event_label(kind: BifurcationKind) -> &'static str {
         BifurcationKind::PeriodDoubling => "PD",
         BifurcationKind::NeimarkSacker => "NS",
         BifurcationKind::BranchPoint => "BP",
+        BifurcationKind::Crossing => "at",
     }
 }
 
@@ -195,6 +196,7 @@ pub(super) fn curve2(
         BifurcationKind::PeriodDoubling => "period-doubling curve",
         BifurcationKind::NeimarkSacker => "Neimark–Sacker curve",
         BifurcationKind::BranchPoint => "branch-point curve",
+        BifurcationKind::Crossing => "curve",
     };
     Picture::new(title, "ω", p_label)
         .with(name, line, Style::Line)

@@ -64,6 +64,7 @@ impl Feature {
             Self::Event(BifurcationKind::PeriodDoubling) => "period_doubling",
             Self::Event(BifurcationKind::NeimarkSacker) => "neimark_sacker",
             Self::Event(BifurcationKind::BranchPoint) => "branch_point",
+            Self::Event(BifurcationKind::Crossing) => "crossing",
             Self::Peak => "peak",
         }
     }
@@ -283,43 +284,48 @@ where
     }
     let n = hb.harmonics;
     let opts = LocateOptions::default();
-    let (q, omega, iterations, d_omega_dp, d_amplitude_dp, amplitude) = match feature {
-        Feature::Event(BifurcationKind::Fold) => {
-            let loc = locate_fold(&mut t.at, q0, omega0, &LocateOptions::fold())?;
-            let (amplitude, grad) = amplitude_gradient(&loc.q, n, dof)?;
-            let (dw, da) = fold(&mut t, &loc.q, loc.lambda, &grad)?;
-            (loc.q, loc.lambda, loc.iterations, dw, da, amplitude)
-        }
-        Feature::Event(
-            kind @ (BifurcationKind::PeriodDoubling | BifurcationKind::NeimarkSacker),
-        ) => {
-            let loc = locate_multiplier_crossing(&mut t.at, kind, q0, omega0, &opts)
-                .map_err(bifurcation_error)?;
-            let (amplitude, grad) = amplitude_gradient(&loc.q, n, dof)?;
-            let matrix: TestMatrix = if kind == BifurcationKind::PeriodDoubling {
-                shifted_monodromy
-            } else {
-                compound_minus_identity
-            };
-            let rows = LocateOptions {
-                fd_step: CROSSING_FD_STEP,
-                ..opts
-            };
-            let (dw, da) = crossing(&mut t, matrix, (&loc.q, loc.lambda), &grad, &rows)?;
-            (loc.q, loc.lambda, loc.iterations, dw, da, amplitude)
-        }
-        Feature::Event(BifurcationKind::BranchPoint) => {
-            let (amplitude, grad) = amplitude_gradient(q0, n, dof)?;
-            let (dw, da) = pitchfork(&mut t, q0, omega0, &grad, &opts)?;
-            (q0.to_vec(), omega0, 0, dw, da, amplitude)
-        }
-        Feature::Peak => {
-            let (q, omega, its) = locate_peak(&mut t.at, (q0, omega0), n, dof, &opts)?;
-            let (amplitude, grad) = amplitude_gradient(&q, n, dof)?;
-            let (dw, da) = peak(&mut t, (&q, omega), n, dof, &grad, &opts)?;
-            (q, omega, its, dw, da, amplitude)
-        }
-    };
+    let (q, omega, iterations, d_omega_dp, d_amplitude_dp, amplitude) =
+        match feature {
+            Feature::Event(BifurcationKind::Fold) => {
+                let loc = locate_fold(&mut t.at, q0, omega0, &LocateOptions::fold())?;
+                let (amplitude, grad) = amplitude_gradient(&loc.q, n, dof)?;
+                let (dw, da) = fold(&mut t, &loc.q, loc.lambda, &grad)?;
+                (loc.q, loc.lambda, loc.iterations, dw, da, amplitude)
+            }
+            Feature::Event(
+                kind @ (BifurcationKind::PeriodDoubling | BifurcationKind::NeimarkSacker),
+            ) => {
+                let loc = locate_multiplier_crossing(&mut t.at, kind, q0, omega0, &opts)
+                    .map_err(bifurcation_error)?;
+                let (amplitude, grad) = amplitude_gradient(&loc.q, n, dof)?;
+                let matrix: TestMatrix = if kind == BifurcationKind::PeriodDoubling {
+                    shifted_monodromy
+                } else {
+                    compound_minus_identity
+                };
+                let rows = LocateOptions {
+                    fd_step: CROSSING_FD_STEP,
+                    ..opts
+                };
+                let (dw, da) = crossing(&mut t, matrix, (&loc.q, loc.lambda), &grad, &rows)?;
+                (loc.q, loc.lambda, loc.iterations, dw, da, amplitude)
+            }
+            Feature::Event(BifurcationKind::BranchPoint) => {
+                let (amplitude, grad) = amplitude_gradient(q0, n, dof)?;
+                let (dw, da) = pitchfork(&mut t, q0, omega0, &grad, &opts)?;
+                (q0.to_vec(), omega0, 0, dw, da, amplitude)
+            }
+            Feature::Event(BifurcationKind::Crossing) => return Err(HbError::InvalidInput(
+                "a crossing of a set value is a requested point, not a feature that moves with p"
+                    .into(),
+            )),
+            Feature::Peak => {
+                let (q, omega, its) = locate_peak(&mut t.at, (q0, omega0), n, dof, &opts)?;
+                let (amplitude, grad) = amplitude_gradient(&q, n, dof)?;
+                let (dw, da) = peak(&mut t, (&q, omega), n, dof, &grad, &opts)?;
+                (q, omega, its, dw, da, amplitude)
+            }
+        };
     Ok(Sensitivity {
         feature,
         omega,

@@ -9,12 +9,9 @@ use crate::branches::events::{dot, Bifurcation, BifurcationError, BifurcationKin
 use crate::branches::family::{Family, FamilyBranch};
 use crate::orbit::ihb::{HbError, HbOptions};
 use ivt_num::vector::norm2;
-use ivt_num::{newton_bordered, Border, LuWorkspace, NewtonOptions, NewtonSystem, NewtonWorkspace};
-use ivt_path::branch::{full_newton_steps, residual_lambda_difference, Branch};
-use ivt_path::events::extended::{
-    check_start, lambda_step, null_vector, put_jacobian, singular_at_start,
-};
-use std::convert::Infallible;
+use ivt_num::{newton_bordered, Border, LuWorkspace, NewtonOptions, NewtonWorkspace};
+use ivt_path::branch::{full_newton_steps, Branch};
+use ivt_path::events::extended::{check_start, null_vector, singular_at_start, BranchWithLambda};
 
 /// A first point on a new branch: Newton on `[R(q, λ); dᵀ(x − x*) − h] = 0`
 /// (`x = {q, λ}`) from the predictor `x* + h d`, where `x* = {q, λ}` is the
@@ -42,12 +39,7 @@ pub fn switch_branch<B: Branch>(
     }
     let star: Vec<f64> = q.iter().copied().chain([lambda]).collect();
     let mut x: Vec<f64> = star.iter().zip(direction).map(|(s, d)| s + h * d).collect();
-    let mut system = BranchWithLambda {
-        branch,
-        opts,
-        jac: vec![0.0; m * m],
-        r_lambda: vec![0.0; m],
-    };
+    let mut system = BranchWithLambda::new(branch, opts);
     // Full steps until the largest update is below `step_tol` of the
     // largest entry of x (at the predictor).
     let scale = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -71,37 +63,6 @@ pub fn switch_branch<B: Branch>(
     .map_err(|e| BifurcationError::from(HbError::Solve(e)))?;
     let lambda = x.pop().unwrap_or(lambda);
     Ok((x, lambda))
-}
-
-/// `R(q, λ)` of a [`Branch`] in the unknowns `{q, λ}`, with the Jacobian
-/// `[R_q, R_λ]` (`R_λ` by the central difference of [`lambda_step`]).
-struct BranchWithLambda<'a, B> {
-    branch: &'a mut B,
-    opts: &'a LocateOptions,
-    jac: Vec<f64>,
-    r_lambda: Vec<f64>,
-}
-
-impl<B: Branch> NewtonSystem for BranchWithLambda<'_, B> {
-    type Error = Infallible;
-
-    fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
-        if let Some((&lambda, q)) = x.split_last() {
-            self.branch.residual(q, lambda, r);
-        }
-        Ok(())
-    }
-
-    fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> Result<(), Infallible> {
-        let Some((&lambda, q)) = x.split_last() else {
-            return Ok(());
-        };
-        self.branch.jacobian(q, lambda, &mut self.jac);
-        let h = lambda_step(self.opts, lambda);
-        residual_lambda_difference(self.branch, q, lambda, h, &mut self.r_lambda);
-        put_jacobian(jac, q.len() + 1, &self.jac, &self.r_lambda);
-        Ok(())
-    }
 }
 
 /// The period-doubled branch at a located period doubling `pd` of the branch

@@ -24,6 +24,9 @@ pub enum BifurcationKind {
     NeimarkSacker,
     /// Two branches cross (rank loss of `[∂R/∂q, ∂R/∂λ]`).
     BranchPoint,
+    /// A component of the path vector crosses a set value (not a
+    /// bifurcation: a requested point, [`crate::events::Crossing`]).
+    Crossing,
 }
 
 impl BifurcationKind {
@@ -34,6 +37,7 @@ impl BifurcationKind {
             Self::PeriodDoubling => "period doubling",
             Self::NeimarkSacker => "Neimark–Sacker point",
             Self::BranchPoint => "branch point",
+            Self::Crossing => "crossing of a set value",
         }
     }
 }
@@ -156,6 +160,8 @@ pub struct Event<E> {
     pub kind: BifurcationKind,
     /// The point before the change (the Newton start).
     pub index: usize,
+    /// Which detector found it: its position in the observer's list.
+    pub detector: usize,
     /// The located bifurcation, or why it could not be located.
     pub location: Result<Bifurcation, E>,
 }

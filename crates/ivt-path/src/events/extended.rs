@@ -191,6 +191,53 @@ pub fn lambda_step(opts: &LocateOptions, lambda: f64) -> f64 {
     opts.fd_step * lambda.abs().max(1e-3)
 }
 
+/// `R(q, λ)` of a [`Branch`] as a system in the unknowns `x = {q, λ}` (one
+/// row fewer than unknowns, closed by the caller's border rows through
+/// [`ivt_num::newton_bordered`]: a step off a bifurcation, a fixed
+/// component), with the Jacobian `[R_q, R_λ]` (`R_λ` by the central
+/// difference of [`lambda_step`]).
+pub struct BranchWithLambda<'a, B> {
+    branch: &'a mut B,
+    opts: &'a LocateOptions,
+    jac: Vec<f64>,
+    r_lambda: Vec<f64>,
+}
+
+impl<'a, B: Branch> BranchWithLambda<'a, B> {
+    /// The system of `branch`, `R_λ` with the step of `opts`.
+    pub fn new(branch: &'a mut B, opts: &'a LocateOptions) -> Self {
+        let m = branch.len();
+        Self {
+            branch,
+            opts,
+            jac: vec![0.0; m * m],
+            r_lambda: vec![0.0; m],
+        }
+    }
+}
+
+impl<B: Branch> NewtonSystem for BranchWithLambda<'_, B> {
+    type Error = Infallible;
+
+    fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), Infallible> {
+        if let Some((&lambda, q)) = x.split_last() {
+            self.branch.residual(q, lambda, r);
+        }
+        Ok(())
+    }
+
+    fn jacobian(&mut self, x: &[f64], jac: &mut [f64]) -> Result<(), Infallible> {
+        let Some((&lambda, q)) = x.split_last() else {
+            return Ok(());
+        };
+        self.branch.jacobian(q, lambda, &mut self.jac);
+        let h = lambda_step(self.opts, lambda);
+        residual_lambda_difference(self.branch, q, lambda, h, &mut self.r_lambda);
+        put_jacobian(jac, q.len() + 1, &self.jac, &self.r_lambda);
+        Ok(())
+    }
+}
+
 /// The blocks `R_q` (row-major `m×m`) and `R_λ` of `[R_q, R_λ]` at `(q, λ)`,
 /// `R_λ` by a central difference with [`lambda_step`].
 pub fn jacobian_blocks<B: Branch>(

@@ -8,7 +8,9 @@
 //! [`PointMultipliers`], gives each point its Floquet multipliers.
 //!
 //! Here: the [`Fold`] of any branch ([`fold`]: the λ component of the secant
-//! changes sign; located by [`locate_fold`]). The events of the Floquet
+//! changes sign; located by [`locate_fold`]) and the [`Crossing`] of a set
+//! value by one component of the path vector ([`crossing`]: the requested
+//! points of a curve). The events of the Floquet
 //! multipliers (period doubling, Neimark–Sacker) and the branch point need
 //! the monodromy of the orbits; they are ivt-hb's (`ivt_hb::branches::events`).
 //!
@@ -16,14 +18,16 @@
 //! locators fail in its own terms, as ivt-hb's, reports its own error type;
 //! the path engine's failures convert into it, `E: From<PathError>`).
 
+pub mod crossing;
 mod detector;
 pub mod extended;
 pub mod fold;
 mod observe;
 
+pub use crossing::Crossing;
 pub use detector::{
     dot, Bifurcation, BifurcationKind, Detector, Event, LocateOptions, Observer, PathSoFar, Start,
     TracedPoint,
 };
 pub use fold::{locate_fold, Fold, FoldLocation};
-pub use observe::{observe, EventObserver, PointMultipliers};
+pub use observe::{observe, observe_residual, EventObserver, PointMultipliers};

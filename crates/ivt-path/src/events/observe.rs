@@ -6,8 +6,9 @@
 //! is located at once by its extended system.
 
 use super::detector::{Detector, Event, LocateOptions, Observer, PathSoFar, Start, TracedPoint};
-use crate::branch::Branch;
-use crate::continuation::{Path, PathPoint, Stepper};
+use crate::branch::{Branch, ResidualBranch};
+use crate::continuation::{BroydenCorrector, ContinuationOptions, Path, PathPoint, Stepper};
+use crate::error::PathError;
 
 /// What gives each arriving point of a branch `B` its Floquet multipliers:
 /// the optional part of an [`EventObserver`] (a branch without them — the
@@ -83,6 +84,7 @@ impl<B: Branch, E> EventObserver<B, E> {
             events.push(Event {
                 kind: det.kind(),
                 index,
+                detector: d,
                 location: det.locate(at),
             });
         }
@@ -177,4 +179,36 @@ pub fn observe<B: Branch, O: Observer<B> + ?Sized>(
     // fold's start may precede a bracket reported before it.
     events.sort_by_key(|e| (e.index, e.kind));
     Ok((path, events))
+}
+
+/// The path of a system given by its residual alone (as
+/// [`follow_residual`](crate::continuation::follow_residual): a
+/// [`ResidualBranch`] on the one [`Stepper`] with the Broyden corrector, no
+/// Jacobian estimate at the start) with each point handed to `observer` as
+/// it arrives ([`observe`]): the path and the events located on it, in path
+/// order.
+///
+/// # Errors
+/// As `follow_residual` (converted into the observer's error); the
+/// observer's error.
+// The pair (path, events) is the result's shape, read at once by every caller.
+#[allow(clippy::type_complexity)]
+pub fn observe_residual<F, O>(
+    residual: F,
+    start: &[f64],
+    direction: f64,
+    opts: &ContinuationOptions,
+    observer: &mut O,
+    mut on_point: impl FnMut(&PathPoint) -> bool,
+) -> Result<(Path, Vec<Event<O::Error>>), O::Error>
+where
+    F: FnMut(&[f64], &mut [f64]),
+    O: Observer<ResidualBranch<F>> + ?Sized,
+    O::Error: From<PathError>,
+{
+    let m = start.len().saturating_sub(1);
+    let mut branch = ResidualBranch::new(m, residual);
+    let corrector = Box::new(BroydenCorrector::new(m, &opts.broyden, None));
+    let mut stepper = Stepper::new(&mut branch, corrector, start, 0, direction, opts)?;
+    observe(&mut stepper, observer, |_, p| on_point(p))
 }

@@ -93,9 +93,11 @@ pub fn locate_multiplier_crossing<F: Family>(
         BifurcationKind::NeimarkSacker => {
             neimark_sacker::locate_neimark_sacker(branch, (q0, lambda0), opts)
         }
-        BifurcationKind::Fold | BifurcationKind::BranchPoint => Err(HbError::InvalidInput(
-            "locate_multiplier_crossing takes period doubling or Neimark–Sacker".into(),
-        )
-        .into()),
+        BifurcationKind::Fold | BifurcationKind::BranchPoint | BifurcationKind::Crossing => {
+            Err(HbError::InvalidInput(
+                "locate_multiplier_crossing takes period doubling or Neimark–Sacker".into(),
+            )
+            .into())
+        }
     }
 }
