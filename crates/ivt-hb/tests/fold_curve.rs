@@ -116,12 +116,15 @@ fn duffing_fold_curve_through_the_cusp_matches_shooting() {
             fd = force_at(d);
         }
     }
-    let f_cusp = force_at(0.5 * (a + b));
+    let x_cusp = 0.5 * (a + b);
+    let f_cusp = force_at(x_cusp);
     eprintln!(
-        "cusp: HB F = {:.10} at ω = {:.8}; shooting F = {f_cusp:.10}, rel {:.1e}",
+        "cusp: HB F = {:.10} at ω = {:.8}, x(0) = {:.8}; shooting F = {f_cusp:.10}, rel {:.1e}, x(0) = {x_cusp:.8}, ω = {:.8}",
         cusp.p,
         cusp.omega,
-        (cusp.p - f_cusp).abs() / f_cusp
+        y[0],
+        (cusp.p - f_cusp).abs() / f_cusp,
+        guess.get()[1],
     );
     assert!((cusp.p - f_cusp).abs() < 1e-6 * f_cusp);
 }

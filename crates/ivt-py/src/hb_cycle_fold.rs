@@ -64,7 +64,7 @@ family_fn! {
 /// (as `cycle_branch`). The folds at each ν of `at` are solved exactly.
 /// Returns {"points": [{"mu", "nu", "omega", "amplitude", "coeffs"}...],
 /// "at": [...], "special": [{"kind": "cusp", ...}...] (turning points in
-/// ν, the path's estimate), "termination"}.
+/// ν, located as the fold of the curve), "termination"}.
 fn cycle_fold_curve<'py>(py, args) [
     nu_from: f64,
     nu_to: f64,

@@ -12,23 +12,24 @@
 //! (a unit null vector: a fixed normalisation `cᵀv = 1` lets `v` grow without
 //! bound where it turns away from `c`, as it does through a cusp) has the unknowns `{q, v, ω}` and `p`; it is
 //! followed by the engine's pseudo-arclength continuation
-//! ([`ivt_path::continuation::Stepper`], Eq. 68–77) with `p` as the path parameter. A cusp is a
-//! turning point of this curve in `p` (there the two folds of the FRC merge):
-//! the path's fold detection brackets it and a second, short path with a
-//! hundredth of the step through the bracket locates it (parabola through the
-//! three points around the turn). The fold at each requested `p` is solved at
-//! fixed `p` by Newton ([`ivt_num::newton()`]) from the bracketing points.
+//! ([`ivt_path::continuation::Stepper`], Eq. 68–77) with `p` as the path
+//! parameter, the extended system given by its residual
+//! ([`ivt_path::ResidualBranch`]). Its events are located as the points
+//! arrive ([`ivt_path::events::observe_residual`]): a cusp is a turning point
+//! of the curve in `p` (there the two folds of the FRC merge), the engine's
+//! [`Fold`] of the extended system; the fold at each requested `p` is the
+//! [`Crossing`] of that value, solved at fixed `p` by Newton from the
+//! interpolation of the two path points around it.
 //!
 //! Here the excitation may depend on `p` (a force amplitude): the residual is
 //! planned anew when `p` changes. `family(p)` returns a `Result`, so a family
 //! built from user callbacks can fail cleanly.
 //!
 //! Period-doubling and Neimark–Sacker curves are in [`multiplier_curve`]
-//! ([`bifurcation_curve`]); the fixed-`p` solve all curves share is
-//! `fixed.rs`.
+//! ([`bifurcation_curve`]), folds of limit cycles in [`cycle_fold`]; the
+//! legs, events and result all curves share are here.
 
 pub mod cycle_fold;
-mod fixed;
 mod fold_system;
 pub mod multiplier_curve;
 pub use cycle_fold::{cycle_fold_curve, CycleFoldCurve, CycleFoldPoint};
@@ -37,12 +38,13 @@ pub use multiplier_curve::{bifurcation_curve, BifurcationCurve, CurvePoint, Curv
 use crate::error::HbError;
 use crate::orbit::ihb::HbOptions;
 use crate::problem::PeriodicProblem;
-use fixed::{solve_crossings, CurveSystem};
 use fold_system::FoldSystem;
 use ivt_num::vector::norm2;
-use ivt_path::continuation::{
-    follow_residual, ContinuationOptions, Path, PathPoint, Termination, Turn,
+use ivt_path::continuation::{ContinuationOptions, Path, PathPoint, Termination};
+use ivt_path::events::{
+    observe_residual, Bifurcation, Crossing, Detector, Event, EventObserver, Fold, LocateOptions,
 };
+use ivt_path::{Branch, PathError};
 
 /// One fold on the curve.
 #[derive(Debug, Clone, PartialEq)]
@@ -75,25 +77,84 @@ pub struct Curve<T> {
 /// A fold curve in (ω, p).
 pub type FoldCurve = Curve<FoldPoint>;
 
-/// The curve of `sys` along `path` (joined [`Legs`]) with the given `cusps`:
-/// each path point mapped to its point and the points at each value of `at`
-/// of the path parameter (the last component) solved at fixed value.
-fn fold_curve_of<S: CurveSystem>(
-    sys: &mut S,
-    (path, termination): (Vec<PathPoint>, Termination),
-    at: &[f64],
-    cusps: Vec<S::Point>,
-    scale: f64,
-) -> Curve<S::Point> {
-    let p_index = path.first().map_or(0, |pt| pt.x.len().saturating_sub(1));
-    let located = solve_crossings(sys, &path, at, p_index, scale);
-    let points = path.iter().filter_map(|pt| sys.point(&pt.x)).collect();
-    Curve {
-        points,
-        at: located,
-        cusps,
-        termination,
+/// The extended system of a two-parameter curve: `n − 1` equations in the
+/// path vector `x` of `n` entries (the path parameter last), followed as a
+/// [`ivt_path::ResidualBranch`] by the one stepper.
+pub(crate) trait CurveSystem {
+    /// What a point of the curve reports.
+    type Point;
+
+    /// The residual at `x` into `r` (`n − 1` entries); `None` where it
+    /// cannot be evaluated (sizes disagree or the family fails at that `p`).
+    fn try_residual(&mut self, x: &[f64], r: &mut [f64]) -> Option<()>;
+
+    /// The curve's point at the path vector `x` (`None` if `x` is short).
+    fn point(&self, x: &[f64]) -> Option<Self::Point>;
+
+    /// [`Self::try_residual`], NaN where it cannot be evaluated (a failed
+    /// step to the path).
+    fn residual(&mut self, x: &[f64], r: &mut [f64]) {
+        if self.try_residual(x, r).is_none() {
+            r.fill(f64::NAN);
+        }
     }
+}
+
+/// The crossings of each value of `values` by component `index` of a
+/// curve's path vector, located to the residual's `scale`
+/// ([`Crossing::scaled`]).
+pub(crate) fn crossings(index: usize, values: &[f64], scale: f64) -> Vec<Crossing> {
+    (values.iter())
+        .map(|&v| Crossing::scaled(index, v, scale))
+        .collect()
+}
+
+/// One leg of a curve: its path and the events located on it as its points
+/// arrived, in path order.
+pub(crate) struct Leg {
+    /// The path.
+    pub path: Path,
+    /// Its events: the crossings (detector `i` is crossing `i`), then the
+    /// cusps (detector = the number of crossings).
+    pub events: Vec<Event<PathError>>,
+}
+
+/// Follows `residual` from `x0` with the sign `direction` of the path
+/// parameter's first change, to its end, the bounds of `opts` or the first
+/// point `keep` refuses, locating each of `watch` and (if `cusps`) the
+/// turning points in the path parameter ([`Fold`]) as the points arrive.
+///
+/// # Errors
+/// The start's failures as [`ivt_path::follow_residual`]'s.
+pub(crate) fn follow_leg(
+    residual: impl FnMut(&[f64], &mut [f64]),
+    x0: &[f64],
+    direction: f64,
+    opts: &ContinuationOptions,
+    (watch, cusps): (&[Crossing], bool),
+    keep: impl FnMut(&PathPoint) -> bool,
+) -> Result<Leg, HbError> {
+    let mut observer = EventObserver::new(&LocateOptions::default(), detectors(watch, cusps));
+    let (path, events) = observe_residual(residual, x0, direction, opts, &mut observer, keep)?;
+    Ok(Leg { path, events })
+}
+
+/// The detectors of a leg: `watch` in order, then the [`Fold`] if `cusps`.
+fn detectors<B: Branch>(watch: &[Crossing], cusps: bool) -> Vec<Box<dyn Detector<B, PathError>>> {
+    let mut found: Vec<Box<dyn Detector<B, PathError>>> = (watch.iter().cloned())
+        .map(|c| Box::new(c) as Box<dyn Detector<B, PathError>>)
+        .collect();
+    if cusps {
+        found.push(Box::new(Fold));
+    }
+    found
+}
+
+/// The path vector `[q, λ]` of a located event.
+pub(crate) fn event_vector(b: &Bifurcation) -> Vec<f64> {
+    let mut x = b.q.clone();
+    x.push(b.lambda);
+    x
 }
 
 /// The two legs of a curve through its start: the path from the start
@@ -105,13 +166,54 @@ fn fold_curve_of<S: CurveSystem>(
 /// are followed.
 pub(crate) struct Legs {
     /// From the start towards the first end.
-    pub first: Path,
+    pub first: Leg,
     /// From the start the other way.
-    pub second: Option<Path>,
+    pub second: Option<Leg>,
+}
+
+/// A curve's legs joined into one path from the first leg's end.
+pub(crate) struct Joined {
+    /// The points in path order.
+    pub points: Vec<PathPoint>,
+    /// The termination (see [`Legs::joined`]).
+    pub termination: Termination,
+    /// The events in the same order; an event that failed to locate is left
+    /// out.
+    pub events: Vec<(usize, Bifurcation)>,
+}
+
+impl Joined {
+    /// The located events of detector `d`, in path order.
+    pub(crate) fn of(&self, d: usize) -> impl Iterator<Item = &Bifurcation> + '_ {
+        (self.events.iter())
+            .filter(move |(detector, _)| *detector == d)
+            .map(|(_, b)| b)
+    }
+
+    /// The curve of `point` (a curve system's point at a path vector) with
+    /// the crossings of detectors `0..n_at` (value by value, each in path
+    /// order) as its `at` points and the events of detector `n_at` as its
+    /// cusps.
+    pub(crate) fn curve<T>(self, n_at: usize, point: impl Fn(&[f64]) -> Option<T>) -> Curve<T> {
+        let at = (0..n_at)
+            .flat_map(|d| self.of(d))
+            .filter_map(|b| point(&event_vector(b)))
+            .collect();
+        let cusps = self
+            .of(n_at)
+            .filter_map(|b| point(&event_vector(b)))
+            .collect();
+        Curve {
+            points: self.points.iter().filter_map(|pt| point(&pt.x)).collect(),
+            at,
+            cusps,
+            termination: self.termination,
+        }
+    }
 }
 
 impl Legs {
-    /// `trace(direction)` (the path from the start with that sign of the
+    /// `trace(direction)` (the leg from the start with that sign of the
     /// path parameter's initial change) for the direction from `p_start`
     /// towards `p_from`, then for the other.
     ///
@@ -119,12 +221,12 @@ impl Legs {
     /// `trace`'s.
     pub(crate) fn follow<E>(
         (p_start, p_from, p_to): (f64, f64, f64),
-        mut trace: impl FnMut(f64) -> Result<Path, E>,
+        mut trace: impl FnMut(f64) -> Result<Leg, E>,
     ) -> Result<Self, E> {
         let direction = if p_from < p_start { -1.0 } else { 1.0 };
         let first = trace(direction)?;
         let cut = matches!(
-            first.termination,
+            first.path.termination,
             Termination::Interrupted | Termination::MaxPoints
         );
         let second = if cut || p_start == p_to {
@@ -135,37 +237,38 @@ impl Legs {
         Ok(Self { first, second })
     }
 
-    /// `locate(path, turn)` for each turn of each leg (a cusp) that it
-    /// locates, in the order of [`Self::joined`].
-    pub(crate) fn cusps<T>(&self, mut locate: impl FnMut(&Path, &Turn) -> Option<T>) -> Vec<T> {
-        let mut found: Vec<T> = (self.first.events.iter())
-            .filter_map(|turn| locate(&self.first, turn))
-            .collect();
-        if let Some(path) = &self.second {
-            found.reverse();
-            found.extend(path.events.iter().filter_map(|turn| locate(path, turn)));
-        }
-        found
-    }
-
     /// One path: with two legs in order from the first leg's end (its points
-    /// reversed, then the second leg's after the shared start), with one the
-    /// first leg from the start. The termination is the last leg's, unless
-    /// the first failed (`step_too_small`): a failure is not hidden by the
-    /// other leg's normal end.
-    pub(crate) fn joined(self) -> (Vec<PathPoint>, Termination) {
+    /// and events reversed, then the second leg's after the shared start),
+    /// with one the first leg from the start. The termination is the last
+    /// leg's, unless the first failed (`step_too_small`): a failure is not
+    /// hidden by the other leg's normal end.
+    pub(crate) fn joined(self) -> Joined {
+        let located = |events: Vec<Event<PathError>>| {
+            (events.into_iter()).filter_map(|e| Some((e.detector, e.location.ok()?)))
+        };
         let Self { first, second } = self;
         match second {
             Some(second) => {
-                let mut points: Vec<PathPoint> = first.points.into_iter().rev().collect();
-                points.extend(second.points.into_iter().skip(1));
-                let termination = match first.termination {
+                let mut points: Vec<PathPoint> = first.path.points.into_iter().rev().collect();
+                points.extend(second.path.points.into_iter().skip(1));
+                let mut events: Vec<_> = located(first.events).collect();
+                events.reverse();
+                events.extend(located(second.events));
+                let termination = match first.path.termination {
                     failed @ Termination::StepTooSmall(_) => failed,
-                    _ => second.termination,
+                    _ => second.path.termination,
                 };
-                (points, termination)
+                Joined {
+                    points,
+                    termination,
+                    events,
+                }
             }
-            None => (first.points, first.termination),
+            None => Joined {
+                points: first.path.points,
+                termination: first.path.termination,
+                events: located(first.events).collect(),
+            },
         }
     }
 }
@@ -181,7 +284,7 @@ impl Legs {
 /// # Errors
 /// [`HbError::InvalidInput`] for sizes or bounds (`p_start` must lie in the
 /// interval); `family(p_start)`'s error; the start's failures as
-/// [`follow_residual`]'s. Later, a `p` where `family` fails is a failed
+/// [`ivt_path::follow_residual`]'s. Later, a `p` where `family` fails is a failed
 /// step, and a failed location of an `at` point or cusp is left out (the
 /// curve is kept).
 #[allow(clippy::too_many_arguments)]
@@ -213,59 +316,12 @@ where
     x0.extend_from_slice(&v0);
     x0.extend([omega, p_start]);
     let copts = bounded(opts, (lo, hi));
+    let watch = crossings(x0.len() - 1, at, norm2(start));
     let legs = Legs::follow((p_start, p_from, p_to), |direction| {
-        follow_curve(&mut sys, &x0, direction, &copts)
+        let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
+        follow_leg(residual, &x0, direction, &copts, (&watch, true), |_| true)
     })?;
-    let cusps = legs.cusps(|path, turn| locate_cusp(&mut sys, path, turn.bracket, &copts));
-    Ok(fold_curve_of(
-        &mut sys,
-        legs.joined(),
-        at,
-        cusps,
-        norm2(start),
-    ))
-}
-
-/// The turning point in `p` near `path.points[bracket..bracket + 3]`: a
-/// short path through the bracket with 1/100 of its spacing, and the vertex of
-/// the parabola through the three points around its own turn.
-fn locate_cusp<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
-    sys: &mut FoldSystem<'_, F>,
-    path: &Path,
-    bracket: usize,
-    opts: &ContinuationOptions,
-) -> Option<FoldPoint> {
-    let (a, b) = (path.points.get(bracket)?, path.points.get(bracket + 2)?);
-    let span: f64 =
-        a.x.iter()
-            .zip(&b.x)
-            .map(|(x, y)| (x - y).powi(2))
-            .sum::<f64>()
-            .sqrt();
-    let ds = span / 200.0;
-    let mut fine = opts.clone();
-    fine.ds = ds;
-    fine.ds_max = ds;
-    fine.ds_min = ds * 1e-3;
-    fine.max_points = 500;
-    let dir = if a.dlambda < 0.0 { -1.0 } else { 1.0 };
-    let mut turned = false;
-    let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
-    let local = follow_residual(residual, &a.x, None, dir, &fine, |pt| {
-        // Stop two points after the turn.
-        let stop = turned;
-        turned = turned || pt.dlambda * dir < 0.0;
-        !stop
-    })
-    .ok()?;
-    let fold = local.events.first()?;
-    let mut x = local.points.get(fold.index)?.x.clone();
-    if let Some(last) = x.last_mut() {
-        *last = fold.lambda;
-    }
-    let mut point = sys.point(&x)?;
-    point.p = fold.lambda;
-    Some(point)
+    Ok(legs.joined().curve(watch.len(), |x| sys.point(x)))
 }
 
 /// `opts` with the path parameter bounded to `[lo, hi]`.
@@ -274,29 +330,6 @@ fn bounded(opts: &ContinuationOptions, (lo, hi): (f64, f64)) -> ContinuationOpti
     copts.lambda_min = lo;
     copts.lambda_max = hi;
     copts
-}
-
-/// The path of the curve of `sys` from `x0` (the path parameter last) with
-/// the sign `direction` of the path parameter's first change, to its end or
-/// the bounds of `opts`.
-///
-/// # Errors
-/// The start's failures as [`follow_residual`]'s.
-fn follow_curve<S: CurveSystem>(
-    sys: &mut S,
-    x0: &[f64],
-    direction: f64,
-    opts: &ContinuationOptions,
-) -> Result<Path, HbError> {
-    let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
-    Ok(follow_residual(
-        residual,
-        x0,
-        None,
-        direction,
-        opts,
-        |_| true,
-    )?)
 }
 
 /// The interval `[lo, hi]` of `p` of a curve of `what` from `(ω, p_start)`.
@@ -319,25 +352,4 @@ pub(crate) fn path_interval(
     Err(HbError::InvalidInput(format!(
         "{what}: finite p_from ≠ p_to with the start's p between them, ω > 0"
     )))
-}
-
-/// Each pair of consecutive points of `path` whose component `index` brackets a
-/// value of `values`, with that value: `(a, b, value)`, values in the order
-/// given, pairs in path order.
-pub(crate) fn crossings<'p>(
-    path: &'p [PathPoint],
-    values: &'p [f64],
-    index: usize,
-) -> impl Iterator<Item = (&'p [f64], &'p [f64], f64)> + 'p {
-    values.iter().flat_map(move |&v| {
-        path.windows(2).filter_map(move |w| {
-            let [a, b] = w else { return None };
-            let (ya, yb) = (*a.x.get(index)?, *b.x.get(index)?);
-            // Strictly inside, or at the window's end (or the path's start):
-            // a point exactly at `v` counts once.
-            let first = std::ptr::eq(a, path.first()?);
-            let hit = (ya - v) * (yb - v) < 0.0 || yb == v || (first && ya == v);
-            (hit && ya != yb).then_some((a.x.as_slice(), b.x.as_slice(), v))
-        })
-    })
 }

@@ -6,7 +6,8 @@
 //! b₁ = 0, Eq. 61, pseudo-arclength Eq. 68–77) with Floquet stability at every
 //! point; its folds (turning points in p) are located as the points arrive,
 //! by the [`Fold`] detector: Newton on the fold system of the cycle equations
-//! ([`crate::locate_fold`]).
+//! ([`crate::locate_fold`]); so are the cycles at the requested values of p
+//! ([`Crossing`]: Newton at that p from the two points around it).
 //!
 //! The start: with the normal form `ż = (β(p) + iω) z + c₁ z|z|²`
 //! (`β = Re λ`, `l₁ = Re c₁/ω`) the cycle at p has `|z|² = −β/(ω l₁)` and
@@ -14,15 +15,19 @@
 //! taken at `p_H ± offset·|p_to − p_from|` and refined by [`limit_cycle`].
 
 use crate::branches::autonomous::{limit_cycle, limit_cycle_leg, LimitCycle};
-use crate::branches::events::{BifurcationKind, EventObserver, Fold, LocateOptions, Observer};
+use crate::branches::events::{
+    BifurcationKind, Detector, EventObserver, Fold, LocateOptions, Observer,
+};
 use crate::error::HbError;
 use crate::orbit::galerkin::GalerkinJacobian;
 use crate::orbit::ihb::{HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
 use crate::stability::hopf::{equilibrium, hopf_points, Field, HopfPoint, Undecided};
 use crate::BroydenStats;
+use ivt_num::vector::norm2;
 use ivt_path::branch::Branch;
 use ivt_path::continuation::{ContinuationOptions, PathPoint, Termination};
+use ivt_path::events::Crossing;
 
 pub(crate) mod member;
 use member::{Failures, Member};
@@ -123,10 +128,17 @@ where
     let (p_start, start) = start_cycle(&family, hb, first, opts.offset * (hi - lo), opts)?;
     let failures = Failures::default();
     let member = |p: f64| Member::new(family(p), n_dof, p, Some(&failures));
-    // Each fold (a turn in p) is located as the points arrive: the [`Fold`]
-    // detector on the cycle equations ([`CycleSystem`], unknowns {q, ω}).
+    // Each fold (a turn in p) and each cycle at a value of `at` is located
+    // as the points arrive: the [`Fold`] and [`Crossing`] detectors on the
+    // cycle equations ([`CycleSystem`], unknowns {q, ω}).
     let mut system = CycleSystem::new(&member, hb, p_start)?;
-    let mut observer = EventObserver::new(&LocateOptions::fold(), vec![Box::new(Fold)]);
+    let p_index = system.len();
+    let scale = norm2(&start.solution.coeffs);
+    let mut detectors: Vec<Box<dyn Detector<_, _>>> = vec![Box::new(Fold)];
+    for &p in &opts.at {
+        detectors.push(Box::new(Crossing::scaled(p_index, p, scale)));
+    }
+    let mut observer = EventObserver::new(&LocateOptions::fold(), detectors);
     let (mut events, mut failure) = (Vec::new(), None);
     let mut watch = |p: &PathPoint| match observer.on_point(&mut system, p) {
         Ok(found) => {
@@ -183,24 +195,39 @@ where
     }
     events.extend(observer.finish(&mut system)?);
     events.sort_by_key(|e| e.index);
-    out.folds = events
-        .into_iter()
+    // A located event's unknowns are `[q; ω]`; failed locations are left out.
+    let located = |e: &ivt_path::Event<HbError>| {
+        let at = e.location.as_ref().ok()?;
+        let (&omega_f, q) = at.q.split_last()?;
+        Some((at.lambda, q.to_vec(), omega_f))
+    };
+    out.folds = (events.iter())
         .filter(|e| e.kind == BifurcationKind::Fold)
-        .filter_map(|e| {
-            let fold = e.location.ok()?;
-            // The fold's unknowns are `[q; ω]`.
-            let (&omega_f, q) = fold.q.split_last()?;
+        .filter_map(located)
+        .map(|(p, coeffs, omega_f)| {
             let solution = HbSolution {
-                coeffs: q.to_vec(),
+                coeffs,
                 omega_f,
                 harmonics: hb.harmonics,
                 subharmonic: 1,
                 stats: BroydenStats::default(),
             };
-            Some((fold.lambda, solution))
+            (p, solution)
         })
         .collect();
-    out.at = cycles_at(&member, hb, &out.points, &opts.at, opts.stability_steps);
+    // The cycles at `at`, value by value, each in path order, with their
+    // multipliers (the located cycle refined by [`limit_cycle`]).
+    for d in 1..=opts.at.len() {
+        for (p, q, omega) in events
+            .iter()
+            .filter(|e| e.detector == d)
+            .filter_map(located)
+        {
+            if let Ok(c) = limit_cycle(&member(p), hb, omega, &q, steps) {
+                out.at.push((p, c));
+            }
+        }
+    }
     Ok(out)
 }
 
@@ -300,42 +327,6 @@ where
         }
     }
     Ok(None)
-}
-
-/// The cycles at each p of `at` where the branch crosses it, by
-/// [`limit_cycle`] from the interpolation of the two points around it
-/// (failures left out).
-fn cycles_at<P: PeriodicProblem>(
-    member: &impl Fn(f64) -> P,
-    hb: &HbOptions,
-    points: &[(f64, LimitCycle)],
-    at: &[f64],
-    steps: usize,
-) -> Vec<(f64, LimitCycle)> {
-    let mut found = Vec::new();
-    for &p in at {
-        for w in points.windows(2) {
-            let [(pa, ca), (pb, cb)] = w else {
-                continue;
-            };
-            if (pa - p) * (pb - p) > 0.0 || pa == pb {
-                continue;
-            }
-            let t = (p - pa) / (pb - pa);
-            let (sa, sb) = (&ca.solution, &cb.solution);
-            let q: Vec<f64> = sa
-                .coeffs
-                .iter()
-                .zip(&sb.coeffs)
-                .map(|(a, b)| a + t * (b - a))
-                .collect();
-            let omega = sa.omega_f + t * (sb.omega_f - sa.omega_f);
-            if let Ok(c) = limit_cycle(&member(p), hb, omega, &q, steps) {
-                found.push((p, c));
-            }
-        }
-    }
-    found
 }
 
 /// The cycle equations `[R(q, ω; p); b₁] = 0` in the unknowns `u = {q, ω}`

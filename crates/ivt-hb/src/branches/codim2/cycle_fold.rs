@@ -15,11 +15,11 @@
 //!
 //! in the path vector `x = [q, ω, v, μ, ν]` has one equation fewer than
 //! unknowns and is followed by the engine's pseudo-arclength continuation
-//! ([`ivt_path::continuation::Stepper`], Eq. 68–77) with ν as the path parameter, μ solved along. A
-//! cusp of cycle folds (two folds merging) is a turning point of this curve in
-//! ν: it is reported at the path's fold estimate (the vertex of the parabola
-//! through the three points around the turn), not refined further. The fold
-//! at each requested ν is solved at fixed ν by Newton (`fixed.rs`).
+//! ([`ivt_path::continuation::Stepper`], Eq. 68–77) with ν as the path
+//! parameter, μ solved along. A cusp of cycle folds (two folds merging) is a
+//! turning point of this curve in ν, located as the engine's fold of the
+//! extended system; the fold at each requested ν is the crossing of that
+//! value (both as the points arrive, as for [`super::fold_curve`]).
 //!
 //! Other codimension-two points are not detected: a Bautin (generalised
 //! Hopf) point, where the fold curve meets the Hopf curve at zero amplitude,
@@ -28,9 +28,8 @@
 
 use std::cell::Cell;
 
-use super::fixed::CurveSystem;
 use super::fold_system::{null_rows, split_fold_residual, split_fold_vector};
-use super::{bounded, fold_curve_of, follow_curve, path_interval, Curve, FoldPoint, Legs};
+use super::{bounded, crossings, follow_leg, path_interval, Curve, CurveSystem, FoldPoint, Legs};
 use crate::branches::cycle_branch::member::Member;
 use crate::branches::cycle_branch::CycleSystem;
 use crate::error::HbError;
@@ -54,7 +53,7 @@ pub struct CycleFoldPoint {
 }
 
 /// A curve of folds of limit cycles in (μ, ν); its cusps are turning points
-/// in ν (the path's estimate).
+/// in ν.
 pub type CycleFoldCurve = Curve<CycleFoldPoint>;
 
 /// Follows the fold of limit cycles of `family(μ, ν)` (autonomous: no
@@ -62,15 +61,15 @@ pub type CycleFoldCurve = Curve<CycleFoldPoint>;
 /// `(mu, nu_start)`: its coefficients with phase `b₁ = 0` and ω) in ν,
 /// first towards `nu_from` of `(nu_from, nu_to)` until ν leaves the
 /// interval between them, then from the start towards `nu_to` (`Legs`);
-/// the folds at each ν of `at` are solved exactly and the cusps reported
-/// (module docs).
+/// the folds at each ν of `at` and the cusps are located (module docs).
 ///
 /// # Errors
 /// [`HbError::InvalidInput`] for sizes or bounds (`nu_start` must lie in the
 /// interval); `family(mu, nu_start)`'s error; [`PathError::SingularStart`]
 /// if no null vector is found at the start; the start's failures as
 /// [`follow_residual`](ivt_path::continuation::follow_residual)'s. Later, a (μ, ν) where `family` fails is a failed step,
-/// and a failed `at` point is left out (the curve is kept).
+/// and a failed location of an `at` point or cusp is left out (the curve
+/// is kept).
 pub fn cycle_fold_curve<P, F>(
     family: F,
     hb: &HbOptions,
@@ -109,21 +108,12 @@ where
     x0.extend_from_slice(&v0);
     x0.extend([mu, nu_start]);
     let copts = bounded(opts, (lo, hi));
+    let watch = crossings(x0.len() - 1, at, norm2(&start.coeffs));
     let legs = Legs::follow((nu_start, nu_from, nu_to), |direction| {
-        follow_curve(&mut sys, &x0, direction, &copts)
+        let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
+        follow_leg(residual, &x0, direction, &copts, (&watch, true), |_| true)
     })?;
-    let cusps = legs.cusps(|path, turn| {
-        let mut point = sys.point(&path.points.get(turn.index)?.x)?;
-        point.fold.p = turn.lambda;
-        Some(point)
-    });
-    Ok(fold_curve_of(
-        &mut sys,
-        legs.joined(),
-        at,
-        cusps,
-        norm2(&start.coeffs),
-    ))
+    Ok(legs.joined().curve(watch.len(), |x| sys.point(x)))
 }
 
 /// The extended system of a cycle fold: the cycle equations of

@@ -4,7 +4,7 @@
 //! the residual planned anew when `p` changes (the excitation may depend on
 //! it).
 
-use super::fixed::CurveSystem;
+use super::CurveSystem;
 use super::FoldPoint;
 use crate::error::HbError;
 use crate::orbit::galerkin::GalerkinJacobian;

@@ -22,9 +22,11 @@
 //! Each system has one equation fewer than unknowns and is followed by the
 //! engine's pseudo-arclength continuation ([`ivt_path::continuation::Stepper`], Eq. 68–77)
 //! with `p` as the path parameter (Φ's derivatives by the path's finite
-//! differences). The point at each `p` of `at` is solved at that `p` by
-//! Newton (`fixed.rs`). On a Neimark–Sacker curve the strong resonances 1:3
-//! and 1:4 (θ = 2π/3, π/2) it crosses are located the same way at fixed θ.
+//! differences). The point at each `p` of `at` is located as the points
+//! arrive, solved at that `p` by Newton (the crossing of a set value, as on
+//! every curve of [`super`]). On a Neimark–Sacker curve the strong
+//! resonances 1:3 and 1:4 (θ = 2π/3, π/2) it crosses are located the same
+//! way at fixed θ.
 //! At the resonances 1:1 and 1:2 (θ = 0 or π) the NS curve ends on a fold or
 //! a period-doubling curve: past them the path would run back along the
 //! same curve on the conjugate pair, so it stops at the first point past
@@ -34,8 +36,9 @@
 //! on the curve, the end is extrapolated from the points at θ_e ± h and
 //! θ_e ± 2h.
 
-use super::fixed::{solve_crossings, CurveSystem};
-use super::{bounded, path_interval, Legs};
+use super::{
+    bounded, crossings, event_vector, follow_leg, path_interval, CurveSystem, Joined, Legs,
+};
 use crate::branches::events::{BifurcationKind, LocateOptions};
 use crate::error::HbError;
 use crate::orbit::ihb::{HbOptions, HbResidual, HbSolution};
@@ -44,7 +47,7 @@ use crate::stability::floquet::{eigenvalues, monodromy_uniform, HsuRule};
 use crate::stability::StabilityAnalyzer;
 use ivt_num::vector::{dot, norm2};
 use ivt_num::LuWorkspace;
-use ivt_path::continuation::{follow_residual, ContinuationOptions, PathPoint, Termination};
+use ivt_path::continuation::{ContinuationOptions, PathPoint, Termination};
 use ivt_path::events::extended::null_vector;
 use ivt_path::PathError;
 use std::f64::consts::{PI, TAU};
@@ -109,7 +112,7 @@ pub struct BifurcationCurve {
 /// [`HbError::InvalidInput`] for sizes, bounds (`start.p` must lie in the
 /// interval), a kind other than the two, or a start whose monodromy matrix
 /// has no such multiplier near the unit circle; `family(start.p)`'s error;
-/// the path's start failures as [`follow_residual`]'s. Later, a `p` where
+/// the path's start failures as [`ivt_path::follow_residual`]'s. Later, a `p` where
 /// `family` fails is a failed step, and a failed location of an `at` point
 /// or resonance is left out (the curve is kept).
 pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
@@ -142,44 +145,73 @@ pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
     let x0 = sys.start_vector(&start.coeffs, start.omega, p_start)?;
     let copts = bounded(opts, (lo, hi));
     let theta_index = m + 1;
+    let p_index = x0.len() - 1;
+    // The events located as the points arrive: the `at` values of p, and on
+    // a Neimark–Sacker curve the angles of the strong resonances (1:3, 1:4)
+    // and those the ends at 1:1 and 1:2 are extrapolated from.
+    let scale = norm2(&start.coeffs);
+    let mut watch = crossings(p_index, at, scale);
+    let (near_ends, strong) = if ns {
+        let h = RESONANCE_STEP;
+        let ends = [
+            (1, 0.0, h),
+            (1, 0.0, 2.0 * h),
+            (2, PI, -h),
+            (2, PI, -2.0 * h),
+        ];
+        (ends.to_vec(), vec![(3, TAU / 3.0), (4, PI / 2.0)])
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    let first_near = watch.len();
+    let angles = (near_ends.iter().map(|(_, end, h)| end + h))
+        .chain(strong.iter().map(|&(_, theta)| theta))
+        .collect::<Vec<_>>();
+    watch.extend(crossings(theta_index, &angles, scale));
     // A Neimark–Sacker path through θ = 0 or π (1:1, 1:2) continues on the
     // conjugate pair back along the same curve: it stops at the point past.
     let legs = Legs::follow((p_start, p_from, p_to), |direction| {
         let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
-        follow_residual(residual, &x0, None, direction, &copts, |pt| {
+        follow_leg(residual, &x0, direction, &copts, (&watch, false), |pt| {
             !ns || pt.x.get(theta_index).is_none_or(|t| t.sin() > 0.0)
         })
     })?;
-    let (mut path, termination) = legs.joined();
-    let scale = norm2(&start.coeffs);
-    let p_index = x0.len() - 1;
-    let mut solve = |path: &[PathPoint], index: usize, values: &[f64]| {
-        solve_crossings(&mut sys, path, values, index, scale)
+    let joined = legs.joined();
+    let first_of = |d: usize| {
+        joined
+            .of(d)
+            .next()
+            .and_then(|b| sys.point(&event_vector(b)))
     };
-    let located = solve(&path, p_index, at);
+    let located = (0..first_near)
+        .flat_map(|d| joined.of(d))
+        .filter_map(|b| sys.point(&event_vector(b)))
+        .collect();
     let mut resonances = Vec::new();
-    if ns {
-        // An end at θ = 0 or π: the NS system degenerates there (every
-        // point of the fold or PD curve solves it), and p, ω, q are even in
-        // θ − θ_e: Richardson from the points at θ_e ± h and ± 2h (inside).
-        let past = |pt: &PathPoint| pt.x.get(theta_index).is_some_and(|t| t.sin() <= 0.0);
-        for (order, end, inward) in [(1, 0.0, 1.0), (2, PI, -1.0)] {
-            let reached = path
-                .iter()
-                .filter(|pt| past(pt))
-                .any(|pt| pt.x.get(theta_index).is_some_and(|t| (t - end).abs() < 0.5));
-            let h = inward * RESONANCE_STEP;
-            let near = solve(&path, theta_index, &[end + h]);
-            let far = solve(&path, theta_index, &[end + 2.0 * h]);
-            if let (true, Some(a), Some(b)) = (reached, near.first(), far.first()) {
-                resonances.push((order, richardson(a, b, end)));
-            }
-        }
-        for (order, theta) in [(3, TAU / 3.0), (4, PI / 2.0)] {
-            let found = solve(&path, theta_index, &[theta]);
-            resonances.extend(found.into_iter().map(|pt| (order, pt)));
+    // An end at θ = 0 or π: the NS system degenerates there (every point of
+    // the fold or PD curve solves it), and p, ω, q are even in θ − θ_e:
+    // Richardson from the points at θ_e ± h and ± 2h (inside).
+    let past = |pt: &PathPoint| pt.x.get(theta_index).is_some_and(|t| t.sin() <= 0.0);
+    for (k, pair) in near_ends.chunks_exact(2).enumerate() {
+        let [(order, end, _), _] = pair else { continue };
+        let reached = (joined.points.iter())
+            .filter(|pt| past(pt))
+            .any(|pt| pt.x.get(theta_index).is_some_and(|t| (t - end).abs() < 0.5));
+        let d = first_near + 2 * k;
+        if let (true, Some(a), Some(b)) = (reached, first_of(d), first_of(d + 1)) {
+            resonances.push((*order, richardson(&a, &b, *end)));
         }
     }
+    for (k, &(order, _)) in strong.iter().enumerate() {
+        let d = first_near + near_ends.len() + k;
+        let found = joined.of(d).filter_map(|b| sys.point(&event_vector(b)));
+        resonances.extend(found.map(|pt| (order, pt)));
+    }
+    let Joined {
+        points: mut path,
+        termination,
+        ..
+    } = joined;
     // The points past a 1:1 or 1:2 end are not on the curve.
     path.retain(|pt| !ns || pt.x.get(theta_index).is_none_or(|t| t.sin() > 0.0));
     let points = path.iter().filter_map(|pt| sys.point(&pt.x)).collect();
