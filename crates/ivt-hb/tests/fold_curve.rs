@@ -129,15 +129,13 @@ fn duffing_fold_curve_through_the_cusp_matches_shooting() {
     assert!((cusp.p - f_cusp).abs() < 1e-6 * f_cusp);
 }
 
-/// A first leg that fails (the family has no model below F = 0.09, so the
-/// path towards F = 0 stalls there) is reported as `step_too_small`, not
-/// hidden by the second leg's normal end; the second leg still runs (the
-/// upper fold at F = 0.2, by shooting 2.2115927040).
-#[test]
-fn a_failed_first_leg_is_not_hidden_by_the_second() {
+/// The fold curve of the Duffing family with F = 0.1's upper fold as its
+/// start, on [0, 0.3] with the folds at `at`, where the family has no
+/// model for the F that `missing` selects.
+fn upper_curve_without(missing: impl Fn(f64) -> bool, at: &[f64]) -> ivt_hb::FoldCurve {
     let family = |f: f64| -> Result<Duffing, HbError> {
-        if f < 0.09 {
-            Err(HbError::InvalidInput("no model below F = 0.09".into()))
+        if missing(f) {
+            Err(HbError::InvalidInput(format!("no model at F = {f}")))
         } else {
             Ok(Duffing::new(0.02, 1.0, 1.0, f))
         }
@@ -147,7 +145,8 @@ fn a_failed_first_leg_is_not_hidden_by_the_second() {
     let start = (frc.events.iter())
         .max_by(|a, b| a.omega_f.total_cmp(&b.omega_f))
         .unwrap();
-    let curve = fold_curve(
+    let steps = common::curve_steps(2000);
+    fold_curve(
         family,
         &hb,
         &start.coeffs,
@@ -155,10 +154,19 @@ fn a_failed_first_leg_is_not_hidden_by_the_second() {
         0.1,
         0.0,
         0.3,
-        &[0.2],
-        &common::curve_steps(2000),
+        at,
+        &steps,
     )
-    .unwrap();
+    .unwrap()
+}
+
+/// A first leg that fails (the family has no model below F = 0.09, so the
+/// path towards F = 0 stalls there) is reported as `step_too_small`, not
+/// hidden by the second leg's normal end; the second leg still runs (the
+/// upper fold at F = 0.2, by shooting 2.2115927040).
+#[test]
+fn a_failed_first_leg_is_not_hidden_by_the_second() {
+    let curve = upper_curve_without(|f| f < 0.09, &[0.2]);
     assert!(
         matches!(curve.termination, Termination::StepTooSmall(_)),
         "{:?}",
@@ -169,4 +177,29 @@ fn a_failed_first_leg_is_not_hidden_by_the_second() {
         upper.iter().any(|w| (w - 2.2115927040).abs() < 1e-7),
         "{upper:?}"
     );
+}
+
+/// A point the path passes but cannot locate is reported, not dropped: the
+/// family has no model at F = 0.2 exactly (the path steps over it), so the
+/// fold there cannot be solved. From the upper F = 0.1 fold to F = 0.3 the
+/// curve passes F = 0.2 twice (once on each fold, as in the test above):
+/// both are `unlocated` with the value and the solver's reason; F = 0.25 is
+/// located on both folds as usual.
+#[test]
+fn an_at_value_that_cannot_be_solved_is_reported_unlocated() {
+    let curve = upper_curve_without(|f| f == 0.2, &[0.2, 0.25]);
+    assert_eq!(curve.termination, Termination::LeftInterval);
+    let located: Vec<f64> = curve.at.iter().map(|a| a.p).collect();
+    assert_eq!(located, [0.25, 0.25], "{located:?}");
+    assert_eq!(curve.unlocated.len(), 2, "{:?}", curve.unlocated);
+    for u in &curve.unlocated {
+        assert_eq!((u.what, u.value), ("at", Some(0.2)));
+        // The locator's start: the path point before the crossing.
+        assert!((u.near.p - 0.2).abs() < 0.05, "{u:?}");
+        assert!(!u.reason.is_empty(), "{u:?}");
+        eprintln!(
+            "unlocated at F = 0.2 near ω = {:.4}: {}",
+            u.near.omega, u.reason
+        );
+    }
 }

@@ -9,7 +9,7 @@
 //! of `family(p_start)` over an interval.
 
 use super::{all_finite, finite, finite_list, path_steps, Array, FrcRequest, Steps};
-use ivt_hb::branches::codim2::{bifurcation_curve, CurvePoint, CurveStart};
+use ivt_hb::branches::codim2::{bifurcation_curve, CurvePoint, CurveStart, Unlocated};
 use ivt_hb::branches::events::BifurcationKind;
 use ivt_hb::branches::frc::{frequency_response, FrcOptions};
 use ivt_hb::orbit::ihb::{HbOptions, HbSolution};
@@ -173,6 +173,22 @@ pub struct SpecialPoint {
     pub point: CurveFoldPoint,
 }
 
+/// A point the curve passed but could not locate (`ivt_hb`'s
+/// `Unlocated`): what was sought, the path point the locator started from,
+/// and why it failed.
+#[derive(Debug, Clone, Serialize)]
+pub struct UnlocatedPoint {
+    /// `"at"`, `"cusp"` or `"resonance_1_1"` … `"resonance_1_4"`.
+    pub what: &'static str,
+    /// The requested `p` of an `at` point (absent otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub value: Option<f64>,
+    /// The locator's failure in words.
+    pub reason: String,
+    /// The path point the locator started from.
+    pub near: CurveFoldPoint,
+}
+
 /// A bifurcation curve: the keys of `ivt hb duffing-folds --json`,
 /// `ivt hb vdp-torus --json` and of the dicts of `ivt.hb.duffing_folds` and
 /// `ivt.hb.continue_bifurcation`.
@@ -190,6 +206,9 @@ pub struct FoldCurveResult {
     /// in that order (Neimark–Sacker curves); none on period-doubling
     /// curves.
     pub special: Vec<SpecialPoint>,
+    /// The `at` points, cusps and resonances the path passed but whose
+    /// location failed, in path order (none is dropped silently).
+    pub unlocated: Vec<UnlocatedPoint>,
     /// Why the path stopped.
     pub termination: Termination,
     /// Wall time of the whole job (the start's FRC included).
@@ -220,7 +239,7 @@ where
     };
     let copts = req.path()?;
     let h = hb.harmonics;
-    let (points, at, special, termination) = if req.kind == BifurcationKind::Fold {
+    let (points, at, special, unlocated, termination) = if req.kind == BifurcationKind::Fold {
         let curve = ivt_hb::fold_curve(
             family,
             hb,
@@ -241,6 +260,7 @@ where
             curve.points.iter().map(fold).collect(),
             curve.at.iter().map(fold).collect(),
             cusps.collect(),
+            unlocated_points(&curve.unlocated, fold),
             curve.termination,
         )
     } else {
@@ -269,6 +289,7 @@ where
             curve.points.iter().map(point).collect(),
             curve.at.iter().map(point).collect(),
             special.collect(),
+            unlocated_points(&curve.unlocated, point),
             curve.termination,
         )
     };
@@ -278,9 +299,26 @@ where
         points,
         at,
         special,
+        unlocated,
         termination,
         time_s: t0.elapsed().as_secs_f64(),
     })
+}
+
+/// The curve's unlocated points with `point` (its sample of a curve point)
+/// as their `near`.
+fn unlocated_points<T>(
+    unlocated: &[Unlocated<T>],
+    point: impl Fn(&T) -> CurveFoldPoint,
+) -> Vec<UnlocatedPoint> {
+    (unlocated.iter())
+        .map(|u| UnlocatedPoint {
+            what: u.what,
+            value: u.value,
+            reason: u.reason.clone(),
+            near: point(&u.near),
+        })
+        .collect()
 }
 
 /// The located point of `req.kind` of largest ω_f on the FRC of

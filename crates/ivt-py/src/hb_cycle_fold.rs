@@ -64,7 +64,9 @@ family_fn! {
 /// (as `cycle_branch`). The folds at each ν of `at` are solved exactly.
 /// Returns {"points": [{"mu", "nu", "omega", "amplitude", "coeffs"}...],
 /// "at": [...], "special": [{"kind": "cusp", ...}...] (turning points in
-/// ν, located as the fold of the curve), "termination"}.
+/// ν, located as the fold of the curve), "unlocated": [{"what": "at" |
+/// "cusp", "value" (an `at` ν), "reason", "near": the path point}...] (points
+/// the curve passed whose location failed), "termination"}.
 fn cycle_fold_curve<'py>(py, args) [
     nu_from: f64,
     nu_to: f64,
@@ -106,6 +108,18 @@ fn cycle_fold_curve<'py>(py, args) [
     out.set_item("points", list(&curve.points)?)?;
     out.set_item("at", list(&curve.at)?)?;
     out.set_item("special", special)?;
+    let unlocated = PyList::empty(py);
+    for u in &curve.unlocated {
+        let d = PyDict::new(py);
+        d.set_item("what", u.what)?;
+        if let Some(v) = u.value {
+            d.set_item("value", v)?;
+        }
+        d.set_item("reason", &u.reason)?;
+        d.set_item("near", point_dict(py, &u.near, harmonics)?)?;
+        unlocated.append(d)?;
+    }
+    out.set_item("unlocated", unlocated)?;
     out.set_item("termination", curve.termination.as_str())?;
     Ok(out)
 }

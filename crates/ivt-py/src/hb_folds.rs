@@ -54,7 +54,10 @@ family_fn! {
 /// [`ivt_jobs::FoldCurveResult`]: {"kind", "start_omega", "points":
 /// [{"omega", "p", "amplitude", "coeffs", "angle" (not on folds)}...],
 /// "at": [...], "special": [{"kind": "cusp" | "resonance_1_1" | ...,
-/// "omega", "p", "amplitude", "coeffs"}...], "termination", "time_s"}.
+/// "omega", "p", "amplitude", "coeffs"}...], "unlocated": [{"what": "at" |
+/// "cusp" | "resonance_1_1" | ..., "value" (an `at` p), "reason", "near":
+/// the path point}...] (points the curve passed whose location failed),
+/// "termination", "time_s"}.
 fn continue_bifurcation<'py>(py, args) [
     start: &Bound<'py, PyDict>,
     p_from: f64,

@@ -163,6 +163,28 @@ def test_continue_bifurcation_duffing_fold_curve_to_the_cusp():
     (cusp,) = curve["special"]
     assert cusp["kind"] == "cusp" and abs(cusp["p"] / 0.0120510724 - 1) < 1e-6
     assert set(curve["points"][0]) >= {"omega", "p", "amplitude", "coeffs"}
+    assert curve["unlocated"] == []
+
+
+def test_continue_bifurcation_reports_an_at_point_it_cannot_solve():
+    # The forcing fails at F = 0.2 exactly (the path steps over it): the fold
+    # curve passes F = 0.2 on both folds but cannot solve either there. Both
+    # are reported in "unlocated" with the value, the reason and the path
+    # point the solve started from; F = 0.25 is located on both folds.
+    def family(F):
+        def force(th):
+            if F == 0.2:
+                raise ValueError("no force at F = 0.2")
+            return F * np.cos(th)
+        return (1.0, 0.04, 1.0, hb.elements.cubic_spring(1.0), force)
+
+    frc = hb.frc(*family(0.1), 0.5, 2.5, n=15, events=True)
+    start = max((b for b in frc["bifurcations"] if b["kind"] == "fold"), key=lambda b: b["omega"])
+    curve = hb.continue_bifurcation(family, start, 0.0, 0.3, at=[0.2, 0.25], p_start=0.1, n=15)
+    assert sorted(a["p"] for a in curve["at"]) == [0.25, 0.25]
+    assert [(u["what"], u["value"]) for u in curve["unlocated"]] == [("at", 0.2)] * 2
+    for u in curve["unlocated"]:
+        assert abs(u["near"]["p"] - 0.2) < 0.05 and u["reason"], u
 
 
 def test_continue_bifurcation_reraises_the_family_error():

@@ -70,12 +70,31 @@ pub struct Curve<T> {
     pub at: Vec<T>,
     /// Cusps: turning points of the curve in its path parameter.
     pub cusps: Vec<T>,
+    /// The `at` points and cusps the path passed but whose location failed,
+    /// in path order.
+    pub unlocated: Vec<Unlocated<T>>,
     /// Why tracing stopped.
     pub termination: Termination,
 }
 
 /// A fold curve in (ω, p).
 pub type FoldCurve = Curve<FoldPoint>;
+
+/// A point of a curve that the path passed (its test changed sign between
+/// two path points) but that could not be located: what it is, the path
+/// point the locator started from, and why it failed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Unlocated<T> {
+    /// What was sought: `"at"` (with the value in `value`), `"cusp"`, or a
+    /// resonance (`"resonance_1_3"`, …).
+    pub what: &'static str,
+    /// The requested value of an `at` point (`None` otherwise).
+    pub value: Option<f64>,
+    /// The path point the locator started from.
+    pub near: T,
+    /// The locator's failure.
+    pub reason: String,
+}
 
 /// The extended system of a two-parameter curve: `n − 1` equations in the
 /// path vector `x` of `n` entries (the path parameter last), followed as a
@@ -117,6 +136,26 @@ pub(crate) struct Leg {
     /// Its events: the crossings (detector `i` is crossing `i`), then the
     /// cusps (detector = the number of crossings).
     pub events: Vec<Event<PathError>>,
+}
+
+impl Leg {
+    /// The leg's events split into the located (detector, location) and the
+    /// failed (detector, the locator's start point, error), each in path
+    /// order.
+    #[allow(clippy::type_complexity)]
+    fn split(&self) -> (Vec<(usize, Bifurcation)>, Vec<(usize, Vec<f64>, PathError)>) {
+        let (mut located, mut failed) = (Vec::new(), Vec::new());
+        for e in &self.events {
+            match &e.location {
+                Ok(b) => located.push((e.detector, b.clone())),
+                Err(err) => {
+                    let start = self.path.points.get(e.index).map(|p| p.x.clone());
+                    failed.push((e.detector, start.unwrap_or_default(), err.clone()));
+                }
+            }
+        }
+        (located, failed)
+    }
 }
 
 /// Follows `residual` from `x0` with the sign `direction` of the path
@@ -177,9 +216,11 @@ pub(crate) struct Joined {
     pub points: Vec<PathPoint>,
     /// The termination (see [`Legs::joined`]).
     pub termination: Termination,
-    /// The events in the same order; an event that failed to locate is left
-    /// out.
+    /// The located events in the same order: (detector, location).
     pub events: Vec<(usize, Bifurcation)>,
+    /// The events that failed to locate, in the same order: (detector, the
+    /// locator's start point, its error).
+    pub failed: Vec<(usize, Vec<f64>, PathError)>,
 }
 
 impl Joined {
@@ -194,7 +235,12 @@ impl Joined {
     /// the crossings of detectors `0..n_at` (value by value, each in path
     /// order) as its `at` points and the events of detector `n_at` as its
     /// cusps.
-    pub(crate) fn curve<T>(self, n_at: usize, point: impl Fn(&[f64]) -> Option<T>) -> Curve<T> {
+    pub(crate) fn curve<T>(
+        self,
+        watch: &[Crossing],
+        point: impl Fn(&[f64]) -> Option<T>,
+    ) -> Curve<T> {
+        let n_at = watch.len();
         let at = (0..n_at)
             .flat_map(|d| self.of(d))
             .filter_map(|b| point(&event_vector(b)))
@@ -203,12 +249,37 @@ impl Joined {
             .of(n_at)
             .filter_map(|b| point(&event_vector(b)))
             .collect();
+        let unlocated = self.unlocated(&point, |d| match watch.get(d) {
+            Some(c) => Some(("at", Some(c.value()))),
+            None => Some(("cusp", None)),
+        });
         Curve {
             points: self.points.iter().filter_map(|pt| point(&pt.x)).collect(),
             at,
             cusps,
+            unlocated,
             termination: self.termination,
         }
+    }
+
+    /// The failed events as [`Unlocated`] points, `what(detector)` naming
+    /// each (and giving its value, if any; `None` leaves it out).
+    pub(crate) fn unlocated<T>(
+        &self,
+        point: impl Fn(&[f64]) -> Option<T>,
+        what: impl Fn(usize) -> Option<(&'static str, Option<f64>)>,
+    ) -> Vec<Unlocated<T>> {
+        (self.failed.iter())
+            .filter_map(|(d, start, e)| {
+                let (what, value) = what(*d)?;
+                Some(Unlocated {
+                    what,
+                    value,
+                    near: point(start)?,
+                    reason: e.to_string(),
+                })
+            })
+            .collect()
     }
 }
 
@@ -243,17 +314,17 @@ impl Legs {
     /// leg's, unless the first failed (`step_too_small`): a failure is not
     /// hidden by the other leg's normal end.
     pub(crate) fn joined(self) -> Joined {
-        let located = |events: Vec<Event<PathError>>| {
-            (events.into_iter()).filter_map(|e| Some((e.detector, e.location.ok()?)))
-        };
         let Self { first, second } = self;
+        let (mut events, mut failed) = first.split();
         match second {
             Some(second) => {
+                events.reverse();
+                failed.reverse();
+                let (more, more_failed) = second.split();
+                events.extend(more);
+                failed.extend(more_failed);
                 let mut points: Vec<PathPoint> = first.path.points.into_iter().rev().collect();
                 points.extend(second.path.points.into_iter().skip(1));
-                let mut events: Vec<_> = located(first.events).collect();
-                events.reverse();
-                events.extend(located(second.events));
                 let termination = match first.path.termination {
                     failed @ Termination::StepTooSmall(_) => failed,
                     _ => second.path.termination,
@@ -262,12 +333,14 @@ impl Legs {
                     points,
                     termination,
                     events,
+                    failed,
                 }
             }
             None => Joined {
                 points: first.path.points,
                 termination: first.path.termination,
-                events: located(first.events).collect(),
+                events,
+                failed,
             },
         }
     }
@@ -285,8 +358,8 @@ impl Legs {
 /// [`HbError::InvalidInput`] for sizes or bounds (`p_start` must lie in the
 /// interval); `family(p_start)`'s error; the start's failures as
 /// [`ivt_path::follow_residual`]'s. Later, a `p` where `family` fails is a failed
-/// step, and a failed location of an `at` point or cusp is left out (the
-/// curve is kept).
+/// step, and an `at` point or cusp whose location fails is reported in
+/// [`Curve::unlocated`] with the reason (the curve is kept).
 #[allow(clippy::too_many_arguments)]
 pub fn fold_curve<P, F>(
     family: F,
@@ -321,7 +394,7 @@ where
         let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
         follow_leg(residual, &x0, direction, &copts, (&watch, true), |_| true)
     })?;
-    Ok(legs.joined().curve(watch.len(), |x| sys.point(x)))
+    Ok(legs.joined().curve(&watch, |x| sys.point(x)))
 }
 
 /// `opts` with the path parameter bounded to `[lo, hi]`.

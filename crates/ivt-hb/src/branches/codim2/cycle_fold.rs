@@ -68,8 +68,8 @@ pub type CycleFoldCurve = Curve<CycleFoldPoint>;
 /// interval); `family(mu, nu_start)`'s error; [`PathError::SingularStart`]
 /// if no null vector is found at the start; the start's failures as
 /// [`follow_residual`](ivt_path::continuation::follow_residual)'s. Later, a (μ, ν) where `family` fails is a failed step,
-/// and a failed location of an `at` point or cusp is left out (the curve
-/// is kept).
+/// and an `at` point or cusp whose location fails is reported in
+/// [`Curve::unlocated`] with the reason (the curve is kept).
 pub fn cycle_fold_curve<P, F>(
     family: F,
     hb: &HbOptions,
@@ -113,7 +113,7 @@ where
         let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
         follow_leg(residual, &x0, direction, &copts, (&watch, true), |_| true)
     })?;
-    Ok(legs.joined().curve(watch.len(), |x| sys.point(x)))
+    Ok(legs.joined().curve(&watch, |x| sys.point(x)))
 }
 
 /// The extended system of a cycle fold: the cycle equations of

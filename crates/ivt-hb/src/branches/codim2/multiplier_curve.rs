@@ -38,6 +38,7 @@
 
 use super::{
     bounded, crossings, event_vector, follow_leg, path_interval, CurveSystem, Joined, Legs,
+    Unlocated,
 };
 use crate::branches::events::{BifurcationKind, LocateOptions};
 use crate::error::HbError;
@@ -95,6 +96,9 @@ pub struct BifurcationCurve {
     /// and 1:2 where the curve ends (θ = 0 on a fold curve, θ = π on a
     /// period-doubling curve), 1:3 and 1:4 where it crosses θ = 2π/3, π/2.
     pub resonances: Vec<(u32, CurvePoint)>,
+    /// The `at` points and resonances the path passed but whose location
+    /// failed, in path order, with the reason.
+    pub unlocated: Vec<Unlocated<CurvePoint>>,
     /// Why tracing stopped.
     pub termination: Termination,
 }
@@ -113,8 +117,9 @@ pub struct BifurcationCurve {
 /// interval), a kind other than the two, or a start whose monodromy matrix
 /// has no such multiplier near the unit circle; `family(start.p)`'s error;
 /// the path's start failures as [`ivt_path::follow_residual`]'s. Later, a `p` where
-/// `family` fails is a failed step, and a failed location of an `at` point
-/// or resonance is left out (the curve is kept).
+/// `family` fails is a failed step, and an `at` point or resonance whose
+/// location fails is reported in [`BifurcationCurve::unlocated`] (the curve
+/// is kept).
 pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
     family: F,
     hb: &HbOptions,
@@ -188,6 +193,7 @@ pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
         .filter_map(|b| sys.point(&event_vector(b)))
         .collect();
     let mut resonances = Vec::new();
+    let mut reached_ends = [false; 2];
     // An end at θ = 0 or π: the NS system degenerates there (every point of
     // the fold or PD curve solves it), and p, ω, q are even in θ − θ_e:
     // Richardson from the points at θ_e ± h and ± 2h (inside).
@@ -198,6 +204,9 @@ pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
             .filter(|pt| past(pt))
             .any(|pt| pt.x.get(theta_index).is_some_and(|t| (t - end).abs() < 0.5));
         let d = first_near + 2 * k;
+        if let Some(r) = reached_ends.get_mut(k) {
+            *r = reached;
+        }
         if let (true, Some(a), Some(b)) = (reached, first_of(d), first_of(d + 1)) {
             resonances.push((*order, richardson(&a, &b, *end)));
         }
@@ -207,6 +216,23 @@ pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
         let found = joined.of(d).filter_map(|b| sys.point(&event_vector(b)));
         resonances.extend(found.map(|pt| (order, pt)));
     }
+    // A failed `at` point, strong resonance or, where the curve reached its
+    // end, one of the two points an end is extrapolated from.
+    let unlocated = joined.unlocated(
+        |x| sys.point(x),
+        |d| {
+            if d < first_near {
+                return Some(("at", at.get(d).copied()));
+            }
+            let k = d - first_near;
+            if let Some((order, _, _)) = near_ends.get(k) {
+                let reached = reached_ends.get(k / 2).copied().unwrap_or(false);
+                return reached.then_some((resonance_name(*order), None));
+            }
+            let (order, _) = strong.get(k - near_ends.len())?;
+            Some((resonance_name(*order), None))
+        },
+    );
     let Joined {
         points: mut path,
         termination,
@@ -220,8 +246,19 @@ pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
         points,
         at: located,
         resonances,
+        unlocated,
         termination,
     })
+}
+
+/// The JSON name of the strong resonance 1:`order`.
+fn resonance_name(order: u32) -> &'static str {
+    match order {
+        1 => "resonance_1_1",
+        2 => "resonance_1_2",
+        3 => "resonance_1_3",
+        _ => "resonance_1_4",
+    }
 }
 
 /// The offset `h` of θ from a 1:1 or 1:2 end of the points its location
