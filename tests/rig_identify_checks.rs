@@ -14,8 +14,11 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+#[path = "common/cores.rs"]
+mod cores;
 #[path = "common/rig.rs"]
 mod rig;
+use cores::on_every_core;
 use rig::{commission_sim, ivt};
 
 fn scratch(name: &str) -> ivt_sim::testing::Scratch {
@@ -133,18 +136,33 @@ fn every_preset_is_identified_inside_its_intervals_or_refused_with_the_reason() 
         .map(|p| (p.name().to_string(), format!("preset = \"{}\"", p.name())))
         .collect();
     cases.push(("l_a = 1 mH".into(), "l_a = 1e-3".into()));
-    let runs = std::iter::once(("ideal", 1)).chain((1..=SEEDS).map(|s| ("realistic", s)));
-    for (case, body) in cases {
+    let runs: Vec<(&str, u64)> = std::iter::once(("ideal", 1))
+        .chain((1..=SEEDS).map(|s| ("realistic", s)))
+        .collect();
+    // Every run of every case commissioned and identified on all cores (each
+    // run is two single-threaded `ivt` processes), then checked in order.
+    let jobs: Vec<(&str, &str, &str, u64)> = cases
+        .iter()
+        .flat_map(|(case, body)| {
+            runs.iter()
+                .map(move |&(s, seed)| (case.as_str(), body.as_str(), s, seed))
+        })
+        .collect();
+    let results = on_every_core(&jobs, |&(case, body, sensors, seed)| {
+        let dir = scratch(&format!("{}-{sensors}-{seed}", case.replace(' ', "_")));
+        let (rec, truth) = commission_with(&dir, body, sensors, seed);
+        let (code, v, secs) = identify(&rec);
+        (truth, code, v, secs)
+    });
+    for ((case, _), outcomes) in cases.iter().zip(results.chunks(runs.len())) {
         let mut missed: BTreeMap<&str, Vec<u64>> = BTreeMap::new();
-        for (sensors, seed) in runs.clone() {
-            let dir = scratch(&format!("{}-{sensors}-{seed}", case.replace(' ', "_")));
-            let (rec, truth) = commission_with(&dir, &body, sensors, seed);
-            let (code, v, secs) = identify(&rec);
+        for (&(sensors, seed), (truth, code, v, secs)) in runs.iter().zip(outcomes) {
+            let code = *code;
             let name = format!("{case} ({sensors} sensors, seed {seed})");
             eprintln!("{name}: exit {code} in {secs:.1} s");
             match code {
                 0 => {
-                    let out = misses(&name, &v, &truth);
+                    let out = misses(&name, v, truth);
                     if sensors == "ideal" {
                         assert!(out.is_empty(), "{name}: the truth outside {out:?}");
                     }
