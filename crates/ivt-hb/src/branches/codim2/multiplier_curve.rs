@@ -37,8 +37,7 @@
 //! θ_e ± 2h.
 
 use super::{
-    bounded, crossings, event_vector, follow_leg, path_interval, CurveSystem, Joined, Legs,
-    Unlocated,
+    bounded, event_vector, follow_leg, path_interval, CurveSystem, Joined, Legs, Unlocated,
 };
 use crate::branches::events::{BifurcationKind, LocateOptions};
 use crate::error::HbError;
@@ -48,8 +47,9 @@ use crate::stability::floquet::{eigenvalues, monodromy_uniform, HsuRule};
 use crate::stability::StabilityAnalyzer;
 use ivt_num::vector::{dot, norm2};
 use ivt_num::LuWorkspace;
-use ivt_path::continuation::{ContinuationOptions, PathPoint, Termination};
+use ivt_path::continuation::{ContinuationOptions, Termination};
 use ivt_path::events::extended::null_vector;
+use ivt_path::events::Crossing;
 use ivt_path::PathError;
 use std::f64::consts::{PI, TAU};
 
@@ -151,28 +151,16 @@ pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
     let copts = bounded(opts, (lo, hi));
     let theta_index = m + 1;
     let p_index = x0.len() - 1;
-    // The events located as the points arrive: the `at` values of p, and on
-    // a Neimark–Sacker curve the angles of the strong resonances (1:3, 1:4)
-    // and those the ends at 1:1 and 1:2 are extrapolated from.
+    // The events located as the points arrive (detector d is targets[d]).
     let scale = norm2(&start.coeffs);
-    let mut watch = crossings(p_index, at, scale);
-    let (near_ends, strong) = if ns {
-        let h = RESONANCE_STEP;
-        let ends = [
-            (1, 0.0, h),
-            (1, 0.0, 2.0 * h),
-            (2, PI, -h),
-            (2, PI, -2.0 * h),
-        ];
-        (ends.to_vec(), vec![(3, TAU / 3.0), (4, PI / 2.0)])
-    } else {
-        (Vec::new(), Vec::new())
-    };
-    let first_near = watch.len();
-    let angles = (near_ends.iter().map(|(_, end, h)| end + h))
-        .chain(strong.iter().map(|&(_, theta)| theta))
-        .collect::<Vec<_>>();
-    watch.extend(crossings(theta_index, &angles, scale));
+    let targets = Target::list(at, ns);
+    let watch: Vec<Crossing> = (targets.iter())
+        .map(|t| match *t {
+            Target::At(p) => Crossing::scaled(p_index, p, scale),
+            Target::NearEnd { end, h, .. } => Crossing::scaled(theta_index, end + h, scale),
+            Target::Strong(order) => Crossing::scaled(theta_index, TAU / f64::from(order), scale),
+        })
+        .collect();
     // A Neimark–Sacker path through θ = 0 or π (1:1, 1:2) continues on the
     // conjugate pair back along the same curve: it stops at the point past.
     let legs = Legs::follow((p_start, p_from, p_to), |direction| {
@@ -182,55 +170,48 @@ pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
         })
     })?;
     let joined = legs.joined();
-    let first_of = |d: usize| {
-        joined
-            .of(d)
-            .next()
-            .and_then(|b| sys.point(&event_vector(b)))
-    };
-    let located = (0..first_near)
-        .flat_map(|d| joined.of(d))
-        .filter_map(|b| sys.point(&event_vector(b)))
+    let located_of = |d: usize| joined.of(d).filter_map(|b| sys.point(&event_vector(b)));
+    let located = (targets.iter().enumerate())
+        .filter(|(_, t)| matches!(t, Target::At(_)))
+        .flat_map(|(d, _)| located_of(d))
         .collect();
+    // An end at θ = 0 or π (reached: a point past it, θ within 0.5 of it):
+    // the NS system degenerates there (every point of the fold or PD curve
+    // solves it), and p, ω, q are even in θ − θ_e: Richardson from the
+    // points at θ_e ± h and ± 2h (inside).
+    let reached = |end: f64| {
+        (joined.points.iter()).any(|pt| {
+            (pt.x.get(theta_index)).is_some_and(|t| t.sin() <= 0.0 && (t - end).abs() < 0.5)
+        })
+    };
     let mut resonances = Vec::new();
-    let mut reached_ends = [false; 2];
-    // An end at θ = 0 or π: the NS system degenerates there (every point of
-    // the fold or PD curve solves it), and p, ω, q are even in θ − θ_e:
-    // Richardson from the points at θ_e ± h and ± 2h (inside).
-    let past = |pt: &PathPoint| pt.x.get(theta_index).is_some_and(|t| t.sin() <= 0.0);
-    for (k, pair) in near_ends.chunks_exact(2).enumerate() {
-        let [(order, end, _), _] = pair else { continue };
-        let reached = (joined.points.iter())
-            .filter(|pt| past(pt))
-            .any(|pt| pt.x.get(theta_index).is_some_and(|t| (t - end).abs() < 0.5));
-        let d = first_near + 2 * k;
-        if let Some(r) = reached_ends.get_mut(k) {
-            *r = reached;
+    for (d, t) in targets.iter().enumerate() {
+        match *t {
+            Target::NearEnd {
+                order,
+                end,
+                far: false,
+                ..
+            } if reached(end) => {
+                // the target at 2h follows the one at h
+                if let (Some(a), Some(b)) = (located_of(d).next(), located_of(d + 1).next()) {
+                    resonances.push((order, richardson(&a, &b, end)));
+                }
+            }
+            Target::Strong(order) => resonances.extend(located_of(d).map(|pt| (order, pt))),
+            _ => {}
         }
-        if let (true, Some(a), Some(b)) = (reached, first_of(d), first_of(d + 1)) {
-            resonances.push((*order, richardson(&a, &b, *end)));
-        }
-    }
-    for (k, &(order, _)) in strong.iter().enumerate() {
-        let d = first_near + near_ends.len() + k;
-        let found = joined.of(d).filter_map(|b| sys.point(&event_vector(b)));
-        resonances.extend(found.map(|pt| (order, pt)));
     }
     // A failed `at` point, strong resonance or, where the curve reached its
     // end, one of the two points an end is extrapolated from.
     let unlocated = joined.unlocated(
         |x| sys.point(x),
-        |d| {
-            if d < first_near {
-                return Some(("at", at.get(d).copied()));
+        |d| match *targets.get(d)? {
+            Target::At(p) => Some(("at", Some(p))),
+            Target::NearEnd { order, end, .. } => {
+                reached(end).then_some((resonance_name(order), None))
             }
-            let k = d - first_near;
-            if let Some((order, _, _)) = near_ends.get(k) {
-                let reached = reached_ends.get(k / 2).copied().unwrap_or(false);
-                return reached.then_some((resonance_name(*order), None));
-            }
-            let (order, _) = strong.get(k - near_ends.len())?;
-            Some((resonance_name(*order), None))
+            Target::Strong(order) => Some((resonance_name(order), None)),
         },
     );
     let Joined {
@@ -249,6 +230,42 @@ pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
         unlocated,
         termination,
     })
+}
+
+/// What a detector of a period-doubling or Neimark–Sacker curve locates.
+#[derive(Debug, Clone, Copy)]
+enum Target {
+    /// The point at p = the value.
+    At(f64),
+    /// θ = `end + h` near the 1:`order` end at θ = `end` (0 or π), one of
+    /// the two points the end is extrapolated from (`far`: the one at 2h).
+    NearEnd {
+        order: u32,
+        end: f64,
+        h: f64,
+        far: bool,
+    },
+    /// The strong resonance 1:`order` (3 or 4) at θ = 2π/order.
+    Strong(u32),
+}
+
+impl Target {
+    /// The `at` values of p, and on a Neimark–Sacker curve (`ns`) the points
+    /// at θ_e ± h, ± 2h of the 1:1 and 1:2 ends (each pair h first) and the
+    /// strong resonances 1:3, 1:4.
+    fn list(at: &[f64], ns: bool) -> Vec<Self> {
+        let mut out: Vec<Self> = at.iter().map(|&p| Self::At(p)).collect();
+        if ns {
+            let h = RESONANCE_STEP;
+            for (order, end, h) in [(1, 0.0, h), (2, PI, -h)] {
+                for (h, far) in [(h, false), (2.0 * h, true)] {
+                    out.push(Self::NearEnd { order, end, h, far });
+                }
+            }
+            out.extend([Self::Strong(3), Self::Strong(4)]);
+        }
+        out
+    }
 }
 
 /// The JSON name of the strong resonance 1:`order`.
