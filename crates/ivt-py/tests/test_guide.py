@@ -6,8 +6,11 @@ run them, chapter by chapter:
   ``examples/`` (the example models), the manifests ``Cargo.toml``,
   ``crates/`` and ``firmware/``, and ``bench/`` (the benchmark gate's
   baseline; symlinks into the repository, read only);
-- its ```python blocks run top to bottom in ONE fresh namespace, so a later
-  block uses what an earlier one defined; their assertions are the checks;
+- as a user copies it: the chapter becomes one script run by a fresh venv's
+  Python that holds the wheel (``$IVT_WHEEL``) with its extras and nothing of
+  the repository (:func:`reader_python`);
+- its ```python blocks run top to bottom at the top level of that script, so a
+  later block uses what an earlier one defined; their assertions are the checks;
 - its ```console blocks run in the same directory, in document order with the
   Python blocks: every line ``$ ivt ...`` runs with the built CLI ($IVT_BIN,
   else target/release/ivt) first on PATH and must exit 0 (a line ending in
@@ -35,6 +38,7 @@ import re
 import shlex
 import shutil
 import subprocess
+import sys
 from typing import Dict, List, Tuple
 
 import pytest
@@ -204,20 +208,50 @@ def test_block_reader() -> None:
     assert as_ivt("cargo run --release -- sim scenes/drive.toml") == "ivt sim scenes/drive.toml"
 
 
-@pytest.mark.parametrize("chapter", chapters())
-def test_chapter_runs(chapter: str, tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch) -> None:
+@pytest.fixture(scope="session")
+def reader_python(tmp_path_factory: pytest.TempPathFactory) -> pathlib.Path:
+    """The Python a reader runs the chapters with: a fresh venv outside the
+    repository holding the wheel (``$IVT_WHEEL``, which scripts/py-test
+    builds) with the extras the chapters name — figures, finite-element
+    models, Dask sweeps — plus numpy and scipy, nothing of the repository
+    importable. Without ``$IVT_WHEEL`` (a developer's own pytest run), the
+    running interpreter and the ``ivt`` installed in it."""
+    wheel = os.environ.get("IVT_WHEEL")
+    if not wheel:
+        return pathlib.Path(sys.executable)
+    from test_wheel import pip_install
+
+    base = tmp_path_factory.mktemp("reader")
+    venv = base / "venv"
+    subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
+    py = venv / "bin" / "python"
+    # --no-compile: Python compiles what the run imports (pip's compiling of
+    # every installed module took 45 of the install's 66 s)
+    pip = [str(py), "-m", "pip", "install", "-q", "--disable-pip-version-check", "--no-compile"]
+    pip_install(pip, f"{wheel}[plot,fe,dask]", "numpy", "scipy", cwd=base)
+    return py
+
+
+def chapter_script(chapter: str) -> str:
+    """The chapter as one Python script, as a reader copies it: its Python
+    blocks in order, at the top level of one module (compiled with the
+    chapter's path and line numbers, so a traceback points into the chapter),
+    and between them its ``$`` lines as shell commands that must exit 0."""
     path = GUIDE / chapter
-    checkout(tmp_path)
-    monkeypatch.chdir(tmp_path)
-    exe = ivt_bin()
-    monkeypatch.setenv("PATH", f"{exe.parent}{os.pathsep}{os.environ.get('PATH', '')}")
-    namespace: Dict[str, object] = {"__name__": "__main__"}
+    where_file = str(path.relative_to(REPO))
+    parts = [
+        "import subprocess as _sp, sys as _sys\n",
+        "def _command(where, cmd):\n"
+        "    run = _sp.run(['bash', '-o', 'pipefail', '-c', cmd], capture_output=True, text=True)\n"
+        "    if run.returncode != 0:\n"
+        "        _sys.exit(f'{where}: `$ {cmd}` exited {run.returncode}\\n'\n"
+        "                  f'stdout: {run.stdout[-2000:]}\\nstderr: {run.stderr[-2000:]}')\n",
+    ]
     for lang, line, body in blocks(path.read_text()):
-        where = f"{path.relative_to(REPO)}:{line}"
+        where = f"{where_file}:{line}"
         if lang == "python":
-            # Line numbers in a traceback point into the chapter.
-            code = compile("\n" * (line - 1) + body, str(path), "exec")
-            exec(code, namespace)
+            code = "\n" * (line - 1) + body
+            parts.append(f"exec(compile({code!r}, {where_file!r}, 'exec'))\n")
         elif lang == "console":
             for cmd in commands(body):
                 cmd = as_ivt(cmd)
@@ -226,20 +260,31 @@ def test_chapter_runs(chapter: str, tmp_path: pathlib.Path, monkeypatch: pytest.
                 assert cmd.split()[0] == "ivt", (
                     f"{where}: `$ {cmd}` is neither an ivt command nor in NOT_RUN"
                 )
-                argv = [str(exe), *shlex.split(cmd)[1:]]
-                if any(c in cmd for c in "|><;&"):
-                    run = subprocess.run(
-                        ["bash", "-o", "pipefail", "-c", cmd], capture_output=True, text=True
-                    )
-                else:
-                    run = subprocess.run(argv, capture_output=True, text=True)
-                assert run.returncode == 0, (
-                    f"{where}: `$ {cmd}` exited {run.returncode}\n"
-                    f"stdout: {run.stdout[-2000:]}\nstderr: {run.stderr[-2000:]}"
-                )
+                parts.append(f"_command({where!r}, {cmd!r})\n")
+    return "".join(parts)
+
+
+@pytest.mark.parametrize("chapter", chapters())
+def test_chapter_runs(chapter: str, tmp_path: pathlib.Path, reader_python: pathlib.Path) -> None:
+    """The chapter run by :func:`reader_python` as ``python -c SCRIPT`` (as
+    pasted into an interpreter or a notebook: a Dask process cluster's
+    workers then do not re-run the chapter — a script file needs ``if
+    __name__ == "__main__":`` around them, as large-models.md says), in its
+    own directory (:func:`checkout`), with the built CLI first on PATH and
+    HOME in that directory; then its figures are copied into the book."""
+    checkout(tmp_path)
+    exe = ivt_bin()
+    run = subprocess.run(
+        [str(reader_python), "-c", chapter_script(chapter)],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        env={"PATH": f"{exe.parent}{os.pathsep}{os.environ.get('PATH', '')}", "HOME": str(tmp_path)},
+    )
+    assert run.returncode == 0, f"{chapter}:\n{run.stdout[-2000:]}\n{run.stderr[-3000:]}"
     # The chapter's figures, drawn just now by its blocks, into the book.
     target = book_dir() / pathlib.PurePosixPath(chapter).parent
-    for figure in figures(path.read_text()):
+    for figure in figures((GUIDE / chapter).read_text()):
         drawn = tmp_path / figure
         assert drawn.is_file(), f"{chapter}: figure {figure} was not drawn by the chapter's code"
         assert drawn.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", f"{chapter}: {figure} is not a PNG"
