@@ -213,6 +213,22 @@ fn orbit_summary(orbit: &jobs::Orbit) -> String {
     )
 }
 
+/// One line per point a path passed but could not locate: what, the value
+/// sought, the path parameter `p_name` where the locator started, the reason.
+fn unlocated_lines(unlocated: &[jobs::UnlocatedPoint], p_name: &str) -> String {
+    let mut out = String::new();
+    for u in unlocated {
+        let value = u
+            .value
+            .map_or(String::new(), |v| format!(" at {p_name} = {v}"));
+        out += &format!(
+            "  {}{value} not located (from {p_name} = {:.8}): {}\n",
+            u.what, u.near.p, u.reason
+        );
+    }
+    out
+}
+
 /// The JSON object of a job's result.
 fn to_json<T: serde::Serialize>(result: &T) -> Result<serde_json::Value, CliError> {
     serde_json::to_value(result).map_err(|e| CliError::Failed(e.to_string()))

@@ -125,6 +125,48 @@ fn subcritical_hopf_cycle_branch_and_fold_match_time_integration() {
         .filter(|w| w[0].1.stable() != w[1].1.stable())
         .count();
     assert_eq!(changes, 1);
+    assert!(branch.unlocated.is_empty(), "{:?}", branch.unlocated);
+}
+
+/// A family with no member at μ = −0.1 exactly (the path steps over it):
+/// the branch passes μ = −0.1 on the small and on the large cycles but
+/// cannot solve either there. Both are `unlocated` with the value, the
+/// locator's start near μ = −0.1 and the reason (the solver's, then the
+/// family's error); the cycles at μ = −0.05 and the fold are located as
+/// usual.
+#[test]
+fn an_at_value_where_the_family_fails_is_reported_unlocated() {
+    let hb = HbOptions::new(25, 128);
+    let opts = CycleBranchOptions {
+        at: vec![-0.1, -0.05],
+        ..CycleBranchOptions::default()
+    };
+    let gappy = |mu: f64| {
+        if mu == -0.1 {
+            Err(HbError::InvalidInput("no model at μ = -0.1".into()))
+        } else {
+            family(mu)
+        }
+    };
+    let branch = cycle_branch(gappy, &hb, -0.2, 0.1, &opts).unwrap();
+    let located: Vec<f64> = branch.at.iter().map(|(p, _)| *p).collect();
+    assert_eq!(located, [-0.05, -0.05], "{located:?}");
+    assert_eq!(branch.folds.len(), 1);
+    assert_eq!(branch.unlocated.len(), 2, "{:?}", branch.unlocated);
+    for u in &branch.unlocated {
+        assert_eq!((u.what, u.value), ("at", Some(-0.1)));
+        assert!((u.near.0 + 0.1).abs() < 0.05, "near μ = {}", u.near.0);
+        assert!(
+            u.reason
+                .ends_with("; the family fails there: invalid input: no model at μ = -0.1"),
+            "{}",
+            u.reason
+        );
+        eprintln!(
+            "unlocated at μ = −0.1 from μ = {:.4}: {}",
+            u.near.0, u.reason
+        );
+    }
 }
 
 /// `limit_cycle_branch` from the small cycle at μ = −0.1 towards −0.2 turns

@@ -185,7 +185,8 @@ fn a_failed_first_leg_is_not_hidden_by_the_second() {
 /// family has no model at F = 0.2 exactly (the path steps over it), so the
 /// fold there cannot be solved. From the upper F = 0.1 fold to F = 0.3 the
 /// curve passes F = 0.2 twice (once on each fold, as in the test above):
-/// both are `unlocated` with the value and the solver's reason; F = 0.25 is
+/// both are `unlocated` with the value and the reason (the solver's, then the
+/// family's error there); F = 0.25 is
 /// located on both folds as usual.
 #[test]
 fn an_at_value_that_cannot_be_solved_is_reported_unlocated() {
@@ -198,7 +199,13 @@ fn an_at_value_that_cannot_be_solved_is_reported_unlocated() {
         assert_eq!((u.what, u.value), ("at", Some(0.2)));
         // The locator's start: the path point before the crossing.
         assert!((u.near.p - 0.2).abs() < 0.05, "{u:?}");
-        assert!(!u.reason.is_empty(), "{u:?}");
+        // The solver's reason, then the family's own error at F = 0.2.
+        assert!(u.reason.contains("non-finite residual"), "{u:?}");
+        assert!(
+            u.reason
+                .ends_with("; the family fails there: invalid input: no model at F = 0.2"),
+            "{u:?}"
+        );
         eprintln!(
             "unlocated at F = 0.2 near ω = {:.4}: {}",
             u.near.omega, u.reason

@@ -4,6 +4,7 @@
 //! and Eq. 68–77, Floquet stability (Hsu) and its folds located).
 
 use super::{all_finite, finite_list, pairs, path_steps, stability_steps, Array, Steps};
+use crate::fold_curve::{unlocated_points, CurveFoldPoint, UnlocatedPoint};
 use ivt_hb::branches::autonomous::LimitCycle;
 use ivt_hb::branches::cycle_branch::{cycle_branch as trace_cycles, CycleBranchOptions};
 use ivt_hb::branches::events::BifurcationKind;
@@ -172,6 +173,10 @@ pub struct CycleBranchResult {
     pub bifurcations: Vec<CycleFold>,
     /// The cycles at each p of `at`.
     pub at: Vec<CycleRecord>,
+    /// The folds (`"fold"`) and cycles at `at` (`"at"`, with the value) the
+    /// branch passed but that could not be located, each with the reason
+    /// and the path point the locator started from (`angle` absent).
+    pub unlocated: Vec<UnlocatedPoint>,
     /// Why tracing stopped (None: no Hopf point).
     pub termination: Option<Termination>,
 }
@@ -236,6 +241,13 @@ where
             })
             .collect(),
         at: cycles(&branch.at),
+        unlocated: unlocated_points(&branch.unlocated, |(p, orbit)| CurveFoldPoint {
+            omega: orbit.omega_f,
+            p: *p,
+            amplitude: orbit.amplitude(0),
+            coeffs: Array(orbit.coeffs.clone()),
+            angle: None,
+        }),
         termination: branch.termination,
     })
 }

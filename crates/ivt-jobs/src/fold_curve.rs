@@ -9,8 +9,9 @@
 //! of `family(p_start)` over an interval.
 
 use super::{all_finite, finite, finite_list, path_steps, Array, FrcRequest, Steps};
-use ivt_hb::branches::codim2::{bifurcation_curve, CurvePoint, CurveStart, Unlocated};
+use ivt_hb::branches::codim2::{bifurcation_curve, CurvePoint, CurveStart};
 use ivt_hb::branches::events::BifurcationKind;
+use ivt_hb::branches::events::Unlocated;
 use ivt_hb::branches::frc::{frequency_response, FrcOptions};
 use ivt_hb::orbit::ihb::{HbOptions, HbSolution};
 use ivt_hb::problem::PeriodicProblem;
@@ -183,7 +184,8 @@ pub struct UnlocatedPoint {
     /// The requested `p` of an `at` point (absent otherwise).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub value: Option<f64>,
-    /// The locator's failure in words.
+    /// The locator's failure in words (at an `at` value where the family
+    /// itself fails, followed by its error).
     pub reason: String,
     /// The path point the locator started from.
     pub near: CurveFoldPoint,
@@ -307,7 +309,7 @@ where
 
 /// The curve's unlocated points with `point` (its sample of a curve point)
 /// as their `near`.
-fn unlocated_points<T>(
+pub(crate) fn unlocated_points<T>(
     unlocated: &[Unlocated<T>],
     point: impl Fn(&T) -> CurveFoldPoint,
 ) -> Vec<UnlocatedPoint> {

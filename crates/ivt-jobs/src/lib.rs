@@ -56,7 +56,7 @@ pub use diagram::{
 };
 pub use fold_curve::{
     fold_curve, CurveFoldPoint, FoldCurveRequest, FoldCurveResult, FoldStart, SpecialKind,
-    SpecialPoint,
+    SpecialPoint, UnlocatedPoint,
 };
 pub use frc::{frc, CurvePoint, EventRecord, FoldPoint, FrcCurve, FrcRequest};
 pub use limit_cycle::{limit_cycle, Cycle, LimitCycleRequest, DEFAULT_TOL, MAX_HARMONICS};

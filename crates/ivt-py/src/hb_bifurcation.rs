@@ -34,7 +34,11 @@ use crate::to_python::to_dict;
 /// "points": [{"p", "omega", "period", "amplitude", "stable", "stability",
 /// "multipliers", "coeffs"}...], "bifurcations": [{"kind": "fold", "p",
 /// "omega", "amplitude", "coeffs"}...], "at": [cycles as in points],
-/// "termination" (None when there is no Hopf point)}.
+/// "unlocated": [{"what" ("fold" or "at"), "value" (an at value), "reason",
+/// "near": {"omega", "p", "amplitude", "coeffs"}}...] (a fold or at cycle the
+/// branch passed but that could not be located, with the path point the
+/// solve started from; none is dropped), "termination" (None when there is
+/// no Hopf point)}.
 #[pyfunction]
 #[pyo3(signature = (
     family, p_from, p_to, at = Vec::new(), n = 20, samples = None,

@@ -54,7 +54,7 @@ NOT_RUN: Dict[str, str] = {
     "python bench/gate/gate.py": "the gate on another build (valgrind, a minute)",
     ".venv/bin/python bench/gate/gate.py": "the gate against another baseline (valgrind, a minute)",
     "cargo install": "installs a tool into the user's ~/.cargo",
-    "pip install": "installs into the user's environment (tests/test_wheel.py installs the wheel)",
+    "pip install": "installs into the user's environment (reader_python's venv holds the wheel)",
     "python -m venv": "creates the user's environment",
     "source ": "activates the user's environment",
     "firmware/run-qemu.sh": "scripts/test runs the firmware step itself",

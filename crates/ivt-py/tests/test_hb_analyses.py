@@ -277,6 +277,7 @@ def _cycle_gap(mu, x0, period):
 
 def test_cycle_branch_hopf_fold_and_the_two_cycles_against_time_integration():
     out = hb.cycle_branch(_hopf_family, -0.2, 0.1, at=[-0.1], n=25, samples=128)
+    assert out["unlocated"] == []
     [hopf] = out["hopf"]
     assert abs(hopf["p"]) < 1e-12 and abs(hopf["omega"] - 1.0) < 1e-12
     assert hopf["subcritical"] and hopf["lyapunov"] > 0

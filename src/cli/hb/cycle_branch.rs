@@ -90,6 +90,12 @@ pub fn run(a: CycleBranchArgs) -> Result<Output, CliError> {
             h.p, h.omega, h.lyapunov
         );
     }
+    for u in &branch.hopf_undecided {
+        human += &format!(
+            "  Hopf search undecided for μ in [{}, {}]: {}\n",
+            u.p_from, u.p_to, u.reason
+        );
+    }
     for f in &branch.bifurcations {
         human += &format!(
             "  fold of cycles at μ = {:.10}, amplitude {:.8}\n",
@@ -105,6 +111,7 @@ pub fn run(a: CycleBranchArgs) -> Result<Output, CliError> {
             c.stability.name()
         );
     }
+    human += &super::unlocated_lines(&branch.unlocated, "μ");
     Ok(Output {
         json: to_json(&branch)?,
         human,

@@ -82,6 +82,7 @@ pub fn run(a: FoldsArgs) -> Result<Output, CliError> {
     for p in &curve.at {
         human += &format!("  fold at F = {}: ω_f = {:.10}\n", p.p, p.omega);
     }
+    human += &super::unlocated_lines(&curve.unlocated, "F");
     Ok(Output {
         json: to_json(&curve)?,
         human,

@@ -125,6 +125,7 @@ pub fn run(a: TorusArgs) -> Result<Output, CliError> {
             p.p, p.omega
         );
     }
+    human += &super::unlocated_lines(&curve.unlocated, "F");
     Ok(Output {
         json: to_json(&curve)?,
         human,

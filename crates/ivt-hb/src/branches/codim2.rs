@@ -35,6 +35,7 @@ pub mod multiplier_curve;
 pub use cycle_fold::{cycle_fold_curve, CycleFoldCurve, CycleFoldPoint};
 pub use multiplier_curve::{bifurcation_curve, BifurcationCurve, CurvePoint, CurveStart};
 
+use crate::branches::events::{name_family_failures, Unlocated};
 use crate::error::HbError;
 use crate::orbit::ihb::HbOptions;
 use crate::problem::PeriodicProblem;
@@ -79,22 +80,6 @@ pub struct Curve<T> {
 
 /// A fold curve in (ω, p).
 pub type FoldCurve = Curve<FoldPoint>;
-
-/// A point of a curve that the path passed (its test changed sign between
-/// two path points) but that could not be located: what it is, the path
-/// point the locator started from, and why it failed.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Unlocated<T> {
-    /// What was sought: `"at"` (with the value in `value`), `"cusp"`, or a
-    /// resonance (`"resonance_1_3"`, …).
-    pub what: &'static str,
-    /// The requested value of an `at` point (`None` otherwise).
-    pub value: Option<f64>,
-    /// The path point the locator started from.
-    pub near: T,
-    /// The locator's failure.
-    pub reason: String,
-}
 
 /// The extended system of a two-parameter curve: `n − 1` equations in the
 /// path vector `x` of `n` entries (the path parameter last), followed as a
@@ -394,7 +379,9 @@ where
         let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
         follow_leg(residual, &x0, direction, &copts, (&watch, true), |_| true)
     })?;
-    Ok(legs.joined().curve(&watch, |x| sys.point(x)))
+    let mut curve = legs.joined().curve(&watch, |x| sys.point(x));
+    name_family_failures(&mut curve.unlocated, |p, _| family(p).err());
+    Ok(curve)
 }
 
 /// `opts` with the path parameter bounded to `[lo, hi]`.

@@ -16,7 +16,8 @@
 
 use crate::branches::autonomous::{limit_cycle, limit_cycle_leg, LimitCycle};
 use crate::branches::events::{
-    BifurcationKind, Detector, EventObserver, Fold, LocateOptions, Observer,
+    name_family_failures, BifurcationKind, Detector, EventObserver, Fold, LocateOptions, Observer,
+    Unlocated,
 };
 use crate::error::HbError;
 use crate::orbit::galerkin::GalerkinJacobian;
@@ -80,6 +81,11 @@ pub struct CycleBranch {
     pub folds: Vec<(f64, HbSolution)>,
     /// The cycles at each p of [`CycleBranchOptions::at`], each crossing.
     pub at: Vec<(f64, LimitCycle)>,
+    /// The folds and `at` cycles the path passed but that could not be
+    /// located, near `(p, orbit)` (the path point the locator started
+    /// from), in path order; then the `at` cycles located but not refined
+    /// by [`limit_cycle`]. Each with the reason.
+    pub unlocated: Vec<Unlocated<(f64, HbSolution)>>,
     /// Why tracing stopped (`None`: no Hopf point, nothing traced).
     pub termination: Option<Termination>,
 }
@@ -119,6 +125,7 @@ where
         points: Vec::new(),
         folds: Vec::new(),
         at: Vec::new(),
+        unlocated: Vec::new(),
         termination: None,
     };
     let Some(first) = out.hopf.first() else {
@@ -140,15 +147,20 @@ where
     }
     let mut observer = EventObserver::new(&LocateOptions::fold(), detectors);
     let (mut events, mut failure) = (Vec::new(), None);
-    let mut watch = |p: &PathPoint| match observer.on_point(&mut system, p) {
-        Ok(found) => {
-            failures.clear();
-            events.extend(found);
-            true
-        }
-        Err(e) => {
-            failure = Some(e);
-            false
+    // The observed points (an event's index is one of them).
+    let mut seen: Vec<Vec<f64>> = Vec::new();
+    let mut watch = |p: &PathPoint| {
+        seen.push(p.x.clone());
+        match observer.on_point(&mut system, p) {
+            Ok(found) => {
+                failures.clear();
+                events.extend(found);
+                true
+            }
+            Err(e) => {
+                failure = Some(e);
+                false
+            }
         }
     };
     // First away from the Hopf point; if the branch turns back past the
@@ -195,39 +207,67 @@ where
     }
     events.extend(observer.finish(&mut system)?);
     events.sort_by_key(|e| e.index);
-    // A located event's unknowns are `[q; ω]`; failed locations are left out.
+    // A located event's unknowns are `[q; ω]`, a path point's `[q; ω; p]`.
+    let orbit = |u: &[f64]| {
+        let (&omega_f, q) = u.split_last()?;
+        Some(HbSolution {
+            coeffs: q.to_vec(),
+            omega_f,
+            harmonics: hb.harmonics,
+            subharmonic: 1,
+            stats: BroydenStats::default(),
+        })
+    };
     let located = |e: &ivt_path::Event<HbError>| {
         let at = e.location.as_ref().ok()?;
-        let (&omega_f, q) = at.q.split_last()?;
-        Some((at.lambda, q.to_vec(), omega_f))
+        Some((at.lambda, orbit(&at.q)?))
     };
+    // Detector 0 is the fold, detector d ≥ 1 the crossing of `at[d − 1]`.
+    let sought = |d: usize| match d {
+        0 => ("fold", None),
+        _ => ("at", opts.at.get(d - 1).copied()),
+    };
+    for e in &events {
+        let Err(err) = &e.location else { continue };
+        let (what, value) = sought(e.detector);
+        let near = seen.get(e.index).and_then(|x| {
+            let (&p, u) = x.split_last()?;
+            Some((p, orbit(u)?))
+        });
+        out.unlocated.extend(near.map(|near| Unlocated {
+            what,
+            value,
+            near,
+            reason: err.to_string(),
+        }));
+    }
     out.folds = (events.iter())
         .filter(|e| e.kind == BifurcationKind::Fold)
         .filter_map(located)
-        .map(|(p, coeffs, omega_f)| {
-            let solution = HbSolution {
-                coeffs,
-                omega_f,
-                harmonics: hb.harmonics,
-                subharmonic: 1,
-                stats: BroydenStats::default(),
-            };
-            (p, solution)
-        })
         .collect();
     // The cycles at `at`, value by value, each in path order, with their
     // multipliers (the located cycle refined by [`limit_cycle`]).
     for d in 1..=opts.at.len() {
-        for (p, q, omega) in events
+        for (p, located) in events
             .iter()
             .filter(|e| e.detector == d)
             .filter_map(located)
         {
-            if let Ok(c) = limit_cycle(&member(p), hb, omega, &q, steps) {
-                out.at.push((p, c));
+            match limit_cycle(&member(p), hb, located.omega_f, &located.coeffs, steps) {
+                Ok(c) => out.at.push((p, c)),
+                Err(e) => {
+                    let (what, value) = sought(d);
+                    out.unlocated.push(Unlocated {
+                        what,
+                        value,
+                        near: (p, located),
+                        reason: format!("the cycle located there was not refined: {e}"),
+                    });
+                }
             }
         }
     }
+    name_family_failures(&mut out.unlocated, |p, _| family(p).err());
     Ok(out)
 }
 

@@ -166,6 +166,31 @@ pub struct Event<E> {
     pub location: Result<Bifurcation, E>,
 }
 
+/// An event the path passed (its test changed sign between two points) but
+/// that could not be located: none is dropped. What was sought, the path
+/// point the locator started from (as the caller reports points), and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Unlocated<T> {
+    /// What was sought, in the caller's words: `"at"` (with the value in
+    /// `value`), `"fold"`, `"cusp"`, a resonance (`"resonance_1_3"`, …).
+    pub what: &'static str,
+    /// The requested value of an `at` point (`None` otherwise).
+    pub value: Option<f64>,
+    /// The path point the locator started from.
+    pub near: T,
+    /// The locator's failure in words, followed by any cause the caller
+    /// adds ([`Unlocated::add_cause`]).
+    pub reason: String,
+}
+
+impl<T> Unlocated<T> {
+    /// Appends `cause` to the reason (`"{reason}; {cause}"`): what the
+    /// caller knows of the failure beyond the locator's words.
+    pub fn add_cause(&mut self, cause: impl std::fmt::Display) {
+        self.reason = format!("{}; {cause}", self.reason);
+    }
+}
+
 /// Watches a path of a [`Branch`] as its points arrive (as BifurcationKit's
 /// event detection does): called once per accepted point, in path order, it
 /// returns the events that point completes, already located; when the path

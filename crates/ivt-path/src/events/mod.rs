@@ -27,7 +27,7 @@ mod observe;
 pub use crossing::Crossing;
 pub use detector::{
     dot, Bifurcation, BifurcationKind, Detector, Event, LocateOptions, Observer, PathSoFar, Start,
-    TracedPoint,
+    TracedPoint, Unlocated,
 };
 pub use fold::{locate_fold, Fold, FoldLocation};
 pub use observe::{observe, observe_residual, EventObserver, PointMultipliers};

@@ -32,6 +32,7 @@ use super::fold_system::{null_rows, split_fold_residual, split_fold_vector};
 use super::{bounded, crossings, follow_leg, path_interval, Curve, CurveSystem, FoldPoint, Legs};
 use crate::branches::cycle_branch::member::Member;
 use crate::branches::cycle_branch::CycleSystem;
+use crate::branches::events::name_family_failures;
 use crate::error::HbError;
 use crate::orbit::ihb::{HbOptions, HbSolution};
 use crate::problem::PeriodicProblem;
@@ -113,7 +114,9 @@ where
         let residual = |x: &[f64], r: &mut [f64]| sys.residual(x, r);
         follow_leg(residual, &x0, direction, &copts, (&watch, true), |_| true)
     })?;
-    Ok(legs.joined().curve(&watch, |x| sys.point(x)))
+    let mut curve = legs.joined().curve(&watch, |x| sys.point(x));
+    name_family_failures(&mut curve.unlocated, |nu, near| family(near.mu, nu).err());
+    Ok(curve)
 }
 
 /// The extended system of a cycle fold: the cycle equations of

@@ -36,10 +36,8 @@
 //! on the curve, the end is extrapolated from the points at θ_e ± h and
 //! θ_e ± 2h.
 
-use super::{
-    bounded, event_vector, follow_leg, path_interval, CurveSystem, Joined, Legs, Unlocated,
-};
-use crate::branches::events::{BifurcationKind, LocateOptions};
+use super::{bounded, event_vector, follow_leg, path_interval, CurveSystem, Joined, Legs};
+use crate::branches::events::{name_family_failures, BifurcationKind, LocateOptions, Unlocated};
 use crate::error::HbError;
 use crate::orbit::ihb::{HbOptions, HbResidual, HbSolution};
 use crate::problem::PeriodicProblem;
@@ -204,7 +202,7 @@ pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
     }
     // A failed `at` point, strong resonance or, where the curve reached its
     // end, one of the two points an end is extrapolated from.
-    let unlocated = joined.unlocated(
+    let mut unlocated = joined.unlocated(
         |x| sys.point(x),
         |d| match *targets.get(d)? {
             Target::At(p) => Some(("at", Some(p))),
@@ -214,6 +212,7 @@ pub fn bifurcation_curve<P: PeriodicProblem, F: Fn(f64) -> Result<P, HbError>>(
             Target::Strong(order) => Some((resonance_name(order), None)),
         },
     );
+    name_family_failures(&mut unlocated, |p, _| family(p).err());
     let Joined {
         points: mut path,
         termination,

@@ -32,11 +32,27 @@ pub use fold::FamilyFold;
 pub use ivt_path::events::{
     dot, locate_fold, observe, Bifurcation, BifurcationKind, Detector, EventObserver, Fold,
     FoldLocation, LocateOptions, Observer, PathSoFar, PointMultipliers, Start, TracedPoint,
+    Unlocated,
 };
 pub use multipliers::Multipliers;
 pub use neimark_sacker::NeimarkSacker;
 pub use period_doubling::PeriodDoubling;
 pub use trace::{every_event, observer, trace, PathOptions, Trace, TraceOptions};
+
+/// Adds to the reason of each unlocated `at` point the family's own error
+/// where the family fails at its value (`fails(value, near)`): a curve's
+/// residual turns a failing member into NaN, so the locator's reason alone
+/// says only that the residual was not finite.
+pub(crate) fn name_family_failures<T>(
+    unlocated: &mut [Unlocated<T>],
+    fails: impl Fn(f64, &T) -> Option<crate::HbError>,
+) {
+    for u in unlocated {
+        if let Some(e) = u.value.and_then(|v| fails(v, &u.near)) {
+            u.add_cause(format_args!("the family fails there: {e}"));
+        }
+    }
+}
 
 use crate::branches::family::{Family, FamilyBranch};
 use crate::orbit::ihb::HbError;
