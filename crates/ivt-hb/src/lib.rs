@@ -49,8 +49,9 @@ pub use problem::elements::{
     element_dofs, restrict_elements, Element, ElementProblem, Harmonic, Law,
 };
 pub use problem::{
-    central_difference_samples, AtFrequency, Duffing, Excitation, FrequencyExcitation,
-    GeneralProblem, MathieuDuffing, Nonlinearity, Oscillator, PeriodicProblem, WithJacobian,
+    central_difference_samples, AtFrequency, BoxedProblem, Duffing, Excitation,
+    FrequencyExcitation, GeneralProblem, MathieuDuffing, Nonlinearity, Oscillator, PeriodicProblem,
+    WithJacobian,
 };
 pub use stability::floquet::{eigenvalues, monodromy_hsu, monodromy_uniform, HsuRule};
 pub use stability::hill::{fourier_blocks, hill_multipliers, HillResult};

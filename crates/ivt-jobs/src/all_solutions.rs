@@ -88,8 +88,8 @@ pub struct AllSolutionsResult {
 /// # Errors
 /// [`HbError::InvalidInput`] for a non-finite frequency or box;
 /// [`ivt_hb::all_solutions()`]'s.
-pub fn all_solutions<P: PeriodicProblem>(
-    problem: &P,
+pub fn all_solutions(
+    problem: &dyn PeriodicProblem,
     hb: &HbOptions,
     req: &AllSolutionsRequest,
 ) -> Result<AllSolutionsResult, HbError> {

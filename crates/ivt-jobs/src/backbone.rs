@@ -101,8 +101,8 @@ pub struct BackboneCurve {
 ///
 /// # Errors
 /// [`BackboneRequest::validate`]'s and [`ivt_hb::backbone()`]'s.
-pub fn backbone<P: PeriodicProblem>(
-    problem: &P,
+pub fn backbone(
+    problem: &dyn PeriodicProblem,
     hb: &HbOptions,
     req: &BackboneRequest,
 ) -> Result<BackboneCurve, HbError> {

@@ -9,7 +9,7 @@ use ivt_hb::branches::autonomous::LimitCycle;
 use ivt_hb::branches::cycle_branch::{cycle_branch as trace_cycles, CycleBranchOptions};
 use ivt_hb::branches::events::BifurcationKind;
 use ivt_hb::orbit::ihb::HbOptions;
-use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::problem::{boxed_family, BoxedFamily, PeriodicProblem};
 use ivt_hb::stability::StabilityKind;
 use ivt_hb::HbError;
 use ivt_path::continuation::{ContinuationOptions, Termination};
@@ -185,15 +185,24 @@ pub struct CycleBranchResult {
 ///
 /// # Errors
 /// [`CycleBranchRequest::validate`]'s and [`ivt_hb::cycle_branch()`]'s.
-pub fn cycle_branch<P, F>(
+pub fn cycle_branch<'p, P, F>(
     family: F,
     hb: &HbOptions,
     req: &CycleBranchRequest,
 ) -> Result<CycleBranchResult, HbError>
 where
-    P: PeriodicProblem,
+    P: PeriodicProblem + 'p,
     F: Fn(f64) -> Result<P, HbError>,
 {
+    cycle_branch_of(&boxed_family(family), hb, req)
+}
+
+/// [`cycle_branch`] on the boxed family.
+fn cycle_branch_of(
+    family: &BoxedFamily<'_, '_>,
+    hb: &HbOptions,
+    req: &CycleBranchRequest,
+) -> Result<CycleBranchResult, HbError> {
     req.validate()?;
     let opts = CycleBranchOptions {
         samples: req.grid,

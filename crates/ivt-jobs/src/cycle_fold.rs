@@ -7,7 +7,7 @@
 use super::{all_finite, finite_list, path_steps, Steps};
 use ivt_hb::branches::codim2::{cycle_fold_curve as follow, CycleFoldCurve};
 use ivt_hb::orbit::ihb::HbOptions;
-use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::problem::{BoxedProblem, PeriodicProblem};
 use ivt_hb::{cycle_branch, CycleBranchOptions, HbError};
 use ivt_path::continuation::ContinuationOptions;
 
@@ -70,15 +70,28 @@ impl CycleFoldRequest {
 /// The request's refusals ([`CycleFoldRequest::validate`]);
 /// [`HbError::InvalidInput`] when the cycle branch at `nu_from` has no fold
 /// in [`mu_from`, `mu_to`]; the failures of the branch and of the curve.
-pub fn cycle_fold_curve<P, F>(
+pub fn cycle_fold_curve<'p, P, F>(
     family: F,
     hb: &HbOptions,
     req: &CycleFoldRequest,
 ) -> Result<CycleFoldCurve, HbError>
 where
-    P: PeriodicProblem,
+    P: PeriodicProblem + 'p,
     F: Fn(f64, f64) -> Result<P, HbError>,
 {
+    cycle_fold_curve_of(
+        &move |mu: f64, nu: f64| family(mu, nu).map(|m| Box::new(m) as BoxedProblem<'p>),
+        hb,
+        req,
+    )
+}
+
+/// [`cycle_fold_curve`] on the boxed family.
+fn cycle_fold_curve_of<'p>(
+    family: &dyn Fn(f64, f64) -> Result<BoxedProblem<'p>, HbError>,
+    hb: &HbOptions,
+    req: &CycleFoldRequest,
+) -> Result<CycleFoldCurve, HbError> {
     req.validate()?;
     let branch = cycle_branch(
         |mu| family(mu, req.nu_from),

@@ -497,12 +497,13 @@ impl<'a, P: PeriodicProblem> Search<'a, P> {
 /// # Errors
 /// [`DiagramRequest::validate`]'s; the primary curve's start and path (a
 /// failure on a later branch is recorded in `search.failures`).
-pub fn diagram<P: PeriodicProblem>(
-    problem: &P,
+pub fn diagram(
+    problem: &dyn PeriodicProblem,
     hb: &HbOptions,
     req: &DiagramRequest,
 ) -> Result<Diagram, HbError> {
     req.validate()?;
+    let problem = &problem;
     let t0 = Instant::now();
     let mut s = Search {
         problem,

@@ -14,7 +14,7 @@ use ivt_hb::branches::events::BifurcationKind;
 use ivt_hb::branches::events::Unlocated;
 use ivt_hb::branches::frc::{frequency_response, FrcOptions};
 use ivt_hb::orbit::ihb::{HbOptions, HbSolution};
-use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::problem::{boxed_family, BoxedFamily, PeriodicProblem};
 use ivt_hb::HbError;
 use ivt_path::continuation::{ContinuationOptions, Corrector, Termination};
 use serde::Serialize;
@@ -224,15 +224,24 @@ pub struct FoldCurveResult {
 /// [`FoldStart::Search`], the FRC's and [`HbError::InvalidInput`] when it has
 /// no located point of the kind; [`ivt_hb::fold_curve`]'s or
 /// [`ivt_hb::branches::codim2::bifurcation_curve`]'s.
-pub fn fold_curve<P, F>(
+pub fn fold_curve<'p, P, F>(
     family: F,
     hb: &HbOptions,
     req: &FoldCurveRequest,
 ) -> Result<FoldCurveResult, HbError>
 where
-    P: PeriodicProblem,
+    P: PeriodicProblem + 'p,
     F: Fn(f64) -> Result<P, HbError>,
 {
+    fold_curve_of(&boxed_family(family), hb, req)
+}
+
+/// [`fold_curve`] on the boxed family.
+fn fold_curve_of(
+    family: &BoxedFamily<'_, '_>,
+    hb: &HbOptions,
+    req: &FoldCurveRequest,
+) -> Result<FoldCurveResult, HbError> {
     req.validate()?;
     let t0 = Instant::now();
     let (omega, coeffs) = match &req.start {

@@ -154,11 +154,12 @@ impl FrcCurve<FoldPoint> {
 ///
 /// # Errors
 /// [`FrcRequest::validate`]'s, the start's and the path's.
-pub fn frc<P: PeriodicProblem>(
-    problem: &P,
+pub fn frc(
+    problem: &dyn PeriodicProblem,
     hb: &HbOptions,
     req: &FrcRequest,
 ) -> Result<FrcCurve<FoldPoint>, HbError> {
+    let problem = &problem;
     req.validate()?;
     let t0 = Instant::now();
     let opts = &req.options;

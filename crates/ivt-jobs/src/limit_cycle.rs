@@ -137,11 +137,12 @@ pub struct Cycle {
 /// [`LimitCycleRequest::validate`]'s, those of [`ivt_hb::limit_cycle`]
 /// (non-convergence, collapse onto the equilibrium) and, without a guess,
 /// those of [`ivt_hb::limit_cycle_from_state`] (a transient that comes to rest).
-pub fn limit_cycle<P: PeriodicProblem>(
-    problem: &P,
+pub fn limit_cycle(
+    problem: &dyn PeriodicProblem,
     hb: &HbOptions,
     req: &LimitCycleRequest,
 ) -> Result<Cycle, HbError> {
+    let problem = &problem;
     req.validate()?;
     ivt_hb::branches::autonomous::require_autonomous(problem, "a limit cycle")?;
     // Too few samples for n (e.g. n = 80 with the default 64): the default

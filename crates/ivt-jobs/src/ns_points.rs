@@ -11,7 +11,7 @@ use faer::c64;
 use ivt_hb::branches::events::BifurcationKind;
 use ivt_hb::branches::frc::FrcOptions;
 use ivt_hb::orbit::ihb::HbOptions;
-use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::problem::{boxed_family, BoxedFamily, PeriodicProblem};
 use ivt_hb::HbError;
 
 /// A located Neimark–Sacker point of the FRC at one p.
@@ -33,16 +33,26 @@ pub struct NeimarkSackerPoint {
 ///
 /// # Errors
 /// `family`'s error; the start or trace failures of each FRC.
-pub fn neimark_sacker_points<P, F>(
+pub fn neimark_sacker_points<'p, P, F>(
     family: F,
     hb: &HbOptions,
     sweep: &FrcOptions,
     ps: &[f64],
 ) -> Result<Vec<NeimarkSackerPoint>, HbError>
 where
-    P: PeriodicProblem,
+    P: PeriodicProblem + 'p,
     F: Fn(f64) -> Result<P, HbError>,
 {
+    neimark_sacker_points_of(&boxed_family(family), hb, sweep, ps)
+}
+
+/// [`neimark_sacker_points`] on the boxed family.
+fn neimark_sacker_points_of(
+    family: &BoxedFamily<'_, '_>,
+    hb: &HbOptions,
+    sweep: &FrcOptions,
+    ps: &[f64],
+) -> Result<Vec<NeimarkSackerPoint>, HbError> {
     let mut found = Vec::new();
     let req = FrcRequest {
         options: sweep.clone(),

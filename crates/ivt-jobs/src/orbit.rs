@@ -125,11 +125,12 @@ impl Orbit {
 /// [`OrbitRequest::validate`]'s, the solver's (non-convergence carries the
 /// residual history), and [`HbError::NonFiniteMultipliers`] when Hsu's
 /// monodromy is not finite (the stability would be unknown).
-pub fn orbit<P: PeriodicProblem>(
-    problem: &P,
+pub fn orbit(
+    problem: &dyn PeriodicProblem,
     hb: &HbOptions,
     req: &OrbitRequest,
 ) -> Result<Orbit, HbError> {
+    let problem = &problem;
     req.validate()?;
     let t0 = Instant::now();
     let mut solver: Box<dyn HbSolver + '_> = match req.method {

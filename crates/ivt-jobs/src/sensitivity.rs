@@ -7,7 +7,7 @@
 use super::{finite, Array};
 use ivt_hb::analyses::sensitivity::{sensitivity, Feature};
 use ivt_hb::orbit::ihb::HbOptions;
-use ivt_hb::problem::PeriodicProblem;
+use ivt_hb::problem::{boxed_family, BoxedFamily, PeriodicProblem};
 use ivt_hb::HbError;
 use serde::Serialize;
 use std::time::Instant;
@@ -56,15 +56,24 @@ pub struct SensitivityResult {
 /// # Errors
 /// [`HbError::InvalidInput`] for a non-finite ω_f, p or coefficients;
 /// [`ivt_hb::analyses::sensitivity::sensitivity`]'s.
-pub fn event_sensitivity<P, F>(
+pub fn event_sensitivity<'p, P, F>(
     family: F,
     hb: &HbOptions,
     req: &SensitivityRequest,
 ) -> Result<SensitivityResult, HbError>
 where
-    P: PeriodicProblem,
+    P: PeriodicProblem + 'p,
     F: Fn(f64) -> Result<P, HbError>,
 {
+    event_sensitivity_of(&boxed_family(family), hb, req)
+}
+
+/// [`event_sensitivity`] on the boxed family.
+fn event_sensitivity_of(
+    family: &BoxedFamily<'_, '_>,
+    hb: &HbOptions,
+    req: &SensitivityRequest,
+) -> Result<SensitivityResult, HbError> {
     let t0 = Instant::now();
     let (omega, p) = (finite("omega", req.omega)?, finite("p", req.p)?);
     super::finite_list("coeffs", &req.coeffs)?;

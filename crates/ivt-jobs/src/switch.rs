@@ -171,11 +171,12 @@ pub struct SwitchedBranch {
 /// bifurcation on the side away from `to`, or (branch point) when the
 /// bifurcation equation has no two real roots; the corrector's and the
 /// path's failures.
-pub fn switch<P: PeriodicProblem>(
-    problem: &P,
+pub fn switch(
+    problem: &dyn PeriodicProblem,
     hb: &HbOptions,
     req: &SwitchRequest,
 ) -> Result<SwitchedBranch, HbError> {
+    let problem = &problem;
     req.validate()?;
     let t0 = Instant::now();
     let (kind, omega, coeffs) = match &req.start {

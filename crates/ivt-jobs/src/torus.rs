@@ -201,11 +201,12 @@ pub struct TorusCurve {
 /// [`TorusRequest::validate`]'s; [`torus_start`]'s; an input error when the
 /// torus leaves the Neimark–Sacker point on the side away from `omega_to`;
 /// the path's start.
-pub fn torus<P: PeriodicProblem>(
-    problem: &P,
+pub fn torus(
+    problem: &dyn PeriodicProblem,
     hb: &HbOptions,
     req: &TorusRequest,
 ) -> Result<TorusCurve, HbError> {
+    let problem = &problem;
     let family = Frequency(problem);
     req.validate()?;
     let t0 = Instant::now();

@@ -137,12 +137,13 @@ pub const MAX_AMPLITUDES: usize = 1000;
 /// [`HbError::InvalidInput`] for a bad frequency or bounds (`amplitudes`
 /// above [`MAX_AMPLITUDES`]), the AFT's size errors; [`HbError::Interrupted`]
 /// when cancelled ([`ivt_num::cancel`]).
-pub fn all_solutions<P: PeriodicProblem>(
-    problem: &P,
+pub fn all_solutions(
+    problem: &dyn PeriodicProblem,
     hb: &HbOptions,
     omega_f: f64,
     opts: &SearchOptions,
 ) -> Result<AllSolutions, HbError> {
+    let problem = &problem;
     crate::orbit::ihb::validate_omega(omega_f)?;
     if opts.amplitudes > MAX_AMPLITUDES {
         return Err(HbError::InvalidInput(format!(

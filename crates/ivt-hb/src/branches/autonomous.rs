@@ -165,11 +165,12 @@ where
 /// # Errors
 /// Those of [`StabilityAnalyzer::new`] (`stability_steps` ≤ the orbit's
 /// harmonics, a problem without DOFs).
-pub fn classify_cycle<P: PeriodicProblem>(
-    problem: &P,
+pub fn classify_cycle(
+    problem: &dyn PeriodicProblem,
     solution: HbSolution,
     stability_steps: usize,
 ) -> Result<LimitCycle, HbError> {
+    let problem = &problem;
     let mut analyzer = StabilityAnalyzer::new(problem, solution.harmonics, stability_steps)?;
     let multipliers = analyzer
         .hsu(problem, &solution, HsuRule::Magnus4)
@@ -248,8 +249,8 @@ pub fn require_autonomous<P: PeriodicProblem>(problem: &P, what: &str) -> Result
 /// [`HbError::Solve`] when Newton does not converge within
 /// `hb.broyden.max_iter` steps (with the ‖F‖ history) or the matrix is
 /// singular; [`HbError::Equilibrium`] if the iteration collapses onto `x = 0`.
-pub fn limit_cycle<P: PeriodicProblem>(
-    problem: &P,
+pub fn limit_cycle(
+    problem: &dyn PeriodicProblem,
     hb: &HbOptions,
     omega_guess: f64,
     guess: &[f64],
@@ -264,12 +265,13 @@ pub fn limit_cycle<P: PeriodicProblem>(
 ///
 /// # Errors
 /// Those of [`limit_cycle`].
-pub fn limit_cycle_orbit<P: PeriodicProblem>(
-    problem: &P,
+pub fn limit_cycle_orbit(
+    problem: &dyn PeriodicProblem,
     hb: &HbOptions,
     omega_guess: f64,
     guess: &[f64],
 ) -> Result<HbSolution, HbError> {
+    let problem = &problem;
     if hb.subharmonic != 1 {
         return Err(HbError::InvalidInput(
             "a limit cycle has no excitation: subharmonic order must be 1".into(),

@@ -82,13 +82,14 @@ pub type Backbone = Traced<BackbonePoint, Turn>;
 /// # Errors
 /// [`HbError::InvalidInput`] for sizes, a zero reference entry of `mode`, bad
 /// amplitudes, or a problem with damping or excitation; [`PathError::ContinuationStart`](ivt_path::PathError::ContinuationStart) when the start does not converge.
-pub fn backbone<P: PeriodicProblem>(
-    problem: &P,
+pub fn backbone(
+    problem: &dyn PeriodicProblem,
     hb: &HbOptions,
     omega0: f64,
     mode: &[f64],
     opts: &BackboneOptions,
 ) -> Result<Backbone, HbError> {
+    let problem = &problem;
     if problem.damping().iter().any(|v| *v != 0.0) {
         return Err(HbError::InvalidInput(
             "a backbone needs an undamped, unforced problem (C = 0, f = 0)".into(),

@@ -38,7 +38,7 @@ pub use multiplier_curve::{bifurcation_curve, BifurcationCurve, CurvePoint, Curv
 use crate::branches::events::{name_family_failures, Unlocated};
 use crate::error::HbError;
 use crate::orbit::ihb::HbOptions;
-use crate::problem::PeriodicProblem;
+use crate::problem::{boxed_family, BoxedFamily, PeriodicProblem};
 use fold_system::FoldSystem;
 use ivt_num::vector::norm2;
 use ivt_path::continuation::{ContinuationOptions, Path, PathPoint, Termination};
@@ -346,7 +346,7 @@ impl Legs {
 /// step, and an `at` point or cusp whose location fails is reported in
 /// [`Curve::unlocated`] with the reason (the curve is kept).
 #[allow(clippy::too_many_arguments)]
-pub fn fold_curve<P, F>(
+pub fn fold_curve<'p, P, F>(
     family: F,
     hb: &HbOptions,
     start: &[f64],
@@ -358,9 +358,35 @@ pub fn fold_curve<P, F>(
     opts: &ContinuationOptions,
 ) -> Result<FoldCurve, HbError>
 where
-    P: PeriodicProblem,
+    P: PeriodicProblem + 'p,
     F: Fn(f64) -> Result<P, HbError>,
 {
+    fold_curve_of(
+        &boxed_family(family),
+        hb,
+        start,
+        omega,
+        p_start,
+        p_from,
+        p_to,
+        at,
+        opts,
+    )
+}
+
+/// [`fold_curve`] on the boxed family.
+#[allow(clippy::too_many_arguments)]
+fn fold_curve_of(
+    family: &BoxedFamily<'_, '_>,
+    hb: &HbOptions,
+    start: &[f64],
+    omega: f64,
+    p_start: f64,
+    p_from: f64,
+    p_to: f64,
+    at: &[f64],
+    opts: &ContinuationOptions,
+) -> Result<FoldCurve, HbError> {
     let (lo, hi) = path_interval("fold curve", omega, p_start, p_from, p_to)?;
     let mut sys = FoldSystem::new(&family, hb, p_start)?;
     let m = sys.m;

@@ -116,12 +116,13 @@ pub fn linear_mode<P: PeriodicProblem>(
 /// # Errors
 /// As [`linear_mode`] and [`crate::backbone()`] (without its `C = 0`); a
 /// reference DOF at a node of the mode is [`HbError::InvalidInput`].
-pub fn damped_modes<P: PeriodicProblem>(
-    problem: &P,
+pub fn damped_modes(
+    problem: &dyn PeriodicProblem,
     hb: &HbOptions,
     mode: usize,
     opts: &BackboneOptions,
 ) -> Result<DampedModes, HbError> {
+    let problem = &problem;
     let (omega0, shape) = linear_mode(problem, mode)?;
     if shape.get(opts.dof).is_none_or(|v| v.abs() < 1e-12) {
         return Err(HbError::InvalidInput(format!(

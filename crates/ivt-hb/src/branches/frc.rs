@@ -143,11 +143,12 @@ pub type Frc = Traced<FrcPoint, FrcFold>;
 ///
 /// # Errors
 /// [`HbError`] if the start point cannot be solved or the sizes are invalid.
-pub fn frequency_response<P: PeriodicProblem>(
-    problem: &P,
+pub fn frequency_response(
+    problem: &dyn PeriodicProblem,
     hb: &HbOptions,
     opts: &FrcOptions,
 ) -> Result<Frc, HbError> {
+    let problem = &problem;
     if !(opts.from.is_finite()
         && opts.to.is_finite()
         && opts.from > 0.0
@@ -174,8 +175,7 @@ pub fn frequency_response<P: PeriodicProblem>(
     // grid without another evaluation of g; a fold is located once the
     // point after its start has arrived, or from the last point when the
     // path ends there.
-    let detectors: Vec<Box<dyn Detector<FamilyBranch<Frequency<'_, P>>, HbError>>> =
-        vec![Box::new(Fold)];
+    let detectors: Vec<Box<dyn Detector<_, HbError>>> = vec![Box::new(Fold)];
     let locate = LocateOptions::fold();
     let mut observer = observer(&family, opts.from, opts.path.stability, &locate, detectors)?;
     let mut stepper = family.stepper(&x0, start.stats.iterations, direction, &copts)?;

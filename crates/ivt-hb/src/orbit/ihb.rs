@@ -437,6 +437,9 @@ impl HbResidual {
             return b0.fill(f64::NAN);
         }
         b0.fill(0.0);
+        // The matrices once, not once per harmonic (a virtual call each for
+        // a `dyn PeriodicProblem`).
+        let mck = (problem.mass(), problem.damping(), problem.stiffness());
         for h in 0..=self.n {
             let set = |row: usize, col: usize, v: f64| {
                 let (i, j) = (self.harmonic_unknown(h, row), self.harmonic_unknown(h, col));
@@ -444,7 +447,7 @@ impl HbResidual {
                     *x = v;
                 }
             };
-            if !self.harmonic_block(problem, omega, h, set) {
+            if !self.harmonic_block(mck, omega, h, set) {
                 return b0.fill(f64::NAN);
             }
         }
@@ -467,6 +470,7 @@ impl HbResidual {
         let mut inv = vec![0.0; bs * bs];
         let mut idx = Vec::with_capacity(bs);
         let mut ok = true;
+        let mck = (problem.mass(), problem.damping(), problem.stiffness());
         for h in 0..=self.n {
             let size = if h == 0 { nd } else { bs };
             let (Some(blk), Some(inv)) = (blk.get_mut(..size * size), inv.get_mut(..size * size))
@@ -478,7 +482,7 @@ impl HbResidual {
                     *x = v;
                 }
             };
-            if !self.harmonic_block(problem, omega, h, set) {
+            if !self.harmonic_block(mck, omega, h, set) {
                 return false;
             }
             idx.clear();
@@ -505,15 +509,14 @@ impl HbResidual {
     /// value)` in the order of [`Self::harmonic_unknown`]: `½K` for h = 0, else
     /// `[[K − (hω)²M, hωC], [−hωC, K − (hω)²M]]`. Every entry of the block is set.
     /// `false` (nothing set) if the problem's matrices are not `n_dof×n_dof`.
-    fn harmonic_block<P: PeriodicProblem>(
+    fn harmonic_block(
         &self,
-        problem: &P,
+        (m, c, k): (&[f64], &[f64], &[f64]),
         omega: f64,
         h: usize,
         mut set: impl FnMut(usize, usize, f64),
     ) -> bool {
         let nd = self.n_dof;
-        let (m, c, k) = (problem.mass(), problem.damping(), problem.stiffness());
         if [m, c, k].iter().any(|a| a.len() != nd * nd) {
             return false;
         }

@@ -18,6 +18,7 @@ mod hysteresis;
 pub mod ode;
 mod omega;
 mod oscillators;
+use crate::HbError;
 pub use general::{GeneralProblem, Nonlinearity, WithJacobian};
 pub use omega::{AtFrequency, Excitation, FrequencyExcitation, REFERENCE_FREQUENCY};
 pub use oscillators::{bautin, Duffing, MathieuDuffing, Oscillator};
@@ -403,44 +404,87 @@ fn orbit_scale(u: &[f64], n: usize, j: usize) -> f64 {
     .unwrap_or(1.0)
 }
 
-/// A borrowed problem is a problem (lets solvers borrow problems that are not
-/// `Clone`, e.g. [`GeneralProblem`] with closures).
-impl<P: PeriodicProblem + ?Sized> PeriodicProblem for &P {
-    forward_matrices!(|s| (**s));
-    fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
-        (**self).nonlinear(x, v, theta, out)
-    }
-    fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
-        (**self).nonlinear_samples(x, v, theta, out)
-    }
-    fn excitation(&self, theta: f64, out: &mut [f64]) {
-        (**self).excitation(theta, out)
-    }
-    fn nonlinear_jacobian(&self, x: &[f64], v: &[f64], theta: f64, dg: &mut [f64]) {
-        (**self).nonlinear_jacobian(x, v, theta, dg)
-    }
-    fn nonlinear_jacobian_samples(&self, x: &[f64], v: &[f64], theta: &[f64], dg: &mut [f64]) {
-        (**self).nonlinear_jacobian_samples(x, v, theta, dg)
-    }
-    fn frequency_dependent(&self) -> bool {
-        (**self).frequency_dependent()
-    }
-    fn nonlinear_samples_at(&self, x: &[f64], v: &[f64], th: &[f64], w: f64, out: &mut [f64]) {
-        (**self).nonlinear_samples_at(x, v, th, w, out)
-    }
-    fn nonlinear_jacobian_samples_at(
-        &self,
-        x: &[f64],
-        v: &[f64],
-        th: &[f64],
-        w: f64,
-        dg: &mut [f64],
-    ) {
-        (**self).nonlinear_jacobian_samples_at(x, v, th, w, dg)
-    }
-    fn excitation_at(&self, theta: f64, omega_f: f64, out: &mut [f64]) {
-        (**self).excitation_at(theta, omega_f, out)
-    }
+/// `impl PeriodicProblem for` a pointer to a problem: every method forwards to
+/// the problem pointed to, the ones it overrides included.
+macro_rules! forward_pointer {
+    ($ptr:ty) => {
+        impl<P: PeriodicProblem + ?Sized> PeriodicProblem for $ptr {
+            forward_matrices!(|s| (**s));
+            fn nonlinear(&self, x: &[f64], v: &[f64], theta: f64, out: &mut [f64]) {
+                (**self).nonlinear(x, v, theta, out)
+            }
+            fn nonlinear_samples(&self, x: &[f64], v: &[f64], theta: &[f64], out: &mut [f64]) {
+                (**self).nonlinear_samples(x, v, theta, out)
+            }
+            fn excitation(&self, theta: f64, out: &mut [f64]) {
+                (**self).excitation(theta, out)
+            }
+            fn nonlinear_jacobian(&self, x: &[f64], v: &[f64], theta: f64, dg: &mut [f64]) {
+                (**self).nonlinear_jacobian(x, v, theta, dg)
+            }
+            fn nonlinear_jacobian_samples(
+                &self,
+                x: &[f64],
+                v: &[f64],
+                theta: &[f64],
+                dg: &mut [f64],
+            ) {
+                (**self).nonlinear_jacobian_samples(x, v, theta, dg)
+            }
+            fn frequency_dependent(&self) -> bool {
+                (**self).frequency_dependent()
+            }
+            fn nonlinear_samples_at(
+                &self,
+                x: &[f64],
+                v: &[f64],
+                th: &[f64],
+                w: f64,
+                out: &mut [f64],
+            ) {
+                (**self).nonlinear_samples_at(x, v, th, w, out)
+            }
+            fn nonlinear_jacobian_samples_at(
+                &self,
+                x: &[f64],
+                v: &[f64],
+                th: &[f64],
+                w: f64,
+                dg: &mut [f64],
+            ) {
+                (**self).nonlinear_jacobian_samples_at(x, v, th, w, dg)
+            }
+            fn excitation_at(&self, theta: f64, omega_f: f64, out: &mut [f64]) {
+                (**self).excitation_at(theta, omega_f, out)
+            }
+        }
+    };
+}
+// A borrowed problem is a problem (lets solvers borrow problems that are not
+// `Clone`, e.g. `GeneralProblem` with closures); `&dyn PeriodicProblem` lets
+// every model share one compiled engine.
+forward_pointer!(&P);
+// A boxed problem is a problem: a family whose members are `BoxedProblem`s
+// shares one compiled engine whatever its members' type.
+forward_pointer!(Box<P>);
+
+/// A problem of any type behind one pointer type. The jobs take
+/// `&dyn PeriodicProblem` and families of `BoxedProblem`s, so that the engine
+/// is compiled once for every model rather than once per model type (each
+/// closure is a type of its own); one virtual call per residual evaluation
+/// (`g` at all samples at once) is the price.
+pub type BoxedProblem<'a> = Box<dyn PeriodicProblem + 'a>;
+
+/// A family `p ↦ problem` with its members boxed, as the engine's and the
+/// jobs' bodies take it: a family function is then compiled once, not once
+/// per family type in every caller ([`BoxedProblem`]).
+pub type BoxedFamily<'f, 'p> = dyn Fn(f64) -> Result<BoxedProblem<'p>, HbError> + 'f;
+
+/// `family` with its members boxed ([`BoxedFamily`]).
+pub fn boxed_family<'p, P: PeriodicProblem + 'p>(
+    family: impl Fn(f64) -> Result<P, HbError>,
+) -> impl Fn(f64) -> Result<BoxedProblem<'p>, HbError> {
+    move |p| family(p).map(|m| Box::new(m) as BoxedProblem<'p>)
 }
 
 #[cfg(test)]
