@@ -144,7 +144,7 @@ impl<'a> KrylovBasis<'a> {
     /// Adds the columns of `block` (M-orthogonalized against the basis and
     /// among themselves, rounding dropped); returns how many were kept.
     ///
-    /// The vectors are orthonormalized twice ([`Self::orthonormal`]): a
+    /// The vectors are orthonormalized twice (`orthonormal`): a
     /// column that keeps only a small part of its M-norm (an exact solution
     /// at a sample lies nearly in the basis and may keep 1e-11 of it) loses
     /// that many digits of its orthogonality to the earlier blocks when it
