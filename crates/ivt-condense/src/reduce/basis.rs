@@ -146,7 +146,8 @@ impl<'a> KrylovBasis<'a> {
     ///
     /// The vectors are orthonormalized twice (`orthonormal`): a
     /// column that keeps only a small part of its M-norm (an exact solution
-    /// at a sample lies nearly in the basis and may keep 1e-11 of it) loses
+    /// at a sample lies nearly in the basis and may keep as little as
+    /// `DROP_SAMPLE` = 1e-14 of it) loses
     /// that many digits of its orthogonality to the earlier blocks when it
     /// is normalized; the second pass, on vectors of norm one, restores it.
     /// The projections take `VᵀMV = I`: with one pass, the reduced `C_r` of
