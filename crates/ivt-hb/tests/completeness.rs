@@ -10,6 +10,7 @@
 //!   crosses at μ = 0 with ω = 1 and turns real at μ = ±2).
 #![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
+use ivt_hb::problem::boxed_family;
 use ivt_hb::{
     all_solutions, cycle_branch, hopf_points, CycleBranchOptions, GeneralProblem, HbError,
     HbOptions, PeriodicProblem, SearchOptions,
@@ -238,7 +239,7 @@ fn cycle_branch_refuses_a_forced_family_and_ends_on_a_failing_member_with_its_ca
     };
     let hb = HbOptions::new(10, 32);
     let opts = CycleBranchOptions::default();
-    let err = cycle_branch(forced, &hb, -0.2, 0.1, &opts).unwrap_err();
+    let err = cycle_branch(&boxed_family(forced), &hb, -0.2, 0.1, &opts).unwrap_err();
     assert!(
         err.to_string().contains("excitation f(θ) is not zero"),
         "{err}"
@@ -256,7 +257,7 @@ fn cycle_branch_refuses_a_forced_family_and_ends_on_a_failing_member_with_its_ca
             |_: f64, f: &mut [f64]| f.fill(0.0),
         ))
     };
-    let err = cycle_branch(parametric, &hb, -0.2, 0.1, &opts).unwrap_err();
+    let err = cycle_branch(&boxed_family(parametric), &hb, -0.2, 0.1, &opts).unwrap_err();
     assert!(err.to_string().contains("depends on θ"), "{err}");
     // g NaN from μ = 0.05 on: the branch (cycles for μ > 0) stalls there and
     // the error names the cause instead of a `step_too_small` end.
@@ -276,7 +277,7 @@ fn cycle_branch_refuses_a_forced_family_and_ends_on_a_failing_member_with_its_ca
             |_: f64, f: &mut [f64]| f.fill(0.0),
         ))
     };
-    let err = cycle_branch(nan_late, &hb, -0.2, 0.1, &opts).unwrap_err();
+    let err = cycle_branch(&boxed_family(nan_late), &hb, -0.2, 0.1, &opts).unwrap_err();
     assert_eq!(err.kind(), "input");
     assert!(err.to_string().contains("g returned NaN"), "{err}");
     // A family that changes size.
@@ -291,6 +292,6 @@ fn cycle_branch_refuses_a_forced_family_and_ends_on_a_failing_member_with_its_ca
             |_: f64, f: &mut [f64]| f.fill(0.0),
         ))
     };
-    let err = cycle_branch(resized, &hb, -0.2, 0.1, &opts).unwrap_err();
+    let err = cycle_branch(&boxed_family(resized), &hb, -0.2, 0.1, &opts).unwrap_err();
     assert!(err.to_string().contains("changes size"), "{err}");
 }

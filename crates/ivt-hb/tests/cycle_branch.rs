@@ -7,7 +7,7 @@
 //! `det ∂y(T)/∂y₀` (the other is 1).
 #![allow(clippy::indexing_slicing, clippy::unwrap_used)]
 
-use ivt_hb::problem::bautin;
+use ivt_hb::problem::{bautin, boxed_family};
 use ivt_hb::{
     cycle_branch, limit_cycle_branch, ContinuationOptions, CycleBranch, CycleBranchOptions,
     HbError, HbOptions, PeriodicProblem, Termination,
@@ -61,7 +61,7 @@ fn branch_over_the_hopf_point() -> (HbOptions, CycleBranch) {
         at: vec![-0.1],
         ..CycleBranchOptions::default()
     };
-    let branch = cycle_branch(family, &hb, -0.2, 0.1, &opts).unwrap();
+    let branch = cycle_branch(&boxed_family(family), &hb, -0.2, 0.1, &opts).unwrap();
     (hb, branch)
 }
 
@@ -148,7 +148,7 @@ fn an_at_value_where_the_family_fails_is_reported_unlocated() {
             family(mu)
         }
     };
-    let branch = cycle_branch(gappy, &hb, -0.2, 0.1, &opts).unwrap();
+    let branch = cycle_branch(&boxed_family(gappy), &hb, -0.2, 0.1, &opts).unwrap();
     let located: Vec<f64> = branch.at.iter().map(|(p, _)| *p).collect();
     assert_eq!(located, [-0.05, -0.05], "{located:?}");
     assert_eq!(branch.folds.len(), 1);

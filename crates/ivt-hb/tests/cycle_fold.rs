@@ -9,7 +9,7 @@
 #![allow(clippy::indexing_slicing)]
 
 use ivt_hb::branches::codim2::cycle_fold_curve;
-use ivt_hb::problem::bautin;
+use ivt_hb::problem::{bautin, boxed_family};
 use ivt_hb::{cycle_branch, HbError, HbOptions, PeriodicProblem};
 
 mod common;
@@ -42,7 +42,14 @@ fn fold_by_shooting(nu: f64, guess: [f64; 3]) -> [f64; 3] {
 #[test]
 fn cycle_fold_curve_matches_shooting_in_nu() {
     let hb = HbOptions::new(25, 128);
-    let branch = cycle_branch(|mu| family(mu, 1.0), &hb, -0.2, 0.1, &Default::default()).unwrap();
+    let branch = cycle_branch(
+        &boxed_family(|mu| family(mu, 1.0)),
+        &hb,
+        -0.2,
+        0.1,
+        &Default::default(),
+    )
+    .unwrap();
     assert_eq!(branch.folds.len(), 1);
     let (mu0, start) = &branch.folds[0];
     let opts = common::curve_steps(2000);

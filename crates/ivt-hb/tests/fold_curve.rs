@@ -7,6 +7,7 @@
 
 #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
 
+use ivt_hb::problem::boxed_family;
 use ivt_hb::{
     fold_curve, frequency_response, Duffing, FrcOptions, HbError, HbOptions, Termination,
 };
@@ -44,7 +45,7 @@ fn curve_from(upper: bool) -> ivt_hb::FoldCurve {
     .unwrap();
     let opts = common::curve_steps(2000);
     let curve = fold_curve(
-        family,
+        &boxed_family(family),
         &hb,
         &start.coeffs,
         start.omega_f,
@@ -149,7 +150,7 @@ fn upper_curve_without(missing: impl Fn(f64) -> bool, at: &[f64]) -> ivt_hb::Fol
         .unwrap();
     let steps = common::curve_steps(2000);
     fold_curve(
-        family,
+        &boxed_family(family),
         &hb,
         &start.coeffs,
         start.omega_f,

@@ -5,6 +5,7 @@
 //! has the multiplier −1, det(∂P/∂y + I) = 0.
 
 use ivt_hb::branches::codim2::{bifurcation_curve, CurveStart};
+use ivt_hb::problem::boxed_family;
 use ivt_hb::{
     period_doubling_cascade, BifurcationKind, CascadeOptions, HbError, HbOptions, MathieuDuffing,
     Termination,
@@ -54,7 +55,16 @@ fn mathieu_duffing_period_doubling_curve_matches_shooting() {
         |beta: f64| -> Result<MathieuDuffing, HbError> { Ok(MathieuDuffing::thesis(beta)) };
     let opts = common::curve_steps(400);
     let hb = HbOptions::new(n, 4 * n);
-    let curve = bifurcation_curve(family, &hb, &start, 4.0, 6.0, &[4.5, 5.0, 5.5], &opts).unwrap();
+    let curve = bifurcation_curve(
+        &boxed_family(family),
+        &hb,
+        &start,
+        4.0,
+        6.0,
+        &[4.5, 5.0, 5.5],
+        &opts,
+    )
+    .unwrap();
     assert_eq!(curve.termination, Termination::LeftInterval);
     let ps: Vec<f64> = curve.at.iter().map(|a| a.p).collect();
     assert_eq!(ps, [4.5, 5.0, 5.5]);

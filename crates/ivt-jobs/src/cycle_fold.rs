@@ -94,7 +94,7 @@ fn cycle_fold_curve_of<'p>(
 ) -> Result<CycleFoldCurve, HbError> {
     req.validate()?;
     let branch = cycle_branch(
-        |mu| family(mu, req.nu_from),
+        &|mu| family(mu, req.nu_from),
         hb,
         req.mu_from,
         req.mu_to,

@@ -7,6 +7,7 @@
 #![allow(clippy::indexing_slicing)]
 
 use ivt_hb::branches::codim2::{bifurcation_curve, CurveStart};
+use ivt_hb::problem::boxed_family;
 use ivt_hb::{
     BifurcationKind, ContinuationOptions, Corrector, FrcOptions, GeneralProblem, HbError,
     HbOptions, PeriodicProblem, Termination,
@@ -122,7 +123,16 @@ fn van_der_pol_neimark_sacker_curve_matches_shooting() {
         ..Default::default()
     };
     let at = [0.2, 0.3, 0.4];
-    let curve = bifurcation_curve(van_der_pol, &hb, &start, 0.0, 0.4, &at, &steps).unwrap();
+    let curve = bifurcation_curve(
+        &boxed_family(van_der_pol),
+        &hb,
+        &start,
+        0.0,
+        0.4,
+        &at,
+        &steps,
+    )
+    .unwrap();
     assert_eq!(curve.termination, Termination::LeftInterval);
     let ps: Vec<f64> = curve.at.iter().map(|a| a.p).collect();
     assert_eq!(ps, [0.2, 0.3, 0.4]);

@@ -16,6 +16,7 @@ mod common;
 
 use common::shooting::{newton3, orbit_state as state, period_map, period_map_jacobian};
 use ivt_hb::analyses::sensitivity::{sensitivity, Feature};
+use ivt_hb::problem::boxed_family;
 use ivt_hb::{
     locate_fold, BifurcationKind, Duffing, FamilyBranch, FrcOptions, Frequency, GeneralProblem,
     HbError, HbOptions, LocateOptions, PeriodicProblem,
@@ -115,7 +116,7 @@ fn duffing_fold_frequencies_move_with_the_force_as_shooting_says() {
             g.set(0);
             jac.set(0);
             let s = sensitivity(
-                family,
+                &boxed_family(family),
                 &hb,
                 Feature::Event(BifurcationKind::Fold),
                 (&fold.coeffs.0, fold.omega),
@@ -177,15 +178,16 @@ fn duffing_fold_amplitude_and_a_stiffness_derivative_match_differences_of_locate
     let fold = Feature::Event(BifurcationKind::Fold);
     for f in &frc.folds {
         let start = (f.coeffs.0.as_slice(), f.omega);
-        let s = sensitivity(by_force, &hb, fold, start, 0.1, 0).unwrap();
+        let s = sensitivity(&boxed_family(by_force), &hb, fold, start, 0.1, 0).unwrap();
         let amplitude_at = |force: f64| {
-            sensitivity(by_force, &hb, fold, start, force, 0)
+            sensitivity(&boxed_family(by_force), &hb, fold, start, force, 0)
                 .unwrap()
                 .amplitude
         };
         let da = richardson(amplitude_at, 0.1, 1e-4);
-        let e = sensitivity(by_eps, &hb, fold, start, 1.0, 0).unwrap();
-        let at_eps = |eps: f64| sensitivity(by_eps, &hb, fold, start, eps, 0).unwrap();
+        let e = sensitivity(&boxed_family(by_eps), &hb, fold, start, 1.0, 0).unwrap();
+        let at_eps =
+            |eps: f64| sensitivity(&boxed_family(by_eps), &hb, fold, start, eps, 0).unwrap();
         let dw_eps = richardson(|x| at_eps(x).omega, 1.0, 1e-4);
         let da_eps = richardson(|x| at_eps(x).amplitude, 1.0, 1e-4);
         eprintln!(
@@ -222,8 +224,18 @@ where
     P: PeriodicProblem,
     F: Fn(f64) -> Result<P, HbError> + Copy,
 {
-    let s = sensitivity(family, hb, feature, start, p, 0).unwrap();
-    let located = |x: f64| sensitivity(family, hb, feature, (&s.coeffs, s.omega), x, 0).unwrap();
+    let s = sensitivity(&boxed_family(family), hb, feature, start, p, 0).unwrap();
+    let located = |x: f64| {
+        sensitivity(
+            &boxed_family(family),
+            hb,
+            feature,
+            (&s.coeffs, s.omega),
+            x,
+            0,
+        )
+        .unwrap()
+    };
     eprintln!("  located in {} steps", s.iterations);
     let dw = richardson(|x| located(x).omega, p, h);
     let da = richardson(|x| located(x).amplitude, p, h);
@@ -359,7 +371,7 @@ fn a_symmetric_branch_point_and_an_amplitude_peak_move_as_their_located_points()
     let bp = located(0.05, 0.8, 2.5);
     let omega = bp.omega.unwrap();
     let s = sensitivity(
-        chain,
+        &boxed_family(chain),
         &hb,
         Feature::Event(BifurcationKind::BranchPoint),
         (&bp.coeffs.as_ref().unwrap().0, omega),

@@ -38,7 +38,7 @@ use crate::branches::events::{
 use crate::branches::family::{Family, FamilyBranch, Frequency};
 use crate::error::HbError;
 use crate::orbit::ihb::HbOptions;
-use crate::problem::{boxed_family, BoxedFamily, PeriodicProblem};
+use crate::problem::BoxedFamily;
 use ivt_num::{BorderedLu, LuWorkspace};
 use ivt_path::branch::{path_lambda_step, Branch};
 use ivt_path::events::extended::{
@@ -250,23 +250,11 @@ fn bifurcation_error(e: BifurcationError) -> HbError {
 /// [`HbError::InvalidInput`] for sizes, a non-finite `p` or `family`'s
 /// failure at `p`, `p ± h`; the locator's failure; a singular extended
 /// system.
-pub fn sensitivity<'p, P, F>(
-    family: F,
-    hb: &HbOptions,
-    feature: Feature,
-    (q0, omega0): (&[f64], f64),
-    p: f64,
-    dof: usize,
-) -> Result<Sensitivity, HbError>
-where
-    P: PeriodicProblem + 'p,
-    F: Fn(f64) -> Result<P, HbError>,
-{
-    sensitivity_of(&boxed_family(family), hb, feature, (q0, omega0), p, dof)
-}
-
-/// [`sensitivity`] on the boxed family.
-fn sensitivity_of(
+///
+/// `family` is any `p ↦ problem` with its members boxed: `&boxed_family(f)`
+/// ([`crate::problem::boxed_family`]), so this body is compiled once for
+/// every model.
+pub fn sensitivity(
     family: &BoxedFamily<'_, '_>,
     hb: &HbOptions,
     feature: Feature,

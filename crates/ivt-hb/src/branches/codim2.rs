@@ -38,7 +38,7 @@ pub use multiplier_curve::{bifurcation_curve, BifurcationCurve, CurvePoint, Curv
 use crate::branches::events::{name_family_failures, Unlocated};
 use crate::error::HbError;
 use crate::orbit::ihb::HbOptions;
-use crate::problem::{boxed_family, BoxedFamily, PeriodicProblem};
+use crate::problem::BoxedFamily;
 use fold_system::FoldSystem;
 use ivt_num::vector::norm2;
 use ivt_path::continuation::{ContinuationOptions, Path, PathPoint, Termination};
@@ -345,38 +345,12 @@ impl Legs {
 /// [`ivt_path::follow_residual`]'s. Later, a `p` where `family` fails is a failed
 /// step, and an `at` point or cusp whose location fails is reported in
 /// [`Curve::unlocated`] with the reason (the curve is kept).
+///
+/// `family` is any `p ↦ problem` with its members boxed: `&boxed_family(f)`
+/// ([`crate::problem::boxed_family`]), so this body is compiled once for
+/// every model.
 #[allow(clippy::too_many_arguments)]
-pub fn fold_curve<'p, P, F>(
-    family: F,
-    hb: &HbOptions,
-    start: &[f64],
-    omega: f64,
-    p_start: f64,
-    p_from: f64,
-    p_to: f64,
-    at: &[f64],
-    opts: &ContinuationOptions,
-) -> Result<FoldCurve, HbError>
-where
-    P: PeriodicProblem + 'p,
-    F: Fn(f64) -> Result<P, HbError>,
-{
-    fold_curve_of(
-        &boxed_family(family),
-        hb,
-        start,
-        omega,
-        p_start,
-        p_from,
-        p_to,
-        at,
-        opts,
-    )
-}
-
-/// [`fold_curve`] on the boxed family.
-#[allow(clippy::too_many_arguments)]
-fn fold_curve_of(
+pub fn fold_curve(
     family: &BoxedFamily<'_, '_>,
     hb: &HbOptions,
     start: &[f64],

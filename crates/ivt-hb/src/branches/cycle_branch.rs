@@ -22,7 +22,7 @@ use crate::branches::events::{
 use crate::error::HbError;
 use crate::orbit::galerkin::GalerkinJacobian;
 use crate::orbit::ihb::{HbOptions, HbResidual, HbSolution};
-use crate::problem::{boxed_family, BoxedFamily, PeriodicProblem};
+use crate::problem::{BoxedFamily, PeriodicProblem};
 use crate::stability::hopf::{equilibrium, hopf_points, Field, HopfPoint, Undecided};
 use crate::BroydenStats;
 use ivt_num::vector::norm2;
@@ -101,22 +101,11 @@ pub struct CycleBranch {
 /// fails is a failed step of the path; when the path stalls on such steps
 /// (the family's error, a member of another size, a `g` that is NaN or ±∞
 /// at a finite state) that cause is the error, not a `step_too_small` end.
-pub fn cycle_branch<'p, P, F>(
-    family: F,
-    hb: &HbOptions,
-    p_from: f64,
-    p_to: f64,
-    opts: &CycleBranchOptions,
-) -> Result<CycleBranch, HbError>
-where
-    P: PeriodicProblem + 'p,
-    F: Fn(f64) -> Result<P, HbError>,
-{
-    cycle_branch_of(&boxed_family(family), hb, p_from, p_to, opts)
-}
-
-/// [`cycle_branch`] on the boxed family.
-fn cycle_branch_of(
+///
+/// `family` is any `p ↦ problem` with its members boxed: `&boxed_family(f)`
+/// ([`crate::problem::boxed_family`]), so this body is compiled once for
+/// every model.
+pub fn cycle_branch(
     family: &BoxedFamily<'_, '_>,
     hb: &HbOptions,
     p_from: f64,

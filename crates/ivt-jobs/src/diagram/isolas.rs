@@ -3,6 +3,7 @@
 //! branches no event leads to.
 
 use super::*;
+use ivt_hb::problem::boxed_family;
 
 /// The largest step of a fold curve in the forcing scale (its crossings of
 /// `s = 1` are solved there exactly; a Python `g` pays per residual).
@@ -82,9 +83,9 @@ impl<P: PeriodicProblem> Search<'_, P> {
         };
         self.search.fold_scale = Some([lo, hi]);
         let problem = self.problem;
-        let family = |scale: f64| -> Result<ForcingScale<'_, P>, HbError> {
+        let family = boxed_family(|scale: f64| -> Result<ForcingScale<'_, P>, HbError> {
             Ok(ForcingScale { problem, scale })
-        };
+        });
         // Only the crossings of s = 1 are kept (each solved at s = 1 by
         // Newton): the curves are followed with long steps.
         let copts = ContinuationOptions {
@@ -109,7 +110,7 @@ impl<P: PeriodicProblem> Search<'_, P> {
             for (from, to) in [(lo, hi), (hi, lo)] {
                 self.search.fold_curves += 1;
                 let curve = match fold_curve(
-                    family,
+                    &family,
                     &self.hb,
                     &fold.q,
                     fold.lambda,

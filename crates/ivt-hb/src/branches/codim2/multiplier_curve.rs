@@ -40,7 +40,7 @@ use super::{bounded, event_vector, follow_leg, path_interval, CurveSystem, Joine
 use crate::branches::events::{name_family_failures, BifurcationKind, LocateOptions, Unlocated};
 use crate::error::HbError;
 use crate::orbit::ihb::{HbOptions, HbResidual, HbSolution};
-use crate::problem::{boxed_family, BoxedFamily, PeriodicProblem};
+use crate::problem::{BoxedFamily, PeriodicProblem};
 use crate::stability::floquet::{eigenvalues, monodromy_uniform, HsuRule};
 use crate::stability::StabilityAnalyzer;
 use ivt_num::vector::{dot, norm2};
@@ -118,24 +118,11 @@ pub struct BifurcationCurve {
 /// `family` fails is a failed step, and an `at` point or resonance whose
 /// location fails is reported in [`BifurcationCurve::unlocated`] (the curve
 /// is kept).
-pub fn bifurcation_curve<'p, P, F>(
-    family: F,
-    hb: &HbOptions,
-    start: &CurveStart,
-    p_from: f64,
-    p_to: f64,
-    at: &[f64],
-    opts: &ContinuationOptions,
-) -> Result<BifurcationCurve, HbError>
-where
-    P: PeriodicProblem + 'p,
-    F: Fn(f64) -> Result<P, HbError>,
-{
-    bifurcation_curve_of(&boxed_family(family), hb, start, p_from, p_to, at, opts)
-}
-
-/// [`bifurcation_curve`] on the boxed family.
-fn bifurcation_curve_of(
+///
+/// `family` is any `p ↦ problem` with its members boxed: `&boxed_family(f)`
+/// ([`crate::problem::boxed_family`]), so this body is compiled once for
+/// every model.
+pub fn bifurcation_curve(
     family: &BoxedFamily<'_, '_>,
     hb: &HbOptions,
     start: &CurveStart,
